@@ -1,0 +1,2 @@
+//! File formats of terramesh.
+#![warn(missing_docs)]
