@@ -1,11 +1,12 @@
 //! UTM accuracy against pyproj/PROJ 9.5 fixtures (written by `fixtures/make_coords.py`).
 
-use terramesh_core::coords::{
-    parse_angle, to_utm, to_utm_with_factors, to_wgs84, Axis, Zone,
-};
+use terramesh_core::coords::{parse_angle, to_utm, to_utm_with_factors, to_wgs84, Axis, Zone};
 
 fn fixture(name: &str) -> Vec<Vec<String>> {
-    let path = format!("{}/../../fixtures/coords/{name}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/../../fixtures/coords/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let mut rows = Vec::new();
     for line in text.lines().skip(1) {
@@ -49,7 +50,9 @@ fn check_forward(name: &str, max_m: f64) -> usize {
     for r in &rows {
         let zone: Zone = r[2].parse().unwrap();
         let (p, fac) = to_utm_with_factors(f(&r[0]), f(&r[1]), Some(zone)).unwrap();
-        let err = (p.easting - f(&r[3])).abs().max((p.northing - f(&r[4])).abs());
+        let err = (p.easting - f(&r[3]))
+            .abs()
+            .max((p.northing - f(&r[4])).abs());
         worst = worst.max(err);
         worst_gamma = worst_gamma.max((fac.convergence_deg - f(&r[5])).abs());
         worst_k = worst_k.max((fac.scale - f(&r[6])).abs());
@@ -60,7 +63,10 @@ fn check_forward(name: &str, max_m: f64) -> usize {
     eprintln!("{name}: worst {worst:e} m, convergence {worst_gamma:e} deg, scale {worst_k:e}");
     assert!(worst <= max_m, "{name}: worst forward error {worst} m");
     // PROJ derives its factors numerically: agreement to 1e-8 degrees and 1e-9 in scale.
-    assert!(worst_gamma < 1e-8, "{name}: convergence off by {worst_gamma} deg");
+    assert!(
+        worst_gamma < 1e-8,
+        "{name}: convergence off by {worst_gamma} deg"
+    );
     assert!(worst_k < 1e-9, "{name}: scale off by {worst_k}");
     rows.len()
 }
@@ -130,10 +136,17 @@ fn paper_table_one_corners() {
         let p = to_utm(lat, lon, None).unwrap();
         assert_eq!(p.zone.to_string(), "32N");
         assert!((p.easting - f(&r[7])).abs() < 1e-4, "easting {}", p.easting);
-        assert!((p.northing - f(&r[8])).abs() < 1e-4, "northing {}", p.northing);
+        assert!(
+            (p.northing - f(&r[8])).abs() < 1e-4,
+            "northing {}",
+            p.northing
+        );
         let de = p.easting - f(&r[5]);
         let dn = p.northing - f(&r[6]);
         assert!(de.abs() < 0.005, "paper easting differs by {de} m");
-        assert!((dn + 0.61).abs() < 0.01, "paper northing differs by {dn} m, expected -0.61");
+        assert!(
+            (dn + 0.61).abs() < 0.01,
+            "paper northing differs by {dn} m, expected -0.61"
+        );
     }
 }

@@ -1,2 +1,7 @@
-//! File formats of terramesh.
+//! File formats of **terramesh**: delimited tables, atomic output files, and (in later
+//! modules) elevation sources and mesh writers. Numerical work lives in `terramesh-core`.
 #![warn(missing_docs)]
+
+pub mod number;
+pub mod output;
+pub mod table;

@@ -103,7 +103,9 @@ pub fn parse_angle(text: &str, axis: Axis) -> Result<f64, CoordError> {
     }
     for (k, &(v, frac)) in nums.iter().enumerate() {
         if frac && k + 1 < nums.len() {
-            return Err(bad("only the last of degrees, minutes, seconds may have decimals"));
+            return Err(bad(
+                "only the last of degrees, minutes, seconds may have decimals",
+            ));
         }
         if k > 0 && v >= 60.0 {
             return Err(bad(if k == 1 {

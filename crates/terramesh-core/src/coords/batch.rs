@@ -78,7 +78,11 @@ pub fn to_wgs84_many(
     zone: Zone,
     par: Parallelism,
 ) -> Result<Vec<(f64, f64)>, CoordError> {
-    assert_eq!(easting.len(), northing.len(), "easting and northing must have equal length");
+    assert_eq!(
+        easting.len(),
+        northing.len(),
+        "easting and northing must have equal length"
+    );
     match par {
         Parallelism::Sequential => easting
             .iter()

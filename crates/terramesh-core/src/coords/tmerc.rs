@@ -307,8 +307,8 @@ impl TransverseMercator {
         }
         for _ in 0..5 {
             let taupa = self.taup_of(tau);
-            let dtau =
-                (taup - taupa) * (1.0 + e2m * tau * tau) / (e2m * tau.hypot(1.0) * taupa.hypot(1.0));
+            let dtau = (taup - taupa) * (1.0 + e2m * tau * tau)
+                / (e2m * tau.hypot(1.0) * taupa.hypot(1.0));
             tau += dtau;
             if dtau.abs() < stol {
                 break;

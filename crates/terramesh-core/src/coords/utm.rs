@@ -38,7 +38,9 @@ pub struct Zone {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CoordError {
     /// A zone string that is not `1..=60` followed by `N` or `S`.
-    #[error("invalid UTM zone '{0}': write the zone number 1-60 followed by N or S, e.g. 32N or 33S")]
+    #[error(
+        "invalid UTM zone '{0}': write the zone number 1-60 followed by N or S, e.g. 32N or 33S"
+    )]
     BadZone(String),
     /// A latitude outside the UTM domain −80..84 degrees with no forced zone.
     #[error("latitude {0} is outside the UTM domain (-80..84 degrees); force a zone with --zone to project it anyway")]
@@ -366,10 +368,7 @@ mod tests {
 
     #[test]
     fn outside_utm_needs_forced_zone() {
-        assert_eq!(
-            to_utm(84.5, 10.0, None),
-            Err(CoordError::OutsideUtm(84.5))
-        );
+        assert_eq!(to_utm(84.5, 10.0, None), Err(CoordError::OutsideUtm(84.5)));
         assert!(matches!(
             to_utm(-80.1, 10.0, None),
             Err(CoordError::OutsideUtm(_))

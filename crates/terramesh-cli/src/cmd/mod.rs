@@ -1,0 +1,3 @@
+//! One module per subcommand: its arguments (`Args`) and its `run`.
+
+pub mod convert;
