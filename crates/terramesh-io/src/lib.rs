@@ -4,4 +4,5 @@
 
 pub mod number;
 pub mod output;
+pub mod region;
 pub mod table;

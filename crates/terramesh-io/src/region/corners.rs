@@ -1,0 +1,137 @@
+//! Corner lists: `"LAT LON; LAT LON; ..."` inline, or a CSV with columns `lat,lon`.
+
+use std::path::Path;
+
+use terramesh_core::coords::{parse_angle, Axis};
+
+use super::RegionError;
+use crate::table::{ReadOptions, Table};
+
+/// Parses one corner `"LAT LON"` (decimal or DMS; a comma between them is allowed) into
+/// `[lon, lat]`.
+///
+/// DMS with spaces (`48 43 20.64 N 7 20 12.48 E`) is split where both halves read as valid
+/// angles; a list that splits more than one way is rejected.
+///
+/// ```
+/// use terramesh_io::region::parse_corner;
+/// let p = parse_corner("N48°43'20.64\" E7°20'12.48\"").unwrap();
+/// assert!((p[0] - 7.3368).abs() < 1e-12 && (p[1] - 48.7224).abs() < 1e-12);
+/// let q = parse_corner("48 43 20.64 N 7 20 12.48 E").unwrap();
+/// assert_eq!(p, q);
+/// assert_eq!(parse_corner("48.5, -7.25").unwrap(), [-7.25, 48.5]);
+/// assert!(parse_corner("48 43 7 20").is_err()); // ambiguous
+/// ```
+pub fn parse_corner(text: &str) -> Result<[f64; 2], String> {
+    let t = text.trim();
+    if let Some((a, b)) = t.split_once(',') {
+        let lat = parse_angle(a, Axis::Lat).map_err(|e| e.to_string())?;
+        let lon = parse_angle(b, Axis::Lon).map_err(|e| e.to_string())?;
+        return Ok([lon, lat]);
+    }
+    let tokens: Vec<&str> = t.split_whitespace().collect();
+    if tokens.len() < 2 {
+        return Err(format!(
+            "corner '{t}' needs a latitude and a longitude, e.g. \"48.7224 7.3368\""
+        ));
+    }
+    let mut found = Vec::new();
+    for k in 1..tokens.len() {
+        let lat = parse_angle(&tokens[..k].join(" "), Axis::Lat);
+        let lon = parse_angle(&tokens[k..].join(" "), Axis::Lon);
+        if let (Ok(lat), Ok(lon)) = (lat, lon) {
+            found.push([lon, lat]);
+        }
+    }
+    match found.len() {
+        1 => Ok(found[0]),
+        0 => Err(format!(
+            "cannot read corner '{t}' as LATITUDE LONGITUDE (decimal degrees or DMS such as N48°43'20.64\" E7°20'12.48\")"
+        )),
+        _ => Err(format!(
+            "corner '{t}' can be split into latitude and longitude in more than one way; \
+             separate them with a comma or add hemisphere letters"
+        )),
+    }
+}
+
+/// Parses `"LAT LON; LAT LON; ..."` into a ring of `[lon, lat]` (a repeated closing corner
+/// is dropped). At least 3 distinct corners are required.
+///
+/// ```
+/// let ring = terramesh_io::region::parse_corners("48.72 7.33; 48.72 7.34; 48.73 7.34")?;
+/// assert_eq!(ring.len(), 3);
+/// # Ok::<(), terramesh_io::region::RegionError>(())
+/// ```
+pub fn parse_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError> {
+    let invalid = |message: String| RegionError::Invalid {
+        source_name: "--corners".into(),
+        message,
+    };
+    let mut ring = Vec::new();
+    for (i, part) in text.split(';').enumerate() {
+        if part.trim().is_empty() {
+            continue;
+        }
+        let p = parse_corner(part).map_err(|m| invalid(format!("corner {}: {m}", i + 1)))?;
+        ring.push(p);
+    }
+    finish_ring(ring).map_err(invalid)
+}
+
+/// Reads a corners CSV with columns `lat,lon` (decimal or DMS).
+pub(super) fn read_corners_csv(path: &Path) -> Result<Vec<[f64; 2]>, RegionError> {
+    let t = Table::read(path, &ReadOptions::default())?;
+    let la = t.require(&["lat", "latitude"])?;
+    let lo = t.require(&["lon", "longitude", "lng", "long"])?;
+    let mut ring = Vec::with_capacity(t.records.len());
+    for r in 0..t.records.len() {
+        let lat = parse_angle(&t.records[r][la], Axis::Lat)
+            .map_err(|e| t.bad_value(r, la, &e.to_string()))?;
+        let lon = parse_angle(&t.records[r][lo], Axis::Lon)
+            .map_err(|e| t.bad_value(r, lo, &e.to_string()))?;
+        ring.push([lon, lat]);
+    }
+    finish_ring(ring).map_err(|message| RegionError::Invalid {
+        source_name: path.display().to_string(),
+        message,
+    })
+}
+
+/// Drops a repeated closing vertex and consecutive duplicates; requires 3 distinct vertices.
+pub(crate) fn finish_ring(mut ring: Vec<[f64; 2]>) -> Result<Vec<[f64; 2]>, String> {
+    ring.dedup();
+    if ring.len() > 1 && ring.first() == ring.last() {
+        ring.pop();
+    }
+    let mut distinct = ring.clone();
+    distinct.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+    distinct.dedup();
+    if distinct.len() < 3 {
+        return Err(format!(
+            "a region needs at least 3 distinct corners, found {}",
+            distinct.len()
+        ));
+    }
+    Ok(ring)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closing_corner_optional() {
+        let a = parse_corners("0 0; 0 1; 1 1; 0 0").unwrap();
+        let b = parse_corners("0 0; 0 1; 1 1").unwrap();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn too_few_corners() {
+        let e = parse_corners("0 0; 0 1; 0 0").unwrap_err().to_string();
+        assert!(e.contains("at least 3 distinct"), "{e}");
+        let e = parse_corners("0 0; 0 1; x y").unwrap_err().to_string();
+        assert!(e.contains("corner 3"), "{e}");
+    }
+}
