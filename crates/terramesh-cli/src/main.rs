@@ -34,15 +34,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("terramesh: error: {e}");
-            let mut source = e.source();
-            while let Some(s) = source {
-                let text = s.to_string();
-                if !e.to_string().contains(&text) {
-                    eprintln!("  caused by: {text}");
-                }
-                source = s.source();
-            }
+            // `{:#}` prints the context chain on one line: "file, line 3: what is wrong".
+            eprintln!("terramesh: error: {e:#}");
             ExitCode::FAILURE
         }
     }

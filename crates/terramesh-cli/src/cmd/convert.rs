@@ -218,7 +218,9 @@ fn angle(table: &Table, r: usize, c: usize, axis: Axis) -> Result<f64> {
             terramesh_core::coords::CoordError::BadAngle { why, .. } => why,
             other => other.to_string(),
         };
-        table.bad_value(r, c, &why).into()
+        table
+            .bad_value(r, c, &format!("is not an angle: {why}"))
+            .into()
     })
 }
 

@@ -42,6 +42,13 @@ pub fn parse_angle(text: &str, axis: Axis) -> Result<f64, CoordError> {
     if let Ok(v) = t.parse::<f64>() {
         return check_range(v, axis, text);
     }
+    // Words (two or more letters together) are never part of an angle.
+    if let Some(word) = t
+        .split(|c: char| !c.is_alphabetic())
+        .find(|w| w.chars().count() > 1)
+    {
+        return Err(bad(&format!("unexpected word '{word}'")));
+    }
     let mut hemi: Option<char> = None;
     let mut sign = 1.0;
     let mut nums: Vec<(f64, bool)> = Vec::with_capacity(3); // (value, had a fraction)
