@@ -33,11 +33,6 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 /// Splits output CSV into rows of fields (quotes handled for DMS cells).
 fn rows(text: &str) -> Vec<Vec<String>> {
-    let mut rdr = csv_lite(text);
-    rdr.drain(..).collect()
-}
-
-fn csv_lite(text: &str) -> Vec<Vec<String>> {
     let mut out = Vec::new();
     for line in text.lines() {
         let mut fields = Vec::new();

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use terramesh_core::coords::{parse_angle, to_utm, to_utm_with_factors, to_wgs84, Axis, Zone};
+use terramesh_io::number::push_fixed;
 use terramesh_io::output::Output;
 use terramesh_io::table::{ReadOptions, Table};
 
@@ -16,8 +17,11 @@ const EAST: &[&str] = &["easting", "east", "x"];
 const NORTH: &[&str] = &["northing", "north", "y"];
 const ZONE: &[&str] = &["zone", "utm_zone"];
 
-/// Rows per parallel work item when formatting output.
+/// Rows per parallel work item.
 const CHUNK: usize = 8192;
+/// Decimals written for metres (micrometres) and degrees (about 1 micrometre too).
+const METRE_DECIMALS: usize = 6;
+const DEGREE_DECIMALS: usize = 11;
 
 /// Target of the conversion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -81,13 +85,13 @@ pub fn run(args: Args) -> Result<()> {
         delimiter,
     };
     let table = Table::read(&args.input, &opts)?;
-    let (extra_header, cells) = match args.to {
+    let (layout, cells) = match args.to {
         Target::Utm => to_utm_cells(&table, zone, args.extras)?,
         Target::Wgs84 => to_wgs84_cells(&table, zone, args.extras)?,
     };
     let mut out = Output::create(args.output.as_deref())
         .with_context(|| format!("cannot write {}", display(&args.output)))?;
-    write_table(&mut out, &table, extra_header, &cells)
+    write_table(&mut out, &table, &layout, &cells)
         .with_context(|| format!("writing {}", display(&args.output)))?;
     out.commit()
         .with_context(|| format!("cannot write {}", display(&args.output)))?;
@@ -99,58 +103,69 @@ fn display(p: &Option<PathBuf>) -> String {
         .map_or_else(|| "standard output".into(), |p| p.display().to_string())
 }
 
-/// New cells for each row, already formatted.
-type Cells = Vec<[String; 5]>;
+/// The new values of one row: two coordinates, a zone, and optionally convergence and scale.
+#[derive(Clone, Copy)]
+struct NewCells {
+    a: f64,
+    b: f64,
+    zone: Option<Zone>,
+    extras: Option<(f64, f64)>,
+}
+
+/// How the new cells are written: header names and decimals of `a`, `b`.
+struct Layout {
+    header: &'static [&'static str],
+    decimals: usize,
+}
 
 fn to_utm_cells(
     table: &Table,
     zone: Option<Zone>,
     extras: bool,
-) -> Result<(&'static [&'static str], Cells)> {
+) -> Result<(Layout, Vec<NewCells>)> {
     let lat_c = table.require(LAT)?;
     let lon_c = table.require(LON)?;
-    let rows: Vec<Result<[String; 5]>> = (0..table.records.len())
-        .into_par_iter()
-        .with_min_len(CHUNK)
-        .map(|r| {
-            let lat = angle(table, r, lat_c, Axis::Lat)?;
-            let lon = angle(table, r, lon_c, Axis::Lon)?;
-            let at = || format!("{}, line {}", table.name, table.lines[r]);
-            if extras {
-                let (p, f) = to_utm_with_factors(lat, lon, zone).with_context(at)?;
-                Ok([
-                    format!("{:.6}", p.easting),
-                    format!("{:.6}", p.northing),
-                    p.zone.to_string(),
-                    format!("{:.10}", f.convergence_deg),
-                    format!("{:.12}", f.scale),
-                ])
-            } else {
-                let p = to_utm(lat, lon, zone).with_context(at)?;
-                Ok([
-                    format!("{:.6}", p.easting),
-                    format!("{:.6}", p.northing),
-                    p.zone.to_string(),
-                    String::new(),
-                    String::new(),
-                ])
+    let cells = rows_in_parallel(table, |r| {
+        let lat = angle(table, r, lat_c, Axis::Lat)?;
+        let lon = angle(table, r, lon_c, Axis::Lon)?;
+        let at = || format!("{}, line {}", table.name, table.lines[r]);
+        Ok(if extras {
+            let (p, f) = to_utm_with_factors(lat, lon, zone).with_context(at)?;
+            NewCells {
+                a: p.easting,
+                b: p.northing,
+                zone: Some(p.zone),
+                extras: Some((f.convergence_deg, f.scale)),
+            }
+        } else {
+            let p = to_utm(lat, lon, zone).with_context(at)?;
+            NewCells {
+                a: p.easting,
+                b: p.northing,
+                zone: Some(p.zone),
+                extras: None,
             }
         })
-        .collect();
-    let cells = first_error(rows)?;
+    })?;
     let header: &[&str] = if extras {
         &["easting", "northing", "zone", "convergence_deg", "scale"]
     } else {
         &["easting", "northing", "zone"]
     };
-    Ok((header, cells))
+    Ok((
+        Layout {
+            header,
+            decimals: METRE_DECIMALS,
+        },
+        cells,
+    ))
 }
 
 fn to_wgs84_cells(
     table: &Table,
     zone: Option<Zone>,
     extras: bool,
-) -> Result<(&'static [&'static str], Cells)> {
+) -> Result<(Layout, Vec<NewCells>)> {
     let e_c = table.require(EAST)?;
     let n_c = table.require(NORTH)?;
     let z_c = match zone {
@@ -162,46 +177,61 @@ fn to_wgs84_cells(
             )
         })?),
     };
-    let rows: Vec<Result<[String; 5]>> = (0..table.records.len())
-        .into_par_iter()
-        .with_min_len(CHUNK)
-        .map(|r| {
-            let e = table.number(r, e_c)?;
-            let n = table.number(r, n_c)?;
-            let z = match (zone, z_c) {
-                (Some(z), _) => z,
-                (None, Some(c)) => table.records[r][c]
-                    .parse::<Zone>()
-                    .map_err(|err| table.bad_value(r, c, &format!("is not a zone: {err}")))?,
-                (None, None) => unreachable!("zone column checked above"),
-            };
-            let at = || format!("{}, line {}", table.name, table.lines[r]);
-            let (lat, lon) = to_wgs84(e, n, z).with_context(at)?;
-            let (conv, scale) = if extras {
-                let (_, f) = to_utm_with_factors(lat, lon, Some(z)).with_context(at)?;
-                (
-                    format!("{:.10}", f.convergence_deg),
-                    format!("{:.12}", f.scale),
-                )
-            } else {
-                (String::new(), String::new())
-            };
-            Ok([
-                format!("{lat:.11}"),
-                format!("{lon:.11}"),
-                conv,
-                scale,
-                String::new(),
-            ])
+    let cells = rows_in_parallel(table, |r| {
+        let e = table.number(r, e_c)?;
+        let n = table.number(r, n_c)?;
+        let z = match (zone, z_c) {
+            (Some(z), _) => z,
+            (None, Some(c)) => table.records[r][c]
+                .parse::<Zone>()
+                .map_err(|err| table.bad_value(r, c, &format!("is not a zone: {err}")))?,
+            (None, None) => unreachable!("zone column checked above"),
+        };
+        let at = || format!("{}, line {}", table.name, table.lines[r]);
+        let (lat, lon) = to_wgs84(e, n, z).with_context(at)?;
+        let extras = if extras {
+            let (_, f) = to_utm_with_factors(lat, lon, Some(z)).with_context(at)?;
+            Some((f.convergence_deg, f.scale))
+        } else {
+            None
+        };
+        Ok(NewCells {
+            a: lat,
+            b: lon,
+            zone: None,
+            extras,
         })
-        .collect();
-    let cells = first_error(rows)?;
+    })?;
     let header: &[&str] = if extras {
         &["lat", "lon", "convergence_deg", "scale"]
     } else {
         &["lat", "lon"]
     };
-    Ok((header, cells))
+    Ok((
+        Layout {
+            header,
+            decimals: DEGREE_DECIMALS,
+        },
+        cells,
+    ))
+}
+
+/// Runs `f` on every row in parallel; the first error in row order wins, so messages are
+/// deterministic.
+fn rows_in_parallel(
+    table: &Table,
+    f: impl Fn(usize) -> Result<NewCells> + Sync,
+) -> Result<Vec<NewCells>> {
+    let n = table.records.len();
+    let parts: Vec<Result<Vec<NewCells>>> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|k| (k * CHUNK..((k + 1) * CHUNK).min(n)).map(&f).collect())
+        .collect();
+    let mut out = Vec::with_capacity(n);
+    for p in parts {
+        out.extend(p?);
+    }
+    Ok(out)
 }
 
 /// Reads an angle cell, naming file, line, column and value on error.
@@ -224,23 +254,13 @@ fn angle(table: &Table, r: usize, c: usize, axis: Axis) -> Result<f64> {
     })
 }
 
-/// The first error in row order, so that messages are deterministic.
-fn first_error(rows: Vec<Result<[String; 5]>>) -> Result<Cells> {
-    rows.into_iter().collect()
-}
-
-fn write_table(
-    out: &mut Output,
-    table: &Table,
-    extra_header: &[&str],
-    cells: &Cells,
-) -> Result<()> {
+fn write_table(out: &mut Output, table: &Table, layout: &Layout, cells: &[NewCells]) -> Result<()> {
     let mut head = Vec::new();
     let headers = table
         .headers
         .iter()
         .map(String::as_str)
-        .chain(extra_header.iter().copied());
+        .chain(layout.header.iter().copied());
     for (i, h) in headers.enumerate() {
         if i > 0 {
             head.push(b',');
@@ -249,12 +269,11 @@ fn write_table(
     }
     head.push(b'\n');
     out.write_all(&head)?;
-    let n_extra = extra_header.len();
     let chunks: Vec<Vec<u8>> = cells
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(k, chunk)| {
-            let mut buf = Vec::with_capacity(chunk.len() * 96);
+            let mut buf = Vec::with_capacity(chunk.len() * 112);
             for (i, new) in chunk.iter().enumerate() {
                 let rec = &table.records[k * CHUNK + i];
                 for (j, f) in rec.iter().enumerate() {
@@ -263,11 +282,21 @@ fn write_table(
                     }
                     push_field(&mut buf, f);
                 }
-                for cell in &new[..n_extra] {
-                    if !rec.is_empty() {
-                        buf.push(b',');
-                    }
-                    buf.extend_from_slice(cell.as_bytes());
+                if !rec.is_empty() {
+                    buf.push(b',');
+                }
+                push_fixed(&mut buf, new.a, layout.decimals);
+                buf.push(b',');
+                push_fixed(&mut buf, new.b, layout.decimals);
+                if let Some(z) = new.zone {
+                    buf.push(b',');
+                    buf.extend_from_slice(z.to_string().as_bytes());
+                }
+                if let Some((gamma, k)) = new.extras {
+                    buf.push(b',');
+                    push_fixed(&mut buf, gamma, 10);
+                    buf.push(b',');
+                    push_fixed(&mut buf, k, 12);
                 }
                 buf.push(b'\n');
             }

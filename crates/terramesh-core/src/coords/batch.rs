@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use super::utm::{to_utm, to_wgs84, CoordError, Utm, Zone};
+use super::utm::{to_wgs84, wgs84, zone_and_dlon, CoordError, Utm, Zone, FALSE_EASTING};
 
 /// How a batch kernel may use threads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,18 +46,48 @@ pub fn to_utm_many(
 ) -> Result<Vec<Utm>, CoordError> {
     assert_eq!(lat.len(), lon.len(), "lat and lon must have equal length");
     match par {
-        Parallelism::Sequential => lat
-            .iter()
-            .zip(lon)
-            .map(|(&a, &o)| to_utm(a, o, zone))
-            .collect(),
-        Parallelism::Rayon { chunk } => lat
-            .par_iter()
-            .zip(lon.par_iter())
-            .with_min_len(chunk.max(1))
-            .map(|(&a, &o)| to_utm(a, o, zone))
-            .collect(),
+        Parallelism::Sequential => utm_slice(lat, lon, zone),
+        Parallelism::Rayon { chunk } => {
+            let parts: Vec<Result<Vec<Utm>, CoordError>> = lat
+                .par_chunks(chunk.max(1))
+                .zip(lon.par_chunks(chunk.max(1)))
+                .map(|(a, o)| utm_slice(a, o, zone))
+                .collect();
+            let mut out = Vec::with_capacity(lat.len());
+            for p in parts {
+                out.extend(p?);
+            }
+            Ok(out)
+        }
     }
+}
+
+/// The sequential kernel: zones and checks point by point, then the projection of blocks of
+/// points through [`TransverseMercator::forward_slice`] (vectorised where the CPU allows).
+fn utm_slice(lat: &[f64], lon: &[f64], zone: Option<Zone>) -> Result<Vec<Utm>, CoordError> {
+    const B: usize = 256;
+    let tm = wgs84();
+    let mut out = Vec::with_capacity(lat.len());
+    let (mut zones, mut dlon) = ([None::<Zone>; B], [0.0f64; B]);
+    let (mut x, mut y) = ([0.0f64; B], [0.0f64; B]);
+    for (la, lo) in lat.chunks(B).zip(lon.chunks(B)) {
+        let n = la.len();
+        for i in 0..n {
+            let (z, d) = zone_and_dlon(la[i], lo[i], zone)?;
+            zones[i] = Some(z);
+            dlon[i] = d;
+        }
+        tm.forward_slice(la, &dlon[..n], &mut x[..n], &mut y[..n]);
+        for i in 0..n {
+            let z = zones[i].expect("set above");
+            out.push(Utm {
+                easting: FALSE_EASTING + x[i],
+                northing: z.false_northing() + y[i],
+                zone: z,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Converts many UTM points (all in `zone`) back to `(lat, lon)` degrees.

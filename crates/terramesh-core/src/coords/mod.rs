@@ -9,6 +9,7 @@
 
 mod angle;
 mod batch;
+mod fastmath;
 mod tmerc;
 mod utm;
 

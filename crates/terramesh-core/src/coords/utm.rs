@@ -11,7 +11,7 @@ pub const FALSE_EASTING: f64 = 500_000.0;
 /// UTM false northing in the southern hemisphere, metres.
 pub const FALSE_NORTHING_SOUTH: f64 = 10_000_000.0;
 
-fn wgs84() -> &'static TransverseMercator {
+pub(crate) fn wgs84() -> &'static TransverseMercator {
     static TM: OnceLock<TransverseMercator> = OnceLock::new();
     TM.get_or_init(TransverseMercator::wgs84_utm)
 }
@@ -117,7 +117,8 @@ impl Zone {
             return Err(CoordError::OutsideUtm(lat));
         }
         let lon = if lon >= 180.0 { lon - 360.0 } else { lon };
-        let mut number = (((lon + 180.0) / 6.0).floor() as i32 + 1).clamp(1, 60) as u8;
+        // (lon + 180) / 6 >= 0, so truncation is floor.
+        let mut number = (((lon + 180.0) / 6.0) as i32 + 1).clamp(1, 60) as u8;
         if (56.0..64.0).contains(&lat) && (3.0..12.0).contains(&lon) {
             number = 32;
         }
@@ -163,7 +164,7 @@ impl Zone {
         (if self.north { 32600 } else { 32700 }) + u32::from(self.number)
     }
 
-    fn false_northing(self) -> f64 {
+    pub(crate) fn false_northing(self) -> f64 {
         if self.north {
             0.0
         } else {
@@ -258,6 +259,23 @@ fn dlon_in(zone: Zone, lon: f64) -> Result<f64, CoordError> {
 /// # Ok::<(), terramesh_core::coords::CoordError>(())
 /// ```
 pub fn to_utm(lat: f64, lon: f64, zone: Option<Zone>) -> Result<Utm, CoordError> {
+    let (zone, d) = zone_and_dlon(lat, lon, zone)?;
+    let p = wgs84().forward(lat, d);
+    Ok(Utm {
+        easting: FALSE_EASTING + p.x,
+        northing: zone.false_northing() + p.y,
+        zone,
+    })
+}
+
+/// The zone of a point (its own or the forced one) and its longitude from the central
+/// meridian, with every check of [`to_utm`].
+#[inline]
+pub(crate) fn zone_and_dlon(
+    lat: f64,
+    lon: f64,
+    zone: Option<Zone>,
+) -> Result<(Zone, f64), CoordError> {
     let zone = match zone {
         Some(z) => {
             check_lat_lon(lat, lon)?;
@@ -265,13 +283,7 @@ pub fn to_utm(lat: f64, lon: f64, zone: Option<Zone>) -> Result<Utm, CoordError>
         }
         None => Zone::for_point(lat, lon)?,
     };
-    let d = dlon_in(zone, lon)?;
-    let p = wgs84().forward(lat, d);
-    Ok(Utm {
-        easting: FALSE_EASTING + p.x,
-        northing: zone.false_northing() + p.y,
-        zone,
-    })
+    Ok((zone, dlon_in(zone, lon)?))
 }
 
 /// Like [`to_utm`], also returning the meridian convergence and point scale factor.
