@@ -76,7 +76,7 @@ pub fn extrude(
         )));
     }
     let min_z = vertices.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
-    if !(base < min_z) {
+    if base.is_nan() || base >= min_z {
         return Err(SolidError::BaseTooHigh { base, min_z });
     }
     // Directed edge use counts; boundary edges are used once and never in reverse.
