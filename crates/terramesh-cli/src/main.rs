@@ -7,6 +7,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
+#[allow(dead_code)] // TODO(build): fields are read by `terramesh build`, next.
+mod project;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
 ///
@@ -24,12 +26,15 @@ struct Cli {
 enum Command {
     /// Convert coordinates between WGS-84 latitude/longitude and UTM.
     Convert(cmd::convert::Args),
+    /// Create a project directory with a commented terramesh.toml.
+    Init(cmd::init::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Init(args) => cmd::init::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
