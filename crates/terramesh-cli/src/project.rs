@@ -207,6 +207,10 @@ impl Default for ExportSection {
     }
 }
 
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
 fn default_crs() -> String {
     "geographic".into()
 }
@@ -324,13 +328,13 @@ impl Project {
             bail!(bad("interpolation.idw_power", "must be positive"));
         }
         if let Some(v) = &i.model {
-            if !(v.range > 0.0) {
+            if !positive(v.range) {
                 bail!(bad("interpolation.model.range", "must be positive"));
             }
-            if !(v.psill > 0.0) {
+            if !positive(v.psill) {
                 bail!(bad("interpolation.model.psill", "must be positive"));
             }
-            if !(v.nugget >= 0.0) {
+            if !(v.nugget.is_finite() && v.nugget >= 0.0) {
                 bail!(bad("interpolation.model.nugget", "must be 0 or positive"));
             }
         }
