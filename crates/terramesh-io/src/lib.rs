@@ -5,5 +5,6 @@
 pub mod export;
 pub mod number;
 pub mod output;
+pub mod pictures;
 pub mod region;
 pub mod table;

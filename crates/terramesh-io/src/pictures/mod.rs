@@ -1,0 +1,225 @@
+//! Pictures of the pipeline, drawn with plotters as PNG and SVG: sample points over the
+//! region, planar meshes, coloured and hill-shaded maps with contours, and a shaded 3D view.
+//!
+//! Every drawing is deterministic (no dates, a bundled font), so two builds give identical
+//! files.
+
+mod colour;
+mod maps;
+mod view3d;
+
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+
+pub use colour::{hillshade, shade, ColourMap};
+pub use maps::{draw_mesh, draw_samples, draw_surface, SurfaceMap};
+pub use view3d::draw_view3d;
+
+/// A picture failed to render or write.
+#[derive(Debug, thiserror::Error)]
+#[error("drawing {file}: {message}")]
+pub struct PictureError {
+    /// The output file.
+    pub file: String,
+    /// What went wrong.
+    pub message: String,
+}
+
+/// Registers the bundled DejaVu Sans font once (no system fonts are needed).
+fn ensure_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // Registration only fails on a malformed font, and the bundled one is fixed.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            dejavu::sans::regular(),
+        );
+    });
+}
+
+/// Renders one drawing as `stem.png` and `stem.svg` at `size` pixels; returns both paths.
+///
+/// The PNG and SVG are written to temporary files and renamed, as every output.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use plotters::prelude::*;
+/// let dir = tempfile::tempdir()?;
+/// let files = terramesh_io::pictures::render_both(&dir.path().join("dot"), (100, 80), |root| {
+///     root.fill(&WHITE)?;
+///     root.draw(&Circle::new((50, 40), 10, RED.filled()))?;
+///     Ok(())
+/// })?;
+/// assert!(files[0].ends_with("dot.png") && files[1].ends_with("dot.svg"));
+/// assert!(std::fs::read_to_string(&files[1])?.contains("<svg"));
+/// # Ok(()) }
+/// ```
+pub fn render_both<F>(stem: &Path, size: (u32, u32), draw: F) -> Result<[PathBuf; 2], PictureError>
+where
+    F: Fn(
+        &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>,
+{
+    ensure_font();
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    let err = |file: &Path, e: &dyn std::fmt::Display| PictureError {
+        file: file.display().to_string(),
+        message: e.to_string(),
+    };
+    // PNG: render into a pixel buffer, encode, write atomically.
+    let mut pixels = vec![255u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let backend = BitMapBackend::with_buffer(&mut pixels, size);
+        let root = DynBackend::Bitmap(backend).into_drawing_area();
+        draw(&root).map_err(|e| err(&png, &e))?;
+        root.present().map_err(|e| err(&png, &e))?;
+    }
+    let encoded = encode_png(&pixels, size).map_err(|e| err(&png, &e))?;
+    crate::output::write_atomic(&png, &encoded).map_err(|e| err(&png, &e))?;
+    // SVG: render into a string.
+    let mut text = String::new();
+    {
+        let backend = SVGBackend::with_string(&mut text, size);
+        let root = DynBackend::Svg(backend).into_drawing_area();
+        draw(&root).map_err(|e| err(&svg, &e))?;
+        root.present().map_err(|e| err(&svg, &e))?;
+    }
+    crate::output::write_atomic(&svg, text.as_bytes()).map_err(|e| err(&svg, &e))?;
+    Ok([png, svg])
+}
+
+/// Encodes RGB pixels as PNG (no time chunk: identical input gives identical bytes).
+fn encode_png(pixels: &[u8], size: (u32, u32)) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, size.0, size.1);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(|e| e.to_string())?;
+        w.write_image_data(pixels).map_err(|e| e.to_string())?;
+    }
+    Ok(out)
+}
+
+/// A drawing backend that is either a bitmap or an SVG, so one drawing function serves both.
+pub enum DynBackend<'a> {
+    /// Pixels.
+    Bitmap(BitMapBackend<'a>),
+    /// Vector.
+    Svg(SVGBackend<'a>),
+}
+
+/// Errors of either backend, as text.
+#[derive(Debug)]
+pub struct DynError(String);
+
+impl std::fmt::Display for DynError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DynError {}
+
+fn conv<E: std::error::Error + Send + Sync>(
+    e: plotters_backend::DrawingErrorKind<E>,
+) -> plotters_backend::DrawingErrorKind<DynError> {
+    match e {
+        plotters_backend::DrawingErrorKind::DrawingError(e) => {
+            plotters_backend::DrawingErrorKind::DrawingError(DynError(e.to_string()))
+        }
+        plotters_backend::DrawingErrorKind::FontError(f) => {
+            plotters_backend::DrawingErrorKind::FontError(f)
+        }
+    }
+}
+
+macro_rules! both {
+    ($self:ident, $b:ident => $e:expr) => {
+        match $self {
+            DynBackend::Bitmap($b) => $e.map_err(conv),
+            DynBackend::Svg($b) => $e.map_err(conv),
+        }
+    };
+}
+
+impl plotters_backend::DrawingBackend for DynBackend<'_> {
+    type ErrorType = DynError;
+
+    fn get_size(&self) -> (u32, u32) {
+        match self {
+            DynBackend::Bitmap(b) => b.get_size(),
+            DynBackend::Svg(b) => b.get_size(),
+        }
+    }
+    fn ensure_prepared(&mut self) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.ensure_prepared())
+    }
+    fn present(&mut self) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.present())
+    }
+    fn draw_pixel(
+        &mut self,
+        point: plotters_backend::BackendCoord,
+        color: plotters_backend::BackendColor,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.draw_pixel(point, color))
+    }
+    fn draw_line<S: plotters_backend::BackendStyle>(
+        &mut self,
+        from: plotters_backend::BackendCoord,
+        to: plotters_backend::BackendCoord,
+        style: &S,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.draw_line(from, to, style))
+    }
+    fn draw_rect<S: plotters_backend::BackendStyle>(
+        &mut self,
+        upper_left: plotters_backend::BackendCoord,
+        bottom_right: plotters_backend::BackendCoord,
+        style: &S,
+        fill: bool,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.draw_rect(upper_left, bottom_right, style, fill))
+    }
+    fn draw_path<
+        S: plotters_backend::BackendStyle,
+        I: IntoIterator<Item = plotters_backend::BackendCoord>,
+    >(
+        &mut self,
+        path: I,
+        style: &S,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.draw_path(path, style))
+    }
+    fn draw_circle<S: plotters_backend::BackendStyle>(
+        &mut self,
+        center: plotters_backend::BackendCoord,
+        radius: u32,
+        style: &S,
+        fill: bool,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.draw_circle(center, radius, style, fill))
+    }
+    fn fill_polygon<
+        S: plotters_backend::BackendStyle,
+        I: IntoIterator<Item = plotters_backend::BackendCoord>,
+    >(
+        &mut self,
+        vert: I,
+        style: &S,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.fill_polygon(vert, style))
+    }
+    fn draw_text<TStyle: plotters_backend::BackendTextStyle>(
+        &mut self,
+        text: &str,
+        style: &TStyle,
+        pos: plotters_backend::BackendCoord,
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {
+        both!(self, b => b.draw_text(text, style, pos))
+    }
+}
