@@ -7,4 +7,5 @@ pub mod number;
 pub mod output;
 pub mod pictures;
 pub mod region;
+pub mod report;
 pub mod table;
