@@ -22,10 +22,6 @@ impl Tree {
         })
     }
 
-    pub(crate) fn len(&self) -> usize {
-        self.len
-    }
-
     /// The `k` nearest points as (squared distance, index), nearest first.
     pub(crate) fn nearest(&self, q: [f64; 2], k: usize, out: &mut Vec<(f64, usize)>) {
         out.clear();
