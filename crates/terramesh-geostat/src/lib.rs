@@ -8,8 +8,11 @@
 #![warn(missing_docs)]
 
 mod band;
+mod cv;
 mod data;
 mod error;
+mod experimental;
+mod fit;
 mod global;
 mod idw;
 mod linalg;
@@ -19,8 +22,11 @@ mod search;
 mod special;
 mod system;
 
+pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, Method};
 pub use error::{GeostatError, Result};
+pub use experimental::{diameter, experimental, Direction, Estimator, Lag, LagSettings};
+pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
 pub use idw::{Idw, Search as IdwSearch};
 pub use neighbourhood::LocalKriging;
