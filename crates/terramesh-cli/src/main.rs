@@ -24,12 +24,21 @@ struct Cli {
 enum Command {
     /// Convert coordinates between WGS-84 latitude/longitude and UTM.
     Convert(cmd::convert::Args),
+    /// Experimental semivariogram and a fitted model (JSON, optional SVG chart).
+    Variogram(cmd::variogram::Args),
+    /// Kriging (simple, ordinary, universal) or IDW at target points or on a grid.
+    Interpolate(cmd::interpolate::Args),
+    /// Cross-validation of kriging or IDW: RMSE, MAE, mean and standardised errors.
+    Cv(cmd::cv::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Variogram(args) => cmd::variogram::run(args),
+        Command::Interpolate(args) => cmd::interpolate::run(args),
+        Command::Cv(args) => cmd::cv::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

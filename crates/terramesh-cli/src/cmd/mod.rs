@@ -1,3 +1,8 @@
 //! One module per subcommand: its arguments (`Args`) and its `run`.
 
 pub mod convert;
+pub mod cv;
+pub(crate) mod geodata;
+pub mod interpolate;
+pub(crate) mod plot;
+pub mod variogram;
