@@ -28,6 +28,12 @@ enum Command {
     Convert(cmd::convert::Args),
     /// Create a project directory with a commented terramesh.toml.
     Init(cmd::init::Args),
+    /// Experimental semivariogram and a fitted model (JSON, optional SVG chart).
+    Variogram(cmd::variogram::Args),
+    /// Kriging (simple, ordinary, universal) or IDW at target points or on a grid.
+    Interpolate(cmd::interpolate::Args),
+    /// Cross-validation of kriging or IDW: RMSE, MAE, mean and standardised errors.
+    Cv(cmd::cv::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +41,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
+        Command::Variogram(args) => cmd::variogram::run(args),
+        Command::Interpolate(args) => cmd::interpolate::run(args),
+        Command::Cv(args) => cmd::cv::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

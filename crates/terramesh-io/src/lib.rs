@@ -3,6 +3,7 @@
 #![warn(missing_docs)]
 
 pub mod export;
+pub mod grid_write;
 pub mod number;
 pub mod output;
 pub mod pictures;

@@ -2,3 +2,8 @@
 
 pub mod convert;
 pub mod init;
+pub mod cv;
+pub(crate) mod geodata;
+pub mod interpolate;
+pub(crate) mod plot;
+pub mod variogram;

@@ -1,0 +1,184 @@
+//! `terramesh variogram`: experimental semivariogram of x,y,z data and a fitted model.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use terramesh_geostat::{
+    experimental, fit_auto, fit_model, Direction, Duplicates, Estimator, LagSettings, ModelKind,
+    Weighting,
+};
+use terramesh_io::output::{write_atomic, Output};
+
+use super::geodata::{in_file, read_data};
+
+/// Estimator flag values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EstimatorArg {
+    /// Matheron's classical estimator.
+    Matheron,
+    /// Cressie–Hawkins robust estimator.
+    Cressie,
+}
+
+/// Weighting flag values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum WeightsArg {
+    /// Cressie's N/γ² weights.
+    Cressie,
+    /// Pair counts.
+    Pairs,
+}
+
+/// Duplicate handling flag values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum DupArg {
+    /// Stop with an error naming both lines.
+    Reject,
+    /// Merge points at one location into their mean.
+    Mean,
+}
+
+impl From<DupArg> for Duplicates {
+    fn from(d: DupArg) -> Self {
+        match d {
+            DupArg::Reject => Duplicates::Reject,
+            DupArg::Mean => Duplicates::Mean,
+        }
+    }
+}
+
+/// Lag and fitting flags, shared with `interpolate --variogram auto` and `cv`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct LagArgs {
+    /// Number of lag classes.
+    #[arg(long, default_value_t = 15)]
+    pub lags: usize,
+    /// Largest lag distance (default: half the data diameter).
+    #[arg(long, allow_hyphen_values = true)]
+    pub max_dist: Option<f64>,
+    /// Directional variogram: azimuth in degrees clockwise from north.
+    #[arg(long, allow_hyphen_values = true)]
+    pub azimuth: Option<f64>,
+    /// Angular tolerance of --azimuth, degrees.
+    #[arg(long, default_value_t = 22.5)]
+    pub tolerance: f64,
+    /// Semivariance estimator.
+    #[arg(long, value_enum, default_value_t = EstimatorArg::Matheron)]
+    pub estimator: EstimatorArg,
+    /// Least-squares weights of the fit.
+    #[arg(long, value_enum, default_value_t = WeightsArg::Cressie)]
+    pub weights: WeightsArg,
+}
+
+impl LagArgs {
+    pub fn settings(&self) -> LagSettings {
+        LagSettings {
+            lags: self.lags,
+            max_dist: self.max_dist,
+            direction: self.azimuth.map(|a| Direction {
+                azimuth: a,
+                tolerance: self.tolerance,
+            }),
+            estimator: match self.estimator {
+                EstimatorArg::Matheron => Estimator::Matheron,
+                EstimatorArg::Cressie => Estimator::CressieHawkins,
+            },
+        }
+    }
+    pub fn weighting(&self) -> Weighting {
+        match self.weights {
+            WeightsArg::Cressie => Weighting::Cressie,
+            WeightsArg::Pairs => Weighting::Pairs,
+        }
+    }
+}
+
+/// Compute an experimental semivariogram and fit a model to it.
+///
+/// Writes JSON with the lag classes (mean distance, semivariance, pair count), the fitted
+/// model (nugget, psill, range: GSLIB practical range) and the fit error; with --model auto
+/// also every candidate with its cross-validation RMSE. The file can be given to
+/// `interpolate --variogram FILE`.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:\n  \
+    terramesh variogram --data pts.csv -o variogram.json --plot variogram.svg\n  \
+    terramesh variogram --data pts.csv --model spherical --lags 20 --max-dist 8000 -o v.json\n  \
+    terramesh variogram --data pts.csv --azimuth 45 --tolerance 22.5 --estimator cressie")]
+pub struct Args {
+    /// Data: CSV with columns x, y, z (projected coordinates, e.g. UTM metres).
+    #[arg(long)]
+    data: PathBuf,
+    /// Model to fit: auto (default), spherical, exponential, gaussian, matern, power, linear, nugget.
+    #[arg(long, default_value = "auto")]
+    model: String,
+    #[command(flatten)]
+    lag: LagArgs,
+    /// Points at one location.
+    #[arg(long, value_enum, default_value_t = DupArg::Reject)]
+    duplicates: DupArg,
+    /// Output JSON (default: standard output).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Also draw the experimental points and the model as an SVG chart.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let fd = read_data(&args.data, args.duplicates.into())?;
+    let lags = experimental(&fd.data, &args.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
+    let (fit, cands) = fit_named(&fd.data, &lags, &args.model, args.lag.weighting())
+        .map_err(|e| e.context(fd.name.clone()))?;
+    let s = args.lag.settings();
+    let json = serde_json::json!({
+        "data": fd.name,
+        "points": fd.data.len(),
+        "lags": {
+            "classes": s.lags,
+            "max_dist": lags.last().map(|l| l.hi),
+            "azimuth": args.lag.azimuth,
+            "tolerance": args.lag.azimuth.map(|_| args.lag.tolerance),
+            "estimator": format!("{:?}", args.lag.estimator).to_lowercase(),
+        },
+        "experimental": lags,
+        "model": fit.variogram,
+        "fit": {
+            "weights": args.lag.weighting(),
+            "objective": fit.objective,
+            "rmse": fit.rmse,
+        },
+        "candidates": cands,
+    });
+    let mut out = Output::create(args.output.as_deref())?;
+    serde_json::to_writer_pretty(&mut out, &json)?;
+    out.write_all(b"\n")?;
+    out.commit()?;
+    if let Some(p) = &args.plot {
+        let title = format!("{}: {} points", fd.name, fd.data.len());
+        write_atomic(p, super::plot::variogram_svg(&lags, &fit.variogram, &title).as_bytes())
+            .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    if args.output.is_some() {
+        eprintln!("terramesh: variogram model: {}", fit.variogram);
+    }
+    Ok(())
+}
+
+/// Fits the model named on the command line (`auto` tries them all).
+pub fn fit_named(
+    data: &terramesh_geostat::Data,
+    lags: &[terramesh_geostat::Lag],
+    model: &str,
+    w: Weighting,
+) -> Result<(terramesh_geostat::Fit, Vec<terramesh_geostat::Candidate>)> {
+    if model.eq_ignore_ascii_case("auto") {
+        let (f, c) = fit_auto(data, lags, w, &ModelKind::ALL)?;
+        return Ok((f, c));
+    }
+    let Some(kind) = ModelKind::parse(model) else {
+        bail!("--model '{model}': expected auto, spherical, exponential, gaussian, matern, power, linear or nugget");
+    };
+    Ok((fit_model(lags, kind, w)?, Vec::new()))
+}

@@ -1,0 +1,247 @@
+//! Experimental semivariograms: lag classes, directions, Matheron and Cressie–Hawkins.
+//!
+//! Pairs are enumerated by a sweep over the data sorted by x: for each point only the points
+//! within `max_dist` in x are examined, so with a maximum distance the cost is the number of
+//! pairs in that strip, not all `n²/2`, and it runs in parallel with rayon.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::data::Data;
+use crate::error::{bad, GeostatError, Result};
+
+/// How the semivariance of a lag class is estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Estimator {
+    /// Matheron's `γ = Σ (z_i − z_j)² / 2N`.
+    #[default]
+    Matheron,
+    /// Cressie & Hawkins (1980), robust: `γ = ½ (Σ |z_i − z_j|^½ / N)⁴ / (0.457 + 0.494/N +
+    /// 0.045/N²)` (GSTools' form of the bias correction).
+    CressieHawkins,
+}
+
+/// A direction for a directional variogram.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Direction {
+    /// Azimuth in degrees clockwise from north (+y), GSLIB's convention.
+    pub azimuth: f64,
+    /// Half-angle tolerance in degrees (0 < tol <= 90).
+    pub tolerance: f64,
+}
+
+/// Lag classes and options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LagSettings {
+    /// Number of equal-width lag classes on `[0, max_dist)` (default 15).
+    pub lags: usize,
+    /// Largest distance; default half the data diameter.
+    pub max_dist: Option<f64>,
+    /// Omnidirectional when `None`.
+    pub direction: Option<Direction>,
+    /// Estimator.
+    pub estimator: Estimator,
+}
+
+impl Default for LagSettings {
+    fn default() -> Self {
+        LagSettings {
+            lags: 15,
+            max_dist: None,
+            direction: None,
+            estimator: Estimator::Matheron,
+        }
+    }
+}
+
+/// One lag class of an experimental variogram.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Lag {
+    /// Lower class bound (inclusive).
+    pub lo: f64,
+    /// Upper class bound (exclusive).
+    pub hi: f64,
+    /// Mean distance of the pairs in the class.
+    pub distance: f64,
+    /// Semivariance.
+    pub gamma: f64,
+    /// Number of pairs.
+    pub pairs: u64,
+}
+
+/// The largest distance between two data points (convex hull, then all hull pairs).
+///
+/// ```
+/// let d = terramesh_geostat::diameter(&[[0.0, 0.0], [3.0, 0.0], [1.0, 1.0], [0.0, 4.0]]);
+/// assert_eq!(d, 5.0);
+/// ```
+pub fn diameter(xy: &[[f64; 2]]) -> f64 {
+    let mut p: Vec<[f64; 2]> = xy.to_vec();
+    p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    p.dedup();
+    if p.len() < 2 {
+        return 0.0;
+    }
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f64; 2]> = Vec::new();
+    for pass in 0..2 {
+        let start = hull.len();
+        let it: Box<dyn Iterator<Item = &[f64; 2]>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
+        for &q in it {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    let mut best: f64 = 0.0;
+    for (i, a) in hull.iter().enumerate() {
+        for b in &hull[i + 1..] {
+            best = best.max((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2));
+        }
+    }
+    best.sqrt()
+}
+
+/// Computes the experimental variogram; lag classes without pairs are left out.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{experimental, Data, Duplicates, LagSettings};
+/// let data = Data::new(vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], vec![0.0, 1.0, 3.0], Duplicates::Reject)?;
+/// let s = LagSettings { lags: 2, max_dist: Some(2.5), ..Default::default() };
+/// let v = experimental(&data, &s)?;
+/// assert_eq!(v[0].pairs, 2); // lags 1 and 1
+/// assert_eq!(v[0].gamma, (1.0 + 4.0) / 4.0);
+/// assert_eq!((v[1].pairs, v[1].gamma), (1, 4.5));
+/// # Ok(()) }
+/// ```
+pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
+    if s.lags == 0 {
+        return Err(bad("lags", 0.0, "must be at least 1"));
+    }
+    let max = match s.max_dist {
+        Some(m) if !(m.is_finite() && m > 0.0) => {
+            return Err(bad("max-dist", m, "must be finite and > 0"))
+        }
+        Some(m) => m,
+        None => 0.5 * diameter(data.xy()),
+    };
+    if !(max > 0.0) {
+        return Err(GeostatError::TooFewData {
+            n: data.len(),
+            needed: 2,
+            what: "an experimental variogram (at distinct locations)".into(),
+        });
+    }
+    let dir = match s.direction {
+        Some(d) => {
+            if !(d.tolerance > 0.0 && d.tolerance <= 90.0) {
+                return Err(bad("tolerance", d.tolerance, "must be in (0, 90] degrees"));
+            }
+            if !d.azimuth.is_finite() {
+                return Err(bad("azimuth", d.azimuth, "must be finite"));
+            }
+            Some((d.azimuth.rem_euclid(180.0), d.tolerance))
+        }
+        None => None,
+    };
+    let nl = s.lags;
+    let w = max / nl as f64;
+    let edges: Vec<f64> = (0..=nl)
+        .map(|k| if k == nl { max } else { k as f64 * w })
+        .collect();
+    let mut order: Vec<usize> = (0..data.len()).collect();
+    let xy = data.xy();
+    order.sort_by(|&a, &b| xy[a][0].total_cmp(&xy[b][0]));
+    let px: Vec<[f64; 2]> = order.iter().map(|&i| xy[i]).collect();
+    let pz: Vec<f64> = order.iter().map(|&i| data.z()[i]).collect();
+    let n = px.len();
+    let max2 = max * max;
+    // accumulators per lag: pairs, sum of distances, sum of squares/2, sum of |dz|^½
+    let acc = (0..n)
+        .into_par_iter()
+        .with_min_len(64)
+        .fold(
+            || vec![[0.0f64; 4]; nl],
+            |mut acc, i| {
+                let (pi, zi) = (px[i], pz[i]);
+                for j in i + 1..n {
+                    let dx = px[j][0] - pi[0];
+                    if dx >= max {
+                        break;
+                    }
+                    let dy = px[j][1] - pi[1];
+                    let d2 = dx * dx + dy * dy;
+                    if d2 >= max2 {
+                        continue;
+                    }
+                    if let Some((az, tol)) = dir {
+                        let a = dx.atan2(dy).to_degrees().rem_euclid(180.0);
+                        let diff = (a - az).abs();
+                        if diff.min(180.0 - diff) > tol {
+                            continue;
+                        }
+                    }
+                    let d = d2.sqrt();
+                    let mut b = ((d / w) as usize).min(nl - 1);
+                    if d < edges[b] {
+                        b -= 1;
+                    } else if d >= edges[b + 1] {
+                        b += 1;
+                        if b >= nl {
+                            continue;
+                        }
+                    }
+                    let dz = pz[j] - zi;
+                    let a = &mut acc[b];
+                    a[0] += 1.0;
+                    a[1] += d;
+                    a[2] += 0.5 * dz * dz;
+                    a[3] += dz.abs().sqrt();
+                }
+                acc
+            },
+        )
+        .reduce(
+            || vec![[0.0f64; 4]; nl],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(&b) {
+                    for t in 0..4 {
+                        x[t] += y[t];
+                    }
+                }
+                a
+            },
+        );
+    Ok(acc
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a[0] > 0.0)
+        .map(|(k, a)| {
+            let np = a[0];
+            let gamma = match s.estimator {
+                Estimator::Matheron => a[2] / np,
+                Estimator::CressieHawkins => {
+                    0.5 * (a[3] / np).powi(4) / (0.457 + 0.494 / np + 0.045 / (np * np))
+                }
+            };
+            Lag {
+                lo: edges[k],
+                hi: edges[k + 1],
+                distance: a[1] / np,
+                gamma,
+                pairs: np as u64,
+            }
+        })
+        .collect())
+}

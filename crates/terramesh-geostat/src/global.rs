@@ -1,0 +1,631 @@
+//! Global kriging: every target uses all the data; the system is factorised once.
+//!
+//! Three exact strategies, chosen from the variogram:
+//! - **band** (covariance with compact support, e.g. spherical, when the data are spread over
+//!   several ranges): data ordered in strips, banded Cholesky, the band of `K^{-1}` by
+//!   Takahashi's recurrence; each target touches only the data within one range
+//!   (`O(s²)` for `s` such data), so cost does not grow with `n` per target.
+//! - **dense** (other bounded models): dense Cholesky of the covariance matrix with faer;
+//!   targets in blocks of [`BLOCK`]: one triangular solve per block for the variances.
+//! - **gamma** (unbounded models: linear, power): PyKrige's bordered variogram system, LU.
+//!
+//! Estimates come from the dual form: `ẑ(x0) = k0ᵀ w + f0ᵀ v` with `[K F; Fᵀ 0][w; v] = [z; 0]`.
+//! Variances are PyKrige's `Σ λ γ + Lagrange terms`, which in covariance form is
+//! `C(0) − k0ᵀ K^{-1} k0 + (Fᵀ K^{-1} k0 − f0)ᵀ (Fᵀ K^{-1} F)^{-1} (Fᵀ K^{-1} k0 − f0)`.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::prelude::*;
+use faer::{Mat, MatMut, MatRef, Par};
+use rayon::prelude::*;
+
+use crate::band::Band;
+use crate::data::{Data, Method};
+use crate::error::{GeostatError, Result};
+use crate::model::Variogram;
+use crate::search::Tree;
+use crate::system::{dist, small_cholesky, small_quad, small_solve, Prepared, EXACT_EPS};
+
+/// Targets per block: bounds memory (`n x BLOCK` doubles) whatever the number of targets.
+pub const BLOCK: usize = 512;
+
+enum Solver {
+    Dense {
+        /// Column-major n x n, Cholesky factor in the lower triangle.
+        l: Vec<f64>,
+        /// `L^{-1} F`, column-major n x p.
+        g: Vec<f64>,
+    },
+    Band {
+        band: Band,
+        /// `K^{-1} F`, row-major n x p.
+        h: Vec<f64>,
+        support: f64,
+    },
+    Gamma {
+        lu: faer::linalg::solvers::PartialPivLu<f64>,
+    },
+}
+
+/// Kriging with all data, factorised once.
+pub struct GlobalKriging {
+    prep: Prepared,
+    /// `prep.pts[i]` is input point `perm[i]`.
+    perm: Vec<usize>,
+    tree: Tree,
+    solver: Solver,
+    sill: f64,
+    mean: f64,
+    /// Dual weights (length n) and drift coefficients (length p).
+    w: Vec<f64>,
+    v: Vec<f64>,
+    /// Lower Cholesky factor of `S = Fᵀ K^{-1} F` (p x p, row-major).
+    rs: Vec<f64>,
+    variance: bool,
+}
+
+impl GlobalKriging {
+    /// Factorises the kriging system for `data`.
+    ///
+    /// `variance = false` skips what only the variances need (the band of `K^{-1}`).
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{Data, Drift, Duplicates, GlobalKriging, Method, ModelKind, Variogram};
+    /// let xy = vec![[0.0, 0.0], [100.0, 0.0], [0.0, 100.0], [100.0, 100.0], [50.0, 40.0]];
+    /// let data = Data::new(xy, vec![10.0, 12.0, 11.0, 15.0, 12.5], Duplicates::Reject)?;
+    /// let v = Variogram::single(ModelKind::Spherical, 0.1, 4.0, 150.0)?;
+    /// let k = GlobalKriging::new(&data, &v, Method::Universal(Drift::Linear), true)?;
+    /// let (mut z, mut var) = (vec![0.0; 2], vec![0.0; 2]);
+    /// k.predict(&[[50.0, 40.0], [60.0, 70.0]], &mut z, Some(&mut var))?;
+    /// assert_eq!((z[0], var[0]), (12.5, 0.0)); // exact at data points
+    /// assert!(var[1] > 0.0);
+    /// # Ok(()) }
+    /// ```
+    pub fn new(data: &Data, variogram: &Variogram, method: Method, variance: bool) -> Result<Self> {
+        let mut prep = Prepared::new(data, variogram, method)?;
+        let n = prep.pts.len();
+        let p = prep.terms();
+        let mean = match method {
+            Method::Simple { mean } => mean,
+            _ => 0.0,
+        };
+        let sill = prep.variogram.sill();
+        let mut perm: Vec<usize> = (0..n).collect();
+        let band_support = match (sill, prep.variogram.compact_support()) {
+            (Some(_), Some(r)) => band_order(&prep.pts, r).map(|o| (r, o)),
+            _ => None,
+        };
+        if let Some((_, order)) = &band_support {
+            perm = order.clone();
+            prep.pts = perm.iter().map(|&i| prep.pts[i]).collect();
+            prep.z = perm.iter().map(|&i| prep.z[i]).collect();
+        }
+        let tree = Tree::new(&prep.pts)?;
+        let zc: Vec<f64> = prep.z.iter().map(|z| z - mean).collect();
+        let mut f = vec![0.0; n * p]; // row-major n x p
+        for i in 0..n {
+            prep.drift(prep.pts[i], &mut f[i * p..(i + 1) * p]);
+        }
+        let (solver, h, kz) = match (sill, band_support) {
+            (Some(s), Some((r, _))) => {
+                let (band, wband) = factor_band(&prep, &tree, s, r)?;
+                let mut band = band;
+                if variance {
+                    band.selected_inverse(wband);
+                }
+                let mut h = vec![0.0; n * p];
+                let mut col = vec![0.0; n];
+                for k in 0..p {
+                    (0..n).for_each(|i| col[i] = f[i * p + k]);
+                    band.solve(&mut col);
+                    (0..n).for_each(|i| h[i * p + k] = col[i]);
+                }
+                let mut kz = zc.clone();
+                band.solve(&mut kz);
+                (
+                    Solver::Band {
+                        band,
+                        h: h.clone(),
+                        support: r,
+                    },
+                    h,
+                    kz,
+                )
+            }
+            (Some(s), None) => {
+                let l = factor_dense(&prep, s)?;
+                let lm = MatRef::from_column_major_slice(&l, n, n);
+                let mut g: Vec<f64> = (0..p)
+                    .flat_map(|k| (0..n).map(move |i| (i, k)))
+                    .map(|(i, k)| f[i * p + k])
+                    .collect();
+                solve_lower_triangular_in_place(
+                    lm,
+                    MatMut::from_column_major_slice_mut(&mut g, n, p),
+                    par(),
+                );
+                let mut hcm = g.clone();
+                solve_upper_triangular_in_place(
+                    lm.transpose(),
+                    MatMut::from_column_major_slice_mut(&mut hcm, n, p),
+                    par(),
+                );
+                let mut h = vec![0.0; n * p];
+                for k in 0..p {
+                    for i in 0..n {
+                        h[i * p + k] = hcm[k * n + i];
+                    }
+                }
+                let mut kz = zc.clone();
+                {
+                    let mut m = MatMut::from_column_major_slice_mut(&mut kz, n, 1);
+                    solve_lower_triangular_in_place(lm, m.rb_mut(), par());
+                    solve_upper_triangular_in_place(lm.transpose(), m, par());
+                }
+                (Solver::Dense { l, g }, h, kz)
+            }
+            (None, _) => {
+                let lu = factor_gamma(&prep, &f)?;
+                let mut rhs = Mat::<f64>::zeros(n + p, 1);
+                for i in 0..n {
+                    rhs[(i, 0)] = prep.z[i];
+                }
+                lu.solve_in_place(rhs.as_mut());
+                let w: Vec<f64> = (0..n).map(|i| rhs[(i, 0)]).collect();
+                let v: Vec<f64> = (0..p).map(|k| rhs[(n + k, 0)]).collect();
+                check_finite(&w)?;
+                return Ok(GlobalKriging {
+                    prep,
+                    perm,
+                    tree,
+                    solver: Solver::Gamma { lu },
+                    sill: 0.0,
+                    mean,
+                    w,
+                    v,
+                    rs: Vec::new(),
+                    variance,
+                });
+            }
+        };
+        // S = Fᵀ K^{-1} F = Fᵀ H, its Cholesky, v = S^{-1} Hᵀ z, w = K^{-1} z − H v.
+        let mut s_mat = vec![0.0; p * p];
+        for a in 0..p {
+            for b in 0..p {
+                s_mat[a * p + b] = (0..n).map(|i| f[i * p + a] * h[i * p + b]).sum();
+            }
+        }
+        small_cholesky(&mut s_mat, p)?;
+        let mut v: Vec<f64> = (0..p)
+            .map(|k| (0..n).map(|i| h[i * p + k] * zc[i]).sum())
+            .collect();
+        small_solve(&s_mat, p, &mut v);
+        let w: Vec<f64> = (0..n)
+            .map(|i| kz[i] - (0..p).map(|k| h[i * p + k] * v[k]).sum::<f64>())
+            .collect();
+        check_finite(&w)?;
+        Ok(GlobalKriging {
+            prep,
+            perm,
+            tree,
+            solver,
+            sill: sill.unwrap_or(0.0),
+            mean,
+            w,
+            v,
+            rs: s_mat,
+            variance,
+        })
+    }
+
+    /// Which strategy was chosen: `"band"`, `"dense"` or `"gamma"`.
+    pub fn strategy(&self) -> &'static str {
+        match self.solver {
+            Solver::Dense { .. } => "dense",
+            Solver::Band { .. } => "band",
+            Solver::Gamma { .. } => "gamma",
+        }
+    }
+
+    /// Estimates (and variances if `var` is given) at `targets`, written to `est` / `var`.
+    ///
+    /// # Panics
+    /// If the output slices are not as long as `targets`, or variances are asked of an
+    /// object built with `variance = false` and a band strategy.
+    pub fn predict(
+        &self,
+        targets: &[[f64; 2]],
+        est: &mut [f64],
+        mut var: Option<&mut [f64]>,
+    ) -> Result<()> {
+        assert_eq!(est.len(), targets.len());
+        if let Some(v) = &var {
+            assert_eq!(v.len(), targets.len());
+            assert!(self.variance || !matches!(self.solver, Solver::Band { .. }));
+        }
+        for (b, chunk) in targets.chunks(BLOCK).enumerate() {
+            let r = b * BLOCK..b * BLOCK + chunk.len();
+            let vslice = var.as_deref_mut().map(|v| &mut v[r.clone()]);
+            self.predict_block(chunk, &mut est[r], vslice)?;
+        }
+        Ok(())
+    }
+
+    fn predict_block(
+        &self,
+        t: &[[f64; 2]],
+        est: &mut [f64],
+        mut var: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let q: Vec<[f64; 2]> = t.iter().map(|p| self.prep.map(*p)).collect();
+        let v = var.as_deref_mut();
+        match &self.solver {
+            Solver::Band { band, h, support } => self.block_band(band, h, *support, &q, est, v),
+            Solver::Dense { l, g } => self.block_dense(l, g, &q, est, v),
+            Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
+        }?;
+        // Exact at data points; variances are never negative.
+        for (i, p) in q.iter().enumerate() {
+            let (d2, k) = self.tree.nearest_one(*p);
+            let at_data = d2.sqrt() <= EXACT_EPS;
+            if at_data {
+                est[i] = self.prep.z[k];
+            }
+            if let Some(v) = var.as_deref_mut() {
+                if at_data || v[i] < 0.0 {
+                    v[i] = 0.0;
+                }
+            }
+        }
+        if let Some(v) = var {
+            check_finite(v)?;
+        }
+        check_finite(est)
+    }
+
+    fn block_band(
+        &self,
+        band: &Band,
+        h: &[f64],
+        r: f64,
+        q: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let p = self.prep.terms();
+        let want_var = var.is_some();
+        let res: Vec<Result<(f64, f64)>> = q
+            .par_iter()
+            .map_init(Vec::new, |near, &x0| {
+                self.tree.within(x0, r, near);
+                near.sort_unstable_by_key(|a| a.1);
+                let mut f0 = [0.0; 6];
+                self.prep.drift(x0, &mut f0[..p]);
+                let mut e = self.mean + (0..p).map(|k| f0[k] * self.v[k]).sum::<f64>();
+                let ks: Vec<f64> = near.iter().map(|&(d2, _)| self.cov(d2.sqrt())).collect();
+                for (&(_, i), k) in near.iter().zip(&ks) {
+                    e += k * self.w[i];
+                }
+                if !want_var {
+                    return Ok((e, 0.0));
+                }
+                let wb = band.inverse_band();
+                let mut q1 = 0.0;
+                for (a, &(_, ia)) in near.iter().enumerate() {
+                    let mut s = 0.5 * ks[a] * band.zij(ia, ia);
+                    for (b, &(_, ib)) in near.iter().enumerate().skip(a + 1) {
+                        if ib - ia > wb {
+                            return Err(GeostatError::Singular {
+                                why: format!("internal: data pair ({ia}, {ib}) outside the inverse band {wb}"),
+                            });
+                        }
+                        s += ks[b] * band.zij(ia, ib);
+                    }
+                    q1 += 2.0 * ks[a] * s;
+                }
+                let mut t = [0.0; 6];
+                for (&(_, i), k) in near.iter().zip(&ks) {
+                    for c in 0..p {
+                        t[c] += k * h[i * p + c];
+                    }
+                }
+                for c in 0..p {
+                    t[c] -= f0[c];
+                }
+                let v = self.sill - q1 + small_quad(&self.rs, p, &mut t[..p]);
+                Ok((e, v))
+            })
+            .collect();
+        let mut var = var;
+        for (i, r) in res.into_iter().enumerate() {
+            let (e, v) = r?;
+            est[i] = e;
+            if let Some(vv) = var.as_deref_mut() {
+                vv[i] = v;
+            }
+        }
+        Ok(())
+    }
+
+    fn block_dense(
+        &self,
+        l: &[f64],
+        g: &[f64],
+        q: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let n = self.prep.pts.len();
+        let p = self.prep.terms();
+        let m = q.len();
+        let mut b = vec![0.0; n * m];
+        b.par_chunks_mut(n).zip(q.par_iter()).for_each(|(col, &x0)| {
+            for (c, &xi) in col.iter_mut().zip(&self.prep.pts) {
+                *c = self.cov(dist(xi, x0));
+            }
+        });
+        let mut f0 = vec![0.0; 6 * m];
+        for (j, &x0) in q.iter().enumerate() {
+            self.prep.drift(x0, &mut f0[j * 6..j * 6 + p]);
+            est[j] = self.mean
+                + crate::band::dot(&b[j * n..(j + 1) * n], &self.w)
+                + (0..p).map(|k| f0[j * 6 + k] * self.v[k]).sum::<f64>();
+        }
+        let Some(var) = var else { return Ok(()) };
+        let lm = MatRef::from_column_major_slice(l, n, n);
+        solve_lower_triangular_in_place(lm, MatMut::from_column_major_slice_mut(&mut b, n, m), par());
+        var.par_iter_mut().enumerate().for_each(|(j, v)| {
+            let y = &b[j * n..(j + 1) * n];
+            let q1 = crate::band::dot(y, y);
+            let mut t = [0.0; 6];
+            for c in 0..p {
+                t[c] = crate::band::dot(&g[c * n..(c + 1) * n], y) - f0[j * 6 + c];
+            }
+            *v = self.sill - q1 + small_quad(&self.rs, p, &mut t[..p]);
+        });
+        Ok(())
+    }
+
+    fn block_gamma(
+        &self,
+        lu: &faer::linalg::solvers::PartialPivLu<f64>,
+        q: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let n = self.prep.pts.len();
+        let p = self.prep.terms();
+        let m = q.len();
+        let vg = &self.prep.variogram;
+        let rhs = Mat::<f64>::from_fn(n + p, m, |i, j| {
+            if i < n {
+                let d = dist(self.prep.pts[i], q[j]);
+                if d <= EXACT_EPS {
+                    0.0
+                } else {
+                    -vg.gamma(d)
+                }
+            } else {
+                let mut f0 = [0.0; 6];
+                self.prep.drift(q[j], &mut f0[..p]);
+                f0[i - n]
+            }
+        });
+        for j in 0..m {
+            est[j] = (0..n).map(|i| rhs[(i, j)] * self.w[i]).sum::<f64>()
+                + (0..p).map(|k| rhs[(n + k, j)] * self.v[k]).sum::<f64>();
+        }
+        if let Some(var) = var {
+            let mut x = rhs.clone();
+            lu.solve_in_place(x.as_mut());
+            for j in 0..m {
+                var[j] = -(0..n + p).map(|i| x[(i, j)] * rhs[(i, j)]).sum::<f64>();
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn cov(&self, d: f64) -> f64 {
+        if d <= 0.0 {
+            self.sill
+        } else {
+            self.sill - self.prep.variogram.gamma(d)
+        }
+    }
+
+    /// Leave-one-out errors `z_i − ẑ_{−i}` and kriging variances of the left-out predictions,
+    /// in input order, from one factorisation (Dubrule 1983: `e_i = w_i / B_ii`,
+    /// `σ²_i = 1 / B_ii` with `B` the data block of the inverse kriging matrix).
+    ///
+    /// Needs a bounded variogram (built with `variance = true` for the band strategy).
+    pub fn leave_one_out(&self) -> Result<(Vec<f64>, Vec<f64>)> {
+        let n = self.prep.pts.len();
+        let p = self.prep.terms();
+        let (diag, h): (Vec<f64>, Vec<f64>) = match &self.solver {
+            Solver::Band { band, h, .. } => {
+                if !self.variance {
+                    return Err(GeostatError::Singular {
+                        why: "leave-one-out needs the inverse band (build with variance)".into(),
+                    });
+                }
+                ((0..n).map(|i| band.zij(i, i)).collect(), h.clone())
+            }
+            Solver::Dense { l, g } => {
+                let lm = MatRef::from_column_major_slice(l, n, n);
+                let mut inv = Mat::<f64>::zeros(n, n);
+                faer::linalg::triangular_inverse::invert_lower_triangular(inv.as_mut(), lm, par());
+                let diag = (0..n)
+                    .into_par_iter()
+                    .map(|i| (i..n).map(|k| inv[(k, i)] * inv[(k, i)]).sum())
+                    .collect();
+                // H = L^{-T} G
+                let mut hcm = g.clone();
+                solve_upper_triangular_in_place(
+                    lm.transpose(),
+                    MatMut::from_column_major_slice_mut(&mut hcm, n, p),
+                    par(),
+                );
+                let mut h = vec![0.0; n * p];
+                for k in 0..p {
+                    for i in 0..n {
+                        h[i * p + k] = hcm[k * n + i];
+                    }
+                }
+                (diag, h)
+            }
+            Solver::Gamma { .. } => {
+                return Err(GeostatError::Unbounded {
+                    what: "fast leave-one-out",
+                    model: self.prep.variogram.unbounded_name().unwrap_or("unbounded"),
+                })
+            }
+        };
+        let mut err = vec![0.0; n];
+        let mut var = vec![0.0; n];
+        for i in 0..n {
+            let mut t = [0.0; 6];
+            t[..p].copy_from_slice(&h[i * p..(i + 1) * p]);
+            let bii = diag[i] - small_quad(&self.rs, p, &mut t[..p]);
+            err[self.perm[i]] = self.w[i] / bii;
+            var[self.perm[i]] = 1.0 / bii;
+        }
+        check_finite(&err)?;
+        Ok((err, var))
+    }
+}
+
+fn par() -> Par {
+    faer::get_global_parallelism()
+}
+
+fn check_finite(v: &[f64]) -> Result<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(GeostatError::Singular {
+            why: format!(
+                "the solution is not finite (at index {i}): the variogram makes the system numerically singular (e.g. a Gaussian model without nugget on close data)"
+            ),
+        }),
+    }
+}
+
+/// Strip order for a compact support `r`, or `None` when a band would not pay off.
+fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
+    let n = pts.len();
+    if n < 64 || r <= 0.0 {
+        return if r <= 0.0 && n > 0 { Some((0..n).collect()) } else { None };
+    }
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for p in pts {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    // Strips stacked along the longer side, each ordered along the shorter one.
+    let (long, short) = if hi[1] - lo[1] >= hi[0] - lo[0] { (1, 0) } else { (0, 1) };
+    let strips = ((hi[long] - lo[long]) / r).floor() as usize + 1;
+    if strips < 4 {
+        return None;
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    let key = |i: usize| ((pts[i][long] - lo[long]) / r).floor() as i64;
+    order.sort_by(|&a, &b| {
+        key(a)
+            .cmp(&key(b))
+            .then(pts[a][short].total_cmp(&pts[b][short]))
+            .then(a.cmp(&b))
+    });
+    Some(order)
+}
+
+/// Banded factor; returns it with the bandwidth the variances need.
+fn factor_band(prep: &Prepared, tree: &Tree, sill: f64, r: f64) -> Result<(Band, usize)> {
+    let n = prep.pts.len();
+    let (wl, w) = (0..n)
+        .into_par_iter()
+        .map_init(Vec::new, |near, i| {
+            let mut wl = 0usize;
+            let mut w = 0usize;
+            tree.within(prep.pts[i], 2.0 * r, near);
+            for &(d2, j) in near.iter() {
+                let d = i.abs_diff(j);
+                w = w.max(d);
+                if d2.sqrt() < r {
+                    wl = wl.max(d);
+                }
+            }
+            (wl, w)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    let vg = &prep.variogram;
+    let band = Band::factor(n, wl, |i, j| {
+        if i == j {
+            sill
+        } else {
+            let d = dist(prep.pts[i], prep.pts[j]);
+            if d >= r {
+                0.0
+            } else {
+                sill - vg.gamma(d)
+            }
+        }
+    })
+    .map_err(|i| not_pd(i))?;
+    Ok((band, w))
+}
+
+fn not_pd(i: usize) -> GeostatError {
+    GeostatError::Singular {
+        why: format!(
+            "the covariance matrix is not positive definite (pivot {i}): data points too close for the variogram, or a Gaussian model without nugget; add a small nugget"
+        ),
+    }
+}
+
+fn factor_dense(prep: &Prepared, sill: f64) -> Result<Vec<f64>> {
+    let n = prep.pts.len();
+    let vg = &prep.variogram;
+    let mut k = vec![0.0; n * n];
+    k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
+        for (i, c) in col.iter_mut().enumerate().skip(j) {
+            *c = if i == j {
+                sill
+            } else {
+                sill - vg.gamma(dist(prep.pts[i], prep.pts[j]))
+            };
+        }
+    });
+    let par = par();
+    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, Default::default()));
+    cholesky_in_place(
+        MatMut::from_column_major_slice_mut(&mut k, n, n),
+        Default::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .map_err(|e| match e {
+        faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => not_pd(index),
+    })?;
+    Ok(k)
+}
+
+fn factor_gamma(prep: &Prepared, f: &[f64]) -> Result<faer::linalg::solvers::PartialPivLu<f64>> {
+    let n = prep.pts.len();
+    let p = prep.terms();
+    let vg = &prep.variogram;
+    let a = Mat::<f64>::from_fn(n + p, n + p, |i, j| match (i < n, j < n) {
+        (true, true) if i == j => 0.0,
+        (true, true) => -vg.gamma(dist(prep.pts[i], prep.pts[j])),
+        (true, false) => f[i * p + (j - n)],
+        (false, true) => f[j * p + (i - n)],
+        (false, false) => 0.0,
+    });
+    Ok(a.partial_piv_lu())
+}

@@ -1,0 +1,242 @@
+//! Grid writers: ESRI ASCII (`.asc`) and GeoTIFF (`.tif`, baseline TIFF, float32, one strip,
+//! georeferenced by ModelPixelScale / ModelTiepoint and EPSG GeoKeys).
+//!
+//! A grid's values sit on its nodes (pixel-is-point): node (i, j) is at
+//! `(xmin + i·dx, ymax − j·dy)`, row 0 the northernmost, as DEMs such as SRTM are posted.
+
+use std::io::{self, Write};
+
+/// A regular grid of `nx x ny` nodes spanning `[xmin, xmax] x [ymin, ymax]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSpec {
+    /// West edge (first column of nodes).
+    pub xmin: f64,
+    /// South edge (last row of nodes).
+    pub ymin: f64,
+    /// East edge.
+    pub xmax: f64,
+    /// North edge.
+    pub ymax: f64,
+    /// Nodes per row (>= 2).
+    pub nx: usize,
+    /// Rows (>= 2).
+    pub ny: usize,
+}
+
+impl GridSpec {
+    /// Parses `xmin,ymin,xmax,ymax,nx,ny`.
+    ///
+    /// ```
+    /// use terramesh_io::grid_write::GridSpec;
+    /// let g: GridSpec = "0,0,100,50,11,6".parse().unwrap();
+    /// assert_eq!((g.dx(), g.dy()), (10.0, 10.0));
+    /// assert_eq!(g.node(1, 0), [10.0, 50.0]);
+    /// assert!("0,0,100,50,1,6".parse::<GridSpec>().is_err());
+    /// ```
+    pub fn parse_str(s: &str) -> Result<GridSpec, String> {
+        let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+        if parts.len() != 6 {
+            return Err(format!("'{s}': expected xmin,ymin,xmax,ymax,nx,ny (6 values)"));
+        }
+        let f = |i: usize, name: &str| -> Result<f64, String> {
+            match parts[i].parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(format!("{name} '{}' is not a finite number", parts[i])),
+            }
+        };
+        let n = |i: usize, name: &str| -> Result<usize, String> {
+            match parts[i].parse::<usize>() {
+                Ok(v) if v >= 2 => Ok(v),
+                _ => Err(format!("{name} '{}' must be an integer >= 2", parts[i])),
+            }
+        };
+        let g = GridSpec {
+            xmin: f(0, "xmin")?,
+            ymin: f(1, "ymin")?,
+            xmax: f(2, "xmax")?,
+            ymax: f(3, "ymax")?,
+            nx: n(4, "nx")?,
+            ny: n(5, "ny")?,
+        };
+        if !(g.xmax > g.xmin && g.ymax > g.ymin) {
+            return Err(format!("'{s}': needs xmax > xmin and ymax > ymin"));
+        }
+        Ok(g)
+    }
+
+    /// Node spacing in x.
+    pub fn dx(&self) -> f64 {
+        (self.xmax - self.xmin) / (self.nx - 1) as f64
+    }
+
+    /// Node spacing in y.
+    pub fn dy(&self) -> f64 {
+        (self.ymax - self.ymin) / (self.ny - 1) as f64
+    }
+
+    /// Coordinates of node (column `i`, row `j`), row 0 at `ymax`.
+    pub fn node(&self, i: usize, j: usize) -> [f64; 2] {
+        [
+            self.xmin + i as f64 * self.dx(),
+            self.ymax - j as f64 * self.dy(),
+        ]
+    }
+}
+
+impl std::str::FromStr for GridSpec {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        GridSpec::parse_str(s)
+    }
+}
+
+/// Writes an ESRI ASCII grid (`values` row-major, north row first). Node-centred header
+/// (`xllcenter`, `yllcenter`); unequal spacings use GDAL's `dx`/`dy` lines.
+///
+/// ```
+/// use terramesh_io::grid_write::{write_asc, GridSpec};
+/// let g: GridSpec = "0,0,2,1,3,2".parse().unwrap();
+/// let mut out = Vec::new();
+/// write_asc(&mut out, &g, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.5]).unwrap();
+/// let s = String::from_utf8(out).unwrap();
+/// assert!(s.starts_with("ncols 3\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n"));
+/// assert!(s.ends_with("1 2 3\n4 5 6.5\n"));
+/// ```
+pub fn write_asc<W: Write>(w: &mut W, g: &GridSpec, values: &[f64]) -> io::Result<()> {
+    assert_eq!(values.len(), g.nx * g.ny);
+    writeln!(w, "ncols {}\nnrows {}", g.nx, g.ny)?;
+    writeln!(w, "xllcenter {}\nyllcenter {}", g.xmin, g.ymin)?;
+    let (dx, dy) = (g.dx(), g.dy());
+    if (dx - dy).abs() <= 1e-9 * dx.abs() {
+        writeln!(w, "cellsize {dx}")?;
+    } else {
+        writeln!(w, "dx {dx}\ndy {dy}")?;
+    }
+    writeln!(w, "NODATA_value -9999")?;
+    for row in values.chunks(g.nx) {
+        for (i, v) in row.iter().enumerate() {
+            if i > 0 {
+                w.write_all(b" ")?;
+            }
+            crate::number::write_shortest(w, *v)?;
+        }
+        w.write_all(b"\n")?;
+    }
+    Ok(())
+}
+
+/// Writes a float32 GeoTIFF (little-endian baseline TIFF, one strip), pixel-is-point, with
+/// `ProjectedCSTypeGeoKey = epsg` when given (e.g. 32632 for UTM 32N).
+pub fn write_geotiff<W: Write>(w: &mut W, g: &GridSpec, values: &[f64], epsg: Option<u16>) -> io::Result<()> {
+    assert_eq!(values.len(), g.nx * g.ny);
+    let mut keys: Vec<u16> = vec![1, 1, 0, 0, 1024, 0, 1, 1, 1025, 0, 1, 2];
+    if let Some(e) = epsg {
+        keys.extend_from_slice(&[3072, 0, 1, e]);
+    }
+    keys[3] = (keys.len() / 4 - 1) as u16;
+    // (tag, type, count, payload bytes); type 3 SHORT, 4 LONG, 12 DOUBLE
+    let image_bytes = (values.len() * 4) as u32;
+    let mut entries: Vec<(u16, u16, u32, Vec<u8>)> = Vec::new();
+    let short = |v: u16| v.to_le_bytes().to_vec();
+    let long = |v: u32| v.to_le_bytes().to_vec();
+    let doubles = |v: &[f64]| v.iter().flat_map(|d| d.to_le_bytes()).collect::<Vec<u8>>();
+    entries.push((256, 4, 1, long(g.nx as u32)));
+    entries.push((257, 4, 1, long(g.ny as u32)));
+    entries.push((258, 3, 1, short(32)));
+    entries.push((259, 3, 1, short(1)));
+    entries.push((262, 3, 1, short(1)));
+    entries.push((273, 4, 1, long(0))); // patched below
+    entries.push((277, 3, 1, short(1)));
+    entries.push((278, 4, 1, long(g.ny as u32)));
+    entries.push((279, 4, 1, long(image_bytes)));
+    entries.push((284, 3, 1, short(1)));
+    entries.push((339, 3, 1, short(3)));
+    entries.push((33550, 12, 3, doubles(&[g.dx(), g.dy(), 0.0])));
+    entries.push((33922, 12, 6, doubles(&[0.0, 0.0, 0.0, g.xmin, g.ymax, 0.0])));
+    entries.push((34735, 3, keys.len() as u32, keys.iter().flat_map(|k| k.to_le_bytes()).collect()));
+    let ifd_len = 2 + 12 * entries.len() + 4;
+    let mut extra_off = 8 + ifd_len;
+    let mut extra: Vec<u8> = Vec::new();
+    let mut ifd: Vec<u8> = Vec::new();
+    ifd.extend_from_slice(&(entries.len() as u16).to_le_bytes());
+    let mut offsets = Vec::new();
+    for (tag, typ, count, payload) in &entries {
+        ifd.extend_from_slice(&tag.to_le_bytes());
+        ifd.extend_from_slice(&typ.to_le_bytes());
+        ifd.extend_from_slice(&count.to_le_bytes());
+        if payload.len() <= 4 {
+            let mut p = payload.clone();
+            p.resize(4, 0);
+            if *tag == 273 {
+                offsets.push(ifd.len());
+            }
+            ifd.extend_from_slice(&p);
+        } else {
+            ifd.extend_from_slice(&(extra_off as u32).to_le_bytes());
+            extra.extend_from_slice(payload);
+            extra_off += payload.len();
+            if extra_off % 2 == 1 {
+                extra.push(0);
+                extra_off += 1;
+            }
+        }
+    }
+    ifd.extend_from_slice(&0u32.to_le_bytes());
+    let data_off = extra_off as u32;
+    for o in offsets {
+        ifd[o..o + 4].copy_from_slice(&data_off.to_le_bytes());
+    }
+    w.write_all(b"II*\0")?;
+    w.write_all(&8u32.to_le_bytes())?;
+    w.write_all(&ifd)?;
+    w.write_all(&extra)?;
+    let mut buf = Vec::with_capacity(values.len() * 4);
+    for v in values {
+        buf.extend_from_slice(&(*v as f32).to_le_bytes());
+    }
+    w.write_all(&buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn u16_at(b: &[u8], o: usize) -> u16 {
+        u16::from_le_bytes([b[o], b[o + 1]])
+    }
+    fn u32_at(b: &[u8], o: usize) -> u32 {
+        u32::from_le_bytes(b[o..o + 4].try_into().unwrap())
+    }
+
+    #[test]
+    fn geotiff_structure_reads_back() {
+        let g: GridSpec = "500000,5400000,500300,5400200,4,3".parse().unwrap();
+        let vals: Vec<f64> = (0..12).map(|i| i as f64 * 1.5).collect();
+        let mut b = Vec::new();
+        write_geotiff(&mut b, &g, &vals, Some(32632)).unwrap();
+        assert_eq!(&b[..4], b"II*\0");
+        let ifd = u32_at(&b, 4) as usize;
+        let n = u16_at(&b, ifd) as usize;
+        let mut tags = std::collections::HashMap::new();
+        for k in 0..n {
+            let e = ifd + 2 + 12 * k;
+            tags.insert(u16_at(&b, e), (u16_at(&b, e + 2), u32_at(&b, e + 4), e + 8));
+        }
+        let val = |t: u16| u32_at(&b, tags[&t].2);
+        assert_eq!((val(256), val(257)), (4, 3));
+        let off = val(273) as usize;
+        let px: Vec<f32> = (0..12)
+            .map(|i| f32::from_le_bytes(b[off + 4 * i..off + 4 * i + 4].try_into().unwrap()))
+            .collect();
+        assert_eq!(px[11], 16.5);
+        // GeoKeys end with ProjectedCSTypeGeoKey = 32632
+        let (_, count, e) = tags[&34735];
+        let ko = u32_at(&b, e) as usize;
+        assert_eq!(u16_at(&b, ko + 2 * (count as usize - 1)), 32632);
+        // tiepoint x, y
+        let to = u32_at(&b, tags[&33922].2) as usize;
+        let x = f64::from_le_bytes(b[to + 24..to + 32].try_into().unwrap());
+        let y = f64::from_le_bytes(b[to + 32..to + 40].try_into().unwrap());
+        assert_eq!((x, y), (500000.0, 5400200.0));
+    }
+}
