@@ -15,3 +15,4 @@
 
 pub mod coords;
 pub mod geometry;
+pub mod sampling;
