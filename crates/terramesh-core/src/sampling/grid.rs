@@ -147,13 +147,21 @@ mod tests {
     use super::*;
 
     fn rect() -> Region {
-        Region::from_ring(vec![[100.0, 200.0], [150.0, 200.0], [150.0, 300.0], [100.0, 300.0]])
+        Region::from_ring(vec![
+            [100.0, 200.0],
+            [150.0, 200.0],
+            [150.0, 300.0],
+            [100.0, 300.0],
+        ])
     }
 
     #[test]
     fn rows_cols_span_the_enlarged_box_exactly() {
         let spec = GridSpec {
-            size: GridSize::RowsCols { rows: 100, cols: 50 },
+            size: GridSize::RowsCols {
+                rows: 100,
+                cols: 50,
+            },
             margin: Margin::Fraction(0.1),
             clip: false,
         };
@@ -175,18 +183,38 @@ mod tests {
         };
         let g = spec.build(&rect()).unwrap();
         assert!(g.nodes.iter().all(|p| rect().contains(*p)));
-        let all = GridSpec { clip: false, ..spec }.build(&rect()).unwrap();
+        let all = GridSpec {
+            clip: false,
+            ..spec
+        }
+        .build(&rect())
+        .unwrap();
         // 90 x 140 box at 5: 19 x 29 nodes; inside 100..150 x 200..300: 11 x 21 (boundary nodes
         // count when contains() says so, so allow the edge rows either way)
         assert_eq!((all.rows, all.cols), (29, 19));
-        assert!(g.nodes.len() >= 9 * 19 && g.nodes.len() <= 11 * 21, "{}", g.nodes.len());
+        assert!(
+            g.nodes.len() >= 9 * 19 && g.nodes.len() <= 11 * 21,
+            "{}",
+            g.nodes.len()
+        );
     }
 
     #[test]
     fn bad_requests_are_errors() {
         let r = rect();
-        let mk = |size, margin| GridSpec { size, margin, clip: false }.build(&r);
-        assert!(mk(GridSize::RowsCols { rows: 1, cols: 5 }, Margin::Fraction(0.0)).is_err());
+        let mk = |size, margin| {
+            GridSpec {
+                size,
+                margin,
+                clip: false,
+            }
+            .build(&r)
+        };
+        assert!(mk(
+            GridSize::RowsCols { rows: 1, cols: 5 },
+            Margin::Fraction(0.0)
+        )
+        .is_err());
         assert!(mk(GridSize::Spacing(0.0), Margin::Fraction(0.0)).is_err());
         assert!(mk(GridSize::Spacing(1.0), Margin::Fraction(-0.1)).is_err());
         assert!(mk(GridSize::Spacing(1e-6), Margin::Fraction(0.0)).is_err());

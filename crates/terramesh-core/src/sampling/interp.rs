@@ -211,13 +211,19 @@ mod tests {
 
     fn hash(r: i64, c: i64) -> f64 {
         // Deterministic irregular values.
-        let h = (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (c as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+        let h = (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (c as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
         (h >> 40) as f64 / 1000.0
     }
 
     #[test]
     fn every_method_is_exact_at_every_post() {
-        let g = G { rows: 6, cols: 5, f: hash, voids: vec![(2, 2)] };
+        let g = G {
+            rows: 6,
+            cols: 5,
+            f: hash,
+            voids: vec![(2, 2)],
+        };
         for m in [Method::Nearest, Method::Bilinear, Method::Bicubic] {
             for r in 0..6 {
                 for c in 0..5 {
@@ -235,12 +241,20 @@ mod tests {
     #[test]
     fn bilinear_and_bicubic_reproduce_planes() {
         let plane = |r: i64, c: i64| 3.0 * r as f64 - 2.0 * c as f64 + 100.0;
-        let g = G { rows: 8, cols: 8, f: plane, voids: vec![] };
+        let g = G {
+            rows: 8,
+            cols: 8,
+            f: plane,
+            voids: vec![],
+        };
         for &(r, c) in &[(0.3, 0.7), (3.5, 4.25), (6.9, 6.1), (1.0, 5.5)] {
             let want = 3.0 * r - 2.0 * c + 100.0;
             for m in [Method::Bilinear, Method::Bicubic] {
                 let got = interpolate(&g, r, c, m).unwrap();
-                assert!((got - want).abs() < 1e-12, "{m} at {r},{c}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 1e-12,
+                    "{m} at {r},{c}: {got} vs {want}"
+                );
             }
         }
     }
@@ -248,7 +262,12 @@ mod tests {
     #[test]
     fn bicubic_reproduces_quadratics_inside() {
         let q = |r: i64, c: i64| (r * r) as f64 + 0.5 * (c * c) as f64 - (r * c) as f64;
-        let g = G { rows: 8, cols: 8, f: q, voids: vec![] };
+        let g = G {
+            rows: 8,
+            cols: 8,
+            f: q,
+            voids: vec![],
+        };
         let (r, c) = (3.3, 4.6);
         let want = r * r + 0.5 * c * c - r * c;
         let got = interpolate(&g, r, c, Method::Bicubic).unwrap();
@@ -257,12 +276,29 @@ mod tests {
 
     #[test]
     fn voids_and_edges_are_reported() {
-        let g = G { rows: 4, cols: 4, f: hash, voids: vec![(1, 1)] };
-        assert_eq!(interpolate(&g, 0.5, 0.5, Method::Bilinear), Err(Missing::Void));
-        assert_eq!(interpolate(&g, 3.5, 0.5, Method::Bilinear), Err(Missing::Outside));
+        let g = G {
+            rows: 4,
+            cols: 4,
+            f: hash,
+            voids: vec![(1, 1)],
+        };
+        assert_eq!(
+            interpolate(&g, 0.5, 0.5, Method::Bilinear),
+            Err(Missing::Void)
+        );
+        assert_eq!(
+            interpolate(&g, 3.5, 0.5, Method::Bilinear),
+            Err(Missing::Outside)
+        );
         assert_eq!(interpolate(&g, -0.1, 0.5, Method::Nearest), Ok(hash(0, 1)));
-        assert_eq!(interpolate(&g, -0.6, 0.5, Method::Nearest), Err(Missing::Outside));
-        assert_eq!(interpolate(&g, f64::NAN, 0.5, Method::Bilinear), Err(Missing::Outside));
+        assert_eq!(
+            interpolate(&g, -0.6, 0.5, Method::Nearest),
+            Err(Missing::Outside)
+        );
+        assert_eq!(
+            interpolate(&g, f64::NAN, 0.5, Method::Bilinear),
+            Err(Missing::Outside)
+        );
         // bicubic falls back to bilinear at the edge, where the 4 x 4 stencil is incomplete
         let b = interpolate(&g, 0.5, 2.5, Method::Bicubic).unwrap();
         assert_eq!(b, interpolate(&g, 0.5, 2.5, Method::Bilinear).unwrap());

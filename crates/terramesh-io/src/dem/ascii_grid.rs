@@ -44,7 +44,10 @@ pub fn read_ascii_grid(path: &Path) -> Result<Raster, DemError> {
             if num >= 1.0 && num.fract() == 0.0 {
                 Ok(num as usize)
             } else {
-                Err(fmt(i + 1, format!("'{k}' must be a positive integer, got '{v}'")))
+                Err(fmt(
+                    i + 1,
+                    format!("'{k}' must be a positive integer, got '{v}'"),
+                ))
             }
         };
         match k.to_ascii_lowercase().as_str() {
@@ -135,7 +138,10 @@ fn crs_of(path: &Path, t: &GeoTransform, rows: usize, cols: usize) -> Result<Sou
             )
         });
     }
-    let (x1, y1) = (t.x0 + (cols - 1) as f64 * t.dx, t.y0 + (rows - 1) as f64 * t.dy);
+    let (x1, y1) = (
+        t.x0 + (cols - 1) as f64 * t.dx,
+        t.y0 + (rows - 1) as f64 * t.dy,
+    );
     if t.x0 >= -180.0 && x1 <= 180.0 && y1 >= -90.0 && t.y0 <= 90.0 {
         Ok(SourceCrs::Geographic)
     } else {

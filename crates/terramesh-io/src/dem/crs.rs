@@ -31,8 +31,12 @@ impl SourceCrs {
     pub fn from_epsg(code: u32) -> Option<SourceCrs> {
         match code {
             4326 => Some(SourceCrs::Geographic),
-            32601..=32660 => Zone::new((code - 32600) as u8, true).ok().map(SourceCrs::Utm),
-            32701..=32760 => Zone::new((code - 32700) as u8, false).ok().map(SourceCrs::Utm),
+            32601..=32660 => Zone::new((code - 32600) as u8, true)
+                .ok()
+                .map(SourceCrs::Utm),
+            32701..=32760 => Zone::new((code - 32700) as u8, false)
+                .ok()
+                .map(SourceCrs::Utm),
             _ => None,
         }
     }
@@ -100,7 +104,11 @@ pub(crate) fn from_wkt(wkt: &str) -> Option<SourceCrs> {
     }
     // WGS 84 / UTM zone 32N, WGS_1984_UTM_Zone_32N
     if upper.contains("WGS") && upper.contains("84") {
-        if let Some(p) = upper.find("UTM ZONE ").map(|p| p + 9).or_else(|| upper.find("UTM_ZONE_").map(|p| p + 9)) {
+        if let Some(p) = upper
+            .find("UTM ZONE ")
+            .map(|p| p + 9)
+            .or_else(|| upper.find("UTM_ZONE_").map(|p| p + 9))
+        {
             let rest = &upper[p..];
             let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
             let hemi = rest[digits.len()..].chars().next();
@@ -116,5 +124,12 @@ pub(crate) fn from_wkt(wkt: &str) -> Option<SourceCrs> {
         .nth(1)
         .unwrap_or("an unnamed projected CRS")
         .to_string();
-    Some(SourceCrs::Projected { name })
+    // The last UNIT of a projected WKT is its linear unit.
+    let unit = t
+        .rfind("UNIT[\"")
+        .and_then(|p| t[p + 6..].split('"').next())
+        .unwrap_or("unknown");
+    Some(SourceCrs::Projected {
+        name: format!("{name}, units: {unit}"),
+    })
 }

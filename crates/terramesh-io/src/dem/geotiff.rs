@@ -71,9 +71,10 @@ pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
         Some(v) => {
             let s = v.into_string().map_err(terr)?;
             let t = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
-            Some(t.parse::<f64>().map_err(|_| {
-                fmt(format!("GDAL_NODATA tag '{t}' is not a number"))
-            })?)
+            Some(
+                t.parse::<f64>()
+                    .map_err(|_| fmt(format!("GDAL_NODATA tag '{t}' is not a number")))?,
+            )
         }
         None => None,
     };
@@ -201,8 +202,7 @@ fn transform_of<R: std::io::Read + std::io::Seek>(
     } else {
         let scale = f64s(dec, Tag::ModelPixelScaleTag)?
             .ok_or_else(|| bad("no ModelPixelScale or ModelTransformation tag"))?;
-        let tie = f64s(dec, Tag::ModelTiepointTag)?
-            .ok_or_else(|| bad("no ModelTiepoint tag"))?;
+        let tie = f64s(dec, Tag::ModelTiepointTag)?.ok_or_else(|| bad("no ModelTiepoint tag"))?;
         if scale.len() < 2 || tie.len() < 6 {
             return Err(bad("short ModelPixelScale or ModelTiepoint tag"));
         }

@@ -63,7 +63,11 @@ pub fn read_points(
         let p = [t.number(r, xc)?, t.number(r, yc)?, t.number(r, z)?];
         if crs == SourceCrs::Geographic && (p[0].abs() > 180.0 || p[1].abs() > 90.0) {
             return Err(t
-                .bad_value(r, if p[0].abs() > 180.0 { xc } else { yc }, "is not a longitude/latitude in degrees")
+                .bad_value(
+                    r,
+                    if p[0].abs() > 180.0 { xc } else { yc },
+                    "is not a longitude/latitude in degrees",
+                )
                 .into());
         }
         xyz.push(p);

@@ -102,12 +102,7 @@ impl ElevationSource for Raster {
     fn describe(&self) -> String {
         format!(
             "{}: {} x {} posts, step {} x {}, {}",
-            self.name,
-            self.rows,
-            self.cols,
-            self.transform.dx,
-            -self.transform.dy,
-            self.crs
+            self.name, self.rows, self.cols, self.transform.dx, -self.transform.dy, self.crs
         )
     }
 }

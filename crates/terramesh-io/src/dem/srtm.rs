@@ -67,7 +67,12 @@ pub struct HgtMosaic {
 
 /// Parses `N48E007` (case-insensitive, any extension) to `(48, 7)`.
 fn parse_name(path: &Path) -> Option<(i32, i32)> {
-    let stem = path.file_name()?.to_str()?.split('.').next()?.to_ascii_uppercase();
+    let stem = path
+        .file_name()?
+        .to_str()?
+        .split('.')
+        .next()?
+        .to_ascii_uppercase();
     let b = stem.as_bytes();
     if b.len() != 7 {
         return None;
@@ -101,10 +106,7 @@ impl HgtMosaic {
         let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
             .map_err(|e| DemError::io(dir, e))?
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                p.extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("hgt"))
-            })
+            .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("hgt")))
             .collect();
         files.sort();
         if files.is_empty() {

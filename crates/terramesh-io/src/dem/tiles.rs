@@ -121,7 +121,10 @@ pub(crate) fn read_tile_file(path: &Path) -> Result<TileMosaic, DemError> {
         ));
     };
     if z > 24 || x >= 1 << z || y >= 1 << z {
-        return Err(DemError::format(path, format!("tile {z}/{x}/{y} does not exist")));
+        return Err(DemError::format(
+            path,
+            format!("tile {z}/{x}/{y} does not exist"),
+        ));
     }
     let mut m = TileMosaic::new(z as u8, &path.display().to_string());
     m.insert(x, y, &bytes)
