@@ -12,6 +12,7 @@ mod geotiff;
 mod las;
 mod points;
 mod raster;
+mod sample;
 mod srtm;
 mod tiles;
 
@@ -22,6 +23,7 @@ pub use geotiff::read_geotiff;
 pub use las::{read_las, LasOptions};
 pub use points::{read_points, PointCloud};
 pub use raster::{GeoTransform, Raster};
+pub use sample::{sample_latlon, sample_nodes, sample_utm};
 pub use srtm::{HgtMosaic, HGT_VOID};
 pub use tiles::{terrarium_decode, TileMosaic};
 
