@@ -24,12 +24,16 @@ struct Cli {
 enum Command {
     /// Convert coordinates between WGS-84 latitude/longitude and UTM.
     Convert(cmd::convert::Args),
+    /// Sample terrain elevations over a region from DEM files, point clouds, terrain tiles or
+    /// elevation web services.
+    Sample(Box<cmd::sample::Args>),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Sample(args) => cmd::sample::run(*args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

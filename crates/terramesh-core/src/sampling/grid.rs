@@ -24,6 +24,34 @@ pub enum Margin {
     Fraction(f64),
     /// A distance in the grid's units.
     Absolute(f64),
+    /// Distances `[along x, along y]` in the grid's units (a metre margin on a degree grid).
+    PerAxis([f64; 2]),
+}
+
+impl Margin {
+    /// The enlarged bounding box `(lo, hi)` of a box.
+    ///
+    /// ```
+    /// use terramesh_core::sampling::Margin;
+    /// let (lo, hi) = Margin::Fraction(0.1).enlarge([0.0, 0.0], [10.0, 20.0]).unwrap();
+    /// assert_eq!((lo, hi), ([-1.0, -2.0], [11.0, 22.0]));
+    /// ```
+    pub fn enlarge(&self, lo: [f64; 2], hi: [f64; 2]) -> Result<([f64; 2], [f64; 2]), GridError> {
+        let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
+        let (mx, my) = match *self {
+            Margin::Fraction(f) if f.is_finite() && f >= 0.0 => (f * w, f * h),
+            Margin::Absolute(d) if d.is_finite() && d >= 0.0 => (d, d),
+            Margin::PerAxis([x, y]) if x.is_finite() && y.is_finite() && x >= 0.0 && y >= 0.0 => {
+                (x, y)
+            }
+            m => {
+                return Err(GridError::Invalid(format!(
+                    "margin {m:?} must be finite and not negative"
+                )))
+            }
+        };
+        Ok(([lo[0] - mx, lo[1] - my], [hi[0] + mx, hi[1] + my]))
+    }
 }
 
 /// A sample grid request.
@@ -82,13 +110,9 @@ impl GridSpec {
         if !(w > 0.0 && h > 0.0) {
             return Err(bad("the region has zero width or height".into()));
         }
-        let (mx, my) = match self.margin {
-            Margin::Fraction(f) if f.is_finite() && f >= 0.0 => (f * w, f * h),
-            Margin::Absolute(d) if d.is_finite() && d >= 0.0 => (d, d),
-            m => return Err(bad(format!("margin {m:?} must be finite and not negative"))),
-        };
-        let (x0, y0) = (lo[0] - mx, lo[1] - my);
-        let (w, h) = (w + 2.0 * mx, h + 2.0 * my);
+        let (lo, hi) = self.margin.enlarge(lo, hi)?;
+        let (x0, y0) = (lo[0], lo[1]);
+        let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         let (rows, cols, dx, dy) = match self.size {
             GridSize::RowsCols { rows, cols } => {
                 if rows < 2 || cols < 2 {

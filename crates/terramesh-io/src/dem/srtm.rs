@@ -117,7 +117,7 @@ impl HgtMosaic {
         }
         let refs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
         let mut m = HgtMosaic::open_files(&refs, fill_voids)?;
-        m.name = format!("{} ({} tiles)", dir.display(), files.len());
+        m.name = dir.display().to_string();
         Ok(m)
     }
 
