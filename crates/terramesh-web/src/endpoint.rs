@@ -148,7 +148,7 @@ impl Endpoint {
         &self,
         agent: &ureq::Agent,
         points: &[[f64; 2]],
-    ) -> Result<ureq::Response, ureq::Error> {
+    ) -> Result<ureq::Response, Box<ureq::Error>> {
         match self.kind {
             ServiceKind::Google | ServiceKind::OpenTopoData => {
                 let mut locs = String::with_capacity(points.len() * 26);
@@ -162,7 +162,7 @@ impl Endpoint {
                 if let Some(k) = &self.key {
                     req = req.query("key", k);
                 }
-                req.call()
+                req.call().map_err(Box::new)
             }
             ServiceKind::OpenElevation => {
                 let locs: Vec<String> = points
@@ -173,6 +173,7 @@ impl Endpoint {
                     .post(&self.base_url)
                     .set("Content-Type", "application/json")
                     .send_string(&format!("{{\"locations\":[{}]}}", locs.join(",")))
+                    .map_err(Box::new)
             }
         }
     }

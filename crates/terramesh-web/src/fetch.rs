@@ -86,6 +86,9 @@ pub struct FetchStats {
     pub retries: usize,
 }
 
+/// A batch's index and its elevations (or why it has none).
+type BatchOutcome = (usize, Result<Vec<Option<f64>>, PointError>);
+
 /// Spaces requests `1/rate` seconds apart.
 struct RateLimit {
     step: Option<Duration>,
@@ -216,7 +219,7 @@ pub fn fetch(
         *mult.entry(key(*p)).or_default() += 1;
     }
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(usize, Result<Vec<Option<f64>>, PointError>)>> = Mutex::new(Vec::new());
+    let results: Mutex<Vec<BatchOutcome>> = Mutex::new(Vec::new());
     let fatal: Mutex<Option<WebError>> = Mutex::new(None);
     let requests = AtomicUsize::new(0);
     let retries = AtomicUsize::new(0);
@@ -241,7 +244,7 @@ pub fn fetch(
                     rate.wait();
                     requests.fetch_add(1, Ordering::Relaxed);
                     let mut retry_after = None;
-                    match endpoint.send(&agent, pts) {
+                    match endpoint.send(&agent, pts).map_err(|e| *e) {
                         Ok(resp) => match resp.into_string() {
                             Ok(body) => match endpoint.parse_reply(&body, pts) {
                                 Ok(z) => {

@@ -94,6 +94,35 @@ impl TileMosaic {
         (x, y)
     }
 
+    /// The tiles holding the 4 x 4 pixels around a point (what bicubic reads; bilinear and
+    /// nearest read a subset): one tile inside a tile, up to four near its edges.
+    ///
+    /// ```
+    /// let m = terramesh_io::dem::TileMosaic::new(11, "tiles");
+    /// assert_eq!(m.tiles_around(-112.2, 36.1), vec![(385, 803)]);
+    /// ```
+    pub fn tiles_around(&self, lon: f64, lat: f64) -> Vec<(u32, u32)> {
+        let (x, y) = self.pixel(lon, lat);
+        let n = (1i64 << self.z) * SIDE as i64;
+        let side = SIDE as i64;
+        let span = |v: f64| {
+            let c = (v - 0.5).floor() as i64;
+            (
+                (c - 1).clamp(0, n - 1) / side,
+                (c + 2).clamp(0, n - 1) / side,
+            )
+        };
+        let (x0, x1) = span(x);
+        let (y0, y1) = span(y);
+        let mut out = Vec::new();
+        for ty in y0..=y1 {
+            for tx in x0..=x1 {
+                out.push((tx as u32, ty as u32));
+            }
+        }
+        out
+    }
+
     /// The tile `(x, y)` containing a point.
     pub fn tile_of(&self, lon: f64, lat: f64) -> (u32, u32) {
         let (x, y) = self.pixel(lon, lat);
@@ -110,7 +139,7 @@ pub(crate) fn read_tile_file(path: &Path) -> Result<TileMosaic, DemError> {
     let bytes = std::fs::read(path).map_err(|e| DemError::io(path, e))?;
     let s = path.with_extension("").display().to_string();
     let nums: Vec<u32> = s
-        .rsplit(|c: char| c == '_' || c == '/' || c == '\\')
+        .rsplit(['_', '/', '\\'])
         .take(3)
         .map_while(|t| t.parse().ok())
         .collect();

@@ -55,19 +55,9 @@ pub fn sample_tiles(s: &Settings, template: &str) -> Result<Samples> {
     let mut need = BTreeSet::new();
     for n in &nodes {
         if let Some([lat, lon]) = n.latlon {
-            let (x, y) = m.tile_of(lon, lat);
-            // The neighbours too, for interpolation across tile edges.
-            for dx in -1i64..=1 {
-                for dy in -1i64..=1 {
-                    let (tx, ty) = (x as i64 + dx, y as i64 + dy);
-                    if tx >= 0 && ty >= 0 && tx < 1 << z && ty < 1 << z {
-                        need.insert((tx as u32, ty as u32));
-                    }
-                }
-            }
+            need.extend(m.tiles_around(lon, lat));
         }
     }
-    // Only the neighbours that a node is near matter; keep the request bounded.
     let need: Vec<(u32, u32)> = need.into_iter().collect();
     if need.len() > 4096 {
         anyhow::bail!("{} tiles at zoom {z}: use a lower --zoom", need.len());
@@ -86,13 +76,16 @@ pub fn sample_tiles(s: &Settings, template: &str) -> Result<Samples> {
     sample(s, &m, nodes)
 }
 
+/// A tile's `(x, y)` and PNG bytes.
+type FetchedTile = ((u32, u32), Vec<u8>);
+
 /// Fetches tiles; a neighbour that does not exist (404) is left out rather than failing.
 fn fetch_tiles_tolerant(
     template: &str,
     z: u8,
     need: &[(u32, u32)],
     opts: &TileOptions,
-) -> Result<Vec<((u32, u32), Vec<u8>)>> {
+) -> Result<Vec<FetchedTile>> {
     let mut out = Vec::with_capacity(need.len());
     for &t in need {
         match fetch_tiles(template, z, &[t], opts) {
