@@ -300,3 +300,73 @@ fn davis_csv_reads_52_points_with_r_style_header() {
     let mean = pc.xyz.iter().map(|p| p[2]).sum::<f64>() / 52.0;
     assert!((mean - 827.08).abs() < 0.01, "{mean}"); // data README: mean 827.08 ft
 }
+
+#[test]
+fn ascii_grid_crs_comes_from_its_prj_or_its_extent() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = "ncols 2\nnrows 2\nxllcorner 377000\nyllcorner 5397000\ncellsize 30\n1 2\n3 4\n";
+    let p = dir.path().join("utm.asc");
+    std::fs::write(&p, grid).unwrap();
+    let e = read_ascii_grid(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("utm.asc") && e.contains("unknown CRS") && e.contains(".prj"),
+        "{e}"
+    );
+    std::fs::write(
+        dir.path().join("utm.prj"),
+        r#"PROJCS["WGS_1984_UTM_Zone_32N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],UNIT["Meter",1]]"#,
+    )
+    .unwrap();
+    let r = read_ascii_grid(&p).unwrap();
+    assert_eq!(r.crs, SourceCrs::from_epsg(32632).unwrap());
+    // post (0, 0) is the centre of the north-west cell; the south-east post holds 4
+    assert_eq!(r.sample(377015.0, 5397045.0, Method::Nearest), Ok(1.0));
+    assert_eq!(r.sample(377045.0, 5397015.0, Method::Bilinear), Ok(4.0));
+    assert_eq!(r.sample(377030.0, 5397030.0, Method::Bilinear), Ok(2.5));
+    // a short grid names the line and the count
+    std::fs::write(
+        &p,
+        "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n",
+    )
+    .unwrap();
+    let e = read_ascii_grid(&p).unwrap_err().to_string();
+    assert!(e.contains("line 7") && e.contains("found 3 values"), "{e}");
+}
+
+#[test]
+fn utm_geotiff_is_sampled_from_latlon_in_any_zone() {
+    use terramesh_core::coords::{to_utm, to_wgs84};
+    use terramesh_io::dem::{sample_latlon, sample_utm};
+    let dem = open_raster(&fixture("synth-utm32-point.tif"), false).unwrap();
+    let zone = "32N".parse().unwrap();
+    // interior UTM points, sampled directly and through lat/lon and through zone 31N
+    let pts: Vec<[f64; 2]> = (0..50)
+        .map(|i| [377650.0 + 9.7 * i as f64, 5398300.0 + 11.3 * i as f64])
+        .collect();
+    let direct: Vec<_> = pts
+        .iter()
+        .map(|p| dem.sample(p[0], p[1], Method::Bilinear).unwrap())
+        .collect();
+    let latlon: Vec<[f64; 2]> = pts
+        .iter()
+        .map(|p| {
+            let (a, b) = to_wgs84(p[0], p[1], zone).unwrap();
+            [a, b]
+        })
+        .collect();
+    let via_latlon = sample_latlon(dem.as_ref(), &latlon, Method::Bilinear).unwrap();
+    let z31 = "31N".parse().unwrap();
+    let in31: Vec<[f64; 2]> = latlon
+        .iter()
+        .map(|p| {
+            let u = to_utm(p[0], p[1], Some(z31)).unwrap();
+            [u.easting, u.northing]
+        })
+        .collect();
+    let via_31 = sample_utm(dem.as_ref(), &in31, z31, Method::Bilinear).unwrap();
+    for i in 0..pts.len() {
+        // a round trip through lat/lon moves a point by nanometres
+        assert!((via_latlon[i].unwrap() - direct[i]).abs() < 1e-6);
+        assert!((via_31[i].unwrap() - direct[i]).abs() < 1e-6);
+    }
+}

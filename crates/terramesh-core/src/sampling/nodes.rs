@@ -1,5 +1,7 @@
 //! Sample nodes with both their UTM and WGS-84 coordinates.
 
+use rayon::prelude::*;
+
 use crate::coords::{to_utm, to_wgs84, CoordError, Zone};
 use crate::geometry::Region;
 
@@ -29,7 +31,8 @@ pub struct Node {
 /// `projected` is the region in metres; `geographic` (`[lon, lat]`) and `zone` are given for
 /// geographic regions. With [`GridPlane::Utm`] the grid is regular in `projected` and every
 /// node is converted to latitude/longitude; with [`GridPlane::LatLon`] it is regular in
-/// `geographic` (spec in degrees) and every node is projected to `zone`.
+/// `geographic` (spec in degrees) and every node is projected to `zone`. Conversions run in
+/// parallel (rayon); the order of the nodes is the grid's.
 ///
 /// ```
 /// use terramesh_core::coords::Zone;
@@ -65,7 +68,8 @@ pub fn grid_nodes(
         (GridPlane::Utm, _, Some(z)) => spec
             .build(projected)?
             .nodes
-            .into_iter()
+            .into_par_iter()
+            .with_min_len(4096)
             .map(|xy| {
                 let (lat, lon) = to_wgs84(xy[0], xy[1], z)?;
                 Ok(Node {
@@ -77,7 +81,8 @@ pub fn grid_nodes(
         (GridPlane::LatLon, Some(g), Some(z)) => spec
             .build(g)?
             .nodes
-            .into_iter()
+            .into_par_iter()
+            .with_min_len(4096)
             .map(|[lon, lat]| {
                 let p = to_utm(lat, lon, Some(z))?;
                 Ok(Node {

@@ -56,7 +56,8 @@ impl Raster {
         self.data.iter().filter(|v| v.is_nan()).count()
     }
 
-    /// Fills voids from their neighbours (see [`super::fill`]); returns how many were filled.
+    /// Fills voids in passes, each void taking the mean of its valid 8-neighbours, so large
+    /// voids fill from the rim inwards; returns how many were filled.
     pub fn fill_voids(&mut self) -> usize {
         super::fill::fill_voids(&mut self.data, self.rows, self.cols)
     }
