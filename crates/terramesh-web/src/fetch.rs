@@ -86,6 +86,59 @@ pub struct FetchStats {
     pub retries: usize,
 }
 
+/// The outcome of one request.
+enum Attempt {
+    /// The elevations, in order (`None`: no data there).
+    Done(Vec<Option<f64>>),
+    /// A failure worth retrying, with the server's `Retry-After` in seconds.
+    Retry {
+        why: String,
+        retry_after: Option<f64>,
+    },
+    /// A refusal: stop the run.
+    Fatal(String),
+}
+
+/// Sends one request for `pts` and judges the reply.
+fn attempt_once(endpoint: &Endpoint, agent: &ureq::Agent, pts: &[[f64; 2]]) -> Attempt {
+    let retry = |why: String| Attempt::Retry {
+        why,
+        retry_after: None,
+    };
+    match endpoint.send(agent, pts).map_err(|e| *e) {
+        Ok(resp) => match resp.into_string() {
+            Ok(body) => match endpoint.parse_reply(&body, pts) {
+                Ok(z) => Attempt::Done(z),
+                Err(Reply::Retry(m)) => retry(m),
+                Err(Reply::Fatal(m)) => Attempt::Fatal(m),
+            },
+            Err(e) => retry(format!("reply cut short ({})", e.kind())),
+        },
+        Err(ureq::Error::Status(code, resp)) => {
+            let retry_after = resp
+                .header("Retry-After")
+                .and_then(|v| v.trim().parse::<f64>().ok())
+                .filter(|v| v.is_finite() && *v >= 0.0);
+            if code == 429 || code >= 500 {
+                return Attempt::Retry {
+                    why: format!("HTTP {code}"),
+                    retry_after,
+                };
+            }
+            let body: String = resp
+                .into_string()
+                .unwrap_or_default()
+                .chars()
+                .take(200)
+                .collect();
+            Attempt::Fatal(
+                endpoint.redact(&format!("HTTP {code} from {}: {body}", endpoint.base_url)),
+            )
+        }
+        Err(ureq::Error::Transport(t)) => retry(endpoint.redact(&t.to_string())),
+    }
+}
+
 /// A batch's index and its elevations (or why it has none).
 type BatchOutcome = (usize, Result<Vec<Option<f64>>, PointError>);
 
@@ -243,46 +296,21 @@ pub fn fetch(
                     }
                     rate.wait();
                     requests.fetch_add(1, Ordering::Relaxed);
-                    let mut retry_after = None;
-                    match endpoint.send(&agent, pts).map_err(|e| *e) {
-                        Ok(resp) => match resp.into_string() {
-                            Ok(body) => match endpoint.parse_reply(&body, pts) {
-                                Ok(z) => {
-                                    outcome = Some(Ok(z));
-                                    break;
-                                }
-                                Err(Reply::Retry(m)) => last = m,
-                                Err(Reply::Fatal(m)) => {
-                                    *fatal.lock().unwrap_or_else(|e| e.into_inner()) =
-                                        Some(WebError::Refused(m));
-                                    return;
-                                }
-                            },
-                            Err(e) => last = format!("reply cut short ({})", e.kind()),
-                        },
-                        Err(ureq::Error::Status(code, resp)) => {
-                            retry_after = resp
-                                .header("Retry-After")
-                                .and_then(|v| v.trim().parse::<f64>().ok())
-                                .filter(|v| v.is_finite() && *v >= 0.0);
-                            let body = resp.into_string().unwrap_or_default();
-                            let body: String = body.chars().take(200).collect();
-                            if code == 429 || code >= 500 {
-                                last = format!("HTTP {code}");
-                            } else {
-                                let m = endpoint.redact(&format!(
-                                    "HTTP {code} from {}: {body}",
-                                    endpoint.base_url
-                                ));
-                                *fatal.lock().unwrap_or_else(|e| e.into_inner()) =
-                                    Some(WebError::Refused(m));
-                                return;
-                            }
+                    let retry_after = match attempt_once(endpoint, &agent, pts) {
+                        Attempt::Done(z) => {
+                            outcome = Some(Ok(z));
+                            break;
                         }
-                        Err(ureq::Error::Transport(t)) => {
-                            last = endpoint.redact(&t.to_string());
+                        Attempt::Retry { why, retry_after } => {
+                            last = why;
+                            retry_after
                         }
-                    }
+                        Attempt::Fatal(m) => {
+                            *fatal.lock().unwrap_or_else(|e| e.into_inner()) =
+                                Some(WebError::Refused(m));
+                            return;
+                        }
+                    };
                     if attempt == opts.retries || stop() {
                         break;
                     }

@@ -118,10 +118,9 @@ impl MockServer {
                     gauge2.clone(),
                 );
                 std::thread::spawn(move || {
-                    let now = gauge[0].fetch_add(1, Ordering::SeqCst) + 1;
-                    gauge[1].fetch_max(now, Ordering::SeqCst);
-                    serve(conn, kind, latency, &*faults, &files, &counter, &log, &stop);
-                    gauge[0].fetch_sub(1, Ordering::SeqCst);
+                    serve(
+                        conn, kind, latency, &*faults, &files, &counter, &log, &stop, &gauge,
+                    )
                 });
             }
         });
@@ -139,7 +138,8 @@ impl MockServer {
         format!("http://{}", self.addr)
     }
 
-    /// The most connections served at the same time.
+    /// The most requests waiting out their latency at the same time (the replies are sent
+    /// after it, so a client's concurrency bounds this).
     pub fn max_in_flight(&self) -> usize {
         self.gauge[1].load(Ordering::SeqCst)
     }
@@ -233,6 +233,7 @@ fn serve(
     counter: &AtomicUsize,
     log: &Mutex<Vec<Request>>,
     stop: &AtomicBool,
+    gauge: &[AtomicUsize; 2],
 ) {
     let _ = conn.set_read_timeout(Some(Duration::from_secs(10)));
     let mut reader = BufReader::new(match conn.try_clone() {
@@ -276,7 +277,11 @@ fn serve(
         .unwrap_or_else(|e| e.into_inner())
         .push(req.clone());
     let fault = faults(i, &req);
+    // Requests waiting out their latency at once: a client's concurrency bounds it.
+    let now = gauge[0].fetch_add(1, Ordering::SeqCst) + 1;
+    gauge[1].fetch_max(now, Ordering::SeqCst);
     std::thread::sleep(latency);
+    gauge[0].fetch_sub(1, Ordering::SeqCst);
     let send = |conn: &mut TcpStream, status: &str, extra: &str, ctype: &str, body: &[u8]| {
         let head = format!(
             "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\n{extra}Connection: close\r\n\r\n",

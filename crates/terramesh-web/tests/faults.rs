@@ -202,6 +202,38 @@ fn refusal_stops_the_run_without_leaking_the_key() {
         "{msg}"
     );
     assert!(!format!("{:?}", endpoint(ServiceKind::Google, &s)).contains("SECRET"));
+    assert!(!std::fs::read_to_string(dir.path().join("cache.txt"))
+        .unwrap_or_default()
+        .contains("SECRET"));
+}
+
+#[test]
+fn connection_errors_name_the_url_without_the_key() {
+    // A port with nothing listening: bind, note the port, close.
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let e = Endpoint::parse(
+        &format!("google:http://127.0.0.1:{port}/elevation"),
+        Some("SECRET-KEY-123".into()),
+    )
+    .unwrap();
+    let opts = FetchOptions {
+        retries: 1,
+        ..quick()
+    };
+    let stop = AtomicBool::new(false);
+    let (z, stats) = fetch(&e, &[[48.5, 7.5]], &opts, &|_, _| {}, &stop).unwrap();
+    assert_eq!(stats.requests, 2);
+    let Err(PointError::Failed { attempts: 2, last }) = &z[0] else {
+        panic!("{:?}", z[0])
+    };
+    assert!(
+        last.contains("127.0.0.1") && last.contains("<key>") && !last.contains("SECRET"),
+        "{last}"
+    );
 }
 
 #[test]
