@@ -370,3 +370,15 @@ fn utm_geotiff_is_sampled_from_latlon_in_any_zone() {
         assert!((via_31[i].unwrap() - direct[i]).abs() < 1e-6);
     }
 }
+
+#[test]
+fn srtm_bicubic_matches_a_numpy_keys_kernel() {
+    let dem = open_raster(&data("srtm/N48E007.hgt"), false).unwrap();
+    let rows = rows("srtm-bicubic.csv");
+    assert_eq!(rows.len(), 200);
+    for r in rows {
+        let v: Vec<f64> = r.iter().map(|s| s.parse().unwrap()).collect();
+        let got = dem.sample(v[1], v[0], Method::Bicubic).unwrap();
+        assert!((got - v[2]).abs() < 1e-7, "{},{}: {got} vs {}", v[0], v[1], v[2]);
+    }
+}
