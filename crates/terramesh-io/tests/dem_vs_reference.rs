@@ -379,6 +379,12 @@ fn srtm_bicubic_matches_a_numpy_keys_kernel() {
     for r in rows {
         let v: Vec<f64> = r.iter().map(|s| s.parse().unwrap()).collect();
         let got = dem.sample(v[1], v[0], Method::Bicubic).unwrap();
-        assert!((got - v[2]).abs() < 1e-7, "{},{}: {got} vs {}", v[0], v[1], v[2]);
+        assert!(
+            (got - v[2]).abs() < 1e-7,
+            "{},{}: {got} vs {}",
+            v[0],
+            v[1],
+            v[2]
+        );
     }
 }

@@ -117,6 +117,13 @@ impl Endpoint {
     }
 
     /// Locations per request (the service's limit).
+    ///
+    /// ```
+    /// let e = terramesh_web::Endpoint::parse("google:", Some("k".into()))?;
+    /// assert_eq!(e.max_batch(), 512);
+    /// assert_eq!(e.cache_id(), "google https://maps.googleapis.com/maps/api/elevation/json");
+    /// # Ok::<(), terramesh_web::WebError>(())
+    /// ```
     pub fn max_batch(&self) -> usize {
         match self.kind {
             ServiceKind::Google => 512,

@@ -13,6 +13,13 @@ use crate::{Endpoint, WebError};
 
 /// Settings of a fetch. Defaults: 4 concurrent requests, no rate limit, 5 retries, 30 s
 /// timeout, backoff 0.5 s doubling up to 30 s, the service's batch limit, no cache, no journal.
+///
+/// ```
+/// use std::time::Duration;
+/// let o = terramesh_web::FetchOptions { concurrency: 8, rate: Some(1.0), ..Default::default() };
+/// assert_eq!(o.retries, 5);
+/// assert_eq!(o.backoff, Duration::from_millis(500));
+/// ```
 #[derive(Debug, Clone)]
 pub struct FetchOptions {
     /// Requests in flight at once (`--concurrency`).

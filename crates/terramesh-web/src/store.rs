@@ -128,6 +128,15 @@ impl PointStore {
     }
 
     /// Deletes the file (after a run that finished).
+    ///
+    /// ```
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let p = dir.path().join("j.txt");
+    /// let s = terramesh_web::PointStore::open(&p, false).unwrap();
+    /// assert!(s.is_empty() && s.get([1.0, 2.0]).is_none());
+    /// s.remove().unwrap();
+    /// assert!(!p.exists());
+    /// ```
     pub fn remove(self) -> io::Result<()> {
         drop(self.file);
         std::fs::remove_file(&self.path)

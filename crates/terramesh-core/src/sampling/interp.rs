@@ -34,6 +34,12 @@ pub enum Missing {
 }
 
 /// Interpolation method.
+///
+/// ```
+/// use terramesh_core::sampling::Method;
+/// assert_eq!("cubic".parse::<Method>(), Ok(Method::Bicubic));
+/// assert_eq!(Method::default().to_string(), "bilinear");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
     /// The nearest post (ties round away from zero).

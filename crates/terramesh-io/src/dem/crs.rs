@@ -42,6 +42,12 @@ impl SourceCrs {
     }
 
     /// The EPSG code, when it is WGS-84 geographic or UTM.
+    ///
+    /// ```
+    /// use terramesh_io::dem::SourceCrs;
+    /// assert_eq!(SourceCrs::Geographic.epsg(), Some(4326));
+    /// assert_eq!(SourceCrs::Projected { name: "Oregon Lambert".into() }.epsg(), None);
+    /// ```
     pub fn epsg(&self) -> Option<u32> {
         match self {
             SourceCrs::Geographic => Some(4326),
@@ -71,6 +77,14 @@ impl SourceCrs {
 
     /// Converts this CRS's `(x, y)` to WGS-84 `(lat, lon)`, or `None` for a CRS terramesh does
     /// not convert.
+    ///
+    /// ```
+    /// use terramesh_io::dem::SourceCrs;
+    /// let utm = SourceCrs::from_epsg(32632).unwrap();
+    /// let (lat, lon) = utm.to_wgs84(500_000.0, 5_400_000.0)?.unwrap();
+    /// assert!((lon - 9.0).abs() < 1e-9 && lat > 48.0 && lat < 49.0);
+    /// # Ok::<(), terramesh_core::coords::CoordError>(())
+    /// ```
     pub fn to_wgs84(&self, x: f64, y: f64) -> Result<Option<(f64, f64)>, CoordError> {
         match self {
             SourceCrs::Geographic => Ok(Some((y, x))),

@@ -32,6 +32,15 @@ use std::path::Path;
 use terramesh_core::sampling::{Method, Missing};
 
 /// A source of elevations that can be sampled anywhere inside its data.
+///
+/// ```
+/// use terramesh_core::sampling::Method;
+/// use terramesh_io::dem::{ElevationSource, GeoTransform, Raster, SourceCrs};
+/// let r = Raster { name: "r".into(), rows: 2, cols: 2, crs: SourceCrs::Geographic,
+///     transform: GeoTransform { x0: 7.0, y0: 49.0, dx: 1.0, dy: -1.0 }, data: vec![0.0, 2.0, 4.0, 6.0] };
+/// let src: &dyn ElevationSource = &r;
+/// assert_eq!(src.sample(7.5, 48.5, Method::Bilinear), Ok(3.0));
+/// ```
 pub trait ElevationSource: Send + Sync {
     /// The CRS of the coordinates [`ElevationSource::sample`] takes.
     fn crs(&self) -> &SourceCrs;

@@ -52,6 +52,16 @@ pub struct Raster {
 
 impl Raster {
     /// Number of void posts.
+    ///
+    /// ```
+    /// use terramesh_io::dem::{GeoTransform, Raster, SourceCrs};
+    /// let mut r = Raster { name: "r".into(), rows: 2, cols: 2, crs: SourceCrs::Geographic,
+    ///     transform: GeoTransform { x0: 0.0, y0: 1.0, dx: 1.0, dy: -1.0 },
+    ///     data: vec![1.0, f64::NAN, 3.0, 5.0] };
+    /// assert_eq!(r.voids(), 1);
+    /// assert_eq!(r.fill_voids(), 1);
+    /// assert_eq!(r.get(0, 1), Some(3.0)); // mean of 1, 3 and 5
+    /// ```
     pub fn voids(&self) -> usize {
         self.data.iter().filter(|v| v.is_nan()).count()
     }

@@ -43,6 +43,16 @@ pub fn sample_latlon(
 }
 
 /// Samples `source` at UTM `[easting, northing]` points of `zone` (in parallel).
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+/// use terramesh_core::sampling::Method;
+/// use terramesh_io::dem::{open_raster, sample_utm};
+/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt")), false)?;
+/// let z = sample_utm(dem.as_ref(), &[[377_700.0, 5_398_000.0]], "32N".parse().unwrap(), Method::Bilinear)?;
+/// assert!(z[0].is_ok());
+/// # Ok(()) }
+/// ```
 pub fn sample_utm(
     source: &dyn ElevationSource,
     points: &[[f64; 2]],
@@ -63,6 +73,17 @@ pub fn sample_utm(
 
 /// Samples `source` at grid nodes. `zone` is the UTM zone of the nodes' `xy` (None when the
 /// region was projected in its own CRS, which must then be the source's).
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+/// use terramesh_core::sampling::{Method, Node};
+/// use terramesh_io::dem::{open_raster, sample_nodes};
+/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt")), false)?;
+/// let n = Node { xy: [377_700.0, 5_398_000.0], latlon: Some([48.7242, 7.3386]) };
+/// let z = sample_nodes(dem.as_ref(), &[n], None, Method::Nearest)?;
+/// assert!(z[0].is_ok());
+/// # Ok(()) }
+/// ```
 pub fn sample_nodes(
     source: &dyn ElevationSource,
     nodes: &[Node],

@@ -122,6 +122,17 @@ impl HgtMosaic {
     }
 
     /// Opens the given `.hgt` files as one mosaic; every tile must have the same resolution.
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+    /// use terramesh_io::dem::HgtMosaic;
+    /// let m = HgtMosaic::open_files(&[std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt"))], false)?;
+    /// assert_eq!(m.step(), 1.0 / 1200.0);
+    /// assert_eq!((m.voids(), m.filled()), (53, 0));
+    /// let f = HgtMosaic::open_files(&[std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt"))], true)?;
+    /// assert_eq!(f.filled(), 53);
+    /// # Ok(()) }
+    /// ```
     pub fn open_files(files: &[&Path], fill_voids: bool) -> Result<HgtMosaic, DemError> {
         let mut tiles = HashMap::new();
         let mut n = 0usize;

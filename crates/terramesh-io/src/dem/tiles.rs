@@ -80,6 +80,13 @@ impl TileMosaic {
     }
 
     /// Adds tile `(x, y)` from its PNG bytes.
+    ///
+    /// ```
+    /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/tiles/terrarium_11_385_803.png");
+    /// let mut m = terramesh_io::dem::TileMosaic::new(11, "tiles");
+    /// m.insert(385, 803, &std::fs::read(p).unwrap()).unwrap();
+    /// assert!(m.insert(385, 804, b"not a png").is_err());
+    /// ```
     pub fn insert(&mut self, x: u32, y: u32, png_bytes: &[u8]) -> Result<(), String> {
         self.tiles.insert((x, y), terrarium_decode(png_bytes)?);
         Ok(())
