@@ -205,6 +205,24 @@ fn geotiff_and_ascii_grid_sources() {
         .all(|r| (2186.0..=3345.0).contains(&r[5].parse::<f64>().unwrap())));
     // a lat/lon grid: rows share latitudes exactly
     assert_eq!(rows[0][0], rows[1][0]);
+    // a 500 m margin on a lat/lon grid reaches about 500 m beyond the corners
+    let (out, _) = ok(&[
+        "--source",
+        &data("grids/colorado-front-range-srtmgl3.asc"),
+        "--corners",
+        corners,
+        "--rows",
+        "5",
+        "--cols",
+        "5",
+        "--grid-crs",
+        "latlon",
+        "--margin",
+        "500m",
+    ]);
+    let (_, rows) = table(&out);
+    let lat0: f64 = rows[0][0].parse().unwrap();
+    assert!((40.12 - lat0 - 500.0 / 111_000.0).abs() < 2e-4, "{lat0}");
 }
 
 #[test]

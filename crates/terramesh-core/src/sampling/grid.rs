@@ -224,6 +224,20 @@ mod tests {
     }
 
     #[test]
+    fn margins_enlarge_each_axis() {
+        let (lo, hi) = ([0.0, 0.0], [10.0, 20.0]);
+        assert_eq!(
+            Margin::Absolute(1.5).enlarge(lo, hi).unwrap(),
+            ([-1.5, -1.5], [11.5, 21.5])
+        );
+        assert_eq!(
+            Margin::PerAxis([1.0, 2.0]).enlarge(lo, hi).unwrap(),
+            ([-1.0, -2.0], [11.0, 22.0])
+        );
+        assert!(Margin::PerAxis([1.0, f64::NAN]).enlarge(lo, hi).is_err());
+    }
+
+    #[test]
     fn bad_requests_are_errors() {
         let r = rect();
         let mk = |size, margin| {
