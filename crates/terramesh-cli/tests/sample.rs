@@ -452,3 +452,77 @@ fn terrarium_tiles_from_a_url_template_are_cached() {
     assert_eq!(again, out);
     assert!(fetched >= 1);
 }
+
+#[test]
+fn failed_points_are_written_as_errors_and_asked_again_on_resume() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let broken = Arc::new(AtomicBool::new(true));
+    // The second batch fails (HTTP 502) while `broken` is set.
+    let seen = Arc::new(std::sync::Mutex::new(None::<[f64; 2]>));
+    let (b3, seen2) = (broken.clone(), seen.clone());
+    let s = MockServer::start(
+        ServiceKind::OpenTopoData,
+        Duration::ZERO,
+        move |i, r| {
+            let mut first = seen2.lock().unwrap();
+            if i == 1 {
+                *first = r.locations.first().copied();
+            }
+            if b3.load(Ordering::SeqCst) && first.is_some() && r.locations.first() == first.as_ref()
+            {
+                Fault::Status(502, None)
+            } else {
+                Fault::None
+            }
+        },
+        Default::default(),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.csv");
+    let args = [
+        "--source",
+        &mock_url(&s),
+        "--corners",
+        PAPER,
+        "--rows",
+        "20",
+        "--cols",
+        "20",
+        "--concurrency",
+        "1",
+        "--retries",
+        "1",
+        "--backoff",
+        "0.01",
+        "--no-cache",
+        "--on-missing",
+        "nodata",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    let (_, err) = ok(&args);
+    assert!(err.contains("100 points had no elevation"), "{err}");
+    let (head, rows) = table(&std::fs::read_to_string(&out).unwrap());
+    assert_eq!(head.last().unwrap(), "error");
+    let failed: Vec<_> = rows.iter().filter(|r| !r[6].is_empty()).collect();
+    assert_eq!(failed.len(), 100);
+    assert!(failed
+        .iter()
+        .all(|r| r[5] == "-9999" && r[6].contains("HTTP 502")));
+    let journal = PathBuf::from(format!("{}.journal", out.display()));
+    assert!(journal.exists());
+    // The service recovers: --resume asks for the 100 failed points only.
+    broken.store(false, Ordering::SeqCst);
+    let before = s.requests().len();
+    let (_, err) = ok(&[&args[..], &["--resume"]].concat());
+    assert!(err.contains("300 from the journal"), "{err}");
+    let asked: usize = s.requests()[before..]
+        .iter()
+        .map(|r| r.locations.len())
+        .sum();
+    assert_eq!(asked, 100);
+    let (_, rows) = table(&std::fs::read_to_string(&out).unwrap());
+    assert!(rows.iter().all(|r| r[6].is_empty()));
+    assert!(!journal.exists());
+}
