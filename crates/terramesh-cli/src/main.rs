@@ -34,6 +34,9 @@ enum Command {
     Interpolate(cmd::interpolate::Args),
     /// Cross-validation of kriging or IDW: RMSE, MAE, mean and standardised errors.
     Cv(cmd::cv::Args),
+    /// Sample terrain elevations over a region from DEM files, point clouds, terrain tiles or
+    /// elevation web services.
+    Sample(Box<cmd::sample::Args>),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Variogram(args) => cmd::variogram::run(args),
         Command::Interpolate(args) => cmd::interpolate::run(args),
         Command::Cv(args) => cmd::cv::run(args),
+        Command::Sample(args) => cmd::sample::run(*args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

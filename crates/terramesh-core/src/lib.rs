@@ -16,3 +16,4 @@
 pub mod coords;
 pub mod geometry;
 pub mod solid;
+pub mod sampling;

@@ -4,6 +4,7 @@
 
 pub mod export;
 pub mod grid_write;
+pub mod dem;
 pub mod number;
 pub mod output;
 pub mod pictures;

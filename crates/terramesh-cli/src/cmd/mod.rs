@@ -7,3 +7,4 @@ pub(crate) mod geodata;
 pub mod interpolate;
 pub(crate) mod plot;
 pub mod variogram;
+pub mod sample;

@@ -1,0 +1,99 @@
+//! Raster sources: DEM files and terrain tiles, sampled at the grid nodes.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use terramesh_io::dem::{open_raster, sample_nodes, ElevationSource, SourceCrs, TileMosaic};
+use terramesh_web::{fetch_tiles, TileOptions};
+
+use super::settings::Settings;
+use super::write::{Row, Samples};
+
+/// Samples a DEM file or directory.
+pub fn sample_file(s: &Settings, path: &Path) -> Result<Samples> {
+    let nodes = s.nodes()?;
+    let dem = open_raster(path, s.fill_voids)?;
+    sample(s, dem.as_ref(), nodes)
+}
+
+fn sample(
+    s: &Settings,
+    dem: &dyn ElevationSource,
+    nodes: Vec<terramesh_core::sampling::Node>,
+) -> Result<Samples> {
+    let z = sample_nodes(dem, &nodes, s.zone, s.method)?;
+    let zone = match dem.crs() {
+        SourceCrs::Projected { .. } => None,
+        _ => s.zone,
+    };
+    let rows = nodes
+        .iter()
+        .zip(z)
+        .map(|(n, z)| Row {
+            latlon: n.latlon,
+            xy: n.xy,
+            z: z.map_err(|m| m.to_string()),
+        })
+        .collect();
+    Ok(Samples {
+        zone,
+        rows,
+        summary: format!("{} ({} interpolation)", dem.describe(), s.method),
+    })
+}
+
+/// Samples Terrarium tiles from a URL template, fetching (and caching) the tiles the grid
+/// needs.
+pub fn sample_tiles(s: &Settings, template: &str) -> Result<Samples> {
+    let nodes = s.nodes()?;
+    let z = s.zoom;
+    if z > 20 {
+        anyhow::bail!("--zoom {z}: terrain tiles go to zoom 15 at most");
+    }
+    let mut m = TileMosaic::new(z, template);
+    let mut need = BTreeSet::new();
+    for n in &nodes {
+        if let Some([lat, lon]) = n.latlon {
+            need.extend(m.tiles_around(lon, lat));
+        }
+    }
+    let need: Vec<(u32, u32)> = need.into_iter().collect();
+    if need.len() > 4096 {
+        anyhow::bail!("{} tiles at zoom {z}: use a lower --zoom", need.len());
+    }
+    let opts = TileOptions {
+        cache_dir: s.cache_dir.clone(),
+        timeout: s.fetch.timeout,
+        retries: s.fetch.retries,
+        backoff: s.fetch.backoff,
+    };
+    let tiles = fetch_tiles_tolerant(template, z, &need, &opts)?;
+    for ((x, y), bytes) in tiles {
+        m.insert(x, y, &bytes)
+            .map_err(|e| anyhow::anyhow!("tile {z}/{x}/{y} from {template}: {e}"))?;
+    }
+    sample(s, &m, nodes)
+}
+
+/// A tile's `(x, y)` and PNG bytes.
+type FetchedTile = ((u32, u32), Vec<u8>);
+
+/// Fetches tiles; a neighbour that does not exist (404) is left out rather than failing.
+fn fetch_tiles_tolerant(
+    template: &str,
+    z: u8,
+    need: &[(u32, u32)],
+    opts: &TileOptions,
+) -> Result<Vec<FetchedTile>> {
+    let mut out = Vec::with_capacity(need.len());
+    for &t in need {
+        match fetch_tiles(template, z, &[t], opts) {
+            Ok(mut b) => out.push((t, b.remove(0))),
+            Err(terramesh_web::WebError::Tile { message, .. })
+                if message.starts_with("HTTP 404") => {}
+            Err(e) => return Err(e).context("fetching terrain tiles"),
+        }
+    }
+    Ok(out)
+}

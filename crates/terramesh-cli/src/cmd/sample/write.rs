@@ -1,0 +1,146 @@
+//! The output table: lat,lon,easting,northing,zone,z or x,y,z.
+
+use std::io::Write;
+
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+use terramesh_core::coords::Zone;
+use terramesh_io::number::{write_fixed, write_shortest};
+use terramesh_io::output::Output;
+
+use super::settings::{OnMissing, Settings};
+
+/// One output point.
+pub struct Row {
+    /// WGS-84 `[lat, lon]` (geographic output).
+    pub latlon: Option<[f64; 2]>,
+    /// UTM easting/northing, or the source's projected x/y.
+    pub xy: [f64; 2],
+    /// The elevation or why there is none.
+    pub z: Result<f64, String>,
+}
+
+/// The sampled table.
+pub struct Samples {
+    /// UTM zone of `xy` for geographic output; `None` for x,y,z output.
+    pub zone: Option<Zone>,
+    pub rows: Vec<Row>,
+    /// What was read, for the summary line.
+    pub summary: String,
+}
+
+const CHUNK: usize = 8192;
+
+/// Applies --on-missing and writes the table atomically.
+pub fn write(s: &Settings, t: Samples) -> Result<()> {
+    let missing: Vec<usize> = (0..t.rows.len())
+        .filter(|&i| t.rows[i].z.is_err())
+        .collect();
+    if s.on_missing == OnMissing::Error {
+        if let Some(&i) = missing.first() {
+            let r = &t.rows[i];
+            let at = match r.latlon {
+                Some([lat, lon]) => format!("lat {lat:.7}, lon {lon:.7}"),
+                None => format!("x {}, y {}", r.xy[0], r.xy[1]),
+            };
+            bail!(
+                "{} of {} points have no elevation; the first (point {}, {at}): {}. \
+                 Use --on-missing nodata or skip to write the others{}",
+                missing.len(),
+                t.rows.len(),
+                i + 1,
+                r.z.as_ref().err().map_or("", |e| e.as_str()),
+                if matches!(s.source, super::settings::Source::Web(_)) {
+                    ", or rerun with --resume to ask again for the failed points only"
+                } else {
+                    ""
+                }
+            );
+        }
+    }
+    let geographic = t.zone.is_some();
+    let with_error = s.on_missing == OnMissing::Nodata;
+    let mut head = if geographic {
+        "lat,lon,easting,northing,zone,z".to_string()
+    } else {
+        "x,y,z".to_string()
+    };
+    if with_error {
+        head.push_str(",error");
+    }
+    head.push('\n');
+    let zone = t.zone.map(|z| z.to_string()).unwrap_or_default();
+    let chunks: Vec<Vec<u8>> = t
+        .rows
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut b = Vec::with_capacity(chunk.len() * 80);
+            for r in chunk {
+                let z = match (&r.z, s.on_missing) {
+                    (Ok(z), _) => Some((*z, "")),
+                    (Err(e), OnMissing::Nodata) => Some((s.nodata, e.as_str())),
+                    (Err(_), _) => None,
+                };
+                let Some((z, why)) = z else { continue };
+                // Writing to a Vec cannot fail.
+                if let Some([lat, lon]) = r.latlon.filter(|_| geographic) {
+                    let _ = write_fixed(&mut b, lat, 11);
+                    b.push(b',');
+                    let _ = write_fixed(&mut b, lon, 11);
+                    b.push(b',');
+                }
+                let _ = write_shortest(&mut b, r.xy[0]);
+                b.push(b',');
+                let _ = write_shortest(&mut b, r.xy[1]);
+                b.push(b',');
+                if geographic {
+                    b.extend_from_slice(zone.as_bytes());
+                    b.push(b',');
+                }
+                let _ = write_shortest(&mut b, z);
+                if with_error {
+                    b.push(b',');
+                    if why.contains(',') {
+                        b.push(b'"');
+                        b.extend_from_slice(why.replace('"', "\"\"").as_bytes());
+                        b.push(b'"');
+                    } else {
+                        b.extend_from_slice(why.as_bytes());
+                    }
+                }
+                b.push(b'\n');
+            }
+            b
+        })
+        .collect();
+    let name = s
+        .output
+        .as_ref()
+        .map_or("standard output".to_string(), |p| p.display().to_string());
+    let mut out =
+        Output::create(s.output.as_deref()).with_context(|| format!("cannot write {name}"))?;
+    out.write_all(head.as_bytes())
+        .and_then(|_| chunks.iter().try_for_each(|c| out.write_all(c)))
+        .with_context(|| format!("writing {name}"))?;
+    out.commit()
+        .with_context(|| format!("cannot write {name}"))?;
+    let written = t.rows.len()
+        - if s.on_missing == OnMissing::Skip {
+            missing.len()
+        } else {
+            0
+        };
+    eprintln!("terramesh: {}", t.summary);
+    eprintln!("terramesh: wrote {written} points to {name}");
+    if !missing.is_empty() {
+        let what = match s.on_missing {
+            OnMissing::Skip => "left out",
+            _ => "written with z = --nodata and the reason in the error column",
+        };
+        eprintln!(
+            "terramesh: {} points had no elevation and were {what}",
+            missing.len()
+        );
+    }
+    Ok(())
+}

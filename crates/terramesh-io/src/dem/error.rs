@@ -1,0 +1,55 @@
+//! Errors of the elevation readers.
+
+/// Errors reading an elevation source. Each names the file and says what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum DemError {
+    /// The file could not be opened or read.
+    #[error("{file}: {source}")]
+    Io {
+        /// File name.
+        file: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file's layout or content is not understood or not supported.
+    #[error("{file}: {message}")]
+    Format {
+        /// File name.
+        file: String,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// The file's coordinate reference system is missing or not supported.
+    #[error("{file}: {message}")]
+    Crs {
+        /// File name.
+        file: String,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// A table error from a points CSV.
+    #[error(transparent)]
+    Table(#[from] crate::table::TableError),
+}
+
+impl DemError {
+    pub(crate) fn io(file: &std::path::Path, source: std::io::Error) -> DemError {
+        DemError::Io {
+            file: file.display().to_string(),
+            source,
+        }
+    }
+    pub(crate) fn format(file: &std::path::Path, message: impl Into<String>) -> DemError {
+        DemError::Format {
+            file: file.display().to_string(),
+            message: message.into(),
+        }
+    }
+    pub(crate) fn crs(file: &std::path::Path, message: impl Into<String>) -> DemError {
+        DemError::Crs {
+            file: file.display().to_string(),
+            message: message.into(),
+        }
+    }
+}

@@ -1,0 +1,223 @@
+//! GeoTIFF rasters: int/float samples, striped or tiled, uncompressed, Deflate, LZW or
+//! PackBits (decoded by the `tiff` crate), georeferenced by GeoKeys in EPSG:4326 or WGS-84
+//! UTM, pixel-is-area or pixel-is-point.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::tags::Tag;
+use tiff::ColorType;
+
+use super::{DemError, GeoTransform, Raster, SourceCrs};
+
+const GT_MODEL_TYPE: u16 = 1024;
+const GT_RASTER_TYPE: u16 = 1025;
+const GEOGRAPHIC_TYPE: u16 = 2048;
+const PROJECTED_CS_TYPE: u16 = 3072;
+
+/// Reads a single-band GeoTIFF into a [`Raster`] (nodata posts become voids).
+///
+/// Pixel-is-area files (`AREA_OR_POINT=Area`, the default) tie the corner of the first pixel;
+/// its post is half a pixel inside. Pixel-is-point files tie the post itself.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif");
+/// let r = terramesh_io::dem::read_geotiff(std::path::Path::new(p))?;
+/// assert_eq!((r.rows, r.cols), (359, 367));
+/// assert!((r.transform.x0 - (-97.485 + 0.5 / 1200.0)).abs() < 1e-9);
+/// # Ok(()) }
+/// ```
+pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
+    let file = File::open(path).map_err(|e| DemError::io(path, e))?;
+    let fmt = |m: String| DemError::format(path, m);
+    let terr = |e: tiff::TiffError| match e {
+        tiff::TiffError::UnsupportedError(u) => fmt(format!(
+            "unsupported TIFF layout ({u}); convert it with \
+             gdal_translate -co COMPRESS=DEFLATE -co TILED=YES in.tif out.tif"
+        )),
+        tiff::TiffError::IoError(io) => DemError::io(path, io),
+        other => fmt(format!("not a readable TIFF: {other}")),
+    };
+    let mut dec = Decoder::new(BufReader::new(file))
+        .map_err(terr)?
+        .with_limits(Limits::unlimited());
+    let (cols, rows) = dec.dimensions().map_err(terr)?;
+    match dec.colortype().map_err(terr)? {
+        ColorType::Gray(_) => {}
+        other => {
+            return Err(fmt(format!(
+                "{other:?} pixels: an elevation GeoTIFF needs a single band; extract one with \
+                 gdal_translate -b 1"
+            )))
+        }
+    }
+    let keys = geokeys(&mut dec).map_err(terr)?.ok_or_else(|| {
+        DemError::crs(
+            path,
+            "no GeoKeyDirectory: a plain TIFF without georeferencing; assign one with \
+             gdal_translate -a_srs EPSG:4326 -a_ullr ...",
+        )
+    })?;
+    let crs = crs_of(path, &keys)?;
+    let point = key(&keys, GT_RASTER_TYPE) == Some(2);
+    let transform = transform_of(path, &mut dec, point).map_err(|e| match e {
+        Either::Tiff(t) => terr(t),
+        Either::Dem(d) => d,
+    })?;
+    let nodata = match dec.find_tag(Tag::GdalNodata).map_err(terr)? {
+        Some(v) => {
+            let s = v.into_string().map_err(terr)?;
+            let t = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
+            Some(
+                t.parse::<f64>()
+                    .map_err(|_| fmt(format!("GDAL_NODATA tag '{t}' is not a number")))?,
+            )
+        }
+        None => None,
+    };
+    let image = dec.read_image().map_err(terr)?;
+    let data = to_f64(image, nodata);
+    if data.len() != rows as usize * cols as usize {
+        return Err(fmt(format!(
+            "decoded {} samples for {cols} x {rows} pixels",
+            data.len()
+        )));
+    }
+    Ok(Raster {
+        name: path.display().to_string(),
+        rows: rows as usize,
+        cols: cols as usize,
+        transform,
+        crs,
+        data,
+    })
+}
+
+fn to_f64(image: DecodingResult, nodata: Option<f64>) -> Vec<f64> {
+    fn conv<T: Copy>(v: Vec<T>, f: impl Fn(T) -> f64, nodata: Option<f64>) -> Vec<f64> {
+        v.into_iter()
+            .map(|x| {
+                let y = f(x);
+                if Some(y) == nodata || !y.is_finite() {
+                    f64::NAN
+                } else {
+                    y
+                }
+            })
+            .collect()
+    }
+    // Float32 nodata is compared in float32, as GDAL writes it.
+    let nd32 = nodata.map(|n| n as f32 as f64);
+    match image {
+        DecodingResult::U8(v) => conv(v, f64::from, nodata),
+        DecodingResult::U16(v) => conv(v, f64::from, nodata),
+        DecodingResult::U32(v) => conv(v, f64::from, nodata),
+        DecodingResult::U64(v) => conv(v, |x| x as f64, nodata),
+        DecodingResult::I8(v) => conv(v, f64::from, nodata),
+        DecodingResult::I16(v) => conv(v, f64::from, nodata),
+        DecodingResult::I32(v) => conv(v, f64::from, nodata),
+        DecodingResult::I64(v) => conv(v, |x| x as f64, nodata),
+        DecodingResult::F32(v) => conv(v, f64::from, nd32),
+        DecodingResult::F64(v) => conv(v, |x| x, nodata),
+    }
+}
+
+/// GeoKey entries `(id, value)` with inline SHORT values.
+fn geokeys<R: std::io::Read + std::io::Seek>(
+    dec: &mut Decoder<R>,
+) -> Result<Option<Vec<(u16, u16)>>, tiff::TiffError> {
+    let Some(v) = dec.find_tag(Tag::GeoKeyDirectoryTag)? else {
+        return Ok(None);
+    };
+    let d = v.into_u16_vec()?;
+    let n = d.get(3).copied().unwrap_or(0) as usize;
+    let mut out = Vec::new();
+    for k in 0..n {
+        let e = &d.get(4 + 4 * k..8 + 4 * k).unwrap_or(&[]);
+        if e.len() == 4 && e[1] == 0 {
+            out.push((e[0], e[3]));
+        }
+    }
+    Ok(Some(out))
+}
+
+fn key(keys: &[(u16, u16)], id: u16) -> Option<u16> {
+    keys.iter().find(|k| k.0 == id).map(|k| k.1)
+}
+
+fn crs_of(path: &Path, keys: &[(u16, u16)]) -> Result<SourceCrs, DemError> {
+    let unsupported = |what: String| {
+        DemError::crs(
+            path,
+            format!(
+                "{what} is not supported: terramesh reads WGS 84 (EPSG:4326) and WGS 84 / UTM \
+                 (EPSG:326xx, 327xx) GeoTIFFs; reproject with gdalwarp -t_srs EPSG:4326"
+            ),
+        )
+    };
+    match key(keys, GT_MODEL_TYPE) {
+        Some(2) => match key(keys, GEOGRAPHIC_TYPE) {
+            Some(4326) => Ok(SourceCrs::Geographic),
+            Some(c) => Err(unsupported(format!("geographic CRS EPSG:{c}"))),
+            None => Err(unsupported("a geographic CRS without an EPSG code".into())),
+        },
+        Some(1) => match key(keys, PROJECTED_CS_TYPE) {
+            Some(c) => SourceCrs::from_epsg(c as u32)
+                .ok_or_else(|| unsupported(format!("projected CRS EPSG:{c}"))),
+            None => Err(unsupported("a projected CRS without an EPSG code".into())),
+        },
+        Some(m) => Err(unsupported(format!("model type {m}"))),
+        None => Err(unsupported("a GeoTIFF without a model type".into())),
+    }
+}
+
+enum Either {
+    Tiff(tiff::TiffError),
+    Dem(DemError),
+}
+
+fn transform_of<R: std::io::Read + std::io::Seek>(
+    path: &Path,
+    dec: &mut Decoder<R>,
+    point: bool,
+) -> Result<GeoTransform, Either> {
+    let f64s = |dec: &mut Decoder<R>, tag| -> Result<Option<Vec<f64>>, Either> {
+        match dec.find_tag(tag).map_err(Either::Tiff)? {
+            Some(v) => v.into_f64_vec().map(Some).map_err(Either::Tiff),
+            None => Ok(None),
+        }
+    };
+    let bad = |m: &str| Either::Dem(DemError::crs(path, m));
+    // (x, y) of pixel corner (i, j), and pixel size.
+    let (ti, tj, tx, ty, sx, sy) = if let Some(m) = f64s(dec, Tag::ModelTransformationTag)? {
+        if m.len() < 8 || m[1] != 0.0 || m[4] != 0.0 {
+            return Err(bad(
+                "a rotated or sheared ModelTransformation is not supported; warp it north-up with gdalwarp",
+            ));
+        }
+        (0.0, 0.0, m[3], m[7], m[0], -m[5])
+    } else {
+        let scale = f64s(dec, Tag::ModelPixelScaleTag)?
+            .ok_or_else(|| bad("no ModelPixelScale or ModelTransformation tag"))?;
+        let tie = f64s(dec, Tag::ModelTiepointTag)?.ok_or_else(|| bad("no ModelTiepoint tag"))?;
+        if scale.len() < 2 || tie.len() < 6 {
+            return Err(bad("short ModelPixelScale or ModelTiepoint tag"));
+        }
+        (tie[0], tie[1], tie[3], tie[4], scale[0], scale[1])
+    };
+    if !(sx > 0.0 && sy > 0.0) {
+        return Err(bad("pixel size must be positive and the raster north-up"));
+    }
+    // Raster space: pixel-is-area puts pixel (i, j)'s corner at (i, j) and its centre at
+    // (i + 0.5, j + 0.5); pixel-is-point puts the post at (i, j).
+    let half = if point { 0.0 } else { 0.5 };
+    Ok(GeoTransform {
+        x0: tx + (half - ti) * sx,
+        y0: ty - (half - tj) * sy,
+        dx: sx,
+        dy: -sy,
+    })
+}

@@ -1,0 +1,390 @@
+//! Every elevation reader against an independent reader: numpy (.hgt), rasterio/GDAL
+//! (GeoTIFF, ASCII grid, PNG), laspy (LAZ), and scipy's bilinear `map_coordinates`.
+//! Fixtures come from `fixtures/make_dem.py`.
+
+use std::path::{Path, PathBuf};
+
+use terramesh_core::sampling::{Method, Missing};
+use terramesh_io::dem::{
+    open_raster, read_ascii_grid, read_geotiff, read_las, read_points, DemError, ElevationSource,
+    HgtMosaic, LasOptions, SourceCrs,
+};
+use terramesh_io::table::ReadOptions;
+
+fn data(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(rel)
+}
+fn fixture(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/dem")
+        .join(rel)
+}
+
+/// Rows of a fixture CSV as strings (no quoting in these files).
+fn rows(name: &str) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(fixture(name)).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+fn num(s: &str) -> Option<f64> {
+    (!s.is_empty()).then(|| s.parse().unwrap())
+}
+
+#[test]
+fn srtm_tile_matches_numpy_posts_and_scipy_bilinear() {
+    let dem = open_raster(&data("srtm/N48E007.hgt"), false).unwrap();
+    let (mut posts, mut voids, mut interp) = (0, 0, 0);
+    for r in rows("srtm-points.csv") {
+        let (lat, lon): (f64, f64) = (r[0].parse().unwrap(), r[1].parse().unwrap());
+        match (num(&r[2]), num(&r[3])) {
+            (Some(z), _) => {
+                for m in [Method::Nearest, Method::Bilinear, Method::Bicubic] {
+                    assert_eq!(dem.sample(lon, lat, m), Ok(z), "{m} at post {lat},{lon}");
+                }
+                posts += 1;
+            }
+            (None, Some(z)) => {
+                let got = dem.sample(lon, lat, Method::Bilinear).unwrap();
+                assert!((got - z).abs() < 1e-9, "{lat},{lon}: {got} vs scipy {z}");
+                interp += 1;
+            }
+            (None, None) => {
+                assert_eq!(dem.sample(lon, lat, Method::Bilinear), Err(Missing::Void));
+                voids += 1;
+            }
+        }
+    }
+    assert!(
+        posts >= 190 && interp >= 390 && voids >= 10,
+        "{posts} {interp} {voids}"
+    );
+    assert_eq!(
+        dem.sample(8.5, 48.5, Method::Bilinear),
+        Err(Missing::Outside)
+    );
+}
+
+#[test]
+fn srtm_paper_study_area_has_20_posts_between_342_and_434_m() {
+    // Haut-Barr: 48.7224-48.7260 N, 7.3368-7.3404 E (data README).
+    let dem = open_raster(&data("srtm/N48E007.hgt"), false).unwrap();
+    let mut zs = Vec::new();
+    for r in 0..1201 {
+        for c in 0..1201 {
+            let (lat, lon) = (49.0 - r as f64 / 1200.0, 7.0 + c as f64 / 1200.0);
+            if (48.7224..=48.7260).contains(&lat) && (7.3368..=7.3404).contains(&lon) {
+                zs.push(dem.sample(lon, lat, Method::Nearest).unwrap());
+            }
+        }
+    }
+    assert_eq!(zs.len(), 20);
+    let (lo, hi) = zs
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, &z| (a.0.min(z), a.1.max(z)));
+    assert_eq!((lo, hi), (342.0, 434.0));
+}
+
+#[test]
+fn srtm_voids_are_counted_and_filled_on_request() {
+    let dir = data("srtm");
+    let m = HgtMosaic::open_dir(&dir, false).unwrap();
+    assert_eq!(m.voids(), 53);
+    let filled = HgtMosaic::open_dir(&dir, true).unwrap();
+    assert_eq!(filled.filled(), 53);
+    let void = rows("srtm-points.csv")
+        .into_iter()
+        .find(|r| r[2].is_empty() && r[3].is_empty())
+        .unwrap();
+    let (lat, lon): (f64, f64) = (void[0].parse().unwrap(), void[1].parse().unwrap());
+    let z = filled.sample(lon, lat, Method::Bilinear).unwrap();
+    assert!((100.0..1400.0).contains(&z), "{z}");
+}
+
+/// Two synthetic 3" tiles side by side whose posts lie on a plane in global post indices, so
+/// bilinear and bicubic must reproduce the plane across the seam at 8 E.
+#[test]
+fn srtm_mosaic_is_seamless_across_tile_edges() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 1201usize;
+    for (name, c0) in [("N48E007.hgt", 0usize), ("N48E008.hgt", 1200)] {
+        let mut b = Vec::with_capacity(n * n * 2);
+        for r in 0..n {
+            for c in 0..n {
+                b.extend_from_slice(&((r + 2 * (c + c0)) as i16).to_be_bytes());
+            }
+        }
+        std::fs::write(dir.path().join(name), b).unwrap();
+    }
+    let m = open_raster(dir.path(), false).unwrap();
+    let plane = |lon: f64, lat: f64| (49.0 - lat) * 1200.0 + 2.0 * (lon - 7.0) * 1200.0;
+    for &lon in &[7.9991, 7.99999, 8.0, 8.00001, 8.0004, 8.3] {
+        for &lat in &[48.0, 48.00004, 48.5, 48.99996] {
+            for meth in [Method::Bilinear, Method::Bicubic] {
+                let z = m.sample(lon, lat, meth).unwrap();
+                assert!(
+                    (z - plane(lon, lat)).abs() < 1e-6,
+                    "{meth} {lon},{lat}: {z}"
+                );
+            }
+        }
+    }
+    assert_eq!(
+        m.sample(9.0001, 48.5, Method::Bilinear),
+        Err(Missing::Outside)
+    );
+}
+
+#[test]
+fn truncated_hgt_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("N48E007.hgt");
+    std::fs::write(&p, vec![0u8; 1000]).unwrap();
+    let e = open_raster(&p, false).err().unwrap().to_string();
+    assert!(e.contains("N48E007.hgt") && e.contains("truncated"), "{e}");
+    std::fs::write(dir.path().join("tile.hgt"), vec![0u8; 2_884_802]).unwrap();
+    let e = open_raster(&dir.path().join("tile.hgt"), false)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("named after its south-west corner"), "{e}");
+}
+
+fn check_raster(dem: &dyn ElevationSource, fixture_rows: &[Vec<String>], tol: f64) {
+    for r in fixture_rows {
+        let (x, y): (f64, f64) = (r[1].parse().unwrap(), r[2].parse().unwrap());
+        let want = num(&r[3]);
+        let got = dem.sample(x, y, Method::Bilinear);
+        match (r[0].as_str(), want) {
+            ("post", Some(z)) => {
+                assert_eq!(got, Ok(z), "post {x},{y}");
+                assert_eq!(dem.sample(x, y, Method::Nearest), Ok(z));
+            }
+            (_, Some(z)) => {
+                let g = got.unwrap_or_else(|e| panic!("{x},{y}: {e}"));
+                assert!((g - z).abs() <= tol, "{x},{y}: {g} vs {z}");
+            }
+            (_, None) => assert_eq!(got, Err(Missing::Void), "{x},{y}"),
+        }
+    }
+}
+
+#[test]
+fn geotiff_fort_worth_matches_rasterio() {
+    let t = read_geotiff(&data("grids/fort-worth-3arcsec.tif")).unwrap();
+    assert_eq!(t.crs, SourceCrs::Geographic);
+    check_raster(&t, &rows("geotiff-fort-worth.csv"), 1e-9);
+}
+
+#[test]
+fn ascii_grid_colorado_matches_gdal() {
+    let a = read_ascii_grid(&data("grids/colorado-front-range-srtmgl3.asc")).unwrap();
+    assert_eq!(a.crs, SourceCrs::Geographic);
+    check_raster(&a, &rows("colorado-asc.csv"), 1e-9);
+}
+
+#[test]
+fn synthetic_layouts_match_gdal_posts_and_bilinear() {
+    let posts = rows("synth-posts.csv");
+    let bil = rows("synth-bilinear.csv");
+    let mut files: Vec<&str> = posts.iter().map(|r| r[0].as_str()).collect();
+    files.dedup();
+    assert_eq!(files.len(), 8);
+    for f in files {
+        let dem = open_raster(&fixture(f), false).unwrap_or_else(|e| panic!("{e}"));
+        let expect_crs = if f.contains("utm32") {
+            SourceCrs::from_epsg(32632).unwrap()
+        } else if f.contains("utm33s") {
+            SourceCrs::from_epsg(32733).unwrap()
+        } else {
+            SourceCrs::Geographic
+        };
+        assert_eq!(dem.crs(), &expect_crs, "{f}");
+        let mine: Vec<Vec<String>> = posts
+            .iter()
+            .filter(|r| r[0] == f)
+            .map(|r| vec!["post".into(), r[1].clone(), r[2].clone(), r[3].clone()])
+            .chain(
+                bil.iter()
+                    .filter(|r| r[0] == f)
+                    .map(|r| vec!["bilinear".into(), r[1].clone(), r[2].clone(), r[3].clone()]),
+            )
+            .collect();
+        assert!(mine.len() >= 23 * 19, "{f}");
+        // Posts are exact; bilinear differs from scipy by the rounding of x, y to fractional
+        // posts (1e-11 post x ~100 m per post in this noise).
+        check_raster(dem.as_ref(), &mine, 1e-7);
+    }
+}
+
+#[test]
+fn unsupported_tiffs_are_clear_errors() {
+    let e = read_geotiff(&fixture("bad-rgb.tif")).unwrap_err();
+    assert!(matches!(e, DemError::Format { .. }), "{e}");
+    assert!(
+        e.to_string().contains("bad-rgb.tif") && e.to_string().contains("single band"),
+        "{e}"
+    );
+    let e = read_geotiff(&fixture("bad-mercator.tif"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("EPSG:3857") && e.contains("gdalwarp"), "{e}");
+    let e = read_geotiff(&fixture("bad-float-predictor2.tif"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unsupported TIFF layout") && e.contains("gdal_translate"),
+        "{e}"
+    );
+    let e = read_geotiff(&fixture("synth-center.asc"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("synth-center.asc") && e.contains("TIFF"), "{e}");
+}
+
+#[test]
+fn laz_matches_laspy() {
+    let p = data("lidar/autzen_trim.laz");
+    let all = read_las(&p, &LasOptions::default()).unwrap();
+    let ground = read_las(&p, &LasOptions { classes: vec![2] }).unwrap();
+    let SourceCrs::Projected { name } = &ground.crs else {
+        panic!("{:?}", ground.crs)
+    };
+    assert!(
+        name.contains("Lambert") && name.ends_with("units: foot"),
+        "{name}"
+    );
+    for (r, pc) in rows("autzen-summary.csv").iter().zip([&all, &ground]) {
+        assert_eq!(pc.xyz.len(), r[1].parse::<usize>().unwrap(), "{}", r[0]);
+        for k in 0..3 {
+            let s: f64 = pc.xyz.iter().map(|p| p[k]).sum();
+            let want: f64 = r[2 + k].parse().unwrap();
+            assert!(
+                (s - want).abs() <= 1e-9 * want.abs(),
+                "{} sum {k}: {s} vs {want}",
+                r[0]
+            );
+        }
+    }
+    for r in rows("autzen-ground-every-100.csv") {
+        let p = ground.xyz[r[0].parse::<usize>().unwrap() * 100];
+        for k in 0..3 {
+            assert!((p[k] - r[1 + k].parse::<f64>().unwrap()).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn terrarium_tile_matches_gdal_png_decoding() {
+    let t = open_raster(&data("tiles/terrarium_11_385_803.png"), false).unwrap();
+    for r in rows("terrarium.csv") {
+        let v: Vec<f64> = r.iter().map(|s| s.parse().unwrap()).collect();
+        assert_eq!(t.sample(v[0], v[1], Method::Nearest), Ok(v[2]));
+        let b = t.sample(v[0], v[1], Method::Bilinear);
+        assert!(b.is_ok_and(|b| (b - v[2]).abs() < 1e-6) || b == Err(Missing::Outside));
+    }
+}
+
+#[test]
+fn davis_csv_reads_52_points_with_r_style_header() {
+    let pc = read_points(
+        &data("points/davis-topo.csv"),
+        &ReadOptions::default(),
+        None,
+    )
+    .unwrap();
+    assert_eq!(pc.xyz.len(), 52);
+    let mean = pc.xyz.iter().map(|p| p[2]).sum::<f64>() / 52.0;
+    assert!((mean - 827.08).abs() < 0.01, "{mean}"); // data README: mean 827.08 ft
+}
+
+#[test]
+fn ascii_grid_crs_comes_from_its_prj_or_its_extent() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = "ncols 2\nnrows 2\nxllcorner 377000\nyllcorner 5397000\ncellsize 30\n1 2\n3 4\n";
+    let p = dir.path().join("utm.asc");
+    std::fs::write(&p, grid).unwrap();
+    let e = read_ascii_grid(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("utm.asc") && e.contains("unknown CRS") && e.contains(".prj"),
+        "{e}"
+    );
+    std::fs::write(
+        dir.path().join("utm.prj"),
+        r#"PROJCS["WGS_1984_UTM_Zone_32N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],UNIT["Meter",1]]"#,
+    )
+    .unwrap();
+    let r = read_ascii_grid(&p).unwrap();
+    assert_eq!(r.crs, SourceCrs::from_epsg(32632).unwrap());
+    // post (0, 0) is the centre of the north-west cell; the south-east post holds 4
+    assert_eq!(r.sample(377015.0, 5397045.0, Method::Nearest), Ok(1.0));
+    assert_eq!(r.sample(377045.0, 5397015.0, Method::Bilinear), Ok(4.0));
+    assert_eq!(r.sample(377030.0, 5397030.0, Method::Bilinear), Ok(2.5));
+    // a short grid names the line and the count
+    std::fs::write(
+        &p,
+        "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n",
+    )
+    .unwrap();
+    let e = read_ascii_grid(&p).unwrap_err().to_string();
+    assert!(e.contains("line 7") && e.contains("found 3 values"), "{e}");
+}
+
+#[test]
+fn utm_geotiff_is_sampled_from_latlon_in_any_zone() {
+    use terramesh_core::coords::{to_utm, to_wgs84};
+    use terramesh_io::dem::{sample_latlon, sample_utm};
+    let dem = open_raster(&fixture("synth-utm32-point.tif"), false).unwrap();
+    let zone = "32N".parse().unwrap();
+    // interior UTM points, sampled directly and through lat/lon and through zone 31N
+    let pts: Vec<[f64; 2]> = (0..50)
+        .map(|i| [377650.0 + 9.7 * i as f64, 5398300.0 + 11.3 * i as f64])
+        .collect();
+    let direct: Vec<_> = pts
+        .iter()
+        .map(|p| dem.sample(p[0], p[1], Method::Bilinear).unwrap())
+        .collect();
+    let latlon: Vec<[f64; 2]> = pts
+        .iter()
+        .map(|p| {
+            let (a, b) = to_wgs84(p[0], p[1], zone).unwrap();
+            [a, b]
+        })
+        .collect();
+    let via_latlon = sample_latlon(dem.as_ref(), &latlon, Method::Bilinear).unwrap();
+    let z31 = "31N".parse().unwrap();
+    let in31: Vec<[f64; 2]> = latlon
+        .iter()
+        .map(|p| {
+            let u = to_utm(p[0], p[1], Some(z31)).unwrap();
+            [u.easting, u.northing]
+        })
+        .collect();
+    let via_31 = sample_utm(dem.as_ref(), &in31, z31, Method::Bilinear).unwrap();
+    for i in 0..pts.len() {
+        // a round trip through lat/lon moves a point by nanometres
+        assert!((via_latlon[i].unwrap() - direct[i]).abs() < 1e-6);
+        assert!((via_31[i].unwrap() - direct[i]).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn srtm_bicubic_matches_a_numpy_keys_kernel() {
+    let dem = open_raster(&data("srtm/N48E007.hgt"), false).unwrap();
+    let rows = rows("srtm-bicubic.csv");
+    assert_eq!(rows.len(), 200);
+    for r in rows {
+        let v: Vec<f64> = r.iter().map(|s| s.parse().unwrap()).collect();
+        let got = dem.sample(v[1], v[0], Method::Bicubic).unwrap();
+        assert!(
+            (got - v[2]).abs() < 1e-7,
+            "{},{}: {got} vs {}",
+            v[0],
+            v[1],
+            v[2]
+        );
+    }
+}
