@@ -388,3 +388,78 @@ fn srtm_bicubic_matches_a_numpy_keys_kernel() {
         );
     }
 }
+
+#[test]
+fn a_geotiff_window_samples_like_the_whole_file() {
+    use terramesh_io::dem::{open_raster_in, read_geotiff_in, LatLonBox};
+    let mut files: Vec<PathBuf> = [
+        "synth-int16-deflate-striped.tif",
+        "synth-int32-lzw-tiled.tif",
+        "synth-float32-packbits.tif",
+        "synth-utm32-point.tif",
+        "synth-utm33s-area.tif",
+    ]
+    .iter()
+    .map(|f| fixture(f))
+    .collect();
+    files.push(data("grids/fort-worth-3arcsec.tif"));
+    for f in files {
+        let whole = read_geotiff(&f).unwrap();
+        // a box over the middle third of the raster, in lat/lon
+        let t = whole.transform;
+        let corner = |r: f64, c: f64| {
+            let (x, y) = (t.x0 + c * t.dx, t.y0 + r * t.dy);
+            let (lat, lon) = whole.crs.to_wgs84(x, y).unwrap().unwrap();
+            [lat, lon]
+        };
+        let (h, w) = (whole.rows as f64, whole.cols as f64);
+        let pts = [
+            corner(h / 3.0, w / 3.0),
+            corner(2.0 * h / 3.0, 2.0 * w / 3.0),
+            corner(h / 3.0, 2.0 * w / 3.0),
+            corner(2.0 * h / 3.0, w / 3.0),
+        ];
+        let area = LatLonBox::around(&pts).unwrap();
+        let part = read_geotiff_in(&f, Some(&area)).unwrap();
+        assert!(
+            part.rows < whole.rows && part.cols < whole.cols,
+            "{}",
+            f.display()
+        );
+        let dem = open_raster_in(&f, false, Some(&area)).unwrap();
+        for i in 0..=20 {
+            for j in 0..=20 {
+                // off the half-post lines, where nearest would be a tie
+                let lat = area.south + (area.north - area.south) * (i as f64 + 0.29) / 21.0;
+                let lon = area.west + (area.east - area.west) * (j as f64 + 0.37) / 21.0;
+                let (x, y) = whole.crs.from_wgs84(lat, lon).unwrap().unwrap();
+                for m in [Method::Nearest, Method::Bilinear, Method::Bicubic] {
+                    // The window's origin moves by whole posts; the fractional post of (x, y)
+                    // may differ in the last bits (1e-11 post x these noisy synthetic slopes).
+                    let want = whole.sample(x, y, m).unwrap();
+                    for got in [part.sample(x, y, m), dem.sample(x, y, m)] {
+                        let got =
+                            got.unwrap_or_else(|e| panic!("{} {x},{y} {m}: {e}", f.display()));
+                        assert!(
+                            (got - want).abs() < 1e-7,
+                            "{} {x},{y} {m}: {got} vs {want}",
+                            f.display()
+                        );
+                    }
+                }
+            }
+        }
+        // an area beyond the data gives an empty window: every sample is outside
+        let far = LatLonBox {
+            south: -10.0,
+            west: 100.0,
+            north: -9.9,
+            east: 100.1,
+        };
+        let none = read_geotiff_in(&f, Some(&far)).unwrap();
+        assert_eq!(
+            none.sample(100.05, -9.95, Method::Nearest),
+            Err(Missing::Outside)
+        );
+    }
+}

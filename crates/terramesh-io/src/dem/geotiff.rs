@@ -10,7 +10,7 @@ use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
 use tiff::ColorType;
 
-use super::{DemError, GeoTransform, Raster, SourceCrs};
+use super::{DemError, GeoTransform, LatLonBox, Raster, SourceCrs};
 
 const GT_MODEL_TYPE: u16 = 1024;
 const GT_RASTER_TYPE: u16 = 1025;
@@ -31,6 +31,23 @@ const PROJECTED_CS_TYPE: u16 = 3072;
 /// # Ok(()) }
 /// ```
 pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
+    read_geotiff_in(path, None)
+}
+
+/// Reads the part of a GeoTIFF that covers `area` (plus two posts of border for bicubic),
+/// decoding only the tiles or strips it touches; the whole file when `area` is `None`.
+/// Samples inside `area` are the same as from the whole file.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+/// use terramesh_io::dem::{read_geotiff_in, LatLonBox};
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif");
+/// let area = LatLonBox { south: 32.70, west: -97.40, north: 32.71, east: -97.39 };
+/// let r = read_geotiff_in(std::path::Path::new(p), Some(&area))?;
+/// assert!(r.rows < 20 && r.cols < 20);
+/// # Ok(()) }
+/// ```
+pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, DemError> {
     let file = File::open(path).map_err(|e| DemError::io(path, e))?;
     let fmt = |m: String| DemError::format(path, m);
     let terr = |e: tiff::TiffError| match e {
@@ -78,9 +95,45 @@ pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
         }
         None => None,
     };
-    let image = dec.read_image().map_err(terr)?;
-    let data = to_f64(image, nodata);
-    if data.len() != rows as usize * cols as usize {
+    let window = area
+        .and_then(|a| a.in_crs(&crs))
+        .map(|b| window_of(&transform, rows as usize, cols as usize, b));
+    let (r0, c0, wrows, wcols, data) = match window {
+        None => {
+            let data = to_f64(dec.read_image().map_err(terr)?, nodata);
+            (0, 0, rows as usize, cols as usize, data)
+        }
+        Some((r0, r1, c0, c1)) => {
+            let (wr, wc) = (r1.saturating_sub(r0), c1.saturating_sub(c0));
+            let mut data = vec![f64::NAN; wr * wc];
+            let (cw, ch) = dec.chunk_dimensions();
+            let (cw, ch) = (cw.max(1) as usize, ch.max(1) as usize);
+            let across = (cols as usize).div_ceil(cw);
+            if wr > 0 && wc > 0 {
+                for tr in r0 / ch..=(r1 - 1) / ch {
+                    for tc in c0 / cw..=(c1 - 1) / cw {
+                        let index = (tr * across + tc) as u32;
+                        let (dw, dh) = dec.chunk_data_dimensions(index);
+                        let chunk = to_f64(dec.read_chunk(index).map_err(terr)?, nodata);
+                        for y in 0..dh as usize {
+                            let row = tr * ch + y;
+                            if row < r0 || row >= r1 {
+                                continue;
+                            }
+                            for x in 0..dw as usize {
+                                let col = tc * cw + x;
+                                if col >= c0 && col < c1 {
+                                    data[(row - r0) * wc + (col - c0)] = chunk[y * dw as usize + x];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            (r0, c0, wr, wc, data)
+        }
+    };
+    if data.len() != wrows * wcols {
         return Err(fmt(format!(
             "decoded {} samples for {cols} x {rows} pixels",
             data.len()
@@ -88,12 +141,36 @@ pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
     }
     Ok(Raster {
         name: path.display().to_string(),
-        rows: rows as usize,
-        cols: cols as usize,
-        transform,
+        rows: wrows,
+        cols: wcols,
+        transform: GeoTransform {
+            x0: transform.x0 + c0 as f64 * transform.dx,
+            y0: transform.y0 + r0 as f64 * transform.dy,
+            ..transform
+        },
         crs,
         data,
     })
+}
+
+/// Rows `r0..r1` and columns `c0..c1` of posts covering the extent `(x_lo, y_lo, x_hi, y_hi)`
+/// with two posts of border, clipped to the raster (empty when they do not meet).
+fn window_of(
+    t: &GeoTransform,
+    rows: usize,
+    cols: usize,
+    (x_lo, y_lo, x_hi, y_hi): (f64, f64, f64, f64),
+) -> (usize, usize, usize, usize) {
+    let (ra, ca) = t.to_post(x_lo, y_hi);
+    let (rb, cb) = t.to_post(x_hi, y_lo);
+    let span = |a: f64, b: f64, n: usize| {
+        let (lo, hi) = (a.min(b).floor() - 2.0, a.max(b).ceil() + 3.0);
+        let clip = |v: f64| v.clamp(0.0, n as f64) as usize;
+        (clip(lo), clip(hi))
+    };
+    let (r0, r1) = span(ra, rb, rows);
+    let (c0, c1) = span(ca, cb, cols);
+    (r0, r1.max(r0), c0, c1.max(c0))
 }
 
 fn to_f64(image: DecodingResult, nodata: Option<f64>) -> Vec<f64> {

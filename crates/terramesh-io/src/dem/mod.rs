@@ -15,17 +15,19 @@ mod raster;
 mod sample;
 mod srtm;
 mod tiles;
+mod window;
 
 pub use ascii_grid::read_ascii_grid;
 pub use crs::SourceCrs;
 pub use error::DemError;
-pub use geotiff::read_geotiff;
+pub use geotiff::{read_geotiff, read_geotiff_in};
 pub use las::{read_las, LasOptions};
 pub use points::{read_points, PointCloud};
 pub use raster::{GeoTransform, Raster};
 pub use sample::{sample_latlon, sample_nodes, sample_utm};
 pub use srtm::{HgtMosaic, HGT_VOID};
 pub use tiles::{terrarium_decode, TileMosaic};
+pub use window::LatLonBox;
 
 use std::path::Path;
 
@@ -67,6 +69,32 @@ pub trait ElevationSource: Send + Sync {
 /// # Ok(()) }
 /// ```
 pub fn open_raster(path: &Path, fill_voids: bool) -> Result<Box<dyn ElevationSource>, DemError> {
+    open_raster_in(path, fill_voids, None)
+}
+
+/// Like [`open_raster`], reading of a GeoTIFF only the tiles or strips that samples inside
+/// `area` need (`.hgt` tiles are memory-mapped anyway; other formats are read whole). Voids
+/// are then filled from neighbours inside that part.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+/// use terramesh_core::sampling::Method;
+/// use terramesh_io::dem::{open_raster, open_raster_in, LatLonBox};
+/// let p = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif"));
+/// let area = LatLonBox { south: 32.70, west: -97.40, north: 32.71, east: -97.39 };
+/// let part = open_raster_in(p, false, Some(&area))?;
+/// let whole = open_raster(p, false)?;
+/// assert_eq!(part.sample(-97.395, 32.705, Method::Nearest), whole.sample(-97.395, 32.705, Method::Nearest));
+/// let (a, b) = (part.sample(-97.3951, 32.7052, Method::Bicubic).unwrap(),
+///               whole.sample(-97.3951, 32.7052, Method::Bicubic).unwrap());
+/// assert!((a - b).abs() < 1e-9); // the part's origin moves by whole posts
+/// # Ok(()) }
+/// ```
+pub fn open_raster_in(
+    path: &Path,
+    fill_voids: bool,
+    area: Option<&LatLonBox>,
+) -> Result<Box<dyn ElevationSource>, DemError> {
     if path.is_dir() {
         return Ok(Box::new(HgtMosaic::open_dir(path, fill_voids)?));
     }
@@ -76,7 +104,7 @@ pub fn open_raster(path: &Path, fill_voids: bool) -> Result<Box<dyn ElevationSou
         .unwrap_or_default();
     let mut r = match ext.as_str() {
         "hgt" => return Ok(Box::new(HgtMosaic::open_files(&[path], fill_voids)?)),
-        "tif" | "tiff" => read_geotiff(path)?,
+        "tif" | "tiff" => read_geotiff_in(path, area)?,
         "asc" => read_ascii_grid(path)?,
         "png" => return Ok(Box::new(tiles::read_tile_file(path)?)),
         _ => {

@@ -4,7 +4,9 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use terramesh_io::dem::{open_raster, sample_nodes, ElevationSource, SourceCrs, TileMosaic};
+use terramesh_io::dem::{
+    open_raster_in, sample_nodes, ElevationSource, LatLonBox, SourceCrs, TileMosaic,
+};
 use terramesh_web::{fetch_tiles, TileOptions};
 
 use super::settings::Settings;
@@ -13,7 +15,12 @@ use super::write::{Row, Samples};
 /// Samples a DEM file or directory.
 pub fn sample_file(s: &Settings, path: &Path) -> Result<Samples> {
     let nodes = s.nodes()?;
-    let dem = open_raster(path, s.fill_voids)?;
+    // Read only the part of a large GeoTIFF that the nodes need.
+    let latlon: Vec<[f64; 2]> = nodes.iter().filter_map(|n| n.latlon).collect();
+    let area = (latlon.len() == nodes.len())
+        .then(|| LatLonBox::around(&latlon))
+        .flatten();
+    let dem = open_raster_in(path, s.fill_voids, area.as_ref())?;
     sample(s, dem.as_ref(), nodes)
 }
 
