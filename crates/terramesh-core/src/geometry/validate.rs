@@ -423,7 +423,10 @@ mod tests {
     #[test]
     fn zero_area_is_rejected() {
         let r = Region::from_ring(vec![[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]);
-        assert!(matches!(validate(&r), Err(ValidationError::ZeroArea { .. })));
+        assert!(matches!(
+            validate(&r),
+            Err(ValidationError::ZeroArea { .. })
+        ));
     }
 
     #[test]

@@ -25,9 +25,11 @@ pub fn parse_geojson(text: &str) -> Result<Region, String> {
     let mut region = Region::default();
     walk(&v, "$", &mut region)?;
     if region.polygons.is_empty() {
-        return Err("no Polygon or MultiPolygon geometry found; draw the study region as a \
+        return Err(
+            "no Polygon or MultiPolygon geometry found; draw the study region as a \
                     polygon"
-            .into());
+                .into(),
+        );
     }
     Ok(region)
 }
@@ -66,7 +68,9 @@ fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
         }
         "Polygon" => {
             let c = coords(v, path)?;
-            region.polygons.push(polygon(c, &format!("{path}.coordinates"))?);
+            region
+                .polygons
+                .push(polygon(c, &format!("{path}.coordinates"))?);
             Ok(())
         }
         "MultiPolygon" => {
@@ -80,7 +84,9 @@ fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
         }
         "LineString" => {
             let c = coords(v, path)?;
-            region.lines.push(positions(c, &format!("{path}.coordinates"))?);
+            region
+                .lines
+                .push(positions(c, &format!("{path}.coordinates"))?);
             Ok(())
         }
         "MultiLineString" => {

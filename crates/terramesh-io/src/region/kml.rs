@@ -78,9 +78,11 @@ pub fn parse_kml(text: &str) -> Result<Region, String> {
         }
     }
     if region.polygons.is_empty() {
-        return Err("no <Polygon> found; in Google Earth draw the region with \"Add Polygon\" \
+        return Err(
+            "no <Polygon> found; in Google Earth draw the region with \"Add Polygon\" \
                     and save it as KML"
-            .into());
+                .into(),
+        );
     }
     Ok(region)
 }

@@ -140,7 +140,10 @@ impl Parser<'_> {
         }
         Ok(())
     }
-    fn list(&mut self, mut item: impl FnMut(&mut Self) -> Result<(), String>) -> Result<(), String> {
+    fn list(
+        &mut self,
+        mut item: impl FnMut(&mut Self) -> Result<(), String>,
+    ) -> Result<(), String> {
         self.expect(b'(')?;
         loop {
             item(self)?;
@@ -189,7 +192,10 @@ impl Parser<'_> {
         self.skip_ws();
         let st = self.i;
         while self.i < self.s.len()
-            && matches!(self.s[self.i], b'0'..=b'9' | b'.' | b'-' | b'+' | b'e' | b'E')
+            && matches!(
+                self.s[self.i],
+                b'0'..=b'9' | b'.' | b'-' | b'+' | b'e' | b'E'
+            )
         {
             self.i += 1;
         }
