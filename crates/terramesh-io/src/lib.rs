@@ -2,6 +2,7 @@
 //! modules) elevation sources and mesh writers. Numerical work lives in `terramesh-core`.
 #![warn(missing_docs)]
 
+pub mod mesh_write;
 pub mod number;
 pub mod output;
 pub mod region;
