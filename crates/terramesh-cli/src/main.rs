@@ -24,12 +24,15 @@ struct Cli {
 enum Command {
     /// Convert coordinates between WGS-84 latitude/longitude and UTM.
     Convert(cmd::convert::Args),
+    /// Mesh the study region: quality triangles, optional smoothing, VTU/OBJ/PLY/MSH output.
+    Mesh(cmd::mesh::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Mesh(args) => cmd::mesh::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -94,3 +94,20 @@ pub fn delaunay_flips(mesh: &mut Mesh) -> usize {
         robust::incircle(p(a), p(b), p(c), p(d)) > 0.0
     })
 }
+
+/// Delaunay flips that keep every new triangle's area at most `area_cap` and the new diagonal
+/// at most `edge_cap` (used after smoothing, so size limits stay met).
+pub(crate) fn delaunay_flips_within(mesh: &mut Mesh, area_cap: f64, edge_cap: f64) -> usize {
+    flip_passes(mesh, 100, |m, [a, b, c, d]| {
+        let p = |v: u32| {
+            let q = m.points[v as usize];
+            robust::Coord { x: q[0], y: q[1] }
+        };
+        if robust::incircle(p(a), p(b), p(c), p(d)) <= 0.0 {
+            return false;
+        }
+        let (pc, pd) = (m.points[c as usize], m.points[d as usize]);
+        let diag = ((pc[0] - pd[0]).powi(2) + (pc[1] - pd[1]).powi(2)).sqrt();
+        diag <= edge_cap && m.tri_area(&[c, a, d]) <= area_cap && m.tri_area(&[c, d, b]) <= area_cap
+    })
+}

@@ -3,7 +3,6 @@
 //! (optimal Delaunay triangulation: the area-weighted mean of the star's circumcentres),
 //! followed by Delaunay edge flips.
 
-use crate::flip::delaunay_flips;
 use crate::mesh::{orient, Mesh};
 use crate::quality::triangle_quality;
 
@@ -35,7 +34,9 @@ pub struct SmoothReport {
 }
 
 /// Smooths the free vertices for `iterations` Gauss-Seidel sweeps, then restores the Delaunay
-/// property by edge flips. Vertices on the boundary and on constraint lines never move.
+/// property by edge flips. Vertices on the boundary and on constraint lines never move; no
+/// move or flip folds a triangle, makes one larger than the largest before smoothing, or an
+/// edge longer than the longest (so `max_area`/`max_edge` limits stay met).
 ///
 /// ```
 /// use terramesh_core::geometry::Region;
@@ -48,6 +49,7 @@ pub struct SmoothReport {
 /// assert!(rep.moves > 0);
 /// assert!(after.min_angle >= before.min_angle);
 /// assert!(after.radius_ratio.mean >= before.radius_ratio.mean);
+/// assert!(after.area.max <= before.area.max); // size limits stay met
 /// mesh.sanity_check(&r).unwrap();
 /// # Ok::<(), terramesh_mesh::MeshError>(())
 /// ```
@@ -58,7 +60,10 @@ pub fn smooth(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothR
     }
     let fixed = mesh.fixed_vertices();
     let (off, tris) = mesh.vertex_stars();
-    let global_min = crate::Quality::planar(mesh).min_angle;
+    let q0 = crate::Quality::planar(mesh);
+    // Size limits met by refinement stay met: no move or flip makes a triangle larger than
+    // the largest one, or an edge longer than the longest one, before smoothing.
+    let (global_min, area_cap, edge_cap) = (q0.min_angle, q0.area.max, q0.edge.max);
     for _ in 0..iterations {
         let mut moved = 0;
         for v in 0..mesh.points.len() {
@@ -78,6 +83,7 @@ pub fn smooth(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothR
                 .iter()
                 .all(|&t| orient_tri(mesh, mesh.triangles[t as usize]) > 0.0);
             let ok = valid
+                && star_within(mesh, star, area_cap, edge_cap)
                 && match smoother {
                     Smoother::Laplacian => true,
                     Smoother::Smart => star_min_angle(mesh, star) >= old_min,
@@ -95,8 +101,20 @@ pub fn smooth(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothR
             break;
         }
     }
-    report.flips = delaunay_flips(mesh);
+    report.flips = crate::flip::delaunay_flips_within(mesh, area_cap, edge_cap);
     report
+}
+
+/// True when every triangle of the star is within the area and edge caps.
+fn star_within(mesh: &Mesh, star: &[u32], area_cap: f64, edge_cap: f64) -> bool {
+    star.iter().all(|&t| {
+        let p = mesh.triangles[t as usize].map(|i| {
+            let q = mesh.points[i as usize];
+            [q[0], q[1], 0.0]
+        });
+        let q = triangle_quality(p);
+        q.area <= area_cap && q.edges.iter().all(|&e| e <= edge_cap)
+    })
 }
 
 fn orient_tri(mesh: &Mesh, t: [u32; 3]) -> f64 {
@@ -219,11 +237,9 @@ mod tests {
     #[test]
     fn flips_restore_delaunay_after_smoothing() {
         let (_, mut m) = jittered();
+        let q = Quality::planar(&m);
         smooth(&mut m, Smoother::Laplacian, 5);
-        assert_eq!(
-            delaunay_flips(&mut m),
-            0,
-            "smooth() already flipped to Delaunay"
-        );
+        let more = crate::flip::delaunay_flips_within(&mut m, q.area.max, q.edge.max);
+        assert_eq!(more, 0, "smooth() already flipped to Delaunay");
     }
 }

@@ -197,10 +197,20 @@ fn clean_ring(ring: &[[f64; 2]], name: &str) -> Result<Vec<[f64; 2]>, Validation
             distinct: distinct.len(),
         });
     }
-    // A non-collinear ring of zero signed area (a symmetric bow tie) is reported as a
-    // self-intersection later.
-    let all_collinear = (2..r.len()).all(|i| orient(r[0], r[1], r[i]) == 0.0);
-    if all_collinear {
+    // Zero area: every vertex within a rounding distance (1e-9 of the ring's extent) of the
+    // line through the first vertex and the vertex farthest from it. A ring of zero signed
+    // area that is not flat (a symmetric bow tie) is reported as a self-intersection later.
+    let d2 = |p: [f64; 2]| (p[0] - r[0][0]).powi(2) + (p[1] - r[0][1]).powi(2);
+    let far = r
+        .iter()
+        .copied()
+        .fold(r[0], |f, p| if d2(p) > d2(f) { p } else { f });
+    let len = d2(far).sqrt();
+    let flat = r.iter().all(|&p| {
+        let cross = (far[0] - r[0][0]) * (p[1] - r[0][1]) - (far[1] - r[0][1]) * (p[0] - r[0][0]);
+        cross.abs() <= 1e-9 * len * len
+    });
+    if flat {
         return Err(ValidationError::ZeroArea {
             ring: name.to_string(),
         });
