@@ -202,6 +202,16 @@ fn near_segment(a: Point2<f64>, b: Point2<f64>, p: Point2<f64>, tol: f64) -> boo
     ex * ex + ey * ey <= tol * tol
 }
 
+/// Rejects coordinates the exact predicates cannot handle (spade's `validate_coordinate`).
+fn check_coordinate(p: [f64; 2]) -> Result<(), MeshError> {
+    spade::validate_coordinate(p[0])
+        .and_then(|_| spade::validate_coordinate(p[1]))
+        .map_err(|e| MeshError::Insertion {
+            at: p,
+            why: format!("{e:?}"),
+        })
+}
+
 fn insert(cdt: &mut Cdt, p: [f64; 2]) -> Result<spade::handles::FixedVertexHandle, MeshError> {
     cdt.insert(Point2::new(p[0], p[1]))
         .map_err(|e| MeshError::Insertion {
@@ -219,52 +229,72 @@ impl CdtState {
         let local = region
             .try_map(|p| Ok::<_, ()>([p[0] - origin[0], p[1] - origin[1]]))
             .expect("infallible");
-        let mut cdt = Cdt::new();
+        let half = [0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])];
+        let tol = 1e-9 * half[0].max(half[1]);
+        // Rings and the sample points clear of them are bulk loaded (spade's bulk CDT);
+        // constraint lines and points on a ring follow one by one.
+        let mut verts = Vec::new();
+        let mut edges = Vec::new();
+        let mut segs = Vec::new();
         for poly in &local.polygons {
             for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
-                let hs = ring
-                    .iter()
-                    .map(|&p| insert(&mut cdt, p))
-                    .collect::<Result<Vec<_>, _>>()?;
-                for i in 0..hs.len() {
-                    let (a, b) = (hs[i], hs[(i + 1) % hs.len()]);
-                    if a != b {
-                        cdt.add_constraint_and_split(a, b, |p| p);
-                    }
-                }
-            }
-        }
-        for line in &local.lines {
-            let hs = line
-                .iter()
-                .map(|&p| insert(&mut cdt, p))
-                .collect::<Result<Vec<_>, _>>()?;
-            for w in hs.windows(2) {
-                if w[0] != w[1] {
-                    cdt.add_constraint_and_split(w[0], w[1], |p| p);
+                let base = verts.len();
+                let n = ring.len();
+                for (i, &p) in ring.iter().enumerate() {
+                    check_coordinate(p)?;
+                    verts.push(Point2::new(p[0], p[1]));
+                    edges.push([base + i, base + (i + 1) % n]);
+                    segs.push((p, ring[(i + 1) % n]));
                 }
             }
         }
         let mut points_outside = 0;
-        let mut inside_points = Vec::new();
+        let mut later = Vec::new();
         for p in points {
             let q = [p[0] - origin[0], p[1] - origin[1]];
-            if local.contains(q) {
-                inside_points.push(q);
-            } else {
+            check_coordinate(q)?;
+            if !local.contains(q) {
                 points_outside += 1;
+                continue;
+            }
+            let pq = Point2::new(q[0], q[1]);
+            let near = segs.iter().any(|&(a, b)| {
+                near_segment(Point2::new(a[0], a[1]), Point2::new(b[0], b[1]), pq, tol)
+            });
+            if near {
+                later.push(q);
+            } else {
+                verts.push(pq);
             }
         }
-        let half = [0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])];
+        let mut conflicts = 0;
+        let cdt = Cdt::try_bulk_load_cdt(verts, edges, |_| conflicts += 1).map_err(|e| {
+            MeshError::Insertion {
+                at: [f64::NAN, f64::NAN],
+                why: format!("{e:?}"),
+            }
+        })?;
+        debug_assert_eq!(conflicts, 0, "validated rings do not cross");
         let mut s = CdtState {
             cdt,
             origin,
             local,
             points_outside,
             spade_classifies: true,
-            tol: 1e-9 * half[0].max(half[1]),
+            tol,
         };
-        for q in inside_points {
+        for line in &s.local.lines.clone() {
+            let hs = line
+                .iter()
+                .map(|&p| s.insert_point(p))
+                .collect::<Result<Vec<_>, _>>()?;
+            for w in hs.windows(2) {
+                if w[0] != w[1] {
+                    s.cdt.add_constraint_and_split(w[0], w[1], |p| p);
+                }
+            }
+        }
+        for q in later {
             s.insert_point(q)?;
         }
         s.spade_classifies = s.spade_agrees();
