@@ -104,22 +104,41 @@ pub struct Stats {
     pub mean: f64,
 }
 
-impl Stats {
-    fn of(values: impl Iterator<Item = f64>) -> Stats {
-        let (mut min, mut max, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
-        for v in values {
-            min = min.min(v);
-            max = max.max(v);
-            sum += v;
-            n += 1;
+/// Running minimum, maximum and sum.
+#[derive(Clone, Copy)]
+struct Acc {
+    min: f64,
+    max: f64,
+    sum: f64,
+    n: usize,
+}
+
+impl Default for Acc {
+    fn default() -> Self {
+        Acc {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            sum: 0.0,
+            n: 0,
         }
-        if n == 0 {
+    }
+}
+
+impl Acc {
+    fn add(&mut self, v: f64) {
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        self.sum += v;
+        self.n += 1;
+    }
+    fn stats(&self) -> Stats {
+        if self.n == 0 {
             return Stats::default();
         }
         Stats {
-            min,
-            max,
-            mean: sum / n as f64,
+            min: self.min,
+            max: self.max,
+            mean: self.sum / self.n as f64,
         }
     }
 }
@@ -180,32 +199,43 @@ impl Quality {
     }
 
     fn compute(mesh: &Mesh, z: Option<&[f64]>) -> Quality {
-        let tq: Vec<TriangleQuality> = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                triangle_quality(t.map(|i| {
-                    let p = mesh.points[i as usize];
-                    [p[0], p[1], z.map_or(0.0, |z| z[i as usize])]
-                }))
-            })
-            .collect();
+        // Streamed: no per-triangle storage (a million-triangle mesh stays cheap).
+        let mut acc = [
+            Acc::default(),
+            Acc::default(),
+            Acc::default(),
+            Acc::default(),
+        ];
+        let (mut min_angle, mut max_angle) = (f64::INFINITY, f64::NEG_INFINITY);
         let mut hist = [0usize; 18];
-        for q in &tq {
+        for t in &mesh.triangles {
+            let q = triangle_quality(t.map(|i| {
+                let p = mesh.points[i as usize];
+                [p[0], p[1], z.map_or(0.0, |z| z[i as usize])]
+            }));
             for a in q.angles {
                 hist[((a / 10.0) as usize).min(17)] += 1;
             }
+            min_angle = min_angle.min(q.min_angle);
+            max_angle = max_angle.max(q.max_angle);
+            acc[0].add(q.radius_ratio);
+            acc[1].add(q.aspect_ratio);
+            acc[2].add(q.area);
+            for e in q.edges {
+                acc[3].add(e);
+            }
         }
+        let empty = mesh.triangles.is_empty();
         Quality {
             dimension: if z.is_some() { "3D" } else { "2D" },
-            triangles: tq.len(),
+            triangles: mesh.triangles.len(),
             vertices: mesh.points.len(),
-            min_angle: Stats::of(tq.iter().map(|q| q.min_angle)).min,
-            max_angle: Stats::of(tq.iter().map(|q| q.max_angle)).max,
-            radius_ratio: Stats::of(tq.iter().map(|q| q.radius_ratio)),
-            aspect_ratio: Stats::of(tq.iter().map(|q| q.aspect_ratio)),
-            area: Stats::of(tq.iter().map(|q| q.area)),
-            edge: Stats::of(tq.iter().flat_map(|q| q.edges)),
+            min_angle: if empty { 0.0 } else { min_angle },
+            max_angle: if empty { 0.0 } else { max_angle },
+            radius_ratio: acc[0].stats(),
+            aspect_ratio: acc[1].stats(),
+            area: acc[2].stats(),
+            edge: acc[3].stats(),
             angle_histogram: hist,
         }
     }
