@@ -57,6 +57,10 @@ def main():
                   f"({int(r['flips'])} flips, {int(r['moves'])} moves); {r['seconds']:.2f} s")
             print(f"{name:7} {tol:7.2f} {'uniform 30 deg mesh':22} {int(r['uniform_triangles']):9d} "
                   f"{'':8} {r['uniform_min3d']:7.2f} {'>=30':>7}  coarsest area limit within the error")
+            out20 = subprocess.run([RUST, name, str(tol), "20"], check=True, capture_output=True, text=True).stdout
+            r20 = {k: float(x) for k, x in (t.split("=") for t in out20.split())}
+            print(f"{name:7} {tol:7.2f} {'terramesh adaptive 20':22} {int(r20['adaptive_triangles']):9d} "
+                  f"{r20['err_grid']:8.4f} {r20['min3d']:7.2f} {r20['min2d']:7.2f}  same, 2D minimum angle 20 deg")
             print(f"{name:7} {tol:7.2f} ratios: adaptive/uniform "
                   f"{r['adaptive_triangles'] / r['uniform_triangles']:.3f}, adaptive/Delatin "
                   f"{r['adaptive_triangles'] / len(d.triangles):.2f}")

@@ -3,7 +3,7 @@
 //! error, errors at centres/midpoints and on the 1 m grid Delatin sees, and 3D angles.
 //!
 //! ```text
-//! adaptive_compare cliff|cone MAX_ERROR
+//! adaptive_compare cliff|cone MAX_ERROR [MIN_ANGLE]
 //! ```
 
 use std::time::Instant;
@@ -25,9 +25,16 @@ fn grid_error(m: &Mesh, z: &[f64], f: &dyn Fn(f64, f64) -> f64) -> f64 {
     for t in &m.triangles {
         let p = t.map(|i| m.absolute(i as usize));
         let zz = t.map(|i| z[i as usize]);
-        let (x0, x1) = (p.iter().map(|q| q[0]).fold(f64::INFINITY, f64::min), p.iter().map(|q| q[0]).fold(f64::NEG_INFINITY, f64::max));
-        let (y0, y1) = (p.iter().map(|q| q[1]).fold(f64::INFINITY, f64::min), p.iter().map(|q| q[1]).fold(f64::NEG_INFINITY, f64::max));
-        let det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+        let (x0, x1) = (
+            p.iter().map(|q| q[0]).fold(f64::INFINITY, f64::min),
+            p.iter().map(|q| q[0]).fold(f64::NEG_INFINITY, f64::max),
+        );
+        let (y0, y1) = (
+            p.iter().map(|q| q[1]).fold(f64::INFINITY, f64::min),
+            p.iter().map(|q| q[1]).fold(f64::NEG_INFINITY, f64::max),
+        );
+        let det =
+            (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
         for gx in (x0.ceil() as i64)..=(x1.floor() as i64) {
             for gy in (y0.ceil() as i64)..=(y1.floor() as i64) {
                 let (x, y) = (gx as f64, gy as f64);
@@ -46,7 +53,12 @@ fn grid_error(m: &Mesh, z: &[f64], f: &dyn Fn(f64, f64) -> f64) -> f64 {
 }
 
 fn heights(m: &Mesh, f: &dyn Fn(f64, f64) -> f64) -> Vec<f64> {
-    (0..m.points.len()).map(|i| { let p = m.absolute(i); f(p[0], p[1]) }).collect()
+    (0..m.points.len())
+        .map(|i| {
+            let p = m.absolute(i);
+            f(p[0], p[1])
+        })
+        .collect()
 }
 
 fn main() {
@@ -59,7 +71,11 @@ fn main() {
     let tol: f64 = args[2].parse().unwrap();
     let r = Region::from_ring(vec![[0.0, 0.0], [200.0, 0.0], [200.0, 200.0], [0.0, 200.0]]);
     let t = Instant::now();
-    let (m, z, rep) = adaptive_mesh(&r, &AdaptiveSettings::new(tol), &f).unwrap();
+    let mut settings = AdaptiveSettings::new(tol);
+    if let Some(a) = args.get(3) {
+        settings.min_angle = a.parse().unwrap();
+    }
+    let (m, z, rep) = adaptive_mesh(&r, &settings, &f).unwrap();
     let secs = t.elapsed().as_secs_f64();
     // Coarsest uniform (30 degrees + area limit) mesh within the same error, by bisection.
     let (mut lo, mut hi) = (1e-3f64, 2000.0f64);

@@ -133,6 +133,15 @@ pub fn adaptive_mesh(
             zs.push(h(*p));
         }
         let inside = st.inside_faces();
+        // Error at every edge midpoint, then one new vertex per bad triangle, at the worst of
+        // its centre and its three midpoints (a shared midpoint is inserted once).
+        let mut edge_err = vec![0.0f64; st.cdt.num_undirected_edges()];
+        for e in st.cdt.undirected_edges() {
+            let [a, b] = e.vertices().map(|v| v.fix().index());
+            let m = [0.5 * (pos[a][0] + pos[b][0]), 0.5 * (pos[a][1] + pos[b][1])];
+            edge_err[e.fix().index()] = (h(m) - 0.5 * (zs[a] + zs[b])).abs();
+        }
+        let mut split = vec![false; edge_err.len()];
         let mut new_points = Vec::new();
         for face in st.cdt.inner_faces() {
             if !inside[face.fix().index()] {
@@ -144,22 +153,26 @@ pub fn adaptive_mesh(
                 (pos[v[0]][1] + pos[v[1]][1] + pos[v[2]][1]) / 3.0,
             ];
             let zc = (zs[v[0]] + zs[v[1]] + zs[v[2]]) / 3.0;
-            if (h(c) - zc).abs() > tol {
+            let ec = (h(c) - zc).abs();
+            let (ei, ee) = face
+                .adjacent_edges()
+                .map(|e| e.as_undirected().fix().index())
+                .into_iter()
+                .map(|k| (k, edge_err[k]))
+                .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+            if ec.max(ee) <= tol {
+                continue;
+            }
+            if ec >= ee {
                 new_points.push(c);
+            } else {
+                split[ei] = true;
             }
         }
         for e in st.cdt.undirected_edges() {
-            let d = e.as_directed();
-            let touches = [d.face(), d.rev().face()]
-                .iter()
-                .any(|f| f.as_inner().is_some_and(|f| inside[f.fix().index()]));
-            if !touches {
-                continue;
-            }
-            let [a, b] = e.vertices().map(|v| v.fix().index());
-            let m = [0.5 * (pos[a][0] + pos[b][0]), 0.5 * (pos[a][1] + pos[b][1])];
-            if (h(m) - 0.5 * (zs[a] + zs[b])).abs() > tol {
-                new_points.push(m);
+            if split[e.fix().index()] {
+                let [a, b] = e.vertices().map(|v| v.position());
+                new_points.push([0.5 * (a.x + b.x), 0.5 * (a.y + b.y)]);
             }
         }
         if new_points.is_empty() {
