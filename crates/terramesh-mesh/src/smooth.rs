@@ -4,7 +4,6 @@
 //! followed by Delaunay edge flips.
 
 use crate::mesh::{orient, Mesh};
-use crate::quality::triangle_quality;
 
 /// Smoothing method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -107,13 +106,14 @@ pub fn smooth(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothR
 
 /// True when every triangle of the star is within the area and edge caps.
 fn star_within(mesh: &Mesh, star: &[u32], area_cap: f64, edge_cap: f64) -> bool {
+    let cap2 = edge_cap * edge_cap;
     star.iter().all(|&t| {
-        let p = mesh.triangles[t as usize].map(|i| {
-            let q = mesh.points[i as usize];
-            [q[0], q[1], 0.0]
-        });
-        let q = triangle_quality(p);
-        q.area <= area_cap && q.edges.iter().all(|&e| e <= edge_cap)
+        let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.points[i as usize]);
+        let d2 = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
+        0.5 * orient(a, b, c) <= area_cap
+            && d2(a, b) <= cap2
+            && d2(b, c) <= cap2
+            && d2(c, a) <= cap2
     })
 }
 
@@ -122,16 +122,20 @@ fn orient_tri(mesh: &Mesh, t: [u32; 3]) -> f64 {
     orient(a, b, c)
 }
 
+/// Smallest angle of the star, in degrees. The smallest angle of a triangle is opposite its
+/// shortest edge and at most 60 degrees, so `asin(2 A / (b c))` with `b`, `c` the two longer
+/// edges gives it with one transcendental call.
 pub(crate) fn star_min_angle(mesh: &Mesh, star: &[u32]) -> f64 {
-    star.iter()
-        .map(|&t| {
-            let p = mesh.triangles[t as usize].map(|i| {
-                let q = mesh.points[i as usize];
-                [q[0], q[1], 0.0]
-            });
-            triangle_quality(p).min_angle
-        })
-        .fold(f64::INFINITY, f64::min)
+    let mut min_sin = f64::INFINITY;
+    for &t in star {
+        let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.points[i as usize]);
+        let d2 = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
+        let mut e = [d2(a, b), d2(b, c), d2(c, a)];
+        e.sort_by(f64::total_cmp);
+        let twice_area = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs();
+        min_sin = min_sin.min(twice_area / (e[1] * e[2]).sqrt());
+    }
+    min_sin.min(1.0).asin().to_degrees()
 }
 
 /// Mean of the neighbours of `v` (each neighbour counted once).
