@@ -116,12 +116,16 @@ pub fn run(args: Args) -> Result<()> {
         builder = builder.points(read_points(p, args.crs, region.zone)?);
     }
     let (mut mesh, report) = builder.build(&region.projected)?;
+    let mut text = String::new();
     if let Some(z) = region.zone {
-        println!("region: {:.1} m2 in UTM zone {z}", region.projected.area());
+        text += &format!(
+            "region: {:.1} m2 in UTM zone {z}\n",
+            region.projected.area()
+        );
     }
     if report.points_outside > 0 {
-        println!(
-            "{} sample points lie outside the region and were skipped",
+        text += &format!(
+            "{} sample points lie outside the region and were skipped\n",
             report.points_outside
         );
     }
@@ -134,28 +138,35 @@ pub fn run(args: Args) -> Result<()> {
         };
         let rep = smooth(&mut mesh, smoother, args.smooth);
         let after = Quality::planar(&mesh);
-        println!(
-            "smoothing ({:?}, {} iterations): {} moves, {} rejected, {} Delaunay flips",
+        text += &format!(
+            "smoothing ({:?}, {} iterations): {} moves, {} rejected, {} Delaunay flips\n",
             args.smoother, args.smooth, rep.moves, rep.rejected, rep.flips
         );
-        print!(
-            "{}",
-            Quality::table(&[("before", &before), ("after", &after)])
-        );
+        text += &Quality::table(&[("before", &before), ("after", &after)]);
     } else {
-        print!("{}", Quality::table(&[("mesh", &before)]));
+        text += &Quality::table(&[("mesh", &before)]);
     }
     write_mesh(
         &args.output,
         &MeshView::planar(mesh.origin, &mesh.points, &mesh.triangles),
     )?;
-    println!(
-        "wrote {} ({} vertices, {} triangles)",
+    text += &format!(
+        "wrote {} ({} vertices, {} triangles)\n",
         args.output.display(),
         mesh.points.len(),
         mesh.triangles.len()
     );
-    Ok(())
+    say(&text)
+}
+
+/// Prints the report; a closed pipe (`| head`) is not an error.
+fn say(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }
 
 /// Reads sample locations in the mesh's coordinates.
