@@ -37,6 +37,8 @@ enum Command {
     /// Sample terrain elevations over a region from DEM files, point clouds, terrain tiles or
     /// elevation web services.
     Sample(Box<cmd::sample::Args>),
+    /// Mesh the study region: quality triangles, optional smoothing, VTU/OBJ/PLY/MSH output.
+    Mesh(cmd::mesh::Args),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +50,7 @@ fn main() -> ExitCode {
         Command::Interpolate(args) => cmd::interpolate::run(args),
         Command::Cv(args) => cmd::cv::run(args),
         Command::Sample(args) => cmd::sample::run(*args),
+        Command::Mesh(args) => cmd::mesh::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

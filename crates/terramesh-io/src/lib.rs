@@ -5,6 +5,7 @@
 pub mod export;
 pub mod grid_write;
 pub mod dem;
+pub mod mesh_write;
 pub mod number;
 pub mod output;
 pub mod pictures;

@@ -8,3 +8,4 @@ pub mod interpolate;
 pub(crate) mod plot;
 pub mod variogram;
 pub mod sample;
+pub mod mesh;

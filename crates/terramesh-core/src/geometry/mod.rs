@@ -1,5 +1,7 @@
 //! Planar geometry of a study region: polygons with holes and interior constraint lines.
 
 mod region;
+mod validate;
 
-pub use region::{Polygon, Region};
+pub use region::{ring_signed_area, Polygon, Region};
+pub use validate::{validate, ValidationError};

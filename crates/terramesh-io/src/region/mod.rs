@@ -2,13 +2,19 @@
 //! projecting geographic input to UTM in one zone.
 
 mod corners;
+mod geojson;
+mod kml;
+mod wkt;
 
 use std::path::{Path, PathBuf};
 
 use terramesh_core::coords::{to_utm, CoordError, Zone};
-use terramesh_core::geometry::Region;
+use terramesh_core::geometry::{validate, Region, ValidationError};
 
 pub use corners::{parse_corner, parse_corners};
+pub use geojson::parse_geojson;
+pub use kml::parse_kml;
+pub use wkt::parse_wkt;
 
 /// Errors while reading a region.
 #[derive(Debug, thiserror::Error)]
@@ -32,6 +38,18 @@ pub enum RegionError {
         /// The underlying error.
         #[source]
         source: std::io::Error,
+    },
+    /// The region's polygons are not valid (fewer than 3 vertices, self-intersecting, a hole
+    /// outside its shell, zero area).
+    #[error("{source_name}: {source} (coordinates as read{crs_note})")]
+    Validation {
+        /// The inline text or file name.
+        source_name: String,
+        /// What is wrong, with its location.
+        #[source]
+        source: ValidationError,
+        /// Which coordinates the location is in.
+        crs_note: String,
     },
     /// Projection to UTM failed.
     #[error("projecting the region to UTM: {0}")]
@@ -101,15 +119,22 @@ pub fn load(
             };
             (Region::from_ring(ring), crs == RegionCrs::Geographic)
         }
-        RegionInput::File(p) => {
-            return Err(RegionError::Invalid {
-                source_name: p.display().to_string(),
-                message: "region files (GeoJSON, KML, WKT) are not supported by this build; \
-                          give the corners with --corners"
-                    .into(),
-            })
-        }
+        RegionInput::File(p) => (read_region_file(p)?, crs == RegionCrs::Geographic),
     };
+    let name = match input {
+        RegionInput::Corners(s) if !looks_like_file(s) => "--corners".to_string(),
+        RegionInput::Corners(s) => s.trim().to_string(),
+        RegionInput::File(p) => p.display().to_string(),
+    };
+    let read = validate(&read).map_err(|source| RegionError::Validation {
+        source_name: name,
+        source,
+        crs_note: if is_geographic {
+            ", longitude latitude".into()
+        } else {
+            ", projected metres".into()
+        },
+    })?;
     if !is_geographic {
         return Ok(LoadedRegion {
             projected: read,
@@ -143,7 +168,109 @@ pub fn project(geographic: Region, zone: Option<Zone>) -> Result<LoadedRegion, R
     })
 }
 
+/// Reads a GeoJSON (`.geojson`, `.json`), KML (`.kml`) or WKT (`.wkt`, other) region file;
+/// the format is chosen by extension, or by the first character for other extensions.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
+/// let p = dir.path().join("area.wkt");
+/// std::fs::write(&p, "POLYGON ((0 0, 10 0, 10 10, 0 10))")?;
+/// let r = terramesh_io::region::read_region_file(&p)?;
+/// assert_eq!(r.area(), 100.0);
+/// # Ok(()) }
+/// ```
+pub fn read_region_file(path: &Path) -> Result<Region, RegionError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| RegionError::Io {
+        file: name.clone(),
+        source,
+    })?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let first = text.trim_start().chars().next().unwrap_or(' ');
+    let parsed = match ext.as_str() {
+        "geojson" | "json" => parse_geojson(&text),
+        "kml" => parse_kml(&text),
+        "wkt" => parse_wkt(&text),
+        _ if first == '{' => parse_geojson(&text),
+        _ if first == '<' => parse_kml(&text),
+        _ => parse_wkt(&text),
+    };
+    parsed.map_err(|message| RegionError::Invalid {
+        source_name: name,
+        message,
+    })
+}
+
 fn looks_like_file(s: &str) -> bool {
     let t = s.trim();
     !t.contains(';') && (t.ends_with(".csv") || t.ends_with(".txt") || Path::new(t).is_file())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> PathBuf {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    #[test]
+    fn three_formats_give_the_same_projected_region() {
+        let dir = tempfile::tempdir().unwrap();
+        let ring = "7.3368 48.7224, 7.3404 48.7224, 7.3404 48.7260, 7.3368 48.7260";
+        let wkt = write(&dir, "a.wkt", &format!("POLYGON (({ring}))"));
+        let kml = write(
+            &dir,
+            "a.kml",
+            "<kml><Placemark><Polygon><outerBoundaryIs><LinearRing><coordinates>\
+             7.3368,48.7224,0 7.3368,48.7260,0 7.3404,48.7260,0 7.3404,48.7224,0 7.3368,48.7224,0\
+             </coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark></kml>",
+        );
+        let gj = write(
+            &dir,
+            "a.geojson",
+            r#"{"type":"Polygon","coordinates":[[[7.3368,48.7224],[7.3404,48.7224],[7.3404,48.7260],[7.3368,48.7260],[7.3368,48.7224]]]}"#,
+        );
+        let areas: Vec<f64> = [wkt, kml, gj]
+            .into_iter()
+            .map(|p| {
+                let r = load(&RegionInput::File(p), RegionCrs::Geographic, None).unwrap();
+                assert_eq!(r.zone.unwrap().to_string(), "32N");
+                r.projected.area()
+            })
+            .collect();
+        assert!(areas[0] > 100_000.0);
+        for a in &areas {
+            assert!((a - areas[0]).abs() < 1e-6 * areas[0], "{areas:?}");
+        }
+    }
+
+    #[test]
+    fn invalid_polygon_error_names_file_and_place() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(&dir, "bow.wkt", "POLYGON ((0 0, 10 10, 10 0, 0 10))");
+        let e = load(&RegionInput::File(p), RegionCrs::Projected, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bow.wkt") && e.contains("(5.0"), "{e}");
+        let p = write(&dir, "x.kml", "<kml><Polygon></Polygon></kml>");
+        let e = load(&RegionInput::File(p), RegionCrs::Projected, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("x.kml") && e.contains("outerBoundaryIs"), "{e}");
+        let e = load(
+            &RegionInput::File(dir.path().join("missing.geojson")),
+            RegionCrs::Projected,
+            None,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("missing.geojson"), "{e}");
+    }
 }

@@ -1,0 +1,198 @@
+//! `terramesh mesh`: a planar quality mesh of the study region in UTM metres.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use terramesh_core::coords::{parse_angle, to_utm, Axis, Zone};
+use terramesh_io::mesh_write::{write_mesh, writer_for, MeshView};
+use terramesh_io::region::{load, RegionCrs, RegionInput};
+use terramesh_io::table::{ReadOptions, Table};
+use terramesh_mesh::{smooth, MeshBuilder, Quality, Smoother};
+
+/// Coordinate reference of the input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Crs {
+    /// WGS-84 latitude/longitude, projected to UTM.
+    Geographic,
+    /// Projected metres, used as they are.
+    Projected,
+}
+
+/// Smoothing method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SmootherArg {
+    /// Plain Laplacian (the paper's): each free vertex to the mean of its neighbours.
+    Laplacian,
+    /// Laplacian moves that never lower the worst angle of the vertex's star.
+    Smart,
+    /// Optimal Delaunay triangulation smoothing (area-weighted circumcentres).
+    Odt,
+}
+
+/// Mesh the study region: constrained Delaunay triangulation refined to a minimum angle and a
+/// maximum triangle area or edge length, optionally smoothed; written in UTM metres (z = 0).
+///
+/// The region is a polygon with optional holes and constraint lines: --corners (inline
+/// "LAT LON; ..." or a CSV with lat,lon columns) or --region (GeoJSON, KML or WKT; holes and
+/// LineString constraints are read from the file). The output format follows the extension of
+/// -o: .vtu, .obj, .ply or .msh (Gmsh 4.1). The quality table goes to standard output.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:\n  \
+    terramesh mesh --corners \"N48°43'20.64\\\" E7°20'12.48\\\"; N48°43'20.64\\\" E7°20'25.44\\\"; \
+    N48°43'33.6\\\" E7°20'25.44\\\"; N48°43'33.6\\\" E7°20'12.48\\\"\" --max-area 50 -o mesh.vtu\n  \
+    terramesh mesh --region area.kml --max-area 50 --smooth 10 --smoother smart -o mesh.msh\n  \
+    terramesh mesh --region site.wkt --crs projected --max-edge 5 --points samples.csv -o mesh.ply")]
+pub struct Args {
+    /// Corners "LAT LON; LAT LON; ..." (at least 3; decimal degrees or DMS) or a CSV file with
+    /// columns lat,lon.
+    #[arg(long, conflicts_with = "region", required_unless_present = "region")]
+    corners: Option<String>,
+    /// Region file: GeoJSON (.geojson/.json), KML (.kml) or WKT (.wkt).
+    #[arg(long)]
+    region: Option<PathBuf>,
+    /// Input coordinates: geographic (longitude/latitude, projected to UTM) or projected
+    /// (metres, used as is).
+    #[arg(long, value_enum, default_value = "geographic")]
+    crs: Crs,
+    /// UTM zone such as 32N (default: the zone of the region's centre).
+    #[arg(long)]
+    zone: Option<String>,
+    /// Maximum triangle area, square metres.
+    #[arg(long)]
+    max_area: Option<f64>,
+    /// Maximum edge length, metres.
+    #[arg(long)]
+    max_edge: Option<f64>,
+    /// Minimum angle, degrees (0 to 33; 0 turns angle refinement off).
+    #[arg(long, default_value_t = 30.0)]
+    min_angle: f64,
+    /// Cap on the vertices refinement may add (default: from the area budget).
+    #[arg(long)]
+    max_vertices: Option<usize>,
+    /// Smoothing iterations (0: none).
+    #[arg(long, default_value_t = 0)]
+    smooth: usize,
+    /// Smoothing method.
+    #[arg(long, value_enum, default_value = "smart")]
+    smoother: SmootherArg,
+    /// Sample locations to insert as mesh vertices: CSV with lat,lon (geographic) or x,y /
+    /// easting,northing (projected, in the region's UTM zone).
+    #[arg(long)]
+    points: Option<PathBuf>,
+    /// Output mesh: .vtu, .obj, .ply or .msh.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    // Resolve settings before any work, so that a bad flag fails fast.
+    writer_for(&args.output)?;
+    let zone = match &args.zone {
+        Some(z) => Some(z.parse::<Zone>().context("--zone")?),
+        None => None,
+    };
+    let crs = match args.crs {
+        Crs::Geographic => RegionCrs::Geographic,
+        Crs::Projected => RegionCrs::Projected,
+    };
+    let input = match (&args.corners, &args.region) {
+        (Some(c), None) => RegionInput::Corners(c.clone()),
+        (None, Some(r)) => RegionInput::File(r.clone()),
+        _ => bail!("give the region with --corners or --region"),
+    };
+    let region = load(&input, crs, zone)?;
+    let mut builder = MeshBuilder::new().min_angle(args.min_angle);
+    if let Some(a) = args.max_area {
+        builder = builder.max_area(a);
+    }
+    if let Some(l) = args.max_edge {
+        builder = builder.max_edge(l);
+    }
+    if let Some(n) = args.max_vertices {
+        builder = builder.max_vertices(n);
+    }
+    if let Some(p) = &args.points {
+        builder = builder.points(read_points(p, args.crs, region.zone)?);
+    }
+    let (mut mesh, report) = builder.build(&region.projected)?;
+    let mut text = String::new();
+    if let Some(z) = region.zone {
+        text += &format!(
+            "region: {:.1} m2 in UTM zone {z}\n",
+            region.projected.area()
+        );
+    }
+    if report.points_outside > 0 {
+        text += &format!(
+            "{} sample points lie outside the region and were skipped\n",
+            report.points_outside
+        );
+    }
+    let before = Quality::planar(&mesh);
+    if args.smooth > 0 {
+        let smoother = match args.smoother {
+            SmootherArg::Laplacian => Smoother::Laplacian,
+            SmootherArg::Smart => Smoother::Smart,
+            SmootherArg::Odt => Smoother::Odt,
+        };
+        let rep = smooth(&mut mesh, smoother, args.smooth);
+        let after = Quality::planar(&mesh);
+        text += &format!(
+            "smoothing ({:?}, {} iterations): {} moves, {} rejected, {} Delaunay flips\n",
+            args.smoother, args.smooth, rep.moves, rep.rejected, rep.flips
+        );
+        text += &Quality::table(&[("before", &before), ("after", &after)]);
+    } else {
+        text += &Quality::table(&[("mesh", &before)]);
+    }
+    write_mesh(
+        &args.output,
+        &MeshView::planar(mesh.origin, &mesh.points, &mesh.triangles),
+    )?;
+    text += &format!(
+        "wrote {} ({} vertices, {} triangles)\n",
+        args.output.display(),
+        mesh.points.len(),
+        mesh.triangles.len()
+    );
+    say(&text)
+}
+
+/// Prints the report; a closed pipe (`| head`) is not an error.
+fn say(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}
+
+/// Reads sample locations in the mesh's coordinates.
+fn read_points(path: &std::path::Path, crs: Crs, zone: Option<Zone>) -> Result<Vec<[f64; 2]>> {
+    let t = Table::read(path, &ReadOptions::default())?;
+    let lat_lon = (
+        t.find(&["lat", "latitude"]),
+        t.find(&["lon", "longitude", "lng"]),
+    );
+    if let (Crs::Geographic, (Some(la), Some(lo))) = (crs, lat_lon) {
+        let zone = zone.context("geographic points need the region's UTM zone")?;
+        let mut out = Vec::with_capacity(t.records.len());
+        for r in 0..t.records.len() {
+            let ang = |c: usize, axis| {
+                parse_angle(&t.records[r][c], axis).map_err(|e| t.bad_value(r, c, &e.to_string()))
+            };
+            let (lat, lon) = (ang(la, Axis::Lat)?, ang(lo, Axis::Lon)?);
+            let p = to_utm(lat, lon, Some(zone))
+                .with_context(|| format!("{}, line {}", t.name, t.lines[r]))?;
+            out.push([p.easting, p.northing]);
+        }
+        return Ok(out);
+    }
+    let x = t.require(&["x", "easting", "east"])?;
+    let y = t.require(&["y", "northing", "north"])?;
+    (0..t.records.len())
+        .map(|r| Ok([t.number(r, x)?, t.number(r, y)?]))
+        .collect()
+}

@@ -1,0 +1,230 @@
+//! End-to-end tests of `terramesh mesh`.
+
+use std::path::Path;
+use std::process::Command;
+
+const PAPER_CORNERS: &str = "N48°43'20.64\" E7°20'12.48\"; N48°43'20.64\" E7°20'25.44\"; \
+                             N48°43'33.6\" E7°20'25.44\"; N48°43'33.6\" E7°20'12.48\"";
+
+/// Runs terramesh with `args`; returns (success, stdout, stderr).
+fn terramesh(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args(args)
+        .output()
+        .expect("run terramesh");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Min angle from the quality table's last column.
+fn table_min_angle(stdout: &str) -> f64 {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("min angle"))
+        .expect("quality table");
+    line.split_whitespace().last().unwrap().parse().unwrap()
+}
+
+/// Reads the points and triangle count of a VTU written by terramesh.
+fn vtu_points(path: &Path) -> (Vec<[f64; 3]>, usize) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let start = text.find("NumberOfComponents=\"3\"").unwrap();
+    let body = &text[start..];
+    let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+    let pts = body
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let cells: usize = text
+        .split("NumberOfCells=\"")
+        .nth(1)
+        .and_then(|s| s.split('"').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    (pts, cells)
+}
+
+#[test]
+fn paper_corners_mesh_in_utm() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mesh.vtu");
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--corners",
+        PAPER_CORNERS,
+        "--max-area",
+        "50",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("UTM zone 32N"), "{stdout}");
+    assert!(table_min_angle(&stdout) >= 30.0);
+    let (pts, cells) = vtu_points(&out);
+    assert!(cells >= 106_000 / 50, "{cells}");
+    // The paper's Table 1 corner 1 in UTM: 377676.932 E, 5397932.106 N (within a metre, as
+    // the paper rounds its DMS); vertices span the 265 m x 400 m rectangle.
+    let min_e = pts.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min);
+    let min_n = pts.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+    assert!((min_e - 377_676.932).abs() < 1.0, "{min_e}");
+    assert!((min_n - 5_397_926.333).abs() < 1.0, "{min_n}");
+    assert!(pts.iter().all(|p| p[2] == 0.0));
+}
+
+#[test]
+fn smoothing_reports_before_and_after_for_each_smoother() {
+    let dir = tempfile::tempdir().unwrap();
+    for (smoother, ext) in [("laplacian", "obj"), ("smart", "ply"), ("odt", "msh")] {
+        let out = dir.path().join(format!("m.{ext}"));
+        let (ok, stdout, stderr) = terramesh(&[
+            "mesh",
+            "--corners",
+            PAPER_CORNERS,
+            "--max-area",
+            "200",
+            "--smooth",
+            "5",
+            "--smoother",
+            smoother,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{smoother}: {stderr}");
+        assert!(
+            stdout.contains("before (2D)") && stdout.contains("after (2D)"),
+            "{stdout}"
+        );
+        assert!(out.metadata().unwrap().len() > 1000);
+    }
+}
+
+#[test]
+fn region_file_with_hole_and_constraint_in_projected_metres() {
+    let dir = tempfile::tempdir().unwrap();
+    let wkt = dir.path().join("site.wkt");
+    std::fs::write(
+        &wkt,
+        "POLYGON ((0 0, 100 0, 100 60, 0 60), (10 10, 20 10, 20 20, 10 20))\n\
+         LINESTRING (30 5, 45 40, 50 58)\n",
+    )
+    .unwrap();
+    let out = dir.path().join("m.vtu");
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--region",
+        wkt.to_str().unwrap(),
+        "--crs",
+        "projected",
+        "--max-edge",
+        "5",
+        "--min-angle",
+        "33",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(table_min_angle(&stdout) >= 33.0, "{stdout}");
+    let (pts, _) = vtu_points(&out);
+    // No vertex inside the hole.
+    assert!(!pts
+        .iter()
+        .any(|p| p[0] > 10.0 && p[0] < 20.0 && p[1] > 10.0 && p[1] < 20.0));
+}
+
+#[test]
+fn sample_points_csv_become_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("samples.csv");
+    std::fs::write(&csv, "x,y\n10.5,10.25\n20.75,30.5\n200,200\n").unwrap();
+    let out = dir.path().join("m.vtu");
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--corners",
+        "0 0; 0 50; 40 50; 40 0",
+        "--crs",
+        "projected",
+        "--min-angle",
+        "0",
+        "--points",
+        csv.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("1 sample points lie outside"), "{stdout}");
+    let (pts, cells) = vtu_points(&out);
+    assert_eq!(pts.len(), 6);
+    assert_eq!(cells, 6);
+    assert!(pts.iter().any(|p| p[0] == 10.5 && p[1] == 10.25));
+}
+
+#[test]
+fn errors_are_clear_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.vtu");
+    let o = out.to_str().unwrap();
+    let bow = dir.path().join("bow.geojson");
+    std::fs::write(
+        &bow,
+        r#"{"type":"Polygon","coordinates":[[[7.0,48.0],[7.1,48.1],[7.1,48.0],[7.0,48.1],[7.0,48.0]]]}"#,
+    )
+    .unwrap();
+    let hole_out = dir.path().join("hole.kml");
+    std::fs::write(
+        &hole_out,
+        "<kml><Placemark><Polygon><outerBoundaryIs><LinearRing><coordinates>\
+         7.0,48.0 7.1,48.0 7.1,48.1 7.0,48.0</coordinates></LinearRing></outerBoundaryIs>\
+         <innerBoundaryIs><LinearRing><coordinates>8.0,48.0 8.1,48.0 8.1,48.01 8.0,48.0\
+         </coordinates></LinearRing></innerBoundaryIs></Polygon></Placemark></kml>",
+    )
+    .unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--corners", "48 7; 48.1 7.1"], "at least 3 distinct"),
+        (vec!["--corners", "48 7; 48.1 7.1; 48.2 7.2"], "zero area"),
+        (
+            vec!["--region", bow.to_str().unwrap()],
+            "intersect at (7.05",
+        ),
+        (
+            vec!["--region", hole_out.to_str().unwrap()],
+            "hole 1 lies outside",
+        ),
+        (
+            vec!["--corners", PAPER_CORNERS, "--min-angle", "34"],
+            "between 0 and 33",
+        ),
+        (
+            vec!["--corners", PAPER_CORNERS, "--max-area", "0"],
+            "--max-area 0",
+        ),
+        (
+            vec![
+                "--corners",
+                PAPER_CORNERS,
+                "--max-area",
+                "0.01",
+                "--max-vertices",
+                "1000",
+            ],
+            "cap of 1000",
+        ),
+    ];
+    for (args, expect) in cases {
+        let mut all = vec!["mesh"];
+        all.extend(&args);
+        all.extend(["-o", o]);
+        let (ok, _, stderr) = terramesh(&all);
+        assert!(!ok, "{args:?} should fail");
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(!out.exists(), "{args:?} left a file");
+    }
+}

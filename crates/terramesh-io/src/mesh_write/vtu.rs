@@ -1,0 +1,82 @@
+//! VTK XML unstructured grid (`.vtu`), ASCII, Float64 points (float32 would lose about
+//! 0.1 m at UTM northings).
+
+use std::io::{self, Write};
+
+use super::{MeshView, MeshWriter};
+
+/// The VTU writer.
+pub struct Vtu;
+
+impl MeshWriter for Vtu {
+    fn name(&self) -> &'static str {
+        "VTU"
+    }
+    fn extensions(&self) -> &'static [&'static str] {
+        &["vtu"]
+    }
+    fn write(&self, m: &MeshView, out: &mut dyn Write) -> io::Result<()> {
+        let (np, nt) = (m.points.len(), m.triangles.len());
+        writeln!(out, "<?xml version=\"1.0\"?>")?;
+        writeln!(
+            out,
+            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
+        )?;
+        writeln!(out, "<UnstructuredGrid>")?;
+        writeln!(
+            out,
+            "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nt}\">"
+        )?;
+        if !m.point_data.is_empty() {
+            writeln!(out, "<PointData>")?;
+            for (name, values) in &m.point_data {
+                writeln!(
+                    out,
+                    "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
+                )?;
+                for v in values.iter() {
+                    writeln!(out, "{v:?}")?;
+                }
+                writeln!(out, "</DataArray>")?;
+            }
+            writeln!(out, "</PointData>")?;
+        }
+        writeln!(out, "<Points>")?;
+        writeln!(
+            out,
+            "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+        )?;
+        for i in 0..np {
+            let p = m.point(i);
+            writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+        }
+        writeln!(out, "</DataArray>\n</Points>\n<Cells>")?;
+        writeln!(
+            out,
+            "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+        )?;
+        for t in m.triangles {
+            writeln!(out, "{} {} {}", t[0], t[1], t[2])?;
+        }
+        writeln!(out, "</DataArray>")?;
+        writeln!(
+            out,
+            "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+        )?;
+        for k in 1..=nt {
+            writeln!(out, "{}", 3 * k)?;
+        }
+        writeln!(out, "</DataArray>")?;
+        writeln!(
+            out,
+            "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+        )?;
+        for _ in 0..nt {
+            writeln!(out, "5")?;
+        }
+        writeln!(
+            out,
+            "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>"
+        )
+    }
+}

@@ -1,0 +1,140 @@
+//! KML regions as Google Earth saves them: every `Polygon` (`outerBoundaryIs` and
+//! `innerBoundaryIs` `LinearRing`s, inside `Placemark`s and `MultiGeometry`s) becomes a
+//! polygon, every `LineString` a constraint line. Coordinates are `lon,lat[,alt]` tuples.
+
+use roxmltree::{Document, Node};
+use terramesh_core::geometry::{Polygon, Region};
+
+/// Parses KML text. Errors name the line of the offending element.
+///
+/// ```
+/// let r = terramesh_io::region::parse_kml(r#"<?xml version="1.0" encoding="UTF-8"?>
+/// <kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark><name>Haut-Barr</name>
+/// <Polygon><outerBoundaryIs><LinearRing><coordinates>
+///   7.3368,48.7224,0 7.3404,48.7224,0 7.3404,48.7260,0 7.3368,48.7260,0 7.3368,48.7224,0
+/// </coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark></Document></kml>"#)?;
+/// assert_eq!(r.polygons[0].outer.len(), 5);
+/// # Ok::<(), String>(())
+/// ```
+pub fn parse_kml(text: &str) -> Result<Region, String> {
+    let doc = Document::parse(text).map_err(|e| format!("not valid XML: {e}"))?;
+    let line = |n: Node| doc.text_pos_at(n.range().start).row;
+    let mut region = Region::default();
+    for n in doc.descendants().filter(|n| n.is_element()) {
+        match n.tag_name().name() {
+            "Polygon" => {
+                let ring_of = |b: Node| -> Result<Vec<[f64; 2]>, String> {
+                    let c = b
+                        .descendants()
+                        .find(|c| c.tag_name().name() == "coordinates")
+                        .ok_or_else(|| {
+                            format!(
+                                "line {}: <{}> without <LinearRing><coordinates>",
+                                line(b),
+                                b.tag_name().name()
+                            )
+                        })?;
+                    coordinates(c.text().unwrap_or(""), line(c))
+                };
+                let mut outer = None;
+                let mut holes = Vec::new();
+                for b in n.children().filter(|c| c.is_element()) {
+                    match b.tag_name().name() {
+                        "outerBoundaryIs" => outer = Some(ring_of(b)?),
+                        "innerBoundaryIs" => {
+                            // One innerBoundaryIs may hold several LinearRings.
+                            let rings: Vec<Node> = b
+                                .children()
+                                .filter(|c| c.tag_name().name() == "LinearRing")
+                                .collect();
+                            if rings.len() > 1 {
+                                for r in rings {
+                                    holes.push(ring_of(r)?);
+                                }
+                            } else {
+                                holes.push(ring_of(b)?);
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                let outer = outer.ok_or_else(|| {
+                    format!("line {}: <Polygon> without <outerBoundaryIs>", line(n))
+                })?;
+                region.polygons.push(Polygon { outer, holes });
+            }
+            "LineString" => {
+                let c = n
+                    .children()
+                    .find(|c| c.tag_name().name() == "coordinates")
+                    .ok_or_else(|| {
+                        format!("line {}: <LineString> without <coordinates>", line(n))
+                    })?;
+                region
+                    .lines
+                    .push(coordinates(c.text().unwrap_or(""), line(c))?);
+            }
+            _ => {}
+        }
+    }
+    if region.polygons.is_empty() {
+        return Err(
+            "no <Polygon> found; in Google Earth draw the region with \"Add Polygon\" \
+                    and save it as KML"
+                .into(),
+        );
+    }
+    Ok(region)
+}
+
+/// Parses a KML `<coordinates>` text: whitespace-separated `lon,lat[,alt]` tuples.
+fn coordinates(text: &str, line: u32) -> Result<Vec<[f64; 2]>, String> {
+    text.split_whitespace()
+        .enumerate()
+        .map(|(i, t)| {
+            let bad = |why: &str| {
+                format!(
+                    "line {line}: coordinate {} '{t}' {why}; expected lon,lat[,alt]",
+                    i + 1
+                )
+            };
+            let mut parts = t.split(',');
+            let lon = parts.next().unwrap_or("");
+            let lat = parts.next().ok_or_else(|| bad("has no latitude"))?;
+            let lon: f64 = lon.parse().map_err(|_| bad("has a bad longitude"))?;
+            let lat: f64 = lat.parse().map_err(|_| bad("has a bad latitude"))?;
+            Ok([lon, lat])
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polygon_with_holes_and_line() {
+        let r = parse_kml(
+            r#"<kml><Document><Placemark><MultiGeometry><Polygon>
+            <outerBoundaryIs><LinearRing><coordinates>0,0 10,0 10,10 0,10 0,0</coordinates></LinearRing></outerBoundaryIs>
+            <innerBoundaryIs><LinearRing><coordinates>2,2,0 4,2,0 4,4,0 2,2,0</coordinates></LinearRing></innerBoundaryIs>
+            <innerBoundaryIs><LinearRing><coordinates>6,6 8,6 8,8 6,6</coordinates></LinearRing></innerBoundaryIs>
+            </Polygon><LineString><coordinates>1,5 9,5</coordinates></LineString></MultiGeometry></Placemark></Document></kml>"#,
+        )
+        .unwrap();
+        assert_eq!(r.polygons.len(), 1);
+        assert_eq!(r.polygons[0].holes.len(), 2);
+        assert_eq!(r.polygons[0].holes[0][1], [4.0, 2.0]);
+        assert_eq!(r.lines.len(), 1);
+    }
+
+    #[test]
+    fn bad_coordinate_names_line() {
+        let e = parse_kml("<kml>\n<Polygon><outerBoundaryIs><LinearRing>\n<coordinates>0,0 1,x 1,1</coordinates></LinearRing></outerBoundaryIs></Polygon></kml>")
+            .unwrap_err();
+        assert!(e.contains("line 3") && e.contains("'1,x'"), "{e}");
+        let e = parse_kml("<kml><Polygon></Polygon></kml>").unwrap_err();
+        assert!(e.contains("outerBoundaryIs"), "{e}");
+        assert!(parse_kml("<kml><Polygon>").unwrap_err().contains("XML"));
+    }
+}

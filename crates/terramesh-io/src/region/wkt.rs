@@ -1,0 +1,234 @@
+//! WKT regions: `POLYGON`, `MULTIPOLYGON`, `LINESTRING`, `MULTILINESTRING` and
+//! `GEOMETRYCOLLECTION`, one or more geometries in a file. Coordinates are `x y` (longitude
+//! latitude for geographic input); `Z`/`M` values are ignored.
+
+use terramesh_core::geometry::{Polygon, Region};
+
+/// Parses WKT text. Errors give the line and column.
+///
+/// ```
+/// let r = terramesh_io::region::parse_wkt(
+///     "POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0), (2 2, 4 2, 4 4, 2 2))\nLINESTRING (1 5, 9 5)")?;
+/// assert_eq!(r.polygons[0].holes.len(), 1);
+/// assert_eq!(r.lines.len(), 1);
+/// # Ok::<(), String>(())
+/// ```
+pub fn parse_wkt(text: &str) -> Result<Region, String> {
+    let mut p = Parser {
+        s: text.as_bytes(),
+        i: 0,
+        text,
+    };
+    let mut region = Region::default();
+    p.skip_ws();
+    while p.i < p.s.len() {
+        p.geometry(&mut region)?;
+        p.skip_ws();
+        if p.peek() == Some(b';') {
+            p.i += 1;
+            p.skip_ws();
+        }
+    }
+    if region.polygons.is_empty() {
+        return Err("no POLYGON or MULTIPOLYGON found".into());
+    }
+    Ok(region)
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    i: usize,
+    text: &'a str,
+}
+
+impl Parser<'_> {
+    fn at(&self) -> String {
+        let before = &self.text[..self.i.min(self.text.len())];
+        let line = before.matches('\n').count() + 1;
+        let col = before.len() - before.rfind('\n').map_or(0, |k| k + 1) + 1;
+        format!("line {line}, column {col}")
+    }
+    fn err(&self, what: &str) -> String {
+        let rest: String = self.text[self.i.min(self.text.len())..]
+            .chars()
+            .take(20)
+            .collect();
+        format!("{}: {what}, found '{rest}'", self.at())
+    }
+    fn skip_ws(&mut self) {
+        while self.i < self.s.len() && self.s[self.i].is_ascii_whitespace() {
+            self.i += 1;
+        }
+    }
+    fn peek(&self) -> Option<u8> {
+        self.s.get(self.i).copied()
+    }
+    fn expect(&mut self, c: u8) -> Result<(), String> {
+        self.skip_ws();
+        if self.peek() == Some(c) {
+            self.i += 1;
+            Ok(())
+        } else {
+            Err(self.err(&format!("expected '{}'", c as char)))
+        }
+    }
+    fn word(&mut self) -> String {
+        self.skip_ws();
+        let st = self.i;
+        while self.i < self.s.len() && self.s[self.i].is_ascii_alphabetic() {
+            self.i += 1;
+        }
+        self.text[st..self.i].to_ascii_uppercase()
+    }
+    /// Reads `Z`, `M`, `ZM` and `EMPTY`; returns true for EMPTY.
+    fn modifiers(&mut self) -> bool {
+        loop {
+            let save = self.i;
+            match self.word().as_str() {
+                "Z" | "M" | "ZM" => continue,
+                "EMPTY" => return true,
+                _ => {
+                    self.i = save;
+                    return false;
+                }
+            }
+        }
+    }
+    fn geometry(&mut self, region: &mut Region) -> Result<(), String> {
+        let start = self.i;
+        let w = self.word();
+        if self.modifiers() {
+            return Ok(());
+        }
+        match w.as_str() {
+            "POLYGON" => region.polygons.push(self.polygon()?),
+            "MULTIPOLYGON" => self.list(|p| {
+                region.polygons.push(p.polygon()?);
+                Ok(())
+            })?,
+            "LINESTRING" => region.lines.push(self.ring()?),
+            "MULTILINESTRING" => self.list(|p| {
+                region.lines.push(p.ring()?);
+                Ok(())
+            })?,
+            "POINT" | "MULTIPOINT" => {
+                // Skip balanced parentheses.
+                let mut depth = 0;
+                loop {
+                    match self.peek() {
+                        Some(b'(') => depth += 1,
+                        Some(b')') => {
+                            depth -= 1;
+                            if depth == 0 {
+                                self.i += 1;
+                                break;
+                            }
+                        }
+                        None => return Err(self.err("unbalanced parentheses")),
+                        _ => {}
+                    }
+                    self.i += 1;
+                }
+            }
+            "GEOMETRYCOLLECTION" => self.list(|p| p.geometry(region))?,
+            _ => {
+                self.i = start;
+                return Err(self.err(
+                    "expected POLYGON, MULTIPOLYGON, LINESTRING, MULTILINESTRING or GEOMETRYCOLLECTION",
+                ));
+            }
+        }
+        Ok(())
+    }
+    fn list(
+        &mut self,
+        mut item: impl FnMut(&mut Self) -> Result<(), String>,
+    ) -> Result<(), String> {
+        self.expect(b'(')?;
+        loop {
+            item(self)?;
+            self.skip_ws();
+            match self.peek() {
+                Some(b',') => self.i += 1,
+                Some(b')') => {
+                    self.i += 1;
+                    return Ok(());
+                }
+                _ => return Err(self.err("expected ',' or ')'")),
+            }
+        }
+    }
+    fn polygon(&mut self) -> Result<Polygon, String> {
+        let mut rings = Vec::new();
+        self.list(|p| {
+            rings.push(p.ring()?);
+            Ok(())
+        })?;
+        let outer = rings.remove(0);
+        Ok(Polygon {
+            outer,
+            holes: rings,
+        })
+    }
+    fn ring(&mut self) -> Result<Vec<[f64; 2]>, String> {
+        let mut pts = Vec::new();
+        self.list(|p| {
+            let x = p.number()?;
+            let y = p.number()?;
+            // Optional Z and M.
+            for _ in 0..2 {
+                p.skip_ws();
+                if matches!(p.peek(), Some(c) if c == b'-' || c == b'+' || c == b'.' || c.is_ascii_digit())
+                {
+                    p.number()?;
+                }
+            }
+            pts.push([x, y]);
+            Ok(())
+        })?;
+        Ok(pts)
+    }
+    fn number(&mut self) -> Result<f64, String> {
+        self.skip_ws();
+        let st = self.i;
+        while self.i < self.s.len()
+            && matches!(
+                self.s[self.i],
+                b'0'..=b'9' | b'.' | b'-' | b'+' | b'e' | b'E'
+            )
+        {
+            self.i += 1;
+        }
+        let t = &self.text[st..self.i];
+        t.parse::<f64>().map_err(|_| {
+            self.i = st;
+            self.err("expected a number")
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn multipolygon_z_and_collection() {
+        let r = parse_wkt(
+            "MULTIPOLYGON Z (((0 0 1, 10 0 1, 10 10 1, 0 0 1)), ((20 0, 30 0, 30 10, 20 0)))\n\
+             GEOMETRYCOLLECTION (LINESTRING (1 1, 2 2), POINT (3 3), POLYGON EMPTY)",
+        )
+        .unwrap();
+        assert_eq!(r.polygons.len(), 2);
+        assert_eq!(r.polygons[1].outer[2], [30.0, 10.0]);
+        assert_eq!(r.lines.len(), 1);
+    }
+
+    #[test]
+    fn errors_give_line_and_column() {
+        let e = parse_wkt("POLYGON ((0 0, 1 0,\n 1 x, 0 0))").unwrap_err();
+        assert!(e.starts_with("line 2, column 4"), "{e}");
+        let e = parse_wkt("CIRCLE (0 0, 1)").unwrap_err();
+        assert!(e.contains("expected POLYGON"), "{e}");
+        assert!(parse_wkt("POLYGON ((0 0, 1 0, 1 1, 0 0)").is_err());
+    }
+}

@@ -1,0 +1,366 @@
+//! Terrain-adaptive refinement: refine until the piecewise-linear surface is within a
+//! tolerance of a height function at triangle centres and edge midpoints, keeping the planar
+//! minimum angle; then improve the lifted (3D) triangles by edge flips and vertex moves that
+//! never raise the surface error above what refinement reached.
+
+use spade::Triangulation;
+use terramesh_core::geometry::{validate, Region};
+
+use crate::build::CdtState;
+use crate::flip::flip_passes;
+use crate::mesh::{orient, Mesh};
+use crate::quality::triangle_quality;
+use crate::smooth::neighbour_mean;
+use crate::{MeshError, MAX_MIN_ANGLE};
+
+/// A terrain height `z(x, y)` in the region's coordinates (absolute, e.g. UTM metres): a
+/// kriging or IDW interpolator, a DEM sampler, an analytic surface. Any `Fn(f64, f64) -> f64`
+/// is one.
+pub trait HeightFunction {
+    /// The height at `(x, y)`.
+    fn height(&self, x: f64, y: f64) -> f64;
+}
+
+impl<F: Fn(f64, f64) -> f64> HeightFunction for F {
+    fn height(&self, x: f64, y: f64) -> f64 {
+        self(x, y)
+    }
+}
+
+/// Settings of [`adaptive_mesh`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveSettings {
+    /// Largest allowed vertical distance between the mesh surface and the function at
+    /// triangle centres and edge midpoints (metres).
+    pub max_error: f64,
+    /// Planar minimum angle kept during refinement (degrees, at most 33). Default 30.
+    pub min_angle: f64,
+    /// Optional maximum triangle area. Default none.
+    pub max_area: Option<f64>,
+    /// Cap on vertices. Default 2,000,000.
+    pub max_vertices: usize,
+    /// Improve the 3D shape by flips and vertex moves afterwards. Default true.
+    pub improve_3d: bool,
+    /// Sweeps of 3D vertex moves. Default 5.
+    pub smooth_iterations: usize,
+}
+
+impl AdaptiveSettings {
+    /// Defaults with the given error tolerance.
+    pub fn new(max_error: f64) -> Self {
+        AdaptiveSettings {
+            max_error,
+            min_angle: 30.0,
+            max_area: None,
+            max_vertices: 2_000_000,
+            improve_3d: true,
+            smooth_iterations: 5,
+        }
+    }
+}
+
+/// What [`adaptive_mesh`] did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AdaptiveReport {
+    /// Insert-and-refine rounds.
+    pub rounds: usize,
+    /// Largest error at centres and midpoints after refinement.
+    pub error_after_refinement: f64,
+    /// Largest error at centres and midpoints of the final mesh.
+    pub max_error: f64,
+    /// Minimum 3D angle after refinement, degrees.
+    pub min_angle_3d_before: f64,
+    /// Minimum 3D angle of the final mesh, degrees.
+    pub min_angle_3d: f64,
+    /// Accepted 3D-improving flips.
+    pub flips: usize,
+    /// Accepted 3D-improving vertex moves.
+    pub moves: usize,
+}
+
+/// Refines a mesh of `region` until the surface through `f` at the vertices is within
+/// `settings.max_error` of `f` at every triangle centre and edge midpoint, then improves the
+/// 3D triangle shape. Returns the mesh, the heights of its vertices and a report.
+///
+/// # Errors
+/// As [`crate::MeshBuilder::build`]; [`MeshError::Incomplete`] when `max_vertices` is reached.
+///
+/// ```
+/// use terramesh_core::geometry::Region;
+/// use terramesh_mesh::{adaptive_mesh, surface_error, AdaptiveSettings};
+/// let r = Region::from_ring(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]]);
+/// let cone = |x: f64, y: f64| 50.0 - ((x - 50.0).powi(2) + (y - 50.0).powi(2)).sqrt();
+/// let (mesh, z, rep) = adaptive_mesh(&r, &AdaptiveSettings::new(0.5), &cone)?;
+/// assert!(rep.max_error <= 0.5);
+/// assert!(surface_error(&mesh, &z, &cone) <= 0.5);
+/// # Ok::<(), terramesh_mesh::MeshError>(())
+/// ```
+pub fn adaptive_mesh(
+    region: &Region,
+    settings: &AdaptiveSettings,
+    f: &dyn HeightFunction,
+) -> Result<(Mesh, Vec<f64>, AdaptiveReport), MeshError> {
+    let bad = |name: &'static str, value: f64, why: &str| MeshError::BadParameter {
+        name,
+        value,
+        why: why.into(),
+    };
+    if !(settings.max_error.is_finite() && settings.max_error > 0.0) {
+        return Err(bad("max-error", settings.max_error, "must be positive"));
+    }
+    if !(0.0..=MAX_MIN_ANGLE).contains(&settings.min_angle) {
+        return Err(bad("min-angle", settings.min_angle, "must be in 0..=33"));
+    }
+    let region = validate(region)?;
+    let mut st = CdtState::new(&region, &[])?;
+    let cap = settings.max_vertices;
+    let mut report = AdaptiveReport::default();
+    if !st.refine(settings.min_angle, settings.max_area, cap)? {
+        return Err(incomplete(cap, &st));
+    }
+    let o = st.origin;
+    let h = |p: [f64; 2]| f.height(p[0] + o[0], p[1] + o[1]);
+    let tol = settings.max_error;
+    let mut zs: Vec<f64> = Vec::new();
+    loop {
+        report.rounds += 1;
+        let pos: Vec<[f64; 2]> = st
+            .cdt
+            .vertices()
+            .map(|v| [v.position().x, v.position().y])
+            .collect();
+        for p in &pos[zs.len()..] {
+            zs.push(h(*p));
+        }
+        let inside = st.inside_faces();
+        // Error at every edge midpoint, then one new vertex per bad triangle, at the worst of
+        // its centre and its three midpoints (a shared midpoint is inserted once).
+        let mut edge_err = vec![0.0f64; st.cdt.num_undirected_edges()];
+        for e in st.cdt.undirected_edges() {
+            let [a, b] = e.vertices().map(|v| v.fix().index());
+            let m = [0.5 * (pos[a][0] + pos[b][0]), 0.5 * (pos[a][1] + pos[b][1])];
+            edge_err[e.fix().index()] = (h(m) - 0.5 * (zs[a] + zs[b])).abs();
+        }
+        let mut split = vec![false; edge_err.len()];
+        let mut new_points = Vec::new();
+        for face in st.cdt.inner_faces() {
+            if !inside[face.fix().index()] {
+                continue;
+            }
+            let v = face.vertices().map(|v| v.fix().index());
+            let c = [
+                (pos[v[0]][0] + pos[v[1]][0] + pos[v[2]][0]) / 3.0,
+                (pos[v[0]][1] + pos[v[1]][1] + pos[v[2]][1]) / 3.0,
+            ];
+            let zc = (zs[v[0]] + zs[v[1]] + zs[v[2]]) / 3.0;
+            let ec = (h(c) - zc).abs();
+            let (ei, ee) = face
+                .adjacent_edges()
+                .map(|e| e.as_undirected().fix().index())
+                .into_iter()
+                .map(|k| (k, edge_err[k]))
+                .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+            if ec.max(ee) <= tol {
+                continue;
+            }
+            if ec >= ee {
+                new_points.push(c);
+            } else {
+                split[ei] = true;
+            }
+        }
+        for e in st.cdt.undirected_edges() {
+            if split[e.fix().index()] {
+                let [a, b] = e.vertices().map(|v| v.position());
+                new_points.push([0.5 * (a.x + b.x), 0.5 * (a.y + b.y)]);
+            }
+        }
+        if new_points.is_empty() {
+            break;
+        }
+        if st.cdt.num_vertices() + new_points.len() > cap {
+            return Err(incomplete(cap, &st));
+        }
+        for p in new_points {
+            st.insert_point(p)?;
+        }
+        if !st.refine(settings.min_angle, settings.max_area, cap)? {
+            return Err(incomplete(cap, &st));
+        }
+    }
+    let mut mesh = st.extract();
+    let mut z: Vec<f64> = mesh.points.iter().map(|&p| h(p)).collect();
+    report.error_after_refinement = surface_error_local(&mesh, &z, &h);
+    report.min_angle_3d_before = crate::Quality::surface(&mesh, &z).min_angle;
+    if settings.improve_3d {
+        let limit = report.error_after_refinement;
+        let min2d = settings.min_angle;
+        for _ in 0..3 {
+            let flips = improve_flips(&mut mesh, &z, &h, limit, min2d);
+            let moves = improve_moves(
+                &mut mesh,
+                &mut z,
+                &h,
+                limit,
+                min2d,
+                settings.smooth_iterations,
+            );
+            report.flips += flips;
+            report.moves += moves;
+            if flips + moves == 0 {
+                break;
+            }
+        }
+    }
+    report.max_error = surface_error_local(&mesh, &z, &h);
+    report.min_angle_3d = crate::Quality::surface(&mesh, &z).min_angle;
+    Ok((mesh, z, report))
+}
+
+fn incomplete(cap: usize, st: &CdtState) -> MeshError {
+    MeshError::Incomplete {
+        cap,
+        vertices: st.cdt.num_vertices(),
+    }
+}
+
+/// Largest vertical distance between the mesh surface (heights `z` at the vertices) and `f`
+/// at triangle centres and edge midpoints. `f` takes absolute coordinates.
+///
+/// ```
+/// use terramesh_mesh::{surface_error, Mesh};
+/// let m = Mesh {
+///     origin: [10.0, 0.0],
+///     points: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]],
+///     triangles: vec![[0, 1, 2]],
+///     constraint_edges: vec![],
+/// };
+/// let plane = |x: f64, y: f64| x + 2.0 * y;
+/// let z: Vec<f64> = (0..3).map(|i| { let p = m.absolute(i); plane(p[0], p[1]) }).collect();
+/// assert!(surface_error(&m, &z, &plane) < 1e-12);
+/// let bowl = |x: f64, y: f64| (x - 10.0).powi(2) + y * y;
+/// let z: Vec<f64> = (0..3).map(|i| { let p = m.absolute(i); bowl(p[0], p[1]) }).collect();
+/// assert!((surface_error(&m, &z, &bowl) - 2.0).abs() < 1e-12); // midpoint (1, 1)
+/// ```
+pub fn surface_error(mesh: &Mesh, z: &[f64], f: &dyn HeightFunction) -> f64 {
+    let o = mesh.origin;
+    surface_error_local(mesh, z, &|p: [f64; 2]| f.height(p[0] + o[0], p[1] + o[1]))
+}
+
+fn surface_error_local(mesh: &Mesh, z: &[f64], h: &dyn Fn([f64; 2]) -> f64) -> f64 {
+    mesh.triangles
+        .iter()
+        .map(|t| tri_error(mesh, z, h, *t))
+        .fold(0.0, f64::max)
+}
+
+/// Error of one triangle at its centre and its three edge midpoints.
+fn tri_error(mesh: &Mesh, z: &[f64], h: &dyn Fn([f64; 2]) -> f64, t: [u32; 3]) -> f64 {
+    let p = t.map(|i| mesh.points[i as usize]);
+    let zz = t.map(|i| z[i as usize]);
+    let c = [
+        (p[0][0] + p[1][0] + p[2][0]) / 3.0,
+        (p[0][1] + p[1][1] + p[2][1]) / 3.0,
+    ];
+    let mut e = (h(c) - (zz[0] + zz[1] + zz[2]) / 3.0).abs();
+    for k in 0..3 {
+        let (a, b) = (k, (k + 1) % 3);
+        let m = [0.5 * (p[a][0] + p[b][0]), 0.5 * (p[a][1] + p[b][1])];
+        e = e.max((h(m) - 0.5 * (zz[a] + zz[b])).abs());
+    }
+    e
+}
+
+fn q3(mesh: &Mesh, z: &[f64], t: [u32; 3]) -> (f64, f64) {
+    let p3 = t.map(|i| {
+        let p = mesh.points[i as usize];
+        [p[0], p[1], z[i as usize]]
+    });
+    let p2 = t.map(|i| {
+        let p = mesh.points[i as usize];
+        [p[0], p[1], 0.0]
+    });
+    (
+        triangle_quality(p3).min_angle,
+        triangle_quality(p2).min_angle,
+    )
+}
+
+/// Flips that raise the pair's minimum 3D angle, keep its planar minimum angle at or above
+/// `min(old, min2d)`, and keep the error within `limit`.
+fn improve_flips(
+    mesh: &mut Mesh,
+    z: &[f64],
+    h: &dyn Fn([f64; 2]) -> f64,
+    limit: f64,
+    min2d: f64,
+) -> usize {
+    flip_passes(mesh, 20, |m, [a, b, c, d]| {
+        let (o1, p1) = q3(m, z, [a, b, c]);
+        let (o2, p2) = q3(m, z, [b, a, d]);
+        let (n1, r1) = q3(m, z, [c, a, d]);
+        let (n2, r2) = q3(m, z, [c, d, b]);
+        n1.min(n2) > o1.min(o2) + 1e-9
+            && r1.min(r2) >= p1.min(p2).min(min2d)
+            && tri_error(m, z, h, [c, a, d]).max(tri_error(m, z, h, [c, d, b])) <= limit
+    })
+}
+
+/// Smart-Laplacian moves of free vertices judged on the lifted star.
+fn improve_moves(
+    mesh: &mut Mesh,
+    z: &mut [f64],
+    h: &dyn Fn([f64; 2]) -> f64,
+    limit: f64,
+    min2d: f64,
+    iterations: usize,
+) -> usize {
+    let fixed = mesh.fixed_vertices();
+    let (off, tris) = mesh.vertex_stars();
+    let mut moves = 0;
+    for _ in 0..iterations {
+        let mut moved = 0;
+        for v in 0..mesh.points.len() {
+            if fixed[v] || off[v] == off[v + 1] {
+                continue;
+            }
+            let star = &tris[off[v]..off[v + 1]];
+            let Some(target) = neighbour_mean(mesh, v, star) else {
+                continue;
+            };
+            let stats = |m: &Mesh, z: &[f64]| {
+                star.iter().fold((f64::INFINITY, f64::INFINITY), |acc, &t| {
+                    let (a3, a2) = q3(m, z, m.triangles[t as usize]);
+                    (acc.0.min(a3), acc.1.min(a2))
+                })
+            };
+            let (old3, old2) = stats(mesh, z);
+            let (old_p, old_z) = (mesh.points[v], z[v]);
+            mesh.points[v] = target;
+            z[v] = h(target);
+            let valid = star.iter().all(|&t| {
+                let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.points[i as usize]);
+                orient(a, b, c) > 0.0
+            });
+            let ok = valid && {
+                let (new3, new2) = stats(mesh, z);
+                new3 > old3 + 1e-9
+                    && new2 >= old2.min(min2d)
+                    && star
+                        .iter()
+                        .all(|&t| tri_error(mesh, z, h, mesh.triangles[t as usize]) <= limit)
+            };
+            if ok {
+                moved += 1;
+            } else {
+                mesh.points[v] = old_p;
+                z[v] = old_z;
+            }
+        }
+        moves += moved;
+        if moved == 0 {
+            break;
+        }
+    }
+    moves
+}

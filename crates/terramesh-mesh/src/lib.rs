@@ -1,0 +1,83 @@
+//! Planar meshing kernels of **terramesh**: constrained Delaunay triangulation of a study
+//! region, Delaunay refinement to a minimum angle and a maximum area or edge length, quality
+//! metrics in 2D and 3D, smoothing, and terrain-adaptive refinement against any height
+//! function. No files, no printing.
+//!
+//! Constrained triangulation and refinement are spade's; predicates are exact (`robust`).
+//!
+//! ```
+//! use terramesh_core::geometry::{Polygon, Region};
+//! use terramesh_mesh::{smooth, MeshBuilder, Quality, Smoother};
+//! let mut region = Region::from_ring(vec![[0.0, 0.0], [20.0, 0.0], [20.0, 10.0], [0.0, 10.0]]);
+//! region.polygons[0].holes.push(vec![[5.0, 4.0], [7.0, 4.0], [7.0, 6.0], [5.0, 6.0]]);
+//! region.lines.push(vec![[10.0, 1.0], [15.0, 9.0]]);
+//! let (mut mesh, _) = MeshBuilder::new().min_angle(30.0).max_area(2.0).build(&region)?;
+//! mesh.sanity_check(&region).unwrap();
+//! smooth(&mut mesh, Smoother::Smart, 5);
+//! assert!(Quality::planar(&mesh).min_angle >= 30.0);
+//! # Ok::<(), terramesh_mesh::MeshError>(())
+//! ```
+#![warn(missing_docs)]
+
+/// Surface-adaptive refinement against a height function, with 3D shape improvement.
+mod adaptive;
+/// Constrained Delaunay triangulation and Delaunay refinement.
+mod build;
+/// Edge flips: Delaunay in the plane, shape-improving on a surface.
+mod flip;
+/// The mesh type and its invariants.
+mod mesh;
+/// Quality metrics in 2D and 3D.
+mod quality;
+/// Laplacian, smart Laplacian and ODT smoothing.
+mod smooth;
+
+pub use adaptive::{
+    adaptive_mesh, surface_error, AdaptiveReport, AdaptiveSettings, HeightFunction,
+};
+pub use build::{BuildReport, MeshBuilder, MAX_MIN_ANGLE};
+pub use flip::delaunay_flips;
+pub use mesh::Mesh;
+pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
+pub use smooth::{smooth, SmoothReport, Smoother};
+
+use terramesh_core::geometry::ValidationError;
+
+/// Errors of mesh construction.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// The region is not a valid polygon set.
+    #[error("invalid region: {0}")]
+    InvalidRegion(#[from] ValidationError),
+    /// A setting is out of range.
+    #[error("--{name} {value}: {why}")]
+    BadParameter {
+        /// The setting, named as the command-line flag.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is wrong.
+        why: String,
+    },
+    /// A vertex could not be inserted (coordinates too large or too small for the predicates).
+    #[error("cannot insert a vertex at ({}, {}) (local coordinates): {why}", at[0], at[1])]
+    Insertion {
+        /// The position.
+        at: [f64; 2],
+        /// spade's reason.
+        why: String,
+    },
+    /// Refinement stopped at its vertex cap before meeting every criterion; no mesh is
+    /// returned rather than a poor one.
+    #[error(
+        "refinement reached its cap of {cap} added vertices ({vertices} vertices) before meeting \
+         the angle and size limits; raise --max-vertices, raise --max-area or --max-edge, or \
+         lower --min-angle"
+    )]
+    Incomplete {
+        /// The cap on added vertices.
+        cap: usize,
+        /// Vertices when it stopped.
+        vertices: usize,
+    },
+}

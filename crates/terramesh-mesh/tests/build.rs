@@ -1,0 +1,187 @@
+//! Meshes of regions with holes and constraints: angle, area, coverage and error cases.
+
+use terramesh_core::geometry::{Polygon, Region, ValidationError};
+use terramesh_mesh::{MeshBuilder, MeshError, Quality};
+
+fn square(x0: f64, y0: f64, s: f64) -> Vec<[f64; 2]> {
+    vec![[x0, y0], [x0 + s, y0], [x0 + s, y0 + s], [x0, y0 + s]]
+}
+
+/// A 100 x 60 rectangle with two holes and a road and a river (one crossing the other).
+fn region_with_holes_and_lines() -> Region {
+    let mut r = Region::from_ring(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 60.0], [0.0, 60.0]]);
+    r.polygons[0].holes.push(square(10.0, 10.0, 10.0));
+    r.polygons[0]
+        .holes
+        .push(vec![[60.0, 30.0], [70.0, 40.0], [60.0, 50.0], [55.0, 40.0]]);
+    r.lines.push(vec![[0.0, 30.0], [40.0, 25.0], [50.0, 5.0]]);
+    r.lines.push(vec![[30.0, 5.0], [45.0, 40.0], [50.0, 58.0]]);
+    r
+}
+
+#[test]
+fn min_angle_area_and_coverage_with_holes_and_constraints() {
+    let r = region_with_holes_and_lines();
+    for angle in [20.0, 30.0, 33.0] {
+        let (mesh, rep) = MeshBuilder::new()
+            .min_angle(angle)
+            .max_area(5.0)
+            .build(&r)
+            .unwrap();
+        assert!(rep.refinement_complete);
+        mesh.sanity_check(&r).unwrap();
+        let q = Quality::planar(&mesh);
+        assert!(q.min_angle >= angle - 1e-9, "{angle}: {}", q.min_angle);
+        assert!(q.area.max <= 5.0 * (1.0 + 1e-12), "{}", q.area.max);
+        let rel = (mesh.area() - r.area()).abs() / r.area();
+        assert!(rel < 1e-9, "{rel}");
+    }
+}
+
+#[test]
+fn max_edge_is_respected() {
+    let r = region_with_holes_and_lines();
+    let (mesh, _) = MeshBuilder::new().max_edge(4.0).build(&r).unwrap();
+    mesh.sanity_check(&r).unwrap();
+    let q = Quality::planar(&mesh);
+    assert!(q.edge.max <= 4.0, "{}", q.edge.max);
+    assert!(q.min_angle >= 30.0 - 1e-9);
+}
+
+#[test]
+fn utm_magnitudes_keep_area_and_angle() {
+    // The paper's Haut-Barr square in UTM 32N (about 270 m a side), shifted to UTM values.
+    let o = [377_676.934, 5_397_931.494];
+    let ring = vec![
+        o,
+        [o[0] + 264.6, o[1] + 5.1],
+        [o[0] + 258.9, o[1] + 405.2],
+        [o[0] - 5.6, o[1] + 400.0],
+    ];
+    let r = Region::from_ring(ring);
+    let (mesh, _) = MeshBuilder::new().max_area(50.0).build(&r).unwrap();
+    mesh.sanity_check(&r).unwrap();
+    assert!(Quality::planar(&mesh).min_angle >= 30.0 - 1e-9);
+    // Points are stored relative to the bounding-box centre.
+    assert!(mesh
+        .points
+        .iter()
+        .all(|p| p[0].abs() < 300.0 && p[1].abs() < 300.0));
+}
+
+#[test]
+fn sample_points_become_vertices() {
+    let r = Region::from_ring(square(0.0, 0.0, 10.0));
+    let pts: Vec<[f64; 2]> = (0..25)
+        .map(|i| [0.5 + (i % 5) as f64 * 2.0, 0.5 + (i / 5) as f64 * 2.0])
+        .chain([[20.0, 20.0]])
+        .collect();
+    // Without refinement: exactly corners + samples.
+    let (mesh, rep) = MeshBuilder::new()
+        .min_angle(0.0)
+        .points(pts.clone())
+        .build(&r)
+        .unwrap();
+    assert_eq!(rep.points_outside, 1);
+    assert_eq!(mesh.points.len(), 4 + 25);
+    mesh.sanity_check(&r).unwrap();
+    // With refinement: samples kept among the vertices.
+    let (mesh, _) = MeshBuilder::new().points(pts.clone()).build(&r).unwrap();
+    for p in &pts[..25] {
+        assert!(
+            mesh.points.iter().any(|q| mesh_abs(&mesh, q) == *p),
+            "{p:?}"
+        );
+    }
+    assert!(Quality::planar(&mesh).min_angle >= 30.0 - 1e-9);
+}
+
+fn mesh_abs(m: &terramesh_mesh::Mesh, q: &[f64; 2]) -> [f64; 2] {
+    [q[0] + m.origin[0], q[1] + m.origin[1]]
+}
+
+#[test]
+fn closed_constraint_loop_is_meshed_inside() {
+    // A ring road: spade's winding rule would call its inside a hole.
+    let mut r = Region::from_ring(square(0.0, 0.0, 20.0));
+    r.lines.push(vec![
+        [5.0, 5.0],
+        [15.0, 5.0],
+        [15.0, 15.0],
+        [5.0, 15.0],
+        [5.0, 5.0],
+    ]);
+    let (mesh, _) = MeshBuilder::new().max_area(1.0).build(&r).unwrap();
+    mesh.sanity_check(&r).unwrap();
+    let q = Quality::planar(&mesh);
+    assert!(q.area.max <= 1.0 && q.min_angle >= 30.0 - 1e-9);
+}
+
+#[test]
+fn multipolygon_is_meshed() {
+    let r = Region {
+        polygons: vec![
+            Polygon {
+                outer: square(0.0, 0.0, 10.0),
+                holes: vec![],
+            },
+            Polygon {
+                outer: square(20.0, 0.0, 10.0),
+                holes: vec![square(23.0, 3.0, 4.0)],
+            },
+        ],
+        lines: vec![],
+    };
+    let (mesh, _) = MeshBuilder::new().max_area(2.0).build(&r).unwrap();
+    mesh.sanity_check(&r).unwrap();
+}
+
+#[test]
+fn angle_beyond_guarantee_is_rejected() {
+    let r = Region::from_ring(square(0.0, 0.0, 10.0));
+    let e = MeshBuilder::new().min_angle(34.0).build(&r).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MeshError::BadParameter {
+                name: "min-angle",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("33"), "{e}");
+    let e = MeshBuilder::new().max_area(-1.0).build(&r).unwrap_err();
+    assert!(e.to_string().contains("--max-area -1"), "{e}");
+}
+
+#[test]
+fn vertex_cap_reached_is_an_error_not_a_poor_mesh() {
+    let r = Region::from_ring(square(0.0, 0.0, 100.0));
+    let e = MeshBuilder::new()
+        .max_area(0.5)
+        .max_vertices(100)
+        .build(&r)
+        .unwrap_err();
+    assert!(matches!(e, MeshError::Incomplete { cap: 100, .. }), "{e}");
+}
+
+#[test]
+fn invalid_regions_are_errors() {
+    let bow = Region::from_ring(vec![[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]);
+    let e = MeshBuilder::new().build(&bow).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MeshError::InvalidRegion(ValidationError::SelfIntersection { .. })
+        ),
+        "{e}"
+    );
+    let two = Region::from_ring(vec![[0.0, 0.0], [1.0, 1.0], [0.0, 0.0]]);
+    assert!(matches!(
+        MeshBuilder::new().build(&two),
+        Err(MeshError::InvalidRegion(
+            ValidationError::TooFewVertices { .. }
+        ))
+    ));
+}
