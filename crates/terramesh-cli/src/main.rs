@@ -7,7 +7,6 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
-#[allow(dead_code)] // TODO(build): fields are read by `terramesh build`, next.
 mod project;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
@@ -28,6 +27,8 @@ enum Command {
     Convert(cmd::convert::Args),
     /// Create a project directory with a commented terramesh.toml.
     Init(cmd::init::Args),
+    /// Build the whole DSM of a project: samples, mesh, kriging, exports, pictures, report.
+    Build(cmd::build::Args),
     /// Experimental semivariogram and a fitted model (JSON, optional SVG chart).
     Variogram(cmd::variogram::Args),
     /// Kriging (simple, ordinary, universal) or IDW at target points or on a grid.
@@ -46,6 +47,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
+        Command::Build(args) => cmd::build::run(args),
         Command::Variogram(args) => cmd::variogram::run(args),
         Command::Interpolate(args) => cmd::interpolate::run(args),
         Command::Cv(args) => cmd::cv::run(args),

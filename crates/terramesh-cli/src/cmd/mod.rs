@@ -1,5 +1,6 @@
 //! One module per subcommand: its arguments (`Args`) and its `run`.
 
+pub mod build;
 pub mod convert;
 pub mod init;
 pub mod cv;

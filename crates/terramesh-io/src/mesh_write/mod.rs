@@ -42,6 +42,8 @@ pub struct MeshView<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Named per-point scalar fields (written where the format has fields: VTU, PLY).
     pub point_data: Vec<(&'a str, &'a [f64])>,
+    /// Named per-triangle scalar fields (written by VTU), e.g. a quality measure.
+    pub cell_data: Vec<(&'a str, &'a [f64])>,
 }
 
 impl<'a> MeshView<'a> {
@@ -53,6 +55,7 @@ impl<'a> MeshView<'a> {
             z: None,
             triangles,
             point_data: Vec::new(),
+            cell_data: Vec::new(),
         }
     }
 

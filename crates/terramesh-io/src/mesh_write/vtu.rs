@@ -41,6 +41,20 @@ impl MeshWriter for Vtu {
             }
             writeln!(out, "</PointData>")?;
         }
+        if !m.cell_data.is_empty() {
+            writeln!(out, "<CellData>")?;
+            for (name, values) in &m.cell_data {
+                writeln!(
+                    out,
+                    "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
+                )?;
+                for v in values.iter() {
+                    writeln!(out, "{v:?}")?;
+                }
+                writeln!(out, "</DataArray>")?;
+            }
+            writeln!(out, "</CellData>")?;
+        }
         writeln!(out, "<Points>")?;
         writeln!(
             out,

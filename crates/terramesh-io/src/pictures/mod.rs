@@ -4,6 +4,7 @@
 //! Every drawing is deterministic (no dates, a bundled font), so two builds give identical
 //! files.
 
+mod chart;
 mod colour;
 mod maps;
 mod view3d;
@@ -12,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
+pub use chart::draw_variogram;
 pub use colour::{hillshade, shade, ColourMap};
 pub use maps::{draw_mesh, draw_samples, draw_surface, SurfaceMap};
 pub use view3d::draw_view3d;

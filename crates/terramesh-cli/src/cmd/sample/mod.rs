@@ -3,9 +3,9 @@
 
 mod points;
 mod raster;
-mod settings;
+pub(crate) mod settings;
 mod web;
-mod write;
+pub(crate) mod write;
 
 use std::path::PathBuf;
 
@@ -139,7 +139,13 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let s = settings::resolve(&args)?;
+    let (s, table) = acquire(&args)?;
+    write::write(&s, table)
+}
+
+/// Resolves the settings and samples the source, without writing (for `terramesh build`).
+pub(crate) fn acquire(args: &Args) -> Result<(settings::Settings, write::Samples)> {
+    let s = settings::resolve(args)?;
     let table = match &s.source {
         settings::Source::Raster(path) => raster::sample_file(&s, path)?,
         settings::Source::Tiles(template) => raster::sample_tiles(&s, template)?,
@@ -147,5 +153,5 @@ pub fn run(args: Args) -> Result<()> {
         settings::Source::Lidar(path) => points::sample_points(&s, path, true)?,
         settings::Source::Web(endpoint) => web::sample_web(&s, endpoint)?,
     };
-    write::write(&s, table)
+    Ok((s, table))
 }

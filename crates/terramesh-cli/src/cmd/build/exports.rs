@@ -1,0 +1,233 @@
+//! Step 5 of `terramesh build`: the DSM in every format, the sealed solid, grids and tables.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use terramesh_core::coords::to_wgs84;
+use terramesh_core::solid::{check_closed, extrude, volume};
+use terramesh_io::export::{write_dxf, write_kml, write_stl, write_tsurf, KmlStyle, TsurfInfo};
+use terramesh_io::grid_write::{write_asc, write_geotiff};
+use terramesh_io::mesh_write::{write_mesh, MeshView};
+use terramesh_io::number::write_shortest;
+use terramesh_io::output::Output;
+use terramesh_mesh::{triangle_quality, Quality};
+
+use super::stages::{Interpolated, Meshed, Samples};
+use crate::project::Project;
+
+/// What was written, for the report.
+pub struct Written {
+    /// Every file, in order.
+    pub files: Vec<PathBuf>,
+    /// Local origin subtracted in the 32-bit formats (STL).
+    pub origin: [f64; 3],
+    /// Base elevation of the solid.
+    pub base: f64,
+    /// Volume of the solid, m³.
+    pub volume: f64,
+    /// 3D quality of the DSM surface.
+    pub quality3d: Quality,
+}
+
+/// Opens `path` atomically, runs `f` on it, commits.
+fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Result<PathBuf> {
+    let mut out = Output::create(Some(path)).with_context(|| format!("cannot write {}", path.display()))?;
+    f(&mut out).with_context(|| format!("writing {}", path.display()))?;
+    out.commit().with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path.to_path_buf())
+}
+
+/// Writes every output of step 5.
+pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Result<Written> {
+    let mesh = &m.mesh;
+    let n = mesh.points.len();
+    let abs: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let q = mesh.absolute(i);
+            [q[0], q[1], it.uk[i]]
+        })
+        .collect();
+    let tris = &mesh.triangles;
+    let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
+    let min_angle: Vec<f64> = tris
+        .iter()
+        .map(|t| {
+            let q = t.map(|i| {
+                let a = mesh.points[i as usize];
+                [a[0], a[1], 0.0]
+            });
+            triangle_quality(q).min_angle
+        })
+        .collect();
+    let mut files = Vec::new();
+    let want = |f: &str| p.export.formats.iter().any(|x| x == f);
+
+    // Per-vertex values as the library computed them.
+    files.push(atomic(&out.join("dsm-vertices.csv"), |w| {
+        w.write_all(b"x,y,elevation_uk,kriging_std,elevation_idw\n")?;
+        for i in 0..n {
+            for (k, v) in [abs[i][0], abs[i][1], it.uk[i], it.uk_std[i], it.idw[i]].iter().enumerate() {
+                if k > 0 {
+                    w.write_all(b",")?;
+                }
+                write_shortest(w, *v)?;
+            }
+            w.write_all(b"\n")?;
+        }
+        Ok(())
+    })?);
+
+    let view = MeshView {
+        origin: mesh.origin,
+        points: &mesh.points,
+        z: Some(&it.uk),
+        triangles: tris,
+        point_data: vec![
+            ("elevation_uk", &it.uk[..]),
+            ("kriging_std", &it.uk_std[..]),
+            ("elevation_idw", &it.idw[..]),
+            ("uk_minus_idw", &diff[..]),
+        ],
+        cell_data: vec![("min_angle_deg", &min_angle[..])],
+    };
+    for ext in ["vtu", "obj", "ply", "msh"] {
+        if want(ext) {
+            let path = out.join(format!("dsm.{ext}"));
+            write_mesh(&path, &view)?;
+            files.push(path);
+        }
+    }
+    let origin = [mesh.origin[0], mesh.origin[1], 0.0];
+    if want("stl") {
+        files.push(atomic(&out.join("dsm.stl"), |w| write_stl(w, &abs, tris, origin))?);
+    }
+    let zone = s.zone;
+    let crs_name = format!("WGS 84 / UTM zone {zone}");
+    if want("ts") {
+        files.push(atomic(&out.join("dsm.ts"), |w| {
+            write_tsurf(w, &abs, tris, &TsurfInfo { name: "terramesh_dsm", crs_name: &crs_name })
+        })?);
+    }
+    if want("dxf") {
+        files.push(atomic(&out.join("dsm.dxf"), |w| write_dxf(w, &abs, tris, "DSM"))?);
+    }
+    if want("kml") {
+        let geo: Vec<[f64; 3]> = abs
+            .iter()
+            .map(|q| {
+                let (lat, lon) = to_wgs84(q[0], q[1], zone)?;
+                Ok([lon, lat, q[2]])
+            })
+            .collect::<Result<_, terramesh_core::coords::CoordError>>()?;
+        let title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
+        files.push(atomic(&out.join("dsm.kml"), |w| {
+            write_kml(w, &geo, tris, &KmlStyle { name: &title, ..KmlStyle::default() })
+        })?);
+    }
+    files.push(atomic(&out.join("dsm-origin.json"), |w| {
+        writeln!(
+            w,
+            "{{\n  \"x\": {},\n  \"y\": {},\n  \"z\": {},\n  \"crs\": \"EPSG:{}\",\n  \"note\": \"STL coordinates are relative to this origin: add it to get UTM metres\"\n}}",
+            origin[0],
+            origin[1],
+            origin[2],
+            zone.epsg()
+        )
+    })?);
+
+    // The sealed solid.
+    let zmin = it.uk.iter().copied().fold(f64::INFINITY, f64::min);
+    let base = p.export.base_elevation.unwrap_or((zmin - 50.0).floor());
+    let solid = extrude(&abs, tris, base).context("export.base_elevation")?;
+    check_closed(&solid.triangles).context("the sealed solid")?;
+    let vol = volume(&solid.vertices, &solid.triangles);
+    files.push(atomic(&out.join("dsm-solid.stl"), |w| write_stl(w, &solid.vertices, &solid.triangles, origin))?);
+    let rel: Vec<[f64; 2]> = solid.vertices.iter().map(|v| [v[0] - origin[0], v[1] - origin[1]]).collect();
+    let sz: Vec<f64> = solid.vertices.iter().map(|v| v[2]).collect();
+    let sview = MeshView {
+        origin: mesh.origin,
+        points: &rel,
+        z: Some(&sz),
+        triangles: &solid.triangles,
+        point_data: Vec::new(),
+        cell_data: Vec::new(),
+    };
+    let spath = out.join("dsm-solid.msh");
+    write_mesh(&spath, &sview)?;
+    files.push(spath);
+    files.push(atomic(&out.join("dsm-solid.json"), |w| {
+        writeln!(
+            w,
+            "{{\n  \"base_elevation\": {base},\n  \"volume\": {vol},\n  \"vertices\": {},\n  \"triangles\": {},\n  \"closed\": true\n}}",
+            solid.vertices.len(),
+            solid.triangles.len()
+        )
+    })?);
+
+    // The DSM grid.
+    let (spec, values) = &it.grid;
+    let epsg = u16::try_from(zone.epsg()).ok();
+    files.push(atomic(&out.join("dsm.tif"), |w| write_geotiff(w, spec, values, epsg))?);
+    files.push(atomic(&out.join("dsm.asc"), |w| write_asc(w, spec, values))?);
+
+    // Tables.
+    let q3 = Quality::surface(mesh, &it.uk);
+    files.push(atomic(&out.join("mesh-quality.csv"), |w| {
+        writeln!(w, "metric,planar_before_smoothing,planar_after_smoothing,surface_3d")?;
+        let rows: [(&str, fn(&Quality) -> f64); 12] = [
+            ("triangles", |q| q.triangles as f64),
+            ("vertices", |q| q.vertices as f64),
+            ("min_angle_deg", |q| q.min_angle),
+            ("max_angle_deg", |q| q.max_angle),
+            ("radius_ratio_min", |q| q.radius_ratio.min),
+            ("radius_ratio_mean", |q| q.radius_ratio.mean),
+            ("aspect_ratio_max", |q| q.aspect_ratio.max),
+            ("aspect_ratio_mean", |q| q.aspect_ratio.mean),
+            ("area_min_m2", |q| q.area.min),
+            ("area_mean_m2", |q| q.area.mean),
+            ("area_max_m2", |q| q.area.max),
+            ("edge_mean_m", |q| q.edge.mean),
+        ];
+        for (name, f) in rows {
+            write!(w, "{name}")?;
+            for q in [&m.before, &m.after, &q3] {
+                w.write_all(b",")?;
+                write_shortest(w, f(q))?;
+            }
+            w.write_all(b"\n")?;
+        }
+        Ok(())
+    })?);
+    files.push(atomic(&out.join("cross-validation.csv"), |w| {
+        writeln!(w, "method,n,rmse,mae,mean_error,mean_standardized,var_standardized")?;
+        for (name, st) in &it.cv {
+            write!(w, "{name},{},", st.n)?;
+            for (k, v) in [Some(st.rmse), Some(st.mae), Some(st.mean_error), st.mean_standardized, st.var_standardized]
+                .iter()
+                .enumerate()
+            {
+                if k > 0 {
+                    w.write_all(b",")?;
+                }
+                if let Some(v) = v {
+                    write_shortest(w, *v)?;
+                }
+            }
+            w.write_all(b"\n")?;
+        }
+        Ok(())
+    })?);
+    let json = serde_json::json!({
+        "data": "samples.csv",
+        "points": s.xyz.len(),
+        "experimental": it.lags,
+        "model": it.variogram,
+        "candidates": it.candidates.iter().map(|(m, cv, fit)| serde_json::json!({"model": m, "cv_rmse": cv, "fit_rmse": fit})).collect::<Vec<_>>(),
+    });
+    files.push(atomic(&out.join("variogram.json"), |w| {
+        serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })?);
+    Ok(Written { files, origin, base, volume: vol, quality3d: q3 })
+}

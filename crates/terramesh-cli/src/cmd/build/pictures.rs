@@ -1,0 +1,301 @@
+//! Pictures and `report.html` of `terramesh build`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use terramesh_core::coords::{format_dms, to_utm, Axis};
+use terramesh_io::output::write_atomic;
+use terramesh_io::pictures::{
+    draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d, render_both, ColourMap, SurfaceMap,
+};
+use terramesh_io::report::{Block, Report, Section};
+use terramesh_mesh::Quality;
+
+use super::exports::Written;
+use super::stages::{Interpolated, Meshed, Samples};
+use super::Timings;
+use crate::project::Project;
+
+const SIZE: (u32, u32) = (900, 700);
+
+/// A picture: its caption and PNG path.
+pub struct Picture {
+    /// Caption in the report.
+    pub caption: String,
+    /// The PNG file (an SVG sits beside it).
+    pub png: PathBuf,
+}
+
+fn outlines(s: &Samples) -> Vec<Vec<[f64; 2]>> {
+    let mut v = Vec::new();
+    for poly in &s.region.projected.polygons {
+        v.push(poly.outer.clone());
+        v.extend(poly.holes.iter().cloned());
+    }
+    v.extend(s.region.projected.lines.iter().cloned());
+    v
+}
+
+/// Draws every picture into `out/pictures/`.
+pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Result<Vec<Picture>> {
+    let dir = out.join("pictures");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let rings = outlines(s);
+    let mut pics = Vec::new();
+    let mut add = |name: &str, caption: String, files: [PathBuf; 2]| {
+        let _ = name;
+        pics.push(Picture { caption, png: files[0].clone() });
+    };
+    let f = render_both(&dir.join("samples"), SIZE, |r| {
+        draw_samples(r, &s.xyz, &rings, &format!("{} samples over the study region", s.xyz.len()))
+    })?;
+    add("samples", format!("Sample points coloured by elevation ({} from {})", s.xyz.len(), s.source), f);
+
+    let xy0: Vec<[f64; 2]> = (0..m.unsmoothed.points.len()).map(|i| m.unsmoothed.absolute(i)).collect();
+    let f = render_both(&dir.join("mesh-before-smoothing"), SIZE, |r| {
+        draw_mesh(r, &xy0, &m.unsmoothed.triangles, &rings, &format!(
+            "Planar mesh before smoothing: min angle {:.1}°", m.before.min_angle))
+    })?;
+    add("mesh0", "Planar mesh after Delaunay refinement, before smoothing".into(), f);
+    let xy: Vec<[f64; 2]> = (0..m.mesh.points.len()).map(|i| m.mesh.absolute(i)).collect();
+    let f = render_both(&dir.join("mesh-after-smoothing"), SIZE, |r| {
+        draw_mesh(r, &xy, &m.mesh.triangles, &rings, &format!(
+            "Planar mesh after smoothing: min angle {:.1}°", m.after.min_angle))
+    })?;
+    add("mesh1", "Planar mesh after smoothing and Delaunay flips".into(), f);
+
+    let pts: Vec<(f64, f64, u64)> = it.lags.iter().map(|l| (l.distance, l.gamma, l.pairs)).collect();
+    let label = it.variogram.to_string();
+    let f = render_both(&dir.join("variogram"), (900, 600), |r| {
+        draw_variogram(r, &pts, &|h| it.variogram.gamma(h), "Experimental variogram and fitted model", &label)
+    })?;
+    add("variogram", format!("Variogram of the samples and the fitted model: {label}"), f);
+
+    let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
+    let maps: [(&str, &str, &[f64], bool, ColourMap, bool, &str); 4] = [
+        ("elevation-uk", "DSM by universal kriging (linear drift)", &it.uk, true, ColourMap::Terrain, false, "elevation (m)"),
+        ("elevation-idw", "DSM by inverse distance weighting", &it.idw, true, ColourMap::Terrain, false, "elevation (m)"),
+        ("kriging-std", "Kriging standard deviation", &it.uk_std, false, ColourMap::Viridis, false, "std. dev. (m)"),
+        ("uk-minus-idw", "UK minus IDW", &diff, false, ColourMap::Diverging, true, "difference (m)"),
+    ];
+    for (name, title, values, shaded, colours, symmetric, unit) in maps {
+        let map = SurfaceMap {
+            xy: &xy,
+            values,
+            shade_z: shaded.then_some(&it.uk[..]),
+            triangles: &m.mesh.triangles,
+            title,
+            unit,
+            colours,
+            symmetric,
+            outlines: &rings,
+        };
+        let f = render_both(&dir.join(name), SIZE, |r| draw_surface(r, &map))?;
+        add(name, format!("{title}{}", if shaded { ", hill-shaded, with contours" } else { ", with contours" }), f);
+    }
+    let v3: Vec<[f64; 3]> = xy.iter().zip(&it.uk).map(|(p, z)| [p[0], p[1], *z]).collect();
+    let (lo, hi) = s.region.projected.bbox().unwrap_or(([0.0, 0.0], [1.0, 1.0]));
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let relief = it.uk.iter().copied().fold(f64::NEG_INFINITY, f64::max) - it.uk.iter().copied().fold(f64::INFINITY, f64::min);
+    let ex = if relief > 0.0 { (0.3 * extent / relief).clamp(1.0, 10.0) } else { 1.0 };
+    let ex = (ex * 2.0).round() / 2.0;
+    let f = render_both(&dir.join("dsm-3d"), SIZE, |r| draw_view3d(r, &v3, &m.mesh.triangles, ex, "The DSM in 3D"))?;
+    add("3d", "Shaded 3D view of the DSM (UK elevations)".into(), f);
+    Ok(pics)
+}
+
+fn num(v: f64, d: usize) -> String {
+    format!("{v:.d$}")
+}
+
+fn quality_rows(cols: &[&Quality]) -> Vec<Vec<String>> {
+    let rows: [(&str, fn(&Quality) -> String); 10] = [
+        ("triangles", |q| q.triangles.to_string()),
+        ("vertices", |q| q.vertices.to_string()),
+        ("minimum angle (deg)", |q| num(q.min_angle, 2)),
+        ("maximum angle (deg)", |q| num(q.max_angle, 2)),
+        ("radius ratio min / mean", |q| format!("{:.3} / {:.3}", q.radius_ratio.min, q.radius_ratio.mean)),
+        ("aspect ratio mean / max", |q| format!("{:.3} / {:.3}", q.aspect_ratio.mean, q.aspect_ratio.max)),
+        ("area min / mean / max (m²)", |q| format!("{:.2} / {:.2} / {:.2}", q.area.min, q.area.mean, q.area.max)),
+        ("edge min / mean / max (m)", |q| format!("{:.2} / {:.2} / {:.2}", q.edge.min, q.edge.mean, q.edge.max)),
+        ("angles below 30 deg", |q| q.angle_histogram[..3].iter().sum::<usize>().to_string()),
+        ("angles above 90 deg", |q| q.angle_histogram[9..].iter().sum::<usize>().to_string()),
+    ];
+    rows.iter()
+        .map(|(name, f)| std::iter::once(name.to_string()).chain(cols.iter().map(|q| f(q))).collect())
+        .collect()
+}
+
+/// Writes `out/report.html`.
+#[allow(clippy::too_many_arguments)]
+pub fn write_report(
+    out: &Path,
+    p: &Project,
+    s: &Samples,
+    m: &Meshed,
+    it: &Interpolated,
+    w: &Written,
+    pics: &[Picture],
+    timings: &Timings,
+) -> Result<()> {
+    let title = p.title.clone().unwrap_or_else(|| "terramesh discrete surface model".into());
+    let mut sections = Vec::new();
+    let png = |k: usize| -> Result<Block> {
+        let pic = &pics[k];
+        Ok(Block::Png {
+            caption: pic.caption.clone(),
+            bytes: std::fs::read(&pic.png).with_context(|| format!("{}", pic.png.display()))?,
+        })
+    };
+    let region_text = match (&p.region.corners, &p.region.file) {
+        (Some(c), _) => format!("corners {c}"),
+        (_, Some(f)) => format!("file {}", f.display()),
+        _ => String::new(),
+    };
+    let kv = |k: &str, v: String| vec![k.to_string(), v];
+    sections.push(Section {
+        heading: "Inputs".into(),
+        blocks: vec![Block::Table {
+            caption: "Project settings".into(),
+            header: vec!["setting".into(), "value".into()],
+            rows: vec![
+                kv("region", region_text),
+                kv("UTM zone", s.zone.to_string()),
+                kv("region area (m²)", num(s.region.projected.area(), 1)),
+                kv("elevation source", s.source.clone()),
+                kv("sampling grid", match p.sampling.spacing {
+                    Some(sp) => format!("spacing {sp} m"),
+                    None => format!("{} rows x {} cols", p.sampling.rows, p.sampling.cols),
+                }),
+                kv("margin / clip", format!("{} / {}", p.sampling.margin, p.sampling.clip)),
+                kv("mesh", format!(
+                    "min angle {} deg, max area {}, smoothing {} x {}",
+                    p.mesh.min_angle,
+                    m.max_area.map_or("-".into(), |a| format!("{a:.2} m²")),
+                    p.mesh.smooth,
+                    p.mesh.smoother
+                )),
+                kv("kriging", format!(
+                    "universal, drift {:?}, {}",
+                    it.drift,
+                    if p.interpolation.neighbors == 0 { "all samples".to_string() } else { format!("{} neighbours", p.interpolation.neighbors) }
+                )),
+                kv("IDW", format!("power {}, {} neighbours", p.interpolation.idw_power, p.interpolation.idw_neighbors)),
+            ],
+        }],
+    });
+    // Table I of the paper, for this region's corners.
+    let mut corner_rows = Vec::new();
+    if let Some(geo) = &s.region.geographic {
+        for (k, c) in geo.polygons.iter().flat_map(|pl| pl.outer.iter()).enumerate() {
+            let (lon, lat) = (c[0], c[1]);
+            let u = to_utm(lat, lon, Some(s.zone)).context("corner")?;
+            corner_rows.push(vec![
+                (k + 1).to_string(),
+                format_dms(lat, Axis::Lat, 2),
+                format_dms(lon, Axis::Lon, 2),
+                num(u.easting, 3),
+                num(u.northing, 3),
+            ]);
+        }
+    }
+    sections.push(Section {
+        heading: "Study area corners".into(),
+        blocks: vec![Block::Table {
+            caption: format!("Coordinates of the corners (WGS-84 and UTM zone {})", s.zone),
+            header: ["point", "latitude", "longitude", "easting (m)", "northing (m)"].map(String::from).to_vec(),
+            rows: corner_rows,
+        }],
+    });
+    sections.push(Section { heading: "Samples".into(), blocks: vec![png(0)?] });
+    let mut mesh_blocks = vec![png(1)?, png(2)?];
+    mesh_blocks.push(Block::Table {
+        caption: "Mesh quality".into(),
+        header: ["measure", "2D before smoothing", "2D after smoothing", "3D surface"].map(String::from).to_vec(),
+        rows: quality_rows(&[&m.before, &m.after, &w.quality3d]),
+    });
+    if let Some(r) = &m.smoothing {
+        mesh_blocks.push(Block::Text(format!(
+            "Smoothing: {} vertex moves, {} rejected, {} Delaunay flips.",
+            r.moves, r.rejected, r.flips
+        )));
+    }
+    sections.push(Section { heading: "Planar mesh".into(), blocks: mesh_blocks });
+    let mut vb = vec![png(3)?];
+    vb.push(Block::Text(format!("Model: {}. Ranges are practical ranges (GSLIB convention).", it.variogram)));
+    if !it.candidates.is_empty() {
+        vb.push(Block::Table {
+            caption: "Models tried by the automatic fit (chosen by leave-one-out RMSE)".into(),
+            header: ["model", "cross-validation RMSE (m)", "fit RMSE (m²)"].map(String::from).to_vec(),
+            rows: it
+                .candidates
+                .iter()
+                .map(|(name, cv, fit)| {
+                    vec![name.clone(), cv.map_or("-".into(), |v| num(v, 4)), fit.map_or("-".into(), |v| num(v, 4))]
+                })
+                .collect(),
+        });
+    }
+    sections.push(Section { heading: "Variogram".into(), blocks: vb });
+    sections.push(Section {
+        heading: "Interpolated surfaces".into(),
+        blocks: vec![png(4)?, png(5)?, png(6)?, png(7)?, png(8)?],
+    });
+    sections.push(Section {
+        heading: "Cross-validation".into(),
+        blocks: vec![Block::Table {
+            caption: format!(
+                "{} cross-validation of the samples",
+                if p.interpolation.cv_folds == 0 { "Leave-one-out".to_string() } else { format!("{}-fold", p.interpolation.cv_folds) }
+            ),
+            header: ["method", "n", "RMSE (m)", "MAE (m)", "mean error (m)", "mean std. error", "var. std. error"]
+                .map(String::from)
+                .to_vec(),
+            rows: it
+                .cv
+                .iter()
+                .map(|(name, st)| {
+                    vec![
+                        name.clone(),
+                        st.n.to_string(),
+                        num(st.rmse, 4),
+                        num(st.mae, 4),
+                        num(st.mean_error, 4),
+                        st.mean_standardized.map_or("-".into(), |v| num(v, 4)),
+                        st.var_standardized.map_or("-".into(), |v| num(v, 4)),
+                    ]
+                })
+                .collect(),
+        }],
+    });
+    sections.push(Section {
+        heading: "Sealed solid and outputs".into(),
+        blocks: vec![
+            Block::Text(format!(
+                "The DSM extruded to {:.1} m: closed, consistently oriented, volume {:.1} m³. \
+                 STL files are relative to the local origin ({}, {}, {}) recorded in dsm-origin.json.",
+                w.base, w.volume, w.origin[0], w.origin[1], w.origin[2]
+            )),
+            Block::Table {
+                caption: "Files".into(),
+                header: vec!["file".into()],
+                rows: w
+                    .files
+                    .iter()
+                    .map(|f| vec![f.strip_prefix(out).unwrap_or(f).display().to_string()])
+                    .collect(),
+            },
+        ],
+    });
+    sections.push(Section {
+        heading: "Timings".into(),
+        blocks: vec![Block::Table {
+            caption: "Time per stage (this machine, this run)".into(),
+            header: vec!["stage".into(), "seconds".into()],
+            rows: timings.0.iter().map(|(n, t)| vec![n.clone(), num(*t, 3)]).collect(),
+        }],
+    });
+    let html = Report { title, sections }.to_html();
+    write_atomic(&out.join("report.html"), html.as_bytes()).context("cannot write report.html")?;
+    Ok(())
+}

@@ -1,0 +1,339 @@
+//! The computing stages of `terramesh build`: samples, planar mesh, vertex elevations.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use clap::Parser;
+use terramesh_core::coords::Zone;
+use terramesh_geostat::{
+    cross_validate, experimental, fit_auto, CvStats, Data, Drift, Duplicates, Folds, GlobalKriging, Idw,
+    IdwSearch, Interpolator, Lag, LagSettings, LocalKriging, Method, ModelKind, Variogram, Weighting,
+};
+use terramesh_io::region::LoadedRegion;
+use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport, Smoother};
+
+use crate::cmd::sample;
+use crate::project::Project;
+
+/// The samples of step 1, in UTM metres.
+pub struct Samples {
+    /// `[easting, northing, z]`.
+    pub xyz: Vec<[f64; 3]>,
+    /// The UTM zone.
+    pub zone: Zone,
+    /// The region, projected and geographic.
+    pub region: LoadedRegion,
+    /// The source actually used (after the fallback).
+    pub source: String,
+    /// Sampling grid cell size, metres `[dx, dy]` (from the samples' extent).
+    pub cell: [f64; 2],
+}
+
+/// Parses `sample`'s own arguments, so that `build` and `sample` share one code path.
+#[derive(Parser)]
+struct SampleArgv {
+    #[command(flatten)]
+    args: sample::Args,
+}
+
+/// Step 1: samples on the project's grid, also written to `out/samples.csv`.
+pub fn sample(p: &Project, base: &Path, out: &Path) -> Result<Samples> {
+    let source = resolve_source(p, base)?;
+    let mut argv: Vec<String> = vec!["sample".into(), "--source".into(), source.clone()];
+    match (&p.region.corners, &p.region.file) {
+        (Some(c), None) => {
+            let path = base.join(c.trim());
+            let c = if !c.contains(';') && path.is_file() { path.display().to_string() } else { c.clone() };
+            argv.extend(["--corners".into(), c]);
+        }
+        (None, Some(f)) => argv.extend(["--region".into(), base.join(f).display().to_string()]),
+        _ => bail!("[region]: give corners or file"),
+    }
+    if let Some(z) = &p.region.zone {
+        argv.extend(["--zone".into(), z.clone()]);
+    }
+    if p.region.crs == "projected" {
+        argv.extend(["--region-crs".into(), "projected".into()]);
+    }
+    let s = &p.sampling;
+    match s.spacing {
+        Some(sp) => argv.extend(["--spacing".into(), sp.to_string()]),
+        None => argv.extend(["--rows".into(), s.rows.to_string(), "--cols".into(), s.cols.to_string()]),
+    }
+    let margin = if s.margin < 1.0 { s.margin.to_string() } else { format!("{}m", s.margin) };
+    argv.extend(["--margin".into(), margin, "--interpolation".into(), s.method.clone()]);
+    if s.clip {
+        argv.push("--clip".into());
+    }
+    if let Some(c) = p.source.class {
+        argv.extend(["--class".into(), c.to_string()]);
+    }
+    argv.extend(["--no-progress".into(), "-o".into(), out.join("samples.csv").display().to_string()]);
+    let parsed = SampleArgv::try_parse_from(&argv)
+        .map_err(|e| anyhow::anyhow!("[sampling]/[source]: {}", e.to_string().lines().next().unwrap_or("")))?;
+    let (settings, table) = sample::acquire(&parsed.args)?;
+    let zone = table
+        .zone
+        .context("the source is in a projected CRS terramesh does not convert; use a geographic or UTM source for build")?;
+    let region = settings.region.clone().context("a region is needed for build")?;
+    let mut xyz = Vec::with_capacity(table.rows.len());
+    for r in &table.rows {
+        if let Ok(z) = r.z {
+            xyz.push([r.xy[0], r.xy[1], z]);
+        }
+    }
+    if xyz.len() < 10 {
+        bail!("only {} samples with an elevation: enlarge the grid or check the source", xyz.len());
+    }
+    let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
+    sample::write::write(&settings, table)?;
+    Ok(Samples { xyz, zone, region, source, cell })
+}
+
+/// The source path relative to the project file, or the fallback when it is absent.
+fn resolve_source(p: &Project, base: &Path) -> Result<String> {
+    let spec = &p.source.path;
+    let is_service = spec.contains("{z}") || ["google:", "opentopodata:", "open-elevation:"].iter().any(|s| spec.starts_with(s));
+    if is_service {
+        return Ok(spec.clone());
+    }
+    let path = base.join(spec);
+    if path.exists() {
+        return Ok(path.display().to_string());
+    }
+    if let Some(f) = &p.source.fallback {
+        let fb = base.join(f);
+        if fb.exists() {
+            return Ok(fb.display().to_string());
+        }
+        bail!("source.path {} and source.fallback {} do not exist", path.display(), fb.display());
+    }
+    bail!("source.path {}: no such file or directory", path.display())
+}
+
+fn grid_cell(xyz: &[[f64; 3]], rows: usize, cols: usize, spacing: Option<f64>) -> [f64; 2] {
+    if let Some(s) = spacing {
+        return [s, s];
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in xyz {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    [
+        (hi[0] - lo[0]) / (cols.max(2) - 1) as f64,
+        (hi[1] - lo[1]) / (rows.max(2) - 1) as f64,
+    ]
+}
+
+/// The planar mesh of step 3 with its quality before and after smoothing.
+pub struct Meshed {
+    /// The smoothed mesh.
+    pub mesh: Mesh,
+    /// The mesh before smoothing (for the picture).
+    pub unsmoothed: Mesh,
+    /// 2D quality before smoothing.
+    pub before: Quality,
+    /// 2D quality after smoothing.
+    pub after: Quality,
+    /// What smoothing did.
+    pub smoothing: Option<SmoothReport>,
+    /// The maximum area used.
+    pub max_area: Option<f64>,
+}
+
+/// Step 3: constrained Delaunay refinement of the region, then smoothing.
+pub fn mesh(p: &Project, s: &Samples) -> Result<Meshed> {
+    let m = &p.mesh;
+    let mut builder = MeshBuilder::new().min_angle(m.min_angle);
+    // Default size: one triangle per sampling cell, so the mesh resolves what was sampled.
+    let max_area = match (m.max_area, m.max_edge) {
+        (Some(a), _) => Some(a),
+        (None, Some(_)) => None,
+        (None, None) => Some(s.cell[0] * s.cell[1]),
+    };
+    if let Some(a) = max_area {
+        builder = builder.max_area(a);
+    }
+    if let Some(e) = m.max_edge {
+        builder = builder.max_edge(e);
+    }
+    if m.insert_samples {
+        builder = builder.points(s.xyz.iter().map(|q| [q[0], q[1]]).collect());
+    }
+    let (mut mesh, _) = builder.build(&s.region.projected).context("[mesh]")?;
+    let unsmoothed = mesh.clone();
+    let before = Quality::planar(&mesh);
+    let smoothing = if m.smooth > 0 {
+        let smoother = match m.smoother.as_str() {
+            "laplacian" => Smoother::Laplacian,
+            "odt" => Smoother::Odt,
+            _ => Smoother::Smart,
+        };
+        Some(smooth(&mut mesh, smoother, m.smooth))
+    } else {
+        None
+    };
+    let after = Quality::planar(&mesh);
+    Ok(Meshed { mesh, unsmoothed, before, after, smoothing, max_area })
+}
+
+/// Step 4: vertex elevations by UK and IDW, a DSM grid, and cross-validation.
+pub struct Interpolated {
+    /// The variogram used.
+    pub variogram: Variogram,
+    /// Experimental variogram of the samples.
+    pub lags: Vec<Lag>,
+    /// Candidate models tried by `auto`, as (model, cv rmse, fit rmse).
+    pub candidates: Vec<(String, Option<f64>, Option<f64>)>,
+    /// UK elevation at each mesh vertex.
+    pub uk: Vec<f64>,
+    /// Kriging standard deviation at each vertex.
+    pub uk_std: Vec<f64>,
+    /// IDW elevation at each vertex.
+    pub idw: Vec<f64>,
+    /// Cross-validation per method.
+    pub cv: Vec<(String, CvStats)>,
+    /// The DSM grid: spec and values (nodata outside the region).
+    pub grid: (terramesh_io::grid_write::GridSpec, Vec<f64>),
+    /// The drift used by UK.
+    pub drift: Drift,
+}
+
+fn drift_of(name: &str) -> Drift {
+    match name {
+        "constant" => Drift::Constant,
+        "quadratic" => Drift::Quadratic,
+        _ => Drift::Linear,
+    }
+}
+
+/// Runs the geostatistics of step 4.
+pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated> {
+    let ip = &p.interpolation;
+    let data = Data::new(
+        s.xyz.iter().map(|q| [q[0], q[1]]).collect(),
+        s.xyz.iter().map(|q| q[2]).collect(),
+        Duplicates::Mean,
+    )
+    .context("samples")?;
+    let lags = experimental(&data, &LagSettings::default()).context("experimental variogram of the samples")?;
+    let mut candidates = Vec::new();
+    let variogram = if let Some(v) = &ip.model {
+        let kind = ModelKind::parse(&v.model).with_context(|| {
+            format!("interpolation.model.model = \"{}\": expected spherical, exponential, gaussian, matern, power, linear or nugget", v.model)
+        })?;
+        Variogram::single(kind, v.nugget, v.psill, v.range).context("interpolation.model")?
+    } else if ip.variogram == "auto" {
+        let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, &ModelKind::ALL).context("fitting the variogram")?;
+        candidates = cands
+            .iter()
+            .map(|c| (c.model.name().to_string(), c.cv_rmse, c.fit.as_ref().map(|f| f.rmse)))
+            .collect();
+        fit.variogram
+    } else {
+        crate::cmd::geodata::read_variogram_file(&std::path::PathBuf::from(&ip.variogram))
+            .context("interpolation.variogram")?
+    };
+    let drift = drift_of(&ip.drift);
+    let uk_method = Method::Universal(drift);
+    let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len()).map(|i| m.mesh.absolute(i)).collect();
+    let (uk, var) = krige(&data, &variogram, uk_method, ip.neighbors, &vertices, true)?;
+    let uk_std: Vec<f64> = var.iter().map(|v| v.max(0.0).sqrt()).collect();
+    let search = if ip.idw_neighbors == 0 { IdwSearch::All } else { IdwSearch::Nearest(ip.idw_neighbors) };
+    let idw_engine = Idw::new(&data, ip.idw_power, search).context("IDW")?;
+    let mut idw = vec![0.0; vertices.len()];
+    idw_engine.predict(&vertices, &mut idw).context("IDW at the mesh vertices")?;
+
+    // Cross-validation of the methods compared in the report.
+    let folds = if ip.cv_folds == 0 { Folds::LeaveOneOut } else { Folds::KFold(ip.cv_folds) };
+    // Global leave-one-out has a closed form only for models with a sill; for the others
+    // (power, linear) it would refit n systems, so they are cross-validated with 64 neighbours.
+    let neighbours = match (ip.neighbors, variogram.sill()) {
+        (0, Some(_)) => None,
+        (0, None) => Some(64.min(data.len() - 1)),
+        (k, _) => Some(k),
+    };
+    let mut cv = Vec::new();
+    for name in &ip.methods {
+        let how = match name.as_str() {
+            "uk" => Interpolator::Kriging { variogram: variogram.clone(), method: uk_method, neighbours },
+            "ok" => Interpolator::Kriging { variogram: variogram.clone(), method: Method::Ordinary, neighbours },
+            "sk" => Interpolator::Kriging {
+                variogram: variogram.clone(),
+                method: Method::Simple { mean: data.z().iter().sum::<f64>() / data.len() as f64 },
+                neighbours,
+            },
+            _ => Interpolator::Idw { power: ip.idw_power, search },
+        };
+        let r = cross_validate(&data, &how, folds).with_context(|| format!("cross-validation of {name}"))?;
+        cv.push((name.to_uppercase(), r.stats));
+    }
+
+    // The DSM grid over the region's bounding box, nodata outside the region.
+    let (lo, hi) = s.region.projected.bbox().context("empty region")?;
+    let step = p.export.grid_spacing.unwrap_or(s.cell[0].min(s.cell[1])).max(1e-3);
+    let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
+    let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
+    let spec = terramesh_io::grid_write::GridSpec {
+        xmin: lo[0],
+        ymin: hi[1] - (ny - 1) as f64 * step,
+        xmax: lo[0] + (nx - 1) as f64 * step,
+        ymax: hi[1],
+        nx,
+        ny,
+    };
+    let mut inside = Vec::new();
+    let mut index = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let q = spec.node(i, j);
+            if s.region.projected.contains(q) {
+                inside.push(q);
+                index.push(j * nx + i);
+            }
+        }
+    }
+    let nodata = -9999.0;
+    let mut values = vec![nodata; nx * ny];
+    if !inside.is_empty() {
+        let (est, _) = krige(&data, &variogram, uk_method, ip.neighbors, &inside, false)?;
+        for (k, &ix) in index.iter().enumerate() {
+            values[ix] = est[k];
+        }
+    }
+    for (name, v) in [("UK", &uk), ("kriging variance", &var), ("IDW", &idw)] {
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            bail!("{name} gave a non-finite value at mesh vertex {i}: the kriging system is ill-conditioned");
+        }
+    }
+    Ok(Interpolated { variogram, lags, candidates, uk, uk_std, idw, cv, grid: (spec, values), drift })
+}
+
+/// Kriging estimates (and variances on request) at `targets`, global or in a neighbourhood.
+fn krige(
+    data: &Data,
+    v: &Variogram,
+    method: Method,
+    neighbors: usize,
+    targets: &[[f64; 2]],
+    variance: bool,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let mut est = vec![0.0; targets.len()];
+    let mut var = vec![0.0; if variance { targets.len() } else { 0 }];
+    let vslot = if variance { Some(&mut var[..]) } else { None };
+    if neighbors == 0 {
+        GlobalKriging::new(data, v, method, variance)
+            .context("kriging system")?
+            .predict(targets, &mut est, vslot)
+            .context("kriging")?;
+    } else {
+        LocalKriging::new(data, v, method, neighbors)
+            .context("kriging system")?
+            .predict(targets, &mut est, vslot)
+            .context("kriging")?;
+    }
+    Ok((est, var))
+}
