@@ -228,3 +228,44 @@ fn errors_are_clear_and_leave_no_file() {
         assert!(!out.exists(), "{args:?} left a file");
     }
 }
+
+#[test]
+fn geographic_sample_points_and_kml_with_hole() {
+    let dir = tempfile::tempdir().unwrap();
+    let kml = dir.path().join("site.kml");
+    std::fs::write(
+        &kml,
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\
+         <Document><Placemark><name>site</name><Polygon><outerBoundaryIs><LinearRing><coordinates>\n\
+         7.3368,48.7224,0 7.3404,48.7224,0 7.3404,48.7260,0 7.3368,48.7260,0 7.3368,48.7224,0\n\
+         </coordinates></LinearRing></outerBoundaryIs><innerBoundaryIs><LinearRing><coordinates>\n\
+         7.3380,48.7236,0 7.3380,48.7242,0 7.3390,48.7242,0 7.3390,48.7236,0 7.3380,48.7236,0\n\
+         </coordinates></LinearRing></innerBoundaryIs></Polygon></Placemark></Document></kml>",
+    )
+    .unwrap();
+    let csv = dir.path().join("samples.csv");
+    std::fs::write(&csv, "lat,lon\nN48°43'25\",E7°20'15\"\n48.7255,7.3400\n").unwrap();
+    let out = dir.path().join("m.vtu");
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--region",
+        kml.to_str().unwrap(),
+        "--zone",
+        "32N",
+        "--max-area",
+        "100",
+        "--points",
+        csv.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(!stdout.contains("outside"), "{stdout}");
+    assert!(table_min_angle(&stdout) >= 30.0);
+    let (pts, _) = vtu_points(&out);
+    // The second sample (48.7255 N, 7.3400 E) in UTM 32N is a vertex.
+    let p = terramesh_core::coords::to_utm(48.7255, 7.34, None).unwrap();
+    assert!(pts
+        .iter()
+        .any(|q| (q[0] - p.easting).abs() < 1e-6 && (q[1] - p.northing).abs() < 1e-6));
+}

@@ -211,16 +211,22 @@ fn convex_delaunay(
     for p in points {
         let q = [p[0] - origin[0], p[1] - origin[1]];
         check_coordinate(q)?;
-        // Strictly inside, clear of the boundary by more than rounding.
-        let clear = (0..n).all(|i| {
+        // Strictly inside, clear of the boundary by more than rounding; a point on the
+        // boundary needs the constrained path, which splits the boundary edge there.
+        let (mut clear, mut out) = (true, false);
+        for i in 0..n {
             let (a, b) = (local[i], local[(i + 1) % n]);
             let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-            crate::mesh::orient(a, b, q) > tol * len
-        });
+            let o = crate::mesh::orient(a, b, q);
+            clear &= o > tol * len;
+            out |= o < -tol * len;
+        }
         if clear {
             verts.push(Point2::new(q[0], q[1]));
-        } else {
+        } else if out {
             outside += 1;
+        } else {
+            return Ok(None);
         }
     }
     for p in &local {

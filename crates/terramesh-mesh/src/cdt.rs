@@ -94,14 +94,15 @@ impl CdtState {
         for p in points {
             let q = [p[0] - origin[0], p[1] - origin[1]];
             check_coordinate(q)?;
-            if !local.contains(q) {
+            let pq = Point2::new(q[0], q[1]);
+            // Points on a ring (within rounding) are kept and split it.
+            let near = segs.iter().any(|&(a, b)| {
+                near_segment(Point2::new(a[0], a[1]), Point2::new(b[0], b[1]), pq, tol) || a == q
+            });
+            if !near && !local.contains(q) {
                 points_outside += 1;
                 continue;
             }
-            let pq = Point2::new(q[0], q[1]);
-            let near = segs.iter().any(|&(a, b)| {
-                near_segment(Point2::new(a[0], a[1]), Point2::new(b[0], b[1]), pq, tol)
-            });
             if near {
                 later.push(q);
             } else {
