@@ -57,6 +57,9 @@ impl<'a> MeshView<'a> {
     }
 
     /// Absolute coordinates of point `i`.
+    ///
+    /// # Panics
+    /// If `i` is out of range for `points` or `z`.
     pub fn point(&self, i: usize) -> [f64; 3] {
         let p = self.points[i];
         [
