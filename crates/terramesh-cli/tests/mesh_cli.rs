@@ -151,6 +151,7 @@ fn sample_points_csv_become_vertices() {
         "0 0; 0 50; 40 50; 40 0",
         "--crs",
         "projected",
+        // NORTHING EASTING, like LAT LON
         "--min-angle",
         "0",
         "--points",
@@ -268,4 +269,44 @@ fn geographic_sample_points_and_kml_with_hole() {
     assert!(pts
         .iter()
         .any(|q| (q[0] - p.easting).abs() < 1e-6 && (q[1] - p.northing).abs() < 1e-6));
+}
+
+#[test]
+fn projected_corners_in_utm_metres() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.vtu");
+    // The paper's Table 1 in UTM, NORTHING EASTING like LAT LON.
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--corners",
+        "5397932.106 377676.932; 5397926.333 377941.691; 5398326.487 377950.404; \
+         5398332.260 377685.664",
+        "--crs",
+        "projected",
+        "--max-area",
+        "50",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(table_min_angle(&stdout) >= 30.0);
+    let (pts, _) = vtu_points(&out);
+    assert!(pts
+        .iter()
+        .any(|p| p[0] == 377676.932 && p[1] == 5397932.106));
+    let csv = dir.path().join("corners.csv");
+    std::fs::write(&csv, "x,y\n0,0\n100,0\n100,x\n").unwrap();
+    let (ok, _, stderr) = terramesh(&[
+        "mesh",
+        "--corners",
+        csv.to_str().unwrap(),
+        "--crs",
+        "projected",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("corners.csv") && stderr.contains("line 4"),
+        "{stderr}"
+    );
 }
