@@ -295,30 +295,30 @@ impl CdtState {
     /// The inside triangles as a [`Mesh`] (unused vertices dropped).
     pub(crate) fn extract(&self) -> Mesh {
         let inside = self.inside_faces();
+        // Triangles with spade's vertex indices first, then the used vertices renumbered in
+        // spade's order (sequential passes rather than random lookups).
+        let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(self.cdt.num_inner_faces());
+        for f in self.cdt.inner_faces() {
+            if inside[f.fix().index()] {
+                triangles.push(f.vertices().map(|v| v.fix().index() as u32));
+            }
+        }
         let mut map = vec![u32::MAX; self.cdt.num_vertices()];
-        let mut points = Vec::new();
-        let mut triangles = Vec::new();
-        let mut id = |v: usize, points: &mut Vec<[f64; 2]>| {
-            if map[v] == u32::MAX {
-                map[v] = points.len() as u32;
-                let p = self
-                    .cdt
-                    .vertex(spade::handles::FixedVertexHandle::from_index(v));
-                let p = p.position();
+        for t in &triangles {
+            for &v in t {
+                map[v as usize] = 0;
+            }
+        }
+        let mut points = Vec::with_capacity(map.len());
+        for (v, m) in self.cdt.vertices().zip(map.iter_mut()) {
+            if *m == 0 {
+                *m = points.len() as u32;
+                let p = v.position();
                 points.push([p.x, p.y]);
             }
-            map[v]
-        };
-        for f in self.cdt.inner_faces() {
-            if !inside[f.fix().index()] {
-                continue;
-            }
-            let vs = f.vertices().map(|v| v.fix().index());
-            triangles.push([
-                id(vs[0], &mut points),
-                id(vs[1], &mut points),
-                id(vs[2], &mut points),
-            ]);
+        }
+        for t in &mut triangles {
+            *t = t.map(|v| map[v as usize]);
         }
         let mut constraint_edges = Vec::new();
         for e in self.cdt.undirected_edges() {
