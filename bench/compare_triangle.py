@@ -4,7 +4,7 @@
 Each run is its own process, so peak memory (VmHWM) is the run's own; the best of REPEATS
 runs is reported. Timings cover meshing only (not process start, Python import or file
 reading). Build first:  cargo build --release -p terramesh-mesh --example bench_mesh
-Usage: /work/venv-fix/bin/python bench/compare_triangle.py [REPEATS]
+Usage: /work/venv-fix/bin/python bench/compare_triangle.py [REPEATS [CASE-SUBSTRING]]
 """
 import os
 import subprocess
@@ -52,12 +52,19 @@ def parse(line):
     return {k: float(v) for k, v in (f.split("=") for f in line.split())}
 
 
-def best(cmd, repeats):
-    runs = []
+def run(cmd):
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.strip()
+    return parse(out.splitlines()[-1])
+
+
+def interleaved(cmds, repeats):
+    """Runs the commands in turn, REPEATS rounds, so that load from other work on the machine
+    falls on both alike; returns each command's best run and all its times."""
+    runs = [[] for _ in cmds]
     for _ in range(repeats):
-        out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.strip()
-        runs.append(parse(out.splitlines()[-1]))
-    return min(runs, key=lambda r: r["seconds"]), [r["seconds"] for r in runs]
+        for k, cmd in enumerate(cmds):
+            runs[k].append(run(cmd))
+    return [(min(r, key=lambda x: x["seconds"]), [x["seconds"] for x in r]) for r in runs]
 
 
 def main():
@@ -72,15 +79,20 @@ def main():
         ("quality 30 deg, max area 15.5", ["quality", "30", "15.5"]),
         ("Delaunay, 1,000,000 random points", ["delaunay", pts_file]),
     ]
-    print(f"best of {repeats} runs, each in its own process; time ratio = terramesh / Triangle")
+    print(f"best of {repeats} interleaved runs, each in its own process; "
+          f"ratios = terramesh / Triangle (time: best and median)")
     print(f"{'case':36} {'tool':10} {'triangles':>10} {'min angle':>9} {'seconds':>8} {'peak MB':>8}  all runs (s)")
+    only = sys.argv[2] if len(sys.argv) > 2 else ""
     for name, args in cases:
-        tri, tri_runs = best([sys.executable, "-c", TRIANGLE_RUN] + args, repeats)
-        ours, our_runs = best([RUST] + args, repeats)
+        if only not in name:
+            continue
+        (tri, tri_runs), (ours, our_runs) = interleaved(
+            [[sys.executable, "-c", TRIANGLE_RUN] + args, [RUST] + args], repeats)
         for tool, r, runs in (("Triangle", tri, tri_runs), ("terramesh", ours, our_runs)):
             print(f"{name:36} {tool:10} {int(r['triangles']):>10} {r['min_angle']:>9.3f} "
                   f"{r['seconds']:>8.3f} {r['peak_rss_mb']:>8.1f}  {' '.join('%.3f' % s for s in runs)}")
-        print(f"{name:36} ratios: time {ours['seconds'] / tri['seconds']:.2f}, "
+        med = float(np.median(our_runs)) / float(np.median(tri_runs))
+        print(f"{name:36} ratios: time {ours['seconds'] / tri['seconds']:.2f} (median {med:.2f}), "
               f"triangles {ours['triangles'] / tri['triangles']:.3f}, "
               f"memory {ours['peak_rss_mb'] / tri['peak_rss_mb']:.2f}")
 

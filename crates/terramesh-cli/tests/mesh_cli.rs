@@ -151,6 +151,7 @@ fn sample_points_csv_become_vertices() {
         "0 0; 0 50; 40 50; 40 0",
         "--crs",
         "projected",
+        // NORTHING EASTING, like LAT LON
         "--min-angle",
         "0",
         "--points",
@@ -227,4 +228,85 @@ fn errors_are_clear_and_leave_no_file() {
         assert!(!stderr.contains("panicked"), "{stderr}");
         assert!(!out.exists(), "{args:?} left a file");
     }
+}
+
+#[test]
+fn geographic_sample_points_and_kml_with_hole() {
+    let dir = tempfile::tempdir().unwrap();
+    let kml = dir.path().join("site.kml");
+    std::fs::write(
+        &kml,
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\
+         <Document><Placemark><name>site</name><Polygon><outerBoundaryIs><LinearRing><coordinates>\n\
+         7.3368,48.7224,0 7.3404,48.7224,0 7.3404,48.7260,0 7.3368,48.7260,0 7.3368,48.7224,0\n\
+         </coordinates></LinearRing></outerBoundaryIs><innerBoundaryIs><LinearRing><coordinates>\n\
+         7.3380,48.7236,0 7.3380,48.7242,0 7.3390,48.7242,0 7.3390,48.7236,0 7.3380,48.7236,0\n\
+         </coordinates></LinearRing></innerBoundaryIs></Polygon></Placemark></Document></kml>",
+    )
+    .unwrap();
+    let csv = dir.path().join("samples.csv");
+    std::fs::write(&csv, "lat,lon\nN48°43'25\",E7°20'15\"\n48.7255,7.3400\n").unwrap();
+    let out = dir.path().join("m.vtu");
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--region",
+        kml.to_str().unwrap(),
+        "--zone",
+        "32N",
+        "--max-area",
+        "100",
+        "--points",
+        csv.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(!stdout.contains("outside"), "{stdout}");
+    assert!(table_min_angle(&stdout) >= 30.0);
+    let (pts, _) = vtu_points(&out);
+    // The second sample (48.7255 N, 7.3400 E) in UTM 32N is a vertex.
+    let p = terramesh_core::coords::to_utm(48.7255, 7.34, None).unwrap();
+    assert!(pts
+        .iter()
+        .any(|q| (q[0] - p.easting).abs() < 1e-6 && (q[1] - p.northing).abs() < 1e-6));
+}
+
+#[test]
+fn projected_corners_in_utm_metres() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.vtu");
+    // The paper's Table 1 in UTM, NORTHING EASTING like LAT LON.
+    let (ok, stdout, stderr) = terramesh(&[
+        "mesh",
+        "--corners",
+        "5397932.106 377676.932; 5397926.333 377941.691; 5398326.487 377950.404; \
+         5398332.260 377685.664",
+        "--crs",
+        "projected",
+        "--max-area",
+        "50",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(table_min_angle(&stdout) >= 30.0);
+    let (pts, _) = vtu_points(&out);
+    assert!(pts
+        .iter()
+        .any(|p| p[0] == 377676.932 && p[1] == 5397932.106));
+    let csv = dir.path().join("corners.csv");
+    std::fs::write(&csv, "x,y\n0,0\n100,0\n100,x\n").unwrap();
+    let (ok, _, stderr) = terramesh(&[
+        "mesh",
+        "--corners",
+        csv.to_str().unwrap(),
+        "--crs",
+        "projected",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && stderr.contains("corners.csv") && stderr.contains("line 4"),
+        "{stderr}"
+    );
 }

@@ -6,7 +6,7 @@
 use spade::Triangulation;
 use terramesh_core::geometry::{validate, Region};
 
-use crate::build::CdtState;
+use crate::cdt::CdtState;
 use crate::flip::flip_passes;
 use crate::mesh::{orient, Mesh};
 use crate::quality::triangle_quality;

@@ -1,19 +1,17 @@
-//! Constrained Delaunay triangulation of a region and Delaunay refinement (Ruppert/Chew style,
-//! by spade) to a minimum angle and a maximum triangle area or edge length.
+//! Mesh settings and the build entry point: validation, constrained Delaunay triangulation,
+//! Delaunay refinement (Ruppert/Chew style, by spade) to a minimum angle and a maximum
+//! triangle area or edge length; plain Delaunay for convex regions without constraints.
 
-use spade::{
-    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
-};
+use spade::{Point2, Triangulation};
 use terramesh_core::geometry::{validate, Region};
 
+use crate::cdt::{check_coordinate, CdtState};
 use crate::mesh::Mesh;
 use crate::MeshError;
 
 /// The largest minimum angle refinement can guarantee (degrees). spade's refinement
 /// terminates up to 33 degrees and runs away at 34 (measured, see `docs/meshing.md`).
 pub const MAX_MIN_ANGLE: f64 = 33.0;
-
-pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Settings of [`MeshBuilder::build`], with documented defaults.
 ///
@@ -213,16 +211,22 @@ fn convex_delaunay(
     for p in points {
         let q = [p[0] - origin[0], p[1] - origin[1]];
         check_coordinate(q)?;
-        // Strictly inside, clear of the boundary by more than rounding.
-        let clear = (0..n).all(|i| {
+        // Strictly inside, clear of the boundary by more than rounding; a point on the
+        // boundary needs the constrained path, which splits the boundary edge there.
+        let (mut clear, mut out) = (true, false);
+        for i in 0..n {
             let (a, b) = (local[i], local[(i + 1) % n]);
             let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-            crate::mesh::orient(a, b, q) > tol * len
-        });
+            let o = crate::mesh::orient(a, b, q);
+            clear &= o > tol * len;
+            out |= o < -tol * len;
+        }
         if clear {
             verts.push(Point2::new(q[0], q[1]));
-        } else {
+        } else if out {
             outside += 1;
+        } else {
+            return Ok(None);
         }
     }
     for p in &local {
@@ -263,334 +267,4 @@ fn convex_delaunay(
         },
         report,
     )))
-}
-
-/// A CDT of a validated region in local coordinates, with the inside/outside classification.
-pub(crate) struct CdtState {
-    pub(crate) cdt: Cdt,
-    pub(crate) origin: [f64; 2],
-    /// The region in local coordinates.
-    pub(crate) local: Region,
-    pub(crate) points_outside: usize,
-    /// Whether spade's winding rule (constraint crossings) agrees with the region; false when
-    /// constraint lines enclose an area, in which case refinement covers the whole hull.
-    spade_classifies: bool,
-    /// Distance under which a new vertex is taken to lie on a constraint edge.
-    tol: f64,
-    /// spade's excluded faces from the last refinement, while they are current and right.
-    excluded: Option<Vec<spade::handles::FixedFaceHandle<spade::handles::InnerTag>>>,
-}
-
-/// True if `p` lies within `tol` of segment `a b` (strictly between its ends).
-fn near_segment(a: Point2<f64>, b: Point2<f64>, p: Point2<f64>, tol: f64) -> bool {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
-    let len2 = dx * dx + dy * dy;
-    if len2 == 0.0 {
-        return false;
-    }
-    let t = ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2;
-    if t <= 0.0 || t >= 1.0 {
-        return false;
-    }
-    let (ex, ey) = (a.x + t * dx - p.x, a.y + t * dy - p.y);
-    ex * ex + ey * ey <= tol * tol
-}
-
-/// Rejects coordinates the exact predicates cannot handle (spade's `validate_coordinate`).
-fn check_coordinate(p: [f64; 2]) -> Result<(), MeshError> {
-    spade::validate_coordinate(p[0])
-        .and_then(|_| spade::validate_coordinate(p[1]))
-        .map_err(|e| MeshError::Insertion {
-            at: p,
-            why: format!("{e:?}"),
-        })
-}
-
-fn insert(cdt: &mut Cdt, p: [f64; 2]) -> Result<spade::handles::FixedVertexHandle, MeshError> {
-    cdt.insert(Point2::new(p[0], p[1]))
-        .map_err(|e| MeshError::Insertion {
-            at: p,
-            why: format!("{e:?}"),
-        })
-}
-
-impl CdtState {
-    pub(crate) fn new(region: &Region, points: &[[f64; 2]]) -> Result<CdtState, MeshError> {
-        let (lo, hi) = region.bbox().ok_or(MeshError::InvalidRegion(
-            terramesh_core::geometry::ValidationError::Empty,
-        ))?;
-        let origin = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-        let local = region
-            .try_map(|p| Ok::<_, ()>([p[0] - origin[0], p[1] - origin[1]]))
-            .expect("infallible");
-        let half = [0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])];
-        let tol = 1e-9 * half[0].max(half[1]);
-        // Rings and the sample points clear of them are bulk loaded (spade's bulk CDT);
-        // constraint lines and points on a ring follow one by one.
-        let mut verts = Vec::new();
-        let mut edges = Vec::new();
-        let mut segs = Vec::new();
-        for poly in &local.polygons {
-            for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
-                let base = verts.len();
-                let n = ring.len();
-                for (i, &p) in ring.iter().enumerate() {
-                    check_coordinate(p)?;
-                    verts.push(Point2::new(p[0], p[1]));
-                    edges.push([base + i, base + (i + 1) % n]);
-                    segs.push((p, ring[(i + 1) % n]));
-                }
-            }
-        }
-        let mut points_outside = 0;
-        let mut later = Vec::new();
-        for p in points {
-            let q = [p[0] - origin[0], p[1] - origin[1]];
-            check_coordinate(q)?;
-            if !local.contains(q) {
-                points_outside += 1;
-                continue;
-            }
-            let pq = Point2::new(q[0], q[1]);
-            let near = segs.iter().any(|&(a, b)| {
-                near_segment(Point2::new(a[0], a[1]), Point2::new(b[0], b[1]), pq, tol)
-            });
-            if near {
-                later.push(q);
-            } else {
-                verts.push(pq);
-            }
-        }
-        let mut conflicts = 0;
-        let cdt = Cdt::try_bulk_load_cdt(verts, edges, |_| conflicts += 1).map_err(|e| {
-            MeshError::Insertion {
-                at: [f64::NAN, f64::NAN],
-                why: format!("{e:?}"),
-            }
-        })?;
-        debug_assert_eq!(conflicts, 0, "validated rings do not cross");
-        let mut s = CdtState {
-            cdt,
-            origin,
-            local,
-            points_outside,
-            spade_classifies: true,
-            tol,
-            excluded: None,
-        };
-        for line in &s.local.lines.clone() {
-            let hs = line
-                .iter()
-                .map(|&p| s.insert_point(p))
-                .collect::<Result<Vec<_>, _>>()?;
-            for w in hs.windows(2) {
-                if w[0] != w[1] {
-                    s.cdt.add_constraint_and_split(w[0], w[1], |p| p);
-                }
-            }
-        }
-        for q in later {
-            s.insert_point(q)?;
-        }
-        // Closed rings alone are classified correctly by spade's winding rule; constraint
-        // lines need the check.
-        if !s.local.lines.is_empty() {
-            s.spade_classifies = s.spade_agrees();
-        }
-        Ok(s)
-    }
-
-    /// Refines to the angle and area; returns whether refinement completed within
-    /// `max_vertices` vertices in total.
-    pub(crate) fn refine(
-        &mut self,
-        min_angle: f64,
-        max_area: Option<f64>,
-        max_vertices: usize,
-    ) -> Result<bool, MeshError> {
-        let n = self.cdt.num_vertices();
-        let mut params = RefinementParameters::<f64>::new()
-            .with_angle_limit(AngleLimit::from_deg(min_angle))
-            .exclude_outer_faces(self.spade_classifies)
-            .with_max_additional_vertices(max_vertices.saturating_sub(n));
-        if let Some(a) = max_area {
-            params = params.with_max_allowed_area(a);
-        }
-        let result = self.cdt.refine(params);
-        self.excluded = self.spade_classifies.then_some(result.excluded_faces);
-        Ok(result.refinement_complete)
-    }
-
-    /// Inserts a vertex; one within a rounding distance of a constraint edge splits that edge
-    /// (spade would otherwise leave the constraint whole beside a sliver).
-    pub(crate) fn insert_point(
-        &mut self,
-        p: [f64; 2],
-    ) -> Result<spade::handles::FixedVertexHandle, MeshError> {
-        use spade::PositionInTriangulation as P;
-        self.excluded = None;
-        let q = Point2::new(p[0], p[1]);
-        if let P::OnFace(f) = self.cdt.locate(q) {
-            let near = self.cdt.face(f).adjacent_edges().into_iter().find(|e| {
-                self.cdt.is_constraint_edge(e.fix().as_undirected())
-                    && near_segment(e.from().position(), e.to().position(), q, self.tol)
-            });
-            if let Some(e) = near {
-                let (a, b) = (e.from().fix(), e.to().fix());
-                self.cdt.remove_constraint_edge(e.fix().as_undirected());
-                let v = insert(&mut self.cdt, p)?;
-                self.cdt.add_constraint_and_split(a, v, |p| p);
-                self.cdt.add_constraint_and_split(v, b, |p| p);
-                return Ok(v);
-            }
-        }
-        insert(&mut self.cdt, p)
-    }
-
-    /// Inserts the midpoints of inside edges longer than `l`; returns how many.
-    pub(crate) fn split_long_edges(&mut self, l: f64) -> Result<usize, MeshError> {
-        let inside = self.inside_faces();
-        let l2 = l * l;
-        let mut mids = Vec::new();
-        for e in self.cdt.undirected_edges() {
-            let [a, b] = e.vertices().map(|v| v.position());
-            if (b.x - a.x).powi(2) + (b.y - a.y).powi(2) <= l2 {
-                continue;
-            }
-            let faces = e.as_directed();
-            let touches = [faces.face(), faces.rev().face()]
-                .iter()
-                .any(|f| f.as_inner().is_some_and(|f| inside[f.fix().index()]));
-            if touches {
-                mids.push([0.5 * (a.x + b.x), 0.5 * (a.y + b.y)]);
-            }
-        }
-        for &m in &mids {
-            self.insert_point(m)?;
-        }
-        Ok(mids.len())
-    }
-
-    /// Inside flags by face index: faces are grouped into components separated by constraint
-    /// edges, and each component is classified by one point-in-region test.
-    pub(crate) fn inside_faces(&self) -> Vec<bool> {
-        let n = self.cdt.num_all_faces();
-        if let Some(ex) = &self.excluded {
-            // spade's classification, checked to agree with the region before refining.
-            let mut inside = vec![true; n];
-            inside[0] = false; // the outer face
-            for f in ex {
-                inside[f.index()] = false;
-            }
-            return inside;
-        }
-        let mut seen = vec![false; n];
-        let mut inside = vec![false; n];
-        let mut stack = Vec::new();
-        for f in self.cdt.inner_faces() {
-            let fi = f.fix().index();
-            if seen[fi] {
-                continue;
-            }
-            let [a, b, c] = f.vertices().map(|v| v.position());
-            let centre = [(a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0];
-            let is_in = self.local.contains(centre);
-            seen[fi] = true;
-            inside[fi] = is_in;
-            stack.push(f.fix());
-            while let Some(g) = stack.pop() {
-                for e in self.cdt.face(g).adjacent_edges() {
-                    if self.cdt.is_constraint_edge(e.fix().as_undirected()) {
-                        continue;
-                    }
-                    if let Some(h) = e.rev().face().as_inner() {
-                        let hi = h.fix().index();
-                        if !seen[hi] {
-                            seen[hi] = true;
-                            inside[hi] = is_in;
-                            stack.push(h.fix());
-                        }
-                    }
-                }
-            }
-        }
-        inside
-    }
-
-    /// Whether spade's own outer-face classification (used to skip faces during refinement)
-    /// matches the region. It does not for constraint lines that enclose an area, nor for
-    /// some dangling lines (its layer peeling depends on visiting order), so it is checked on
-    /// a copy by a refinement that changes nothing (zero angle, no area limit).
-    fn spade_agrees(&self) -> bool {
-        let mut probe = self.cdt.clone();
-        let before = probe.num_vertices();
-        let res = probe.refine(
-            RefinementParameters::<f64>::new()
-                .with_angle_limit(AngleLimit::from_deg(0.0))
-                .keep_constraint_edges()
-                .exclude_outer_faces(true)
-                .with_max_additional_vertices(0),
-        );
-        if probe.num_vertices() != before {
-            return false;
-        }
-        let inside = self.inside_faces();
-        let mut excluded = vec![false; inside.len()];
-        for f in &res.excluded_faces {
-            excluded[f.index()] = true;
-        }
-        self.cdt
-            .fixed_inner_faces()
-            .all(|f| inside[f.index()] != excluded[f.index()])
-    }
-
-    /// The inside triangles as a [`Mesh`] (unused vertices dropped).
-    pub(crate) fn extract(&self) -> Mesh {
-        let inside = self.inside_faces();
-        let mut map = vec![u32::MAX; self.cdt.num_vertices()];
-        let mut points = Vec::new();
-        let mut triangles = Vec::new();
-        let mut id = |v: usize, points: &mut Vec<[f64; 2]>| {
-            if map[v] == u32::MAX {
-                map[v] = points.len() as u32;
-                let p = self
-                    .cdt
-                    .vertex(spade::handles::FixedVertexHandle::from_index(v));
-                let p = p.position();
-                points.push([p.x, p.y]);
-            }
-            map[v]
-        };
-        for f in self.cdt.inner_faces() {
-            if !inside[f.fix().index()] {
-                continue;
-            }
-            let vs = f.vertices().map(|v| v.fix().index());
-            triangles.push([
-                id(vs[0], &mut points),
-                id(vs[1], &mut points),
-                id(vs[2], &mut points),
-            ]);
-        }
-        let mut constraint_edges = Vec::new();
-        for e in self.cdt.undirected_edges() {
-            if !self.cdt.is_constraint_edge(e.fix()) {
-                continue;
-            }
-            let d = e.as_directed();
-            let touches = [d.face(), d.rev().face()]
-                .iter()
-                .any(|f| f.as_inner().is_some_and(|f| inside[f.fix().index()]));
-            if touches {
-                let [a, b] = e.vertices().map(|v| map[v.fix().index()]);
-                constraint_edges.push([a, b]);
-            }
-        }
-        Mesh {
-            origin: self.origin,
-            points,
-            triangles,
-            constraint_edges,
-        }
-    }
 }

@@ -21,8 +21,10 @@
 
 /// Surface-adaptive refinement against a height function, with 3D shape improvement.
 mod adaptive;
-/// Constrained Delaunay triangulation and Delaunay refinement.
+/// Mesh settings and the build entry point.
 mod build;
+/// Constrained Delaunay triangulation and Delaunay refinement.
+mod cdt;
 /// Edge flips: Delaunay in the plane, shape-improving on a surface.
 mod flip;
 /// The mesh type and its invariants.

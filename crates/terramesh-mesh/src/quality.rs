@@ -194,8 +194,25 @@ impl Quality {
     /// # Panics
     /// If `z.len() != mesh.points.len()`.
     pub fn surface(mesh: &Mesh, z: &[f64]) -> Quality {
-        assert_eq!(z.len(), mesh.points.len(), "one height per vertex");
-        Self::compute(mesh, Some(z))
+        Self::try_surface(mesh, z).expect("one height per vertex")
+    }
+
+    /// Quality of the mesh lifted to heights `z`; `None` unless there is one height per
+    /// vertex.
+    ///
+    /// ```
+    /// # use terramesh_mesh::{Mesh, Quality};
+    /// let m = Mesh {
+    ///     origin: [0.0, 0.0],
+    ///     points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+    ///     triangles: vec![[0, 1, 2]],
+    ///     constraint_edges: vec![],
+    /// };
+    /// assert!(Quality::try_surface(&m, &[0.0, 0.0]).is_none());
+    /// assert_eq!(Quality::try_surface(&m, &[0.0, 0.0, 1.0]).unwrap().dimension, "3D");
+    /// ```
+    pub fn try_surface(mesh: &Mesh, z: &[f64]) -> Option<Quality> {
+        (z.len() == mesh.points.len()).then(|| Self::compute(mesh, Some(z)))
     }
 
     fn compute(mesh: &Mesh, z: Option<&[f64]>) -> Quality {

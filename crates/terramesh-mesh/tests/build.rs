@@ -185,3 +185,44 @@ fn invalid_regions_are_errors() {
         ))
     ));
 }
+
+#[test]
+fn regression_points_on_the_boundary_split_it_without_slivers() {
+    // Samples on (or within rounding of) boundary edges: 1/3 is not representable, so these
+    // land beside the constraint edge unless insertion splits it.
+    let r = Region::from_ring(square(0.0, 0.0, 1.0));
+    let mut pts = Vec::new();
+    for k in 1..9 {
+        let t = k as f64 / 9.0;
+        pts.extend([
+            [t, 0.0],
+            [1.0, t],
+            [1.0 - t, 1.0],
+            [0.0, 1.0 - t],
+            [t, t / 3.0],
+        ]);
+    }
+    for angle in [0.0, 30.0] {
+        let (mesh, rep) = MeshBuilder::new()
+            .min_angle(angle)
+            .points(pts.clone())
+            .build(&r)
+            .unwrap();
+        mesh.sanity_check(&r).unwrap();
+        if angle > 0.0 {
+            assert!(Quality::planar(&mesh).min_angle >= 30.0 - 1e-9);
+            assert_eq!(rep.points_outside, 0);
+        }
+    }
+}
+
+#[test]
+fn regression_midpoints_of_constraint_lines_split_them() {
+    // max_edge inserts midpoints of long constraint edges; they must split the constraint
+    // (this looped forever when spade kept the constraint whole beside the new vertex).
+    let mut r = Region::from_ring(square(0.0, 0.0, 30.0));
+    r.lines.push(vec![[1.0, 1.0], [29.0, 10.0 / 3.0]]);
+    let (mesh, _) = MeshBuilder::new().max_edge(1.5).build(&r).unwrap();
+    mesh.sanity_check(&r).unwrap();
+    assert!(Quality::planar(&mesh).edge.max <= 1.5);
+}

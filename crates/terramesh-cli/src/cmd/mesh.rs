@@ -44,7 +44,8 @@ pub enum SmootherArg {
     terramesh mesh --region site.wkt --crs projected --max-edge 5 --points samples.csv -o mesh.ply")]
 pub struct Args {
     /// Corners "LAT LON; LAT LON; ..." (at least 3; decimal degrees or DMS) or a CSV file with
-    /// columns lat,lon.
+    /// columns lat,lon. With --crs projected: "NORTHING EASTING; ..." in metres, or a CSV with
+    /// columns x,y.
     #[arg(long, conflicts_with = "region", required_unless_present = "region")]
     corners: Option<String>,
     /// Region file: GeoJSON (.geojson/.json), KML (.kml) or WKT (.wkt).

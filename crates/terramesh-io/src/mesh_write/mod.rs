@@ -60,6 +60,9 @@ impl<'a> MeshView<'a> {
     }
 
     /// Absolute coordinates of point `i`.
+    ///
+    /// # Panics
+    /// If `i` is out of range for `points` or `z`.
     pub fn point(&self, i: usize) -> [f64; 3] {
         let p = self.points[i];
         [
@@ -114,7 +117,8 @@ pub enum MeshWriteError {
 /// ```
 /// use terramesh_io::mesh_write::writer_for;
 /// assert_eq!(writer_for("out/mesh.VTU".as_ref())?.name(), "VTU");
-/// assert!(writer_for("mesh.xyz".as_ref()).unwrap_err().to_string().contains(".vtu"));
+/// let err = writer_for("mesh.xyz".as_ref()).err().unwrap();
+/// assert!(err.to_string().contains(".vtu"));
 /// # Ok::<(), terramesh_io::mesh_write::MeshWriteError>(())
 /// ```
 pub fn writer_for(path: &Path) -> Result<Box<dyn MeshWriter>, MeshWriteError> {

@@ -98,6 +98,60 @@ pub(super) fn read_corners_csv(path: &Path) -> Result<Vec<[f64; 2]>, RegionError
     })
 }
 
+/// Parses projected corners `"NORTHING EASTING; ..."` (metres, the order of `LAT LON`; a
+/// comma between them is allowed) into `[easting, northing]`.
+///
+/// ```
+/// let ring = terramesh_io::region::parse_projected_corners(
+///     "5397932.106 377676.932; 5397926.333, 377941.691; 5398326.487 377950.404")?;
+/// assert_eq!(ring[1], [377941.691, 5397926.333]);
+/// # Ok::<(), terramesh_io::region::RegionError>(())
+/// ```
+pub fn parse_projected_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError> {
+    let invalid = |message: String| RegionError::Invalid {
+        source_name: "--corners".into(),
+        message,
+    };
+    let mut ring = Vec::new();
+    for (i, part) in text.split(';').enumerate() {
+        if part.trim().is_empty() {
+            continue;
+        }
+        let nums: Vec<&str> = part
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|t| !t.is_empty())
+            .collect();
+        let parsed: Option<Vec<f64>> = nums.iter().map(|t| t.parse().ok()).collect();
+        match parsed.as_deref() {
+            Some([n, e]) if n.is_finite() && e.is_finite() => ring.push([*e, *n]),
+            _ => {
+                return Err(invalid(format!(
+                    "corner {} '{}': with --crs projected each corner is NORTHING EASTING in \
+                     metres, e.g. \"5397932.106 377676.932\"",
+                    i + 1,
+                    part.trim()
+                )))
+            }
+        }
+    }
+    finish_ring(ring).map_err(invalid)
+}
+
+/// Reads projected corners from a CSV with columns `x,y` (also `easting,northing`).
+pub(super) fn read_projected_csv(path: &Path) -> Result<Vec<[f64; 2]>, RegionError> {
+    let t = Table::read(path, &ReadOptions::default())?;
+    let x = t.require(&["x", "easting", "east"])?;
+    let y = t.require(&["y", "northing", "north"])?;
+    let mut ring = Vec::with_capacity(t.records.len());
+    for r in 0..t.records.len() {
+        ring.push([t.number(r, x)?, t.number(r, y)?]);
+    }
+    finish_ring(ring).map_err(|message| RegionError::Invalid {
+        source_name: path.display().to_string(),
+        message,
+    })
+}
+
 /// Drops a repeated closing vertex and consecutive duplicates; requires 3 distinct vertices.
 pub(crate) fn finish_ring(mut ring: Vec<[f64; 2]>) -> Result<Vec<[f64; 2]>, String> {
     ring.dedup();

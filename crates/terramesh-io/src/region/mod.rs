@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use terramesh_core::coords::{to_utm, CoordError, Zone};
 use terramesh_core::geometry::{validate, Region, ValidationError};
 
-pub use corners::{parse_corner, parse_corners};
+pub use corners::{parse_corner, parse_corners, parse_projected_corners};
 pub use geojson::parse_geojson;
 pub use kml::parse_kml;
 pub use wkt::parse_wkt;
@@ -60,7 +60,8 @@ pub enum RegionError {
 #[derive(Debug, Clone)]
 pub enum RegionInput {
     /// `--corners`: an inline list `"LAT LON; LAT LON; ..."` or the path of a CSV with
-    /// columns `lat,lon`.
+    /// columns `lat,lon`; for projected input `"NORTHING EASTING; ..."` in metres or a CSV
+    /// with columns `x,y` (or `easting,northing`).
     Corners(String),
     /// `--region FILE`: GeoJSON, KML or WKT.
     File(PathBuf),
@@ -112,10 +113,11 @@ pub fn load(
     let (read, is_geographic) = match input {
         RegionInput::Corners(s) => {
             let path = Path::new(s.trim());
-            let ring = if looks_like_file(s) {
-                corners::read_corners_csv(path)?
-            } else {
-                parse_corners(s)?
+            let ring = match (looks_like_file(s), crs) {
+                (true, RegionCrs::Geographic) => corners::read_corners_csv(path)?,
+                (true, RegionCrs::Projected) => corners::read_projected_csv(path)?,
+                (false, RegionCrs::Geographic) => parse_corners(s)?,
+                (false, RegionCrs::Projected) => corners::parse_projected_corners(s)?,
             };
             (Region::from_ring(ring), crs == RegionCrs::Geographic)
         }
