@@ -15,5 +15,5 @@
 
 pub mod coords;
 pub mod geometry;
-pub mod solid;
 pub mod sampling;
+pub mod solid;

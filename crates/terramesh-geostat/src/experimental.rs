@@ -168,12 +168,14 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
     let n = px.len();
     let max2 = max * max;
     // accumulators per lag: pairs, sum of distances, sum of squares/2, sum of |dz|^½
-    let acc = (0..n)
+    // Fixed blocks of rows, summed in block order: the result does not depend on how rayon
+    // schedules the work (a fold/reduce would regroup the sums from run to run).
+    const ROWS: usize = 256;
+    let blocks: Vec<Vec<[f64; 4]>> = (0..n.div_ceil(ROWS))
         .into_par_iter()
-        .with_min_len(64)
-        .fold(
-            || vec![[0.0f64; 4]; nl],
-            |mut acc, i| {
+        .map(|blk| {
+            let mut acc = vec![[0.0f64; 4]; nl];
+            for i in blk * ROWS..((blk + 1) * ROWS).min(n) {
                 let (pi, zi) = (px[i], pz[i]);
                 for j in i + 1..n {
                     let dx = px[j][0] - pi[0];
@@ -209,20 +211,18 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
                     a[2] += 0.5 * dz * dz;
                     a[3] += dz.abs().sqrt();
                 }
-                acc
-            },
-        )
-        .reduce(
-            || vec![[0.0f64; 4]; nl],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(&b) {
-                    for t in 0..4 {
-                        x[t] += y[t];
-                    }
-                }
-                a
-            },
-        );
+            }
+            acc
+        })
+        .collect();
+    let mut acc = vec![[0.0f64; 4]; nl];
+    for b in &blocks {
+        for (x, y) in acc.iter_mut().zip(b) {
+            for t in 0..4 {
+                x[t] += y[t];
+            }
+        }
+    }
     Ok(acc
         .iter()
         .enumerate()

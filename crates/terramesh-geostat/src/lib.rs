@@ -29,5 +29,5 @@ pub use experimental::{diameter, experimental, Direction, Estimator, Lag, LagSet
 pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
 pub use idw::{Idw, Search as IdwSearch};
-pub use neighbourhood::LocalKriging;
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
+pub use neighbourhood::LocalKriging;

@@ -46,7 +46,12 @@ impl LocalKriging {
     /// assert_eq!((z[0], var[0]), (11.0, 0.0));
     /// # Ok(()) }
     /// ```
-    pub fn new(data: &Data, variogram: &crate::Variogram, method: Method, k: usize) -> Result<Self> {
+    pub fn new(
+        data: &Data,
+        variogram: &crate::Variogram,
+        method: Method,
+        k: usize,
+    ) -> Result<Self> {
         let prep = Prepared::new(data, variogram, method)?;
         let p = prep.terms();
         let k = k.min(prep.pts.len());
@@ -59,14 +64,24 @@ impl LocalKriging {
         }
         let tree = Tree::new(&prep.pts)?;
         let sill = prep.variogram.sill().unwrap_or(0.0);
-        Ok(LocalKriging { prep, tree, k, sill })
+        Ok(LocalKriging {
+            prep,
+            tree,
+            k,
+            sill,
+        })
     }
 
     /// Estimates (and variances) at `targets`, in parallel.
     ///
     /// # Panics
     /// If the output slices are not as long as `targets`.
-    pub fn predict(&self, targets: &[[f64; 2]], est: &mut [f64], var: Option<&mut [f64]>) -> Result<()> {
+    pub fn predict(
+        &self,
+        targets: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) -> Result<()> {
         self.predict_excluding(targets, None, est, var)
     }
 
@@ -99,9 +114,14 @@ impl LocalKriging {
                 for i in 0..e.len() {
                     let t = c * chunk + i;
                     let ex = exclude.map(|x| x[t]);
-                    let (ee, vv) = self.one(targets[t], ex, s).map_err(|why| GeostatError::Singular {
-                        why: format!("at target {t} ({}, {}): {why}", targets[t][0], targets[t][1]),
-                    })?;
+                    let (ee, vv) =
+                        self.one(targets[t], ex, s)
+                            .map_err(|why| GeostatError::Singular {
+                                why: format!(
+                                    "at target {t} ({}, {}): {why}",
+                                    targets[t][0], targets[t][1]
+                                ),
+                            })?;
                     e[i] = ee;
                     v[i] = vv;
                 }
@@ -109,7 +129,12 @@ impl LocalKriging {
             })
     }
 
-    fn one(&self, target: [f64; 2], exclude: Option<usize>, s: &mut Scratch) -> Result<(f64, f64), String> {
+    fn one(
+        &self,
+        target: [f64; 2],
+        exclude: Option<usize>,
+        s: &mut Scratch,
+    ) -> Result<(f64, f64), String> {
         let x0 = self.prep.map(target);
         let want = self.k + usize::from(exclude.is_some());
         self.tree.nearest(x0, want, &mut s.near);
@@ -132,7 +157,11 @@ impl LocalKriging {
             for &(_, i) in &s.near {
                 for &(_, j) in &s.near {
                     let d = dist(pts[i], pts[j]);
-                    s.a.push(if i == j { self.sill } else { self.sill - vg.gamma(d) });
+                    s.a.push(if i == j {
+                        self.sill
+                    } else {
+                        self.sill - vg.gamma(d)
+                    });
                 }
                 s.b.push(self.sill - vg.gamma(dist(pts[i], x0)));
             }
@@ -193,4 +222,3 @@ fn singular_why(k: usize, p: usize) -> String {
         ),
     }
 }
-

@@ -2,9 +2,9 @@
 //! modules) elevation sources and mesh writers. Numerical work lives in `terramesh-core`.
 #![warn(missing_docs)]
 
+pub mod dem;
 pub mod export;
 pub mod grid_write;
-pub mod dem;
 pub mod mesh_write;
 pub mod number;
 pub mod output;

@@ -2,11 +2,11 @@
 
 pub mod build;
 pub mod convert;
-pub mod init;
 pub mod cv;
 pub(crate) mod geodata;
+pub mod init;
 pub mod interpolate;
-pub(crate) mod plot;
-pub mod variogram;
-pub mod sample;
 pub mod mesh;
+pub(crate) mod plot;
+pub mod sample;
+pub mod variogram;

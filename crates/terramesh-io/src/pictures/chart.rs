@@ -26,10 +26,12 @@ where
 {
     root.fill(&WHITE)?;
     let hmax = points.iter().map(|p| p.0).fold(0.0, f64::max).max(1e-9) * 1.08;
-    let curve: Vec<(f64, f64)> = (0..=200).map(|k| {
-        let h = hmax * k as f64 / 200.0;
-        (h, model(h))
-    }).collect();
+    let curve: Vec<(f64, f64)> = (0..=200)
+        .map(|k| {
+            let h = hmax * k as f64 / 200.0;
+            (h, model(h))
+        })
+        .collect();
     let gmax = points
         .iter()
         .map(|p| p.1)
@@ -53,9 +55,17 @@ where
         .light_line_style(RGBColor(235, 235, 235))
         .draw()?;
     chart
-        .draw_series(LineSeries::new(curve, RGBColor(200, 40, 40).stroke_width(2)))?
+        .draw_series(LineSeries::new(
+            curve,
+            RGBColor(200, 40, 40).stroke_width(2),
+        ))?
         .label(model_label)
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RGBColor(200, 40, 40).stroke_width(2)));
+        .legend(|(x, y)| {
+            PathElement::new(
+                vec![(x, y), (x + 18, y)],
+                RGBColor(200, 40, 40).stroke_width(2),
+            )
+        });
     chart
         .draw_series(points.iter().map(|&(h, g, n)| {
             let r = 3.0 + 5.0 * (n as f64 / maxpairs).sqrt();

@@ -32,14 +32,22 @@ pub struct Written {
 
 /// Opens `path` atomically, runs `f` on it, commits.
 fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Result<PathBuf> {
-    let mut out = Output::create(Some(path)).with_context(|| format!("cannot write {}", path.display()))?;
+    let mut out =
+        Output::create(Some(path)).with_context(|| format!("cannot write {}", path.display()))?;
     f(&mut out).with_context(|| format!("writing {}", path.display()))?;
-    out.commit().with_context(|| format!("cannot write {}", path.display()))?;
+    out.commit()
+        .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(path.to_path_buf())
 }
 
 /// Writes every output of step 5.
-pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Result<Written> {
+pub fn write_all(
+    p: &Project,
+    out: &Path,
+    s: &Samples,
+    m: &Meshed,
+    it: &Interpolated,
+) -> Result<Written> {
     let mesh = &m.mesh;
     let n = mesh.points.len();
     let abs: Vec<[f64; 3]> = (0..n)
@@ -67,7 +75,10 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
     files.push(atomic(&out.join("dsm-vertices.csv"), |w| {
         w.write_all(b"x,y,elevation_uk,kriging_std,elevation_idw\n")?;
         for i in 0..n {
-            for (k, v) in [abs[i][0], abs[i][1], it.uk[i], it.uk_std[i], it.idw[i]].iter().enumerate() {
+            for (k, v) in [abs[i][0], abs[i][1], it.uk[i], it.uk_std[i], it.idw[i]]
+                .iter()
+                .enumerate()
+            {
                 if k > 0 {
                     w.write_all(b",")?;
                 }
@@ -100,17 +111,29 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
     }
     let origin = [mesh.origin[0], mesh.origin[1], 0.0];
     if want("stl") {
-        files.push(atomic(&out.join("dsm.stl"), |w| write_stl(w, &abs, tris, origin))?);
+        files.push(atomic(&out.join("dsm.stl"), |w| {
+            write_stl(w, &abs, tris, origin)
+        })?);
     }
     let zone = s.zone;
     let crs_name = format!("WGS 84 / UTM zone {zone}");
     if want("ts") {
         files.push(atomic(&out.join("dsm.ts"), |w| {
-            write_tsurf(w, &abs, tris, &TsurfInfo { name: "terramesh_dsm", crs_name: &crs_name })
+            write_tsurf(
+                w,
+                &abs,
+                tris,
+                &TsurfInfo {
+                    name: "terramesh_dsm",
+                    crs_name: &crs_name,
+                },
+            )
         })?);
     }
     if want("dxf") {
-        files.push(atomic(&out.join("dsm.dxf"), |w| write_dxf(w, &abs, tris, "DSM"))?);
+        files.push(atomic(&out.join("dsm.dxf"), |w| {
+            write_dxf(w, &abs, tris, "DSM")
+        })?);
     }
     if want("kml") {
         let geo: Vec<[f64; 3]> = abs
@@ -122,7 +145,15 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
             .collect::<Result<_, terramesh_core::coords::CoordError>>()?;
         let title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
         files.push(atomic(&out.join("dsm.kml"), |w| {
-            write_kml(w, &geo, tris, &KmlStyle { name: &title, ..KmlStyle::default() })
+            write_kml(
+                w,
+                &geo,
+                tris,
+                &KmlStyle {
+                    name: &title,
+                    ..KmlStyle::default()
+                },
+            )
         })?);
     }
     files.push(atomic(&out.join("dsm-origin.json"), |w| {
@@ -142,8 +173,14 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
     let solid = extrude(&abs, tris, base).context("export.base_elevation")?;
     check_closed(&solid.triangles).context("the sealed solid")?;
     let vol = volume(&solid.vertices, &solid.triangles);
-    files.push(atomic(&out.join("dsm-solid.stl"), |w| write_stl(w, &solid.vertices, &solid.triangles, origin))?);
-    let rel: Vec<[f64; 2]> = solid.vertices.iter().map(|v| [v[0] - origin[0], v[1] - origin[1]]).collect();
+    files.push(atomic(&out.join("dsm-solid.stl"), |w| {
+        write_stl(w, &solid.vertices, &solid.triangles, origin)
+    })?);
+    let rel: Vec<[f64; 2]> = solid
+        .vertices
+        .iter()
+        .map(|v| [v[0] - origin[0], v[1] - origin[1]])
+        .collect();
     let sz: Vec<f64> = solid.vertices.iter().map(|v| v[2]).collect();
     let sview = MeshView {
         origin: mesh.origin,
@@ -168,13 +205,20 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
     // The DSM grid.
     let (spec, values) = &it.grid;
     let epsg = u16::try_from(zone.epsg()).ok();
-    files.push(atomic(&out.join("dsm.tif"), |w| write_geotiff(w, spec, values, epsg))?);
-    files.push(atomic(&out.join("dsm.asc"), |w| write_asc(w, spec, values))?);
+    files.push(atomic(&out.join("dsm.tif"), |w| {
+        write_geotiff(w, spec, values, epsg)
+    })?);
+    files.push(atomic(&out.join("dsm.asc"), |w| {
+        write_asc(w, spec, values)
+    })?);
 
     // Tables.
     let q3 = Quality::surface(mesh, &it.uk);
     files.push(atomic(&out.join("mesh-quality.csv"), |w| {
-        writeln!(w, "metric,planar_before_smoothing,planar_after_smoothing,surface_3d")?;
+        writeln!(
+            w,
+            "metric,planar_before_smoothing,planar_after_smoothing,surface_3d"
+        )?;
         let rows: [(&str, fn(&Quality) -> f64); 12] = [
             ("triangles", |q| q.triangles as f64),
             ("vertices", |q| q.vertices as f64),
@@ -200,12 +244,21 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
         Ok(())
     })?);
     files.push(atomic(&out.join("cross-validation.csv"), |w| {
-        writeln!(w, "method,n,rmse,mae,mean_error,mean_standardized,var_standardized")?;
+        writeln!(
+            w,
+            "method,n,rmse,mae,mean_error,mean_standardized,var_standardized"
+        )?;
         for (name, st) in &it.cv {
             write!(w, "{name},{},", st.n)?;
-            for (k, v) in [Some(st.rmse), Some(st.mae), Some(st.mean_error), st.mean_standardized, st.var_standardized]
-                .iter()
-                .enumerate()
+            for (k, v) in [
+                Some(st.rmse),
+                Some(st.mae),
+                Some(st.mean_error),
+                st.mean_standardized,
+                st.var_standardized,
+            ]
+            .iter()
+            .enumerate()
             {
                 if k > 0 {
                     w.write_all(b",")?;
@@ -229,5 +282,11 @@ pub fn write_all(p: &Project, out: &Path, s: &Samples, m: &Meshed, it: &Interpol
         serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
         w.write_all(b"\n")
     })?);
-    Ok(Written { files, origin, base, volume: vol, quality3d: q3 })
+    Ok(Written {
+        files,
+        origin,
+        base,
+        volume: vol,
+        quality3d: q3,
+    })
 }

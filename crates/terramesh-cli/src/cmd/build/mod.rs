@@ -51,15 +51,25 @@ pub fn run(args: Args) -> Result<()> {
         .parent()
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("."));
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("cannot create the output directory {}", args.output.display()))?;
+    std::fs::create_dir_all(&args.output).with_context(|| {
+        format!(
+            "cannot create the output directory {}",
+            args.output.display()
+        )
+    })?;
     let mut progress = Progress::new(args.quiet, 6);
     let mut timings = Timings::default();
 
     let s = progress.start("samples");
-    let samples = stages::sample(&project, &base, &args.output)?;
-    progress.done(&format!("{} samples from {}", samples.xyz.len(), samples.source));
-    timings.0.push(("samples".into(), s.elapsed().as_secs_f64()));
+    let samples = stages::sample(&project, &base, &args.output, args.quiet)?;
+    progress.done(&format!(
+        "{} samples from {}",
+        samples.xyz.len(),
+        samples.source
+    ));
+    timings
+        .0
+        .push(("samples".into(), s.elapsed().as_secs_f64()));
 
     let s = progress.start("mesh");
     let mesh = stages::mesh(&project, &samples)?;
@@ -73,23 +83,43 @@ pub fn run(args: Args) -> Result<()> {
 
     let s = progress.start("interpolation");
     let interp = stages::interpolate(&project, &samples, &mesh)?;
-    progress.done(&format!("variogram {}", interp.variogram));
-    timings.0.push(("interpolation".into(), s.elapsed().as_secs_f64()));
+    progress.done(&format!(
+        "variogram {}",
+        pictures::short_numbers(&interp.variogram.to_string())
+    ));
+    timings
+        .0
+        .push(("interpolation".into(), s.elapsed().as_secs_f64()));
 
     let s = progress.start("exports");
     let written = exports::write_all(&project, &args.output, &samples, &mesh, &interp)?;
     progress.done(&format!("{} files", written.files.len()));
-    timings.0.push(("exports".into(), s.elapsed().as_secs_f64()));
+    timings
+        .0
+        .push(("exports".into(), s.elapsed().as_secs_f64()));
 
     if project.export.pictures || project.export.report {
         let s = progress.start("pictures");
         let pics = pictures::draw_all(&args.output, &samples, &mesh, &interp)?;
         progress.done(&format!("{} pictures", pics.len()));
-        timings.0.push(("pictures".into(), s.elapsed().as_secs_f64()));
+        timings
+            .0
+            .push(("pictures".into(), s.elapsed().as_secs_f64()));
         if project.export.report {
             let s = progress.start("report");
-            timings.0.push(("total before report".into(), t0.elapsed().as_secs_f64()));
-            pictures::write_report(&args.output, &project, &samples, &mesh, &interp, &written, &pics, &timings)?;
+            timings
+                .0
+                .push(("total before report".into(), t0.elapsed().as_secs_f64()));
+            pictures::write_report(
+                &args.output,
+                &project,
+                &samples,
+                &mesh,
+                &interp,
+                &written,
+                &pics,
+                &timings,
+            )?;
             progress.done("report.html");
             let _ = s;
         }

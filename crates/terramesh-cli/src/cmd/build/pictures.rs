@@ -6,7 +6,8 @@ use anyhow::{Context, Result};
 use terramesh_core::coords::{format_dms, to_utm, Axis};
 use terramesh_io::output::write_atomic;
 use terramesh_io::pictures::{
-    draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d, render_both, ColourMap, SurfaceMap,
+    draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d, render_both, ColourMap,
+    SurfaceMap,
 };
 use terramesh_io::report::{Block, Report, Section};
 use terramesh_mesh::Quality;
@@ -44,39 +45,129 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     let mut pics = Vec::new();
     let mut add = |name: &str, caption: String, files: [PathBuf; 2]| {
         let _ = name;
-        pics.push(Picture { caption, png: files[0].clone() });
+        pics.push(Picture {
+            caption,
+            png: files[0].clone(),
+        });
     };
     let f = render_both(&dir.join("samples"), SIZE, |r| {
-        draw_samples(r, &s.xyz, &rings, &format!("{} samples over the study region", s.xyz.len()))
+        draw_samples(
+            r,
+            &s.xyz,
+            &rings,
+            &format!("{} samples over the study region", s.xyz.len()),
+        )
     })?;
-    add("samples", format!("Sample points coloured by elevation ({} from {})", s.xyz.len(), s.source), f);
+    add(
+        "samples",
+        format!(
+            "Sample points coloured by elevation ({} from {})",
+            s.xyz.len(),
+            s.source
+        ),
+        f,
+    );
 
-    let xy0: Vec<[f64; 2]> = (0..m.unsmoothed.points.len()).map(|i| m.unsmoothed.absolute(i)).collect();
+    let xy0: Vec<[f64; 2]> = (0..m.unsmoothed.points.len())
+        .map(|i| m.unsmoothed.absolute(i))
+        .collect();
     let f = render_both(&dir.join("mesh-before-smoothing"), SIZE, |r| {
-        draw_mesh(r, &xy0, &m.unsmoothed.triangles, &rings, &format!(
-            "Planar mesh before smoothing: min angle {:.1}°", m.before.min_angle))
+        draw_mesh(
+            r,
+            &xy0,
+            &m.unsmoothed.triangles,
+            &rings,
+            &format!(
+                "Planar mesh before smoothing: min angle {:.1}°",
+                m.before.min_angle
+            ),
+        )
     })?;
-    add("mesh0", "Planar mesh after Delaunay refinement, before smoothing".into(), f);
-    let xy: Vec<[f64; 2]> = (0..m.mesh.points.len()).map(|i| m.mesh.absolute(i)).collect();
+    add(
+        "mesh0",
+        "Planar mesh after Delaunay refinement, before smoothing".into(),
+        f,
+    );
+    let xy: Vec<[f64; 2]> = (0..m.mesh.points.len())
+        .map(|i| m.mesh.absolute(i))
+        .collect();
     let f = render_both(&dir.join("mesh-after-smoothing"), SIZE, |r| {
-        draw_mesh(r, &xy, &m.mesh.triangles, &rings, &format!(
-            "Planar mesh after smoothing: min angle {:.1}°", m.after.min_angle))
+        draw_mesh(
+            r,
+            &xy,
+            &m.mesh.triangles,
+            &rings,
+            &format!(
+                "Planar mesh after smoothing: min angle {:.1}°",
+                m.after.min_angle
+            ),
+        )
     })?;
-    add("mesh1", "Planar mesh after smoothing and Delaunay flips".into(), f);
+    add(
+        "mesh1",
+        "Planar mesh after smoothing and Delaunay flips".into(),
+        f,
+    );
 
-    let pts: Vec<(f64, f64, u64)> = it.lags.iter().map(|l| (l.distance, l.gamma, l.pairs)).collect();
-    let label = it.variogram.to_string();
+    let pts: Vec<(f64, f64, u64)> = it
+        .lags
+        .iter()
+        .map(|l| (l.distance, l.gamma, l.pairs))
+        .collect();
+    let label = short_numbers(&it.variogram.to_string());
     let f = render_both(&dir.join("variogram"), (900, 600), |r| {
-        draw_variogram(r, &pts, &|h| it.variogram.gamma(h), "Experimental variogram and fitted model", &label)
+        draw_variogram(
+            r,
+            &pts,
+            &|h| it.variogram.gamma(h),
+            "Experimental variogram and fitted model",
+            &label,
+        )
     })?;
-    add("variogram", format!("Variogram of the samples and the fitted model: {label}"), f);
+    add(
+        "variogram",
+        format!("Variogram of the samples and the fitted model: {label}"),
+        f,
+    );
 
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
     let maps: [(&str, &str, &[f64], bool, ColourMap, bool, &str); 4] = [
-        ("elevation-uk", "DSM by universal kriging (linear drift)", &it.uk, true, ColourMap::Terrain, false, "elevation (m)"),
-        ("elevation-idw", "DSM by inverse distance weighting", &it.idw, true, ColourMap::Terrain, false, "elevation (m)"),
-        ("kriging-std", "Kriging standard deviation", &it.uk_std, false, ColourMap::Viridis, false, "std. dev. (m)"),
-        ("uk-minus-idw", "UK minus IDW", &diff, false, ColourMap::Diverging, true, "difference (m)"),
+        (
+            "elevation-uk",
+            "DSM by universal kriging (linear drift)",
+            &it.uk,
+            true,
+            ColourMap::Terrain,
+            false,
+            "elevation (m)",
+        ),
+        (
+            "elevation-idw",
+            "DSM by inverse distance weighting",
+            &it.idw,
+            true,
+            ColourMap::Terrain,
+            false,
+            "elevation (m)",
+        ),
+        (
+            "kriging-std",
+            "Kriging standard deviation",
+            &it.uk_std,
+            false,
+            ColourMap::Viridis,
+            false,
+            "std. dev. (m)",
+        ),
+        (
+            "uk-minus-idw",
+            "UK minus IDW",
+            &diff,
+            false,
+            ColourMap::Diverging,
+            true,
+            "difference (m)",
+        ),
     ];
     for (name, title, values, shaded, colours, symmetric, unit) in maps {
         let map = SurfaceMap {
@@ -91,17 +182,68 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
             outlines: &rings,
         };
         let f = render_both(&dir.join(name), SIZE, |r| draw_surface(r, &map))?;
-        add(name, format!("{title}{}", if shaded { ", hill-shaded, with contours" } else { ", with contours" }), f);
+        add(
+            name,
+            format!(
+                "{title}{}",
+                if shaded {
+                    ", hill-shaded, with contours"
+                } else {
+                    ", with contours"
+                }
+            ),
+            f,
+        );
     }
-    let v3: Vec<[f64; 3]> = xy.iter().zip(&it.uk).map(|(p, z)| [p[0], p[1], *z]).collect();
-    let (lo, hi) = s.region.projected.bbox().unwrap_or(([0.0, 0.0], [1.0, 1.0]));
+    let v3: Vec<[f64; 3]> = xy
+        .iter()
+        .zip(&it.uk)
+        .map(|(p, z)| [p[0], p[1], *z])
+        .collect();
+    let (lo, hi) = s
+        .region
+        .projected
+        .bbox()
+        .unwrap_or(([0.0, 0.0], [1.0, 1.0]));
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let relief = it.uk.iter().copied().fold(f64::NEG_INFINITY, f64::max) - it.uk.iter().copied().fold(f64::INFINITY, f64::min);
-    let ex = if relief > 0.0 { (0.3 * extent / relief).clamp(1.0, 10.0) } else { 1.0 };
+    let relief = it.uk.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - it.uk.iter().copied().fold(f64::INFINITY, f64::min);
+    let ex = if relief > 0.0 {
+        (0.3 * extent / relief).clamp(1.0, 10.0)
+    } else {
+        1.0
+    };
     let ex = (ex * 2.0).round() / 2.0;
-    let f = render_both(&dir.join("dsm-3d"), SIZE, |r| draw_view3d(r, &v3, &m.mesh.triangles, ex, "The DSM in 3D"))?;
+    let f = render_both(&dir.join("dsm-3d"), SIZE, |r| {
+        draw_view3d(r, &v3, &m.mesh.triangles, ex, "The DSM in 3D")
+    })?;
     add("3d", "Shaded 3D view of the DSM (UK elevations)".into(), f);
     Ok(pics)
+}
+
+/// Rewrites every decimal number in `s` with at most 4 significant decimals, for labels.
+pub fn short_numbers(s: &str) -> String {
+    let mut out = String::new();
+    let mut num = String::new();
+    let flush = |num: &mut String, out: &mut String| {
+        if let (true, Ok(v)) = (num.contains('.'), num.parse::<f64>()) {
+            let d = if v.abs() >= 100.0 { 1 } else { 4 };
+            out.push_str(&format!("{v:.d$}"));
+        } else {
+            out.push_str(num);
+        }
+        num.clear();
+    };
+    for c in s.chars() {
+        if c.is_ascii_digit() || c == '.' {
+            num.push(c);
+        } else {
+            flush(&mut num, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut num, &mut out);
+    out
 }
 
 fn num(v: f64, d: usize) -> String {
@@ -114,15 +256,31 @@ fn quality_rows(cols: &[&Quality]) -> Vec<Vec<String>> {
         ("vertices", |q| q.vertices.to_string()),
         ("minimum angle (deg)", |q| num(q.min_angle, 2)),
         ("maximum angle (deg)", |q| num(q.max_angle, 2)),
-        ("radius ratio min / mean", |q| format!("{:.3} / {:.3}", q.radius_ratio.min, q.radius_ratio.mean)),
-        ("aspect ratio mean / max", |q| format!("{:.3} / {:.3}", q.aspect_ratio.mean, q.aspect_ratio.max)),
-        ("area min / mean / max (m²)", |q| format!("{:.2} / {:.2} / {:.2}", q.area.min, q.area.mean, q.area.max)),
-        ("edge min / mean / max (m)", |q| format!("{:.2} / {:.2} / {:.2}", q.edge.min, q.edge.mean, q.edge.max)),
-        ("angles below 30 deg", |q| q.angle_histogram[..3].iter().sum::<usize>().to_string()),
-        ("angles above 90 deg", |q| q.angle_histogram[9..].iter().sum::<usize>().to_string()),
+        ("radius ratio min / mean", |q| {
+            format!("{:.3} / {:.3}", q.radius_ratio.min, q.radius_ratio.mean)
+        }),
+        ("aspect ratio mean / max", |q| {
+            format!("{:.3} / {:.3}", q.aspect_ratio.mean, q.aspect_ratio.max)
+        }),
+        ("area min / mean / max (m²)", |q| {
+            format!("{:.2} / {:.2} / {:.2}", q.area.min, q.area.mean, q.area.max)
+        }),
+        ("edge min / mean / max (m)", |q| {
+            format!("{:.2} / {:.2} / {:.2}", q.edge.min, q.edge.mean, q.edge.max)
+        }),
+        ("angles below 30 deg", |q| {
+            q.angle_histogram[..3].iter().sum::<usize>().to_string()
+        }),
+        ("angles above 90 deg", |q| {
+            q.angle_histogram[9..].iter().sum::<usize>().to_string()
+        }),
     ];
     rows.iter()
-        .map(|(name, f)| std::iter::once(name.to_string()).chain(cols.iter().map(|q| f(q))).collect())
+        .map(|(name, f)| {
+            std::iter::once(name.to_string())
+                .chain(cols.iter().map(|q| f(q)))
+                .collect()
+        })
         .collect()
 }
 
@@ -138,7 +296,10 @@ pub fn write_report(
     pics: &[Picture],
     timings: &Timings,
 ) -> Result<()> {
-    let title = p.title.clone().unwrap_or_else(|| "terramesh discrete surface model".into());
+    let title = p
+        .title
+        .clone()
+        .unwrap_or_else(|| "terramesh discrete surface model".into());
     let mut sections = Vec::new();
     let png = |k: usize| -> Result<Block> {
         let pic = &pics[k];
@@ -163,31 +324,58 @@ pub fn write_report(
                 kv("UTM zone", s.zone.to_string()),
                 kv("region area (m²)", num(s.region.projected.area(), 1)),
                 kv("elevation source", s.source.clone()),
-                kv("sampling grid", match p.sampling.spacing {
-                    Some(sp) => format!("spacing {sp} m"),
-                    None => format!("{} rows x {} cols", p.sampling.rows, p.sampling.cols),
-                }),
-                kv("margin / clip", format!("{} / {}", p.sampling.margin, p.sampling.clip)),
-                kv("mesh", format!(
-                    "min angle {} deg, max area {}, smoothing {} x {}",
-                    p.mesh.min_angle,
-                    m.max_area.map_or("-".into(), |a| format!("{a:.2} m²")),
-                    p.mesh.smooth,
-                    p.mesh.smoother
-                )),
-                kv("kriging", format!(
-                    "universal, drift {:?}, {}",
-                    it.drift,
-                    if p.interpolation.neighbors == 0 { "all samples".to_string() } else { format!("{} neighbours", p.interpolation.neighbors) }
-                )),
-                kv("IDW", format!("power {}, {} neighbours", p.interpolation.idw_power, p.interpolation.idw_neighbors)),
+                kv(
+                    "sampling grid",
+                    match p.sampling.spacing {
+                        Some(sp) => format!("spacing {sp} m"),
+                        None => format!("{} rows x {} cols", p.sampling.rows, p.sampling.cols),
+                    },
+                ),
+                kv(
+                    "margin / clip",
+                    format!("{} / {}", p.sampling.margin, p.sampling.clip),
+                ),
+                kv(
+                    "mesh",
+                    format!(
+                        "min angle {} deg, max area {}, smoothing {} x {}",
+                        p.mesh.min_angle,
+                        m.max_area.map_or("-".into(), |a| format!("{a:.2} m²")),
+                        p.mesh.smooth,
+                        p.mesh.smoother
+                    ),
+                ),
+                kv(
+                    "kriging",
+                    format!(
+                        "universal, drift {:?}, {}",
+                        it.drift,
+                        if p.interpolation.neighbors == 0 {
+                            "all samples".to_string()
+                        } else {
+                            format!("{} neighbours", p.interpolation.neighbors)
+                        }
+                    ),
+                ),
+                kv(
+                    "IDW",
+                    format!(
+                        "power {}, {} neighbours",
+                        p.interpolation.idw_power, p.interpolation.idw_neighbors
+                    ),
+                ),
             ],
         }],
     });
     // Table I of the paper, for this region's corners.
     let mut corner_rows = Vec::new();
     if let Some(geo) = &s.region.geographic {
-        for (k, c) in geo.polygons.iter().flat_map(|pl| pl.outer.iter()).enumerate() {
+        for (k, c) in geo
+            .polygons
+            .iter()
+            .flat_map(|pl| pl.outer.iter())
+            .enumerate()
+        {
             let (lon, lat) = (c[0], c[1]);
             let u = to_utm(lat, lon, Some(s.zone)).context("corner")?;
             corner_rows.push(vec![
@@ -202,16 +390,37 @@ pub fn write_report(
     sections.push(Section {
         heading: "Study area corners".into(),
         blocks: vec![Block::Table {
-            caption: format!("Coordinates of the corners (WGS-84 and UTM zone {})", s.zone),
-            header: ["point", "latitude", "longitude", "easting (m)", "northing (m)"].map(String::from).to_vec(),
+            caption: format!(
+                "Coordinates of the corners (WGS-84 and UTM zone {})",
+                s.zone
+            ),
+            header: [
+                "point",
+                "latitude",
+                "longitude",
+                "easting (m)",
+                "northing (m)",
+            ]
+            .map(String::from)
+            .to_vec(),
             rows: corner_rows,
         }],
     });
-    sections.push(Section { heading: "Samples".into(), blocks: vec![png(0)?] });
+    sections.push(Section {
+        heading: "Samples".into(),
+        blocks: vec![png(0)?],
+    });
     let mut mesh_blocks = vec![png(1)?, png(2)?];
     mesh_blocks.push(Block::Table {
         caption: "Mesh quality".into(),
-        header: ["measure", "2D before smoothing", "2D after smoothing", "3D surface"].map(String::from).to_vec(),
+        header: [
+            "measure",
+            "2D before smoothing",
+            "2D after smoothing",
+            "3D surface",
+        ]
+        .map(String::from)
+        .to_vec(),
         rows: quality_rows(&[&m.before, &m.after, &w.quality3d]),
     });
     if let Some(r) = &m.smoothing {
@@ -220,23 +429,38 @@ pub fn write_report(
             r.moves, r.rejected, r.flips
         )));
     }
-    sections.push(Section { heading: "Planar mesh".into(), blocks: mesh_blocks });
+    sections.push(Section {
+        heading: "Planar mesh".into(),
+        blocks: mesh_blocks,
+    });
     let mut vb = vec![png(3)?];
-    vb.push(Block::Text(format!("Model: {}. Ranges are practical ranges (GSLIB convention).", it.variogram)));
+    vb.push(Block::Text(format!(
+        "Model: {}. Ranges are practical ranges (GSLIB convention).",
+        short_numbers(&it.variogram.to_string())
+    )));
     if !it.candidates.is_empty() {
         vb.push(Block::Table {
             caption: "Models tried by the automatic fit (chosen by leave-one-out RMSE)".into(),
-            header: ["model", "cross-validation RMSE (m)", "fit RMSE (m²)"].map(String::from).to_vec(),
+            header: ["model", "cross-validation RMSE (m)", "fit RMSE (m²)"]
+                .map(String::from)
+                .to_vec(),
             rows: it
                 .candidates
                 .iter()
                 .map(|(name, cv, fit)| {
-                    vec![name.clone(), cv.map_or("-".into(), |v| num(v, 4)), fit.map_or("-".into(), |v| num(v, 4))]
+                    vec![
+                        name.clone(),
+                        cv.map_or("-".into(), |v| num(v, 4)),
+                        fit.map_or("-".into(), |v| num(v, 4)),
+                    ]
                 })
                 .collect(),
         });
     }
-    sections.push(Section { heading: "Variogram".into(), blocks: vb });
+    sections.push(Section {
+        heading: "Variogram".into(),
+        blocks: vb,
+    });
     sections.push(Section {
         heading: "Interpolated surfaces".into(),
         blocks: vec![png(4)?, png(5)?, png(6)?, png(7)?, png(8)?],
@@ -246,11 +470,23 @@ pub fn write_report(
         blocks: vec![Block::Table {
             caption: format!(
                 "{} cross-validation of the samples",
-                if p.interpolation.cv_folds == 0 { "Leave-one-out".to_string() } else { format!("{}-fold", p.interpolation.cv_folds) }
+                if p.interpolation.cv_folds == 0 {
+                    "Leave-one-out".to_string()
+                } else {
+                    format!("{}-fold", p.interpolation.cv_folds)
+                }
             ),
-            header: ["method", "n", "RMSE (m)", "MAE (m)", "mean error (m)", "mean std. error", "var. std. error"]
-                .map(String::from)
-                .to_vec(),
+            header: [
+                "method",
+                "n",
+                "RMSE (m)",
+                "MAE (m)",
+                "mean error (m)",
+                "mean std. error",
+                "var. std. error",
+            ]
+            .map(String::from)
+            .to_vec(),
             rows: it
                 .cv
                 .iter()
@@ -292,7 +528,11 @@ pub fn write_report(
         blocks: vec![Block::Table {
             caption: "Time per stage (this machine, this run)".into(),
             header: vec!["stage".into(), "seconds".into()],
-            rows: timings.0.iter().map(|(n, t)| vec![n.clone(), num(*t, 3)]).collect(),
+            rows: timings
+                .0
+                .iter()
+                .map(|(n, t)| vec![n.clone(), num(*t, 3)])
+                .collect(),
         }],
     });
     let html = Report { title, sections }.to_html();

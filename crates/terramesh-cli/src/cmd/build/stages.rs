@@ -6,8 +6,9 @@ use anyhow::{bail, Context, Result};
 use clap::Parser;
 use terramesh_core::coords::Zone;
 use terramesh_geostat::{
-    cross_validate, experimental, fit_auto, CvStats, Data, Drift, Duplicates, Folds, GlobalKriging, Idw,
-    IdwSearch, Interpolator, Lag, LagSettings, LocalKriging, Method, ModelKind, Variogram, Weighting,
+    cross_validate, experimental, fit_auto, CvStats, Data, Drift, Duplicates, Folds, GlobalKriging,
+    Idw, IdwSearch, Interpolator, Lag, LagSettings, LocalKriging, Method, ModelKind, Variogram,
+    Weighting,
 };
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport, Smoother};
@@ -37,13 +38,17 @@ struct SampleArgv {
 }
 
 /// Step 1: samples on the project's grid, also written to `out/samples.csv`.
-pub fn sample(p: &Project, base: &Path, out: &Path) -> Result<Samples> {
+pub fn sample(p: &Project, base: &Path, out: &Path, quiet: bool) -> Result<Samples> {
     let source = resolve_source(p, base)?;
     let mut argv: Vec<String> = vec!["sample".into(), "--source".into(), source.clone()];
     match (&p.region.corners, &p.region.file) {
         (Some(c), None) => {
             let path = base.join(c.trim());
-            let c = if !c.contains(';') && path.is_file() { path.display().to_string() } else { c.clone() };
+            let c = if !c.contains(';') && path.is_file() {
+                path.display().to_string()
+            } else {
+                c.clone()
+            };
             argv.extend(["--corners".into(), c]);
         }
         (None, Some(f)) => argv.extend(["--region".into(), base.join(f).display().to_string()]),
@@ -58,24 +63,50 @@ pub fn sample(p: &Project, base: &Path, out: &Path) -> Result<Samples> {
     let s = &p.sampling;
     match s.spacing {
         Some(sp) => argv.extend(["--spacing".into(), sp.to_string()]),
-        None => argv.extend(["--rows".into(), s.rows.to_string(), "--cols".into(), s.cols.to_string()]),
+        None => argv.extend([
+            "--rows".into(),
+            s.rows.to_string(),
+            "--cols".into(),
+            s.cols.to_string(),
+        ]),
     }
-    let margin = if s.margin < 1.0 { s.margin.to_string() } else { format!("{}m", s.margin) };
-    argv.extend(["--margin".into(), margin, "--interpolation".into(), s.method.clone()]);
+    let margin = if s.margin < 1.0 {
+        s.margin.to_string()
+    } else {
+        format!("{}m", s.margin)
+    };
+    argv.extend([
+        "--margin".into(),
+        margin,
+        "--interpolation".into(),
+        s.method.clone(),
+    ]);
     if s.clip {
         argv.push("--clip".into());
     }
     if let Some(c) = p.source.class {
         argv.extend(["--class".into(), c.to_string()]);
     }
-    argv.extend(["--no-progress".into(), "-o".into(), out.join("samples.csv").display().to_string()]);
-    let parsed = SampleArgv::try_parse_from(&argv)
-        .map_err(|e| anyhow::anyhow!("[sampling]/[source]: {}", e.to_string().lines().next().unwrap_or("")))?;
-    let (settings, table) = sample::acquire(&parsed.args)?;
+    argv.extend([
+        "--no-progress".into(),
+        "-o".into(),
+        out.join("samples.csv").display().to_string(),
+    ]);
+    let parsed = SampleArgv::try_parse_from(&argv).map_err(|e| {
+        anyhow::anyhow!(
+            "[sampling]/[source]: {}",
+            e.to_string().lines().next().unwrap_or("")
+        )
+    })?;
+    let (mut settings, table) = sample::acquire(&parsed.args)?;
+    settings.quiet = quiet;
     let zone = table
         .zone
         .context("the source is in a projected CRS terramesh does not convert; use a geographic or UTM source for build")?;
-    let region = settings.region.clone().context("a region is needed for build")?;
+    let region = settings
+        .region
+        .clone()
+        .context("a region is needed for build")?;
     let mut xyz = Vec::with_capacity(table.rows.len());
     for r in &table.rows {
         if let Ok(z) = r.z {
@@ -83,17 +114,29 @@ pub fn sample(p: &Project, base: &Path, out: &Path) -> Result<Samples> {
         }
     }
     if xyz.len() < 10 {
-        bail!("only {} samples with an elevation: enlarge the grid or check the source", xyz.len());
+        bail!(
+            "only {} samples with an elevation: enlarge the grid or check the source",
+            xyz.len()
+        );
     }
     let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
     sample::write::write(&settings, table)?;
-    Ok(Samples { xyz, zone, region, source, cell })
+    Ok(Samples {
+        xyz,
+        zone,
+        region,
+        source,
+        cell,
+    })
 }
 
 /// The source path relative to the project file, or the fallback when it is absent.
 fn resolve_source(p: &Project, base: &Path) -> Result<String> {
     let spec = &p.source.path;
-    let is_service = spec.contains("{z}") || ["google:", "opentopodata:", "open-elevation:"].iter().any(|s| spec.starts_with(s));
+    let is_service = spec.contains("{z}")
+        || ["google:", "opentopodata:", "open-elevation:"]
+            .iter()
+            .any(|s| spec.starts_with(s));
     if is_service {
         return Ok(spec.clone());
     }
@@ -106,7 +149,11 @@ fn resolve_source(p: &Project, base: &Path) -> Result<String> {
         if fb.exists() {
             return Ok(fb.display().to_string());
         }
-        bail!("source.path {} and source.fallback {} do not exist", path.display(), fb.display());
+        bail!(
+            "source.path {} and source.fallback {} do not exist",
+            path.display(),
+            fb.display()
+        );
     }
     bail!("source.path {}: no such file or directory", path.display())
 }
@@ -177,7 +224,14 @@ pub fn mesh(p: &Project, s: &Samples) -> Result<Meshed> {
         None
     };
     let after = Quality::planar(&mesh);
-    Ok(Meshed { mesh, unsmoothed, before, after, smoothing, max_area })
+    Ok(Meshed {
+        mesh,
+        unsmoothed,
+        before,
+        after,
+        smoothing,
+        max_area,
+    })
 }
 
 /// Step 4: vertex elevations by UK and IDW, a DSM grid, and cross-validation.
@@ -219,7 +273,8 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
         Duplicates::Mean,
     )
     .context("samples")?;
-    let lags = experimental(&data, &LagSettings::default()).context("experimental variogram of the samples")?;
+    let lags = experimental(&data, &LagSettings::default())
+        .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let variogram = if let Some(v) = &ip.model {
         let kind = ModelKind::parse(&v.model).with_context(|| {
@@ -227,10 +282,17 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
         })?;
         Variogram::single(kind, v.nugget, v.psill, v.range).context("interpolation.model")?
     } else if ip.variogram == "auto" {
-        let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, &ModelKind::ALL).context("fitting the variogram")?;
+        let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, &ModelKind::ALL)
+            .context("fitting the variogram")?;
         candidates = cands
             .iter()
-            .map(|c| (c.model.name().to_string(), c.cv_rmse, c.fit.as_ref().map(|f| f.rmse)))
+            .map(|c| {
+                (
+                    c.model.name().to_string(),
+                    c.cv_rmse,
+                    c.fit.as_ref().map(|f| f.rmse),
+                )
+            })
             .collect();
         fit.variogram
     } else {
@@ -239,16 +301,29 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
     };
     let drift = drift_of(&ip.drift);
     let uk_method = Method::Universal(drift);
-    let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len()).map(|i| m.mesh.absolute(i)).collect();
-    let (uk, var) = krige(&data, &variogram, uk_method, ip.neighbors, &vertices, true)?;
+    let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len())
+        .map(|i| m.mesh.absolute(i))
+        .collect();
+    let engine = Kriging::new(&data, &variogram, uk_method, ip.neighbors)?;
+    let (uk, var) = engine.predict(&vertices, true)?;
     let uk_std: Vec<f64> = var.iter().map(|v| v.max(0.0).sqrt()).collect();
-    let search = if ip.idw_neighbors == 0 { IdwSearch::All } else { IdwSearch::Nearest(ip.idw_neighbors) };
+    let search = if ip.idw_neighbors == 0 {
+        IdwSearch::All
+    } else {
+        IdwSearch::Nearest(ip.idw_neighbors)
+    };
     let idw_engine = Idw::new(&data, ip.idw_power, search).context("IDW")?;
     let mut idw = vec![0.0; vertices.len()];
-    idw_engine.predict(&vertices, &mut idw).context("IDW at the mesh vertices")?;
+    idw_engine
+        .predict(&vertices, &mut idw)
+        .context("IDW at the mesh vertices")?;
 
     // Cross-validation of the methods compared in the report.
-    let folds = if ip.cv_folds == 0 { Folds::LeaveOneOut } else { Folds::KFold(ip.cv_folds) };
+    let folds = if ip.cv_folds == 0 {
+        Folds::LeaveOneOut
+    } else {
+        Folds::KFold(ip.cv_folds)
+    };
     // Global leave-one-out has a closed form only for models with a sill; for the others
     // (power, linear) it would refit n systems, so they are cross-validated with 64 neighbours.
     let neighbours = match (ip.neighbors, variogram.sill()) {
@@ -259,22 +334,40 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
     let mut cv = Vec::new();
     for name in &ip.methods {
         let how = match name.as_str() {
-            "uk" => Interpolator::Kriging { variogram: variogram.clone(), method: uk_method, neighbours },
-            "ok" => Interpolator::Kriging { variogram: variogram.clone(), method: Method::Ordinary, neighbours },
-            "sk" => Interpolator::Kriging {
+            "uk" => Interpolator::Kriging {
                 variogram: variogram.clone(),
-                method: Method::Simple { mean: data.z().iter().sum::<f64>() / data.len() as f64 },
+                method: uk_method,
                 neighbours,
             },
-            _ => Interpolator::Idw { power: ip.idw_power, search },
+            "ok" => Interpolator::Kriging {
+                variogram: variogram.clone(),
+                method: Method::Ordinary,
+                neighbours,
+            },
+            "sk" => Interpolator::Kriging {
+                variogram: variogram.clone(),
+                method: Method::Simple {
+                    mean: data.z().iter().sum::<f64>() / data.len() as f64,
+                },
+                neighbours,
+            },
+            _ => Interpolator::Idw {
+                power: ip.idw_power,
+                search,
+            },
         };
-        let r = cross_validate(&data, &how, folds).with_context(|| format!("cross-validation of {name}"))?;
+        let r = cross_validate(&data, &how, folds)
+            .with_context(|| format!("cross-validation of {name}"))?;
         cv.push((name.to_uppercase(), r.stats));
     }
 
     // The DSM grid over the region's bounding box, nodata outside the region.
     let (lo, hi) = s.region.projected.bbox().context("empty region")?;
-    let step = p.export.grid_spacing.unwrap_or(s.cell[0].min(s.cell[1])).max(1e-3);
+    let step = p
+        .export
+        .grid_spacing
+        .unwrap_or(s.cell[0].min(s.cell[1]))
+        .max(1e-3);
     let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
     let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
     let spec = terramesh_io::grid_write::GridSpec {
@@ -299,7 +392,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
     let nodata = -9999.0;
     let mut values = vec![nodata; nx * ny];
     if !inside.is_empty() {
-        let (est, _) = krige(&data, &variogram, uk_method, ip.neighbors, &inside, false)?;
+        let (est, _) = engine.predict(&inside, false)?;
         for (k, &ix) in index.iter().enumerate() {
             values[ix] = est[k];
         }
@@ -309,31 +402,45 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
             bail!("{name} gave a non-finite value at mesh vertex {i}: the kriging system is ill-conditioned");
         }
     }
-    Ok(Interpolated { variogram, lags, candidates, uk, uk_std, idw, cv, grid: (spec, values), drift })
+    Ok(Interpolated {
+        variogram,
+        lags,
+        candidates,
+        uk,
+        uk_std,
+        idw,
+        cv,
+        grid: (spec, values),
+        drift,
+    })
 }
 
-/// Kriging estimates (and variances on request) at `targets`, global or in a neighbourhood.
-fn krige(
-    data: &Data,
-    v: &Variogram,
-    method: Method,
-    neighbors: usize,
-    targets: &[[f64; 2]],
-    variance: bool,
-) -> Result<(Vec<f64>, Vec<f64>)> {
-    let mut est = vec![0.0; targets.len()];
-    let mut var = vec![0.0; if variance { targets.len() } else { 0 }];
-    let vslot = if variance { Some(&mut var[..]) } else { None };
-    if neighbors == 0 {
-        GlobalKriging::new(data, v, method, variance)
-            .context("kriging system")?
-            .predict(targets, &mut est, vslot)
-            .context("kriging")?;
-    } else {
-        LocalKriging::new(data, v, method, neighbors)
-            .context("kriging system")?
-            .predict(targets, &mut est, vslot)
-            .context("kriging")?;
+/// A kriging system factorised once and evaluated at many targets.
+enum Kriging {
+    Global(GlobalKriging),
+    Local(LocalKriging),
+}
+
+impl Kriging {
+    /// Global kriging for `neighbors == 0`, else a moving neighbourhood of that size.
+    fn new(data: &Data, v: &Variogram, method: Method, neighbors: usize) -> Result<Kriging> {
+        Ok(if neighbors == 0 {
+            Kriging::Global(GlobalKriging::new(data, v, method, true).context("kriging system")?)
+        } else {
+            Kriging::Local(LocalKriging::new(data, v, method, neighbors).context("kriging system")?)
+        })
     }
-    Ok((est, var))
+
+    /// Estimates (and variances on request) at `targets`.
+    fn predict(&self, targets: &[[f64; 2]], variance: bool) -> Result<(Vec<f64>, Vec<f64>)> {
+        let mut est = vec![0.0; targets.len()];
+        let mut var = vec![0.0; if variance { targets.len() } else { 0 }];
+        let vslot = if variance { Some(&mut var[..]) } else { None };
+        match self {
+            Kriging::Global(g) => g.predict(targets, &mut est, vslot),
+            Kriging::Local(l) => l.predict(targets, &mut est, vslot),
+        }
+        .context("kriging")?;
+        Ok((est, var))
+    }
 }

@@ -80,6 +80,8 @@ pub struct Settings {
     pub cache_dir: Option<PathBuf>,
     pub zoom: u8,
     pub progress: bool,
+    /// No summary lines on standard error (`terramesh build --quiet`).
+    pub quiet: bool,
     pub output: Option<PathBuf>,
 }
 
@@ -251,6 +253,7 @@ pub fn resolve(a: &Args) -> Result<Settings> {
         },
         zoom: a.zoom,
         progress: !a.no_progress && std::io::stderr().is_terminal(),
+        quiet: false,
         output: a.output.clone(),
     })
 }

@@ -130,8 +130,10 @@ pub fn write(s: &Settings, t: Samples) -> Result<()> {
         } else {
             0
         };
-    eprintln!("terramesh: {}", t.summary);
-    eprintln!("terramesh: wrote {written} points to {name}");
+    if !s.quiet {
+        eprintln!("terramesh: {}", t.summary);
+        eprintln!("terramesh: wrote {written} points to {name}");
+    }
     if !missing.is_empty() {
         let what = match s.on_missing {
             OnMissing::Skip => "left out",

@@ -1,0 +1,382 @@
+//! End-to-end tests of `terramesh init` and `terramesh build` on the Haut-Barr example.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn example() -> PathBuf {
+    root().join("examples/haut-barr/terramesh.toml")
+}
+
+fn terramesh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args(args)
+        .output()
+        .expect("run terramesh")
+}
+
+fn ok(o: &Output) {
+    assert!(
+        o.status.success(),
+        "terramesh failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn build(dir: &Path, extra: &[&str]) -> Output {
+    let ex = example();
+    let mut args = vec![
+        "build",
+        ex.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    terramesh(&args)
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn json_number(text: &str, key: &str) -> f64 {
+    let i = text
+        .find(&format!("\"{key}\""))
+        .unwrap_or_else(|| panic!("no {key}"));
+    let rest = &text[i + key.len() + 3..];
+    let end = rest.find([',', '\n', '}']).unwrap();
+    rest[..end].trim().parse().unwrap()
+}
+
+#[test]
+fn example_builds_every_output_deterministically() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    ok(&build(a.path(), &[]));
+    ok(&build(b.path(), &[]));
+    let expected = [
+        "dsm.vtu",
+        "dsm.obj",
+        "dsm.ply",
+        "dsm.stl",
+        "dsm.ts",
+        "dsm.msh",
+        "dsm.dxf",
+        "dsm.kml",
+        "dsm-solid.stl",
+        "dsm-solid.msh",
+        "dsm-solid.json",
+        "dsm-origin.json",
+        "dsm-vertices.csv",
+        "dsm.tif",
+        "dsm.asc",
+        "samples.csv",
+        "mesh-quality.csv",
+        "cross-validation.csv",
+        "variogram.json",
+        "report.html",
+    ];
+    for f in expected {
+        assert!(a.path().join(f).is_file(), "{f} missing");
+    }
+    for name in [
+        "samples",
+        "mesh-before-smoothing",
+        "mesh-after-smoothing",
+        "variogram",
+        "elevation-uk",
+        "elevation-idw",
+        "kriging-std",
+        "uk-minus-idw",
+        "dsm-3d",
+    ] {
+        for ext in ["png", "svg"] {
+            assert!(
+                a.path()
+                    .join("pictures")
+                    .join(format!("{name}.{ext}"))
+                    .is_file(),
+                "{name}.{ext}"
+            );
+        }
+    }
+    // Byte-identical except the timings in report.html.
+    let mut files = Vec::new();
+    for e in walk(a.path()) {
+        let rel = e.strip_prefix(a.path()).unwrap().to_path_buf();
+        if rel != Path::new("report.html") {
+            files.push(rel);
+        }
+    }
+    assert!(files.len() >= expected.len() - 1 + 18);
+    for rel in files {
+        assert_eq!(
+            std::fs::read(a.path().join(&rel)).unwrap(),
+            std::fs::read(b.path().join(&rel)).unwrap(),
+            "{} differs between two builds",
+            rel.display()
+        );
+    }
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn example_outputs_agree_with_each_other() {
+    let d = tempfile::tempdir().unwrap();
+    ok(&build(d.path(), &[]));
+    let out = d.path();
+    // The vertices of the CSV are the VTU's points; elevations are the UK column.
+    let csv = read(&out.join("dsm-vertices.csv"));
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let vtu = read(&out.join("dsm.vtu"));
+    assert!(vtu.contains(&format!("NumberOfPoints=\"{}\"", rows.len())));
+    for name in [
+        "elevation_uk",
+        "kriging_std",
+        "elevation_idw",
+        "uk_minus_idw",
+        "min_angle_deg",
+    ] {
+        assert!(
+            vtu.contains(&format!("Name=\"{name}\"")),
+            "VTU lacks {name}"
+        );
+    }
+    assert!(rows.iter().all(|r| r.iter().all(|v| v.is_finite())));
+    assert!(
+        rows.iter().all(|r| r[3] >= 0.0),
+        "kriging std is never negative"
+    );
+    // The elevations lie within the samples' range (SRTM says 342-434 m inside the area,
+    // a little wider with the margin).
+    let (lo, hi) = rows
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), r| {
+            (l.min(r[2]), h.max(r[2]))
+        });
+    assert!(lo > 300.0 && hi < 470.0, "UK range {lo}..{hi}");
+    // STL: same triangles as the VTU, coordinates relative to the recorded origin.
+    let origin = read(&out.join("dsm-origin.json"));
+    let ox = json_number(&origin, "x");
+    let oy = json_number(&origin, "y");
+    let (header, tris) = terramesh_io_read_stl(&out.join("dsm.stl"));
+    assert!(header.contains(&format!("origin {ox} {oy} 0")), "{header}");
+    let ncells: usize = vtu
+        .split("NumberOfCells=\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(tris, ncells);
+    // GOCAD TSurf: one VRTX per vertex, one TRGL per triangle.
+    let ts = read(&out.join("dsm.ts"));
+    assert_eq!(
+        ts.lines().filter(|l| l.starts_with("VRTX ")).count(),
+        rows.len()
+    );
+    assert_eq!(
+        ts.lines().filter(|l| l.starts_with("TRGL ")).count(),
+        ncells
+    );
+    // DXF and KML: one face per triangle.
+    assert_eq!(
+        read(&out.join("dsm.dxf")).matches("\n3DFACE\n").count(),
+        ncells
+    );
+    assert_eq!(
+        read(&out.join("dsm.kml")).matches("<Polygon>").count(),
+        ncells
+    );
+    // The solid: closed, positive volume, base below the surface.
+    let solid = read(&out.join("dsm-solid.json"));
+    assert!(solid.contains("\"closed\": true"));
+    let base = json_number(&solid, "base_elevation");
+    let vol = json_number(&solid, "volume");
+    assert!(base < lo && vol > 0.0);
+    // Quality: the planar mesh keeps the 30 degree minimum angle through smoothing.
+    let q = read(&out.join("mesh-quality.csv"));
+    let min_angle: Vec<f64> = q
+        .lines()
+        .find(|l| l.starts_with("min_angle_deg"))
+        .unwrap()
+        .split(',')
+        .skip(1)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(
+        min_angle[0] >= 30.0 && min_angle[1] >= 30.0,
+        "{min_angle:?}"
+    );
+    // Cross-validation compares UK, OK and IDW.
+    let cv = read(&out.join("cross-validation.csv"));
+    for m in ["UK,", "OK,", "IDW,"] {
+        assert!(cv.contains(&format!("\n{m}")), "{cv}");
+    }
+    // The report is one self-contained page with every picture inlined.
+    let html = read(&out.join("report.html"));
+    assert_eq!(html.matches("data:image/png;base64,").count(), 9);
+    assert!(!html.contains("src=\"http") && !html.contains("<script"));
+    for h in [
+        "Study area corners",
+        "Cross-validation",
+        "Mesh quality",
+        "Timings",
+        "N48°43&#x27;20.64",
+    ] {
+        let h = h.replace("&#x27;", "'");
+        assert!(html.contains(&h), "report lacks {h}");
+    }
+    // The variogram file can be reused by `terramesh interpolate --variogram`.
+    assert!(read(&out.join("variogram.json")).contains("\"model\""));
+}
+
+/// Binary STL: the header and the triangle count.
+fn terramesh_io_read_stl(p: &Path) -> (String, usize) {
+    let bytes = std::fs::read(p).unwrap();
+    let header = String::from_utf8_lossy(&bytes[..80]).trim_end().to_string();
+    let n = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
+    assert_eq!(bytes.len(), 84 + 50 * n, "STL size");
+    (header, n)
+}
+
+#[test]
+fn bundled_crop_gives_the_same_samples_as_the_srtm_tile() {
+    // The crop's posts are the tile's posts, so bilinear samples are identical.
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let common = [
+        "--set",
+        "export.pictures=false",
+        "--set",
+        "export.report=false",
+        "--set",
+        "sampling.rows=30",
+        "--set",
+        "sampling.cols=20",
+    ];
+    ok(&build(a.path(), &common));
+    let mut with_crop = common.to_vec();
+    with_crop.extend(["--set", "source.path=no-such-dir"]);
+    ok(&build(b.path(), &with_crop));
+    let sa = read(&a.path().join("samples.csv"));
+    let sb = read(&b.path().join("samples.csv"));
+    let parse = |s: &str| -> Vec<Vec<f64>> {
+        s.lines()
+            .skip(1)
+            .map(|l| {
+                l.split(',')
+                    .filter(|c| !c.ends_with('N'))
+                    .map(|v| v.parse().unwrap())
+                    .collect()
+            })
+            .collect()
+    };
+    let (pa, pb) = (parse(&sa), parse(&sb));
+    assert_eq!(pa.len(), pb.len());
+    for (x, y) in pa.iter().zip(&pb) {
+        for (u, v) in x.iter().zip(y) {
+            assert!((u - v).abs() < 1e-6, "{x:?} vs {y:?}");
+        }
+    }
+    assert!(!a.path().join("report.html").exists());
+}
+
+#[test]
+fn set_overrides_and_project_errors() {
+    let d = tempfile::tempdir().unwrap();
+    ok(&build(
+        d.path(),
+        &[
+            "--set",
+            "sampling.rows=20",
+            "--set",
+            "sampling.cols=10",
+            "--set",
+            "export.pictures=false",
+            "--set",
+            "export.report=false",
+            "--set",
+            "export.formats=[\"vtu\"]",
+        ],
+    ));
+    let n = read(&d.path().join("samples.csv")).lines().count() - 1;
+    assert!(n < 200, "{n} samples from a 20 x 10 grid");
+    assert!(!d.path().join("dsm.obj").exists());
+    // Errors name the key.
+    let o = build(d.path(), &["--set", "mesh.min_angle=40"]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("mesh.min_angle") && e.contains("33"), "{e}");
+    let o = build(d.path(), &["--set", "mesh.typo=1"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("typo"));
+    let bad = d.path().join("bad.toml");
+    std::fs::write(&bad, "[region]\ncorners = \"48.7 7.3; 48.7 7.4; 48.8 7.4\"\n[source]\npath = \"x\"\n\n[sampling]\nrowz = 3\n").unwrap();
+    let o = terramesh(&[
+        "build",
+        bad.to_str().unwrap(),
+        "-o",
+        d.path().to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("bad.toml") && e.contains("rowz") && e.contains("line 7"),
+        "{e}"
+    );
+    let o = build(
+        d.path(),
+        &[
+            "--set",
+            "source.path=nothing-here",
+            "--set",
+            "source.fallback=nor-here",
+        ],
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("nothing-here") && e.contains("nor-here"),
+        "{e}"
+    );
+}
+
+#[test]
+fn init_writes_a_project_that_parses_and_refuses_to_overwrite() {
+    let d = tempfile::tempdir().unwrap();
+    let site = d.path().join("my-site");
+    ok(&terramesh(&["init", site.to_str().unwrap()]));
+    let text = read(&site.join("terramesh.toml"));
+    assert!(text.contains("[sampling]") && text.contains("rows = 100"));
+    let o = terramesh(&["init", site.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--force"));
+    // Building the fresh project fails only because its source does not exist yet.
+    let o = terramesh(&[
+        "build",
+        site.join("terramesh.toml").to_str().unwrap(),
+        "-o",
+        d.path().join("out").to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && e.contains("source.path"), "{e}");
+}
