@@ -30,7 +30,7 @@ use crate::search::Tree;
 use crate::system::{dist, small_cholesky, small_quad, small_solve, Prepared, EXACT_EPS};
 
 /// Targets per block: bounds memory (`n x BLOCK` doubles) whatever the number of targets.
-pub const BLOCK: usize = 512;
+pub const BLOCK: usize = 2048;
 
 enum Solver {
     Dense {
