@@ -9,7 +9,9 @@ fn bin() -> Command {
 }
 
 fn fx(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/geostat").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/geostat")
+        .join(name)
 }
 
 fn run(args: &[&str]) -> (bool, String, String) {
@@ -35,10 +37,25 @@ fn interpolate_uk_matches_pykrige_fixture() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.csv");
     let (ok, _, err) = run(&[
-        "interpolate", "--data", fx("data-srtm.csv").to_str().unwrap(),
-        "--targets", fx("targets-srtm.csv").to_str().unwrap(),
-        "--method", "uk", "--drift", "linear", "--model", "spherical",
-        "--psill", "12000", "--range", "6000", "--nugget", "50", "-o", out.to_str().unwrap(),
+        "interpolate",
+        "--data",
+        fx("data-srtm.csv").to_str().unwrap(),
+        "--targets",
+        fx("targets-srtm.csv").to_str().unwrap(),
+        "--method",
+        "uk",
+        "--drift",
+        "linear",
+        "--model",
+        "spherical",
+        "--psill",
+        "12000",
+        "--range",
+        "6000",
+        "--nugget",
+        "50",
+        "-o",
+        out.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(&out).unwrap();
@@ -54,10 +71,23 @@ fn interpolate_uk_matches_pykrige_fixture() {
     // --method uk without --drift is the paper's linear drift.
     let out2 = dir.path().join("out2.csv");
     let (ok, _, err) = run(&[
-        "interpolate", "--data", fx("data-srtm.csv").to_str().unwrap(),
-        "--targets", fx("targets-srtm.csv").to_str().unwrap(), "--method", "uk",
-        "--model", "spherical", "--psill", "12000", "--range", "6000", "--nugget", "50",
-        "-o", out2.to_str().unwrap(),
+        "interpolate",
+        "--data",
+        fx("data-srtm.csv").to_str().unwrap(),
+        "--targets",
+        fx("targets-srtm.csv").to_str().unwrap(),
+        "--method",
+        "uk",
+        "--model",
+        "spherical",
+        "--psill",
+        "12000",
+        "--range",
+        "6000",
+        "--nugget",
+        "50",
+        "-o",
+        out2.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
     assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&out2).unwrap());
@@ -70,20 +100,43 @@ fn variogram_file_feeds_interpolate_and_grid_outputs() {
     let svg = dir.path().join("v.svg");
     let data = fx("data-srtm.csv");
     let (ok, _, err) = run(&[
-        "variogram", "--data", data.to_str().unwrap(), "--model", "exponential", "--lags", "12",
-        "-o", v.to_str().unwrap(), "--plot", svg.to_str().unwrap(),
+        "variogram",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "exponential",
+        "--lags",
+        "12",
+        "-o",
+        v.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
     let json = std::fs::read_to_string(&v).unwrap();
-    assert!(json.contains("\"experimental\"") && json.contains("\"exponential\"") && json.contains("\"rmse\""));
+    assert!(
+        json.contains("\"experimental\"")
+            && json.contains("\"exponential\"")
+            && json.contains("\"rmse\"")
+    );
     let s = std::fs::read_to_string(&svg).unwrap();
     assert!(s.starts_with("<svg") && s.matches("<circle").count() >= 12 && s.contains("<path"));
     for ext in ["asc", "tif"] {
         let g = dir.path().join(format!("dem.{ext}"));
         let (ok, _, err) = run(&[
-            "interpolate", "--data", data.to_str().unwrap(),
-            "--grid", "370000,5385000,390000,5405000,21,11", "--method", "ok",
-            "--variogram", v.to_str().unwrap(), "--epsg", "32632", "-o", g.to_str().unwrap(),
+            "interpolate",
+            "--data",
+            data.to_str().unwrap(),
+            "--grid",
+            "370000,5385000,390000,5405000,21,11",
+            "--method",
+            "ok",
+            "--variogram",
+            v.to_str().unwrap(),
+            "--epsg",
+            "32632",
+            "-o",
+            g.to_str().unwrap(),
         ]);
         assert!(ok, "{err}");
         let bytes = std::fs::read(&g).unwrap();
@@ -101,17 +154,41 @@ fn variogram_file_feeds_interpolate_and_grid_outputs() {
 #[test]
 fn cv_and_idw_run() {
     let (ok, out, err) = run(&[
-        "cv", "--data", fx("data-davis.csv").to_str().unwrap(), "--method", "ok",
-        "--model", "spherical", "--psill", "3000", "--range", "60", "--nugget", "50",
+        "cv",
+        "--data",
+        fx("data-davis.csv").to_str().unwrap(),
+        "--method",
+        "ok",
+        "--model",
+        "spherical",
+        "--psill",
+        "3000",
+        "--range",
+        "60",
+        "--nugget",
+        "50",
     ]);
     assert!(ok, "{err}");
-    assert!(out.contains("rmse,") && out.contains("var_standardized_error,"), "{out}");
+    assert!(
+        out.contains("rmse,") && out.contains("var_standardized_error,"),
+        "{out}"
+    );
     let (ok, out, err) = run(&[
-        "cv", "--data", fx("data-davis.csv").to_str().unwrap(), "--method", "idw",
-        "--neighbors", "8", "--folds", "5",
+        "cv",
+        "--data",
+        fx("data-davis.csv").to_str().unwrap(),
+        "--method",
+        "idw",
+        "--neighbors",
+        "8",
+        "--folds",
+        "5",
     ]);
     assert!(ok, "{err}");
-    assert!(out.contains("folds,5") && !out.contains("standardized"), "{out}");
+    assert!(
+        out.contains("folds,5") && !out.contains("standardized"),
+        "{out}"
+    );
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
@@ -133,11 +210,21 @@ fn fails_with(args: &[&str], needles: &[&str]) {
 fn errors_name_file_line_flag_and_value() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let good = write(d, "good.csv", "x,y,z\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n5,5,2\n");
+    let good = write(
+        d,
+        "good.csv",
+        "x,y,z\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n5,5,2\n",
+    );
     let t = write(d, "t.csv", "x,y\n1,1\n");
     let sph = ["--model", "spherical", "--psill", "1", "--range", "20"];
     let ip = |data: &str, extra: &[&str]| {
-        let mut v = vec!["interpolate".to_string(), "--data".into(), data.into(), "--targets".into(), t.clone()];
+        let mut v = vec![
+            "interpolate".to_string(),
+            "--data".into(),
+            data.into(),
+            "--targets".into(),
+            t.clone(),
+        ];
         v.extend(extra.iter().map(|s| s.to_string()));
         v
     };
@@ -150,36 +237,128 @@ fn errors_name_file_line_flag_and_value() {
     call(ip(&nz, &["--method", "ok"]), &["nz.csv", "no column 'z'"]);
     // non-numeric value: file, line, column, value
     let bad = write(d, "bad.csv", "x,y,z\n0,0,1\n1,abc,2\n");
-    call(ip(&bad, &["--method", "idw"]), &["bad.csv, line 3, column 'y'", "'abc'"]);
+    call(
+        ip(&bad, &["--method", "idw"]),
+        &["bad.csv, line 3, column 'y'", "'abc'"],
+    );
     // fewer points than the drift needs
     let two = write(d, "two.csv", "x,y,z\n0,0,1\n1,0,2\n");
     let mut a = vec!["--method", "uk"];
     a.extend(sph);
-    call(ip(&two, &a), &["two.csv", "2 data points", "linear drift needs at least 3"]);
+    call(
+        ip(&two, &a),
+        &["two.csv", "2 data points", "linear drift needs at least 3"],
+    );
     // collinear data for a linear drift
     let line = write(d, "line.csv", "x,y,z\n0,0,1\n1,1,2\n2,2,3\n3,3,3\n");
     call(ip(&line, &a), &["line.csv", "straight line"]);
     // duplicates name both lines
     let dup = write(d, "dup.csv", "x,y,z\n0,0,1\n1,0,2\n0,0,3\n");
-    call(ip(&dup, &["--method", "idw"]), &["dup.csv, lines 2 and 4", "--duplicates mean"]);
+    call(
+        ip(&dup, &["--method", "idw"]),
+        &["dup.csv, lines 2 and 4", "--duplicates mean"],
+    );
     // negative range, zero sill: flag and value
-    call(ip(&good, &["--method", "ok", "--model", "spherical", "--psill", "1", "--range", "-5"]), &["--range -5"]);
-    call(ip(&good, &["--method", "ok", "--model", "spherical", "--psill", "0", "--range", "5"]), &["--psill 0", "sill is zero"]);
+    call(
+        ip(
+            &good,
+            &[
+                "--method",
+                "ok",
+                "--model",
+                "spherical",
+                "--psill",
+                "1",
+                "--range",
+                "-5",
+            ],
+        ),
+        &["--range -5"],
+    );
+    call(
+        ip(
+            &good,
+            &[
+                "--method",
+                "ok",
+                "--model",
+                "spherical",
+                "--psill",
+                "0",
+                "--range",
+                "5",
+            ],
+        ),
+        &["--psill 0", "sill is zero"],
+    );
     call(ip(&good, &["--method", "ok"]), &["needs a variogram"]);
-    call(ip(&good, &["--method", "idw", "--power", "-1"]), &["--power -1"]);
+    call(
+        ip(&good, &["--method", "idw", "--power", "-1"]),
+        &["--power -1"],
+    );
     // too few neighbours for the drift
     let mut a = vec!["--method", "uk", "--drift", "quadratic", "--neighbors", "4"];
     a.extend(sph);
     call(ip(&good, &a), &["good.csv", "at least 6"]);
     // a bad target names file, line, column and value
     let bt = write(d, "bt.csv", "x,y\n1,1\n2,oops\n");
-    fails_with(&["interpolate", "--data", &good, "--targets", &bt, "--method", "idw"], &["bt.csv, line 3, column 'y'", "'oops'"]);
+    fails_with(
+        &[
+            "interpolate",
+            "--data",
+            &good,
+            "--targets",
+            &bt,
+            "--method",
+            "idw",
+        ],
+        &["bt.csv, line 3, column 'y'", "'oops'"],
+    );
     // IDW radius with no data near a target: names the target row, never NaN
     let far = write(d, "far.csv", "x,y\n1,1\n1000,1000\n");
-    fails_with(&["interpolate", "--data", &good, "--targets", &far, "--method", "idw", "--radius", "50"], &["far.csv", "target row 2", "radius 50"]);
+    fails_with(
+        &[
+            "interpolate",
+            "--data",
+            &good,
+            "--targets",
+            &far,
+            "--method",
+            "idw",
+            "--radius",
+            "50",
+        ],
+        &["far.csv", "target row 2", "radius 50"],
+    );
     // a bad grid spec names the flag
-    fails_with(&["interpolate", "--data", &good, "--grid", "0,0,1,1,1,5", "--method", "idw", "-o", "x.asc"], &["--grid", "nx '1'"]);
+    fails_with(
+        &[
+            "interpolate",
+            "--data",
+            &good,
+            "--grid",
+            "0,0,1,1,1,5",
+            "--method",
+            "idw",
+            "-o",
+            "x.asc",
+        ],
+        &["--grid", "nx '1'"],
+    );
     // a variogram file without a model
     let vj = write(d, "v.json", "{\"experimental\": []}");
-    fails_with(&["interpolate", "--data", &good, "--targets", &t, "--method", "ok", "--variogram", &vj], &["v.json", "no \"model\""]);
+    fails_with(
+        &[
+            "interpolate",
+            "--data",
+            &good,
+            "--targets",
+            &t,
+            "--method",
+            "ok",
+            "--variogram",
+            &vj,
+        ],
+        &["v.json", "no \"model\""],
+    );
 }

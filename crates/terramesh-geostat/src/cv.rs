@@ -103,18 +103,23 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
             }
             let idx: Vec<usize> = (0..n).collect();
             match how {
-                Interpolator::Idw { power, search } => {
-                    Idw::new(data, *power, *search)?.predict_excluding(data.xy(), Some(&idx), &mut est)?
-                }
-                Interpolator::Kriging { variogram, method, neighbours: Some(k) } => {
-                    LocalKriging::new(data, variogram, *method, *k)?.predict_excluding(
-                        data.xy(),
-                        Some(&idx),
-                        &mut est,
-                        Some(&mut var),
-                    )?
-                }
-                Interpolator::Kriging { variogram, method, neighbours: None } if variogram.sill().is_some() => {
+                Interpolator::Idw { power, search } => Idw::new(data, *power, *search)?
+                    .predict_excluding(data.xy(), Some(&idx), &mut est)?,
+                Interpolator::Kriging {
+                    variogram,
+                    method,
+                    neighbours: Some(k),
+                } => LocalKriging::new(data, variogram, *method, *k)?.predict_excluding(
+                    data.xy(),
+                    Some(&idx),
+                    &mut est,
+                    Some(&mut var),
+                )?,
+                Interpolator::Kriging {
+                    variogram,
+                    method,
+                    neighbours: None,
+                } if variogram.sill().is_some() => {
                     let g = GlobalKriging::new(data, variogram, *method, true)?;
                     let (e, v) = g.leave_one_out()?;
                     for i in 0..n {
@@ -130,7 +135,11 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
         }
         Folds::KFold(k) => {
             if k < 2 || k > n {
-                return Err(crate::error::bad("folds", k as f64, &format!("must be in 2..={n}")));
+                return Err(crate::error::bad(
+                    "folds",
+                    k as f64,
+                    &format!("must be in 2..={n}"),
+                ));
             }
             let mut order: Vec<usize> = (0..n).collect();
             let mut s = 0x9E37_79B9_7F4A_7C15u64;
@@ -176,13 +185,25 @@ fn refit(
         let mut e = vec![0.0; t.len()];
         let mut v = vec![0.0; t.len()];
         match how {
-            Interpolator::Idw { power, search } => Idw::new(&tr, *power, *search)?.predict(&t, &mut e)?,
-            Interpolator::Kriging { variogram, method, neighbours: Some(k) } => {
+            Interpolator::Idw { power, search } => {
+                Idw::new(&tr, *power, *search)?.predict(&t, &mut e)?
+            }
+            Interpolator::Kriging {
+                variogram,
+                method,
+                neighbours: Some(k),
+            } => {
                 LocalKriging::new(&tr, variogram, *method, *k)?.predict(&t, &mut e, Some(&mut v))?
             }
-            Interpolator::Kriging { variogram, method, neighbours: None } => {
-                GlobalKriging::new(&tr, variogram, *method, true)?.predict(&t, &mut e, Some(&mut v))?
-            }
+            Interpolator::Kriging {
+                variogram,
+                method,
+                neighbours: None,
+            } => GlobalKriging::new(&tr, variogram, *method, true)?.predict(
+                &t,
+                &mut e,
+                Some(&mut v),
+            )?,
         }
         for (a, &i) in test.iter().enumerate() {
             est[i] = e[a];
@@ -242,7 +263,12 @@ pub struct Candidate {
 
 /// Fits every model in `kinds` and picks the one with the least leave-one-out RMSE of
 /// ordinary kriging in a neighbourhood of 32 (on at most 2,000 data, chosen evenly).
-pub fn fit_auto(data: &Data, lags: &[Lag], weighting: Weighting, kinds: &[ModelKind]) -> Result<(Fit, Vec<Candidate>)> {
+pub fn fit_auto(
+    data: &Data,
+    lags: &[Lag],
+    weighting: Weighting,
+    kinds: &[ModelKind],
+) -> Result<(Fit, Vec<Candidate>)> {
     let sub = if data.len() > 2000 {
         let idx: Vec<usize> = (0..2000).map(|i| i * data.len() / 2000).collect();
         data.subset(&idx)
@@ -267,16 +293,30 @@ pub fn fit_auto(data: &Data, lags: &[Lag], weighting: Weighting, kinds: &[ModelK
                 if best.as_ref().is_none_or(|b| rmse < b.0) {
                     best = Some((rmse, f.clone()));
                 }
-                cands.push(Candidate { model: kind, fit: Some(f), cv_rmse: Some(rmse), error: None });
+                cands.push(Candidate {
+                    model: kind,
+                    fit: Some(f),
+                    cv_rmse: Some(rmse),
+                    error: None,
+                });
             }
-            Err(e) => cands.push(Candidate { model: kind, fit: None, cv_rmse: None, error: Some(e.to_string()) }),
+            Err(e) => cands.push(Candidate {
+                model: kind,
+                fit: None,
+                cv_rmse: None,
+                error: Some(e.to_string()),
+            }),
         }
     }
     match best {
         Some((_, f)) => Ok((f, cands)),
         None => Err(GeostatError::Fit(format!(
             "no model could be fitted: {}",
-            cands.iter().filter_map(|c| c.error.clone()).collect::<Vec<_>>().join("; ")
+            cands
+                .iter()
+                .filter_map(|c| c.error.clone())
+                .collect::<Vec<_>>()
+                .join("; ")
         ))),
     }
 }

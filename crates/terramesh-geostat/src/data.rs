@@ -286,8 +286,12 @@ pub(crate) fn check_drift(method: Method, pts: &[[f64; 2]], frame: &Frame) -> Re
         let norm = c.iter().map(|v| v * v).sum::<f64>().sqrt();
         if !(norm > 1e-9 * norm0.max(1e-300)) || norm0 == 0.0 {
             let why = match drift {
-                Drift::Linear if k < 2 => "all data points lie on one straight line (or at one point)",
-                Drift::Quadratic => "the data points lie on one conic (e.g. a line or a circle) or are too few",
+                Drift::Linear if k < 2 => {
+                    "all data points lie on one straight line (or at one point)"
+                }
+                Drift::Quadratic => {
+                    "the data points lie on one conic (e.g. a line or a circle) or are too few"
+                }
                 _ => "the drift functions are linearly dependent at the data points",
             };
             return Err(GeostatError::DegenerateDrift {
@@ -308,7 +312,9 @@ mod tests {
 
     #[test]
     fn collinear_data_reject_a_linear_drift() {
-        let xy: Vec<[f64; 2]> = (0..10).map(|i| [5e5 + i as f64, 5e6 + 2.0 * i as f64]).collect();
+        let xy: Vec<[f64; 2]> = (0..10)
+            .map(|i| [5e5 + i as f64, 5e6 + 2.0 * i as f64])
+            .collect();
         let d = Data::new(xy.clone(), vec![1.0; 10], Duplicates::Reject).unwrap();
         let v = Variogram::single(ModelKind::Spherical, 0.0, 1.0, 10.0).unwrap();
         let f = Frame::new(&d, &v);

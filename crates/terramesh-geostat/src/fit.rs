@@ -78,15 +78,22 @@ pub fn fit_model(lags: &[Lag], kind: ModelKind, weighting: Weighting) -> Result<
     let mut best: Option<(f64, f64, f64, f64, f64)> = None; // (obj, c0, c, range, shape)
     for &shape in &shapes {
         let eval = |a: f64| solve_linear(&pts, kind, a, shape, weighting);
-        let cand = if matches!(kind, ModelKind::Linear | ModelKind::Power | ModelKind::Nugget) {
+        let cand = if matches!(
+            kind,
+            ModelKind::Linear | ModelKind::Power | ModelKind::Nugget
+        ) {
             let (o, c0, c) = eval(hmax);
             (o, c0, c, hmax)
         } else {
             let (lo, hi) = ((hmin / 4.0).ln(), (4.0 * hmax).ln());
             let m = 60;
-            let grid: Vec<f64> = (0..=m).map(|k| lo + (hi - lo) * k as f64 / m as f64).collect();
+            let grid: Vec<f64> = (0..=m)
+                .map(|k| lo + (hi - lo) * k as f64 / m as f64)
+                .collect();
             let objs: Vec<f64> = grid.iter().map(|&g| eval(g.exp()).0).collect();
-            let k = (0..=m).min_by(|&a, &b| objs[a].total_cmp(&objs[b])).unwrap();
+            let k = (0..=m)
+                .min_by(|&a, &b| objs[a].total_cmp(&objs[b]))
+                .unwrap();
             let (mut a, mut b) = (grid[k.saturating_sub(1)], grid[(k + 1).min(m)]);
             let phi = 0.5 * (5f64.sqrt() - 1.0);
             let (mut x1, mut x2) = (b - phi * (b - a), a + phi * (b - a));
@@ -161,7 +168,11 @@ fn solve_linear(
         Weighting::Pairs => pts.iter().map(|p| p.2).collect(),
         Weighting::Cressie => pts.iter().map(|p| p.2 / p.1.max(floor).powi(2)).collect(),
     };
-    let passes = if weighting == Weighting::Cressie { 4 } else { 1 };
+    let passes = if weighting == Weighting::Cressie {
+        4
+    } else {
+        1
+    };
     let mut sol = (0.0, 0.0);
     for pass in 0..passes {
         sol = nnls2(pts, &u, &w, kind == ModelKind::Nugget);

@@ -363,11 +363,13 @@ impl GlobalKriging {
         let p = self.prep.terms();
         let m = q.len();
         let mut b = vec![0.0; n * m];
-        b.par_chunks_mut(n).zip(q.par_iter()).for_each(|(col, &x0)| {
-            for (c, &xi) in col.iter_mut().zip(&self.prep.pts) {
-                *c = self.cov(dist(xi, x0));
-            }
-        });
+        b.par_chunks_mut(n)
+            .zip(q.par_iter())
+            .for_each(|(col, &x0)| {
+                for (c, &xi) in col.iter_mut().zip(&self.prep.pts) {
+                    *c = self.cov(dist(xi, x0));
+                }
+            });
         let mut f0 = vec![0.0; 6 * m];
         for (j, &x0) in q.iter().enumerate() {
             self.prep.drift(x0, &mut f0[j * 6..j * 6 + p]);
@@ -377,7 +379,11 @@ impl GlobalKriging {
         }
         let Some(var) = var else { return Ok(()) };
         let lm = MatRef::from_column_major_slice(l, n, n);
-        solve_lower_triangular_in_place(lm, MatMut::from_column_major_slice_mut(&mut b, n, m), par());
+        solve_lower_triangular_in_place(
+            lm,
+            MatMut::from_column_major_slice_mut(&mut b, n, m),
+            par(),
+        );
         var.par_iter_mut().enumerate().for_each(|(j, v)| {
             let y = &b[j * n..(j + 1) * n];
             let q1 = crate::band::dot(y, y);
@@ -518,7 +524,11 @@ fn check_finite(v: &[f64]) -> Result<()> {
 fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
     let n = pts.len();
     if n < 64 || r <= 0.0 {
-        return if r <= 0.0 && n > 0 { Some((0..n).collect()) } else { None };
+        return if r <= 0.0 && n > 0 {
+            Some((0..n).collect())
+        } else {
+            None
+        };
     }
     let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
     for p in pts {
@@ -528,7 +538,11 @@ fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
         }
     }
     // Strips stacked along the longer side, each ordered along the shorter one.
-    let (long, short) = if hi[1] - lo[1] >= hi[0] - lo[0] { (1, 0) } else { (0, 1) };
+    let (long, short) = if hi[1] - lo[1] >= hi[0] - lo[0] {
+        (1, 0)
+    } else {
+        (0, 1)
+    };
     let strips = ((hi[long] - lo[long]) / r).floor() as usize + 1;
     if strips < 4 {
         return None;
@@ -576,7 +590,7 @@ fn factor_band(prep: &Prepared, tree: &Tree, sill: f64, r: f64) -> Result<(Band,
             }
         }
     })
-    .map_err(|i| not_pd(i))?;
+    .map_err(not_pd)?;
     Ok((band, w))
 }
 

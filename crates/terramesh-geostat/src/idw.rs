@@ -52,7 +52,11 @@ impl Idw {
             _ => {}
         }
         if data.is_empty() {
-            return Err(GeostatError::TooFewData { n: 0, needed: 1, what: "IDW".into() });
+            return Err(GeostatError::TooFewData {
+                n: 0,
+                needed: 1,
+                what: "IDW".into(),
+            });
         }
         // Centre coordinates for precision with UTM-sized numbers.
         let n = data.len() as f64;
@@ -100,7 +104,10 @@ impl Idw {
             .try_for_each_init(Vec::new, |near, (c, out)| {
                 for (i, o) in out.iter_mut().enumerate() {
                     let t = order[c * chunk + i] as usize;
-                    let q = [targets[t][0] - self.centre[0], targets[t][1] - self.centre[1]];
+                    let q = [
+                        targets[t][0] - self.centre[0],
+                        targets[t][1] - self.centre[1],
+                    ];
                     let ex = exclude.map_or(usize::MAX, |x| x[t]);
                     *o = self.one(q, ex, near).ok_or(GeostatError::NoNeighbours {
                         index: t,

@@ -6,6 +6,9 @@
 //! a discontinuity, kriging variance `Σ λ γ` plus the Lagrange terms, exact at data points.
 //! Ranges are GSLIB practical ranges (see [`model`](crate::Variogram)).
 #![warn(missing_docs)]
+// Index loops mirror the formulas of the dense kernels; `!(x > 0.0)` is deliberate: it also
+// rejects NaN.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 mod band;
 mod cv;
@@ -29,5 +32,5 @@ pub use experimental::{diameter, experimental, Direction, Estimator, Lag, LagSet
 pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
 pub use idw::{Idw, Search as IdwSearch};
-pub use neighbourhood::LocalKriging;
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
+pub use neighbourhood::LocalKriging;

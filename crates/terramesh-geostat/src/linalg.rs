@@ -142,7 +142,12 @@ pub(crate) fn morton_order(pts: &[[f64; 2]]) -> Vec<u32> {
     let mut keys: Vec<(u64, u32)> = pts
         .iter()
         .enumerate()
-        .map(|(i, p)| (spread(scale(p[0], 0)) | (spread(scale(p[1], 1)) << 1), i as u32))
+        .map(|(i, p)| {
+            (
+                spread(scale(p[0], 0)) | (spread(scale(p[1], 1)) << 1),
+                i as u32,
+            )
+        })
         .collect();
     keys.sort_unstable();
     keys.into_iter().map(|k| k.1).collect()
@@ -158,13 +163,19 @@ mod chol_tests {
         let a: Vec<f64> = (0..n * n)
             .map(|t| {
                 let (i, j) = (t / n, t % n);
-                if i == j { 10.0 } else { 1.0 / (1.0 + (i + j) as f64) }
+                if i == j {
+                    10.0
+                } else {
+                    1.0 / (1.0 + (i + j) as f64)
+                }
             })
             .collect();
         let mut l = a.clone();
         cholesky(&mut l, n).unwrap();
         let x: Vec<f64> = (0..n).map(|i| i as f64 - 2.0).collect();
-        let mut b: Vec<f64> = (0..n).map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum()).collect();
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
+            .collect();
         forward(&l, n, &mut b);
         backward(&l, n, &mut b);
         for i in 0..n {

@@ -328,7 +328,13 @@ impl std::fmt::Display for Variogram {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "nugget {}", self.nugget)?;
         for s in &self.structures {
-            write!(f, " + {} (psill {}, range {}", s.kind.name(), s.psill, s.range)?;
+            write!(
+                f,
+                " + {} (psill {}, range {}",
+                s.kind.name(),
+                s.psill,
+                s.range
+            )?;
             match s.kind {
                 ModelKind::Power => write!(f, ", exponent {})", s.shape)?,
                 ModelKind::Matern => write!(f, ", nu {})", s.shape)?,
@@ -361,7 +367,10 @@ mod tests {
     fn practical_range_reaches_95_percent() {
         for k in [ModelKind::Exponential, ModelKind::Gaussian] {
             let s = Structure::new(k, 1.0, 100.0);
-            assert!((s.gamma(100.0) - (1.0 - (-3.0f64).exp())).abs() < 1e-15, "{k:?}");
+            assert!(
+                (s.gamma(100.0) - (1.0 - (-3.0f64).exp())).abs() < 1e-15,
+                "{k:?}"
+            );
         }
     }
 
@@ -380,7 +389,8 @@ mod tests {
         assert_eq!(v.sill(), Some(6.0));
         assert_eq!(v.covariance(6.0, 0.0), 6.0);
         let mut w = v.clone();
-        w.structures.push(Structure::new(ModelKind::Exponential, 1.0, 5.0));
+        w.structures
+            .push(Structure::new(ModelKind::Exponential, 1.0, 5.0));
         assert_eq!(w.compact_support(), None);
     }
 

@@ -49,7 +49,12 @@ impl LocalKriging {
     /// assert_eq!((z[0], var[0]), (11.0, 0.0));
     /// # Ok(()) }
     /// ```
-    pub fn new(data: &Data, variogram: &crate::Variogram, method: Method, k: usize) -> Result<Self> {
+    pub fn new(
+        data: &Data,
+        variogram: &crate::Variogram,
+        method: Method,
+        k: usize,
+    ) -> Result<Self> {
         let prep = Prepared::new(data, variogram, method)?;
         let p = prep.terms();
         let k = k.min(prep.pts.len());
@@ -76,7 +81,12 @@ impl LocalKriging {
     ///
     /// # Panics
     /// If the output slices are not as long as `targets`.
-    pub fn predict(&self, targets: &[[f64; 2]], est: &mut [f64], var: Option<&mut [f64]>) -> Result<()> {
+    pub fn predict(
+        &self,
+        targets: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) -> Result<()> {
         self.predict_excluding(targets, None, est, var)
     }
 
@@ -105,18 +115,24 @@ impl LocalKriging {
         let order = crate::linalg::morton_order(targets);
         let chunk = 4096;
         let mut res = vec![(0.0, 0.0); targets.len()];
-        res.par_chunks_mut(chunk)
-            .enumerate()
-            .try_for_each_init(Scratch::default, |s, (c, out)| {
+        res.par_chunks_mut(chunk).enumerate().try_for_each_init(
+            Scratch::default,
+            |s, (c, out)| {
                 for (i, o) in out.iter_mut().enumerate() {
                     let t = order[c * chunk + i] as usize;
                     let ex = exclude.map(|x| x[t]);
-                    *o = self.one(targets[t], ex, s).map_err(|why| GeostatError::Singular {
-                        why: format!("at target {t} ({}, {}): {why}", targets[t][0], targets[t][1]),
-                    })?;
+                    *o = self
+                        .one(targets[t], ex, s)
+                        .map_err(|why| GeostatError::Singular {
+                            why: format!(
+                                "at target {t} ({}, {}): {why}",
+                                targets[t][0], targets[t][1]
+                            ),
+                        })?;
                 }
                 Ok::<(), GeostatError>(())
-            })?;
+            },
+        )?;
         for (i, &t) in order.iter().enumerate() {
             est[t as usize] = res[i].0;
             var[t as usize] = res[i].1;
@@ -124,7 +140,12 @@ impl LocalKriging {
         Ok(())
     }
 
-    fn one(&self, target: [f64; 2], exclude: Option<usize>, s: &mut Scratch) -> Result<(f64, f64), String> {
+    fn one(
+        &self,
+        target: [f64; 2],
+        exclude: Option<usize>,
+        s: &mut Scratch,
+    ) -> Result<(f64, f64), String> {
         let x0 = self.prep.map(target);
         let want = self.k + usize::from(exclude.is_some());
         self.tree.nearest(x0, want, &mut s.near);
@@ -147,7 +168,11 @@ impl LocalKriging {
             for &(_, i) in &s.near {
                 for &(_, j) in &s.near {
                     let d = dist(pts[i], pts[j]);
-                    s.a.push(if i == j { self.sill } else { self.sill - vg.gamma(d) });
+                    s.a.push(if i == j {
+                        self.sill
+                    } else {
+                        self.sill - vg.gamma(d)
+                    });
                 }
                 s.b.push(self.sill - vg.gamma(dist(pts[i], x0)));
             }
@@ -285,4 +310,3 @@ fn singular_why(k: usize, p: usize) -> String {
         ),
     }
 }
-

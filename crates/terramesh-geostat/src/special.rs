@@ -96,7 +96,10 @@ mod tests {
                 let closed = matern_correlation(u, nu);
                 let nu2 = nu + 1e-9; // forces the integral
                 let num = matern_correlation(u, nu2);
-                assert!((closed - num).abs() < 1e-8, "nu {nu} u {u}: {closed} vs {num}");
+                assert!(
+                    (closed - num).abs() < 1e-8,
+                    "nu {nu} u {u}: {closed} vs {num}"
+                );
             }
         }
     }

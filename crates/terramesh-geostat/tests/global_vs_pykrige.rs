@@ -39,12 +39,21 @@ fn check(set: &str, model: &str, method: Method, tag: &str, v: &Variogram) -> &'
     let mut var = vec![0.0; t.len()];
     k.predict(&t, &mut est, Some(&mut var)).unwrap();
     let sill = v.sill().unwrap_or(params(set).psill);
-    assert_close(&format!("{set} {tag} ({})", k.strategy()), &est, Some(&var), &want, sill);
+    assert_close(
+        &format!("{set} {tag} ({})", k.strategy()),
+        &est,
+        Some(&var),
+        &want,
+        sill,
+    );
     // Estimates alone agree with the estimates of the full run.
     let k2 = GlobalKriging::new(&data(set), v, method, false).unwrap();
     let mut est2 = vec![0.0; t.len()];
     k2.predict(&t, &mut est2, None).unwrap();
-    assert_eq!(est, est2, "{set} {model}: estimates with and without variances");
+    assert_eq!(
+        est, est2,
+        "{set} {model}: estimates with and without variances"
+    );
     k.strategy()
 }
 
@@ -91,5 +100,11 @@ fn geometric_anisotropy_matches_pykrige() {
         angle: 30.0,
         ratio: 0.5,
     });
-    check("srtm", "spherical", Method::Ordinary, "ok-spherical-aniso", &v);
+    check(
+        "srtm",
+        "spherical",
+        Method::Ordinary,
+        "ok-spherical-aniso",
+        &v,
+    );
 }

@@ -23,13 +23,23 @@ fn moving_neighbourhood_ordinary_kriging_matches_pykrige() {
                 "spherical" => Structure::new(ModelKind::Spherical, p.psill, p.range),
                 _ => Structure::new(ModelKind::Exponential, p.psill, p.range),
             };
-            let v = Variogram { nugget: p.nugget, structures: vec![s], anisotropy: None };
+            let v = Variogram {
+                nugget: p.nugget,
+                structures: vec![s],
+                anisotropy: None,
+            };
             let t = xy(&columns(&format!("targets-{set}.csv")));
             let want = columns(&format!("krige-{set}-ok-{model}-n12.csv"));
             let k = LocalKriging::new(&data(set), &v, Method::Ordinary, 12).unwrap();
             let (mut est, mut var) = (vec![0.0; t.len()], vec![0.0; t.len()]);
             k.predict(&t, &mut est, Some(&mut var)).unwrap();
-            assert_close(&format!("{set} {model} n12"), &est, Some(&var), &want, v.sill().unwrap());
+            assert_close(
+                &format!("{set} {model} n12"),
+                &est,
+                Some(&var),
+                &want,
+                v.sill().unwrap(),
+            );
         }
     }
 }
@@ -48,12 +58,27 @@ fn neighbourhood_of_all_data_equals_global_kriging() {
     ] {
         let g = GlobalKriging::new(&d, &v, m, true).unwrap();
         let l = LocalKriging::new(&d, &v, m, d.len()).unwrap();
-        let (mut e1, mut v1, mut e2, mut v2) = (vec![0.0; t.len()], vec![0.0; t.len()], vec![0.0; t.len()], vec![0.0; t.len()]);
+        let (mut e1, mut v1, mut e2, mut v2) = (
+            vec![0.0; t.len()],
+            vec![0.0; t.len()],
+            vec![0.0; t.len()],
+            vec![0.0; t.len()],
+        );
         g.predict(&t, &mut e1, Some(&mut v1)).unwrap();
         l.predict(&t, &mut e2, Some(&mut v2)).unwrap();
         for i in 0..t.len() {
-            assert!((e1[i] - e2[i]).abs() < 1e-8 * e1[i].abs(), "{m:?} {i}: {} {}", e1[i], e2[i]);
-            assert!((v1[i] - v2[i]).abs() < 1e-7 * p.psill, "{m:?} {i}: {} {}", v1[i], v2[i]);
+            assert!(
+                (e1[i] - e2[i]).abs() < 1e-8 * e1[i].abs(),
+                "{m:?} {i}: {} {}",
+                e1[i],
+                e2[i]
+            );
+            assert!(
+                (v1[i] - v2[i]).abs() < 1e-7 * p.psill,
+                "{m:?} {i}: {} {}",
+                v1[i],
+                v2[i]
+            );
         }
     }
 }
@@ -75,11 +100,18 @@ fn idw_matches_scipy_reference() {
         idw.predict(&tt, &mut est).unwrap();
         for (a, &i) in keep.iter().enumerate() {
             let w = want[2][i];
-            assert!((est[a] - w).abs() <= 1e-9 * w.abs(), "{file} {i}: {} vs {w}", est[a]);
+            assert!(
+                (est[a] - w).abs() <= 1e-9 * w.abs(),
+                "{file} {i}: {} vs {w}",
+                est[a]
+            );
         }
         if keep.len() < t.len() {
             // Targets with no datum in the radius are an error naming the target, never NaN.
-            let e = idw.predict(&t, &mut vec![0.0; t.len()]).unwrap_err().to_string();
+            let e = idw
+                .predict(&t, &mut vec![0.0; t.len()])
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("no data within the search radius 1500"), "{e}");
         }
     }
@@ -89,14 +121,21 @@ fn idw_matches_scipy_reference() {
 fn errors_for_bad_neighbourhoods() {
     let d = data("davis");
     let v = Variogram::single(ModelKind::Spherical, 0.0, 1.0, 50.0).unwrap();
-    let e = LocalKriging::new(&d, &v, Method::Universal(Drift::Quadratic), 4).err().unwrap();
+    let e = LocalKriging::new(&d, &v, Method::Universal(Drift::Quadratic), 4)
+        .err()
+        .unwrap();
     assert!(e.to_string().contains("at least 6"), "{e}");
     let e = Idw::new(&d, -1.0, IdwSearch::All).err().unwrap();
     assert!(e.to_string().contains("power = -1"), "{e}");
     // Collinear neighbours with a linear drift: an error naming the target, never NaN.
-    let xy: Vec<[f64; 2]> = (0..20).map(|i| [i as f64, if i < 10 { 0.0 } else { 100.0 + i as f64 }]).collect();
+    let xy: Vec<[f64; 2]> = (0..20)
+        .map(|i| [i as f64, if i < 10 { 0.0 } else { 100.0 + i as f64 }])
+        .collect();
     let dd = Data::new(xy, (0..20).map(|i| i as f64).collect(), Duplicates::Reject).unwrap();
     let l = LocalKriging::new(&dd, &v, Method::Universal(Drift::Linear), 5).unwrap();
-    let e = l.predict(&[[3.5, 0.0]], &mut [0.0], None).unwrap_err().to_string();
+    let e = l
+        .predict(&[[3.5, 0.0]], &mut [0.0], None)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("target 0") && e.contains("collinear"), "{e}");
 }

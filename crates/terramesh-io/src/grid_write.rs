@@ -36,7 +36,9 @@ impl GridSpec {
     pub fn parse_str(s: &str) -> Result<GridSpec, String> {
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         if parts.len() != 6 {
-            return Err(format!("'{s}': expected xmin,ymin,xmax,ymax,nx,ny (6 values)"));
+            return Err(format!(
+                "'{s}': expected xmin,ymin,xmax,ymax,nx,ny (6 values)"
+            ));
         }
         let f = |i: usize, name: &str| -> Result<f64, String> {
             match parts[i].parse::<f64>() {
@@ -127,7 +129,12 @@ pub fn write_asc<W: Write>(w: &mut W, g: &GridSpec, values: &[f64]) -> io::Resul
 
 /// Writes a float32 GeoTIFF (little-endian baseline TIFF, one strip), pixel-is-point, with
 /// `ProjectedCSTypeGeoKey = epsg` when given (e.g. 32632 for UTM 32N).
-pub fn write_geotiff<W: Write>(w: &mut W, g: &GridSpec, values: &[f64], epsg: Option<u16>) -> io::Result<()> {
+pub fn write_geotiff<W: Write>(
+    w: &mut W,
+    g: &GridSpec,
+    values: &[f64],
+    epsg: Option<u16>,
+) -> io::Result<()> {
     assert_eq!(values.len(), g.nx * g.ny);
     let mut keys: Vec<u16> = vec![1, 1, 0, 0, 1024, 0, 1, 1, 1025, 0, 1, 2];
     if let Some(e) = epsg {
@@ -153,7 +160,12 @@ pub fn write_geotiff<W: Write>(w: &mut W, g: &GridSpec, values: &[f64], epsg: Op
     entries.push((339, 3, 1, short(3)));
     entries.push((33550, 12, 3, doubles(&[g.dx(), g.dy(), 0.0])));
     entries.push((33922, 12, 6, doubles(&[0.0, 0.0, 0.0, g.xmin, g.ymax, 0.0])));
-    entries.push((34735, 3, keys.len() as u32, keys.iter().flat_map(|k| k.to_le_bytes()).collect()));
+    entries.push((
+        34735,
+        3,
+        keys.len() as u32,
+        keys.iter().flat_map(|k| k.to_le_bytes()).collect(),
+    ));
     let ifd_len = 2 + 12 * entries.len() + 4;
     let mut extra_off = 8 + ifd_len;
     let mut extra: Vec<u8> = Vec::new();

@@ -60,7 +60,11 @@ pub fn run(args: Args) -> Result<()> {
     let s = r.stats;
     println!("key,value");
     println!("n,{}", s.n);
-    println!("folds,{}", args.folds.map_or("leave-one-out".to_string(), |k| k.to_string()));
+    println!(
+        "folds,{}",
+        args.folds
+            .map_or("leave-one-out".to_string(), |k| k.to_string())
+    );
     println!("rmse,{}", s.rmse);
     println!("mae,{}", s.mae);
     println!("mean_error,{}", s.mean_error);

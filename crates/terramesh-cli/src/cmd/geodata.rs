@@ -37,10 +37,7 @@ pub fn read_data(path: &Path, duplicates: Duplicates) -> Result<FileData> {
         ),
         other => anyhow::anyhow!("{}: {other}", t.name),
     })?;
-    Ok(FileData {
-        data,
-        name: t.name,
-    })
+    Ok(FileData { data, name: t.name })
 }
 
 /// Variogram flags shared by the commands.
@@ -123,21 +120,26 @@ pub fn explicit_variogram(m: &ModelArgs) -> Result<Option<Variogram>> {
         structures: vec![s],
         anisotropy,
     };
-    v.validate().map_err(|e| anyhow::anyhow!("variogram flags: {e}"))?;
+    v.validate()
+        .map_err(|e| anyhow::anyhow!("variogram flags: {e}"))?;
     Ok(Some(v))
 }
 
 /// Reads the `model` of a file written by `terramesh variogram`.
 pub fn read_variogram_file(path: &PathBuf) -> Result<Variogram> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let json: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not JSON", path.display()))?;
-    let model = json
-        .get("model")
-        .with_context(|| format!("{}: no \"model\" key (write it with terramesh variogram)", path.display()))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let model = json.get("model").with_context(|| {
+        format!(
+            "{}: no \"model\" key (write it with terramesh variogram)",
+            path.display()
+        )
+    })?;
     let v: Variogram = serde_json::from_value(model.clone())
         .with_context(|| format!("{}: \"model\" is not a variogram", path.display()))?;
-    v.validate().with_context(|| format!("{}: model", path.display()))?;
+    v.validate()
+        .with_context(|| format!("{}: model", path.display()))?;
     Ok(v)
 }
 

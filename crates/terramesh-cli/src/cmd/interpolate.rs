@@ -13,7 +13,9 @@ use terramesh_io::grid_write::{write_asc, write_geotiff, GridSpec};
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 
-use super::geodata::{explicit_variogram, in_file, read_data, read_variogram_file, FileData, ModelArgs, X, Y};
+use super::geodata::{
+    explicit_variogram, in_file, read_data, read_variogram_file, FileData, ModelArgs, X, Y,
+};
 use super::variogram::{fit_named, DupArg, LagArgs};
 
 /// Targets read and predicted per block: memory does not grow with the number of targets.
@@ -116,13 +118,18 @@ pub struct Args {
 
 /// A ready interpolator.
 pub enum Engine {
-    Global(GlobalKriging),
+    Global(Box<GlobalKriging>),
     Local(LocalKriging),
     Idw(Idw),
 }
 
 impl Engine {
-    pub fn predict(&self, t: &[[f64; 2]], est: &mut [f64], var: Option<&mut [f64]>) -> terramesh_geostat::Result<()> {
+    pub fn predict(
+        &self,
+        t: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) -> terramesh_geostat::Result<()> {
         match self {
             Engine::Global(g) => g.predict(t, est, var),
             Engine::Local(l) => l.predict(t, est, var),
@@ -139,7 +146,11 @@ pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
         }
         return Ok(v);
     }
-    let auto_model = m.model.model.as_deref().is_some_and(|s| s.eq_ignore_ascii_case("auto"));
+    let auto_model = m
+        .model
+        .model
+        .as_deref()
+        .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
     match m.variogram.as_deref() {
         Some(s) if s.eq_ignore_ascii_case("auto") => auto(m, fd),
         Some(file) => read_variogram_file(&PathBuf::from(file)),
@@ -165,7 +176,9 @@ pub fn method(m: &MethodArgs, data: &Data) -> Result<Method> {
     }
     Ok(match m.method {
         MethodArg::Sk => Method::Simple {
-            mean: m.mean.unwrap_or_else(|| data.z().iter().sum::<f64>() / data.len() as f64),
+            mean: m
+                .mean
+                .unwrap_or_else(|| data.z().iter().sum::<f64>() / data.len() as f64),
         },
         MethodArg::Ok => Method::Ordinary,
         MethodArg::Uk => Method::Universal(match m.drift.unwrap_or(DriftArg::Linear) {
@@ -191,11 +204,15 @@ pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Engine> {
         let search = match (m.neighbors, m.radius) {
             (Some(_), Some(_)) => bail!("IDW takes --neighbors or --radius, not both"),
             (Some(k), None) => IdwSearch::Nearest(k),
-            (None, Some(r)) if !(r.is_finite() && r > 0.0) => bail!("--radius {r}: must be a finite number > 0"),
+            (None, Some(r)) if !(r.is_finite() && r > 0.0) => {
+                bail!("--radius {r}: must be a finite number > 0")
+            }
             (None, Some(r)) => IdwSearch::Radius(r),
             (None, None) => IdwSearch::All,
         };
-        return Ok(Engine::Idw(Idw::new(&fd.data, m.power, search).map_err(|e| in_file(&fd.name, e))?));
+        return Ok(Engine::Idw(
+            Idw::new(&fd.data, m.power, search).map_err(|e| in_file(&fd.name, e))?,
+        ));
     }
     if m.radius.is_some() {
         bail!("--radius applies to --method idw; kriging takes --neighbors");
@@ -203,8 +220,12 @@ pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Engine> {
     let method = method(m, &fd.data)?;
     let v = resolve_variogram(m, fd)?;
     let e = match m.neighbors {
-        Some(k) => Engine::Local(LocalKriging::new(&fd.data, &v, method, k).map_err(|e| in_file(&fd.name, e))?),
-        None => Engine::Global(GlobalKriging::new(&fd.data, &v, method, variance).map_err(|e| in_file(&fd.name, e))?),
+        Some(k) => Engine::Local(
+            LocalKriging::new(&fd.data, &v, method, k).map_err(|e| in_file(&fd.name, e))?,
+        ),
+        None => Engine::Global(Box::new(
+            GlobalKriging::new(&fd.data, &v, method, variance).map_err(|e| in_file(&fd.name, e))?,
+        )),
     };
     Ok(e)
 }
@@ -230,28 +251,51 @@ pub fn run(args: Args) -> Result<()> {
 fn run_points(eng: &Engine, targets: &Path, want_var: bool, output: Option<&Path>) -> Result<()> {
     let name = targets.display().to_string();
     let file = File::open(targets).with_context(|| name.clone())?;
-    let mut rdr = csv::ReaderBuilder::new().has_headers(true).from_reader(BufReader::with_capacity(1 << 20, file));
-    let headers: Vec<String> = rdr.headers().with_context(|| name.clone())?.iter().map(|h| h.trim().to_string()).collect();
-    let find = |names: &[&str]| headers.iter().position(|h| names.iter().any(|n| h.eq_ignore_ascii_case(n)));
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(BufReader::with_capacity(1 << 20, file));
+    let headers: Vec<String> = rdr
+        .headers()
+        .with_context(|| name.clone())?
+        .iter()
+        .map(|h| h.trim().to_string())
+        .collect();
+    let find = |names: &[&str]| {
+        headers
+            .iter()
+            .position(|h| names.iter().any(|n| h.eq_ignore_ascii_case(n)))
+    };
     let (Some(xc), Some(yc)) = (find(X), find(Y)) else {
-        bail!("{name}: needs columns 'x' and 'y' (the header has: {})", headers.join(", "));
+        bail!(
+            "{name}: needs columns 'x' and 'y' (the header has: {})",
+            headers.join(", ")
+        );
     };
     let mut out = Output::create(output).with_context(|| "cannot create the output".to_string())?;
-    out.write_all(if want_var { b"x,y,z,variance\n" } else { b"x,y,z\n" })?;
+    out.write_all(if want_var {
+        b"x,y,z,variance\n"
+    } else {
+        b"x,y,z\n"
+    })?;
     let mut rec = csv::StringRecord::new();
     let mut pts: Vec<[f64; 2]> = Vec::with_capacity(TARGET_BLOCK);
     let mut first_row = 0usize;
     let mut buf = Vec::with_capacity(TARGET_BLOCK * 64);
     let mut total = 0usize;
     loop {
-        let more = rdr.read_record(&mut rec).with_context(|| format!("{name}: malformed CSV"))?;
+        let more = rdr
+            .read_record(&mut rec)
+            .with_context(|| format!("{name}: malformed CSV"))?;
         if more {
             let line = rec.position().map_or(0, |p| p.line());
             let num = |c: usize| -> Result<f64> {
                 let s = rec.get(c).unwrap_or("").trim();
                 match s.parse::<f64>() {
                     Ok(v) if v.is_finite() => Ok(v),
-                    _ => bail!("{name}, line {line}, column '{}': '{s}' is not a finite number", headers[c]),
+                    _ => bail!(
+                        "{name}, line {line}, column '{}': '{s}' is not a finite number",
+                        headers[c]
+                    ),
                 }
             };
             pts.push([num(xc)?, num(yc)?]);
@@ -260,7 +304,9 @@ fn run_points(eng: &Engine, targets: &Path, want_var: bool, output: Option<&Path
             let mut est = vec![0.0; pts.len()];
             let mut var = vec![0.0; if want_var { pts.len() } else { 0 }];
             eng.predict(&pts, &mut est, want_var.then_some(&mut var[..]))
-                .map_err(|e| anyhow::anyhow!("{name}: {}", shift_target(&e.to_string(), first_row)))?;
+                .map_err(|e| {
+                    anyhow::anyhow!("{name}: {}", shift_target(&e.to_string(), first_row))
+                })?;
             buf.clear();
             for (i, p) in pts.iter().enumerate() {
                 write_shortest(&mut buf, p[0])?;
@@ -294,7 +340,9 @@ fn run_points(eng: &Engine, targets: &Path, want_var: bool, output: Option<&Path
 fn shift_target(msg: &str, offset: usize) -> String {
     if let Some(i) = msg.find("target ") {
         let rest = &msg[i + 7..];
-        let end = rest.find(|c: char| !c.is_ascii_digit()).unwrap_or(rest.len());
+        let end = rest
+            .find(|c: char| !c.is_ascii_digit())
+            .unwrap_or(rest.len());
         if let Ok(k) = rest[..end].parse::<usize>() {
             return format!("{}target row {}{}", &msg[..i], k + offset + 1, &rest[end..]);
         }
@@ -303,9 +351,16 @@ fn shift_target(msg: &str, offset: usize) -> String {
 }
 
 fn run_grid(eng: &Engine, g: &GridSpec, out_path: &Path, epsg: Option<u16>) -> Result<()> {
-    let ext = out_path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = out_path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     if ext != "asc" && ext != "tif" && ext != "tiff" {
-        bail!("-o {}: a grid is written as .asc (ESRI ASCII) or .tif (GeoTIFF)", out_path.display());
+        bail!(
+            "-o {}: a grid is written as .asc (ESRI ASCII) or .tif (GeoTIFF)",
+            out_path.display()
+        );
     }
     let mut values = vec![0.0; g.nx * g.ny];
     let rows_per_block = (TARGET_BLOCK / g.nx).max(1);

@@ -157,8 +157,11 @@ pub fn run(args: Args) -> Result<()> {
     out.commit()?;
     if let Some(p) = &args.plot {
         let title = format!("{}: {} points", fd.name, fd.data.len());
-        write_atomic(p, super::plot::variogram_svg(&lags, &fit.variogram, &title).as_bytes())
-            .with_context(|| format!("cannot write {}", p.display()))?;
+        write_atomic(
+            p,
+            super::plot::variogram_svg(&lags, &fit.variogram, &title).as_bytes(),
+        )
+        .with_context(|| format!("cannot write {}", p.display()))?;
     }
     if args.output.is_some() {
         eprintln!("terramesh: variogram model: {}", fit.variogram);

@@ -24,7 +24,11 @@ pub fn columns(name: &str) -> Vec<Vec<f64>> {
 }
 
 pub fn xy(cols: &[Vec<f64>]) -> Vec<[f64; 2]> {
-    cols[0].iter().zip(&cols[1]).map(|(&x, &y)| [x, y]).collect()
+    cols[0]
+        .iter()
+        .zip(&cols[1])
+        .map(|(&x, &y)| [x, y])
+        .collect()
 }
 
 pub struct Params {
