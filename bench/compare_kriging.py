@@ -59,12 +59,13 @@ def terramesh(args):
     # peak RSS of this child alone: run under /usr/bin/env python wrapper measuring rusage
     code = ("import resource,subprocess,sys,time;t=time.perf_counter();"
             "r=subprocess.run(sys.argv[1:]);w=time.perf_counter()-t;"
-            "print(w, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss);sys.exit(r.returncode)")
+            "u=resource.getrusage(resource.RUSAGE_CHILDREN);"
+            "print(w, u.ru_maxrss, u.ru_utime + u.ru_stime);sys.exit(r.returncode)")
     p = subprocess.run([sys.executable, "-c", code, BIN] + args, capture_output=True, text=True)
     if p.returncode != 0:
         sys.exit(f"terramesh failed: {args}\n{p.stderr}")
-    wall, kb = p.stdout.split()
-    return float(wall), int(kb) / 1024
+    wall, kb, cpu = p.stdout.split()
+    return float(wall), int(kb) / 1024, float(cpu)
 
 
 PYK = r"""
@@ -73,17 +74,19 @@ d = np.loadtxt(sys.argv[1], delimiter=",", skiprows=1); t = np.loadtxt(sys.argv[
 model = sys.argv[3]; psill, rng_, nug = 12000.0, 6000.0, 50.0
 uk = pykrige.UniversalKriging(d[:, 0], d[:, 1], d[:, 2], variogram_model=model,
         variogram_parameters={"psill": psill, "range": rng_, "nugget": nug}, drift_terms=["regional_linear"])
-t0 = time.perf_counter(); z, s = uk.execute("points", t[:, 0], t[:, 1], backend="vectorized")
-print(time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+u0 = resource.getrusage(resource.RUSAGE_SELF); t0 = time.perf_counter()
+z, s = uk.execute("points", t[:, 0], t[:, 1], backend="vectorized")
+u1 = resource.getrusage(resource.RUSAGE_SELF)
+print(time.perf_counter() - t0, u1.ru_maxrss / 1024, u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime)
 """
 
 
 def pykrige(data, targets, model):
     p = subprocess.run([sys.executable, "-c", PYK, data, targets, model], capture_output=True, text=True)
     if p.returncode != 0:
-        return None, p.stderr.strip().splitlines()[-1] if p.stderr else "failed"
-    t, mb = p.stdout.split()
-    return float(t), float(mb)
+        return None, (p.stderr.strip().splitlines()[-1] if p.stderr else "failed"), None
+    t, mb, cpu = p.stdout.split()
+    return float(t), float(mb), float(cpu)
 
 
 def main():
@@ -96,7 +99,10 @@ def main():
         write(f"targets{m}.csv", (rng.uniform(box[0], box[1], m), rng.uniform(box[2], box[3], m)), "x,y")
     t20, t100 = os.path.join(TMP, "targets20000.csv"), os.path.join(TMP, "targets100000.csv")
     common = ["--psill", "12000", "--range", "6000", "--nugget", "50"]
-    print("case | terramesh s | terramesh MB | PyKrige execute s | PyKrige MB | ratio")
+    last_pyk = {}
+    print("| case | terramesh wall s | terramesh CPU s | terramesh peak MB | PyKrige execute wall s "
+          "| PyKrige CPU s | PyKrige peak MB | ratio wall | ratio CPU |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for label, model, tg, extra in [
         ("UK linear, spherical, 5k data, 20k targets, variances", "spherical", t20, []),
         ("UK linear, exponential, 5k data, 20k targets, variances", "exponential", t20, []),
@@ -105,27 +111,32 @@ def main():
         ("UK linear, spherical, 5k data, 100k targets, variances", "spherical", t100, []),
     ]:
         out = os.path.join(TMP, "out.csv")
-        tm, mb = terramesh(["interpolate", "--data", data, "--targets", tg, "--method", "uk",
-                            "--model", model] + common + extra + ["-o", out])
+        tm, mb, tc = terramesh(["interpolate", "--data", data, "--targets", tg, "--method", "uk",
+                                "--model", model] + common + extra + ["-o", out])
         if skip or tg == t100:
-            pt, pmb = (None, "not run (PyKrige needs > 24 GB at 100k targets)" if tg == t100 else "skipped")
+            pt, pmb, pc = (None, "not run (needs > 24 GB at 100k targets)" if tg == t100 else "skipped", None)
+        elif extra:
+            pt, pmb, pc = last_pyk.get(model, (None, "-", None))
         else:
-            pt, pmb = pykrige(data, tg, model)
-        ratio = f"{tm / pt:.3f}" if pt else "-"
-        print(f"{label} | {tm:.2f} | {mb:.0f} | {pt if pt is None else round(pt, 2)} | "
-              f"{pmb if isinstance(pmb, str) else round(pmb)} | {ratio}")
+            pt, pmb, pc = pykrige(data, tg, model)
+            last_pyk[model] = (pt, pmb, pc)
+        rw = f"{tm / pt:.3f}" if pt else "-"
+        rc = f"{tc / pc:.3f}" if pc else "-"
+        f = lambda v: "-" if v is None else (v if isinstance(v, str) else f"{v:.2f}")
+        print(f"| {label} | {tm:.2f} | {tc:.2f} | {mb:.0f} | {f(pt)} | {f(pc)} | "
+              f"{pmb if isinstance(pmb, str) else round(pmb)} | {rw} | {rc} |", flush=True)
     if "--big" in sys.argv:
         j = rng.choice(len(x), 1000000, replace=False)
         big = write("data1m.csv", (x[j], y[j], z[j]), "x,y,z")
         bt = write("targets1m.csv", (rng.uniform(box[0], box[1], 1000000),
                                      rng.uniform(box[2], box[3], 1000000)), "x,y")
         out = os.path.join(TMP, "out.csv")
-        tm, mb = terramesh(["interpolate", "--data", big, "--targets", bt, "--method", "ok",
-                            "--model", "spherical"] + common + ["--neighbors", "32", "-o", out])
-        print(f"OK, 32 neighbours, 1M data, 1M targets (CLI, with CSV I/O) | {tm:.2f} | {mb:.0f} | - | - | -")
-        tm, mb = terramesh(["interpolate", "--data", big, "--targets", bt, "--method", "idw",
-                            "--power", "2", "--neighbors", "16", "-o", out])
-        print(f"IDW, 16 neighbours, 1M data, 1M targets (CLI, with CSV I/O) | {tm:.2f} | {mb:.0f} | - | - | -")
+        tm, mb, tc = terramesh(["interpolate", "--data", big, "--targets", bt, "--method", "ok",
+                                "--model", "spherical"] + common + ["--neighbors", "32", "-o", out])
+        print(f"| OK, 32 neighbours, 1M data, 1M targets (CLI, with CSV I/O) | {tm:.2f} | {tc:.2f} | {mb:.0f} | - | - | - | - | - |")
+        tm, mb, tc = terramesh(["interpolate", "--data", big, "--targets", bt, "--method", "idw",
+                                "--power", "2", "--neighbors", "16", "-o", out])
+        print(f"| IDW, 16 neighbours, 1M data, 1M targets (CLI, with CSV I/O) | {tm:.2f} | {tc:.2f} | {mb:.0f} | - | - | - | - | - |")
 
 
 if __name__ == "__main__":
