@@ -50,13 +50,14 @@ pub(super) fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
     Some(order)
 }
 
-/// Banded factor; returns it with the bandwidth the variances need.
+/// Banded factor with the bandwidth the variances need; `None` when the band is so wide
+/// (over half of n: no saving in memory over dense) that the dense path is cheaper and leaner.
 pub(super) fn factor_band(
     prep: &Prepared,
     tree: &Tree,
     sill: f64,
     r: f64,
-) -> Result<(Band, usize)> {
+) -> Result<Option<(Band, usize)>> {
     let n = prep.pts.len();
     let (wl, w) = (0..n)
         .into_par_iter()
@@ -74,6 +75,9 @@ pub(super) fn factor_band(
             (wl, w)
         })
         .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    if w > 0 && 2 * w > n {
+        return Ok(None);
+    }
     let vg = &prep.variogram;
     let band = Band::factor(n, wl, |i, j| {
         if i == j {
@@ -88,7 +92,7 @@ pub(super) fn factor_band(
         }
     })
     .map_err(not_pd)?;
-    Ok((band, w))
+    Ok(Some((band, w)))
 }
 
 fn not_pd(i: usize) -> GeostatError {

@@ -112,10 +112,12 @@ impl GlobalKriging {
         for i in 0..n {
             prep.drift(prep.pts[i], &mut f[i * p..(i + 1) * p]);
         }
-        let (solver, h, kz) = match (sill, band_support) {
-            (Some(s), Some((r, _))) => {
-                let (band, wband) = factor_band(&prep, &tree, s, r)?;
-                let mut band = band;
+        let banded = match (sill, &band_support) {
+            (Some(s), Some((r, _))) => factor_band(&prep, &tree, s, *r)?.map(|b| (b, *r)),
+            _ => None,
+        };
+        let (solver, h, kz) = match (sill, banded) {
+            (Some(_), Some(((mut band, wband), r))) => {
                 if variance {
                     band.selected_inverse(wband);
                 }
