@@ -242,10 +242,10 @@ impl LocalKriging {
         for (a, &(d2, i)) in s.near.iter().enumerate() {
             let row = a * k;
             for (b, &(_, j)) in s.near.iter().enumerate().take(a) {
-                s.a[row + b] = self.sill - vg.gamma(dist(pts[i], pts[j]));
+                s.a[row + b] = vg.covariance_at(dist(pts[i], pts[j]));
             }
             s.a[row + a] = self.sill;
-            s.b.push(self.sill - vg.gamma(d2.sqrt()));
+            s.b.push(vg.covariance_at(d2.sqrt()));
         }
         crate::linalg::cholesky(&mut s.a, k).ok()?;
         // y = L^{-1} k0; G = L^{-1} F (column-major k x p)

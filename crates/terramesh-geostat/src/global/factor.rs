@@ -87,7 +87,7 @@ pub(super) fn factor_band(
             if d >= r {
                 0.0
             } else {
-                sill - vg.gamma(d)
+                vg.covariance_at(d)
             }
         }
     })
@@ -112,7 +112,7 @@ pub(super) fn factor_dense(prep: &Prepared, sill: f64) -> Result<Vec<f64>> {
             *c = if i == j {
                 sill
             } else {
-                sill - vg.gamma(dist(prep.pts[i], prep.pts[j]))
+                vg.covariance_at(dist(prep.pts[i], prep.pts[j]))
             };
         }
     });

@@ -375,12 +375,15 @@ impl GlobalKriging {
                 }
             });
         let mut f0 = vec![0.0; 6 * m];
-        for (j, &x0) in q.iter().enumerate() {
-            self.prep.drift(x0, &mut f0[j * 6..j * 6 + p]);
-            est[j] = self.mean
-                + crate::band::dot(&b[j * n..(j + 1) * n], &self.w)
-                + (0..p).map(|k| f0[j * 6 + k] * self.v[k]).sum::<f64>();
-        }
+        est.par_iter_mut()
+            .zip(f0.par_chunks_mut(6))
+            .enumerate()
+            .for_each(|(j, (e, f))| {
+                self.prep.drift(q[j], &mut f[..p]);
+                *e = self.mean
+                    + crate::band::dot(&b[j * n..(j + 1) * n], &self.w)
+                    + (0..p).map(|k| f[k] * self.v[k]).sum::<f64>();
+            });
         let Some(var) = var else { return Ok(()) };
         let lm = MatRef::from_column_major_slice(l, n, n);
         solve_lower_triangular_in_place(
@@ -441,11 +444,7 @@ impl GlobalKriging {
 
     #[inline]
     fn cov(&self, d: f64) -> f64 {
-        if d <= 0.0 {
-            self.sill
-        } else {
-            self.sill - self.prep.variogram.gamma(d)
-        }
+        self.prep.variogram.covariance_at(d)
     }
 
     /// Leave-one-out errors `z_i − ẑ_{−i}` and kriging variances of the left-out predictions,
