@@ -298,6 +298,16 @@ impl Variogram {
     /// Covariance `C(h) = sill − γ(h)` of a bounded model, computed from the correlation
     /// functions directly (`c·exp(−3h/a)` rather than `c0 + c − γ`), which is cheaper and keeps
     /// full relative precision far from the origin. `C(0)` is the sill (nugget included).
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{ModelKind, Variogram};
+    /// let v = Variogram::single(ModelKind::Spherical, 1.0, 4.0, 100.0)?;
+    /// assert_eq!(v.covariance_at(0.0), 5.0);
+    /// assert_eq!(v.covariance_at(100.0), 0.0); // compact support
+    /// assert!((v.covariance_at(50.0) - (5.0 - v.gamma(50.0))).abs() < 1e-15);
+    /// # Ok(()) }
+    /// ```
     #[inline]
     pub fn covariance_at(&self, h: f64) -> f64 {
         if h <= 0.0 {

@@ -452,6 +452,22 @@ impl GlobalKriging {
     /// `σ²_i = 1 / B_ii` with `B` the data block of the inverse kriging matrix).
     ///
     /// Needs a bounded variogram (built with `variance = true` for the band strategy).
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{Data, Duplicates, GlobalKriging, Method, ModelKind, Variogram};
+    /// let xy = vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0], [10.0, 10.0], [4.0, 6.0]];
+    /// let z = vec![1.0, 2.0, 3.0, 5.0, 2.5];
+    /// let data = Data::new(xy.clone(), z.clone(), Duplicates::Reject)?;
+    /// let v = Variogram::single(ModelKind::Exponential, 0.1, 2.0, 20.0)?;
+    /// let (err, var) = GlobalKriging::new(&data, &v, Method::Ordinary, true)?.leave_one_out()?;
+    /// // The same as kriging point 4 from the other four:
+    /// let rest = Data::new(xy[..4].to_vec(), z[..4].to_vec(), Duplicates::Reject)?;
+    /// let (mut e, mut s) = ([0.0], [0.0]);
+    /// GlobalKriging::new(&rest, &v, Method::Ordinary, true)?.predict(&[xy[4]], &mut e, Some(&mut s))?;
+    /// assert!((z[4] - e[0] - err[4]).abs() < 1e-12 && (s[0] - var[4]).abs() < 1e-12);
+    /// # Ok(()) }
+    /// ```
     pub fn leave_one_out(&self) -> Result<(Vec<f64>, Vec<f64>)> {
         let n = self.prep.pts.len();
         let p = self.prep.terms();
