@@ -263,6 +263,20 @@ pub struct Candidate {
 
 /// Fits every model in `kinds` and picks the one with the least leave-one-out RMSE of
 /// ordinary kriging in a neighbourhood of 32 (on at most 2,000 data, chosen evenly).
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{experimental, fit_auto, Data, Duplicates, LagSettings, ModelKind, Weighting};
+/// let xy: Vec<[f64; 2]> = (0..400).map(|i| [(i % 20) as f64 * 10.0, (i / 20) as f64 * 10.0]).collect();
+/// let z: Vec<f64> = xy.iter().map(|p| (p[0] / 40.0).sin() + (p[1] / 55.0).cos()).collect();
+/// let data = Data::new(xy, z, Duplicates::Reject)?;
+/// let lags = experimental(&data, &LagSettings::default())?;
+/// let kinds = [ModelKind::Spherical, ModelKind::Exponential, ModelKind::Gaussian];
+/// let (best, all) = fit_auto(&data, &lags, Weighting::Cressie, &kinds)?;
+/// let min = all.iter().filter_map(|c| c.cv_rmse).fold(f64::MAX, f64::min);
+/// assert!(all.iter().any(|c| c.fit.as_ref() == Some(&best) && c.cv_rmse == Some(min)));
+/// # Ok(()) }
+/// ```
 pub fn fit_auto(
     data: &Data,
     lags: &[Lag],

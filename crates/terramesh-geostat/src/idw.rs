@@ -96,12 +96,14 @@ impl Idw {
         est: &mut [f64],
     ) -> Result<()> {
         assert_eq!(est.len(), targets.len());
+        let order = crate::linalg::morton_order(targets);
         let chunk = 4096;
-        est.par_chunks_mut(chunk)
+        let mut res = vec![0.0; targets.len()];
+        res.par_chunks_mut(chunk)
             .enumerate()
             .try_for_each_init(Vec::new, |near, (c, out)| {
                 for (i, o) in out.iter_mut().enumerate() {
-                    let t = c * chunk + i;
+                    let t = order[c * chunk + i] as usize;
                     let q = [
                         targets[t][0] - self.centre[0],
                         targets[t][1] - self.centre[1],
@@ -117,8 +119,12 @@ impl Idw {
                         },
                     })?;
                 }
-                Ok(())
-            })
+                Ok::<(), GeostatError>(())
+            })?;
+        for (i, &t) in order.iter().enumerate() {
+            est[t as usize] = res[i];
+        }
+        Ok(())
     }
 
     fn one(&self, q: [f64; 2], exclude: usize, near: &mut Vec<(f64, usize)>) -> Option<f64> {

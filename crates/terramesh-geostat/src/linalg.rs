@@ -73,3 +73,117 @@ mod tests {
         assert_eq!(lu_solve(&mut s, 2, &mut b, 1e-14), Err(1));
     }
 }
+
+/// Cholesky `A = L Lᵀ` in place (row-major `n x n`, lower triangle used and overwritten).
+/// `Err(k)` at the first non-positive pivot.
+pub(crate) fn cholesky(a: &mut [f64], n: usize) -> Result<(), usize> {
+    for i in 0..n {
+        for j in 0..=i {
+            let (ri, rj) = (i * n, j * n);
+            let s = a[ri + j] - crate::band::dot(&a[ri..ri + j], &a[rj..rj + j]);
+            if i == j {
+                if !(s > 0.0) {
+                    return Err(i);
+                }
+                a[ri + i] = s.sqrt();
+            } else {
+                a[ri + j] = s / a[rj + j];
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves `L y = b` in place.
+pub(crate) fn forward(l: &[f64], n: usize, b: &mut [f64]) {
+    for i in 0..n {
+        let s = b[i] - crate::band::dot(&l[i * n..i * n + i], &b[..i]);
+        b[i] = s / l[i * n + i];
+    }
+}
+
+/// Solves `Lᵀ x = y` in place.
+pub(crate) fn backward(l: &[f64], n: usize, b: &mut [f64]) {
+    for i in (0..n).rev() {
+        let xi = b[i] / l[i * n + i];
+        b[i] = xi;
+        for k in 0..i {
+            b[k] -= l[i * n + k] * xi;
+        }
+    }
+}
+
+/// Morton (Z-order) permutation of points: neighbouring targets become neighbours in memory
+/// order, so consecutive k-d tree queries reuse cached leaves.
+pub(crate) fn morton_order(pts: &[[f64; 2]]) -> Vec<u32> {
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for p in pts {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let scale = |v: f64, a: usize| -> u64 {
+        let span = hi[a] - lo[a];
+        if span > 0.0 {
+            (((v - lo[a]) / span) * 65535.0) as u64
+        } else {
+            0
+        }
+    };
+    let spread = |mut x: u64| {
+        x &= 0xFFFF;
+        x = (x | (x << 8)) & 0x00FF_00FF;
+        x = (x | (x << 4)) & 0x0F0F_0F0F;
+        x = (x | (x << 2)) & 0x3333_3333;
+        x = (x | (x << 1)) & 0x5555_5555;
+        x
+    };
+    let mut keys: Vec<(u64, u32)> = pts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            (
+                spread(scale(p[0], 0)) | (spread(scale(p[1], 1)) << 1),
+                i as u32,
+            )
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.into_iter().map(|k| k.1).collect()
+}
+
+#[cfg(test)]
+mod chol_tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_solves_spd() {
+        let n = 5;
+        let a: Vec<f64> = (0..n * n)
+            .map(|t| {
+                let (i, j) = (t / n, t % n);
+                if i == j {
+                    10.0
+                } else {
+                    1.0 / (1.0 + (i + j) as f64)
+                }
+            })
+            .collect();
+        let mut l = a.clone();
+        cholesky(&mut l, n).unwrap();
+        let x: Vec<f64> = (0..n).map(|i| i as f64 - 2.0).collect();
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
+            .collect();
+        forward(&l, n, &mut b);
+        backward(&l, n, &mut b);
+        for i in 0..n {
+            assert!((b[i] - x[i]).abs() < 1e-13);
+        }
+        let mut bad = vec![1.0, 2.0, 2.0, 1.0];
+        assert_eq!(cholesky(&mut bad, 2), Err(1));
+        let o = morton_order(&[[0.0, 0.0], [10.0, 10.0], [0.1, 0.1], [9.0, 9.9]]);
+        assert_eq!(o, [0, 2, 3, 1]);
+    }
+}

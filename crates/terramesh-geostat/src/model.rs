@@ -295,6 +295,45 @@ impl Variogram {
         sill - self.gamma(h)
     }
 
+    /// Covariance `C(h) = sill − γ(h)` of a bounded model, computed from the correlation
+    /// functions directly (`c·exp(−3h/a)` rather than `c0 + c − γ`), which is cheaper and keeps
+    /// full relative precision far from the origin. `C(0)` is the sill (nugget included).
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{ModelKind, Variogram};
+    /// let v = Variogram::single(ModelKind::Spherical, 1.0, 4.0, 100.0)?;
+    /// assert_eq!(v.covariance_at(0.0), 5.0);
+    /// assert_eq!(v.covariance_at(100.0), 0.0); // compact support
+    /// assert!((v.covariance_at(50.0) - (5.0 - v.gamma(50.0))).abs() < 1e-15);
+    /// # Ok(()) }
+    /// ```
+    #[inline]
+    pub fn covariance_at(&self, h: f64) -> f64 {
+        if h <= 0.0 {
+            return self.nugget + self.structures.iter().map(|s| s.psill).sum::<f64>();
+        }
+        let mut c = 0.0;
+        for s in &self.structures {
+            let a = s.range;
+            c += s.psill
+                * match s.kind {
+                    ModelKind::Nugget => 0.0,
+                    ModelKind::Spherical if h >= a => 0.0,
+                    ModelKind::Spherical => {
+                        let r = h / a;
+                        1.0 - r * (1.5 - 0.5 * r * r)
+                    }
+                    ModelKind::Exponential => (-3.0 * h / a).exp(),
+                    ModelKind::Gaussian => (-3.0 * (h / a) * (h / a)).exp(),
+                    ModelKind::Matern => matern_correlation(s.shape.sqrt() * h / a, s.shape),
+                    // Unbounded: not a covariance; callers check `sill()` first.
+                    ModelKind::Linear | ModelKind::Power => f64::NAN,
+                };
+        }
+        c
+    }
+
     /// The lag beyond which the covariance is exactly zero, when every structure has compact
     /// support (spherical or nugget); `None` otherwise.
     pub fn compact_support(&self) -> Option<f64> {
@@ -388,6 +427,14 @@ mod tests {
         assert_eq!(v.compact_support(), Some(50.0));
         assert_eq!(v.sill(), Some(6.0));
         assert_eq!(v.covariance(6.0, 0.0), 6.0);
+        for h in [0.0, 3.0, 10.0, 30.0, 60.0] {
+            assert!(
+                (v.covariance_at(h) - v.covariance(6.0, h)).abs() < 1e-14,
+                "{h}"
+            );
+        }
+        let e = Variogram::single(ModelKind::Exponential, 1.0, 2.0, 10.0).unwrap();
+        assert!((e.covariance_at(7.0) - e.covariance(3.0, 7.0)).abs() < 1e-14);
         let mut w = v.clone();
         w.structures
             .push(Structure::new(ModelKind::Exponential, 1.0, 5.0));

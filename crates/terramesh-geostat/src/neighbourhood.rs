@@ -19,6 +19,7 @@ pub struct LocalKriging {
     tree: Tree,
     k: usize,
     sill: f64,
+    bounded: bool,
 }
 
 /// Per-thread buffers.
@@ -28,6 +29,8 @@ struct Scratch {
     a: Vec<f64>,
     b: Vec<f64>,
     rhs: Vec<f64>,
+    g: Vec<f64>,
+    lam: Vec<f64>,
 }
 
 impl LocalKriging {
@@ -64,11 +67,13 @@ impl LocalKriging {
         }
         let tree = Tree::new(&prep.pts)?;
         let sill = prep.variogram.sill().unwrap_or(0.0);
+        let bounded = prep.variogram.sill().is_some();
         Ok(LocalKriging {
             prep,
             tree,
             k,
             sill,
+            bounded,
         })
     }
 
@@ -106,27 +111,33 @@ impl LocalKriging {
                 &mut vbuf
             }
         };
+        // Process targets in Morton order (cache-friendly k-d tree queries), then scatter.
+        let order = crate::linalg::morton_order(targets);
         let chunk = 4096;
-        est.par_chunks_mut(chunk)
-            .zip(var.par_chunks_mut(chunk))
-            .enumerate()
-            .try_for_each_init(Scratch::default, |s, (c, (e, v))| {
-                for i in 0..e.len() {
-                    let t = c * chunk + i;
+        let mut res = vec![(0.0, 0.0); targets.len()];
+        res.par_chunks_mut(chunk).enumerate().try_for_each_init(
+            Scratch::default,
+            |s, (c, out)| {
+                for (i, o) in out.iter_mut().enumerate() {
+                    let t = order[c * chunk + i] as usize;
                     let ex = exclude.map(|x| x[t]);
-                    let (ee, vv) =
-                        self.one(targets[t], ex, s)
-                            .map_err(|why| GeostatError::Singular {
-                                why: format!(
-                                    "at target {t} ({}, {}): {why}",
-                                    targets[t][0], targets[t][1]
-                                ),
-                            })?;
-                    e[i] = ee;
-                    v[i] = vv;
+                    *o = self
+                        .one(targets[t], ex, s)
+                        .map_err(|why| GeostatError::Singular {
+                            why: format!(
+                                "at target {t} ({}, {}): {why}",
+                                targets[t][0], targets[t][1]
+                            ),
+                        })?;
                 }
-                Ok(())
-            })
+                Ok::<(), GeostatError>(())
+            },
+        )?;
+        for (i, &t) in order.iter().enumerate() {
+            est[t as usize] = res[i].0;
+            var[t as usize] = res[i].1;
+        }
+        Ok(())
     }
 
     fn one(
@@ -176,6 +187,11 @@ impl LocalKriging {
             return Ok((e, v.max(0.0)));
         }
         let p = self.prep.terms();
+        if self.bounded {
+            if let Some(r) = self.covariance_form(x0, p, s) {
+                return Ok(r);
+            }
+        }
         let m = k + p;
         s.a.clear();
         s.a.resize(m * m, 0.0);
@@ -211,6 +227,78 @@ impl LocalKriging {
             return Err(singular_why(k, p));
         }
         Ok((e, v.max(0.0)))
+    }
+
+    /// OK/UK in covariance form: `K = L Lᵀ` (Cholesky), drift by its Schur complement.
+    /// The same λ as PyKrige's bordered γ system; `σ² = C(0) − λᵀk0 − μᵀf0`. `None` when
+    /// the Cholesky fails (then the caller uses the bordered LU).
+    fn covariance_form(&self, x0: [f64; 2], p: usize, s: &mut Scratch) -> Option<(f64, f64)> {
+        let vg = &self.prep.variogram;
+        let pts = &self.prep.pts;
+        let k = s.near.len();
+        s.a.clear();
+        s.a.resize(k * k, 0.0);
+        s.b.clear();
+        for (a, &(d2, i)) in s.near.iter().enumerate() {
+            let row = a * k;
+            for (b, &(_, j)) in s.near.iter().enumerate().take(a) {
+                s.a[row + b] = vg.covariance_at(dist(pts[i], pts[j]));
+            }
+            s.a[row + a] = self.sill;
+            s.b.push(vg.covariance_at(d2.sqrt()));
+        }
+        crate::linalg::cholesky(&mut s.a, k).ok()?;
+        // y = L^{-1} k0; G = L^{-1} F (column-major k x p)
+        s.rhs.clone_from(&s.b);
+        crate::linalg::forward(&s.a, k, &mut s.rhs);
+        s.g.clear();
+        s.g.resize(k * p, 0.0);
+        let mut f = [0.0; 6];
+        for (a, &(_, i)) in s.near.iter().enumerate() {
+            self.prep.drift(pts[i], &mut f[..p]);
+            for c in 0..p {
+                s.g[c * k + a] = f[c];
+            }
+        }
+        for c in 0..p {
+            crate::linalg::forward(&s.a, k, &mut s.g[c * k..(c + 1) * k]);
+        }
+        let mut f0 = [0.0; 6];
+        self.prep.drift(x0, &mut f0[..p]);
+        // S = GᵀG, t = Gᵀy − f0, μ = S^{-1} t
+        let mut sm = [0.0; 36];
+        let mut t = [0.0; 6];
+        for a in 0..p {
+            let ga = &s.g[a * k..(a + 1) * k];
+            for b in 0..=a {
+                let v = crate::band::dot(ga, &s.g[b * k..(b + 1) * k]);
+                sm[a * p + b] = v;
+                sm[b * p + a] = v;
+            }
+            t[a] = crate::band::dot(ga, &s.rhs) - f0[a];
+        }
+        crate::linalg::cholesky(&mut sm[..p * p], p).ok()?;
+        let mut mu = t;
+        crate::linalg::forward(&sm[..p * p], p, &mut mu[..p]);
+        crate::linalg::backward(&sm[..p * p], p, &mut mu[..p]);
+        // λ = L^{-T}(y − G μ)
+        s.lam.clone_from(&s.rhs);
+        for c in 0..p {
+            for a in 0..k {
+                s.lam[a] -= s.g[c * k + a] * mu[c];
+            }
+        }
+        crate::linalg::backward(&s.a, k, &mut s.lam);
+        let mut e = 0.0;
+        let mut v = self.sill;
+        for (a, &(_, i)) in s.near.iter().enumerate() {
+            e += s.lam[a] * self.prep.z[i];
+            v -= s.lam[a] * s.b[a];
+        }
+        for c in 0..p {
+            v -= mu[c] * f0[c];
+        }
+        (e.is_finite() && v.is_finite()).then_some((e, v.max(0.0)))
     }
 }
 

@@ -57,7 +57,7 @@ fn directional_variogram_matches_brute_force() {
     };
     let got = experimental(&d, &s).unwrap();
     let (xy, z) = (d.xy(), d.z());
-    let mut acc = vec![(0u64, 0.0f64); 6];
+    let mut acc = [(0u64, 0.0f64); 6];
     for i in 0..xy.len() {
         for j in 0..xy.len() {
             if i == j {

@@ -118,7 +118,7 @@ pub struct Args {
 
 /// A ready interpolator.
 pub enum Engine {
-    Global(GlobalKriging),
+    Global(Box<GlobalKriging>),
     Local(LocalKriging),
     Idw(Idw),
 }
@@ -223,9 +223,9 @@ pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Engine> {
         Some(k) => Engine::Local(
             LocalKriging::new(&fd.data, &v, method, k).map_err(|e| in_file(&fd.name, e))?,
         ),
-        None => Engine::Global(
+        None => Engine::Global(Box::new(
             GlobalKriging::new(&fd.data, &v, method, variance).map_err(|e| in_file(&fd.name, e))?,
-        ),
+        )),
     };
     Ok(e)
 }

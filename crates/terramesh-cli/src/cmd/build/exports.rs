@@ -74,8 +74,8 @@ pub fn write_all(
     // Per-vertex values as the library computed them.
     files.push(atomic(&out.join("dsm-vertices.csv"), |w| {
         w.write_all(b"x,y,elevation_uk,kriging_std,elevation_idw\n")?;
-        for i in 0..n {
-            for (k, v) in [abs[i][0], abs[i][1], it.uk[i], it.uk_std[i], it.idw[i]]
+        for (i, a) in abs.iter().enumerate() {
+            for (k, v) in [a[0], a[1], it.uk[i], it.uk_std[i], it.idw[i]]
                 .iter()
                 .enumerate()
             {
@@ -219,7 +219,8 @@ pub fn write_all(
             w,
             "metric,planar_before_smoothing,planar_after_smoothing,surface_3d"
         )?;
-        let rows: [(&str, fn(&Quality) -> f64); 12] = [
+        type Row = (&'static str, fn(&Quality) -> f64);
+        let rows: [Row; 12] = [
             ("triangles", |q| q.triangles as f64),
             ("vertices", |q| q.vertices as f64),
             ("min_angle_deg", |q| q.min_angle),

@@ -131,7 +131,8 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     );
 
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
-    let maps: [(&str, &str, &[f64], bool, ColourMap, bool, &str); 4] = [
+    type Map<'a> = (&'a str, &'a str, &'a [f64], bool, ColourMap, bool, &'a str);
+    let maps: [Map; 4] = [
         (
             "elevation-uk",
             "DSM by universal kriging (linear drift)",
@@ -251,7 +252,8 @@ fn num(v: f64, d: usize) -> String {
 }
 
 fn quality_rows(cols: &[&Quality]) -> Vec<Vec<String>> {
-    let rows: [(&str, fn(&Quality) -> String); 10] = [
+    type Row = (&'static str, fn(&Quality) -> String);
+    let rows: [Row; 10] = [
         ("triangles", |q| q.triangles.to_string()),
         ("vertices", |q| q.vertices.to_string()),
         ("minimum angle (deg)", |q| num(q.min_angle, 2)),

@@ -417,17 +417,21 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
 
 /// A kriging system factorised once and evaluated at many targets.
 enum Kriging {
-    Global(GlobalKriging),
-    Local(LocalKriging),
+    Global(Box<GlobalKriging>),
+    Local(Box<LocalKriging>),
 }
 
 impl Kriging {
     /// Global kriging for `neighbors == 0`, else a moving neighbourhood of that size.
     fn new(data: &Data, v: &Variogram, method: Method, neighbors: usize) -> Result<Kriging> {
         Ok(if neighbors == 0 {
-            Kriging::Global(GlobalKriging::new(data, v, method, true).context("kriging system")?)
+            Kriging::Global(Box::new(
+                GlobalKriging::new(data, v, method, true).context("kriging system")?,
+            ))
         } else {
-            Kriging::Local(LocalKriging::new(data, v, method, neighbors).context("kriging system")?)
+            Kriging::Local(Box::new(
+                LocalKriging::new(data, v, method, neighbors).context("kriging system")?,
+            ))
         })
     }
 

@@ -13,14 +13,16 @@
 //! Variances are PyKrige's `Σ λ γ + Lagrange terms`, which in covariance form is
 //! `C(0) − k0ᵀ K^{-1} k0 + (Fᵀ K^{-1} k0 − f0)ᵀ (Fᵀ K^{-1} F)^{-1} (Fᵀ K^{-1} k0 − f0)`.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::prelude::*;
 use faer::{Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
+
+mod factor;
+
+use factor::{band_order, factor_band, factor_dense, factor_gamma};
 
 use crate::band::Band;
 use crate::data::{Data, Method};
@@ -30,7 +32,7 @@ use crate::search::Tree;
 use crate::system::{dist, small_cholesky, small_quad, small_solve, Prepared, EXACT_EPS};
 
 /// Targets per block: bounds memory (`n x BLOCK` doubles) whatever the number of targets.
-pub const BLOCK: usize = 512;
+pub const BLOCK: usize = 2048;
 
 enum Solver {
     Dense {
@@ -110,10 +112,12 @@ impl GlobalKriging {
         for i in 0..n {
             prep.drift(prep.pts[i], &mut f[i * p..(i + 1) * p]);
         }
-        let (solver, h, kz) = match (sill, band_support) {
-            (Some(s), Some((r, _))) => {
-                let (band, wband) = factor_band(&prep, &tree, s, r)?;
-                let mut band = band;
+        let banded = match (sill, &band_support) {
+            (Some(s), Some((r, _))) => factor_band(&prep, &tree, s, *r)?.map(|b| (b, *r)),
+            _ => None,
+        };
+        let (solver, h, kz) = match (sill, banded) {
+            (Some(_), Some(((mut band, wband), r))) => {
                 if variance {
                     band.selected_inverse(wband);
                 }
@@ -371,12 +375,15 @@ impl GlobalKriging {
                 }
             });
         let mut f0 = vec![0.0; 6 * m];
-        for (j, &x0) in q.iter().enumerate() {
-            self.prep.drift(x0, &mut f0[j * 6..j * 6 + p]);
-            est[j] = self.mean
-                + crate::band::dot(&b[j * n..(j + 1) * n], &self.w)
-                + (0..p).map(|k| f0[j * 6 + k] * self.v[k]).sum::<f64>();
-        }
+        est.par_iter_mut()
+            .zip(f0.par_chunks_mut(6))
+            .enumerate()
+            .for_each(|(j, (e, f))| {
+                self.prep.drift(q[j], &mut f[..p]);
+                *e = self.mean
+                    + crate::band::dot(&b[j * n..(j + 1) * n], &self.w)
+                    + (0..p).map(|k| f[k] * self.v[k]).sum::<f64>();
+            });
         let Some(var) = var else { return Ok(()) };
         let lm = MatRef::from_column_major_slice(l, n, n);
         solve_lower_triangular_in_place(
@@ -437,11 +444,7 @@ impl GlobalKriging {
 
     #[inline]
     fn cov(&self, d: f64) -> f64 {
-        if d <= 0.0 {
-            self.sill
-        } else {
-            self.sill - self.prep.variogram.gamma(d)
-        }
+        self.prep.variogram.covariance_at(d)
     }
 
     /// Leave-one-out errors `z_i − ẑ_{−i}` and kriging variances of the left-out predictions,
@@ -449,6 +452,22 @@ impl GlobalKriging {
     /// `σ²_i = 1 / B_ii` with `B` the data block of the inverse kriging matrix).
     ///
     /// Needs a bounded variogram (built with `variance = true` for the band strategy).
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{Data, Duplicates, GlobalKriging, Method, ModelKind, Variogram};
+    /// let xy = vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0], [10.0, 10.0], [4.0, 6.0]];
+    /// let z = vec![1.0, 2.0, 3.0, 5.0, 2.5];
+    /// let data = Data::new(xy.clone(), z.clone(), Duplicates::Reject)?;
+    /// let v = Variogram::single(ModelKind::Exponential, 0.1, 2.0, 20.0)?;
+    /// let (err, var) = GlobalKriging::new(&data, &v, Method::Ordinary, true)?.leave_one_out()?;
+    /// // The same as kriging point 4 from the other four:
+    /// let rest = Data::new(xy[..4].to_vec(), z[..4].to_vec(), Duplicates::Reject)?;
+    /// let (mut e, mut s) = ([0.0], [0.0]);
+    /// GlobalKriging::new(&rest, &v, Method::Ordinary, true)?.predict(&[xy[4]], &mut e, Some(&mut s))?;
+    /// assert!((z[4] - e[0] - err[4]).abs() < 1e-12 && (s[0] - var[4]).abs() < 1e-12);
+    /// # Ok(()) }
+    /// ```
     pub fn leave_one_out(&self) -> Result<(Vec<f64>, Vec<f64>)> {
         let n = self.prep.pts.len();
         let p = self.prep.terms();
@@ -505,7 +524,7 @@ impl GlobalKriging {
     }
 }
 
-fn par() -> Par {
+pub(crate) fn par() -> Par {
     faer::get_global_parallelism()
 }
 
@@ -518,128 +537,4 @@ fn check_finite(v: &[f64]) -> Result<()> {
             ),
         }),
     }
-}
-
-/// Strip order for a compact support `r`, or `None` when a band would not pay off.
-fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
-    let n = pts.len();
-    if n < 64 || r <= 0.0 {
-        return if r <= 0.0 && n > 0 {
-            Some((0..n).collect())
-        } else {
-            None
-        };
-    }
-    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-    for p in pts {
-        for a in 0..2 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
-    // Strips stacked along the longer side, each ordered along the shorter one.
-    let (long, short) = if hi[1] - lo[1] >= hi[0] - lo[0] {
-        (1, 0)
-    } else {
-        (0, 1)
-    };
-    let strips = ((hi[long] - lo[long]) / r).floor() as usize + 1;
-    if strips < 4 {
-        return None;
-    }
-    let mut order: Vec<usize> = (0..n).collect();
-    let key = |i: usize| ((pts[i][long] - lo[long]) / r).floor() as i64;
-    order.sort_by(|&a, &b| {
-        key(a)
-            .cmp(&key(b))
-            .then(pts[a][short].total_cmp(&pts[b][short]))
-            .then(a.cmp(&b))
-    });
-    Some(order)
-}
-
-/// Banded factor; returns it with the bandwidth the variances need.
-fn factor_band(prep: &Prepared, tree: &Tree, sill: f64, r: f64) -> Result<(Band, usize)> {
-    let n = prep.pts.len();
-    let (wl, w) = (0..n)
-        .into_par_iter()
-        .map_init(Vec::new, |near, i| {
-            let mut wl = 0usize;
-            let mut w = 0usize;
-            tree.within(prep.pts[i], 2.0 * r, near);
-            for &(d2, j) in near.iter() {
-                let d = i.abs_diff(j);
-                w = w.max(d);
-                if d2.sqrt() < r {
-                    wl = wl.max(d);
-                }
-            }
-            (wl, w)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
-    let vg = &prep.variogram;
-    let band = Band::factor(n, wl, |i, j| {
-        if i == j {
-            sill
-        } else {
-            let d = dist(prep.pts[i], prep.pts[j]);
-            if d >= r {
-                0.0
-            } else {
-                sill - vg.gamma(d)
-            }
-        }
-    })
-    .map_err(|i| not_pd(i))?;
-    Ok((band, w))
-}
-
-fn not_pd(i: usize) -> GeostatError {
-    GeostatError::Singular {
-        why: format!(
-            "the covariance matrix is not positive definite (pivot {i}): data points too close for the variogram, or a Gaussian model without nugget; add a small nugget"
-        ),
-    }
-}
-
-fn factor_dense(prep: &Prepared, sill: f64) -> Result<Vec<f64>> {
-    let n = prep.pts.len();
-    let vg = &prep.variogram;
-    let mut k = vec![0.0; n * n];
-    k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
-        for (i, c) in col.iter_mut().enumerate().skip(j) {
-            *c = if i == j {
-                sill
-            } else {
-                sill - vg.gamma(dist(prep.pts[i], prep.pts[j]))
-            };
-        }
-    });
-    let par = par();
-    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, Default::default()));
-    cholesky_in_place(
-        MatMut::from_column_major_slice_mut(&mut k, n, n),
-        Default::default(),
-        par,
-        MemStack::new(&mut mem),
-        Default::default(),
-    )
-    .map_err(|e| match e {
-        faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => not_pd(index),
-    })?;
-    Ok(k)
-}
-
-fn factor_gamma(prep: &Prepared, f: &[f64]) -> Result<faer::linalg::solvers::PartialPivLu<f64>> {
-    let n = prep.pts.len();
-    let p = prep.terms();
-    let vg = &prep.variogram;
-    let a = Mat::<f64>::from_fn(n + p, n + p, |i, j| match (i < n, j < n) {
-        (true, true) if i == j => 0.0,
-        (true, true) => -vg.gamma(dist(prep.pts[i], prep.pts[j])),
-        (true, false) => f[i * p + (j - n)],
-        (false, true) => f[j * p + (i - n)],
-        (false, false) => 0.0,
-    });
-    Ok(a.partial_piv_lu())
 }

@@ -1,0 +1,149 @@
+//! Factorisations of the global kriging system: strip order and banded Cholesky for compact
+//! support, dense Cholesky (faer) for other bounded models, bordered LU for unbounded ones.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+use faer::{Mat, MatMut};
+use rayon::prelude::*;
+
+use super::par;
+use crate::band::Band;
+use crate::error::{GeostatError, Result};
+use crate::search::Tree;
+use crate::system::{dist, Prepared};
+
+/// Strip order for a compact support `r`, or `None` when a band would not pay off.
+pub(super) fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
+    let n = pts.len();
+    if n < 64 || r <= 0.0 {
+        return if r <= 0.0 && n > 0 {
+            Some((0..n).collect())
+        } else {
+            None
+        };
+    }
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for p in pts {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    // Strips stacked along the longer side, each ordered along the shorter one.
+    let (long, short) = if hi[1] - lo[1] >= hi[0] - lo[0] {
+        (1, 0)
+    } else {
+        (0, 1)
+    };
+    let strips = ((hi[long] - lo[long]) / r).floor() as usize + 1;
+    if strips < 4 {
+        return None;
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    let key = |i: usize| ((pts[i][long] - lo[long]) / r).floor() as i64;
+    order.sort_by(|&a, &b| {
+        key(a)
+            .cmp(&key(b))
+            .then(pts[a][short].total_cmp(&pts[b][short]))
+            .then(a.cmp(&b))
+    });
+    Some(order)
+}
+
+/// Banded factor with the bandwidth the variances need; `None` when the band is so wide
+/// (over half of n: no saving in memory over dense) that the dense path is cheaper and leaner.
+pub(super) fn factor_band(
+    prep: &Prepared,
+    tree: &Tree,
+    sill: f64,
+    r: f64,
+) -> Result<Option<(Band, usize)>> {
+    let n = prep.pts.len();
+    let (wl, w) = (0..n)
+        .into_par_iter()
+        .map_init(Vec::new, |near, i| {
+            let mut wl = 0usize;
+            let mut w = 0usize;
+            tree.within(prep.pts[i], 2.0 * r, near);
+            for &(d2, j) in near.iter() {
+                let d = i.abs_diff(j);
+                w = w.max(d);
+                if d2.sqrt() < r {
+                    wl = wl.max(d);
+                }
+            }
+            (wl, w)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    if w > 0 && 2 * w > n {
+        return Ok(None);
+    }
+    let vg = &prep.variogram;
+    let band = Band::factor(n, wl, |i, j| {
+        if i == j {
+            sill
+        } else {
+            let d = dist(prep.pts[i], prep.pts[j]);
+            if d >= r {
+                0.0
+            } else {
+                vg.covariance_at(d)
+            }
+        }
+    })
+    .map_err(not_pd)?;
+    Ok(Some((band, w)))
+}
+
+fn not_pd(i: usize) -> GeostatError {
+    GeostatError::Singular {
+        why: format!(
+            "the covariance matrix is not positive definite (pivot {i}): data points too close for the variogram, or a Gaussian model without nugget; add a small nugget"
+        ),
+    }
+}
+
+pub(super) fn factor_dense(prep: &Prepared, sill: f64) -> Result<Vec<f64>> {
+    let n = prep.pts.len();
+    let vg = &prep.variogram;
+    let mut k = vec![0.0; n * n];
+    k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
+        for (i, c) in col.iter_mut().enumerate().skip(j) {
+            *c = if i == j {
+                sill
+            } else {
+                vg.covariance_at(dist(prep.pts[i], prep.pts[j]))
+            };
+        }
+    });
+    let par = par();
+    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, Default::default()));
+    cholesky_in_place(
+        MatMut::from_column_major_slice_mut(&mut k, n, n),
+        Default::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .map_err(|e| match e {
+        faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => not_pd(index),
+    })?;
+    Ok(k)
+}
+
+pub(super) fn factor_gamma(
+    prep: &Prepared,
+    f: &[f64],
+) -> Result<faer::linalg::solvers::PartialPivLu<f64>> {
+    let n = prep.pts.len();
+    let p = prep.terms();
+    let vg = &prep.variogram;
+    let a = Mat::<f64>::from_fn(n + p, n + p, |i, j| match (i < n, j < n) {
+        (true, true) if i == j => 0.0,
+        (true, true) => -vg.gamma(dist(prep.pts[i], prep.pts[j])),
+        (true, false) => f[i * p + (j - n)],
+        (false, true) => f[j * p + (i - n)],
+        (false, false) => 0.0,
+    });
+    Ok(a.partial_piv_lu())
+}
