@@ -21,6 +21,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import warnings
 import xml.etree.ElementTree as ET
 import zlib
 from pathlib import Path
@@ -505,8 +506,10 @@ def check_report_render(out):
         console = [ln for ln in r.stderr.splitlines() if ":CONSOLE" in ln]
         require(not console, f"report.html: console messages: {' | '.join(console)[:600]}")
         require(shot.is_file(), f"report.html: no screenshot (exit {r.returncode}): {r.stderr.strip()[-400:]}")
-        with rasterio.open(shot) as ds:
-            img = ds.read()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
+            with rasterio.open(shot) as ds:
+                img = ds.read()
     require(img.shape[1] > 100 and img.shape[2] > 100, f"report.html: screenshot only {img.shape}")
     require(len(np.unique(img.reshape(img.shape[0], -1), axis=1).T) > 2, "report.html: screenshot is blank")
 
@@ -586,7 +589,7 @@ def run(out_dir, compare=None, only=None):
         checks.append(("determinism (--compare)", lambda o: check_identical(o, compare)))
     passed = failed = 0
     for name, fn in checks:
-        if only and not any(s in name for s in only):
+        if only and not any(name.startswith(s) for s in only):
             continue
         try:
             with contextlib.redirect_stdout(io.StringIO()):  # meshio prints blank lines
@@ -608,7 +611,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out_dir", help="output directory of `terramesh build`")
     ap.add_argument("--compare", metavar="OUT2", help="a second build's directory: files must be byte-identical")
-    ap.add_argument("--only", action="append", help="run only checks whose name contains this (repeatable)")
+    ap.add_argument("--only", action="append", help="run only the checks whose name starts with this (repeatable)")
     args = ap.parse_args(argv)
     if not Path(args.out_dir).is_dir():
         print(f"error: {args.out_dir} is not a directory", file=sys.stderr)
