@@ -1,0 +1,258 @@
+"""Negative tests of verify_outputs.py: each check passes on a valid generated directory and
+fails on a copy in which one file is broken.
+
+    .venv-verify/bin/python -m pytest tests/verify
+"""
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import make_fixture as fx  # noqa: E402
+import verify_outputs as vo  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def valid(tmp_path_factory):
+    d = tmp_path_factory.mktemp("valid")
+    fx.write_all(d)
+    return d
+
+
+@pytest.fixture
+def out(valid, tmp_path):
+    d = tmp_path / "out"
+    shutil.copytree(valid, d)
+    return d
+
+
+def failures(d, check, capsys, compare=None):
+    """Runs only the check named `check`; returns its FAIL lines."""
+    names = [n for n, _ in vo.CHECKS] + ["determinism (--compare)"]
+    assert check in names, check
+    vo.run(d, compare=compare, only=[check])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[-1] in ("1 passed, 0 failed", "0 passed, 1 failed"), lines
+    return [ln for ln in lines if ln.startswith("FAIL")]
+
+
+def surface():
+    xy, uk, std, idw, tris = fx.surface()
+    return np.column_stack([xy, uk]), tris
+
+
+def edit(path, old, new, count=1):
+    s = path.read_text()
+    assert old in s, old
+    path.write_text(s.replace(old, new, count))
+
+
+def test_valid_directory_passes_every_check(valid, capsys):
+    assert vo.main([str(valid), "--compare", str(valid)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[-1] == f"{len(vo.CHECKS) + 1} passed, 0 failed"
+
+
+def test_cli_exits_nonzero_and_counts(out):
+    (out / "dsm.obj").write_text("v 0 0 0\n")
+    r = subprocess.run([sys.executable, str(HERE / "verify_outputs.py"), str(out), "--only", "obj"],
+                       capture_output=True, text=True)
+    assert r.returncode == 1
+    assert r.stdout.splitlines()[-1] == "0 passed, 1 failed"
+
+
+def test_csv_header(out, capsys):
+    edit(out / "dsm-vertices.csv", "kriging_std", "std")
+    assert "header" in failures(out, "vertices csv + vtu triangles", capsys)[0]
+
+
+def test_vtu_missing_cell_data(out, capsys):
+    edit(out / "dsm.vtu", 'Name="min_angle_deg"', 'Name="min_angle"')
+    assert "min_angle_deg" in failures(out, "vtu: geometry, point and cell data", capsys)[0]
+
+
+def test_vtu_point_data_differs(out, capsys):
+    pts, tris = surface()
+    xy, uk, std, idw, _ = fx.surface()
+    fields = {"elevation_uk": uk, "kriging_std": std * 1.01, "elevation_idw": idw, "uk_minus_idw": uk - idw}
+    fx.write_vtu(out / "dsm.vtu", pts, tris, fields, {"min_angle_deg": fx.min_angles(xy, tris)})
+    assert "kriging_std" in failures(out, "vtu: geometry, point and cell data", capsys)[0]
+
+
+def test_vtu_clockwise_triangle(out, capsys):
+    pts, tris = surface()
+    xy, uk, std, idw, _ = fx.surface()
+    tris[3] = tris[3][::-1]
+    fields = {"elevation_uk": uk, "kriging_std": std, "elevation_idw": idw, "uk_minus_idw": uk - idw}
+    fx.write_vtu(out / "dsm.vtu", pts, tris, fields, {"min_angle_deg": fx.min_angles(xy, tris)})
+    assert "#3" in failures(out, "vtu: counter-clockwise triangles", capsys)[0]
+
+
+def test_obj_missing_face(out, capsys):
+    lines = (out / "dsm.obj").read_text().splitlines()
+    (out / "dsm.obj").write_text("\n".join(lines[:-1]) + "\n")
+    assert "triangles" in failures(out, "obj", capsys)[0]
+
+
+def test_ply_ascii_rejected(out, capsys):
+    pts, tris = surface()
+    body = "".join(f"{p[0]!r} {p[1]!r} {p[2]!r}\n" for p in pts.tolist())
+    body += "".join(f"3 {a} {b} {c}\n" for a, b, c in tris)
+    (out / "dsm.ply").write_text(f"ply\nformat ascii 1.0\nelement vertex {len(pts)}\nproperty double x\n"
+                                 f"property double y\nproperty double z\nelement face {len(tris)}\n"
+                                 f"property list uchar int vertex_indices\nend_header\n{body}")
+    assert "binary" in failures(out, "ply", capsys)[0]
+
+
+def test_ply_wrong_z(out, capsys):
+    pts, tris = surface()
+    pts[5, 2] += 0.01
+    fx.write_ply(out / "dsm.ply", pts, tris, {})
+    assert "elevation_uk" in failures(out, "ply", capsys)[0]
+
+
+def test_msh_moved_node(out, capsys):
+    pts, tris = surface()
+    pts[2, 0] += 1e-3
+    fx.write_msh(out / "dsm.msh", pts, tris)
+    assert "x,y" in failures(out, "msh", capsys)[0]
+
+
+def test_stl_truncated(out, capsys):
+    data = (out / "dsm.stl").read_bytes()
+    (out / "dsm.stl").write_bytes(data[:-20])
+    assert "bytes" in failures(out, "stl", capsys)[0]
+
+
+def test_stl_origin_mismatch(out, capsys):
+    (out / "dsm-origin.json").write_text(json.dumps({"x": fx.ORIGIN[0] + 1, "y": fx.ORIGIN[1], "z": 0.0}))
+    assert "origin" in failures(out, "stl", capsys)[0]
+
+
+def test_stl_geometry(out, capsys):
+    pts, tris = surface()
+    pts[7, 2] += 0.05
+    fx.write_stl(out / "dsm.stl", pts, tris, fx.ORIGIN)
+    assert "float32" in failures(out, "stl", capsys)[0]
+
+
+def test_tsurf_without_end(out, capsys):
+    edit(out / "dsm.ts", "END\n", "")
+    assert "GocadTSurfaceReader failed" in failures(out, "tsurf (GocadTSurfaceReader)", capsys)[0]
+
+
+def test_tsurf_wrong_vertex(out, capsys):
+    edit(out / "dsm.ts", "VRTX 2 ", "VRTX 2 1")  # prefixes x with a digit
+    assert "x,y" in failures(out, "tsurf (GocadTSurfaceReader)", capsys)[0]
+
+
+def test_dxf_missing_face(out, capsys):
+    s = (out / "dsm.dxf").read_text()
+    first = s.index("0\n3DFACE")
+    second = s.index("0\n3DFACE", first + 1)
+    (out / "dsm.dxf").write_text(s[:first] + s[second:])
+    assert "3DFACEs" in failures(out, "dxf (ezdxf)", capsys)[0]
+
+
+def test_kml_schema_invalid_element(out, capsys):
+    edit(out / "dsm.kml", "<altitudeMode>", "<altitude>0</altitude><altitudeMode>")
+    assert "xmllint" in failures(out, "kml schema (xmllint)", capsys)[0]
+
+
+def test_kml_altitude_mode(out, capsys):
+    edit(out / "dsm.kml", "<altitudeMode>absolute", "<altitudeMode>clampToGround", count=2)
+    assert "absolute" in failures(out, "kml geometry", capsys)[0]
+    assert not failures(out, "kml schema (xmllint)", capsys)  # schema-valid, caught by the geometry check
+
+
+def test_kml_swapped_lon_lat(out, capsys):
+    xy, uk, _, _, tris = fx.surface()
+    fx.write_kml(out / "dsm.kml", xy, uk + 0.01, tris)
+    assert "altitude" in failures(out, "kml geometry", capsys)[0]
+
+
+def test_solid_stl_not_watertight(out, capsys):
+    pts, tris = surface()
+    sp, st = fx.solid(pts, tris, fx.BASE)
+    fx.write_stl(out / "dsm-solid.stl", sp, st[:-1], fx.ORIGIN)
+    assert "watertight" in failures(out, "solid stl: watertight, volume", capsys)[0]
+
+
+def test_solid_msh_inward(out, capsys):
+    pts, tris = surface()
+    sp, st = fx.solid(pts, tris, fx.BASE)
+    fx.write_msh(out / "dsm-solid.msh", sp, st[:, ::-1])
+    assert "not positive" in failures(out, "solid msh: watertight, volume", capsys)[0]
+
+
+def test_solid_volume_in_json(out, capsys):
+    info = json.loads((out / "dsm-solid.json").read_text())
+    info["volume"] *= 1.001
+    (out / "dsm-solid.json").write_text(json.dumps(info))
+    assert "integral" in failures(out, "solid volume vs surface integral", capsys)[0]
+    assert "dsm-solid.json" in failures(out, "solid msh: watertight, volume", capsys)[0]
+
+
+def test_grid_crs_not_utm(out, capsys):
+    import rasterio
+    with rasterio.open(out / "dsm.tif", "r+") as ds:
+        ds.crs = "EPSG:3857"
+    assert "UTM" in failures(out, "grids tif + asc (rasterio)", capsys)[0]
+
+
+def test_grid_values_differ(out, capsys):
+    lines = (out / "dsm.asc").read_text().splitlines()
+    vals = lines[7].split()
+    vals[2] = repr(float(vals[2]) + 0.5)
+    lines[7] = " ".join(vals)
+    (out / "dsm.asc").write_text("\n".join(lines) + "\n")
+    assert "values" in failures(out, "grids tif + asc (rasterio)", capsys)[0]
+
+
+def test_report_external_url(out, capsys):
+    edit(out / "report.html", "<h1>", '<img src="https://example.org/x.png"><h1>')
+    assert "external URL" in failures(out, "report.html: self-contained", capsys)[0]
+
+
+def test_report_image_bad_png(out, capsys):
+    png = bytearray(fx.write_png(None))
+    png[20] ^= 0xFF  # inside IHDR: the CRC no longer matches
+    import base64
+    edit(out / "report.html", "<h1>", f'<img src="data:image/png;base64,{base64.b64encode(png).decode()}"><h1>')
+    assert "CRC" in failures(out, "report.html: self-contained", capsys)[0]
+
+
+def test_report_console_error(out, capsys):
+    edit(out / "report.html", "</body>", "<script>console.error('boom')</script></body>")
+    assert "boom" in failures(out, "report.html: renders (chromium)", capsys)[0]
+    assert "script" in failures(out, "report.html: self-contained", capsys)[0]
+
+
+def test_report_blank(out, capsys):
+    (out / "report.html").write_text("<!DOCTYPE html><html><body></body></html>\n")
+    assert "blank" in failures(out, "report.html: renders (chromium)", capsys)[0]
+
+
+def test_pictures_broken_svg(out, capsys):
+    (out / "pictures" / "dsm.svg").write_text("<svg xmlns='http://www.w3.org/2000/svg'>")
+    assert "well-formed" in failures(out, "pictures", capsys)[0]
+
+
+def test_tables_ragged(out, capsys):
+    (out / "samples.csv").write_text("x,y,elevation\n1,2\n")
+    assert "widths" in failures(out, "tables", capsys)[0]
+
+
+def test_compare_detects_difference(out, valid, capsys):
+    edit(out / "report.html", "triangles", "triangles (timing 1.2 s)")
+    assert not failures(valid, "determinism (--compare)", capsys, compare=out)
+    edit(out / "dsm.obj", "f 1 ", "f 1  ")
+    assert "dsm.obj" in failures(valid, "determinism (--compare)", capsys, compare=out)[0]
