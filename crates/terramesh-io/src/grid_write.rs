@@ -1,4 +1,4 @@
-//! Grid writers: ESRI ASCII (`.asc`) and GeoTIFF (`.tif`, baseline TIFF, float32, one strip,
+//! Grid writers: ESRI ASCII (`.asc`) and GeoTIFF (`.tif`, baseline TIFF, float64, one strip,
 //! georeferenced by ModelPixelScale / ModelTiepoint and EPSG GeoKeys).
 //!
 //! A grid's values sit on its nodes (pixel-is-point): node (i, j) is at
@@ -127,13 +127,15 @@ pub fn write_asc<W: Write>(w: &mut W, g: &GridSpec, values: &[f64]) -> io::Resul
     Ok(())
 }
 
-/// Writes a float32 GeoTIFF (little-endian baseline TIFF, one strip), pixel-is-point, with
-/// `ProjectedCSTypeGeoKey = epsg` when given (e.g. 32632 for UTM 32N).
+/// Writes a float64 GeoTIFF (little-endian baseline TIFF, one strip), pixel-is-point, with
+/// `ProjectedCSTypeGeoKey = epsg` when given (e.g. 32632 for UTM 32N) and GDAL's nodata tag
+/// (42113) when `nodata` is given.
 pub fn write_geotiff<W: Write>(
     w: &mut W,
     g: &GridSpec,
     values: &[f64],
     epsg: Option<u16>,
+    nodata: Option<f64>,
 ) -> io::Result<()> {
     assert_eq!(values.len(), g.nx * g.ny);
     let mut keys: Vec<u16> = vec![1, 1, 0, 0, 1024, 0, 1, 1, 1025, 0, 1, 2];
@@ -142,14 +144,14 @@ pub fn write_geotiff<W: Write>(
     }
     keys[3] = (keys.len() / 4 - 1) as u16;
     // (tag, type, count, payload bytes); type 3 SHORT, 4 LONG, 12 DOUBLE
-    let image_bytes = (values.len() * 4) as u32;
+    let image_bytes = (values.len() * 8) as u32;
     let mut entries: Vec<(u16, u16, u32, Vec<u8>)> = Vec::new();
     let short = |v: u16| v.to_le_bytes().to_vec();
     let long = |v: u32| v.to_le_bytes().to_vec();
     let doubles = |v: &[f64]| v.iter().flat_map(|d| d.to_le_bytes()).collect::<Vec<u8>>();
     entries.push((256, 4, 1, long(g.nx as u32)));
     entries.push((257, 4, 1, long(g.ny as u32)));
-    entries.push((258, 3, 1, short(32)));
+    entries.push((258, 3, 1, short(64)));
     entries.push((259, 3, 1, short(1)));
     entries.push((262, 3, 1, short(1)));
     entries.push((273, 4, 1, long(0))); // patched below
@@ -166,6 +168,12 @@ pub fn write_geotiff<W: Write>(
         keys.len() as u32,
         keys.iter().flat_map(|k| k.to_le_bytes()).collect(),
     ));
+    if let Some(nd) = nodata {
+        // GDAL_NODATA: ASCII, NUL-terminated (type 2).
+        let mut text = format!("{nd}").into_bytes();
+        text.push(0);
+        entries.push((42113, 2, text.len() as u32, text));
+    }
     let ifd_len = 2 + 12 * entries.len() + 4;
     let mut extra_off = 8 + ifd_len;
     let mut extra: Vec<u8> = Vec::new();
@@ -202,9 +210,9 @@ pub fn write_geotiff<W: Write>(
     w.write_all(&8u32.to_le_bytes())?;
     w.write_all(&ifd)?;
     w.write_all(&extra)?;
-    let mut buf = Vec::with_capacity(values.len() * 4);
+    let mut buf = Vec::with_capacity(values.len() * 8);
     for v in values {
-        buf.extend_from_slice(&(*v as f32).to_le_bytes());
+        buf.extend_from_slice(&v.to_le_bytes());
     }
     w.write_all(&buf)
 }
@@ -225,7 +233,7 @@ mod tests {
         let g: GridSpec = "500000,5400000,500300,5400200,4,3".parse().unwrap();
         let vals: Vec<f64> = (0..12).map(|i| i as f64 * 1.5).collect();
         let mut b = Vec::new();
-        write_geotiff(&mut b, &g, &vals, Some(32632)).unwrap();
+        write_geotiff(&mut b, &g, &vals, Some(32632), Some(-9999.0)).unwrap();
         assert_eq!(&b[..4], b"II*\0");
         let ifd = u32_at(&b, 4) as usize;
         let n = u16_at(&b, ifd) as usize;
@@ -237,9 +245,11 @@ mod tests {
         let val = |t: u16| u32_at(&b, tags[&t].2);
         assert_eq!((val(256), val(257)), (4, 3));
         let off = val(273) as usize;
-        let px: Vec<f32> = (0..12)
-            .map(|i| f32::from_le_bytes(b[off + 4 * i..off + 4 * i + 4].try_into().unwrap()))
+        let px: Vec<f64> = (0..12)
+            .map(|i| f64::from_le_bytes(b[off + 8 * i..off + 8 * i + 8].try_into().unwrap()))
             .collect();
+        let nd = tags[&42113];
+        assert_eq!((nd.0, nd.1), (2, 6)); // "-9999\0"
         assert_eq!(px[11], 16.5);
         // GeoKeys end with ProjectedCSTypeGeoKey = 32632
         let (_, count, e) = tags[&34735];

@@ -380,7 +380,7 @@ fn run_grid(eng: &Engine, g: &GridSpec, out_path: &Path, epsg: Option<u16>) -> R
     if ext == "asc" {
         write_asc(&mut out, g, &values)?;
     } else {
-        write_geotiff(&mut out, g, &values, epsg)?;
+        write_geotiff(&mut out, g, &values, epsg, None)?;
     }
     out.commit()?;
     Ok(())

@@ -1,4 +1,5 @@
-//! Stanford PLY (`.ply`), ASCII, double-precision vertices and per-vertex fields.
+//! Stanford PLY (`.ply`), binary little-endian, double-precision vertices and per-vertex
+//! fields (doubles keep UTM coordinates exact; binary keeps large meshes small and fast).
 
 use std::io::{self, Write};
 
@@ -15,7 +16,10 @@ impl MeshWriter for Ply {
         &["ply"]
     }
     fn write(&self, m: &MeshView, out: &mut dyn Write) -> io::Result<()> {
-        writeln!(out, "ply\nformat ascii 1.0\ncomment terramesh")?;
+        writeln!(
+            out,
+            "ply\nformat binary_little_endian 1.0\ncomment terramesh"
+        )?;
         writeln!(out, "element vertex {}", m.points.len())?;
         writeln!(
             out,
@@ -26,17 +30,27 @@ impl MeshWriter for Ply {
         }
         writeln!(out, "element face {}", m.triangles.len())?;
         writeln!(out, "property list uchar int vertex_indices\nend_header")?;
+        let mut buf = Vec::with_capacity(m.points.len() * 8 * (3 + m.point_data.len()));
         for i in 0..m.points.len() {
             let p = m.point(i);
-            write!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
-            for (_, v) in &m.point_data {
-                write!(out, " {:?}", v[i])?;
+            for c in p {
+                buf.extend_from_slice(&c.to_le_bytes());
             }
-            writeln!(out)?;
+            for (_, v) in &m.point_data {
+                buf.extend_from_slice(&v[i].to_le_bytes());
+            }
         }
+        out.write_all(&buf)?;
+        buf.clear();
         for t in m.triangles {
-            writeln!(out, "3 {} {} {}", t[0], t[1], t[2])?;
+            buf.push(3u8);
+            for &k in t {
+                let k = i32::try_from(k).map_err(|_| {
+                    io::Error::new(io::ErrorKind::InvalidInput, "vertex index beyond PLY's int")
+                })?;
+                buf.extend_from_slice(&k.to_le_bytes());
+            }
         }
-        Ok(())
+        out.write_all(&buf)
     }
 }

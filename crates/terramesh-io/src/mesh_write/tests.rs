@@ -50,7 +50,22 @@ fn written(ext: &str) -> (String, MeshView<'static>) {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join(format!("m.{ext}"));
     write_mesh(&p, &m).unwrap();
-    (std::fs::read_to_string(&p).unwrap(), m)
+    (
+        String::from_utf8_lossy(&std::fs::read(&p).unwrap()).into_owned(),
+        m,
+    )
+}
+
+fn written_bytes(ext: &str) -> (Vec<u8>, MeshView<'static>) {
+    let (pts, tris, z) = grid();
+    let (pts, tris, z) = (pts.leak(), tris.leak(), z.leak());
+    let mut m = MeshView::planar(ORIGIN, pts, tris);
+    m.z = Some(z);
+    m.point_data.push(("elevation", z));
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join(format!("m.{ext}"));
+    write_mesh(&p, &m).unwrap();
+    (std::fs::read(&p).unwrap(), m)
 }
 
 fn check(points: &[[f64; 3]], tris: &[[usize; 3]], m: &MeshView) {
@@ -122,25 +137,34 @@ fn obj_round_trips() {
 
 #[test]
 fn ply_round_trips() {
-    let (text, m) = written("ply");
-    let (head, body) = text.split_once("end_header\n").unwrap();
+    let (bytes, m) = written_bytes("ply");
+    let at = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    let head = std::str::from_utf8(&bytes[..at]).unwrap();
+    assert!(head.contains("format binary_little_endian 1.0"));
     assert!(head.contains("property double x") && head.contains("property double elevation"));
     assert!(head.contains("element vertex 12") && head.contains("element face 12"));
-    let lines: Vec<&str> = body.lines().collect();
-    let points: Vec<[f64; 3]> = lines[..12]
-        .iter()
-        .map(|l| {
-            let v = nums(l);
-            assert_eq!(v.len(), 4);
-            [v[0], v[1], v[2]]
+    let f64_at = |o: usize| f64::from_le_bytes(bytes[o..o + 8].try_into().unwrap());
+    let points: Vec<[f64; 3]> = (0..12)
+        .map(|i| {
+            let o = at + i * 32;
+            assert_eq!(f64_at(o + 24), f64_at(o + 16), "elevation field equals z");
+            [f64_at(o), f64_at(o + 8), f64_at(o + 16)]
         })
         .collect();
-    let tris: Vec<[usize; 3]> = lines[12..]
-        .iter()
-        .map(|l| {
-            let v = nums(l);
-            assert_eq!(v[0], 3.0);
-            [v[1] as usize, v[2] as usize, v[3] as usize]
+    let faces = at + 12 * 32;
+    assert_eq!(bytes.len(), faces + 12 * 13);
+    let tris: Vec<[usize; 3]> = (0..12)
+        .map(|k| {
+            let o = faces + k * 13;
+            assert_eq!(bytes[o], 3);
+            let i = |j: usize| {
+                i32::from_le_bytes(bytes[o + 1 + 4 * j..o + 5 + 4 * j].try_into().unwrap()) as usize
+            };
+            [i(0), i(1), i(2)]
         })
         .collect();
     check(&points, &tris, &m);

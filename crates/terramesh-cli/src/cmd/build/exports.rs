@@ -206,7 +206,7 @@ pub fn write_all(
     let (spec, values) = &it.grid;
     let epsg = u16::try_from(zone.epsg()).ok();
     files.push(atomic(&out.join("dsm.tif"), |w| {
-        write_geotiff(w, spec, values, epsg)
+        write_geotiff(w, spec, values, epsg, Some(-9999.0))
     })?);
     files.push(atomic(&out.join("dsm.asc"), |w| {
         write_asc(w, spec, values)
