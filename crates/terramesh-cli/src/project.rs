@@ -105,8 +105,6 @@ pub struct MeshSection {
     pub smooth: usize,
     /// `laplacian`, `smart` or `odt`.
     pub smoother: String,
-    /// Terrain-adaptive refinement: maximum vertical error in metres.
-    pub max_error: Option<f64>,
     /// Insert the sample locations as mesh vertices.
     pub insert_samples: bool,
 }
@@ -119,7 +117,6 @@ impl Default for MeshSection {
             min_angle: 30.0,
             smooth: 10,
             smoother: "smart".into(),
-            max_error: None,
             insert_samples: false,
         }
     }
@@ -286,11 +283,7 @@ impl Project {
         if !(m.min_angle > 0.0 && m.min_angle <= 33.0) {
             bail!(bad("mesh.min_angle", "must be in (0, 33] degrees"));
         }
-        for (k, v) in [
-            ("mesh.max_area", m.max_area),
-            ("mesh.max_edge", m.max_edge),
-            ("mesh.max_error", m.max_error),
-        ] {
+        for (k, v) in [("mesh.max_area", m.max_area), ("mesh.max_edge", m.max_edge)] {
             if let Some(v) = v {
                 if !(v > 0.0 && v.is_finite()) {
                     bail!(bad(k, "must be positive"));

@@ -57,7 +57,7 @@ pub fn run(args: Args) -> Result<()> {
             args.output.display()
         )
     })?;
-    let mut progress = Progress::new(args.quiet, 6);
+    let mut progress = Progress::new(args.quiet, 7);
     let mut timings = Timings::default();
 
     let s = progress.start("samples");
@@ -71,6 +71,13 @@ pub fn run(args: Args) -> Result<()> {
         .0
         .push(("samples".into(), s.elapsed().as_secs_f64()));
 
+    let s = progress.start("variogram");
+    let model = stages::model(&project, &samples, &base)?;
+    progress.done(&pictures::short_numbers(&model.variogram.to_string()));
+    timings
+        .0
+        .push(("variogram".into(), s.elapsed().as_secs_f64()));
+
     let s = progress.start("mesh");
     let mesh = stages::mesh(&project, &samples)?;
     progress.done(&format!(
@@ -82,10 +89,10 @@ pub fn run(args: Args) -> Result<()> {
     timings.0.push(("mesh".into(), s.elapsed().as_secs_f64()));
 
     let s = progress.start("interpolation");
-    let interp = stages::interpolate(&project, &samples, &mesh)?;
+    let interp = stages::interpolate(&project, &samples, &mesh, &model)?;
     progress.done(&format!(
-        "variogram {}",
-        pictures::short_numbers(&interp.variogram.to_string())
+        "UK and IDW at {} vertices, cross-validation",
+        interp.uk.len()
     ));
     timings
         .0

@@ -265,7 +265,20 @@ fn drift_of(name: &str) -> Drift {
 }
 
 /// Runs the geostatistics of step 4.
-pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated> {
+/// The samples as kriging data and the variogram model (fitted, given, or read).
+pub struct Model {
+    /// The samples.
+    pub data: Data,
+    /// The variogram used.
+    pub variogram: Variogram,
+    /// Experimental variogram of the samples.
+    pub lags: Vec<Lag>,
+    /// Candidate models tried by `auto`, as (model, cv rmse, fit rmse).
+    pub candidates: Vec<(String, Option<f64>, Option<f64>)>,
+}
+
+/// Step 4a: the variogram of the samples (needed before meshing for adaptive refinement).
+pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     let ip = &p.interpolation;
     let data = Data::new(
         s.xyz.iter().map(|q| [q[0], q[1]]).collect(),
@@ -296,15 +309,30 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
             .collect();
         fit.variogram
     } else {
-        crate::cmd::geodata::read_variogram_file(&std::path::PathBuf::from(&ip.variogram))
+        crate::cmd::geodata::read_variogram_file(&base.join(&ip.variogram))
             .context("interpolation.variogram")?
     };
+    Ok(Model {
+        data,
+        variogram,
+        lags,
+        candidates,
+    })
+}
+
+/// Step 4b: vertex elevations by UK and IDW, the DSM grid, cross-validation.
+pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Result<Interpolated> {
+    let ip = &p.interpolation;
+    let data = &model.data;
+    let variogram = model.variogram.clone();
+    let lags = model.lags.clone();
+    let candidates = model.candidates.clone();
     let drift = drift_of(&ip.drift);
     let uk_method = Method::Universal(drift);
     let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len())
         .map(|i| m.mesh.absolute(i))
         .collect();
-    let engine = Kriging::new(&data, &variogram, uk_method, ip.neighbors)?;
+    let engine = Kriging::new(data, &variogram, uk_method, ip.neighbors)?;
     let (uk, var) = engine.predict(&vertices, true)?;
     let uk_std: Vec<f64> = var.iter().map(|v| v.max(0.0).sqrt()).collect();
     let search = if ip.idw_neighbors == 0 {
@@ -312,7 +340,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
     } else {
         IdwSearch::Nearest(ip.idw_neighbors)
     };
-    let idw_engine = Idw::new(&data, ip.idw_power, search).context("IDW")?;
+    let idw_engine = Idw::new(data, ip.idw_power, search).context("IDW")?;
     let mut idw = vec![0.0; vertices.len()];
     idw_engine
         .predict(&vertices, &mut idw)
@@ -356,7 +384,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed) -> Result<Interpolated>
                 search,
             },
         };
-        let r = cross_validate(&data, &how, folds)
+        let r = cross_validate(data, &how, folds)
             .with_context(|| format!("cross-validation of {name}"))?;
         cv.push((name.to_uppercase(), r.stats));
     }
