@@ -42,18 +42,8 @@ fn nums(line: &str) -> Vec<f64> {
 }
 
 fn written(ext: &str) -> (String, MeshView<'static>) {
-    let (pts, tris, z) = grid();
-    let (pts, tris, z) = (pts.leak(), tris.leak(), z.leak());
-    let mut m = MeshView::planar(ORIGIN, pts, tris);
-    m.z = Some(z);
-    m.point_data.push(("elevation", z));
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join(format!("m.{ext}"));
-    write_mesh(&p, &m).unwrap();
-    (
-        String::from_utf8_lossy(&std::fs::read(&p).unwrap()).into_owned(),
-        m,
-    )
+    let (bytes, m) = written_bytes(ext);
+    (String::from_utf8_lossy(&bytes).into_owned(), m)
 }
 
 fn written_bytes(ext: &str) -> (Vec<u8>, MeshView<'static>) {

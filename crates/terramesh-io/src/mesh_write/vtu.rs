@@ -27,34 +27,8 @@ impl MeshWriter for Vtu {
             out,
             "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nt}\">"
         )?;
-        if !m.point_data.is_empty() {
-            writeln!(out, "<PointData>")?;
-            for (name, values) in &m.point_data {
-                writeln!(
-                    out,
-                    "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-                )?;
-                for v in values.iter() {
-                    writeln!(out, "{v:?}")?;
-                }
-                writeln!(out, "</DataArray>")?;
-            }
-            writeln!(out, "</PointData>")?;
-        }
-        if !m.cell_data.is_empty() {
-            writeln!(out, "<CellData>")?;
-            for (name, values) in &m.cell_data {
-                writeln!(
-                    out,
-                    "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-                )?;
-                for v in values.iter() {
-                    writeln!(out, "{v:?}")?;
-                }
-                writeln!(out, "</DataArray>")?;
-            }
-            writeln!(out, "</CellData>")?;
-        }
+        data_section(out, "PointData", &m.point_data)?;
+        data_section(out, "CellData", &m.cell_data)?;
         writeln!(out, "<Points>")?;
         writeln!(
             out,
@@ -93,4 +67,23 @@ impl MeshWriter for Vtu {
             "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>"
         )
     }
+}
+
+/// Writes named Float64 arrays as a `<PointData>` or `<CellData>` section (nothing if empty).
+fn data_section(out: &mut dyn Write, tag: &str, arrays: &[(&str, &[f64])]) -> io::Result<()> {
+    if arrays.is_empty() {
+        return Ok(());
+    }
+    writeln!(out, "<{tag}>")?;
+    for (name, values) in arrays {
+        writeln!(
+            out,
+            "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
+        )?;
+        for v in values.iter() {
+            writeln!(out, "{v:?}")?;
+        }
+        writeln!(out, "</DataArray>")?;
+    }
+    writeln!(out, "</{tag}>")
 }
