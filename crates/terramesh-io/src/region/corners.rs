@@ -64,17 +64,25 @@ pub fn parse_corner(text: &str) -> Result<[f64; 2], String> {
 /// # Ok::<(), terramesh_io::region::RegionError>(())
 /// ```
 pub fn parse_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError> {
+    parse_list(text, |i, part| {
+        parse_corner(part).map_err(|m| format!("corner {i}: {m}"))
+    })
+}
+
+/// Splits `"A; B; ..."` into corners with `one(number, text)`, then checks the ring.
+fn parse_list(
+    text: &str,
+    one: impl Fn(usize, &str) -> Result<[f64; 2], String>,
+) -> Result<Vec<[f64; 2]>, RegionError> {
     let invalid = |message: String| RegionError::Invalid {
         source_name: "--corners".into(),
         message,
     };
     let mut ring = Vec::new();
     for (i, part) in text.split(';').enumerate() {
-        if part.trim().is_empty() {
-            continue;
+        if !part.trim().is_empty() {
+            ring.push(one(i + 1, part).map_err(invalid)?);
         }
-        let p = parse_corner(part).map_err(|m| invalid(format!("corner {}: {m}", i + 1)))?;
-        ring.push(p);
     }
     finish_ring(ring).map_err(invalid)
 }
@@ -108,33 +116,21 @@ pub(super) fn read_corners_csv(path: &Path) -> Result<Vec<[f64; 2]>, RegionError
 /// # Ok::<(), terramesh_io::region::RegionError>(())
 /// ```
 pub fn parse_projected_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError> {
-    let invalid = |message: String| RegionError::Invalid {
-        source_name: "--corners".into(),
-        message,
-    };
-    let mut ring = Vec::new();
-    for (i, part) in text.split(';').enumerate() {
-        if part.trim().is_empty() {
-            continue;
-        }
-        let nums: Vec<&str> = part
+    parse_list(text, |i, part| {
+        let parsed: Option<Vec<f64>> = part
             .split(|c: char| c == ',' || c.is_whitespace())
             .filter(|t| !t.is_empty())
+            .map(|t| t.parse().ok())
             .collect();
-        let parsed: Option<Vec<f64>> = nums.iter().map(|t| t.parse().ok()).collect();
         match parsed.as_deref() {
-            Some([n, e]) if n.is_finite() && e.is_finite() => ring.push([*e, *n]),
-            _ => {
-                return Err(invalid(format!(
-                    "corner {} '{}': with --crs projected each corner is NORTHING EASTING in \
-                     metres, e.g. \"5397932.106 377676.932\"",
-                    i + 1,
-                    part.trim()
-                )))
-            }
+            Some([n, e]) if n.is_finite() && e.is_finite() => Ok([*e, *n]),
+            _ => Err(format!(
+                "corner {i} '{}': with --crs projected each corner is NORTHING EASTING in \
+                 metres, e.g. \"5397932.106 377676.932\"",
+                part.trim()
+            )),
         }
-    }
-    finish_ring(ring).map_err(invalid)
+    })
 }
 
 /// Reads projected corners from a CSV with columns `x,y` (also `easting,northing`).
