@@ -73,6 +73,7 @@ fn benches(c: &mut Criterion) {
     g.bench_function("experimental_20k_points_max_10km", |b| {
         let s = LagSettings {
             max_dist: Some(10_000.0),
+            max_points: None,
             ..Default::default()
         };
         b.iter(|| experimental(&d20k, &s).unwrap())

@@ -41,6 +41,11 @@ pub struct LagSettings {
     pub direction: Option<Direction>,
     /// Estimator.
     pub estimator: Estimator,
+    /// Largest number of data used: above it, the variogram is computed on this many data
+    /// chosen by a fixed pseudo-random draw (the same on every run), as GSTools'
+    /// `sampling_size`; the pair count grows with the square of the data. Default 10,000;
+    /// `None` uses all.
+    pub max_points: Option<usize>,
 }
 
 impl Default for LagSettings {
@@ -50,8 +55,37 @@ impl Default for LagSettings {
             max_dist: None,
             direction: None,
             estimator: Estimator::Matheron,
+            max_points: Some(DEFAULT_MAX_POINTS),
         }
     }
+}
+
+/// Default of [`LagSettings::max_points`].
+pub const DEFAULT_MAX_POINTS: usize = 10_000;
+
+/// `m` of the indices `0..n`, chosen by a fixed pseudo-random draw (splitmix64 keys), sorted.
+///
+/// ```
+/// let a = terramesh_geostat::draw_subset(1000, 10);
+/// assert_eq!(a.len(), 10);
+/// assert_eq!(a, terramesh_geostat::draw_subset(1000, 10));
+/// assert!(a.windows(2).all(|w| w[0] < w[1]));
+/// ```
+pub fn draw_subset(n: usize, m: usize) -> Vec<usize> {
+    if m >= n {
+        return (0..n).collect();
+    }
+    let key = |i: usize| {
+        let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    };
+    let mut idx: Vec<usize> = (0..n).collect();
+    idx.select_nth_unstable_by_key(m, |&i| (key(i), i));
+    let mut out = idx[..m].to_vec();
+    out.sort_unstable();
+    out
 }
 
 /// One lag class of an experimental variogram.
@@ -136,6 +170,20 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
         Some(m) => m,
         None => 0.5 * diameter(data.xy()),
     };
+    if let Some(m) = s.max_points {
+        if m < 2 {
+            return Err(bad("max-points", m as f64, "must be at least 2"));
+        }
+        if data.len() > m {
+            let sub = data.subset(&draw_subset(data.len(), m));
+            let settings = LagSettings {
+                max_dist: Some(max),
+                max_points: None,
+                ..*s
+            };
+            return experimental(&sub, &settings);
+        }
+    }
     if !(max > 0.0) {
         return Err(GeostatError::TooFewData {
             n: data.len(),

@@ -28,7 +28,9 @@ mod system;
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, Method};
 pub use error::{GeostatError, Result};
-pub use experimental::{diameter, experimental, Direction, Estimator, Lag, LagSettings};
+pub use experimental::{
+    diameter, draw_subset, experimental, Direction, Estimator, Lag, LagSettings, DEFAULT_MAX_POINTS,
+};
 pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
 pub use idw::{Idw, Search as IdwSearch};

@@ -27,6 +27,7 @@ fn experimental_variogram_matches_gstools() {
             max_dist: Some(9876.5),
             direction: None,
             estimator: est,
+            max_points: None,
         };
         let got = experimental(&d, &s).unwrap();
         assert_eq!(got.len(), want[0].len(), "{file}");
@@ -54,6 +55,7 @@ fn directional_variogram_matches_brute_force() {
             tolerance: 22.5,
         }),
         estimator: Estimator::Matheron,
+        max_points: None,
     };
     let got = experimental(&d, &s).unwrap();
     let (xy, z) = (d.xy(), d.z());
@@ -226,4 +228,48 @@ fn kfold_covers_every_point_once() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("folds = 1"), "{e}");
+}
+
+#[test]
+fn max_points_draws_a_fixed_subset_close_to_the_full_variogram() {
+    let d = data("srtm3000");
+    let full = LagSettings {
+        max_dist: Some(9000.0),
+        max_points: None,
+        ..Default::default()
+    };
+    let capped = LagSettings {
+        max_points: Some(1500),
+        ..full
+    };
+    let all = experimental(&d, &full).unwrap();
+    let some = experimental(&d, &capped).unwrap();
+    // The cap is the same as computing on the drawn subset, and it is the same every run.
+    let sub = d.subset(&terramesh_geostat::draw_subset(d.len(), 1500));
+    assert_eq!(some, experimental(&sub, &full).unwrap());
+    assert_eq!(some, experimental(&d, &capped).unwrap());
+    // About a quarter of the pairs, and semivariances within 15 % of the full estimate.
+    let (pa, ps): (u64, u64) = (
+        all.iter().map(|l| l.pairs).sum(),
+        some.iter().map(|l| l.pairs).sum(),
+    );
+    assert!(ps * 5 > pa && ps * 3 < pa, "{ps} of {pa} pairs");
+    for (a, s) in all.iter().zip(&some) {
+        assert_eq!((a.lo, a.hi), (s.lo, s.hi));
+        assert!((a.gamma - s.gamma).abs() < 0.15 * a.gamma, "{a:?} vs {s:?}");
+    }
+    // Fewer data than the cap: all of them.
+    let big = LagSettings {
+        max_points: Some(d.len()),
+        ..full
+    };
+    assert_eq!(experimental(&d, &big).unwrap(), all);
+    assert!(experimental(
+        &d,
+        &LagSettings {
+            max_points: Some(1),
+            ..full
+        }
+    )
+    .is_err());
 }

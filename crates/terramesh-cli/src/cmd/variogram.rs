@@ -69,6 +69,10 @@ pub struct LagArgs {
     /// Least-squares weights of the fit.
     #[arg(long, value_enum, default_value_t = WeightsArg::Cressie)]
     pub weights: WeightsArg,
+    /// Compute the experimental variogram on at most this many data, drawn pseudo-randomly
+    /// (the same draw every run); 0 uses all (the pair count grows with the square).
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
+    pub max_points: usize,
 }
 
 impl LagArgs {
@@ -84,6 +88,7 @@ impl LagArgs {
                 EstimatorArg::Matheron => Estimator::Matheron,
                 EstimatorArg::Cressie => Estimator::CressieHawkins,
             },
+            max_points: (self.max_points > 0).then_some(self.max_points),
         }
     }
     pub fn weighting(&self) -> Weighting {
