@@ -107,6 +107,10 @@ pub struct MeshSection {
     pub smoother: String,
     /// Insert the sample locations as mesh vertices.
     pub insert_samples: bool,
+    /// Terrain-adaptive refinement: refine until the mesh surface is within this many metres
+    /// of the first interpolation method's surface at triangle centres and edge midpoints,
+    /// then improve the 3D triangle shape (replaces planar smoothing).
+    pub max_error: Option<f64>,
 }
 
 impl Default for MeshSection {
@@ -118,6 +122,7 @@ impl Default for MeshSection {
             smooth: 10,
             smoother: "smart".into(),
             insert_samples: false,
+            max_error: None,
         }
     }
 }
@@ -283,7 +288,11 @@ impl Project {
         if !(m.min_angle > 0.0 && m.min_angle <= 33.0) {
             bail!(bad("mesh.min_angle", "must be in (0, 33] degrees"));
         }
-        for (k, v) in [("mesh.max_area", m.max_area), ("mesh.max_edge", m.max_edge)] {
+        for (k, v) in [
+            ("mesh.max_area", m.max_area),
+            ("mesh.max_edge", m.max_edge),
+            ("mesh.max_error", m.max_error),
+        ] {
             if let Some(v) = v {
                 if !(v > 0.0 && v.is_finite()) {
                     bail!(bad(k, "must be positive"));

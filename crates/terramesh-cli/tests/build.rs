@@ -380,3 +380,79 @@ fn init_writes_a_project_that_parses_and_refuses_to_overwrite() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && e.contains("source.path"), "{e}");
 }
+
+/// The number after `prefix` in `text`.
+fn number_after(text: &str, prefix: &str) -> f64 {
+    let i = text
+        .find(prefix)
+        .unwrap_or_else(|| panic!("no '{prefix}' in {text}"));
+    let rest = &text[i + prefix.len()..];
+    let end = rest
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(rest.len());
+    rest[..end].parse().unwrap()
+}
+
+#[test]
+fn adaptive_build_meets_its_error_against_kriging_with_fewer_vertices() {
+    let (uniform, adaptive) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let off = [
+        "--set",
+        "export.pictures=false",
+        "--set",
+        "export.report=false",
+    ];
+    let u = build(uniform.path(), &off);
+    ok(&u);
+    let mut extra = off.to_vec();
+    extra.extend(["--set", "mesh.max_error=0.5"]);
+    let ex = example();
+    let mut args = vec!["build", ex.to_str().unwrap(), "-o"];
+    args.push(adaptive.path().to_str().unwrap());
+    args.extend(extra);
+    let a = terramesh(&args);
+    ok(&a);
+    let log = String::from_utf8_lossy(&a.stderr).to_string();
+    // The error is measured against kriging itself at every triangle centre and edge midpoint.
+    let verified = number_after(&log, "adaptive: within ");
+    assert!(verified > 0.0 && verified <= 0.5, "{log}");
+    assert!(number_after(&log, "min 3D angle ") >= 20.0, "{log}");
+    let count = |d: &Path| read(&d.join("dsm-vertices.csv")).lines().count() - 1;
+    let (nu, na) = (count(uniform.path()), count(adaptive.path()));
+    assert!(na * 3 < nu, "adaptive {na} vertices vs uniform {nu}");
+    // The exports of an adaptive mesh agree with each other like any other.
+    let q = read(&adaptive.path().join("mesh-quality.csv"));
+    assert!(q.contains("min_angle"), "{q}");
+
+    // Settings adaptive meshing cannot honour are refused, naming the keys.
+    let dir = tempfile::tempdir().unwrap();
+    let ex = example();
+    let e = terramesh(&[
+        "build",
+        ex.to_str().unwrap(),
+        "-o",
+        dir.path().to_str().unwrap(),
+        "--set",
+        "mesh.max_error=0.5",
+        "--set",
+        "mesh.max_edge=5",
+    ]);
+    let msg = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        !e.status.success() && msg.contains("max_edge") && msg.contains("max_error"),
+        "{msg}"
+    );
+    let e = terramesh(&[
+        "build",
+        ex.to_str().unwrap(),
+        "-o",
+        dir.path().to_str().unwrap(),
+        "--set",
+        "mesh.max_error=-1",
+    ]);
+    let msg = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        !e.status.success() && msg.contains("mesh.max_error"),
+        "{msg}"
+    );
+}

@@ -154,16 +154,24 @@ pub fn adaptive_mesh(
             ];
             let zc = (zs[v[0]] + zs[v[1]] + zs[v[2]]) / 3.0;
             let ec = (h(c) - zc).abs();
-            let (ei, ee) = face
+            let (ei, ee, on_segment) = face
                 .adjacent_edges()
-                .map(|e| e.as_undirected().fix().index())
+                .map(|e| {
+                    let u = e.as_undirected().fix();
+                    (u.index(), edge_err[u.index()], st.cdt.is_constraint_edge(u))
+                })
                 .into_iter()
-                .map(|k| (k, edge_err[k]))
-                .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+                .fold(
+                    (0, f64::NEG_INFINITY, false),
+                    |a, b| if b.1 > a.1 { b } else { a },
+                );
             if ec.max(ee) <= tol {
                 continue;
             }
-            if ec >= ee {
+            // A boundary or constraint segment is not split here: a point computed on it may
+            // round to its outer side. The centre goes in instead; refinement then splits the
+            // segment itself once a vertex comes close enough to encroach on it.
+            if ec >= ee || on_segment {
                 new_points.push(c);
             } else {
                 split[ei] = true;
@@ -181,8 +189,14 @@ pub fn adaptive_mesh(
         if st.cdt.num_vertices() + new_points.len() > cap {
             return Err(incomplete(cap, &st));
         }
+        let count = st.cdt.num_vertices();
         for p in new_points {
             st.insert_point(p)?;
+        }
+        if st.cdt.num_vertices() == count {
+            // Every point landed on an existing vertex: nothing more can be gained (the
+            // report's error says how close refinement came).
+            break;
         }
         if !st.refine(settings.min_angle, settings.max_area, cap)? {
             return Err(incomplete(cap, &st));
@@ -245,6 +259,53 @@ fn incomplete(cap: usize, st: &CdtState) -> MeshError {
 pub fn surface_error(mesh: &Mesh, z: &[f64], f: &dyn HeightFunction) -> f64 {
     let o = mesh.origin;
     surface_error_local(mesh, z, &|p: [f64; 2]| f.height(p[0] + o[0], p[1] + o[1]))
+}
+
+/// The points where [`surface_error`] compares the mesh with a height function, in absolute
+/// coordinates: every triangle's centre, then every edge's midpoint (once each); and the
+/// mesh's linear surface there. For a function that is costly point by point (kriging),
+/// evaluate it at all of them in one batch: the largest difference is the surface error.
+///
+/// ```
+/// use terramesh_mesh::{error_probes, surface_error, Mesh};
+/// let m = Mesh {
+///     origin: [10.0, 0.0],
+///     points: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0], [2.0, 2.0]],
+///     triangles: vec![[0, 1, 2], [1, 3, 2]],
+///     constraint_edges: vec![],
+/// };
+/// let bowl = |x: f64, y: f64| (x - 10.0).powi(2) + y * y;
+/// let z: Vec<f64> = (0..4).map(|i| { let p = m.absolute(i); bowl(p[0], p[1]) }).collect();
+/// let (pts, lin) = error_probes(&m, &z);
+/// assert_eq!(pts.len(), 2 + 5); // two centres, five edges
+/// let worst = pts.iter().zip(&lin).map(|(p, l)| (bowl(p[0], p[1]) - l).abs()).fold(0.0, f64::max);
+/// assert_eq!(worst, surface_error(&m, &z, &bowl));
+/// ```
+pub fn error_probes(mesh: &Mesh, z: &[f64]) -> (Vec<[f64; 2]>, Vec<f64>) {
+    let o = mesh.origin;
+    let mut pts = Vec::with_capacity(mesh.triangles.len() * 5 / 2 + 4);
+    let mut lin = Vec::with_capacity(pts.capacity());
+    for t in &mesh.triangles {
+        let p = t.map(|i| mesh.points[i as usize]);
+        pts.push([
+            (p[0][0] + p[1][0] + p[2][0]) / 3.0 + o[0],
+            (p[0][1] + p[1][1] + p[2][1]) / 3.0 + o[1],
+        ]);
+        lin.push(t.iter().map(|&i| z[i as usize]).sum::<f64>() / 3.0);
+    }
+    let mut edges: Vec<(u32, u32)> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    for (a, b) in edges {
+        let (pa, pb) = (mesh.points[a as usize], mesh.points[b as usize]);
+        pts.push([0.5 * (pa[0] + pb[0]) + o[0], 0.5 * (pa[1] + pb[1]) + o[1]]);
+        lin.push(0.5 * (z[a as usize] + z[b as usize]));
+    }
+    (pts, lin)
 }
 
 fn surface_error_local(mesh: &Mesh, z: &[f64], h: &dyn Fn([f64; 2]) -> f64) -> f64 {

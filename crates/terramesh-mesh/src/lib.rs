@@ -35,7 +35,7 @@ mod quality;
 mod smooth;
 
 pub use adaptive::{
-    adaptive_mesh, surface_error, AdaptiveReport, AdaptiveSettings, HeightFunction,
+    adaptive_mesh, error_probes, surface_error, AdaptiveReport, AdaptiveSettings, HeightFunction,
 };
 pub use build::{BuildReport, MeshBuilder, MAX_MIN_ANGLE};
 pub use flip::delaunay_flips;

@@ -111,3 +111,34 @@ fn bad_settings_are_errors() {
         Ok((m, _, _)) => panic!("{} vertices under a cap of 200", m.points.len()),
     }
 }
+
+/// Refinement that must split slanted boundary segments: their computed midpoints can round to
+/// the outer side of the segment. This once looped for ever on the paper's UTM corners.
+#[test]
+fn slanted_boundary_segments_are_refined_to_the_tolerance() {
+    // The Haut-Barr corners in UTM 32N, relative to their centre: a slightly rotated rectangle.
+    let ring = vec![
+        [-134.24, -199.45],
+        [130.31, -203.38],
+        [136.17, 199.68],
+        [-128.38, 203.61],
+    ];
+    let r = Region::from_ring(ring);
+    // Terrain that is steep across the boundary everywhere.
+    let f = |x: f64, y: f64| 8.0 * ((x + 0.3 * y) / 25.0).sin() + 6.0 * (y / 17.0).cos();
+    for tol in [0.5, 0.1] {
+        let (mesh, z, rep) = adaptive_mesh(&r, &AdaptiveSettings::new(tol), &f).unwrap();
+        assert!(rep.max_error <= tol, "tolerance {tol}: {rep:?}");
+        assert!(surface_error(&mesh, &z, &f) <= tol);
+        let area: f64 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.points[i as usize]);
+                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+            })
+            .sum();
+        let want = r.area();
+        assert!((area - want).abs() < 1e-9 * want, "area {area} vs {want}");
+    }
+}

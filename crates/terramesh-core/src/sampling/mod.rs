@@ -10,7 +10,9 @@
 mod grid;
 mod interp;
 mod nodes;
+mod surface;
 
 pub use grid::{Grid, GridError, GridSize, GridSpec, Margin};
 pub use interp::{interpolate, Method, Missing, Post, Posts};
 pub use nodes::{grid_nodes, GridPlane, Node, NodeError};
+pub use surface::GridSurface;

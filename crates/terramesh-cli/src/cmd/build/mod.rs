@@ -5,6 +5,7 @@
 //! -> exports (surfaces, sealed solid, grids, tables) -> pictures and report. Each stage calls
 //! the library crates; this module only sequences them, times them and reports progress.
 
+mod adaptive;
 mod exports;
 mod pictures;
 mod progress;
@@ -79,9 +80,15 @@ pub fn run(args: Args) -> Result<()> {
         .push(("variogram".into(), s.elapsed().as_secs_f64()));
 
     let s = progress.start("mesh");
-    let mesh = stages::mesh(&project, &samples)?;
+    let mesh = stages::mesh(&project, &samples, &model)?;
+    let adaptive_note = mesh.adaptive.as_ref().map_or(String::new(), |a| {
+        format!(
+            ", adaptive: within {:.3} m of kriging (target {} m), min 3D angle {:.1} deg",
+            a.verified_error, a.target, a.report.min_angle_3d
+        )
+    });
     progress.done(&format!(
-        "{} vertices, {} triangles, min angle {:.1} deg",
+        "{} vertices, {} triangles, min angle {:.1} deg{adaptive_note}",
         mesh.mesh.points.len(),
         mesh.mesh.triangles.len(),
         mesh.after.min_angle

@@ -339,13 +339,20 @@ pub fn write_report(
                 ),
                 kv(
                     "mesh",
-                    format!(
-                        "min angle {} deg, max area {}, smoothing {} x {}",
-                        p.mesh.min_angle,
-                        m.max_area.map_or("-".into(), |a| format!("{a:.2} m²")),
-                        p.mesh.smooth,
-                        p.mesh.smoother
-                    ),
+                    match p.mesh.max_error {
+                        Some(e) => format!(
+                            "min angle {} deg, max area {}, terrain-adaptive to {e} m",
+                            p.mesh.min_angle,
+                            m.max_area.map_or("-".into(), |a| format!("{a:.2} m²")),
+                        ),
+                        None => format!(
+                            "min angle {} deg, max area {}, smoothing {} x {}",
+                            p.mesh.min_angle,
+                            m.max_area.map_or("-".into(), |a| format!("{a:.2} m²")),
+                            p.mesh.smooth,
+                            p.mesh.smoother
+                        ),
+                    },
                 ),
                 kv(
                     "kriging",
@@ -425,6 +432,39 @@ pub fn write_report(
         .to_vec(),
         rows: quality_rows(&[&m.before, &m.after, &w.quality3d]),
     });
+    if let Some(a) = &m.adaptive {
+        let r = &a.report;
+        mesh_blocks.push(Block::Table {
+            caption: "Terrain-adaptive refinement against the kriged (UK) surface".into(),
+            header: vec!["measure".into(), "value".into()],
+            rows: vec![
+                kv("target (mesh.max_error)", format!("{} m", a.target)),
+                kv(
+                    "stand-in grid for refinement",
+                    format!(
+                        "{} nodes, spacing {:.3} m, off kriging by up to {:.4} m",
+                        a.grid_nodes, a.grid_step, a.grid_error
+                    ),
+                ),
+                kv("refinement tolerance", format!("{:.4} m", a.tolerance)),
+                kv("insert-and-refine rounds", r.rounds.to_string()),
+                kv(
+                    "3D improvement",
+                    format!(
+                        "{} flips, {} vertex moves; min 3D angle {:.2} -> {:.2} deg",
+                        r.flips, r.moves, r.min_angle_3d_before, r.min_angle_3d
+                    ),
+                ),
+                kv(
+                    "verified error against kriging",
+                    format!(
+                        "{:.4} m (largest of {} triangle centres and edge midpoints)",
+                        a.verified_error, a.probes
+                    ),
+                ),
+            ],
+        });
+    }
     if let Some(r) = &m.smoothing {
         mesh_blocks.push(Block::Text(format!(
             "Smoothing: {} vertex moves, {} rejected, {} Delaunay flips.",

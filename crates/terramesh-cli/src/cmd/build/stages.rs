@@ -189,11 +189,27 @@ pub struct Meshed {
     pub smoothing: Option<SmoothReport>,
     /// The maximum area used.
     pub max_area: Option<f64>,
+    /// Terrain-adaptive refinement, when `mesh.max_error` is set.
+    pub adaptive: Option<super::adaptive::AdaptiveInfo>,
 }
 
-/// Step 3: constrained Delaunay refinement of the region, then smoothing.
-pub fn mesh(p: &Project, s: &Samples) -> Result<Meshed> {
+/// Step 3: constrained Delaunay refinement of the region, then smoothing; or, with
+/// `mesh.max_error`, terrain-adaptive refinement against the kriged surface.
+pub fn mesh(p: &Project, s: &Samples, model: &Model) -> Result<Meshed> {
     let m = &p.mesh;
+    if let Some(target) = m.max_error {
+        let (mesh, info) = super::adaptive::adaptive(p, s, model, target)?;
+        let q = Quality::planar(&mesh);
+        return Ok(Meshed {
+            unsmoothed: mesh.clone(),
+            mesh,
+            before: q.clone(),
+            after: q,
+            smoothing: None,
+            max_area: m.max_area,
+            adaptive: Some(info),
+        });
+    }
     let mut builder = MeshBuilder::new().min_angle(m.min_angle);
     // Default size: one triangle per sampling cell, so the mesh resolves what was sampled.
     let max_area = match (m.max_area, m.max_edge) {
@@ -231,6 +247,7 @@ pub fn mesh(p: &Project, s: &Samples) -> Result<Meshed> {
         after,
         smoothing,
         max_area,
+        adaptive: None,
     })
 }
 
@@ -256,7 +273,7 @@ pub struct Interpolated {
     pub drift: Drift,
 }
 
-fn drift_of(name: &str) -> Drift {
+pub(super) fn drift_of(name: &str) -> Drift {
     match name {
         "constant" => Drift::Constant,
         "quadratic" => Drift::Quadratic,
@@ -444,14 +461,19 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
 }
 
 /// A kriging system factorised once and evaluated at many targets.
-enum Kriging {
+pub(super) enum Kriging {
     Global(Box<GlobalKriging>),
     Local(Box<LocalKriging>),
 }
 
 impl Kriging {
     /// Global kriging for `neighbors == 0`, else a moving neighbourhood of that size.
-    fn new(data: &Data, v: &Variogram, method: Method, neighbors: usize) -> Result<Kriging> {
+    pub(super) fn new(
+        data: &Data,
+        v: &Variogram,
+        method: Method,
+        neighbors: usize,
+    ) -> Result<Kriging> {
         Ok(if neighbors == 0 {
             Kriging::Global(Box::new(
                 GlobalKriging::new(data, v, method, true).context("kriging system")?,
@@ -464,7 +486,11 @@ impl Kriging {
     }
 
     /// Estimates (and variances on request) at `targets`.
-    fn predict(&self, targets: &[[f64; 2]], variance: bool) -> Result<(Vec<f64>, Vec<f64>)> {
+    pub(super) fn predict(
+        &self,
+        targets: &[[f64; 2]],
+        variance: bool,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
         let mut est = vec![0.0; targets.len()];
         let mut var = vec![0.0; if variance { targets.len() } else { 0 }];
         let vslot = if variance { Some(&mut var[..]) } else { None };
