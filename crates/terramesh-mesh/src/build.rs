@@ -244,7 +244,7 @@ fn convex_delaunay(
     }
     let input = verts.len();
     let mut dt = DelaunayTriangulation::<Point2<f64>>::with_capacity(input, 3 * input, 2 * input);
-    let verts = crate::order::brio_sorted(&verts);
+    let verts = crate::order::brio_sorted(verts);
     for &p in &verts {
         dt.insert(Point2::new(p[0], p[1]))
             .map_err(|e| MeshError::Insertion {

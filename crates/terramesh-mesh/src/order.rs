@@ -49,10 +49,11 @@ fn mix(i: u64) -> u64 {
 
 /// `points` in BRIO order, each round along a Hilbert curve over the points' bounding box
 /// (sorted with their keys rather than by index, so that insertion reads them in sequence).
-pub(crate) fn brio_sorted(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
+/// Takes the points by value, so that their memory is freed once they are keyed.
+pub(crate) fn brio_sorted(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
-    for p in points {
+    for p in &points {
         for k in 0..2 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
@@ -68,14 +69,14 @@ pub(crate) fn brio_sorted(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
         }
     });
     let mut keyed: Vec<(u64, [f64; 2])> = points
-        .iter()
+        .into_iter()
         .enumerate()
         .map(|(i, p)| {
             let cell = [0, 1].map(|k| (((p[k] - lo[k]) * scale[k]) as u32).min(cells as u32));
             // Round 0 (inserted last) with probability 1/2, round 1 with 1/4, ...
             let round = (mix(i as u64) | (1 << (ROUNDS - 1))).trailing_zeros();
             let key = u64::from(ROUNDS - 1 - round) << (2 * BITS) | hilbert(cell[0], cell[1]);
-            (key, *p)
+            (key, p)
         })
         .collect();
     keyed.sort_unstable_by_key(|k| k.0);
@@ -114,8 +115,8 @@ mod tests {
         let pts: Vec<[f64; 2]> = (0..1000)
             .map(|i| [f64::from(i % 37) * 1.5, f64::from(i / 37) - 3.0])
             .collect();
-        let a = brio_sorted(&pts);
-        assert_eq!(a, brio_sorted(&pts));
+        let a = brio_sorted(pts.clone());
+        assert_eq!(a, brio_sorted(pts.clone()));
         let key = |p: &[f64; 2]| (p[0].to_bits(), p[1].to_bits());
         let mut s = a.clone();
         s.sort_unstable_by_key(key);
@@ -125,7 +126,7 @@ mod tests {
         // About half of the points fall in the last round.
         let last = (0..1000u64).filter(|&i| mix(i) & 1 == 1).count();
         assert!((400..600).contains(&last), "{last}");
-        assert_eq!(brio_sorted(&[[1.0, 1.0]]), vec![[1.0, 1.0]]);
-        assert!(brio_sorted(&[]).is_empty());
+        assert_eq!(brio_sorted(vec![[1.0, 1.0]]), vec![[1.0, 1.0]]);
+        assert!(brio_sorted(Vec::new()).is_empty());
     }
 }
