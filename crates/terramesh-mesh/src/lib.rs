@@ -29,6 +29,8 @@ mod cdt;
 mod flip;
 /// The mesh type and its invariants.
 mod mesh;
+/// Insertion order (BRIO along a Hilbert curve) for incremental Delaunay triangulation.
+mod order;
 /// Quality metrics in 2D and 3D.
 mod quality;
 /// Laplacian, smart Laplacian and ODT smoothing.

@@ -96,6 +96,49 @@ fn sample_points_become_vertices() {
     assert!(Quality::planar(&mesh).min_angle >= 30.0 - 1e-9);
 }
 
+/// Plain Delaunay (no refinement) of random and of grid samples: counter-clockwise
+/// triangles, every sample a vertex, Euler's count, and no vertex strictly inside any
+/// triangle's circumcircle (exact `incircle`).
+#[test]
+fn plain_delaunay_is_delaunay_for_random_and_grid_samples() {
+    let r = Region::from_ring(square(0.0, 0.0, 100.0));
+    let mut state = 12345u64;
+    let mut rnd = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let random: Vec<[f64; 2]> = (0..1500)
+        .map(|_| [0.5 + 99.0 * rnd(), 0.5 + 99.0 * rnd()])
+        .collect();
+    let grid: Vec<[f64; 2]> = (0..900)
+        .map(|i| [1.0 + (i % 30) as f64 * 3.2, 1.0 + (i / 30) as f64 * 3.2])
+        .collect();
+    for pts in [random, grid] {
+        let (mesh, rep) = MeshBuilder::new()
+            .min_angle(0.0)
+            .points(pts.clone())
+            .build(&r)
+            .unwrap();
+        assert_eq!(rep.points_outside, 0);
+        assert_eq!(mesh.points.len(), 4 + pts.len());
+        // A triangulated convex polygon with its 4 corners on the hull: 2 n - 2 - 4 triangles.
+        assert_eq!(mesh.triangles.len(), 2 * mesh.points.len() - 6);
+        mesh.sanity_check(&r).unwrap();
+        let c = |p: [f64; 2]| robust::Coord { x: p[0], y: p[1] };
+        for t in &mesh.triangles {
+            let [a, b, d] = t.map(|i| c(mesh.points[i as usize]));
+            assert!(robust::orient2d(a, b, d) > 0.0);
+            for (k, p) in mesh.points.iter().enumerate() {
+                if !t.contains(&(k as u32)) {
+                    assert!(robust::incircle(a, b, d, c(*p)) <= 0.0, "{t:?} {k}");
+                }
+            }
+        }
+    }
+}
+
 fn mesh_abs(m: &terramesh_mesh::Mesh, q: &[f64; 2]) -> [f64; 2] {
     [q[0] + m.origin[0], q[1] + m.origin[1]]
 }
