@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what tests/verify/verify_outputs.py needs: Chromium and xmllint (apt, only if
-# missing) and the Python readers in .venv-verify (pinned in tests/verify/requirements.txt).
+# Installs what tests/verify/verify_outputs.py needs: Chromium, xmllint and the shared
+# libraries that the gmsh wheel links (apt, only if missing) and the Python readers in
+# .venv-verify (pinned in tests/verify/requirements.txt).
 # Idempotent: a second run changes nothing and says so.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,13 +10,22 @@ missing=()
 command -v chromium >/dev/null 2>&1 || missing+=(chromium)
 command -v xmllint >/dev/null 2>&1 || missing+=(libxml2-utils)
 python3 -c 'import ensurepip, venv' >/dev/null 2>&1 || missing+=(python3-venv)
+# The gmsh wheel's libgmsh links X11, OpenGL/GLU, Xft and fontconfig (ldd libgmsh.so.4.15).
+# (Skipped where there is no ldconfig cache to ask.)
+ldcache=$({ ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null || true)
+[ -n "$ldcache" ] && for pair in libGLU.so.1:libglu1-mesa libGL.so.1:libgl1 libX11.so.6:libx11-6 libXext.so.6:libxext6 \
+  libXrender.so.1:libxrender1 libXcursor.so.1:libxcursor1 libXfixes.so.3:libxfixes3 \
+  libXft.so.2:libxft2 libXinerama.so.1:libxinerama1 libfontconfig.so.1:libfontconfig1 \
+  libgomp.so.1:libgomp1; do
+  grep -q "${pair%%:*} " <<<"$ldcache" || missing+=("${pair#*:}")
+done
 if ((${#missing[@]})); then
   echo "verify-setup: apt-get install ${missing[*]}"
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
 else
-  echo "verify-setup: chromium and xmllint already installed"
+  echo "verify-setup: chromium, xmllint and gmsh's libraries already installed"
 fi
 
 req=tests/verify/requirements.txt
@@ -27,6 +37,11 @@ else
   echo "verify-setup: creating .venv-verify and installing $req"
   python3 -m venv .venv-verify
   .venv-verify/bin/pip install -q --disable-pip-version-check -r "$req"
+  # The gmsh wheel loads its library at import: fail here, naming what is missing.
+  if ! .venv-verify/bin/python -c 'import gmsh' >/dev/null 2>&1; then
+    echo "verify-setup: gmsh does not load: $(ldd .venv-verify/lib/libgmsh.so* 2>&1 | grep 'not found' | tr -s ' \n' ' ')" >&2
+    exit 1
+  fi
   echo "$want" > "$stamp"
 fi
-echo "verify-setup: done ($(.venv-verify/bin/python --version), $(xmllint --version 2>&1 | head -1), $(chromium --version 2>/dev/null))"
+echo "verify-setup: done ($(.venv-verify/bin/python --version), $(xmllint --version 2>&1 | head -1), $(chromium --version 2>/dev/null), gmsh $(.venv-verify/bin/python -c 'import gmsh; print(gmsh.__version__)'))"

@@ -175,6 +175,59 @@ def write_kml(path, xy, z, tris):
                     + "\n".join(polys) + "\n</MultiGeometry></Placemark></Document></kml>\n")
 
 
+def ecef(lat, lon, h):
+    """Geodetic degrees and ellipsoidal height to WGS-84 ECEF metres (numpy, not PROJ)."""
+    a, f = 6378137.0, 1 / 298.257223563
+    e2 = f * (2 - f)
+    la, lo = np.radians(lat), np.radians(lon)
+    n = a / np.sqrt(1 - e2 * np.sin(la) ** 2)
+    return np.column_stack([(n + h) * np.cos(la) * np.cos(lo), (n + h) * np.cos(la) * np.sin(lo),
+                            (n * (1 - e2) + h) * np.sin(la)])
+
+
+def to_enu(lat, lon, h, lat0, lon0, h0):
+    """East, north, up metres in the tangent plane at (lat0, lon0, h0)."""
+    d = ecef(lat, lon, h) - ecef(np.array([lat0]), np.array([lon0]), np.array([h0]))
+    la, lo = np.radians(lat0), np.radians(lon0)
+    rot = np.array([[-np.sin(lo), np.cos(lo), 0.0],
+                    [-np.sin(la) * np.cos(lo), -np.sin(la) * np.sin(lo), np.cos(la)],
+                    [np.cos(la) * np.cos(lo), np.cos(la) * np.sin(lo), np.sin(la)]])
+    return d @ rot.T
+
+
+def write_dae(out, xy, z, tris, fmt=repr):
+    """dsm.dae (COLLADA 1.4.1, Z_UP, east-north-up metres) and dsm-model.kml placing it; returns
+    the ENU positions. `fmt` writes each coordinate (repr: shortest round trip)."""
+    from pyproj import Transformer
+    lon, lat = Transformer.from_crs(EPSG, 4326, always_xy=True).transform(xy[:, 0], xy[:, 1])
+    lon0, lat0 = Transformer.from_crs(EPSG, 4326, always_xy=True).transform(
+        0.5 * (xy[:, 0].min() + xy[:, 0].max()), 0.5 * (xy[:, 1].min() + xy[:, 1].max()))
+    h0 = float(z.min())
+    enu = to_enu(lat, lon, z, lat0, lon0, h0)
+    pos = " ".join(fmt(float(v)) for v in enu.ravel())
+    idx = " ".join(str(int(i)) for i in np.ravel(tris))
+    (Path(out) / "dsm.dae").write_text(
+        '<?xml version="1.0" encoding="utf-8"?>\n'
+        '<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">\n'
+        "<asset><created>2024-01-01T00:00:00</created><modified>2024-01-01T00:00:00</modified>"
+        '<unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>\n'
+        '<library_geometries><geometry id="g"><mesh>\n'
+        f'<source id="pos"><float_array id="pos-a" count="{enu.size}">{pos}</float_array>'
+        f'<technique_common><accessor source="#pos-a" count="{len(enu)}" stride="3"><param name="X" type="float"/>'
+        '<param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>\n'
+        '<vertices id="v"><input semantic="POSITION" source="#pos"/></vertices>\n'
+        f'<triangles count="{len(tris)}"><input semantic="VERTEX" source="#v" offset="0"/><p>{idx}</p></triangles>\n'
+        "</mesh></geometry></library_geometries>\n"
+        '<library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node>'
+        '</visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url="#s"/></scene>\n</COLLADA>\n')
+    (Path(out) / "dsm-model.kml").write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n<kml xmlns="http://www.opengis.net/kml/2.2">\n'
+        "<Placemark><name>DSM</name><Model><altitudeMode>absolute</altitudeMode>"
+        f"<Location><longitude>{lon0!r}</longitude><latitude>{lat0!r}</latitude><altitude>{h0!r}</altitude>"
+        "</Location><Link><href>dsm.dae</href></Link></Model></Placemark>\n</kml>\n")
+    return enu
+
+
 def write_all(out):
     out = Path(out)
     (out / "pictures").mkdir(parents=True, exist_ok=True)
@@ -202,13 +255,15 @@ def write_all(out):
             for k, i in enumerate([*t, t[2]])))
     (out / "dsm.dxf").write_text("".join(dxf) + "0\nENDSEC\n0\nEOF\n")
     write_kml(out / "dsm.kml", xy, uk, tris)
+    write_dae(out, xy, uk, tris)
     sp, st = solid(pts, tris, BASE)
     write_stl(out / "dsm-solid.stl", sp, st, ORIGIN)
     write_msh(out / "dsm-solid.msh", sp, st)
     a = xy[tris]
     area = 0.5 * ((a[:, 1, 0] - a[:, 0, 0]) * (a[:, 2, 1] - a[:, 0, 1]) - (a[:, 2, 0] - a[:, 0, 0]) * (a[:, 1, 1] - a[:, 0, 1]))
     volume = float(np.sum(area * (uk[tris].mean(1) - BASE)))
-    (out / "dsm-solid.json").write_text(json.dumps({"base_elevation": BASE, "volume": volume}) + "\n")
+    (out / "dsm-solid.json").write_text(json.dumps({"base_elevation": BASE, "volume": volume,
+                                                           "vertices": len(sp), "triangles": len(st)}) + "\n")
     write_grids(out, xy, uk)
     (out / "samples.csv").write_text("x,y,elevation\n377010.5,5397020.25,351.5\n377150.0,5397100.0,360.25\n")
     (out / "mesh-quality.csv").write_text("metric,value\nmin_angle_deg,%r\n" % float(min_angles(xy, tris).min()))

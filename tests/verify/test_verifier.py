@@ -16,7 +16,9 @@ import pytest
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+import check_programs  # noqa: E402
 import make_fixture as fx  # noqa: E402
+import vcommon  # noqa: E402
 import verify_outputs as vo  # noqa: E402
 
 
@@ -256,3 +258,144 @@ def test_compare_detects_difference(out, valid, capsys):
     assert not failures(valid, "determinism (--compare)", capsys, compare=out)
     edit(out / "dsm.obj", "f 1 ", "f 1  ")
     assert "dsm.obj" in failures(valid, "determinism (--compare)", capsys, compare=out)[0]
+
+
+# ---------------------------------------------------------------- COLLADA (check_collada.py)
+
+
+def test_dae_schema_invalid_element(out, capsys):
+    edit(out / "dsm.dae", "<unit ", "<units ")
+    assert "COLLADA 1.4.1 schema" in failures(out, "dae schema (COLLADA 1.4.1)", capsys)[0]
+
+
+def test_dae_wrong_version(out, capsys):
+    edit(out / "dsm.dae", 'version="1.4.1"', 'version="1.5.0"')
+    assert "1.5.0" in failures(out, "dae schema (COLLADA 1.4.1)", capsys)[0]
+
+
+def test_dae_truncated(out, capsys):
+    data = (out / "dsm.dae").read_text()
+    (out / "dsm.dae").write_text(data[: len(data) // 2])
+    assert "dsm.dae" in failures(out, "dae schema (COLLADA 1.4.1)", capsys)[0]
+    assert "dsm.dae" in failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+
+
+def test_dae_missing_triangle(out, capsys):
+    xy, uk, _, _, tris = fx.surface()
+    fx.write_dae(out, xy, uk, tris[:-1])
+    assert "triangles" in failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+
+
+def test_dae_clockwise_triangle(out, capsys):
+    xy, uk, _, _, tris = fx.surface()
+    tris[4] = tris[4][::-1]
+    fx.write_dae(out, xy, uk, tris)
+    fail = failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+    assert "triangles differ" in fail or "counter-clockwise" in fail
+
+
+def test_dae_altitude_off_by_a_millimetre(out, capsys):
+    xy, uk, _, _, tris = fx.surface()
+    z = uk.copy()
+    z[6] += 1e-3
+    fx.write_dae(out, xy, z, tris)
+    # The model KML's altitude is the lowest z: unchanged, so only vertex 6 moves.
+    assert "altitude" in failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+
+
+def test_dae_float32_positions(out, capsys):
+    xy, uk, _, _, tris = fx.surface()
+    fx.write_dae(out, xy, uk, tris, fmt=lambda v: repr(float(np.float32(v))))
+    fail = failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+    assert "lon/lat" in fail or "altitude" in fail
+
+
+def test_dae_location_moved(out, capsys):
+    s = (out / "dsm-model.kml").read_text()
+    lon = s.split("<longitude>")[1].split("<")[0]
+    edit(out / "dsm-model.kml", f"<longitude>{lon}<", f"<longitude>{float(lon) + 1e-9!r}<")
+    assert "lon/lat" in failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+
+
+def test_dae_y_up_accepted(out, capsys):
+    # The same surface written Y_UP (x, up, -north) is still in place.
+    xy, uk, _, _, tris = fx.surface()
+    enu = fx.write_dae(out, xy, uk, tris)
+    yup = np.column_stack([enu[:, 0], enu[:, 2], -enu[:, 1]])
+    s = (out / "dsm.dae").read_text()
+    old = " ".join(repr(float(v)) for v in enu.ravel())
+    assert old in s
+    s = s.replace(old, " ".join(repr(float(v)) for v in yup.ravel())).replace("Z_UP", "Y_UP")
+    (out / "dsm.dae").write_text(s)
+    assert not failures(out, "dae geometry (pycollada, PROJ)", capsys)
+    (out / "dsm.dae").write_text(s.replace("Y_UP", "Z_UP"))
+    fail = failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+    assert "counter-clockwise" in fail or "lon/lat" in fail
+
+
+def test_model_kml_not_absolute(out, capsys):
+    edit(out / "dsm-model.kml", "<altitudeMode>absolute", "<altitudeMode>relativeToGround")
+    assert "absolute" in failures(out, "dae model kml schema (xmllint)", capsys)[0]
+    assert "absolute" in failures(out, "dae geometry (pycollada, PROJ)", capsys)[0]
+
+
+def test_model_kml_schema_invalid(out, capsys):
+    edit(out / "dsm-model.kml", "<Location>", "<Position>")
+    edit(out / "dsm-model.kml", "</Location>", "</Position>")
+    assert "xmllint" in failures(out, "dae model kml schema (xmllint)", capsys)[0]
+
+
+def test_model_kml_wrong_link(out, capsys):
+    edit(out / "dsm-model.kml", "<href>dsm.dae", "<href>model.dae")
+    assert "model.dae" in failures(out, "dae model kml schema (xmllint)", capsys)[0]
+
+
+# ---------------------------------------------------------------- Gmsh and VTK (check_programs.py)
+
+
+def test_gmsh_truncated_msh(out, capsys):
+    s = (out / "dsm.msh").read_text()
+    (out / "dsm.msh").write_text(s[: s.index("$Elements") + 40])
+    assert "dsm.msh" in failures(out, "gmsh: dsm.msh", capsys)[0]
+
+
+def test_gmsh_moved_node(out, capsys):
+    pts, tris = surface()
+    pts[3, 0] += 1e-3
+    fx.write_msh(out / "dsm.msh", pts, tris)
+    assert "Gmsh node coordinates" in failures(out, "gmsh: dsm.msh", capsys)[0]
+
+
+def test_gmsh_solid_open(out, capsys):
+    pts, tris = surface()
+    sp, st = fx.solid(pts, tris, fx.BASE)
+    fx.write_msh(out / "dsm-solid.msh", sp, st[1:])
+    info = json.loads((out / "dsm-solid.json").read_text())
+    info["triangles"] -= 1
+    (out / "dsm-solid.json").write_text(json.dumps(info))
+    assert "closed surface" in failures(out, "gmsh: dsm-solid.msh closed", capsys)[0]
+
+
+def test_gmsh_solid_count_vs_json(out, capsys):
+    info = json.loads((out / "dsm-solid.json").read_text())
+    info["vertices"] += 1
+    (out / "dsm-solid.json").write_text(json.dumps(info))
+    assert "dsm-solid.json says" in failures(out, "gmsh: dsm-solid.msh closed", capsys)[0]
+
+
+def test_vtk_float32_points(out, capsys):
+    edit(out / "dsm.vtu", '<DataArray type="Float64" Name="Points"', '<DataArray type="Float32" Name="Points"')
+    assert "Float64" in failures(out, "vtk: dsm.vtu (ParaView's reader)", capsys)[0]
+
+
+def test_vtk_missing_point_data(out, capsys):
+    edit(out / "dsm.vtu", 'Name="uk_minus_idw"', 'Name="difference"')
+    assert "uk_minus_idw" in failures(out, "vtk: dsm.vtu (ParaView's reader)", capsys)[0]
+
+
+def test_vtk_broken_xml(out, capsys):
+    edit(out / "dsm.vtu", "</Piece>", "</Peace>")
+    # meshio (the reference) fails on it too; VTK's own reader must report it as well.
+    assert "dsm.vtu" in failures(out, "vtk: dsm.vtu (ParaView's reader)", capsys)[0]
+    with pytest.raises(vcommon.CheckFailed, match="dsm.vtu: VTK"):
+        check_programs.vtk_read(vcommon.Outputs(out), "dsm.vtu")

@@ -183,7 +183,8 @@ impl Default for InterpolationSection {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExportSection {
-    /// Surface formats: `vtu`, `obj`, `ply`, `stl`, `ts`, `msh`, `dxf`, `kml`.
+    /// Surface formats: `vtu`, `obj`, `ply`, `stl`, `ts`, `msh`, `dxf`, `kml`, `dae` (COLLADA
+    /// with `dsm-model.kml` for Google Earth).
     pub formats: Vec<String>,
     /// Base of the sealed solid, metres (default: 50 m below the lowest vertex).
     pub base_elevation: Option<f64>,
@@ -198,7 +199,7 @@ pub struct ExportSection {
 impl Default for ExportSection {
     fn default() -> Self {
         ExportSection {
-            formats: ["vtu", "obj", "ply", "stl", "ts", "msh", "dxf", "kml"]
+            formats: ["vtu", "obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae"]
                 .map(String::from)
                 .to_vec(),
             base_elevation: None,
@@ -343,11 +344,11 @@ impl Project {
         for f in &self.export.formats {
             if !matches!(
                 f.as_str(),
-                "vtu" | "obj" | "ply" | "stl" | "ts" | "msh" | "dxf" | "kml"
+                "vtu" | "obj" | "ply" | "stl" | "ts" | "msh" | "dxf" | "kml" | "dae"
             ) {
                 bail!(bad(
                     "export.formats",
-                    &format!("unknown format \"{f}\" (vtu, obj, ply, stl, ts, msh, dxf, kml)")
+                    &format!("unknown format \"{f}\" (vtu, obj, ply, stl, ts, msh, dxf, kml, dae)")
                 ));
             }
         }

@@ -66,6 +66,8 @@ fn example_builds_every_output_deterministically() {
         "dsm.msh",
         "dsm.dxf",
         "dsm.kml",
+        "dsm.dae",
+        "dsm-model.kml",
         "dsm-solid.stl",
         "dsm-solid.msh",
         "dsm-solid.json",
@@ -210,6 +212,13 @@ fn example_outputs_agree_with_each_other() {
         read(&out.join("dsm.kml")).matches("<Polygon>").count(),
         ncells
     );
+    // COLLADA: the triangle count, the model KML linking it (the verifier reads both).
+    let dae = read(&out.join("dsm.dae"));
+    assert!(
+        dae.contains(&format!("<triangles count=\"{ncells}\"")),
+        "dsm.dae lacks <triangles count=\"{ncells}\">"
+    );
+    assert!(read(&out.join("dsm-model.kml")).contains("<Link><href>dsm.dae</href></Link>"));
     // The solid: closed, positive volume, base below the surface.
     let solid = read(&out.join("dsm-solid.json"));
     assert!(solid.contains("\"closed\": true"));

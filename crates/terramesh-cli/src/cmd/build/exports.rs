@@ -4,9 +4,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use terramesh_core::coords::to_wgs84;
+use terramesh_core::coords::{to_wgs84, LocalEnu, Zone};
 use terramesh_core::solid::{check_closed, extrude, volume};
-use terramesh_io::export::{write_dxf, write_kml, write_stl, write_tsurf, KmlStyle, TsurfInfo};
+use terramesh_io::export::{
+    write_collada, write_dxf, write_kml, write_model_kml, write_stl, write_tsurf, ColladaOptions,
+    KmlStyle, TsurfInfo,
+};
 use terramesh_io::grid_write::{write_asc, write_geotiff};
 use terramesh_io::mesh_write::{write_mesh, MeshView};
 use terramesh_io::number::write_shortest;
@@ -38,6 +41,44 @@ fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Re
     out.commit()
         .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(path.to_path_buf())
+}
+
+/// `dsm.dae` (COLLADA, vertices in east-north-up metres around the model origin) and
+/// `dsm-model.kml`, whose `<Model>` places it at that origin with absolute altitude. The origin
+/// is the centre of the mesh's UTM bounding box at the lowest elevation.
+fn write_dae(
+    out: &Path,
+    abs: &[[f64; 3]],
+    geo: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    zone: Zone,
+    title: &str,
+) -> Result<Vec<PathBuf>> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in abs {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    let (lat0, lon0) = to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), zone)?;
+    let frame = LocalEnu::new(lat0, lon0, lo[2]);
+    let enu: Vec<[f64; 3]> = geo.iter().map(|g| frame.to_enu(g[1], g[0], g[2])).collect();
+    let dae = atomic(&out.join("dsm.dae"), |w| {
+        write_collada(
+            w,
+            &enu,
+            tris,
+            &ColladaOptions {
+                name: title,
+                ..ColladaOptions::default()
+            },
+        )
+    })?;
+    let kml = atomic(&out.join("dsm-model.kml"), |w| {
+        write_model_kml(w, "dsm.dae", [lon0, lat0, lo[2]], title)
+    })?;
+    Ok(vec![dae, kml])
 }
 
 /// Writes every output of step 5.
@@ -135,15 +176,18 @@ pub fn write_all(
             write_dxf(w, &abs, tris, "DSM")
         })?);
     }
-    if want("kml") {
-        let geo: Vec<[f64; 3]> = abs
-            .iter()
+    let geo: Vec<[f64; 3]> = if want("kml") || want("dae") {
+        abs.iter()
             .map(|q| {
                 let (lat, lon) = to_wgs84(q[0], q[1], zone)?;
                 Ok([lon, lat, q[2]])
             })
-            .collect::<Result<_, terramesh_core::coords::CoordError>>()?;
-        let title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
+            .collect::<Result<_, terramesh_core::coords::CoordError>>()?
+    } else {
+        Vec::new()
+    };
+    let title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
+    if want("kml") {
         files.push(atomic(&out.join("dsm.kml"), |w| {
             write_kml(
                 w,
@@ -155,6 +199,9 @@ pub fn write_all(
                 },
             )
         })?);
+    }
+    if want("dae") {
+        files.extend(write_dae(out, &abs, &geo, tris, zone, &title)?);
     }
     files.push(atomic(&out.join("dsm-origin.json"), |w| {
         writeln!(
