@@ -310,3 +310,133 @@ fn projected_corners_in_utm_metres() {
         "{stderr}"
     );
 }
+
+/// Vertices and triangles (0-based) of an OBJ written by terramesh.
+fn obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    for l in text.lines() {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => v.push([1, 2, 3].map(|k| w[k].parse::<f64>().unwrap())),
+            Some(&"f") => f.push([1, 2, 3].map(|k| w[k].parse::<usize>().unwrap() - 1)),
+            _ => {}
+        }
+    }
+    (v, f)
+}
+
+#[test]
+fn max_error_refines_to_the_dem_within_the_tolerance() {
+    use terramesh_core::sampling::Method;
+    use terramesh_io::dem::{open_raster, sample_utm};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("adaptive.obj");
+    let srtm = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/srtm");
+    let (ok, stdout, err) = terramesh(&[
+        "mesh",
+        "--corners",
+        PAPER_CORNERS,
+        "--max-error",
+        "0.5",
+        "--dem",
+        srtm.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(table_min_angle(&stdout) >= 20.0, "{stdout}");
+    // Independently: the DEM at every vertex, triangle centre and edge midpoint.
+    let (v, f) = obj(&out);
+    let dem = open_raster(&srtm, true).unwrap();
+    let zone = "32N".parse().unwrap();
+    let dem_at = |pts: &[[f64; 2]]| -> Vec<f64> {
+        sample_utm(dem.as_ref(), pts, zone, Method::Bilinear)
+            .unwrap()
+            .into_iter()
+            .map(|r| r.unwrap())
+            .collect()
+    };
+    let xy: Vec<[f64; 2]> = v.iter().map(|p| [p[0], p[1]]).collect();
+    for (p, z) in v.iter().zip(dem_at(&xy)) {
+        assert!((p[2] - z).abs() < 1e-9, "vertex {p:?}: DEM {z}");
+    }
+    let mut probes = Vec::new();
+    let mut linear = Vec::new();
+    for t in &f {
+        let p = t.map(|i| v[i]);
+        probes.push([
+            (p[0][0] + p[1][0] + p[2][0]) / 3.0,
+            (p[0][1] + p[1][1] + p[2][1]) / 3.0,
+        ]);
+        linear.push((p[0][2] + p[1][2] + p[2][2]) / 3.0);
+        for k in 0..3 {
+            let (a, b) = (p[k], p[(k + 1) % 3]);
+            probes.push([0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]);
+            linear.push(0.5 * (a[2] + b[2]));
+        }
+    }
+    let worst = dem_at(&probes)
+        .iter()
+        .zip(&linear)
+        .map(|(d, l)| (d - l).abs())
+        .fold(0.0, f64::max);
+    assert!(worst <= 0.5 + 1e-9, "error {worst} m");
+    // Far fewer vertices than a uniform mesh of the sampling resolution.
+    assert!(v.len() < 2000, "{} vertices", v.len());
+
+    // Errors: no DEM, a DEM that does not cover the region, conflicting flags.
+    let o = out.to_str().unwrap();
+    let (ok, _, err) = terramesh(&[
+        "mesh",
+        "--corners",
+        PAPER_CORNERS,
+        "--max-error",
+        "0.5",
+        "-o",
+        o,
+    ]);
+    assert!(!ok && err.contains("--dem"), "{err}");
+    let tile = srtm.join("N48E007.hgt");
+    let (ok, _, err) = terramesh(&[
+        "mesh",
+        "--corners",
+        "48.70 7.90; 48.70 8.10; 48.74 8.10",
+        "--max-error",
+        "2",
+        "--dem",
+        tile.to_str().unwrap(),
+        "-o",
+        o,
+    ]);
+    assert!(
+        !ok && err.contains("N48E007.hgt") && err.contains("no elevation at"),
+        "{err}"
+    );
+    let (ok, _, err) = terramesh(&[
+        "mesh",
+        "--corners",
+        PAPER_CORNERS,
+        "--max-error",
+        "0.5",
+        "--dem",
+        tile.to_str().unwrap(),
+        "--smooth",
+        "5",
+        "-o",
+        o,
+    ]);
+    assert!(!ok && err.contains("--smooth"), "{err}");
+    let (ok, _, err) = terramesh(&[
+        "mesh",
+        "--corners",
+        PAPER_CORNERS,
+        "--max-error=-1",
+        "--dem",
+        tile.to_str().unwrap(),
+        "-o",
+        o,
+    ]);
+    assert!(!ok && err.contains("max-error"), "{err}");
+}

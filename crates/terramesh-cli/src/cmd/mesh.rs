@@ -4,10 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use terramesh_core::coords::{parse_angle, to_utm, Axis, Zone};
+use terramesh_io::dem::open_raster;
 use terramesh_io::mesh_write::{write_mesh, writer_for, MeshView};
 use terramesh_io::region::{load, RegionCrs, RegionInput};
 use terramesh_io::table::{ReadOptions, Table};
-use terramesh_mesh::{smooth, MeshBuilder, Quality, Smoother};
+use terramesh_mesh::{adaptive_mesh, smooth, AdaptiveSettings, MeshBuilder, Quality, Smoother};
 
 /// Coordinate reference of the input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -41,7 +42,8 @@ pub enum SmootherArg {
     terramesh mesh --corners \"N48°43'20.64\\\" E7°20'12.48\\\"; N48°43'20.64\\\" E7°20'25.44\\\"; \
     N48°43'33.6\\\" E7°20'25.44\\\"; N48°43'33.6\\\" E7°20'12.48\\\"\" --max-area 50 -o mesh.vtu\n  \
     terramesh mesh --region area.kml --max-area 50 --smooth 10 --smoother smart -o mesh.msh\n  \
-    terramesh mesh --region site.wkt --crs projected --max-edge 5 --points samples.csv -o mesh.ply")]
+    terramesh mesh --region site.wkt --crs projected --max-edge 5 --points samples.csv -o mesh.ply\n  \
+    terramesh mesh --corners corners.csv --max-error 0.5 --dem ../shared/data/srtm -o dsm.vtu")]
 pub struct Args {
     /// Corners "LAT LON; LAT LON; ..." (at least 3; decimal degrees or DMS) or a CSV file with
     /// columns lat,lon. With --crs projected: "NORTHING EASTING; ..." in metres, or a CSV with
@@ -80,6 +82,16 @@ pub struct Args {
     /// easting,northing (projected, in the region's UTM zone).
     #[arg(long)]
     points: Option<PathBuf>,
+    /// Terrain-adaptive refinement: refine until the mesh surface is within this many metres
+    /// of the --dem surface at every triangle centre and edge midpoint, keeping --min-angle,
+    /// then improve the 3D triangle shape by flips and vertex moves that keep that error.
+    /// The mesh is written with the DEM heights as z (and point data `elevation`).
+    #[arg(long, requires = "dem", conflicts_with_all = ["max_edge", "points", "smooth"])]
+    max_error: Option<f64>,
+    /// The height function for --max-error: a DEM (.hgt, a directory of .hgt tiles, .tif,
+    /// .asc), interpolated bilinearly; voids are filled from their neighbours.
+    #[arg(long, requires = "max_error")]
+    dem: Option<PathBuf>,
     /// Output mesh: .vtu, .obj, .ply or .msh.
     #[arg(short, long)]
     output: PathBuf,
@@ -103,6 +115,9 @@ pub fn run(args: Args) -> Result<()> {
         _ => bail!("give the region with --corners or --region"),
     };
     let region = load(&input, crs, zone)?;
+    if let (Some(e), Some(dem)) = (args.max_error, &args.dem) {
+        return run_adaptive(&args, &region, e, dem);
+    }
     let mut builder = MeshBuilder::new().min_angle(args.min_angle);
     if let Some(a) = args.max_area {
         builder = builder.max_area(a);
@@ -151,6 +166,116 @@ pub fn run(args: Args) -> Result<()> {
         &args.output,
         &MeshView::planar(mesh.origin, &mesh.points, &mesh.triangles),
     )?;
+    text += &format!(
+        "wrote {} ({} vertices, {} triangles)\n",
+        args.output.display(),
+        mesh.points.len(),
+        mesh.triangles.len()
+    );
+    say(&text)
+}
+
+/// `--max-error`: terrain-adaptive refinement against a DEM.
+fn run_adaptive(
+    args: &Args,
+    region: &terramesh_io::region::LoadedRegion,
+    max_error: f64,
+    dem_path: &std::path::Path,
+) -> Result<()> {
+    use terramesh_core::sampling::Method;
+    let dem =
+        open_raster(dem_path, true).with_context(|| format!("--dem {}", dem_path.display()))?;
+    let zone = region.zone;
+    let at = |x: f64, y: f64| -> Result<f64, String> {
+        let (sx, sy) = match zone {
+            Some(z) => {
+                let (lat, lon) =
+                    terramesh_core::coords::to_wgs84(x, y, z).map_err(|e| e.to_string())?;
+                dem.crs()
+                    .from_wgs84(lat, lon)
+                    .map_err(|e| e.to_string())?
+                    .ok_or("outside the DEM's coordinate system")?
+            }
+            None => (x, y),
+        };
+        dem.sample(sx, sy, Method::Bilinear)
+            .or_else(|_| dem.sample(sx, sy, Method::Nearest))
+            .map_err(|e| e.to_string())
+    };
+    // The DEM must cover the region: check its corners and a 100 x 100 grid inside it.
+    let (lo, hi) = region.projected.bbox().context("empty region")?;
+    let mut probes: Vec<[f64; 2]> = region
+        .projected
+        .polygons
+        .iter()
+        .flat_map(|p| p.outer.iter().copied())
+        .collect();
+    for r in 0..=100 {
+        for c in 0..=100 {
+            let q = [
+                lo[0] + (hi[0] - lo[0]) * c as f64 / 100.0,
+                lo[1] + (hi[1] - lo[1]) * r as f64 / 100.0,
+            ];
+            if region.projected.contains(q) {
+                probes.push(q);
+            }
+        }
+    }
+    for q in &probes {
+        if let Err(why) = at(q[0], q[1]) {
+            bail!(
+                "--dem {}: no elevation at ({:.2}, {:.2}) inside the region ({why}); give a DEM that covers the whole region",
+                dem_path.display(),
+                q[0],
+                q[1]
+            );
+        }
+    }
+    let failed = std::sync::atomic::AtomicBool::new(false);
+    let f = |x: f64, y: f64| {
+        at(x, y).unwrap_or_else(|_| {
+            failed.store(true, std::sync::atomic::Ordering::Relaxed);
+            0.0
+        })
+    };
+    let mut settings = AdaptiveSettings::new(max_error);
+    settings.min_angle = args.min_angle;
+    settings.max_area = args.max_area;
+    if let Some(n) = args.max_vertices {
+        settings.max_vertices = n;
+    }
+    let (mesh, z, rep) = adaptive_mesh(&region.projected, &settings, &f)?;
+    if failed.load(std::sync::atomic::Ordering::Relaxed) {
+        bail!(
+            "--dem {}: the DEM has no elevation at some point inside the region",
+            dem_path.display()
+        );
+    }
+    let mut text = String::new();
+    if let Some(z) = zone {
+        text += &format!(
+            "region: {:.1} m2 in UTM zone {z}\n",
+            region.projected.area()
+        );
+    }
+    text += &format!("heights: {}\n", dem.describe());
+    text += &format!(
+        "adaptive refinement to {max_error} m: {} rounds, error {:.4} m after refinement, {:.4} m final; {} flips and {} vertex moves raised the minimum 3D angle from {:.2} to {:.2} deg\n",
+        rep.rounds,
+        rep.error_after_refinement,
+        rep.max_error,
+        rep.flips,
+        rep.moves,
+        rep.min_angle_3d_before,
+        rep.min_angle_3d
+    );
+    let planar = Quality::planar(&mesh);
+    let surface = Quality::surface(&mesh, &z);
+    text += &Quality::table(&[("planar", &planar), ("3D surface", &surface)]);
+    let mut view = MeshView::planar(mesh.origin, &mesh.points, &mesh.triangles);
+    view.z = Some(&z);
+    view.point_data.push(("elevation", &z));
+    write_mesh(&args.output, &view)?;
     text += &format!(
         "wrote {} ({} vertices, {} triangles)\n",
         args.output.display(),
