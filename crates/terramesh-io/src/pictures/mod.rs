@@ -18,6 +18,9 @@ pub use colour::{hillshade, shade, ColourMap};
 pub use maps::{draw_mesh, draw_samples, draw_surface, SurfaceMap};
 pub use view3d::draw_view3d;
 
+/// Above this many triangles, the build draws mesh pictures as [`SvgMode::Raster`].
+pub const VECTOR_TRIANGLE_LIMIT: usize = 100_000;
+
 /// A picture failed to render or write.
 #[derive(Debug, thiserror::Error)]
 #[error("drawing {file}: {message}")]
@@ -64,6 +67,46 @@ where
         &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
     ) -> Result<(), Box<dyn std::error::Error>>,
 {
+    render_both_as(stem, size, SvgMode::Vector, draw)
+}
+
+/// How [`render_both_as`] writes the SVG.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SvgMode {
+    /// Every shape as an SVG element (the default).
+    Vector,
+    /// The PNG rendering inside the SVG as one embedded image: for drawings of millions of
+    /// triangles, whose vector SVG would run to hundreds of megabytes.
+    Raster,
+}
+
+/// [`render_both`] with a choice of SVG content.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use plotters::prelude::*;
+/// use terramesh_io::pictures::{render_both_as, SvgMode};
+/// let dir = tempfile::tempdir()?;
+/// let files = render_both_as(&dir.path().join("dot"), (100, 80), SvgMode::Raster, |root| {
+///     root.fill(&WHITE)?;
+///     root.draw(&Circle::new((50, 40), 10, RED.filled()))?;
+///     Ok(())
+/// })?;
+/// let svg = std::fs::read_to_string(&files[1])?;
+/// assert!(svg.contains("<image") && svg.contains("data:image/png;base64,") && !svg.contains("<circle"));
+/// # Ok(()) }
+/// ```
+pub fn render_both_as<F>(
+    stem: &Path,
+    size: (u32, u32),
+    mode: SvgMode,
+    draw: F,
+) -> Result<[PathBuf; 2], PictureError>
+where
+    F: Fn(
+        &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>,
+{
     ensure_font();
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
@@ -81,6 +124,17 @@ where
     }
     let encoded = encode_png(&pixels, size).map_err(|e| err(&png, &e))?;
     crate::output::write_atomic(&png, &encoded).map_err(|e| err(&png, &e))?;
+    if mode == SvgMode::Raster {
+        let (w, h) = size;
+        let data = crate::report::base64(&encoded);
+        let text = format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" \
+             width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">\n<image x=\"0\" y=\"0\" \
+             width=\"{w}\" height=\"{h}\" xlink:href=\"data:image/png;base64,{data}\"/>\n</svg>\n"
+        );
+        crate::output::write_atomic(&svg, text.as_bytes()).map_err(|e| err(&svg, &e))?;
+        return Ok([png, svg]);
+    }
     // SVG: render into a string.
     let mut text = String::new();
     {
