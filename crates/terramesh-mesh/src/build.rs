@@ -13,6 +13,16 @@ use crate::MeshError;
 /// terminates up to 33 degrees and runs away at 34 (measured, see `docs/meshing.md`).
 pub const MAX_MIN_ANGLE: f64 = 33.0;
 
+/// Area of an equilateral triangle of unit side, `√3/4` rounded down.
+const EQUILATERAL_AREA: f64 = 0.433;
+/// Lattice side as a fraction of the side whose triangles have exactly the area limit
+/// (at 1.0 rounding puts half of them over the limit; measured in `docs/meshing.md`).
+const LATTICE_FILL: f64 = 0.97;
+/// Lattice points keep this many sides from every segment.
+const LATTICE_CLEARANCE: f64 = 0.7;
+/// Largest minimum angle at which the lattice is used.
+const LATTICE_MAX_ANGLE: f64 = 30.0;
+
 /// Settings of [`MeshBuilder::build`], with documented defaults.
 ///
 /// ```
@@ -134,19 +144,31 @@ impl MeshBuilder {
                 return Ok(out);
             }
         }
-        let mut state = CdtState::new(&region, &self.points)?;
+        let budget = match (self.max_area, self.max_edge) {
+            (Some(a), Some(l)) => Some(a.min(EQUILATERAL_AREA * l * l)),
+            (Some(a), None) => Some(a),
+            (None, Some(l)) => Some(EQUILATERAL_AREA * l * l),
+            (None, None) => None,
+        };
+        // A size limit at up to 30 degrees: seed the interior with an equilateral lattice of
+        // triangles just under the limit (`crate::lattice`), so that refinement only finishes
+        // the band along the segments. Not at more than 30 degrees: a vertex that refinement
+        // drops into an equilateral lattice makes 30-degree angles, which would then cascade
+        // through the whole lattice. Not with sample points, which must stay as given.
+        let lattice = match budget {
+            Some(a) if self.min_angle <= LATTICE_MAX_ANGLE && self.points.is_empty() => {
+                let side = LATTICE_FILL * (a / EQUILATERAL_AREA).sqrt();
+                Some((side, LATTICE_CLEARANCE * side))
+            }
+            _ => None,
+        };
+        let mut state = CdtState::seeded(&region, &self.points, lattice)?;
         let mut report = BuildReport {
             input_vertices: state.cdt.num_vertices(),
             points_outside: state.points_outside,
             ..BuildReport::default()
         };
         let n0 = state.cdt.num_vertices();
-        let budget = match (self.max_area, self.max_edge) {
-            (Some(a), Some(l)) => Some(a.min(0.433 * l * l)),
-            (Some(a), None) => Some(a),
-            (None, Some(l)) => Some(0.433 * l * l),
-            (None, None) => None,
-        };
         let cap = self.max_vertices.unwrap_or_else(|| {
             let area = region.area();
             budget.map_or(0, |a| (4.0 * area / a).min(1e12) as usize) + 1000 * n0 + 100_000

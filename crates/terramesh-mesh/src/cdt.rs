@@ -63,6 +63,16 @@ fn insert(cdt: &mut Cdt, p: [f64; 2]) -> Result<spade::handles::FixedVertexHandl
 
 impl CdtState {
     pub(crate) fn new(region: &Region, points: &[[f64; 2]]) -> Result<CdtState, MeshError> {
+        Self::seeded(region, points, None)
+    }
+
+    /// As [`CdtState::new`], plus an equilateral lattice of side `lattice.0` at least
+    /// `lattice.1` from every segment ([`crate::lattice`]), bulk loaded with the rings.
+    pub(crate) fn seeded(
+        region: &Region,
+        points: &[[f64; 2]],
+        lattice: Option<(f64, f64)>,
+    ) -> Result<CdtState, MeshError> {
         let (lo, hi) = region.bbox().ok_or(MeshError::InvalidRegion(
             terramesh_core::geometry::ValidationError::Empty,
         ))?;
@@ -108,6 +118,13 @@ impl CdtState {
             } else {
                 verts.push(pq);
             }
+        }
+        if let Some((a, clear)) = lattice {
+            verts.extend(
+                crate::lattice::lattice_points(&local, a, clear)
+                    .into_iter()
+                    .map(|p| Point2::new(p[0], p[1])),
+            );
         }
         let mut conflicts = 0;
         let cdt = Cdt::try_bulk_load_cdt(verts, edges, |_| conflicts += 1).map_err(|e| {

@@ -27,6 +27,8 @@ mod build;
 mod cdt;
 /// Edge flips: Delaunay in the plane, shape-improving on a surface.
 mod flip;
+/// Equilateral lattice seeding of uniform-size quality meshes.
+mod lattice;
 /// The mesh type and its invariants.
 mod mesh;
 /// Insertion order (BRIO along a Hilbert curve) for incremental Delaunay triangulation.

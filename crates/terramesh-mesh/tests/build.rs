@@ -269,3 +269,31 @@ fn regression_midpoints_of_constraint_lines_split_them() {
     mesh.sanity_check(&r).unwrap();
     assert!(Quality::planar(&mesh).edge.max <= 1.5);
 }
+
+/// With an area limit at up to 30 degrees, the interior is seeded with an equilateral lattice
+/// just under the limit: close to the fewest triangles the limit allows (refinement alone
+/// makes about 1.5 times as many), with every guarantee kept.
+#[test]
+fn area_limited_meshes_are_close_to_the_fewest_triangles_the_limit_allows() {
+    let r = region_with_holes_and_lines();
+    for (angle, area) in [(30.0, 0.5), (25.0, 2.0), (0.0, 1.0)] {
+        let (mesh, _) = MeshBuilder::new()
+            .min_angle(angle)
+            .max_area(area)
+            .build(&r)
+            .unwrap();
+        mesh.sanity_check(&r).unwrap();
+        let q = Quality::planar(&mesh);
+        assert!(q.area.max <= area * (1.0 + 1e-12), "{}", q.area.max);
+        assert!(q.min_angle >= angle - 1e-9);
+        let fewest = r.area() / area;
+        let n = mesh.triangles.len() as f64;
+        assert!(
+            n >= fewest && n < 1.25 * fewest,
+            "{angle} deg, {area}: {n} triangles, at least {fewest}"
+        );
+        // The interior is the lattice: most angles lie between 50 and 70 degrees.
+        let near60: usize = q.angle_histogram[5..7].iter().sum();
+        assert!(near60 as f64 > 0.5 * 3.0 * n, "{:?}", q.angle_histogram);
+    }
+}
