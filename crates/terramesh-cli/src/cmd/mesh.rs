@@ -162,17 +162,11 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         text += &Quality::table(&[("mesh", &before)]);
     }
-    write_mesh(
+    write_and_say(
         &args.output,
         &MeshView::planar(mesh.origin, &mesh.points, &mesh.triangles),
-    )?;
-    text += &format!(
-        "wrote {} ({} vertices, {} triangles)\n",
-        args.output.display(),
-        mesh.points.len(),
-        mesh.triangles.len()
-    );
-    say(&text)
+        text,
+    )
 }
 
 /// `--max-error`: terrain-adaptive refinement against a DEM.
@@ -275,12 +269,17 @@ fn run_adaptive(
     let mut view = MeshView::planar(mesh.origin, &mesh.points, &mesh.triangles);
     view.z = Some(&z);
     view.point_data.push(("elevation", &z));
-    write_mesh(&args.output, &view)?;
+    write_and_say(&args.output, &view, text)
+}
+
+/// Writes the mesh, then prints `text` and what was written.
+fn write_and_say(output: &std::path::Path, view: &MeshView, mut text: String) -> Result<()> {
+    write_mesh(output, view)?;
     text += &format!(
         "wrote {} ({} vertices, {} triangles)\n",
-        args.output.display(),
-        mesh.points.len(),
-        mesh.triangles.len()
+        output.display(),
+        view.points.len(),
+        view.triangles.len()
     );
     say(&text)
 }
