@@ -18,14 +18,15 @@ fn repo_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Runs `terramesh build PROJECT -o out`, panicking with its stderr on failure.
-fn build(root: &Path, project: &Path, out: &Path) {
+/// Runs `terramesh build PROJECT -o out EXTRA...`, panicking with its stderr on failure.
+fn build(root: &Path, project: &Path, out: &Path, extra: &[&str]) {
     let run = Command::new(env!("CARGO_BIN_EXE_terramesh"))
         .current_dir(root)
         .arg("build")
         .arg(project)
         .arg("-o")
         .arg(out)
+        .args(extra)
         .output()
         .expect("run terramesh build");
     assert!(
@@ -39,12 +40,25 @@ fn build(root: &Path, project: &Path, out: &Path) {
 
 #[test]
 fn build_outputs_pass_independent_verifier() {
+    verify_example(&[]);
+}
+
+/// The same for a terrain-adaptive mesh (`mesh.max_error`): every export, the solid and the
+/// report of a graded mesh, and its determinism.
+#[test]
+fn adaptive_build_outputs_pass_independent_verifier() {
+    verify_example(&["--set", "mesh.max_error=0.5"]);
+}
+
+/// Builds the example twice with `extra` and runs the verifier on the first, comparing it with
+/// the second.
+fn verify_example(extra: &[&str]) {
     let root = repo_root();
     let project = root.join("examples/haut-barr/terramesh.toml");
     let tmp = tempfile::tempdir().expect("temporary directory");
     let (first, second) = (tmp.path().join("first"), tmp.path().join("second"));
-    build(&root, &project, &first);
-    build(&root, &project, &second);
+    build(&root, &project, &first, extra);
+    build(&root, &project, &second, extra);
 
     let python = root.join(".venv-verify/bin/python");
     if !python.exists() {
