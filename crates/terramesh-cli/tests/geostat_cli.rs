@@ -120,7 +120,8 @@ fn variogram_file_feeds_interpolate_and_grid_outputs() {
             && json.contains("\"rmse\"")
     );
     let s = std::fs::read_to_string(&svg).unwrap();
-    assert!(s.starts_with("<svg") && s.matches("<circle").count() >= 12 && s.contains("<path"));
+    // Drawn by plotters: a point per lag, the model as a line.
+    assert!(s.starts_with("<svg") && s.matches("<circle").count() >= 12 && s.contains("<polyline"));
     for ext in ["asc", "tif"] {
         let g = dir.path().join(format!("dem.{ext}"));
         let (ok, _, err) = run(&[
@@ -361,4 +362,36 @@ fn errors_name_file_line_flag_and_value() {
         ],
         &["v.json", "no \"model\""],
     );
+}
+
+#[test]
+fn variogram_plot_is_png_or_svg_by_extension() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = fx("data-srtm.csv");
+    let png = dir.path().join("v.png");
+    let (ok, _, err) = run(&[
+        "variogram",
+        "--data",
+        data.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(std::fs::read(&png)
+        .unwrap()
+        .starts_with(b"\x89PNG\r\n\x1a\n"));
+    // Another extension is refused before any work, naming the flag and the file.
+    let gif = dir.path().join("v.gif");
+    let (ok, _, err) = run(&[
+        "variogram",
+        "--data",
+        data.to_str().unwrap(),
+        "--plot",
+        gif.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("--plot") && err.contains("v.gif"),
+        "{err}"
+    );
+    assert!(!gif.exists());
 }

@@ -7,6 +7,5 @@ pub(crate) mod geodata;
 pub mod init;
 pub mod interpolate;
 pub mod mesh;
-pub(crate) mod plot;
 pub mod sample;
 pub mod variogram;

@@ -8,7 +8,7 @@ use terramesh_geostat::{
     experimental, fit_auto, fit_model, Direction, Duplicates, Estimator, LagSettings, ModelKind,
     Weighting,
 };
-use terramesh_io::output::{write_atomic, Output};
+use terramesh_io::output::Output;
 
 use super::geodata::{in_file, read_data};
 
@@ -125,13 +125,25 @@ pub struct Args {
     /// Output JSON (default: standard output).
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Also draw the experimental points and the model as an SVG chart.
+    /// Also draw the experimental points (sized by pair count) and the model as a chart:
+    /// SVG or PNG by the file extension.
     #[arg(long)]
     plot: Option<PathBuf>,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
+    if let Some(p) = &args.plot {
+        let ext = p
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if !matches!(ext.as_deref(), Some("svg" | "png")) {
+            anyhow::bail!(
+                "--plot {}: the file name must end in .svg or .png",
+                p.display()
+            );
+        }
+    }
     let fd = read_data(&args.data, args.duplicates.into())?;
     let lags = experimental(&fd.data, &args.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
     let (fit, cands) = fit_named(&fd.data, &lags, &args.model, args.lag.weighting())
@@ -162,11 +174,21 @@ pub fn run(args: Args) -> Result<()> {
     out.commit()?;
     if let Some(p) = &args.plot {
         let title = format!("{}: {} points", fd.name, fd.data.len());
-        write_atomic(
-            p,
-            super::plot::variogram_svg(&lags, &fit.variogram, &title).as_bytes(),
-        )
-        .with_context(|| format!("cannot write {}", p.display()))?;
+        let pts: Vec<(f64, f64, u64)> = lags
+            .iter()
+            .map(|l| (l.distance, l.gamma, l.pairs))
+            .collect();
+        let label = fit.variogram.to_string();
+        terramesh_io::pictures::render_file(p, (900, 600), |root| {
+            terramesh_io::pictures::draw_variogram(
+                root,
+                &pts,
+                &|h| fit.variogram.gamma(h),
+                &title,
+                &label,
+            )
+        })
+        .with_context(|| format!("--plot {}", p.display()))?;
     }
     if args.output.is_some() {
         eprintln!("terramesh: variogram model: {}", fit.variogram);

@@ -80,6 +80,83 @@ pub enum SvgMode {
     Raster,
 }
 
+/// Renders `draw` into PNG bytes (no time chunk).
+fn png_bytes<F>(size: (u32, u32), draw: &F) -> Result<Vec<u8>, String>
+where
+    F: Fn(
+        &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>,
+{
+    ensure_font();
+    let mut pixels = vec![255u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let backend = BitMapBackend::with_buffer(&mut pixels, size);
+        let root = DynBackend::Bitmap(backend).into_drawing_area();
+        draw(&root).map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    encode_png(&pixels, size)
+}
+
+/// Renders `draw` as SVG text.
+fn svg_text<F>(size: (u32, u32), draw: &F) -> Result<String, String>
+where
+    F: Fn(
+        &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>,
+{
+    ensure_font();
+    let mut text = String::new();
+    {
+        let backend = SVGBackend::with_string(&mut text, size);
+        let root = DynBackend::Svg(backend).into_drawing_area();
+        draw(&root).map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(text)
+}
+
+/// Renders one drawing into `path`, as PNG or SVG by its extension.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use plotters::prelude::*;
+/// let dir = tempfile::tempdir()?;
+/// let dot = |root: &DrawingArea<terramesh_io::pictures::DynBackend<'_>, plotters::coord::Shift>|
+///     -> Result<(), Box<dyn std::error::Error>> {
+///     root.fill(&WHITE)?;
+///     root.draw(&Circle::new((50, 40), 10, RED.filled()))?;
+///     Ok(())
+/// };
+/// terramesh_io::pictures::render_file(&dir.path().join("dot.svg"), (100, 80), dot)?;
+/// assert!(std::fs::read_to_string(dir.path().join("dot.svg"))?.contains("<circle"));
+/// terramesh_io::pictures::render_file(&dir.path().join("dot.png"), (100, 80), dot)?;
+/// assert!(std::fs::read(dir.path().join("dot.png"))?.starts_with(b"\x89PNG"));
+/// assert!(terramesh_io::pictures::render_file(&dir.path().join("dot.gif"), (100, 80), dot).is_err());
+/// # Ok(()) }
+/// ```
+pub fn render_file<F>(path: &Path, size: (u32, u32), draw: F) -> Result<(), PictureError>
+where
+    F: Fn(
+        &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>,
+{
+    let err = |message: String| PictureError {
+        file: path.display().to_string(),
+        message,
+    };
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let bytes = match ext.as_str() {
+        "png" => png_bytes(size, &draw).map_err(err)?,
+        "svg" => svg_text(size, &draw).map_err(err)?.into_bytes(),
+        _ => return Err(err("the file name must end in .png or .svg".into())),
+    };
+    crate::output::write_atomic(path, &bytes).map_err(|e| err(e.to_string()))
+}
+
 /// [`render_both`] with a choice of SVG content.
 ///
 /// ```
@@ -107,43 +184,27 @@ where
         &DrawingArea<DynBackend<'_>, plotters::coord::Shift>,
     ) -> Result<(), Box<dyn std::error::Error>>,
 {
-    ensure_font();
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
-    let err = |file: &Path, e: &dyn std::fmt::Display| PictureError {
+    let err = |file: &Path, message: String| PictureError {
         file: file.display().to_string(),
-        message: e.to_string(),
+        message,
     };
-    // PNG: render into a pixel buffer, encode, write atomically.
-    let mut pixels = vec![255u8; size.0 as usize * size.1 as usize * 3];
-    {
-        let backend = BitMapBackend::with_buffer(&mut pixels, size);
-        let root = DynBackend::Bitmap(backend).into_drawing_area();
-        draw(&root).map_err(|e| err(&png, &e))?;
-        root.present().map_err(|e| err(&png, &e))?;
-    }
-    let encoded = encode_png(&pixels, size).map_err(|e| err(&png, &e))?;
-    crate::output::write_atomic(&png, &encoded).map_err(|e| err(&png, &e))?;
-    if mode == SvgMode::Raster {
-        let (w, h) = size;
-        let data = crate::report::base64(&encoded);
-        let text = format!(
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" \
-             width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">\n<image x=\"0\" y=\"0\" \
-             width=\"{w}\" height=\"{h}\" xlink:href=\"data:image/png;base64,{data}\"/>\n</svg>\n"
-        );
-        crate::output::write_atomic(&svg, text.as_bytes()).map_err(|e| err(&svg, &e))?;
-        return Ok([png, svg]);
-    }
-    // SVG: render into a string.
-    let mut text = String::new();
-    {
-        let backend = SVGBackend::with_string(&mut text, size);
-        let root = DynBackend::Svg(backend).into_drawing_area();
-        draw(&root).map_err(|e| err(&svg, &e))?;
-        root.present().map_err(|e| err(&svg, &e))?;
-    }
-    crate::output::write_atomic(&svg, text.as_bytes()).map_err(|e| err(&svg, &e))?;
+    let encoded = png_bytes(size, &draw).map_err(|e| err(&png, e))?;
+    crate::output::write_atomic(&png, &encoded).map_err(|e| err(&png, e.to_string()))?;
+    let text = match mode {
+        SvgMode::Raster => {
+            let (w, h) = size;
+            let data = crate::report::base64(&encoded);
+            format!(
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" \
+                 width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">\n<image x=\"0\" y=\"0\" \
+                 width=\"{w}\" height=\"{h}\" xlink:href=\"data:image/png;base64,{data}\"/>\n</svg>\n"
+            )
+        }
+        SvgMode::Vector => svg_text(size, &draw).map_err(|e| err(&svg, e))?,
+    };
+    crate::output::write_atomic(&svg, text.as_bytes()).map_err(|e| err(&svg, e.to_string()))?;
     Ok([png, svg])
 }
 
