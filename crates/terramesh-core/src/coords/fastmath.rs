@@ -19,24 +19,33 @@ pub(crate) fn sincos_deg(x: f64) -> (f64, f64) {
     let r = (x - 90.0 * k).to_radians(); // |r| <= π/4
     let r2 = r * r;
     // Taylor series, truncation error below 5e-17 on |r| <= π/4.
-    let s = r
-        * (1.0
-            + r2 * (-1.0 / 6.0
-                + r2 * (1.0 / 120.0
-                    + r2 * (-1.0 / 5040.0
-                        + r2 * (1.0 / 362_880.0
-                            + r2 * (-1.0 / 39_916_800.0
-                                + r2 * (1.0 / 6_227_020_800.0
-                                    + r2 * (-1.0 / 1_307_674_368_000.0))))))));
-    let c = 1.0
-        + r2 * (-0.5
-            + r2 * (1.0 / 24.0
-                + r2 * (-1.0 / 720.0
-                    + r2 * (1.0 / 40_320.0
-                        + r2 * (-1.0 / 3_628_800.0
-                            + r2 * (1.0 / 479_001_600.0
-                                + r2 * (-1.0 / 87_178_291_200.0
-                                    + r2 * (1.0 / 20_922_789_888_000.0))))))));
+    let s = r * horner(
+        r2,
+        &[
+            1.0,
+            -1.0 / 6.0,
+            1.0 / 120.0,
+            -1.0 / 5040.0,
+            1.0 / 362_880.0,
+            -1.0 / 39_916_800.0,
+            1.0 / 6_227_020_800.0,
+            -1.0 / 1_307_674_368_000.0,
+        ],
+    );
+    let c = horner(
+        r2,
+        &[
+            1.0,
+            -0.5,
+            1.0 / 24.0,
+            -1.0 / 720.0,
+            1.0 / 40_320.0,
+            -1.0 / 3_628_800.0,
+            1.0 / 479_001_600.0,
+            -1.0 / 87_178_291_200.0,
+            1.0 / 20_922_789_888_000.0,
+        ],
+    );
     // Quadrant k mod 4 (k in -2..=2), as branch-free selects.
     let q = ki & 3;
     let odd = q & 1 == 1;
@@ -53,23 +62,41 @@ pub(crate) fn atan2_right(y: f64, x: f64) -> f64 {
     let a = y.abs();
     let swap = a > x;
     let (num, den) = if swap { (x, a) } else { (a, x) };
-    let z = if den == 0.0 { 0.0 } else { num / den }; // 0 <= z <= 1
-                                                      // Reduce around t_k = tan(kπ/16), k = 0..4: atan z = kπ/16 + atan((z - t)/(1 + z t)).
+    // 0 <= z <= 1. Reduce around t_k = tan(kπ/16), k = 0..4:
+    // atan z = kπ/16 + atan((z - t)/(1 + z t)).
+    let z = if den == 0.0 { 0.0 } else { num / den };
     let k = ((z * 4.0 + 0.5) as i32).min(4) as f64; // z >= 0: truncation is floor
     let t = tan_k_pi_16(k);
     let w = (z - t) / (1.0 + z * t); // |w| < 0.13
     let w2 = w * w;
-    let at = w
-        * (1.0
-            + w2 * (-1.0 / 3.0
-                + w2 * (1.0 / 5.0
-                    + w2 * (-1.0 / 7.0
-                        + w2 * (1.0 / 9.0
-                            + w2 * (-1.0 / 11.0
-                                + w2 * (1.0 / 13.0 + w2 * (-1.0 / 15.0 + w2 * (1.0 / 17.0)))))))));
+    let at = w * horner(
+        w2,
+        &[
+            1.0,
+            -1.0 / 3.0,
+            1.0 / 5.0,
+            -1.0 / 7.0,
+            1.0 / 9.0,
+            -1.0 / 11.0,
+            1.0 / 13.0,
+            -1.0 / 15.0,
+            1.0 / 17.0,
+        ],
+    );
     let base = k * (std::f64::consts::PI / 16.0) + at;
     let r = if swap { FRAC_PI_2 - base } else { base };
     r.copysign(y)
+}
+
+/// `c[0] + x (c[1] + x (c[2] + ...))`, evaluated from the innermost term (Horner); the loop
+/// over a fixed-size array unrolls to the same arithmetic as the nested expression.
+#[inline(always)]
+fn horner<const N: usize>(x: f64, c: &[f64; N]) -> f64 {
+    let mut acc = c[N - 1];
+    for k in (0..N - 1).rev() {
+        acc = c[k] + x * acc;
+    }
+    acc
 }
 
 /// `tan(kπ/16)` for `k` in 0..=4 without a table lookup.
@@ -105,16 +132,22 @@ pub(crate) fn ln(y: f64) -> f64 {
     // ln m = 2 atanh(s), s = (m - 1)/(m + 1), |s| <= 0.1716.
     let s = (m - 1.0) / (m + 1.0);
     let s2 = s * s;
-    let series = 1.0
-        + s2 * (1.0 / 3.0
-            + s2 * (1.0 / 5.0
-                + s2 * (1.0 / 7.0
-                    + s2 * (1.0 / 9.0
-                        + s2 * (1.0 / 11.0
-                            + s2 * (1.0 / 13.0
-                                + s2 * (1.0 / 15.0
-                                    + s2 * (1.0 / 17.0
-                                        + s2 * (1.0 / 19.0 + s2 * (1.0 / 21.0))))))))));
+    let series = horner(
+        s2,
+        &[
+            1.0,
+            1.0 / 3.0,
+            1.0 / 5.0,
+            1.0 / 7.0,
+            1.0 / 9.0,
+            1.0 / 11.0,
+            1.0 / 13.0,
+            1.0 / 15.0,
+            1.0 / 17.0,
+            1.0 / 19.0,
+            1.0 / 21.0,
+        ],
+    );
     2.0 * s * series + e * LN_2
 }
 
