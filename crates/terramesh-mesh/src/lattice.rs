@@ -22,13 +22,7 @@ pub(crate) fn lattice_points(region: &Region, a: f64, clear: f64) -> Vec<[f64; 2
     }
     let segs = segments(region);
     let near = SegmentGrid::new(&segs, lo, hi, clear);
-    let mut rings: Vec<([f64; 2], [f64; 2])> = Vec::new();
-    for poly in &region.polygons {
-        for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
-            let n = ring.len();
-            rings.extend((0..n).map(|i| (ring[i], ring[(i + 1) % n])));
-        }
-    }
+    let mut rings = ring_segments(region);
     // Edges by lowest y, swept with an active list.
     rings.sort_by(|p, q| p.0[1].min(p.1[1]).total_cmp(&q.0[1].min(q.1[1])));
     let dy = a * 3f64.sqrt() / 2.0;
@@ -70,8 +64,8 @@ pub(crate) fn lattice_points(region: &Region, a: f64, clear: f64) -> Vec<[f64; 2
     out
 }
 
-/// Every ring segment and constraint-line segment of `region`.
-fn segments(region: &Region) -> Vec<([f64; 2], [f64; 2])> {
+/// Every segment of the rings (outer rings and holes) of `region`.
+fn ring_segments(region: &Region) -> Vec<([f64; 2], [f64; 2])> {
     let mut v = Vec::new();
     for poly in &region.polygons {
         for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
@@ -79,6 +73,12 @@ fn segments(region: &Region) -> Vec<([f64; 2], [f64; 2])> {
             v.extend((0..n).map(|i| (ring[i], ring[(i + 1) % n])));
         }
     }
+    v
+}
+
+/// Every ring segment and constraint-line segment of `region`.
+fn segments(region: &Region) -> Vec<([f64; 2], [f64; 2])> {
+    let mut v = ring_segments(region);
     for line in &region.lines {
         v.extend(line.windows(2).map(|w| (w[0], w[1])));
     }
