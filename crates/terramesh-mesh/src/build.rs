@@ -14,10 +14,10 @@ use crate::MeshError;
 pub const MAX_MIN_ANGLE: f64 = 33.0;
 
 /// Area of an equilateral triangle of unit side, `√3/4` rounded down.
-const EQUILATERAL_AREA: f64 = 0.433;
+pub(crate) const EQUILATERAL_AREA: f64 = 0.433;
 /// Lattice side as a fraction of the side whose triangles have exactly the area limit
 /// (at 1.0 rounding puts half of them over the limit; measured in `docs/meshing.md`).
-const LATTICE_FILL: f64 = 0.97;
+pub(crate) const LATTICE_FILL: f64 = 0.97;
 /// Lattice points keep this many sides from every segment.
 const LATTICE_CLEARANCE: f64 = 0.7;
 /// Largest minimum angle at which the lattice is used.
@@ -42,6 +42,7 @@ pub struct MeshBuilder {
     max_edge: Option<f64>,
     max_vertices: Option<usize>,
     points: Vec<[f64; 2]>,
+    strips: Option<usize>,
 }
 
 /// What [`MeshBuilder::build`] did.
@@ -57,6 +58,12 @@ pub struct BuildReport {
     pub vertex_cap: usize,
     /// True when refinement met every criterion before reaching the cap.
     pub refinement_complete: bool,
+    /// Vertical strips the region was meshed in, in parallel (1: in one piece). Strips meet
+    /// along straight cuts that are constraint edges of both sides, so the mesh is
+    /// constrained-Delaunay with respect to the cuts; angle and size limits hold everywhere.
+    pub strips: usize,
+    /// Rounds of exchanging cut vertices between neighbouring strips (0 in one piece).
+    pub strip_rounds: usize,
 }
 
 impl Default for MeshBuilder {
@@ -75,6 +82,7 @@ impl MeshBuilder {
             max_edge: None,
             max_vertices: None,
             points: Vec::new(),
+            strips: None,
         }
     }
     /// Minimum angle in degrees, `0..=33` (0 turns angle refinement off).
@@ -96,6 +104,14 @@ impl MeshBuilder {
     /// `area / max_area` plus 1,000 per input vertex plus 100,000).
     pub fn max_vertices(mut self, n: usize) -> Self {
         self.max_vertices = Some(n);
+        self
+    }
+    /// Number of vertical strips meshed in parallel, 1 to 16 (default: from the expected
+    /// number of triangles alone, so that a region gives the same mesh on any machine: 1 below
+    /// 300,000, see [`BuildReport::strips`]). Strips apply to meshes with a size limit and no
+    /// sample points; where no good cut is found the mesh is built in one piece.
+    pub fn strips(mut self, n: usize) -> Self {
+        self.strips = Some(n);
         self
     }
     /// Sample locations to insert as mesh vertices (absolute coordinates; points outside the
@@ -138,8 +154,8 @@ impl MeshBuilder {
     pub fn build(&self, region: &Region) -> Result<(Mesh, BuildReport), MeshError> {
         self.check()?;
         let region = validate(region)?;
-        let refine = self.min_angle > 0.0 || self.max_area.is_some() || self.max_edge.is_some();
-        if !refine {
+        let refining = self.min_angle > 0.0 || self.max_area.is_some() || self.max_edge.is_some();
+        if !refining {
             if let Some(out) = convex_delaunay(&region, &self.points)? {
                 return Ok(out);
             }
@@ -162,9 +178,28 @@ impl MeshBuilder {
             }
             _ => None,
         };
+        // Large meshes: vertical strips meshed in parallel (`crate::strips`), unless the
+        // region has no good place for a cut.
+        let strips = match (self.strips, budget) {
+            (Some(k), Some(_)) => k.clamp(1, crate::strips::MAX_STRIPS),
+            (None, Some(a)) => crate::strips::auto_strips(region.area() / a),
+            _ => 1,
+        };
+        if strips > 1 && self.points.is_empty() {
+            let job = crate::strips::Job {
+                min_angle: self.min_angle,
+                budget: budget.expect("strips need a size limit"),
+                max_edge: self.max_edge,
+                lattice,
+                max_vertices: self.max_vertices,
+            };
+            if let Some(out) = crate::strips::build(&region, strips, &job)? {
+                return Ok(out);
+            }
+        }
         let mut state = CdtState::seeded(&region, &self.points, lattice)?;
         let mut report = BuildReport {
-            input_vertices: state.cdt.num_vertices(),
+            input_vertices: state.cdt.num_vertices() - state.frame,
             points_outside: state.points_outside,
             ..BuildReport::default()
         };
@@ -175,18 +210,10 @@ impl MeshBuilder {
         });
         report.vertex_cap = cap;
         report.refinement_complete = true;
+        report.strips = 1;
         if self.min_angle > 0.0 || budget.is_some() {
-            let complete = state.refine(self.min_angle, budget, n0 + cap)?;
-            if let Some(l) = self.max_edge {
-                // Split edges longer than the limit, then restore the angle; repeat.
-                let mut complete = complete;
-                while complete && state.split_long_edges(l)? > 0 {
-                    complete = state.refine(self.min_angle, budget, n0 + cap)?;
-                }
-                report.refinement_complete = complete;
-            } else {
-                report.refinement_complete = complete;
-            }
+            report.refinement_complete =
+                refine(&mut state, self.min_angle, budget, self.max_edge, n0 + cap)?;
         }
         report.steiner_points = state.cdt.num_vertices() - n0;
         if !report.refinement_complete {
@@ -197,6 +224,24 @@ impl MeshBuilder {
         }
         Ok((state.extract(), report))
     }
+}
+
+/// Refines to the angle and size; with an edge limit, splits the edges longer than it and
+/// refines again until none is. Returns whether refinement finished within `max_vertices`.
+pub(crate) fn refine(
+    state: &mut CdtState,
+    min_angle: f64,
+    budget: Option<f64>,
+    max_edge: Option<f64>,
+    max_vertices: usize,
+) -> Result<bool, MeshError> {
+    let mut complete = state.refine(min_angle, budget, max_vertices)?;
+    if let Some(l) = max_edge {
+        while complete && state.split_long_edges(l)? > 0 {
+            complete = state.refine(min_angle, budget, max_vertices)?;
+        }
+    }
+    Ok(complete)
 }
 
 /// Plain Delaunay triangulation for a single convex polygon without holes or lines: its hull
@@ -294,6 +339,8 @@ fn convex_delaunay(
         steiner_points: 0,
         vertex_cap: 0,
         refinement_complete: true,
+        strips: 1,
+        strip_rounds: 0,
     };
     Ok(Some((
         Mesh {

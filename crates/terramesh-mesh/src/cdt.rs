@@ -18,12 +18,16 @@ pub(crate) struct CdtState {
     pub(crate) origin: [f64; 2],
     /// The region in local coordinates.
     pub(crate) local: Region,
+    /// The slab `x0 < x < x1` the mesh is restricted to (see [`Soup`]).
+    pub(crate) slab: [f64; 2],
     pub(crate) points_outside: usize,
     /// Whether spade's winding rule (constraint crossings) agrees with the region; false when
     /// constraint lines enclose an area, in which case refinement covers the whole hull.
     spade_classifies: bool,
     /// Distance under which a new vertex is taken to lie on a constraint edge.
-    tol: f64,
+    pub(crate) tol: f64,
+    /// Vertices of the frame around the region (see [`CdtState::from_soup`]).
+    pub(crate) frame: usize,
     /// spade's excluded faces from the last refinement, while they are current and right.
     excluded: Option<Vec<spade::handles::FixedFaceHandle<spade::handles::InnerTag>>>,
 }
@@ -61,6 +65,62 @@ fn insert(cdt: &mut Cdt, p: [f64; 2]) -> Result<spade::handles::FixedVertexHandl
         })
 }
 
+/// The segments a CDT is built from, in local coordinates: closed rings as a vertex list and
+/// index pairs (bulk loaded together), constraint polylines (inserted one by one after), and
+/// the slab `x0 < x < x1` the mesh is restricted to (unbounded for a whole region; one strip
+/// of it for [`crate::strips`]).
+pub(crate) struct Soup {
+    pub(crate) verts: Vec<[f64; 2]>,
+    pub(crate) edges: Vec<[usize; 2]>,
+    pub(crate) lines: Vec<Vec<[f64; 2]>>,
+    pub(crate) slab: [f64; 2],
+}
+
+/// Corners of a rectangle around the region's bounding box (cut to the slab), 5% of its
+/// larger side clear of it.
+fn frame(local: &Region, slab: [f64; 2]) -> [[f64; 2]; 4] {
+    let (lo, hi) = local.bbox().unwrap_or(([0.0, 0.0], [1.0, 1.0]));
+    let (x0, x1) = (lo[0].max(slab[0]), hi[0].min(slab[1]));
+    let m = 0.05 * (x1 - x0).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+    let (x0, x1, y0, y1) = (x0 - m, x1 + m, lo[1] - m, hi[1] + m);
+    [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+}
+
+impl Soup {
+    /// The rings and lines of a whole region.
+    pub(crate) fn of_region(local: &Region) -> Soup {
+        let mut verts = Vec::new();
+        let mut edges = Vec::new();
+        for poly in &local.polygons {
+            for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
+                let base = verts.len();
+                let n = ring.len();
+                verts.extend_from_slice(ring);
+                edges.extend((0..n).map(|i| [base + i, base + (i + 1) % n]));
+            }
+        }
+        Soup {
+            verts,
+            edges,
+            lines: local.lines.clone(),
+            slab: [f64::NEG_INFINITY, f64::INFINITY],
+        }
+    }
+}
+
+/// The local origin (bounding-box centre), the region about it and the rounding tolerance.
+pub(crate) fn localize(region: &Region) -> Result<([f64; 2], Region, f64), MeshError> {
+    let (lo, hi) = region.bbox().ok_or(MeshError::InvalidRegion(
+        terramesh_core::geometry::ValidationError::Empty,
+    ))?;
+    let origin = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    let local = region
+        .try_map(|p| Ok::<_, ()>([p[0] - origin[0], p[1] - origin[1]]))
+        .expect("infallible");
+    let half = [0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])];
+    Ok((origin, local, 1e-9 * half[0].max(half[1])))
+}
+
 impl CdtState {
     pub(crate) fn new(region: &Region, points: &[[f64; 2]]) -> Result<CdtState, MeshError> {
         Self::seeded(region, points, None)
@@ -73,32 +133,35 @@ impl CdtState {
         points: &[[f64; 2]],
         lattice: Option<(f64, f64)>,
     ) -> Result<CdtState, MeshError> {
-        let (lo, hi) = region.bbox().ok_or(MeshError::InvalidRegion(
-            terramesh_core::geometry::ValidationError::Empty,
-        ))?;
-        let origin = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-        let local = region
-            .try_map(|p| Ok::<_, ()>([p[0] - origin[0], p[1] - origin[1]]))
-            .expect("infallible");
-        let half = [0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])];
-        let tol = 1e-9 * half[0].max(half[1]);
+        let (origin, local, tol) = localize(region)?;
+        let soup = Soup::of_region(&local);
+        Self::from_soup(local, origin, tol, soup, points, lattice)
+    }
+
+    /// The CDT of `soup` (a whole region or one strip of `local`), with the sample `points`
+    /// (absolute coordinates) and the lattice points inside the soup's slab.
+    pub(crate) fn from_soup(
+        local: Region,
+        origin: [f64; 2],
+        tol: f64,
+        soup: Soup,
+        points: &[[f64; 2]],
+        lattice: Option<(f64, f64)>,
+    ) -> Result<CdtState, MeshError> {
         // Rings and the sample points clear of them are bulk loaded (spade's bulk CDT);
         // constraint lines and points on a ring follow one by one.
-        let mut verts = Vec::new();
-        let mut edges = Vec::new();
-        let mut segs = Vec::new();
-        for poly in &local.polygons {
-            for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
-                let base = verts.len();
-                let n = ring.len();
-                for (i, &p) in ring.iter().enumerate() {
-                    check_coordinate(p)?;
-                    verts.push(Point2::new(p[0], p[1]));
-                    edges.push([base + i, base + (i + 1) % n]);
-                    segs.push((p, ring[(i + 1) % n]));
-                }
-            }
+        let mut verts = Vec::with_capacity(soup.verts.len());
+        for &p in &soup.verts {
+            check_coordinate(p)?;
+            verts.push(Point2::new(p[0], p[1]));
         }
+        let segs: Vec<([f64; 2], [f64; 2])> = soup
+            .edges
+            .iter()
+            .map(|&[a, b]| (soup.verts[a], soup.verts[b]))
+            .collect();
+        let slab = soup.slab;
+        let inside = |q: [f64; 2]| q[0] > slab[0] && q[0] < slab[1] && local.contains(q);
         let mut points_outside = 0;
         let mut later = Vec::new();
         for p in points {
@@ -109,7 +172,7 @@ impl CdtState {
             let near = segs.iter().any(|&(a, b)| {
                 near_segment(Point2::new(a[0], a[1]), Point2::new(b[0], b[1]), pq, tol) || a == q
             });
-            if !near && !local.contains(q) {
+            if !near && !inside(q) {
                 points_outside += 1;
                 continue;
             }
@@ -119,15 +182,22 @@ impl CdtState {
                 verts.push(pq);
             }
         }
+        // A frame of four unconstrained vertices around the segments keeps every segment off
+        // the hull: spade may take a vertex inserted exactly on a hull edge for one outside
+        // the hull and leave the edge running through it (refinement of `--max-edge` meshes
+        // then looped for ever on slanted boundaries). Frame triangles are outside the region.
+        let corners = frame(&local, slab);
+        verts.extend(corners.map(|p| Point2::new(p[0], p[1])));
         if let Some((a, clear)) = lattice {
+            let xs = [slab[0] + clear, slab[1] - clear];
             verts.extend(
-                crate::lattice::lattice_points(&local, a, clear)
+                crate::lattice::lattice_points(&local, a, clear, xs)
                     .into_iter()
                     .map(|p| Point2::new(p[0], p[1])),
             );
         }
         let mut conflicts = 0;
-        let cdt = Cdt::try_bulk_load_cdt(verts, edges, |_| conflicts += 1).map_err(|e| {
+        let cdt = Cdt::try_bulk_load_cdt(verts, soup.edges, |_| conflicts += 1).map_err(|e| {
             MeshError::Insertion {
                 at: [f64::NAN, f64::NAN],
                 why: format!("{e:?}"),
@@ -138,12 +208,14 @@ impl CdtState {
             cdt,
             origin,
             local,
+            slab,
             points_outside,
             spade_classifies: true,
             tol,
             excluded: None,
+            frame: corners.len(),
         };
-        for line in &s.local.lines.clone() {
+        for line in &soup.lines {
             let hs = line
                 .iter()
                 .map(|&p| s.insert_point(p))
@@ -159,10 +231,15 @@ impl CdtState {
         }
         // Closed rings alone are classified correctly by spade's winding rule; constraint
         // lines need the check.
-        if !s.local.lines.is_empty() {
+        if !soup.lines.is_empty() {
             s.spade_classifies = s.spade_agrees();
         }
         Ok(s)
+    }
+
+    /// Whether a point (local coordinates) is inside the region and the slab.
+    pub(crate) fn contains(&self, q: [f64; 2]) -> bool {
+        q[0] > self.slab[0] && q[0] < self.slab[1] && self.local.contains(q)
     }
 
     /// Refines to the angle and area; returns whether refinement completed within
@@ -195,24 +272,26 @@ impl CdtState {
         use spade::PositionInTriangulation as P;
         self.excluded = None;
         let q = Point2::new(p[0], p[1]);
-        if let P::OnFace(f) = self.cdt.locate(q) {
-            let near = self.cdt.face(f).adjacent_edges().into_iter().find(|e| {
+        let near = match self.cdt.locate(q) {
+            P::OnFace(f) => self.cdt.face(f).adjacent_edges().into_iter().find(|e| {
                 self.cdt.is_constraint_edge(e.fix().as_undirected())
                     && near_segment(e.from().position(), e.to().position(), q, self.tol)
-            });
-            if let Some(e) = near {
-                let (a, b) = (e.from().fix(), e.to().fix());
-                self.cdt.remove_constraint_edge(e.fix().as_undirected());
-                let v = insert(&mut self.cdt, p)?;
-                self.cdt.add_constraint_and_split(a, v, |p| p);
-                self.cdt.add_constraint_and_split(v, b, |p| p);
-                return Ok(v);
-            }
+            }),
+            _ => None,
+        };
+        if let Some(e) = near {
+            let (a, b) = (e.from().fix(), e.to().fix());
+            self.cdt.remove_constraint_edge(e.fix().as_undirected());
+            let v = insert(&mut self.cdt, p)?;
+            self.cdt.add_constraint_and_split(a, v, |p| p);
+            self.cdt.add_constraint_and_split(v, b, |p| p);
+            return Ok(v);
         }
         insert(&mut self.cdt, p)
     }
 
-    /// Inserts the midpoints of inside edges longer than `l`; returns how many.
+    /// Inserts the midpoints of inside edges longer than `l`; returns how many, or an error
+    /// if there were some and none could be inserted (refinement would loop for ever).
     pub(crate) fn split_long_edges(&mut self, l: f64) -> Result<usize, MeshError> {
         let inside = self.inside_faces();
         let l2 = l * l;
@@ -230,8 +309,15 @@ impl CdtState {
                 mids.push([0.5 * (a.x + b.x), 0.5 * (a.y + b.y)]);
             }
         }
+        let before = self.cdt.num_vertices();
         for &m in &mids {
             self.insert_point(m)?;
+        }
+        if !mids.is_empty() && self.cdt.num_vertices() == before {
+            return Err(MeshError::Insertion {
+                at: mids[0],
+                why: "the midpoint of an edge longer than --max-edge is already a vertex".into(),
+            });
         }
         Ok(mids.len())
     }
@@ -259,7 +345,7 @@ impl CdtState {
             }
             let [a, b, c] = f.vertices().map(|v| v.position());
             let centre = [(a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0];
-            let is_in = self.local.contains(centre);
+            let is_in = self.contains(centre);
             seen[fi] = true;
             inside[fi] = is_in;
             stack.push(f.fix());

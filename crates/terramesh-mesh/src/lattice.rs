@@ -11,9 +11,10 @@
 use terramesh_core::geometry::Region;
 
 /// Points of an equilateral lattice of side `a` that lie inside `region` (its polygons,
-/// outside their holes) and at least `clear` from every ring segment and constraint line.
-/// Rows run along x, `a √3/2` apart; odd rows are shifted by `a/2`.
-pub(crate) fn lattice_points(region: &Region, a: f64, clear: f64) -> Vec<[f64; 2]> {
+/// outside their holes), at least `clear` from every ring segment and constraint line, and
+/// with `xs[0] <= x <= xs[1]`. Rows run along x, `a √3/2` apart; odd rows are shifted by
+/// `a/2`; the lattice is anchored at the region's bounding box, whatever `xs`.
+pub(crate) fn lattice_points(region: &Region, a: f64, clear: f64, xs: [f64; 2]) -> Vec<[f64; 2]> {
     let Some((lo, hi)) = region.bbox() else {
         return Vec::new();
     };
@@ -30,7 +31,7 @@ pub(crate) fn lattice_points(region: &Region, a: f64, clear: f64) -> Vec<[f64; 2
     let mut out = Vec::new();
     let mut next = 0;
     let mut active: Vec<([f64; 2], [f64; 2])> = Vec::new();
-    let mut xs: Vec<f64> = Vec::new();
+    let mut cross: Vec<f64> = Vec::new();
     for j in 1..=rows {
         let y = lo[1] + j as f64 * dy;
         while next < rings.len() && rings[next].0[1].min(rings[next].1[1]) <= y {
@@ -38,16 +39,16 @@ pub(crate) fn lattice_points(region: &Region, a: f64, clear: f64) -> Vec<[f64; 2
             next += 1;
         }
         active.retain(|(p, q)| p[1].max(q[1]) >= y);
-        xs.clear();
+        cross.clear();
         for (p, q) in &active {
             if (p[1] <= y) != (q[1] <= y) {
-                xs.push(p[0] + (y - p[1]) * (q[0] - p[0]) / (q[1] - p[1]));
+                cross.push(p[0] + (y - p[1]) * (q[0] - p[0]) / (q[1] - p[1]));
             }
         }
-        xs.sort_by(f64::total_cmp);
+        cross.sort_by(f64::total_cmp);
         let shift = if j % 2 == 1 { 0.5 * a } else { 0.0 };
-        for pair in xs.chunks_exact(2) {
-            let (x0, x1) = (pair[0] + clear, pair[1] - clear);
+        for pair in cross.chunks_exact(2) {
+            let (x0, x1) = ((pair[0] + clear).max(xs[0]), (pair[1] - clear).min(xs[1]));
             if x1 <= x0 {
                 continue;
             }
@@ -176,6 +177,8 @@ mod tests {
     use super::*;
     use terramesh_core::geometry::Polygon;
 
+    const ALL: [f64; 2] = [f64::NEG_INFINITY, f64::INFINITY];
+
     fn square(x0: f64, y0: f64, s: f64) -> Vec<[f64; 2]> {
         vec![[x0, y0], [x0 + s, y0], [x0 + s, y0 + s], [x0, y0 + s]]
     }
@@ -190,7 +193,7 @@ mod tests {
             lines: vec![vec![[50.0, 10.0], [90.0, 90.0]]],
         };
         let (a, clear) = (2.0, 1.5);
-        let pts = lattice_points(&r, a, clear);
+        let pts = lattice_points(&r, a, clear, ALL);
         // Brute force: every point inside, outside the hole, clear of every segment.
         let segs = segments(&r);
         for p in &pts {
@@ -218,9 +221,23 @@ mod tests {
     }
 
     #[test]
+    fn an_x_range_keeps_exactly_the_lattice_points_within_it() {
+        let r = Region::from_ring(square(0.0, 0.0, 50.0));
+        let all = lattice_points(&r, 1.5, 1.0, ALL);
+        let part = lattice_points(&r, 1.5, 1.0, [10.0, 20.5]);
+        let want: Vec<_> = all
+            .iter()
+            .filter(|p| (10.0..=20.5).contains(&p[0]))
+            .copied()
+            .collect();
+        assert!(!part.is_empty() && part.len() < all.len());
+        assert_eq!(part, want);
+    }
+
+    #[test]
     fn degenerate_inputs_give_no_points() {
         let r = Region::from_ring(square(0.0, 0.0, 1.0));
-        assert!(lattice_points(&r, 0.0, 0.1).is_empty());
-        assert!(lattice_points(&r, 5.0, 0.1).is_empty());
+        assert!(lattice_points(&r, 0.0, 0.1, ALL).is_empty());
+        assert!(lattice_points(&r, 5.0, 0.1, ALL).is_empty());
     }
 }

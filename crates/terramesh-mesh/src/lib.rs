@@ -37,6 +37,8 @@ mod order;
 mod quality;
 /// Laplacian, smart Laplacian and ODT smoothing.
 mod smooth;
+/// Meshing large regions in vertical strips, in parallel.
+mod strips;
 
 pub use adaptive::{
     adaptive_mesh, error_probes, surface_error, AdaptiveReport, AdaptiveSettings, HeightFunction,

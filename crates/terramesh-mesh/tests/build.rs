@@ -297,3 +297,128 @@ fn area_limited_meshes_are_close_to_the_fewest_triangles_the_limit_allows() {
         assert!(near60 as f64 > 0.5 * 3.0 * n, "{:?}", q.angle_histogram);
     }
 }
+
+/// A region for strips: a gently sloping top edge, a hole the middle cut passes through, and
+/// a road across all strips.
+fn region_for_strips() -> Region {
+    let mut r = Region::from_ring(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 50.0], [0.0, 60.0]]);
+    r.polygons[0]
+        .holes
+        .push(vec![[35.0, 20.0], [35.0, 30.0], [65.0, 30.0], [65.0, 20.0]]);
+    r.lines.push(vec![[5.0, 10.0], [50.0, 12.0], [95.0, 8.0]]);
+    r
+}
+
+#[test]
+fn strips_give_one_valid_mesh_within_the_limits() {
+    let r = region_for_strips();
+    for angle in [30.0, 33.0] {
+        for (area, edge) in [(Some(0.5), None), (None, Some(1.2))] {
+            let b = |k: usize| {
+                let mut b = MeshBuilder::new().min_angle(angle).strips(k);
+                if let Some(a) = area {
+                    b = b.max_area(a);
+                }
+                if let Some(l) = edge {
+                    b = b.max_edge(l);
+                }
+                b
+            };
+            let (mesh, rep) = b(4).build(&r).unwrap();
+            let what = format!("{angle} deg, area {area:?}, edge {edge:?}");
+            assert_eq!(rep.strips, 4, "{what}: the planned cuts were refused");
+            assert!(rep.refinement_complete);
+            // Joined without hanging vertices or gaps: every edge used once is a boundary or
+            // road segment, areas add up, every segment is covered.
+            mesh.sanity_check(&r).unwrap();
+            let q = Quality::planar(&mesh);
+            assert!(q.min_angle >= angle - 1e-9, "{what}: {}", q.min_angle);
+            if let Some(a) = area {
+                assert!(q.area.max <= a * (1.0 + 1e-12), "{what}: {}", q.area.max);
+            }
+            if let Some(l) = edge {
+                assert!(q.edge.max <= l, "{what}: {}", q.edge.max);
+            }
+            // No two vertices in one place (a cut vertex kept twice).
+            let mut pts: Vec<_> = mesh.points.iter().map(|p| p.map(f64::to_bits)).collect();
+            pts.sort_unstable();
+            assert!(pts.windows(2).all(|w| w[0] != w[1]), "{what}");
+            // About as many triangles as in one piece (measured: within 3% with an area
+            // limit; up to 20% more with an edge limit on a mesh this small, where the
+            // exchange across cuts splits them further); the same mesh every time.
+            let (whole, one) = b(1).build(&r).unwrap();
+            assert_eq!(one.strips, 1);
+            let ratio = mesh.triangles.len() as f64 / whole.triangles.len() as f64;
+            let most = if edge.is_some() { 1.25 } else { 1.05 };
+            assert!((0.97..most).contains(&ratio), "{what}: {ratio}");
+            assert_eq!(b(4).build(&r).unwrap().0, mesh, "{what}");
+        }
+    }
+}
+
+#[test]
+fn strips_fall_back_to_one_piece_where_no_cut_is_good() {
+    // Steep slanted sides: a vertical cut would meet them at under 60 degrees.
+    let r = Region::from_ring(vec![[0.0, 0.0], [10.0, 0.0], [60.0, 100.0], [50.0, 100.0]]);
+    let (mesh, rep) = MeshBuilder::new()
+        .max_area(0.5)
+        .strips(4)
+        .build(&r)
+        .unwrap();
+    assert_eq!(rep.strips, 1);
+    mesh.sanity_check(&r).unwrap();
+    assert!(Quality::planar(&mesh).min_angle >= 30.0 - 1e-9);
+}
+
+#[test]
+fn large_meshes_are_built_in_strips_by_default() {
+    // 700,000 square metres at 2 square metres: about 350,000 triangles, two strips.
+    let mut r = Region::from_ring(vec![
+        [0.0, 0.0],
+        [1000.0, 0.0],
+        [1000.0, 700.0],
+        [0.0, 700.0],
+    ]);
+    r.polygons[0]
+        .holes
+        .push(square(480.0, 280.0, 40.0).into_iter().rev().collect());
+    let (mesh, rep) = MeshBuilder::new()
+        .min_angle(33.0)
+        .max_area(2.0)
+        .build(&r)
+        .unwrap();
+    assert_eq!(rep.strips, 2);
+    mesh.sanity_check(&r).unwrap();
+    let q = Quality::planar(&mesh);
+    assert!(q.min_angle >= 33.0 - 1e-9 && q.area.max <= 2.0 * (1.0 + 1e-12));
+    assert_eq!(rep.steiner_points + rep.input_vertices, mesh.points.len());
+}
+
+#[test]
+fn regression_edge_limit_on_slanted_boundaries_terminates() {
+    // A slanted top edge: midpoints of its pieces round to just off it. spade took such a
+    // point, inserted exactly on a hull edge, for one outside the hull and left the edge
+    // running through it; splitting long edges then inserted the same midpoint for ever.
+    // With a dangling road the whole hull is refined, which ran away instead.
+    let slanted = Region::from_ring(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 50.0], [0.0, 60.0]]);
+    let mut road = slanted.clone();
+    road.lines
+        .push(vec![[5.0, 10.0], [50.0, 12.0], [95.0, 8.0]]);
+    for r in [&slanted, &road] {
+        for (angle, l) in [(30.0, 1.0), (30.0, 1.2), (33.0, 1.2), (25.0, 2.0)] {
+            let (mesh, rep) = MeshBuilder::new()
+                .min_angle(angle)
+                .max_edge(l)
+                .max_vertices(200_000)
+                .build(r)
+                .unwrap();
+            assert!(rep.refinement_complete);
+            mesh.sanity_check(r).unwrap();
+            let q = Quality::planar(&mesh);
+            assert!(
+                q.edge.max <= l && q.min_angle >= angle - 1e-9,
+                "{angle} {l}"
+            );
+        }
+    }
+}
