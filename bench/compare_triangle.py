@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Side-by-side timing of terramesh-mesh (spade CDT + refinement) against Triangle.
 
-Each run is its own process, so peak memory (VmHWM) is the run's own; the best of REPEATS
+terramesh uses its default strips (4 for the 1.55 cases, run on the machine's cores; Triangle
+is single-threaded); the "one strip" cases run it in one piece on one core. Each run is its own
+process, so peak memory (VmHWM) is the run's own; the best of REPEATS
 runs is reported. Timings cover meshing only (not process start, Python import or file
 reading). Build first:  cargo build --release -p terramesh-mesh --example bench_mesh
 Usage: /work/venv-fix/bin/python bench/compare_triangle.py [REPEATS [CASE-SUBSTRING]]
@@ -78,6 +80,9 @@ def main():
         ("quality 33 deg, max area 1.55", ["quality", "33", "1.55"]),
         ("quality 30 deg, max area 15.5", ["quality", "30", "15.5"]),
         ("Delaunay, 1,000,000 random points", ["delaunay", pts_file]),
+        # terramesh in one piece, on one core (the cases above use its default strips).
+        ("quality 30 deg, area 1.55, one strip", ["quality", "30", "1.55", "1"]),
+        ("quality 33 deg, area 1.55, one strip", ["quality", "33", "1.55", "1"]),
     ]
     print(f"best of {repeats} interleaved runs, each in its own process; "
           f"ratios = terramesh / Triangle (time: best and median)")

@@ -168,6 +168,41 @@ fn sample_points_csv_become_vertices() {
 }
 
 #[test]
+fn strips_mesh_the_paper_rectangle_in_parallel_pieces() {
+    // The paper's rectangle at 2 m2 (about 53,000 triangles, one piece by default) in 4 strips.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = |strips: Option<&str>| {
+        let out = dir.path().join(format!("m{}.vtu", strips.unwrap_or("-")));
+        let mut args = vec!["mesh", "--corners", PAPER_CORNERS, "--max-area", "2"];
+        if let Some(k) = strips {
+            args.extend(["--strips", k]);
+        }
+        args.extend(["--min-angle", "33", "-o", out.to_str().unwrap()]);
+        let (ok, stdout, stderr) = terramesh(&args);
+        assert!(ok, "{stderr}");
+        assert!(table_min_angle(&stdout) >= 33.0, "{stdout}");
+        (stdout, vtu_points(&out))
+    };
+    let (one, (_, whole)) = mesh(None);
+    assert!(!one.contains("strips"), "{one}");
+    let (four, (pts, cells)) = mesh(Some("4"));
+    assert!(
+        four.contains("meshed in 4 vertical strips in parallel"),
+        "{four}"
+    );
+    let ratio = cells as f64 / whole as f64;
+    assert!((0.98..1.03).contains(&ratio), "{cells} vs {whole}");
+    // Written as one mesh: every vertex used once (no cut vertex doubled).
+    let mut keys: Vec<_> = pts
+        .iter()
+        .map(|p| (p[0].to_bits(), p[1].to_bits()))
+        .collect();
+    keys.sort_unstable();
+    keys.dedup();
+    assert_eq!(keys.len(), pts.len());
+}
+
+#[test]
 fn errors_are_clear_and_leave_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("m.vtu");
@@ -216,6 +251,10 @@ fn errors_are_clear_and_leave_no_file() {
                 "1000",
             ],
             "cap of 1000",
+        ),
+        (
+            vec!["--corners", PAPER_CORNERS, "--strips", "17"],
+            "--strips <STRIPS>",
         ),
     ];
     for (args, expect) in cases {

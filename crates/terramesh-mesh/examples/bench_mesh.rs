@@ -2,7 +2,7 @@
 //! is the run's own).
 //!
 //! ```text
-//! bench_mesh quality MIN_ANGLE MAX_AREA    # 1000 x 1000 square with two 100 x 100 holes
+//! bench_mesh quality MIN_ANGLE MAX_AREA [STRIPS]   # 1000 x 1000 square, two 100 x 100 holes
 //! bench_mesh delaunay POINTS.f64           # raw little-endian x,y pairs in [0, 1000]^2
 //! ```
 //! Prints one line: `triangles=N seconds=S min_angle=A peak_rss_mb=M`.
@@ -38,12 +38,12 @@ fn main() {
                 }],
                 lines: vec![],
             };
+            let mut builder = MeshBuilder::new().min_angle(angle).max_area(area);
+            if let Some(k) = args.get(4) {
+                builder = builder.strips(k.parse().expect("STRIPS"));
+            }
             let t = Instant::now();
-            let (mesh, _) = MeshBuilder::new()
-                .min_angle(angle)
-                .max_area(area)
-                .build(&region)
-                .expect("mesh");
+            let (mesh, _) = builder.build(&region).expect("mesh");
             (mesh, t.elapsed().as_secs_f64())
         }
         Some("delaunay") => {
@@ -67,7 +67,9 @@ fn main() {
             (mesh, t.elapsed().as_secs_f64())
         }
         _ => {
-            eprintln!("usage: bench_mesh quality MIN_ANGLE MAX_AREA | delaunay POINTS.f64");
+            eprintln!(
+                "usage: bench_mesh quality MIN_ANGLE MAX_AREA [STRIPS] | delaunay POINTS.f64"
+            );
             std::process::exit(2);
         }
     };

@@ -72,6 +72,11 @@ pub struct Args {
     /// Cap on the vertices refinement may add (default: from the area budget).
     #[arg(long)]
     max_vertices: Option<usize>,
+    /// Vertical strips meshed in parallel, 1 to 16 (default: from the expected number of
+    /// triangles alone, 1 below 300,000, so that a region gives the same mesh on any machine;
+    /// 1 meshes the region in one piece).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
+    strips: Option<u8>,
     /// Smoothing iterations (0: none).
     #[arg(long, default_value_t = 0)]
     smooth: usize,
@@ -131,12 +136,21 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(p) = &args.points {
         builder = builder.points(read_points(p, args.crs, region.zone)?);
     }
+    if let Some(k) = args.strips {
+        builder = builder.strips(k.into());
+    }
     let (mut mesh, report) = builder.build(&region.projected)?;
     let mut text = String::new();
     if let Some(z) = region.zone {
         text += &format!(
             "region: {:.1} m2 in UTM zone {z}\n",
             region.projected.area()
+        );
+    }
+    if report.strips > 1 {
+        text += &format!(
+            "meshed in {} vertical strips in parallel ({} exchange rounds along the cuts)\n",
+            report.strips, report.strip_rounds
         );
     }
     if report.points_outside > 0 {
