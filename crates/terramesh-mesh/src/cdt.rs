@@ -74,16 +74,52 @@ pub(crate) struct Soup {
     pub(crate) edges: Vec<[usize; 2]>,
     pub(crate) lines: Vec<Vec<[f64; 2]>>,
     pub(crate) slab: [f64; 2],
+    /// Distance the frame keeps from the segments, beyond 2 % of the size (see [`frame`]):
+    /// a few target edge lengths, so that refining the whole hull puts triangles of about the
+    /// target size outside the segments rather than small ones squeezed into a thin band
+    /// (which split the segments from outside). `None`: a quarter of the size (no size limit).
+    pub(crate) margin: Option<f64>,
 }
 
-/// Corners of a rectangle around the region's bounding box (cut to the slab), 5% of its
-/// larger side clear of it.
-fn frame(local: &Region, slab: [f64; 2]) -> [[f64; 2]; 4] {
-    let (lo, hi) = local.bbox().unwrap_or(([0.0, 0.0], [1.0, 1.0]));
-    let (x0, x1) = (lo[0].max(slab[0]), hi[0].min(slab[1]));
-    let m = 0.05 * (x1 - x0).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-    let (x0, x1, y0, y1) = (x0 - m, x1 + m, lo[1] - m, hi[1] + m);
-    [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+/// The frame: the vertices of the convex hull of `points` moved away from its centre by 2 % of
+/// their distance plus `margin`, so that it holds every point strictly inside, close enough
+/// that refining the whole hull (when spade's classification cannot be used) adds only a band
+/// of triangles outside the region.
+fn frame(points: &[[f64; 2]], margin: f64) -> Vec<[f64; 2]> {
+    let mut p: Vec<[f64; 2]> = points.to_vec();
+    p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    p.dedup();
+    if p.len() < 3 {
+        return Vec::new();
+    }
+    // Andrew's monotone chain, counter-clockwise, collinear points dropped.
+    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        for &q in p.iter() {
+            while hull.len() >= start + 2
+                && crate::mesh::orient(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+        if pass == 0 {
+            p.reverse();
+        }
+    }
+    let n = hull.len() as f64;
+    let c = hull
+        .iter()
+        .fold([0.0, 0.0], |c, q| [c[0] + q[0] / n, c[1] + q[1] / n]);
+    hull.iter()
+        .map(|q| {
+            let d = (q[0] - c[0]).hypot(q[1] - c[1]);
+            let f = 1.02 + margin / d;
+            [c[0] + f * (q[0] - c[0]), c[1] + f * (q[1] - c[1])]
+        })
+        .collect()
 }
 
 impl Soup {
@@ -104,6 +140,7 @@ impl Soup {
             edges,
             lines: local.lines.clone(),
             slab: [f64::NEG_INFINITY, f64::INFINITY],
+            margin: None,
         }
     }
 }
@@ -123,18 +160,21 @@ pub(crate) fn localize(region: &Region) -> Result<([f64; 2], Region, f64), MeshE
 
 impl CdtState {
     pub(crate) fn new(region: &Region, points: &[[f64; 2]]) -> Result<CdtState, MeshError> {
-        Self::seeded(region, points, None)
+        Self::seeded(region, points, None, None)
     }
 
     /// As [`CdtState::new`], plus an equilateral lattice of side `lattice.0` at least
-    /// `lattice.1` from every segment ([`crate::lattice`]), bulk loaded with the rings.
+    /// `lattice.1` from every segment ([`crate::lattice`]), bulk loaded with the rings, and
+    /// the frame `margin` from the region (see [`Soup::margin`]).
     pub(crate) fn seeded(
         region: &Region,
         points: &[[f64; 2]],
         lattice: Option<(f64, f64)>,
+        margin: Option<f64>,
     ) -> Result<CdtState, MeshError> {
         let (origin, local, tol) = localize(region)?;
-        let soup = Soup::of_region(&local);
+        let mut soup = Soup::of_region(&local);
+        soup.margin = margin;
         Self::from_soup(local, origin, tol, soup, points, lattice)
     }
 
@@ -182,12 +222,19 @@ impl CdtState {
                 verts.push(pq);
             }
         }
-        // A frame of four unconstrained vertices around the segments keeps every segment off
+        // A frame of unconstrained vertices around the segments keeps every segment off
         // the hull: spade may take a vertex inserted exactly on a hull edge for one outside
         // the hull and leave the edge running through it (refinement of `--max-edge` meshes
         // then looped for ever on slanted boundaries). Frame triangles are outside the region.
-        let corners = frame(&local, slab);
-        verts.extend(corners.map(|p| Point2::new(p[0], p[1])));
+        let mut all = soup.verts.clone();
+        all.extend(soup.lines.iter().flatten());
+        let margin = soup.margin.unwrap_or_else(|| {
+            local
+                .bbox()
+                .map_or(0.0, |(lo, hi)| 0.25 * (hi[0] - lo[0]).max(hi[1] - lo[1]))
+        });
+        let corners = frame(&all, margin);
+        verts.extend(corners.iter().map(|p| Point2::new(p[0], p[1])));
         if let Some((a, clear)) = lattice {
             let xs = [slab[0] + clear, slab[1] - clear];
             verts.extend(
@@ -443,5 +490,38 @@ impl CdtState {
             triangles,
             constraint_edges,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_frame_holds_every_point_strictly_inside() {
+        // A slanted L with collinear and repeated points.
+        let pts = vec![
+            [0.0, 0.0],
+            [5.0, 0.5],
+            [10.0, 1.0],
+            [10.0, 1.0],
+            [10.0, 4.0],
+            [4.0, 4.0],
+            [4.0, 9.0],
+            [0.0, 9.0],
+            [2.0, 3.0],
+        ];
+        let f = frame(&pts, 0.5);
+        assert!((3..=6).contains(&f.len()), "{f:?}");
+        for i in 0..f.len() {
+            let (a, b) = (f[i], f[(i + 1) % f.len()]);
+            for &p in &pts {
+                assert!(
+                    crate::mesh::orient(a, b, p) > 0.0,
+                    "{p:?} not inside {a:?} {b:?}"
+                );
+            }
+        }
+        assert!(frame(&pts[..2], 0.0).is_empty());
     }
 }

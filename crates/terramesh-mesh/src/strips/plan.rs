@@ -175,7 +175,7 @@ pub(crate) fn plan(region: &Region, k: usize, gap: f64, spacing: f64) -> Option<
 
 /// The segments of strip `i` of the strips between `cuts`: the region's rings and lines
 /// clipped to the strip, and the pieces of its one or two cuts.
-pub(crate) fn strip_soup(region: &Region, cuts: &[Cut], i: usize) -> Soup {
+pub(crate) fn strip_soup(region: &Region, cuts: &[Cut], i: usize, margin: f64) -> Soup {
     let xl = if i == 0 {
         f64::NEG_INFINITY
     } else {
@@ -202,6 +202,7 @@ pub(crate) fn strip_soup(region: &Region, cuts: &[Cut], i: usize) -> Soup {
         edges: Vec::new(),
         lines: Vec::new(),
         slab: [xl, xr],
+        margin: Some(margin),
     };
     let mut index: HashMap<[u64; 2], usize> = HashMap::new();
     let mut id = |verts: &mut Vec<[f64; 2]>, p: [f64; 2]| {
@@ -320,7 +321,7 @@ mod tests {
         }
         let mut area = 0.0;
         for i in 0..3 {
-            let s = strip_soup(&r, &cuts, i);
+            let s = strip_soup(&r, &cuts, i, 1.0);
             // Every cut vertex of a strip is one of the cut's vertices, bit for bit.
             for p in &s.verts {
                 if let Some(c) = cuts.iter().find(|c| c.x == p[0]) {
