@@ -11,8 +11,8 @@
 //! Splits agree bit for bit: spade splits a cut edge at its midpoint, or at a power-of-two
 //! distance from an end it created in the same pass, and both sides start each pass with the
 //! same cut vertices. The strips' meshes are then joined at those vertices. The angle and
-//! size limits hold in every strip, hence everywhere; the mesh is constrained-Delaunay with
-//! respect to the cuts.
+//! size limits hold in every strip, hence everywhere; the mesh is Delaunay within each strip,
+//! not across the cuts. Anything that fails in strips falls back to meshing in one piece.
 //!
 //! The number of strips follows from the expected number of triangles alone
 //! ([`auto_strips`]), not from the machine, so that a region gives the same mesh everywhere.
@@ -153,7 +153,8 @@ pub(crate) fn build(
             return Ok(None);
         }
     }
-    let meshes: Vec<Mesh> = states.par_iter().map(CdtState::extract).collect();
+    // Each strip's triangulation is dropped as soon as its mesh is out (peak memory).
+    let meshes: Vec<Mesh> = states.into_par_iter().map(|s| s.extract()).collect();
     let Some(mesh) = join(meshes, &cuts) else {
         return Ok(None);
     };
