@@ -20,6 +20,12 @@ pub(crate) const EQUILATERAL_AREA: f64 = 0.433;
 pub(crate) const LATTICE_FILL: f64 = 0.97;
 /// Lattice points keep this many sides from every segment.
 const LATTICE_CLEARANCE: f64 = 0.7;
+/// With an edge limit, segments are split in advance into pieces no longer than this many
+/// limits. Otherwise the long edges refinement leaves along a segment beside the lattice,
+/// split at their midpoints, can start a wave of splits across the whole lattice, a row at a
+/// time, each row costing a refinement of the whole mesh: 188 s instead of 3.3 s for the
+/// benchmark square at edge 1.89 (`docs/meshing.md`; 0.8 still set one off at edge 5).
+pub(crate) const EDGE_PRESPLIT: f64 = 0.7;
 /// Largest minimum angle at which the lattice is used.
 const LATTICE_MAX_ANGLE: f64 = 30.0;
 
@@ -201,7 +207,8 @@ impl MeshBuilder {
             }
         }
         let margin = budget.map(|a| crate::strips::FRAME_MARGIN * (a / EQUILATERAL_AREA).sqrt());
-        let mut state = CdtState::seeded(&region, &self.points, lattice, margin)?;
+        let presplit = self.max_edge.map(|l| EDGE_PRESPLIT * l);
+        let mut state = CdtState::seeded(&region, &self.points, lattice, margin, presplit)?;
         let mut report = BuildReport {
             input_vertices: state.cdt.num_vertices() - state.frame,
             points_outside: state.points_outside,

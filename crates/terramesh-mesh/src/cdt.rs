@@ -122,23 +122,57 @@ fn frame(points: &[[f64; 2]], margin: f64) -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// `a`, then points splitting segment `a b` evenly into pieces no longer than `spacing` (if
+/// any), without `b`.
+pub(crate) fn split_points(
+    a: [f64; 2],
+    b: [f64; 2],
+    spacing: Option<f64>,
+) -> impl Iterator<Item = [f64; 2]> {
+    let n = spacing.map_or(1, |s| {
+        ((b[0] - a[0]).hypot(b[1] - a[1]) / s)
+            .ceil()
+            .clamp(1.0, 1e6) as usize
+    });
+    (0..n).map(move |j| {
+        let t = j as f64 / n as f64;
+        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+    })
+}
+
 impl Soup {
-    /// The rings and lines of a whole region.
-    pub(crate) fn of_region(local: &Region) -> Soup {
+    /// The rings and lines of a whole region, their segments split into pieces no longer than
+    /// `presplit` if given (see [`crate::MeshBuilder::max_edge`]).
+    pub(crate) fn of_region(local: &Region, presplit: Option<f64>) -> Soup {
         let mut verts = Vec::new();
         let mut edges = Vec::new();
         for poly in &local.polygons {
             for ring in std::iter::once(&poly.outer).chain(&poly.holes) {
                 let base = verts.len();
                 let n = ring.len();
-                verts.extend_from_slice(ring);
-                edges.extend((0..n).map(|i| [base + i, base + (i + 1) % n]));
+                for i in 0..n {
+                    verts.extend(split_points(ring[i], ring[(i + 1) % n], presplit));
+                }
+                let m = verts.len() - base;
+                edges.extend((0..m).map(|i| [base + i, base + (i + 1) % m]));
             }
         }
+        let lines = local
+            .lines
+            .iter()
+            .map(|line| {
+                let mut l: Vec<[f64; 2]> = line
+                    .windows(2)
+                    .flat_map(|w| split_points(w[0], w[1], presplit))
+                    .collect();
+                l.extend(line.last());
+                l
+            })
+            .collect();
         Soup {
             verts,
             edges,
-            lines: local.lines.clone(),
+            lines,
             slab: [f64::NEG_INFINITY, f64::INFINITY],
             margin: None,
         }
@@ -160,20 +194,22 @@ pub(crate) fn localize(region: &Region) -> Result<([f64; 2], Region, f64), MeshE
 
 impl CdtState {
     pub(crate) fn new(region: &Region, points: &[[f64; 2]]) -> Result<CdtState, MeshError> {
-        Self::seeded(region, points, None, None)
+        Self::seeded(region, points, None, None, None)
     }
 
     /// As [`CdtState::new`], plus an equilateral lattice of side `lattice.0` at least
     /// `lattice.1` from every segment ([`crate::lattice`]), bulk loaded with the rings, and
-    /// the frame `margin` from the region (see [`Soup::margin`]).
+    /// the frame `margin` from the region (see [`Soup::margin`]); segments split in advance
+    /// into pieces no longer than `presplit`.
     pub(crate) fn seeded(
         region: &Region,
         points: &[[f64; 2]],
         lattice: Option<(f64, f64)>,
         margin: Option<f64>,
+        presplit: Option<f64>,
     ) -> Result<CdtState, MeshError> {
         let (origin, local, tol) = localize(region)?;
-        let mut soup = Soup::of_region(&local);
+        let mut soup = Soup::of_region(&local, presplit);
         soup.margin = margin;
         Self::from_soup(local, origin, tol, soup, points, lattice)
     }

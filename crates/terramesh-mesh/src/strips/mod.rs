@@ -89,7 +89,13 @@ pub(crate) fn build(
         if k < 2 {
             return Ok(None);
         }
-        if let Some(cuts) = plan::plan(&local, k, GAP * side, CUT_SPACING * side) {
+        if let Some(cuts) = plan::plan(
+            &local,
+            k,
+            GAP * side,
+            CUT_SPACING * side,
+            job.lattice.map(|l| l.0),
+        ) {
             break cuts;
         }
         k /= 2;
@@ -101,7 +107,8 @@ pub(crate) fn build(
     let Ok(mut states) = (0..k)
         .into_par_iter()
         .map(|i| {
-            let soup = plan::strip_soup(&local, &cuts, i, FRAME_MARGIN * side);
+            let presplit = job.max_edge.map(|l| crate::build::EDGE_PRESPLIT * l);
+            let soup = plan::strip_soup(&local, &cuts, i, FRAME_MARGIN * side, presplit);
             CdtState::from_soup(local.clone(), origin, tol, soup, &[], job.lattice)
         })
         .collect::<Result<Vec<_>, _>>()
