@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! bench_mesh quality MIN_ANGLE MAX_AREA [STRIPS]   # 1000 x 1000 square, two 100 x 100 holes
+//! bench_mesh edge MIN_ANGLE MAX_EDGE [STRIPS]      # the same square with an edge limit
 //! bench_mesh delaunay POINTS.f64           # raw little-endian x,y pairs in [0, 1000]^2
 //! ```
 //! Prints one line: `triangles=N seconds=S min_angle=A peak_rss_mb=M`.
@@ -28,9 +29,9 @@ fn peak_rss_mb() -> f64 {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (mesh, seconds) = match args.get(1).map(String::as_str) {
-        Some("quality") => {
+        Some(mode @ ("quality" | "edge")) => {
             let angle: f64 = args[2].parse().expect("MIN_ANGLE");
-            let area: f64 = args[3].parse().expect("MAX_AREA");
+            let limit: f64 = args[3].parse().expect("MAX_AREA or MAX_EDGE");
             let region = Region {
                 polygons: vec![Polygon {
                     outer: square(0.0, 0.0, 1000.0),
@@ -38,7 +39,12 @@ fn main() {
                 }],
                 lines: vec![],
             };
-            let mut builder = MeshBuilder::new().min_angle(angle).max_area(area);
+            let mut builder = MeshBuilder::new().min_angle(angle);
+            builder = if mode == "edge" {
+                builder.max_edge(limit)
+            } else {
+                builder.max_area(limit)
+            };
             if let Some(k) = args.get(4) {
                 builder = builder.strips(k.parse().expect("STRIPS"));
             }
@@ -68,7 +74,7 @@ fn main() {
         }
         _ => {
             eprintln!(
-                "usage: bench_mesh quality MIN_ANGLE MAX_AREA [STRIPS] | delaunay POINTS.f64"
+                "usage: bench_mesh quality MIN_ANGLE MAX_AREA [STRIPS] | edge MIN_ANGLE MAX_EDGE [STRIPS] | delaunay POINTS.f64"
             );
             std::process::exit(2);
         }

@@ -23,7 +23,7 @@ const LATTICE_CLEARANCE: f64 = 0.7;
 /// With an edge limit, segments are split in advance into pieces no longer than this many
 /// limits. Otherwise the long edges refinement leaves along a segment beside the lattice,
 /// split at their midpoints, can start a wave of splits across the whole lattice, a row at a
-/// time, each row costing a refinement of the whole mesh: 188 s instead of 3.3 s for the
+/// time, each row costing a refinement of the whole mesh: 188 s instead of 1.5-1.7 s for the
 /// benchmark square at edge 1.89 (`docs/meshing.md`; 0.8 still set one off at edge 5).
 pub(crate) const EDGE_PRESPLIT: f64 = 0.7;
 /// Largest minimum angle at which the lattice is used.
