@@ -14,10 +14,10 @@ use crate::MeshError;
 pub const MAX_MIN_ANGLE: f64 = 33.0;
 
 /// Area of an equilateral triangle of unit side, `√3/4` rounded down.
-pub(crate) const EQUILATERAL_AREA: f64 = 0.433;
+const EQUILATERAL_AREA: f64 = 0.433;
 /// Lattice side as a fraction of the side whose triangles have exactly the area limit
 /// (at 1.0 rounding puts half of them over the limit; measured in `docs/meshing.md`).
-pub(crate) const LATTICE_FILL: f64 = 0.97;
+const LATTICE_FILL: f64 = 0.97;
 /// Lattice points keep this many sides from every segment.
 const LATTICE_CLEARANCE: f64 = 0.7;
 /// With an edge limit, segments are split in advance into pieces no longer than this many
@@ -25,7 +25,7 @@ const LATTICE_CLEARANCE: f64 = 0.7;
 /// split at their midpoints, can start a wave of splits across the whole lattice, a row at a
 /// time, each row costing a refinement of the whole mesh: 188 s instead of 1.5-1.7 s for the
 /// benchmark square at edge 1.89 (`docs/meshing.md`; 0.8 still set one off at edge 5).
-pub(crate) const EDGE_PRESPLIT: f64 = 0.7;
+const EDGE_PRESPLIT: f64 = 0.7;
 /// Largest minimum angle at which the lattice is used.
 const LATTICE_MAX_ANGLE: f64 = 30.0;
 
@@ -175,18 +175,22 @@ impl MeshBuilder {
             (None, Some(l)) => Some(EQUILATERAL_AREA * l * l),
             (None, None) => None,
         };
+        // The side of an equilateral triangle with the area limit: the target edge length.
+        let side = budget.map(|a| (a / EQUILATERAL_AREA).sqrt());
         // A size limit at up to 30 degrees: seed the interior with an equilateral lattice of
         // triangles just under the limit (`crate::lattice`), so that refinement only finishes
         // the band along the segments. Not at more than 30 degrees: a vertex that refinement
         // drops into an equilateral lattice makes 30-degree angles, which would then cascade
         // through the whole lattice. Not with sample points, which must stay as given.
-        let lattice = match budget {
-            Some(a) if self.min_angle <= LATTICE_MAX_ANGLE && self.points.is_empty() => {
-                let side = LATTICE_FILL * (a / EQUILATERAL_AREA).sqrt();
-                Some((side, LATTICE_CLEARANCE * side))
+        let lattice = match side {
+            Some(t) if self.min_angle <= LATTICE_MAX_ANGLE && self.points.is_empty() => {
+                let a = LATTICE_FILL * t;
+                Some((a, LATTICE_CLEARANCE * a))
             }
             _ => None,
         };
+        let margin = side.map(|t| crate::strips::FRAME_MARGIN * t);
+        let presplit = self.max_edge.map(|l| EDGE_PRESPLIT * l);
         // Large meshes: vertical strips meshed in parallel (`crate::strips`), unless the
         // region has no good place for a cut.
         let strips = match (self.strips, budget) {
@@ -194,20 +198,22 @@ impl MeshBuilder {
             (None, Some(a)) => crate::strips::auto_strips(region.area() / a),
             _ => 1,
         };
-        if strips > 1 && self.points.is_empty() {
-            let job = crate::strips::Job {
-                min_angle: self.min_angle,
-                budget: budget.expect("strips need a size limit"),
-                max_edge: self.max_edge,
-                lattice,
-                max_vertices: self.max_vertices,
-            };
-            if let Some(out) = crate::strips::build(&region, strips, &job)? {
-                return Ok(out);
+        if let (Some(budget), Some(side)) = (budget, side) {
+            if strips > 1 && self.points.is_empty() {
+                let job = crate::strips::Job {
+                    min_angle: self.min_angle,
+                    budget,
+                    side,
+                    max_edge: self.max_edge,
+                    presplit,
+                    lattice,
+                    max_vertices: self.max_vertices,
+                };
+                if let Some(out) = crate::strips::build(&region, strips, &job)? {
+                    return Ok(out);
+                }
             }
         }
-        let margin = budget.map(|a| crate::strips::FRAME_MARGIN * (a / EQUILATERAL_AREA).sqrt());
-        let presplit = self.max_edge.map(|l| EDGE_PRESPLIT * l);
         let mut state = CdtState::seeded(&region, &self.points, lattice, margin, presplit)?;
         let mut report = BuildReport {
             input_vertices: state.cdt.num_vertices() - state.frame,
@@ -215,10 +221,9 @@ impl MeshBuilder {
             ..BuildReport::default()
         };
         let n0 = state.cdt.num_vertices();
-        let cap = self.max_vertices.unwrap_or_else(|| {
-            let area = region.area();
-            budget.map_or(0, |a| (4.0 * area / a).min(1e12) as usize) + 1000 * n0 + 100_000
-        });
+        let cap = self
+            .max_vertices
+            .unwrap_or_else(|| default_cap(region.area(), budget, n0));
         report.vertex_cap = cap;
         report.refinement_complete = true;
         report.strips = 1;
@@ -235,6 +240,12 @@ impl MeshBuilder {
         }
         Ok((state.extract(), report))
     }
+}
+
+/// The default cap on added vertices (see [`MeshBuilder::max_vertices`]): four times the area
+/// budget `area / budget`, plus 1,000 per input vertex, plus 100,000.
+pub(crate) fn default_cap(area: f64, budget: Option<f64>, n0: usize) -> usize {
+    budget.map_or(0, |a| (4.0 * area / a).min(1e12) as usize) + 1000 * n0 + 100_000
 }
 
 /// Refines to the angle and size; with an edge limit, splits the edges longer than it and

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use spade::Triangulation;
 use terramesh_core::geometry::Region;
 
-use crate::build::{refine, BuildReport, EQUILATERAL_AREA};
+use crate::build::{default_cap, refine, BuildReport};
 use crate::cdt::{localize, CdtState};
 use crate::mesh::Mesh;
 use crate::MeshError;
@@ -68,8 +68,13 @@ pub(crate) fn auto_strips(triangles: f64) -> usize {
 /// What each strip is refined to (see [`crate::MeshBuilder`]).
 pub(crate) struct Job {
     pub(crate) min_angle: f64,
+    /// The area limit.
     pub(crate) budget: f64,
+    /// The target edge length: the side of an equilateral triangle of area `budget`.
+    pub(crate) side: f64,
     pub(crate) max_edge: Option<f64>,
+    /// Segments are split in advance into pieces no longer than this.
+    pub(crate) presplit: Option<f64>,
     pub(crate) lattice: Option<(f64, f64)>,
     pub(crate) max_vertices: Option<usize>,
 }
@@ -82,7 +87,7 @@ pub(crate) fn build(
     job: &Job,
 ) -> Result<Option<(Mesh, BuildReport)>, MeshError> {
     let (origin, local, tol) = localize(region)?;
-    let side = (job.budget / EQUILATERAL_AREA).sqrt();
+    let side = job.side;
     // Fewer strips where the planned number finds no good cuts.
     let mut k = k;
     let cuts = loop {
@@ -107,8 +112,7 @@ pub(crate) fn build(
     let Ok(mut states) = (0..k)
         .into_par_iter()
         .map(|i| {
-            let presplit = job.max_edge.map(|l| crate::build::EDGE_PRESPLIT * l);
-            let soup = plan::strip_soup(&local, &cuts, i, FRAME_MARGIN * side, presplit);
+            let soup = plan::strip_soup(&local, &cuts, i, FRAME_MARGIN * side, job.presplit);
             CdtState::from_soup(local.clone(), origin, tol, soup, &[], job.lattice)
         })
         .collect::<Result<Vec<_>, _>>()
@@ -123,9 +127,9 @@ pub(crate) fn build(
     let n0 = states.iter().map(|s| s.cdt.num_vertices()).sum::<usize>() - shared - framed;
     // The cap of the one-piece build (`MeshBuilder::max_vertices`); each strip may add twice
     // its share of what is left of it in a round.
-    let cap = job.max_vertices.unwrap_or_else(|| {
-        (4.0 * region.area() / job.budget).min(1e12) as usize + 1000 * n0 + 100_000
-    });
+    let cap = job
+        .max_vertices
+        .unwrap_or_else(|| default_cap(region.area(), Some(job.budget), n0));
     let mut todo: Vec<Vec<[f64; 2]>> = vec![Vec::new(); k];
     let mut first = true;
     let mut rounds = 0;
