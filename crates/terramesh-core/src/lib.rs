@@ -17,3 +17,4 @@ pub mod coords;
 pub mod geometry;
 pub mod sampling;
 pub mod solid;
+pub mod vocab;

@@ -1,0 +1,9 @@
+//! **terramesh**, the library: from a study region and elevation samples to a discrete surface
+//! model (DSM) and everything around it. This is the crate Rust users (and the Python
+//! bindings, and the `terramesh` binary) call: it owns the project file, the resolved plans,
+//! acquisition of elevations, the pipeline stages, exports, pictures and the report. The
+//! numerical kernels live below it (`terramesh-core`, `terramesh-geostat`, `terramesh-mesh`),
+//! file formats in `terramesh-io`, web services in `terramesh-web`.
+#![warn(missing_docs)]
+
+pub mod progress;
