@@ -1,13 +1,13 @@
 //! The `terramesh` command: from a study region and elevation samples to a discrete surface
-//! model. This binary only parses arguments and reports progress; the work is done by the
-//! `terramesh-core` (numerics) and `terramesh-io` (files) libraries.
+//! model. This binary only parses arguments, reports progress and prints; the work is done by
+//! the `terramesh` library and the kernel crates under it.
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 mod cmd;
-mod project;
+mod progress;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
 ///
@@ -62,4 +62,25 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// A clap parser for a library enum with a fixed vocabulary ([`terramesh_core::vocab::Named`]):
+/// the accepted names are the library's, listed in `--help`.
+pub fn named<T>() -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: terramesh_core::vocab::Named + Clone + Send + Sync,
+{
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(T::names())
+        .map(|s: String| T::parse_name(&s).unwrap_or(T::ALL[0]))
+}
+
+/// A library error worded for the command line: each setting as its flag.
+pub fn flag_error(e: terramesh::Error) -> anyhow::Error {
+    anyhow::anyhow!(e.render(&cmd::sample::flag_of))
+}
+
+/// A library error worded for a project file: each setting as its key.
+pub fn project_error(e: terramesh::Error) -> anyhow::Error {
+    anyhow::anyhow!(e.render(&terramesh::project::key_of))
 }

@@ -6,4 +6,13 @@
 //! file formats in `terramesh-io`, web services in `terramesh-web`.
 #![warn(missing_docs)]
 
+pub mod acquire;
+mod error;
 pub mod progress;
+mod setting;
+
+pub use error::{Context, Error, Result};
+pub use setting::Setting;
+pub mod build;
+pub mod project;
+pub mod variogram_file;

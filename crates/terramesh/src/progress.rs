@@ -27,8 +27,10 @@ pub trait Progress: Sync {
     fn task_advance(&self, _done: u64) {}
     /// The counted task is over.
     fn task_end(&self) {}
-    /// A note for the user (what was read, what was skipped).
+    /// A note for the user (what was read, what was written); quiet front ends drop it.
     fn note(&self, _text: &str) {}
+    /// A warning the user should see even when quiet (points left out).
+    fn warn(&self, _text: &str) {}
 }
 
 /// A reporter that reports nothing.

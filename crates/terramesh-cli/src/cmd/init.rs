@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use terramesh_io::output::write_atomic;
 
-use crate::project::{Project, TEMPLATE};
+use terramesh::project::{Project, TEMPLATE};
 
 /// Create a project directory with a commented terramesh.toml, ready to edit.
 #[derive(clap::Args, Debug)]
@@ -32,7 +32,7 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     // The template must always be a valid project.
-    Project::parse("the built-in template", TEMPLATE, &[])?;
+    Project::parse("the built-in template", TEMPLATE, &[]).map_err(crate::project_error)?;
     write_atomic(&path, TEMPLATE.as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))?;
     eprintln!("wrote {}", path.display());

@@ -57,7 +57,7 @@ pub enum RegionError {
 }
 
 /// Where a region comes from.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum RegionInput {
     /// `--corners`: an inline list `"LAT LON; LAT LON; ..."` or the path of a CSV with
     /// columns `lat,lon`; for projected input `"NORTHING EASTING; ..."` in metres or a CSV

@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{Context, Result};
 use terramesh_core::coords::{to_wgs84, LocalEnu, Zone};
 use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_io::export::{

@@ -2,11 +2,12 @@
 
 use std::sync::atomic::AtomicBool;
 
-use anyhow::{Context, Result};
 use terramesh_web::{fetch, Endpoint, FetchOptions, PointError, PointStore};
 
-use super::settings::Settings;
-use super::write::{Row, Samples};
+use super::plan::SamplePlan;
+use super::table::{Row, SampleTable};
+use crate::error::{Context, Result};
+use crate::progress::Progress;
 
 fn fnv(s: &str) -> u64 {
     s.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
@@ -14,8 +15,12 @@ fn fnv(s: &str) -> u64 {
     })
 }
 
-/// Asks the service for every node, with a progress bar.
-pub fn sample_web(s: &Settings, endpoint: &Endpoint) -> Result<Samples> {
+/// Asks the service for every node, reporting the points answered.
+pub fn sample_web(
+    s: &SamplePlan,
+    endpoint: &Endpoint,
+    progress: &dyn Progress,
+) -> Result<SampleTable> {
     let nodes = s.nodes()?;
     let latlon: Vec<[f64; 2]> = nodes
         .iter()
@@ -29,27 +34,16 @@ pub fn sample_web(s: &Settings, endpoint: &Endpoint) -> Result<Samples> {
             .map(|d| d.join(format!("elevations-{:016x}.txt", fnv(&endpoint.cache_id())))),
         ..s.fetch.clone()
     };
-    let bar = if s.progress {
-        let b = indicatif::ProgressBar::new(latlon.len() as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} points  {per_sec}  ETA {eta}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    progress.task_start("points", latlon.len() as u64);
     let cancel = AtomicBool::new(false);
     let (z, stats) = fetch(
         endpoint,
         &latlon,
         &opts,
-        &|done, _| bar.set_position(done as u64),
+        &|done, _| progress.task_advance(done as u64),
         &cancel,
     )?;
-    bar.finish_and_clear();
+    progress.task_end();
     let failed = z.iter().filter(|z| z.is_err()).count();
     // A finished run with every point answered needs no journal.
     if failed == 0 {
@@ -70,7 +64,7 @@ pub fn sample_web(s: &Settings, endpoint: &Endpoint) -> Result<Samples> {
             z: z.map_err(|e: PointError| e.to_string()),
         })
         .collect();
-    Ok(Samples {
+    Ok(SampleTable {
         zone: s.zone,
         rows,
         summary: format!(

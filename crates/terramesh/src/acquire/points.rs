@@ -2,29 +2,40 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use terramesh_core::coords::{to_utm, Zone};
 use terramesh_io::dem::{read_las, read_points, LasOptions, SourceCrs};
 
-use super::settings::{projected_margin, Settings};
-use super::write::{Row, Samples};
+use super::plan::SamplePlan;
+use super::table::{Row, SampleTable};
+use crate::error::{Context, Error, Result};
+use crate::progress::Progress;
+use crate::setting::Setting;
 
 /// Reads the points and keeps those inside the region (enlarged by the margin, clipped back to
-/// the region with --clip); all of them without a region.
-pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> {
+/// the region when clipping); all of them without a region.
+pub fn sample_points(
+    s: &SamplePlan,
+    path: &Path,
+    lidar: bool,
+    progress: &dyn Progress,
+) -> Result<SampleTable> {
     if !lidar && !s.classes.is_empty() {
-        bail!(
-            "--class filters LAS/LAZ classifications; {} is a table",
-            path.display()
-        );
+        return Err(Error::setting(
+            Setting::Classes,
+            "",
+            format!(
+                "{{class}} filters LAS/LAZ classifications; {} is a table",
+                path.display()
+            ),
+        ));
     }
     if s.rows_cols.is_some() || s.spacing.is_some() {
-        eprintln!(
-            "terramesh: note: {} is a point cloud: its points inside the region are kept, \
-             --rows/--cols/--spacing do not apply",
+        progress.note(&format!(
+            "note: {} is a point cloud: its points inside the region are kept, the grid size \
+             does not apply",
             path.display()
-        );
+        ));
     }
     let mut pc = if lidar {
         read_las(
@@ -45,7 +56,7 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
     let keep = |xy: [f64; 2]| -> Result<bool> {
         let Some(r) = region else { return Ok(true) };
         let (lo, hi) = r.projected.bbox().context("the region has no vertices")?;
-        let (lo, hi) = projected_margin(s.margin).enlarge(lo, hi)?;
+        let (lo, hi) = s.margin.projected().enlarge(lo, hi)?;
         let inside_box = xy[0] >= lo[0] && xy[0] <= hi[0] && xy[1] >= lo[1] && xy[1] <= hi[1];
         Ok(inside_box && (!s.clip || r.projected.contains(xy)))
     };
@@ -57,12 +68,16 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
     match &pc.crs {
         SourceCrs::Projected { name } => {
             if region.is_some_and(|r| r.geographic.is_some()) {
-                bail!(
-                    "{} is in {name}, which terramesh does not convert from latitude/longitude: \
-                     give the region in the file's own coordinates with --region-crs projected, \
-                     or leave the region out to take every point",
-                    path.display()
-                );
+                return Err(Error::setting(
+                    Setting::RegionCrs,
+                    "",
+                    format!(
+                        "{} is in {name}, which terramesh does not convert from \
+                         latitude/longitude: give the region in the file's own coordinates with \
+                         {{region-crs}} projected, or leave the region out to take every point",
+                        path.display()
+                    ),
+                ));
             }
             let mut rows = Vec::new();
             for p in &pc.xyz {
@@ -74,7 +89,7 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
                     });
                 }
             }
-            Ok(Samples {
+            Ok(SampleTable {
                 zone: None,
                 summary: format!(
                     "{}: {} points{class_note}, {} kept; x, y, z are in {name}, kept as in the file (not converted to UTM)",
@@ -87,10 +102,15 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
         }
         crs => {
             if region.is_some_and(|r| r.geographic.is_none()) {
-                bail!(
-                    "{} is in {crs}: give the region in latitude/longitude (--region-crs geographic)",
-                    path.display()
-                );
+                return Err(Error::setting(
+                    Setting::RegionCrs,
+                    "",
+                    format!(
+                        "{} is in {crs}: give the region in latitude/longitude ({{region-crs}} \
+                         geographic)",
+                        path.display()
+                    ),
+                ));
             }
             let latlon: Vec<[f64; 2]> = pc
                 .xyz
@@ -104,7 +124,7 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
                 })
                 .collect();
             if let Some(i) = latlon.iter().position(|p| p[0].is_nan()) {
-                bail!(
+                crate::error::bail!(
                     "{}: point {} ({}, {}) is not a valid position in {crs}",
                     pc.name,
                     i + 1,
@@ -132,7 +152,8 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
                 .collect();
             let mut rows = Vec::new();
             for (i, p) in xy.into_iter().enumerate() {
-                let p = p.map_err(|e| anyhow::anyhow!("{}: point {}: {e}", pc.name, i + 1))?;
+                let p =
+                    p.map_err(|e| Error::invalid(format!("{}: point {}: {e}", pc.name, i + 1)))?;
                 if keep(p)? {
                     rows.push(Row {
                         latlon: Some(latlon[i]),
@@ -141,7 +162,7 @@ pub fn sample_points(s: &Settings, path: &Path, lidar: bool) -> Result<Samples> 
                     });
                 }
             }
-            Ok(Samples {
+            Ok(SampleTable {
                 zone: Some(zone),
                 summary: format!(
                     "{}: {} points{class_note} in {crs}, {} kept",

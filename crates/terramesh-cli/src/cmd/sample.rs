@@ -1,17 +1,37 @@
 //! `terramesh sample`: elevations on a grid over a region (the paper's step 1), from DEM
 //! files, point clouds, terrain tiles or elevation web services.
 
-mod points;
-mod raster;
-pub(crate) mod settings;
-mod web;
-pub(crate) mod write;
-
 use std::path::PathBuf;
 
 use anyhow::Result;
+use terramesh::acquire::{
+    acquire, write_table, MarginSpec, OnMissing, SampleOptions, SamplePlan, WebOptions,
+    DEFAULT_BACKOFF, DEFAULT_CONCURRENCY, DEFAULT_NODATA, DEFAULT_RETRIES, DEFAULT_TIMEOUT,
+    DEFAULT_ZOOM,
+};
+use terramesh_core::coords::Zone;
+use terramesh_core::sampling::GridPlane;
+use terramesh_io::region::{RegionCrs, RegionInput};
 
-pub use settings::{GridCrsArg, OnMissing, RegionCrsArg};
+use crate::progress::Terminal;
+
+/// Coordinates of the region.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum RegionCrsArg {
+    /// WGS-84 latitude/longitude.
+    Geographic,
+    /// The source's own projected coordinates.
+    Projected,
+}
+
+/// Plane of the grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum GridCrsArg {
+    /// Regular in UTM metres.
+    Utm,
+    /// Regular in latitude/longitude degrees.
+    Latlon,
+}
 
 /// Sample terrain elevations over a region.
 ///
@@ -50,7 +70,7 @@ pub struct Args {
     pub region_crs: RegionCrsArg,
     /// UTM zone of the output, e.g. 32N (default: the zone of the region's centre).
     #[arg(long)]
-    pub zone: Option<String>,
+    pub zone: Option<Zone>,
     /// Grid rows (south to north).
     #[arg(long, requires = "cols")]
     pub rows: Option<usize>,
@@ -76,10 +96,10 @@ pub struct Args {
     /// A point outside the data, on a void, or failed by the service: error (stop, default),
     /// nodata (write --nodata and the reason in an `error` column) or skip (leave it out and
     /// say how many).
-    #[arg(long, value_enum, default_value_t = OnMissing::Error)]
+    #[arg(long, value_parser = crate::named::<OnMissing>(), default_value_t = OnMissing::Error)]
     pub on_missing: OnMissing,
     /// The z written for missing points with --on-missing nodata.
-    #[arg(long, default_value_t = -9999.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = DEFAULT_NODATA, allow_negative_numbers = true)]
     pub nodata: f64,
     /// Fill raster voids (SRTM -32768, GeoTIFF nodata) from their neighbours.
     #[arg(long)]
@@ -98,20 +118,20 @@ pub struct Args {
     #[arg(long)]
     pub source_crs: Option<String>,
     /// Web: requests in flight at once.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = DEFAULT_CONCURRENCY)]
     pub concurrency: usize,
     /// Web: at most this many requests per second.
     #[arg(long)]
     pub rate: Option<f64>,
     /// Web: retries of a failed request (timeouts, connection errors, 429, 5xx, malformed or
     /// short replies), with exponential backoff and jitter.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = DEFAULT_RETRIES)]
     pub retries: u32,
     /// Web: timeout of one request in seconds.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = DEFAULT_TIMEOUT)]
     pub timeout: f64,
     /// Web: first retry delay in seconds (doubles each retry, up to 30 s).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = DEFAULT_BACKOFF)]
     pub backoff: f64,
     /// Web: locations per request (default and maximum: the service's limit).
     #[arg(long)]
@@ -127,7 +147,7 @@ pub struct Args {
     #[arg(long)]
     pub resume: bool,
     /// Tiles: zoom level of the {z}/{x}/{y} template.
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, default_value_t = DEFAULT_ZOOM)]
     pub zoom: u8,
     /// Do not show the progress bar.
     #[arg(long)]
@@ -137,21 +157,76 @@ pub struct Args {
     pub output: Option<PathBuf>,
 }
 
-/// Runs the command.
-pub fn run(args: Args) -> Result<()> {
-    let (s, table) = acquire(&args)?;
-    write::write(&s, table)
+impl Args {
+    /// The acquisition these flags ask for.
+    pub fn options(&self) -> terramesh::Result<SampleOptions> {
+        let margin: MarginSpec = self.margin.parse().map_err(|why| {
+            terramesh::Error::setting(terramesh::Setting::Margin, &self.margin, why)
+        })?;
+        Ok(SampleOptions {
+            source: self.source.clone(),
+            region: match (&self.corners, &self.region) {
+                (Some(c), _) => Some(RegionInput::Corners(c.clone())),
+                (None, Some(r)) => Some(RegionInput::File(r.clone())),
+                (None, None) => None,
+            },
+            region_crs: match self.region_crs {
+                RegionCrsArg::Geographic => RegionCrs::Geographic,
+                RegionCrsArg::Projected => RegionCrs::Projected,
+            },
+            zone: self.zone,
+            rows_cols: self.rows.zip(self.cols),
+            spacing: self.spacing,
+            margin,
+            clip: self.clip,
+            plane: match self.grid_crs {
+                GridCrsArg::Utm => GridPlane::Utm,
+                GridCrsArg::Latlon => GridPlane::LatLon,
+            },
+            kernel: self.interpolation,
+            on_missing: self.on_missing,
+            nodata: self.nodata,
+            fill_voids: self.fill_voids,
+            classes: self.class.clone(),
+            columns: self.columns.clone(),
+            delimiter: self.delimiter,
+            source_crs: self.source_crs.clone(),
+            web: WebOptions {
+                concurrency: self.concurrency,
+                rate: self.rate,
+                retries: self.retries,
+                timeout: self.timeout,
+                backoff: self.backoff,
+                batch: self.batch,
+                cache_dir: self.cache_dir.clone(),
+                no_cache: self.no_cache,
+                resume: self.resume,
+                zoom: self.zoom,
+            },
+            output: self.output.clone(),
+        })
+    }
 }
 
-/// Resolves the settings and samples the source, without writing (for `terramesh build`).
-pub(crate) fn acquire(args: &Args) -> Result<(settings::Settings, write::Samples)> {
-    let s = settings::resolve(args)?;
-    let table = match &s.source {
-        settings::Source::Raster(path) => raster::sample_file(&s, path)?,
-        settings::Source::Tiles(template) => raster::sample_tiles(&s, template)?,
-        settings::Source::Points(path) => points::sample_points(&s, path, false)?,
-        settings::Source::Lidar(path) => points::sample_points(&s, path, true)?,
-        settings::Source::Web(endpoint) => web::sample_web(&s, endpoint)?,
-    };
-    Ok((s, table))
+/// The flag that sets `s`, as messages name it.
+pub fn flag_of(s: terramesh::Setting) -> String {
+    use terramesh::Setting as S;
+    match s {
+        S::Region => "--corners or --region",
+        S::GridSize => "--rows and --cols, or --spacing METRES",
+        S::GridPlane => "--grid-crs",
+        S::Classes => "--class",
+        S::Output => "-o",
+        other => return format!("--{other}"),
+    }
+    .to_string()
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let progress = Terminal::new(false, !args.no_progress);
+    let options = args.options().map_err(crate::flag_error)?;
+    let plan = SamplePlan::resolve(&options).map_err(crate::flag_error)?;
+    let table = acquire(&plan, &progress).map_err(crate::flag_error)?;
+    write_table(&plan, table, &progress).map_err(crate::flag_error)
 }

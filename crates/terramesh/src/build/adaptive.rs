@@ -7,7 +7,7 @@
 //! below `max_error`. At the end, kriging itself is evaluated at every triangle centre and
 //! edge midpoint of the mesh, and that verified error is what the report shows.
 
-use anyhow::{bail, Context, Result};
+use crate::error::{bail, Context, Result};
 use terramesh_core::sampling::{GridSurface, Method as Kernel};
 use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, AdaptiveSettings, Mesh};
 

@@ -3,17 +3,18 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use anyhow::{Context, Result};
 use terramesh_io::dem::{
     open_raster_in, sample_nodes, ElevationSource, LatLonBox, SourceCrs, TileMosaic,
 };
 use terramesh_web::{fetch_tiles, TileOptions};
 
-use super::settings::Settings;
-use super::write::{Row, Samples};
+use super::plan::SamplePlan;
+use super::table::{Row, SampleTable};
+use crate::error::{Context, Error, Result};
+use crate::setting::Setting;
 
-/// Samples a DEM file or directory.
-pub fn sample_file(s: &Settings, path: &Path) -> Result<Samples> {
+/// SampleTable a DEM file or directory.
+pub fn sample_file(s: &SamplePlan, path: &Path) -> Result<SampleTable> {
     let nodes = s.nodes()?;
     // Read only the part of a large GeoTIFF that the nodes need.
     let latlon: Vec<[f64; 2]> = nodes.iter().filter_map(|n| n.latlon).collect();
@@ -25,10 +26,10 @@ pub fn sample_file(s: &Settings, path: &Path) -> Result<Samples> {
 }
 
 fn sample(
-    s: &Settings,
+    s: &SamplePlan,
     dem: &dyn ElevationSource,
     nodes: Vec<terramesh_core::sampling::Node>,
-) -> Result<Samples> {
+) -> Result<SampleTable> {
     let z = sample_nodes(dem, &nodes, s.zone, s.method)?;
     let zone = match dem.crs() {
         SourceCrs::Projected { .. } => None,
@@ -43,20 +44,24 @@ fn sample(
             z: z.map_err(|m| m.to_string()),
         })
         .collect();
-    Ok(Samples {
+    Ok(SampleTable {
         zone,
         rows,
         summary: format!("{} ({} interpolation)", dem.describe(), s.method),
     })
 }
 
-/// Samples Terrarium tiles from a URL template, fetching (and caching) the tiles the grid
+/// SampleTable Terrarium tiles from a URL template, fetching (and caching) the tiles the grid
 /// needs.
-pub fn sample_tiles(s: &Settings, template: &str) -> Result<Samples> {
+pub fn sample_tiles(s: &SamplePlan, template: &str) -> Result<SampleTable> {
     let nodes = s.nodes()?;
     let z = s.zoom;
     if z > 20 {
-        anyhow::bail!("--zoom {z}: terrain tiles go to zoom 15 at most");
+        return Err(Error::setting(
+            Setting::Zoom,
+            z,
+            "terrain tiles go to zoom 15 at most",
+        ));
     }
     let mut m = TileMosaic::new(z, template);
     let mut need = BTreeSet::new();
@@ -67,7 +72,11 @@ pub fn sample_tiles(s: &Settings, template: &str) -> Result<Samples> {
     }
     let need: Vec<(u32, u32)> = need.into_iter().collect();
     if need.len() > 4096 {
-        anyhow::bail!("{} tiles at zoom {z}: use a lower --zoom", need.len());
+        return Err(Error::setting(
+            Setting::Zoom,
+            z,
+            format!("needs {} tiles: use a lower zoom", need.len()),
+        ));
     }
     let opts = TileOptions {
         cache_dir: s.cache_dir.clone(),
@@ -78,7 +87,7 @@ pub fn sample_tiles(s: &Settings, template: &str) -> Result<Samples> {
     let tiles = fetch_tiles_tolerant(template, z, &need, &opts)?;
     for ((x, y), bytes) in tiles {
         m.insert(x, y, &bytes)
-            .map_err(|e| anyhow::anyhow!("tile {z}/{x}/{y} from {template}: {e}"))?;
+            .map_err(|e| Error::invalid(format!("tile {z}/{x}/{y} from {template}: {e}")))?;
     }
     sample(s, &m, nodes)
 }

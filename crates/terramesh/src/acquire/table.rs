@@ -2,13 +2,15 @@
 
 use std::io::Write;
 
-use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use terramesh_core::coords::Zone;
 use terramesh_io::number::{write_fixed, write_shortest};
 use terramesh_io::output::Output;
 
-use super::settings::{OnMissing, Settings};
+use super::plan::{OnMissing, SamplePlan};
+use crate::error::{Context, Error, Result};
+use crate::progress::Progress;
+use crate::setting::Setting;
 
 /// One output point.
 pub struct Row {
@@ -21,9 +23,10 @@ pub struct Row {
 }
 
 /// The sampled table.
-pub struct Samples {
+pub struct SampleTable {
     /// UTM zone of `xy` for geographic output; `None` for x,y,z output.
     pub zone: Option<Zone>,
+    /// The points, in grid or file order.
     pub rows: Vec<Row>,
     /// What was read, for the summary line.
     pub summary: String,
@@ -31,8 +34,9 @@ pub struct Samples {
 
 const CHUNK: usize = 8192;
 
-/// Applies --on-missing and writes the table atomically.
-pub fn write(s: &Settings, t: Samples) -> Result<()> {
+/// Applies the on-missing policy and writes the table atomically to the plan's output
+/// (standard output without one); what was read and written goes to `progress` as notes.
+pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> Result<()> {
     let missing: Vec<usize> = (0..t.rows.len())
         .filter(|&i| t.rows[i].z.is_err())
         .collect();
@@ -43,19 +47,23 @@ pub fn write(s: &Settings, t: Samples) -> Result<()> {
                 Some([lat, lon]) => format!("lat {lat:.7}, lon {lon:.7}"),
                 None => format!("x {}, y {}", r.xy[0], r.xy[1]),
             };
-            bail!(
-                "{} of {} points have no elevation; the first (point {}, {at}): {}. \
-                 Use --on-missing nodata or skip to write the others{}",
-                missing.len(),
-                t.rows.len(),
-                i + 1,
-                r.z.as_ref().err().map_or("", |e| e.as_str()),
-                if matches!(s.source, super::settings::Source::Web(_)) {
-                    ", or rerun with --resume to ask again for the failed points only"
-                } else {
-                    ""
-                }
-            );
+            return Err(Error::setting(
+                Setting::OnMissing,
+                "",
+                format!(
+                    "{} of {} points have no elevation; the first (point {}, {at}): {}. \
+                     Use {{on-missing}} nodata or skip to write the others{}",
+                    missing.len(),
+                    t.rows.len(),
+                    i + 1,
+                    r.z.as_ref().err().map_or("", |e| e.as_str()),
+                    if matches!(s.source, super::plan::Source::Web(_)) {
+                        ", or rerun with {resume} to ask again for the failed points only"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
         }
     }
     let geographic = t.zone.is_some();
@@ -130,19 +138,17 @@ pub fn write(s: &Settings, t: Samples) -> Result<()> {
         } else {
             0
         };
-    if !s.quiet {
-        eprintln!("terramesh: {}", t.summary);
-        eprintln!("terramesh: wrote {written} points to {name}");
-    }
+    progress.note(&t.summary);
+    progress.note(&format!("wrote {written} points to {name}"));
     if !missing.is_empty() {
         let what = match s.on_missing {
             OnMissing::Skip => "left out",
-            _ => "written with z = --nodata and the reason in the error column",
+            _ => "written with z = the nodata value and the reason in the error column",
         };
-        eprintln!(
-            "terramesh: {} points had no elevation and were {what}",
+        progress.warn(&format!(
+            "{} points had no elevation and were {what}",
             missing.len()
-        );
+        ));
     }
     Ok(())
 }

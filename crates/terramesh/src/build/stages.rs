@@ -2,8 +2,6 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
-use clap::Parser;
 use terramesh_core::coords::Zone;
 use terramesh_geostat::{
     cross_validate, experimental, fit_auto, CvStats, Data, Drift, Duplicates, Folds, GlobalKriging,
@@ -13,7 +11,9 @@ use terramesh_geostat::{
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport, Smoother};
 
-use crate::cmd::sample;
+use crate::acquire::{acquire, write_table, SamplePlan};
+use crate::error::{bail, Context, Result};
+use crate::progress::Progress;
 use crate::project::Project;
 
 /// The samples of step 1, in UTM metres.
@@ -30,80 +30,16 @@ pub struct Samples {
     pub cell: [f64; 2],
 }
 
-/// Parses `sample`'s own arguments, so that `build` and `sample` share one code path.
-#[derive(Parser)]
-struct SampleArgv {
-    #[command(flatten)]
-    args: sample::Args,
-}
-
 /// Step 1: samples on the project's grid, also written to `out/samples.csv`.
-pub fn sample(p: &Project, base: &Path, out: &Path, quiet: bool) -> Result<Samples> {
-    let source = resolve_source(p, base)?;
-    let mut argv: Vec<String> = vec!["sample".into(), "--source".into(), source.clone()];
-    match (&p.region.corners, &p.region.file) {
-        (Some(c), None) => {
-            let path = base.join(c.trim());
-            let c = if !c.contains(';') && path.is_file() {
-                path.display().to_string()
-            } else {
-                c.clone()
-            };
-            argv.extend(["--corners".into(), c]);
-        }
-        (None, Some(f)) => argv.extend(["--region".into(), base.join(f).display().to_string()]),
-        _ => bail!("[region]: give corners or file"),
-    }
-    if let Some(z) = &p.region.zone {
-        argv.extend(["--zone".into(), z.clone()]);
-    }
-    if p.region.crs == "projected" {
-        argv.extend(["--region-crs".into(), "projected".into()]);
-    }
-    let s = &p.sampling;
-    match s.spacing {
-        Some(sp) => argv.extend(["--spacing".into(), sp.to_string()]),
-        None => argv.extend([
-            "--rows".into(),
-            s.rows.to_string(),
-            "--cols".into(),
-            s.cols.to_string(),
-        ]),
-    }
-    let margin = if s.margin < 1.0 {
-        s.margin.to_string()
-    } else {
-        format!("{}m", s.margin)
-    };
-    argv.extend([
-        "--margin".into(),
-        margin,
-        "--interpolation".into(),
-        s.method.clone(),
-    ]);
-    if s.clip {
-        argv.push("--clip".into());
-    }
-    if let Some(c) = p.source.class {
-        argv.extend(["--class".into(), c.to_string()]);
-    }
-    argv.extend([
-        "--no-progress".into(),
-        "-o".into(),
-        out.join("samples.csv").display().to_string(),
-    ]);
-    let parsed = SampleArgv::try_parse_from(&argv).map_err(|e| {
-        anyhow::anyhow!(
-            "[sampling]/[source]: {}",
-            e.to_string().lines().next().unwrap_or("")
-        )
-    })?;
-    let (mut settings, table) = sample::acquire(&parsed.args)?;
-    settings.quiet = quiet;
-    let zone = table
-        .zone
-        .context("the source is in a projected CRS terramesh does not convert; use a geographic or UTM source for build")?;
-    let region = settings
+pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
+    let options = p.sample_options(base, &out.join("samples.csv"))?;
+    let plan = SamplePlan::resolve(&options).map_err(|e| p.reword(e))?;
+    let table = acquire(&plan, progress).map_err(|e| p.reword(e))?;
+    let zone = table.zone.context(
+        "the source is in a projected CRS terramesh does not convert; use a geographic or UTM \
+         source for build",
+    )?;
+    let region = plan
         .region
         .clone()
         .context("a region is needed for build")?;
@@ -119,43 +55,16 @@ pub fn sample(p: &Project, base: &Path, out: &Path, quiet: bool) -> Result<Sampl
             xyz.len()
         );
     }
+    let s = &p.sampling;
     let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
-    sample::write::write(&settings, table)?;
+    write_table(&plan, table, progress).map_err(|e| p.reword(e))?;
     Ok(Samples {
         xyz,
         zone,
         region,
-        source,
+        source: options.source,
         cell,
     })
-}
-
-/// The source path relative to the project file, or the fallback when it is absent.
-fn resolve_source(p: &Project, base: &Path) -> Result<String> {
-    let spec = &p.source.path;
-    let is_service = spec.contains("{z}")
-        || ["google:", "opentopodata:", "open-elevation:"]
-            .iter()
-            .any(|s| spec.starts_with(s));
-    if is_service {
-        return Ok(spec.clone());
-    }
-    let path = base.join(spec);
-    if path.exists() {
-        return Ok(path.display().to_string());
-    }
-    if let Some(f) = &p.source.fallback {
-        let fb = base.join(f);
-        if fb.exists() {
-            return Ok(fb.display().to_string());
-        }
-        bail!(
-            "source.path {} and source.fallback {} do not exist",
-            path.display(),
-            fb.display()
-        );
-    }
-    bail!("source.path {}: no such file or directory", path.display())
 }
 
 fn grid_cell(xyz: &[[f64; 3]], rows: usize, cols: usize, spacing: Option<f64>) -> [f64; 2] {
@@ -326,7 +235,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
             .collect();
         fit.variogram
     } else {
-        crate::cmd::geodata::read_variogram_file(&base.join(&ip.variogram))
+        crate::variogram_file::read_variogram_file(&base.join(&ip.variogram))
             .context("interpolation.variogram")?
     };
     Ok(Model {

@@ -1,0 +1,59 @@
+//! Acquisition, the paper's step 1: elevations on a grid over a region from DEM files, point
+//! clouds, terrain tiles or elevation web services.
+//!
+//! Rasters and web services are sampled on a rows x cols (or spacing) grid over the region's
+//! bounding box enlarged by a margin, optionally clipped back to the region; point clouds are
+//! not gridded: the points inside the enlarged region are kept. `terramesh sample` and
+//! `terramesh build` both run [`SamplePlan::resolve`] then [`acquire`].
+//!
+//! ```
+//! use terramesh::acquire::{acquire, MarginSpec, SampleOptions, SamplePlan};
+//! use terramesh::progress::Silent;
+//! use terramesh_io::region::{RegionCrs, RegionInput};
+//!
+//! // A 3 x 3 grid of spot heights, sampled as a point cloud in its own projected metres.
+//! let dir = tempfile::tempdir()?;
+//! let csv = dir.path().join("points.csv");
+//! let mut text = String::from("x,y,z\n");
+//! for i in 0..3 {
+//!     for j in 0..3 {
+//!         text += &format!("{},{},{}\n", 100 * i, 100 * j, 10 * (i + j));
+//!     }
+//! }
+//! std::fs::write(&csv, text)?;
+//! let mut options = SampleOptions::new(csv.display().to_string());
+//! options.region = Some(RegionInput::Corners("0 0; 0 150; 150 150; 150 0".into()));
+//! options.region_crs = RegionCrs::Projected;
+//! options.margin = MarginSpec::Metres(10.0);
+//! let plan = SamplePlan::resolve(&options)?;
+//! let table = acquire(&plan, &Silent)?;
+//! assert_eq!(table.rows.len(), 4); // (0,0), (0,100), (100,0), (100,100)
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod plan;
+mod points;
+mod raster;
+mod table;
+mod web;
+
+pub use plan::{
+    default_cache_dir, is_remote, journal_path, MarginSpec, OnMissing, SampleOptions, SamplePlan,
+    Source, WebOptions, DEFAULT_BACKOFF, DEFAULT_CONCURRENCY, DEFAULT_NODATA, DEFAULT_RETRIES,
+    DEFAULT_TIMEOUT, DEFAULT_ZOOM, MARGIN_HELP,
+};
+pub use table::{write_table, Row, SampleTable};
+
+use crate::error::Result;
+use crate::progress::Progress;
+
+/// Samples the plan's source, without writing anything.
+pub fn acquire(plan: &SamplePlan, progress: &dyn Progress) -> Result<SampleTable> {
+    match &plan.source {
+        Source::Raster(path) => raster::sample_file(plan, path),
+        Source::Tiles(template) => raster::sample_tiles(plan, template),
+        Source::Points(path) => points::sample_points(plan, path, false, progress),
+        Source::Lidar(path) => points::sample_points(plan, path, true, progress),
+        Source::Web(endpoint) => web::sample_web(plan, endpoint, progress),
+    }
+}

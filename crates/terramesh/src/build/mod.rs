@@ -1,0 +1,153 @@
+//! `terramesh build`: the whole pipeline from a project to a DSM, its exports, pictures and a
+//! report.
+//!
+//! Stages: region -> samples -> variogram -> planar mesh -> vertex elevations (UK, IDW,
+//! cross-validation) -> exports (surfaces, sealed solid, grids, tables) -> pictures and
+//! report. Each stage is a module with one entry point that calls the kernel crates; [`build`]
+//! sequences them, times them and reports progress.
+
+mod adaptive;
+mod exports;
+mod pictures;
+mod report;
+mod stages;
+
+use std::path::Path;
+use std::time::Instant;
+
+pub use adaptive::AdaptiveInfo;
+pub use exports::Written;
+pub use pictures::{short_numbers, Picture};
+pub use stages::{Interpolated, Meshed, Model, Samples};
+
+use crate::error::{Context, Result};
+use crate::progress::Progress;
+use crate::project::Project;
+
+/// Time spent in each stage, for the report.
+#[derive(Debug, Default, Clone)]
+pub struct Timings(pub Vec<(String, f64)>);
+
+/// The number of stages [`build`] reports.
+pub const STAGES: usize = 7;
+
+/// What a build made.
+#[derive(Debug)]
+pub struct Built {
+    /// Files written, in order (pictures and the report not included).
+    pub files: Vec<std::path::PathBuf>,
+    /// Vertices of the DSM.
+    pub vertices: usize,
+    /// Triangles of the DSM.
+    pub triangles: usize,
+    /// Seconds per stage.
+    pub timings: Timings,
+}
+
+struct Stages<'a> {
+    progress: &'a dyn Progress,
+    k: usize,
+    timings: Timings,
+}
+
+impl Stages<'_> {
+    fn run<T>(
+        &mut self,
+        name: &str,
+        f: impl FnOnce() -> Result<T>,
+        detail: impl FnOnce(&T) -> String,
+    ) -> Result<T> {
+        self.k += 1;
+        self.progress.stage_start(self.k, STAGES, name);
+        let t = Instant::now();
+        let out = f()?;
+        let secs = t.elapsed().as_secs_f64();
+        self.progress.stage_done(name, &detail(&out), secs);
+        self.timings.0.push((name.to_string(), secs));
+        Ok(out)
+    }
+}
+
+/// Builds the discrete surface model of `project` (whose paths are relative to `base`, the
+/// folder of its file) into `out`: samples, mesh, kriging and IDW, exports, pictures and
+/// `report.html`.
+pub fn build(project: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Built> {
+    let t0 = Instant::now();
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the output directory {}", out.display()))?;
+    let mut st = Stages {
+        progress,
+        k: 0,
+        timings: Timings::default(),
+    };
+    let samples = st.run(
+        "samples",
+        || stages::sample(project, base, out, progress),
+        |s| format!("{} samples from {}", s.xyz.len(), s.source),
+    )?;
+    let model = st.run(
+        "variogram",
+        || stages::model(project, &samples, base),
+        |m| short_numbers(&m.variogram.to_string()),
+    )?;
+    let mesh = st.run(
+        "mesh",
+        || stages::mesh(project, &samples, &model),
+        |m| {
+            let adaptive = m.adaptive.as_ref().map_or(String::new(), |a| {
+                format!(
+                    ", adaptive: within {:.3} m of kriging (target {} m), min 3D angle {:.1} deg",
+                    a.verified_error, a.target, a.report.min_angle_3d
+                )
+            });
+            format!(
+                "{} vertices, {} triangles, min angle {:.1} deg{adaptive}",
+                m.mesh.points.len(),
+                m.mesh.triangles.len(),
+                m.after.min_angle
+            )
+        },
+    )?;
+    let interp = st.run(
+        "interpolation",
+        || stages::interpolate(project, &samples, &mesh, &model),
+        |i| format!("UK and IDW at {} vertices, cross-validation", i.uk.len()),
+    )?;
+    let written = st.run(
+        "exports",
+        || exports::write_all(project, out, &samples, &mesh, &interp),
+        |w| format!("{} files", w.files.len()),
+    )?;
+    if project.export.pictures || project.export.report {
+        let pics = st.run(
+            "pictures",
+            || pictures::draw_all(out, &samples, &mesh, &interp),
+            |p| format!("{} pictures", p.len()),
+        )?;
+        if project.export.report {
+            st.k += 1;
+            progress.stage_start(st.k, STAGES, "report");
+            let t = Instant::now();
+            st.timings
+                .0
+                .push(("total before report".into(), t0.elapsed().as_secs_f64()));
+            report::write_report(
+                out,
+                project,
+                &samples,
+                &mesh,
+                &interp,
+                &written,
+                &pics,
+                &st.timings,
+            )?;
+            progress.stage_done("report", "report.html", t.elapsed().as_secs_f64());
+        }
+    }
+    Ok(Built {
+        files: written.files,
+        vertices: mesh.mesh.points.len(),
+        triangles: mesh.mesh.triangles.len(),
+        timings: st.timings,
+    })
+}

@@ -1,0 +1,357 @@
+//! Pictures and `report.html` of `terramesh build`.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Context, Result};
+use terramesh_io::pictures::{
+    draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d, render_both,
+    render_both_as, ColourMap, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
+};
+use terramesh_mesh::Mesh;
+
+use super::stages::{Interpolated, Meshed, Samples};
+
+const SIZE: (u32, u32) = (900, 700);
+
+/// A picture: its caption and PNG path.
+pub struct Picture {
+    /// Caption in the report.
+    pub caption: String,
+    /// The PNG file (an SVG sits beside it).
+    pub png: PathBuf,
+}
+
+fn outlines(s: &Samples) -> Vec<Vec<[f64; 2]>> {
+    let mut v = Vec::new();
+    for poly in &s.region.projected.polygons {
+        v.push(poly.outer.clone());
+        v.extend(poly.holes.iter().cloned());
+    }
+    v.extend(s.region.projected.lines.iter().cloned());
+    v
+}
+
+/// Draws every picture into `out/pictures/`.
+pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Result<Vec<Picture>> {
+    let dir = out.join("pictures");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let rings = outlines(s);
+    let mut pics = Vec::new();
+    let mut add = |name: &str, caption: String, files: [PathBuf; 2]| {
+        let _ = name;
+        pics.push(Picture {
+            caption,
+            png: files[0].clone(),
+        });
+    };
+    let sample_mode = if s.xyz.len() > VECTOR_TRIANGLE_LIMIT {
+        SvgMode::Raster
+    } else {
+        SvgMode::Vector
+    };
+    let f = render_both_as(&dir.join("samples"), SIZE, sample_mode, |r| {
+        draw_samples(
+            r,
+            &s.xyz,
+            &rings,
+            &format!("{} samples over the study region", s.xyz.len()),
+        )
+    })?;
+    add(
+        "samples",
+        format!(
+            "Sample points coloured by elevation ({} from {})",
+            s.xyz.len(),
+            s.source
+        ),
+        f,
+    );
+
+    // Mesh pictures of large meshes show a central detail of about DETAIL triangles: the
+    // whole mesh would be a grey blot at this size.
+    let adaptive = m.adaptive.is_some();
+    for (k, (mesh, q, file)) in [
+        (&m.unsmoothed, &m.before, "mesh-before-smoothing"),
+        (&m.mesh, &m.after, "mesh-after-smoothing"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let (xy, tris, detail) = mesh_detail(mesh, s.region.projected.area());
+        let mut title = match (adaptive, k) {
+            (true, _) => format!("Terrain-adaptive mesh: min angle {:.1}°", q.min_angle),
+            (false, 0) => format!(
+                "Planar mesh before smoothing: min angle {:.1}°",
+                q.min_angle
+            ),
+            _ => format!("Planar mesh after smoothing: min angle {:.1}°", q.min_angle),
+        };
+        let mut caption = match (adaptive, k) {
+            (true, 0) => "Terrain-adaptive mesh after refinement and 3D improvement".to_string(),
+            (true, _) => "Terrain-adaptive mesh (no planar smoothing: 3D flips and moves)".into(),
+            (false, 0) => "Planar mesh after Delaunay refinement, before smoothing".into(),
+            _ => "Planar mesh after smoothing and Delaunay flips".into(),
+        };
+        if let Some(side) = detail {
+            title += &format!(" (central {side:.0} m square)");
+            caption += &format!(
+                "; detail: the {} triangles in the central {side:.0} m square of {}",
+                tris.len(),
+                mesh.triangles.len()
+            );
+        }
+        let rings_here = if detail.is_some() {
+            Vec::new()
+        } else {
+            rings.clone()
+        };
+        let f = render_both(&dir.join(file), SIZE, |r| {
+            draw_mesh(r, &xy, &tris, &rings_here, &title)
+        })?;
+        add(file, caption, f);
+    }
+    let xy: Vec<[f64; 2]> = (0..m.mesh.points.len())
+        .map(|i| m.mesh.absolute(i))
+        .collect();
+    let svg_mode = if m.mesh.triangles.len() > VECTOR_TRIANGLE_LIMIT {
+        SvgMode::Raster
+    } else {
+        SvgMode::Vector
+    };
+
+    let pts: Vec<(f64, f64, u64)> = it
+        .lags
+        .iter()
+        .map(|l| (l.distance, l.gamma, l.pairs))
+        .collect();
+    let label = short_numbers(&it.variogram.to_string());
+    let f = render_both(&dir.join("variogram"), (900, 600), |r| {
+        draw_variogram(
+            r,
+            &pts,
+            &|h| it.variogram.gamma(h),
+            "Experimental variogram and fitted model",
+            &label,
+        )
+    })?;
+    add(
+        "variogram",
+        format!("Variogram of the samples and the fitted model: {label}"),
+        f,
+    );
+
+    let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
+    type Map<'a> = (&'a str, &'a str, &'a [f64], bool, ColourMap, bool, &'a str);
+    let maps: [Map; 4] = [
+        (
+            "elevation-uk",
+            "DSM by universal kriging (linear drift)",
+            &it.uk,
+            true,
+            ColourMap::Terrain,
+            false,
+            "elevation (m)",
+        ),
+        (
+            "elevation-idw",
+            "DSM by inverse distance weighting",
+            &it.idw,
+            true,
+            ColourMap::Terrain,
+            false,
+            "elevation (m)",
+        ),
+        (
+            "kriging-std",
+            "Kriging standard deviation",
+            &it.uk_std,
+            false,
+            ColourMap::Viridis,
+            false,
+            "std. dev. (m)",
+        ),
+        (
+            "uk-minus-idw",
+            "UK minus IDW",
+            &diff,
+            false,
+            ColourMap::Diverging,
+            true,
+            "difference (m)",
+        ),
+    ];
+    for (name, title, values, shaded, colours, symmetric, unit) in maps {
+        let map = SurfaceMap {
+            xy: &xy,
+            values,
+            shade_z: shaded.then_some(&it.uk[..]),
+            triangles: &m.mesh.triangles,
+            title,
+            unit,
+            colours,
+            symmetric,
+            outlines: &rings,
+        };
+        let f = render_both_as(&dir.join(name), SIZE, svg_mode, |r| draw_surface(r, &map))?;
+        add(
+            name,
+            format!(
+                "{title}{}",
+                if shaded {
+                    ", hill-shaded, with contours"
+                } else {
+                    ", with contours"
+                }
+            ),
+            f,
+        );
+    }
+    let v3: Vec<[f64; 3]> = xy
+        .iter()
+        .zip(&it.uk)
+        .map(|(p, z)| [p[0], p[1], *z])
+        .collect();
+    let (lo, hi) = s
+        .region
+        .projected
+        .bbox()
+        .unwrap_or(([0.0, 0.0], [1.0, 1.0]));
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let relief = it.uk.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - it.uk.iter().copied().fold(f64::INFINITY, f64::min);
+    let ex = if relief > 0.0 {
+        (0.3 * extent / relief).clamp(1.0, 10.0)
+    } else {
+        1.0
+    };
+    let ex = (ex * 2.0).round() / 2.0;
+    let f = render_both_as(&dir.join("dsm-3d"), SIZE, svg_mode, |r| {
+        draw_view3d(r, &v3, &m.mesh.triangles, ex, "The DSM in 3D")
+    })?;
+    add("3d", "Shaded 3D view of the DSM (UK elevations)".into(), f);
+    Ok(pics)
+}
+
+/// Triangles a mesh picture shows at most.
+const DETAIL: usize = 20_000;
+
+/// The absolute points and triangles to draw for `mesh`: all of them, or for a mesh of more
+/// than [`DETAIL`] triangles those whose centre lies in a central square holding about that
+/// many (with the square's side).
+fn mesh_detail(mesh: &Mesh, area: f64) -> (Vec<[f64; 2]>, Vec<[u32; 3]>, Option<f64>) {
+    let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
+    let n = mesh.triangles.len();
+    if n <= DETAIL {
+        return (xy, mesh.triangles.clone(), None);
+    }
+    let side = (area * DETAIL as f64 / n as f64).sqrt();
+    let (lo, hi) = xy.iter().fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        },
+    );
+    let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    let mut index = vec![u32::MAX; xy.len()];
+    let mut pts = Vec::new();
+    let mut tris = Vec::new();
+    for t in &mesh.triangles {
+        let g = t.iter().fold([0.0, 0.0], |a, &i| {
+            [
+                a[0] + xy[i as usize][0] / 3.0,
+                a[1] + xy[i as usize][1] / 3.0,
+            ]
+        });
+        if (g[0] - c[0]).abs() > 0.5 * side || (g[1] - c[1]).abs() > 0.5 * side {
+            continue;
+        }
+        tris.push(t.map(|i| {
+            if index[i as usize] == u32::MAX {
+                index[i as usize] = pts.len() as u32;
+                pts.push(xy[i as usize]);
+            }
+            index[i as usize]
+        }));
+    }
+    (pts, tris, Some(side))
+}
+
+/// Rewrites every decimal number in `s` with at most 4 significant decimals, for labels.
+pub fn short_numbers(s: &str) -> String {
+    let mut out = String::new();
+    let mut num = String::new();
+    let flush = |num: &mut String, out: &mut String| {
+        if let (true, Ok(v)) = (num.contains('.'), num.parse::<f64>()) {
+            let d = if v.abs() >= 100.0 { 1 } else { 4 };
+            out.push_str(&format!("{v:.d$}"));
+        } else {
+            out.push_str(num);
+        }
+        num.clear();
+    };
+    for c in s.chars() {
+        if c.is_ascii_digit() || c == '.' {
+            num.push(c);
+        } else {
+            flush(&mut num, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut num, &mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `n` x `n` grid of unit squares, two triangles each, with its origin at (1000, 2000).
+    fn grid(n: u32) -> Mesh {
+        let mut points = Vec::new();
+        for r in 0..=n {
+            for c in 0..=n {
+                points.push([c as f64, r as f64]);
+            }
+        }
+        let mut triangles = Vec::new();
+        let id = |r: u32, c: u32| r * (n + 1) + c;
+        for r in 0..n {
+            for c in 0..n {
+                triangles.push([id(r, c), id(r, c + 1), id(r + 1, c + 1)]);
+                triangles.push([id(r, c), id(r + 1, c + 1), id(r + 1, c)]);
+            }
+        }
+        Mesh {
+            origin: [1000.0, 2000.0],
+            points,
+            triangles,
+            constraint_edges: vec![],
+        }
+    }
+
+    #[test]
+    fn small_meshes_are_drawn_whole_and_large_ones_as_a_central_detail() {
+        let small = grid(10);
+        let (xy, tris, detail) = mesh_detail(&small, 100.0);
+        assert_eq!((xy.len(), tris.len(), detail), (121, 200, None));
+        assert_eq!(xy[0], [1000.0, 2000.0]);
+
+        let big = grid(200); // 80,000 triangles
+        let (xy, tris, detail) = mesh_detail(&big, 40_000.0);
+        let side = detail.expect("a detail");
+        assert!((side - 100.0).abs() < 1e-9, "{side}"); // a quarter of the triangles' area
+        assert!(tris.len() > DETAIL * 9 / 10 && tris.len() <= DETAIL * 11 / 10);
+        // Every drawn triangle is a triangle of the mesh, centred in the window.
+        for t in &tris {
+            let g = t.iter().fold([0.0, 0.0], |a, &i| {
+                let p = xy[i as usize];
+                [a[0] + p[0] / 3.0, a[1] + p[1] / 3.0]
+            });
+            assert!((g[0] - 1100.0).abs() <= 50.0 && (g[1] - 2100.0).abs() <= 50.0);
+        }
+        assert!(xy.len() < big.points.len());
+    }
+}

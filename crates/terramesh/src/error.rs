@@ -1,0 +1,263 @@
+//! The error of the pipeline: typed, with the context a message needs.
+//!
+//! Kernel errors (geostatistics, meshing, coordinates, files, web) are carried as they are.
+//! A bad value of a setting is [`Error::Setting`], which names the [`Setting`] and not how a
+//! user typed it: a front end renders it with its own word for the setting
+//! ([`Error::render`]), the command line as a flag (`--margin`), the project file as a key
+//! (`sampling.margin`), so no library message sends a user to a flag that does not exist
+//! where they are.
+
+use std::fmt::Display;
+
+use crate::setting::Setting;
+
+/// Everything that can go wrong in the pipeline.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A setting has a value the pipeline cannot use.
+    #[error("{}", setting_message(*setting, value, why, &neutral))]
+    Setting {
+        /// Which setting.
+        setting: Setting,
+        /// The value as given (empty when the message needs none).
+        value: String,
+        /// What is wrong, and what to do.
+        why: String,
+    },
+    /// A project file is malformed or has a bad key or value.
+    #[error("{file}{}: {why}", line.map_or(String::new(), |l| format!(", line {l}")))]
+    Project {
+        /// The file (or "the built-in template").
+        file: String,
+        /// The line, when known.
+        line: Option<usize>,
+        /// Why (names the key).
+        why: String,
+    },
+    /// Geostatistics.
+    #[error(transparent)]
+    Geostat(#[from] terramesh_geostat::GeostatError),
+    /// Meshing.
+    #[error(transparent)]
+    Mesh(#[from] terramesh_mesh::MeshError),
+    /// Coordinates.
+    #[error(transparent)]
+    Coord(#[from] terramesh_core::coords::CoordError),
+    /// A sampling grid.
+    #[error(transparent)]
+    Grid(#[from] terramesh_core::sampling::GridError),
+    /// Grid nodes over a region.
+    #[error(transparent)]
+    Nodes(#[from] terramesh_core::sampling::NodeError),
+    /// The sealed solid.
+    #[error(transparent)]
+    Solid(#[from] terramesh_core::solid::SolidError),
+    /// An elevation file.
+    #[error(transparent)]
+    Dem(#[from] terramesh_io::dem::DemError),
+    /// A region file or corner list.
+    #[error(transparent)]
+    Region(#[from] terramesh_io::region::RegionError),
+    /// A table (CSV) file.
+    #[error(transparent)]
+    Table(#[from] terramesh_io::table::TableError),
+    /// Writing a mesh file.
+    #[error(transparent)]
+    MeshWrite(#[from] terramesh_io::mesh_write::MeshWriteError),
+    /// Drawing a picture.
+    #[error(transparent)]
+    Picture(#[from] terramesh_io::pictures::PictureError),
+    /// An elevation web service or tile server.
+    #[error(transparent)]
+    Web(#[from] terramesh_web::WebError),
+    /// A JSON file.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// Reading or writing a file.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// Anything else, in words.
+    #[error("{0}")]
+    Invalid(String),
+    /// What was being done when `source` happened.
+    #[error("{context}")]
+    Context {
+        /// What was being done (a file name, a stage).
+        context: String,
+        /// The error.
+        #[source]
+        source: Box<Error>,
+    },
+}
+
+/// The message of a bad setting: `NAME 'VALUE': WHY`, or `NAME: WHY` without a value. `WHY`
+/// may name settings as `{name}` (`{zone}`, `{grid size}`): each is written the way `word`
+/// words it; a `WHY` that names its own setting is the whole message.
+fn setting_message(
+    setting: Setting,
+    value: &str,
+    why: &str,
+    word: &dyn Fn(Setting) -> String,
+) -> String {
+    use terramesh_core::vocab::Named;
+    let mut text = why.to_string();
+    let own = format!("{{{}}}", setting.name());
+    let whole = text.contains(&own);
+    for s in Setting::ALL {
+        let tag = format!("{{{}}}", s.name());
+        if text.contains(&tag) {
+            text = text.replace(&tag, &word(*s));
+        }
+    }
+    if whole {
+        text
+    } else if value.is_empty() {
+        format!("{}: {text}", word(setting))
+    } else {
+        format!("{} '{value}': {text}", word(setting))
+    }
+}
+
+fn neutral(s: Setting) -> String {
+    s.to_string()
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// A bad value of `setting`.
+    pub fn setting(setting: Setting, value: impl Display, why: impl Display) -> Error {
+        Error::Setting {
+            setting,
+            value: value.to_string(),
+            why: why.to_string(),
+        }
+    }
+
+    /// An error in words.
+    pub fn invalid(why: impl Display) -> Error {
+        Error::Invalid(why.to_string())
+    }
+
+    /// The whole chain on one line, `context: cause: cause`, with each [`Setting`] written as
+    /// `name` words it (a flag, a project key).
+    ///
+    /// ```
+    /// use terramesh::{Error, Setting};
+    /// let e = Error::setting(Setting::Margin, "ten", "give a fraction such as 0.1 or metres such as 50m");
+    /// assert_eq!(e.render(&|s| format!("--{}", s)), "--margin 'ten': give a fraction such as 0.1 or metres such as 50m");
+    /// ```
+    pub fn render(&self, name: &dyn Fn(Setting) -> String) -> String {
+        let mut parts = Vec::new();
+        let mut cur: Option<&(dyn std::error::Error + 'static)> = Some(self);
+        while let Some(e) = cur {
+            let text = match e.downcast_ref::<Error>() {
+                Some(Error::Setting {
+                    setting,
+                    value,
+                    why,
+                }) => setting_message(*setting, value, why, name),
+                _ => e.to_string(),
+            };
+            // Transparent wrappers repeat their inner message: write it once.
+            if parts.last() != Some(&text) {
+                parts.push(text);
+            }
+            cur = match e.downcast_ref::<Error>() {
+                Some(Error::Context { source, .. }) => Some(source.as_ref()),
+                Some(Error::Setting { .. } | Error::Invalid(_) | Error::Project { .. }) => None,
+                _ => e.source(),
+            };
+        }
+        parts.join(": ")
+    }
+
+    /// The settings this error (or a cause) is about, outermost first.
+    pub fn settings(&self) -> Vec<Setting> {
+        let mut out = Vec::new();
+        let mut cur = Some(self);
+        while let Some(e) = cur {
+            cur = match e {
+                Error::Setting { setting, .. } => {
+                    out.push(*setting);
+                    None
+                }
+                Error::Context { source, .. } => Some(source),
+                _ => None,
+            };
+        }
+        out
+    }
+}
+
+/// Adds context to errors, like `anyhow::Context`, for this crate's [`Error`].
+pub trait Context<T> {
+    /// Wraps the error with `context`.
+    fn context(self, context: impl Display) -> Result<T>;
+    /// Wraps the error with the context `f` makes (only on error).
+    fn with_context<C: Display>(self, f: impl FnOnce() -> C) -> Result<T>;
+}
+
+impl<T, E: Into<Error>> Context<T> for std::result::Result<T, E> {
+    fn context(self, context: impl Display) -> Result<T> {
+        self.map_err(|e| Error::Context {
+            context: context.to_string(),
+            source: Box::new(e.into()),
+        })
+    }
+    fn with_context<C: Display>(self, f: impl FnOnce() -> C) -> Result<T> {
+        self.map_err(|e| Error::Context {
+            context: f().to_string(),
+            source: Box::new(e.into()),
+        })
+    }
+}
+
+impl<T> Context<T> for Option<T> {
+    fn context(self, context: impl Display) -> Result<T> {
+        self.ok_or_else(|| Error::Invalid(context.to_string()))
+    }
+    fn with_context<C: Display>(self, f: impl FnOnce() -> C) -> Result<T> {
+        self.ok_or_else(|| Error::Invalid(f().to_string()))
+    }
+}
+
+/// `bail!(...)`: return an [`Error::Invalid`] with a formatted message.
+macro_rules! bail {
+    ($($t:tt)*) => {
+        return Err($crate::error::Error::Invalid(format!($($t)*)))
+    };
+}
+pub(crate) use bail;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn render_walks_the_chain_and_words_settings() {
+        let e: Result<()> = Err(Error::setting(Setting::Zone, "99X", "not a UTM zone"));
+        let e = e.context("samples").unwrap_err();
+        assert_eq!(e.to_string(), "samples");
+        assert_eq!(
+            e.render(&|s| format!("--{s}")),
+            "samples: --zone '99X': not a UTM zone"
+        );
+        assert_eq!(e.settings(), [Setting::Zone]);
+        let io: Result<()> = Err(std::io::Error::other("disk full").into());
+        let e = io.context("writing out/x").unwrap_err();
+        let own = Error::setting(
+            Setting::Region,
+            "",
+            "{source} x needs a region: give {region}",
+        );
+        assert_eq!(
+            own.render(&|s| format!("--{s}")),
+            "--source x needs a region: give --region"
+        );
+        assert_eq!(own.to_string(), "source x needs a region: give region");
+        assert_eq!(e.render(&|s| s.to_string()), "writing out/x: disk full");
+    }
+}

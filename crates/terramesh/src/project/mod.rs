@@ -1,0 +1,222 @@
+//! The project file `terramesh.toml`: every setting of a `terramesh build`, with defaults.
+//!
+//! Unknown keys and bad values are errors that name the key and the line; `--set KEY=VALUE`
+//! overrides a key from the command line (`--set mesh.min_angle=32`).
+
+mod lower;
+mod parse;
+
+pub use lower::key_of;
+
+use std::path::PathBuf;
+
+use serde::Deserialize;
+
+/// A whole project.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Project {
+    /// Free text shown in the report.
+    #[serde(default)]
+    pub title: Option<String>,
+    /// The study region.
+    pub region: RegionSection,
+    /// The elevation source.
+    pub source: SourceSection,
+    /// The sampling grid.
+    #[serde(default)]
+    pub sampling: SamplingSection,
+    /// The planar mesh.
+    #[serde(default)]
+    pub mesh: MeshSection,
+    /// Interpolation of vertex elevations.
+    #[serde(default)]
+    pub interpolation: InterpolationSection,
+    /// Exports.
+    #[serde(default)]
+    pub export: ExportSection,
+}
+
+/// `[region]`: corners or a region file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSection {
+    /// `"LAT LON; LAT LON; ..."` (decimal or DMS) or a corners CSV path.
+    pub corners: Option<String>,
+    /// A GeoJSON, KML or WKT file (relative to the project file).
+    pub file: Option<PathBuf>,
+    /// UTM zone such as `32N` (default: the zone of the region's centre).
+    pub zone: Option<String>,
+    /// `geographic` (default) or `projected`.
+    #[serde(default = "default_crs")]
+    pub crs: String,
+}
+
+/// `[source]`: where elevations come from.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceSection {
+    /// A DEM file or directory of tiles, a point file, or a web service `opentopodata:URL`.
+    pub path: String,
+    /// A second source used when `path` does not exist (the bundled crop of the example).
+    pub fallback: Option<String>,
+    /// LAS/LAZ classification to keep (2 = ground).
+    pub class: Option<u8>,
+}
+
+/// `[sampling]`: the grid of the paper's step 1.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SamplingSection {
+    /// Grid rows (north-south).
+    pub rows: usize,
+    /// Grid columns (east-west).
+    pub cols: usize,
+    /// Grid spacing in metres (instead of rows/cols).
+    pub spacing: Option<f64>,
+    /// Enlargement of the region: a fraction of its size (< 1) or metres (>= 1).
+    pub margin: f64,
+    /// Keep only samples inside the (unenlarged) region.
+    pub clip: bool,
+    /// Raster interpolation: `bilinear`, `bicubic` or `nearest`.
+    pub method: String,
+}
+
+impl Default for SamplingSection {
+    fn default() -> Self {
+        SamplingSection {
+            rows: 100,
+            cols: 50,
+            spacing: None,
+            margin: 0.1,
+            clip: false,
+            method: "bilinear".into(),
+        }
+    }
+}
+
+/// `[mesh]`: the planar mesh of step 3.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MeshSection {
+    /// Maximum triangle area, m².
+    pub max_area: Option<f64>,
+    /// Maximum edge length, m.
+    pub max_edge: Option<f64>,
+    /// Minimum angle, degrees (up to 33).
+    pub min_angle: f64,
+    /// Smoothing iterations.
+    pub smooth: usize,
+    /// `laplacian`, `smart` or `odt`.
+    pub smoother: String,
+    /// Insert the sample locations as mesh vertices.
+    pub insert_samples: bool,
+    /// Terrain-adaptive refinement: refine until the mesh surface is within this many metres
+    /// of the first interpolation method's surface at triangle centres and edge midpoints,
+    /// then improve the 3D triangle shape (replaces planar smoothing).
+    pub max_error: Option<f64>,
+}
+
+impl Default for MeshSection {
+    fn default() -> Self {
+        MeshSection {
+            max_area: None,
+            max_edge: None,
+            min_angle: 30.0,
+            smooth: 10,
+            smoother: "smart".into(),
+            insert_samples: false,
+            max_error: None,
+        }
+    }
+}
+
+/// A variogram given in the project file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariogramSpec {
+    /// Model name: `spherical`, `exponential`, `gaussian`, ...
+    pub model: String,
+    /// Partial sill.
+    pub psill: f64,
+    /// Practical range, metres.
+    pub range: f64,
+    /// Nugget.
+    #[serde(default)]
+    pub nugget: f64,
+}
+
+/// `[interpolation]`: step 4.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InterpolationSection {
+    /// Methods to run; the first gives the DSM elevations (`uk`, `ok`, `idw`).
+    pub methods: Vec<String>,
+    /// Drift of universal kriging: `linear` (the paper's) or `quadratic`.
+    pub drift: String,
+    /// `auto` (fit from the samples) or a path to a `variogram.json`.
+    pub variogram: String,
+    /// An explicit variogram (overrides `variogram`).
+    pub model: Option<VariogramSpec>,
+    /// Kriging neighbours per target (0: all data, global kriging).
+    pub neighbors: usize,
+    /// IDW power.
+    pub idw_power: f64,
+    /// IDW neighbours.
+    pub idw_neighbors: usize,
+    /// Cross-validation folds (0: leave-one-out).
+    pub cv_folds: usize,
+}
+
+impl Default for InterpolationSection {
+    fn default() -> Self {
+        InterpolationSection {
+            methods: vec!["uk".into(), "idw".into()],
+            drift: "linear".into(),
+            variogram: "auto".into(),
+            model: None,
+            neighbors: 0,
+            idw_power: 2.0,
+            idw_neighbors: 16,
+            cv_folds: 0,
+        }
+    }
+}
+
+/// `[export]`: step 5.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ExportSection {
+    /// Surface formats: `vtu`, `obj`, `ply`, `stl`, `ts`, `msh`, `dxf`, `kml`, `dae` (COLLADA
+    /// with `dsm-model.kml` for Google Earth).
+    pub formats: Vec<String>,
+    /// Base of the sealed solid, metres (default: 50 m below the lowest vertex).
+    pub base_elevation: Option<f64>,
+    /// Cell size of the DSM grid (GeoTIFF and ESRI ASCII), metres.
+    pub grid_spacing: Option<f64>,
+    /// Write pictures (PNG and SVG).
+    pub pictures: bool,
+    /// Write `report.html`.
+    pub report: bool,
+}
+
+impl Default for ExportSection {
+    fn default() -> Self {
+        ExportSection {
+            formats: ["vtu", "obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae"]
+                .map(String::from)
+                .to_vec(),
+            base_elevation: None,
+            grid_spacing: None,
+            pictures: true,
+            report: true,
+        }
+    }
+}
+
+fn default_crs() -> String {
+    "geographic".into()
+}
+
+/// The commented project file written by `terramesh init`.
+pub const TEMPLATE: &str = include_str!("template.toml");

@@ -1,0 +1,330 @@
+//! Reading a project file: TOML with every key checked, errors that name the key and its line,
+//! and `--set KEY=VALUE` overrides.
+
+use std::path::Path;
+
+use terramesh_mesh::MAX_MIN_ANGLE;
+
+use super::Project;
+use crate::error::{Error, Result};
+
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+/// The 1-based line of byte `offset` in `text`.
+fn line_at(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// The line that sets `key` (`section.name`, or `section.sub.name` for an inline table
+/// entry, or `[section]` for the section header) in `text`, if it is there.
+pub(crate) fn key_line(text: &str, key: &str) -> Option<usize> {
+    let key = key.trim_start_matches('[').trim_end_matches(']');
+    let mut parts = key.split('.');
+    let section = parts.next()?;
+    let name = parts.next();
+    let mut current = String::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if let Some(h) = line.strip_prefix('[') {
+            current = h.trim_end_matches(']').trim().to_string();
+            if name.is_none() && current == section {
+                return Some(i + 1);
+            }
+            continue;
+        }
+        let Some(n) = name else { continue };
+        if current == section {
+            if let Some((k, _)) = line.split_once('=') {
+                if k.trim() == n {
+                    return Some(i + 1);
+                }
+            }
+        }
+    }
+    None
+}
+
+impl Project {
+    /// Reads a project file, applying `--set KEY=VALUE` overrides.
+    pub fn load(path: &Path, sets: &[String]) -> Result<Project> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Project {
+            file: path.display().to_string(),
+            line: None,
+            why: format!("cannot read the project file: {e}"),
+        })?;
+        Project::parse(&path.display().to_string(), &text, sets)
+    }
+
+    /// Parses project text; `name` is used in messages.
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let p = Project::parse("t.toml", TEMPLATE, &["mesh.min_angle=32".into()])?;
+    /// assert_eq!(p.mesh.min_angle, 32.0);
+    /// let e = Project::parse("t.toml", "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angle = 40\n", &[]);
+    /// assert_eq!(e.unwrap_err().to_string(), "t.toml, line 6: mesh.min_angle: must be in [0, 33] degrees (0 turns angle refinement off)");
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn parse(name: &str, text: &str, sets: &[String]) -> Result<Project> {
+        let syntax = |e: toml::de::Error| Error::Project {
+            file: name.to_string(),
+            line: e.span().map(|s| line_at(text, s.start)),
+            why: one_line(e.message()),
+        };
+        let mut doc: toml::Table = toml::from_str(text).map_err(syntax)?;
+        for s in sets {
+            apply_set(&mut doc, s).map_err(|why| Error::Project {
+                file: name.to_string(),
+                line: None,
+                why,
+            })?;
+        }
+        // Parse the original text when nothing was overridden, so errors carry line numbers.
+        let project: Project = if sets.is_empty() {
+            toml::from_str(text).map_err(syntax)?
+        } else {
+            let merged = toml::to_string(&doc).map_err(|e| Error::Project {
+                file: name.to_string(),
+                line: None,
+                why: format!("re-serialising the project: {e}"),
+            })?;
+            toml::from_str(&merged).map_err(|e| Error::Project {
+                file: format!("{name} with --set {}", sets.join(", ")),
+                line: None,
+                why: one_line(e.message()),
+            })?
+        };
+        let text_for_lines = if sets.is_empty() { text } else { "" };
+        project.validate().map_err(|(key, why)| Error::Project {
+            file: name.to_string(),
+            line: key_line(text_for_lines, &key),
+            why: format!("{key}: {why}"),
+        })?;
+        Ok(project)
+    }
+
+    /// Checks every value; the error is the key and what is wrong with it.
+    fn validate(&self) -> std::result::Result<(), (String, String)> {
+        let bad = |key: &str, why: &str| Err((key.to_string(), why.to_string()));
+        match (&self.region.corners, &self.region.file) {
+            (None, None) => {
+                return bad(
+                    "[region]",
+                    "give corners = \"LAT LON; ...\" or file = \"area.geojson\"",
+                )
+            }
+            (Some(_), Some(_)) => return bad("[region]", "give either corners or file, not both"),
+            _ => {}
+        }
+        if !matches!(self.region.crs.as_str(), "geographic" | "projected") {
+            return bad("region.crs", "must be \"geographic\" or \"projected\"");
+        }
+        let s = &self.sampling;
+        if s.spacing.is_none() && (s.rows < 2 || s.cols < 2) {
+            return bad(
+                "sampling.rows",
+                "need at least 2 rows and 2 cols (or give sampling.spacing)",
+            );
+        }
+        if let Some(sp) = s.spacing {
+            if !positive(sp) {
+                return bad("sampling.spacing", "must be a positive number of metres");
+            }
+        }
+        if !(s.margin >= 0.0 && s.margin.is_finite()) {
+            return bad(
+                "sampling.margin",
+                "must be 0 or positive (a fraction below 1, or metres)",
+            );
+        }
+        let m = &self.mesh;
+        if !(0.0..=MAX_MIN_ANGLE).contains(&m.min_angle) {
+            return bad(
+                "mesh.min_angle",
+                &format!("must be in [0, {MAX_MIN_ANGLE}] degrees (0 turns angle refinement off)"),
+            );
+        }
+        for (k, v) in [
+            ("mesh.max_area", m.max_area),
+            ("mesh.max_edge", m.max_edge),
+            ("mesh.max_error", m.max_error),
+        ] {
+            if let Some(v) = v {
+                if !positive(v) {
+                    return bad(k, "must be positive");
+                }
+            }
+        }
+        if !matches!(m.smoother.as_str(), "laplacian" | "smart" | "odt") {
+            return bad(
+                "mesh.smoother",
+                "must be \"laplacian\", \"smart\" or \"odt\"",
+            );
+        }
+        let i = &self.interpolation;
+        if i.methods.is_empty() {
+            return bad(
+                "interpolation.methods",
+                "name at least one of \"uk\", \"ok\", \"idw\"",
+            );
+        }
+        for meth in &i.methods {
+            if !matches!(meth.as_str(), "uk" | "ok" | "sk" | "idw") {
+                return bad(
+                    "interpolation.methods",
+                    &format!("unknown method \"{meth}\" (uk, ok, sk, idw)"),
+                );
+            }
+        }
+        if !matches!(i.drift.as_str(), "constant" | "linear" | "quadratic") {
+            return bad(
+                "interpolation.drift",
+                "must be \"constant\", \"linear\" or \"quadratic\"",
+            );
+        }
+        if !positive(i.idw_power) {
+            return bad("interpolation.idw_power", "must be positive");
+        }
+        if let Some(v) = &i.model {
+            if !positive(v.range) {
+                return bad("interpolation.model.range", "must be positive");
+            }
+            if !positive(v.psill) {
+                return bad("interpolation.model.psill", "must be positive");
+            }
+            if !(v.nugget.is_finite() && v.nugget >= 0.0) {
+                return bad("interpolation.model.nugget", "must be 0 or positive");
+            }
+        }
+        for f in &self.export.formats {
+            if !matches!(
+                f.as_str(),
+                "vtu" | "obj" | "ply" | "stl" | "ts" | "msh" | "dxf" | "kml" | "dae"
+            ) {
+                return bad(
+                    "export.formats",
+                    &format!("unknown format \"{f}\" (vtu, obj, ply, stl, ts, msh, dxf, kml, dae)"),
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Applies `section.key=value` to the TOML table; the value is read as TOML (number, boolean,
+/// array, quoted string) and otherwise taken as a bare string.
+fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), String> {
+    let (key, value) = set
+        .split_once('=')
+        .ok_or_else(|| format!("--set '{set}': write KEY=VALUE, e.g. --set mesh.min_angle=32"))?;
+    let key = key.trim();
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(format!("--set '{set}': bad key '{key}'"));
+    }
+    let value = match toml::from_str::<toml::Table>(&format!("v = {}", value.trim())) {
+        Ok(mut t) => t.remove("v"),
+        Err(_) => None,
+    }
+    .unwrap_or_else(|| toml::Value::String(value.trim().to_string()));
+    let mut table = doc;
+    for p in &parts[..parts.len() - 1] {
+        let entry = table
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = entry
+            .as_table_mut()
+            .ok_or_else(|| format!("--set '{set}': '{p}' is not a section"))?;
+    }
+    table.insert(parts[parts.len() - 1].to_string(), value);
+    Ok(())
+}
+
+fn one_line(s: &str) -> String {
+    s.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && *l != "|")
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::project::TEMPLATE;
+
+    #[test]
+    fn template_parses_with_documented_defaults() {
+        let p = Project::parse("t.toml", TEMPLATE, &[]).unwrap();
+        assert_eq!(p.sampling.rows, 100);
+        assert_eq!(p.sampling.cols, 50);
+        assert_eq!(p.mesh.min_angle, 30.0);
+        assert_eq!(p.interpolation.methods, ["uk", "idw"]);
+    }
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angel = 30\n";
+        let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("p.toml") && e.contains("min_angel") && e.contains("line 6"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn bad_value_names_key() {
+        let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angle = \"thirty\"\n";
+        let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
+        assert!(e.contains("min_angle") && e.contains("line 6"), "{e}");
+        let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angle = 40\n";
+        let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
+        assert!(e.contains("mesh.min_angle") && e.contains("33"), "{e}");
+    }
+
+    #[test]
+    fn set_overrides() {
+        let p = Project::parse(
+            "t.toml",
+            TEMPLATE,
+            &[
+                "mesh.min_angle=32".into(),
+                "interpolation.methods=[\"idw\"]".into(),
+                "region.zone=31N".into(),
+            ],
+        )
+        .unwrap();
+        assert_eq!(p.mesh.min_angle, 32.0);
+        assert_eq!(p.interpolation.methods, ["idw"]);
+        assert_eq!(p.region.zone.as_deref(), Some("31N"));
+        let e = Project::parse("t.toml", TEMPLATE, &["mesh.min_angle".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("KEY=VALUE"), "{e}");
+        let e = Project::parse("t.toml", TEMPLATE, &["mesh.typo=1".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("typo") && e.contains("--set"), "{e}");
+    }
+
+    #[test]
+    fn bad_values_name_the_key_and_its_line() {
+        let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nsmooth = 3\nmax_area = -1\n";
+        let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
+        assert_eq!(e, "p.toml, line 7: mesh.max_area: must be positive");
+        let text =
+            "[region]\ncorners = \"0 0; 0 1; 1 1\"\nfile = \"a.kml\"\n[source]\npath = \"x\"\n";
+        let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
+        assert!(e.starts_with("p.toml, line 1: [region]"), "{e}");
+        assert_eq!(key_line("[a]\nb = 1\n[c]\nb = 2\n", "c.b"), Some(4));
+        assert_eq!(key_line("[a]\nb = 1\n", "a.x"), None);
+    }
+
+    #[test]
+    fn min_angle_zero_is_accepted_like_the_library() {
+        let p = Project::parse("t.toml", TEMPLATE, &["mesh.min_angle=0".into()]).unwrap();
+        assert_eq!(p.mesh.min_angle, 0.0);
+    }
+}

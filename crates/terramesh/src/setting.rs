@@ -1,0 +1,75 @@
+//! The settings of acquisition, by name: what [`Error::Setting`](crate::Error::Setting)
+//! points at. Each front end words them its own way: the command line as flags, the project
+//! file as keys (`terramesh::project::key_of`).
+
+/// One setting of a sampling plan.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Setting {
+    /// The elevation source (a file, a directory, a service, a tile URL).
+    Source,
+    /// The study region (corners or a region file).
+    Region,
+    /// The coordinates of the region (geographic or projected).
+    RegionCrs,
+    /// The UTM zone.
+    Zone,
+    /// The size of the sampling grid (rows and columns, or a spacing).
+    GridSize,
+    /// The grid spacing, metres.
+    Spacing,
+    /// The enlargement of the region.
+    Margin,
+    /// The plane of the grid (UTM or latitude/longitude).
+    GridPlane,
+    /// What to do with a point without an elevation.
+    OnMissing,
+    /// LAS/LAZ classes to keep.
+    Classes,
+    /// Column names of a headerless points file.
+    Columns,
+    /// The field delimiter of a points file.
+    Delimiter,
+    /// The CRS of a points file.
+    SourceCrs,
+    /// Web requests in flight at once.
+    Concurrency,
+    /// Web requests per second.
+    Rate,
+    /// Timeout of one web request.
+    Timeout,
+    /// First retry delay.
+    Backoff,
+    /// Continue an interrupted web acquisition.
+    Resume,
+    /// Zoom level of terrain tiles.
+    Zoom,
+    /// The z written for points without an elevation.
+    Nodata,
+    /// The output file.
+    Output,
+}
+
+terramesh_core::named_enum!(Setting, "setting", [
+    Setting::Source => "source",
+    Setting::Region => "region",
+    Setting::RegionCrs => "region-crs",
+    Setting::Zone => "zone",
+    Setting::GridSize => "grid size",
+    Setting::Spacing => "spacing",
+    Setting::Margin => "margin",
+    Setting::GridPlane => "grid-crs",
+    Setting::OnMissing => "on-missing",
+    Setting::Classes => "class",
+    Setting::Columns => "columns",
+    Setting::Delimiter => "delimiter",
+    Setting::SourceCrs => "source-crs",
+    Setting::Concurrency => "concurrency",
+    Setting::Rate => "rate",
+    Setting::Timeout => "timeout",
+    Setting::Backoff => "backoff",
+    Setting::Resume => "resume",
+    Setting::Zoom => "zoom",
+    Setting::Nodata => "nodata",
+    Setting::Output => "output",
+]);
