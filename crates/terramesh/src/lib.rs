@@ -14,5 +14,6 @@ mod setting;
 pub use error::{Context, Error, Result};
 pub use setting::Setting;
 pub mod build;
+pub mod convert;
 pub mod project;
 pub mod variogram_file;

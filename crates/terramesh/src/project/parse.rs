@@ -46,6 +46,26 @@ pub(crate) fn key_line(text: &str, key: &str) -> Option<usize> {
     None
 }
 
+/// The `section.key` set on line `line` of `text`, if that line sets one.
+fn key_at_line(text: &str, line: usize) -> Option<String> {
+    let mut section = String::new();
+    for (i, raw) in text.lines().enumerate().take(line) {
+        let l = raw.trim();
+        if let Some(h) = l.strip_prefix('[') {
+            section = h.trim_end_matches(']').trim().to_string();
+        } else if i + 1 == line {
+            let (k, _) = l.split_once('=')?;
+            let k = k.trim();
+            return Some(if section.is_empty() {
+                k.to_string()
+            } else {
+                format!("{section}.{k}")
+            });
+        }
+    }
+    None
+}
+
 impl Project {
     /// Reads a project file, applying `--set KEY=VALUE` overrides.
     pub fn load(path: &Path, sets: &[String]) -> Result<Project> {
@@ -68,10 +88,19 @@ impl Project {
     /// # Ok::<(), terramesh::Error>(())
     /// ```
     pub fn parse(name: &str, text: &str, sets: &[String]) -> Result<Project> {
-        let syntax = |e: toml::de::Error| Error::Project {
-            file: name.to_string(),
-            line: e.span().map(|s| line_at(text, s.start)),
-            why: one_line(e.message()),
+        let syntax = |e: toml::de::Error| {
+            let line = e.span().map(|s| line_at(text, s.start));
+            let key = line.and_then(|l| key_at_line(text, l));
+            Error::Project {
+                file: name.to_string(),
+                line,
+                why: match key {
+                    Some(k) if !e.message().contains(&k) => {
+                        format!("{k}: {}", one_line(e.message()))
+                    }
+                    _ => one_line(e.message()),
+                },
+            }
         };
         let mut doc: toml::Table = toml::from_str(text).map_err(syntax)?;
         for s in sets {
@@ -278,7 +307,10 @@ mod tests {
     fn bad_value_names_key() {
         let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angle = \"thirty\"\n";
         let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
-        assert!(e.contains("min_angle") && e.contains("line 6"), "{e}");
+        assert_eq!(
+            e,
+            "p.toml, line 6: mesh.min_angle: invalid type: string \"thirty\", expected f64"
+        );
         let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angle = 40\n";
         let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
         assert!(e.contains("mesh.min_angle") && e.contains("33"), "{e}");
