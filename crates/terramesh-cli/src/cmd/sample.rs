@@ -230,3 +230,85 @@ pub fn run(args: Args) -> Result<()> {
     let table = acquire(&plan, &progress).map_err(crate::flag_error)?;
     write_table(&plan, table, &progress).map_err(crate::flag_error)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use terramesh::project::Project;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn flags(argv: &[&str]) -> SampleOptions {
+        let cli = Cli::try_parse_from(std::iter::once("sample").chain(argv.iter().copied()))
+            .unwrap_or_else(|e| panic!("{e}"));
+        cli.args.options().unwrap()
+    }
+
+    #[test]
+    fn project_and_flags_lower_to_the_same_plan() {
+        let dir = tempfile::tempdir().unwrap();
+        let dem = dir.path().join("dem.asc");
+        std::fs::write(&dem, "not read by the plan").unwrap();
+        let out = dir.path().join("out").join("samples.csv");
+        let corners = "48.72 7.33; 48.72 7.34; 48.73 7.34; 48.73 7.33";
+        for (margin_key, margin_flag, extra_key, extra_flags) in [
+            (
+                "0.1",
+                "0.1",
+                "clip = true\nmethod = \"bicubic\"",
+                &["--clip", "--interpolation", "bicubic"][..],
+            ),
+            ("50", "50m", "", &[][..]),
+        ] {
+            let text = format!(
+                "[region]\ncorners = \"{corners}\"\nzone = \"32N\"\n[source]\npath = \"dem.asc\"\n\
+                 [sampling]\nrows = 20\ncols = 10\nmargin = {margin_key}\n{extra_key}\n"
+            );
+            let project = Project::parse("p.toml", &text, &[]).unwrap();
+            let from_project = project.sample_options(dir.path(), &out).unwrap();
+            let mut argv = vec![
+                "--source",
+                dem.to_str().unwrap(),
+                "--corners",
+                corners,
+                "--zone",
+                "32N",
+                "--rows",
+                "20",
+                "--cols",
+                "10",
+                "--margin",
+                margin_flag,
+                "-o",
+                out.to_str().unwrap(),
+            ];
+            argv.extend(extra_flags);
+            let from_flags = flags(&argv);
+            assert_eq!(from_project, from_flags);
+            let a = SamplePlan::resolve(&from_project).unwrap();
+            let b = SamplePlan::resolve(&from_flags).unwrap();
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+    }
+
+    #[test]
+    fn settings_are_worded_as_flags_and_as_keys() {
+        let e = flags(&["--source", "x.tif", "--margin", "0"]);
+        assert_eq!(e.margin, MarginSpec::Fraction(0.0));
+        let cli = Cli::try_parse_from(["sample", "--source", "x.tif", "--margin", "ten"]).unwrap();
+        let e = cli.args.options().unwrap_err();
+        assert_eq!(
+            e.render(&flag_of),
+            format!("--margin 'ten': {}", terramesh::acquire::MARGIN_HELP)
+        );
+        assert_eq!(
+            e.render(&terramesh::project::key_of),
+            format!("sampling.margin 'ten': {}", terramesh::acquire::MARGIN_HELP)
+        );
+    }
+}
