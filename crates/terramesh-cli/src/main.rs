@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 mod cmd;
 mod project;
+mod wording;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
 ///
@@ -58,7 +59,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // `{:#}` prints the context chain on one line: "file, line 3: what is wrong".
-            eprintln!("terramesh: error: {e:#}");
+            // Library phrases become the flags they stand for (`wording`).
+            eprintln!(
+                "terramesh: error: {}",
+                wording::flag_words(&format!("{e:#}"))
+            );
             ExitCode::FAILURE
         }
     }

@@ -8,7 +8,7 @@
 //! edge midpoint of the mesh, and that verified error is what the report shows.
 
 use anyhow::{bail, Context, Result};
-use terramesh_core::sampling::{GridSurface, Method as Kernel};
+use terramesh_core::sampling::{GridSurface, Kernel};
 use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, AdaptiveSettings, Mesh};
 
 use super::stages::{Kriging, Model, Samples};
@@ -116,8 +116,9 @@ pub fn adaptive(
     settings.min_angle = m.min_angle;
     settings.max_area = m.max_area;
     let f = |x: f64, y: f64| surface.height(x, y, Kernel::Bilinear);
-    let (mesh, _, report) =
-        adaptive_mesh(&s.region.projected, &settings, &f).context("[mesh] adaptive refinement")?;
+    let (mesh, _, report) = adaptive_mesh(&s.region.projected, &settings, &f)
+        .map_err(crate::wording::mesh_error)
+        .context("[mesh] adaptive refinement")?;
     // Verify against kriging itself, with kriged vertex heights as the DSM will have them.
     let vertices: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let (z, _) = engine.predict(&vertices, false)?;

@@ -226,7 +226,10 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model) -> Result<Meshed> {
     if m.insert_samples {
         builder = builder.points(s.xyz.iter().map(|q| [q[0], q[1]]).collect());
     }
-    let (mut mesh, _) = builder.build(&s.region.projected).context("[mesh]")?;
+    let (mut mesh, _) = builder
+        .build(&s.region.projected)
+        .map_err(crate::wording::mesh_error)
+        .context("[mesh]")?;
     let unsmoothed = mesh.clone();
     let before = Quality::planar(&mesh);
     let smoothing = if m.smooth > 0 {
@@ -268,7 +271,7 @@ pub struct Interpolated {
     /// Cross-validation per method.
     pub cv: Vec<(String, CvStats)>,
     /// The DSM grid: spec and values (nodata outside the region).
-    pub grid: (terramesh_io::grid_write::GridSpec, Vec<f64>),
+    pub grid: (terramesh_io::grid_write::RasterGrid, Vec<f64>),
     /// The drift used by UK.
     pub drift: Drift,
 }
@@ -415,7 +418,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         .max(1e-3);
     let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
     let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
-    let spec = terramesh_io::grid_write::GridSpec {
+    let spec = terramesh_io::grid_write::RasterGrid {
         xmin: lo[0],
         ymin: hi[1] - (ny - 1) as f64 * step,
         xmax: lo[0] + (nx - 1) as f64 * step,

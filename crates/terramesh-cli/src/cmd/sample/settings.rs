@@ -5,7 +5,9 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use terramesh_core::coords::Zone;
-use terramesh_core::sampling::{grid_nodes, GridPlane, GridSize, GridSpec, Margin, Method, Node};
+use terramesh_core::sampling::{
+    grid_nodes, GridPlane, GridSize, Kernel, Margin, Node, SamplingGrid,
+};
 use terramesh_io::dem::SourceCrs;
 use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
 use terramesh_io::table::ReadOptions;
@@ -69,7 +71,7 @@ pub struct Settings {
     pub margin: MarginArg,
     pub clip: bool,
     pub plane: GridPlane,
-    pub method: Method,
+    pub method: Kernel,
     pub on_missing: OnMissing,
     pub nodata: f64,
     pub fill_voids: bool,
@@ -314,7 +316,7 @@ impl Settings {
             }
             (None, None) => bail!("give the grid size: --rows and --cols, or --spacing METRES"),
         };
-        let spec = GridSpec {
+        let spec = SamplingGrid {
             size,
             margin,
             clip: self.clip,
