@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 mod cmd;
 mod progress;
+mod wording;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
 ///
@@ -44,6 +45,8 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // A project's settings are keys, worded by the library; a command's are flags.
+    let flags = !matches!(cli.command, Command::Build(_) | Command::Init(_));
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
@@ -58,7 +61,14 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // `{:#}` prints the context chain on one line: "file, line 3: what is wrong".
-            eprintln!("terramesh: error: {e:#}");
+            // Library phrases become the flags they stand for (`wording`).
+            let text = format!("{e:#}");
+            let text = if flags {
+                wording::flag_words(&text)
+            } else {
+                text
+            };
+            eprintln!("terramesh: error: {text}");
             ExitCode::FAILURE
         }
     }

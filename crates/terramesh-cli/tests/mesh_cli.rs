@@ -368,7 +368,7 @@ fn obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
 
 #[test]
 fn max_error_refines_to_the_dem_within_the_tolerance() {
-    use terramesh_core::sampling::Method;
+    use terramesh_core::sampling::Kernel;
     use terramesh_io::dem::{open_raster, sample_utm};
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("adaptive.obj");
@@ -391,7 +391,7 @@ fn max_error_refines_to_the_dem_within_the_tolerance() {
     let dem = open_raster(&srtm, true).unwrap();
     let zone = "32N".parse().unwrap();
     let dem_at = |pts: &[[f64; 2]]| -> Vec<f64> {
-        sample_utm(dem.as_ref(), pts, zone, Method::Bilinear)
+        sample_utm(dem.as_ref(), pts, zone, Kernel::Bilinear)
             .unwrap()
             .into_iter()
             .map(|r| r.unwrap())

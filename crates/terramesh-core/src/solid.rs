@@ -10,9 +10,10 @@ use std::collections::HashMap;
 
 /// Errors building or checking a solid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SolidError {
     /// The base is not below every surface vertex.
-    #[error("base elevation {base} m is not below the lowest surface point ({min_z} m): choose a lower --base-elevation")]
+    #[error("base elevation {base} m is not below the lowest surface point ({min_z} m): choose a lower base elevation")]
     BaseTooHigh {
         /// The requested base.
         base: f64,

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use terramesh_core::sampling::Method;
+use terramesh_core::sampling::Kernel;
 use terramesh_io::dem::{open_raster, read_las, sample_latlon, LasOptions};
 
 fn data(rel: &str) -> std::path::PathBuf {
@@ -35,10 +35,10 @@ fn bench(c: &mut Criterion) {
     let hgt = open_raster(&data("srtm"), false).unwrap();
     let p = points(1_000_000, (48.0, 49.0), (7.0, 8.0));
     g.bench_function("hgt_1M_bilinear", |b| {
-        b.iter(|| sample_latlon(hgt.as_ref(), &p, Method::Bilinear).unwrap())
+        b.iter(|| sample_latlon(hgt.as_ref(), &p, Kernel::Bilinear).unwrap())
     });
     g.bench_function("hgt_1M_bicubic", |b| {
-        b.iter(|| sample_latlon(hgt.as_ref(), &p, Method::Bicubic).unwrap())
+        b.iter(|| sample_latlon(hgt.as_ref(), &p, Kernel::Bicubic).unwrap())
     });
     let tif = data("grids/fort-worth-3arcsec.tif");
     g.bench_function("geotiff_open", |b| {
@@ -47,7 +47,7 @@ fn bench(c: &mut Criterion) {
     let t = open_raster(&tif, false).unwrap();
     let q = points(1_000_000, (32.525, 32.82), (-97.48, -97.18));
     g.bench_function("geotiff_1M_bilinear", |b| {
-        b.iter(|| sample_latlon(t.as_ref(), &q, Method::Bilinear).unwrap())
+        b.iter(|| sample_latlon(t.as_ref(), &q, Kernel::Bilinear).unwrap())
     });
     let laz = data("lidar/autzen_trim.laz");
     g.bench_function("laz_read_110k", |b| {

@@ -8,7 +8,7 @@ use std::io::{self, Write};
 
 /// A regular grid of `nx x ny` nodes spanning `[xmin, xmax] x [ymin, ymax]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GridSpec {
+pub struct RasterGrid {
     /// West edge (first column of nodes).
     pub xmin: f64,
     /// South edge (last row of nodes).
@@ -23,17 +23,17 @@ pub struct GridSpec {
     pub ny: usize,
 }
 
-impl GridSpec {
+impl RasterGrid {
     /// Parses `xmin,ymin,xmax,ymax,nx,ny`.
     ///
     /// ```
-    /// use terramesh_io::grid_write::GridSpec;
-    /// let g: GridSpec = "0,0,100,50,11,6".parse().unwrap();
+    /// use terramesh_io::grid_write::RasterGrid;
+    /// let g: RasterGrid = "0,0,100,50,11,6".parse().unwrap();
     /// assert_eq!((g.dx(), g.dy()), (10.0, 10.0));
     /// assert_eq!(g.node(1, 0), [10.0, 50.0]);
-    /// assert!("0,0,100,50,1,6".parse::<GridSpec>().is_err());
+    /// assert!("0,0,100,50,1,6".parse::<RasterGrid>().is_err());
     /// ```
-    pub fn parse_str(s: &str) -> Result<GridSpec, String> {
+    pub fn parse_str(s: &str) -> Result<RasterGrid, String> {
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         if parts.len() != 6 {
             return Err(format!(
@@ -52,7 +52,7 @@ impl GridSpec {
                 _ => Err(format!("{name} '{}' must be an integer >= 2", parts[i])),
             }
         };
-        let g = GridSpec {
+        let g = RasterGrid {
             xmin: f(0, "xmin")?,
             ymin: f(1, "ymin")?,
             xmax: f(2, "xmax")?,
@@ -85,10 +85,10 @@ impl GridSpec {
     }
 }
 
-impl std::str::FromStr for GridSpec {
+impl std::str::FromStr for RasterGrid {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        GridSpec::parse_str(s)
+        RasterGrid::parse_str(s)
     }
 }
 
@@ -96,15 +96,15 @@ impl std::str::FromStr for GridSpec {
 /// (`xllcenter`, `yllcenter`); unequal spacings use GDAL's `dx`/`dy` lines.
 ///
 /// ```
-/// use terramesh_io::grid_write::{write_asc, GridSpec};
-/// let g: GridSpec = "0,0,2,1,3,2".parse().unwrap();
+/// use terramesh_io::grid_write::{write_asc, RasterGrid};
+/// let g: RasterGrid = "0,0,2,1,3,2".parse().unwrap();
 /// let mut out = Vec::new();
 /// write_asc(&mut out, &g, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.5]).unwrap();
 /// let s = String::from_utf8(out).unwrap();
 /// assert!(s.starts_with("ncols 3\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n"));
 /// assert!(s.ends_with("1 2 3\n4 5 6.5\n"));
 /// ```
-pub fn write_asc<W: Write>(w: &mut W, g: &GridSpec, values: &[f64]) -> io::Result<()> {
+pub fn write_asc<W: Write>(w: &mut W, g: &RasterGrid, values: &[f64]) -> io::Result<()> {
     assert_eq!(values.len(), g.nx * g.ny);
     writeln!(w, "ncols {}\nnrows {}", g.nx, g.ny)?;
     writeln!(w, "xllcenter {}\nyllcenter {}", g.xmin, g.ymin)?;
@@ -132,7 +132,7 @@ pub fn write_asc<W: Write>(w: &mut W, g: &GridSpec, values: &[f64]) -> io::Resul
 /// (42113) when `nodata` is given.
 pub fn write_geotiff<W: Write>(
     w: &mut W,
-    g: &GridSpec,
+    g: &RasterGrid,
     values: &[f64],
     epsg: Option<u16>,
     nodata: Option<f64>,
@@ -230,7 +230,7 @@ mod tests {
 
     #[test]
     fn geotiff_structure_reads_back() {
-        let g: GridSpec = "500000,5400000,500300,5400200,4,3".parse().unwrap();
+        let g: RasterGrid = "500000,5400000,500300,5400200,4,3".parse().unwrap();
         let vals: Vec<f64> = (0..12).map(|i| i as f64 * 1.5).collect();
         let mut b = Vec::new();
         write_geotiff(&mut b, &g, &vals, Some(32632), Some(-9999.0)).unwrap();

@@ -9,6 +9,7 @@ use std::path::Path;
 
 /// Errors while reading a table.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum TableError {
     /// The file could not be opened or read.
     #[error("{file}: {source}")]
@@ -38,7 +39,7 @@ pub enum TableError {
         message: String,
     },
     /// A required column is absent.
-    #[error("{file}: no column {wanted} (the header has: {found}); rename the column, or for a file without a header give --columns")]
+    #[error("{file}: no column {wanted} (the header has: {found}); rename the column, or for a file without a header name the columns")]
     MissingColumn {
         /// File name as given.
         file: String,
@@ -354,7 +355,7 @@ fn read_whitespace(name: String, bytes: &[u8], cols: &[String]) -> Result<Table,
                 file: name,
                 line: line_no,
                 message: format!(
-                    "{} fields where --columns names {} ({})",
+                    "{} fields where the columns given are {} ({})",
                     fields.len(),
                     cols.len(),
                     cols.join(",")

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use terramesh_core::sampling::{Method, Missing};
+use terramesh_core::sampling::{Kernel, Missing};
 use terramesh_io::dem::{
     open_raster, read_ascii_grid, read_geotiff, read_las, read_points, DemError, ElevationSource,
     HgtMosaic, LasOptions, SourceCrs,
@@ -42,18 +42,18 @@ fn srtm_tile_matches_numpy_posts_and_scipy_bilinear() {
         let (lat, lon): (f64, f64) = (r[0].parse().unwrap(), r[1].parse().unwrap());
         match (num(&r[2]), num(&r[3])) {
             (Some(z), _) => {
-                for m in [Method::Nearest, Method::Bilinear, Method::Bicubic] {
+                for m in [Kernel::Nearest, Kernel::Bilinear, Kernel::Bicubic] {
                     assert_eq!(dem.sample(lon, lat, m), Ok(z), "{m} at post {lat},{lon}");
                 }
                 posts += 1;
             }
             (None, Some(z)) => {
-                let got = dem.sample(lon, lat, Method::Bilinear).unwrap();
+                let got = dem.sample(lon, lat, Kernel::Bilinear).unwrap();
                 assert!((got - z).abs() < 1e-9, "{lat},{lon}: {got} vs scipy {z}");
                 interp += 1;
             }
             (None, None) => {
-                assert_eq!(dem.sample(lon, lat, Method::Bilinear), Err(Missing::Void));
+                assert_eq!(dem.sample(lon, lat, Kernel::Bilinear), Err(Missing::Void));
                 voids += 1;
             }
         }
@@ -63,7 +63,7 @@ fn srtm_tile_matches_numpy_posts_and_scipy_bilinear() {
         "{posts} {interp} {voids}"
     );
     assert_eq!(
-        dem.sample(8.5, 48.5, Method::Bilinear),
+        dem.sample(8.5, 48.5, Kernel::Bilinear),
         Err(Missing::Outside)
     );
 }
@@ -77,7 +77,7 @@ fn srtm_paper_study_area_has_20_posts_between_342_and_434_m() {
         for c in 0..1201 {
             let (lat, lon) = (49.0 - r as f64 / 1200.0, 7.0 + c as f64 / 1200.0);
             if (48.7224..=48.7260).contains(&lat) && (7.3368..=7.3404).contains(&lon) {
-                zs.push(dem.sample(lon, lat, Method::Nearest).unwrap());
+                zs.push(dem.sample(lon, lat, Kernel::Nearest).unwrap());
             }
         }
     }
@@ -100,7 +100,7 @@ fn srtm_voids_are_counted_and_filled_on_request() {
         .find(|r| r[2].is_empty() && r[3].is_empty())
         .unwrap();
     let (lat, lon): (f64, f64) = (void[0].parse().unwrap(), void[1].parse().unwrap());
-    let z = filled.sample(lon, lat, Method::Bilinear).unwrap();
+    let z = filled.sample(lon, lat, Kernel::Bilinear).unwrap();
     assert!((100.0..1400.0).contains(&z), "{z}");
 }
 
@@ -123,7 +123,7 @@ fn srtm_mosaic_is_seamless_across_tile_edges() {
     let plane = |lon: f64, lat: f64| (49.0 - lat) * 1200.0 + 2.0 * (lon - 7.0) * 1200.0;
     for &lon in &[7.9991, 7.99999, 8.0, 8.00001, 8.0004, 8.3] {
         for &lat in &[48.0, 48.00004, 48.5, 48.99996] {
-            for meth in [Method::Bilinear, Method::Bicubic] {
+            for meth in [Kernel::Bilinear, Kernel::Bicubic] {
                 let z = m.sample(lon, lat, meth).unwrap();
                 assert!(
                     (z - plane(lon, lat)).abs() < 1e-6,
@@ -133,7 +133,7 @@ fn srtm_mosaic_is_seamless_across_tile_edges() {
         }
     }
     assert_eq!(
-        m.sample(9.0001, 48.5, Method::Bilinear),
+        m.sample(9.0001, 48.5, Kernel::Bilinear),
         Err(Missing::Outside)
     );
 }
@@ -157,11 +157,11 @@ fn check_raster(dem: &dyn ElevationSource, fixture_rows: &[Vec<String>], tol: f6
     for r in fixture_rows {
         let (x, y): (f64, f64) = (r[1].parse().unwrap(), r[2].parse().unwrap());
         let want = num(&r[3]);
-        let got = dem.sample(x, y, Method::Bilinear);
+        let got = dem.sample(x, y, Kernel::Bilinear);
         match (r[0].as_str(), want) {
             ("post", Some(z)) => {
                 assert_eq!(got, Ok(z), "post {x},{y}");
-                assert_eq!(dem.sample(x, y, Method::Nearest), Ok(z));
+                assert_eq!(dem.sample(x, y, Kernel::Nearest), Ok(z));
             }
             (_, Some(z)) => {
                 let g = got.unwrap_or_else(|e| panic!("{x},{y}: {e}"));
@@ -282,8 +282,8 @@ fn terrarium_tile_matches_gdal_png_decoding() {
     let t = open_raster(&data("tiles/terrarium_11_385_803.png"), false).unwrap();
     for r in rows("terrarium.csv") {
         let v: Vec<f64> = r.iter().map(|s| s.parse().unwrap()).collect();
-        assert_eq!(t.sample(v[0], v[1], Method::Nearest), Ok(v[2]));
-        let b = t.sample(v[0], v[1], Method::Bilinear);
+        assert_eq!(t.sample(v[0], v[1], Kernel::Nearest), Ok(v[2]));
+        let b = t.sample(v[0], v[1], Kernel::Bilinear);
         assert!(b.is_ok_and(|b| (b - v[2]).abs() < 1e-6) || b == Err(Missing::Outside));
     }
 }
@@ -320,9 +320,9 @@ fn ascii_grid_crs_comes_from_its_prj_or_its_extent() {
     let r = read_ascii_grid(&p).unwrap();
     assert_eq!(r.crs, SourceCrs::from_epsg(32632).unwrap());
     // post (0, 0) is the centre of the north-west cell; the south-east post holds 4
-    assert_eq!(r.sample(377015.0, 5397045.0, Method::Nearest), Ok(1.0));
-    assert_eq!(r.sample(377045.0, 5397015.0, Method::Bilinear), Ok(4.0));
-    assert_eq!(r.sample(377030.0, 5397030.0, Method::Bilinear), Ok(2.5));
+    assert_eq!(r.sample(377015.0, 5397045.0, Kernel::Nearest), Ok(1.0));
+    assert_eq!(r.sample(377045.0, 5397015.0, Kernel::Bilinear), Ok(4.0));
+    assert_eq!(r.sample(377030.0, 5397030.0, Kernel::Bilinear), Ok(2.5));
     // a short grid names the line and the count
     std::fs::write(
         &p,
@@ -345,7 +345,7 @@ fn utm_geotiff_is_sampled_from_latlon_in_any_zone() {
         .collect();
     let direct: Vec<_> = pts
         .iter()
-        .map(|p| dem.sample(p[0], p[1], Method::Bilinear).unwrap())
+        .map(|p| dem.sample(p[0], p[1], Kernel::Bilinear).unwrap())
         .collect();
     let latlon: Vec<[f64; 2]> = pts
         .iter()
@@ -354,7 +354,7 @@ fn utm_geotiff_is_sampled_from_latlon_in_any_zone() {
             [a, b]
         })
         .collect();
-    let via_latlon = sample_latlon(dem.as_ref(), &latlon, Method::Bilinear).unwrap();
+    let via_latlon = sample_latlon(dem.as_ref(), &latlon, Kernel::Bilinear).unwrap();
     let z31 = "31N".parse().unwrap();
     let in31: Vec<[f64; 2]> = latlon
         .iter()
@@ -363,7 +363,7 @@ fn utm_geotiff_is_sampled_from_latlon_in_any_zone() {
             [u.easting, u.northing]
         })
         .collect();
-    let via_31 = sample_utm(dem.as_ref(), &in31, z31, Method::Bilinear).unwrap();
+    let via_31 = sample_utm(dem.as_ref(), &in31, z31, Kernel::Bilinear).unwrap();
     for i in 0..pts.len() {
         // a round trip through lat/lon moves a point by nanometres
         assert!((via_latlon[i].unwrap() - direct[i]).abs() < 1e-6);
@@ -378,7 +378,7 @@ fn srtm_bicubic_matches_a_numpy_keys_kernel() {
     assert_eq!(rows.len(), 200);
     for r in rows {
         let v: Vec<f64> = r.iter().map(|s| s.parse().unwrap()).collect();
-        let got = dem.sample(v[1], v[0], Method::Bicubic).unwrap();
+        let got = dem.sample(v[1], v[0], Kernel::Bicubic).unwrap();
         assert!(
             (got - v[2]).abs() < 1e-7,
             "{},{}: {got} vs {}",
@@ -433,7 +433,7 @@ fn a_geotiff_window_samples_like_the_whole_file() {
                 let lat = area.south + (area.north - area.south) * (i as f64 + 0.29) / 21.0;
                 let lon = area.west + (area.east - area.west) * (j as f64 + 0.37) / 21.0;
                 let (x, y) = whole.crs.from_wgs84(lat, lon).unwrap().unwrap();
-                for m in [Method::Nearest, Method::Bilinear, Method::Bicubic] {
+                for m in [Kernel::Nearest, Kernel::Bilinear, Kernel::Bicubic] {
                     // The window's origin moves by whole posts; the fractional post of (x, y)
                     // may differ in the last bits (1e-11 post x these noisy synthetic slopes).
                     let want = whole.sample(x, y, m).unwrap();
@@ -458,7 +458,7 @@ fn a_geotiff_window_samples_like_the_whole_file() {
         };
         let none = read_geotiff_in(&f, Some(&far)).unwrap();
         assert_eq!(
-            none.sample(100.05, -9.95, Method::Nearest),
+            none.sample(100.05, -9.95, Kernel::Nearest),
             Err(Missing::Outside)
         );
     }

@@ -11,21 +11,52 @@ use crate::flip::flip_passes;
 use crate::mesh::{orient, Mesh};
 use crate::quality::triangle_quality;
 use crate::smooth::neighbour_mean;
-use crate::{MeshError, MAX_MIN_ANGLE};
+use crate::{MeshError, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE};
 
 /// A terrain height `z(x, y)` in the region's coordinates (absolute, e.g. UTM metres): a
 /// kriging or IDW interpolator, a DEM sampler, an analytic surface. Any `Fn(f64, f64) -> f64`
-/// is one.
+/// is one that cannot fail; wrap a closure returning `Result<f64, E>` in [`Fallible`] for one
+/// that can (a DEM with voids). [`adaptive_mesh`] stops at the first failure and returns it
+/// as [`MeshError::Height`].
 pub trait HeightFunction {
-    /// The height at `(x, y)`.
-    fn height(&self, x: f64, y: f64) -> f64;
+    /// The height at `(x, y)`, or why there is none there.
+    fn height(&self, x: f64, y: f64) -> Result<f64, String>;
 }
 
 impl<F: Fn(f64, f64) -> f64> HeightFunction for F {
-    fn height(&self, x: f64, y: f64) -> f64 {
-        self(x, y)
+    fn height(&self, x: f64, y: f64) -> Result<f64, String> {
+        Ok(self(x, y))
     }
 }
+
+/// A height function that can fail: a closure `Fn(f64, f64) -> Result<f64, E>`, its error
+/// displayed into [`MeshError::Height`].
+///
+/// ```
+/// use terramesh_core::geometry::Region;
+/// use terramesh_mesh::{adaptive_mesh, AdaptiveSettings, Fallible, MeshError};
+/// let r = Region::from_ring(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]]);
+/// let west_only = Fallible(|x: f64, _y: f64| if x < 60.0 { Ok(x) } else { Err("no data") });
+/// match adaptive_mesh(&r, &AdaptiveSettings::new(0.5), &west_only) {
+///     Err(MeshError::Height { at, why }) => assert!(at[0] >= 60.0 && why == "no data"),
+///     other => panic!("{other:?}"),
+/// }
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct Fallible<F>(pub F);
+
+impl<F, E> HeightFunction for Fallible<F>
+where
+    F: Fn(f64, f64) -> Result<f64, E>,
+    E: std::fmt::Display,
+{
+    fn height(&self, x: f64, y: f64) -> Result<f64, String> {
+        (self.0)(x, y).map_err(|e| e.to_string())
+    }
+}
+
+/// Heights in the triangulation's local coordinates.
+type LocalHeight<'a> = dyn Fn([f64; 2]) -> Result<f64, MeshError> + 'a;
 
 /// Settings of [`adaptive_mesh`].
 #[derive(Debug, Clone, PartialEq)]
@@ -33,7 +64,8 @@ pub struct AdaptiveSettings {
     /// Largest allowed vertical distance between the mesh surface and the function at
     /// triangle centres and edge midpoints (metres).
     pub max_error: f64,
-    /// Planar minimum angle kept during refinement (degrees, at most 33). Default 30.
+    /// Planar minimum angle kept during refinement (degrees, at most 33). Default
+    /// [`DEFAULT_MIN_ANGLE`].
     pub min_angle: f64,
     /// Optional maximum triangle area. Default none.
     pub max_area: Option<f64>,
@@ -50,7 +82,7 @@ impl AdaptiveSettings {
     pub fn new(max_error: f64) -> Self {
         AdaptiveSettings {
             max_error,
-            min_angle: 30.0,
+            min_angle: DEFAULT_MIN_ANGLE,
             max_area: None,
             max_vertices: 2_000_000,
             improve_3d: true,
@@ -83,7 +115,8 @@ pub struct AdaptiveReport {
 /// 3D triangle shape. Returns the mesh, the heights of its vertices and a report.
 ///
 /// # Errors
-/// As [`crate::MeshBuilder::build`]; [`MeshError::Incomplete`] when `max_vertices` is reached.
+/// As [`crate::MeshBuilder::build`]; [`MeshError::Incomplete`] when `max_vertices` is reached;
+/// [`MeshError::Height`] at the first point where `f` fails (refinement stops there).
 ///
 /// ```
 /// use terramesh_core::geometry::Region;
@@ -106,10 +139,10 @@ pub fn adaptive_mesh(
         why: why.into(),
     };
     if !(settings.max_error.is_finite() && settings.max_error > 0.0) {
-        return Err(bad("max-error", settings.max_error, "must be positive"));
+        return Err(bad("max_error", settings.max_error, "must be positive"));
     }
     if !(0.0..=MAX_MIN_ANGLE).contains(&settings.min_angle) {
-        return Err(bad("min-angle", settings.min_angle, "must be in 0..=33"));
+        return Err(bad("min_angle", settings.min_angle, "must be in 0..=33"));
     }
     let region = validate(region)?;
     let mut st = CdtState::new(&region, &[])?;
@@ -119,7 +152,7 @@ pub fn adaptive_mesh(
         return Err(incomplete(cap, &st));
     }
     let o = st.origin;
-    let h = |p: [f64; 2]| f.height(p[0] + o[0], p[1] + o[1]);
+    let h = |p: [f64; 2]| local_height(f, o, p);
     let tol = settings.max_error;
     let mut zs: Vec<f64> = Vec::new();
     loop {
@@ -130,7 +163,7 @@ pub fn adaptive_mesh(
             .map(|v| [v.position().x, v.position().y])
             .collect();
         for p in &pos[zs.len()..] {
-            zs.push(h(*p));
+            zs.push(h(*p)?);
         }
         let inside = st.inside_faces();
         // Error at every edge midpoint, then one new vertex per bad triangle, at the worst of
@@ -139,7 +172,7 @@ pub fn adaptive_mesh(
         for e in st.cdt.undirected_edges() {
             let [a, b] = e.vertices().map(|v| v.fix().index());
             let m = [0.5 * (pos[a][0] + pos[b][0]), 0.5 * (pos[a][1] + pos[b][1])];
-            edge_err[e.fix().index()] = (h(m) - 0.5 * (zs[a] + zs[b])).abs();
+            edge_err[e.fix().index()] = (h(m)? - 0.5 * (zs[a] + zs[b])).abs();
         }
         let mut split = vec![false; edge_err.len()];
         let mut new_points = Vec::new();
@@ -153,7 +186,7 @@ pub fn adaptive_mesh(
                 (pos[v[0]][1] + pos[v[1]][1] + pos[v[2]][1]) / 3.0,
             ];
             let zc = (zs[v[0]] + zs[v[1]] + zs[v[2]]) / 3.0;
-            let ec = (h(c) - zc).abs();
+            let ec = (h(c)? - zc).abs();
             let (ei, ee, on_segment) = face
                 .adjacent_edges()
                 .map(|e| {
@@ -203,14 +236,18 @@ pub fn adaptive_mesh(
         }
     }
     let mut mesh = st.extract();
-    let mut z: Vec<f64> = mesh.points.iter().map(|&p| h(p)).collect();
-    report.error_after_refinement = surface_error_local(&mesh, &z, &h);
+    let mut z: Vec<f64> = mesh
+        .points
+        .iter()
+        .map(|&p| h(p))
+        .collect::<Result<_, _>>()?;
+    report.error_after_refinement = surface_error_local(&mesh, &z, &h)?;
     report.min_angle_3d_before = crate::Quality::surface(&mesh, &z).min_angle;
     if settings.improve_3d {
         let limit = report.error_after_refinement;
         let min2d = settings.min_angle;
         for _ in 0..3 {
-            let flips = improve_flips(&mut mesh, &z, &h, limit, min2d);
+            let flips = improve_flips(&mut mesh, &z, &h, limit, min2d)?;
             let moves = improve_moves(
                 &mut mesh,
                 &mut z,
@@ -218,7 +255,7 @@ pub fn adaptive_mesh(
                 limit,
                 min2d,
                 settings.smooth_iterations,
-            );
+            )?;
             report.flips += flips;
             report.moves += moves;
             if flips + moves == 0 {
@@ -226,9 +263,16 @@ pub fn adaptive_mesh(
             }
         }
     }
-    report.max_error = surface_error_local(&mesh, &z, &h);
+    report.max_error = surface_error_local(&mesh, &z, &h)?;
     report.min_angle_3d = crate::Quality::surface(&mesh, &z).min_angle;
     Ok((mesh, z, report))
+}
+
+/// `f` at the local point `p` of a triangulation with origin `o`.
+fn local_height(f: &dyn HeightFunction, o: [f64; 2], p: [f64; 2]) -> Result<f64, MeshError> {
+    let at = [p[0] + o[0], p[1] + o[1]];
+    f.height(at[0], at[1])
+        .map_err(|why| MeshError::Height { at, why })
 }
 
 fn incomplete(cap: usize, st: &CdtState) -> MeshError {
@@ -239,7 +283,8 @@ fn incomplete(cap: usize, st: &CdtState) -> MeshError {
 }
 
 /// Largest vertical distance between the mesh surface (heights `z` at the vertices) and `f`
-/// at triangle centres and edge midpoints. `f` takes absolute coordinates.
+/// at triangle centres and edge midpoints. `f` takes absolute coordinates and cannot fail
+/// (for one that can, evaluate it at [`error_probes`]).
 ///
 /// ```
 /// use terramesh_mesh::{surface_error, Mesh};
@@ -256,9 +301,13 @@ fn incomplete(cap: usize, st: &CdtState) -> MeshError {
 /// let z: Vec<f64> = (0..3).map(|i| { let p = m.absolute(i); bowl(p[0], p[1]) }).collect();
 /// assert!((surface_error(&m, &z, &bowl) - 2.0).abs() < 1e-12); // midpoint (1, 1)
 /// ```
-pub fn surface_error(mesh: &Mesh, z: &[f64], f: &dyn HeightFunction) -> f64 {
+pub fn surface_error(mesh: &Mesh, z: &[f64], f: &dyn Fn(f64, f64) -> f64) -> f64 {
     let o = mesh.origin;
-    surface_error_local(mesh, z, &|p: [f64; 2]| f.height(p[0] + o[0], p[1] + o[1]))
+    let h = |p: [f64; 2]| Ok(f(p[0] + o[0], p[1] + o[1]));
+    match surface_error_local(mesh, z, &h) {
+        Ok(e) => e,
+        Err(_) => unreachable!("an infallible height function failed"),
+    }
 }
 
 /// The points where [`surface_error`] compares the mesh with a height function, in absolute
@@ -308,28 +357,29 @@ pub fn error_probes(mesh: &Mesh, z: &[f64]) -> (Vec<[f64; 2]>, Vec<f64>) {
     (pts, lin)
 }
 
-fn surface_error_local(mesh: &Mesh, z: &[f64], h: &dyn Fn([f64; 2]) -> f64) -> f64 {
-    mesh.triangles
-        .iter()
-        .map(|t| tri_error(mesh, z, h, *t))
-        .fold(0.0, f64::max)
+fn surface_error_local(mesh: &Mesh, z: &[f64], h: &LocalHeight) -> Result<f64, MeshError> {
+    let mut worst = 0.0f64;
+    for t in &mesh.triangles {
+        worst = worst.max(tri_error(mesh, z, h, *t)?);
+    }
+    Ok(worst)
 }
 
 /// Error of one triangle at its centre and its three edge midpoints.
-fn tri_error(mesh: &Mesh, z: &[f64], h: &dyn Fn([f64; 2]) -> f64, t: [u32; 3]) -> f64 {
+fn tri_error(mesh: &Mesh, z: &[f64], h: &LocalHeight, t: [u32; 3]) -> Result<f64, MeshError> {
     let p = t.map(|i| mesh.points[i as usize]);
     let zz = t.map(|i| z[i as usize]);
     let c = [
         (p[0][0] + p[1][0] + p[2][0]) / 3.0,
         (p[0][1] + p[1][1] + p[2][1]) / 3.0,
     ];
-    let mut e = (h(c) - (zz[0] + zz[1] + zz[2]) / 3.0).abs();
+    let mut e = (h(c)? - (zz[0] + zz[1] + zz[2]) / 3.0).abs();
     for k in 0..3 {
         let (a, b) = (k, (k + 1) % 3);
         let m = [0.5 * (p[a][0] + p[b][0]), 0.5 * (p[a][1] + p[b][1])];
-        e = e.max((h(m) - 0.5 * (zz[a] + zz[b])).abs());
+        e = e.max((h(m)? - 0.5 * (zz[a] + zz[b])).abs());
     }
-    e
+    Ok(e)
 }
 
 fn q3(mesh: &Mesh, z: &[f64], t: [u32; 3]) -> (f64, f64) {
@@ -348,34 +398,49 @@ fn q3(mesh: &Mesh, z: &[f64], t: [u32; 3]) -> (f64, f64) {
 }
 
 /// Flips that raise the pair's minimum 3D angle, keep its planar minimum angle at or above
-/// `min(old, min2d)`, and keep the error within `limit`.
+/// `min(old, min2d)`, and keep the error within `limit`. After a failure of `h` no flip is
+/// accepted and `h` is not asked again; the failure is returned.
 fn improve_flips(
     mesh: &mut Mesh,
     z: &[f64],
-    h: &dyn Fn([f64; 2]) -> f64,
+    h: &LocalHeight,
     limit: f64,
     min2d: f64,
-) -> usize {
-    flip_passes(mesh, 20, |m, [a, b, c, d]| {
+) -> Result<usize, MeshError> {
+    let mut failure = None;
+    let flips = flip_passes(mesh, 20, |m, [a, b, c, d]| {
+        if failure.is_some() {
+            return false;
+        }
         let (o1, p1) = q3(m, z, [a, b, c]);
         let (o2, p2) = q3(m, z, [b, a, d]);
         let (n1, r1) = q3(m, z, [c, a, d]);
         let (n2, r2) = q3(m, z, [c, d, b]);
-        n1.min(n2) > o1.min(o2) + 1e-9
-            && r1.min(r2) >= p1.min(p2).min(min2d)
-            && tri_error(m, z, h, [c, a, d]).max(tri_error(m, z, h, [c, d, b])) <= limit
-    })
+        if !(n1.min(n2) > o1.min(o2) + 1e-9 && r1.min(r2) >= p1.min(p2).min(min2d)) {
+            return false;
+        }
+        let error =
+            tri_error(m, z, h, [c, a, d]).and_then(|e1| Ok(e1.max(tri_error(m, z, h, [c, d, b])?)));
+        match error {
+            Ok(e) => e <= limit,
+            Err(e) => {
+                failure = Some(e);
+                false
+            }
+        }
+    });
+    failure.map_or(Ok(flips), Err)
 }
 
 /// Smart-Laplacian moves of free vertices judged on the lifted star.
 fn improve_moves(
     mesh: &mut Mesh,
     z: &mut [f64],
-    h: &dyn Fn([f64; 2]) -> f64,
+    h: &LocalHeight,
     limit: f64,
     min2d: f64,
     iterations: usize,
-) -> usize {
+) -> Result<usize, MeshError> {
     let fixed = mesh.fixed_vertices();
     let (off, tris) = mesh.vertex_stars();
     let mut moves = 0;
@@ -398,18 +463,23 @@ fn improve_moves(
             let (old3, old2) = stats(mesh, z);
             let (old_p, old_z) = (mesh.points[v], z[v]);
             mesh.points[v] = target;
-            z[v] = h(target);
+            z[v] = h(target)?;
             let valid = star.iter().all(|&t| {
                 let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.points[i as usize]);
                 orient(a, b, c) > 0.0
             });
             let ok = valid && {
                 let (new3, new2) = stats(mesh, z);
-                new3 > old3 + 1e-9
-                    && new2 >= old2.min(min2d)
-                    && star
-                        .iter()
-                        .all(|&t| tri_error(mesh, z, h, mesh.triangles[t as usize]) <= limit)
+                new3 > old3 + 1e-9 && new2 >= old2.min(min2d) && {
+                    let mut within = true;
+                    for &t in star {
+                        if tri_error(mesh, z, h, mesh.triangles[t as usize])? > limit {
+                            within = false;
+                            break;
+                        }
+                    }
+                    within
+                }
             };
             if ok {
                 moved += 1;
@@ -423,5 +493,5 @@ fn improve_moves(
             break;
         }
     }
-    moves
+    Ok(moves)
 }

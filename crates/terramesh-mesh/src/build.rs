@@ -7,11 +7,16 @@ use terramesh_core::geometry::{validate, Region};
 
 use crate::cdt::{check_coordinate, CdtState};
 use crate::mesh::Mesh;
+use crate::refine::{default_cap, refine};
+use crate::report::BuildReport;
 use crate::MeshError;
 
 /// The largest minimum angle refinement can guarantee (degrees). spade's refinement
 /// terminates up to 33 degrees and runs away at 34 (measured, see `docs/meshing.md`).
 pub const MAX_MIN_ANGLE: f64 = 33.0;
+
+/// The minimum angle meshes are refined to unless told otherwise (degrees).
+pub const DEFAULT_MIN_ANGLE: f64 = 30.0;
 
 /// Area of an equilateral triangle of unit side, `√3/4` rounded down.
 const EQUILATERAL_AREA: f64 = 0.433;
@@ -51,30 +56,6 @@ pub struct MeshBuilder {
     strips: Option<usize>,
 }
 
-/// What [`MeshBuilder::build`] did.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct BuildReport {
-    /// Vertices before refinement: rings, lines and sample points inside the region, the
-    /// seeding lattice, and in strips the vertices the cuts are split at.
-    pub input_vertices: usize,
-    /// Sample points given with [`MeshBuilder::points`] that lie outside the region (skipped).
-    pub points_outside: usize,
-    /// Steiner points added by refinement (where the whole hull is refined, those outside the
-    /// region too).
-    pub steiner_points: usize,
-    /// The vertex cap refinement ran under.
-    pub vertex_cap: usize,
-    /// True when refinement met every criterion before reaching the cap.
-    pub refinement_complete: bool,
-    /// Vertical strips the region was meshed in, in parallel (1: in one piece). Strips meet
-    /// along straight cuts that both sides were refined against as constraints: the mesh is
-    /// Delaunay within each strip, not across the cuts (which are not among its
-    /// `constraint_edges`); angle and size limits hold everywhere.
-    pub strips: usize,
-    /// Rounds of exchanging cut vertices between neighbouring strips (0 in one piece).
-    pub strip_rounds: usize,
-}
-
 impl Default for MeshBuilder {
     fn default() -> Self {
         Self::new()
@@ -82,11 +63,11 @@ impl Default for MeshBuilder {
 }
 
 impl MeshBuilder {
-    /// Defaults: minimum angle 30 degrees, no area or edge limit, vertex cap from the area
+    /// Defaults: minimum angle [`DEFAULT_MIN_ANGLE`] (30 degrees), no area or edge limit, vertex cap from the area
     /// budget, no sample points.
     pub fn new() -> Self {
         MeshBuilder {
-            min_angle: 30.0,
+            min_angle: DEFAULT_MIN_ANGLE,
             max_area: None,
             max_edge: None,
             max_vertices: None,
@@ -138,13 +119,13 @@ impl MeshBuilder {
         };
         if !(0.0..=MAX_MIN_ANGLE).contains(&self.min_angle) {
             return Err(bad(
-                "min-angle",
+                "min_angle",
                 self.min_angle,
                 "must be between 0 and 33 degrees: Delaunay refinement cannot guarantee more \
                  (it does not terminate at 34)",
             ));
         }
-        for (name, v) in [("max-area", self.max_area), ("max-edge", self.max_edge)] {
+        for (name, v) in [("max_area", self.max_area), ("max_edge", self.max_edge)] {
             if let Some(v) = v {
                 if !(v.is_finite() && v > 0.0) {
                     return Err(bad(name, v, "must be a positive number"));
@@ -240,30 +221,6 @@ impl MeshBuilder {
         }
         Ok((state.extract(), report))
     }
-}
-
-/// The default cap on added vertices (see [`MeshBuilder::max_vertices`]): four times the area
-/// budget `area / budget`, plus 1,000 per input vertex, plus 100,000.
-pub(crate) fn default_cap(area: f64, budget: Option<f64>, n0: usize) -> usize {
-    budget.map_or(0, |a| (4.0 * area / a).min(1e12) as usize) + 1000 * n0 + 100_000
-}
-
-/// Refines to the angle and size; with an edge limit, splits the edges longer than it and
-/// refines again until none is. Returns whether refinement finished within `max_vertices`.
-pub(crate) fn refine(
-    state: &mut CdtState,
-    min_angle: f64,
-    budget: Option<f64>,
-    max_edge: Option<f64>,
-    max_vertices: usize,
-) -> Result<bool, MeshError> {
-    let mut complete = state.refine(min_angle, budget, max_vertices)?;
-    if let Some(l) = max_edge {
-        while complete && state.split_long_edges(l)? > 0 {
-            complete = state.refine(min_angle, budget, max_vertices)?;
-        }
-    }
-    Ok(complete)
 }
 
 /// Plain Delaunay triangulation for a single convex polygon without holes or lines: its hull

@@ -35,32 +35,40 @@ mod mesh;
 mod order;
 /// Quality metrics in 2D and 3D.
 mod quality;
+/// The refinement driver and the default vertex cap, shared by the build and the strips.
+mod refine;
+/// What a build did.
+mod report;
 /// Laplacian, smart Laplacian and ODT smoothing.
 mod smooth;
 /// Meshing large regions in vertical strips, in parallel.
 mod strips;
 
 pub use adaptive::{
-    adaptive_mesh, error_probes, surface_error, AdaptiveReport, AdaptiveSettings, HeightFunction,
+    adaptive_mesh, error_probes, surface_error, AdaptiveReport, AdaptiveSettings, Fallible,
+    HeightFunction,
 };
-pub use build::{BuildReport, MeshBuilder, MAX_MIN_ANGLE};
+pub use build::{MeshBuilder, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE};
 pub use flip::delaunay_flips;
 pub use mesh::Mesh;
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
-pub use smooth::{smooth, SmoothReport, Smoother};
+pub use report::BuildReport;
+pub use smooth::{smooth, SmoothReport, Smoother, DEFAULT_SMOOTHER};
 
 use terramesh_core::geometry::ValidationError;
 
 /// Errors of mesh construction.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum MeshError {
     /// The region is not a valid polygon set.
     #[error("invalid region: {0}")]
     InvalidRegion(#[from] ValidationError),
     /// A setting is out of range.
-    #[error("--{name} {value}: {why}")]
+    #[error("{name} = {value}: {why}")]
     BadParameter {
-        /// The setting, named as the command-line flag.
+        /// The setting, named as the field of [`MeshBuilder`] or [`AdaptiveSettings`]
+        /// (`"min_angle"`, `"max_area"`, `"max_edge"`, `"max_error"`).
         name: &'static str,
         /// Its value.
         value: f64,
@@ -79,13 +87,21 @@ pub enum MeshError {
     /// returned rather than a poor one.
     #[error(
         "refinement reached its cap of {cap} added vertices ({vertices} vertices) before meeting \
-         the angle and size limits; raise --max-vertices, raise --max-area or --max-edge, or \
-         lower --min-angle"
+         the angle and size limits; raise max_vertices, raise max_area or max_edge, or lower \
+         min_angle"
     )]
     Incomplete {
         /// The cap on added vertices.
         cap: usize,
         /// Vertices when it stopped.
         vertices: usize,
+    },
+    /// The height function of [`adaptive_mesh`] failed; refinement stopped there.
+    #[error("no height at ({}, {}): {why}", at[0], at[1])]
+    Height {
+        /// The point, in the region's (absolute) coordinates.
+        at: [f64; 2],
+        /// The function's reason.
+        why: String,
     },
 }

@@ -5,20 +5,43 @@
 
 use crate::mesh::{orient, Mesh};
 
-/// Smoothing method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Smoothing method, named `laplacian`, `smart` and `odt` (see
+/// [`terramesh_core::vocab`]).
+///
+/// ```
+/// use terramesh_mesh::{Smoother, DEFAULT_SMOOTHER};
+/// assert_eq!("ODT".parse::<Smoother>()?, Smoother::Odt);
+/// assert_eq!(DEFAULT_SMOOTHER.to_string(), "smart");
+/// # Ok::<(), terramesh_core::vocab::UnknownName>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Smoother {
     /// Move each free vertex to the mean of its neighbours (Mei, Tipper & Xu). A move that
     /// would fold a triangle over is skipped.
     Laplacian,
     /// Laplacian moves accepted only when the smallest angle of the vertex's star does not
     /// decrease (Freitag's "smart" Laplacian). Never lowers the mesh's minimum angle.
-    #[default]
     Smart,
     /// Optimal Delaunay triangulation smoothing (Chen & Xu 2004): move to the area-weighted
     /// mean of the circumcentres of the star's triangles. Accepted when no triangle folds and
     /// the star's smallest angle stays at or above the mesh's minimum angle before smoothing.
     Odt,
+}
+
+terramesh_core::named_enum!(Smoother, "smoother", [
+    Smoother::Laplacian => "laplacian",
+    Smoother::Smart => "smart",
+    Smoother::Odt => "odt",
+]);
+
+/// The smoother used unless told otherwise.
+pub const DEFAULT_SMOOTHER: Smoother = Smoother::Smart;
+
+impl Default for Smoother {
+    /// [`DEFAULT_SMOOTHER`].
+    fn default() -> Self {
+        DEFAULT_SMOOTHER
+    }
 }
 
 /// What [`smooth`] did.

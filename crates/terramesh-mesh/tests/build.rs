@@ -187,7 +187,7 @@ fn angle_beyond_guarantee_is_rejected() {
         matches!(
             e,
             MeshError::BadParameter {
-                name: "min-angle",
+                name: "min_angle",
                 ..
             }
         ),
@@ -195,7 +195,7 @@ fn angle_beyond_guarantee_is_rejected() {
     );
     assert!(e.to_string().contains("33"), "{e}");
     let e = MeshBuilder::new().max_area(-1.0).build(&r).unwrap_err();
-    assert!(e.to_string().contains("--max-area -1"), "{e}");
+    assert!(e.to_string().contains("max_area = -1"), "{e}");
 }
 
 #[test]

@@ -63,6 +63,7 @@ impl Default for FetchOptions {
 
 /// Why one point has no elevation.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum PointError {
     /// The service answered but has no data there (`null` elevation).
     #[error("the service has no data at this location")]

@@ -5,7 +5,24 @@
 //! short replies), an on-disk cache and a resumable journal; and Terrarium terrain tiles
 //! fetched from a URL template with a disk cache.
 //!
-//! [`mock`] is a fault-injecting HTTP server on 127.0.0.1 for tests and benchmarks.
+//! [`mock`] is a fault-injecting HTTP server on 127.0.0.1 for tests and benchmarks; the
+//! example asks it for two points, the way a client asks OpenTopoData:
+//!
+//! ```
+//! # fn main() -> Result<(), terramesh_web::WebError> {
+//! use std::sync::atomic::AtomicBool;
+//! use std::time::Duration;
+//! use terramesh_web::mock::{elevation_at, Fault, MockServer};
+//! use terramesh_web::{fetch, Endpoint, FetchOptions, PointError, ServiceKind};
+//! let server = MockServer::start(ServiceKind::OpenTopoData, Duration::ZERO, |_, _| Fault::None, Default::default());
+//! let service = Endpoint::parse(&format!("opentopodata:{}/v1/srtm30m", server.url()), None)?;
+//! let points = [[48.7242, 7.3386], [89.5, 0.0]]; // [lat, lon]; the mock has no data north of 89 N
+//! let (z, stats) = fetch(&service, &points, &FetchOptions::default(), &|_, _| {}, &AtomicBool::new(false))?;
+//! assert_eq!(z[0], Ok(elevation_at(48.7242, 7.3386).unwrap()));
+//! assert!(matches!(z[1], Err(PointError::NoData)));
+//! assert_eq!(stats.requests, 1);
+//! # Ok(()) }
+//! ```
 #![warn(missing_docs)]
 
 mod endpoint;
@@ -21,6 +38,7 @@ pub use tiles::{fetch_tiles, TileOptions};
 
 /// Errors that stop a whole fetch.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum WebError {
     /// A bad source specification or option.
     #[error("{0}")]

@@ -64,7 +64,7 @@ pub enum Error {
     Table(#[from] terramesh_io::table::TableError),
     /// Writing a mesh file.
     #[error(transparent)]
-    MeshWrite(#[from] terramesh_io::mesh_write::MeshWriteError),
+    MeshWrite(#[from] terramesh_io::export::MeshWriteError),
     /// Drawing a picture.
     #[error(transparent)]
     Picture(#[from] terramesh_io::pictures::PictureError),

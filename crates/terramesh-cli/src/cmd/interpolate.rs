@@ -9,7 +9,7 @@ use anyhow::{bail, Context, Result};
 use terramesh_geostat::{
     experimental, Data, Drift, GlobalKriging, Idw, IdwSearch, LocalKriging, Method, Variogram,
 };
-use terramesh_io::grid_write::{write_asc, write_geotiff, GridSpec};
+use terramesh_io::grid_write::{write_asc, write_geotiff, RasterGrid};
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 
@@ -238,7 +238,7 @@ pub fn run(args: Args) -> Result<()> {
     match (&args.targets, &args.grid) {
         (Some(t), None) => run_points(&eng, t, want_var, args.output.as_deref()),
         (None, Some(g)) => {
-            let spec: GridSpec = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
+            let spec: RasterGrid = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
             let Some(out) = &args.output else {
                 bail!("--grid needs -o FILE.asc or -o FILE.tif");
             };
@@ -350,7 +350,7 @@ fn shift_target(msg: &str, offset: usize) -> String {
     msg.to_string()
 }
 
-fn run_grid(eng: &Engine, g: &GridSpec, out_path: &Path, epsg: Option<u16>) -> Result<()> {
+fn run_grid(eng: &Engine, g: &RasterGrid, out_path: &Path, epsg: Option<u16>) -> Result<()> {
     let ext = out_path
         .extension()
         .and_then(|e| e.to_str())

@@ -5,10 +5,12 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use terramesh_core::coords::{parse_angle, to_utm, Axis, Zone};
 use terramesh_io::dem::open_raster;
-use terramesh_io::mesh_write::{write_mesh, writer_for, MeshView};
+use terramesh_io::export::{write_mesh, writer_for, MeshView};
 use terramesh_io::region::{load, RegionCrs, RegionInput};
 use terramesh_io::table::{ReadOptions, Table};
-use terramesh_mesh::{adaptive_mesh, smooth, AdaptiveSettings, MeshBuilder, Quality, Smoother};
+use terramesh_mesh::{
+    adaptive_mesh, smooth, AdaptiveSettings, Fallible, MeshBuilder, MeshError, Quality, Smoother,
+};
 
 /// Coordinate reference of the input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -139,7 +141,9 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(k) = args.strips {
         builder = builder.strips(k.into());
     }
-    let (mut mesh, report) = builder.build(&region.projected)?;
+    let (mut mesh, report) = builder
+        .build(&region.projected)
+        .map_err(crate::wording::mesh_error)?;
     let mut text = String::new();
     if let Some(z) = region.zone {
         text += &format!(
@@ -190,7 +194,7 @@ fn run_adaptive(
     max_error: f64,
     dem_path: &std::path::Path,
 ) -> Result<()> {
-    use terramesh_core::sampling::Method;
+    use terramesh_core::sampling::Kernel;
     let dem =
         open_raster(dem_path, true).with_context(|| format!("--dem {}", dem_path.display()))?;
     let zone = region.zone;
@@ -206,8 +210,8 @@ fn run_adaptive(
             }
             None => (x, y),
         };
-        dem.sample(sx, sy, Method::Bilinear)
-            .or_else(|_| dem.sample(sx, sy, Method::Nearest))
+        dem.sample(sx, sy, Kernel::Bilinear)
+            .or_else(|_| dem.sample(sx, sy, Kernel::Nearest))
             .map_err(|e| e.to_string())
     };
     // The DEM must cover the region: check its corners and a 100 x 100 grid inside it.
@@ -239,26 +243,21 @@ fn run_adaptive(
             );
         }
     }
-    let failed = std::sync::atomic::AtomicBool::new(false);
-    let f = |x: f64, y: f64| {
-        at(x, y).unwrap_or_else(|_| {
-            failed.store(true, std::sync::atomic::Ordering::Relaxed);
-            0.0
-        })
-    };
+    let f = Fallible(at);
     let mut settings = AdaptiveSettings::new(max_error);
     settings.min_angle = args.min_angle;
     settings.max_area = args.max_area;
     if let Some(n) = args.max_vertices {
         settings.max_vertices = n;
     }
-    let (mesh, z, rep) = adaptive_mesh(&region.projected, &settings, &f)?;
-    if failed.load(std::sync::atomic::Ordering::Relaxed) {
-        bail!(
+    let (mesh, z, rep) = match adaptive_mesh(&region.projected, &settings, &f) {
+        Ok(out) => out,
+        Err(MeshError::Height { .. }) => bail!(
             "--dem {}: the DEM has no elevation at some point inside the region",
             dem_path.display()
-        );
-    }
+        ),
+        Err(e) => return Err(crate::wording::mesh_error(e)),
+    };
     let mut text = String::new();
     if let Some(z) = zone {
         text += &format!(

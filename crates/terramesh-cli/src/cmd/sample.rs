@@ -92,7 +92,7 @@ pub struct Args {
     pub grid_crs: GridCrsArg,
     /// Raster interpolation: bilinear (default), bicubic or nearest.
     #[arg(long, default_value = "bilinear")]
-    pub interpolation: terramesh_core::sampling::Method,
+    pub interpolation: terramesh_core::sampling::Kernel,
     /// A point outside the data, on a void, or failed by the service: error (stop, default),
     /// nodata (write --nodata and the reason in an `error` column) or skip (leave it out and
     /// say how many).

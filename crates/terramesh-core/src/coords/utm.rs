@@ -36,6 +36,7 @@ pub struct Zone {
 
 /// Errors from coordinate conversion and parsing.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CoordError {
     /// A zone string that is not `1..=60` followed by `N` or `S`.
     #[error(
@@ -43,7 +44,7 @@ pub enum CoordError {
     )]
     BadZone(String),
     /// A latitude outside the UTM domain −80..84 degrees with no forced zone.
-    #[error("latitude {0} is outside the UTM domain (-80..84 degrees); force a zone with --zone to project it anyway")]
+    #[error("latitude {0} is outside the UTM domain (-80..84 degrees); force a zone to project it anyway")]
     OutsideUtm(f64),
     /// A latitude or longitude out of its range, or not finite.
     #[error("{what} {value} is out of range ({range})")]

@@ -8,6 +8,7 @@ use super::region::{ring_contains, ring_signed_area, Polygon, Region};
 /// Why a region cannot be meshed. Locations are in the region's own coordinates
 /// (`[lon, lat]` degrees or projected metres).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ValidationError {
     /// The region has no polygon.
     #[error("the region has no polygon")]

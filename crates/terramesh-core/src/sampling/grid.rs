@@ -54,9 +54,10 @@ impl Margin {
     }
 }
 
-/// A sample grid request.
+/// A sampling grid over a region: its size (rows x cols or a spacing), a margin around the
+/// region's bounding box, and whether to clip back to the region.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridSpec {
+pub struct SamplingGrid {
     /// Number of nodes or spacing.
     pub size: GridSize,
     /// Enlargement of the bounding box (default none).
@@ -67,6 +68,7 @@ pub struct GridSpec {
 
 /// Errors building a grid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum GridError {
     /// The grid request is invalid.
     #[error("{0}")]
@@ -87,17 +89,17 @@ pub struct Grid {
     pub index: Vec<(u32, u32)>,
 }
 
-impl GridSpec {
+impl SamplingGrid {
     /// Builds the grid over `region` (any planar coordinates: UTM metres or lon/lat degrees).
     ///
     /// ```
     /// use terramesh_core::geometry::Region;
-    /// use terramesh_core::sampling::{GridSize, GridSpec, Margin};
+    /// use terramesh_core::sampling::{GridSize, SamplingGrid, Margin};
     /// let tri = Region::from_ring(vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]);
-    /// let spec = GridSpec { size: GridSize::RowsCols { rows: 11, cols: 11 },
+    /// let spec = SamplingGrid { size: GridSize::RowsCols { rows: 11, cols: 11 },
     ///                       margin: Margin::Fraction(0.0), clip: false };
     /// assert_eq!(spec.build(&tri)?.nodes.len(), 121);
-    /// let clipped = GridSpec { clip: true, ..spec }.build(&tri)?;
+    /// let clipped = SamplingGrid { clip: true, ..spec }.build(&tri)?;
     /// assert!(clipped.nodes.len() >= 36 && clipped.nodes.iter().all(|p| p[0] + p[1] <= 10.0));
     /// # Ok::<(), terramesh_core::sampling::GridError>(())
     /// ```
@@ -181,7 +183,7 @@ mod tests {
 
     #[test]
     fn rows_cols_span_the_enlarged_box_exactly() {
-        let spec = GridSpec {
+        let spec = SamplingGrid {
             size: GridSize::RowsCols {
                 rows: 100,
                 cols: 50,
@@ -200,14 +202,14 @@ mod tests {
 
     #[test]
     fn clip_keeps_only_inside_nodes() {
-        let spec = GridSpec {
+        let spec = SamplingGrid {
             size: GridSize::Spacing(5.0),
             margin: Margin::Absolute(20.0),
             clip: true,
         };
         let g = spec.build(&rect()).unwrap();
         assert!(g.nodes.iter().all(|p| rect().contains(*p)));
-        let all = GridSpec {
+        let all = SamplingGrid {
             clip: false,
             ..spec
         }
@@ -241,7 +243,7 @@ mod tests {
     fn bad_requests_are_errors() {
         let r = rect();
         let mk = |size, margin| {
-            GridSpec {
+            SamplingGrid {
                 size,
                 margin,
                 clip: false,

@@ -1,8 +1,5 @@
 //! Interpolation kernels on a grid of posts (a DEM's sample points).
 
-use std::fmt;
-use std::str::FromStr;
-
 /// What a grid of posts holds at one post.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Post {
@@ -33,15 +30,17 @@ pub enum Missing {
     Void,
 }
 
-/// Interpolation method.
+/// The interpolation kernel of a raster sampler, named `bilinear`, `bicubic` (alias `cubic`)
+/// and `nearest` (see [`crate::vocab`]).
 ///
 /// ```
-/// use terramesh_core::sampling::Method;
-/// assert_eq!("cubic".parse::<Method>(), Ok(Method::Bicubic));
-/// assert_eq!(Method::default().to_string(), "bilinear");
+/// use terramesh_core::sampling::Kernel;
+/// assert_eq!("cubic".parse::<Kernel>(), Ok(Kernel::Bicubic));
+/// assert_eq!("Nearest".parse::<Kernel>(), Ok(Kernel::Nearest));
+/// assert_eq!(Kernel::default().to_string(), "bilinear");
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Method {
+pub enum Kernel {
     /// The nearest post (ties round away from zero).
     Nearest,
     /// Bilinear on the 2 x 2 posts around the point (the default).
@@ -52,29 +51,11 @@ pub enum Method {
     Bicubic,
 }
 
-impl FromStr for Method {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Method, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "nearest" => Ok(Method::Nearest),
-            "bilinear" => Ok(Method::Bilinear),
-            "bicubic" | "cubic" => Ok(Method::Bicubic),
-            _ => Err(format!(
-                "unknown interpolation '{s}': use nearest, bilinear or bicubic"
-            )),
-        }
-    }
-}
-
-impl fmt::Display for Method {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Method::Nearest => "nearest",
-            Method::Bilinear => "bilinear",
-            Method::Bicubic => "bicubic",
-        })
-    }
-}
+crate::named_enum!(Kernel, "interpolation", [
+    Kernel::Bilinear => "bilinear",
+    Kernel::Bicubic => "bicubic" | "cubic",
+    Kernel::Nearest => "nearest",
+]);
 
 fn value(p: Post) -> Result<f64, Missing> {
     match p {
@@ -98,7 +79,7 @@ fn lerp(a: f64, b: f64, t: f64) -> f64 {
 /// row of the data gets that post's value.
 ///
 /// ```
-/// use terramesh_core::sampling::{interpolate, Method, Post, Posts};
+/// use terramesh_core::sampling::{interpolate, Kernel, Post, Posts};
 /// struct Plane; // z = 10 row + col on a 3 x 3 grid
 /// impl Posts for Plane {
 ///     fn post(&self, r: i64, c: i64) -> Post {
@@ -106,25 +87,25 @@ fn lerp(a: f64, b: f64, t: f64) -> f64 {
 ///         else { Post::Outside }
 ///     }
 /// }
-/// assert_eq!(interpolate(&Plane, 1.5, 0.25, Method::Bilinear)?, 15.25);
-/// assert_eq!(interpolate(&Plane, 2.0, 2.0, Method::Bicubic)?, 22.0);
-/// assert!(interpolate(&Plane, 2.5, 0.0, Method::Bilinear).is_err());
+/// assert_eq!(interpolate(&Plane, 1.5, 0.25, Kernel::Bilinear)?, 15.25);
+/// assert_eq!(interpolate(&Plane, 2.0, 2.0, Kernel::Bicubic)?, 22.0);
+/// assert!(interpolate(&Plane, 2.5, 0.0, Kernel::Bilinear).is_err());
 /// # Ok::<(), terramesh_core::sampling::Missing>(())
 /// ```
 pub fn interpolate<P: Posts + ?Sized>(
     posts: &P,
     row: f64,
     col: f64,
-    method: Method,
+    method: Kernel,
 ) -> Result<f64, Missing> {
     if !row.is_finite() || !col.is_finite() || row.abs() > 1e15 || col.abs() > 1e15 {
         return Err(Missing::Outside);
     }
     let (row, col) = (snap(row), snap(col));
     match method {
-        Method::Nearest => value(posts.post(row.round() as i64, col.round() as i64)),
-        Method::Bilinear => bilinear(posts, row, col),
-        Method::Bicubic => bicubic(posts, row, col).or_else(|_| bilinear(posts, row, col)),
+        Kernel::Nearest => value(posts.post(row.round() as i64, col.round() as i64)),
+        Kernel::Bilinear => bilinear(posts, row, col),
+        Kernel::Bicubic => bicubic(posts, row, col).or_else(|_| bilinear(posts, row, col)),
     }
 }
 
@@ -230,7 +211,7 @@ mod tests {
             f: hash,
             voids: vec![(2, 2)],
         };
-        for m in [Method::Nearest, Method::Bilinear, Method::Bicubic] {
+        for m in [Kernel::Nearest, Kernel::Bilinear, Kernel::Bicubic] {
             for r in 0..6 {
                 for c in 0..5 {
                     let got = interpolate(&g, r as f64, c as f64, m);
@@ -255,7 +236,7 @@ mod tests {
         };
         for &(r, c) in &[(0.3, 0.7), (3.5, 4.25), (6.9, 6.1), (1.0, 5.5)] {
             let want = 3.0 * r - 2.0 * c + 100.0;
-            for m in [Method::Bilinear, Method::Bicubic] {
+            for m in [Kernel::Bilinear, Kernel::Bicubic] {
                 let got = interpolate(&g, r, c, m).unwrap();
                 assert!(
                     (got - want).abs() < 1e-12,
@@ -276,7 +257,7 @@ mod tests {
         };
         let (r, c) = (3.3, 4.6);
         let want = r * r + 0.5 * c * c - r * c;
-        let got = interpolate(&g, r, c, Method::Bicubic).unwrap();
+        let got = interpolate(&g, r, c, Kernel::Bicubic).unwrap();
         assert!((got - want).abs() < 1e-9, "{got} vs {want}");
     }
 
@@ -289,24 +270,24 @@ mod tests {
             voids: vec![(1, 1)],
         };
         assert_eq!(
-            interpolate(&g, 0.5, 0.5, Method::Bilinear),
+            interpolate(&g, 0.5, 0.5, Kernel::Bilinear),
             Err(Missing::Void)
         );
         assert_eq!(
-            interpolate(&g, 3.5, 0.5, Method::Bilinear),
+            interpolate(&g, 3.5, 0.5, Kernel::Bilinear),
             Err(Missing::Outside)
         );
-        assert_eq!(interpolate(&g, -0.1, 0.5, Method::Nearest), Ok(hash(0, 1)));
+        assert_eq!(interpolate(&g, -0.1, 0.5, Kernel::Nearest), Ok(hash(0, 1)));
         assert_eq!(
-            interpolate(&g, -0.6, 0.5, Method::Nearest),
+            interpolate(&g, -0.6, 0.5, Kernel::Nearest),
             Err(Missing::Outside)
         );
         assert_eq!(
-            interpolate(&g, f64::NAN, 0.5, Method::Bilinear),
+            interpolate(&g, f64::NAN, 0.5, Kernel::Bilinear),
             Err(Missing::Outside)
         );
         // bicubic falls back to bilinear at the edge, where the 4 x 4 stencil is incomplete
-        let b = interpolate(&g, 0.5, 2.5, Method::Bicubic).unwrap();
-        assert_eq!(b, interpolate(&g, 0.5, 2.5, Method::Bilinear).unwrap());
+        let b = interpolate(&g, 0.5, 2.5, Kernel::Bicubic).unwrap();
+        assert_eq!(b, interpolate(&g, 0.5, 2.5, Kernel::Bilinear).unwrap());
     }
 }

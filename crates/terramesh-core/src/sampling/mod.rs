@@ -1,10 +1,10 @@
 //! Elevation sampling (the paper's step 1): grids of sample nodes over a region, and
 //! interpolation kernels on a grid of posts.
 //!
-//! * [`GridSpec`], [`Grid`]: a rows x cols (or spacing) grid over a region's bounding box,
+//! * [`SamplingGrid`], [`Grid`]: a rows x cols (or spacing) grid over a region's bounding box,
 //!   enlarged by a margin and optionally clipped back to the region.
 //! * [`grid_nodes`]: those grids as nodes with UTM and WGS-84 coordinates.
-//! * [`Posts`], [`interpolate`], [`Method`]: nearest, bilinear and bicubic interpolation at
+//! * [`Posts`], [`interpolate`], [`Kernel`]: nearest, bilinear and bicubic interpolation at
 //!   fractional post coordinates, exact at posts, with voids and the data edge reported.
 
 mod grid;
@@ -12,7 +12,7 @@ mod interp;
 mod nodes;
 mod surface;
 
-pub use grid::{Grid, GridError, GridSize, GridSpec, Margin};
-pub use interp::{interpolate, Method, Missing, Post, Posts};
+pub use grid::{Grid, GridError, GridSize, Margin, SamplingGrid};
+pub use interp::{interpolate, Kernel, Missing, Post, Posts};
 pub use nodes::{grid_nodes, GridPlane, Node, NodeError};
 pub use surface::GridSurface;

@@ -5,16 +5,19 @@ use rayon::prelude::*;
 use crate::coords::{to_utm, to_wgs84, CoordError, Zone};
 use crate::geometry::Region;
 
-use super::{GridError, GridSpec};
+use super::{GridError, SamplingGrid};
 
-/// The plane a grid is laid out in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The plane a grid is laid out in, named `utm` and `latlon` (see [`crate::vocab`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum GridPlane {
     /// Regular in UTM easting/northing (the default).
+    #[default]
     Utm,
     /// Regular in longitude/latitude degrees.
     LatLon,
 }
+
+crate::named_enum!(GridPlane, "grid plane", [GridPlane::Utm => "utm", GridPlane::LatLon => "latlon"]);
 
 /// A sample node: where the elevation is wanted.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,14 +40,14 @@ pub struct Node {
 /// ```
 /// use terramesh_core::coords::Zone;
 /// use terramesh_core::geometry::Region;
-/// use terramesh_core::sampling::{grid_nodes, GridPlane, GridSize, GridSpec, Margin};
+/// use terramesh_core::sampling::{grid_nodes, GridPlane, GridSize, SamplingGrid, Margin};
 /// let zone: Zone = "32N".parse()?;
 /// let geo = Region::from_ring(vec![[7.3368, 48.7224], [7.3404, 48.7224], [7.3404, 48.7260], [7.3368, 48.7260]]);
 /// let utm = geo.try_map(|[lon, lat]| {
 ///     let p = terramesh_core::coords::to_utm(lat, lon, Some(zone))?;
 ///     Ok::<_, terramesh_core::coords::CoordError>([p.easting, p.northing])
 /// })?;
-/// let spec = GridSpec { size: GridSize::RowsCols { rows: 100, cols: 50 }, margin: Margin::Fraction(0.1), clip: false };
+/// let spec = SamplingGrid { size: GridSize::RowsCols { rows: 100, cols: 50 }, margin: Margin::Fraction(0.1), clip: false };
 /// let nodes = grid_nodes(&utm, Some(&geo), Some(zone), &spec, GridPlane::Utm).unwrap();
 /// assert_eq!(nodes.len(), 5000);
 /// let [lat, lon] = nodes[0].latlon.unwrap();
@@ -55,7 +58,7 @@ pub fn grid_nodes(
     projected: &Region,
     geographic: Option<&Region>,
     zone: Option<Zone>,
-    spec: &GridSpec,
+    spec: &SamplingGrid,
     plane: GridPlane,
 ) -> Result<Vec<Node>, NodeError> {
     match (plane, geographic, zone) {
@@ -99,6 +102,7 @@ pub fn grid_nodes(
 
 /// Errors building sample nodes.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum NodeError {
     /// The grid request is invalid.
     #[error(transparent)]

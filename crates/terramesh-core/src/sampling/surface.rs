@@ -2,17 +2,17 @@
 //! stand-in (surrogate) for a height function that is costly point by point, such as kriging,
 //! where an algorithm asks for millions of single heights.
 
-use super::interp::{interpolate, Method, Post, Posts};
+use super::interp::{interpolate, Kernel, Post, Posts};
 
 /// Heights on a regular grid: node `(r, c)` sits at `(x0 + c dx, y0 + r dy)`, row-major.
 ///
 /// ```
-/// use terramesh_core::sampling::{GridSurface, Method};
+/// use terramesh_core::sampling::{GridSurface, Kernel};
 /// // z = x + 10 y on 3 x 2 nodes with 1 m spacing starting at (100, 200).
 /// let s = GridSurface::from_fn([100.0, 200.0], [1.0, 1.0], 3, 2, |x, y| (x - 100.0) + 10.0 * (y - 200.0));
-/// assert_eq!(s.height(101.5, 200.5, Method::Bilinear), 6.5);
+/// assert_eq!(s.height(101.5, 200.5, Kernel::Bilinear), 6.5);
 /// // Outside the nodes the nearest edge value is used.
-/// assert_eq!(s.height(90.0, 200.0, Method::Bilinear), 0.0);
+/// assert_eq!(s.height(90.0, 200.0, Kernel::Bilinear), 0.0);
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridSurface {
@@ -55,9 +55,9 @@ impl GridSurface {
     /// If `values.len() != nx * ny`, a grid dimension is 0 or a step is not positive.
     ///
     /// ```
-    /// use terramesh_core::sampling::{GridSurface, Method};
+    /// use terramesh_core::sampling::{GridSurface, Kernel};
     /// let s = GridSurface::new([0.0, 0.0], [1.0, 1.0], 2, 2, vec![0.0, 1.0, 2.0, 3.0]);
-    /// assert_eq!(s.height(0.5, 0.5, Method::Bilinear), 1.5);
+    /// assert_eq!(s.height(0.5, 0.5, Kernel::Bilinear), 1.5);
     /// ```
     pub fn new(
         origin: [f64; 2],
@@ -81,9 +81,9 @@ impl GridSurface {
     /// A surface from a function evaluated at every node.
     ///
     /// ```
-    /// use terramesh_core::sampling::{GridSurface, Method};
+    /// use terramesh_core::sampling::{GridSurface, Kernel};
     /// let s = GridSurface::from_fn([0.0, 0.0], [0.5, 0.5], 5, 5, |x, y| x * y);
-    /// assert_eq!(s.height(1.0, 2.0, Method::Nearest), 2.0);
+    /// assert_eq!(s.height(1.0, 2.0, Kernel::Nearest), 2.0);
     /// ```
     pub fn from_fn(
         origin: [f64; 2],
@@ -101,7 +101,7 @@ impl GridSurface {
 
     /// The interpolated height at `(x, y)`; points beyond the nodes take the value at the
     /// nearest point of the grid's rectangle.
-    pub fn height(&self, x: f64, y: f64, method: Method) -> f64 {
+    pub fn height(&self, x: f64, y: f64, method: Kernel) -> f64 {
         let col = ((x - self.origin[0]) / self.step[0]).clamp(0.0, (self.nx - 1) as f64);
         let row = ((y - self.origin[1]) / self.step[1]).clamp(0.0, (self.ny - 1) as f64);
         let col = if col.is_nan() { 0.0 } else { col };
@@ -135,7 +135,7 @@ mod tests {
             (22.0, 4.0),
             (15.0, 1.0),
         ] {
-            let got = s.height(x, y, Method::Bilinear);
+            let got = s.height(x, y, Kernel::Bilinear);
             assert!(
                 (got - f(x, y)).abs() < 1e-12,
                 "({x}, {y}): {got} vs {}",
@@ -143,21 +143,21 @@ mod tests {
             );
         }
         // Bicubic is exact at the nodes.
-        assert!((s.height(14.0, 1.0, Method::Bicubic) - f(14.0, 1.0)).abs() < 1e-12);
+        assert!((s.height(14.0, 1.0, Kernel::Bicubic) - f(14.0, 1.0)).abs() < 1e-12);
     }
 
     #[test]
     fn outside_points_clamp_to_the_rectangle() {
         let s = GridSurface::from_fn([0.0, 0.0], [1.0, 1.0], 3, 3, |x, y| x + 10.0 * y);
-        assert_eq!(s.height(-5.0, 1.0, Method::Bilinear), 10.0);
-        assert_eq!(s.height(9.0, 9.0, Method::Bilinear), 22.0);
-        assert_eq!(s.height(f64::NAN, 0.0, Method::Bilinear), 0.0);
+        assert_eq!(s.height(-5.0, 1.0, Kernel::Bilinear), 10.0);
+        assert_eq!(s.height(9.0, 9.0, Kernel::Bilinear), 22.0);
+        assert_eq!(s.height(f64::NAN, 0.0, Kernel::Bilinear), 0.0);
         assert_eq!(s.post(3, 0), Post::Outside);
     }
 
     #[test]
     fn a_single_node_is_a_constant() {
         let s = GridSurface::new([0.0, 0.0], [1.0, 1.0], 1, 1, vec![7.0]);
-        assert_eq!(s.height(0.3, -2.0, Method::Bilinear), 7.0);
+        assert_eq!(s.height(0.3, -2.0, Kernel::Bilinear), 7.0);
     }
 }

@@ -2,6 +2,7 @@
 
 /// Errors reading an elevation source. Each names the file and says what to do.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum DemError {
     /// The file could not be opened or read.
     #[error("{file}: {source}")]

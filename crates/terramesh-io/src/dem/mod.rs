@@ -31,24 +31,24 @@ pub use window::LatLonBox;
 
 use std::path::Path;
 
-use terramesh_core::sampling::{Method, Missing};
+use terramesh_core::sampling::{Kernel, Missing};
 
 /// A source of elevations that can be sampled anywhere inside its data.
 ///
 /// ```
-/// use terramesh_core::sampling::Method;
+/// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{ElevationSource, GeoTransform, Raster, SourceCrs};
 /// let r = Raster { name: "r".into(), rows: 2, cols: 2, crs: SourceCrs::Geographic,
 ///     transform: GeoTransform { x0: 7.0, y0: 49.0, dx: 1.0, dy: -1.0 }, data: vec![0.0, 2.0, 4.0, 6.0] };
 /// let src: &dyn ElevationSource = &r;
-/// assert_eq!(src.sample(7.5, 48.5, Method::Bilinear), Ok(3.0));
+/// assert_eq!(src.sample(7.5, 48.5, Kernel::Bilinear), Ok(3.0));
 /// ```
 pub trait ElevationSource: Send + Sync {
     /// The CRS of the coordinates [`ElevationSource::sample`] takes.
     fn crs(&self) -> &SourceCrs;
     /// The elevation at `(x, y)` in the source CRS (longitude, latitude in degrees for a
     /// geographic source).
-    fn sample(&self, x: f64, y: f64, method: Method) -> Result<f64, Missing>;
+    fn sample(&self, x: f64, y: f64, method: Kernel) -> Result<f64, Missing>;
     /// A one-line description for messages: file, size, resolution.
     fn describe(&self) -> String;
 }
@@ -60,11 +60,11 @@ pub trait ElevationSource: Send + Sync {
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// use terramesh_core::sampling::Method;
+/// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, ElevationSource};
 /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt");
 /// let dem = open_raster(std::path::Path::new(p), false)?;
-/// let z = dem.sample(7.3386, 48.7242, Method::Bilinear).unwrap();
+/// let z = dem.sample(7.3386, 48.7242, Kernel::Bilinear).unwrap();
 /// assert!(z > 300.0 && z < 450.0);
 /// # Ok(()) }
 /// ```
@@ -78,15 +78,15 @@ pub fn open_raster(path: &Path, fill_voids: bool) -> Result<Box<dyn ElevationSou
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// use terramesh_core::sampling::Method;
+/// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, open_raster_in, LatLonBox};
 /// let p = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif"));
 /// let area = LatLonBox { south: 32.70, west: -97.40, north: 32.71, east: -97.39 };
 /// let part = open_raster_in(p, false, Some(&area))?;
 /// let whole = open_raster(p, false)?;
-/// assert_eq!(part.sample(-97.395, 32.705, Method::Nearest), whole.sample(-97.395, 32.705, Method::Nearest));
-/// let (a, b) = (part.sample(-97.3951, 32.7052, Method::Bicubic).unwrap(),
-///               whole.sample(-97.3951, 32.7052, Method::Bicubic).unwrap());
+/// assert_eq!(part.sample(-97.395, 32.705, Kernel::Nearest), whole.sample(-97.395, 32.705, Kernel::Nearest));
+/// let (a, b) = (part.sample(-97.3951, 32.7052, Kernel::Bicubic).unwrap(),
+///               whole.sample(-97.3951, 32.7052, Kernel::Bicubic).unwrap());
 /// assert!((a - b).abs() < 1e-9); // the part's origin moves by whole posts
 /// # Ok(()) }
 /// ```

@@ -1,6 +1,6 @@
 //! An in-memory grid of posts with its georeferencing.
 
-use terramesh_core::sampling::{interpolate, Method, Missing, Post, Posts};
+use terramesh_core::sampling::{interpolate, Kernel, Missing, Post, Posts};
 
 use super::{ElevationSource, SourceCrs};
 
@@ -106,7 +106,7 @@ impl ElevationSource for Raster {
         &self.crs
     }
     #[inline]
-    fn sample(&self, x: f64, y: f64, method: Method) -> Result<f64, Missing> {
+    fn sample(&self, x: f64, y: f64, method: Kernel) -> Result<f64, Missing> {
         let (r, c) = self.transform.to_post(x, y);
         interpolate(self, r, c, method)
     }

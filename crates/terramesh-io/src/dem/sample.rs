@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 use terramesh_core::coords::{to_utm, Zone};
-use terramesh_core::sampling::{Method, Missing, Node};
+use terramesh_core::sampling::{Kernel, Missing, Node};
 
 use super::{DemError, ElevationSource, SourceCrs};
 
@@ -15,18 +15,18 @@ const CHUNK: usize = 4096;
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// use terramesh_core::sampling::Method;
+/// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, sample_latlon};
 /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt");
 /// let dem = open_raster(std::path::Path::new(p), false)?;
-/// let z = sample_latlon(dem.as_ref(), &[[48.7242, 7.3386], [50.0, 7.0]], Method::Bilinear)?;
+/// let z = sample_latlon(dem.as_ref(), &[[48.7242, 7.3386], [50.0, 7.0]], Kernel::Bilinear)?;
 /// assert!(z[0].is_ok() && z[1].is_err());
 /// # Ok(()) }
 /// ```
 pub fn sample_latlon(
     source: &dyn ElevationSource,
     latlon: &[[f64; 2]],
-    method: Method,
+    method: Kernel,
 ) -> Result<Vec<Result<f64, Missing>>, DemError> {
     let crs = source.crs().clone();
     if let SourceCrs::Projected { name } = &crs {
@@ -46,10 +46,10 @@ pub fn sample_latlon(
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// use terramesh_core::sampling::Method;
+/// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, sample_utm};
 /// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt")), false)?;
-/// let z = sample_utm(dem.as_ref(), &[[377_700.0, 5_398_000.0]], "32N".parse().unwrap(), Method::Bilinear)?;
+/// let z = sample_utm(dem.as_ref(), &[[377_700.0, 5_398_000.0]], "32N".parse().unwrap(), Kernel::Bilinear)?;
 /// assert!(z[0].is_ok());
 /// # Ok(()) }
 /// ```
@@ -57,7 +57,7 @@ pub fn sample_utm(
     source: &dyn ElevationSource,
     points: &[[f64; 2]],
     zone: Zone,
-    method: Method,
+    method: Kernel,
 ) -> Result<Vec<Result<f64, Missing>>, DemError> {
     let nodes: Vec<Node> = points
         .iter()
@@ -76,11 +76,11 @@ pub fn sample_utm(
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// use terramesh_core::sampling::{Method, Node};
+/// use terramesh_core::sampling::{Kernel, Node};
 /// use terramesh_io::dem::{open_raster, sample_nodes};
 /// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt")), false)?;
 /// let n = Node { xy: [377_700.0, 5_398_000.0], latlon: Some([48.7242, 7.3386]) };
-/// let z = sample_nodes(dem.as_ref(), &[n], None, Method::Nearest)?;
+/// let z = sample_nodes(dem.as_ref(), &[n], None, Kernel::Nearest)?;
 /// assert!(z[0].is_ok());
 /// # Ok(()) }
 /// ```
@@ -88,7 +88,7 @@ pub fn sample_nodes(
     source: &dyn ElevationSource,
     nodes: &[Node],
     zone: Option<Zone>,
-    method: Method,
+    method: Kernel,
 ) -> Result<Vec<Result<f64, Missing>>, DemError> {
     let crs = source.crs().clone();
     let geographic_nodes = nodes.iter().all(|n| n.latlon.is_some());
@@ -131,7 +131,7 @@ fn not_convertible(source: &dyn ElevationSource, name: &str) -> DemError {
         file: source.describe(),
         message: format!(
             "the source is in {name}, which terramesh does not convert from latitude/longitude; \
-             give the region in the source's own coordinates (--region-crs projected)"
+             give the region in the source's own coordinates (a projected region)"
         ),
     }
 }

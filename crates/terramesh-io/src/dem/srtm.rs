@@ -10,7 +10,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use memmap2::Mmap;
-use terramesh_core::sampling::{interpolate, Method, Missing, Post, Posts};
+use terramesh_core::sampling::{interpolate, Kernel, Missing, Post, Posts};
 
 use super::{fill, DemError, ElevationSource, SourceCrs};
 
@@ -292,7 +292,7 @@ impl ElevationSource for HgtMosaic {
         &self.crs
     }
     #[inline]
-    fn sample(&self, lon: f64, lat: f64, method: Method) -> Result<f64, Missing> {
+    fn sample(&self, lon: f64, lat: f64, method: Kernel) -> Result<f64, Missing> {
         let (r, c) = self.to_post(lon, lat);
         // Fast path: when the whole 4 x 4 stencil is inside one tile, look the tile up once.
         if r.is_finite() && c.is_finite() && r.abs() < 1e9 && c.abs() < 1e9 {

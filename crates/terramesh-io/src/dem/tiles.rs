@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::path::Path;
 
-use terramesh_core::sampling::{interpolate, Method, Missing, Post, Posts};
+use terramesh_core::sampling::{interpolate, Kernel, Missing, Post, Posts};
 
 use super::{DemError, ElevationSource, SourceCrs};
 
@@ -193,7 +193,7 @@ impl ElevationSource for TileMosaic {
     fn crs(&self) -> &SourceCrs {
         &self.crs
     }
-    fn sample(&self, lon: f64, lat: f64, method: Method) -> Result<f64, Missing> {
+    fn sample(&self, lon: f64, lat: f64, method: Kernel) -> Result<f64, Missing> {
         if !(-85.051_128_78..=85.051_128_78).contains(&lat) {
             return Err(Missing::Outside);
         }

@@ -75,7 +75,7 @@ fn parse_list(
     one: impl Fn(usize, &str) -> Result<[f64; 2], String>,
 ) -> Result<Vec<[f64; 2]>, RegionError> {
     let invalid = |message: String| RegionError::Invalid {
-        source_name: "--corners".into(),
+        source_name: super::CORNER_LIST.into(),
         message,
     };
     let mut ring = Vec::new();
@@ -125,7 +125,7 @@ pub fn parse_projected_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError>
         match parsed.as_deref() {
             Some([n, e]) if n.is_finite() && e.is_finite() => Ok([*e, *n]),
             _ => Err(format!(
-                "corner {i} '{}': with --crs projected each corner is NORTHING EASTING in \
+                "corner {i} '{}': in projected coordinates each corner is NORTHING EASTING in \
                  metres, e.g. \"5397932.106 377676.932\"",
                 part.trim()
             )),

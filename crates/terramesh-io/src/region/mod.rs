@@ -18,6 +18,7 @@ pub use wkt::parse_wkt;
 
 /// Errors while reading a region.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum RegionError {
     /// A corner list or file that cannot be understood.
     #[error("{source_name}: {message}")]
@@ -56,26 +57,35 @@ pub enum RegionError {
     Projection(#[from] CoordError),
 }
 
+/// How errors name an inline corner list ([`RegionInput::Corners`] that is not a file).
+pub const CORNER_LIST: &str = "the corner list";
+
 /// Where a region comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum RegionInput {
-    /// `--corners`: an inline list `"LAT LON; LAT LON; ..."` or the path of a CSV with
+    /// An inline list `"LAT LON; LAT LON; ..."` or the path of a CSV with
     /// columns `lat,lon`; for projected input `"NORTHING EASTING; ..."` in metres or a CSV
     /// with columns `x,y` (or `easting,northing`).
     Corners(String),
-    /// `--region FILE`: GeoJSON, KML or WKT.
+    /// A region file: GeoJSON, KML or WKT.
     File(PathBuf),
 }
 
-/// Whether region coordinates are geographic (projected to UTM) or already projected.
+/// Whether region coordinates are geographic (projected to UTM) or already projected, named
+/// `geographic` and `projected` (see [`terramesh_core::vocab`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum RegionCrs {
     /// WGS-84 longitude/latitude (GeoJSON, KML and corner lists are).
     #[default]
     Geographic,
-    /// Projected metres, used as they are (`--crs projected`).
+    /// Projected metres, used as they are.
     Projected,
 }
+
+terramesh_core::named_enum!(RegionCrs, "region coordinate system", [
+    RegionCrs::Geographic => "geographic",
+    RegionCrs::Projected => "projected",
+]);
 
 /// A region ready for meshing and sampling.
 #[derive(Debug, Clone)]
@@ -124,7 +134,7 @@ pub fn load(
         RegionInput::File(p) => (read_region_file(p)?, crs == RegionCrs::Geographic),
     };
     let name = match input {
-        RegionInput::Corners(s) if !looks_like_file(s) => "--corners".to_string(),
+        RegionInput::Corners(s) if !looks_like_file(s) => CORNER_LIST.to_string(),
         RegionInput::Corners(s) => s.trim().to_string(),
         RegionInput::File(p) => p.display().to_string(),
     };

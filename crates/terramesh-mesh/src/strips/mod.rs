@@ -25,9 +25,10 @@ use rayon::prelude::*;
 use spade::Triangulation;
 use terramesh_core::geometry::Region;
 
-use crate::build::{default_cap, refine, BuildReport};
 use crate::cdt::{localize, CdtState};
 use crate::mesh::Mesh;
+use crate::refine::{default_cap, refine};
+use crate::report::BuildReport;
 use crate::MeshError;
 
 pub(crate) use plan::Cut;

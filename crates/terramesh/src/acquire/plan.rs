@@ -10,7 +10,9 @@ use std::str::FromStr;
 use std::time::Duration;
 
 use terramesh_core::coords::Zone;
-use terramesh_core::sampling::{grid_nodes, GridPlane, GridSize, GridSpec, Margin, Method, Node};
+use terramesh_core::sampling::{
+    grid_nodes, GridPlane, GridSize, Kernel, Margin, Node, SamplingGrid,
+};
 use terramesh_io::dem::SourceCrs;
 use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
 use terramesh_io::table::ReadOptions;
@@ -170,7 +172,7 @@ pub struct SampleOptions {
     /// The plane of the grid.
     pub plane: GridPlane,
     /// Raster interpolation.
-    pub kernel: Method,
+    pub kernel: Kernel,
     /// What to do with a point without an elevation.
     pub on_missing: OnMissing,
     /// The z written for such points under [`OnMissing::Nodata`].
@@ -204,7 +206,7 @@ impl SampleOptions {
             margin: MarginSpec::Fraction(0.0),
             clip: false,
             plane: GridPlane::Utm,
-            kernel: Method::Bilinear,
+            kernel: Kernel::Bilinear,
             on_missing: OnMissing::Error,
             nodata: DEFAULT_NODATA,
             fill_voids: false,
@@ -255,7 +257,7 @@ pub struct SamplePlan {
     /// The grid plane.
     pub plane: GridPlane,
     /// Raster interpolation.
-    pub method: Method,
+    pub method: Kernel,
     /// Points without elevation.
     pub on_missing: OnMissing,
     /// Their z under [`OnMissing::Nodata`].
@@ -531,7 +533,7 @@ impl SamplePlan {
                 ))
             }
         };
-        let spec = GridSpec {
+        let spec = SamplingGrid {
             size,
             margin,
             clip: self.clip,

@@ -8,7 +8,7 @@
 //! edge midpoint of the mesh, and that verified error is what the report shows.
 
 use crate::error::{bail, Context, Result};
-use terramesh_core::sampling::{GridSurface, Method as Kernel};
+use terramesh_core::sampling::{GridSurface, Kernel};
 use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, AdaptiveSettings, Mesh};
 
 use super::stages::{Kriging, Model, Samples};

@@ -10,8 +10,8 @@ use terramesh_io::export::{
     write_collada, write_dxf, write_kml, write_model_kml, write_stl, write_tsurf, ColladaOptions,
     KmlStyle, TsurfInfo,
 };
+use terramesh_io::export::{write_mesh, MeshView};
 use terramesh_io::grid_write::{write_asc, write_geotiff};
-use terramesh_io::mesh_write::{write_mesh, MeshView};
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 use terramesh_mesh::{triangle_quality, Quality};

@@ -177,7 +177,7 @@ pub struct Interpolated {
     /// Cross-validation per method.
     pub cv: Vec<(String, CvStats)>,
     /// The DSM grid: spec and values (nodata outside the region).
-    pub grid: (terramesh_io::grid_write::GridSpec, Vec<f64>),
+    pub grid: (terramesh_io::grid_write::RasterGrid, Vec<f64>),
     /// The drift used by UK.
     pub drift: Drift,
 }
@@ -324,7 +324,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         .max(1e-3);
     let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
     let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
-    let spec = terramesh_io::grid_write::GridSpec {
+    let spec = terramesh_io::grid_write::RasterGrid {
         xmin: lo[0],
         ymin: hi[1] - (ny - 1) as f64 * step,
         xmax: lo[0] + (nx - 1) as f64 * step,
