@@ -80,9 +80,11 @@ pub fn named<T>() -> impl clap::builder::TypedValueParser<Value = T>
 where
     T: terramesh_core::vocab::Named + Clone + Send + Sync,
 {
-    use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(T::names())
-        .map(|s: String| T::parse_name(&s).unwrap_or(T::ALL[0]))
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values = T::ALL
+        .iter()
+        .map(|v| PossibleValue::new(v.name()).aliases(v.aliases().iter().copied()));
+    PossibleValuesParser::new(values).map(|s: String| T::parse_name(&s).unwrap_or(T::ALL[0]))
 }
 
 /// A library error worded for the command line: each setting as its flag.
@@ -93,4 +95,14 @@ pub fn flag_error(e: terramesh::Error) -> anyhow::Error {
 /// A library error worded for a project file: each setting as its key.
 pub fn project_error(e: terramesh::Error) -> anyhow::Error {
     anyhow::anyhow!(e.render(&terramesh::project::key_of))
+}
+
+/// Prints `text` on standard output; a closed pipe (`| head`) is not an error.
+pub fn say(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }

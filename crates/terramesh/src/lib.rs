@@ -15,5 +15,6 @@ pub use error::{Context, Error, Result};
 pub use setting::Setting;
 pub mod build;
 pub mod convert;
+pub mod mesh;
 pub mod project;
 pub mod variogram_file;

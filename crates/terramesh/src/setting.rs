@@ -46,6 +46,8 @@ pub enum Setting {
     Zoom,
     /// The z written for points without an elevation.
     Nodata,
+    /// A DEM used as a height function.
+    Dem,
     /// The output file.
     Output,
 }
@@ -71,5 +73,6 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Resume => "resume",
     Setting::Zoom => "zoom",
     Setting::Nodata => "nodata",
+    Setting::Dem => "dem",
     Setting::Output => "output",
 ]);

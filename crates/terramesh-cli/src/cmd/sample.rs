@@ -10,28 +10,10 @@ use terramesh::acquire::{
     DEFAULT_ZOOM,
 };
 use terramesh_core::coords::Zone;
-use terramesh_core::sampling::GridPlane;
+use terramesh_core::sampling::{GridPlane, Kernel};
 use terramesh_io::region::{RegionCrs, RegionInput};
 
 use crate::progress::Terminal;
-
-/// Coordinates of the region.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum RegionCrsArg {
-    /// WGS-84 latitude/longitude.
-    Geographic,
-    /// The source's own projected coordinates.
-    Projected,
-}
-
-/// Plane of the grid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum GridCrsArg {
-    /// Regular in UTM metres.
-    Utm,
-    /// Regular in latitude/longitude degrees.
-    Latlon,
-}
 
 /// Sample terrain elevations over a region.
 ///
@@ -66,8 +48,8 @@ pub struct Args {
     /// Coordinates of the region: geographic (WGS-84 lat/lon, default) or projected (the
     /// source's own projected coordinates, for a point cloud in a CRS terramesh does not
     /// convert).
-    #[arg(long, value_enum, default_value_t = RegionCrsArg::Geographic)]
-    pub region_crs: RegionCrsArg,
+    #[arg(long, value_parser = crate::named::<RegionCrs>(), default_value_t = RegionCrs::Geographic)]
+    pub region_crs: RegionCrs,
     /// UTM zone of the output, e.g. 32N (default: the zone of the region's centre).
     #[arg(long)]
     pub zone: Option<Zone>,
@@ -88,11 +70,11 @@ pub struct Args {
     #[arg(long)]
     pub clip: bool,
     /// Plane of the grid: utm (regular in metres, default) or latlon (regular in degrees).
-    #[arg(long, value_enum, default_value_t = GridCrsArg::Utm)]
-    pub grid_crs: GridCrsArg,
+    #[arg(long, value_parser = crate::named::<GridPlane>(), default_value_t = GridPlane::Utm)]
+    pub grid_crs: GridPlane,
     /// Raster interpolation: bilinear (default), bicubic or nearest.
-    #[arg(long, default_value = "bilinear")]
-    pub interpolation: terramesh_core::sampling::Kernel,
+    #[arg(long, value_parser = crate::named::<Kernel>(), default_value_t = Kernel::Bilinear)]
+    pub interpolation: Kernel,
     /// A point outside the data, on a void, or failed by the service: error (stop, default),
     /// nodata (write --nodata and the reason in an `error` column) or skip (leave it out and
     /// say how many).
@@ -170,19 +152,13 @@ impl Args {
                 (None, Some(r)) => Some(RegionInput::File(r.clone())),
                 (None, None) => None,
             },
-            region_crs: match self.region_crs {
-                RegionCrsArg::Geographic => RegionCrs::Geographic,
-                RegionCrsArg::Projected => RegionCrs::Projected,
-            },
+            region_crs: self.region_crs,
             zone: self.zone,
             rows_cols: self.rows.zip(self.cols),
             spacing: self.spacing,
             margin,
             clip: self.clip,
-            plane: match self.grid_crs {
-                GridCrsArg::Utm => GridPlane::Utm,
-                GridCrsArg::Latlon => GridPlane::LatLon,
-            },
+            plane: self.grid_crs,
             kernel: self.interpolation,
             on_missing: self.on_missing,
             nodata: self.nodata,

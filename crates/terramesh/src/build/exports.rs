@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{Context, Result};
 use terramesh_core::coords::{to_wgs84, LocalEnu, Zone};
 use terramesh_core::solid::{check_closed, extrude, volume};
+use terramesh_core::vocab::Named;
 use terramesh_io::export::{
     write_collada, write_dxf, write_kml, write_model_kml, write_stl, write_tsurf, ColladaOptions,
     KmlStyle, TsurfInfo,
@@ -110,7 +111,7 @@ pub fn write_all(
         })
         .collect();
     let mut files = Vec::new();
-    let want = |f: &str| p.export.formats.iter().any(|x| x == f);
+    let want = |f: &str| p.export.formats.iter().any(|x| x.name() == f);
 
     // Per-vertex values as the library computed them.
     files.push(atomic(&out.join("dsm-vertices.csv"), |w| {

@@ -9,7 +9,7 @@ use terramesh_geostat::{
     Weighting,
 };
 use terramesh_io::region::LoadedRegion;
-use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport, Smoother};
+use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport};
 
 use crate::acquire::{acquire, write_table, SamplePlan};
 use crate::error::{bail, Context, Result};
@@ -139,12 +139,7 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model) -> Result<Meshed> {
     let unsmoothed = mesh.clone();
     let before = Quality::planar(&mesh);
     let smoothing = if m.smooth > 0 {
-        let smoother = match m.smoother.as_str() {
-            "laplacian" => Smoother::Laplacian,
-            "odt" => Smoother::Odt,
-            _ => Smoother::Smart,
-        };
-        Some(smooth(&mut mesh, smoother, m.smooth))
+        Some(smooth(&mut mesh, m.smoother, m.smooth))
     } else {
         None
     };

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use terramesh_core::coords::Zone;
-use terramesh_io::region::{RegionCrs, RegionInput};
+use terramesh_io::region::RegionInput;
 
 use super::Project;
 use crate::acquire::{is_remote, MarginSpec, SampleOptions};
@@ -62,11 +62,7 @@ impl Project {
             ),
             None => None,
         };
-        o.region_crs = if self.region.crs == "projected" {
-            RegionCrs::Projected
-        } else {
-            RegionCrs::Geographic
-        };
+        o.region_crs = self.region.crs;
         let s = &self.sampling;
         match s.spacing {
             Some(sp) => o.spacing = Some(sp),
@@ -77,10 +73,7 @@ impl Project {
         } else {
             MarginSpec::Metres(s.margin)
         };
-        o.kernel = s
-            .method
-            .parse()
-            .map_err(|e| Error::invalid(format!("sampling.method = \"{}\": {e}", s.method)))?;
+        o.kernel = s.method;
         o.clip = s.clip;
         o.classes = self.source.class.into_iter().collect();
         o.output = Some(samples_csv.to_path_buf());

@@ -11,6 +11,10 @@ pub use lower::key_of;
 use std::path::PathBuf;
 
 use serde::Deserialize;
+use terramesh_core::sampling::Kernel;
+use terramesh_io::export::{Format, DEFAULT_FORMATS};
+use terramesh_io::region::RegionCrs;
+use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
 /// A whole project.
 #[derive(Debug, Clone, Deserialize)]
@@ -48,8 +52,8 @@ pub struct RegionSection {
     /// UTM zone such as `32N` (default: the zone of the region's centre).
     pub zone: Option<String>,
     /// `geographic` (default) or `projected`.
-    #[serde(default = "default_crs")]
-    pub crs: String,
+    #[serde(default)]
+    pub crs: RegionCrs,
 }
 
 /// `[source]`: where elevations come from.
@@ -79,7 +83,7 @@ pub struct SamplingSection {
     /// Keep only samples inside the (unenlarged) region.
     pub clip: bool,
     /// Raster interpolation: `bilinear`, `bicubic` or `nearest`.
-    pub method: String,
+    pub method: Kernel,
 }
 
 impl Default for SamplingSection {
@@ -90,7 +94,7 @@ impl Default for SamplingSection {
             spacing: None,
             margin: 0.1,
             clip: false,
-            method: "bilinear".into(),
+            method: Kernel::Bilinear,
         }
     }
 }
@@ -108,7 +112,7 @@ pub struct MeshSection {
     /// Smoothing iterations.
     pub smooth: usize,
     /// `laplacian`, `smart` or `odt`.
-    pub smoother: String,
+    pub smoother: Smoother,
     /// Insert the sample locations as mesh vertices.
     pub insert_samples: bool,
     /// Terrain-adaptive refinement: refine until the mesh surface is within this many metres
@@ -122,9 +126,9 @@ impl Default for MeshSection {
         MeshSection {
             max_area: None,
             max_edge: None,
-            min_angle: 30.0,
-            smooth: 10,
-            smoother: "smart".into(),
+            min_angle: DEFAULT_MIN_ANGLE,
+            smooth: DEFAULT_SMOOTH,
+            smoother: DEFAULT_SMOOTHER,
             insert_samples: false,
             max_error: None,
         }
@@ -189,7 +193,7 @@ impl Default for InterpolationSection {
 pub struct ExportSection {
     /// Surface formats: `vtu`, `obj`, `ply`, `stl`, `ts`, `msh`, `dxf`, `kml`, `dae` (COLLADA
     /// with `dsm-model.kml` for Google Earth).
-    pub formats: Vec<String>,
+    pub formats: Vec<Format>,
     /// Base of the sealed solid, metres (default: 50 m below the lowest vertex).
     pub base_elevation: Option<f64>,
     /// Cell size of the DSM grid (GeoTIFF and ESRI ASCII), metres.
@@ -203,9 +207,7 @@ pub struct ExportSection {
 impl Default for ExportSection {
     fn default() -> Self {
         ExportSection {
-            formats: ["vtu", "obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae"]
-                .map(String::from)
-                .to_vec(),
+            formats: DEFAULT_FORMATS.to_vec(),
             base_elevation: None,
             grid_spacing: None,
             pictures: true,
@@ -214,9 +216,8 @@ impl Default for ExportSection {
     }
 }
 
-fn default_crs() -> String {
-    "geographic".into()
-}
+/// Smoothing iterations of a project's mesh, by default.
+pub const DEFAULT_SMOOTH: usize = 10;
 
 /// The commented project file written by `terramesh init`.
 pub const TEMPLATE: &str = include_str!("template.toml");

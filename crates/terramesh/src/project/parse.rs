@@ -147,9 +147,6 @@ impl Project {
             (Some(_), Some(_)) => return bad("[region]", "give either corners or file, not both"),
             _ => {}
         }
-        if !matches!(self.region.crs.as_str(), "geographic" | "projected") {
-            return bad("region.crs", "must be \"geographic\" or \"projected\"");
-        }
         let s = &self.sampling;
         if s.spacing.is_none() && (s.rows < 2 || s.cols < 2) {
             return bad(
@@ -186,12 +183,6 @@ impl Project {
                 }
             }
         }
-        if !matches!(m.smoother.as_str(), "laplacian" | "smart" | "odt") {
-            return bad(
-                "mesh.smoother",
-                "must be \"laplacian\", \"smart\" or \"odt\"",
-            );
-        }
         let i = &self.interpolation;
         if i.methods.is_empty() {
             return bad(
@@ -225,17 +216,6 @@ impl Project {
             }
             if !(v.nugget.is_finite() && v.nugget >= 0.0) {
                 return bad("interpolation.model.nugget", "must be 0 or positive");
-            }
-        }
-        for f in &self.export.formats {
-            if !matches!(
-                f.as_str(),
-                "vtu" | "obj" | "ply" | "stl" | "ts" | "msh" | "dxf" | "kml" | "dae"
-            ) {
-                return bad(
-                    "export.formats",
-                    &format!("unknown format \"{f}\" (vtu, obj, ply, stl, ts, msh, dxf, kml, dae)"),
-                );
             }
         }
         Ok(())

@@ -1,0 +1,323 @@
+//! Meshing a study region on its own (`terramesh mesh`): a planar quality mesh, optionally
+//! smoothed, or a terrain-adaptive mesh against a DEM, with the summary the command prints.
+//!
+//! ```
+//! use terramesh::mesh::{mesh_region, MeshSettings};
+//! use terramesh_io::region::{load, RegionCrs, RegionInput};
+//! let region = load(&RegionInput::Corners("0 0; 0 100; 100 100; 100 0".into()), RegionCrs::Projected, None)?;
+//! let mut settings = MeshSettings::default();
+//! settings.max_area = Some(50.0);
+//! settings.smooth = 5;
+//! let planar = mesh_region(&region, &settings)?;
+//! assert!(planar.after.min_angle >= 28.0);
+//! assert!(planar.summary(&region).contains("smoothing (Smart, 5 iterations)"));
+//! # Ok::<(), terramesh::Error>(())
+//! ```
+
+use std::path::Path;
+
+use terramesh_core::coords::{parse_angle, to_utm, to_wgs84, Axis, Zone};
+use terramesh_core::sampling::Kernel;
+use terramesh_io::dem::{open_raster, ElevationSource};
+use terramesh_io::region::{LoadedRegion, RegionCrs};
+use terramesh_io::table::{ReadOptions, Table};
+use terramesh_mesh::{
+    adaptive_mesh, smooth, AdaptiveReport, AdaptiveSettings, BuildReport, Fallible, Mesh,
+    MeshBuilder, MeshError, Quality, SmoothReport, Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER,
+};
+
+use crate::error::{Context, Error, Result};
+use crate::setting::Setting;
+
+/// What to mesh and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshSettings {
+    /// Minimum angle, degrees (0 turns angle refinement off).
+    pub min_angle: f64,
+    /// Maximum triangle area, m².
+    pub max_area: Option<f64>,
+    /// Maximum edge length, m.
+    pub max_edge: Option<f64>,
+    /// Cap on the vertices refinement may add.
+    pub max_vertices: Option<usize>,
+    /// Vertical strips meshed in parallel (default: from the expected size).
+    pub strips: Option<usize>,
+    /// Smoothing iterations (0: none).
+    pub smooth: usize,
+    /// The smoother.
+    pub smoother: Smoother,
+    /// Points to insert as mesh vertices, in the region's coordinates.
+    pub points: Vec<[f64; 2]>,
+}
+
+impl Default for MeshSettings {
+    fn default() -> Self {
+        MeshSettings {
+            min_angle: DEFAULT_MIN_ANGLE,
+            max_area: None,
+            max_edge: None,
+            max_vertices: None,
+            strips: None,
+            smooth: 0,
+            smoother: DEFAULT_SMOOTHER,
+            points: Vec::new(),
+        }
+    }
+}
+
+/// A planar mesh with its quality before and after smoothing.
+#[derive(Debug)]
+pub struct PlanarMesh {
+    /// The mesh (smoothed when asked).
+    pub mesh: Mesh,
+    /// What the builder did.
+    pub report: BuildReport,
+    /// Quality before smoothing.
+    pub before: Quality,
+    /// Quality after smoothing (the same without smoothing).
+    pub after: Quality,
+    /// What smoothing did, with the smoother and the iterations.
+    pub smoothing: Option<(Smoother, usize, SmoothReport)>,
+}
+
+/// Meshes `region`: constrained Delaunay refinement to the angle and size limits, then
+/// smoothing.
+pub fn mesh_region(region: &LoadedRegion, s: &MeshSettings) -> Result<PlanarMesh> {
+    let mut builder = MeshBuilder::new().min_angle(s.min_angle);
+    if let Some(a) = s.max_area {
+        builder = builder.max_area(a);
+    }
+    if let Some(l) = s.max_edge {
+        builder = builder.max_edge(l);
+    }
+    if let Some(n) = s.max_vertices {
+        builder = builder.max_vertices(n);
+    }
+    if !s.points.is_empty() {
+        builder = builder.points(s.points.clone());
+    }
+    if let Some(k) = s.strips {
+        builder = builder.strips(k);
+    }
+    let (mut mesh, report) = builder.build(&region.projected)?;
+    let before = Quality::planar(&mesh);
+    let smoothing = (s.smooth > 0).then(|| {
+        let r = smooth(&mut mesh, s.smoother, s.smooth);
+        (s.smoother, s.smooth, r)
+    });
+    let after = Quality::planar(&mesh);
+    Ok(PlanarMesh {
+        mesh,
+        report,
+        before,
+        after,
+        smoothing,
+    })
+}
+
+fn region_line(region: &LoadedRegion) -> String {
+    region.zone.map_or(String::new(), |z| {
+        format!(
+            "region: {:.1} m2 in UTM zone {z}\n",
+            region.projected.area()
+        )
+    })
+}
+
+impl PlanarMesh {
+    /// What was done and the quality table, as `terramesh mesh` prints it.
+    pub fn summary(&self, region: &LoadedRegion) -> String {
+        let mut text = region_line(region);
+        let r = &self.report;
+        if r.strips > 1 {
+            text += &format!(
+                "meshed in {} vertical strips in parallel ({} exchange rounds along the cuts)\n",
+                r.strips, r.strip_rounds
+            );
+        }
+        if r.points_outside > 0 {
+            text += &format!(
+                "{} sample points lie outside the region and were skipped\n",
+                r.points_outside
+            );
+        }
+        match &self.smoothing {
+            Some((smoother, n, rep)) => {
+                text += &format!(
+                    "smoothing ({smoother:?}, {n} iterations): {} moves, {} rejected, {} Delaunay flips\n",
+                    rep.moves, rep.rejected, rep.flips
+                );
+                text += &Quality::table(&[("before", &self.before), ("after", &self.after)]);
+            }
+            None => text += &Quality::table(&[("mesh", &self.before)]),
+        }
+        text
+    }
+}
+
+/// A DEM as a height function over a region's plane: UTM metres (or the region's own
+/// projected metres) to the DEM's coordinates, interpolated bilinearly (nearest at the edge);
+/// voids are filled from their neighbours.
+pub struct DemHeights {
+    dem: Box<dyn ElevationSource>,
+    zone: Option<Zone>,
+    name: String,
+}
+
+impl DemHeights {
+    /// Opens the DEM at `path` for a region in `zone` (`None`: the DEM's own coordinates).
+    pub fn open(path: &Path, zone: Option<Zone>) -> Result<DemHeights> {
+        let dem =
+            open_raster(path, true).map_err(|e| Error::setting(Setting::Dem, path.display(), e))?;
+        Ok(DemHeights {
+            dem,
+            zone,
+            name: path.display().to_string(),
+        })
+    }
+
+    /// What the DEM is.
+    pub fn describe(&self) -> String {
+        self.dem.describe()
+    }
+
+    /// The height at `(x, y)`, or why there is none.
+    pub fn height(&self, x: f64, y: f64) -> std::result::Result<f64, String> {
+        let (sx, sy) = match self.zone {
+            Some(z) => {
+                let (lat, lon) = to_wgs84(x, y, z).map_err(|e| e.to_string())?;
+                self.dem
+                    .crs()
+                    .from_wgs84(lat, lon)
+                    .map_err(|e| e.to_string())?
+                    .ok_or("outside the DEM's coordinate system")?
+            }
+            None => (x, y),
+        };
+        self.dem
+            .sample(sx, sy, Kernel::Bilinear)
+            .or_else(|_| self.dem.sample(sx, sy, Kernel::Nearest))
+            .map_err(|e| e.to_string())
+    }
+
+    /// Checks that the DEM covers `region`: its corners and a 101 x 101 grid inside it.
+    pub fn check_covers(&self, region: &LoadedRegion) -> Result<()> {
+        let (lo, hi) = region.projected.bbox().context("empty region")?;
+        let mut probes: Vec<[f64; 2]> = region
+            .projected
+            .polygons
+            .iter()
+            .flat_map(|p| p.outer.iter().copied())
+            .collect();
+        for r in 0..=100 {
+            for c in 0..=100 {
+                let q = [
+                    lo[0] + (hi[0] - lo[0]) * c as f64 / 100.0,
+                    lo[1] + (hi[1] - lo[1]) * r as f64 / 100.0,
+                ];
+                if region.projected.contains(q) {
+                    probes.push(q);
+                }
+            }
+        }
+        for q in &probes {
+            if let Err(why) = self.height(q[0], q[1]) {
+                return Err(Error::setting(
+                    Setting::Dem,
+                    "",
+                    format!(
+                        "{{dem}} {}: no elevation at ({:.2}, {:.2}) inside the region ({why}); \
+                         give a DEM that covers the whole region",
+                        self.name, q[0], q[1]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A terrain-adaptive mesh with its vertex heights and report.
+pub struct AdaptiveMesh {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The DEM height of each vertex.
+    pub z: Vec<f64>,
+    /// What refinement and 3D improvement did.
+    pub report: AdaptiveReport,
+}
+
+/// Refines `region` until the mesh is within `settings.tolerance` of the DEM at every triangle
+/// centre and edge midpoint (see [`terramesh_mesh::adaptive_mesh`]).
+pub fn adaptive_dem(
+    region: &LoadedRegion,
+    dem: &DemHeights,
+    settings: &AdaptiveSettings,
+) -> Result<AdaptiveMesh> {
+    dem.check_covers(region)?;
+    let f = Fallible(|x: f64, y: f64| dem.height(x, y));
+    match adaptive_mesh(&region.projected, settings, &f) {
+        Ok((mesh, z, report)) => Ok(AdaptiveMesh { mesh, z, report }),
+        Err(MeshError::Height { .. }) => Err(Error::setting(
+            Setting::Dem,
+            "",
+            format!(
+                "{{dem}} {}: the DEM has no elevation at some point inside the region",
+                dem.name
+            ),
+        )),
+        Err(e) => Err(e.into()),
+    }
+}
+
+impl AdaptiveMesh {
+    /// What was done and the quality table, as `terramesh mesh --max-error` prints it.
+    pub fn summary(&self, region: &LoadedRegion, dem: &DemHeights, max_error: f64) -> String {
+        let rep = &self.report;
+        let mut text = region_line(region);
+        text += &format!("heights: {}\n", dem.describe());
+        text += &format!(
+            "adaptive refinement to {max_error} m: {} rounds, error {:.4} m after refinement, {:.4} m final; {} flips and {} vertex moves raised the minimum 3D angle from {:.2} to {:.2} deg\n",
+            rep.rounds,
+            rep.error_after_refinement,
+            rep.max_error,
+            rep.flips,
+            rep.moves,
+            rep.min_angle_3d_before,
+            rep.min_angle_3d
+        );
+        let planar = Quality::planar(&self.mesh);
+        let surface = Quality::surface(&self.mesh, &self.z);
+        text += &Quality::table(&[("planar", &planar), ("3D surface", &surface)]);
+        text
+    }
+}
+
+/// Reads point locations in a region's coordinates: `lat,lon` (projected to `zone`) for a
+/// geographic region, else `x,y` / `easting,northing`.
+pub fn read_points(path: &Path, crs: RegionCrs, zone: Option<Zone>) -> Result<Vec<[f64; 2]>> {
+    let t = Table::read(path, &ReadOptions::default())?;
+    let lat_lon = (
+        t.find(&["lat", "latitude"]),
+        t.find(&["lon", "longitude", "lng"]),
+    );
+    if let (RegionCrs::Geographic, (Some(la), Some(lo))) = (crs, lat_lon) {
+        let zone = zone.context("geographic points need the region's UTM zone")?;
+        let mut out = Vec::with_capacity(t.records.len());
+        for r in 0..t.records.len() {
+            let ang = |c: usize, axis| {
+                parse_angle(&t.records[r][c], axis).map_err(|e| t.bad_value(r, c, &e.to_string()))
+            };
+            let (lat, lon) = (ang(la, Axis::Lat)?, ang(lo, Axis::Lon)?);
+            let p = to_utm(lat, lon, Some(zone))
+                .with_context(|| format!("{}, line {}", t.name, t.lines[r]))?;
+            out.push([p.easting, p.northing]);
+        }
+        return Ok(out);
+    }
+    let x = t.require(&["x", "easting", "east"])?;
+    let y = t.require(&["y", "northing", "north"])?;
+    (0..t.records.len())
+        .map(|r| Ok([t.number(r, x)?, t.number(r, y)?]))
+        .collect()
+}
