@@ -18,7 +18,7 @@
 //! // A 5 m sampling grid over a 100 m square around that point.
 //! let (e, n) = (p.easting, p.northing);
 //! let square = Region::from_ring(vec![[e, n], [e + 100.0, n], [e + 100.0, n + 100.0], [e, n + 100.0]]);
-//! let grid = SamplingGrid { size: GridSize::Spacing(5.0), margin: Margin::Fraction(0.0), clip: true };
+//! let grid = SamplingGrid { size: GridSize::Spacing(5.0), margin: Margin::Fraction(0.0), clip: false };
 //! assert_eq!(grid.build(&square).unwrap().nodes.len(), 21 * 21);
 //! assert_eq!("cubic".parse::<Kernel>().unwrap(), Kernel::Bicubic);
 //! # Ok::<(), terramesh_core::coords::CoordError>(())
