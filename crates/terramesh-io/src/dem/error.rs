@@ -3,6 +3,12 @@
 /// Errors reading an elevation source. Each names the file and says what to do.
 #[derive(Debug, thiserror::Error)]
 pub enum DemError {
+    /// The path given as an elevation source does not exist.
+    #[error("{file}: does not exist (no such file or directory)")]
+    NotFound {
+        /// The path as given.
+        file: String,
+    },
     /// The file could not be opened or read.
     #[error("{file}: {source}")]
     Io {
@@ -34,10 +40,19 @@ pub enum DemError {
 }
 
 impl DemError {
+    /// An I/O error; a missing file is [`DemError::NotFound`].
     pub(crate) fn io(file: &std::path::Path, source: std::io::Error) -> DemError {
+        if source.kind() == std::io::ErrorKind::NotFound {
+            return DemError::not_found(file);
+        }
         DemError::Io {
             file: file.display().to_string(),
             source,
+        }
+    }
+    pub(crate) fn not_found(file: &std::path::Path) -> DemError {
+        DemError::NotFound {
+            file: file.display().to_string(),
         }
     }
     pub(crate) fn format(file: &std::path::Path, message: impl Into<String>) -> DemError {
