@@ -6,15 +6,16 @@
 ///
 /// ```
 /// use terramesh::progress::Progress;
-/// struct Log(std::cell::RefCell<Vec<String>>);
+/// // reporters are Sync (stages may report from worker threads): a Mutex, not a RefCell
+/// struct Log(std::sync::Mutex<Vec<String>>);
 /// impl Progress for Log {
 ///     fn stage_done(&self, name: &str, detail: &str, _seconds: f64) {
-///         self.0.borrow_mut().push(format!("{name}: {detail}"));
+///         self.0.lock().unwrap().push(format!("{name}: {detail}"));
 ///     }
 /// }
 /// let log = Log(Default::default());
 /// log.stage_done("mesh", "10 triangles", 0.1);
-/// assert_eq!(log.0.borrow()[0], "mesh: 10 triangles");
+/// assert_eq!(log.0.lock().unwrap()[0], "mesh: 10 triangles");
 /// ```
 pub trait Progress: Sync {
     /// A stage begins: `index` of `total` (1-based).
