@@ -7,8 +7,8 @@
    bench/pyproj_convert.py (pandas + pyproj), each run 3 times, best time kept.
 
 Run from the repository root after `cargo build --release --workspace --examples`:
-    .venv-fixtures/bin/python bench/compare_convert.py
-(needs pyproj, numpy and pandas: fixtures/requirements.txt). Prints the ratios.
+    .venv-bench/bin/python bench/compare_convert.py
+(needs pyproj, numpy and pandas: bench/requirements.txt, see bench/README.md). Prints the ratios.
 """
 import os
 import subprocess
@@ -20,8 +20,10 @@ import numpy as np
 import pyproj
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "terramesh")
-EXAMPLE = os.path.join(ROOT, "target", "release", "examples", "utm_throughput")
+# cargo's output folder: $CARGO_TARGET_DIR when set, as cargo itself does
+TARGET = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+BIN = os.path.join(TARGET, "release", "terramesh")
+EXAMPLE = os.path.join(TARGET, "release", "examples", "utm_throughput")
 N = 1_000_000
 
 

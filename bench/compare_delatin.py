@@ -6,7 +6,7 @@ Delatin meshes the 201 x 201 heightmap at 1 m spacing and measures its error at 
 points; terramesh measures at triangle centres and edge midpoints (err_nodes) and, for
 comparison, at the same grid points (err_grid). 3D angles are of the lifted triangles.
 Build first: cargo build --release -p terramesh-mesh --example adaptive_compare
-Usage: /work/venv-fix/bin/python bench/compare_delatin.py
+Usage: .venv-bench/bin/python bench/compare_delatin.py
 """
 import os
 import subprocess
@@ -15,7 +15,9 @@ import numpy as np
 from pydelatin import Delatin
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-RUST = os.path.join(ROOT, "target", "release", "examples", "adaptive_compare")
+# cargo's output folder: $CARGO_TARGET_DIR when set, as cargo itself does
+TARGET = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+RUST = os.path.join(TARGET, "release", "examples", "adaptive_compare")
 
 FUNCS = {
     "cliff": lambda x, y: 20.0 * np.tanh((x - 100.0) / 5.0),

@@ -2,7 +2,7 @@
 """Side-by-side timings of terramesh and PyKrige on the same machine; prints ratios.
 
 Run from the repository root after `cargo build --release -p terramesh-cli`:
-    /path/to/venv/bin/python bench/compare_kriging.py [--skip-pykrige] [--big]
+    .venv-bench/bin/python bench/compare_kriging.py [--skip-pykrige] [--big]
 
 Data: posts of the SRTM tile ../shared/data/srtm/N48E007.hgt projected to UTM 32N with pyproj
 (seeded random subsets), targets uniform in the data's box. Written to $TMPDIR/terramesh-bench.
@@ -24,7 +24,9 @@ import numpy as np
 import pyproj
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "terramesh")
+# cargo's output folder: $CARGO_TARGET_DIR when set, as cargo itself does
+TARGET = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+BIN = os.path.join(TARGET, "release", "terramesh")
 TMP = os.path.join(tempfile.gettempdir(), "terramesh-bench")
 os.makedirs(TMP, exist_ok=True)
 rng = np.random.default_rng(7)

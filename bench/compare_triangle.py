@@ -6,7 +6,7 @@ is single-threaded); the "one strip" cases run it in one piece on one core. Each
 process, so peak memory (VmHWM) is the run's own; the best of REPEATS
 runs is reported. Timings cover meshing only (not process start, Python import or file
 reading). Build first:  cargo build --release -p terramesh-mesh --example bench_mesh
-Usage: /work/venv-fix/bin/python bench/compare_triangle.py [REPEATS [CASE-SUBSTRING]]
+Usage: .venv-bench/bin/python bench/compare_triangle.py [REPEATS [CASE-SUBSTRING]]
 """
 import os
 import subprocess
@@ -16,7 +16,9 @@ import tempfile
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-RUST = os.path.join(ROOT, "target", "release", "examples", "bench_mesh")
+# cargo's output folder: $CARGO_TARGET_DIR when set, as cargo itself does
+TARGET = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+RUST = os.path.join(TARGET, "release", "examples", "bench_mesh")
 
 TRIANGLE_RUN = r"""
 import sys, time, numpy as np, triangle

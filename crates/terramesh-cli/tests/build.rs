@@ -273,7 +273,11 @@ fn terramesh_io_read_stl(p: &Path) -> (String, usize) {
 
 #[test]
 fn bundled_crop_gives_the_same_samples_as_the_srtm_tile() {
-    // The crop's posts are the tile's posts, so bilinear samples are identical.
+    // The crop's posts are the tile's posts, so bilinear samples are identical. Without the
+    // tile the example falls back to the crop, and the comparison would be the crop's twice.
+    if terramesh_testdata::shared("srtm/N48E007.hgt").is_none() {
+        return;
+    }
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     let common = [
         "--set",

@@ -368,11 +368,27 @@ fn obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
 
 #[test]
 fn max_error_refines_to_the_dem_within_the_tolerance() {
+    let Some(srtm) = terramesh_testdata::shared("srtm") else {
+        return;
+    };
+    let tile = srtm.join("N48E007.hgt");
+    max_error_case(&srtm, &tile, "N48E007.hgt");
+}
+
+/// The same on the Haut-Barr crop of the SRTM tile (examples/haut-barr/srtm-crop.asc).
+#[test]
+fn max_error_refines_to_the_dem_crop_within_the_tolerance() {
+    let asc = terramesh_testdata::root().join("examples/haut-barr/srtm-crop.asc");
+    max_error_case(&asc, &asc, "srtm-crop.asc");
+}
+
+/// `--max-error` against the DEM `srtm`; the error cases with `tile`, whose file name is
+/// `name`.
+fn max_error_case(srtm: &Path, tile: &Path, name: &str) {
     use terramesh_core::sampling::Kernel;
     use terramesh_io::dem::{open_raster, sample_utm};
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("adaptive.obj");
-    let srtm = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/srtm");
     let (ok, stdout, err) = terramesh(&[
         "mesh",
         "--corners",
@@ -388,7 +404,7 @@ fn max_error_refines_to_the_dem_within_the_tolerance() {
     assert!(table_min_angle(&stdout) >= 20.0, "{stdout}");
     // Independently: the DEM at every vertex, triangle centre and edge midpoint.
     let (v, f) = obj(&out);
-    let dem = open_raster(&srtm, true).unwrap();
+    let dem = open_raster(srtm, true).unwrap();
     let zone = "32N".parse().unwrap();
     let dem_at = |pts: &[[f64; 2]]| -> Vec<f64> {
         sample_utm(dem.as_ref(), pts, zone, Kernel::Bilinear)
@@ -437,7 +453,6 @@ fn max_error_refines_to_the_dem_within_the_tolerance() {
         o,
     ]);
     assert!(!ok && err.contains("--dem"), "{err}");
-    let tile = srtm.join("N48E007.hgt");
     let (ok, _, err) = terramesh(&[
         "mesh",
         "--corners",
@@ -450,7 +465,7 @@ fn max_error_refines_to_the_dem_within_the_tolerance() {
         o,
     ]);
     assert!(
-        !ok && err.contains("N48E007.hgt") && err.contains("no elevation at"),
+        !ok && err.contains(name) && err.contains("no elevation at"),
         "{err}"
     );
     let (ok, _, err) = terramesh(&[

@@ -1,4 +1,8 @@
 //! End-to-end tests of `terramesh sample`.
+//!
+//! Each source kind runs on a crop committed in the repository (`fixtures/data/`,
+//! `examples/haut-barr/srtm-crop.asc`) and, where `../shared/data` is beside the repository,
+//! on the whole file too (skipped without it, a failure when `CI` is set).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -11,12 +15,46 @@ use terramesh_web::ServiceKind;
 const PAPER: &str = "N48°43'20.64\" E7°20'12.48\"; N48°43'20.64\" E7°20'25.44\"; \
                      N48°43'33.6\" E7°20'25.44\"; N48°43'33.6\" E7°20'12.48\"";
 
-fn data(rel: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .join(rel)
+fn data(rel: &str) -> Option<String> {
+    terramesh_testdata::shared(rel).map(|p| p.display().to_string())
+}
+fn crop(rel: &str) -> String {
+    terramesh_testdata::crop(rel).display().to_string()
+}
+/// The Haut-Barr crop of the SRTM tile (examples/haut-barr/srtm-crop.asc).
+fn haut_barr_asc() -> String {
+    terramesh_testdata::root()
+        .join("examples/haut-barr/srtm-crop.asc")
         .display()
         .to_string()
+}
+/// The Haut-Barr crop put back in its tile `N48E007.hgt` (other posts void), in a temporary
+/// directory: the directory, and the tile.
+fn haut_barr_tile() -> (tempfile::TempDir, String, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let tile = terramesh_testdata::hgt_tile_from_asc(Path::new(&haut_barr_asc()), dir.path());
+    let d = dir.path().display().to_string();
+    (dir, d, tile.display().to_string())
+}
+/// `min_z`, `max_z` of a crop in fixtures/dem/crops.csv (written by fixtures/make_dem.py).
+fn crop_range(file: &str) -> (f64, f64) {
+    let text = std::fs::read_to_string(terramesh_testdata::fixture("dem/crops.csv")).unwrap();
+    let r: Vec<&str> = text
+        .lines()
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .find(|r| r[0] == file)
+        .unwrap_or_else(|| panic!("{file} not in crops.csv"));
+    (r[3].parse().unwrap(), r[4].parse().unwrap())
+}
+/// The point count of a crop in fixtures/dem/crops.csv.
+fn crop_count(file: &str) -> usize {
+    let text = std::fs::read_to_string(terramesh_testdata::fixture("dem/crops.csv")).unwrap();
+    let r: Vec<&str> = text
+        .lines()
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .find(|r| r[0] == file)
+        .unwrap_or_else(|| panic!("{file} not in crops.csv"));
+    r[1].parse().unwrap()
 }
 
 fn terramesh(args: &[&str]) -> Output {
@@ -60,9 +98,21 @@ fn table(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
 
 #[test]
 fn paper_grid_on_the_srtm_tile() {
+    if let Some(srtm) = data("srtm") {
+        paper_grid(&srtm);
+    }
+}
+
+#[test]
+fn paper_grid_on_the_srtm_crop() {
+    let (_dir, srtm, _) = haut_barr_tile();
+    paper_grid(&srtm);
+}
+
+fn paper_grid(srtm: &str) {
     let (out, err) = ok(&[
         "--source",
-        &data("srtm"),
+        srtm,
         "--corners",
         PAPER,
         "--rows",
@@ -94,18 +144,23 @@ fn paper_grid_on_the_srtm_tile() {
 
 #[test]
 fn clip_keeps_only_nodes_inside_the_region() {
+    if let Some(tile) = data("srtm/N48E007.hgt") {
+        clip(&tile);
+    }
+}
+
+#[test]
+fn clip_keeps_only_nodes_inside_the_region_of_the_crop() {
+    let (_dir, _, tile) = haut_barr_tile();
+    clip(&tile);
+}
+
+fn clip(tile: &str) {
     let corners = "48.7224 7.3368; 48.7224 7.3404; 48.7260 7.3382";
-    let (all, _) = ok(&[
-        "--source",
-        &data("srtm/N48E007.hgt"),
-        "--corners",
-        corners,
-        "--spacing",
-        "10",
-    ]);
+    let (all, _) = ok(&["--source", tile, "--corners", corners, "--spacing", "10"]);
     let (clipped, _) = ok(&[
         "--source",
-        &data("srtm/N48E007.hgt"),
+        tile,
         "--corners",
         corners,
         "--spacing",
@@ -137,10 +192,26 @@ fn clip_keeps_only_nodes_inside_the_region() {
 #[test]
 fn points_outside_the_data_follow_on_missing() {
     // A region straddling 49 N, the northern edge of the only tile.
-    let corners = "48.995 7.5; 48.995 7.51; 49.005 7.51; 49.005 7.5";
+    if let Some(srtm) = data("srtm") {
+        outside(
+            &srtm,
+            "48.995 7.5; 48.995 7.51; 49.005 7.51; 49.005 7.5",
+            49.0,
+        );
+    }
+}
+
+#[test]
+fn points_outside_the_crop_follow_on_missing() {
+    // A region straddling 48.78 N, the northern edge of the crop.
+    let corners = "48.775 7.30; 48.775 7.31; 48.785 7.31; 48.785 7.30";
+    outside(&haut_barr_asc(), corners, 48.78);
+}
+
+fn outside(source: &str, corners: &str, north: f64) {
     let base = [
         "--source",
-        &data("srtm"),
+        source,
         "--corners",
         corners,
         "--rows",
@@ -158,7 +229,7 @@ fn points_outside_the_data_follow_on_missing() {
     assert_eq!(head.last().unwrap(), "error");
     let missing: Vec<_> = rows.iter().filter(|r| r[6] == "outside the data").collect();
     assert!(!missing.is_empty() && missing.iter().all(|r| r[5] == "-32768"));
-    assert!(missing.iter().all(|r| r[0].parse::<f64>().unwrap() > 49.0));
+    assert!(missing.iter().all(|r| r[0].parse::<f64>().unwrap() > north));
     let (out, err) = ok(&[&base[..], &["--on-missing", "skip"]].concat());
     assert_eq!(table(&out).1.len(), 100 - missing.len());
     assert!(
@@ -169,10 +240,31 @@ fn points_outside_the_data_follow_on_missing() {
 
 #[test]
 fn geotiff_and_ascii_grid_sources() {
-    let corners = "32.80 -97.48; 32.80 -97.40; 32.75 -97.40; 32.75 -97.48";
+    if let Some(tif) = data("grids/fort-worth-3arcsec.tif") {
+        let corners = "32.80 -97.48; 32.80 -97.40; 32.75 -97.40; 32.75 -97.48";
+        geotiff(&tif, corners, (140.0, 300.0));
+    }
+    if let Some(asc) = data("grids/colorado-front-range-srtmgl3.asc") {
+        let corners = "40.12 -105.55; 40.12 -105.45; 40.20 -105.45; 40.20 -105.55";
+        ascii_grid(&asc, corners, 40.12, (2186.0, 3345.0));
+    }
+}
+
+#[test]
+fn geotiff_and_ascii_grid_crops() {
+    // inside the crop, away from its voids
+    let corners = "48.715 7.845; 48.715 7.89; 48.73 7.89; 48.73 7.845";
+    let tif = "grids/srtm-N48E007-r300-c1000.tif";
+    geotiff(&crop(tif), corners, crop_range(tif));
+    let asc = "grids/colorado-front-range-srtmgl3-sw72.asc";
+    let corners = "40.10 -105.55; 40.10 -105.51; 40.14 -105.51; 40.14 -105.55";
+    ascii_grid(&crop(asc), corners, 40.10, crop_range(asc));
+}
+
+fn geotiff(tif: &str, corners: &str, (lo, hi): (f64, f64)) {
     let (out, _) = ok(&[
         "--source",
-        &data("grids/fort-worth-3arcsec.tif"),
+        tif,
         "--corners",
         corners,
         "--rows",
@@ -186,11 +278,13 @@ fn geotiff_and_ascii_grid_sources() {
     assert_eq!(rows.len(), 600);
     assert!(rows
         .iter()
-        .all(|r| (140.0..300.0).contains(&r[5].parse::<f64>().unwrap())));
-    let corners = "40.12 -105.55; 40.12 -105.45; 40.20 -105.45; 40.20 -105.55";
+        .all(|r| (lo..=hi).contains(&r[5].parse::<f64>().unwrap())));
+}
+
+fn ascii_grid(asc: &str, corners: &str, south: f64, (lo, hi): (f64, f64)) {
     let (out, _) = ok(&[
         "--source",
-        &data("grids/colorado-front-range-srtmgl3.asc"),
+        asc,
         "--corners",
         corners,
         "--spacing",
@@ -202,13 +296,13 @@ fn geotiff_and_ascii_grid_sources() {
     assert!(rows.len() > 100);
     assert!(rows
         .iter()
-        .all(|r| (2186.0..=3345.0).contains(&r[5].parse::<f64>().unwrap())));
+        .all(|r| (lo..=hi).contains(&r[5].parse::<f64>().unwrap())));
     // a lat/lon grid: rows share latitudes exactly
     assert_eq!(rows[0][0], rows[1][0]);
     // a 500 m margin on a lat/lon grid reaches about 500 m beyond the corners
     let (out, _) = ok(&[
         "--source",
-        &data("grids/colorado-front-range-srtmgl3.asc"),
+        asc,
         "--corners",
         corners,
         "--rows",
@@ -222,34 +316,53 @@ fn geotiff_and_ascii_grid_sources() {
     ]);
     let (_, rows) = table(&out);
     let lat0: f64 = rows[0][0].parse().unwrap();
-    assert!((40.12 - lat0 - 500.0 / 111_000.0).abs() < 2e-4, "{lat0}");
+    assert!((south - lat0 - 500.0 / 111_000.0).abs() < 2e-4, "{lat0}");
 }
 
 #[test]
 fn lidar_ground_points_keep_their_crs() {
-    let (out, err) = ok(&["--source", &data("lidar/autzen_trim.laz"), "--class", "2"]);
+    if let Some(laz) = data("lidar/autzen_trim.laz") {
+        lidar(&laz, 26_107);
+    }
+}
+
+#[test]
+fn lidar_crop_ground_points_keep_their_crs() {
+    let laz = "lidar/autzen_trim-636500-849000.laz";
+    lidar(&crop(laz), crop_count(&format!("{laz}#ground")));
+}
+
+fn lidar(laz: &str, ground: usize) {
+    let (out, err) = ok(&["--source", laz, "--class", "2"]);
     let (head, rows) = table(&out);
     assert_eq!(head, ["x", "y", "z"]);
-    assert_eq!(rows.len(), 26_107);
+    assert_eq!(rows.len(), ground);
     assert!(
         err.contains("kept as in the file") && err.contains("foot"),
         "{err}"
     );
-    let e = fails(&[
-        "--source",
-        &data("lidar/autzen_trim.laz"),
-        "--corners",
-        PAPER,
-    ]);
+    let e = fails(&["--source", laz, "--corners", PAPER]);
     assert!(e.contains("--region-crs projected"), "{e}");
 }
 
 #[test]
 fn davis_points_csv() {
-    let (out, _) = ok(&["--source", &data("points/davis-topo.csv")]);
+    if let Some(csv) = data("points/davis-topo.csv") {
+        davis(&csv, 52);
+    }
+}
+
+#[test]
+fn davis_points_csv_crop() {
+    let csv = "points/davis-topo-first26.csv";
+    davis(&crop(csv), crop_count(csv));
+}
+
+fn davis(csv: &str, n: usize) {
+    let (out, _) = ok(&["--source", csv]);
     let (head, rows) = table(&out);
     assert_eq!(head, ["x", "y", "z"]);
-    assert_eq!(rows.len(), 52);
+    assert_eq!(rows.len(), n);
 }
 
 #[test]
@@ -265,13 +378,14 @@ fn bad_inputs_are_clear_errors() {
         "2",
     ]);
     assert!(e.contains("nope.tif") && e.contains("no such file"), "{e}");
-    let e = fails(&["--source", &data("srtm"), "--rows", "2", "--cols", "2"]);
+    let srtm = haut_barr_asc();
+    let e = fails(&["--source", &srtm, "--rows", "2", "--cols", "2"]);
     assert!(e.contains("--corners or --region"), "{e}");
-    let e = fails(&["--source", &data("srtm"), "--corners", PAPER]);
+    let e = fails(&["--source", &srtm, "--corners", PAPER]);
     assert!(e.contains("--rows and --cols, or --spacing"), "{e}");
     let e = fails(&[
         "--source",
-        &data("srtm"),
+        &srtm,
         "--corners",
         PAPER,
         "--spacing",
@@ -412,7 +526,21 @@ fn a_killed_run_resumes_and_asks_only_for_the_rest() {
 
 #[test]
 fn terrarium_tiles_from_a_url_template_are_cached() {
-    let png = std::fs::read(data("tiles/terrarium_11_385_803.png")).unwrap();
+    if let Some(png) = data("tiles/terrarium_11_385_803.png") {
+        terrarium(&png, (715.0, 2489.0));
+    }
+}
+
+#[test]
+fn terrarium_crop_from_a_url_template_is_cached() {
+    // the region lies inside the crop's 96 x 96 pixels (lon -112.269..-112.203,
+    // lat 36.076..36.129)
+    let png = "tiles/crop_11_385_803.png";
+    terrarium(&crop(png), crop_range(png));
+}
+
+fn terrarium(png: &str, (lo, hi): (f64, f64)) {
+    let png = std::fs::read(png).unwrap();
     let files = [("/t/11/385/803.png".to_string(), png)]
         .into_iter()
         .collect();
@@ -445,7 +573,7 @@ fn terrarium_tiles_from_a_url_template_are_cached() {
     assert_eq!(rows.len(), 100);
     assert!(rows
         .iter()
-        .all(|r| (715.0..=2489.0).contains(&r[5].parse::<f64>().unwrap())));
+        .all(|r| (lo..=hi).contains(&r[5].parse::<f64>().unwrap())));
     let fetched = s.requests().len();
     drop(s); // the server is gone: the cache must answer
     let (again, _) = ok(&args);

@@ -12,9 +12,9 @@ use super::{DemError, GeoTransform, Raster, SourceCrs};
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/colorado-front-range-srtmgl3.asc");
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/grids/colorado-front-range-srtmgl3-sw72.asc");
 /// let r = terramesh_io::dem::read_ascii_grid(std::path::Path::new(p))?;
-/// assert_eq!((r.rows, r.cols), (144, 144));
+/// assert_eq!((r.rows, r.cols), (72, 72));
 /// # Ok(()) }
 /// ```
 pub fn read_ascii_grid(path: &Path) -> Result<Raster, DemError> {

@@ -4,6 +4,12 @@
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum DemError {
+    /// The path given as an elevation source does not exist.
+    #[error("{file}: does not exist (no such file or directory)")]
+    NotFound {
+        /// The path as given.
+        file: String,
+    },
     /// The file could not be opened or read.
     #[error("{file}: {source}")]
     Io {
@@ -35,10 +41,19 @@ pub enum DemError {
 }
 
 impl DemError {
+    /// An I/O error; a missing file is [`DemError::NotFound`].
     pub(crate) fn io(file: &std::path::Path, source: std::io::Error) -> DemError {
+        if source.kind() == std::io::ErrorKind::NotFound {
+            return DemError::not_found(file);
+        }
         DemError::Io {
             file: file.display().to_string(),
             source,
+        }
+    }
+    pub(crate) fn not_found(file: &std::path::Path) -> DemError {
+        DemError::NotFound {
+            file: file.display().to_string(),
         }
     }
     pub(crate) fn format(file: &std::path::Path, message: impl Into<String>) -> DemError {

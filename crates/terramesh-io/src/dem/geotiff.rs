@@ -24,10 +24,11 @@ const PROJECTED_CS_TYPE: u16 = 3072;
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif");
+/// // SRTM posts in a pixel-is-area GeoTIFF: the first post is half a pixel inside the corner
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/grids/srtm-N48E007-r300-c1000.tif");
 /// let r = terramesh_io::dem::read_geotiff(std::path::Path::new(p))?;
-/// assert_eq!((r.rows, r.cols), (359, 367));
-/// assert!((r.transform.x0 - (-97.485 + 0.5 / 1200.0)).abs() < 1e-9);
+/// assert_eq!((r.rows, r.cols), (111, 131));
+/// assert!((r.transform.x0 - (7.0 + 1000.0 / 1200.0)).abs() < 1e-9);
 /// # Ok(()) }
 /// ```
 pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
@@ -41,8 +42,8 @@ pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_io::dem::{read_geotiff_in, LatLonBox};
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif");
-/// let area = LatLonBox { south: 32.70, west: -97.40, north: 32.71, east: -97.39 };
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/grids/srtm-N48E007-r300-c1000.tif");
+/// let area = LatLonBox { south: 48.70, west: 7.88, north: 48.71, east: 7.89 };
 /// let r = read_geotiff_in(std::path::Path::new(p), Some(&area))?;
 /// assert!(r.rows < 20 && r.cols < 20);
 /// # Ok(()) }

@@ -18,12 +18,15 @@ pub struct LasOptions {
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_io::dem::{read_las, LasOptions};
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/lidar/autzen_trim.laz");
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/lidar/autzen_trim-636500-849000.laz");
 /// let ground = read_las(std::path::Path::new(p), &LasOptions { classes: vec![2] })?;
-/// assert_eq!(ground.xyz.len(), 26_107);
+/// assert_eq!(ground.xyz.len(), 5_978);
 /// # Ok(()) }
 /// ```
 pub fn read_las(path: &Path, opts: &LasOptions) -> Result<PointCloud, DemError> {
+    if !path.exists() {
+        return Err(DemError::not_found(path));
+    }
     let las_err = |e: las::Error| match e {
         las::Error::Io(io) => DemError::io(path, io),
         other => DemError::format(path, format!("not a readable LAS/LAZ file: {other}")),

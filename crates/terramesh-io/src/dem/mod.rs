@@ -56,13 +56,14 @@ pub trait ElevationSource: Send + Sync {
 /// Opens a raster source from a path: a directory of `.hgt` tiles, or a file by its
 /// extension (`.hgt`, `.tif`/`.tiff`, `.asc`, `.png` Terrarium tile named `Z_X_Y`).
 ///
-/// `fill_voids` fills void posts from their neighbours (SRTM voids, GeoTIFF nodata).
+/// `fill_voids` fills void posts from their neighbours (SRTM voids, GeoTIFF nodata). A path
+/// that does not exist is [`DemError::NotFound`], whatever its extension.
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, ElevationSource};
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt");
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/haut-barr/srtm-crop.asc");
 /// let dem = open_raster(std::path::Path::new(p), false)?;
 /// let z = dem.sample(7.3386, 48.7242, Kernel::Bilinear).unwrap();
 /// assert!(z > 300.0 && z < 450.0);
@@ -80,13 +81,13 @@ pub fn open_raster(path: &Path, fill_voids: bool) -> Result<Box<dyn ElevationSou
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, open_raster_in, LatLonBox};
-/// let p = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/grids/fort-worth-3arcsec.tif"));
-/// let area = LatLonBox { south: 32.70, west: -97.40, north: 32.71, east: -97.39 };
+/// let p = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/grids/srtm-N48E007-r300-c1000.tif"));
+/// let area = LatLonBox { south: 48.70, west: 7.88, north: 48.71, east: 7.89 };
 /// let part = open_raster_in(p, false, Some(&area))?;
 /// let whole = open_raster(p, false)?;
-/// assert_eq!(part.sample(-97.395, 32.705, Kernel::Nearest), whole.sample(-97.395, 32.705, Kernel::Nearest));
-/// let (a, b) = (part.sample(-97.3951, 32.7052, Kernel::Bicubic).unwrap(),
-///               whole.sample(-97.3951, 32.7052, Kernel::Bicubic).unwrap());
+/// assert_eq!(part.sample(7.885, 48.705, Kernel::Nearest), whole.sample(7.885, 48.705, Kernel::Nearest));
+/// let (a, b) = (part.sample(7.8851, 48.7052, Kernel::Bicubic).unwrap(),
+///               whole.sample(7.8851, 48.7052, Kernel::Bicubic).unwrap());
 /// assert!((a - b).abs() < 1e-9); // the part's origin moves by whole posts
 /// # Ok(()) }
 /// ```
@@ -95,6 +96,9 @@ pub fn open_raster_in(
     fill_voids: bool,
     area: Option<&LatLonBox>,
 ) -> Result<Box<dyn ElevationSource>, DemError> {
+    if !path.exists() {
+        return Err(DemError::not_found(path));
+    }
     if path.is_dir() {
         return Ok(Box::new(HgtMosaic::open_dir(path, fill_voids)?));
     }

@@ -34,9 +34,9 @@ pub struct PointCloud {
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_io::dem::{read_points, SourceCrs};
 /// use terramesh_io::table::ReadOptions;
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/points/davis-topo.csv");
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/points/davis-topo-first26.csv");
 /// let pc = read_points(std::path::Path::new(p), &ReadOptions::default(), None)?;
-/// assert_eq!(pc.xyz.len(), 52);
+/// assert_eq!(pc.xyz.len(), 26);
 /// assert!(matches!(pc.crs, SourceCrs::Projected { .. }));
 /// # Ok(()) }
 /// ```

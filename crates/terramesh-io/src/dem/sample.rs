@@ -17,7 +17,7 @@ const CHUNK: usize = 4096;
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, sample_latlon};
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt");
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/haut-barr/srtm-crop.asc");
 /// let dem = open_raster(std::path::Path::new(p), false)?;
 /// let z = sample_latlon(dem.as_ref(), &[[48.7242, 7.3386], [50.0, 7.0]], Kernel::Bilinear)?;
 /// assert!(z[0].is_ok() && z[1].is_err());
@@ -48,7 +48,7 @@ pub fn sample_latlon(
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_core::sampling::Kernel;
 /// use terramesh_io::dem::{open_raster, sample_utm};
-/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt")), false)?;
+/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/haut-barr/srtm-crop.asc")), false)?;
 /// let z = sample_utm(dem.as_ref(), &[[377_700.0, 5_398_000.0]], "32N".parse().unwrap(), Kernel::Bilinear)?;
 /// assert!(z[0].is_ok());
 /// # Ok(()) }
@@ -78,7 +78,7 @@ pub fn sample_utm(
 /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
 /// use terramesh_core::sampling::{Kernel, Node};
 /// use terramesh_io::dem::{open_raster, sample_nodes};
-/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt")), false)?;
+/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/haut-barr/srtm-crop.asc")), false)?;
 /// let n = Node { xy: [377_700.0, 5_398_000.0], latlon: Some([48.7242, 7.3386]) };
 /// let z = sample_nodes(dem.as_ref(), &[n], None, Kernel::Nearest)?;
 /// assert!(z[0].is_ok());

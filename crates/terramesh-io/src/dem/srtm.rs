@@ -97,9 +97,13 @@ impl HgtMosaic {
     ///
     /// ```
     /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
-    /// let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm");
-    /// let m = terramesh_io::dem::HgtMosaic::open_dir(std::path::Path::new(dir), false)?;
-    /// assert_eq!(m.voids(), 53);
+    /// // a flat 3" tile at 0 m with one void post in its north-west corner
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let mut posts = vec![0u8; 1201 * 1201 * 2];
+    /// posts[..2].copy_from_slice(&terramesh_io::dem::HGT_VOID.to_be_bytes());
+    /// std::fs::write(dir.path().join("N48E007.hgt"), &posts).unwrap();
+    /// let m = terramesh_io::dem::HgtMosaic::open_dir(dir.path(), false)?;
+    /// assert_eq!(m.voids(), 1);
     /// # Ok(()) }
     /// ```
     pub fn open_dir(dir: &Path, fill_voids: bool) -> Result<HgtMosaic, DemError> {
@@ -126,11 +130,19 @@ impl HgtMosaic {
     /// ```
     /// # fn main() -> Result<(), terramesh_io::dem::DemError> {
     /// use terramesh_io::dem::HgtMosaic;
-    /// let m = HgtMosaic::open_files(&[std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt"))], false)?;
+    /// // a 3" tile whose posts are 0 m but two voids
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let tile = dir.path().join("N48E007.hgt");
+    /// let mut posts = vec![0u8; 1201 * 1201 * 2];
+    /// for i in [600 * 1201 + 600, 600 * 1201 + 601] {
+    ///     posts[2 * i..2 * i + 2].copy_from_slice(&terramesh_io::dem::HGT_VOID.to_be_bytes());
+    /// }
+    /// std::fs::write(&tile, &posts).unwrap();
+    /// let m = HgtMosaic::open_files(&[tile.as_path()], false)?;
     /// assert_eq!(m.step(), 1.0 / 1200.0);
-    /// assert_eq!((m.voids(), m.filled()), (53, 0));
-    /// let f = HgtMosaic::open_files(&[std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/srtm/N48E007.hgt"))], true)?;
-    /// assert_eq!(f.filled(), 53);
+    /// assert_eq!((m.voids(), m.filled()), (2, 0));
+    /// let f = HgtMosaic::open_files(&[tile.as_path()], true)?;
+    /// assert_eq!(f.filled(), 2);
     /// # Ok(()) }
     /// ```
     pub fn open_files(files: &[&Path], fill_voids: bool) -> Result<HgtMosaic, DemError> {

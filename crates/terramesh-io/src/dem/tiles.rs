@@ -18,7 +18,7 @@ const SIDE: usize = 256;
 ///
 /// ```
 /// # fn main() -> Result<(), String> {
-/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/tiles/terrarium_11_385_803.png");
+/// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/tiles/crop_11_385_803.png");
 /// let z = terramesh_io::dem::terrarium_decode(&std::fs::read(p).unwrap())?;
 /// assert_eq!(z.len(), 256 * 256);
 /// # Ok(()) }
@@ -82,7 +82,7 @@ impl TileMosaic {
     /// Adds tile `(x, y)` from its PNG bytes.
     ///
     /// ```
-    /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/tiles/terrarium_11_385_803.png");
+    /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/tiles/crop_11_385_803.png");
     /// let mut m = terramesh_io::dem::TileMosaic::new(11, "tiles");
     /// m.insert(385, 803, &std::fs::read(p).unwrap()).unwrap();
     /// assert!(m.insert(385, 804, b"not a png").is_err());
