@@ -77,6 +77,11 @@ impl LocalKriging {
         })
     }
 
+    /// Always true: every local system gives its variance (for [`crate::Predictor`]).
+    pub fn has_variance(&self) -> bool {
+        true
+    }
+
     /// Estimates (and variances) at `targets`, in parallel.
     ///
     /// # Panics

@@ -41,35 +41,22 @@ pub trait Predictor: Send + Sync {
     fn has_variance(&self) -> bool;
 }
 
-impl Predictor for GlobalKriging {
-    fn predict(
-        &self,
-        targets: &[[f64; 2]],
-        est: &mut [f64],
-        var: Option<&mut [f64]>,
-    ) -> Result<()> {
-        GlobalKriging::predict(self, targets, est, var)
-    }
+/// Kriging predictors delegate to their inherent `predict` and `has_variance`.
+macro_rules! kriging_predictor {
+    ($($t:ty),+) => {$(
+        impl Predictor for $t {
+            fn predict(&self, t: &[[f64; 2]], est: &mut [f64], var: Option<&mut [f64]>) -> Result<()> {
+                <$t>::predict(self, t, est, var)
+            }
 
-    fn has_variance(&self) -> bool {
-        GlobalKriging::has_variance(self)
-    }
+            fn has_variance(&self) -> bool {
+                <$t>::has_variance(self)
+            }
+        }
+    )+};
 }
 
-impl Predictor for LocalKriging {
-    fn predict(
-        &self,
-        targets: &[[f64; 2]],
-        est: &mut [f64],
-        var: Option<&mut [f64]>,
-    ) -> Result<()> {
-        LocalKriging::predict(self, targets, est, var)
-    }
-
-    fn has_variance(&self) -> bool {
-        true
-    }
-}
+kriging_predictor!(GlobalKriging, LocalKriging);
 
 impl Predictor for Idw {
     fn predict(
