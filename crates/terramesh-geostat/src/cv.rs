@@ -10,18 +10,19 @@ use crate::global::GlobalKriging;
 use crate::idw::{Idw, Search};
 use crate::model::{ModelKind, Variogram};
 use crate::neighbourhood::LocalKriging;
+use crate::predictor::{kriging, Neighbourhood, Predictor};
 
 /// An interpolation method to validate.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Interpolator {
-    /// Kriging, global (`neighbours: None`) or in a moving neighbourhood.
+    /// Kriging, global ([`Neighbourhood::All`]) or in a moving neighbourhood.
     Kriging {
         /// The variogram.
         variogram: Variogram,
         /// SK, OK or UK.
         method: Method,
-        /// Neighbourhood size.
-        neighbours: Option<usize>,
+        /// Which data each estimate uses.
+        neighbours: Neighbourhood,
     },
     /// Inverse distance weighting.
     Idw {
@@ -108,7 +109,7 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
                 Interpolator::Kriging {
                     variogram,
                     method,
-                    neighbours: Some(k),
+                    neighbours: Neighbourhood::Nearest(k),
                 } => LocalKriging::new(data, variogram, *method, *k)?.predict_excluding(
                     data.xy(),
                     Some(&idx),
@@ -118,7 +119,7 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
                 Interpolator::Kriging {
                     variogram,
                     method,
-                    neighbours: None,
+                    neighbours: Neighbourhood::All,
                 } if variogram.sill().is_some() => {
                     let g = GlobalKriging::new(data, variogram, *method, true)?;
                     let (e, v) = g.leave_one_out()?;
@@ -184,27 +185,15 @@ fn refit(
         let t: Vec<[f64; 2]> = test.iter().map(|&i| data.xy()[i]).collect();
         let mut e = vec![0.0; t.len()];
         let mut v = vec![0.0; t.len()];
-        match how {
-            Interpolator::Idw { power, search } => {
-                Idw::new(&tr, *power, *search)?.predict(&t, &mut e)?
-            }
+        let p: Box<dyn Predictor> = match how {
+            Interpolator::Idw { power, search } => Box::new(Idw::new(&tr, *power, *search)?),
             Interpolator::Kriging {
                 variogram,
                 method,
-                neighbours: Some(k),
-            } => {
-                LocalKriging::new(&tr, variogram, *method, *k)?.predict(&t, &mut e, Some(&mut v))?
-            }
-            Interpolator::Kriging {
-                variogram,
-                method,
-                neighbours: None,
-            } => GlobalKriging::new(&tr, variogram, *method, true)?.predict(
-                &t,
-                &mut e,
-                Some(&mut v),
-            )?,
-        }
+                neighbours,
+            } => kriging(&tr, variogram, *method, *neighbours, true)?,
+        };
+        p.predict(&t, &mut e, p.has_variance().then_some(&mut v[..]))?;
         for (a, &i) in test.iter().enumerate() {
             est[i] = e[a];
             var[i] = v[a];
@@ -297,7 +286,7 @@ pub fn fit_auto(
             let how = Interpolator::Kriging {
                 variogram: f.variogram.clone(),
                 method: Method::Ordinary,
-                neighbours: Some(k),
+                neighbours: Neighbourhood::Nearest(k),
             };
             let cv = cross_validate(&sub, &how, Folds::LeaveOneOut)?;
             Ok((f, cv.stats.rmse))

@@ -5,10 +5,12 @@
 //! the data centroid and divided by the data's half extent, so that they are of order one
 //! and the kriging system stays well conditioned. The result does not depend on the frame.
 
+use terramesh_core::vocab::Named;
+
 use crate::error::{GeostatError, Result};
 use crate::model::Variogram;
 
-/// What to do with data points that share a location.
+/// What to do with data points that share a location: `reject` or `mean`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Duplicates {
     /// An error naming both points (the default).
@@ -17,6 +19,11 @@ pub enum Duplicates {
     /// Replace them by one point with the mean value.
     Mean,
 }
+
+terramesh_core::named_enum!(Duplicates, "duplicate handling", [
+    Duplicates::Reject => "reject",
+    Duplicates::Mean => "mean",
+]);
 
 /// Scattered data: locations and values, all finite, no two at one location.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,6 +126,11 @@ impl Data {
         &self.z
     }
 
+    /// The mean value (the default known mean of simple kriging); NaN without data.
+    pub fn mean(&self) -> f64 {
+        self.z.iter().sum::<f64>() / self.z.len() as f64
+    }
+
     /// The subset at `idx` (already validated, so no checks).
     pub fn subset(&self, idx: &[usize]) -> Data {
         Data {
@@ -128,7 +140,15 @@ impl Data {
     }
 }
 
-/// The trend of universal kriging, in the coordinates x, y.
+/// The trend of universal kriging, in the coordinates x, y: `constant`, `linear` or
+/// `quadratic` (see [`Named`]).
+///
+/// ```
+/// use terramesh_geostat::{Drift, Named};
+/// assert_eq!("quadratic".parse::<Drift>(), Ok(Drift::Quadratic));
+/// assert_eq!(Drift::Linear.name(), "linear");
+/// assert_eq!(Drift::Linear.terms(), 3);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Drift {
     /// 1 (ordinary kriging).
@@ -148,16 +168,13 @@ impl Drift {
             Drift::Quadratic => 6,
         }
     }
-
-    /// Name used in messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            Drift::Constant => "constant",
-            Drift::Linear => "linear",
-            Drift::Quadratic => "quadratic",
-        }
-    }
 }
+
+terramesh_core::named_enum!(Drift, "drift", [
+    Drift::Constant => "constant",
+    Drift::Linear => "linear",
+    Drift::Quadratic => "quadratic",
+]);
 
 /// Kriging flavour.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -186,6 +203,54 @@ impl Method {
     /// Number of drift functions (0 for simple kriging).
     pub fn terms(self) -> usize {
         self.drift().map_or(0, Drift::terms)
+    }
+}
+
+/// An interpolation method by name: `sk`, `ok`, `uk` (kriging) or `idw`, as the project
+/// file's `interpolation.methods` and the command line's `--method` spell them.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{Data, Drift, Duplicates, InterpolationMethod, Method};
+/// let data = Data::new(vec![[0.0, 0.0], [1.0, 0.0]], vec![1.0, 3.0], Duplicates::Reject)?;
+/// let uk: InterpolationMethod = "UK".parse().unwrap();
+/// assert_eq!(uk.method(Drift::Linear, None, &data), Some(Method::Universal(Drift::Linear)));
+/// let sk = InterpolationMethod::Simple;
+/// assert_eq!(sk.method(Drift::Linear, None, &data), Some(Method::Simple { mean: 2.0 }));
+/// assert_eq!(InterpolationMethod::Idw.method(Drift::Linear, None, &data), None);
+/// # Ok(()) }
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InterpolationMethod {
+    /// Simple kriging around a known mean.
+    Simple,
+    /// Ordinary kriging.
+    Ordinary,
+    /// Universal kriging with a drift.
+    Universal,
+    /// Inverse distance weighting.
+    Idw,
+}
+
+terramesh_core::named_enum!(InterpolationMethod, "interpolation method", [
+    InterpolationMethod::Simple => "sk",
+    InterpolationMethod::Ordinary => "ok",
+    InterpolationMethod::Universal => "uk",
+    InterpolationMethod::Idw => "idw",
+]);
+
+impl InterpolationMethod {
+    /// The kriging [`Method`]: `drift` is used by universal kriging only, `mean` by simple
+    /// kriging only (`None`: the mean of `data`); `None` for IDW, which is not kriging.
+    pub fn method(self, drift: Drift, mean: Option<f64>, data: &Data) -> Option<Method> {
+        match self {
+            InterpolationMethod::Simple => Some(Method::Simple {
+                mean: mean.unwrap_or_else(|| data.mean()),
+            }),
+            InterpolationMethod::Ordinary => Some(Method::Ordinary),
+            InterpolationMethod::Universal => Some(Method::Universal(drift)),
+            InterpolationMethod::Idw => None,
+        }
     }
 }
 

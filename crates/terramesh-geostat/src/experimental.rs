@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 use crate::data::Data;
 use crate::error::{bad, GeostatError, Result};
 
-/// How the semivariance of a lag class is estimated.
+/// How the semivariance of a lag class is estimated: `matheron` or `cressie` (see
+/// [`Named`](crate::Named)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Estimator {
     /// Matheron's `γ = Σ (z_i − z_j)² / 2N`.
@@ -21,19 +22,31 @@ pub enum Estimator {
     CressieHawkins,
 }
 
+terramesh_core::named_enum!(Estimator, "estimator", [
+    Estimator::Matheron => "matheron",
+    Estimator::CressieHawkins => "cressie" | "cressie-hawkins",
+]);
+
+/// Default of [`LagSettings::lags`]: the number of lag classes.
+pub const DEFAULT_LAGS: usize = 15;
+
+/// Default angular tolerance of a [`Direction`], in degrees.
+pub const DEFAULT_TOLERANCE: f64 = 22.5;
+
 /// A direction for a directional variogram.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Direction {
     /// Azimuth in degrees clockwise from north (+y), GSLIB's convention.
     pub azimuth: f64,
-    /// Half-angle tolerance in degrees (0 < tol <= 90).
+    /// Half-angle tolerance in degrees (0 < tol <= 90; the command line's default is
+    /// [`DEFAULT_TOLERANCE`]).
     pub tolerance: f64,
 }
 
 /// Lag classes and options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LagSettings {
-    /// Number of equal-width lag classes on `[0, max_dist)` (default 15).
+    /// Number of equal-width lag classes on `[0, max_dist)` (default [`DEFAULT_LAGS`]).
     pub lags: usize,
     /// Largest distance; default half the data diameter.
     pub max_dist: Option<f64>,
@@ -51,7 +64,7 @@ pub struct LagSettings {
 impl Default for LagSettings {
     fn default() -> Self {
         LagSettings {
-            lags: 15,
+            lags: DEFAULT_LAGS,
             max_dist: None,
             direction: None,
             estimator: Estimator::Matheron,

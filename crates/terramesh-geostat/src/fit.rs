@@ -8,14 +8,14 @@
 //! lag (it is only a scale); the power exponent and Matérn ν are scanned.
 
 use serde::{Deserialize, Serialize};
+use terramesh_core::vocab::Named;
 
 use crate::error::{GeostatError, Result};
 use crate::experimental::Lag;
 use crate::model::{ModelKind, Structure, Variogram};
 
-/// Weights of the least-squares fit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+/// Weights of the least-squares fit: `cressie` or `pairs` (see [`Named`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Weighting {
     /// Cressie (1985): `N_k / γ(h_k)²`, relative errors weighted by pair counts.
     #[default]
@@ -23,6 +23,11 @@ pub enum Weighting {
     /// Pair counts `N_k`.
     Pairs,
 }
+
+terramesh_core::named_enum!(Weighting, "fit weighting", [
+    Weighting::Cressie => "cressie",
+    Weighting::Pairs => "pairs",
+]);
 
 /// A fitted model and how well it fits.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -59,7 +64,7 @@ pub fn fit_model(lags: &[Lag], kind: ModelKind, weighting: Weighting) -> Result<
         .collect();
     if pts.len() < 2 {
         return Err(GeostatError::Fit(format!(
-            "{} lag classes with pairs: at least 2 are needed (more data, or more --lags)",
+            "{} lag classes with pairs: at least 2 are needed (more data, or more lag classes)",
             pts.len()
         )));
     }

@@ -6,6 +6,9 @@ use crate::data::Data;
 use crate::error::{bad, GeostatError, Result};
 use crate::search::Tree;
 
+/// Default IDW power (the command line's `--power`).
+pub const DEFAULT_IDW_POWER: f64 = 2.0;
+
 /// Which data enter each estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Search {

@@ -1,10 +1,50 @@
 //! Geostatistics kernels of **terramesh**: variogram models, experimental variograms and
 //! their fitting, simple / ordinary / universal kriging (global and moving neighbourhood),
-//! inverse distance weighting and cross-validation. No file I/O, no printing.
+//! inverse distance weighting, cross-validation and the automatic choice of a model, and the
+//! variogram file's contents ([`VariogramFile`], as JSON text). No file I/O, no printing.
+//!
+//! - Data: [`Data`] (validated, duplicates rejected or merged by [`Duplicates`]).
+//! - Variograms: [`Variogram`] of [`Structure`]s of a [`ModelKind`]; [`experimental`] lag
+//!   classes ([`LagSettings`]), [`fit_model`] and [`fit_auto`].
+//! - Prediction: every interpolator is a [`Predictor`]; [`kriging`] builds [`GlobalKriging`]
+//!   ([`Neighbourhood::All`]) or [`LocalKriging`] ([`Neighbourhood::Nearest`]) for a
+//!   [`Method`]; [`Idw`] is inverse distance weighting.
+//! - Validation: [`cross_validate`] an [`Interpolator`].
+//! - Names: every setting with a fixed set of values ([`ModelKind`], [`Drift`],
+//!   [`Estimator`], [`Weighting`], [`Duplicates`], [`InterpolationMethod`]) implements
+//!   [`Named`]: one spelling for parsing, display and serde.
+//! - Errors: [`GeostatError`], in the library's own words; errors about one target carry its
+//!   index ([`GeostatError::target`]).
 //!
 //! Conventions follow PyKrige so that results compare exactly: γ(0) = 0 with the nugget as
 //! a discontinuity, kriging variance `Σ λ γ` plus the Lagrange terms, exact at data points.
 //! Ranges are GSLIB practical ranges (see [`model`](crate::Variogram)).
+//!
+//! ```
+//! # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+//! use terramesh_geostat::{
+//!     experimental, fit_model, kriging, Data, Drift, Duplicates, LagSettings, Method,
+//!     ModelKind, Neighbourhood, Weighting,
+//! };
+//! // A smooth surface sampled on a 20 x 20 grid.
+//! let xy: Vec<[f64; 2]> = (0..400).map(|i| [(i % 20) as f64 * 10.0, (i / 20) as f64 * 10.0]).collect();
+//! let z: Vec<f64> = xy.iter().map(|p| 100.0 + 0.1 * p[0] + (p[1] / 40.0).sin()).collect();
+//! let data = Data::new(xy, z, Duplicates::Reject)?;
+//!
+//! // Fit a spherical model to the experimental variogram.
+//! let lags = experimental(&data, &LagSettings::default())?;
+//! let fit = fit_model(&lags, ModelKind::Spherical, Weighting::Cressie)?;
+//!
+//! // Universal kriging with a linear drift, in a neighbourhood of 16 data.
+//! let method = Method::Universal(Drift::Linear);
+//! let p = kriging(&data, &fit.variogram, method, Neighbourhood::Nearest(16), true)?;
+//! let (mut est, mut var) = (vec![0.0; 2], vec![0.0; 2]);
+//! p.predict(&[[55.0, 55.0], [100.0, 100.0]], &mut est, Some(&mut var))?;
+//! let truth = 100.0 + 5.5 + (55.0f64 / 40.0).sin();
+//! assert!((est[0] - truth).abs() < 0.05 && var[0] > 0.0);
+//! assert_eq!(var[1], 0.0); // (100, 100) is a data point: exact there
+//! # Ok(()) }
+//! ```
 #![warn(missing_docs)]
 // Index loops mirror the formulas of the dense kernels; `!(x > 0.0)` is deliberate: it also
 // rejects NaN.
@@ -15,24 +55,33 @@ mod cv;
 mod data;
 mod error;
 mod experimental;
+mod file;
 mod fit;
 mod global;
 mod idw;
 mod linalg;
 mod model;
 mod neighbourhood;
+mod predictor;
 mod search;
 mod special;
 mod system;
 
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
-pub use data::{Data, Drift, Duplicates, Method};
+pub use data::{Data, Drift, Duplicates, InterpolationMethod, Method};
 pub use error::{GeostatError, Result};
 pub use experimental::{
-    diameter, draw_subset, experimental, Direction, Estimator, Lag, LagSettings, DEFAULT_MAX_POINTS,
+    diameter, draw_subset, experimental, Direction, Estimator, Lag, LagSettings, DEFAULT_LAGS,
+    DEFAULT_MAX_POINTS, DEFAULT_TOLERANCE,
+};
+pub use file::{
+    CandidateEntry, CandidateSummary, FitSummary, LagSummary, VariogramFile, VariogramFileError,
 };
 pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
-pub use idw::{Idw, Search as IdwSearch};
+pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
+pub use predictor::{kriging, Neighbourhood, Predictor};
+/// The vocabulary trait of `terramesh-core`, re-exported: `ModelKind::ALL`, `.name()`, ...
+pub use terramesh_core::vocab::{Named, UnknownName};

@@ -20,13 +20,25 @@
 //! `scale` is `c/a^α`.
 
 use serde::{Deserialize, Serialize};
+use terramesh_core::vocab::Named;
 
 use crate::error::{bad, GeostatError, Result};
 use crate::special::matern_correlation;
 
 /// The shape of one variogram structure.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+///
+/// Named (see [`Named`]) `nugget`, `spherical`, `exponential`, `gaussian`, `linear`, `power`
+/// and `matern`, in files and on the command line; [`Named::ALL`] lists them in the order
+/// [`fit_auto`](crate::fit_auto) is usually given them (`--model auto`).
+///
+/// ```
+/// use terramesh_geostat::{ModelKind, Named};
+/// assert_eq!("Spherical".parse::<ModelKind>(), Ok(ModelKind::Spherical));
+/// assert!("cubic".parse::<ModelKind>().is_err());
+/// assert_eq!(ModelKind::Matern.name(), "matern");
+/// assert_eq!(ModelKind::ALL[0], ModelKind::Spherical);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ModelKind {
     /// Pure nugget (a structure with zero range: γ = c for h > 0).
     Nugget,
@@ -44,44 +56,18 @@ pub enum ModelKind {
     Matern,
 }
 
+// `ALL` in the order `--model auto` tries them.
+terramesh_core::named_enum!(ModelKind, "variogram model", [
+    ModelKind::Spherical => "spherical",
+    ModelKind::Exponential => "exponential",
+    ModelKind::Gaussian => "gaussian",
+    ModelKind::Matern => "matern",
+    ModelKind::Power => "power",
+    ModelKind::Linear => "linear",
+    ModelKind::Nugget => "nugget",
+]);
+
 impl ModelKind {
-    /// All kinds, in the order `--model auto` tries them.
-    pub const ALL: [ModelKind; 7] = [
-        ModelKind::Spherical,
-        ModelKind::Exponential,
-        ModelKind::Gaussian,
-        ModelKind::Matern,
-        ModelKind::Power,
-        ModelKind::Linear,
-        ModelKind::Nugget,
-    ];
-
-    /// The lower-case name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Nugget => "nugget",
-            ModelKind::Spherical => "spherical",
-            ModelKind::Exponential => "exponential",
-            ModelKind::Gaussian => "gaussian",
-            ModelKind::Linear => "linear",
-            ModelKind::Power => "power",
-            ModelKind::Matern => "matern",
-        }
-    }
-
-    /// Parses a name (case-insensitive).
-    ///
-    /// ```
-    /// use terramesh_geostat::ModelKind;
-    /// assert_eq!(ModelKind::parse("Spherical"), Some(ModelKind::Spherical));
-    /// assert_eq!(ModelKind::parse("cubic"), None);
-    /// ```
-    pub fn parse(s: &str) -> Option<ModelKind> {
-        ModelKind::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
-    }
-
     /// Whether the model has a sill.
     pub fn bounded(self) -> bool {
         !matches!(self, ModelKind::Linear | ModelKind::Power)

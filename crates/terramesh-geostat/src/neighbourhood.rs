@@ -62,7 +62,7 @@ impl LocalKriging {
             return Err(GeostatError::TooFewData {
                 n: k,
                 needed: p.max(1),
-                what: format!("the neighbourhood (--neighbors) with {} drift terms", p),
+                what: format!("a neighbourhood with {p} drift terms"),
             });
         }
         let tree = Tree::new(&prep.pts)?;
@@ -75,6 +75,11 @@ impl LocalKriging {
             sill,
             bounded,
         })
+    }
+
+    /// Always true: every local system gives its variance (for [`crate::Predictor`]).
+    pub fn has_variance(&self) -> bool {
+        true
     }
 
     /// Estimates (and variances) at `targets`, in parallel.
@@ -123,11 +128,11 @@ impl LocalKriging {
                     let ex = exclude.map(|x| x[t]);
                     *o = self
                         .one(targets[t], ex, s)
-                        .map_err(|why| GeostatError::Singular {
-                            why: format!(
-                                "at target {t} ({}, {}): {why}",
-                                targets[t][0], targets[t][1]
-                            ),
+                        .map_err(|why| GeostatError::SingularAt {
+                            index: t,
+                            x: targets[t][0],
+                            y: targets[t][1],
+                            why,
                         })?;
                 }
                 Ok::<(), GeostatError>(())
@@ -306,7 +311,7 @@ fn singular_why(k: usize, p: usize) -> String {
     match p {
         0 | 1 => format!("the system of the {k} nearest data is singular (zero sill or coincident points)"),
         _ => format!(
-            "the {k} nearest data cannot support the drift ({p} terms): they are collinear or too few; raise --neighbors"
+            "the {k} nearest data cannot support the drift ({p} terms): they are collinear or too few; use a larger neighbourhood"
         ),
     }
 }

@@ -5,8 +5,8 @@ mod common;
 use common::*;
 use terramesh_geostat::{
     cross_validate, experimental, fit_auto, fit_model, Data, Direction, Drift, Duplicates,
-    Estimator, Folds, Interpolator, LagSettings, Method, ModelKind, Structure, Variogram,
-    Weighting,
+    Estimator, Folds, Interpolator, LagSettings, Method, ModelKind, Named, Neighbourhood,
+    Structure, Variogram, Weighting,
 };
 
 fn data(set: &str) -> Data {
@@ -153,7 +153,7 @@ fn fitting_recovers_known_models() {
 fn auto_picks_a_model_on_real_data() {
     let d = data("srtm3000");
     let lags = experimental(&d, &LagSettings::default()).unwrap();
-    let (best, cands) = fit_auto(&d, &lags, Weighting::Cressie, &ModelKind::ALL).unwrap();
+    let (best, cands) = fit_auto(&d, &lags, Weighting::Cressie, ModelKind::ALL).unwrap();
     let best_rmse = cands
         .iter()
         .filter_map(|c| c.cv_rmse)
@@ -181,7 +181,7 @@ fn fast_leave_one_out_equals_refitting() {
             &Interpolator::Kriging {
                 variogram: v.clone(),
                 method,
-                neighbours: None,
+                neighbours: Neighbourhood::All,
             },
             Folds::LeaveOneOut,
         )
@@ -191,7 +191,7 @@ fn fast_leave_one_out_equals_refitting() {
             &Interpolator::Kriging {
                 variogram: v.clone(),
                 method,
-                neighbours: None,
+                neighbours: Neighbourhood::All,
             },
             Folds::KFold(d.len()),
         )

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use terramesh_geostat::{cross_validate, Folds, IdwSearch, Interpolator};
+use terramesh_geostat::{cross_validate, Folds, IdwSearch, Interpolator, Neighbourhood};
 
 use super::geodata::{in_file, read_data};
 use super::interpolate::{method, resolve_variogram, MethodArg, MethodArgs};
@@ -48,7 +48,10 @@ pub fn run(args: Args) -> Result<()> {
         Interpolator::Kriging {
             variogram: resolve_variogram(&args.m, &fd)?,
             method: method(&args.m, &fd.data)?,
-            neighbours: args.m.neighbors,
+            neighbours: args
+                .m
+                .neighbors
+                .map_or(Neighbourhood::All, Neighbourhood::Nearest),
         }
     };
     let folds = match args.folds {

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use terramesh_geostat::{
-    Anisotropy, Data, Duplicates, GeostatError, ModelKind, Structure, Variogram,
+    Anisotropy, Data, Duplicates, GeostatError, ModelKind, Structure, Variogram, VariogramFile,
+    VariogramFileError,
 };
 use terramesh_io::table::{ReadOptions, Table};
 
@@ -78,7 +79,7 @@ pub fn explicit_variogram(m: &ModelArgs) -> Result<Option<Variogram>> {
     if name.eq_ignore_ascii_case("auto") {
         return Ok(None);
     }
-    let kind = ModelKind::parse(name).with_context(|| {
+    let kind = name.parse::<ModelKind>().ok().with_context(|| {
         format!("--model '{name}': expected one of spherical, exponential, gaussian, matern, power, linear, nugget, auto")
     })?;
     let nugget = m.nugget.unwrap_or(0.0);
@@ -128,19 +129,14 @@ pub fn explicit_variogram(m: &ModelArgs) -> Result<Option<Variogram>> {
 /// Reads the `model` of a file written by `terramesh variogram`.
 pub fn read_variogram_file(path: &PathBuf) -> Result<Variogram> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let model = json.get("model").with_context(|| {
-        format!(
-            "{}: no \"model\" key (write it with terramesh variogram)",
+    match VariogramFile::from_json(&text) {
+        Ok(f) => Ok(f.model),
+        Err(e @ VariogramFileError::NoModel) => bail!(
+            "{}: {e} (write it with terramesh variogram)",
             path.display()
-        )
-    })?;
-    let v: Variogram = serde_json::from_value(model.clone())
-        .with_context(|| format!("{}: \"model\" is not a variogram", path.display()))?;
-    v.validate()
-        .with_context(|| format!("{}: model", path.display()))?;
-    Ok(v)
+        ),
+        Err(e) => bail!("{}: {e}", path.display()),
+    }
 }
 
 /// Wraps a library error with the data file name.

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use terramesh_geostat::{
-    experimental, Data, Drift, GlobalKriging, Idw, IdwSearch, LocalKriging, Method, Variogram,
+    experimental, kriging, Data, Drift, Idw, IdwSearch, Method, Neighbourhood, Predictor, Variogram,
 };
 use terramesh_io::grid_write::{write_asc, write_geotiff, RasterGrid};
 use terramesh_io::number::write_shortest;
@@ -71,7 +71,7 @@ pub struct MethodArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub radius: Option<f64>,
     /// IDW power.
-    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_IDW_POWER, allow_hyphen_values = true)]
     pub power: f64,
     /// Points at one location.
     #[arg(long, value_enum, default_value_t = DupArg::Reject)]
@@ -114,28 +114,6 @@ pub struct Args {
     /// Output file (default: standard output; required for --grid).
     #[arg(short, long)]
     output: Option<PathBuf>,
-}
-
-/// A ready interpolator.
-pub enum Engine {
-    Global(Box<GlobalKriging>),
-    Local(LocalKriging),
-    Idw(Idw),
-}
-
-impl Engine {
-    pub fn predict(
-        &self,
-        t: &[[f64; 2]],
-        est: &mut [f64],
-        var: Option<&mut [f64]>,
-    ) -> terramesh_geostat::Result<()> {
-        match self {
-            Engine::Global(g) => g.predict(t, est, var),
-            Engine::Local(l) => l.predict(t, est, var),
-            Engine::Idw(i) => i.predict(t, est),
-        }
-    }
 }
 
 /// The variogram from --model/--psill/..., --variogram FILE or auto.
@@ -191,7 +169,7 @@ pub fn method(m: &MethodArgs, data: &Data) -> Result<Method> {
 }
 
 /// Builds the interpolator for the flags.
-pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Engine> {
+pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Box<dyn Predictor>> {
     if let Some(k) = m.neighbors {
         if k == 0 {
             bail!("--neighbors 0: must be at least 1");
@@ -210,7 +188,7 @@ pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Engine> {
             (None, Some(r)) => IdwSearch::Radius(r),
             (None, None) => IdwSearch::All,
         };
-        return Ok(Engine::Idw(
+        return Ok(Box::new(
             Idw::new(&fd.data, m.power, search).map_err(|e| in_file(&fd.name, e))?,
         ));
     }
@@ -219,15 +197,10 @@ pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Engine> {
     }
     let method = method(m, &fd.data)?;
     let v = resolve_variogram(m, fd)?;
-    let e = match m.neighbors {
-        Some(k) => Engine::Local(
-            LocalKriging::new(&fd.data, &v, method, k).map_err(|e| in_file(&fd.name, e))?,
-        ),
-        None => Engine::Global(Box::new(
-            GlobalKriging::new(&fd.data, &v, method, variance).map_err(|e| in_file(&fd.name, e))?,
-        )),
-    };
-    Ok(e)
+    let hood = m
+        .neighbors
+        .map_or(Neighbourhood::All, Neighbourhood::Nearest);
+    kriging(&fd.data, &v, method, hood, variance).map_err(|e| in_file(&fd.name, e))
 }
 
 /// Runs the command.
@@ -236,19 +209,24 @@ pub fn run(args: Args) -> Result<()> {
     let want_var = args.m.method != MethodArg::Idw && !args.no_variance;
     let eng = engine(&args.m, &fd, want_var)?;
     match (&args.targets, &args.grid) {
-        (Some(t), None) => run_points(&eng, t, want_var, args.output.as_deref()),
+        (Some(t), None) => run_points(&*eng, t, want_var, args.output.as_deref()),
         (None, Some(g)) => {
             let spec: RasterGrid = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
             let Some(out) = &args.output else {
                 bail!("--grid needs -o FILE.asc or -o FILE.tif");
             };
-            run_grid(&eng, &spec, out, args.epsg)
+            run_grid(&*eng, &spec, out, args.epsg)
         }
         _ => bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
     }
 }
 
-fn run_points(eng: &Engine, targets: &Path, want_var: bool, output: Option<&Path>) -> Result<()> {
+fn run_points(
+    eng: &dyn Predictor,
+    targets: &Path,
+    want_var: bool,
+    output: Option<&Path>,
+) -> Result<()> {
     let name = targets.display().to_string();
     let file = File::open(targets).with_context(|| name.clone())?;
     let mut rdr = csv::ReaderBuilder::new()
@@ -305,7 +283,11 @@ fn run_points(eng: &Engine, targets: &Path, want_var: bool, output: Option<&Path
             let mut var = vec![0.0; if want_var { pts.len() } else { 0 }];
             eng.predict(&pts, &mut est, want_var.then_some(&mut var[..]))
                 .map_err(|e| {
-                    anyhow::anyhow!("{name}: {}", shift_target(&e.to_string(), first_row))
+                    let e = e.offset_target(first_row);
+                    anyhow::anyhow!(
+                        "{name}: {}",
+                        e.display_with_target(|i| format!("target row {}", i + 1))
+                    )
                 })?;
             buf.clear();
             for (i, p) in pts.iter().enumerate() {
@@ -336,21 +318,7 @@ fn run_points(eng: &Engine, targets: &Path, want_var: bool, output: Option<&Path
     Ok(())
 }
 
-/// Library messages count targets from 0 within a block; report the data row (1-based).
-fn shift_target(msg: &str, offset: usize) -> String {
-    if let Some(i) = msg.find("target ") {
-        let rest = &msg[i + 7..];
-        let end = rest
-            .find(|c: char| !c.is_ascii_digit())
-            .unwrap_or(rest.len());
-        if let Ok(k) = rest[..end].parse::<usize>() {
-            return format!("{}target row {}{}", &msg[..i], k + offset + 1, &rest[end..]);
-        }
-    }
-    msg.to_string()
-}
-
-fn run_grid(eng: &Engine, g: &RasterGrid, out_path: &Path, epsg: Option<u16>) -> Result<()> {
+fn run_grid(eng: &dyn Predictor, g: &RasterGrid, out_path: &Path, epsg: Option<u16>) -> Result<()> {
     let ext = out_path
         .extension()
         .and_then(|e| e.to_str())

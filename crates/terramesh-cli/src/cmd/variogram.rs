@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use terramesh_geostat::{
-    experimental, fit_auto, fit_model, Direction, Duplicates, Estimator, LagSettings, ModelKind,
-    Weighting,
+    experimental, fit_auto, fit_model, CandidateEntry, Direction, Duplicates, Estimator,
+    FitSummary, LagSettings, LagSummary, ModelKind, Named, VariogramFile, Weighting,
 };
 use terramesh_io::output::Output;
 
@@ -52,7 +52,7 @@ impl From<DupArg> for Duplicates {
 #[derive(clap::Args, Debug, Clone)]
 pub struct LagArgs {
     /// Number of lag classes.
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_LAGS)]
     pub lags: usize,
     /// Largest lag distance (default: half the data diameter).
     #[arg(long, allow_hyphen_values = true)]
@@ -61,7 +61,7 @@ pub struct LagArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub azimuth: Option<f64>,
     /// Angular tolerance of --azimuth, degrees.
-    #[arg(long, default_value_t = 22.5)]
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_TOLERANCE)]
     pub tolerance: f64,
     /// Semivariance estimator.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Matheron)]
@@ -149,27 +149,27 @@ pub fn run(args: Args) -> Result<()> {
     let (fit, cands) = fit_named(&fd.data, &lags, &args.model, args.lag.weighting())
         .map_err(|e| e.context(fd.name.clone()))?;
     let s = args.lag.settings();
-    let json = serde_json::json!({
-        "data": fd.name,
-        "points": fd.data.len(),
-        "lags": {
-            "classes": s.lags,
-            "max_dist": lags.last().map(|l| l.hi),
-            "azimuth": args.lag.azimuth,
-            "tolerance": args.lag.azimuth.map(|_| args.lag.tolerance),
-            "estimator": format!("{:?}", args.lag.estimator).to_lowercase(),
-        },
-        "experimental": lags,
-        "model": fit.variogram,
-        "fit": {
-            "weights": args.lag.weighting(),
-            "objective": fit.objective,
-            "rmse": fit.rmse,
-        },
-        "candidates": cands,
-    });
+    let file = VariogramFile {
+        data: fd.name.clone(),
+        points: fd.data.len(),
+        lags: Some(LagSummary {
+            classes: s.lags,
+            max_dist: lags.last().map(|l| l.hi),
+            azimuth: args.lag.azimuth,
+            tolerance: args.lag.azimuth.map(|_| args.lag.tolerance),
+            estimator: s.estimator,
+        }),
+        experimental: lags.clone(),
+        model: fit.variogram.clone(),
+        fit: Some(FitSummary {
+            weights: args.lag.weighting(),
+            objective: fit.objective,
+            rmse: fit.rmse,
+        }),
+        candidates: cands.into_iter().map(CandidateEntry::Full).collect(),
+    };
     let mut out = Output::create(args.output.as_deref())?;
-    serde_json::to_writer_pretty(&mut out, &json)?;
+    out.write_all(file.to_json_pretty().as_bytes())?;
     out.write_all(b"\n")?;
     out.commit()?;
     if let Some(p) = &args.plot {
@@ -204,10 +204,10 @@ pub fn fit_named(
     w: Weighting,
 ) -> Result<(terramesh_geostat::Fit, Vec<terramesh_geostat::Candidate>)> {
     if model.eq_ignore_ascii_case("auto") {
-        let (f, c) = fit_auto(data, lags, w, &ModelKind::ALL)?;
+        let (f, c) = fit_auto(data, lags, w, ModelKind::ALL)?;
         return Ok((f, c));
     }
-    let Some(kind) = ModelKind::parse(model) else {
+    let Ok(kind) = model.parse::<ModelKind>() else {
         bail!("--model '{model}': expected auto, spherical, exponential, gaussian, matern, power, linear or nugget");
     };
     Ok((fit_model(lags, kind, w)?, Vec::new()))

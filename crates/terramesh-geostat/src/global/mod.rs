@@ -237,9 +237,11 @@ impl GlobalKriging {
 
     /// Estimates (and variances if `var` is given) at `targets`, written to `est` / `var`.
     ///
+    /// Variances asked of an object built with `variance = false` that needs them for
+    /// variances (the band strategy) are [`GeostatError::NoVariance`].
+    ///
     /// # Panics
-    /// If the output slices are not as long as `targets`, or variances are asked of an
-    /// object built with `variance = false` and a band strategy.
+    /// If the output slices are not as long as `targets`.
     pub fn predict(
         &self,
         targets: &[[f64; 2]],
@@ -249,14 +251,25 @@ impl GlobalKriging {
         assert_eq!(est.len(), targets.len());
         if let Some(v) = &var {
             assert_eq!(v.len(), targets.len());
-            assert!(self.variance || !matches!(self.solver, Solver::Band { .. }));
+            if !self.has_variance() {
+                return Err(GeostatError::NoVariance {
+                    what: "global kriging built without variances",
+                });
+            }
         }
         for (b, chunk) in targets.chunks(BLOCK).enumerate() {
             let r = b * BLOCK..b * BLOCK + chunk.len();
             let vslice = var.as_deref_mut().map(|v| &mut v[r.clone()]);
-            self.predict_block(chunk, &mut est[r], vslice)?;
+            self.predict_block(chunk, &mut est[r], vslice)
+                .map_err(|e| e.offset_target(b * BLOCK))?;
         }
         Ok(())
+    }
+
+    /// Whether [`GlobalKriging::predict`] can give variances: built with `variance = true`,
+    /// or with a strategy that needs nothing more for them.
+    pub fn has_variance(&self) -> bool {
+        self.variance || !matches!(self.solver, Solver::Band { .. })
     }
 
     fn predict_block(
@@ -268,7 +281,7 @@ impl GlobalKriging {
         let q: Vec<[f64; 2]> = t.iter().map(|p| self.prep.map(*p)).collect();
         let v = var.as_deref_mut();
         match &self.solver {
-            Solver::Band { band, h, support } => self.block_band(band, h, *support, &q, est, v),
+            Solver::Band { band, h, support } => self.block_band(band, h, *support, t, &q, est, v),
             Solver::Dense { l, g } => self.block_dense(l, g, &q, est, v),
             Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
         }?;
@@ -286,16 +299,18 @@ impl GlobalKriging {
             }
         }
         if let Some(v) = var {
-            check_finite(v)?;
+            finite_at(v, "variance")?;
         }
-        check_finite(est)
+        finite_at(est, "estimate")
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn block_band(
         &self,
         band: &Band,
         h: &[f64],
         r: f64,
+        t: &[[f64; 2]],
         q: &[[f64; 2]],
         est: &mut [f64],
         var: Option<&mut [f64]>,
@@ -304,7 +319,8 @@ impl GlobalKriging {
         let want_var = var.is_some();
         let res: Vec<Result<(f64, f64)>> = q
             .par_iter()
-            .map_init(Vec::new, |near, &x0| {
+            .enumerate()
+            .map_init(Vec::new, |near, (j, &x0)| {
                 self.tree.within(x0, r, near);
                 near.sort_unstable_by_key(|a| a.1);
                 let mut f0 = [0.0; 6];
@@ -323,7 +339,10 @@ impl GlobalKriging {
                     let mut s = 0.5 * ks[a] * band.zij(ia, ia);
                     for (b, &(_, ib)) in near.iter().enumerate().skip(a + 1) {
                         if ib - ia > wb {
-                            return Err(GeostatError::Singular {
+                            return Err(GeostatError::SingularAt {
+                                index: j,
+                                x: t[j][0],
+                                y: t[j][1],
                                 why: format!("internal: data pair ({ia}, {ib}) outside the inverse band {wb}"),
                             });
                         }
@@ -526,6 +545,14 @@ impl GlobalKriging {
 
 pub(crate) fn par() -> Par {
     faer::get_global_parallelism()
+}
+
+/// `NotFiniteAt` the first target whose `what` is not finite.
+fn finite_at(v: &[f64], what: &'static str) -> Result<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(GeostatError::NotFiniteAt { index, what }),
+    }
 }
 
 fn check_finite(v: &[f64]) -> Result<()> {

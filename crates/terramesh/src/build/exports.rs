@@ -7,6 +7,7 @@ use crate::error::{Context, Result};
 use terramesh_core::coords::{to_wgs84, LocalEnu, Zone};
 use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_core::vocab::Named;
+use terramesh_geostat::{CandidateEntry, CandidateSummary, VariogramFile};
 use terramesh_io::export::{
     write_collada, write_dxf, write_kml, write_model_kml, write_stl, write_tsurf, ColladaOptions,
     KmlStyle, TsurfInfo,
@@ -320,15 +321,24 @@ pub fn write_all(
         }
         Ok(())
     })?);
-    let json = serde_json::json!({
-        "data": "samples.csv",
-        "points": s.xyz.len(),
-        "experimental": it.lags,
-        "model": it.variogram,
-        "candidates": it.candidates.iter().map(|(m, cv, fit)| serde_json::json!({"model": m, "cv_rmse": cv, "fit_rmse": fit})).collect::<Vec<_>>(),
-    });
+    let mut candidates = Vec::with_capacity(it.candidates.len());
+    for (m, cv, fit) in &it.candidates {
+        candidates.push(CandidateEntry::Summary(CandidateSummary {
+            model: *m,
+            cv_rmse: *cv,
+            fit_rmse: *fit,
+        }));
+    }
+    let json = VariogramFile {
+        data: "samples.csv".into(),
+        points: s.xyz.len(),
+        experimental: it.lags.clone(),
+        candidates,
+        ..VariogramFile::new(it.variogram.clone())
+    }
+    .to_json_pretty();
     files.push(atomic(&out.join("variogram.json"), |w| {
-        serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
+        w.write_all(json.as_bytes())?;
         w.write_all(b"\n")
     })?);
     Ok(Written {

@@ -259,7 +259,7 @@ pub fn write_report(
                 .iter()
                 .map(|(name, cv, fit)| {
                     vec![
-                        name.clone(),
+                        name.to_string(),
                         cv.map_or("-".into(), |v| num(v, 4)),
                         fit.map_or("-".into(), |v| num(v, 4)),
                     ]

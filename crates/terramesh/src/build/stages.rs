@@ -4,9 +4,9 @@ use std::path::Path;
 
 use terramesh_core::coords::Zone;
 use terramesh_geostat::{
-    cross_validate, experimental, fit_auto, CvStats, Data, Drift, Duplicates, Folds, GlobalKriging,
-    Idw, IdwSearch, Interpolator, Lag, LagSettings, LocalKriging, Method, ModelKind, Variogram,
-    Weighting,
+    cross_validate, experimental, fit_auto, kriging, CvStats, Data, Drift, Duplicates, Folds, Idw,
+    IdwSearch, Interpolator, Lag, LagSettings, Method, ModelKind, Named, Neighbourhood, Predictor,
+    Variogram, Weighting,
 };
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport};
@@ -162,7 +162,7 @@ pub struct Interpolated {
     /// Experimental variogram of the samples.
     pub lags: Vec<Lag>,
     /// Candidate models tried by `auto`, as (model, cv rmse, fit rmse).
-    pub candidates: Vec<(String, Option<f64>, Option<f64>)>,
+    pub candidates: Vec<(ModelKind, Option<f64>, Option<f64>)>,
     /// UK elevation at each mesh vertex.
     pub uk: Vec<f64>,
     /// Kriging standard deviation at each vertex.
@@ -195,7 +195,7 @@ pub struct Model {
     /// Experimental variogram of the samples.
     pub lags: Vec<Lag>,
     /// Candidate models tried by `auto`, as (model, cv rmse, fit rmse).
-    pub candidates: Vec<(String, Option<f64>, Option<f64>)>,
+    pub candidates: Vec<(ModelKind, Option<f64>, Option<f64>)>,
 }
 
 /// Step 4a: the variogram of the samples (needed before meshing for adaptive refinement).
@@ -211,22 +211,16 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let variogram = if let Some(v) = &ip.model {
-        let kind = ModelKind::parse(&v.model).with_context(|| {
+        let kind = v.model.parse::<ModelKind>().ok().with_context(|| {
             format!("interpolation.model.model = \"{}\": expected spherical, exponential, gaussian, matern, power, linear or nugget", v.model)
         })?;
         Variogram::single(kind, v.nugget, v.psill, v.range).context("interpolation.model")?
     } else if ip.variogram == "auto" {
-        let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, &ModelKind::ALL)
+        let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL)
             .context("fitting the variogram")?;
         candidates = cands
             .iter()
-            .map(|c| {
-                (
-                    c.model.name().to_string(),
-                    c.cv_rmse,
-                    c.fit.as_ref().map(|f| f.rmse),
-                )
-            })
+            .map(|c| (c.model, c.cv_rmse, c.fit.as_ref().map(|f| f.rmse)))
             .collect();
         fit.variogram
     } else {
@@ -276,9 +270,9 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     // Global leave-one-out has a closed form only for models with a sill; for the others
     // (power, linear) it would refit n systems, so they are cross-validated with 64 neighbours.
     let neighbours = match (ip.neighbors, variogram.sill()) {
-        (0, Some(_)) => None,
-        (0, None) => Some(64.min(data.len() - 1)),
-        (k, _) => Some(k),
+        (0, Some(_)) => Neighbourhood::All,
+        (0, None) => Neighbourhood::Nearest(64.min(data.len() - 1)),
+        (k, _) => Neighbourhood::Nearest(k),
     };
     let mut cv = Vec::new();
     for name in &ip.methods {
@@ -365,10 +359,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
 }
 
 /// A kriging system factorised once and evaluated at many targets.
-pub(super) enum Kriging {
-    Global(Box<GlobalKriging>),
-    Local(Box<LocalKriging>),
-}
+pub(super) struct Kriging(Box<dyn Predictor>);
 
 impl Kriging {
     /// Global kriging for `neighbors == 0`, else a moving neighbourhood of that size.
@@ -378,15 +369,13 @@ impl Kriging {
         method: Method,
         neighbors: usize,
     ) -> Result<Kriging> {
-        Ok(if neighbors == 0 {
-            Kriging::Global(Box::new(
-                GlobalKriging::new(data, v, method, true).context("kriging system")?,
-            ))
-        } else {
-            Kriging::Local(Box::new(
-                LocalKriging::new(data, v, method, neighbors).context("kriging system")?,
-            ))
-        })
+        let hood = match neighbors {
+            0 => Neighbourhood::All,
+            k => Neighbourhood::Nearest(k),
+        };
+        Ok(Kriging(
+            kriging(data, v, method, hood, true).context("kriging system")?,
+        ))
     }
 
     /// Estimates (and variances on request) at `targets`.
@@ -398,11 +387,9 @@ impl Kriging {
         let mut est = vec![0.0; targets.len()];
         let mut var = vec![0.0; if variance { targets.len() } else { 0 }];
         let vslot = if variance { Some(&mut var[..]) } else { None };
-        match self {
-            Kriging::Global(g) => g.predict(targets, &mut est, vslot),
-            Kriging::Local(l) => l.predict(targets, &mut est, vslot),
-        }
-        .context("kriging")?;
+        self.0
+            .predict(targets, &mut est, vslot)
+            .context("kriging")?;
         Ok((est, var))
     }
 }
