@@ -71,6 +71,9 @@ pub enum Error {
     /// An elevation web service or tile server.
     #[error(transparent)]
     Web(#[from] terramesh_web::WebError),
+    /// A CSV file.
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
     /// A JSON file.
     #[error(transparent)]
     Json(#[from] serde_json::Error),

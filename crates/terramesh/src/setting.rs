@@ -46,6 +46,10 @@ pub enum Setting {
     Zoom,
     /// The z written for points without an elevation.
     Nodata,
+    /// What to do with data points at one location.
+    Duplicates,
+    /// The variogram model.
+    Model,
     /// A DEM used as a height function.
     Dem,
     /// The output file.
@@ -73,6 +77,8 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Resume => "resume",
     Setting::Zoom => "zoom",
     Setting::Nodata => "nodata",
+    Setting::Duplicates => "duplicates",
+    Setting::Model => "model",
     Setting::Dem => "dem",
     Setting::Output => "output",
 ]);

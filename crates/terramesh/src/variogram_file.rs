@@ -1,25 +1,33 @@
-//! Reading a variogram file written by `terramesh variogram` or `terramesh build`.
+//! Reading a variogram file written by `terramesh variogram` or `terramesh build`
+//! ([`VariogramFile`]): only its `model` is needed.
 
 use std::path::Path;
 
-use terramesh_geostat::Variogram;
+use terramesh_geostat::{Variogram, VariogramFile, VariogramFileError};
 
-use crate::error::{Context, Result};
+use crate::error::{Context, Error, Result};
 
-/// Reads the `model` of a file written by `terramesh variogram`.
+/// Reads the model of the variogram file at `path`.
+///
+/// ```
+/// let dir = tempfile::tempdir()?;
+/// let p = dir.path().join("v.json");
+/// std::fs::write(&p, r#"{"model": {"nugget": 1.0, "structures": [{"type": "spherical", "psill": 10.0, "range": 100.0}]}}"#)?;
+/// let v = terramesh::variogram_file::read_variogram_file(&p)?;
+/// assert_eq!(v.nugget, 1.0);
+/// std::fs::write(&p, "{}")?;
+/// let e = terramesh::variogram_file::read_variogram_file(&p).unwrap_err();
+/// assert!(e.to_string().ends_with("no \"model\" key (write it with terramesh variogram)"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn read_variogram_file(path: &Path) -> Result<Variogram> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let model = json.get("model").with_context(|| {
-        format!(
-            "{}: no \"model\" key (write it with terramesh variogram)",
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    match VariogramFile::from_json(&text) {
+        Ok(f) => Ok(f.model),
+        Err(e @ VariogramFileError::NoModel) => Err(Error::invalid(format!(
+            "{}: {e} (write it with terramesh variogram)",
             path.display()
-        )
-    })?;
-    let v: Variogram = serde_json::from_value(model.clone())
-        .with_context(|| format!("{}: \"model\" is not a variogram", path.display()))?;
-    v.validate()
-        .with_context(|| format!("{}: model", path.display()))?;
-    Ok(v)
+        ))),
+        Err(e) => Err(Error::invalid(format!("{}: {e}", path.display()))),
+    }
 }

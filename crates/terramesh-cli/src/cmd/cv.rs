@@ -5,8 +5,11 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use terramesh_geostat::{cross_validate, Folds, IdwSearch, Interpolator, Neighbourhood};
 
-use super::geodata::{in_file, read_data};
-use super::interpolate::{method, resolve_variogram, MethodArg, MethodArgs};
+use terramesh::interpolate::read_data;
+use terramesh_geostat::InterpolationMethod;
+
+use super::geodata::in_file;
+use super::interpolate::{method, resolve_variogram, MethodArgs};
 
 /// Cross-validate an interpolation method: leave-one-out (default) or k-fold.
 ///
@@ -30,8 +33,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let fd = read_data(&args.data, args.m.duplicates.into())?;
-    let how = if args.m.method == MethodArg::Idw {
+    let fd = read_data(&args.data, args.m.duplicates).map_err(crate::flag_error)?;
+    let how = if args.m.method == InterpolationMethod::Idw {
         if !(args.m.power.is_finite() && args.m.power > 0.0) {
             bail!("--power {}: must be a finite number > 0", args.m.power);
         }

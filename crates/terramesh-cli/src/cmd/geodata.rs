@@ -1,45 +1,8 @@
-//! Shared by `variogram`, `interpolate` and `cv`: reading x,y,z data with line numbers,
-//! variogram flags and files, and error messages that name the file, line or flag.
-
-use std::path::{Path, PathBuf};
+//! Shared by `variogram`, `interpolate` and `cv`: the variogram flags and error messages that
+//! name the file or the flag.
 
 use anyhow::{bail, Context, Result};
-use terramesh_geostat::{
-    Anisotropy, Data, Duplicates, GeostatError, ModelKind, Structure, Variogram, VariogramFile,
-    VariogramFileError,
-};
-use terramesh_io::table::{ReadOptions, Table};
-
-/// Accepted column names.
-pub const X: &[&str] = &["x", "easting", "east"];
-pub const Y: &[&str] = &["y", "northing", "north"];
-pub const Z: &[&str] = &["z", "elevation", "height", "value"];
-
-/// Data read from a file, with the line of each point for messages.
-pub struct FileData {
-    pub data: Data,
-    pub name: String,
-}
-
-/// Reads `x,y,z` (names as above) from a CSV.
-pub fn read_data(path: &Path, duplicates: Duplicates) -> Result<FileData> {
-    let t = Table::read(path, &ReadOptions::default())?;
-    let (xc, yc, zc) = (t.require(X)?, t.require(Y)?, t.require(Z)?);
-    let mut xy = Vec::with_capacity(t.records.len());
-    let mut z = Vec::with_capacity(t.records.len());
-    for r in 0..t.records.len() {
-        xy.push([t.number(r, xc)?, t.number(r, yc)?]);
-        z.push(t.number(r, zc)?);
-    }
-    let data = Data::new(xy, z, duplicates).map_err(|e| match e {
-        GeostatError::DuplicateLocation { first, second, x, y } => anyhow::anyhow!(
-            "{}, lines {} and {}: two data points at ({x}, {y}); remove one, or give --duplicates mean",
-            t.name, t.lines[first], t.lines[second]
-        ),
-        other => anyhow::anyhow!("{}: {other}", t.name),
-    })?;
-    Ok(FileData { data, name: t.name })
-}
+use terramesh_geostat::{Anisotropy, GeostatError, ModelKind, Structure, Variogram};
 
 /// Variogram flags shared by the commands.
 #[derive(clap::Args, Debug, Clone)]
@@ -124,19 +87,6 @@ pub fn explicit_variogram(m: &ModelArgs) -> Result<Option<Variogram>> {
     v.validate()
         .map_err(|e| anyhow::anyhow!("variogram flags: {e}"))?;
     Ok(Some(v))
-}
-
-/// Reads the `model` of a file written by `terramesh variogram`.
-pub fn read_variogram_file(path: &PathBuf) -> Result<Variogram> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    match VariogramFile::from_json(&text) {
-        Ok(f) => Ok(f.model),
-        Err(e @ VariogramFileError::NoModel) => bail!(
-            "{}: {e} (write it with terramesh variogram)",
-            path.display()
-        ),
-        Err(e) => bail!("{}: {e}", path.display()),
-    }
 }
 
 /// Wraps a library error with the data file name.

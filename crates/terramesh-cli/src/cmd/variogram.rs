@@ -3,50 +3,16 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use terramesh_geostat::{
-    experimental, fit_auto, fit_model, CandidateEntry, Direction, Duplicates, Estimator,
-    FitSummary, LagSettings, LagSummary, ModelKind, Named, VariogramFile, Weighting,
+    experimental, CandidateEntry, Direction, Duplicates, Estimator, FitSummary, LagSettings,
+    LagSummary, VariogramFile, Weighting,
 };
 use terramesh_io::output::Output;
 
-use super::geodata::{in_file, read_data};
+use terramesh::interpolate::{fit_named, read_data};
 
-/// Estimator flag values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum EstimatorArg {
-    /// Matheron's classical estimator.
-    Matheron,
-    /// Cressie–Hawkins robust estimator.
-    Cressie,
-}
-
-/// Weighting flag values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum WeightsArg {
-    /// Cressie's N/γ² weights.
-    Cressie,
-    /// Pair counts.
-    Pairs,
-}
-
-/// Duplicate handling flag values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum DupArg {
-    /// Stop with an error naming both lines.
-    Reject,
-    /// Merge points at one location into their mean.
-    Mean,
-}
-
-impl From<DupArg> for Duplicates {
-    fn from(d: DupArg) -> Self {
-        match d {
-            DupArg::Reject => Duplicates::Reject,
-            DupArg::Mean => Duplicates::Mean,
-        }
-    }
-}
+use super::geodata::in_file;
 
 /// Lag and fitting flags, shared with `interpolate --variogram auto` and `cv`.
 #[derive(clap::Args, Debug, Clone)]
@@ -64,11 +30,11 @@ pub struct LagArgs {
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_TOLERANCE)]
     pub tolerance: f64,
     /// Semivariance estimator.
-    #[arg(long, value_enum, default_value_t = EstimatorArg::Matheron)]
-    pub estimator: EstimatorArg,
+    #[arg(long, value_parser = crate::named::<Estimator>(), default_value_t = Estimator::Matheron)]
+    pub estimator: Estimator,
     /// Least-squares weights of the fit.
-    #[arg(long, value_enum, default_value_t = WeightsArg::Cressie)]
-    pub weights: WeightsArg,
+    #[arg(long, value_parser = crate::named::<Weighting>(), default_value_t = Weighting::Cressie)]
+    pub weights: Weighting,
     /// Compute the experimental variogram on at most this many data, drawn pseudo-randomly
     /// (the same draw every run); 0 uses all (the pair count grows with the square).
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
@@ -84,18 +50,12 @@ impl LagArgs {
                 azimuth: a,
                 tolerance: self.tolerance,
             }),
-            estimator: match self.estimator {
-                EstimatorArg::Matheron => Estimator::Matheron,
-                EstimatorArg::Cressie => Estimator::CressieHawkins,
-            },
+            estimator: self.estimator,
             max_points: (self.max_points > 0).then_some(self.max_points),
         }
     }
     pub fn weighting(&self) -> Weighting {
-        match self.weights {
-            WeightsArg::Cressie => Weighting::Cressie,
-            WeightsArg::Pairs => Weighting::Pairs,
-        }
+        self.weights
     }
 }
 
@@ -120,8 +80,8 @@ pub struct Args {
     #[command(flatten)]
     lag: LagArgs,
     /// Points at one location.
-    #[arg(long, value_enum, default_value_t = DupArg::Reject)]
-    duplicates: DupArg,
+    #[arg(long, value_parser = crate::named::<Duplicates>(), default_value_t = Duplicates::Reject)]
+    duplicates: Duplicates,
     /// Output JSON (default: standard output).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -144,10 +104,10 @@ pub fn run(args: Args) -> Result<()> {
             );
         }
     }
-    let fd = read_data(&args.data, args.duplicates.into())?;
+    let fd = read_data(&args.data, args.duplicates).map_err(crate::flag_error)?;
     let lags = experimental(&fd.data, &args.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
     let (fit, cands) = fit_named(&fd.data, &lags, &args.model, args.lag.weighting())
-        .map_err(|e| e.context(fd.name.clone()))?;
+        .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
     let s = args.lag.settings();
     let file = VariogramFile {
         data: fd.name.clone(),
@@ -194,21 +154,4 @@ pub fn run(args: Args) -> Result<()> {
         eprintln!("terramesh: variogram model: {}", fit.variogram);
     }
     Ok(())
-}
-
-/// Fits the model named on the command line (`auto` tries them all).
-pub fn fit_named(
-    data: &terramesh_geostat::Data,
-    lags: &[terramesh_geostat::Lag],
-    model: &str,
-    w: Weighting,
-) -> Result<(terramesh_geostat::Fit, Vec<terramesh_geostat::Candidate>)> {
-    if model.eq_ignore_ascii_case("auto") {
-        let (f, c) = fit_auto(data, lags, w, ModelKind::ALL)?;
-        return Ok((f, c));
-    }
-    let Ok(kind) = model.parse::<ModelKind>() else {
-        bail!("--model '{model}': expected auto, spherical, exponential, gaussian, matern, power, linear or nugget");
-    };
-    Ok((fit_model(lags, kind, w)?, Vec::new()))
 }

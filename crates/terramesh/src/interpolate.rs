@@ -1,0 +1,259 @@
+//! Interpolation of scattered x, y, z data on its own (`terramesh variogram`, `interpolate`,
+//! `cv`): reading the data with line numbers, fitting a variogram by name, and predicting at
+//! the targets of a CSV file or on a grid through any [`Predictor`].
+//!
+//! ```
+//! use terramesh::interpolate::{fit_named, predict_csv, read_data};
+//! use terramesh_geostat::{experimental, kriging, Duplicates, LagSettings, Method, Neighbourhood, Weighting};
+//! let dir = tempfile::tempdir()?;
+//! let mut text = String::from("x,y,z\n");
+//! for i in 0..10 {
+//!     for j in 0..10 {
+//!         text += &format!("{},{},{}\n", 10 * i, 10 * j, (i as f64 / 3.0).sin() + j as f64 / 5.0);
+//!     }
+//! }
+//! std::fs::write(dir.path().join("d.csv"), text)?;
+//! std::fs::write(dir.path().join("t.csv"), "x,y\n15,15\n")?;
+//! let fd = read_data(&dir.path().join("d.csv"), Duplicates::Reject)?;
+//! let lags = experimental(&fd.data, &LagSettings::default())?;
+//! let (fit, _) = fit_named(&fd.data, &lags, "spherical", Weighting::Cressie)?;
+//! let eng = kriging(&fd.data, &fit.variogram, Method::Ordinary, Neighbourhood::All, true)?;
+//! let out = dir.path().join("out.csv");
+//! predict_csv(eng.as_ref(), &dir.path().join("t.csv"), true, Some(&out))?;
+//! assert!(std::fs::read_to_string(&out)?.starts_with("x,y,z,variance\n15,15,"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::fs::File;
+use std::io::{BufReader, Write};
+use std::path::Path;
+
+use terramesh_geostat::{
+    fit_auto, fit_model, Candidate, Data, Duplicates, Fit, GeostatError, Lag, ModelKind, Named,
+    Predictor, Weighting,
+};
+use terramesh_io::grid_write::{write_asc, write_geotiff, RasterGrid};
+use terramesh_io::number::write_shortest;
+use terramesh_io::output::Output;
+use terramesh_io::table::{ReadOptions, Table};
+
+use crate::error::{bail, Context, Error, Result};
+use crate::setting::Setting;
+
+/// Targets read and predicted per block: memory does not grow with the number of targets.
+const TARGET_BLOCK: usize = 65_536;
+
+/// Accepted column names.
+/// Names of the x column.
+pub const X: &[&str] = &["x", "easting", "east"];
+/// Names of the y column.
+pub const Y: &[&str] = &["y", "northing", "north"];
+/// Names of the z column.
+pub const Z: &[&str] = &["z", "elevation", "height", "value"];
+
+/// Data read from a file, with the line of each point for messages.
+pub struct FileData {
+    /// The data.
+    pub data: Data,
+    /// The file, for messages.
+    pub name: String,
+}
+
+/// Reads `x,y,z` (names as above) from a CSV.
+pub fn read_data(path: &Path, duplicates: Duplicates) -> Result<FileData> {
+    let t = Table::read(path, &ReadOptions::default())?;
+    let (xc, yc, zc) = (t.require(X)?, t.require(Y)?, t.require(Z)?);
+    let mut xy = Vec::with_capacity(t.records.len());
+    let mut z = Vec::with_capacity(t.records.len());
+    for r in 0..t.records.len() {
+        xy.push([t.number(r, xc)?, t.number(r, yc)?]);
+        z.push(t.number(r, zc)?);
+    }
+    let data = Data::new(xy, z, duplicates).map_err(|e| match e {
+        GeostatError::DuplicateLocation {
+            first,
+            second,
+            x,
+            y,
+        } => Error::setting(
+            Setting::Duplicates,
+            "",
+            format!(
+                "{}, lines {} and {}: two data points at ({x}, {y}); remove one, or give \
+                 {{duplicates}} mean",
+                t.name, t.lines[first], t.lines[second]
+            ),
+        ),
+        other => Error::invalid(format!("{}: {other}", t.name)),
+    })?;
+    Ok(FileData { data, name: t.name })
+}
+
+/// Fits the model named `model` to the lags; `auto` tries every model and keeps the best by
+/// cross-validation (with every candidate).
+pub fn fit_named(
+    data: &Data,
+    lags: &[Lag],
+    model: &str,
+    w: Weighting,
+) -> Result<(Fit, Vec<Candidate>)> {
+    if model.eq_ignore_ascii_case("auto") {
+        let (f, c) = fit_auto(data, lags, w, ModelKind::ALL)?;
+        return Ok((f, c));
+    }
+    let Ok(kind) = model.parse::<ModelKind>() else {
+        return Err(Error::setting(
+            Setting::Model,
+            model,
+            format!(
+                "expected auto or {}",
+                terramesh_core::vocab::one_of(&ModelKind::names())
+            ),
+        ));
+    };
+    Ok((fit_model(lags, kind, w)?, Vec::new()))
+}
+
+/// Predicts at the `x,y` targets of a CSV file, block by block (memory does not grow with the
+/// number of targets), and writes `x,y,z[,variance]` to `output` (standard output without
+/// one) atomically. Errors name the file, the line, the column, or the 1-based target row.
+pub fn predict_csv(
+    eng: &dyn Predictor,
+    targets: &Path,
+    want_var: bool,
+    output: Option<&Path>,
+) -> Result<()> {
+    let name = targets.display().to_string();
+    let file = File::open(targets).with_context(|| name.clone())?;
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(BufReader::with_capacity(1 << 20, file));
+    let headers: Vec<String> = rdr
+        .headers()
+        .with_context(|| name.clone())?
+        .iter()
+        .map(|h| h.trim().to_string())
+        .collect();
+    let find = |names: &[&str]| {
+        headers
+            .iter()
+            .position(|h| names.iter().any(|n| h.eq_ignore_ascii_case(n)))
+    };
+    let (Some(xc), Some(yc)) = (find(X), find(Y)) else {
+        bail!(
+            "{name}: needs columns 'x' and 'y' (the header has: {})",
+            headers.join(", ")
+        );
+    };
+    let mut out = Output::create(output).with_context(|| "cannot create the output".to_string())?;
+    out.write_all(if want_var {
+        b"x,y,z,variance\n"
+    } else {
+        b"x,y,z\n"
+    })?;
+    let mut rec = csv::StringRecord::new();
+    let mut pts: Vec<[f64; 2]> = Vec::with_capacity(TARGET_BLOCK);
+    let mut first_row = 0usize;
+    let mut buf = Vec::with_capacity(TARGET_BLOCK * 64);
+    let mut total = 0usize;
+    loop {
+        let more = rdr
+            .read_record(&mut rec)
+            .with_context(|| format!("{name}: malformed CSV"))?;
+        if more {
+            let line = rec.position().map_or(0, |p| p.line());
+            let num = |c: usize| -> Result<f64> {
+                let s = rec.get(c).unwrap_or("").trim();
+                match s.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    _ => bail!(
+                        "{name}, line {line}, column '{}': '{s}' is not a finite number",
+                        headers[c]
+                    ),
+                }
+            };
+            pts.push([num(xc)?, num(yc)?]);
+        }
+        if pts.len() == TARGET_BLOCK || (!more && !pts.is_empty()) {
+            let mut est = vec![0.0; pts.len()];
+            let mut var = vec![0.0; if want_var { pts.len() } else { 0 }];
+            eng.predict(&pts, &mut est, want_var.then_some(&mut var[..]))
+                .map_err(|e| {
+                    let e = e.offset_target(first_row);
+                    Error::invalid(format!(
+                        "{name}: {}",
+                        e.display_with_target(|i| format!("target row {}", i + 1))
+                    ))
+                })?;
+            buf.clear();
+            for (i, p) in pts.iter().enumerate() {
+                write_shortest(&mut buf, p[0])?;
+                buf.push(b',');
+                write_shortest(&mut buf, p[1])?;
+                buf.push(b',');
+                write_shortest(&mut buf, est[i])?;
+                if want_var {
+                    buf.push(b',');
+                    write_shortest(&mut buf, var[i])?;
+                }
+                buf.push(b'\n');
+            }
+            out.write_all(&buf)?;
+            first_row += pts.len();
+            total += pts.len();
+            pts.clear();
+        }
+        if !more {
+            break;
+        }
+    }
+    if total == 0 {
+        bail!("{name}: no target rows after the header");
+    }
+    out.commit()?;
+    Ok(())
+}
+
+/// Predicts at the nodes of `g` and writes them as an ESRI ASCII grid (`.asc`) or a GeoTIFF
+/// (`.tif`, with `epsg`) at `out_path`, atomically.
+pub fn predict_grid(
+    eng: &dyn Predictor,
+    g: &RasterGrid,
+    out_path: &Path,
+    epsg: Option<u16>,
+) -> Result<()> {
+    let ext = out_path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext != "asc" && ext != "tif" && ext != "tiff" {
+        return Err(Error::setting(
+            Setting::Output,
+            out_path.display(),
+            "a grid is written as .asc (ESRI ASCII) or .tif (GeoTIFF)",
+        ));
+    }
+    let mut values = vec![0.0; g.nx * g.ny];
+    let rows_per_block = (TARGET_BLOCK / g.nx).max(1);
+    let mut pts = Vec::with_capacity(rows_per_block * g.nx);
+    for j0 in (0..g.ny).step_by(rows_per_block) {
+        let j1 = (j0 + rows_per_block).min(g.ny);
+        pts.clear();
+        for j in j0..j1 {
+            for i in 0..g.nx {
+                pts.push(g.node(i, j));
+            }
+        }
+        eng.predict(&pts, &mut values[j0 * g.nx..j1 * g.nx], None)
+            .context("the grid")?;
+    }
+    let mut out = Output::create(Some(out_path))?;
+    if ext == "asc" {
+        write_asc(&mut out, g, &values)?;
+    } else {
+        write_geotiff(&mut out, g, &values, epsg, None)?;
+    }
+    out.commit()?;
+    Ok(())
+}
