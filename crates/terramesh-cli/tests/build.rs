@@ -479,3 +479,63 @@ fn adaptive_build_meets_its_error_against_kriging_with_fewer_vertices() {
         "{msg}"
     );
 }
+
+/// The `v x y z` lines of an OBJ file.
+fn obj_vertices(text: &str) -> Vec<[f64; 3]> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+#[test]
+fn the_first_interpolation_method_gives_the_dsm_elevations() {
+    // dsm-vertices.csv: x,y,elevation_uk,kriging_std,elevation_idw (column 2 is UK, 4 IDW).
+    for (methods, column) in [("[\"idw\", \"uk\"]", 4), ("[\"uk\", \"idw\"]", 2)] {
+        let dir = tempfile::tempdir().unwrap();
+        let set = format!("interpolation.methods={methods}");
+        ok(&build(
+            dir.path(),
+            &[
+                "--set",
+                &set,
+                "--set",
+                "export.formats=[\"obj\"]",
+                "--set",
+                "export.pictures=false",
+                "--set",
+                "export.report=false",
+            ],
+        ));
+        let table = read(&dir.path().join("dsm-vertices.csv"));
+        let rows: Vec<Vec<f64>> = table
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|t| t.parse().unwrap()).collect())
+            .collect();
+        let v = obj_vertices(&read(&dir.path().join("dsm.obj")));
+        assert_eq!(v.len(), rows.len());
+        let mut differs = false;
+        for (p, r) in v.iter().zip(&rows) {
+            assert_eq!((p[0], p[1]), (r[0], r[1]));
+            assert_eq!(p[2], r[column], "{methods}: z is not column {column}");
+            differs |= r[2] != r[4];
+        }
+        // UK and IDW differ, so the check above tells them apart.
+        assert!(differs);
+        // The cross-validation table lists the methods in their order.
+        let cv = read(&dir.path().join("cross-validation.csv"));
+        let first = cv
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .to_string();
+        assert_eq!(first, if column == 4 { "IDW" } else { "UK" });
+    }
+}

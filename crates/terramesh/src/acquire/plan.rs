@@ -318,7 +318,7 @@ fn classify(spec: &str) -> Result<Source> {
         return Err(Error::setting(
             Setting::Source,
             spec,
-            "no such file or directory (services are google:, opentopodata:DATASET, \
+            "does not exist: no such file or directory (services are google:, opentopodata:DATASET, \
              open-elevation:; tile URLs contain {z}/{x}/{y})",
         ));
     }

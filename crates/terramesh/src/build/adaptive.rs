@@ -11,7 +11,7 @@ use crate::error::{bail, Context, Result};
 use terramesh_core::sampling::{GridSurface, Kernel};
 use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, AdaptiveSettings, Mesh};
 
-use super::stages::{Kriging, Model, Samples};
+use super::stages::{Model, Samples, Surface};
 use crate::project::Project;
 
 /// Most grid nodes of the stand-in surface.
@@ -55,13 +55,8 @@ pub fn adaptive(
     if m.insert_samples {
         bail!("[mesh]: insert_samples cannot be combined with max_error");
     }
-    let ip = &p.interpolation;
-    let engine = Kriging::new(
-        &model.data,
-        &model.variogram,
-        terramesh_geostat::Method::Universal(super::stages::drift_of(&ip.drift)),
-        ip.neighbors,
-    )?;
+    // The surface of the first interpolation method, which gives the DSM heights.
+    let engine = Surface::primary(p, &model.data, &model.variogram)?;
     let (lo, hi) = s.region.projected.bbox().context("empty region")?;
     let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
     // Half the sampling cell resolves what was sampled; the node cap bounds the work.

@@ -96,7 +96,7 @@ pub fn write_all(
     let abs: Vec<[f64; 3]> = (0..n)
         .map(|i| {
             let q = mesh.absolute(i);
-            [q[0], q[1], it.uk[i]]
+            [q[0], q[1], it.dsm[i]]
         })
         .collect();
     let tris = &mesh.triangles;
@@ -135,7 +135,7 @@ pub fn write_all(
     let view = MeshView {
         origin: mesh.origin,
         points: &mesh.points,
-        z: Some(&it.uk),
+        z: Some(&it.dsm),
         triangles: tris,
         point_data: vec![
             ("elevation_uk", &it.uk[..]),
@@ -217,7 +217,7 @@ pub fn write_all(
     })?);
 
     // The sealed solid.
-    let zmin = it.uk.iter().copied().fold(f64::INFINITY, f64::min);
+    let zmin = it.dsm.iter().copied().fold(f64::INFINITY, f64::min);
     let base = p.export.base_elevation.unwrap_or((zmin - 50.0).floor());
     let solid = extrude(&abs, tris, base).context("export.base_elevation")?;
     check_closed(&solid.triangles).context("the sealed solid")?;
@@ -262,7 +262,7 @@ pub fn write_all(
     })?);
 
     // Tables.
-    let q3 = Quality::surface(mesh, &it.uk);
+    let q3 = Quality::surface(mesh, &it.dsm);
     files.push(atomic(&out.join("mesh-quality.csv"), |w| {
         writeln!(
             w,

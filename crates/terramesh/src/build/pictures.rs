@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Context, Result};
+use terramesh_geostat::{InterpolationMethod, Named};
 use terramesh_io::pictures::{
     draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d, render_both,
     render_both_as, ColourMap, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
@@ -208,7 +209,7 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     }
     let v3: Vec<[f64; 3]> = xy
         .iter()
-        .zip(&it.uk)
+        .zip(&it.dsm)
         .map(|(p, z)| [p[0], p[1], *z])
         .collect();
     let (lo, hi) = s
@@ -217,8 +218,8 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
         .bbox()
         .unwrap_or(([0.0, 0.0], [1.0, 1.0]));
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let relief = it.uk.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-        - it.uk.iter().copied().fold(f64::INFINITY, f64::min);
+    let relief = it.dsm.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - it.dsm.iter().copied().fold(f64::INFINITY, f64::min);
     let ex = if relief > 0.0 {
         (0.3 * extent / relief).clamp(1.0, 10.0)
     } else {
@@ -228,7 +229,15 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     let f = render_both_as(&dir.join("dsm-3d"), SIZE, svg_mode, |r| {
         draw_view3d(r, &v3, &m.mesh.triangles, ex, "The DSM in 3D")
     })?;
-    add("3d", "Shaded 3D view of the DSM (UK elevations)".into(), f);
+    let by = match it.dsm_method {
+        InterpolationMethod::Universal => "UK".to_string(),
+        other => other.name().to_uppercase(),
+    };
+    add(
+        "3d",
+        format!("Shaded 3D view of the DSM ({by} elevations)"),
+        f,
+    );
     Ok(pics)
 }
 

@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use terramesh_core::coords::{format_dms, to_utm, Axis};
+use terramesh_geostat::InterpolationMethod;
 use terramesh_io::output::write_atomic;
 use terramesh_io::report::{Block, Report, Section};
 use terramesh_mesh::Quality;
@@ -144,6 +145,15 @@ pub fn write_report(
             ],
         }],
     });
+    // The DSM's method, when it is not the paper's universal kriging.
+    if it.dsm_method != InterpolationMethod::Universal {
+        if let Some(Block::Table { rows, .. }) = sections[0].blocks.first_mut() {
+            rows.push(kv(
+                "DSM elevations",
+                format!("{} (interpolation.methods[0])", it.dsm_method),
+            ));
+        }
+    }
     // Table I of the paper, for this region's corners.
     let mut corner_rows = Vec::new();
     if let Some(geo) = &s.region.geographic {

@@ -5,8 +5,8 @@ use std::path::Path;
 use terramesh_core::coords::Zone;
 use terramesh_geostat::{
     cross_validate, experimental, fit_auto, kriging, CvStats, Data, Drift, Duplicates, Folds, Idw,
-    IdwSearch, Interpolator, Lag, LagSettings, Method, ModelKind, Named, Neighbourhood, Predictor,
-    Variogram, Weighting,
+    IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, ModelKind, Named,
+    Neighbourhood, Predictor, Variogram, Weighting,
 };
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport};
@@ -175,17 +175,12 @@ pub struct Interpolated {
     pub grid: (terramesh_io::grid_write::RasterGrid, Vec<f64>),
     /// The drift used by UK.
     pub drift: Drift,
+    /// The DSM elevation at each vertex: the first of `interpolation.methods`.
+    pub dsm: Vec<f64>,
+    /// That method.
+    pub dsm_method: InterpolationMethod,
 }
 
-pub(super) fn drift_of(name: &str) -> Drift {
-    match name {
-        "constant" => Drift::Constant,
-        "quadratic" => Drift::Quadratic,
-        _ => Drift::Linear,
-    }
-}
-
-/// Runs the geostatistics of step 4.
 /// The samples as kriging data and the variogram model (fitted, given, or read).
 pub struct Model {
     /// The samples.
@@ -211,10 +206,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let variogram = if let Some(v) = &ip.model {
-        let kind = v.model.parse::<ModelKind>().ok().with_context(|| {
-            format!("interpolation.model.model = \"{}\": expected spherical, exponential, gaussian, matern, power, linear or nugget", v.model)
-        })?;
-        Variogram::single(kind, v.nugget, v.psill, v.range).context("interpolation.model")?
+        Variogram::single(v.model, v.nugget, v.psill, v.range).context("interpolation.model")?
     } else if ip.variogram == "auto" {
         let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL)
             .context("fitting the variogram")?;
@@ -242,24 +234,30 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     let variogram = model.variogram.clone();
     let lags = model.lags.clone();
     let candidates = model.candidates.clone();
-    let drift = drift_of(&ip.drift);
+    let drift = ip.drift;
     let uk_method = Method::Universal(drift);
     let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len())
         .map(|i| m.mesh.absolute(i))
         .collect();
-    let engine = Kriging::new(data, &variogram, uk_method, ip.neighbors)?;
-    let (uk, var) = engine.predict(&vertices, true)?;
+    let uk_engine = Surface::kriging(data, &variogram, uk_method, ip.neighbors)?;
+    let (uk, var) = uk_engine.predict(&vertices, true)?;
     let uk_std: Vec<f64> = var.iter().map(|v| v.max(0.0).sqrt()).collect();
-    let search = if ip.idw_neighbors == 0 {
-        IdwSearch::All
-    } else {
-        IdwSearch::Nearest(ip.idw_neighbors)
-    };
-    let idw_engine = Idw::new(data, ip.idw_power, search).context("IDW")?;
-    let mut idw = vec![0.0; vertices.len()];
-    idw_engine
-        .predict(&vertices, &mut idw)
+    let search = idw_search(ip.idw_neighbors);
+    let idw_engine = Surface::idw(data, ip.idw_power, ip.idw_neighbors)?;
+    let (idw, _) = idw_engine
+        .predict(&vertices, false)
         .context("IDW at the mesh vertices")?;
+    // The first method gives the DSM (its heights and its grid).
+    let primary = ip.methods[0];
+    let other;
+    let (dsm, engine) = match primary {
+        InterpolationMethod::Universal => (uk.clone(), &uk_engine),
+        InterpolationMethod::Idw => (idw.clone(), &idw_engine),
+        _ => {
+            other = Surface::primary(p, data, &variogram)?;
+            (other.predict(&vertices, false)?.0, &other)
+        }
+    };
 
     // Cross-validation of the methods compared in the report.
     let folds = if ip.cv_folds == 0 {
@@ -275,33 +273,21 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         (k, _) => Neighbourhood::Nearest(k),
     };
     let mut cv = Vec::new();
-    for name in &ip.methods {
-        let how = match name.as_str() {
-            "uk" => Interpolator::Kriging {
+    for &name in &ip.methods {
+        let how = match name.method(drift, None, data) {
+            Some(method) => Interpolator::Kriging {
                 variogram: variogram.clone(),
-                method: uk_method,
+                method,
                 neighbours,
             },
-            "ok" => Interpolator::Kriging {
-                variogram: variogram.clone(),
-                method: Method::Ordinary,
-                neighbours,
-            },
-            "sk" => Interpolator::Kriging {
-                variogram: variogram.clone(),
-                method: Method::Simple {
-                    mean: data.z().iter().sum::<f64>() / data.len() as f64,
-                },
-                neighbours,
-            },
-            _ => Interpolator::Idw {
+            None => Interpolator::Idw {
                 power: ip.idw_power,
                 search,
             },
         };
         let r = cross_validate(data, &how, folds)
             .with_context(|| format!("cross-validation of {name}"))?;
-        cv.push((name.to_uppercase(), r.stats));
+        cv.push((name.name().to_uppercase(), r.stats));
     }
 
     // The DSM grid over the region's bounding box, nodata outside the region.
@@ -340,7 +326,12 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
             values[ix] = est[k];
         }
     }
-    for (name, v) in [("UK", &uk), ("kriging variance", &var), ("IDW", &idw)] {
+    for (name, v) in [
+        ("UK", &uk),
+        ("kriging variance", &var),
+        ("IDW", &idw),
+        ("the DSM method", &dsm),
+    ] {
         if let Some(i) = v.iter().position(|x| !x.is_finite()) {
             bail!("{name} gave a non-finite value at mesh vertex {i}: the kriging system is ill-conditioned");
         }
@@ -355,35 +346,60 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         cv,
         grid: (spec, values),
         drift,
+        dsm,
+        dsm_method: primary,
     })
 }
 
-/// A kriging system factorised once and evaluated at many targets.
-pub(super) struct Kriging(Box<dyn Predictor>);
+/// IDW's search for `neighbors` (0: every sample).
+fn idw_search(neighbors: usize) -> IdwSearch {
+    if neighbors == 0 {
+        IdwSearch::All
+    } else {
+        IdwSearch::Nearest(neighbors)
+    }
+}
 
-impl Kriging {
-    /// Global kriging for `neighbors == 0`, else a moving neighbourhood of that size.
-    pub(super) fn new(
-        data: &Data,
-        v: &Variogram,
-        method: Method,
-        neighbors: usize,
-    ) -> Result<Kriging> {
+/// An interpolated surface: a predictor set up once (a kriging system factorised, a search
+/// tree built) and evaluated at many targets.
+pub(super) struct Surface(Box<dyn Predictor>);
+
+impl Surface {
+    /// Kriging: global for `neighbors == 0` (the project's "all samples"), else a moving
+    /// neighbourhood of that size.
+    fn kriging(data: &Data, v: &Variogram, method: Method, neighbors: usize) -> Result<Surface> {
         let hood = match neighbors {
             0 => Neighbourhood::All,
             k => Neighbourhood::Nearest(k),
         };
-        Ok(Kriging(
+        Ok(Surface(
             kriging(data, v, method, hood, true).context("kriging system")?,
         ))
     }
 
-    /// Estimates (and variances on request) at `targets`.
+    /// IDW with `power` over `neighbors` neighbours (0: all).
+    fn idw(data: &Data, power: f64, neighbors: usize) -> Result<Surface> {
+        Ok(Surface(Box::new(
+            Idw::new(data, power, idw_search(neighbors)).context("IDW")?,
+        )))
+    }
+
+    /// The surface of the project's first interpolation method, which gives the DSM.
+    pub(super) fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
+        let ip = &p.interpolation;
+        match ip.methods[0].method(ip.drift, None, data) {
+            Some(method) => Surface::kriging(data, v, method, ip.neighbors),
+            None => Surface::idw(data, ip.idw_power, ip.idw_neighbors),
+        }
+    }
+
+    /// Estimates (and variances on request, kriging only) at `targets`.
     pub(super) fn predict(
         &self,
         targets: &[[f64; 2]],
         variance: bool,
     ) -> Result<(Vec<f64>, Vec<f64>)> {
+        let variance = variance && self.0.has_variance();
         let mut est = vec![0.0; targets.len()];
         let mut var = vec![0.0; if variance { targets.len() } else { 0 }];
         let vslot = if variance { Some(&mut var[..]) } else { None };

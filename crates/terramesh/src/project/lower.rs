@@ -103,7 +103,7 @@ impl Project {
             )));
         }
         Err(Error::invalid(format!(
-            "source.path {}: no such file or directory",
+            "source.path {}: does not exist (no such file or directory)",
             path.display()
         )))
     }

@@ -12,6 +12,7 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 use terramesh_core::sampling::Kernel;
+use terramesh_geostat::{Drift, InterpolationMethod, ModelKind, DEFAULT_IDW_POWER};
 use terramesh_io::export::{Format, DEFAULT_FORMATS};
 use terramesh_io::region::RegionCrs;
 use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
@@ -140,7 +141,7 @@ impl Default for MeshSection {
 #[serde(deny_unknown_fields)]
 pub struct VariogramSpec {
     /// Model name: `spherical`, `exponential`, `gaussian`, ...
-    pub model: String,
+    pub model: ModelKind,
     /// Partial sill.
     pub psill: f64,
     /// Practical range, metres.
@@ -154,10 +155,11 @@ pub struct VariogramSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InterpolationSection {
-    /// Methods to run; the first gives the DSM elevations (`uk`, `ok`, `idw`).
-    pub methods: Vec<String>,
-    /// Drift of universal kriging: `linear` (the paper's) or `quadratic`.
-    pub drift: String,
+    /// Methods to run (`uk`, `ok`, `sk`, `idw`); the first gives the DSM elevations, all are
+    /// cross-validated.
+    pub methods: Vec<InterpolationMethod>,
+    /// Drift of universal kriging: `constant`, `linear` (the paper's) or `quadratic`.
+    pub drift: Drift,
     /// `auto` (fit from the samples) or a path to a `variogram.json`.
     pub variogram: String,
     /// An explicit variogram (overrides `variogram`).
@@ -175,13 +177,13 @@ pub struct InterpolationSection {
 impl Default for InterpolationSection {
     fn default() -> Self {
         InterpolationSection {
-            methods: vec!["uk".into(), "idw".into()],
-            drift: "linear".into(),
+            methods: DEFAULT_METHODS.to_vec(),
+            drift: Drift::Linear,
             variogram: "auto".into(),
             model: None,
             neighbors: 0,
-            idw_power: 2.0,
-            idw_neighbors: 16,
+            idw_power: DEFAULT_IDW_POWER,
+            idw_neighbors: DEFAULT_IDW_NEIGHBORS,
             cv_folds: 0,
         }
     }
@@ -215,6 +217,13 @@ impl Default for ExportSection {
         }
     }
 }
+
+/// The interpolation methods of a project, by default: UK gives the DSM, IDW is compared.
+pub const DEFAULT_METHODS: [InterpolationMethod; 2] =
+    [InterpolationMethod::Universal, InterpolationMethod::Idw];
+
+/// IDW neighbours of a project, by default.
+pub const DEFAULT_IDW_NEIGHBORS: usize = 16;
 
 /// Smoothing iterations of a project's mesh, by default.
 pub const DEFAULT_SMOOTH: usize = 10;

@@ -187,21 +187,7 @@ impl Project {
         if i.methods.is_empty() {
             return bad(
                 "interpolation.methods",
-                "name at least one of \"uk\", \"ok\", \"idw\"",
-            );
-        }
-        for meth in &i.methods {
-            if !matches!(meth.as_str(), "uk" | "ok" | "sk" | "idw") {
-                return bad(
-                    "interpolation.methods",
-                    &format!("unknown method \"{meth}\" (uk, ok, sk, idw)"),
-                );
-            }
-        }
-        if !matches!(i.drift.as_str(), "constant" | "linear" | "quadratic") {
-            return bad(
-                "interpolation.drift",
-                "must be \"constant\", \"linear\" or \"quadratic\"",
+                "name at least one of \"uk\", \"ok\", \"sk\", \"idw\" (the first gives the DSM)",
             );
         }
         if !positive(i.idw_power) {
@@ -270,7 +256,7 @@ mod tests {
         assert_eq!(p.sampling.rows, 100);
         assert_eq!(p.sampling.cols, 50);
         assert_eq!(p.mesh.min_angle, 30.0);
-        assert_eq!(p.interpolation.methods, ["uk", "idw"]);
+        assert_eq!(p.interpolation.methods, crate::project::DEFAULT_METHODS);
     }
 
     #[test]
@@ -309,7 +295,10 @@ mod tests {
         )
         .unwrap();
         assert_eq!(p.mesh.min_angle, 32.0);
-        assert_eq!(p.interpolation.methods, ["idw"]);
+        assert_eq!(
+            p.interpolation.methods,
+            [terramesh_geostat::InterpolationMethod::Idw]
+        );
         assert_eq!(p.region.zone.as_deref(), Some("31N"));
         let e = Project::parse("t.toml", TEMPLATE, &["mesh.min_angle".into()])
             .unwrap_err()
