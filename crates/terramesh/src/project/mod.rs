@@ -90,10 +90,10 @@ pub struct SamplingSection {
 impl Default for SamplingSection {
     fn default() -> Self {
         SamplingSection {
-            rows: 100,
-            cols: 50,
+            rows: DEFAULT_ROWS,
+            cols: DEFAULT_COLS,
             spacing: None,
-            margin: 0.1,
+            margin: DEFAULT_MARGIN,
             clip: false,
             method: Kernel::Bilinear,
         }
@@ -217,6 +217,13 @@ impl Default for ExportSection {
         }
     }
 }
+
+/// Sampling grid rows of a project, by default (the paper's 100 x 50).
+pub const DEFAULT_ROWS: usize = 100;
+/// Sampling grid columns of a project, by default.
+pub const DEFAULT_COLS: usize = 50;
+/// Enlargement of a project's region, by default: 10 % on every side.
+pub const DEFAULT_MARGIN: f64 = 0.1;
 
 /// The interpolation methods of a project, by default: UK gives the DSM, IDW is compared.
 pub const DEFAULT_METHODS: [InterpolationMethod; 2] =

@@ -249,6 +249,7 @@ fn one_line(s: &str) -> String {
 mod tests {
     use super::*;
     use crate::project::TEMPLATE;
+    use terramesh_core::vocab::Named;
 
     #[test]
     fn template_parses_with_documented_defaults() {
@@ -321,6 +322,43 @@ mod tests {
         assert!(e.starts_with("p.toml, line 1: [region]"), "{e}");
         assert_eq!(key_line("[a]\nb = 1\n[c]\nb = 2\n", "c.b"), Some(4));
         assert_eq!(key_line("[a]\nb = 1\n", "a.x"), None);
+    }
+
+    /// The template shows every default: its values are the constants the library uses.
+    #[test]
+    fn the_template_writes_every_default() {
+        use crate::project::{ExportSection, InterpolationSection, MeshSection, SamplingSection};
+        let p = Project::parse("t.toml", TEMPLATE, &[]).unwrap();
+        assert_eq!(
+            format!("{:?}", p.sampling),
+            format!("{:?}", SamplingSection::default())
+        );
+        assert_eq!(
+            format!("{:?}", p.mesh),
+            format!("{:?}", MeshSection::default())
+        );
+        assert_eq!(
+            format!("{:?}", p.interpolation),
+            format!("{:?}", InterpolationSection::default())
+        );
+        assert_eq!(
+            format!("{:?}", p.export),
+            format!("{:?}", ExportSection::default())
+        );
+        assert_eq!(p.region.crs, terramesh_io::region::RegionCrs::default());
+        assert_eq!(p.mesh.min_angle, terramesh_mesh::DEFAULT_MIN_ANGLE);
+        assert_eq!(p.mesh.smoother, terramesh_mesh::DEFAULT_SMOOTHER);
+        // Every name the template shows in a comment is one the library accepts.
+        for (line, names) in [
+            ("method = ", terramesh_core::sampling::Kernel::names()),
+            ("smoother = ", terramesh_mesh::Smoother::names()),
+            ("drift = ", terramesh_geostat::Drift::names()),
+        ] {
+            let l = TEMPLATE.lines().find(|l| l.starts_with(line)).unwrap();
+            for n in names {
+                assert!(l.contains(n), "{l} lacks {n}");
+            }
+        }
     }
 
     #[test]
