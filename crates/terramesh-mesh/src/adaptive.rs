@@ -447,10 +447,9 @@ fn improve_moves(
     for _ in 0..iterations {
         let mut moved = 0;
         for v in 0..mesh.points.len() {
-            if fixed[v] || off[v] == off[v + 1] {
+            let Some(star) = crate::smooth::free_star(&fixed, &off, &tris, v) else {
                 continue;
-            }
-            let star = &tris[off[v]..off[v + 1]];
+            };
             let Some(target) = neighbour_mean(mesh, v, star) else {
                 continue;
             };

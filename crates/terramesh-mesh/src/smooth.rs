@@ -89,10 +89,9 @@ pub fn smooth(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothR
     for _ in 0..iterations {
         let mut moved = 0;
         for v in 0..mesh.points.len() {
-            if fixed[v] || off[v] == off[v + 1] {
+            let Some(star) = crate::smooth::free_star(&fixed, &off, &tris, v) else {
                 continue;
-            }
-            let star = &tris[off[v]..off[v + 1]];
+            };
             let target = match smoother {
                 Smoother::Laplacian | Smoother::Smart => neighbour_mean(mesh, v, star),
                 Smoother::Odt => odt_point(mesh, star),
@@ -148,6 +147,17 @@ fn orient_tri(mesh: &Mesh, t: [u32; 3]) -> f64 {
 /// Smallest angle of the star, in degrees. The smallest angle of a triangle is opposite its
 /// shortest edge and at most 60 degrees, so `asin(2 A / (b c))` with `b`, `c` the two longer
 /// edges gives it with one transcendental call.
+/// The star (incident triangles) of vertex `v` from [`Mesh::vertex_stars`], or `None` for a
+/// fixed vertex or one without triangles: the vertices smoothing may move.
+pub(crate) fn free_star<'a>(
+    fixed: &[bool],
+    off: &[usize],
+    tris: &'a [u32],
+    v: usize,
+) -> Option<&'a [u32]> {
+    (!fixed[v] && off[v] != off[v + 1]).then(|| &tris[off[v]..off[v + 1]])
+}
+
 pub(crate) fn star_min_angle(mesh: &Mesh, star: &[u32]) -> f64 {
     let mut min_sin = f64::INFINITY;
     for &t in star {

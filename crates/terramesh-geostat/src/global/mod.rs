@@ -152,18 +152,7 @@ impl GlobalKriging {
                     MatMut::from_column_major_slice_mut(&mut g, n, p),
                     par(),
                 );
-                let mut hcm = g.clone();
-                solve_upper_triangular_in_place(
-                    lm.transpose(),
-                    MatMut::from_column_major_slice_mut(&mut hcm, n, p),
-                    par(),
-                );
-                let mut h = vec![0.0; n * p];
-                for k in 0..p {
-                    for i in 0..n {
-                        h[i * p + k] = hcm[k * n + i];
-                    }
-                }
+                let h = upper_solve_rows(lm, &g, n, p);
                 let mut kz = zc.clone();
                 {
                     let mut m = MatMut::from_column_major_slice_mut(&mut kz, n, 1);
@@ -429,9 +418,9 @@ impl GlobalKriging {
         est: &mut [f64],
         var: Option<&mut [f64]>,
     ) -> Result<()> {
+        let m = q.len();
         let n = self.prep.pts.len();
         let p = self.prep.terms();
-        let m = q.len();
         let vg = &self.prep.variogram;
         let rhs = Mat::<f64>::from_fn(n + p, m, |i, j| {
             if i < n {
@@ -508,18 +497,7 @@ impl GlobalKriging {
                     .map(|i| (i..n).map(|k| inv[(k, i)] * inv[(k, i)]).sum())
                     .collect();
                 // H = L^{-T} G
-                let mut hcm = g.clone();
-                solve_upper_triangular_in_place(
-                    lm.transpose(),
-                    MatMut::from_column_major_slice_mut(&mut hcm, n, p),
-                    par(),
-                );
-                let mut h = vec![0.0; n * p];
-                for k in 0..p {
-                    for i in 0..n {
-                        h[i * p + k] = hcm[k * n + i];
-                    }
-                }
+                let h = upper_solve_rows(lm, g, n, p);
                 (diag, h)
             }
             Solver::Gamma { .. } => {
@@ -564,4 +542,21 @@ fn check_finite(v: &[f64]) -> Result<()> {
             ),
         }),
     }
+}
+
+/// `H = L^{-T} G` for the column-major `n x p` matrix `g`, returned row-major (`h[i * p + k]`).
+fn upper_solve_rows(lm: MatRef<'_, f64>, g: &[f64], n: usize, p: usize) -> Vec<f64> {
+    let mut hcm = g.to_vec();
+    solve_upper_triangular_in_place(
+        lm.transpose(),
+        MatMut::from_column_major_slice_mut(&mut hcm, n, p),
+        par(),
+    );
+    let mut h = vec![0.0; n * p];
+    for k in 0..p {
+        for i in 0..n {
+            h[i * p + k] = hcm[k * n + i];
+        }
+    }
+    h
 }

@@ -158,7 +158,7 @@ where
 }
 
 /// Draws the edges of a planar mesh with the region outline.
-pub fn draw_mesh<DB: DrawingBackend>(
+pub fn draw_mesh<DB>(
     root: &DrawingArea<DB, Shift>,
     xy: &[[f64; 2]],
     triangles: &[[u32; 3]],
@@ -166,6 +166,7 @@ pub fn draw_mesh<DB: DrawingBackend>(
     title: &str,
 ) -> Res
 where
+    DB: DrawingBackend,
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE)?;

@@ -235,37 +235,18 @@ pub enum Source {
     Web(Endpoint),
 }
 
-/// A resolved acquisition: what [`acquire`](crate::acquire::acquire) runs.
+/// A resolved acquisition: what [`acquire`](crate::acquire::acquire) runs: the options as
+/// given and what they resolved to.
 #[derive(Debug)]
 pub struct SamplePlan {
+    /// The options as given.
+    pub options: SampleOptions,
     /// The source.
     pub source: Source,
-    /// The source as given (for messages).
-    pub source_name: String,
     /// The region, loaded and projected.
     pub region: Option<LoadedRegion>,
-    /// The output zone.
+    /// The output zone (given, or the region's).
     pub zone: Option<Zone>,
-    /// Grid rows and columns.
-    pub rows_cols: Option<(usize, usize)>,
-    /// Grid spacing, metres.
-    pub spacing: Option<f64>,
-    /// The margin.
-    pub margin: MarginSpec,
-    /// Clip to the region.
-    pub clip: bool,
-    /// The grid plane.
-    pub plane: GridPlane,
-    /// Raster interpolation.
-    pub method: Kernel,
-    /// Points without elevation.
-    pub on_missing: OnMissing,
-    /// Their z under [`OnMissing::Nodata`].
-    pub nodata: f64,
-    /// Fill raster voids.
-    pub fill_voids: bool,
-    /// LAS/LAZ classes.
-    pub classes: Vec<u8>,
     /// Reading a points table.
     pub read: ReadOptions,
     /// CRS of a points file.
@@ -274,10 +255,6 @@ pub struct SamplePlan {
     pub fetch: FetchOptions,
     /// The cache directory, if the cache is used.
     pub cache_dir: Option<PathBuf>,
-    /// Tile zoom.
-    pub zoom: u8,
-    /// The output file.
-    pub output: Option<PathBuf>,
 }
 
 /// The default cache directory: `$TERRAMESH_CACHE`, else `$XDG_CACHE_HOME/terramesh`, else
@@ -437,20 +414,10 @@ impl SamplePlan {
             resume: w.resume,
         };
         Ok(SamplePlan {
+            options: a.clone(),
             source,
-            source_name: a.source.clone(),
             region,
             zone,
-            rows_cols: a.rows_cols,
-            spacing: a.spacing,
-            margin: a.margin,
-            clip: a.clip,
-            plane: a.plane,
-            method: a.kernel,
-            on_missing: a.on_missing,
-            nodata: a.nodata,
-            fill_voids: a.fill_voids,
-            classes: a.classes.clone(),
             read: ReadOptions {
                 columns: a.columns.clone(),
                 delimiter,
@@ -462,8 +429,6 @@ impl SamplePlan {
             } else {
                 w.cache_dir.clone().or_else(default_cache_dir)
             },
-            zoom: w.zoom,
-            output: a.output.clone(),
         })
     }
 
@@ -475,7 +440,7 @@ impl SamplePlan {
                 "",
                 format!(
                     "{{source}} {} is sampled on a grid over a region: give {{region}}",
-                    self.source_name
+                    self.options.source
                 ),
             )
         })
@@ -491,7 +456,7 @@ impl SamplePlan {
             None => (lo, hi),
         };
         let degrees = (geo_hi[0] - geo_lo[0], geo_hi[1] - geo_lo[1]);
-        let latlon = self.plane == GridPlane::LatLon;
+        let latlon = self.options.plane == GridPlane::LatLon;
         if latlon && r.geographic.is_none() {
             return Err(Error::setting(
                 Setting::GridPlane,
@@ -499,14 +464,14 @@ impl SamplePlan {
                 "needs a region in latitude/longitude",
             ));
         }
-        let margin = match self.margin {
+        let margin = match self.options.margin {
             MarginSpec::Fraction(f) => Margin::Fraction(f),
             MarginSpec::Metres(m) if latlon => {
                 Margin::PerAxis([m * degrees.0 / metres.0, m * degrees.1 / metres.1])
             }
             MarginSpec::Metres(m) => Margin::Absolute(m),
         };
-        let size = match (self.rows_cols, self.spacing) {
+        let size = match (self.options.rows_cols, self.options.spacing) {
             (Some((rows, cols)), _) => GridSize::RowsCols { rows, cols },
             (None, Some(s)) if !latlon => GridSize::Spacing(s),
             (None, Some(s)) => {
@@ -518,7 +483,7 @@ impl SamplePlan {
                         "must be a positive number of metres",
                     ));
                 }
-                let (mlo, mhi) = self.margin.projected().enlarge(lo, hi)?;
+                let (mlo, mhi) = self.options.margin.projected().enlarge(lo, hi)?;
                 let n = |len: f64| (len / s).floor() as usize + 1;
                 GridSize::RowsCols {
                     rows: n(mhi[1] - mlo[1]).max(2),
@@ -536,14 +501,14 @@ impl SamplePlan {
         let spec = SamplingGrid {
             size,
             margin,
-            clip: self.clip,
+            clip: self.options.clip,
         };
         Ok(grid_nodes(
             &r.projected,
             r.geographic.as_ref(),
             r.zone,
             &spec,
-            self.plane,
+            self.options.plane,
         )?)
     }
 }

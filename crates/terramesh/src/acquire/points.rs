@@ -20,7 +20,7 @@ pub fn sample_points(
     lidar: bool,
     progress: &dyn Progress,
 ) -> Result<SampleTable> {
-    if !lidar && !s.classes.is_empty() {
+    if !lidar && !s.options.classes.is_empty() {
         return Err(Error::setting(
             Setting::Classes,
             "",
@@ -30,7 +30,7 @@ pub fn sample_points(
             ),
         ));
     }
-    if s.rows_cols.is_some() || s.spacing.is_some() {
+    if s.options.rows_cols.is_some() || s.options.spacing.is_some() {
         progress.note(&format!(
             "note: {} is a point cloud: its points inside the region are kept, the grid size \
              does not apply",
@@ -41,7 +41,7 @@ pub fn sample_points(
         read_las(
             path,
             &LasOptions {
-                classes: s.classes.clone(),
+                classes: s.options.classes.clone(),
             },
         )?
     } else {
@@ -56,14 +56,14 @@ pub fn sample_points(
     let keep = |xy: [f64; 2]| -> Result<bool> {
         let Some(r) = region else { return Ok(true) };
         let (lo, hi) = r.projected.bbox().context("the region has no vertices")?;
-        let (lo, hi) = s.margin.projected().enlarge(lo, hi)?;
+        let (lo, hi) = s.options.margin.projected().enlarge(lo, hi)?;
         let inside_box = xy[0] >= lo[0] && xy[0] <= hi[0] && xy[1] >= lo[1] && xy[1] <= hi[1];
-        Ok(inside_box && (!s.clip || r.projected.contains(xy)))
+        Ok(inside_box && (!s.options.clip || r.projected.contains(xy)))
     };
-    let class_note = if s.classes.is_empty() {
+    let class_note = if s.options.classes.is_empty() {
         String::new()
     } else {
-        format!(", classes {:?}", s.classes)
+        format!(", classes {:?}", s.options.classes)
     };
     match &pc.crs {
         SourceCrs::Projected { name } => {

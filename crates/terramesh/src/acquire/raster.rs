@@ -9,7 +9,7 @@ use terramesh_io::dem::{
 use terramesh_web::{fetch_tiles, TileOptions};
 
 use super::plan::SamplePlan;
-use super::table::{Row, SampleTable};
+use super::table::SampleTable;
 use crate::error::{Context, Error, Result};
 use crate::setting::Setting;
 
@@ -21,7 +21,7 @@ pub fn sample_file(s: &SamplePlan, path: &Path) -> Result<SampleTable> {
     let area = (latlon.len() == nodes.len())
         .then(|| LatLonBox::around(&latlon))
         .flatten();
-    let dem = open_raster_in(path, s.fill_voids, area.as_ref())?;
+    let dem = open_raster_in(path, s.options.fill_voids, area.as_ref())?;
     sample(s, dem.as_ref(), nodes)
 }
 
@@ -30,24 +30,16 @@ fn sample(
     dem: &dyn ElevationSource,
     nodes: Vec<terramesh_core::sampling::Node>,
 ) -> Result<SampleTable> {
-    let z = sample_nodes(dem, &nodes, s.zone, s.method)?;
+    let z = sample_nodes(dem, &nodes, s.zone, s.options.kernel)?;
     let zone = match dem.crs() {
         SourceCrs::Projected { .. } => None,
         _ => s.zone,
     };
-    let rows = nodes
-        .iter()
-        .zip(z)
-        .map(|(n, z)| Row {
-            latlon: n.latlon,
-            xy: n.xy,
-            z: z.map_err(|m| m.to_string()),
-        })
-        .collect();
+    let rows = super::table::node_rows(&nodes, z);
     Ok(SampleTable {
         zone,
         rows,
-        summary: format!("{} ({} interpolation)", dem.describe(), s.method),
+        summary: format!("{} ({} interpolation)", dem.describe(), s.options.kernel),
     })
 }
 
@@ -55,7 +47,7 @@ fn sample(
 /// needs.
 pub fn sample_tiles(s: &SamplePlan, template: &str) -> Result<SampleTable> {
     let nodes = s.nodes()?;
-    let z = s.zoom;
+    let z = s.options.web.zoom;
     if z > 20 {
         return Err(Error::setting(
             Setting::Zoom,

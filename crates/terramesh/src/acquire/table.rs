@@ -34,13 +34,29 @@ pub struct SampleTable {
 
 const CHUNK: usize = 8192;
 
+/// The rows of sampled grid nodes: each node with its elevation or why it has none.
+pub(crate) fn node_rows<E: std::fmt::Display>(
+    nodes: &[terramesh_core::sampling::Node],
+    z: Vec<std::result::Result<f64, E>>,
+) -> Vec<Row> {
+    nodes
+        .iter()
+        .zip(z)
+        .map(|(n, z)| Row {
+            latlon: n.latlon,
+            xy: n.xy,
+            z: z.map_err(|e| e.to_string()),
+        })
+        .collect()
+}
+
 /// Applies the on-missing policy and writes the table atomically to the plan's output
 /// (standard output without one); what was read and written goes to `progress` as notes.
 pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> Result<()> {
     let missing: Vec<usize> = (0..t.rows.len())
         .filter(|&i| t.rows[i].z.is_err())
         .collect();
-    if s.on_missing == OnMissing::Error {
+    if s.options.on_missing == OnMissing::Error {
         if let Some(&i) = missing.first() {
             let r = &t.rows[i];
             let at = match r.latlon {
@@ -67,7 +83,7 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
         }
     }
     let geographic = t.zone.is_some();
-    let with_error = s.on_missing == OnMissing::Nodata;
+    let with_error = s.options.on_missing == OnMissing::Nodata;
     let mut head = if geographic {
         "lat,lon,easting,northing,zone,z".to_string()
     } else {
@@ -84,9 +100,9 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
         .map(|chunk| {
             let mut b = Vec::with_capacity(chunk.len() * 80);
             for r in chunk {
-                let z = match (&r.z, s.on_missing) {
+                let z = match (&r.z, s.options.on_missing) {
                     (Ok(z), _) => Some((*z, "")),
-                    (Err(e), OnMissing::Nodata) => Some((s.nodata, e.as_str())),
+                    (Err(e), OnMissing::Nodata) => Some((s.options.nodata, e.as_str())),
                     (Err(_), _) => None,
                 };
                 let Some((z, why)) = z else { continue };
@@ -122,18 +138,19 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
         })
         .collect();
     let name = s
+        .options
         .output
         .as_ref()
         .map_or("standard output".to_string(), |p| p.display().to_string());
-    let mut out =
-        Output::create(s.output.as_deref()).with_context(|| format!("cannot write {name}"))?;
+    let mut out = Output::create(s.options.output.as_deref())
+        .with_context(|| format!("cannot write {name}"))?;
     out.write_all(head.as_bytes())
         .and_then(|_| chunks.iter().try_for_each(|c| out.write_all(c)))
         .with_context(|| format!("writing {name}"))?;
     out.commit()
         .with_context(|| format!("cannot write {name}"))?;
     let written = t.rows.len()
-        - if s.on_missing == OnMissing::Skip {
+        - if s.options.on_missing == OnMissing::Skip {
             missing.len()
         } else {
             0
@@ -141,7 +158,7 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
     progress.note(&t.summary);
     progress.note(&format!("wrote {written} points to {name}"));
     if !missing.is_empty() {
-        let what = match s.on_missing {
+        let what = match s.options.on_missing {
             OnMissing::Skip => "left out",
             _ => "written with z = the nodata value and the reason in the error column",
         };

@@ -2,10 +2,10 @@
 
 use std::sync::atomic::AtomicBool;
 
-use terramesh_web::{fetch, Endpoint, FetchOptions, PointError, PointStore};
+use terramesh_web::{fetch, Endpoint, FetchOptions, PointStore};
 
 use super::plan::SamplePlan;
-use super::table::{Row, SampleTable};
+use super::table::SampleTable;
 use crate::error::{Context, Result};
 use crate::progress::Progress;
 
@@ -55,21 +55,13 @@ pub fn sample_web(
             }
         }
     }
-    let rows = nodes
-        .iter()
-        .zip(z)
-        .map(|(n, z)| Row {
-            latlon: n.latlon,
-            xy: n.xy,
-            z: z.map_err(|e: PointError| e.to_string()),
-        })
-        .collect();
+    let rows = super::table::node_rows(&nodes, z);
     Ok(SampleTable {
         zone: s.zone,
         rows,
         summary: format!(
             "{} ({}): {} from the journal/cache, {} fetched in {} requests ({} retries)",
-            s.source_name,
+            s.options.source,
             endpoint.base_url,
             stats.from_store,
             stats.fetched,
