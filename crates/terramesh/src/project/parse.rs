@@ -67,7 +67,7 @@ fn key_at_line(text: &str, line: usize) -> Option<String> {
 }
 
 impl Project {
-    /// Reads a project file, applying `--set KEY=VALUE` overrides.
+    /// Reads a project file, applying `KEY=VALUE` overrides (`terramesh build --set`).
     pub fn load(path: &Path, sets: &[String]) -> Result<Project> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::Project {
             file: path.display().to_string(),
@@ -120,7 +120,7 @@ impl Project {
                 why: format!("re-serialising the project: {e}"),
             })?;
             toml::from_str(&merged).map_err(|e| Error::Project {
-                file: format!("{name} with --set {}", sets.join(", ")),
+                file: format!("{name} with the overrides {}", sets.join(", ")),
                 line: None,
                 why: one_line(e.message()),
             })?
@@ -213,11 +213,11 @@ impl Project {
 fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), String> {
     let (key, value) = set
         .split_once('=')
-        .ok_or_else(|| format!("--set '{set}': write KEY=VALUE, e.g. --set mesh.min_angle=32"))?;
+        .ok_or_else(|| format!("override '{set}': write KEY=VALUE, e.g. mesh.min_angle=32"))?;
     let key = key.trim();
     let parts: Vec<&str> = key.split('.').collect();
     if parts.iter().any(|p| p.is_empty()) {
-        return Err(format!("--set '{set}': bad key '{key}'"));
+        return Err(format!("override '{set}': bad key '{key}'"));
     }
     let value = match toml::from_str::<toml::Table>(&format!("v = {}", value.trim())) {
         Ok(mut t) => t.remove("v"),
@@ -231,7 +231,7 @@ fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), String
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
         table = entry
             .as_table_mut()
-            .ok_or_else(|| format!("--set '{set}': '{p}' is not a section"))?;
+            .ok_or_else(|| format!("override '{set}': '{p}' is not a section"))?;
     }
     table.insert(parts[parts.len() - 1].to_string(), value);
     Ok(())
@@ -308,7 +308,7 @@ mod tests {
         let e = Project::parse("t.toml", TEMPLATE, &["mesh.typo=1".into()])
             .unwrap_err()
             .to_string();
-        assert!(e.contains("typo") && e.contains("--set"), "{e}");
+        assert!(e.contains("typo") && e.contains("overrides"), "{e}");
     }
 
     #[test]
