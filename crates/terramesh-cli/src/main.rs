@@ -47,6 +47,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // A project's settings are keys, worded by the library; a command's are flags.
     let flags = !matches!(cli.command, Command::Build(_) | Command::Init(_));
+    let crs = if matches!(cli.command, Command::Mesh(_)) {
+        "--crs"
+    } else {
+        "--region-crs"
+    };
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
@@ -64,7 +69,7 @@ fn main() -> ExitCode {
             // Library phrases become the flags they stand for (`wording`).
             let text = format!("{e:#}");
             let text = if flags {
-                wording::flag_words(&text)
+                wording::flag_words(&text, crs)
             } else {
                 text
             };

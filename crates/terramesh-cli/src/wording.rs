@@ -33,11 +33,6 @@ const PHRASES: &[(&str, &str)] = &[
         "; force a zone to project it anyway",
         "; force a zone with --zone to project it anyway",
     ),
-    // terramesh_core::solid::SolidError::BaseTooHigh
-    (
-        ": choose a lower base elevation",
-        ": choose a lower --base-elevation",
-    ),
     // terramesh_io::table::TableError::MissingColumn and Malformed
     (
         "for a file without a header name the columns",
@@ -51,20 +46,22 @@ const PHRASES: &[(&str, &str)] = &[
     (terramesh_io::region::CORNER_LIST, "--corners"),
     (
         "': in projected coordinates each corner is NORTHING EASTING",
-        "': with --crs projected each corner is NORTHING EASTING",
+        "': with {crs} projected each corner is NORTHING EASTING",
     ),
     // terramesh_io::dem::sample (a source in coordinates terramesh does not convert)
     (
         "in the source's own coordinates (a projected region)",
-        "in the source's own coordinates (--region-crs projected)",
+        "in the source's own coordinates ({crs} projected)",
     ),
 ];
 
-/// `message` with the libraries' names of settings replaced by the flags (see [`PHRASES`]).
-pub fn flag_words(message: &str) -> String {
-    PHRASES
-        .iter()
-        .fold(message.to_string(), |m, (lib, flag)| m.replace(lib, flag))
+/// `message` with the libraries' names of settings replaced by the flags (see [`PHRASES`]);
+/// `crs` is the command's flag for the region's coordinates (`--crs` for `mesh`,
+/// `--region-crs` for `sample`).
+pub fn flag_words(message: &str, crs: &str) -> String {
+    PHRASES.iter().fold(message.to_string(), |m, (lib, flag)| {
+        m.replace(lib, &flag.replace("{crs}", crs))
+    })
 }
 
 #[cfg(test)]
@@ -83,6 +80,10 @@ mod tests {
             "--max-area 0: must be a positive number"
         );
         let e = terramesh_core::coords::CoordError::OutsideUtm(84.5);
-        assert!(flag_words(&e.to_string()).contains("with --zone to project"));
+        assert!(flag_words(&e.to_string(), "--crs").contains("with --zone to project"));
+        // The region's coordinates are --crs for mesh, --region-crs for sample.
+        let m = "corner 'x': in projected coordinates each corner is NORTHING EASTING";
+        assert!(flag_words(m, "--region-crs").contains("with --region-crs projected"));
+        assert!(flag_words(m, "--crs").contains("with --crs projected"));
     }
 }
