@@ -19,33 +19,8 @@ pub(crate) fn sincos_deg(x: f64) -> (f64, f64) {
     let r = (x - 90.0 * k).to_radians(); // |r| <= π/4
     let r2 = r * r;
     // Taylor series, truncation error below 5e-17 on |r| <= π/4.
-    let s = r * horner(
-        r2,
-        &[
-            1.0,
-            -1.0 / 6.0,
-            1.0 / 120.0,
-            -1.0 / 5040.0,
-            1.0 / 362_880.0,
-            -1.0 / 39_916_800.0,
-            1.0 / 6_227_020_800.0,
-            -1.0 / 1_307_674_368_000.0,
-        ],
-    );
-    let c = horner(
-        r2,
-        &[
-            1.0,
-            -0.5,
-            1.0 / 24.0,
-            -1.0 / 720.0,
-            1.0 / 40_320.0,
-            -1.0 / 3_628_800.0,
-            1.0 / 479_001_600.0,
-            -1.0 / 87_178_291_200.0,
-            1.0 / 20_922_789_888_000.0,
-        ],
-    );
+    let s = r * horner(r2, &SIN_OVER_R);
+    let c = horner(r2, &COS);
     // Quadrant k mod 4 (k in -2..=2), as branch-free selects.
     let q = ki & 3;
     let odd = q & 1 == 1;
@@ -69,24 +44,32 @@ pub(crate) fn atan2_right(y: f64, x: f64) -> f64 {
     let t = tan_k_pi_16(k);
     let w = (z - t) / (1.0 + z * t); // |w| < 0.13
     let w2 = w * w;
-    let at = w * horner(
-        w2,
-        &[
-            1.0,
-            -1.0 / 3.0,
-            1.0 / 5.0,
-            -1.0 / 7.0,
-            1.0 / 9.0,
-            -1.0 / 11.0,
-            1.0 / 13.0,
-            -1.0 / 15.0,
-            1.0 / 17.0,
-        ],
-    );
+    let at = w * horner(w2, &ATAN_OVER_W);
     let base = k * (std::f64::consts::PI / 16.0) + at;
     let r = if swap { FRAC_PI_2 - base } else { base };
     r.copysign(y)
 }
+
+/// Taylor coefficients of `sin(r) / r` in powers of `r²`: `(-1)^k / (2k + 1)!`.
+#[rustfmt::skip]
+const SIN_OVER_R: [f64; 8] = [
+    1.0, -1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0, -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0, -1.0 / 1_307_674_368_000.0,
+];
+
+/// Taylor coefficients of `cos(r)` in powers of `r²`: `(-1)^k / (2k)!`.
+#[rustfmt::skip]
+const COS: [f64; 9] = [
+    1.0, -0.5, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40_320.0, -1.0 / 3_628_800.0,
+    1.0 / 479_001_600.0, -1.0 / 87_178_291_200.0, 1.0 / 20_922_789_888_000.0,
+];
+
+/// Taylor coefficients of `atan(w) / w` in powers of `w²`: `(-1)^k / (2k + 1)`.
+#[rustfmt::skip]
+const ATAN_OVER_W: [f64; 9] = [
+    1.0, -1.0 / 3.0, 1.0 / 5.0, -1.0 / 7.0, 1.0 / 9.0, -1.0 / 11.0, 1.0 / 13.0, -1.0 / 15.0,
+    1.0 / 17.0,
+];
 
 /// `c[0] + x (c[1] + x (c[2] + ...))`, evaluated from the innermost term (Horner); the loop
 /// over a fixed-size array unrolls to the same arithmetic as the nested expression.
