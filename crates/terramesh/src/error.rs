@@ -176,23 +176,6 @@ impl Error {
         }
         parts.join(": ")
     }
-
-    /// The settings this error (or a cause) is about, outermost first.
-    pub fn settings(&self) -> Vec<Setting> {
-        let mut out = Vec::new();
-        let mut cur = Some(self);
-        while let Some(e) = cur {
-            cur = match e {
-                Error::Setting { setting, .. } => {
-                    out.push(*setting);
-                    None
-                }
-                Error::Context { source, .. } => Some(source),
-                _ => None,
-            };
-        }
-        out
-    }
 }
 
 /// Adds context to errors, like `anyhow::Context`, for this crate's [`Error`].
@@ -248,7 +231,6 @@ mod tests {
             e.render(&|s| format!("--{s}")),
             "samples: --zone '99X': not a UTM zone"
         );
-        assert_eq!(e.settings(), [Setting::Zone]);
         let io: Result<()> = Err(std::io::Error::other("disk full").into());
         let e = io.context("writing out/x").unwrap_err();
         let own = Error::setting(

@@ -246,7 +246,7 @@ pub fn predict_grid(
             }
         }
         eng.predict(&pts, &mut values[j0 * g.nx..j1 * g.nx], None)
-            .context("the grid")?;
+            .map_err(|e| Error::setting(Setting::Grid, "", format!("{{grid}}: {e}")))?;
     }
     let mut out = Output::create(Some(out_path))?;
     if ext == "asc" {

@@ -167,8 +167,7 @@ pub struct DemHeights {
 impl DemHeights {
     /// Opens the DEM at `path` for a region in `zone` (`None`: the DEM's own coordinates).
     pub fn open(path: &Path, zone: Option<Zone>) -> Result<DemHeights> {
-        let dem =
-            open_raster(path, true).map_err(|e| Error::setting(Setting::Dem, path.display(), e))?;
+        let dem = open_raster(path, true).map_err(|e| Error::setting(Setting::Dem, "", e))?;
         Ok(DemHeights {
             dem,
             zone,

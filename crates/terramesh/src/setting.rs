@@ -50,6 +50,8 @@ pub enum Setting {
     Duplicates,
     /// The variogram model.
     Model,
+    /// The grid of nodes an interpolation is asked for.
+    Grid,
     /// A DEM used as a height function.
     Dem,
     /// The output file.
@@ -79,6 +81,7 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Nodata => "nodata",
     Setting::Duplicates => "duplicates",
     Setting::Model => "model",
+    Setting::Grid => "grid",
     Setting::Dem => "dem",
     Setting::Output => "output",
 ]);

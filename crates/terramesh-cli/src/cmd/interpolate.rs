@@ -170,21 +170,15 @@ pub fn run(args: Args) -> Result<()> {
     let eng = engine(&args.m, &fd, want_var)?;
     match (&args.targets, &args.grid) {
         (Some(t), None) => {
-            predict_csv(&*eng, t, want_var, args.output.as_deref()).map_err(grid_error)
+            predict_csv(&*eng, t, want_var, args.output.as_deref()).map_err(crate::flag_error)
         }
         (None, Some(g)) => {
             let spec: RasterGrid = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
             let Some(out) = &args.output else {
                 bail!("--grid needs -o FILE.asc or -o FILE.tif");
             };
-            predict_grid(&*eng, &spec, out, args.epsg).map_err(grid_error)
+            predict_grid(&*eng, &spec, out, args.epsg).map_err(crate::flag_error)
         }
         _ => bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
     }
-}
-
-/// A library error worded for this command (`--grid` for the grid).
-fn grid_error(e: terramesh::Error) -> anyhow::Error {
-    let text = e.render(&super::sample::flag_of);
-    anyhow::anyhow!(text.replacen("the grid: ", "--grid: ", 1))
 }

@@ -105,10 +105,10 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     let fd = read_data(&args.data, args.duplicates).map_err(crate::flag_error)?;
-    let lags = experimental(&fd.data, &args.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
+    let s = args.lag.settings();
+    let lags = experimental(&fd.data, &s).map_err(|e| in_file(&fd.name, e))?;
     let (fit, cands) = fit_named(&fd.data, &lags, &args.model, args.lag.weighting())
         .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
-    let s = args.lag.settings();
     let file = VariogramFile {
         data: fd.name.clone(),
         points: fd.data.len(),

@@ -33,8 +33,8 @@ pub struct Samples {
 /// Step 1: samples on the project's grid, also written to `out/samples.csv`.
 pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
     let options = p.sample_options(base, &out.join("samples.csv"))?;
-    let plan = SamplePlan::resolve(&options).map_err(|e| p.reword(e))?;
-    let table = acquire(&plan, progress).map_err(|e| p.reword(e))?;
+    let plan = SamplePlan::resolve(&options)?;
+    let table = acquire(&plan, progress)?;
     let zone = table.zone.context(
         "the source is in a projected CRS terramesh does not convert; use a geographic or UTM \
          source for build",
@@ -57,7 +57,7 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
     }
     let s = &p.sampling;
     let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
-    write_table(&plan, table, progress).map_err(|e| p.reword(e))?;
+    write_table(&plan, table, progress)?;
     Ok(Samples {
         xyz,
         zone,
@@ -405,7 +405,7 @@ impl Surface {
         let vslot = if variance { Some(&mut var[..]) } else { None };
         self.0
             .predict(targets, &mut est, vslot)
-            .context("kriging")?;
+            .context("interpolation")?;
         Ok((est, var))
     }
 }

@@ -107,14 +107,4 @@ impl Project {
             path.display()
         )))
     }
-
-    /// Rewords an error of a stage for this project: each setting named as its key.
-    pub fn reword(&self, e: Error) -> Error {
-        match e {
-            e @ (Error::Setting { .. } | Error::Context { .. }) if !e.settings().is_empty() => {
-                Error::invalid(e.render(&key_of))
-            }
-            e => e,
-        }
-    }
 }
