@@ -8,17 +8,21 @@
 //! * [`to_utm_many`], [`to_wgs84_many`]: batch conversion over slices, in parallel on request.
 //! * [`LocalEnu`], [`geodetic_to_ecef`]: local east-north-up metres around an origin on the
 //!   WGS-84 ellipsoid (the frame of a COLLADA model placed by KML).
+//! * [`egm96_undulation`], [`GeoidGrid`], [`VerticalDatum`]: heights above the EGM96 geoid
+//!   (a DEM's) to heights above the ellipsoid (Cesium's, 3D Tiles').
 
 mod angle;
 mod batch;
 mod enu;
 mod fastmath;
+mod geoid;
 mod tmerc;
 mod utm;
 
 pub use angle::{format_dms, parse_angle, Axis};
 pub use batch::{to_utm_many, to_wgs84_many, Parallelism};
 pub use enu::{geodetic_to_ecef, LocalEnu, WGS84_A, WGS84_F};
+pub use geoid::{egm96_undulation, GeoidGrid, VerticalDatum, GEOID_GRID_STEP};
 pub use tmerc::{LocalFactors, Projected, TransverseMercator};
 pub use utm::{
     to_utm, to_utm_with_factors, to_wgs84, CoordError, Utm, Zone, FALSE_EASTING,
