@@ -29,4 +29,5 @@ pub mod output;
 pub mod pictures;
 pub mod region;
 pub mod report;
+pub mod scratch;
 pub mod table;
