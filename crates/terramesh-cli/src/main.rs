@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
+mod interrupt;
 mod progress;
 mod wording;
 
@@ -45,6 +46,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    interrupt::install();
     // A project's settings are keys, worded by the library; a command's are flags.
     let flags = !matches!(cli.command, Command::Build(_) | Command::Init(_));
     let crs = if matches!(cli.command, Command::Mesh(_)) {
@@ -62,7 +64,15 @@ fn main() -> ExitCode {
         Command::Sample(args) => cmd::sample::run(*args),
         Command::Mesh(args) => cmd::mesh::run(args),
     };
+    interrupt::finishing();
     match result {
+        // Stopped by Ctrl-C or SIGTERM (a command that finished anyway succeeded).
+        Err(_) if interrupt::cancelled() => {
+            eprintln!(
+                "terramesh: interrupted: unfinished files removed, existing outputs untouched"
+            );
+            ExitCode::from(interrupt::EXIT_INTERRUPTED)
+        }
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // `{:#}` prints the context chain on one line: "file, line 3: what is wrong".

@@ -83,6 +83,10 @@ pub enum Error {
     /// Anything else, in words.
     #[error("{0}")]
     Invalid(String),
+    /// The work was stopped on request ([`Progress::cancelled`](crate::progress::Progress::cancelled)
+    /// turned true): nothing it was writing was kept.
+    #[error("stopped before it finished; its unfinished files were removed")]
+    Cancelled,
     /// What was being done when `source` happened.
     #[error("{context}")]
     Context {
@@ -118,7 +122,28 @@ fn setting_message(
     } else if value.is_empty() {
         format!("{}: {text}", word(setting))
     } else {
-        format!("{} '{value}': {text}", word(setting))
+        format!("{} '{}': {text}", word(setting), cut(value))
+    }
+}
+
+/// The longest value a message quotes, in characters.
+pub const QUOTE_LIMIT: usize = 60;
+
+/// `value` as a message quotes it: whole up to [`QUOTE_LIMIT`] characters, else its start
+/// and how long it is, so a huge field does not make a huge message.
+///
+/// ```
+/// assert_eq!(terramesh::cut("48.7 7.3"), "48.7 7.3");
+/// let long = "9".repeat(5000);
+/// assert_eq!(terramesh::cut(&long), format!("{}... (5000 characters)", &long[..60]));
+/// ```
+pub fn cut(value: &str) -> String {
+    let n = value.chars().count();
+    if n <= QUOTE_LIMIT {
+        value.to_string()
+    } else {
+        let head: String = value.chars().take(QUOTE_LIMIT).collect();
+        format!("{head}... ({n} characters)")
     }
 }
 
