@@ -13,7 +13,12 @@ fn example() -> PathBuf {
 
 fn command(out: &Path, extra: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_terramesh"));
-    c.arg("build").arg(example()).arg("-o").arg(out).arg("--quiet").args(extra);
+    c.arg("build")
+        .arg(example())
+        .arg("-o")
+        .arg(out)
+        .arg("--quiet")
+        .args(extra);
     c
 }
 
@@ -81,12 +86,10 @@ fn wait_for_staging(parent: &Path, child: &mut Child) -> PathBuf {
     }
 }
 
-#[test]
-fn failed_builds_leave_the_previous_build_byte_identical() {
-    let dir = tempfile::tempdir().unwrap();
-    let (out, before) = first_build(dir.path());
-    // 50 m above the lowest surface point (the default base is 50 m below it): the sealed
-    // solid fails in the exports stage, after most files have been written.
+/// A `--set` that passes every check made before writing but fails in the exports stage,
+/// after most files have been written: a base 50 m above the lowest surface point of the
+/// build `before` (whose default base is 50 m below it).
+fn late_failure(before: &BTreeMap<PathBuf, Vec<u8>>) -> String {
     let solid = String::from_utf8(before[Path::new("dsm-solid.json")].clone()).unwrap();
     let base: f64 = solid
         .lines()
@@ -96,9 +99,19 @@ fn failed_builds_leave_the_previous_build_byte_identical() {
         .trim()
         .parse()
         .unwrap();
-    let late = format!("export.base_elevation={}", base + 100.0);
+    format!("export.base_elevation={}", base + 100.0)
+}
+
+#[test]
+fn failed_builds_leave_the_previous_build_byte_identical() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, before) = first_build(dir.path());
+    let late = late_failure(&before);
     for (set, key) in [
-        ("interpolation.variogram=nope.json", "interpolation.variogram"),
+        (
+            "interpolation.variogram=nope.json",
+            "interpolation.variogram",
+        ),
         ("interpolation.neighbors=1", "interpolation.neighbors"),
         ("interpolation.cv_folds=1", "interpolation.cv_folds"),
         ("export.base_elevation=1e9", "export.base_elevation"),
@@ -109,8 +122,14 @@ fn failed_builds_leave_the_previous_build_byte_identical() {
         let o = build(&out, &["--set", set]);
         let err = stderr(&o);
         assert!(!o.status.success(), "{set} was accepted");
-        assert!(err.contains(key), "{set}: the message does not name {key}: {err}");
-        assert!(!err.contains("--"), "{set}: the message names a flag: {err}");
+        assert!(
+            err.contains(key),
+            "{set}: the message does not name {key}: {err}"
+        );
+        assert!(
+            !err.contains("--"),
+            "{set}: the message names a flag: {err}"
+        );
         assert_eq!(names(dir.path()), ["out"], "{set} left a folder beside out");
         assert!(snapshot(&out) == before, "{set} changed the previous build");
     }
@@ -124,16 +143,27 @@ fn a_build_killed_midway_leaves_the_previous_build_intact() {
     let staging = wait_for_staging(dir.path(), &mut child);
     child.kill().unwrap(); // SIGKILL: nothing of the build runs after it
     child.wait().unwrap();
-    assert!(snapshot(&out) == before, "the killed build changed the previous one");
-    assert!(staging.is_dir(), "SIGKILL cannot clean up: the staging folder stays");
-    // The next build removes it, even one that then fails.
+    assert!(
+        snapshot(&out) == before,
+        "the killed build changed the previous one"
+    );
+    assert!(
+        staging.is_dir(),
+        "SIGKILL cannot clean up: the staging folder stays"
+    );
+    // The next build removes it, even one that then fails (after its own checks: a build
+    // refused by them writes nothing at all).
     let o = build(&out, &["--set", "interpolation.cv_folds=1"]);
     assert!(!o.status.success());
-    assert_eq!(names(dir.path()), ["out", staging.file_name().unwrap().to_str().unwrap()]);
-    let o = build(&out, &["--set", "sampling.rows=40"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(names(dir.path()), ["out"], "the stale staging folder is still there");
-    assert!(snapshot(&out) != before);
+    assert!(staging.is_dir());
+    let o = build(&out, &["--set", &late_failure(&before)]);
+    assert!(!o.status.success());
+    assert_eq!(
+        names(dir.path()),
+        ["out"],
+        "the stale staging folder is still there"
+    );
+    assert!(snapshot(&out) == before);
 }
 
 /// Sends `signal` to a build of a larger sampling (so that it runs for seconds) once it has
@@ -158,12 +188,18 @@ fn stopped_by(signal: &str) {
     assert!(kill.success());
     let o = child.wait_with_output().unwrap();
     let took = sent.elapsed();
-    assert!(took < Duration::from_secs(5), "{signal}: took {took:?} to stop");
+    assert!(
+        took < Duration::from_secs(5),
+        "{signal}: took {took:?} to stop"
+    );
     assert_eq!(o.status.code(), Some(130), "{signal}: {}", stderr(&o));
     assert!(stderr(&o).contains("interrupted"), "{}", stderr(&o));
     assert!(!staging.exists(), "{signal}: the staging folder is left");
     assert_eq!(names(dir.path()), ["out"]);
-    assert!(snapshot(&out) == before, "{signal} changed the previous build");
+    assert!(
+        snapshot(&out) == before,
+        "{signal} changed the previous build"
+    );
 }
 
 #[test]
