@@ -75,9 +75,9 @@ fn main() -> ExitCode {
         }
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // `{:#}` prints the context chain on one line: "file, line 3: what is wrong".
+            // The context chain on one line: "file, line 3: what is wrong".
             // Library phrases become the flags they stand for (`wording`).
-            let text = format!("{e:#}");
+            let text = one_line(&e);
             let text = if flags {
                 wording::flag_words(&text, crs)
             } else {
@@ -87,6 +87,20 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The chain of `e` on one line, `context: cause: cause`, each cause once: a cause whose
+/// text its wrapper already shows (`"{file}: {source}"`, a transparent wrapper) is not
+/// repeated.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if !parts.last().is_some_and(|last| last.contains(&text)) {
+            parts.push(text);
+        }
+    }
+    parts.join(": ")
 }
 
 /// A clap parser for a library enum with a fixed vocabulary ([`terramesh_core::vocab::Named`]):
@@ -119,5 +133,26 @@ pub fn say(text: &str) -> anyhow::Result<()> {
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An error that shows its source in its own text is written once, not twice.
+    #[test]
+    fn a_cause_its_wrapper_shows_is_written_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = terramesh_io::region::RegionError::Io {
+            file: "area.geojson".into(),
+            source: io,
+        };
+        let e = anyhow::Error::new(e).context("reading the region");
+        assert_eq!(format!("{e:#}").matches("no such file").count(), 2);
+        assert_eq!(
+            one_line(&e),
+            "reading the region: area.geojson: no such file"
+        );
     }
 }

@@ -126,26 +126,7 @@ fn setting_message(
     }
 }
 
-/// The longest value a message quotes, in characters.
-pub const QUOTE_LIMIT: usize = 60;
-
-/// `value` as a message quotes it: whole up to [`QUOTE_LIMIT`] characters, else its start
-/// and how long it is, so a huge field does not make a huge message.
-///
-/// ```
-/// assert_eq!(terramesh::cut("48.7 7.3"), "48.7 7.3");
-/// let long = "9".repeat(5000);
-/// assert_eq!(terramesh::cut(&long), format!("{}... (5000 characters)", &long[..60]));
-/// ```
-pub fn cut(value: &str) -> String {
-    let n = value.chars().count();
-    if n <= QUOTE_LIMIT {
-        value.to_string()
-    } else {
-        let head: String = value.chars().take(QUOTE_LIMIT).collect();
-        format!("{head}... ({n} characters)")
-    }
-}
+pub use terramesh_io::quote::cut;
 
 fn neutral(s: Setting) -> String {
     s.to_string()
@@ -189,8 +170,12 @@ impl Error {
                 }) => setting_message(*setting, value, why, name),
                 _ => e.to_string(),
             };
-            // Transparent wrappers repeat their inner message: write it once.
-            if parts.last() != Some(&text) {
+            // Transparent wrappers, and messages such as "{file}: {source}", already show
+            // their cause: write it once.
+            if !parts
+                .last()
+                .is_some_and(|last: &String| last.contains(&text))
+            {
                 parts.push(text);
             }
             cur = match e.downcast_ref::<Error>() {
