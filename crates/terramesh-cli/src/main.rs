@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
+mod interrupt;
 mod progress;
 mod wording;
 
@@ -45,6 +46,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    interrupt::install();
     // A project's settings are keys, worded by the library; a command's are flags.
     let flags = !matches!(cli.command, Command::Build(_) | Command::Init(_));
     let crs = if matches!(cli.command, Command::Mesh(_)) {
@@ -62,12 +64,20 @@ fn main() -> ExitCode {
         Command::Sample(args) => cmd::sample::run(*args),
         Command::Mesh(args) => cmd::mesh::run(args),
     };
+    interrupt::finishing();
     match result {
+        // Stopped by Ctrl-C or SIGTERM (a command that finished anyway succeeded).
+        Err(_) if interrupt::cancelled() => {
+            eprintln!(
+                "terramesh: interrupted: unfinished files removed, existing outputs untouched"
+            );
+            ExitCode::from(interrupt::EXIT_INTERRUPTED)
+        }
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // `{:#}` prints the context chain on one line: "file, line 3: what is wrong".
+            // The context chain on one line: "file, line 3: what is wrong".
             // Library phrases become the flags they stand for (`wording`).
-            let text = format!("{e:#}");
+            let text = one_line(&e);
             let text = if flags {
                 wording::flag_words(&text, crs)
             } else {
@@ -77,6 +87,20 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The chain of `e` on one line, `context: cause: cause`, each cause once: a cause whose
+/// text its wrapper already shows (`"{file}: {source}"`, a transparent wrapper) is not
+/// repeated.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if !parts.last().is_some_and(|last| last.contains(&text)) {
+            parts.push(text);
+        }
+    }
+    parts.join(": ")
 }
 
 /// A clap parser for a library enum with a fixed vocabulary ([`terramesh_core::vocab::Named`]):
@@ -109,5 +133,26 @@ pub fn say(text: &str) -> anyhow::Result<()> {
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An error that shows its source in its own text is written once, not twice.
+    #[test]
+    fn a_cause_its_wrapper_shows_is_written_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = terramesh_io::region::RegionError::Io {
+            file: "area.geojson".into(),
+            source: io,
+        };
+        let e = anyhow::Error::new(e).context("reading the region");
+        assert_eq!(format!("{e:#}").matches("no such file").count(), 2);
+        assert_eq!(
+            one_line(&e),
+            "reading the region: area.geojson: no such file"
+        );
     }
 }

@@ -112,4 +112,8 @@ impl terramesh::progress::Progress for Terminal {
     fn warn(&self, text: &str) {
         eprintln!("terramesh: {text}");
     }
+
+    fn cancelled(&self) -> bool {
+        crate::interrupt::cancelled()
+    }
 }

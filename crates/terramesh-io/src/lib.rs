@@ -27,6 +27,8 @@ pub mod grid_write;
 pub mod number;
 pub mod output;
 pub mod pictures;
+pub mod quote;
 pub mod region;
 pub mod report;
+pub mod scratch;
 pub mod table;

@@ -17,6 +17,9 @@ pub enum Output {
         tmp: BufWriter<tempfile::NamedTempFile>,
         /// The final path.
         target: PathBuf,
+        /// Lists the temporary file for a signal handler until commit or drop
+        /// ([`crate::scratch`]).
+        scratch: crate::scratch::Scratch,
     },
 }
 
@@ -65,9 +68,11 @@ impl Output {
                             format!("cannot create a file in {}: {e}", dir.display()),
                         )
                     })?;
+                let scratch = crate::scratch::register(tmp.path());
                 Ok(Output::File {
                     tmp: BufWriter::with_capacity(1 << 16, tmp),
                     target: p.to_path_buf(),
+                    scratch,
                 })
             }
         }
@@ -77,7 +82,7 @@ impl Output {
     pub fn commit(self) -> io::Result<()> {
         match self {
             Output::Stdout(mut w) => w.flush(),
-            Output::File { tmp, target } => {
+            Output::File { tmp, target, .. } => {
                 let tmp = tmp.into_inner().map_err(|e| e.into_error())?;
                 tmp.as_file().sync_all()?;
                 // Keep the usual permissions of a new file rather than tempfile's 0600.

@@ -83,6 +83,10 @@ pub enum Error {
     /// Anything else, in words.
     #[error("{0}")]
     Invalid(String),
+    /// The work was stopped on request ([`Progress::cancelled`](crate::progress::Progress::cancelled)
+    /// turned true): nothing it was writing was kept.
+    #[error("stopped before it finished; its unfinished files were removed")]
+    Cancelled,
     /// What was being done when `source` happened.
     #[error("{context}")]
     Context {
@@ -118,9 +122,11 @@ fn setting_message(
     } else if value.is_empty() {
         format!("{}: {text}", word(setting))
     } else {
-        format!("{} '{value}': {text}", word(setting))
+        format!("{} '{}': {text}", word(setting), cut(value))
     }
 }
+
+pub use terramesh_io::quote::cut;
 
 fn neutral(s: Setting) -> String {
     s.to_string()
@@ -164,8 +170,12 @@ impl Error {
                 }) => setting_message(*setting, value, why, name),
                 _ => e.to_string(),
             };
-            // Transparent wrappers repeat their inner message: write it once.
-            if parts.last() != Some(&text) {
+            // Transparent wrappers, and messages such as "{file}: {source}", already show
+            // their cause: write it once.
+            if !parts
+                .last()
+                .is_some_and(|last: &String| last.contains(&text))
+            {
                 parts.push(text);
             }
             cur = match e.downcast_ref::<Error>() {

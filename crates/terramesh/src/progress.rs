@@ -31,6 +31,25 @@ pub trait Progress: Sync {
     fn note(&self, _text: &str) {}
     /// A warning the user should see even when quiet (points left out).
     fn warn(&self, _text: &str) {}
+    /// Whether the work should stop (the user pressed Ctrl-C). Long work asks between its
+    /// stages and steps and then stops with [`Error::Cancelled`](crate::Error::Cancelled),
+    /// removing what it was writing.
+    ///
+    /// ```
+    /// use std::sync::atomic::{AtomicBool, Ordering};
+    /// use terramesh::progress::Progress;
+    /// struct Stop(AtomicBool);
+    /// impl Progress for Stop {
+    ///     fn cancelled(&self) -> bool {
+    ///         self.0.load(Ordering::Relaxed)
+    ///     }
+    /// }
+    /// let stop = Stop(AtomicBool::new(true));
+    /// assert!(stop.cancelled());
+    /// ```
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// A reporter that reports nothing.

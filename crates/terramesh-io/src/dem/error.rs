@@ -40,11 +40,24 @@ pub enum DemError {
     Table(#[from] crate::table::TableError),
 }
 
+/// What a reader says of a file that ends before its data does.
+pub(crate) const TRUNCATED: &str = "the file ends before its data does: it is truncated (an \
+                                    interrupted download or copy?); get it again";
+
+/// Whether a decoder's message (which may wrap the I/O error in its own words) means the
+/// file ended early.
+pub(crate) fn is_truncation(message: &str) -> bool {
+    message.contains("failed to fill whole buffer") || message.contains("UnexpectedEof")
+}
+
 impl DemError {
-    /// An I/O error; a missing file is [`DemError::NotFound`].
+    /// An I/O error; a missing file is [`DemError::NotFound`], one that ends early says so.
     pub(crate) fn io(file: &std::path::Path, source: std::io::Error) -> DemError {
         if source.kind() == std::io::ErrorKind::NotFound {
             return DemError::not_found(file);
+        }
+        if source.kind() == std::io::ErrorKind::UnexpectedEof {
+            return DemError::format(file, TRUNCATED);
         }
         DemError::Io {
             file: file.display().to_string(),

@@ -29,6 +29,9 @@ pub fn read_las(path: &Path, opts: &LasOptions) -> Result<PointCloud, DemError> 
     }
     let las_err = |e: las::Error| match e {
         las::Error::Io(io) => DemError::io(path, io),
+        other if super::error::is_truncation(&other.to_string()) => {
+            DemError::format(path, super::error::TRUNCATED)
+        }
         other => DemError::format(path, format!("not a readable LAS/LAZ file: {other}")),
     };
     let mut reader = las::Reader::from_path(path).map_err(las_err)?;

@@ -92,6 +92,12 @@ fn parse_name(path: &Path) -> Option<(i32, i32)> {
     Some((lat, lon))
 }
 
+/// Whether a tile's south-west corner `(lat, lon)` (whole degrees) starts a 1° tile on
+/// Earth: latitude -90..=89, longitude -180..=179.
+fn corner_on_earth((lat, lon): (i32, i32)) -> bool {
+    (-90..=89).contains(&lat) && (-180..=179).contains(&lon)
+}
+
 impl HgtMosaic {
     /// Opens every `*.hgt` file in a directory as one mosaic.
     ///
@@ -157,6 +163,17 @@ impl HgtMosaic {
                     "an SRTM tile must be named after its south-west corner, e.g. N48E007.hgt",
                 )
             })?;
+            if !corner_on_earth(key) {
+                return Err(DemError::format(
+                    path,
+                    format!(
+                        "the name says the tile's south-west corner is at latitude {}, \
+                         longitude {}: tiles start at latitudes S90 to N89 and longitudes W180 \
+                         to E179; rename it after its south-west corner, e.g. N48E007.hgt",
+                        key.0, key.1
+                    ),
+                ));
+            }
             let file = File::open(path).map_err(|e| DemError::io(path, e))?;
             let len = file.metadata().map_err(|e| DemError::io(path, e))?.len();
             let side = match len {
@@ -351,5 +368,20 @@ mod tests {
         assert_eq!(parse_name(Path::new("a/N48E007.hgt")), Some((48, 7)));
         assert_eq!(parse_name(Path::new("s12w077.HGT")), Some((-12, -77)));
         assert_eq!(parse_name(Path::new("tile.hgt")), None);
+        for ok in ["N89E179.hgt", "S90W180.hgt", "N00E000.hgt"] {
+            assert!(corner_on_earth(parse_name(Path::new(ok)).unwrap()), "{ok}");
+        }
+        for bad in [
+            "N91E007.hgt",
+            "N90E007.hgt",
+            "S91E007.hgt",
+            "N48E180.hgt",
+            "N48W181.hgt",
+        ] {
+            assert!(
+                !corner_on_earth(parse_name(Path::new(bad)).unwrap()),
+                "{bad}"
+            );
+        }
     }
 }

@@ -26,11 +26,11 @@ const SIDE: usize = 256;
 pub fn terrarium_decode(png_bytes: &[u8]) -> Result<Vec<f32>, String> {
     let mut dec = png::Decoder::new(png_bytes);
     dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = dec.read_info().map_err(|e| format!("not a PNG: {e}"))?;
+    let mut reader = dec.read_info().map_err(|e| png_error("not a PNG", e))?;
     let mut buf = vec![0; reader.output_buffer_size()];
     let info = reader
         .next_frame(&mut buf)
-        .map_err(|e| format!("bad PNG data: {e}"))?;
+        .map_err(|e| png_error("bad PNG data", e))?;
     if (info.width as usize, info.height as usize) != (SIDE, SIDE) {
         return Err(format!(
             "{} x {} pixels: a terrain tile is 256 x 256",
@@ -208,4 +208,24 @@ impl ElevationSource for TileMosaic {
             self.z
         )
     }
+}
+
+/// A PNG decoder's error in words: its checksum errors end in a debug dump of the chunk type
+/// (`while decoding ChunkType { type: IDAT, critical: true, ... } chunk.`), cut to the name.
+fn png_error(what: &str, e: png::DecodingError) -> String {
+    let text = e.to_string();
+    if text.contains("CRC error") {
+        let chunk = text
+            .split_once("type: ")
+            .and_then(|(_, rest)| rest.split([',', ' ', '}']).next())
+            .unwrap_or("a");
+        return format!(
+            "{what}: the checksum (CRC) of its {chunk} chunk does not match its data: the file \
+             is damaged; fetch the tile again"
+        );
+    }
+    if super::error::is_truncation(&text) {
+        return super::error::TRUNCATED.to_string();
+    }
+    format!("{what}: {text}")
 }

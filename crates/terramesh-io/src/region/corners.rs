@@ -46,11 +46,13 @@ pub fn parse_corner(text: &str) -> Result<[f64; 2], String> {
     match found.len() {
         1 => Ok(found[0]),
         0 => Err(format!(
-            "cannot read corner '{t}' as LATITUDE LONGITUDE (decimal degrees or DMS such as N48°43'20.64\" E7°20'12.48\")"
+            "cannot read corner '{}' as LATITUDE LONGITUDE (decimal degrees or DMS such as N48°43'20.64\" E7°20'12.48\")",
+            crate::quote::cut(t)
         )),
         _ => Err(format!(
-            "corner '{t}' can be split into latitude and longitude in more than one way; \
-             separate them with a comma or add hemisphere letters"
+            "corner '{}' can be split into latitude and longitude in more than one way; \
+             separate them with a comma or add hemisphere letters",
+            crate::quote::cut(t)
         )),
     }
 }

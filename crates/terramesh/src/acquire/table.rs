@@ -50,6 +50,38 @@ pub(crate) fn node_rows<E: std::fmt::Display>(
         .collect()
 }
 
+/// `" (the grid spans lat A to B, lon C to D)"`, or x and y for projected points.
+fn extent(rows: &[Row]) -> String {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let geographic = rows.iter().all(|r| r.latlon.is_some());
+    for r in rows {
+        let p = match r.latlon {
+            Some(ll) if geographic => ll,
+            _ => r.xy,
+        };
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if !lo[0].is_finite() {
+        String::new()
+    } else if geographic {
+        format!(
+            " (the points span lat {:.5} to {:.5}, lon {:.5} to {:.5}: check that the source \
+             covers them)",
+            lo[0], hi[0], lo[1], hi[1]
+        )
+    } else {
+        format!(
+            " (the points span x {:.1} to {:.1}, y {:.1} to {:.1}: check that the source covers \
+             them)",
+            lo[0], hi[0], lo[1], hi[1]
+        )
+    }
+}
+
 /// Applies the on-missing policy and writes the table atomically to the plan's output
 /// (standard output without one); what was read and written goes to `progress` as notes.
 pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> Result<()> {
@@ -67,10 +99,12 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
                 Setting::OnMissing,
                 "",
                 format!(
-                    "{} of {} points have no elevation; the first (point {}, {at}): {}. \
-                     Use {{on-missing}} nodata or skip to write the others{}",
+                    "{} of {} points have no elevation in {}{}; the first (point {}, {at}): \
+                     {}. Use {{on-missing}} nodata or skip to write the others{}",
                     missing.len(),
                     t.rows.len(),
+                    s.options.source,
+                    extent(&t.rows),
                     i + 1,
                     r.z.as_ref().err().map_or("", |e| e.as_str()),
                     if matches!(s.source, super::plan::Source::Web(_)) {

@@ -5,12 +5,18 @@
 //! cross-validation) -> exports (surfaces, sealed solid, grids, tables) -> pictures and
 //! report. Each stage is a module with one entry point that calls the kernel crates; [`build`]
 //! sequences them, times them and reports progress.
+//!
+//! A build is atomic as a whole ([`staging`]): every setting and input file is checked before
+//! anything is written, the files go into a temporary sibling of the output folder, and that
+//! folder replaces the output folder only when the build is complete. An error, a signal or
+//! a crash leaves the previous build as it was.
 
 mod adaptive;
 mod exports;
 mod pictures;
 mod report;
 mod stages;
+pub mod staging;
 
 use std::path::Path;
 use std::time::Instant;
@@ -20,7 +26,7 @@ pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
 pub use stages::{Interpolated, Meshed, Model, Samples};
 
-use crate::error::{Context, Result};
+use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
 
@@ -57,6 +63,7 @@ impl Stages<'_> {
         f: impl FnOnce() -> Result<T>,
         detail: impl FnOnce(&T) -> String,
     ) -> Result<T> {
+        self.check()?;
         self.k += 1;
         self.progress.stage_start(self.k, STAGES, name);
         let t = Instant::now();
@@ -64,17 +71,52 @@ impl Stages<'_> {
         let secs = t.elapsed().as_secs_f64();
         self.progress.stage_done(name, &detail(&out), secs);
         self.timings.0.push((name.to_string(), secs));
+        self.check()?;
         Ok(out)
+    }
+
+    /// Stops the build when the front end asks.
+    fn check(&self) -> Result<()> {
+        if self.progress.cancelled() {
+            Err(Error::Cancelled)
+        } else {
+            Ok(())
+        }
     }
 }
 
 /// Builds the discrete surface model of `project` (whose paths are relative to `base`, the
 /// folder of its file) into `out`: samples, mesh, kriging and IDW, exports, pictures and
 /// `report.html`.
+///
+/// The settings and input files are checked first ([`Project::check_inputs`]); the build is
+/// written into a temporary sibling of `out` that replaces `out` at the end
+/// ([`staging::Staging`]), so an error, or [`Progress::cancelled`], leaves `out` as it was.
+/// An existing `out` that is not a build folder (see [`staging::MARKER`]) is refused.
 pub fn build(project: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Built> {
     let t0 = Instant::now();
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create the output directory {}", out.display()))?;
+    project.check_inputs(base)?;
+    let staging = staging::Staging::begin(out, progress)?;
+    let built = build_into(project, base, staging.dir(), progress, t0)?;
+    if progress.cancelled() {
+        return Err(Error::Cancelled);
+    }
+    let files = built
+        .files
+        .iter()
+        .map(|f| out.join(f.strip_prefix(staging.dir()).unwrap_or(f)))
+        .collect();
+    staging.commit()?;
+    Ok(Built { files, ..built })
+}
+
+fn build_into(
+    project: &Project,
+    base: &Path,
+    out: &Path,
+    progress: &dyn Progress,
+    t0: Instant,
+) -> Result<Built> {
     let mut st = Stages {
         progress,
         k: 0,
@@ -144,6 +186,7 @@ pub fn build(project: &Project, base: &Path, out: &Path, progress: &dyn Progress
             progress.stage_done("report", "report.html", t.elapsed().as_secs_f64());
         }
     }
+    st.check()?;
     Ok(Built {
         files: written.files,
         vertices: mesh.mesh.points.len(),

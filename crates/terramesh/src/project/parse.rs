@@ -5,7 +5,7 @@ use std::path::Path;
 
 use terramesh_mesh::MAX_MIN_ANGLE;
 
-use super::Project;
+use super::{Project, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 use crate::error::{Error, Result};
 
 fn positive(v: f64) -> bool {
@@ -190,6 +190,24 @@ impl Project {
                 "name at least one of \"uk\", \"ok\", \"sk\", \"idw\" (the first gives the DSM)",
             );
         }
+        if i.neighbors != 0 && i.neighbors < i.drift.terms() {
+            return bad(
+                "interpolation.neighbors",
+                &format!(
+                    "{} is too few: universal kriging with a {} drift needs at least {} \
+                     neighbours (or 0 for all samples)",
+                    i.neighbors,
+                    i.drift,
+                    i.drift.terms()
+                ),
+            );
+        }
+        if i.cv_folds == 1 {
+            return bad(
+                "interpolation.cv_folds",
+                "1 fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more folds",
+            );
+        }
         if !positive(i.idw_power) {
             return bad("interpolation.idw_power", "must be positive");
         }
@@ -202,6 +220,24 @@ impl Project {
             }
             if !(v.nugget.is_finite() && v.nugget >= 0.0) {
                 return bad("interpolation.model.nugget", "must be 0 or positive");
+            }
+        }
+        let x = &self.export;
+        if let Some(b) = x.base_elevation {
+            if !(MIN_BASE_ELEVATION..=MAX_BASE_ELEVATION).contains(&b) {
+                return bad(
+                    "export.base_elevation",
+                    &format!(
+                        "{b} m is not an elevation on Earth: give metres between \
+                         {MIN_BASE_ELEVATION} and {MAX_BASE_ELEVATION}, below the lowest \
+                         point of the surface (or leave it out: 50 m below it)"
+                    ),
+                );
+            }
+        }
+        if let Some(g) = x.grid_spacing {
+            if !positive(g) {
+                return bad("export.grid_spacing", "must be a positive number of metres");
             }
         }
         Ok(())

@@ -1,0 +1,84 @@
+//! The inputs of a build, checked before it writes anything: the elevation source (or its
+//! fallback), the region file and a variogram file are there and readable, each error naming
+//! the project key and the path.
+
+use std::path::Path;
+
+use super::Project;
+use crate::acquire::is_remote;
+use crate::error::{Error, Result};
+
+/// `path` can be read: a file opened, a folder listed.
+fn readable(key: &str, path: &Path) -> Result<()> {
+    let read = if path.is_dir() {
+        std::fs::read_dir(path).map(|_| ())
+    } else {
+        std::fs::File::open(path).map(|_| ())
+    };
+    read.map_err(|e| {
+        Error::invalid(format!(
+            "{key} {}: cannot be read ({e}): check the path and its permissions",
+            path.display()
+        ))
+    })
+}
+
+impl Project {
+    /// Checks the files a build of this project reads, with paths relative to `base`: the
+    /// source (`source.path`, or `source.fallback` when it does not exist), `region.file` and
+    /// `interpolation.variogram` (read and parsed). [`crate::build::build`] calls it before
+    /// writing anything.
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let dir = tempfile::tempdir()?;
+    /// std::fs::write(dir.path().join("dem.asc"), "")?;
+    /// let p = Project::parse("t.toml", TEMPLATE, &[
+    ///     "source.path=dem.asc".into(),
+    ///     "interpolation.variogram=variogram.json".into(),
+    /// ])?;
+    /// let e = p.check_inputs(dir.path()).unwrap_err().to_string();
+    /// assert!(e.starts_with("interpolation.variogram ") && e.contains("variogram.json"), "{e}");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn check_inputs(&self, base: &Path) -> Result<()> {
+        let spec = self.source_spec(base)?;
+        if !is_remote(&spec) {
+            let key = if Path::new(&spec) == base.join(&self.source.path) {
+                "source.path"
+            } else {
+                "source.fallback"
+            };
+            readable(key, Path::new(&spec))?;
+        }
+        if let Some(f) = &self.region.file {
+            let path = base.join(f);
+            if !path.exists() {
+                return Err(Error::invalid(format!(
+                    "region.file {}: does not exist (no such file or directory)",
+                    path.display()
+                )));
+            }
+            readable("region.file", &path)?;
+        }
+        let ip = &self.interpolation;
+        if ip.model.is_none() && ip.variogram != "auto" {
+            let path = base.join(&ip.variogram);
+            if !path.is_file() {
+                return Err(Error::invalid(format!(
+                    "interpolation.variogram {}: no such file: give \"auto\" to fit one, or \
+                     the variogram.json of a previous build or of terramesh variogram",
+                    path.display()
+                )));
+            }
+            readable("interpolation.variogram", &path)?;
+            crate::variogram_file::read_variogram_file(&path).map_err(|e| {
+                Error::invalid(format!(
+                    "interpolation.variogram: {}",
+                    e.render(&|s| s.to_string())
+                ))
+            })?;
+        }
+        Ok(())
+    }
+}
