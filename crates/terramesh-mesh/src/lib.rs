@@ -39,6 +39,10 @@ mod quality;
 mod refine;
 /// What a build did.
 mod report;
+/// Point location and linear interpolation on a mesh's surface.
+mod locate;
+/// Level-of-detail trees of adaptive meshes for 3D Tiles.
+mod lod;
 /// Laplacian, smart Laplacian and ODT smoothing.
 mod smooth;
 /// Meshing large regions in vertical strips, in parallel.
@@ -50,6 +54,8 @@ pub use adaptive::{
 };
 pub use build::{MeshBuilder, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE};
 pub use flip::delaunay_flips;
+pub use locate::SurfaceLocator;
+pub use lod::{lod_tree, LodLevel, LodSettings, LodTile};
 pub use mesh::Mesh;
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;
