@@ -201,7 +201,20 @@ def check_tileset_heights(out):
     cols, ref_pts, _ = out.ref()
     to_geo = Transformer.from_crs("EPSG:4978", "EPSG:4979", always_xy=True)
     to_utm = Transformer.from_crs("EPSG:4326", f"EPSG:{out.epsg()}", always_xy=True)
-    key = {(round(x * 100), round(y * 100)): z for x, y, z in ref_pts}
+    key = {}
+    for x, y, z in ref_pts:
+        key.setdefault((round(x * 100), round(y * 100)), []).append((x, y, z))
+
+    def dsm_z(x, y):
+        """Elevation of the DSM vertex within 1 cm of (x, y), or None."""
+        kx, ky = round(x * 100), round(y * 100)
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for px, py, pz in key.get((kx + dx, ky + dy), []):
+                    if np.hypot(px - x, py - y) <= 0.01:
+                        return pz
+        return None
+
     shifts = []
     for tile, _ in tiles(root):
         if tile.get("children") or "content" not in tile:
@@ -213,7 +226,7 @@ def check_tileset_heights(out):
             lon, lat, h = to_geo.transform(e[:, 0], e[:, 1], e[:, 2])
             x, y = to_utm.transform(lon, lat)
             for xi, yi, hi in zip(x, y, h):
-                z = key.get((round(xi * 100), round(yi * 100)))
+                z = dsm_z(xi, yi)
                 require(z is not None, f"3dtiles: leaf vertex at UTM {xi:.3f} {yi:.3f} is no DSM vertex (1 cm)")
                 shifts.append(hi - z)
     s = np.array(shifts)
