@@ -29,6 +29,10 @@ mod cdt;
 mod flip;
 /// Equilateral lattice seeding of uniform-size quality meshes.
 mod lattice;
+/// Point location and linear interpolation on a mesh's surface.
+mod locate;
+/// Level-of-detail trees of adaptive meshes for 3D Tiles.
+mod lod;
 /// The mesh type and its invariants.
 mod mesh;
 /// Insertion order (BRIO along a Hilbert curve) for incremental Delaunay triangulation.
@@ -39,10 +43,6 @@ mod quality;
 mod refine;
 /// What a build did.
 mod report;
-/// Point location and linear interpolation on a mesh's surface.
-mod locate;
-/// Level-of-detail trees of adaptive meshes for 3D Tiles.
-mod lod;
 /// Laplacian, smart Laplacian and ODT smoothing.
 mod smooth;
 /// Meshing large regions in vertical strips, in parallel.

@@ -72,9 +72,10 @@ impl<'a> SurfaceLocator<'a> {
             .par_iter()
             .map(|t| {
                 let p = t.map(|i| mesh.points[i as usize]);
-                let (a, b) = s.cell_of(p.iter().fold([f64::INFINITY; 2], |m, q| {
-                    [m[0].min(q[0]), m[1].min(q[1])]
-                }));
+                let (a, b) = s.cell_of(
+                    p.iter()
+                        .fold([f64::INFINITY; 2], |m, q| [m[0].min(q[0]), m[1].min(q[1])]),
+                );
                 let (c, d) = s.cell_of(p.iter().fold([f64::NEG_INFINITY; 2], |m, q| {
                     [m[0].max(q[0]), m[1].max(q[1])]
                 }));
@@ -187,7 +188,9 @@ mod tests {
         let s = SurfaceLocator::new(&m, &z);
         let mut state = 12345u64;
         let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         for _ in 0..2000 {

@@ -176,7 +176,14 @@ pub fn lod_tree(
         });
         level_tiles.push(tiles);
     }
-    let leaves = cut(dsm, z, &vec![0.0; dsm.triangles.len()], levels as u32 - 1, lo, hi);
+    let leaves = cut(
+        dsm,
+        z,
+        &vec![0.0; dsm.triangles.len()],
+        levels as u32 - 1,
+        lo,
+        hi,
+    );
     summary.push(LodLevel {
         tolerance: None,
         vertices: dsm.points.len(),
@@ -282,7 +289,9 @@ fn triangle_errors(m: &Mesh, mz: &[f64], dsm: &Mesh, z: &[f64], full: &SurfaceLo
         .into_par_iter()
         .filter_map(|i| {
             let q = dsm.absolute(i);
-            coarse.locate(q[0], q[1]).map(|(t, h)| (t, (h - z[i]).abs()))
+            coarse
+                .locate(q[0], q[1])
+                .map(|(t, h)| (t, (h - z[i]).abs()))
         })
         .collect();
     for (t, e) in hits {
@@ -340,4 +349,116 @@ fn cut(m: &Mesh, z: &[f64], errs: &[f64], level: u32, lo: [f64; 2], hi: [f64; 2]
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hill_dsm() -> (Region, Mesh, Vec<f64>) {
+        let r = Region::from_ring(vec![[0.0, 0.0], [120.0, 0.0], [120.0, 80.0], [0.0, 80.0]]);
+        let hill = |x: f64, y: f64| {
+            10.0 * (-((x - 40.0).powi(2) + (y - 30.0).powi(2)) / 400.0).exp() + 0.05 * x
+        };
+        let (m, z, _) = adaptive_mesh(&r, &AdaptiveSettings::new(0.02), &hill).unwrap();
+        (r, m, z)
+    }
+
+    fn tiles(t: &LodTile) -> Vec<&LodTile> {
+        let mut v = vec![t];
+        for c in &t.children {
+            v.extend(tiles(c));
+        }
+        v
+    }
+
+    /// The height of a mesh's surface at a local point by trying every triangle.
+    fn brute(tris: &[[u32; 3]], p: &[[f64; 3]], q: [f64; 2]) -> Option<f64> {
+        tris.iter().find_map(|t| {
+            let [a, b, c] = t.map(|i| p[i as usize]);
+            let det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+            let l1 = ((q[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (q[1] - a[1])) / det;
+            let l2 = ((b[0] - a[0]) * (q[1] - a[1]) - (q[0] - a[0]) * (b[1] - a[1])) / det;
+            let l0 = 1.0 - l1 - l2;
+            (l0.min(l1).min(l2) >= -1e-9).then(|| l0 * a[2] + l1 * b[2] + l2 * c[2])
+        })
+    }
+
+    #[test]
+    fn leaves_cut_the_full_mesh_and_errors_never_grow_towards_them() {
+        let (r, m, z) = hill_dsm();
+        let s = LodSettings {
+            levels: Some(3),
+            ..LodSettings::default()
+        };
+        let (root, levels) = lod_tree(&r, &m, &z, &s).unwrap();
+        assert_eq!(levels.len(), 3);
+        assert!(levels[0].triangles < levels[1].triangles);
+        assert!(levels[1].triangles < levels[2].triangles);
+        let all = tiles(&root);
+        let leaves: Vec<_> = all.iter().filter(|t| t.children.is_empty()).collect();
+        assert!(leaves.iter().all(|t| t.address[0] == 2 && t.error == 0.0));
+        let n: usize = leaves.iter().map(|t| t.triangles.len()).sum();
+        assert_eq!(n, m.triangles.len());
+        for t in &all {
+            for c in &t.children {
+                assert!(
+                    c.error <= t.error,
+                    "{:?} {} > {}",
+                    c.address,
+                    c.error,
+                    t.error
+                );
+                assert_eq!(c.address[0], t.address[0] + 1);
+                assert_eq!(
+                    [c.address[1] / 2, c.address[2] / 2],
+                    [t.address[1], t.address[2]]
+                );
+            }
+            assert!(t.measured_error <= t.error);
+        }
+    }
+
+    #[test]
+    fn the_root_error_is_the_largest_difference_found_by_brute_force() {
+        let (r, m, z) = hill_dsm();
+        let s = LodSettings {
+            levels: Some(2),
+            ..LodSettings::default()
+        };
+        let (root, _) = lod_tree(&r, &m, &z, &s).unwrap();
+        let full: Vec<[f64; 3]> = (0..m.points.len())
+            .map(|i| {
+                let p = m.absolute(i);
+                [p[0], p[1], z[i]]
+            })
+            .collect();
+        let (rv, rt) = (&root.vertices, &root.triangles);
+        let mut want = 0.0f64;
+        // The full mesh at the root's vertices, edge midpoints and centres.
+        for t in rt {
+            let p = t.map(|i| rv[i as usize]);
+            let mut probes: Vec<[f64; 3]> = p.to_vec();
+            for k in 0..3 {
+                let (a, b) = (p[k], p[(k + 1) % 3]);
+                probes.push([0, 1, 2].map(|j| 0.5 * (a[j] + b[j])));
+            }
+            probes.push([0, 1, 2].map(|j| (p[0][j] + p[1][j] + p[2][j]) / 3.0));
+            for q in probes {
+                let f = brute(&m.triangles, &full, [q[0], q[1]]).unwrap();
+                want = want.max((f - q[2]).abs());
+            }
+        }
+        // The root at the full mesh's vertices.
+        for v in &full {
+            let h = brute(rt, rv, [v[0], v[1]]).unwrap();
+            want = want.max((h - v[2]).abs());
+        }
+        assert!(want > 0.1, "a coarse root differs from the DSM: {want}");
+        assert!(
+            (root.measured_error - want).abs() < 1e-9,
+            "{} vs {want}",
+            root.measured_error
+        );
+    }
 }

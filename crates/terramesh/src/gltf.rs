@@ -171,7 +171,14 @@ pub fn write_dsm_tileset(
     for q in &abs {
         (x0, x1, y0, y1) = (x0.min(q[0]), x1.max(q[0]), y0.min(q[1]), y1.max(q[1]));
     }
-    for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1), (c[0], y0), (c[0], y1)] {
+    for (x, y) in [
+        (x0, y0),
+        (x1, y0),
+        (x0, y1),
+        (x1, y1),
+        (c[0], y0),
+        (c[0], y1),
+    ] {
         let (lat, lon) = to_wgs84(x, y, zone)?;
         (lo, hi) = (
             [lo[0].min(lat), lo[1].min(lon)],
@@ -259,10 +266,22 @@ fn enu_to_ecef(lat: f64, lon: f64, h: f64) -> [f64; 16] {
     let (sl, cl) = lon.to_radians().sin_cos();
     let t = geodetic_to_ecef(lat, lon, h);
     [
-        -sl, cl, 0.0, 0.0, // east
-        -sp * cl, -sp * sl, cp, 0.0, // north
-        cp * cl, cp * sl, sp, 0.0, // up
-        t[0], t[1], t[2], 1.0,
+        -sl,
+        cl,
+        0.0,
+        0.0, // east
+        -sp * cl,
+        -sp * sl,
+        cp,
+        0.0, // north
+        cp * cl,
+        cp * sl,
+        sp,
+        0.0, // up
+        t[0],
+        t[1],
+        t[2],
+        1.0,
     ]
 }
 

@@ -88,7 +88,11 @@ struct Packed {
 
 fn pack(m: &GlbMesh, origin: [f64; 3]) -> io::Result<Packed> {
     let n = m.vertices.len();
-    if let Some(t) = m.triangles.iter().find(|t| t.iter().any(|&i| i as usize >= n)) {
+    if let Some(t) = m
+        .triangles
+        .iter()
+        .find(|t| t.iter().any(|&i| i as usize >= n))
+    {
         return Err(invalid(format!(
             "mesh '{}': triangle {t:?} refers past its {n} vertices",
             m.name
@@ -185,7 +189,9 @@ pub fn write_glb<W: Write>(w: &mut W, meshes: &[GlbMesh], opts: &GlbOptions) -> 
     let mut gl_meshes = Vec::new();
     let mut offset = 0usize;
     let mut view = |len: usize, target: u32, views: &mut Vec<Value>| {
-        views.push(json!({ "buffer": 0, "byteOffset": offset, "byteLength": len, "target": target }));
+        views.push(
+            json!({ "buffer": 0, "byteOffset": offset, "byteLength": len, "target": target }),
+        );
         offset += pad4(len);
         views.len() - 1
     };
@@ -199,11 +205,14 @@ pub fn write_glb<W: Write>(w: &mut W, meshes: &[GlbMesh], opts: &GlbOptions) -> 
         }));
         attributes.insert("POSITION".into(), json!(accessors.len() - 1));
         let nv = view(12 * n, 34962, &mut views);
-        accessors.push(json!({ "bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3" }));
+        accessors
+            .push(json!({ "bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3" }));
         attributes.insert("NORMAL".into(), json!(accessors.len() - 1));
         if m.colours.is_some() {
             let cv = view(12 * n, 34962, &mut views);
-            accessors.push(json!({ "bufferView": cv, "componentType": 5126, "count": n, "type": "VEC3" }));
+            accessors.push(
+                json!({ "bufferView": cv, "componentType": 5126, "count": n, "type": "VEC3" }),
+            );
             attributes.insert("COLOR_0".into(), json!(accessors.len() - 1));
         }
         let isize = if p.short { 2 } else { 4 };
@@ -386,7 +395,10 @@ mod tests {
         assert_eq!(acc[2]["componentType"], json!(5123)); // first mesh: u16 (6 bytes, padded)
         assert_eq!(acc[5]["componentType"], json!(5125));
         assert_eq!(doc["nodes"][2]["name"], json!("b"));
-        assert_eq!(doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize, bin.len());
+        assert_eq!(
+            doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize,
+            bin.len()
+        );
     }
 
     #[test]
@@ -403,7 +415,9 @@ mod tests {
             triangles: &[[0, 1, 3]],
             colours: None,
         };
-        let e = write_glb(&mut Vec::new(), &[m], &opts).unwrap_err().to_string();
+        let e = write_glb(&mut Vec::new(), &[m], &opts)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("unit-7") && e.contains("[0, 1, 3]"), "{e}");
         let m = GlbMesh {
             name: "c",
@@ -411,7 +425,9 @@ mod tests {
             triangles: &[],
             colours: Some(&[[0.0; 3]]),
         };
-        let e = write_glb(&mut Vec::new(), &[m], &opts).unwrap_err().to_string();
+        let e = write_glb(&mut Vec::new(), &[m], &opts)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("1 colours for 3 vertices"), "{e}");
     }
 }

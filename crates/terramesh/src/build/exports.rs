@@ -205,7 +205,12 @@ pub fn write_all(
     if want("dae") {
         files.extend(write_dae(out, &abs, &geo, tris, zone, &title)?);
     }
-    let dsm = crate::gltf::Dsm { mesh, z: &it.dsm, zone, title: &title };
+    let dsm = crate::gltf::Dsm {
+        mesh,
+        z: &it.dsm,
+        zone,
+        title: &title,
+    };
     if want("glb") {
         let path = out.join("dsm.glb");
         crate::gltf::write_dsm_glb(&path, &dsm)?;

@@ -15,7 +15,7 @@ mod tileset;
 
 use std::fs;
 use std::io;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rayon::prelude::*;
 use serde_json::Value;
@@ -110,11 +110,7 @@ fn invalid(msg: String) -> io::Error {
 /// assert!(json.contains("\"version\":\"1.1\"") && json.contains("tiles/1/1_0.glb"));
 /// # Ok(()) }
 /// ```
-pub fn write_tileset(
-    dir: &Path,
-    root: &Tile,
-    opts: &TilesetOptions,
-) -> io::Result<TilesetSummary> {
+pub fn write_tileset(dir: &Path, root: &Tile, opts: &TilesetOptions) -> io::Result<TilesetSummary> {
     check_errors(root, f64::INFINITY)?;
     if !(opts.geometric_error >= root.geometric_error) {
         return Err(invalid(format!(
@@ -198,7 +194,10 @@ fn depth(t: &Tile) -> usize {
 fn write_content(dir: &Path, t: &Tile, opts: &TilesetOptions) -> io::Result<()> {
     let c = t.content.as_ref().expect("tiles with content");
     let b = Aabb::of(&c.vertices).unwrap_or_default();
-    let name = format!("{}-{}-{}-{}", opts.name, t.address[0], t.address[1], t.address[2]);
+    let name = format!(
+        "{}-{}-{}-{}",
+        opts.name, t.address[0], t.address[1], t.address[2]
+    );
     let mesh = GlbMesh {
         name: &name,
         vertices: &c.vertices,
@@ -252,8 +251,13 @@ mod tests {
             ..Tile::default()
         };
         let dir = tempfile::tempdir().unwrap();
-        let e = write_tileset(dir.path(), &root, &opts()).unwrap_err().to_string();
-        assert!(e.contains("[1, 0, 0]") && e.contains("exceeds its parent's 1"), "{e}");
+        let e = write_tileset(dir.path(), &root, &opts())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("[1, 0, 0]") && e.contains("exceeds its parent's 1"),
+            "{e}"
+        );
     }
 
     #[test]
