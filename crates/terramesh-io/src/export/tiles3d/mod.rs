@@ -112,7 +112,7 @@ fn invalid(msg: String) -> io::Error {
 /// ```
 pub fn write_tileset(dir: &Path, root: &Tile, opts: &TilesetOptions) -> io::Result<TilesetSummary> {
     check_errors(root, f64::INFINITY)?;
-    if !(opts.geometric_error >= root.geometric_error) {
+    if opts.geometric_error.is_nan() || opts.geometric_error < root.geometric_error {
         return Err(invalid(format!(
             "the tileset's geometric error {} is below the root's {}",
             opts.geometric_error, root.geometric_error
