@@ -22,7 +22,7 @@ use serde_json::Value;
 
 use super::glb::{write_glb, GlbMesh, GlbOptions};
 use crate::output::Output;
-pub use bounds::Aabb;
+pub use bounds::{Aabb, BOX_PADDING};
 
 /// The geometry of one tile, in the tileset's frame (z up).
 #[derive(Debug, Clone, Default, PartialEq)]
