@@ -124,6 +124,52 @@ impl<'a> SurfaceLocator<'a> {
         self.locate(x, y).map(|(_, z)| z)
     }
 
+    /// As [`Self::height`] inside the mesh; outside it, the height of the nearest vertex of
+    /// the triangles in the nearest non-empty ring of buckets (for points a mesher probes
+    /// beyond the region, whose heights do not matter but must be cheap).
+    ///
+    /// ```
+    /// use terramesh_mesh::{Mesh, SurfaceLocator};
+    /// let m = Mesh { origin: [0.0, 0.0], points: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]],
+    ///                triangles: vec![[0, 1, 2]], constraint_edges: vec![] };
+    /// let s = SurfaceLocator::new(&m, &[1.0, 5.0, 9.0]);
+    /// assert_eq!(s.height_or_nearest(3.0, -1.0), 5.0);
+    /// ```
+    pub fn height_or_nearest(&self, x: f64, y: f64) -> f64 {
+        if let Some(z) = self.height(x, y) {
+            return z;
+        }
+        let p = [x - self.mesh.origin[0], y - self.mesh.origin[1]];
+        let (ci, cj) = self.cell_of(p);
+        let (ci, cj) = (ci as i64, cj as i64);
+        let mut best = (f64::INFINITY, f64::NAN);
+        let mut found_at = None;
+        for r in 0..self.shape[0].max(self.shape[1]) as i64 {
+            if found_at.is_some_and(|f: i64| r > f + 1) {
+                break;
+            }
+            for j in (cj - r).max(0)..=(cj + r).min(self.shape[1] as i64 - 1) {
+                for i in (ci - r).max(0)..=(ci + r).min(self.shape[0] as i64 - 1) {
+                    if (i - ci).abs() != r && (j - cj).abs() != r {
+                        continue; // inside the ring: seen
+                    }
+                    let k = j as usize * self.shape[0] + i as usize;
+                    for &t in &self.items[self.start[k] as usize..self.start[k + 1] as usize] {
+                        for v in self.mesh.triangles[t as usize] {
+                            let q = self.mesh.points[v as usize];
+                            let d = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+                            if d < best.0 {
+                                best = (d, self.z[v as usize]);
+                            }
+                        }
+                        found_at.get_or_insert(r);
+                    }
+                }
+            }
+        }
+        best.1
+    }
+
     /// The triangle at absolute `(x, y)` and the surface's height there, as [`Self::height`].
     pub(crate) fn locate(&self, x: f64, y: f64) -> Option<(usize, f64)> {
         let p = [x - self.mesh.origin[0], y - self.mesh.origin[1]];

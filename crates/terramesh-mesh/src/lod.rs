@@ -147,7 +147,7 @@ pub fn lod_tree(
                 improve_3d: false,
                 ..AdaptiveSettings::new(tol)
             };
-            let f = |x: f64, y: f64| full.height(x, y).unwrap_or_else(|| nearest_z(dsm, z, x, y));
+            let f = |x: f64, y: f64| full.height_or_nearest(x, y);
             match adaptive_mesh(region, &s, &f) {
                 Ok((m, mz, _)) => Ok(Some((m, mz, tol))),
                 Err(MeshError::Incomplete { .. }) => Ok(None),
@@ -245,16 +245,6 @@ fn bbox(m: &Mesh) -> ([f64; 2], [f64; 2]) {
     (lo, hi)
 }
 
-/// The height of the vertex nearest `(x, y)`: for points a rounding error outside the mesh.
-fn nearest_z(m: &Mesh, z: &[f64], x: f64, y: f64) -> f64 {
-    let p = [x - m.origin[0], y - m.origin[1]];
-    let d = |q: &[f64; 2]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
-    let i = (0..m.points.len())
-        .min_by(|&a, &b| d(&m.points[a]).total_cmp(&d(&m.points[b])))
-        .unwrap_or(0);
-    z.get(i).copied().unwrap_or(0.0)
-}
-
 /// Per triangle of the coarse mesh `m`, the largest `|m - full|` at its vertices, edge
 /// midpoints and centre, and at the full mesh's vertices that fall on it.
 fn triangle_errors(m: &Mesh, mz: &[f64], dsm: &Mesh, z: &[f64], full: &SurfaceLocator) -> Vec<f64> {
@@ -324,18 +314,20 @@ fn cut(m: &Mesh, z: &[f64], errs: &[f64], level: u32, lo: [f64; 2], hi: [f64; 2]
         .enumerate()
         .filter(|(_, tris)| !tris.is_empty())
         .map(|(cell, tris)| {
-            let mut map = std::collections::HashMap::new();
+            let mut map = vec![u32::MAX; m.points.len()];
             let mut vertices = Vec::new();
             let mut triangles = Vec::with_capacity(tris.len());
             let mut error = 0.0f64;
             for &k in &tris {
                 error = error.max(errs[k]);
                 triangles.push(m.triangles[k].map(|i| {
-                    *map.entry(i).or_insert_with(|| {
+                    let slot = &mut map[i as usize];
+                    if *slot == u32::MAX {
                         let p = m.absolute(i as usize);
                         vertices.push([p[0], p[1], z[i as usize]]);
-                        vertices.len() as u32 - 1
-                    })
+                        *slot = vertices.len() as u32 - 1;
+                    }
+                    *slot
                 }));
             }
             let cell = cell as u32;
