@@ -1,8 +1,9 @@
 """glTF and 3D Tiles checks of the output verifier: every GLB through the Khronos glTF-Validator
 (npm `gltf-validator`, pinned in tests/verify/gltf), dsm.glb read back with pygltflib against
-dsm-vertices.csv, and 3dtiles/tileset.json read with our own reader (py3dtiles 12.1.1
-needs numba, which needs numpy < 2.4, against the numpy 2.4.6 pinned for the other readers) for containment, error monotonicity and the ellipsoidal heights, which PROJ
-(pyproj) takes from ECEF back to latitude, longitude and height (see docs/verification.md)."""
+dsm-vertices.csv, and 3dtiles/tileset.json read with our own reader (py3dtiles 12.1.1 needs
+numba, which needs numpy < 2.4, against the numpy 2.4.6 pinned for the other readers) for
+containment, error monotonicity and the ellipsoidal heights, which PROJ (pyproj) takes from
+ECEF back to latitude, longitude and height (see docs/verification.md)."""
 
 import json
 import subprocess
