@@ -44,4 +44,11 @@ else
   fi
   echo "$want" > "$stamp"
 fi
+# The Khronos glTF-Validator (npm, pinned by tests/verify/gltf/package-lock.json).
+gl=tests/verify/gltf; glwant=$(sha256sum "$gl/package-lock.json" | cut -d' ' -f1)
+if [ -d "$gl/node_modules/gltf-validator" ] && [ "$(cat "$gl/node_modules/.lock.sha256" 2>/dev/null)" = "$glwant" ]; then
+  echo "verify-setup: gltf-validator up to date with $gl/package-lock.json"
+else
+  echo "verify-setup: npm ci in $gl"; (cd "$gl" && npm ci --no-audit --no-fund --silent) && echo "$glwant" > "$gl/node_modules/.lock.sha256"
+fi
 echo "verify-setup: done ($(.venv-verify/bin/python --version), $(xmllint --version 2>&1 | head -1), $(chromium --version 2>/dev/null), gmsh $(.venv-verify/bin/python -c 'import gmsh; print(gmsh.__version__)'))"

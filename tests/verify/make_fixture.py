@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+import make_gltf_fixture
+
 EPSG = 32632
 ORIGIN = (377000.0, 5397000.0, 0.0)
 BASE = 300.0
@@ -256,6 +258,7 @@ def write_all(out):
     (out / "dsm.dxf").write_text("".join(dxf) + "0\nENDSEC\n0\nEOF\n")
     write_kml(out / "dsm.kml", xy, uk, tris)
     write_dae(out, xy, uk, tris)
+    make_gltf_fixture.write_gltf(out, xy, uk, tris, EPSG)
     sp, st = solid(pts, tris, BASE)
     write_stl(out / "dsm-solid.stl", sp, st, ORIGIN)
     write_msh(out / "dsm-solid.msh", sp, st)

@@ -399,3 +399,99 @@ def test_vtk_broken_xml(out, capsys):
     assert "dsm.vtu" in failures(out, "vtk: dsm.vtu (ParaView's reader)", capsys)[0]
     with pytest.raises(vcommon.CheckFailed, match="dsm.vtu: VTK"):
         check_programs.vtk_read(vcommon.Outputs(out), "dsm.vtu")
+
+
+# ---------------------------------------------------------------- glTF and 3D Tiles
+
+
+def rewrite_glb(path, change):
+    """Applies `change` to the JSON chunk of a GLB (a dict) and writes it back."""
+    import struct
+    b = path.read_bytes()
+    jl = struct.unpack_from("<I", b, 12)[0]
+    doc = json.loads(b[20:20 + jl])
+    change(doc)
+    js = json.dumps(doc).encode()
+    js += b" " * (-len(js) % 4)
+    rest = b[20 + jl:]
+    body = struct.pack("<I4s", len(js), b"JSON") + js + rest
+    path.write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body)
+
+
+def test_glb_validator_reports_a_wrong_accessor_max(out, capsys):
+    def wrong_max(doc):
+        doc["accessors"][0]["max"][0] += 1.0
+    rewrite_glb(out / "dsm.glb", wrong_max)
+    f = failures(out, "glb: glTF-Validator", capsys)
+    assert "dsm.glb" in f[0] and "ACCESSOR_MAX_MISMATCH" in f[0], f
+
+
+def test_glb_validator_checks_the_tile_contents(out, capsys):
+    def wrong_min(doc):
+        doc["accessors"][0]["min"][1] -= 1.0
+    rewrite_glb(out / "3dtiles" / "tiles" / "leaf1.glb", wrong_min)
+    f = failures(out, "glb: glTF-Validator", capsys)
+    assert "leaf1.glb" in f[0], f
+
+
+def test_dsm_glb_origin_off_by_a_centimetre(out, capsys):
+    def shift(doc):
+        doc["nodes"][0]["translation"][0] += 0.01
+    rewrite_glb(out / "dsm.glb", shift)
+    assert "> 1 mm" in failures(out, "glb: dsm.glb vertices (pygltflib)", capsys)[0]
+
+
+def test_dsm_glb_in_ellipsoidal_heights(out, capsys):
+    def datum(doc):
+        doc["nodes"][0]["extras"]["vertical_datum"] = "wgs84"
+    rewrite_glb(out / "dsm.glb", datum)
+    assert "vertical datum" in failures(out, "glb: dsm.glb vertices (pygltflib)", capsys)[0]
+
+
+def edit_tileset(out, change):
+    p = out / "3dtiles" / "tileset.json"
+    ts = json.loads(p.read_text())
+    change(ts)
+    p.write_text(json.dumps(ts))
+
+
+def test_tileset_leaf_with_an_error(out, capsys):
+    edit_tileset(out, lambda ts: ts["root"]["children"][0].update(geometricError=0.5))
+    assert "leaf" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+
+
+def test_tileset_child_error_above_its_parent(out, capsys):
+    edit_tileset(out, lambda ts: ts["root"].update(geometricError=1.0, children=[
+        {**ts["root"], "geometricError": 2.0, "children": ts["root"]["children"]}]))
+    assert "exceeds its parent" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+
+
+def test_tileset_box_too_small_for_its_content(out, capsys):
+    def shrink(ts):
+        ts["root"]["children"][1]["boundingVolume"]["box"][3] *= 0.9
+    edit_tileset(out, shrink)
+    assert "sticks out of its box" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+
+
+def test_tileset_content_outside_an_ancestor_box(out, capsys):
+    def shrink(ts):
+        ts["root"]["boundingVolume"]["box"][11] = 0.01  # flat root box; the leaves rise above it
+        ts["root"].pop("content")
+    edit_tileset(out, shrink)
+    assert "an ancestor" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+
+
+def test_tileset_without_the_ellipsoidal_shift(out, capsys):
+    def drop(ts):
+        tr = ts["root"]["transform"]
+        for k in range(3):  # move the frame down its up axis by the undulation
+            tr[12 + k] -= 48.6 * tr[8 + k]
+    edit_tileset(out, drop)
+    assert "records" in failures(out, "3dtiles: ellipsoidal heights (PROJ)", capsys)[0]
+
+
+def test_tileset_leaf_vertices_off_the_dsm(out, capsys):
+    def move(ts):
+        ts["root"]["transform"][12] += 0.5
+    edit_tileset(out, move)
+    assert "no DSM vertex" in failures(out, "3dtiles: ellipsoidal heights (PROJ)", capsys)[0]

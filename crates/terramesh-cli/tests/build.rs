@@ -68,6 +68,8 @@ fn example_builds_every_output_deterministically() {
         "dsm.kml",
         "dsm.dae",
         "dsm-model.kml",
+        "dsm.glb",
+        "3dtiles/tileset.json",
         "dsm-solid.stl",
         "dsm-solid.msh",
         "dsm-solid.json",

@@ -23,6 +23,7 @@
 
 pub mod dem;
 pub mod export;
+pub mod folder;
 pub mod grid_write;
 pub mod number;
 pub mod output;

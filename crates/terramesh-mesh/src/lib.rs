@@ -29,6 +29,10 @@ mod cdt;
 mod flip;
 /// Equilateral lattice seeding of uniform-size quality meshes.
 mod lattice;
+/// Point location and linear interpolation on a mesh's surface.
+mod locate;
+/// Level-of-detail trees of adaptive meshes for 3D Tiles.
+mod lod;
 /// The mesh type and its invariants.
 mod mesh;
 /// Insertion order (BRIO along a Hilbert curve) for incremental Delaunay triangulation.
@@ -50,6 +54,8 @@ pub use adaptive::{
 };
 pub use build::{MeshBuilder, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE};
 pub use flip::delaunay_flips;
+pub use locate::SurfaceLocator;
+pub use lod::{lod_tree, LodLevel, LodSettings, LodTile};
 pub use mesh::Mesh;
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;

@@ -176,7 +176,7 @@ fn write_values<W: Write>(w: &mut W, values: &[f64]) -> io::Result<()> {
 
 /// Unit per-vertex normals: the sum of the adjacent triangles' cross products (area-weighted),
 /// normalised; `[0, 0, 1]` for a vertex in no triangle or only in degenerate ones.
-fn vertex_normals(p: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
+pub(crate) fn vertex_normals(p: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
     let mut acc = vec![[0.0f64; 3]; p.len()];
     for t in triangles {
         let [a, b, c] = t.map(|i| p[i as usize]);

@@ -1,6 +1,7 @@
 //! Every surface and solid writer, one module per format: VTU (VTK XML unstructured grid,
 //! Float64 points), OBJ, PLY, Gmsh MSH 4.1, binary STL, GOCAD TSurf, DXF 3DFACE, KML, and
-//! COLLADA with its KML `<Model>` for Google Earth. [`Format`] names them.
+//! COLLADA with its KML `<Model>` for Google Earth, glTF 2.0 binary (GLB) and Cesium 3D Tiles
+//! 1.1 (a `tileset.json` over GLB tiles). [`Format`] names them.
 //!
 //! VTU, OBJ, PLY and MSH are [`MeshWriter`]s of a [`MeshView`] (triangles over points stored
 //! relative to an origin, added back on output so that UTM coordinates keep full precision,
@@ -13,11 +14,13 @@
 
 mod collada;
 mod dxf;
+mod glb;
 mod kml;
 mod msh;
 mod obj;
 mod ply;
 mod stl;
+pub mod tiles3d;
 mod tsurf;
 mod vtu;
 
@@ -30,6 +33,7 @@ use crate::output::Output;
 
 pub use collada::{write_collada, write_model_kml, ColladaOptions};
 pub use dxf::write_dxf;
+pub use glb::{elevation_colours, write_glb, GlbMesh, GlbOptions};
 pub use kml::{write_kml, KmlStyle};
 pub use msh::Msh41;
 pub use obj::Obj;
@@ -39,7 +43,7 @@ pub use tsurf::{write_tsurf, TsurfInfo};
 pub use vtu::Vtu;
 
 /// A surface export format, named as its file extension: `vtu`, `obj`, `ply`, `stl`, `ts`,
-/// `msh`, `dxf`, `kml`, `dae` (the values of a project file's `export.formats`, see
+/// `msh`, `dxf`, `kml`, `dae`, `glb`, and `3dtiles` for the 3D Tiles folder (the values of a project file's `export.formats`, see
 /// [`terramesh_core::vocab`]).
 ///
 /// ```
@@ -47,7 +51,9 @@ pub use vtu::Vtu;
 /// use terramesh_io::export::{Format, DEFAULT_FORMATS};
 /// assert_eq!("TS".parse::<Format>()?, Format::Tsurf);
 /// assert_eq!(Format::Collada.to_string(), "dae");
-/// assert_eq!(DEFAULT_FORMATS.len(), 9);
+/// assert_eq!(DEFAULT_FORMATS.len(), 10);
+/// assert!(!DEFAULT_FORMATS.contains(&Format::Tiles3d));
+/// assert_eq!("3dtiles".parse::<Format>()?, Format::Tiles3d);
 /// assert_eq!(Format::Obj.writer().map(|w| w.name()), Some("OBJ"));
 /// assert!(Format::Stl.writer().is_none());
 /// # Ok::<(), terramesh_core::vocab::UnknownName>(())
@@ -72,6 +78,10 @@ pub enum Format {
     Kml,
     /// COLLADA ([`write_collada`]), with its KML `<Model>` ([`write_model_kml`]).
     Collada,
+    /// glTF 2.0 binary ([`write_glb`]).
+    Glb,
+    /// Cesium 3D Tiles 1.1: a folder with `tileset.json` and GLB tiles ([`tiles3d`]).
+    Tiles3d,
 }
 
 terramesh_core::named_enum!(Format, "export format", [
@@ -84,10 +94,24 @@ terramesh_core::named_enum!(Format, "export format", [
     Format::Dxf => "dxf",
     Format::Kml => "kml",
     Format::Collada => "dae",
+    Format::Glb => "glb",
+    Format::Tiles3d => "3dtiles",
 ]);
 
-/// The formats exported unless told otherwise: all of them, in the order of [`Format`].
-pub const DEFAULT_FORMATS: &[Format] = <Format as Named>::ALL;
+/// The formats exported unless told otherwise: every single-file format, in the order of
+/// [`Format`]; the formats that write folders (3D Tiles) are opt-in.
+pub const DEFAULT_FORMATS: &[Format] = &[
+    Format::Vtu,
+    Format::Obj,
+    Format::Ply,
+    Format::Stl,
+    Format::Tsurf,
+    Format::Msh,
+    Format::Dxf,
+    Format::Kml,
+    Format::Collada,
+    Format::Glb,
+];
 
 impl Format {
     /// The [`MeshWriter`] of the formats written from a [`MeshView`] (VTU, OBJ, PLY, MSH);

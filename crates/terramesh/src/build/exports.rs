@@ -205,6 +205,22 @@ pub fn write_all(
     if want("dae") {
         files.extend(write_dae(out, &abs, &geo, tris, zone, &title)?);
     }
+    let dsm = crate::gltf::Dsm {
+        mesh,
+        z: &it.dsm,
+        zone,
+        title: &title,
+    };
+    if want("glb") {
+        let path = out.join("dsm.glb");
+        crate::gltf::write_dsm_glb(&path, &dsm)?;
+        files.push(path);
+    }
+    if want("3dtiles") {
+        let settings = terramesh_mesh::LodSettings::default();
+        crate::gltf::write_dsm_tileset(&out.join("3dtiles"), &s.region.projected, &dsm, &settings)?;
+        files.push(out.join("3dtiles").join("tileset.json"));
+    }
     files.push(atomic(&out.join("dsm-origin.json"), |w| {
         writeln!(
             w,
