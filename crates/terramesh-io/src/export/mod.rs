@@ -1,6 +1,7 @@
 //! Every surface and solid writer, one module per format: VTU (VTK XML unstructured grid,
 //! Float64 points), OBJ, PLY, Gmsh MSH 4.1, binary STL, GOCAD TSurf, DXF 3DFACE, KML, and
-//! COLLADA with its KML `<Model>` for Google Earth. [`Format`] names them.
+//! COLLADA with its KML `<Model>` for Google Earth, and Cesium quantized-mesh terrain tiles
+//! ([`write_terrain`]). [`Format`] names them.
 //!
 //! VTU, OBJ, PLY and MSH are [`MeshWriter`]s of a [`MeshView`] (triangles over points stored
 //! relative to an origin, added back on output so that UTM coordinates keep full precision,
@@ -18,6 +19,7 @@ mod msh;
 mod obj;
 mod ply;
 mod stl;
+mod terrain;
 mod tsurf;
 mod vtu;
 
@@ -35,12 +37,18 @@ pub use msh::Msh41;
 pub use obj::Obj;
 pub use ply::Ply;
 pub use stl::{read_stl, write_stl};
+pub use terrain::{
+    build_pyramid, deepest_level, edge_indices, encode_tile, layer_json, level_spacing_m,
+    oct_encode, tile_range, tile_size_deg, tiles_of, write_terrain, zigzag, GeoSurface, Lattice,
+    LayerInfo, PyramidOptions, QuantizedMesh, TerrainError, TerrainSummary, TileHeights, TileId,
+    LATTICE, MAX_LEVEL, QUANT_MAX,
+};
 pub use tsurf::{write_tsurf, TsurfInfo};
 pub use vtu::Vtu;
 
 /// A surface export format, named as its file extension: `vtu`, `obj`, `ply`, `stl`, `ts`,
-/// `msh`, `dxf`, `kml`, `dae` (the values of a project file's `export.formats`, see
-/// [`terramesh_core::vocab`]).
+/// `msh`, `dxf`, `kml`, `dae`, and `terrain` for the folder of Cesium terrain tiles (the values
+/// of a project file's `export.formats`, see [`terramesh_core::vocab`]).
 ///
 /// ```
 /// use terramesh_core::vocab::Named;
@@ -48,6 +56,7 @@ pub use vtu::Vtu;
 /// assert_eq!("TS".parse::<Format>()?, Format::Tsurf);
 /// assert_eq!(Format::Collada.to_string(), "dae");
 /// assert_eq!(DEFAULT_FORMATS.len(), 9);
+/// assert!(!DEFAULT_FORMATS.contains(&Format::Terrain)); // opt-in
 /// assert_eq!(Format::Obj.writer().map(|w| w.name()), Some("OBJ"));
 /// assert!(Format::Stl.writer().is_none());
 /// # Ok::<(), terramesh_core::vocab::UnknownName>(())
@@ -72,6 +81,8 @@ pub enum Format {
     Kml,
     /// COLLADA ([`write_collada`]), with its KML `<Model>` ([`write_model_kml`]).
     Collada,
+    /// Cesium quantized-mesh terrain tiles, a folder ([`write_terrain`]); opt-in.
+    Terrain,
 }
 
 terramesh_core::named_enum!(Format, "export format", [
@@ -84,10 +95,22 @@ terramesh_core::named_enum!(Format, "export format", [
     Format::Dxf => "dxf",
     Format::Kml => "kml",
     Format::Collada => "dae",
+    Format::Terrain => "terrain",
 ]);
 
-/// The formats exported unless told otherwise: all of them, in the order of [`Format`].
-pub const DEFAULT_FORMATS: &[Format] = <Format as Named>::ALL;
+/// The formats exported unless told otherwise: the single-file surface formats, in the order
+/// of [`Format`] (the terrain tiles are opt-in).
+pub const DEFAULT_FORMATS: &[Format] = &[
+    Format::Vtu,
+    Format::Obj,
+    Format::Ply,
+    Format::Stl,
+    Format::Tsurf,
+    Format::Msh,
+    Format::Dxf,
+    Format::Kml,
+    Format::Collada,
+];
 
 impl Format {
     /// The [`MeshWriter`] of the formats written from a [`MeshView`] (VTU, OBJ, PLY, MSH);
