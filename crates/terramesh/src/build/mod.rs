@@ -11,6 +11,7 @@ mod exports;
 mod pictures;
 mod report;
 mod stages;
+mod terrain;
 
 use std::path::Path;
 use std::time::Instant;
