@@ -32,6 +32,7 @@ from vcommon import (F32_EPS, GRID_OVERSHOOT, KML_ALT, KML_DEG, NOT_DETERMINISTI
                      planar_areas, require, signed_volume, single_triangle_block, watertight, xmllint_schema)
 import check_collada
 import check_programs
+import check_terrain
 
 
 # ---------------------------------------------------------------- surface mesh checks
@@ -443,6 +444,7 @@ CHECKS = [
     ("kml schema (xmllint)", check_kml_schema),
     ("kml geometry", check_kml_geometry),
     *check_collada.CHECKS,
+    *check_terrain.CHECKS,
     ("solid stl: watertight, volume", check_solid_stl),
     ("solid msh: watertight, volume", check_solid_msh),
     *check_programs.CHECKS,

@@ -149,6 +149,18 @@ impl GeoSurface {
     /// The surface's height at (`lon`, `lat`) in degrees, `None` outside every triangle.
     /// On an edge shared by two triangles either gives the same height.
     pub fn height(&self, lon: f64, lat: f64) -> Option<f64> {
+        let mut hint = u32::MAX;
+        self.height_near(lon, lat, &mut hint)
+    }
+
+    /// [`GeoSurface::height`], trying triangle `hint` first and leaving in it the triangle
+    /// found: neighbouring points mostly fall in the same triangle.
+    pub fn height_near(&self, lon: f64, lat: f64, hint: &mut u32) -> Option<f64> {
+        if (*hint as usize) < self.tris.len() {
+            if let Some(h) = self.barycentric(*hint as usize, lon, lat) {
+                return Some(h);
+            }
+        }
         let b = self.bbox;
         if !(lon >= b[0] && lon <= b[2] && lat >= b[1] && lat <= b[3]) {
             return None;
@@ -157,8 +169,11 @@ impl GeoSurface {
         let cy = (((lat - b[1]) / self.cell[1]) as usize).min(self.cells[1] - 1);
         let c = cy * self.cells[0] + cx;
         let slot = &self.items[self.start[c] as usize..self.start[c + 1] as usize];
-        slot.iter()
-            .find_map(|&t| self.barycentric(t as usize, lon, lat))
+        slot.iter().find_map(|&t| {
+            let h = self.barycentric(t as usize, lon, lat)?;
+            *hint = t;
+            Some(h)
+        })
     }
 
     /// The height on triangle `t` if (`x`, `y`) lies in it (with a relative tolerance of

@@ -179,6 +179,7 @@ fn sample_tile(surface: &GeoSurface, id: TileId, fill: f64) -> Vec<f64> {
     let sb = surface.bbox();
     let mut h = vec![fill; BLOCK * BLOCK];
     // Only rows and columns that can meet the DSM need a look-up.
+    let mut hint = u32::MAX;
     for (j, &lat) in lats.iter().enumerate() {
         if lat < sb[1] || lat > sb[3] {
             continue;
@@ -187,7 +188,7 @@ fn sample_tile(surface: &GeoSurface, id: TileId, fill: f64) -> Vec<f64> {
             if lon < sb[0] || lon > sb[2] {
                 continue;
             }
-            if let Some(z) = surface.height(lon, lat) {
+            if let Some(z) = surface.height_near(lon, lat, &mut hint) {
                 h[j * BLOCK + i] = z;
             }
         }
@@ -231,13 +232,13 @@ fn finish_tile(id: TileId, s: &[f64], step: f64, lattice: &Lattice) -> TileHeigh
         .iter()
         .map(|&k| ((s[at(k)] / step).round() - k0) as u16)
         .collect();
-    let b = id.bounds();
+    let frame = NormalFrame::new(id.bounds());
     let normals = lattice
         .lattice_index
         .iter()
         .map(|&k| {
-            let (i, j) = ((k as usize % n) as i32, (k as usize / n) as i32);
-            oct_encode(normal(s, b, i, j))
+            let (i, j) = (k as usize % n, k as usize / n);
+            oct_encode(frame.normal(s, i, j))
         })
         .collect();
     TileHeights {
@@ -249,37 +250,64 @@ fn finish_tile(id: TileId, s: &[f64], step: f64, lattice: &Lattice) -> TileHeigh
     }
 }
 
-/// The ECEF unit normal at lattice vertex (`i`, `j`) from central differences of the block.
-fn normal(s: &[f64], b: [f64; 4], i: i32, j: i32) -> [f64; 3] {
-    use terramesh_core::coords::{WGS84_A, WGS84_F};
-    let e2 = WGS84_F * (2.0 - WGS84_F);
-    let lat = line_deg(b, j, 1).clamp(-90.0, 90.0);
-    let lon = line_deg(b, i, 0);
-    let (sp, cp) = lat.to_radians().sin_cos();
-    let (sl, cl) = lon.to_radians().sin_cos();
-    let w = (1.0 - e2 * sp * sp).sqrt();
-    let (rn, rm) = (WGS84_A / w, WGS84_A * (1.0 - e2) / (w * w * w));
-    let h = |di: i32, dj: i32| s[(j + 1 + dj) as usize * BLOCK + (i + 1 + di) as usize];
-    let de = (line_deg(b, i + 1, 0) - line_deg(b, i - 1, 0)).to_radians() * rn * cp;
-    let dn = (line_deg(b, j + 1, 1).clamp(-90.0, 90.0) - line_deg(b, j - 1, 1).clamp(-90.0, 90.0))
-        .to_radians()
-        * rm;
-    let gx = if de.abs() > 1e-9 {
-        (h(1, 0) - h(-1, 0)) / de
-    } else {
-        0.0
-    };
-    let gy = if dn.abs() > 1e-9 {
-        (h(0, 1) - h(0, -1)) / dn
-    } else {
-        0.0
-    };
-    let east = [-sl, cl, 0.0];
-    let north = [-sp * cl, -sp * sl, cp];
-    let up = [cp * cl, cp * sl, sp];
-    let v: [f64; 3] = std::array::from_fn(|a| -gx * east[a] - gy * north[a] + up[a]);
-    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|c| c / len)
+/// What the normals of one tile need per lattice column and row: the trigonometry of each
+/// line and the metres between the lines either side of it.
+struct NormalFrame {
+    /// sin, cos of each column's longitude; the longitude step across it (radians).
+    lon: Vec<[f64; 3]>,
+    /// sin, cos of each row's latitude; metres per radian east (N cos φ) and across the row
+    /// (M times the latitude step).
+    lat: Vec<[f64; 4]>,
+}
+
+impl NormalFrame {
+    fn new(b: [f64; 4]) -> NormalFrame {
+        use terramesh_core::coords::{WGS84_A, WGS84_F};
+        let e2 = WGS84_F * (2.0 - WGS84_F);
+        let n = LATTICE as i32;
+        let lat_of = |j: i32| line_deg(b, j, 1).clamp(-90.0, 90.0);
+        let lon = (0..=n)
+            .map(|i| {
+                let (sl, cl) = line_deg(b, i, 0).to_radians().sin_cos();
+                let d = (line_deg(b, i + 1, 0) - line_deg(b, i - 1, 0)).to_radians();
+                [sl, cl, d]
+            })
+            .collect();
+        let lat = (0..=n)
+            .map(|j| {
+                let (sp, cp) = lat_of(j).to_radians().sin_cos();
+                let w = (1.0 - e2 * sp * sp).sqrt();
+                let (rn, rm) = (WGS84_A / w, WGS84_A * (1.0 - e2) / (w * w * w));
+                let dn = (lat_of(j + 1) - lat_of(j - 1)).to_radians() * rm;
+                [sp, cp, rn * cp, dn]
+            })
+            .collect();
+        NormalFrame { lon, lat }
+    }
+
+    /// The ECEF unit normal at lattice vertex (`i`, `j`) from central differences of the block.
+    fn normal(&self, s: &[f64], i: usize, j: usize) -> [f64; 3] {
+        let [sl, cl, dlon] = self.lon[i];
+        let [sp, cp, east_m, dn] = self.lat[j];
+        let h = |bi: usize, bj: usize| s[bj * BLOCK + bi];
+        let de = dlon * east_m;
+        let gx = if de.abs() > 1e-9 {
+            (h(i + 2, j + 1) - h(i, j + 1)) / de
+        } else {
+            0.0
+        };
+        let gy = if dn.abs() > 1e-9 {
+            (h(i + 1, j + 2) - h(i + 1, j)) / dn
+        } else {
+            0.0
+        };
+        let east = [-sl, cl, 0.0];
+        let north = [-sp * cl, -sp * sl, cp];
+        let up = [cp * cl, cp * sl, sp];
+        let v: [f64; 3] = std::array::from_fn(|a| -gx * east[a] - gy * north[a] + up[a]);
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / len)
+    }
 }
 
 /// Oct-encodes a unit vector into two bytes (Cigolle et al. 2014, "A Survey of Efficient
