@@ -48,6 +48,7 @@ def ecef(lat, lon, h):
 def sample(px, py, xy, z, tris):
     """Barycentric height on the triangle holding each point (brute force), NaN outside."""
     t = xy[tris]
+    np.seterr(invalid="ignore")  # points far away project to inf; they are outside anyway
     (ax, bx, cx), (ay, by, cy) = t[:, :, 0].T, t[:, :, 1].T
     d = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay)
     px, py = px[:, None], py[:, None]
