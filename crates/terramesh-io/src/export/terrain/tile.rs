@@ -436,7 +436,7 @@ mod tests {
         );
         let t = &tiles[0];
         // The vertex at the equator on the tile's western edge (lon -180): up is -x in ECEF.
-        let n = LATTICE as u32 + 1;
+        let n = LATTICE + 1;
         let k = l
             .lattice_index
             .iter()
