@@ -29,14 +29,16 @@ else
 fi
 
 req=tests/verify/requirements.txt
+req_any=tests/verify/requirements-any-python.txt
 stamp=.venv-verify/.requirements.sha256
-want=$(sha256sum "$req" | cut -d' ' -f1)
+want=$(cat "$req" "$req_any" | sha256sum | cut -d' ' -f1)
 if [ -x .venv-verify/bin/python ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
   echo "verify-setup: .venv-verify up to date with $req"
 else
   echo "verify-setup: creating .venv-verify and installing $req"
   python3 -m venv .venv-verify
   .venv-verify/bin/pip install -q --disable-pip-version-check -r "$req"
+  .venv-verify/bin/pip install -q --disable-pip-version-check --no-deps --ignore-requires-python -r "$req_any"
   # The gmsh wheel loads its library at import: fail here, naming what is missing.
   if ! .venv-verify/bin/python -c 'import gmsh' >/dev/null 2>&1; then
     echo "verify-setup: gmsh does not load: $(ldd .venv-verify/lib/libgmsh.so* 2>&1 | grep 'not found' | tr -s ' \n' ' ')" >&2

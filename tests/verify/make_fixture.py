@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 import make_gltf_fixture
+import fixture_terrain
 
 EPSG = 32632
 ORIGIN = (377000.0, 5397000.0, 0.0)
@@ -268,6 +269,7 @@ def write_all(out):
     (out / "dsm-solid.json").write_text(json.dumps({"base_elevation": BASE, "volume": volume,
                                                            "vertices": len(sp), "triangles": len(st)}) + "\n")
     write_grids(out, xy, uk)
+    fixture_terrain.write_terrain(out, xy, uk, tris, EPSG)
     (out / "samples.csv").write_text("x,y,elevation\n377010.5,5397020.25,351.5\n377150.0,5397100.0,360.25\n")
     (out / "mesh-quality.csv").write_text("metric,value\nmin_angle_deg,%r\n" % float(min_angles(xy, tris).min()))
     (out / "cross-validation.csv").write_text("x,y,observed,predicted,std\n377010.5,5397020.25,351.5,351.4,0.5\n")

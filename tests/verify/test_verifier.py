@@ -495,3 +495,149 @@ def test_tileset_leaf_vertices_off_the_dsm(out, capsys):
         ts["root"]["transform"][12] += 0.5
     edit_tileset(out, move)
     assert "no DSM vertex" in failures(out, "3dtiles: ellipsoidal heights (PROJ)", capsys)[0]
+# ---------------------------------------------------------------- terrain tiles
+
+
+def tile_paths(d):
+    return sorted((d / "terrain").rglob("*.terrain"), key=lambda p: [int(x) for x in p.relative_to(d / "terrain").with_suffix("").parts])
+
+
+def rewrite_tile(path, fn):
+    """Decodes a tile with quantized-mesh-tile, applies `fn` to it and writes it back."""
+    from quantized_mesh_tile.global_geodetic import GlobalGeodetic
+    from quantized_mesh_tile.terrain import TerrainTile
+    z, x, y = (int(p) for p in path.with_suffix("").parts[-3:])
+    w, s, e, n = GlobalGeodetic(True).TileBounds(x, y, z)
+    t = TerrainTile(west=w, south=s, east=e, north=n)
+    t.fromFile(str(path), hasLighting=True)
+    fn(t)
+    path.write_bytes(t.toBytesIO().getvalue())
+
+
+def deepest(d):
+    paths = tile_paths(d)
+    z = int(paths[-1].parts[-3])
+    return z, [p for p in paths if int(p.parts[-3]) == z]
+
+
+def centre_tile_and_vertex(d):
+    """The deepest tile holding the fixture DSM's centre, and its vertex nearest to it."""
+    import egm96  # noqa: F401  (the check needs it too)
+    from pyproj import Transformer
+    xy = fx.surface()[0]
+    lon, lat = Transformer.from_crs(fx.EPSG, 4326, always_xy=True).transform(*xy.mean(axis=0))
+    z, paths = deepest(d)
+    size = 180 / 2 ** z
+    p = d / "terrain" / str(z) / str(int((lon + 180) // size)) / f"{int((lat + 90) // size)}.terrain"
+    assert p in paths
+    w, s = -180 + int((lon + 180) // size) * size, -90 + int((lat + 90) // size) * size
+    return p, (lon - w) / size * 32767, (lat - s) / size * 32767
+
+
+def test_python_egm96_matches_nga_test_points():
+    # NGA's EGM96 test points (INTPT.DAT / OUTINTPT.DAT, NIMA 1996), as in terramesh-core's
+    # coords/geoid.rs: the egm96 package installed on this Python must reproduce them.
+    import egm96
+    pts = [(38.6281550, 269.7791550, -31.628), (-14.6212170, 305.0211140, -2.969),
+           (46.8743190, 102.4487290, -43.575), (-23.6174460, 133.8747120, 15.871),
+           (38.6254730, 359.9995000, 50.066), (-0.4667440, 0.0023000, 17.329)]
+    for lat, lon, n in pts:
+        assert abs(egm96.undulation(lat, lon) - n) < vo.check_terrain.GEOID_TOL
+
+
+def test_terrain_layer_format(out, capsys):
+    edit(out / "terrain" / "layer.json", '"quantized-mesh-1.0"', '"heightmap-1.0"')
+    assert "format" in failures(out, "terrain layer.json (Cesium keys, available, levels)", capsys)[0]
+
+
+def test_terrain_missing_tile(out, capsys):
+    _, paths = deepest(out)
+    paths[0].unlink()
+    assert "without a file" in failures(out, "terrain layer.json (Cesium keys, available, levels)", capsys)[0]
+
+
+def test_terrain_unlisted_tile(out, capsys):
+    _, paths = deepest(out)
+    extra = paths[0].parent.parent / "1" / "0.terrain"
+    extra.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copy(paths[0], extra)
+    assert "not listed" in failures(out, "terrain layer.json (Cesium keys, available, levels)", capsys)[0]
+
+
+def test_terrain_pyramid_too_shallow(out, capsys):
+    z, paths = deepest(out)
+    shutil.rmtree(out / "terrain" / str(z))
+    lj = json.loads((out / "terrain" / "layer.json").read_text())
+    lj["available"].pop()
+    lj["maxzoom"] = z - 1
+    (out / "terrain" / "layer.json").write_text(json.dumps(lj))
+    assert "mean edge" in failures(out, "terrain layer.json (Cesium keys, available, levels)", capsys)[0]
+
+
+def test_terrain_truncated_tile(out, capsys):
+    p = tile_paths(out)[5]
+    p.write_bytes(p.read_bytes()[:200])
+    assert "cannot read" in failures(out, "terrain tiles (quantized-mesh-tile)", capsys)[0]
+
+
+def test_terrain_normals_pointing_down(out, capsys):
+    rewrite_tile(tile_paths(out)[-1], lambda t: setattr(t, "vLight", [[-c for c in n] for n in t.vLight]))
+    assert "below the horizon" in failures(out, "terrain tiles (quantized-mesh-tile)", capsys)[0]
+
+
+def test_terrain_occlusion_point_too_close(out, capsys):
+    def shrink(t):
+        for k in ["horizonOcclusionPointX", "horizonOcclusionPointY", "horizonOcclusionPointZ"]:
+            t.header[k] *= 0.99999
+    rewrite_tile(tile_paths(out)[-1], shrink)
+    assert "too close" in failures(out, "terrain tiles (quantized-mesh-tile)", capsys)[0]
+
+
+def test_terrain_edge_list_incomplete(out, capsys):
+    rewrite_tile(tile_paths(out)[-1], lambda t: setattr(t, "westI", t.westI[:-1]))
+    assert "west edge lists" in failures(out, "terrain edge indices", capsys)[0]
+
+
+def test_terrain_edge_list_order(out, capsys):
+    rewrite_tile(tile_paths(out)[-1], lambda t: setattr(t, "southI", t.southI[::-1]))
+    assert "south edge indices out of order" in failures(out, "terrain edge indices", capsys)[0]
+
+
+def test_terrain_shared_edge_heights(out, capsys):
+    _, paths = deepest(out)
+    def bump(t):  # one quantum up on the tile's eastern edge: within the height tolerance
+        k = t.eastI[len(t.eastI) // 2]
+        t.h[k] = t.h[k] + 1 if t.h[k] < 32767 else t.h[k] - 1
+    rewrite_tile(paths[0], bump)
+    assert "heights differ" in failures(out, "terrain shared edges", capsys)[0]
+
+
+def test_terrain_height_off_the_dsm(out, capsys):
+    p, u0, v0 = centre_tile_and_vertex(out)
+    def lift(t):
+        k = int(np.argmin((np.array(t.u) - u0) ** 2 + (np.array(t.v) - v0) ** 2))
+        step = (t.header["maximumHeight"] - t.header["minimumHeight"]) / 32767
+        t.h[k] += int(round(0.2 / step))  # 20 cm
+    rewrite_tile(p, lift)
+    assert "the DSM + EGM96 gives" in failures(out, "terrain heights vs DSM + EGM96", capsys)[0]
+
+
+def test_terrain_height_off_by_centimetres(out, capsys):
+    p, u0, v0 = centre_tile_and_vertex(out)
+    def lift(t):  # 2 cm: within the geoid tolerance, caught as a bump in the geoid difference
+        k = int(np.argmin((np.array(t.u) - u0) ** 2 + (np.array(t.v) - v0) ** 2))
+        step = (t.header["maximumHeight"] - t.header["minimumHeight"]) / 32767
+        t.h[k] += int(round(0.02 / step))
+    rewrite_tile(p, lift)
+    assert "not a smooth geoid difference" in failures(out, "terrain heights vs DSM + EGM96", capsys)[0]
+
+
+def test_terrain_heights_without_the_geoid(out, capsys):
+    import egm96
+    n = egm96.undulation(48.7, 7.33)
+    for p in tile_paths(out):
+        def lower(t):
+            t.header["minimumHeight"] -= n
+            t.header["maximumHeight"] -= n
+        rewrite_tile(p, lower)
+    assert failures(out, "terrain heights vs DSM + EGM96", capsys)

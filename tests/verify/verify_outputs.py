@@ -33,6 +33,7 @@ from vcommon import (F32_EPS, GRID_OVERSHOOT, KML_ALT, KML_DEG, NOT_DETERMINISTI
 import check_collada
 import check_gltf
 import check_programs
+import check_terrain
 
 
 # ---------------------------------------------------------------- surface mesh checks
@@ -445,6 +446,7 @@ CHECKS = [
     ("kml geometry", check_kml_geometry),
     *check_collada.CHECKS,
     *check_gltf.CHECKS,
+    *check_terrain.CHECKS,
     ("solid stl: watertight, volume", check_solid_stl),
     ("solid msh: watertight, volume", check_solid_msh),
     *check_programs.CHECKS,

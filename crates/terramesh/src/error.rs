@@ -65,6 +65,9 @@ pub enum Error {
     /// Writing a mesh file.
     #[error(transparent)]
     MeshWrite(#[from] terramesh_io::export::MeshWriteError),
+    /// Writing the terrain tiles.
+    #[error(transparent)]
+    Terrain(#[from] terramesh_io::export::TerrainError),
     /// Drawing a picture.
     #[error(transparent)]
     Picture(#[from] terramesh_io::pictures::PictureError),

@@ -1,7 +1,8 @@
 //! Every surface and solid writer, one module per format: VTU (VTK XML unstructured grid,
 //! Float64 points), OBJ, PLY, Gmsh MSH 4.1, binary STL, GOCAD TSurf, DXF 3DFACE, KML, and
-//! COLLADA with its KML `<Model>` for Google Earth, glTF 2.0 binary (GLB) and Cesium 3D Tiles
-//! 1.1 (a `tileset.json` over GLB tiles). [`Format`] names them.
+//! COLLADA with its KML `<Model>` for Google Earth, glTF 2.0 binary (GLB), Cesium 3D Tiles 1.1
+//! (a `tileset.json` over GLB tiles) and Cesium quantized-mesh terrain tiles
+//! ([`write_terrain`]). [`Format`] names them.
 //!
 //! VTU, OBJ, PLY and MSH are [`MeshWriter`]s of a [`MeshView`] (triangles over points stored
 //! relative to an origin, added back on output so that UTM coordinates keep full precision,
@@ -20,6 +21,7 @@ mod msh;
 mod obj;
 mod ply;
 mod stl;
+mod terrain;
 pub mod tiles3d;
 mod tsurf;
 mod vtu;
@@ -39,11 +41,18 @@ pub use msh::Msh41;
 pub use obj::Obj;
 pub use ply::Ply;
 pub use stl::{read_stl, write_stl};
+pub use terrain::{
+    build_pyramid, deepest_level, edge_indices, encode_tile, layer_json, level_spacing_m,
+    oct_encode, tile_range, tile_size_deg, tiles_of, write_terrain, zigzag, GeoSurface, Lattice,
+    LayerInfo, PyramidOptions, QuantizedMesh, TerrainError, TerrainSummary, TileHeights, TileId,
+    LATTICE, MAX_LEVEL, QUANT_MAX,
+};
 pub use tsurf::{write_tsurf, TsurfInfo};
 pub use vtu::Vtu;
 
 /// A surface export format, named as its file extension: `vtu`, `obj`, `ply`, `stl`, `ts`,
-/// `msh`, `dxf`, `kml`, `dae`, `glb`, and `3dtiles` for the 3D Tiles folder (the values of a project file's `export.formats`, see
+/// `msh`, `dxf`, `kml`, `dae`, `glb`, `3dtiles` for the 3D Tiles folder and `terrain` for the
+/// folder of Cesium terrain tiles (the values of a project file's `export.formats`, see
 /// [`terramesh_core::vocab`]).
 ///
 /// ```
@@ -53,6 +62,7 @@ pub use vtu::Vtu;
 /// assert_eq!(Format::Collada.to_string(), "dae");
 /// assert_eq!(DEFAULT_FORMATS.len(), 10);
 /// assert!(!DEFAULT_FORMATS.contains(&Format::Tiles3d));
+/// assert!(!DEFAULT_FORMATS.contains(&Format::Terrain)); // opt-in
 /// assert_eq!("3dtiles".parse::<Format>()?, Format::Tiles3d);
 /// assert_eq!(Format::Obj.writer().map(|w| w.name()), Some("OBJ"));
 /// assert!(Format::Stl.writer().is_none());
@@ -82,6 +92,8 @@ pub enum Format {
     Glb,
     /// Cesium 3D Tiles 1.1: a folder with `tileset.json` and GLB tiles ([`tiles3d`]).
     Tiles3d,
+    /// Cesium quantized-mesh terrain tiles, a folder ([`write_terrain`]); opt-in.
+    Terrain,
 }
 
 terramesh_core::named_enum!(Format, "export format", [
@@ -96,10 +108,11 @@ terramesh_core::named_enum!(Format, "export format", [
     Format::Collada => "dae",
     Format::Glb => "glb",
     Format::Tiles3d => "3dtiles",
+    Format::Terrain => "terrain",
 ]);
 
 /// The formats exported unless told otherwise: every single-file format, in the order of
-/// [`Format`]; the formats that write folders (3D Tiles) are opt-in.
+/// [`Format`]; the formats that write folders (3D Tiles, terrain tiles) are opt-in.
 pub const DEFAULT_FORMATS: &[Format] = &[
     Format::Vtu,
     Format::Obj,

@@ -178,7 +178,7 @@ pub fn write_all(
             write_dxf(w, &abs, tris, "DSM")
         })?);
     }
-    let geo: Vec<[f64; 3]> = if want("kml") || want("dae") {
+    let geo: Vec<[f64; 3]> = if want("kml") || want("dae") || want("terrain") {
         abs.iter()
             .map(|q| {
                 let (lat, lon) = to_wgs84(q[0], q[1], zone)?;
@@ -220,6 +220,10 @@ pub fn write_all(
         let settings = terramesh_mesh::LodSettings::default();
         crate::gltf::write_dsm_tileset(&out.join("3dtiles"), &s.region.projected, &dsm, &settings)?;
         files.push(out.join("3dtiles").join("tileset.json"));
+    }
+    if want("terrain") {
+        let res = m.after.edge.mean;
+        files.push(super::terrain::write(out, &geo, tris, res, &title)?);
     }
     files.push(atomic(&out.join("dsm-origin.json"), |w| {
         writeln!(

@@ -17,6 +17,7 @@ mod pictures;
 mod report;
 mod stages;
 pub mod staging;
+mod terrain;
 
 use std::path::Path;
 use std::time::Instant;
