@@ -11,6 +11,7 @@ mod exports;
 mod pictures;
 mod report;
 mod stages;
+mod viewer;
 
 use std::path::Path;
 use std::time::Instant;
@@ -19,6 +20,7 @@ pub use adaptive::AdaptiveInfo;
 pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
 pub use stages::{Interpolated, Meshed, Model, Samples};
+pub use viewer::{VIEWER_SAMPLES, VIEWER_VERTICES};
 
 use crate::error::{Context, Result};
 use crate::progress::Progress;
