@@ -94,7 +94,7 @@
     "  if (u_points == 1) { vec2 d = gl_PointCoord - 0.5; float r = dot(d, d);\n" +
     "    if (r > 0.25) discard; o = vec4(r > 0.12 ? vec3(0.1) : c, 1.0); return; }\n" +
     "  vec3 n = normalize(cross(dFdx(v_world), dFdy(v_world)));\n" +
-    "  float s = 0.35 + 0.65 * max(dot(n, u_light), 0.0);\n" +
+    "  float s = 0.45 + 0.55 * max(dot(n, u_light), 0.0);\n" +
     "  if (!gl_FrontFacing) s *= 0.55;\n" +
     "  o = vec4(c * s, 1.0); }\n";
   function shader(type, src) {
@@ -182,7 +182,7 @@
   var FOV = 40 * Math.PI / 180;
   var cam = {};
   function resetCamera() {
-    cam.yaw = -0.55; cam.pitch = 0.6; cam.dist = 2.6 * radius;
+    cam.yaw = -0.55; cam.pitch = 0.6; cam.dist = 3.4 * radius;
     cam.tx = 0.5 * (lo[0] + hi[0]); cam.ty = 0.5 * (lo[1] + hi[1]);
   }
   resetCamera();

@@ -100,7 +100,7 @@ pub fn scene(s: &Samples, m: &Meshed, it: &Interpolated, base: f64) -> Result<Sc
         positions: solid_v,
         geometry: Geometry::Triangles(solid_t),
         fields: Vec::new(),
-        colour: [168, 140, 112],
+        colour: [125, 135, 165],
         visible: true,
         pickable: false,
         clipped: true,
