@@ -135,18 +135,12 @@
   });
 
   var lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-  var surfaceZ = null;
   var layers = scene.layers.map(function (l) {
     var pos = new Float32Array(bytes(l.positions));
     var L = { name: l.name, kind: l.kind, pos: pos, n: l.vertices, colour: l.colour.map(function (c) { return c / 255; }),
       pickable: l.pickable, clipped: l.clipped, fields: {}, vbufs: {}, count: 0 };
     for (var i = 0; i < pos.length; i += 3) {
       for (var k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], pos[i + k]); hi[k] = Math.max(hi[k], pos[i + k]); }
-    }
-    if (l.kind === "triangles" && !surfaceZ && l.vertices > 0) {
-      var zl = Infinity, zh = -Infinity;
-      for (var j = 2; j < pos.length; j += 3) { zl = Math.min(zl, pos[j]); zh = Math.max(zh, pos[j]); }
-      surfaceZ = [zl, zh];
     }
     L.vao = gl.createVertexArray();
     gl.bindVertexArray(L.vao);
@@ -175,7 +169,6 @@
     gl.bindVertexArray(null);
     return L;
   });
-  if (!surfaceZ) surfaceZ = [lo[2], hi[2]];
   var radius = 0.5 * Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-3);
 
   // ---------------------------------------------------------------- camera
@@ -189,7 +182,7 @@
   function exag() { return parseFloat(exagIn.value); }
   function basis() {
     var e = exag(), cp = Math.cos(cam.pitch);
-    var t = [cam.tx, cam.ty, 0.5 * (surfaceZ[0] + surfaceZ[1]) * e];
+    var t = [cam.tx, cam.ty, 0.5 * (lo[2] + hi[2]) * e];
     var d = [-Math.sin(cam.yaw) * cp, -Math.cos(cam.yaw) * cp, Math.sin(cam.pitch)];
     var eye = [t[0] + cam.dist * d[0], t[1] + cam.dist * d[1], t[2] + cam.dist * d[2]];
     var f = [-d[0], -d[1], -d[2]];

@@ -318,7 +318,11 @@ impl<'a> Locator<'a> {
                         if worst >= -1e-9 {
                             return Some((self.tris[k as usize], w));
                         }
-                        if best.as_ref().map_or(true, |b| worst > b.0) {
+                        let better = match &best {
+                            None => true,
+                            Some(b) => worst > b.0,
+                        };
+                        if better {
                             best = Some((worst, k as usize, w));
                         }
                     }
