@@ -147,7 +147,7 @@ try {
   }
 
   const first = await snapshot("first");
-  if (first.nonBackground < 0.2 || first.colours < 50) {
+  if (first.nonBackground < 0.05 || first.colours < 50) {
     fail(`the canvas is blank: ${(100 * first.nonBackground).toFixed(1)} % non-background, ${first.colours} colours`);
   }
   ok(`the canvas is not blank: ${(100 * first.nonBackground).toFixed(1)} % non-background pixels, ${first.colours} colours (sampled)`);
@@ -224,8 +224,13 @@ try {
       fail(`colour by ${key}: ${(100 * d).toFixed(2)} % of the pixels changed, centre ${s.centre} ${off.toFixed(1)} off its map`);
     }
     ok(`colour by ${key} changed ${(100 * d).toFixed(1)} % of the pixels; centre ${s.centre} on its map (within ${off.toFixed(1)})`);
-    if (key === "kriging_std") await shot("viewer-kriging-std.png");
     prev = s;
+    if (key === "kriging_std") {
+      // The README's picture from the first view; the next field is compared with it.
+      await page.click("#tmv-reset");
+      prev = await snapshot("reset-std");
+      await shot("viewer-kriging-std.png");
+    }
   }
 
   // The cross-section plane.

@@ -175,11 +175,12 @@
   var FOV = 40 * Math.PI / 180;
   var cam = {};
   function resetCamera() {
-    cam.yaw = -0.55; cam.pitch = 0.6; cam.dist = 3.4 * radius;
+    cam.yaw = -0.55; cam.pitch = 0.7;
+    cam.dist = 4 * Math.max(radius, 0.6 * (hi[2] - lo[2]) * exag());
     cam.tx = 0.5 * (lo[0] + hi[0]); cam.ty = 0.5 * (lo[1] + hi[1]);
   }
-  resetCamera();
   function exag() { return parseFloat(exagIn.value); }
+  resetCamera();
   function basis() {
     var e = exag(), cp = Math.cos(cam.pitch);
     var t = [cam.tx, cam.ty, 0.5 * (lo[2] + hi[2]) * e];
