@@ -301,12 +301,14 @@ impl<'a> Locator<'a> {
         (i0, j0, i1, j1)
     }
 
-    /// The triangle under `(x, y)` and the barycentric weights of its corners; for a point a
-    /// rounding error outside the mesh, the nearest triangle in its bucket, weights clamped.
+    /// The triangle under `(x, y)` and the barycentric weights of its corners; for a point
+    /// outside the mesh (a rounding error, or where the new mesh's boundary cuts a corner
+    /// differently), the nearest triangle of the nearest non-empty ring of buckets, weights
+    /// clamped.
     fn locate(&self, x: f64, y: f64) -> Option<([u32; 3], [f64; 3])> {
         let (i, j) = self.bucket(x, y);
         let mut best: Option<(f64, usize, [f64; 3])> = None;
-        for ring in 0..3usize {
+        for ring in 0..self.nx.max(self.ny) {
             let (i0, i1) = (i.saturating_sub(ring), (i + ring).min(self.nx - 1));
             let (j0, j1) = (j.saturating_sub(ring), (j + ring).min(self.ny - 1));
             for jj in j0..=j1 {
@@ -351,6 +353,7 @@ impl<'a> Locator<'a> {
     }
 
     fn interpolate(&self, x: f64, y: f64, f: &[f64]) -> Option<f64> {
+        // None only for a mesh without triangles.
         let (t, w) = self.locate(x, y)?;
         Some(w[0] * f[t[0] as usize] + w[1] * f[t[1] as usize] + w[2] * f[t[2] as usize])
     }
@@ -417,6 +420,17 @@ mod tests {
             assert_eq!(found, *t);
             assert!(w.iter().all(|v| (v - 1.0 / 3.0).abs() < 1e-6), "{w:?}");
         }
+    }
+
+    #[test]
+    fn a_point_outside_the_mesh_gets_its_nearest_triangle() {
+        let (_, abs, tris) = hill();
+        let loc = Locator::new(&abs, &tris);
+        let z: Vec<f64> = abs.iter().map(|p| p[2]).collect();
+        // 5 m west of the south-west corner, many buckets away from any triangle.
+        let corner = loc.interpolate(500_000.0, 5_400_000.0, &z).unwrap();
+        let outside = loc.interpolate(499_995.0, 5_399_995.0, &z).unwrap();
+        assert!((outside - corner).abs() < 1e-6, "{outside} vs {corner}");
     }
 
     #[test]
