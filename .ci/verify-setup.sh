@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs what tests/verify/verify_outputs.py needs: Chromium, xmllint and the shared
 # libraries that the gmsh wheel links (apt, only if missing) and the Python readers in
-# .venv-verify (pinned in tests/verify/requirements.txt).
+# .venv-verify (pinned in tests/verify/requirements.txt); and what the browser test of the
+# report's 3D viewer needs: node and playwright-core in tests/browser/node_modules (`npm ci`
+# from the committed package-lock.json).
 # Idempotent: a second run changes nothing and says so.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,6 +11,7 @@ cd "$(dirname "$0")/.."
 missing=()
 command -v chromium >/dev/null 2>&1 || missing+=(chromium)
 command -v xmllint >/dev/null 2>&1 || missing+=(libxml2-utils)
+command -v node >/dev/null 2>&1 || missing+=(nodejs npm)
 python3 -c 'import ensurepip, venv' >/dev/null 2>&1 || missing+=(python3-venv)
 # The gmsh wheel's libgmsh links X11, OpenGL/GLU, Xft and fontconfig (ldd libgmsh.so.4.15).
 # (Skipped where there is no ldconfig cache to ask.)
@@ -53,4 +56,20 @@ if [ -d "$gl/node_modules/gltf-validator" ] && [ "$(cat "$gl/node_modules/.lock.
 else
   echo "verify-setup: npm ci in $gl"; (cd "$gl" && npm ci --no-audit --no-fund --silent) && echo "$glwant" > "$gl/node_modules/.lock.sha256"
 fi
-echo "verify-setup: done ($(.venv-verify/bin/python --version), $(xmllint --version 2>&1 | head -1), $(chromium --version 2>/dev/null), gmsh $(.venv-verify/bin/python -c 'import gmsh; print(gmsh.__version__)'))"
+# playwright-core for tests/browser (crates/terramesh-cli/tests/report_viewer.rs).
+node_major=$(node -p 'process.versions.node.split(".")[0]')
+if [ "$node_major" -lt 20 ]; then
+  echo "verify-setup: node $(node --version) is too old for playwright-core (needs 20 or newer)" >&2
+  exit 1
+fi
+lock=tests/browser/package-lock.json
+nstamp=tests/browser/node_modules/.package-lock.sha256
+nwant=$(sha256sum "$lock" | cut -d' ' -f1)
+if [ "$(cat "$nstamp" 2>/dev/null)" = "$nwant" ]; then
+  echo "verify-setup: tests/browser/node_modules up to date with $lock"
+else
+  echo "verify-setup: npm ci in tests/browser"
+  (cd tests/browser && npm ci --no-audit --no-fund --silent)
+  echo "$nwant" > "$nstamp"
+fi
+echo "verify-setup: done ($(.venv-verify/bin/python --version), $(xmllint --version 2>&1 | head -1), $(chromium --version 2>/dev/null), gmsh $(.venv-verify/bin/python -c 'import gmsh; print(gmsh.__version__)'), node $(node --version))"

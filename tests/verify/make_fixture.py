@@ -231,6 +231,27 @@ def write_dae(out, xy, z, tris, fmt=repr):
     return enu
 
 
+def viewer_data(pts, tris, std, diff):
+    """The 3D viewer's scene as terramesh_io::viewer writes it: float32 offsets from an origin
+    (bbox centre in x, y; lowest z), Uint32 triangles, float32 fields, all base64."""
+    origin = [float((pts[:, 0].min() + pts[:, 0].max()) / 2), float((pts[:, 1].min() + pts[:, 1].max()) / 2),
+              float(pts[:, 2].min())]
+    b64 = lambda a, t: base64.b64encode(np.asarray(a, dtype=t).tobytes()).decode()
+    field = lambda label, colours, v: {"label": label, "unit": "m", "lo": float(v.min()), "hi": float(v.max()),
+                                       "colours": colours, "diverging": False}
+    grey = [[0, 0, 0], [255, 255, 255]]
+    layer = {"name": "DSM surface", "kind": "triangles", "vertices": len(pts), "triangles": len(tris),
+             "positions": b64(pts - origin, "<f4"), "indices": b64(tris, "<u4"),
+             "fields": {"elevation": b64(pts[:, 2], "<f4"), "kriging_std": b64(std, "<f4"),
+                        "uk_minus_idw": b64(diff, "<f4")},
+             "colour": [200, 200, 200], "visible": True, "pickable": True, "clipped": True}
+    return json.dumps({"crs": "WGS 84 / UTM zone 32N", "note": None, "origin": origin,
+                       "fields": {"elevation": field("elevation", grey, pts[:, 2]),
+                                  "kriging_std": field("kriging std", grey, std),
+                                  "uk_minus_idw": field("UK minus IDW", grey, diff)},
+                       "layers": [layer]})
+
+
 def write_all(out):
     out = Path(out)
     (out / "pictures").mkdir(parents=True, exist_ok=True)
@@ -278,10 +299,12 @@ def write_all(out):
     (out / "pictures" / "dsm.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">'
                                               '<rect width="10" height="10" fill="teal"/></svg>\n')
     uri = "data:image/png;base64," + base64.b64encode(png).decode()
+    viewer = viewer_data(pts, tris, std, uk - idw)
     (out / "report.html").write_text(
         f'<!DOCTYPE html>\n<html><head><meta charset="utf-8"><title>DSM report</title>'
         f"<style>body{{background:{CHECKER};font-family:sans-serif}}</style></head><body>"
         f'<h1>Discrete surface model</h1><p>{len(tris)} triangles.</p><img alt="dsm" width="400" src="{uri}">'
+        f'<script type="application/json" id="tmv-data">{viewer}</script>'
         f"</body></html>\n")
 
 

@@ -235,7 +235,51 @@ def test_report_image_bad_png(out, capsys):
 def test_report_console_error(out, capsys):
     edit(out / "report.html", "</body>", "<script>console.error('boom')</script></body>")
     assert "boom" in failures(out, "report.html: renders (chromium)", capsys)[0]
-    assert "script" in failures(out, "report.html: self-contained", capsys)[0]
+
+
+def test_report_script_file(out, capsys):
+    edit(out / "report.html", "</body>", '<script src="viewer.js"></script></body>')
+    assert "scripts must be inline" in failures(out, "report.html: self-contained", capsys)[0]
+
+
+def test_viewer_missing(out, capsys):
+    edit(out / "report.html", 'id="tmv-data"', 'id="other"')
+    assert "no 3D viewer data" in failures(out, "report.html: 3D viewer data", capsys)[0]
+
+
+def test_viewer_origin_off(out, capsys):
+    import re
+    s = (out / "report.html").read_text()
+    s = re.sub(r'"origin": \[([-0-9.e]+)', lambda m: f'"origin": [{float(m.group(1)) + 0.5!r}', s, count=1)
+    (out / "report.html").write_text(s)
+    assert "surface vertex" in failures(out, "report.html: 3D viewer data", capsys)[0]
+
+
+def test_viewer_triangles_differ(out, capsys):
+    import base64
+    import json
+    import re
+    s = (out / "report.html").read_text()
+    m = re.search(r'id="tmv-data">(.*?)</script>', s)
+    scene = json.loads(m.group(1))
+    idx = np.frombuffer(base64.b64decode(scene["layers"][0]["indices"]), "<u4").copy()
+    idx[[0, 1]] = idx[[1, 0]]  # one triangle turned over
+    scene["layers"][0]["indices"] = base64.b64encode(idx.tobytes()).decode()
+    (out / "report.html").write_text(s.replace(m.group(1), json.dumps(scene)))
+    assert "triangles differ" in failures(out, "report.html: 3D viewer data", capsys)[0]
+
+
+def test_viewer_field_wrong(out, capsys):
+    import base64
+    import json
+    import re
+    s = (out / "report.html").read_text()
+    m = re.search(r'id="tmv-data">(.*?)</script>', s)
+    scene = json.loads(m.group(1))
+    # The elevations where UK minus IDW belongs.
+    scene["layers"][0]["fields"]["uk_minus_idw"] = scene["layers"][0]["fields"]["elevation"]
+    (out / "report.html").write_text(s.replace(m.group(1), json.dumps(scene)))
+    assert "field uk_minus_idw" in failures(out, "report.html: 3D viewer data", capsys)[0]
 
 
 def test_report_blank(out, capsys):

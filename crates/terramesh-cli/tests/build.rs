@@ -246,11 +246,14 @@ fn example_outputs_agree_with_each_other() {
     for m in ["UK,", "OK,", "IDW,"] {
         assert!(cv.contains(&format!("\n{m}")), "{cv}");
     }
-    // The report is one self-contained page with every picture inlined.
+    // The report is one self-contained page with every picture inlined and only inline
+    // scripts (the 3D viewer's data and code).
     let html = read(&out.join("report.html"));
     assert_eq!(html.matches("data:image/png;base64,").count(), 9);
-    assert!(!html.contains("src=\"http") && !html.contains("<script"));
+    assert!(!html.contains("src=\"http") && !html.contains("<script src"));
     for h in [
+        "3D view",
+        "id=\"tmv-data\"",
         "Study area corners",
         "Cross-validation",
         "Mesh quality",

@@ -2,8 +2,8 @@
 //! ([`output`]), study regions from corner lists, GeoJSON, KML and WKT ([`region`]),
 //! elevation sources (SRTM `.hgt` tiles, GeoTIFF, ASCII grids, LAS/LAZ points, [`dem`]),
 //! rasters ([`grid_write`]), every surface export format ([`export`]), pictures
-//! ([`pictures`]) and reports ([`report`]). Numerical work lives in `terramesh-core` and
-//! `terramesh-mesh`.
+//! ([`pictures`]), reports ([`report`]) and their 3D viewer ([`viewer`]). Numerical work
+//! lives in `terramesh-core` and `terramesh-mesh`.
 //!
 //! ```
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -33,3 +33,4 @@ pub mod region;
 pub mod report;
 pub mod scratch;
 pub mod table;
+pub mod viewer;

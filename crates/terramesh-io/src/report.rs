@@ -1,5 +1,5 @@
-//! `report.html`: one self-contained page (pictures inlined, no scripts, no external links)
-//! that a person opens in a browser.
+//! `report.html`: one self-contained page (pictures inlined, no external links, no script but
+//! the inlined 3D viewer of [`crate::viewer`]) that a person opens in a browser, offline.
 
 use std::fmt::Write as _;
 
@@ -42,6 +42,9 @@ pub enum Block {
         /// The PNG file's bytes.
         bytes: Vec<u8>,
     },
+    /// The interactive 3D viewer of a scene ([`crate::viewer`]); at most one per report. Its
+    /// script and data are inlined, so the page stays one file.
+    Viewer(Box<crate::viewer::Scene>),
 }
 
 /// Escapes text for HTML.
@@ -102,18 +105,32 @@ impl Report {
     ///         }],
     ///     }],
     /// };
-    /// let html = r.to_html();
+    /// let html = r.to_html()?;
     /// assert!(html.contains("<title>Haut-Barr &lt;DSM&gt;</title>"));
     /// assert!(html.contains("<td>1.23</td>"));
+    /// # Ok::<(), terramesh_io::viewer::SceneError>(())
     /// ```
-    pub fn to_html(&self) -> String {
+    ///
+    /// # Errors
+    /// A [`Block::Viewer`] whose scene is invalid ([`crate::viewer::Scene::validate`]).
+    pub fn to_html(&self) -> Result<String, crate::viewer::SceneError> {
         let mut h = String::new();
         let t = esc(&self.title);
+        let has_viewer = self
+            .sections
+            .iter()
+            .flat_map(|s| &s.blocks)
+            .any(|b| matches!(b, Block::Viewer(_)));
+        let viewer_css = if has_viewer {
+            crate::viewer::VIEWER_CSS
+        } else {
+            ""
+        };
         let _ = write!(
             h,
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
              <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-             <title>{t}</title>\n<style>\n{CSS}</style>\n</head>\n<body>\n<h1>{t}</h1>\n"
+             <title>{t}</title>\n<style>\n{CSS}{viewer_css}</style>\n</head>\n<body>\n<h1>{t}</h1>\n"
         );
         if self.sections.len() > 1 {
             h.push_str("<nav><ol>\n");
@@ -161,6 +178,7 @@ impl Report {
                             c = esc(caption)
                         );
                     }
+                    Block::Viewer(scene) => h.push_str(&scene.to_html()?),
                 }
             }
             h.push_str("</section>\n");
@@ -168,7 +186,7 @@ impl Report {
         h.push_str("<footer>Made by terramesh ");
         h.push_str(env!("CARGO_PKG_VERSION"));
         h.push_str(". SRTM data courtesy of NASA/USGS where used.</footer>\n</body>\n</html>\n");
-        h
+        Ok(h)
     }
 }
 
@@ -217,7 +235,7 @@ mod tests {
                 },
             ],
         };
-        let h = r.to_html();
+        let h = r.to_html().unwrap();
         assert!(h.contains("data:image/png;base64,iVBORw=="));
         assert!(h.contains("x &lt; y"));
         assert!(!h.contains("http://") && !h.contains("https://") && !h.contains("<script"));

@@ -71,6 +71,9 @@ pub enum Error {
     /// Drawing a picture.
     #[error(transparent)]
     Picture(#[from] terramesh_io::pictures::PictureError),
+    /// The scene of the report's 3D viewer.
+    #[error(transparent)]
+    Scene(#[from] terramesh_io::viewer::SceneError),
     /// An elevation web service or tile server.
     #[error(transparent)]
     Web(#[from] terramesh_web::WebError),

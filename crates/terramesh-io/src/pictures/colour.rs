@@ -38,6 +38,23 @@ const DIVERGING: [(u8, u8, u8); 5] = [
 ];
 
 impl ColourMap {
+    /// The anchors, low to high, evenly spaced over `[0, 1]` (the 3D viewer of
+    /// `report.html` interpolates the same ones).
+    ///
+    /// ```
+    /// use terramesh_io::pictures::ColourMap;
+    /// let a = ColourMap::Terrain.anchors();
+    /// let c = ColourMap::Terrain.at(0.0);
+    /// assert_eq!(a[0], (c.0, c.1, c.2));
+    /// ```
+    pub fn anchors(self) -> &'static [(u8, u8, u8)] {
+        match self {
+            ColourMap::Terrain => &TERRAIN,
+            ColourMap::Viridis => &VIRIDIS,
+            ColourMap::Diverging => &DIVERGING,
+        }
+    }
+
     /// The colour at `t` in `[0, 1]` (clamped; NaN maps to grey).
     ///
     /// ```
@@ -49,11 +66,7 @@ impl ColourMap {
         if t.is_nan() {
             return RGBColor(128, 128, 128);
         }
-        let anchors: &[(u8, u8, u8)] = match self {
-            ColourMap::Terrain => &TERRAIN,
-            ColourMap::Viridis => &VIRIDIS,
-            ColourMap::Diverging => &DIVERGING,
-        };
+        let anchors = self.anchors();
         let t = t.clamp(0.0, 1.0) * (anchors.len() - 1) as f64;
         let i = (t.floor() as usize).min(anchors.len() - 2);
         let f = t - i as f64;

@@ -18,6 +18,7 @@ mod report;
 mod stages;
 pub mod staging;
 mod terrain;
+mod viewer;
 
 use std::path::Path;
 use std::time::Instant;
@@ -26,6 +27,7 @@ pub use adaptive::AdaptiveInfo;
 pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
 pub use stages::{Interpolated, Meshed, Model, Samples};
+pub use viewer::{VIEWER_SAMPLES, VIEWER_VERTICES};
 
 use crate::error::{Error, Result};
 use crate::progress::Progress;

@@ -1,5 +1,5 @@
 //! `report.html` of `terramesh build`: inputs, the corner table (like the paper's Table I),
-//! every picture, variogram parameters, cross-validation, mesh quality, time per stage.
+//! the interactive 3D view (`super::viewer`), every picture, variogram parameters, cross-validation, mesh quality, time per stage.
 
 use std::path::Path;
 
@@ -194,6 +194,12 @@ pub fn write_report(
         }],
     });
     sections.push(Section {
+        heading: "3D view".into(),
+        blocks: vec![Block::Viewer(Box::new(super::viewer::scene(
+            s, m, it, w.base,
+        )?))],
+    });
+    sections.push(Section {
         heading: "Samples".into(),
         blocks: vec![png(0)?],
     });
@@ -355,7 +361,9 @@ pub fn write_report(
                 .collect(),
         }],
     });
-    let html = Report { title, sections }.to_html();
+    let html = Report { title, sections }
+        .to_html()
+        .context("the 3D view of report.html")?;
     write_atomic(&out.join("report.html"), html.as_bytes()).context("cannot write report.html")?;
     Ok(())
 }

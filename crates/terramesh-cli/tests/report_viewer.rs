@@ -1,0 +1,110 @@
+//! The 3D viewer of `report.html` in a real browser: builds the Haut-Barr example and runs
+//! `tests/browser/viewer.test.mjs` (playwright-core driving Debian's chromium), which checks
+//! that the page loads without console errors, the canvas shows terrain colours, and a drag,
+//! the exaggeration slider, the solid layer's toggle, the colour-by selector, the
+//! cross-section and the cursor readout all work.
+//!
+//! It needs node, `tests/browser/node_modules` (`npm ci` there, done by `.ci/verify-setup.sh`)
+//! and chromium. Without them the test fails when the `CI` environment variable is set, and
+//! otherwise prints "skipped: ..." and passes after checking the report alone.
+//!
+//! `TERRAMESH_VIEWER_SCREENSHOTS=docs/images cargo test --release -p terramesh-cli --test
+//! report_viewer` also writes the README's screenshots `docs/images/viewer-*.png`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .nth(2)
+        .expect("workspace root")
+        .to_path_buf()
+}
+
+/// What the browser test needs and is missing, if anything.
+fn missing_tools(root: &Path) -> Option<String> {
+    let chromium = std::env::var_os("CHROMIUM")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+    let node = Command::new("node").arg("--version").output();
+    if !node.is_ok_and(|o| o.status.success()) {
+        return Some("node is not installed".into());
+    }
+    if !root
+        .join("tests/browser/node_modules/playwright-core")
+        .is_dir()
+    {
+        return Some("tests/browser/node_modules/playwright-core is missing".into());
+    }
+    if !chromium.exists() {
+        return Some(format!("{} is missing", chromium.display()));
+    }
+    None
+}
+
+#[test]
+fn report_viewer_works_in_chromium() {
+    let root = repo_root();
+    let tmp = tempfile::tempdir().expect("temporary directory");
+    let out = tmp.path().join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .current_dir(&root)
+        .args(["build", "examples/haut-barr/terramesh.toml", "-o"])
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .expect("run terramesh build");
+    assert!(
+        run.status.success(),
+        "terramesh build failed:\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    // The viewer (container, data, script) stays under 1 MB of the page, and the still
+    // pictures stay in it for printing.
+    let start = html
+        .find("<div class=\"tmv\"")
+        .expect("the viewer's container");
+    let data = html[start..]
+        .find("id=\"tmv-data\"")
+        .expect("the viewer's data")
+        + start;
+    let end = html[data..]
+        .find("<script>")
+        .and_then(|s| html[data + s..].find("</script>").map(|e| data + s + e))
+        .expect("the viewer's script");
+    let added = end + "</script>".len() - start;
+    println!("the viewer adds {added} bytes to report.html");
+    assert!(added < 1_000_000, "the viewer adds {added} bytes");
+    assert!(
+        html.matches("<img ").count() >= 9,
+        "the still pictures are kept"
+    );
+
+    if let Some(why) = missing_tools(&root) {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set and {why}: run .ci/verify-setup.sh"
+        );
+        eprintln!("report_viewer_works_in_chromium: skipped: {why} (run .ci/verify-setup.sh)");
+        return;
+    }
+    let mut cmd = Command::new("node");
+    cmd.current_dir(&root)
+        .arg("tests/browser/viewer.test.mjs")
+        .arg(out.join("report.html"));
+    if let Some(dir) = std::env::var_os("TERRAMESH_VIEWER_SCREENSHOTS") {
+        cmd.arg("--screenshots").arg(root.join(dir));
+    }
+    let run = cmd
+        .output()
+        .expect("run node tests/browser/viewer.test.mjs");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    println!("{stdout}");
+    assert!(
+        run.status.success(),
+        "the browser test failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}

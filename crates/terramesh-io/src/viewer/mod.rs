@@ -1,0 +1,519 @@
+//! The interactive 3D viewer of `report.html`: a scene of named layers (the DSM surface, the
+//! sealed solid's sides and base, the samples as points; later geological units and
+//! boreholes), embedded compactly in the page and drawn by a small WebGL 2 viewer of our own.
+//!
+//! **Why our own viewer and not three.js.** The page must stay one file that works offline.
+//! three.js r170's minified module build is 691,648 bytes and its `OrbitControls.js` 32,134
+//! (`npm pack three@0.170.0`; r187 ships no minified module build), and one HTML file can only
+//! load it through an import map with a data: URL, base64, a third larger again. Everything
+//! this viewer needs (orbit, pan, zoom, a vertical exaggeration, colour maps, flat shading,
+//! points, a clipping plane, a cursor readout by ray casting) is one script of about 20 KB,
+//! [`VIEWER_JS`], with nothing to vendor, pin or update. Sizes measured on the example are in
+//! `docs/report.md`.
+//!
+//! **Data.** Positions are written as little-endian `Float32` relative to an origin (the centre
+//! of the scene's bounding box in x and y, the lowest elevation of the first surface in z), so
+//! UTM magnitudes lose nothing: float32 keeps about 7 digits of the offsets, millimetres over a
+//! few kilometres. Triangles are `Uint32` indices, per-vertex fields `Float32`, each array
+//! base64 in a JSON `<script type="application/json">` block; the script decodes them.
+
+use std::fmt::Write as _;
+
+use serde_json::{json, Map, Value};
+
+use crate::pictures::ColourMap;
+use crate::report::base64;
+
+/// The viewer's script (WebGL 2, no dependencies), inlined into the page.
+pub const VIEWER_JS: &str = include_str!("viewer.js");
+/// The viewer's style sheet, added to the page's `<style>` when it has a viewer.
+pub const VIEWER_CSS: &str = include_str!("viewer.css");
+
+/// What a layer draws.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Geometry {
+    /// Triangles: three indices into the layer's positions each.
+    Triangles(Vec<[u32; 3]>),
+    /// Every position as a point.
+    Points,
+}
+
+/// A per-vertex scalar that the viewer can colour by.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Field {
+    /// Key, shared by the layers that have this field (e.g. `elevation`); the colour-by
+    /// selector lists each key once.
+    pub key: String,
+    /// What the selector and readout call it (e.g. `kriging standard deviation`).
+    pub label: String,
+    /// Unit for the readout and the legend (e.g. `m`).
+    pub unit: String,
+    /// Colour map (the same anchors as the still pictures). A [`ColourMap::Diverging`] field
+    /// gets a range symmetric about zero.
+    pub colours: ColourMap,
+    /// One value per position of the layer.
+    pub values: Vec<f64>,
+}
+
+/// One named layer with a visibility toggle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layer {
+    /// Name shown beside its toggle.
+    pub name: String,
+    /// Absolute coordinates (e.g. UTM metres and elevation).
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles or points.
+    pub geometry: Geometry,
+    /// Fields to colour by; a layer without the selected field is coloured by its first field,
+    /// or in [`Layer::colour`] when it has none.
+    pub fields: Vec<Field>,
+    /// Uniform colour (RGB) when no field applies.
+    pub colour: [u8; 3],
+    /// Shown when the page opens.
+    pub visible: bool,
+    /// The cursor readout reports positions on this layer (triangle layers only).
+    pub pickable: bool,
+    /// Cut by the cross-section plane.
+    pub clipped: bool,
+}
+
+/// A scene for the viewer.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Scene {
+    /// The horizontal coordinate system, named in the readout (e.g. `WGS 84 / UTM zone 32N`).
+    pub crs: String,
+    /// A note shown under the view (e.g. that the surface is decimated, and to what).
+    pub note: Option<String>,
+    /// Layers, drawn in order.
+    pub layers: Vec<Layer>,
+}
+
+/// A scene that cannot be shown.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// A layer's field has a different number of values than the layer has positions.
+    #[error(
+        "viewer layer {layer:?}: field {field:?} has {values} values for {positions} positions"
+    )]
+    FieldLength {
+        /// The layer.
+        layer: String,
+        /// The field key.
+        field: String,
+        /// Values given.
+        values: usize,
+        /// Positions of the layer.
+        positions: usize,
+    },
+    /// A triangle refers to a position the layer does not have.
+    #[error("viewer layer {layer:?}: triangle {triangle} refers to vertex {index} of {positions}")]
+    Index {
+        /// The layer.
+        layer: String,
+        /// The triangle's number.
+        triangle: usize,
+        /// The bad index.
+        index: u32,
+        /// Positions of the layer.
+        positions: usize,
+    },
+    /// A coordinate or field value is NaN or infinite.
+    #[error("viewer layer {layer:?}: {what} {index} is not finite")]
+    NotFinite {
+        /// The layer.
+        layer: String,
+        /// `position` or the field key.
+        what: String,
+        /// The vertex.
+        index: usize,
+    },
+    /// No layer has a position.
+    #[error("the viewer scene has no positions")]
+    Empty,
+}
+
+fn f32_base64(v: impl Iterator<Item = f64>) -> String {
+    let mut bytes = Vec::new();
+    for x in v {
+        bytes.extend_from_slice(&(x as f32).to_le_bytes());
+    }
+    base64(&bytes)
+}
+
+impl Scene {
+    /// Checks the layers: field lengths, indices in range, finite values.
+    ///
+    /// # Errors
+    /// The first problem found, naming the layer.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        for l in &self.layers {
+            let n = l.positions.len();
+            if let Some(i) = l
+                .positions
+                .iter()
+                .position(|p| p.iter().any(|c| !c.is_finite()))
+            {
+                return Err(SceneError::NotFinite {
+                    layer: l.name.clone(),
+                    what: "position".into(),
+                    index: i,
+                });
+            }
+            if let Geometry::Triangles(t) = &l.geometry {
+                for (k, tri) in t.iter().enumerate() {
+                    if let Some(&i) = tri.iter().find(|&&i| i as usize >= n) {
+                        return Err(SceneError::Index {
+                            layer: l.name.clone(),
+                            triangle: k,
+                            index: i,
+                            positions: n,
+                        });
+                    }
+                }
+            }
+            for f in &l.fields {
+                if f.values.len() != n {
+                    return Err(SceneError::FieldLength {
+                        layer: l.name.clone(),
+                        field: f.key.clone(),
+                        values: f.values.len(),
+                        positions: n,
+                    });
+                }
+                if let Some(i) = f.values.iter().position(|v| !v.is_finite()) {
+                    return Err(SceneError::NotFinite {
+                        layer: l.name.clone(),
+                        what: f.key.clone(),
+                        index: i,
+                    });
+                }
+            }
+        }
+        if self.layers.iter().all(|l| l.positions.is_empty()) {
+            return Err(SceneError::Empty);
+        }
+        Ok(())
+    }
+
+    /// The origin subtracted from every position: the centre of the bounding box in x and y,
+    /// the lowest elevation of the first triangle layer (of all layers if there is none) in z.
+    pub fn origin(&self) -> [f64; 3] {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in self.layers.iter().flat_map(|l| &l.positions) {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let surface = self
+            .layers
+            .iter()
+            .find(|l| matches!(l.geometry, Geometry::Triangles(_)) && !l.positions.is_empty());
+        let z0 = surface.map_or(lo[2], |l| {
+            l.positions
+                .iter()
+                .map(|p| p[2])
+                .fold(f64::INFINITY, f64::min)
+        });
+        [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), z0]
+    }
+
+    /// The scene as JSON for the viewer script (arrays as base64 little-endian binary).
+    ///
+    /// # Errors
+    /// As [`Scene::validate`].
+    pub fn to_json(&self) -> Result<String, SceneError> {
+        self.validate()?;
+        let o = self.origin();
+        // Each field key once, with its range over every layer that has it.
+        let mut fields = Map::new();
+        for f in self.layers.iter().flat_map(|l| &l.fields) {
+            let (lo, hi) = f
+                .values
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let entry = fields.entry(f.key.clone()).or_insert_with(|| {
+                json!({
+                    "label": f.label,
+                    "unit": f.unit,
+                    "lo": lo,
+                    "hi": hi,
+                    "colours": f.colours.anchors().iter().map(|c| [c.0, c.1, c.2]).collect::<Vec<_>>(),
+                    "diverging": f.colours == ColourMap::Diverging,
+                })
+            });
+            let (a, b) = (
+                entry["lo"].as_f64().unwrap_or(lo),
+                entry["hi"].as_f64().unwrap_or(hi),
+            );
+            entry["lo"] = json!(a.min(lo));
+            entry["hi"] = json!(b.max(hi));
+        }
+        for v in fields.values_mut() {
+            let (mut lo, mut hi) = (
+                v["lo"].as_f64().unwrap_or(0.0),
+                v["hi"].as_f64().unwrap_or(0.0),
+            );
+            if v["diverging"] == json!(true) {
+                let m = lo.abs().max(hi.abs());
+                (lo, hi) = (-m, m);
+            }
+            if hi - lo < 1e-9 {
+                (lo, hi) = (lo - 0.5, hi + 0.5);
+            }
+            v["lo"] = json!(lo);
+            v["hi"] = json!(hi);
+        }
+        let layers: Vec<Value> = self
+            .layers
+            .iter()
+            .map(|l| {
+                let positions = f32_base64(
+                    l.positions
+                        .iter()
+                        .flat_map(|p| [p[0] - o[0], p[1] - o[1], p[2] - o[2]]),
+                );
+                let (kind, indices, triangles) = match &l.geometry {
+                    Geometry::Triangles(t) => {
+                        let mut bytes = Vec::with_capacity(t.len() * 12);
+                        for i in t.iter().flatten() {
+                            bytes.extend_from_slice(&i.to_le_bytes());
+                        }
+                        ("triangles", base64(&bytes), t.len())
+                    }
+                    Geometry::Points => ("points", String::new(), 0),
+                };
+                let lf: Map<String, Value> = l
+                    .fields
+                    .iter()
+                    .map(|f| (f.key.clone(), json!(f32_base64(f.values.iter().copied()))))
+                    .collect();
+                json!({
+                    "name": l.name,
+                    "kind": kind,
+                    "vertices": l.positions.len(),
+                    "triangles": triangles,
+                    "positions": positions,
+                    "indices": indices,
+                    "fields": lf,
+                    "colour": l.colour,
+                    "visible": l.visible,
+                    "pickable": l.pickable,
+                    "clipped": l.clipped,
+                })
+            })
+            .collect();
+        let scene = json!({
+            "crs": self.crs,
+            "note": self.note,
+            "origin": o,
+            "fields": fields,
+            "layers": layers,
+        });
+        // Inside <script>, "</" could end the element: JSON allows "<\/" for it.
+        Ok(scene.to_string().replace("</", "<\\/"))
+    }
+
+    /// The viewer as an HTML fragment: a container, the scene's JSON and the script. One
+    /// viewer per page (its elements have fixed ids).
+    ///
+    /// ```
+    /// use terramesh_io::pictures::ColourMap;
+    /// use terramesh_io::viewer::{Field, Geometry, Layer, Scene};
+    /// let positions = vec![[500_000.0, 5_400_000.0, 300.0], [500_010.0, 5_400_000.0, 301.0],
+    ///                      [500_000.0, 5_400_010.0, 302.0]];
+    /// let scene = Scene {
+    ///     crs: "WGS 84 / UTM zone 32N".into(),
+    ///     note: None,
+    ///     layers: vec![Layer {
+    ///         name: "DSM surface".into(),
+    ///         fields: vec![Field {
+    ///             key: "elevation".into(),
+    ///             label: "elevation".into(),
+    ///             unit: "m".into(),
+    ///             colours: ColourMap::Terrain,
+    ///             values: positions.iter().map(|p| p[2]).collect(),
+    ///         }],
+    ///         positions,
+    ///         geometry: Geometry::Triangles(vec![[0, 1, 2]]),
+    ///         colour: [200, 200, 200],
+    ///         visible: true,
+    ///         pickable: true,
+    ///         clipped: true,
+    ///     }],
+    /// };
+    /// let html = scene.to_html()?;
+    /// assert!(html.contains("id=\"tmv-data\"") && html.contains("getContext"));
+    /// assert_eq!(scene.origin(), [500_005.0, 5_400_005.0, 300.0]);
+    /// # Ok::<(), terramesh_io::viewer::SceneError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Scene::validate`].
+    pub fn to_html(&self) -> Result<String, SceneError> {
+        let data = self.to_json()?;
+        let mut h = String::with_capacity(data.len() + VIEWER_JS.len() + 512);
+        h.push_str(
+            "<div class=\"tmv\" id=\"tmv\"><noscript>The interactive 3D view needs JavaScript; \
+             the still pictures below show the same model.</noscript></div>\n",
+        );
+        let _ = writeln!(
+            h,
+            "<script type=\"application/json\" id=\"tmv-data\">{data}</script>"
+        );
+        let _ = writeln!(h, "<script>\n{VIEWER_JS}</script>");
+        Ok(h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri_layer() -> Layer {
+        Layer {
+            name: "s".into(),
+            positions: vec![[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 1.0, 3.0]],
+            geometry: Geometry::Triangles(vec![[0, 1, 2]]),
+            fields: vec![Field {
+                key: "d".into(),
+                label: "difference".into(),
+                unit: "m".into(),
+                colours: ColourMap::Diverging,
+                values: vec![-1.0, 0.5, 2.0],
+            }],
+            colour: [1, 2, 3],
+            visible: true,
+            pickable: true,
+            clipped: false,
+        }
+    }
+
+    fn decode(s: &str) -> Vec<u8> {
+        // Inverse of base64 for the round-trip test.
+        const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut out = Vec::new();
+        let v: Vec<u32> = s
+            .bytes()
+            .filter(|&c| c != b'=')
+            .map(|c| A.iter().position(|&a| a == c).unwrap() as u32)
+            .collect();
+        for ch in v.chunks(4) {
+            let n = ch
+                .iter()
+                .enumerate()
+                .fold(0u32, |n, (k, &c)| n | c << (18 - 6 * k));
+            for k in 0..ch.len() - 1 {
+                out.push((n >> (16 - 8 * k)) as u8);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn positions_round_trip_relative_to_the_origin() {
+        let mut l = tri_layer();
+        for p in &mut l.positions {
+            p[0] += 389_123.456;
+            p[1] += 5_398_765.432;
+        }
+        let scene = Scene {
+            layers: vec![l.clone()],
+            ..Scene::default()
+        };
+        let o = scene.origin();
+        let v: Value = serde_json::from_str(&scene.to_json().unwrap()).unwrap();
+        let bytes = decode(v["layers"][0]["positions"].as_str().unwrap());
+        let f: Vec<f32> = bytes
+            .chunks(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        for (i, p) in l.positions.iter().enumerate() {
+            for k in 0..3 {
+                let back = o[k] + f64::from(f[3 * i + k]);
+                assert!((back - p[k]).abs() < 1e-6, "{back} vs {}", p[k]);
+            }
+        }
+        let idx = decode(v["layers"][0]["indices"].as_str().unwrap());
+        assert_eq!(
+            idx,
+            [0u32, 1, 2]
+                .iter()
+                .flat_map(|i| i.to_le_bytes())
+                .collect::<Vec<_>>()
+        );
+    }
+
+    #[test]
+    fn diverging_ranges_are_symmetric_and_shared_across_layers() {
+        let mut b = tri_layer();
+        b.fields[0].values = vec![-3.0, 0.0, 0.0];
+        let scene = Scene {
+            layers: vec![tri_layer(), b],
+            ..Scene::default()
+        };
+        let v: Value = serde_json::from_str(&scene.to_json().unwrap()).unwrap();
+        assert_eq!(v["fields"]["d"]["lo"], json!(-3.0));
+        assert_eq!(v["fields"]["d"]["hi"], json!(3.0));
+        assert_eq!(
+            v["fields"]["d"]["colours"].as_array().unwrap().len(),
+            ColourMap::Diverging.anchors().len()
+        );
+    }
+
+    #[test]
+    fn bad_layers_are_errors_that_name_them() {
+        let mut l = tri_layer();
+        l.fields[0].values.pop();
+        let e = Scene {
+            layers: vec![l],
+            ..Scene::default()
+        }
+        .to_json()
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("\"s\"") && e.to_string().contains("2 values for 3"),
+            "{e}"
+        );
+        let mut l = tri_layer();
+        l.geometry = Geometry::Triangles(vec![[0, 1, 7]]);
+        let e = Scene {
+            layers: vec![l],
+            ..Scene::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert!(matches!(e, SceneError::Index { index: 7, .. }), "{e}");
+        let mut l = tri_layer();
+        l.positions[1][2] = f64::NAN;
+        assert!(matches!(
+            Scene {
+                layers: vec![l],
+                ..Scene::default()
+            }
+            .validate(),
+            Err(SceneError::NotFinite { index: 1, .. })
+        ));
+        assert_eq!(Scene::default().validate(), Err(SceneError::Empty));
+    }
+
+    #[test]
+    fn the_json_cannot_close_its_script_element() {
+        let mut l = tri_layer();
+        l.name = "a</script><script>alert(1)".into();
+        let html = Scene {
+            layers: vec![l],
+            ..Scene::default()
+        }
+        .to_html()
+        .unwrap();
+        assert_eq!(
+            html.matches("</script>").count(),
+            2,
+            "only the two real closing tags"
+        );
+    }
+}

@@ -1,0 +1,256 @@
+// Drives the 3D viewer of a built report.html in Debian's chromium through playwright-core and
+// checks what a person would see:
+//
+//   node tests/browser/viewer.test.mjs OUT/report.html [--screenshots DIR]
+//
+// Asserted: no console error or warning and no page error; the canvas is not blank; its
+// centre pixel is a shade of the elevation colour map (not the background); a mouse drag,
+// the vertical exaggeration slider (keyboard), hiding the solid layer, the colour-by selector
+// and the cross-section each change the image; hiding the solid removes its colour from the
+// picture; after switching fields the centre pixel is a shade of that field's colour map; the
+// cursor readout shows coordinates and an elevation inside the ranges of dsm-vertices.csv
+// (read here, beside report.html). Exit status 1 with the failed check on stderr.
+import { chromium } from "playwright-core";
+import { existsSync, mkdirSync, readFileSync } from "node:fs";
+import { dirname, join, resolve } from "node:path";
+import { pathToFileURL } from "node:url";
+
+const args = process.argv.slice(2);
+const report = args[0];
+const shotDir = args.includes("--screenshots") ? args[args.indexOf("--screenshots") + 1] : null;
+if (!report || !existsSync(report)) {
+  console.error(`usage: node viewer.test.mjs OUT/report.html [--screenshots DIR] (no file ${report})`);
+  process.exit(2);
+}
+const executablePath = process.env.CHROMIUM || "/usr/bin/chromium";
+if (!existsSync(executablePath)) {
+  console.error(`${executablePath} is missing: run .ci/verify-setup.sh (or set CHROMIUM)`);
+  process.exit(2);
+}
+
+function fail(msg) {
+  console.error(`FAIL ${msg}`);
+  process.exitCode = 1;
+  throw new Error(msg);
+}
+function ok(msg) {
+  console.log(`ok   ${msg}`);
+}
+
+// The vertex table of the same build: the independent range for the readout.
+const csv = readFileSync(join(dirname(report), "dsm-vertices.csv"), "utf8").trim().split("\n");
+const head = csv[0].split(",");
+const col = (name) => head.indexOf(name);
+const range = { x: [Infinity, -Infinity], y: [Infinity, -Infinity], z: [Infinity, -Infinity] };
+for (const line of csv.slice(1)) {
+  const v = line.split(",").map(Number);
+  for (const [k, c] of [["x", col("x")], ["y", col("y")], ["z", col("elevation_uk")]]) {
+    range[k][0] = Math.min(range[k][0], v[c]);
+    range[k][1] = Math.max(range[k][1], v[c]);
+  }
+}
+
+// Chromium 137+ no longer falls back to software WebGL silently: with --disable-gpu,
+// --enable-unsafe-swiftshader opts in (the page is a local, trusted file).
+const browser = await chromium.launch({
+  executablePath,
+  args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--enable-unsafe-swiftshader"],
+});
+const problems = [];
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+  page.on("console", (m) => {
+    // Software GL reports every read-back of the canvas as a performance notice; it is the
+    // browser's, not the page's, and says nothing about the page.
+    if (/GL Driver Message \(OpenGL, Performance/.test(m.text())) return;
+    if (m.type() === "error" || m.type() === "warning") problems.push(`console ${m.type()}: ${m.text()}`);
+  });
+  page.on("pageerror", (e) => problems.push(`page error: ${e.message}`));
+  page.on("requestfailed", (r) => problems.push(`failed request: ${r.url()}`));
+  const t0 = Date.now();
+  await page.goto(pathToFileURL(resolve(report)).href);
+  await page.waitForSelector("#tmv[data-ready='1']", { timeout: 120000 }).catch(() =>
+    fail(`the viewer did not draw within 120 s; ${problems.join(" | ") || "no console message"}`));
+  ok(`the viewer drew its first frame ${((Date.now() - t0) / 1000).toFixed(2)} s after navigation`);
+  const canvas = page.locator("#tmv-canvas");
+  await canvas.scrollIntoViewIfNeeded();
+  const box = await canvas.boundingBox();
+  const centre = [box.x + box.width / 2, box.y + box.height / 2];
+  const scene = await page.evaluate(() => JSON.parse(document.getElementById("tmv-data").textContent));
+
+  // The canvas's pixels after the next frame, kept in the page under `name`: the centre
+  // pixel, the background (corner) colour and colour statistics come back.
+  async function snapshot(name) {
+    return page.evaluate(async (name) => {
+      const root = document.getElementById("tmv");
+      for (let i = 0; i < 3; i++) await new Promise((r) => requestAnimationFrame(r));
+      const c = document.getElementById("tmv-canvas");
+      const two = document.createElement("canvas");
+      two.width = c.width; two.height = c.height;
+      const g = two.getContext("2d");
+      g.drawImage(c, 0, 0);
+      const d = g.getImageData(0, 0, c.width, c.height).data;
+      (window.__snaps = window.__snaps || {})[name] = d;
+      const bg = [d[0], d[1], d[2]];
+      let other = 0; const colours = new Set();
+      for (let i = 0; i < d.length; i += 4) {
+        if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 6) other++;
+        if (i % 40 === 0) colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+      }
+      const k = 4 * (Math.floor(c.height / 2) * c.width + Math.floor(c.width / 2));
+      return { name, frames: Number(root.dataset.frames), centre: [d[k], d[k + 1], d[k + 2]], bg,
+        nonBackground: other / (d.length / 4), colours: colours.size };
+    }, name);
+  }
+  // The fraction of pixels that differ between two snapshots.
+  async function changed(a, b) {
+    return page.evaluate(([a, b]) => {
+      const x = window.__snaps[a], y = window.__snaps[b];
+      let n = 0;
+      for (let i = 0; i < x.length; i += 4) {
+        if (Math.abs(x[i] - y[i]) + Math.abs(x[i + 1] - y[i + 1]) + Math.abs(x[i + 2] - y[i + 2]) > 12) n++;
+      }
+      return n / (x.length / 4);
+    }, [a.name, b.name]);
+  }
+  // Pixels of a snapshot that are a shade s * rgb of one colour (within 3 per channel).
+  async function countShade(snap, rgb) {
+    return page.evaluate(([name, rgb]) => {
+      const d = window.__snaps[name], r2 = rgb[0] ** 2 + rgb[1] ** 2 + rgb[2] ** 2;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        const s = (d[i] * rgb[0] + d[i + 1] * rgb[1] + d[i + 2] * rgb[2]) / r2;
+        if (s > 0.1 && Math.abs(d[i] - s * rgb[0]) <= 3 && Math.abs(d[i + 1] - s * rgb[1]) <= 3
+          && Math.abs(d[i + 2] - s * rgb[2]) <= 3) n++;
+      }
+      return n;
+    }, [snap.name, rgb]);
+  }
+  // How far a pixel is from the nearest shade s * map(t) of a colour map (max channel error).
+  function offMap(px, anchors) {
+    let best = Infinity;
+    for (let i = 0; i <= 1000; i++) {
+      const t = (i / 1000) * (anchors.length - 1), j = Math.min(Math.floor(t), anchors.length - 2), f = t - j;
+      const m = [0, 1, 2].map((c) => anchors[j][c] + (anchors[j + 1][c] - anchors[j][c]) * f);
+      const s = Math.min(1.05, Math.max(0.15, (px[0] * m[0] + px[1] * m[1] + px[2] * m[2]) / (m[0] ** 2 + m[1] ** 2 + m[2] ** 2)));
+      best = Math.min(best, Math.max(...[0, 1, 2].map((c) => Math.abs(px[c] - s * m[c]))));
+    }
+    return best;
+  }
+  async function shot(name) {
+    if (!shotDir) return;
+    mkdirSync(shotDir, { recursive: true });
+    await page.locator("#tmv").screenshot({ path: join(shotDir, name) });
+    ok(`screenshot ${join(shotDir, name)}`);
+  }
+
+  const first = await snapshot("first");
+  if (first.nonBackground < 0.05 || first.colours < 50) {
+    fail(`the canvas is blank: ${(100 * first.nonBackground).toFixed(1)} % non-background, ${first.colours} colours`);
+  }
+  ok(`the canvas is not blank: ${(100 * first.nonBackground).toFixed(1)} % non-background pixels, ${first.colours} colours (sampled)`);
+  const elev = scene.fields.elevation.colours;
+  const bgOff = Math.max(...[0, 1, 2].map((c) => Math.abs(first.centre[c] - first.bg[c])));
+  const centreOff = offMap(first.centre, elev);
+  if (bgOff < 10 || centreOff > 6) {
+    fail(`the centre pixel ${first.centre} is not terrain-coloured (${centreOff.toFixed(1)} off the elevation map, ${bgOff} from the background ${first.bg})`);
+  }
+  ok(`the centre pixel ${first.centre} is a shade of the elevation colour map (within ${centreOff.toFixed(1)}), not the background ${first.bg}`);
+  await shot("viewer-elevation.png");
+
+  // Cursor readout at the centre.
+  await page.mouse.move(centre[0] - 5, centre[1] - 5);
+  await page.mouse.move(centre[0], centre[1]);
+  await page.waitForSelector("#tmv-readout[data-easting]", { timeout: 10000 }).catch(async () =>
+    fail(`no cursor readout: ${await page.textContent("#tmv-readout")}`));
+  const ro = await page.evaluate(() => {
+    const r = document.getElementById("tmv-readout");
+    return { text: r.textContent, e: +r.dataset.easting, n: +r.dataset.northing, z: +r.dataset.elevation };
+  });
+  const inside = (v, [a, b], tol) => v >= a - tol && v <= b + tol;
+  if (!/E \d/.test(ro.text) || !/N \d/.test(ro.text) || !/elevation \d/.test(ro.text)
+    || !inside(ro.e, range.x, 1e-3) || !inside(ro.n, range.y, 1e-3) || !inside(ro.z, range.z, 1e-3)) {
+    fail(`the readout "${ro.text}" is not a point of the DSM (x ${range.x}, y ${range.y}, z ${range.z} in dsm-vertices.csv)`);
+  }
+  ok(`cursor readout: "${ro.text}"`);
+
+  // A drag orbits.
+  await page.mouse.down();
+  for (let i = 1; i <= 10; i++) await page.mouse.move(centre[0] + 14 * i, centre[1] + 3 * i);
+  await page.mouse.up();
+  const dragged = await snapshot("dragged");
+  const dDrag = await changed(first, dragged);
+  if (dDrag < 0.02) fail(`a drag changed only ${(100 * dDrag).toFixed(2)} % of the pixels`);
+  ok(`a mouse drag changed ${(100 * dDrag).toFixed(1)} % of the pixels`);
+
+  // The exaggeration slider, by keyboard.
+  await page.focus("#tmv-exag");
+  for (let i = 0; i < 6; i++) await page.keyboard.press("ArrowRight");
+  const exag = await page.inputValue("#tmv-exag");
+  const exaggerated = await snapshot("exaggerated");
+  const dExag = await changed(dragged, exaggerated);
+  if (exag !== "4" || dExag < 0.02) fail(`the exaggeration slider (now ${exag}) changed ${(100 * dExag).toFixed(2)} % of the pixels`);
+  ok(`vertical exaggeration ${exag}x changed ${(100 * dExag).toFixed(1)} % of the pixels`);
+
+  // Hiding the solid layer.
+  const solidLayer = scene.layers.find((l) => l.name.startsWith("solid"));
+  if (!solidLayer) fail("the scene has no solid layer");
+  const solidRgb = solidLayer.colour;
+  const withSolid = await countShade(exaggerated, solidRgb);
+  await page.locator(`input[data-layer="${solidLayer.name}"]`).uncheck();
+  const noSolid = await snapshot("noSolid");
+  const dSolid = await changed(exaggerated, noSolid);
+  const withoutSolid = await countShade(noSolid, solidRgb);
+  if (dSolid < 0.005 || withSolid < 500 || withoutSolid > 0.1 * withSolid) {
+    fail(`hiding "${solidLayer.name}" changed ${(100 * dSolid).toFixed(2)} % of the pixels; solid-coloured pixels ${withSolid} -> ${withoutSolid}`);
+  }
+  ok(`hiding "${solidLayer.name}" changed ${(100 * dSolid).toFixed(1)} % of the pixels; solid-coloured pixels ${withSolid} -> ${withoutSolid}`);
+  await page.locator(`input[data-layer="${solidLayer.name}"]`).check();
+  const solidBack = await snapshot("solidBack");
+  if (await changed(exaggerated, solidBack) > 0.001) fail("showing the solid again did not restore the picture");
+  ok("showing the solid again restores the picture");
+
+  // Colour by the other fields.
+  let prev = solidBack;
+  for (const key of ["kriging_std", "uk_minus_idw"]) {
+    if (!scene.fields[key]) fail(`the colour-by selector has no ${key}`);
+    await page.selectOption("#tmv-field", key);
+    const s = await snapshot(key);
+    const d = await changed(prev, s);
+    const off = offMap(s.centre, scene.fields[key].colours);
+    if (d < 0.02 || off > 6) {
+      fail(`colour by ${key}: ${(100 * d).toFixed(2)} % of the pixels changed, centre ${s.centre} ${off.toFixed(1)} off its map`);
+    }
+    ok(`colour by ${key} changed ${(100 * d).toFixed(1)} % of the pixels; centre ${s.centre} on its map (within ${off.toFixed(1)})`);
+    prev = s;
+    if (key === "kriging_std") {
+      // The README's picture from the first view; the next field is compared with it.
+      await page.click("#tmv-reset");
+      prev = await snapshot("reset-std");
+      await shot("viewer-kriging-std.png");
+    }
+  }
+
+  // The cross-section plane.
+  await page.selectOption("#tmv-field", "elevation");
+  await page.check("#tmv-clip");
+  const cut = await snapshot("cut");
+  const dCut = await changed(prev, cut);
+  if (dCut < 0.02) fail(`the cross-section changed only ${(100 * dCut).toFixed(2)} % of the pixels`);
+  ok(`the cross-section changed ${(100 * dCut).toFixed(1)} % of the pixels`);
+  await page.click("#tmv-reset");
+  await snapshot("reset");
+  await shot("viewer-cross-section.png");
+
+  if (problems.length) fail(`console or page problems: ${problems.join(" | ")}`);
+  ok("no console error or warning, no page error, no failed request");
+} catch (e) {
+  if (!process.exitCode) {
+    console.error(`FAIL ${e.stack || e}`);
+    process.exitCode = 1;
+  }
+} finally {
+  await browser.close();
+}
