@@ -217,6 +217,11 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
         None => None,
     };
     let nl = s.lags;
+    // One table of lag sums per block of 256 rows (below), plus the lag edges.
+    let tables = data.len().div_ceil(256) as f64 + 1.0;
+    terramesh_core::limits::Estimate::new("lag classes", nl as f64 * tables, 32.0)
+        .remedy(terramesh_core::limits::Remedy::lower("lags"))
+        .check()?;
     let w = max / nl as f64;
     let edges: Vec<f64> = (0..=nl)
         .map(|k| if k == nl { max } else { k as f64 * w })
