@@ -121,7 +121,7 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
                     method,
                     neighbours: Neighbourhood::All,
                 } if variogram.sill().is_some() => {
-                    let g = GlobalKriging::new(data, variogram, *method, true)?;
+                    let g = GlobalKriging::for_leave_one_out(data, variogram, *method)?;
                     let (e, v) = g.leave_one_out()?;
                     for i in 0..n {
                         est[i] = data.z()[i] - e[i];

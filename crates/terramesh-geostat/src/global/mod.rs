@@ -88,6 +88,27 @@ impl GlobalKriging {
     /// # Ok(()) }
     /// ```
     pub fn new(data: &Data, variogram: &Variogram, method: Method, variance: bool) -> Result<Self> {
+        Self::build(data, variogram, method, variance, false)
+    }
+
+    /// [`GlobalKriging::new`] with variances, for [`GlobalKriging::leave_one_out`]: the
+    /// memory check counts the inverse that leave-one-out adds to a dense factor, before the
+    /// factor is made.
+    pub(crate) fn for_leave_one_out(
+        data: &Data,
+        variogram: &Variogram,
+        method: Method,
+    ) -> Result<Self> {
+        Self::build(data, variogram, method, true, true)
+    }
+
+    fn build(
+        data: &Data,
+        variogram: &Variogram,
+        method: Method,
+        variance: bool,
+        loo: bool,
+    ) -> Result<Self> {
         let mut prep = Prepared::new(data, variogram, method)?;
         let n = prep.pts.len();
         let p = prep.terms();
@@ -120,6 +141,7 @@ impl GlobalKriging {
             // The dense system: n x n covariances factored in place and an n x BLOCK block of
             // right-hand sides, or the (n + p)-square variogram system and its LU factors.
             let entries = match sill {
+                Some(_) if loo => 2.0 * n as f64 * n as f64,
                 Some(_) => n as f64 * (n + BLOCK) as f64,
                 None => 2.0 * ((n + p) as f64).powi(2),
             };
