@@ -419,6 +419,30 @@ fn cross_validation_of_huge_values_gives_finite_scaled_statistics() {
 }
 
 #[test]
+fn variogram_of_values_whose_squares_overflow_is_refused_not_missing_lags() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = davis_xyz(dir.path(), 1e200);
+    let out = dir.path().join("v.json");
+    let o = run(&[
+        "variogram",
+        "--data",
+        &data,
+        "--model",
+        "spherical",
+        "-o",
+        s(&out),
+    ]);
+    refused(
+        &o,
+        &[
+            "experimental semivariance is not a finite number",
+            "rescale z",
+        ],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
 fn las_scale_factor_of_zero_or_nan_is_refused_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
     for (name, v) in [("zero", 0.0f64), ("nan", f64::NAN)] {

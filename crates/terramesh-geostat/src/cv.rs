@@ -247,11 +247,11 @@ fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> Result<CvStats> {
         None => (None, None),
     };
     let stats = [
-        ("RMSE", Some(rmse)),
-        ("MAE", Some(mae)),
-        ("mean error", Some(mean_error)),
-        ("mean standardised error", ms),
-        ("variance of the standardised errors", vs),
+        ("cross-validation RMSE", Some(rmse)),
+        ("cross-validation MAE", Some(mae)),
+        ("cross-validation mean error", Some(mean_error)),
+        ("cross-validation mean standardised error", ms),
+        ("cross-validation variance of the standardised errors", vs),
     ];
     for (what, v) in stats {
         if v.is_some_and(|v| !v.is_finite()) {

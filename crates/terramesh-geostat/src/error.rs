@@ -124,9 +124,9 @@ pub enum GeostatError {
     Fit(String),
     /// A cross-validation statistic came out NaN or infinite (data values beyond what
     /// double precision can square).
-    #[error("the cross-validation {what} is not a finite number: the data values are too large for double precision; rescale z (for example to kilometres)")]
+    #[error("the {what} is not a finite number: the data values are too large for double precision; rescale z (for example to kilometres)")]
     NonFiniteStatistic {
-        /// The statistic (`RMSE`, ...).
+        /// The statistic (`cross-validation RMSE`, `experimental semivariance`).
         what: &'static str,
     },
     /// A kriging matrix or a variogram table would not fit in memory

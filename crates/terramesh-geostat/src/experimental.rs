@@ -289,7 +289,7 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
             }
         }
     }
-    Ok(acc
+    let lags: Vec<Lag> = acc
         .iter()
         .enumerate()
         .filter(|(_, a)| a[0] > 0.0)
@@ -309,5 +309,13 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
                 pairs: np as u64,
             }
         })
-        .collect())
+        .collect();
+    // Squares of differences beyond 1.3e154 overflow: an infinite semivariance is an error,
+    // never a lag left out or written as `inf`.
+    if lags.iter().any(|l| !l.gamma.is_finite()) {
+        return Err(GeostatError::NonFiniteStatistic {
+            what: "experimental semivariance",
+        });
+    }
+    Ok(lags)
 }
