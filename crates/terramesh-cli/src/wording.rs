@@ -22,8 +22,14 @@ pub fn mesh_error(e: MeshError) -> anyhow::Error {
             at,
             why: why.replace("longer than max_edge", "longer than --max-edge"),
         }),
+        MeshError::TooLarge(t) => anyhow::anyhow!("{}", t.describe(&flag_of_field)),
         other => other.into(),
     }
+}
+
+/// A library setting named as its field (`max_area`) as this tool's flag (`--max-area`).
+pub fn flag_of_field(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
 }
 
 /// Library phrases and the flags they stand for.

@@ -27,6 +27,7 @@
 
 pub mod coords;
 pub mod geometry;
+pub mod limits;
 pub mod sampling;
 pub mod solid;
 pub mod vocab;

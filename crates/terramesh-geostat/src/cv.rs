@@ -121,7 +121,7 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
                     method,
                     neighbours: Neighbourhood::All,
                 } if variogram.sill().is_some() => {
-                    let g = GlobalKriging::new(data, variogram, *method, true)?;
+                    let g = GlobalKriging::for_leave_one_out(data, variogram, *method)?;
                     let (e, v) = g.leave_one_out()?;
                     for i in 0..n {
                         est[i] = data.z()[i] - e[i];
@@ -159,7 +159,7 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
             refit(data, how, &assign, k, &mut est, &mut var)?;
         }
     }
-    let stats = summarize(data.z(), &est, kriging.then_some(&var[..]));
+    let stats = summarize(data.z(), &est, kriging.then_some(&var[..]))?;
     Ok(CvResult {
         estimate: est,
         variance: if kriging { var } else { Vec::new() },
@@ -202,13 +202,30 @@ fn refit(
     Ok(())
 }
 
-fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> CvStats {
+/// The statistics of the errors `est - z`. Sums of squares are taken of errors scaled by the
+/// largest one, so that errors of 1e200 give a finite RMSE; a statistic that is still not a
+/// finite number is an error, never written as `inf`.
+fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> Result<CvStats> {
     let n = z.len();
     let err: Vec<f64> = est.iter().zip(z).map(|(e, z)| e - z).collect();
+    if let Some(i) = err.iter().position(|e| !e.is_finite()) {
+        return Err(GeostatError::NotFiniteAt {
+            index: i,
+            what: "cross-validation error",
+        });
+    }
     let nf = n as f64;
-    let rmse = (err.iter().map(|e| e * e).sum::<f64>() / nf).sqrt();
-    let mae = err.iter().map(|e| e.abs()).sum::<f64>() / nf;
-    let mean_error = err.iter().sum::<f64>() / nf;
+    let rms = |v: &[f64]| {
+        let s = v.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+        if s == 0.0 {
+            0.0
+        } else {
+            s * (v.iter().map(|e| (e / s) * (e / s)).sum::<f64>() / v.len() as f64).sqrt()
+        }
+    };
+    let rmse = rms(&err);
+    let mae = err.iter().map(|e| e.abs() / nf).sum::<f64>();
+    let mean_error = err.iter().map(|e| e / nf).sum::<f64>();
     let (ms, vs) = match var {
         Some(v) => {
             let s: Vec<f64> = err
@@ -218,8 +235,10 @@ fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> CvStats {
                 .map(|(e, v)| e / v.sqrt())
                 .collect();
             if s.len() >= 2 {
-                let m = s.iter().sum::<f64>() / s.len() as f64;
-                let var = s.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (s.len() - 1) as f64;
+                let m = s.iter().map(|x| x / s.len() as f64).sum::<f64>();
+                let dev: Vec<f64> = s.iter().map(|x| x - m).collect();
+                let r = rms(&dev);
+                let var = r * r * s.len() as f64 / (s.len() - 1) as f64;
                 (Some(m), Some(var))
             } else {
                 (None, None)
@@ -227,14 +246,26 @@ fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> CvStats {
         }
         None => (None, None),
     };
-    CvStats {
+    let stats = [
+        ("cross-validation RMSE", Some(rmse)),
+        ("cross-validation MAE", Some(mae)),
+        ("cross-validation mean error", Some(mean_error)),
+        ("cross-validation mean standardised error", ms),
+        ("cross-validation variance of the standardised errors", vs),
+    ];
+    for (what, v) in stats {
+        if v.is_some_and(|v| !v.is_finite()) {
+            return Err(GeostatError::NonFiniteStatistic { what });
+        }
+    }
+    Ok(CvStats {
         n,
         rmse,
         mae,
         mean_error,
         mean_standardized: ms,
         var_standardized: vs,
-    }
+    })
 }
 
 /// One candidate of `--model auto`.

@@ -122,6 +122,17 @@ pub enum GeostatError {
     /// Fitting a variogram model failed.
     #[error("cannot fit a variogram: {0}")]
     Fit(String),
+    /// A cross-validation statistic came out NaN or infinite (data values beyond what
+    /// double precision can square).
+    #[error("the {what} is not a finite number: the data values are too large for double precision; rescale z (for example to kilometres)")]
+    NonFiniteStatistic {
+        /// The statistic (`cross-validation RMSE`, `experimental semivariance`).
+        what: &'static str,
+    },
+    /// A kriging matrix or a variogram table would not fit in memory
+    /// ([`terramesh_core::limits`]); refused before anything is allocated.
+    #[error(transparent)]
+    TooLarge(#[from] terramesh_core::limits::TooLarge),
 }
 
 impl GeostatError {

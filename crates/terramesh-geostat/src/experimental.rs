@@ -217,6 +217,11 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
         None => None,
     };
     let nl = s.lags;
+    // One table of lag sums per block of 256 rows (below), plus the lag edges.
+    let tables = data.len().div_ceil(256) as f64 + 1.0;
+    terramesh_core::limits::Estimate::new("lag classes", nl as f64 * tables, 32.0)
+        .remedy(terramesh_core::limits::Remedy::lower("lags"))
+        .check()?;
     let w = max / nl as f64;
     let edges: Vec<f64> = (0..=nl)
         .map(|k| if k == nl { max } else { k as f64 * w })
@@ -284,7 +289,7 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
             }
         }
     }
-    Ok(acc
+    let lags: Vec<Lag> = acc
         .iter()
         .enumerate()
         .filter(|(_, a)| a[0] > 0.0)
@@ -304,5 +309,13 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
                 pairs: np as u64,
             }
         })
-        .collect())
+        .collect();
+    // Squares of differences beyond 1.3e154 overflow: an infinite semivariance is an error,
+    // never a lag left out or written as `inf`.
+    if lags.iter().any(|l| !l.gamma.is_finite()) {
+        return Err(GeostatError::NonFiniteStatistic {
+            what: "experimental semivariance",
+        });
+    }
+    Ok(lags)
 }

@@ -65,6 +65,15 @@ impl LocalKriging {
                 what: format!("a neighbourhood with {p} drift terms"),
             });
         }
+        // Each worker thread holds one (k + p)-square system and its factors.
+        let side = (k + p + 1) as f64;
+        terramesh_core::limits::Estimate::new(
+            "kriging matrix entries",
+            side * side * rayon::current_num_threads() as f64,
+            16.0,
+        )
+        .remedy(terramesh_core::limits::Remedy::lower("neighbors"))
+        .check()?;
         let tree = Tree::new(&prep.pts)?;
         let sill = prep.variogram.sill().unwrap_or(0.0);
         let bounded = prep.variogram.sill().is_some();

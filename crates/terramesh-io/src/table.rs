@@ -48,6 +48,23 @@ pub enum TableError {
         /// The columns that are there.
         found: String,
     },
+    /// Two columns answer to one name (`lat,lat,lon`, or `lat` beside `latitude`): taking
+    /// either would be a guess.
+    #[error("{file}: columns {first} ('{first_name}') and {second} ('{second_name}') are both {wanted}; rename or remove one")]
+    DuplicateColumn {
+        /// File name as given.
+        file: String,
+        /// The accepted names, e.g. `'lat' (or 'latitude')`.
+        wanted: String,
+        /// 1-based number of the first such column.
+        first: usize,
+        /// Its name.
+        first_name: String,
+        /// 1-based number of the second.
+        second: usize,
+        /// Its name.
+        second_name: String,
+    },
     /// A cell that should be a number is not.
     #[error("{file}, line {line}, column '{column}': '{value}' {message}")]
     BadValue {
@@ -213,24 +230,49 @@ impl Table {
         })
     }
 
-    /// Like [`Table::find`] but an error naming the file and the columns present.
+    /// Like [`Table::find`] but an error naming the file and the columns present, and an
+    /// error when two columns answer to the names.
+    ///
+    /// ```
+    /// use terramesh_io::table::{Table, ReadOptions};
+    /// let t = Table::from_bytes("a.csv", b"lat,lat,lon\n1,2,3\n", &ReadOptions::default())?;
+    /// let e = t.require(&["lat", "latitude"]).unwrap_err().to_string();
+    /// assert_eq!(e, "a.csv: columns 1 ('lat') and 2 ('lat') are both 'lat' (or 'latitude'); rename or remove one");
+    /// # Ok::<(), terramesh_io::table::TableError>(())
+    /// ```
     pub fn require(&self, names: &[&str]) -> Result<usize, TableError> {
-        self.find(names).ok_or_else(|| {
+        let wanted = || {
             let mut wanted = format!("'{}'", names[0]);
             if names.len() > 1 {
                 let alts: Vec<String> = names[1..].iter().map(|n| format!("'{n}'")).collect();
                 wanted.push_str(&format!(" (or {})", alts.join(", ")));
             }
-            TableError::MissingColumn {
+            wanted
+        };
+        let mut hits = self
+            .headers
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| names.iter().any(|n| h.trim().eq_ignore_ascii_case(n)));
+        if let (Some((i, a)), Some((j, b))) = (hits.next(), hits.next()) {
+            return Err(TableError::DuplicateColumn {
                 file: self.name.clone(),
-                wanted,
-                found: self
-                    .headers
-                    .iter()
-                    .map(|h| format!("'{h}'"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            }
+                wanted: wanted(),
+                first: i + 1,
+                first_name: a.clone(),
+                second: j + 1,
+                second_name: b.clone(),
+            });
+        }
+        self.find(names).ok_or_else(|| TableError::MissingColumn {
+            file: self.name.clone(),
+            wanted: wanted(),
+            found: self
+                .headers
+                .iter()
+                .map(|h| format!("'{h}'"))
+                .collect::<Vec<_>>()
+                .join(", "),
         })
     }
 

@@ -145,6 +145,15 @@ pub fn adaptive_mesh(
         return Err(bad("min_angle", settings.min_angle, "must be in 0..=33"));
     }
     let region = validate(region)?;
+    if let Some(a) = settings.max_area {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(bad("max_area", a, "must be a positive number"));
+        }
+        // Refinement stops at the vertex cap (about two triangles a vertex), so the cap
+        // bounds the size as much as the area limit does.
+        let cap_area = region.area() / (2.0 * settings.max_vertices as f64).max(1.0);
+        crate::build::check_size(region.area(), a.max(cap_area), "max_area")?;
+    }
     let mut st = CdtState::new(&region, &[])?;
     let cap = settings.max_vertices;
     let mut report = AdaptiveReport::default();

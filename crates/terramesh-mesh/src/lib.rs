@@ -102,6 +102,10 @@ pub enum MeshError {
         /// Vertices when it stopped.
         vertices: usize,
     },
+    /// The mesh a size limit asks for would not fit in memory ([`terramesh_core::limits`]);
+    /// refused before anything is allocated, with the setting to change.
+    #[error(transparent)]
+    TooLarge(#[from] terramesh_core::limits::TooLarge),
     /// The height function of [`adaptive_mesh`] failed; refinement stopped there.
     #[error("no height at ({}, {}): {why}", at[0], at[1])]
     Height {

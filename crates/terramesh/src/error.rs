@@ -86,6 +86,9 @@ pub enum Error {
     /// Reading or writing a file.
     #[error(transparent)]
     Io(#[from] std::io::Error),
+    /// A size that follows from input would not fit in memory.
+    #[error(transparent)]
+    TooLarge(#[from] terramesh_core::limits::TooLarge),
     /// Anything else, in words.
     #[error("{0}")]
     Invalid(String),
@@ -174,6 +177,11 @@ impl Error {
                     value,
                     why,
                 }) => setting_message(*setting, value, why, name),
+                Some(
+                    Error::TooLarge(t)
+                    | Error::Mesh(terramesh_mesh::MeshError::TooLarge(t))
+                    | Error::Geostat(terramesh_geostat::GeostatError::TooLarge(t)),
+                ) => t.describe(&|field| Setting::of_field(field).map_or(field.to_string(), name)),
                 _ => e.to_string(),
             };
             // Transparent wrappers, and messages such as "{file}: {source}", already show
@@ -260,5 +268,24 @@ mod tests {
         );
         assert_eq!(own.to_string(), "source x needs a region: give region");
         assert_eq!(e.render(&|s| s.to_string()), "writing out/x: disk full");
+    }
+
+    #[test]
+    fn sizes_too_large_name_the_setting_as_the_front_end_words_it() {
+        use terramesh_core::limits::{Estimate, Remedy};
+        let t = Estimate::new("triangles", 4.1e9, 105.0)
+            .remedy(Remedy::raise("max_area"))
+            .check()
+            .unwrap_err();
+        let e = Error::Mesh(terramesh_mesh::MeshError::TooLarge(t));
+        let key = e.render(&crate::project::key_of);
+        assert!(
+            key.starts_with("about 4.1e9 triangles, about 430 GB"),
+            "{key}"
+        );
+        assert!(key.ends_with(": raise mesh.max_area"), "{key}");
+        assert!(e
+            .render(&|s| format!("--{s}"))
+            .ends_with(": raise --max-area"));
     }
 }

@@ -234,7 +234,18 @@ pub fn predict_grid(
             "a grid is written as .asc (ESRI ASCII) or .tif (GeoTIFF)",
         ));
     }
-    let mut values = vec![0.0; g.nx * g.ny];
+    // The values and the file's buffer: 16 bytes a node.
+    let nodes =
+        terramesh_core::limits::Estimate::new("grid nodes", g.nx as f64 * g.ny as f64, 16.0)
+            .check()
+            .map_err(|e| {
+                Error::setting(
+                    Setting::Grid,
+                    "",
+                    format!("{{grid}}: {e}: give fewer nodes"),
+                )
+            })?;
+    let mut values = terramesh_core::limits::try_vec(nodes, 0.0, "grid nodes")?;
     let rows_per_block = (TARGET_BLOCK / g.nx).max(1);
     let mut pts = Vec::with_capacity(rows_per_block * g.nx);
     for j0 in (0..g.ny).step_by(rows_per_block) {

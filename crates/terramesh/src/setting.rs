@@ -56,6 +56,38 @@ pub enum Setting {
     Dem,
     /// The output file.
     Output,
+    /// The largest triangle area of a mesh.
+    MaxArea,
+    /// The longest edge of a mesh.
+    MaxEdge,
+    /// The data per kriging neighbourhood (0 or none: global kriging).
+    Neighbors,
+    /// The lag classes of an experimental variogram.
+    Lags,
+    /// The cell size of the DSM grid.
+    GridSpacing,
+}
+
+impl Setting {
+    /// The setting a library names by its field (`max_area` in `terramesh_mesh`,
+    /// `neighbors` in `terramesh_geostat`), as in a [`terramesh_core::limits::Remedy`].
+    ///
+    /// ```
+    /// use terramesh::Setting;
+    /// assert_eq!(Setting::of_field("max_area"), Some(Setting::MaxArea));
+    /// assert_eq!(Setting::of_field("no such field"), None);
+    /// ```
+    pub fn of_field(field: &str) -> Option<Setting> {
+        Some(match field {
+            "max_area" => Setting::MaxArea,
+            "max_edge" => Setting::MaxEdge,
+            "neighbors" => Setting::Neighbors,
+            "lags" => Setting::Lags,
+            "grid" => Setting::Grid,
+            "grid_spacing" => Setting::GridSpacing,
+            _ => return None,
+        })
+    }
 }
 
 terramesh_core::named_enum!(Setting, "setting", [
@@ -84,4 +116,9 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Grid => "grid",
     Setting::Dem => "dem",
     Setting::Output => "output",
+    Setting::MaxArea => "max-area",
+    Setting::MaxEdge => "max-edge",
+    Setting::Neighbors => "neighbors",
+    Setting::Lags => "lags",
+    Setting::GridSpacing => "grid-spacing",
 ]);

@@ -91,5 +91,11 @@ pub fn explicit_variogram(m: &ModelArgs) -> Result<Option<Variogram>> {
 
 /// Wraps a library error with the data file name.
 pub fn in_file(name: &str, e: GeostatError) -> anyhow::Error {
-    anyhow::anyhow!("{name}: {e}")
+    match e {
+        // A size refused before allocation names the setting to change as its flag.
+        GeostatError::TooLarge(t) => {
+            anyhow::anyhow!("{name}: {}", t.describe(&crate::wording::flag_of_field))
+        }
+        e => anyhow::anyhow!("{name}: {e}"),
+    }
 }

@@ -55,6 +55,8 @@ pub fn parse_angle(text: &str, axis: Axis) -> Result<f64, CoordError> {
     let mut chars = t.char_indices().peekable();
     let mut last_was_number = false;
     let mut letter_units = false;
+    // The unit marks seen: (index of the number marked, 0 degrees / 1 minutes / 2 seconds).
+    let mut last_mark: Option<(usize, usize)> = None;
     while let Some(&(i, ch)) = chars.peek() {
         if ch.is_ascii_digit() || ch == '.' {
             let start = i;
@@ -81,6 +83,41 @@ pub fn parse_angle(text: &str, axis: Axis) -> Result<f64, CoordError> {
         chars.next();
         let after_number = last_was_number;
         last_was_number = false;
+        // A unit mark names the number before it: degrees the first, minutes the second,
+        // seconds the third. A mark with no number before it (`'5`) or on the wrong number
+        // (`5'` is five minutes, not five degrees) is an error, not a guess.
+        let kind = match ch {
+            '°' | 'º' | 'd' | 'D' => Some(0),
+            '\'' | '′' | '’' | 'm' | 'M' => Some(1),
+            '"' | '″' | '”' => Some(2),
+            's' | 'S' if after_number && letter_units => Some(2),
+            _ => None,
+        };
+        if let Some(mut kind) = kind {
+            let Some(at) = nums.len().checked_sub(1) else {
+                return Err(bad(&format!(
+                    "the unit mark '{ch}' comes before any number"
+                )));
+            };
+            // `''` is a seconds mark written as two minutes marks.
+            if kind == 1 && matches!(chars.peek(), Some(&(_, '\'' | '′' | '’'))) {
+                chars.next();
+                kind = 2;
+            }
+            if last_mark.is_some_and(|(n, _)| n == at) {
+                return Err(bad(&format!("a second unit mark '{ch}' on one number")));
+            }
+            if kind != at {
+                const UNIT: [&str; 3] = ["degrees", "minutes", "seconds"];
+                const ORDINAL: [&str; 3] = ["first", "second", "third"];
+                return Err(bad(&format!(
+                    "'{ch}' marks {} but follows the {} number; write degrees first, as in \
+                     48°43'20\"",
+                    UNIT[kind], ORDINAL[at]
+                )));
+            }
+            last_mark = Some((at, kind));
+        }
         match ch {
             // With letter units (`7d20m12.48s`), an `s` right after a number is the seconds
             // sign; otherwise S is the southern hemisphere.
@@ -247,6 +284,30 @@ mod tests {
         assert!(parse_angle("N7", Axis::Lon).is_err());
         assert!(parse_angle("nan", Axis::Lon).is_err());
         assert!(parse_angle("inf", Axis::Lat).is_err());
+    }
+
+    #[test]
+    fn unit_marks_must_follow_their_number() {
+        // A stray mark is not dropped: '5 is not 5 degrees, and 5' is five minutes.
+        for bad in ["'5", "5'", "48\"", "N48'43°", "°48", "48°43'20.64\"10"] {
+            let e = parse_angle(bad, Axis::Lat);
+            assert!(e.is_err(), "{bad}: {e:?}");
+        }
+        assert!(parse_angle("'5", Axis::Lat)
+            .unwrap_err()
+            .to_string()
+            .contains("before any number"));
+        // Marks in their places, doubled quotes for seconds, letters and colons still read.
+        let want = 48.0 + 43.0 / 60.0 + 20.64 / 3600.0;
+        for good in [
+            "48°43'20.64\"",
+            "48°43'20.64''",
+            "48d43m20.64s",
+            "48:43:20.64",
+            "48 43' 20.64\"",
+        ] {
+            assert!((lat(good) - want).abs() < 1e-12, "{good}");
+        }
     }
 
     #[test]

@@ -327,6 +327,18 @@ impl TransverseMercator {
     /// assert!((lat - 48.72).abs() < 1e-12 && (dlon - 1.3).abs() < 1e-12);
     /// ```
     pub fn inverse(&self, x: f64, y: f64) -> (f64, f64) {
+        self.inverse_checked(x, y).unwrap_or_else(|pole| pole)
+    }
+
+    /// [`TransverseMercator::inverse`], or `Err` with the nearest pole when `(x, y)` lies
+    /// beyond a pole (outside the projection's image), where `inverse` gives the pole itself.
+    ///
+    /// ```
+    /// let tm = terramesh_core::coords::TransverseMercator::wgs84_utm();
+    /// assert!(tm.inverse_checked(0.0, 9_000_000.0).is_ok());
+    /// assert_eq!(tm.inverse_checked(0.0, 10_500_000.0), Err((90.0, 0.0)));
+    /// ```
+    pub fn inverse_checked(&self, x: f64, y: f64) -> Result<(f64, f64), (f64, f64)> {
         let xi = y / self.k0_a;
         let eta = x / self.k0_a;
         let (s2x, c2x) = (2.0 * xi).sin_cos();
@@ -338,16 +350,20 @@ impl TransverseMercator {
         let etap = eta - sum.1;
         let sh = etap.sinh();
         let (sx, cx) = xip.sin_cos();
+        let pole = (if xip >= 0.0 { 90.0 } else { -90.0 }, 0.0);
+        // cos ξ' < 0: beyond the pole (a rounding margin keeps the pole itself).
+        if cx < -1e-12 {
+            return Err(pole);
+        }
         let cx = cx.max(0.0);
         let r = (sh * sh + cx * cx).sqrt();
         if r == 0.0 {
-            // A pole.
-            return (if xip >= 0.0 { 90.0 } else { -90.0 }, 0.0);
+            return Ok(pole);
         }
         let lam = sh.atan2(cx);
         let taup = sx / r;
         let tau = self.tau_from_taup(taup);
-        (tau.atan().to_degrees(), lam.to_degrees())
+        Ok((tau.atan().to_degrees(), lam.to_degrees()))
     }
 
     /// `τ' = tan χ` (conformal) from `τ = tan φ`.

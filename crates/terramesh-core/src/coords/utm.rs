@@ -74,6 +74,18 @@ pub enum CoordError {
         /// The value.
         value: f64,
     },
+    /// A projected point beyond a pole, which no latitude and longitude project to.
+    #[error("easting {easting}, northing {northing} in zone {zone} lies beyond the {pole} pole: no point on the ellipsoid projects there; check the northing and the zone's hemisphere")]
+    BeyondPole {
+        /// The easting.
+        easting: f64,
+        /// The northing.
+        northing: f64,
+        /// The zone.
+        zone: Zone,
+        /// "north" or "south".
+        pole: &'static str,
+    },
     /// An angle string that could not be parsed.
     #[error("cannot read '{value}' as an angle: {why}")]
     BadAngle {
@@ -343,7 +355,14 @@ pub fn to_wgs84(easting: f64, northing: f64, zone: Zone) -> Result<(f64, f64), C
             value: northing,
         });
     }
-    let (lat, dlon) = wgs84().inverse(easting - FALSE_EASTING, northing - zone.false_northing());
+    let (lat, dlon) = wgs84()
+        .inverse_checked(easting - FALSE_EASTING, northing - zone.false_northing())
+        .map_err(|(lat, _)| CoordError::BeyondPole {
+            easting,
+            northing,
+            zone,
+            pole: if lat > 0.0 { "north" } else { "south" },
+        })?;
     let mut lon = zone.central_meridian() + dlon;
     if lon > 180.0 {
         lon -= 360.0;
@@ -356,6 +375,26 @@ pub fn to_wgs84(easting: f64, northing: f64, zone: Zone) -> Result<(f64, f64), C
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn northings_beyond_the_pole_are_refused() {
+        let z = Zone::new(32, true).unwrap();
+        // The pole itself, from the forward projection, still comes back.
+        let pole = wgs84().forward(90.0, 0.0);
+        let (lat, _) = to_wgs84(FALSE_EASTING, pole.y, z).unwrap();
+        assert_eq!(lat, 90.0);
+        for n in [pole.y + 1.0, 15_000_000.0, 20_000_000.0] {
+            match to_wgs84(FALSE_EASTING, n, z) {
+                Err(CoordError::BeyondPole { pole: "north", .. }) => {}
+                other => panic!("northing {n}: {other:?}"),
+            }
+        }
+        let s = Zone::new(32, false).unwrap();
+        assert!(matches!(
+            to_wgs84(FALSE_EASTING, -5_000_000.0, s),
+            Err(CoordError::BeyondPole { pole: "south", .. })
+        ));
+    }
 
     #[test]
     fn zone_edges() {

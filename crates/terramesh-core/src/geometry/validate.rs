@@ -338,12 +338,11 @@ fn bad_contact(s: &Seg, t: &Seg) -> Option<[f64; 2]> {
         if !hit {
             continue;
         }
-        if adjacent {
-            // Neighbours share one endpoint; anything more (a fold back) is an overlap.
-            let shared = (a == c || a == d || b == c || b == d) && (o1 != 0.0 || o2 != 0.0);
-            if shared {
-                continue;
-            }
+        if adjacent && is_shared(s, t, p) && !folds_back(s, t, o1, o2) {
+            // Neighbours share one endpoint. A vertex on the straight line between its
+            // neighbours is valid (OGC simple features); only a fold back, where the second
+            // edge returns along the first, is an overlap.
+            continue;
         }
         // A constraint line may touch a ring or another line (ending on the boundary, passing
         // through a vertex): the mesher splits there. Only proper crossings are errors, and
@@ -354,6 +353,30 @@ fn bad_contact(s: &Seg, t: &Seg) -> Option<[f64; 2]> {
         return Some(p);
     }
     None
+}
+
+/// Whether `p` is the endpoint that the neighbouring segments `s` and `t` share.
+fn is_shared(s: &Seg, t: &Seg, p: [f64; 2]) -> bool {
+    (p == s.a || p == s.b) && (p == t.a || p == t.b)
+}
+
+/// Whether neighbouring segments, both on one line (`o1`, `o2`: the orientations of `t`'s
+/// endpoints against `s`), point in opposite directions away from their shared vertex, so
+/// that they overlap. Exact: on one line, directions compare by coordinates alone.
+fn folds_back(s: &Seg, t: &Seg, o1: f64, o2: f64) -> bool {
+    if o1 != 0.0 || o2 != 0.0 {
+        return false;
+    }
+    // Orient both as leaving the shared vertex `v`: s towards `p`, t towards `q`.
+    let (v, p) = if s.a == t.a || s.a == t.b {
+        (s.a, s.b)
+    } else {
+        (s.b, s.a)
+    };
+    let q = if t.a == v { t.b } else { t.a };
+    // Both leave v; they overlap when p and q lie on the same side of v along the line.
+    let side = |w: [f64; 2]| (w[0].total_cmp(&v[0]), w[1].total_cmp(&v[1]));
+    side(p) == side(q)
 }
 
 fn check_nesting(region: &Region) -> Result<(), ValidationError> {
@@ -489,6 +512,55 @@ mod tests {
         r.lines.push(vec![[5.0, 5.5], [15.0, 5.5]]);
         let e = validate(&r).unwrap_err();
         assert!(matches!(e, ValidationError::SelfIntersection { .. }), "{e}");
+    }
+
+    #[test]
+    fn collinear_vertices_are_valid_and_kept() {
+        // A vertex on the straight line between its neighbours, in the shell and in a hole,
+        // and the closing vertex on a straight edge.
+        let mut r = Region::from_ring(vec![
+            [0.0, 0.0],
+            [5.0, 0.0],
+            [10.0, 0.0],
+            [10.0, 10.0],
+            [0.0, 10.0],
+            [0.0, 5.0],
+            [0.0, 0.0],
+        ]);
+        r.polygons[0].holes.push(vec![
+            [2.0, 2.0],
+            [3.0, 2.0],
+            [4.0, 2.0],
+            [4.0, 4.0],
+            [2.0, 4.0],
+        ]);
+        let v = validate(&r).unwrap();
+        assert_eq!(v.polygons[0].outer.len(), 6);
+        assert!(v.polygons[0].outer.contains(&[5.0, 0.0]));
+        assert!(v.polygons[0].outer.contains(&[0.0, 5.0]));
+        assert!(v.polygons[0].holes[0].contains(&[3.0, 2.0]));
+    }
+
+    #[test]
+    fn fold_backs_and_self_touching_rings_are_rejected() {
+        // The second edge returns along the first (a spike).
+        let spike = Region::from_ring(vec![[0.0, 0.0], [10.0, 0.0], [5.0, 0.0], [5.0, 5.0]]);
+        assert!(matches!(
+            validate(&spike),
+            Err(ValidationError::SelfIntersection { .. })
+        ));
+        // A ring whose vertex touches a non-adjacent edge.
+        let touch = Region::from_ring(vec![
+            [0.0, 0.0],
+            [10.0, 0.0],
+            [10.0, 10.0],
+            [5.0, 0.0],
+            [0.0, 10.0],
+        ]);
+        match validate(&touch) {
+            Err(ValidationError::SelfIntersection { at, .. }) => assert_eq!(at, [5.0, 0.0]),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

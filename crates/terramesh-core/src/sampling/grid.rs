@@ -138,6 +138,14 @@ impl SamplingGrid {
                 "{rows} x {cols} = {total} nodes is too many; use fewer rows/columns or a larger spacing"
             )));
         }
+        // A node ([f64; 2]) and its grid index, 24 bytes, against the memory ceiling.
+        crate::limits::Estimate::new("grid nodes", total as f64, 24.0)
+            .check()
+            .map_err(|e| {
+                bad(format!(
+                    "{rows} x {cols}: {e}; use fewer rows/columns or a larger spacing"
+                ))
+            })?;
         let mut nodes = Vec::with_capacity(if self.clip { 0 } else { total as usize });
         let mut index = Vec::with_capacity(nodes.capacity());
         for r in 0..rows {

@@ -78,6 +78,8 @@ pub(super) fn factor_band(
     if w > 0 && 2 * w > n {
         return Ok(None);
     }
+    // The factor's band and the band of its inverse (for variances).
+    super::check_dense(n as f64 * (wl + 1 + w + 1) as f64)?;
     let vg = &prep.variogram;
     let band = Band::factor(n, wl, |i, j| {
         if i == j {

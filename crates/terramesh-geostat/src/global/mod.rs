@@ -88,6 +88,27 @@ impl GlobalKriging {
     /// # Ok(()) }
     /// ```
     pub fn new(data: &Data, variogram: &Variogram, method: Method, variance: bool) -> Result<Self> {
+        Self::build(data, variogram, method, variance, false)
+    }
+
+    /// [`GlobalKriging::new`] with variances, for [`GlobalKriging::leave_one_out`]: the
+    /// memory check counts the inverse that leave-one-out adds to a dense factor, before the
+    /// factor is made.
+    pub(crate) fn for_leave_one_out(
+        data: &Data,
+        variogram: &Variogram,
+        method: Method,
+    ) -> Result<Self> {
+        Self::build(data, variogram, method, true, true)
+    }
+
+    fn build(
+        data: &Data,
+        variogram: &Variogram,
+        method: Method,
+        variance: bool,
+        loo: bool,
+    ) -> Result<Self> {
         let mut prep = Prepared::new(data, variogram, method)?;
         let n = prep.pts.len();
         let p = prep.terms();
@@ -116,6 +137,16 @@ impl GlobalKriging {
             (Some(s), Some((r, _))) => factor_band(&prep, &tree, s, *r)?.map(|b| (b, *r)),
             _ => None,
         };
+        if banded.is_none() {
+            // The dense system: n x n covariances factored in place and an n x BLOCK block of
+            // right-hand sides, or the (n + p)-square variogram system and its LU factors.
+            let entries = match sill {
+                Some(_) if loo => 2.0 * n as f64 * n as f64,
+                Some(_) => n as f64 * (n + BLOCK) as f64,
+                None => 2.0 * ((n + p) as f64).powi(2),
+            };
+            check_dense(entries)?;
+        }
         let (solver, h, kz) = match (sill, banded) {
             (Some(_), Some(((mut band, wband), r))) => {
                 if variance {
@@ -489,6 +520,8 @@ impl GlobalKriging {
                 ((0..n).map(|i| band.zij(i, i)).collect(), h.clone())
             }
             Solver::Dense { l, g } => {
+                // The inverse of the factor beside the factor itself.
+                check_dense(2.0 * n as f64 * n as f64)?;
                 let lm = MatRef::from_column_major_slice(l, n, n);
                 let mut inv = Mat::<f64>::zeros(n, n);
                 faer::linalg::triangular_inverse::invert_lower_triangular(inv.as_mut(), lm, par());
@@ -559,4 +592,17 @@ fn upper_solve_rows(lm: MatRef<'_, f64>, g: &[f64], n: usize, p: usize) -> Vec<f
         }
     }
     h
+}
+
+/// Refuses a dense kriging system of `entries` doubles beyond the memory ceiling: the moving
+/// neighbourhood (`neighbors`) is the way to krige that many data.
+fn check_dense(entries: f64) -> Result<()> {
+    use terramesh_core::limits::{Estimate, Remedy};
+    Estimate::new("kriging matrix entries", entries, 8.0)
+        .remedy(Remedy::new(
+            "krige in a moving neighbourhood instead of globally: give",
+            "neighbors",
+        ))
+        .check()?;
+    Ok(())
 }

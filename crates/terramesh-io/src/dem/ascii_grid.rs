@@ -8,6 +8,11 @@ use std::path::Path;
 
 use super::{DemError, GeoTransform, Raster, SourceCrs};
 
+/// The byte offset of `line`, a slice of `text`.
+fn offset_of(text: &str, line: &str) -> usize {
+    line.as_ptr() as usize - text.as_ptr() as usize
+}
+
 /// Reads an ESRI ASCII grid into a [`Raster`] (NODATA_value cells become voids).
 ///
 /// ```
@@ -82,7 +87,27 @@ pub fn read_ascii_grid(path: &Path) -> Result<Raster, DemError> {
     if cell <= 0.0 {
         return Err(DemError::format(path, "cellsize must be positive"));
     }
-    let mut data = Vec::with_capacity(nrows * ncols);
+    // Each value takes at least two bytes (a digit and a separator): a header claiming more
+    // cells than the file can hold is wrong, and is refused before anything is allocated.
+    let cells = nrows as f64 * ncols as f64;
+    let body = text.len()
+        - lines
+            .peek()
+            .map_or(text.len(), |&(_, l)| offset_of(&text, l));
+    if cells > (body / 2 + 1) as f64 {
+        return Err(DemError::format(
+            path,
+            format!(
+                "the header says {nrows} x {ncols} = {cells:.0} cells, but the {body} bytes \
+                 of values hold at most {}: the header is wrong or the file is truncated",
+                body / 2 + 1
+            ),
+        ));
+    }
+    let cells = terramesh_core::limits::Estimate::new("cells", cells, 8.0)
+        .check()
+        .map_err(|e| DemError::format(path, format!("the header asks for {e}")))?;
+    let mut data = Vec::with_capacity(cells);
     let mut last_line = 0;
     for (i, line) in lines {
         last_line = i + 1;
@@ -95,13 +120,13 @@ pub fn read_ascii_grid(path: &Path) -> Result<Raster, DemError> {
             data.push(if Some(v) == nodata { f64::NAN } else { v });
         }
     }
-    if data.len() != nrows * ncols {
+    if data.len() != cells {
         return Err(fmt(
             last_line,
             format!(
                 "found {} values, the header says {nrows} x {ncols} = {}: the file is truncated or the header is wrong",
                 data.len(),
-                nrows * ncols
+                cells
             ),
         ));
     }

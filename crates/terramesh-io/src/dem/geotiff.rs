@@ -72,6 +72,9 @@ pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, 
             )))
         }
     }
+    check_chunk_sizes(&mut dec, cols, rows)
+        .map_err(terr)?
+        .map_err(fmt)?;
     let keys = geokeys(&mut dec).map_err(terr)?.ok_or_else(|| {
         DemError::crs(
             path,
@@ -152,6 +155,76 @@ pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, 
         crs,
         data,
     })
+}
+
+/// Checks that the tags describing the samples match the data stored: in an uncompressed
+/// file every tile or strip holds exactly its pixels times `BitsPerSample / 8` bytes
+/// (`TileByteCounts`, `StripByteCounts`). A BitsPerSample of 64 on int16 tiles would read
+/// four pixels as one and give elevations of about 5.7e16. Compressed chunks have no such
+/// size to compare; the decoder checks their decompressed length. Also refuses, before
+/// anything is decoded, a raster larger than the memory ceiling.
+fn check_chunk_sizes(
+    dec: &mut Decoder<BufReader<File>>,
+    cols: u32,
+    rows: u32,
+) -> tiff::TiffResult<Result<(), String>> {
+    let bytes_each = 8.0
+        + f64::from(
+            dec.find_tag_unsigned::<u32>(Tag::BitsPerSample)?
+                .unwrap_or(8),
+        ) / 8.0;
+    if let Err(e) = terramesh_core::limits::Estimate::new(
+        "pixels",
+        f64::from(cols) * f64::from(rows),
+        bytes_each,
+    )
+    .check()
+    {
+        return Ok(Err(format!("{cols} x {rows} pixels: {e}")));
+    }
+    if dec.find_tag_unsigned::<u32>(Tag::Compression)?.unwrap_or(1) != 1 {
+        return Ok(Ok(()));
+    }
+    let bits = dec
+        .find_tag_unsigned_vec::<u32>(Tag::BitsPerSample)?
+        .unwrap_or(vec![1]);
+    let samples = dec
+        .find_tag_unsigned::<u32>(Tag::SamplesPerPixel)?
+        .unwrap_or(1);
+    let bits = u64::from(bits.first().copied().unwrap_or(1)) * u64::from(samples);
+    let tiled = matches!(dec.get_chunk_type(), tiff::decoder::ChunkType::Tile);
+    let (cw, ch) = dec.chunk_dimensions();
+    let counts = if tiled {
+        dec.find_tag_unsigned_vec::<u64>(Tag::TileByteCounts)?
+    } else {
+        dec.find_tag_unsigned_vec::<u64>(Tag::StripByteCounts)?
+    };
+    let Some(counts) = counts else {
+        return Ok(Ok(()));
+    };
+    for (i, &count) in counts.iter().enumerate() {
+        // Tiles are stored whole; the last strip holds only the rows that remain.
+        let chunk_rows = if tiled {
+            u64::from(ch)
+        } else {
+            u64::from(ch).min(u64::from(rows).saturating_sub(i as u64 * u64::from(ch)))
+        };
+        let need = (u64::from(cw) * bits).div_ceil(8) * chunk_rows;
+        if count < need {
+            let (what, tag) = if tiled {
+                ("tile", "TileByteCounts")
+            } else {
+                ("strip", "StripByteCounts")
+            };
+            return Ok(Err(format!(
+                "BitsPerSample {} does not match the data: {what} {i} of {cw} x {chunk_rows} \
+                 pixels needs {need} bytes at that size, but {tag} gives {count}; the tags are \
+                 wrong or the file is truncated",
+                bits / u64::from(samples.max(1))
+            )));
+        }
+    }
+    Ok(Ok(()))
 }
 
 /// Rows `r0..r1` and columns `c0..c1` of posts covering the extent `(x_lo, y_lo, x_hi, y_hi)`

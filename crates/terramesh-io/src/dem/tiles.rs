@@ -27,16 +27,16 @@ pub fn terrarium_decode(png_bytes: &[u8]) -> Result<Vec<f32>, String> {
     let mut dec = png::Decoder::new(png_bytes);
     dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
     let mut reader = dec.read_info().map_err(|e| png_error("not a PNG", e))?;
+    // The header's size is checked before the frame buffer is allocated from it (a header of
+    // 2^20 x 2^20 pixels asked for terabytes).
+    let (w, h) = (reader.info().width, reader.info().height);
+    if (w as usize, h as usize) != (SIDE, SIDE) {
+        return Err(format!("{w} x {h} pixels: a terrain tile is 256 x 256"));
+    }
     let mut buf = vec![0; reader.output_buffer_size()];
     let info = reader
         .next_frame(&mut buf)
         .map_err(|e| png_error("bad PNG data", e))?;
-    if (info.width as usize, info.height as usize) != (SIDE, SIDE) {
-        return Err(format!(
-            "{} x {} pixels: a terrain tile is 256 x 256",
-            info.width, info.height
-        ));
-    }
     let ch = match info.color_type {
         png::ColorType::Rgb => 3,
         png::ColorType::Rgba => 4,

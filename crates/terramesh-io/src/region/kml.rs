@@ -5,6 +5,50 @@
 use roxmltree::{Document, Node};
 use terramesh_core::geometry::{Polygon, Region};
 
+/// The deepest element nesting read. The XML parser recurses per level: 50,000 nested
+/// `<Folder>`s overflowed the stack. Google Earth's files nest a few levels.
+pub const MAX_KML_DEPTH: usize = 256;
+
+/// Refuses text whose elements nest deeper than [`MAX_KML_DEPTH`], counting start and end
+/// tags (comments, CDATA, processing instructions and declarations skipped), with the line.
+fn check_depth(text: &str) -> Result<(), String> {
+    let b = text.as_bytes();
+    let (mut i, mut depth) = (0usize, 0usize);
+    let skip_to = |from: usize, end: &str| {
+        text[from..]
+            .find(end)
+            .map_or(b.len(), |k| from + k + end.len())
+    };
+    while let Some(k) = text[i..].find('<') {
+        let at = i + k;
+        let rest = &text[at..];
+        if rest.starts_with("<!--") {
+            i = skip_to(at, "-->");
+        } else if rest.starts_with("<![CDATA[") {
+            i = skip_to(at, "]]>");
+        } else if rest.starts_with("<?") || rest.starts_with("<!") {
+            i = skip_to(at, ">");
+        } else if rest.starts_with("</") {
+            depth = depth.saturating_sub(1);
+            i = skip_to(at, ">");
+        } else {
+            let end = skip_to(at, ">");
+            if !text[at..end].ends_with("/>") {
+                depth += 1;
+                if depth > MAX_KML_DEPTH {
+                    let line = text[..at].matches('\n').count() + 1;
+                    return Err(format!(
+                        "line {line}: elements nest more than {MAX_KML_DEPTH} deep; flatten \
+                         the folders"
+                    ));
+                }
+            }
+            i = end;
+        }
+    }
+    Ok(())
+}
+
 /// Parses KML text. Errors name the line of the offending element.
 ///
 /// ```
@@ -17,6 +61,7 @@ use terramesh_core::geometry::{Polygon, Region};
 /// # Ok::<(), String>(())
 /// ```
 pub fn parse_kml(text: &str) -> Result<Region, String> {
+    check_depth(text)?;
     let doc = Document::parse(text).map_err(|e| format!("not valid XML: {e}"))?;
     let line = |n: Node| doc.text_pos_at(n.range().start).row;
     let mut region = Region::default();
@@ -111,6 +156,22 @@ fn coordinates(text: &str, line: u32) -> Result<Vec<[f64; 2]>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn deep_nesting_is_refused_not_a_stack_overflow() {
+        let deep = |n: usize| {
+            "<kml><!-- <a><b> --><Document>".to_string()
+                + &"<Folder><name>f</name><br/>".repeat(n)
+                + "<Placemark><Polygon><outerBoundaryIs><LinearRing><coordinates>\
+                   0,0 1,0 1,1 0,0</coordinates></LinearRing></outerBoundaryIs></Polygon>\
+                   </Placemark>"
+                + &"</Folder>".repeat(n)
+                + "</Document></kml>"
+        };
+        assert_eq!(parse_kml(&deep(200)).unwrap().polygons.len(), 1);
+        let e = parse_kml(&deep(50_000)).unwrap_err();
+        assert!(e.contains("nest more than 256 deep"), "{e}");
+    }
 
     #[test]
     fn polygon_with_holes_and_line() {

@@ -13,8 +13,8 @@ use terramesh_core::geometry::{validate, Region, ValidationError};
 
 pub use corners::{parse_corner, parse_corners, parse_projected_corners};
 pub use geojson::parse_geojson;
-pub use kml::parse_kml;
-pub use wkt::parse_wkt;
+pub use kml::{parse_kml, MAX_KML_DEPTH};
+pub use wkt::{parse_wkt, MAX_WKT_DEPTH};
 
 /// Errors while reading a region.
 #[derive(Debug, thiserror::Error)]

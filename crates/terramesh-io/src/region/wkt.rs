@@ -4,6 +4,11 @@
 
 use terramesh_core::geometry::{Polygon, Region};
 
+/// The deepest nesting of `GEOMETRYCOLLECTION`s read. Each level is a recursive call, so the
+/// depth must be bounded: 50,000 nested collections overflowed the stack. Real files nest one
+/// or two levels.
+pub const MAX_WKT_DEPTH: usize = 64;
+
 /// Parses WKT text. Errors give the line and column.
 ///
 /// ```
@@ -18,6 +23,7 @@ pub fn parse_wkt(text: &str) -> Result<Region, String> {
         s: text.as_bytes(),
         i: 0,
         text,
+        depth: 0,
     };
     let mut region = Region::default();
     p.skip_ws();
@@ -39,6 +45,8 @@ struct Parser<'a> {
     s: &'a [u8],
     i: usize,
     text: &'a str,
+    /// Collections open around the current position.
+    depth: usize,
 }
 
 impl Parser<'_> {
@@ -130,7 +138,18 @@ impl Parser<'_> {
                     self.i += 1;
                 }
             }
-            "GEOMETRYCOLLECTION" => self.list(|p| p.geometry(region))?,
+            "GEOMETRYCOLLECTION" => {
+                if self.depth == MAX_WKT_DEPTH {
+                    self.i = start;
+                    return Err(self.err(&format!(
+                        "GEOMETRYCOLLECTIONs nest more than {MAX_WKT_DEPTH} deep; flatten the \
+                         collection"
+                    )));
+                }
+                self.depth += 1;
+                self.list(|p| p.geometry(region))?;
+                self.depth -= 1;
+            }
             _ => {
                 self.i = start;
                 return Err(self.err(
@@ -221,6 +240,19 @@ mod tests {
         assert_eq!(r.polygons.len(), 2);
         assert_eq!(r.polygons[1].outer[2], [30.0, 10.0]);
         assert_eq!(r.lines.len(), 1);
+    }
+
+    #[test]
+    fn deep_collections_are_refused_not_a_stack_overflow() {
+        let deep = |n: usize| {
+            "GEOMETRYCOLLECTION (".repeat(n) + "POLYGON ((0 0, 1 0, 1 1, 0 0))" + &")".repeat(n)
+        };
+        // At the limit the polygon is read; one more level and 50,000 are errors.
+        assert_eq!(parse_wkt(&deep(MAX_WKT_DEPTH)).unwrap().polygons.len(), 1);
+        let e = parse_wkt(&deep(MAX_WKT_DEPTH + 1)).unwrap_err();
+        assert!(e.contains("nest more than 64 deep"), "{e}");
+        let e = parse_wkt(&deep(50_000)).unwrap_err();
+        assert!(e.contains("line 1, column 1281"), "{e}");
     }
 
     #[test]

@@ -28,6 +28,10 @@ pub fn key_of(s: Setting) -> String {
         Setting::Spacing => "sampling.spacing",
         Setting::Margin => "sampling.margin",
         Setting::Classes => "source.class",
+        Setting::MaxArea => "mesh.max_area",
+        Setting::MaxEdge => "mesh.max_edge",
+        Setting::Neighbors => "interpolation.neighbors",
+        Setting::GridSpacing => "export.grid_spacing",
         other => return other.to_string(),
     }
     .to_string()

@@ -183,6 +183,11 @@ impl Project {
                 }
             }
         }
+        if let Some(g) = self.export.grid_spacing {
+            if !positive(g) {
+                return bad("export.grid_spacing", "must be a positive number of metres");
+            }
+        }
         let i = &self.interpolation;
         if i.methods.is_empty() {
             return bad(
