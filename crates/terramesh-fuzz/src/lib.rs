@@ -230,7 +230,10 @@ pub fn las(data: &[u8]) {
 pub fn png_tile(data: &[u8]) {
     if let Ok(z) = terrarium_decode(data) {
         assert_eq!(z.len(), 256 * 256, "a tile is 256 x 256");
-        assert!(!z.iter().any(|v| v.is_infinite()), "a tile elevation is infinite");
+        assert!(
+            !z.iter().any(|v| v.is_infinite()),
+            "a tile elevation is infinite"
+        );
     }
 }
 
