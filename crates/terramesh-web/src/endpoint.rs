@@ -187,12 +187,17 @@ impl Endpoint {
 
     /// Reads the elevations of a response for `points`, in order. `Err(Retry)` for answers
     /// worth asking again (malformed, short, wrong locations, over quota), `Err(Fatal)` for
-    /// refusals (bad key, invalid request).
-    pub(crate) fn parse_reply(
-        &self,
-        body: &str,
-        points: &[[f64; 2]],
-    ) -> Result<Vec<Option<f64>>, Reply> {
+    /// refusals (bad key, invalid request). Public for the fuzzing harnesses.
+    ///
+    /// ```
+    /// use terramesh_web::{Endpoint, Reply};
+    /// let e = Endpoint::parse("open-elevation:", None)?;
+    /// let body = r#"{"results":[{"latitude":48.7,"longitude":7.3,"elevation":412.5}]}"#;
+    /// assert_eq!(e.parse_reply(body, &[[48.7, 7.3]]).ok(), Some(vec![Some(412.5)]));
+    /// assert!(matches!(e.parse_reply("{", &[[48.7, 7.3]]), Err(Reply::Retry(_))));
+    /// # Ok::<(), terramesh_web::WebError>(())
+    /// ```
+    pub fn parse_reply(&self, body: &str, points: &[[f64; 2]]) -> Result<Vec<Option<f64>>, Reply> {
         let v: serde_json::Value = serde_json::from_str(body)
             .map_err(|e| Reply::Retry(format!("malformed JSON ({e})")))?;
         if let Some(status) = v.get("status").and_then(|s| s.as_str()) {
@@ -259,7 +264,7 @@ impl Endpoint {
 
 /// How a reply is judged.
 #[derive(Debug)]
-pub(crate) enum Reply {
+pub enum Reply {
     /// Worth retrying.
     Retry(String),
     /// The service refuses the request; retrying will not help.

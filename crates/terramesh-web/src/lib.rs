@@ -31,7 +31,7 @@ pub mod mock;
 mod store;
 mod tiles;
 
-pub use endpoint::{Endpoint, ServiceKind};
+pub use endpoint::{Endpoint, Reply, ServiceKind};
 pub use fetch::{fetch, FetchOptions, FetchStats, PointError};
 pub use store::PointStore;
 pub use tiles::{fetch_tiles, TileOptions};

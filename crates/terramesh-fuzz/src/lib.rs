@@ -1,0 +1,254 @@
+//! The fuzzing harnesses of terramesh: one function per parser or reader, and one for the
+//! mesher, each taking arbitrary bytes. A harness returns normally for every input (an error is
+//! a normal outcome); it panics only when the code under test panics, or when a result breaks
+//! an invariant that must hold for every input (a non-finite elevation out of a reader, a mesh
+//! that fails its own sanity check).
+//!
+//! The same functions run in two places:
+//! * `fuzz/fuzz_targets/<name>.rs`, one cargo-fuzz (libFuzzer) target each, on a nightly
+//!   toolchain (`cargo +nightly fuzz run <name>`);
+//! * `tests/replay.rs`, a stable `cargo test` that feeds every committed seed
+//!   (`fuzz/corpus/<name>/`) and every input a fuzzer once crashed on
+//!   (`fuzz/regressions/<name>/`) through them.
+//!
+//! [`TARGETS`] lists them by name; the names are the folder names.
+//!
+//! ```
+//! let (name, run) = terramesh_fuzz::TARGETS[0];
+//! assert_eq!(name, "table_csv");
+//! run(b"x,y,z\n1,2,3\n"); // an ordinary table
+//! run(b"\xff\x00,,\n\n\"");   // and garbage: an error, not a panic
+//! ```
+
+mod files;
+mod mesher;
+
+use std::path::Path;
+
+use terramesh_core::coords::{parse_angle, Axis};
+use terramesh_core::sampling::Kernel;
+use terramesh_io::dem::{
+    read_ascii_grid, read_geotiff, read_las, read_points, terrarium_decode, ElevationSource,
+    HgtMosaic, LasOptions, Raster,
+};
+use terramesh_io::region::{
+    parse_corners, parse_geojson, parse_kml, parse_projected_corners, parse_wkt,
+};
+use terramesh_io::table::{ReadOptions, Table};
+
+pub use mesher::mesher;
+
+/// A harness: arbitrary bytes in, a panic only on a bug.
+pub type Harness = fn(&[u8]);
+
+/// Every harness by name (the name of its cargo-fuzz target and of its corpus folders).
+pub const TARGETS: &[(&str, Harness)] = &[
+    ("table_csv", table_csv),
+    ("points_csv", points_csv),
+    ("angle", angle),
+    ("geojson", geojson),
+    ("kml", kml),
+    ("wkt", wkt),
+    ("corners", corners),
+    ("project_toml", project_toml),
+    ("variogram_json", variogram_json),
+    ("hgt", hgt),
+    ("asc", asc),
+    ("geotiff", geotiff),
+    ("las", las),
+    ("png_tile", png_tile),
+    ("web_reply", web_reply),
+    ("mesher", mesher),
+];
+
+/// Committed data crops (in `fixtures/data/`, paths from the repository root) that also seed a
+/// target, so that the seeds include real files without a second copy in `fuzz/corpus/`.
+pub const FIXTURE_SEEDS: &[(&str, &str)] = &[
+    ("points_csv", "fixtures/data/points/davis-topo-first26.csv"),
+    ("table_csv", "fixtures/data/points/davis-topo-first26.csv"),
+    (
+        "asc",
+        "fixtures/data/grids/colorado-front-range-srtmgl3-sw72.asc",
+    ),
+    ("asc", "fixtures/data/srtm/N48E007-r300-c1000.asc"),
+    ("geotiff", "fixtures/data/grids/srtm-N48E007-r300-c1000.tif"),
+    ("las", "fixtures/data/lidar/autzen_trim-636500-849000.laz"),
+    ("png_tile", "fixtures/data/tiles/crop_11_385_803.png"),
+    ("project_toml", "examples/fort-worth-1m/terramesh.toml"),
+];
+
+fn text(data: &[u8]) -> Option<&str> {
+    std::str::from_utf8(data).ok()
+}
+
+/// A CSV or whitespace table read from memory; every cell read as a number.
+pub fn table_csv(data: &[u8]) {
+    if let Ok(t) = Table::from_bytes("fuzz.csv", data, &ReadOptions::default()) {
+        for c in 0..t.headers.len() {
+            if let Ok(v) = t.numbers(c) {
+                assert!(
+                    v.iter().all(|x| x.is_finite()),
+                    "a table number is not finite"
+                );
+            }
+        }
+    }
+}
+
+/// A sample-point file (`x,y,z` or `lat,lon,z` with DMS angles), read from a file.
+pub fn points_csv(data: &[u8]) {
+    let path = files::write("points.csv", data);
+    if let Ok(pc) = read_points(&path, &ReadOptions::default(), None) {
+        assert!(
+            pc.xyz.iter().flatten().all(|v| v.is_finite()),
+            "a point coordinate is not finite"
+        );
+    }
+}
+
+/// An angle in decimal degrees or DMS, as a latitude and as a longitude.
+pub fn angle(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    for (axis, limit) in [(Axis::Lat, 90.0), (Axis::Lon, 180.0)] {
+        if let Ok(a) = parse_angle(s, axis) {
+            assert!(a.is_finite() && a.abs() <= limit, "angle {a} out of range");
+        }
+    }
+}
+
+/// A GeoJSON region, then its validation.
+pub fn geojson(data: &[u8]) {
+    if let Some(Ok(r)) = text(data).map(parse_geojson) {
+        let _ = terramesh_core::geometry::validate(&r);
+    }
+}
+
+/// A KML region, then its validation.
+pub fn kml(data: &[u8]) {
+    if let Some(Ok(r)) = text(data).map(parse_kml) {
+        let _ = terramesh_core::geometry::validate(&r);
+    }
+}
+
+/// A WKT region, then its validation.
+pub fn wkt(data: &[u8]) {
+    if let Some(Ok(r)) = text(data).map(parse_wkt) {
+        let _ = terramesh_core::geometry::validate(&r);
+    }
+}
+
+/// A corner string, geographic and projected.
+pub fn corners(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    if let Ok(c) = parse_corners(s) {
+        assert!(c.iter().flatten().all(|v| v.is_finite()));
+    }
+    let _ = parse_projected_corners(s);
+}
+
+/// A project file; lines after a line `---` are `--set key=value` overrides.
+pub fn project_toml(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    let (toml, sets) = s.split_once("\n---\n").unwrap_or((s, ""));
+    let sets: Vec<String> = sets.lines().map(str::to_string).collect();
+    let _ = terramesh::project::Project::parse("fuzz.toml", toml, &sets);
+}
+
+/// A `variogram.json` file.
+pub fn variogram_json(data: &[u8]) {
+    if let Some(s) = text(data) {
+        let _ = terramesh_geostat::VariogramFile::from_json(s);
+    }
+}
+
+/// Samples a source at a few points around a post; every elevation given must be finite.
+fn probe(src: &dyn ElevationSource, x: f64, y: f64, step: f64) {
+    for k in [Kernel::Nearest, Kernel::Bilinear, Kernel::Bicubic] {
+        for (i, j) in [(0.0, 0.0), (0.5, 0.5), (-0.25, 1.75)] {
+            if let Ok(z) = src.sample(x + i * step, y + j * step, k) {
+                assert!(
+                    z.is_finite(),
+                    "{}: elevation {z} at ({x}, {y})",
+                    src.describe()
+                );
+            }
+        }
+    }
+}
+
+fn probe_raster(r: &Raster) {
+    let t = r.transform;
+    let (x, y) = (
+        t.x0 + t.dx * (r.cols / 2) as f64,
+        t.y0 + t.dy * (r.rows / 2) as f64,
+    );
+    probe(r, x, y, t.dx.abs().max(t.dy.abs()));
+}
+
+/// An SRTM `.hgt` tile (named `N48E007.hgt`), opened and sampled.
+pub fn hgt(data: &[u8]) {
+    let path = files::write("N48E007.hgt", data);
+    if let Ok(m) = HgtMosaic::open_files(&[Path::new(&path)], data.first() == Some(&0)) {
+        probe(&m, 7.5, 48.5, m.step());
+    }
+}
+
+/// An ESRI ASCII grid, read and sampled.
+pub fn asc(data: &[u8]) {
+    let path = files::write("grid.asc", data);
+    if let Ok(r) = read_ascii_grid(&path) {
+        probe_raster(&r);
+    }
+}
+
+/// A GeoTIFF, read and sampled.
+pub fn geotiff(data: &[u8]) {
+    let path = files::write("dem.tif", data);
+    if let Ok(r) = read_geotiff(&path) {
+        probe_raster(&r);
+    }
+}
+
+/// A LAS or LAZ point cloud (the first byte's low bit picks the file extension).
+pub fn las(data: &[u8]) {
+    let name = if data.first().is_some_and(|b| b & 1 == 1) {
+        "cloud.laz"
+    } else {
+        "cloud.las"
+    };
+    let path = files::write(name, data);
+    if let Ok(pc) = read_las(&path, &LasOptions::default()) {
+        assert!(
+            pc.xyz.iter().flatten().all(|v| v.is_finite()),
+            "a point coordinate is not finite"
+        );
+    }
+}
+
+/// A Terrarium PNG elevation tile: 256 x 256 elevations, NaN only for a void (a transparent
+/// pixel), never infinite.
+pub fn png_tile(data: &[u8]) {
+    if let Ok(z) = terrarium_decode(data) {
+        assert_eq!(z.len(), 256 * 256, "a tile is 256 x 256");
+        assert!(
+            !z.iter().any(|v| v.is_infinite()),
+            "a tile elevation is infinite"
+        );
+    }
+}
+
+/// An elevation service's JSON reply, judged by each service's rules for two locations.
+pub fn web_reply(data: &[u8]) {
+    let Some(body) = text(data) else { return };
+    let points = [[48.7, 7.3], [-33.9, 18.4]];
+    for spec in ["open-elevation:", "opentopodata:srtm90m"] {
+        let e = terramesh_web::Endpoint::parse(spec, None).expect("a valid endpoint");
+        if let Ok(z) = e.parse_reply(body, &points) {
+            assert_eq!(z.len(), points.len(), "{spec}: one elevation per location");
+            assert!(z.iter().flatten().all(|v| v.is_finite()));
+        }
+    }
+    if let Ok(e) = terramesh_web::Endpoint::parse("google:", Some("KEY".into())) {
+        let _ = e.parse_reply(body, &points);
+    }
+}
