@@ -59,6 +59,22 @@ pub enum ValidationError {
     /// Two polygons of a MultiPolygon overlap.
     #[error("polygon {0} and polygon {1} overlap; merge them or remove one")]
     Overlap(usize, usize),
+    /// A constraint line runs along a ring edge (a stretch of positive length): the boundary is
+    /// a mesh edge already, and a second constraint on it is ambiguous.
+    #[error(
+        "{line} runs along {edge} from ({:.9}, {:.9}) to ({:.9}, {:.9}): the boundary is a mesh \
+         edge already; remove that part of the line", from[0], from[1], to[0], to[1]
+    )]
+    LineAlongBoundary {
+        /// The line segment, e.g. "constraint line 1, segment 2".
+        line: String,
+        /// The ring edge, e.g. "polygon 1 outer ring, edge 4".
+        edge: String,
+        /// Where the shared stretch starts.
+        from: [f64; 2],
+        /// Where it ends.
+        to: [f64; 2],
+    },
     /// A constraint line leaves the region.
     #[error(
         "constraint line {line}, vertex {vertex} at ({:.9}, {:.9}) lies outside the region; \
@@ -289,6 +305,17 @@ fn check_intersections(region: &Region, names: &[String]) -> Result<(), Validati
             if s.line && t.line {
                 continue; // crossing constraint lines are split by the mesher
             }
+            if s.line != t.line {
+                if let Some((from, to)) = collinear_overlap(s, t) {
+                    let (l, e) = if s.line { (s, t) } else { (t, s) };
+                    return Err(ValidationError::LineAlongBoundary {
+                        line: describe(l),
+                        edge: describe(e),
+                        from,
+                        to,
+                    });
+                }
+            }
             if let Some(at) = bad_contact(s, t) {
                 let (first, second) = if (s.owner, s.index) < (t.owner, t.index) {
                     (describe(s), describe(t))
@@ -353,6 +380,30 @@ fn bad_contact(s: &Seg, t: &Seg) -> Option<[f64; 2]> {
         return Some(p);
     }
     None
+}
+
+/// The stretch two segments share when they lie on one line and overlap along a positive
+/// length (exact: orientations and coordinate comparisons only).
+fn collinear_overlap(s: &Seg, t: &Seg) -> Option<([f64; 2], [f64; 2])> {
+    if orient(s.a, s.b, t.a) != 0.0 || orient(s.a, s.b, t.b) != 0.0 {
+        return None;
+    }
+    // On one line: order points along it by x, or by y for a vertical line.
+    let axis = usize::from(s.a[0] == s.b[0]);
+    let key = |p: [f64; 2]| p[axis];
+    let (s0, s1) = if key(s.a) <= key(s.b) {
+        (s.a, s.b)
+    } else {
+        (s.b, s.a)
+    };
+    let (t0, t1) = if key(t.a) <= key(t.b) {
+        (t.a, t.b)
+    } else {
+        (t.b, t.a)
+    };
+    let from = if key(s0) >= key(t0) { s0 } else { t0 };
+    let to = if key(s1) <= key(t1) { s1 } else { t1 };
+    (key(from) < key(to)).then_some((from, to))
 }
 
 /// Whether `p` is the endpoint that the neighbouring segments `s` and `t` share.
@@ -512,6 +563,22 @@ mod tests {
         r.lines.push(vec![[5.0, 5.5], [15.0, 5.5]]);
         let e = validate(&r).unwrap_err();
         assert!(matches!(e, ValidationError::SelfIntersection { .. }), "{e}");
+    }
+
+    #[test]
+    fn lines_along_the_boundary_are_refused_by_name() {
+        // Found by the mesher fuzz target: a line on part of a boundary edge.
+        let mut r = Region::from_ring(square(0.0, 0.0, 15.0));
+        r.lines.push(vec![[0.0, 1.0], [0.0, 0.0]]);
+        let e = validate(&r).unwrap_err().to_string();
+        assert!(
+            e.contains("constraint line 1, segment 1 runs along polygon 1 outer ring"),
+            "{e}"
+        );
+        // Touching the boundary at a point, or crossing it inwards, stays valid.
+        let mut r = Region::from_ring(square(0.0, 0.0, 15.0));
+        r.lines.push(vec![[0.0, 1.0], [5.0, 5.0], [15.0, 7.0]]);
+        assert!(validate(&r).is_ok());
     }
 
     #[test]
