@@ -349,6 +349,9 @@ fn build_size_settings_are_refused_naming_the_key() {
     refused(&o, &["triangles", "raise mesh.max_area"]);
     let o = build_with("export.grid_spacing=0", &dir.path().join("b"));
     refused(&o, &["export.grid_spacing", "positive"]);
+    // A tiny positive spacing: about 1e11 nodes of the DSM grid, refused before allocation.
+    let o = build_with("export.grid_spacing=1e-6", &dir.path().join("c"));
+    refused(&o, &["DSM grid nodes", "raise export.grid_spacing"]);
 }
 
 // ---- 2. No silently wrong result ------------------------------------------------------------

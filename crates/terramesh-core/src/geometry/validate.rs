@@ -63,17 +63,16 @@ pub enum ValidationError {
     /// a mesh edge already, and a second constraint on it is ambiguous.
     #[error(
         "{line} runs along {edge} from ({:.9}, {:.9}) to ({:.9}, {:.9}): the boundary is a mesh \
-         edge already; remove that part of the line", from[0], from[1], to[0], to[1]
+         edge already; remove that part of the line", stretch[0][0], stretch[0][1], stretch[1][0],
+         stretch[1][1]
     )]
     LineAlongBoundary {
         /// The line segment, e.g. "constraint line 1, segment 2".
         line: String,
         /// The ring edge, e.g. "polygon 1 outer ring, edge 4".
         edge: String,
-        /// Where the shared stretch starts.
-        from: [f64; 2],
-        /// Where it ends.
-        to: [f64; 2],
+        /// Where the shared stretch starts and ends (boxed: the error stays small).
+        stretch: Box<[[f64; 2]; 2]>,
     },
     /// A constraint line leaves the region.
     #[error(
@@ -311,8 +310,7 @@ fn check_intersections(region: &Region, names: &[String]) -> Result<(), Validati
                     return Err(ValidationError::LineAlongBoundary {
                         line: describe(l),
                         edge: describe(e),
-                        from,
-                        to,
+                        stretch: Box::new([from, to]),
                     });
                 }
             }

@@ -297,6 +297,13 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         .grid_spacing
         .unwrap_or(s.cell[0].min(s.cell[1]))
         .max(1e-3);
+    // The node count follows from the settings: estimated before the grid is allocated (16
+    // bytes a node: the value and its index), refused with the key that changes it.
+    let (fx, fy) = ((hi[0] - lo[0]) / step + 1.0, (hi[1] - lo[1]) / step + 1.0);
+    terramesh_core::limits::Estimate::new("DSM grid nodes", fx.ceil() * fy.ceil(), 16.0)
+        .remedy(terramesh_core::limits::Remedy::raise("grid_spacing"))
+        .check()
+        .map_err(crate::error::Error::TooLarge)?;
     let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
     let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
     let spec = terramesh_io::grid_write::RasterGrid {
