@@ -66,6 +66,9 @@ fn a_projection_error_names_the_file_and_is_said_once() {
         out.to_str().unwrap(),
     ]);
     said_once(&err, "latitude 91.5 is out of range");
+    // The file and the vertex that cannot be projected.
+    assert!(err.contains("r.geojson"), "{err}");
+    said_once(&err, "the vertex at longitude 7.1, latitude 91.5");
     assert!(!out.exists());
 }
 

@@ -52,9 +52,17 @@ pub enum RegionError {
         /// Which coordinates the location is in.
         crs_note: String,
     },
-    /// Projection to UTM failed.
-    #[error("projecting the region to UTM: {0}")]
-    Projection(#[from] CoordError),
+    /// Projection to UTM failed, at a vertex or for the zone of the region's centre.
+    #[error("{source_name}: {what} cannot be projected to UTM: {source}")]
+    Projection {
+        /// The inline text or file name.
+        source_name: String,
+        /// The vertex (with its longitude and latitude) or "the centre of the region".
+        what: String,
+        /// Why.
+        #[source]
+        source: CoordError,
+    },
 }
 
 /// How errors name an inline corner list ([`RegionInput::Corners`] that is not a file).
@@ -139,7 +147,7 @@ pub fn load(
         RegionInput::File(p) => p.display().to_string(),
     };
     let read = validate(&read).map_err(|source| RegionError::Validation {
-        source_name: name,
+        source_name: name.clone(),
         source,
         crs_note: if is_geographic {
             ", longitude latitude".into()
@@ -154,25 +162,53 @@ pub fn load(
             zone: None,
         });
     }
-    project(read, zone)
+    project_named(read, zone, &name)
 }
 
 /// Projects a `[lon, lat]` region to UTM in `zone` or the zone of its bounding-box centre.
+///
+/// ```
+/// use terramesh_core::geometry::Region;
+/// let r = Region::from_ring(vec![[7.3, 48.7], [7.4, 48.7], [7.4, 91.5]]);
+/// let e = terramesh_io::region::project(r, None).unwrap_err().to_string();
+/// assert!(e.contains("the vertex at longitude 7.4, latitude 91.5"), "{e}");
+/// ```
 pub fn project(geographic: Region, zone: Option<Zone>) -> Result<LoadedRegion, RegionError> {
+    project_named(geographic, zone, "the region")
+}
+
+/// [`project`], naming the region's file or corner list (`name`) in errors.
+fn project_named(
+    geographic: Region,
+    zone: Option<Zone>,
+    name: &str,
+) -> Result<LoadedRegion, RegionError> {
+    let failed = |what: String, source: CoordError| RegionError::Projection {
+        source_name: name.to_string(),
+        what,
+        source,
+    };
     let zone = match zone {
         Some(z) => z,
         None => {
             let (lo, hi) = geographic.bbox().ok_or_else(|| RegionError::Invalid {
-                source_name: "region".into(),
+                source_name: name.to_string(),
                 message: "the region has no vertices".into(),
             })?;
-            Zone::for_point(0.5 * (lo[1] + hi[1]), 0.5 * (lo[0] + hi[0]))?
+            Zone::for_point(0.5 * (lo[1] + hi[1]), 0.5 * (lo[0] + hi[0]))
+                .map_err(|e| failed("the centre of the region".into(), e))?
         }
     };
-    let projected = geographic.try_map(|[lon, lat]| {
-        let p = to_utm(lat, lon, Some(zone))?;
-        Ok::<_, CoordError>([p.easting, p.northing])
-    })?;
+    let projected = geographic
+        .try_map(|[lon, lat]| {
+            let p = to_utm(lat, lon, Some(zone)).map_err(|e| ([lon, lat], e))?;
+            Ok::<_, ([f64; 2], CoordError)>([p.easting, p.northing])
+        })
+        .map_err(|([lon, lat], e)| {
+            let lon = crate::quote::cut(&lon.to_string());
+            let lat = crate::quote::cut(&lat.to_string());
+            failed(format!("the vertex at longitude {lon}, latitude {lat}"), e)
+        })?;
     Ok(LoadedRegion {
         projected,
         geographic: Some(geographic),
