@@ -34,7 +34,7 @@ mod tiling;
 
 use std::fs;
 use std::io;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rayon::prelude::*;
 use terramesh_core::coords::VerticalDatum;
@@ -135,18 +135,7 @@ pub fn write_terrain(
         let path = path.display().to_string();
         move |source| TerrainError::Io { path, source }
     };
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let stem = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "terrain".into());
-    let tmp = tempfile::Builder::new()
-        .prefix(&format!(".{stem}."))
-        .tempdir_in(&parent)
-        .map_err(io_err(dir))?;
+    let tmp = crate::folder::OutputFolder::create(dir).map_err(io_err(dir))?;
     for z in 0..=max_level {
         for x in tiles.iter().filter(|t| t.id.z == z).map(|t| t.id.x) {
             let d = tmp.path().join(format!("{z}/{x}"));
@@ -184,39 +173,12 @@ pub fn write_terrain(
     );
     let lp = tmp.path().join("layer.json");
     fs::write(&lp, layer).map_err(io_err(&lp))?;
-    commit_dir(tmp, dir).map_err(io_err(dir))?;
+    tmp.commit().map_err(io_err(dir))?;
     Ok(TerrainSummary {
         max_level,
         tiles: tiles.len(),
         fill_height,
     })
-}
-
-/// Renames the finished temporary folder to `target`, moving a previous `target` aside first
-/// and deleting it after (restoring it if the rename fails).
-fn commit_dir(tmp: tempfile::TempDir, target: &Path) -> io::Result<()> {
-    let parent = tmp
-        .path()
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
-    if target.exists() {
-        let old = tempfile::Builder::new()
-            .prefix(".terrain-old.")
-            .tempdir_in(&parent)?;
-        let old_path = old.path().join("previous");
-        fs::rename(target, &old_path)?;
-        if let Err(e) = fs::rename(tmp.path(), target) {
-            let _ = fs::rename(&old_path, target);
-            return Err(e);
-        }
-        let _ = tmp.keep();
-        drop(old); // removes the previous folder
-    } else {
-        fs::rename(tmp.path(), target)?;
-        let _ = tmp.keep();
-    }
-    Ok(())
 }
 
 #[cfg(test)]
