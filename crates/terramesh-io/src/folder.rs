@@ -31,14 +31,7 @@ pub struct OutputFolder {
 impl OutputFolder {
     /// Creates the temporary sibling of `target` (whose parent must exist).
     pub fn create(target: &Path) -> io::Result<OutputFolder> {
-        let parent = match target.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let (parent, name) = crate::output::parent_and_name(target);
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(".tmp")

@@ -50,14 +50,7 @@ impl Output {
                 io::stdout(),
             ))),
             Some(p) => {
-                let dir = match p.parent() {
-                    Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-                    _ => PathBuf::from("."),
-                };
-                let name = p
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default();
+                let (dir, name) = parent_and_name(p);
                 let tmp = tempfile::Builder::new()
                     .prefix(&format!(".{name}."))
                     .suffix(".tmp")
@@ -140,6 +133,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut o = Output::create(Some(path))?;
     o.write_all(bytes)?;
     o.commit()
+}
+
+/// The folder a temporary sibling of `path` goes in (`.` for a bare name) and `path`'s file
+/// name, shared by [`Output`] and [`crate::folder::OutputFolder`].
+pub(crate) fn parent_and_name(path: &Path) -> (PathBuf, String) {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    (dir, name)
 }
 
 #[cfg(test)]
