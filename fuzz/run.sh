@@ -19,6 +19,10 @@ fi
 seeds_of() { # the fixture crops seeding a target, from FIXTURE_SEEDS in the harness crate
   sed -n "s|^ *(\"$1\", \"\(.*\)\"),\$|\1|p" ../crates/terramesh-fuzz/src/lib.rs
 }
+# The memory ceiling of terramesh's own size guard (terramesh_core::limits) is lowered to 1 GiB,
+# below libFuzzer's 4 GiB malloc limit: an input the guard refuses is an error, as it should
+# be, and only an allocation the guard does not see trips the limit.
+export TERRAMESH_MAX_MEMORY="${TERRAMESH_MAX_MEMORY:-1GiB}"
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 cargo +nightly fuzz build -O

@@ -495,6 +495,37 @@ fn geotiff_bits_per_sample_not_matching_the_tiles_is_refused() {
     );
 }
 
+#[test]
+fn geotiff_chunk_byte_counts_beyond_the_file_are_refused_before_allocation() {
+    // Found by the geotiff fuzzer (an allocation of 69 GB): a compressed tile is read into a
+    // buffer of its TileByteCounts size. Here the counts are retyped from SHORT to LONG8 (type
+    // 16), so each reads as about 2^60 bytes, and the tiles are declared deflate-compressed.
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = std::fs::read(fixture("grids/srtm-N48E007-r300-c1000.tif")).unwrap();
+    let ifd = u32_at(&b, 4);
+    for k in 0..u16_at(&b, ifd) {
+        let e = ifd + 2 + 12 * k;
+        match u16_at(&b, e) {
+            325 => b[e + 2..e + 4].copy_from_slice(&16u16.to_le_bytes()),
+            259 => b[e + 8..e + 10].copy_from_slice(&8u16.to_le_bytes()),
+            _ => {}
+        }
+    }
+    let p = write(dir.path(), "counts.tif", b);
+    let o = run(&[
+        "sample",
+        "--source",
+        &p,
+        "--corners",
+        "48.70 7.88; 48.70 7.89; 48.71 7.89",
+        "--spacing",
+        "200",
+        "-o",
+        s(&dir.path().join("s.csv")),
+    ]);
+    refused(&o, &["counts.tif", "more bytes than the file holds"]);
+}
+
 // ---- 3. No crash in a parser ----------------------------------------------------------------
 
 #[test]

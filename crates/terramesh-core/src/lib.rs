@@ -31,3 +31,4 @@ pub mod limits;
 pub mod sampling;
 pub mod solid;
 pub mod vocab;
+pub mod volume;

@@ -50,6 +50,7 @@ pub fn read_geotiff(path: &Path) -> Result<Raster, DemError> {
 /// ```
 pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, DemError> {
     let file = File::open(path).map_err(|e| DemError::io(path, e))?;
+    let file_len = file.metadata().map_err(|e| DemError::io(path, e))?.len();
     let fmt = |m: String| DemError::format(path, m);
     let terr = |e: tiff::TiffError| match e {
         tiff::TiffError::UnsupportedError(u) => fmt(format!(
@@ -57,11 +58,17 @@ pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, 
              gdal_translate -co COMPRESS=DEFLATE -co TILED=YES in.tif out.tif"
         )),
         tiff::TiffError::IoError(io) => DemError::io(path, io),
+        tiff::TiffError::LimitsExceeded => fmt(format!(
+            "a tag, tile or strip of this TIFF claims more bytes than the file holds or the \
+             memory ceiling allows ({} bytes, {}); the file is truncated or damaged",
+            terramesh_core::limits::max_memory(),
+            terramesh_core::limits::MAX_MEMORY_VAR
+        )),
         other => fmt(format!("not a readable TIFF: {other}")),
     };
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(terr)?
-        .with_limits(Limits::unlimited());
+        .with_limits(decoder_limits(file_len));
     let (cols, rows) = dec.dimensions().map_err(terr)?;
     match dec.colortype().map_err(terr)? {
         ColorType::Gray(_) => {}
@@ -157,6 +164,20 @@ pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, 
     })
 }
 
+/// The decoder's limits: the memory ceiling ([`terramesh_core::limits::max_memory`]) for the
+/// decoded image, the file's own length for one compressed chunk (a strip cannot hold more
+/// bytes than the file), and 256 MiB for one tag's values (the tile offsets of a
+/// 4-billion-pixel raster in 256-pixel tiles take 512 KiB). Without them a `StripByteCounts`
+/// of 2^36 is allocated before a byte of the strip is read.
+fn decoder_limits(file_len: u64) -> Limits {
+    let ceiling = terramesh_core::limits::max_memory();
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = usize::try_from(ceiling).unwrap_or(usize::MAX);
+    limits.intermediate_buffer_size = usize::try_from(ceiling.min(file_len)).unwrap_or(usize::MAX);
+    limits.ifd_value_size = 256 << 20;
+    limits
+}
+
 /// Checks that the tags describing the samples match the data stored: in an uncompressed
 /// file every tile or strip holds exactly its pixels times `BitsPerSample / 8` bytes
 /// (`TileByteCounts`, `StripByteCounts`). A BitsPerSample of 64 on int16 tiles would read
@@ -182,6 +203,22 @@ fn check_chunk_sizes(
     {
         return Ok(Err(format!("{cols} x {rows} pixels: {e}")));
     }
+    let tiled = matches!(dec.get_chunk_type(), tiff::decoder::ChunkType::Tile);
+    let (cw, ch) = dec.chunk_dimensions();
+    // A strip may claim more rows than the image has (one strip of RowsPerStrip 2^32 - 1).
+    let stored_rows = if tiled { ch } else { ch.min(rows) };
+    if let Err(e) = terramesh_core::limits::Estimate::new(
+        "pixels in one tile or strip",
+        f64::from(cw) * f64::from(stored_rows),
+        bytes_each,
+    )
+    .check()
+    {
+        return Ok(Err(format!(
+            "a tile or strip of {cw} x {stored_rows} pixels: {e}; the TileWidth, TileLength or \
+             RowsPerStrip tag is wrong, or retile it with gdal_translate -co TILED=YES"
+        )));
+    }
     if dec.find_tag_unsigned::<u32>(Tag::Compression)?.unwrap_or(1) != 1 {
         return Ok(Ok(()));
     }
@@ -192,8 +229,6 @@ fn check_chunk_sizes(
         .find_tag_unsigned::<u32>(Tag::SamplesPerPixel)?
         .unwrap_or(1);
     let bits = u64::from(bits.first().copied().unwrap_or(1)) * u64::from(samples);
-    let tiled = matches!(dec.get_chunk_type(), tiff::decoder::ChunkType::Tile);
-    let (cw, ch) = dec.chunk_dimensions();
     let counts = if tiled {
         dec.find_tag_unsigned_vec::<u64>(Tag::TileByteCounts)?
     } else {
