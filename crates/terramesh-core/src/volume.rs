@@ -244,3 +244,57 @@ pub fn cell_volume(points: &[[f64; 3]], cell: &Cell) -> f64 {
         }
     }
 }
+
+/// The cells of the volume mesh (`[geology] element`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Element {
+    /// Layered prisms (wedges), degenerating to pyramids and tetrahedra where a unit pinches
+    /// out in part of a column.
+    #[default]
+    Prism,
+    /// Every prism split into three tetrahedra by a rule on global node numbers, so that
+    /// neighbouring prisms split their shared quadrilateral faces the same way.
+    Tetra,
+}
+crate::named_enum!(Element, "element", [Element::Prism => "prism" | "wedge", Element::Tetra => "tetra" | "tetrahedra"]);
+
+/// What is interpolated between the boreholes (`[geology] interpolate`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Interpolated {
+    /// Unit thicknesses (isopachs), stacked down from the terrain.
+    #[default]
+    Thickness,
+    /// The elevation of every unit's top.
+    Tops,
+}
+crate::named_enum!(Interpolated, "interpolated quantity", [Interpolated::Thickness => "thickness" | "isopach", Interpolated::Tops => "tops"]);
+
+/// The unit of elevations and depths in an input file (`z_unit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum ZUnit {
+    /// Metres.
+    #[default]
+    Metre,
+    /// International feet (0.3048 m).
+    Foot,
+    /// US survey feet (1200/3937 m).
+    UsFoot,
+}
+crate::named_enum!(ZUnit, "vertical unit", [ZUnit::Metre => "m" | "metre" | "meter" | "metres" | "meters", ZUnit::Foot => "ft" | "foot" | "feet", ZUnit::UsFoot => "us-ft" | "ftus" | "us_survey_foot"]);
+
+impl ZUnit {
+    /// Metres per unit.
+    ///
+    /// ```
+    /// use terramesh_core::volume::ZUnit;
+    /// assert_eq!(ZUnit::Foot.metres(), 0.3048);
+    /// assert_eq!("ft".parse::<ZUnit>().unwrap(), ZUnit::Foot);
+    /// ```
+    pub fn metres(self) -> f64 {
+        match self {
+            ZUnit::Metre => 1.0,
+            ZUnit::Foot => 0.3048,
+            ZUnit::UsFoot => 1200.0 / 3937.0,
+        }
+    }
+}
