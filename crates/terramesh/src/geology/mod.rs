@@ -4,3 +4,4 @@
 //! written by `terramesh_io::model`.
 
 pub mod fields;
+pub mod section;
