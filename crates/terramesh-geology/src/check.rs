@@ -47,7 +47,11 @@ pub struct CheckSummary {
 }
 
 fn fail(mesh: &VolumeMesh, node: u32, what: String) -> GeologyError {
-    let p = mesh.points.get(node as usize).copied().unwrap_or([f64::NAN; 3]);
+    let p = mesh
+        .points
+        .get(node as usize)
+        .copied()
+        .unwrap_or([f64::NAN; 3]);
     GeologyError::Check {
         what,
         x: p[0],
@@ -234,7 +238,11 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
         return Err(fail(
             mesh,
             mesh.cells[c].nodes[0].min(n.saturating_sub(1)),
-            format!("cell {c} has volume {} (nodes {:?})", volumes[c], mesh.cells[c].used()),
+            format!(
+                "cell {c} has volume {} (nodes {:?})",
+                volumes[c],
+                mesh.cells[c].used()
+            ),
         ));
     }
     let units = mesh.units.len();
@@ -289,7 +297,11 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
                     format!(
                         "the face {:?} is in {k} cells{}",
                         used(&all[i].0),
-                        if k == 2 { " with the same orientation" } else { "" }
+                        if k == 2 {
+                            " with the same orientation"
+                        } else {
+                            ""
+                        }
                     ),
                 ))
             }
@@ -297,8 +309,7 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
         i = j;
     }
     // 3. The boundary is closed.
-    let faces_of_boundary: Vec<[u32; 4]> =
-        boundary.iter().map(|f| oriented(f.0, f.1)).collect();
+    let faces_of_boundary: Vec<[u32; 4]> = boundary.iter().map(|f| oriented(f.0, f.1)).collect();
     closed(mesh, faces_of_boundary.par_iter().map(used), "the boundary")?;
     // 4. Tagged faces.
     check_tags(mesh, &mut boundary, &mut interfaces)?;
@@ -306,7 +317,11 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
     let r = mesh.points.first().copied().unwrap_or_default();
     let under: f64 = faces_of_boundary
         .par_iter()
-        .map(|f| triangles(f).map(|t| z_flux(&mesh.points, r, t)).sum::<f64>())
+        .map(|f| {
+            triangles(f)
+                .map(|t| z_flux(&mesh.points, r, t))
+                .sum::<f64>()
+        })
         .sum::<f64>()
         / 6.0;
     if !close(under, volume) {
@@ -325,13 +340,19 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
         return Err(fail(
             mesh,
             0,
-            format!("the bodies are of units {bodies:?} but the units with cells are {with_cells:?}"),
+            format!(
+                "the bodies are of units {bodies:?} but the units with cells are {with_cells:?}"
+            ),
         ));
     }
     for b in &mesh.bodies {
         let name = &mesh.units[b.unit];
         if let Some(t) = b.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
-            return Err(fail(mesh, 0, format!("body {name}: triangle {t:?} names a missing node")));
+            return Err(fail(
+                mesh,
+                0,
+                format!("body {name}: triangle {t:?} names a missing node"),
+            ));
         }
         pinch_edges += closed(
             mesh,
@@ -376,11 +397,21 @@ fn check_tags(
     let mut inner = Vec::with_capacity(interfaces.len());
     for (i, f) in mesh.faces.iter().enumerate() {
         let Some(tag) = mesh.tags.get(f.tag as usize) else {
-            return Err(fail(mesh, 0, format!("tagged face {i} has tag {} of {}", f.tag, mesh.tags.len())));
+            return Err(fail(
+                mesh,
+                0,
+                format!("tagged face {i} has tag {} of {}", f.tag, mesh.tags.len()),
+            ));
         };
         let nodes = used(&f.nodes);
-        if nodes.iter().any(|&v| v as usize >= mesh.points.len()) || f.cell as usize >= mesh.cells.len() {
-            return Err(fail(mesh, 0, format!("tagged face {i} names a missing node or cell")));
+        if nodes.iter().any(|&v| v as usize >= mesh.points.len())
+            || f.cell as usize >= mesh.cells.len()
+        {
+            return Err(fail(
+                mesh,
+                0,
+                format!("tagged face {i} names a missing node or cell"),
+            ));
         }
         let (key, o) = canonical(f.nodes);
         // Its direction: the z of its normal, against its extent.
@@ -413,7 +444,10 @@ fn check_tags(
             return Err(fail(
                 mesh,
                 nodes[0],
-                format!("tagged face {i} ({}) points the wrong way or names the wrong unit", tag.name()),
+                format!(
+                    "tagged face {i} ({}) points the wrong way or names the wrong unit",
+                    tag.name()
+                ),
             ));
         }
         match tag {
@@ -421,7 +455,10 @@ fn check_tags(
             _ => outer.push((key, o, f.cell)),
         }
     }
-    for (what, tagged, found) in [("boundary", &mut outer, boundary), ("interface", &mut inner, interfaces)] {
+    for (what, tagged, found) in [
+        ("boundary", &mut outer, boundary),
+        ("interface", &mut inner, interfaces),
+    ] {
         tagged.par_sort_unstable();
         found.par_sort_unstable();
         if tagged.as_slice() != &found[..] {
@@ -458,7 +495,10 @@ fn check_tags(
 /// # Ok::<(), terramesh_geology::GeologyError>(())
 /// ```
 pub fn volume_between(planar: &Planar, stack: &Stack) -> f64 {
-    let (top, base) = (&stack.surfaces[0], &stack.surfaces[stack.surfaces.len() - 1]);
+    let (top, base) = (
+        &stack.surfaces[0],
+        &stack.surfaces[stack.surfaces.len() - 1],
+    );
     (0..planar.triangles.len())
         .into_par_iter()
         .map(|t| {

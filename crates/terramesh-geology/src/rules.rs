@@ -189,7 +189,11 @@ pub fn apply_rules(
     check_finite(planar, &|| "the terrain".into(), &raw.terrain)?;
     check_finite(planar, &|| "the base".into(), &raw.base)?;
     for (i, top) in raw.tops.iter().enumerate() {
-        check_finite(planar, &|| format!("the top of unit {} (0 = the top unit)", i + 1), top)?;
+        check_finite(
+            planar,
+            &|| format!("the top of unit {} (0 = the top unit)", i + 1),
+            top,
+        )?;
     }
     let worst = (0..raw.terrain.len())
         .map(|v| (v, raw.base[v] - raw.terrain[v]))

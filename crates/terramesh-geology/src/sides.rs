@@ -45,7 +45,9 @@ pub(crate) fn classify(
     };
     match tags {
         SideTags::Compass => {
-            let names = ["north", "east", "south", "west"].map(String::from).to_vec();
+            let names = ["north", "east", "south", "west"]
+                .map(String::from)
+                .to_vec();
             let side = edges
                 .iter()
                 .map(|e| {

@@ -77,11 +77,7 @@ pub fn unit_stats(planar: &Planar, stack: &Stack, mesh: &VolumeMesh) -> Vec<Unit
                 .map(|v| stack.thickness(u, v))
                 .collect();
             let pinched_area = (0..planar.triangles.len())
-                .filter(|&i| {
-                    planar.triangles[i]
-                        .iter()
-                        .all(|&v| t[v as usize] == 0.0)
-                })
+                .filter(|&i| planar.triangles[i].iter().all(|&v| t[v as usize] == 0.0))
                 .map(|i| planar.area(i))
                 .sum();
             let n = t.len().max(1) as f64;

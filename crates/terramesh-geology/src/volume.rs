@@ -129,7 +129,11 @@ fn validate(planar: &Planar, stack: &Stack, layering: &Layering) -> Result<(), G
             ));
         }
         for (v, &z) in s.iter().enumerate() {
-            let above = if k == 0 { f64::INFINITY } else { stack.surfaces[k - 1][v] };
+            let above = if k == 0 {
+                f64::INFINITY
+            } else {
+                stack.surfaces[k - 1][v]
+            };
             if !(z.is_finite() && z <= above) {
                 let [x, y] = planar.points[v];
                 return Err(GeologyError::NonFinite {
@@ -293,7 +297,11 @@ fn column(
             let used = if nodes[3] == NONE { 3 } else { 4 };
             let owner = emitted
                 .clone()
-                .find(|&c| nodes[..used].iter().all(|n| out.cells[c].used().contains(n)))
+                .find(|&c| {
+                    nodes[..used]
+                        .iter()
+                        .all(|n| out.cells[c].used().contains(n))
+                })
                 .expect("every face of a cell belongs to one of its tetrahedra");
             out.faces.push(TaggedFace {
                 nodes,
@@ -303,7 +311,9 @@ fn column(
         };
         match previous_unit {
             None => face([up[0], up[1], up[2], NONE], 0, out),
-            Some(p) if p != unit => face([up[0], up[1], up[2], NONE], tag_interface + unit - 1, out),
+            Some(p) if p != unit => {
+                face([up[0], up[1], up[2], NONE], tag_interface + unit - 1, out)
+            }
             _ => {}
         }
         for k in 0..3 {
