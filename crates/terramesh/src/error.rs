@@ -74,6 +74,12 @@ pub enum Error {
     /// The scene of the report's 3D viewer.
     #[error(transparent)]
     Scene(#[from] terramesh_io::viewer::SceneError),
+    /// The geological model (rules, volume mesh, checks).
+    #[error(transparent)]
+    Geology(#[from] terramesh_geology::GeologyError),
+    /// A borehole file.
+    #[error(transparent)]
+    Borehole(#[from] terramesh_io::boreholes::BoreholeError),
     /// An elevation web service or tile server.
     #[error(transparent)]
     Web(#[from] terramesh_web::WebError),

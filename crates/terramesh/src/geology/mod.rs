@@ -4,4 +4,5 @@
 //! written by `terramesh_io::model`.
 
 pub mod fields;
+pub mod model;
 pub mod section;
