@@ -130,3 +130,22 @@ fn kimberlina_tetrahedral_model_has_the_same_volumes() {
     }
     assert!(t.mesh.cells.len() > p.mesh.cells.len());
 }
+
+#[test]
+fn kimberlina_model_json_lists_every_unit_and_contact() {
+    let (m, contacts) = model(Element::Prism);
+    let s = terramesh::geology::summary::ModelSummary::of(&m, "EPSG:26711");
+    let v = serde_json::to_value(&s).unwrap();
+    assert_eq!(v["units"].as_array().unwrap().len(), 16);
+    assert_eq!(v["boreholes"].as_array().unwrap().len(), contacts);
+    assert_eq!(v["units"][0]["interpolated"], "its top is the terrain");
+    assert!(v["units"][1]["interpolated"]
+        .as_str()
+        .unwrap()
+        .starts_with("kriged"));
+    assert!(v["checks"]["relative_difference"].as_f64().unwrap() < 1e-9);
+    let first = &v["boreholes"][0];
+    for key in ["hole", "unit", "observed", "model", "misfit"] {
+        assert!(!first[key].is_null(), "{key}");
+    }
+}

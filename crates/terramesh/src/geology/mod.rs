@@ -6,3 +6,4 @@
 pub mod fields;
 pub mod model;
 pub mod section;
+pub mod summary;
