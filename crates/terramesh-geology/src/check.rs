@@ -134,23 +134,92 @@ fn used(f: &[u32; 4]) -> &[u32] {
     }
 }
 
+/// The outputs of every item of `src` (at most 8 each, which `write` puts into a buffer,
+/// returning how many), sorted: bucketed by the node `first(output)` in two passes (a count,
+/// then a scatter, so that nothing is stored twice), then each bucket sorted on its own, in
+/// parallel. `first` must be the leading part of the order.
+fn bucketed<S, T: Copy + Send + Ord + Default>(
+    src: &[S],
+    nodes: usize,
+    write: impl Fn(usize, &S, &mut [T; 8]) -> usize,
+    first: impl Fn(&T) -> u32 + Sync,
+) -> Vec<T> {
+    let mut start = vec![0usize; nodes + 1];
+    let mut buf = [T::default(); 8];
+    for (i, s) in src.iter().enumerate() {
+        let k = write(i, s, &mut buf);
+        for t in &buf[..k] {
+            start[first(t) as usize + 1] += 1;
+        }
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut out = vec![T::default(); start[nodes]];
+    for (i, s) in src.iter().enumerate() {
+        let k = write(i, s, &mut buf);
+        for t in &buf[..k] {
+            let slot = &mut start[first(t) as usize];
+            out[*slot] = *t;
+            *slot += 1;
+        }
+    }
+    out.par_chunk_by_mut(|a, b| first(a) == first(b))
+        .for_each(|bucket| bucket.sort_unstable());
+    out
+}
+
+/// Sorts `items`, bucketed first by the node `first(item)` (a counting sort over the nodes,
+/// linear), then each bucket on its own (small sorts, in parallel). `first` must be the
+/// leading part of the order.
+fn sort_by_node<T: Copy + Send + Ord>(
+    items: &[T],
+    nodes: usize,
+    first: impl Fn(&T) -> u32 + Sync,
+) -> Vec<T> {
+    let Some(&fill) = items.first() else {
+        return Vec::new();
+    };
+    let mut start = vec![0usize; nodes + 1];
+    for it in items {
+        start[first(it) as usize + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut out = vec![fill; items.len()];
+    for it in items {
+        let slot = &mut start[first(it) as usize];
+        out[*slot] = *it;
+        *slot += 1;
+    }
+    out.par_chunk_by_mut(|a, b| first(a) == first(b))
+        .for_each(|bucket| bucket.sort_unstable());
+    out
+}
+
 /// Every edge of the polygons in two of them or four, as often one way as the other; returns
 /// the number of edges in four.
-fn closed<'a>(
+fn closed<P>(
     mesh: &VolumeMesh,
-    polygons: impl ParallelIterator<Item = &'a [u32]>,
+    polygons: &[P],
+    nodes_of: impl Fn(&P) -> &[u32],
     what: &str,
 ) -> Result<usize, GeologyError> {
-    let mut edges: Vec<u64> = polygons
-        .flat_map_iter(|p| {
-            (0..p.len()).map(move |i| {
+    let edges: Vec<u64> = bucketed(
+        polygons,
+        mesh.points.len(),
+        |_, p, out| {
+            let p = nodes_of(p);
+            for i in 0..p.len() {
                 let (a, b) = (p[i] as u64, p[(i + 1) % p.len()] as u64);
-                // (min, max) and the direction in the lowest bit; 32-bit nodes fit in 63 bits.
-                (a.min(b) << 32 | a.max(b)) << 1 | (a < b) as u64
-            })
-        })
-        .collect();
-    edges.par_sort_unstable();
+                // (min, max) and the direction in the lowest bit (nodes below 2^31).
+                out[i] = (a.min(b) << 32 | a.max(b)) << 1 | (a < b) as u64;
+            }
+            p.len()
+        },
+        |e| (e >> 33) as u32,
+    );
     let mut fours = 0;
     let mut i = 0;
     while i < edges.len() {
@@ -219,6 +288,9 @@ fn triangles(f: &[u32; 4]) -> impl Iterator<Item = [u32; 3]> {
 /// [`GeologyError::Check`] naming the first failure and where it is.
 pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
     let n = mesh.points.len() as u32;
+    if mesh.points.len() >= 1 << 31 {
+        return Err(fail(mesh, 0, "the check handles up to 2^31 nodes".into()));
+    }
     if mesh.material.len() != mesh.cells.len() {
         return Err(fail(mesh, 0, "one material per cell is needed".into()));
     }
@@ -234,7 +306,7 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
             }
         })
         .collect();
-    if let Some(c) = volumes.iter().position(|v| !(*v > 0.0)) {
+    if let Some(c) = volumes.iter().position(|v| v.is_nan() || *v <= 0.0) {
         return Err(fail(
             mesh,
             mesh.cells[c].nodes[0].min(n.saturating_sub(1)),
@@ -259,18 +331,20 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
     }
     let volume: f64 = unit_volumes.iter().sum();
     // 2. Faces: shared by two cells, oppositely, or boundary.
-    let mut all: Vec<([u32; 4], bool, u32)> = mesh
-        .cells
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(c, cell)| {
-            faces(cell).map(move |f| {
-                let (k, o) = canonical(f);
-                (k, o, c as u32)
-            })
-        })
-        .collect();
-    all.par_sort_unstable_by_key(|f| f.0);
+    let all: Vec<([u32; 4], bool, u32)> = bucketed(
+        &mesh.cells,
+        mesh.points.len(),
+        |i, c, out| {
+            let mut k = 0;
+            for f in faces(c) {
+                let (key, o) = canonical(f);
+                out[k] = (key, o, i as u32);
+                k += 1;
+            }
+            k
+        },
+        |f| f.0[0],
+    );
     let mut boundary = Vec::new();
     let mut interfaces = Vec::new();
     let mut interior_faces = 0;
@@ -310,9 +384,9 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
     }
     // 3. The boundary is closed.
     let faces_of_boundary: Vec<[u32; 4]> = boundary.iter().map(|f| oriented(f.0, f.1)).collect();
-    closed(mesh, faces_of_boundary.par_iter().map(used), "the boundary")?;
+    closed(mesh, &faces_of_boundary, used, "the boundary")?;
     // 4. Tagged faces.
-    check_tags(mesh, &mut boundary, &mut interfaces)?;
+    check_tags(mesh, &boundary, &interfaces)?;
     // 6. The volume under the boundary.
     let r = mesh.points.first().copied().unwrap_or_default();
     let under: f64 = faces_of_boundary
@@ -356,7 +430,8 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
         }
         pinch_edges += closed(
             mesh,
-            b.triangles.par_iter().map(|t| &t[..]),
+            &b.triangles,
+            |t| &t[..],
             &format!("the body of unit {name}"),
         )?;
         let enclosed: f64 = b
@@ -390,8 +465,8 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
 /// Check 4: the tagged faces against the boundary and interface faces found from the cells.
 fn check_tags(
     mesh: &VolumeMesh,
-    boundary: &mut [([u32; 4], bool, u32)],
-    interfaces: &mut [([u32; 4], bool, u32)],
+    boundary: &[([u32; 4], bool, u32)],
+    interfaces: &[([u32; 4], bool, u32)],
 ) -> Result<(), GeologyError> {
     let mut outer = Vec::with_capacity(boundary.len());
     let mut inner = Vec::with_capacity(interfaces.len());
@@ -456,11 +531,11 @@ fn check_tags(
         }
     }
     for (what, tagged, found) in [
-        ("boundary", &mut outer, boundary),
-        ("interface", &mut inner, interfaces),
+        ("boundary", outer, boundary),
+        ("interface", inner, interfaces),
     ] {
-        tagged.par_sort_unstable();
-        found.par_sort_unstable();
+        let tagged = sort_by_node(&tagged, mesh.points.len(), |f| f.0[0]);
+        let found = sort_by_node(found, mesh.points.len(), |f| f.0[0]);
         if tagged.as_slice() != &found[..] {
             let diff = tagged
                 .iter()

@@ -33,7 +33,7 @@ impl Columns {
         let mut unit_levels = Vec::with_capacity(units);
         for (u, &l) in layers.iter().enumerate() {
             let top = unit_of_layer.len();
-            unit_of_layer.extend(std::iter::repeat(u).take(l));
+            unit_of_layer.resize(top + l, u);
             unit_levels.push((top, top + l));
         }
         let levels = unit_of_layer.len() + 1;

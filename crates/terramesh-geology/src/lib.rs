@@ -3,7 +3,7 @@
 //!
 //! 1. [`apply_rules`] (or [`stack_thicknesses`]) repairs the surfaces: erosion, onlap,
 //!    pinch-out, base, in that order, and reports how many vertices each rule changed;
-//! 2. [`volume_mesh`] builds the layered volume mesh ([`VolumeMesh`]): one column of nodes
+//! 2. [`volume_mesh`] builds the layered volume mesh ([`VolumeMesh`](terramesh_core::volume::VolumeMesh)): one column of nodes
 //!    per planar vertex, wedges degenerating to pyramids and tetrahedra where a unit pinches
 //!    out (or tetrahedra only, conformal by a rule on global node numbers), tagged boundary and
 //!    interface faces, and the sealed body of every unit;

@@ -56,7 +56,7 @@ impl<'a> Planar<'a> {
                 });
             }
             let area = planar.area(t);
-            if !(area > 0.0) {
+            if area.is_nan() || area <= 0.0 {
                 let p = points[tri[0] as usize];
                 return Err(GeologyError::Triangle {
                     triangle: t,

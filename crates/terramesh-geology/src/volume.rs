@@ -291,8 +291,7 @@ fn column(
         let first = out.cells.len();
         emit(&cols.points, cell, tetra, &mut out.cells);
         let emitted = first..out.cells.len();
-        out.material
-            .extend(std::iter::repeat(unit as i32).take(emitted.len()));
+        out.material.resize(out.cells.len(), unit as i32);
         let face = |nodes: [u32; 4], tag: usize, out: &mut Chunk| {
             let used = if nodes[3] == NONE { 3 } else { 4 };
             let owner = emitted
@@ -316,15 +315,15 @@ fn column(
             }
             _ => {}
         }
-        for k in 0..3 {
-            if edge_side[k] == 0 {
+        for (k, &side) in edge_side.iter().enumerate() {
+            if side == 0 {
                 continue;
             }
             let (a, b) = (k, (k + 1) % 3);
             let Some(f) = side_face(up[a], up[b], lo[a], lo[b]) else {
                 continue;
             };
-            let tag = 1 + edge_side[k] as usize; // 2 + side index
+            let tag = 1 + side as usize; // 2 + side index
             if tetra && f[3] != NONE {
                 for t in split_quad(f) {
                     face([t[0], t[1], t[2], NONE], tag, out);

@@ -290,8 +290,14 @@ fn thickness_mode_stacks_down_and_reaches_the_base() {
     let planar = Planar::new(&pts, &tris).unwrap();
     let terrain: Vec<f64> = pts.iter().map(|p| 100.0 + 0.1 * p[0]).collect();
     let t0: Vec<f64> = pts.iter().map(|p| 5.0 - 0.3 * p[1]).collect(); // negative at y = 20
-    let (stack, report) =
-        stack_thicknesses(&planar, &terrain, &[t0.clone()], &[60.0; 9], 0.5).unwrap();
+    let (stack, report) = stack_thicknesses(
+        &planar,
+        &terrain,
+        std::slice::from_ref(&t0),
+        &[60.0; 9],
+        0.5,
+    )
+    .unwrap();
     assert_eq!(report.interfaces[0].negative_thickness, 3);
     for v in 0..9 {
         assert_eq!(stack.surfaces[0][v], terrain[v]);
