@@ -59,6 +59,9 @@ pub enum Error {
     /// A region file or corner list.
     #[error(transparent)]
     Region(#[from] terramesh_io::region::RegionError),
+    /// Borehole files.
+    #[error(transparent)]
+    Boreholes(#[from] terramesh_io::boreholes::BoreholeError),
     /// A table (CSV) file.
     #[error(transparent)]
     Table(#[from] terramesh_io::table::TableError),
