@@ -184,11 +184,13 @@ def check_vtu_cells(model):
 
 
 def check_vtu_vtk(model):
-    """model.vtu read by VTK (ParaView's reader): points and MaterialIDs equal meshio's; its
-    vtkCellValidator finds every tetrahedron and pyramid valid. (Not the wedges: VTK's
-    documentation, meshio and OpenGeoSys want a wedge's first triangle facing away from the
-    second, which VTK 9's own validator and vtkCellSizeFilter call inverted; OpenGeoSys'
-    checkMesh decides, in the next check.)"""
+    """model.vtu read by VTK (ParaView's reader): points and MaterialIDs equal meshio's; VTK's
+    vtkCellSizeFilter gives every tetrahedron and pyramid a positive volume equal to ours (1e-9)
+    and vtkCellValidator finds them valid. Wedges: VTK's documentation, meshio and OpenGeoSys
+    want a wedge's first triangle facing away from the second (what model.vtu holds), which
+    VTK 9's own vtkCellSizeFilter and vtkCellValidator call inverted: for wedges only the size
+    (VTK's volume up to its sign) is compared; OpenGeoSys' checkMesh rules on the order (next
+    check)."""
     import vtk
     from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
     pts, _, _, _, _ = model.vtu()
@@ -202,21 +204,31 @@ def check_vtu_vtk(model):
     close(vtk_to_numpy(g.GetPoints().GetData()), pts, 0.0, "model.vtu: VTK's points vs meshio's")
     ids = vtk_to_numpy(g.GetCellData().GetArray("MaterialIDs"))
     require(np.array_equal(ids, mats), "model.vtu: VTK's MaterialIDs differ from meshio's")
-    # Validated around the origin: its absolute tolerance means nothing at UTM magnitudes.
+    # Around the origin: VTK's tolerances are absolute, and UTM magnitudes cancel badly.
     local = vtk.vtkUnstructuredGrid()
     local.DeepCopy(g)
     p = vtk.vtkPoints()
     p.SetData(numpy_to_vtk(pts - pts.mean(axis=0), deep=True))
     local.SetPoints(p)
+    f = vtk.vtkCellSizeFilter()
+    f.SetInputData(local)
+    f.Update()
+    size = vtk_to_numpy(f.GetOutput().GetCellData().GetArray("Volume"))
+    ours = cell_volumes(pts, cells, VTK_FACES)
+    wedge = np.array([t == "wedge" for t, _ in cells])
+    neg = np.nonzero((size <= 0) & ~wedge)[0]
+    require(len(neg) == 0, f"model.vtu: vtkCellSizeFilter gives {len(neg)} tetrahedra or pyramids a non-positive "
+            f"volume, e.g. cell {neg[:1]} {size[neg[:1]]}")
+    close(np.where(wedge, np.abs(size), size), ours, 1e-9, "model.vtu: vtkCellSizeFilter's volumes vs ours",
+          atol=1e-9 * np.abs(ours).max())
     v = vtk.vtkCellValidator()
     v.SetInputData(local)
     v.SetTolerance(1e-9)
     v.Update()
     state = vtk_to_numpy(v.GetOutput().GetCellData().GetArray("ValidityState"))
-    not_wedge = np.array([t != "wedge" for t, _ in cells])
-    bad = np.nonzero((state != 0) & not_wedge)[0]
+    bad = np.nonzero((state != 0) & ~wedge)[0]
     require(len(bad) == 0, f"model.vtu: vtkCellValidator flags {len(bad)} tetrahedra or pyramids, e.g. cell "
-            f"{bad[:1]} state {state[bad[:1]]} (8: nonconvex, 32: faces oriented incorrectly)")
+            f"{bad[:1]} state {state[bad[:1]]} (16: nonconvex, 32: faces oriented incorrectly)")
 
 
 def check_vtu_ogs(model):
