@@ -80,9 +80,6 @@ pub enum Error {
     /// The geological model (rules, volume mesh, checks).
     #[error(transparent)]
     Geology(#[from] terramesh_geology::GeologyError),
-    /// A borehole file.
-    #[error(transparent)]
-    Borehole(#[from] terramesh_io::boreholes::BoreholeError),
     /// An elevation web service or tile server.
     #[error(transparent)]
     Web(#[from] terramesh_web::WebError),
