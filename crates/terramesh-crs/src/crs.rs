@@ -146,7 +146,10 @@ impl Crs {
     /// assert!(terramesh_crs::Crs::wgs84().is_geographic());
     /// ```
     pub fn wgs84() -> Crs {
-        Crs::from_epsg(4326).expect("EPSG:4326 is in the table")
+        static WGS84: std::sync::OnceLock<Crs> = std::sync::OnceLock::new();
+        WGS84
+            .get_or_init(|| Crs::from_epsg(4326).expect("EPSG:4326 is in the table"))
+            .clone()
     }
 
     fn from_proj4(definition: &str, epsg: Option<u32>) -> Result<Crs, CrsError> {

@@ -48,6 +48,7 @@ pub use setting::Setting;
 pub mod build;
 pub mod convert;
 pub mod gltf;
+pub mod horizon;
 pub mod interpolate;
 pub mod mesh;
 pub mod project;
