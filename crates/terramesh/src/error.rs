@@ -56,6 +56,12 @@ pub enum Error {
     /// An elevation file.
     #[error(transparent)]
     Dem(#[from] terramesh_io::dem::DemError),
+    /// A coordinate reference system or a transformation between two.
+    #[error(transparent)]
+    Crs(#[from] terramesh_crs::CrsError),
+    /// A horizon grid.
+    #[error(transparent)]
+    Horizon(#[from] crate::horizon::HorizonError),
     /// A region file or corner list.
     #[error(transparent)]
     Region(#[from] terramesh_io::region::RegionError),

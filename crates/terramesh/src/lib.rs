@@ -49,6 +49,7 @@ pub mod build;
 pub mod convert;
 pub mod geology;
 pub mod gltf;
+pub mod horizon;
 pub mod interpolate;
 pub mod mesh;
 pub mod project;
