@@ -419,37 +419,47 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
             ),
         ));
     }
-    for b in &mesh.bodies {
-        let name = &mesh.units[b.unit];
-        if let Some(t) = b.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
-            return Err(fail(
+    // The bodies in parallel; the first failure in body order is reported.
+    let per_body: Vec<Result<(usize, f64), GeologyError>> = mesh
+        .bodies
+        .par_iter()
+        .map(|b| {
+            let name = &mesh.units[b.unit];
+            if let Some(t) = b.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
+                return Err(fail(
+                    mesh,
+                    0,
+                    format!("body {name}: triangle {t:?} names a missing node"),
+                ));
+            }
+            let fours = closed(
                 mesh,
-                0,
-                format!("body {name}: triangle {t:?} names a missing node"),
-            ));
-        }
-        pinch_edges += closed(
-            mesh,
-            &b.triangles,
-            |t| &t[..],
-            &format!("the body of unit {name}"),
-        )?;
-        let enclosed: f64 = b
-            .triangles
-            .par_iter()
-            .map(|&t| z_flux(&mesh.points, r, t))
-            .sum::<f64>()
-            / 6.0;
-        if !close(enclosed, unit_volumes[b.unit]) {
-            return Err(fail(
-                mesh,
-                b.triangles[0][0],
-                format!(
-                    "the body of unit {name} encloses {enclosed} m³ but its cells hold {} m³",
-                    unit_volumes[b.unit]
-                ),
-            ));
-        }
+                &b.triangles,
+                |t| &t[..],
+                &format!("the body of unit {name}"),
+            )?;
+            let enclosed: f64 = b
+                .triangles
+                .iter()
+                .map(|&t| z_flux(&mesh.points, r, t))
+                .sum::<f64>()
+                / 6.0;
+            if !close(enclosed, unit_volumes[b.unit]) {
+                return Err(fail(
+                    mesh,
+                    b.triangles[0][0],
+                    format!(
+                        "the body of unit {name} encloses {enclosed} m³ but its cells hold {} m³",
+                        unit_volumes[b.unit]
+                    ),
+                ));
+            }
+            Ok((fours, enclosed))
+        })
+        .collect();
+    for r in per_body {
+        let (fours, enclosed) = r?;
+        pinch_edges += fours;
         body_volumes.push(enclosed);
     }
     Ok(CheckSummary {
