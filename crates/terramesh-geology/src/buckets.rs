@@ -66,3 +66,42 @@ pub(crate) fn sort_by_node<T: Copy + Send + Ord>(
         .for_each(|bucket| bucket.sort_unstable());
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bucket_sorts_agree_with_a_plain_sort() {
+        // Seeded xorshift pairs (node, payload) over 500 nodes.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let items: Vec<(u32, u64)> = (0..20_000)
+            .map(|_| ((next() % 500) as u32, next() % 1000))
+            .collect();
+        let mut expected = items.clone();
+        expected.sort_unstable();
+        assert_eq!(sort_by_node(&items, 500, |t| t.0), expected);
+        // Each source item gives itself and a copy with the next node (up to 8 allowed).
+        let both = bucketed(
+            &items,
+            501,
+            |_, t, out| {
+                out[0] = *t;
+                out[1] = (t.0 + 1, t.1);
+                2
+            },
+            |t| t.0,
+        );
+        let mut expected: Vec<(u32, u64)> =
+            items.iter().flat_map(|t| [*t, (t.0 + 1, t.1)]).collect();
+        expected.sort_unstable();
+        assert_eq!(both, expected);
+        assert!(sort_by_node::<(u32, u64)>(&[], 3, |t| t.0).is_empty());
+    }
+}
