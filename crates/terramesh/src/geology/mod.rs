@@ -6,5 +6,5 @@
 pub mod fields;
 pub mod model;
 pub mod section;
-pub mod summary;
 pub mod stage;
+pub mod summary;

@@ -17,8 +17,8 @@ use terramesh_mesh::Mesh;
 use super::model::{assemble, Base, GeologicalModel, ModelInputs};
 use super::summary::{interface_grid, ModelSummary};
 use crate::error::{bail, Context, Error, Result};
-use crate::project::{Base as BaseKey, GeologySettings};
 use crate::project::Project;
+use crate::project::{Base as BaseKey, GeologySettings};
 
 /// What the geology stage made.
 #[derive(Debug)]
@@ -100,18 +100,26 @@ pub fn run(
     };
     let model = assemble(mesh, dsm, &inputs).context("[geology]")?;
     let crs_name = epsg.map_or_else(|| "projected".to_string(), |e| format!("EPSG:{e}"));
-    let mut files: Vec<PathBuf> = write_model(out, &model.mesh, &ModelInfo { crs: crs_name.clone() })
-        .map_err(|e| Error::invalid(e.to_string()))?
-        .into_iter()
-        .map(|f| out.join(f))
-        .collect();
+    let mut files: Vec<PathBuf> = write_model(
+        out,
+        &model.mesh,
+        &ModelInfo {
+            crs: crs_name.clone(),
+        },
+    )
+    .map_err(|e| Error::invalid(e.to_string()))?
+    .into_iter()
+    .map(|f| out.join(f))
+    .collect();
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
     for (k, unit) in g.units.iter().enumerate() {
         let values = interface_grid(mesh, &model.stack.surfaces[k], grid, -9999.0);
         let path = dir.join(format!("{unit}.tif"));
         let code = epsg.and_then(|e| u16::try_from(e).ok());
-        write_atomic(&path, |w| write_geotiff(w, grid, &values, code, Some(-9999.0)))?;
+        write_atomic(&path, |w| {
+            write_geotiff(w, grid, &values, code, Some(-9999.0))
+        })?;
         files.push(path);
     }
     let summary = ModelSummary::of(&model, &crs_name);
