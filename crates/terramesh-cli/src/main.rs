@@ -31,6 +31,9 @@ enum Command {
     Init(cmd::init::Args),
     /// Build the whole DSM of a project: samples, mesh, kriging, exports, pictures, report.
     Build(cmd::build::Args),
+    /// Build only the sealed geological model of a project with [geology]: volume mesh,
+    /// boundary meshes, Gmsh, FLAC3D, unit bodies, interface grids, model.json.
+    Model(cmd::model::Args),
     /// Experimental semivariogram and a fitted model (JSON, optional SVG chart).
     Variogram(cmd::variogram::Args),
     /// Kriging (simple, ordinary, universal) or IDW at target points or on a grid.
@@ -48,7 +51,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     interrupt::install();
     // A project's settings are keys, worded by the library; a command's are flags.
-    let flags = !matches!(cli.command, Command::Build(_) | Command::Init(_));
+    let flags = !matches!(
+        cli.command,
+        Command::Build(_) | Command::Model(_) | Command::Init(_)
+    );
     let crs = if matches!(cli.command, Command::Mesh(_)) {
         "--crs"
     } else {
@@ -58,6 +64,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
         Command::Build(args) => cmd::build::run(args),
+        Command::Model(args) => cmd::model::run(args),
         Command::Variogram(args) => cmd::variogram::run(args),
         Command::Interpolate(args) => cmd::interpolate::run(args),
         Command::Cv(args) => cmd::cv::run(args),

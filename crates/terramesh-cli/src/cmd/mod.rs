@@ -7,5 +7,6 @@ pub(crate) mod geodata;
 pub mod init;
 pub mod interpolate;
 pub mod mesh;
+pub mod model;
 pub mod sample;
 pub mod variogram;

@@ -98,10 +98,46 @@ impl Stages<'_> {
 /// ([`staging::Staging`]), so an error, or [`Progress::cancelled`], leaves `out` as it was.
 /// An existing `out` that is not a build folder (see [`staging::MARKER`]) is refused.
 pub fn build(project: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Built> {
+    build_as(project, base, out, progress, What::Everything)
+}
+
+/// Builds only the geological model of `project` (`terramesh model`): the DSM is made in
+/// memory as [`build`] makes it (the same samples, mesh and elevations), and `out` receives
+/// the samples table, the model's files and `model.json`, not the DSM's exports, pictures or
+/// report. Atomic like [`build`]. A project without `[geology]` is refused.
+pub fn build_model(
+    project: &Project,
+    base: &Path,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Built> {
+    if project.geology().is_none() {
+        return Err(Error::invalid(
+            "the project has no [geology] section: add one (terramesh init --geology writes \
+             a template) or use terramesh build for the surface model",
+        ));
+    }
+    build_as(project, base, out, progress, What::ModelOnly)
+}
+
+/// What a build writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum What {
+    Everything,
+    ModelOnly,
+}
+
+fn build_as(
+    project: &Project,
+    base: &Path,
+    out: &Path,
+    progress: &dyn Progress,
+    what: What,
+) -> Result<Built> {
     let t0 = Instant::now();
     project.check_inputs(base)?;
     let staging = staging::Staging::begin(out, progress)?;
-    let built = build_into(project, base, staging.dir(), progress, t0)?;
+    let built = build_into(project, base, staging.dir(), progress, t0, what)?;
     if progress.cancelled() {
         return Err(Error::Cancelled);
     }
@@ -120,11 +156,15 @@ fn build_into(
     out: &Path,
     progress: &dyn Progress,
     t0: Instant,
+    what: What,
 ) -> Result<Built> {
     let mut st = Stages {
         progress,
         k: 0,
-        total: STAGES + usize::from(project.geology().is_some()),
+        total: match what {
+            What::Everything => STAGES + usize::from(project.geology().is_some()),
+            What::ModelOnly => 5,
+        },
         timings: Timings::default(),
     };
     let samples = st.run(
@@ -200,6 +240,15 @@ fn build_into(
         )?),
         None => None,
     };
+    if what == What::ModelOnly {
+        st.check()?;
+        return Ok(Built {
+            files: geo.map(|g| g.files).unwrap_or_default(),
+            vertices: mesh.mesh.points.len(),
+            triangles: mesh.mesh.triangles.len(),
+            timings: st.timings,
+        });
+    }
     let written = st.run(
         "exports",
         || exports::write_all(project, out, &samples, &mesh, &interp),
