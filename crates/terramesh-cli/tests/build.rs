@@ -399,6 +399,85 @@ fn init_writes_a_project_that_parses_and_refuses_to_overwrite() {
     assert!(!o.status.success() && e.contains("source.path"), "{e}");
 }
 
+#[test]
+fn init_geology_writes_a_commented_geology_section_that_parses() {
+    let d = tempfile::tempdir().unwrap();
+    let site = d.path().join("model");
+    ok(&terramesh(&["init", "--geology", site.to_str().unwrap()]));
+    let text = read(&site.join("terramesh.toml"));
+    assert!(text.contains("[sampling]") && text.contains("rows = 100"));
+    for key in [
+        "[geology]",
+        "collars =",
+        "intervals =",
+        "# tops =",
+        "# survey =",
+        "units =",
+        "surfaces",
+        "base =",
+        "min_thickness =",
+        "layers",
+        "element =",
+        "interpolate =",
+        "z_unit =",
+    ] {
+        assert!(text.contains(key), "the template lacks {key}");
+    }
+    // Without --geology, no [geology] section.
+    let plain = d.path().join("plain");
+    ok(&terramesh(&["init", plain.to_str().unwrap()]));
+    assert!(!read(&plain.join("terramesh.toml")).contains("[geology]"));
+    // Building it fails on the first missing input; --set reaches the [geology] keys and a
+    // bad one names the key.
+    let o = terramesh(&[
+        "build",
+        site.join("terramesh.toml").to_str().unwrap(),
+        "-o",
+        d.path().join("out").to_str().unwrap(),
+        "--set",
+        "geology.min_thickness=-1",
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("geology.min_thickness"),
+        "{e}"
+    );
+}
+
+/// Boreholes that contradict themselves stop the build before it writes anything, with the
+/// file, line and hole.
+#[test]
+fn bad_boreholes_stop_the_build_before_it_writes() {
+    let d = tempfile::tempdir().unwrap();
+    let site = d.path().join("model");
+    ok(&terramesh(&["init", "--geology", site.to_str().unwrap()]));
+    std::fs::write(site.join("collars.csv"), "hole,x,y,z\nB1,0,0,20\n").unwrap();
+    std::fs::write(
+        site.join("intervals.csv"),
+        "hole,from,to,unit\nB1,0,5,sand\nB1,4,9,clay\n",
+    )
+    .unwrap();
+    // Point the source at the example's bundled crop so that only [geology] can fail.
+    let crop = root().join("examples/haut-barr/srtm-crop.asc");
+    let out = d.path().join("out");
+    let o = terramesh(&[
+        "build",
+        site.join("terramesh.toml").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        &format!("source.path={}", crop.display()),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && e.contains("intervals.csv, line 3, hole 'B1'")
+            && e.contains("overlaps"),
+        "{e}"
+    );
+    assert!(!out.exists());
+}
+
 /// The number after `prefix` in `text`.
 fn number_after(text: &str, prefix: &str) -> f64 {
     let i = text

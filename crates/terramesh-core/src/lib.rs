@@ -26,6 +26,7 @@
 #![warn(missing_docs)]
 
 pub mod coords;
+pub mod desurvey;
 pub mod geometry;
 pub mod limits;
 pub mod sampling;

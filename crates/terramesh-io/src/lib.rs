@@ -22,6 +22,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod boreholes;
 pub mod dem;
 pub mod export;
 pub mod folder;

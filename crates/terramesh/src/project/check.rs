@@ -26,8 +26,8 @@ fn readable(key: &str, path: &Path) -> Result<()> {
 impl Project {
     /// Checks the files a build of this project reads, with paths relative to `base`: the
     /// source (`source.path`, or `source.fallback` when it does not exist), `region.file` and
-    /// `interpolation.variogram` (read and parsed). [`crate::build::build`] calls it before
-    /// writing anything.
+    /// `interpolation.variogram` (read and parsed), and the files of `[geology]` (the boreholes
+    /// read and checked). [`crate::build::build`] calls it before writing anything.
     ///
     /// ```
     /// use terramesh::project::{Project, TEMPLATE};
@@ -78,6 +78,9 @@ impl Project {
                     e.render(&|s| s.to_string())
                 ))
             })?;
+        }
+        if let Some(g) = self.geology() {
+            g.check_inputs()?;
         }
         Ok(())
     }

@@ -4,9 +4,14 @@
 //! overrides a key from the command line (`--set mesh.min_angle=32`).
 
 mod check;
+mod geology;
 mod lower;
 mod parse;
 
+pub use geology::{
+    Base, BaseSpec, GeologySection, GeologySettings, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS,
+    GEOLOGY_TEMPLATE, MAX_LAYERS,
+};
 pub use lower::key_of;
 
 use std::path::PathBuf;
@@ -41,6 +46,27 @@ pub struct Project {
     /// Exports.
     #[serde(default)]
     pub export: ExportSection,
+    /// The geological model (`[geology]`), as written; see [`Project::geology`].
+    #[serde(default)]
+    pub geology: Option<GeologySection>,
+    /// `[geology]` lowered by [`Project::parse`].
+    #[serde(skip)]
+    geology_settings: Option<GeologySettings>,
+}
+
+impl Project {
+    /// The `[geology]` settings, with paths resolved against the project file's folder (the
+    /// folder of the name given to [`Project::parse`], the file's for [`Project::load`]);
+    /// `None` without a `[geology]` section.
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// assert!(Project::parse("t.toml", TEMPLATE, &[])?.geology().is_none());
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn geology(&self) -> Option<&GeologySettings> {
+        self.geology_settings.as_ref()
+    }
 }
 
 /// `[region]`: corners or a region file.

@@ -111,7 +111,7 @@ impl Project {
             })?;
         }
         // Parse the original text when nothing was overridden, so errors carry line numbers.
-        let project: Project = if sets.is_empty() {
+        let mut project: Project = if sets.is_empty() {
             toml::from_str(text).map_err(syntax)?
         } else {
             let merged = toml::to_string(&doc).map_err(|e| Error::Project {
@@ -131,6 +131,8 @@ impl Project {
             line: key_line(text_for_lines, &key),
             why: format!("{key}: {why}"),
         })?;
+        let folder = Path::new(name).parent().unwrap_or(Path::new(""));
+        project.geology_settings = project.geology.as_ref().map(|g| g.lower(folder));
         Ok(project)
     }
 
@@ -244,6 +246,9 @@ impl Project {
             if !positive(g) {
                 return bad("export.grid_spacing", "must be a positive number of metres");
             }
+        }
+        if let Some(g) = &self.geology {
+            g.validate()?;
         }
         Ok(())
     }

@@ -1,0 +1,318 @@
+//! Boreholes: collars, unit logs (intervals or tops) and surveys read from CSV files, each
+//! hole desurveyed by minimum curvature, and the **contacts** (the observed top of every unit
+//! of the stratigraphic column in every hole) and unit thicknesses a geological model honours.
+//!
+//! **Files** (exact column names, case-insensitive, in any order; other columns are allowed
+//! and ignored):
+//! * `collars.csv`: `hole,x,y,z` (the project's projected CRS) or `hole,lat,lon,z` (decimal
+//!   degrees or DMS; projected by [`BoreholeOptions::project`]); `x,y` win when both are there;
+//! * `intervals.csv`: `hole,from,to,unit` (depths along the hole from the collar), or
+//!   `tops.csv`: `hole,unit,depth` or `hole,unit,elevation` (the top of each unit met);
+//! * `survey.csv` (optional): `hole,depth,azimuth,dip` (see [`terramesh_core::desurvey`] for
+//!   the conventions); a hole without stations is vertical.
+//!
+//! Every depth and elevation (collar `z`, `from`, `to`, `depth`, `elevation`, survey
+//! `depth`) is in [`BoreholeOptions::z_unit`] and converted to metres; `x,y` are not.
+//!
+//! **Rules** (in this order, per hole):
+//! 1. A unit's top is *observed* where the log shows the change into it: in intervals, its
+//!    first interval's `from` when the interval above ends exactly there, or `from = 0` at the
+//!    collar ([`ContactKind::Collar`]: the interface is at or above the ground there); after a
+//!    gap in the log its top is not observed. In tops, every row is an observed top.
+//! 2. Inverted tops (a unit's top higher than the top of a unit above it in the column) are
+//!    repaired by the onlap rule when the inversion is at most
+//!    [`BoreholeOptions::max_inversion`]: the lower top is lowered onto the upper one (same
+//!    point, [`ContactKind::Repaired`], listed in [`Boreholes::repairs`]); a larger one is
+//!    [`BoreholeError::Inversion`]. In intervals, a unit logged below a unit that the column
+//!    puts under it is [`BoreholeError::OutOfOrder`].
+//! 3. A unit of the column absent from a hole that reaches a unit below it has zero thickness
+//!    there: its top is the next present unit's top ([`ContactKind::Absent`]).
+//! 4. A unit's vertical thickness is known where its top and the top of the next unit of the
+//!    column are both contacts; where the hole ends inside it (or its base lies in a gap of
+//!    the log) it is [`Thickness::Censored`], never a contact.
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use terramesh_io::boreholes::{read, BoreholeFiles, BoreholeOptions, LogFile, Thickness};
+//! let dir = tempfile::tempdir()?;
+//! std::fs::write(dir.path().join("collars.csv"), "hole,x,y,z\nB1,100,200,50\n")?;
+//! std::fs::write(dir.path().join("intervals.csv"), "hole,from,to,unit\nB1,0,4,fill\nB1,4,10,clay\n")?;
+//! let files = BoreholeFiles {
+//!     collars: dir.path().join("collars.csv"),
+//!     log: LogFile::Intervals(dir.path().join("intervals.csv")),
+//!     survey: None,
+//! };
+//! let units = vec!["fill".to_string(), "sand".into(), "clay".into(), "gravel".into()];
+//! let b = read(&files, &BoreholeOptions::new(units))?;
+//! let hole = &b.holes[0];
+//! // fill at the collar, sand absent (zero thickness at the top of clay), clay at 46 m.
+//! let tops: Vec<_> = hole.tops.iter().map(|t| t.as_ref().map(|c| c.position[2])).collect();
+//! assert_eq!(tops, [Some(50.0), Some(46.0), Some(46.0), None]);
+//! assert_eq!(hole.thickness[0], Thickness::Known(4.0));
+//! assert_eq!(hole.thickness[1], Thickness::Known(0.0));
+//! assert_eq!(hole.thickness[2], Thickness::Censored); // the hole ends in clay
+//! assert_eq!(b.contacts().count(), 3);
+//! # Ok(()) }
+//! ```
+
+mod error;
+mod parse;
+mod rules;
+
+use std::path::PathBuf;
+
+pub use error::BoreholeError;
+use terramesh_core::desurvey::HolePath;
+use terramesh_core::volume::ZUnit;
+
+/// The largest inversion of tops repaired by default, metres (`[geology] max_inversion`):
+/// about the precision of formation-top picks in well logs, and above the largest inversion
+/// of the Kimberlina wells (4.4 m).
+pub const DEFAULT_MAX_INVERSION: f64 = 10.0;
+
+/// The unit log of the holes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LogFile {
+    /// `hole,from,to,unit`.
+    Intervals(PathBuf),
+    /// `hole,unit,depth` or `hole,unit,elevation`.
+    Tops(PathBuf),
+}
+
+/// The files of a borehole data set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoreholeFiles {
+    /// `hole,x,y,z` or `hole,lat,lon,z`.
+    pub collars: PathBuf,
+    /// Intervals or tops.
+    pub log: LogFile,
+    /// `hole,depth,azimuth,dip`, optional.
+    pub survey: Option<PathBuf>,
+}
+
+/// A projection of geographic collars: `(lat, lon)` in degrees to `[x, y]` in the project's
+/// CRS, or why not.
+pub type Projection<'a> = &'a dyn Fn(f64, f64) -> Result<[f64; 2], String>;
+
+/// How to read boreholes.
+#[derive(Clone)]
+pub struct BoreholeOptions<'a> {
+    /// The stratigraphic column, top to bottom, names as in the files.
+    pub units: Vec<String>,
+    /// The unit of every depth and elevation of the files.
+    pub z_unit: ZUnit,
+    /// The largest inversion of tops repaired, metres (see the module's rule 2).
+    pub max_inversion: f64,
+    /// Projects geographic collars; `None`: only `x,y` collars are accepted.
+    pub project: Option<Projection<'a>>,
+}
+
+impl<'a> BoreholeOptions<'a> {
+    /// Options for a column, with metres, [`DEFAULT_MAX_INVERSION`] and no projection.
+    ///
+    /// ```
+    /// let o = terramesh_io::boreholes::BoreholeOptions::new(vec!["sand".into()]);
+    /// assert_eq!(o.max_inversion, terramesh_io::boreholes::DEFAULT_MAX_INVERSION);
+    /// ```
+    pub fn new(units: Vec<String>) -> Self {
+        BoreholeOptions {
+            units,
+            z_unit: ZUnit::Metre,
+            max_inversion: DEFAULT_MAX_INVERSION,
+            project: None,
+        }
+    }
+}
+
+/// How a contact is known.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactKind {
+    /// The log shows the change into the unit there.
+    Logged,
+    /// The first logged unit starts at the collar: its top is at or above the ground.
+    Collar,
+    /// The unit is absent from the hole (zero thickness): the next present unit's top.
+    Absent,
+    /// An inverted top lowered onto the top above it (see [`Boreholes::repairs`]).
+    Repaired,
+}
+
+/// The top of one unit in one hole.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    /// The unit, an index into [`Boreholes::units`].
+    pub unit: usize,
+    /// Measured depth along the hole, metres.
+    pub md: f64,
+    /// `[x, y, z]`: where the hole meets the top (z the elevation, metres).
+    pub position: [f64; 3],
+    /// How it is known.
+    pub kind: ContactKind,
+    /// The line of the log row it comes from (for an absent unit, the next present unit's).
+    pub line: u64,
+}
+
+/// The vertical thickness of one unit in one hole.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Thickness {
+    /// Top minus base elevation, metres (0 where the unit is absent or pinched by a repair).
+    Known(f64),
+    /// The top is a contact but the base is not observed (the hole ends inside the unit, the
+    /// base lies in a gap of the log, or it is the lowest unit): a lower bound only.
+    Censored,
+    /// The hole does not show the unit's top.
+    Unknown,
+}
+
+/// One inverted top that was repaired.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Repair {
+    /// The hole.
+    pub hole: String,
+    /// The unit whose top was lowered.
+    pub unit: usize,
+    /// The unit above it onto whose top it was lowered.
+    pub above: usize,
+    /// The line of the inverted top.
+    pub line: u64,
+    /// By how much it was lowered, metres.
+    pub amount: f64,
+}
+
+/// One hole.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hole {
+    /// Its name.
+    pub name: String,
+    /// Its line in the collars file.
+    pub line: u64,
+    /// The collar `[x, y, z]`, metres.
+    pub collar: [f64; 3],
+    /// The desurveyed path.
+    pub path: HolePath,
+    /// The top of every unit of the column (index as [`Boreholes::units`]), where known.
+    pub tops: Vec<Option<Contact>>,
+    /// The vertical thickness of every unit of the column.
+    pub thickness: Vec<Thickness>,
+}
+
+/// A borehole data set, read and checked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Boreholes {
+    /// The stratigraphic column, top to bottom.
+    pub units: Vec<String>,
+    /// The holes, in the order of the collars file.
+    pub holes: Vec<Hole>,
+    /// The inverted tops that were repaired, in hole order.
+    pub repairs: Vec<Repair>,
+}
+
+impl Boreholes {
+    /// Every contact, hole by hole, top to bottom.
+    pub fn contacts(&self) -> impl Iterator<Item = (&Hole, &Contact)> {
+        self.holes
+            .iter()
+            .flat_map(|h| h.tops.iter().flatten().map(move |c| (h, c)))
+    }
+
+    /// The known thicknesses of `unit` (an index into [`Boreholes::units`]): the hole, its
+    /// thickness and where (the `[x, y]` of the unit's top), for `interpolate = "thickness"`.
+    ///
+    /// ```
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// # use terramesh_io::boreholes::{read, BoreholeFiles, BoreholeOptions, LogFile};
+    /// # let dir = tempfile::tempdir()?;
+    /// # std::fs::write(dir.path().join("c.csv"), "hole,x,y,z\nA,0,0,10\n")?;
+    /// # std::fs::write(dir.path().join("t.csv"), "hole,unit,elevation\nA,sand,8\nA,clay,5\n")?;
+    /// # let files = BoreholeFiles { collars: dir.path().join("c.csv"), log: LogFile::Tops(dir.path().join("t.csv")), survey: None };
+    /// let b = read(&files, &BoreholeOptions::new(vec!["sand".into(), "clay".into()]))?;
+    /// let t: Vec<f64> = b.thicknesses(0).map(|(_, t, _)| t).collect();
+    /// assert_eq!(t, [3.0]);
+    /// # Ok(()) }
+    /// ```
+    pub fn thicknesses(&self, unit: usize) -> impl Iterator<Item = (&Hole, f64, [f64; 2])> {
+        self.holes
+            .iter()
+            .filter_map(move |h| match h.thickness.get(unit) {
+                Some(Thickness::Known(t)) => {
+                    let p = h.tops[unit].as_ref()?.position;
+                    Some((h, *t, [p[0], p[1]]))
+                }
+                _ => None,
+            })
+    }
+
+    /// The index of a unit by name.
+    pub fn unit_index(&self, name: &str) -> Option<usize> {
+        self.units.iter().position(|u| u == name)
+    }
+}
+
+/// Reads and checks a borehole data set: collars, the log, the survey; desurveys every hole
+/// and applies the rules of the module documentation.
+pub fn read(files: &BoreholeFiles, opts: &BoreholeOptions) -> Result<Boreholes, BoreholeError> {
+    let mut seen = std::collections::HashSet::new();
+    if opts.units.is_empty() {
+        return Err(BoreholeError::Column("the column names no unit".into()));
+    }
+    for u in &opts.units {
+        if !seen.insert(u.as_str()) {
+            return Err(BoreholeError::Column(format!(
+                "unit '{u}' is listed twice: every unit once, top to bottom"
+            )));
+        }
+    }
+    let collars = parse::collars(&files.collars, opts)?;
+    let collars_name = files.collars.display().to_string();
+    let surveys = match &files.survey {
+        Some(p) => parse::survey(p, opts, &collars, &collars_name)?,
+        None => Default::default(),
+    };
+    let (log_name, mut logs) = match &files.log {
+        LogFile::Intervals(p) => (
+            p.display().to_string(),
+            parse::intervals(p, opts, &collars, &collars_name)?,
+        ),
+        LogFile::Tops(p) => (
+            p.display().to_string(),
+            parse::tops(p, opts, &collars, &collars_name)?,
+        ),
+    };
+    let mut holes = Vec::with_capacity(collars.len());
+    let mut repairs = Vec::new();
+    for c in collars {
+        let path = match surveys.get(&c.name) {
+            Some((file, stations, lines)) => {
+                HolePath::new(c.xyz, stations).map_err(|source| BoreholeError::Survey {
+                    file: file.clone(),
+                    line: rules::station_line(&source, stations, lines),
+                    hole: c.name.clone(),
+                    source,
+                })?
+            }
+            None => HolePath::vertical(c.xyz),
+        };
+        let present = logs.remove(&c.name).unwrap_or_default();
+        let ctx = rules::HoleContext {
+            file: &log_name,
+            hole: &c.name,
+            units: &opts.units,
+            max_inversion: opts.max_inversion,
+        };
+        let (tops, thickness, mut r) = rules::contacts(&ctx, &path, &present)?;
+        repairs.append(&mut r);
+        holes.push(Hole {
+            name: c.name,
+            line: c.line,
+            collar: c.xyz,
+            path,
+            tops,
+            thickness,
+        });
+    }
+    Ok(Boreholes {
+        units: opts.units.clone(),
+        holes,
+        repairs,
+    })
+}
