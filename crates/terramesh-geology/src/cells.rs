@@ -189,6 +189,61 @@ mod tests {
     }
 
     #[test]
+    fn neighbouring_wedges_cut_their_shared_face_the_same_way() {
+        // Two wedges over the triangles (0,0) (1,0) (0,1) and (1,0) (1,1) (0,1), sharing the
+        // vertical face over the edge (1,0)-(0,1); local columns 0..4, each with a lower and an
+        // upper node. Every numbering of the eight nodes by a seeded shuffle.
+        let xy = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..2000 {
+            let mut ids: Vec<u32> = (0..8).collect();
+            for i in (1..8).rev() {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                ids.swap(i, (state % (i as u64 + 1)) as usize);
+            }
+            // ids[c] the lower node of column c, ids[4 + c] its upper node.
+            let mut p = vec![[0.0; 3]; 8];
+            for c in 0..4 {
+                p[ids[c] as usize] = [xy[c][0], xy[c][1], 0.0];
+                p[ids[4 + c] as usize] = [xy[c][0], xy[c][1], 1.0 + 0.1 * c as f64];
+            }
+            let wedge = |t: [usize; 3]| {
+                split_wedge(
+                    &p,
+                    [
+                        ids[t[0]],
+                        ids[t[1]],
+                        ids[t[2]],
+                        ids[4 + t[0]],
+                        ids[4 + t[1]],
+                        ids[4 + t[2]],
+                    ],
+                )
+            };
+            let shared = [ids[1], ids[2], ids[5], ids[6]];
+            let on_face = |tets: [[u32; 4]; 3]| {
+                let mut tris: Vec<[u32; 3]> = Vec::new();
+                for t in tets {
+                    for skip in 0..4 {
+                        let mut f: Vec<u32> = (0..4).filter(|&k| k != skip).map(|k| t[k]).collect();
+                        if f.iter().all(|n| shared.contains(n)) {
+                            f.sort_unstable();
+                            tris.push([f[0], f[1], f[2]]);
+                        }
+                    }
+                }
+                tris.sort_unstable();
+                tris
+            };
+            let (a, b) = (on_face(wedge([0, 1, 2])), on_face(wedge([1, 3, 2])));
+            assert_eq!(a.len(), 2);
+            assert_eq!(a, b, "numbering {ids:?}");
+        }
+    }
+
+    #[test]
     fn degenerate_cells_have_positive_volume() {
         let p = pts();
         // Vertex 2 collapsed (its upper node is its lower node): a pyramid.

@@ -18,6 +18,7 @@
 use rayon::prelude::*;
 use terramesh_core::volume::{cell_volume, Cell, CellKind, FaceTag, VolumeMesh};
 
+use crate::buckets::{bucketed, sort_by_node};
 use crate::cells::split_quad;
 use crate::{GeologyError, Planar, Stack};
 
@@ -132,70 +133,6 @@ fn used(f: &[u32; 4]) -> &[u32] {
     } else {
         f
     }
-}
-
-/// The outputs of every item of `src` (at most 8 each, which `write` puts into a buffer,
-/// returning how many), sorted: bucketed by the node `first(output)` in two passes (a count,
-/// then a scatter, so that nothing is stored twice), then each bucket sorted on its own, in
-/// parallel. `first` must be the leading part of the order.
-fn bucketed<S, T: Copy + Send + Ord + Default>(
-    src: &[S],
-    nodes: usize,
-    write: impl Fn(usize, &S, &mut [T; 8]) -> usize,
-    first: impl Fn(&T) -> u32 + Sync,
-) -> Vec<T> {
-    let mut start = vec![0usize; nodes + 1];
-    let mut buf = [T::default(); 8];
-    for (i, s) in src.iter().enumerate() {
-        let k = write(i, s, &mut buf);
-        for t in &buf[..k] {
-            start[first(t) as usize + 1] += 1;
-        }
-    }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut out = vec![T::default(); start[nodes]];
-    for (i, s) in src.iter().enumerate() {
-        let k = write(i, s, &mut buf);
-        for t in &buf[..k] {
-            let slot = &mut start[first(t) as usize];
-            out[*slot] = *t;
-            *slot += 1;
-        }
-    }
-    out.par_chunk_by_mut(|a, b| first(a) == first(b))
-        .for_each(|bucket| bucket.sort_unstable());
-    out
-}
-
-/// Sorts `items`, bucketed first by the node `first(item)` (a counting sort over the nodes,
-/// linear), then each bucket on its own (small sorts, in parallel). `first` must be the
-/// leading part of the order.
-fn sort_by_node<T: Copy + Send + Ord>(
-    items: &[T],
-    nodes: usize,
-    first: impl Fn(&T) -> u32 + Sync,
-) -> Vec<T> {
-    let Some(&fill) = items.first() else {
-        return Vec::new();
-    };
-    let mut start = vec![0usize; nodes + 1];
-    for it in items {
-        start[first(it) as usize + 1] += 1;
-    }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut out = vec![fill; items.len()];
-    for it in items {
-        let slot = &mut start[first(it) as usize];
-        out[*slot] = *it;
-        *slot += 1;
-    }
-    out.par_chunk_by_mut(|a, b| first(a) == first(b))
-        .for_each(|bucket| bucket.sort_unstable());
-    out
 }
 
 /// Every edge of the polygons in two of them or four, as often one way as the other; returns
@@ -419,37 +356,47 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
             ),
         ));
     }
-    for b in &mesh.bodies {
-        let name = &mesh.units[b.unit];
-        if let Some(t) = b.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
-            return Err(fail(
+    // The bodies in parallel; the first failure in body order is reported.
+    let per_body: Vec<Result<(usize, f64), GeologyError>> = mesh
+        .bodies
+        .par_iter()
+        .map(|b| {
+            let name = &mesh.units[b.unit];
+            if let Some(t) = b.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
+                return Err(fail(
+                    mesh,
+                    0,
+                    format!("body {name}: triangle {t:?} names a missing node"),
+                ));
+            }
+            let fours = closed(
                 mesh,
-                0,
-                format!("body {name}: triangle {t:?} names a missing node"),
-            ));
-        }
-        pinch_edges += closed(
-            mesh,
-            &b.triangles,
-            |t| &t[..],
-            &format!("the body of unit {name}"),
-        )?;
-        let enclosed: f64 = b
-            .triangles
-            .par_iter()
-            .map(|&t| z_flux(&mesh.points, r, t))
-            .sum::<f64>()
-            / 6.0;
-        if !close(enclosed, unit_volumes[b.unit]) {
-            return Err(fail(
-                mesh,
-                b.triangles[0][0],
-                format!(
-                    "the body of unit {name} encloses {enclosed} m³ but its cells hold {} m³",
-                    unit_volumes[b.unit]
-                ),
-            ));
-        }
+                &b.triangles,
+                |t| &t[..],
+                &format!("the body of unit {name}"),
+            )?;
+            let enclosed: f64 = b
+                .triangles
+                .iter()
+                .map(|&t| z_flux(&mesh.points, r, t))
+                .sum::<f64>()
+                / 6.0;
+            if !close(enclosed, unit_volumes[b.unit]) {
+                return Err(fail(
+                    mesh,
+                    b.triangles[0][0],
+                    format!(
+                        "the body of unit {name} encloses {enclosed} m³ but its cells hold {} m³",
+                        unit_volumes[b.unit]
+                    ),
+                ));
+            }
+            Ok((fours, enclosed))
+        })
+        .collect();
+    for r in per_body {
+        let (fours, enclosed) = r?;
+        pinch_edges += fours;
         body_volumes.push(enclosed);
     }
     Ok(CheckSummary {
@@ -535,8 +482,8 @@ fn check_tags(
         ("interface", inner, interfaces),
     ] {
         let tagged = sort_by_node(&tagged, mesh.points.len(), |f| f.0[0]);
-        let found = sort_by_node(found, mesh.points.len(), |f| f.0[0]);
-        if tagged.as_slice() != &found[..] {
+        // `found` is in key order already (taken from the sorted faces), keys unique.
+        if tagged.as_slice() != found {
             let diff = tagged
                 .iter()
                 .zip(found.iter())

@@ -37,6 +37,8 @@
 
 /// Sealed bodies: the closed outward surface of every unit.
 mod bodies;
+/// Sorting by node (counting sort), for the checks.
+mod buckets;
 /// Cells of one planar triangle: wedges, pyramids, tetrahedra, and the diagonal rule.
 mod cells;
 /// Independent checks of a volume mesh.

@@ -7,3 +7,4 @@ pub mod fields;
 pub mod model;
 pub mod section;
 pub mod summary;
+pub mod stage;
