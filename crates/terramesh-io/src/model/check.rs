@@ -146,7 +146,7 @@ pub fn check_mesh(m: &VolumeMesh) -> Result<(), MeshError> {
             });
         }
         let v = cell_volume(&m.points, c);
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return Err(MeshError::Volume { cell: i, volume: v });
         }
     }

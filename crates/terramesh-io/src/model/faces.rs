@@ -61,14 +61,21 @@ pub fn ogs_face_index(kind: CellKind, face: usize) -> u64 {
 /// The position in `cell_faces(kind)` of the face whose nodes are `face` (any order), given the
 /// cell's nodes.
 pub(crate) fn find_face(kind: CellKind, cell: &[u32], face: &[u32]) -> Option<usize> {
-    let mut want: Vec<u32> = face.to_vec();
-    want.sort_unstable();
-    cell_faces(kind).iter().position(|f| {
-        if f.len() != want.len() {
-            return false;
+    fn sorted(nodes: impl Iterator<Item = u32>) -> ([u32; 4], usize) {
+        let mut a = [u32::MAX; 4];
+        let mut n = 0;
+        for v in nodes.take(4) {
+            a[n] = v;
+            n += 1;
         }
-        let mut got: Vec<u32> = f.iter().map(|&k| cell[k]).collect();
-        got.sort_unstable();
-        got == want
-    })
+        a.sort_unstable();
+        (a, n)
+    }
+    if face.len() > 4 {
+        return None;
+    }
+    let want = sorted(face.iter().copied());
+    cell_faces(kind)
+        .iter()
+        .position(|f| f.len() == want.1 && sorted(f.iter().map(|&k| cell[k])) == want)
 }

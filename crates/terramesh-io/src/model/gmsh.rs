@@ -30,9 +30,9 @@ impl Bbox {
         Bbox([f64::INFINITY; 3], [f64::NEG_INFINITY; 3])
     }
     fn add(&mut self, p: [f64; 3]) {
-        for k in 0..3 {
-            self.0[k] = self.0[k].min(p[k]);
-            self.1[k] = self.1[k].max(p[k]);
+        for (k, c) in p.into_iter().enumerate() {
+            self.0[k] = self.0[k].min(c);
+            self.1[k] = self.1[k].max(c);
         }
     }
     fn write<W: Write + ?Sized>(&self, w: &mut W) -> io::Result<()> {

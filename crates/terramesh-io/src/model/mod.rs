@@ -57,6 +57,8 @@ use std::path::Path;
 
 use terramesh_core::volume::{FaceTag, VolumeMesh};
 
+use rayon::prelude::*;
+
 use crate::output::Output;
 
 pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
@@ -115,7 +117,9 @@ pub fn boundary_file_name(tag: &FaceTag) -> Option<String> {
 /// atomically through [`Output`]; the facade makes the build folder atomic as a whole):
 /// `model.vtu`, one boundary mesh per top, bottom and side tag, `model.msh`, `model.f3grid`,
 /// and `unit-<name>.ts` and `unit-<name>.stl` per body. Returns the file names written, in that
-/// order. The mesh is checked first ([`check_mesh`]): nothing is written for a broken one.
+/// order. The files are written in parallel (rayon); when one fails, the others may have been
+/// written (the facade's build folder is swapped in only when all succeed). The mesh is checked
+/// first ([`check_mesh`]): nothing is written for a broken one.
 ///
 /// The bodies' STL coordinates are relative to [`stl_origin`], written in each STL header.
 pub fn write_model(
@@ -124,9 +128,45 @@ pub fn write_model(
     info: &ModelInfo,
 ) -> Result<Vec<String>, ModelWriteError> {
     check_mesh(mesh)?;
-    let mut written = Vec::new();
-    let mut file =
-        |name: String, f: &dyn Fn(&mut Output) -> io::Result<()>| -> Result<(), ModelWriteError> {
+    type Job<'a> = (
+        String,
+        Box<dyn Fn(&mut Output) -> io::Result<()> + Send + Sync + 'a>,
+    );
+    let mut jobs: Vec<Job> = vec![(
+        "model.vtu".into(),
+        Box::new(|w: &mut Output| write_model_vtu(w, mesh, info)),
+    )];
+    for t in boundary_tags(mesh) {
+        let name = boundary_file_name(&mesh.tags[t as usize]).expect("a boundary tag");
+        jobs.push((
+            name,
+            Box::new(move |w: &mut Output| write_boundary_vtu(w, &boundary_mesh(mesh, t))),
+        ));
+    }
+    jobs.push((
+        "model.msh".into(),
+        Box::new(|w: &mut Output| write_model_msh(w, mesh, info)),
+    ));
+    jobs.push((
+        "model.f3grid".into(),
+        Box::new(|w: &mut Output| write_model_f3grid(w, mesh, info)),
+    ));
+    let origin = stl_origin(mesh);
+    for body in &mesh.bodies {
+        let unit = &mesh.units[body.unit];
+        jobs.push((
+            format!("unit-{unit}.ts"),
+            Box::new(move |w: &mut Output| write_body_tsurf(w, mesh, body, info)),
+        ));
+        jobs.push((
+            format!("unit-{unit}.stl"),
+            Box::new(move |w: &mut Output| write_body_stl(w, mesh, body, origin)),
+        ));
+    }
+    // Every file on its own thread of the rayon pool; the first error in file order is returned.
+    let results: Vec<Result<String, ModelWriteError>> = jobs
+        .into_par_iter()
+        .map(|(name, f)| {
             let path = dir.join(&name);
             let err = |source| ModelWriteError::Io {
                 file: path.display().to_string(),
@@ -135,30 +175,10 @@ pub fn write_model(
             let mut out = Output::create(Some(&path)).map_err(err)?;
             f(&mut out).map_err(err)?;
             out.commit().map_err(err)?;
-            written.push(name);
-            Ok(())
-        };
-    file("model.vtu".into(), &|w| write_model_vtu(w, mesh, info))?;
-    for t in boundary_tags(mesh) {
-        let name = boundary_file_name(&mesh.tags[t as usize]).expect("a boundary tag");
-        let b = boundary_mesh(mesh, t);
-        file(name, &|w| write_boundary_vtu(w, &b))?;
-    }
-    file("model.msh".into(), &|w| write_model_msh(w, mesh, info))?;
-    file("model.f3grid".into(), &|w| {
-        write_model_f3grid(w, mesh, info)
-    })?;
-    let origin = stl_origin(mesh);
-    for body in &mesh.bodies {
-        let unit = &mesh.units[body.unit];
-        file(format!("unit-{unit}.ts"), &|w| {
-            write_body_tsurf(w, mesh, body, info)
-        })?;
-        file(format!("unit-{unit}.stl"), &|w| {
-            write_body_stl(w, mesh, body, origin)
-        })?;
-    }
-    Ok(written)
+            Ok(name)
+        })
+        .collect();
+    results.into_iter().collect()
 }
 
 /// Writes `v` in the shortest form that reads back to the same `f64` (`-0` as `0`).
