@@ -260,6 +260,10 @@ fn build_into(
             || pictures::draw_all(out, &samples, &mesh, &interp),
             |p| format!("{} pictures", p.len()),
         )?;
+        let extra = match &geo {
+            Some(g) => vec![crate::geology::report::model_section(out, g, &mesh.mesh)?],
+            None => Vec::new(),
+        };
         if project.export.report {
             st.k += 1;
             progress.stage_start(st.k, st.total, "report");
@@ -276,6 +280,7 @@ fn build_into(
                 &written,
                 &pics,
                 &st.timings,
+                extra,
             )?;
             progress.stage_done("report", "report.html", t.elapsed().as_secs_f64());
         }

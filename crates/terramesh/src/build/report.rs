@@ -66,6 +66,7 @@ pub fn write_report(
     w: &Written,
     pics: &[Picture],
     timings: &Timings,
+    extra: Vec<terramesh_io::report::Section>,
 ) -> Result<()> {
     let title = p
         .title
@@ -349,6 +350,7 @@ pub fn write_report(
             },
         ],
     });
+    sections.extend(extra);
     sections.push(Section {
         heading: "Timings".into(),
         blocks: vec![Block::Table {

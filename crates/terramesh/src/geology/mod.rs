@@ -5,6 +5,7 @@
 
 pub mod fields;
 pub mod model;
+pub mod report;
 pub mod section;
 pub mod stage;
 pub mod summary;

@@ -1,0 +1,188 @@
+//! The geological model in the report: two vertical sections (along the region's long axis
+//! and across it, units coloured, the boreholes near each line drawn with their logged
+//! units), a thickness map per unit, the unit volume table and the misfit at the holes.
+//! Pictures go to `out/pictures/model-*.png` (and `.svg`).
+
+use std::path::Path;
+
+use terramesh_io::pictures::{
+    draw_section, draw_surface, render_both_as, ColourMap, Section as Cut, SectionHole, SurfaceMap,
+    SvgMode, VECTOR_TRIANGLE_LIMIT,
+};
+use terramesh_io::report::{Block, Section};
+use terramesh_mesh::Mesh;
+
+use super::section::{along_line, long_and_cross_axes, profile};
+use super::stage::ModelBuilt;
+use crate::error::{Context, Result};
+
+/// Stations along each section line.
+pub const SECTION_STATIONS: usize = 600;
+
+/// The report section of the model, with its pictures drawn into `out/pictures/`.
+pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section> {
+    let dir = out.join("pictures");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let units = &m.model.mesh.units;
+    let surfaces = &m.model.stack.surfaces;
+    let mode = if mesh.triangles.len() > VECTOR_TRIANGLE_LIMIT {
+        SvgMode::Raster
+    } else {
+        SvgMode::Vector
+    };
+    let mut blocks = Vec::new();
+    let [long, cross] = long_and_cross_axes(mesh);
+    for (name, (a, b), title) in [
+        (
+            "model-section-long",
+            long,
+            "Section along the region's long axis",
+        ),
+        ("model-section-cross", cross, "Section across the region"),
+    ] {
+        let (d, z) = profile(mesh, surfaces, a, b, SECTION_STATIONS);
+        let len = d.last().copied().unwrap_or(0.0);
+        // Holes within 5 % of the section's length from the line.
+        let holes: Vec<SectionHole> = m
+            .boreholes
+            .iter()
+            .flat_map(|bh| bh.holes.iter())
+            .filter_map(|h| {
+                let (t, off) = along_line(a, b, [h.collar[0], h.collar[1]])?;
+                (off <= 0.05 * len).then(|| SectionHole {
+                    name: h.name.clone(),
+                    distance: t,
+                    intervals: logged(h),
+                })
+            })
+            .collect();
+        let cut = Cut {
+            title,
+            distance: &d,
+            surfaces: &z,
+            units,
+            holes: &holes,
+        };
+        let files = render_both_as(&dir.join(name), (1100, 550), SvgMode::Vector, |r| {
+            draw_section(r, &cut)
+        })?;
+        blocks.push(png(
+            &files[0],
+            format!(
+                "{title}: from ({:.0}, {:.0}) to ({:.0}, {:.0}), {:.0} m, with the {} holes within \
+                 {:.0} m of the line and their logged units",
+                a[0],
+                a[1],
+                b[0],
+                b[1],
+                len,
+                holes.len(),
+                0.05 * len
+            ),
+        )?);
+    }
+    let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
+    for (k, unit) in units.iter().enumerate() {
+        let thickness: Vec<f64> = (0..xy.len())
+            .map(|v| surfaces[k][v] - surfaces[k + 1][v])
+            .collect();
+        let title = format!("Thickness of {unit} (m)");
+        let map = SurfaceMap {
+            xy: &xy,
+            values: &thickness,
+            shade_z: None,
+            triangles: &mesh.triangles,
+            title: &title,
+            unit: "thickness (m)",
+            colours: ColourMap::Viridis,
+            symmetric: false,
+            outlines: &[],
+        };
+        let files = render_both_as(
+            &dir.join(format!("model-thickness-{unit}")),
+            (900, 700),
+            mode,
+            |r| draw_surface(r, &map),
+        )?;
+        blocks.push(png(
+            &files[0],
+            format!("Thickness of {unit} (isopach), metres"),
+        )?);
+    }
+    let s = &m.summary;
+    blocks.push(Block::Table {
+        caption: format!(
+            "Units, top to bottom ({} cells on {} points; the volumes add up to the volume between \
+             the terrain and the base to {:.1e} relative)",
+            s.cells, s.points, s.checks.relative_difference
+        ),
+        header: [
+            "unit",
+            "MaterialIDs",
+            "volume (m³)",
+            "cells",
+            "thickness min / mean / max (m)",
+            "pinched-out area (m²)",
+            "interpolated",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: s
+            .units
+            .iter()
+            .map(|u| {
+                vec![
+                    u.name.clone(),
+                    u.material_id.to_string(),
+                    format!("{:.6e}", u.volume),
+                    u.cells.to_string(),
+                    format!(
+                        "{:.2} / {:.2} / {:.2}",
+                        u.min_thickness, u.mean_thickness, u.max_thickness
+                    ),
+                    format!("{:.1}", u.pinched_out_area),
+                    u.interpolated.clone(),
+                ]
+            })
+            .collect(),
+    });
+    if !s.boreholes.is_empty() {
+        let worst = s
+            .boreholes
+            .iter()
+            .max_by(|a, b| a.misfit.abs().total_cmp(&b.misfit.abs()))
+            .map(|w| format!("{} m ({} in {})", w.misfit, w.unit, w.hole))
+            .unwrap_or_default();
+        blocks.push(Block::Text(format!(
+            "{} observed contacts (every collar against the terrain, every logged top against its \
+             interface); the largest misfit (model − observed) is {worst}. model.json lists each.",
+            s.boreholes.len()
+        )));
+    }
+    Ok(Section {
+        heading: "Geological model".into(),
+        blocks,
+    })
+}
+
+/// The logged intervals of a hole, `(top, bottom, unit)`: from each known top down to the
+/// next known top below it.
+fn logged(h: &terramesh_io::boreholes::Hole) -> Vec<(f64, f64, usize)> {
+    let tops: Vec<(f64, usize)> = h
+        .tops
+        .iter()
+        .flatten()
+        .map(|c| (c.position[2], c.unit))
+        .collect();
+    tops.windows(2)
+        .filter(|w| w[0].0 > w[1].0)
+        .map(|w| (w[0].0, w[1].0, w[0].1))
+        .collect()
+}
+
+fn png(path: &Path, caption: String) -> Result<Block> {
+    Ok(Block::Png {
+        caption,
+        bytes: std::fs::read(path).with_context(|| path.display().to_string())?,
+    })
+}
