@@ -73,3 +73,13 @@ else
   echo "$nwant" > "$nstamp"
 fi
 echo "verify-setup: done ($(.venv-verify/bin/python --version), $(xmllint --version 2>&1 | head -1), $(chromium --version 2>/dev/null), gmsh $(.venv-verify/bin/python -c 'import gmsh; print(gmsh.__version__)'), node $(node --version))"
+# OpenGeoSys' programs from the ogs wheel (in .venv-verify since requirements.txt pins it; about
+# 30 s to download and install alone): the geological model's checks run `ogs`, ExtractBoundary
+# and checkMesh (tests/verify/check_model.py). Fail here, naming the one that does not start.
+for tool in ogs ExtractBoundary checkMesh; do
+  if ! .venv-verify/bin/$tool --version >/dev/null 2>&1; then
+    echo "verify-setup: OpenGeoSys' $tool does not start: $(.venv-verify/bin/$tool --version 2>&1 | tail -1)" >&2
+    exit 1
+  fi
+done
+echo "verify-setup: OpenGeoSys $(.venv-verify/bin/ogs --version 2>&1 | grep -o 'version: [0-9.]*') with ExtractBoundary and checkMesh"

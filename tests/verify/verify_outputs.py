@@ -31,6 +31,7 @@ from vcommon import (F32_EPS, GRID_OVERSHOOT, KML_ALT, KML_DEG, NOT_DETERMINISTI
                      REL_DOUBLE, REL_FLOAT32, CheckFailed, Outputs, canonical_triangles, close, kml_schema_dir,
                      planar_areas, require, signed_volume, single_triangle_block, watertight, xmllint_schema)
 import check_collada
+import check_model
 import check_gltf
 import check_viewer
 import check_programs
@@ -473,6 +474,9 @@ def run(out_dir, compare=None, only=None):
     """Runs the checks, prints a line each, returns (passed, failed)."""
     out = Outputs(out_dir)
     checks = list(CHECKS)
+    if (out.root / "model.vtu").exists():  # a build with [geology]: the model's checks too
+        checks += [(f"geology model: {n}", lambda o, fn=fn: fn(check_model.Model(o.root)))
+                   for n, fn in check_model.CHECKS]
     if compare:
         checks.append(("determinism (--compare)", lambda o: check_identical(o, compare)))
     passed = failed = 0

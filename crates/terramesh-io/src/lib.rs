@@ -1,7 +1,8 @@
 //! File formats of **terramesh**: delimited tables ([`table`]), atomic output files
 //! ([`output`]), study regions from corner lists, GeoJSON, KML and WKT ([`region`]),
 //! elevation sources (SRTM `.hgt` tiles, GeoTIFF, ASCII grids, LAS/LAZ points, [`dem`]),
-//! rasters ([`grid_write`]), every surface export format ([`export`]), pictures
+//! rasters ([`grid_write`]), every surface export format ([`export`]), the geological
+//! model's volume mesh, boundary meshes and bodies ([`model`]), pictures
 //! ([`pictures`]), reports ([`report`]) and their 3D viewer ([`viewer`]). Numerical work
 //! lives in `terramesh-core` and `terramesh-mesh`.
 //!
@@ -26,6 +27,7 @@ pub mod dem;
 pub mod export;
 pub mod folder;
 pub mod grid_write;
+pub mod model;
 pub mod number;
 pub mod output;
 pub mod pictures;

@@ -59,7 +59,7 @@ pub use lod::{lod_tree, LodLevel, LodSettings, LodTile};
 pub use mesh::Mesh;
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;
-pub use smooth::{smooth, SmoothReport, Smoother, DEFAULT_SMOOTHER};
+pub use smooth::{smooth, smooth_keeping, SmoothReport, Smoother, DEFAULT_SMOOTHER};
 
 use terramesh_core::geometry::ValidationError;
 

@@ -76,11 +76,41 @@ pub struct SmoothReport {
 /// # Ok::<(), terramesh_mesh::MeshError>(())
 /// ```
 pub fn smooth(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothReport {
+    smooth_keeping(mesh, smoother, iterations, &[])
+}
+
+/// [`smooth`], keeping the vertices `keep` where they are too (borehole collars inserted as
+/// vertices, whose positions are data).
+///
+/// ```
+/// use terramesh_core::geometry::Region;
+/// use terramesh_mesh::{smooth_keeping, MeshBuilder, Smoother};
+/// let r = Region::from_ring(vec![[0.0, 0.0], [30.0, 0.0], [30.0, 10.0], [0.0, 10.0]]);
+/// let (mut mesh, _) = MeshBuilder::new().max_area(3.0).points(vec![[12.3, 4.56]]).build(&r)?;
+/// let v = (0..mesh.points.len())
+///     .find(|&i| { let p = mesh.absolute(i); (p[0] - 12.3).abs() < 1e-9 && (p[1] - 4.56).abs() < 1e-9 })
+///     .unwrap();
+/// let before = mesh.points[v];
+/// smooth_keeping(&mut mesh, Smoother::Smart, 10, &[v as u32]);
+/// assert_eq!(mesh.points[v], before);
+/// # Ok::<(), terramesh_mesh::MeshError>(())
+/// ```
+pub fn smooth_keeping(
+    mesh: &mut Mesh,
+    smoother: Smoother,
+    iterations: usize,
+    keep: &[u32],
+) -> SmoothReport {
     let mut report = SmoothReport::default();
     if iterations == 0 || mesh.triangles.is_empty() {
         return report;
     }
-    let fixed = mesh.fixed_vertices();
+    let mut fixed = mesh.fixed_vertices();
+    for &v in keep {
+        if let Some(f) = fixed.get_mut(v as usize) {
+            *f = true;
+        }
+    }
     let (off, tris) = mesh.vertex_stars();
     let q0 = crate::Quality::planar(mesh);
     // Size limits met by refinement stay met: no move or flip makes a triangle larger than

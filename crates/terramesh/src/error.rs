@@ -56,6 +56,12 @@ pub enum Error {
     /// An elevation file.
     #[error(transparent)]
     Dem(#[from] terramesh_io::dem::DemError),
+    /// A coordinate reference system or a transformation between two.
+    #[error(transparent)]
+    Crs(#[from] terramesh_crs::CrsError),
+    /// A horizon grid.
+    #[error(transparent)]
+    Horizon(#[from] crate::horizon::HorizonError),
     /// A region file or corner list.
     #[error(transparent)]
     Region(#[from] terramesh_io::region::RegionError),
@@ -77,6 +83,9 @@ pub enum Error {
     /// The scene of the report's 3D viewer.
     #[error(transparent)]
     Scene(#[from] terramesh_io::viewer::SceneError),
+    /// The geological model (rules, volume mesh, checks).
+    #[error(transparent)]
+    Geology(#[from] terramesh_geology::GeologyError),
     /// An elevation web service or tile server.
     #[error(transparent)]
     Web(#[from] terramesh_web::WebError),

@@ -3,6 +3,7 @@
 use std::fmt;
 
 use terramesh_core::coords::{to_utm, to_wgs84, CoordError, Zone};
+use terramesh_crs::{Crs, CrsError, Transformer};
 
 /// The CRS of an elevation source's coordinates.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,6 +18,9 @@ pub enum SourceCrs {
         /// A description, e.g. `NAD83(HARN) / Oregon GIC Lambert (ft)`.
         name: String,
     },
+    /// Any other CRS with an EPSG code (or a PROJ string), converted through
+    /// [`terramesh_crs`]: NAD83 geographic, CONUS Albers, RD New, State Plane (feet), ...
+    Epsg(Crs),
 }
 
 impl SourceCrs {
@@ -41,7 +45,40 @@ impl SourceCrs {
         }
     }
 
-    /// The EPSG code, when it is WGS-84 geographic or UTM.
+    /// The CRS of any EPSG code terramesh knows: [`SourceCrs::from_epsg`]'s WGS-84 variants,
+    /// [`SourceCrs::Epsg`] otherwise.
+    ///
+    /// ```
+    /// use terramesh_io::dem::SourceCrs;
+    /// assert_eq!(SourceCrs::from_any_epsg(32632)?, SourceCrs::from_epsg(32632).unwrap());
+    /// assert!(matches!(SourceCrs::from_any_epsg(5070)?, SourceCrs::Epsg(_)));
+    /// assert!(SourceCrs::from_any_epsg(1).is_err());
+    /// # Ok::<(), terramesh_crs::CrsError>(())
+    /// ```
+    pub fn from_any_epsg(code: u32) -> Result<SourceCrs, CrsError> {
+        match SourceCrs::from_epsg(code) {
+            Some(c) => Ok(c),
+            None => Crs::from_epsg(code).map(SourceCrs::Epsg),
+        }
+    }
+
+    /// The [`Crs`] of this source, `None` for [`SourceCrs::Projected`] (unknown).
+    ///
+    /// ```
+    /// use terramesh_io::dem::SourceCrs;
+    /// assert_eq!(SourceCrs::Geographic.to_crs()?.unwrap().epsg(), Some(4326));
+    /// # Ok::<(), terramesh_crs::CrsError>(())
+    /// ```
+    pub fn to_crs(&self) -> Result<Option<Crs>, CrsError> {
+        match self {
+            SourceCrs::Geographic => Ok(Some(Crs::wgs84())),
+            SourceCrs::Utm(z) => Crs::from_epsg(z.epsg()).map(Some),
+            SourceCrs::Projected { .. } => Ok(None),
+            SourceCrs::Epsg(c) => Ok(Some(c.clone())),
+        }
+    }
+
+    /// The EPSG code, when it is WGS-84 geographic or UTM (or an EPSG [`SourceCrs::Epsg`]).
     ///
     /// ```
     /// use terramesh_io::dem::SourceCrs;
@@ -53,11 +90,13 @@ impl SourceCrs {
             SourceCrs::Geographic => Some(4326),
             SourceCrs::Utm(z) => Some(z.epsg()),
             SourceCrs::Projected { .. } => None,
+            SourceCrs::Epsg(c) => c.epsg(),
         }
     }
 
     /// Converts WGS-84 latitude, longitude to this CRS's `(x, y)`, or `None` for a CRS
-    /// terramesh does not convert.
+    /// terramesh does not convert (also an EPSG CRS whose datum has no shift to WGS 84, such
+    /// as NAD27's grids, or a point outside its projection).
     ///
     /// ```
     /// use terramesh_io::dem::SourceCrs;
@@ -72,6 +111,10 @@ impl SourceCrs {
                 Ok(Some((p.easting, p.northing)))
             }
             SourceCrs::Projected { .. } => Ok(None),
+            SourceCrs::Epsg(c) => Ok(Transformer::new(&Crs::wgs84(), c)
+                .and_then(|t| t.transform(lon, lat))
+                .ok()
+                .map(|[x, y]| (x, y))),
         }
     }
 
@@ -90,6 +133,10 @@ impl SourceCrs {
             SourceCrs::Geographic => Ok(Some((y, x))),
             SourceCrs::Utm(z) => to_wgs84(x, y, *z).map(Some),
             SourceCrs::Projected { .. } => Ok(None),
+            SourceCrs::Epsg(c) => Ok(Transformer::new(c, &Crs::wgs84())
+                .and_then(|t| t.transform(x, y))
+                .ok()
+                .map(|[lon, lat]| (lat, lon))),
         }
     }
 }
@@ -100,6 +147,7 @@ impl fmt::Display for SourceCrs {
             SourceCrs::Geographic => f.write_str("WGS 84 (EPSG:4326)"),
             SourceCrs::Utm(z) => write!(f, "WGS 84 / UTM zone {z} (EPSG:{})", z.epsg()),
             SourceCrs::Projected { name } => write!(f, "{name} (kept as is)"),
+            SourceCrs::Epsg(c) => write!(f, "{c} ({})", c.definition()),
         }
     }
 }

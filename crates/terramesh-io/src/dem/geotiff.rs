@@ -1,6 +1,8 @@
 //! GeoTIFF rasters: int/float samples, striped or tiled, uncompressed, Deflate, LZW or
-//! PackBits (decoded by the `tiff` crate), georeferenced by GeoKeys in EPSG:4326 or WGS-84
-//! UTM, pixel-is-area or pixel-is-point.
+//! PackBits (decoded by the `tiff` crate), georeferenced by GeoKeys naming an EPSG code
+//! (WGS 84 and its UTM zones natively, any other code of `terramesh_crs`'s table as
+//! `SourceCrs::Epsg`, and user-defined projections from their GeoKeys), pixel-is-area or
+//! pixel-is-point.
 
 use std::fs::File;
 use std::io::BufReader;
@@ -10,12 +12,10 @@ use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
 use tiff::ColorType;
 
-use super::{DemError, GeoTransform, LatLonBox, Raster, SourceCrs};
+use super::geokeys::{crs_of, geokeys};
+use super::{DemError, GeoTransform, LatLonBox, Raster};
 
-const GT_MODEL_TYPE: u16 = 1024;
 const GT_RASTER_TYPE: u16 = 1025;
-const GEOGRAPHIC_TYPE: u16 = 2048;
-const PROJECTED_CS_TYPE: u16 = 3072;
 
 /// Reads a single-band GeoTIFF into a [`Raster`] (nodata posts become voids).
 ///
@@ -90,7 +90,7 @@ pub fn read_geotiff_in(path: &Path, area: Option<&LatLonBox>) -> Result<Raster, 
         )
     })?;
     let crs = crs_of(path, &keys)?;
-    let point = key(&keys, GT_RASTER_TYPE) == Some(2);
+    let point = keys.short(GT_RASTER_TYPE) == Some(2);
     let transform = transform_of(path, &mut dec, point).map_err(|e| match e {
         Either::Tiff(t) => terr(t),
         Either::Dem(d) => d,
@@ -312,54 +312,6 @@ fn to_f64(image: DecodingResult, nodata: Option<f64>) -> Vec<f64> {
 }
 
 /// GeoKey entries `(id, value)` with inline SHORT values.
-fn geokeys<R: std::io::Read + std::io::Seek>(
-    dec: &mut Decoder<R>,
-) -> Result<Option<Vec<(u16, u16)>>, tiff::TiffError> {
-    let Some(v) = dec.find_tag(Tag::GeoKeyDirectoryTag)? else {
-        return Ok(None);
-    };
-    let d = v.into_u16_vec()?;
-    let n = d.get(3).copied().unwrap_or(0) as usize;
-    let mut out = Vec::new();
-    for k in 0..n {
-        let e = &d.get(4 + 4 * k..8 + 4 * k).unwrap_or(&[]);
-        if e.len() == 4 && e[1] == 0 {
-            out.push((e[0], e[3]));
-        }
-    }
-    Ok(Some(out))
-}
-
-fn key(keys: &[(u16, u16)], id: u16) -> Option<u16> {
-    keys.iter().find(|k| k.0 == id).map(|k| k.1)
-}
-
-fn crs_of(path: &Path, keys: &[(u16, u16)]) -> Result<SourceCrs, DemError> {
-    let unsupported = |what: String| {
-        DemError::crs(
-            path,
-            format!(
-                "{what} is not supported: terramesh reads WGS 84 (EPSG:4326) and WGS 84 / UTM \
-                 (EPSG:326xx, 327xx) GeoTIFFs; reproject with gdalwarp -t_srs EPSG:4326"
-            ),
-        )
-    };
-    match key(keys, GT_MODEL_TYPE) {
-        Some(2) => match key(keys, GEOGRAPHIC_TYPE) {
-            Some(4326) => Ok(SourceCrs::Geographic),
-            Some(c) => Err(unsupported(format!("geographic CRS EPSG:{c}"))),
-            None => Err(unsupported("a geographic CRS without an EPSG code".into())),
-        },
-        Some(1) => match key(keys, PROJECTED_CS_TYPE) {
-            Some(c) => SourceCrs::from_epsg(c as u32)
-                .ok_or_else(|| unsupported(format!("projected CRS EPSG:{c}"))),
-            None => Err(unsupported("a projected CRS without an EPSG code".into())),
-        },
-        Some(m) => Err(unsupported(format!("model type {m}"))),
-        None => Err(unsupported("a GeoTIFF without a model type".into())),
-    }
-}
-
 enum Either {
     Tiff(tiff::TiffError),
     Dem(DemError),

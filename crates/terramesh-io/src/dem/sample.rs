@@ -3,6 +3,7 @@
 use rayon::prelude::*;
 use terramesh_core::coords::{to_utm, Zone};
 use terramesh_core::sampling::{Kernel, Missing, Node};
+use terramesh_crs::{Crs, Transformer};
 
 use super::{DemError, ElevationSource, SourceCrs};
 
@@ -31,6 +32,17 @@ pub fn sample_latlon(
     let crs = source.crs().clone();
     if let SourceCrs::Projected { name } = &crs {
         return Err(not_convertible(source, name));
+    }
+    if let SourceCrs::Epsg(c) = &crs {
+        let t = transformer(source, &Crs::wgs84(), c)?;
+        return Ok(latlon
+            .par_iter()
+            .with_min_len(CHUNK)
+            .map(|&[lat, lon]| match t.transform(lon, lat) {
+                Ok([x, y]) => source.sample(x, y, method),
+                Err(_) => Err(Missing::Outside),
+            })
+            .collect());
     }
     Ok(latlon
         .par_iter()
@@ -106,13 +118,24 @@ pub fn sample_nodes(
         }
         _ => {}
     }
+    if let SourceCrs::Epsg(c) = &crs {
+        let t = transformer(source, &Crs::wgs84(), c)?;
+        return Ok(nodes
+            .par_iter()
+            .with_min_len(CHUNK)
+            .map(|n| match n.latlon.map(|[lat, lon]| t.transform(lon, lat)) {
+                Some(Ok([x, y])) => source.sample(x, y, method),
+                _ => Err(Missing::Outside),
+            })
+            .collect());
+    }
     let same_zone = matches!(crs, SourceCrs::Utm(z) if Some(z) == zone);
     Ok(nodes
         .par_iter()
         .with_min_len(CHUNK)
         .map(|n| {
             let (x, y) = match (&crs, n.latlon) {
-                (SourceCrs::Projected { .. }, _) => (n.xy[0], n.xy[1]),
+                (SourceCrs::Projected { .. } | SourceCrs::Epsg(_), _) => (n.xy[0], n.xy[1]),
                 _ if same_zone => (n.xy[0], n.xy[1]),
                 (SourceCrs::Geographic, Some([lat, lon])) => (lon, lat),
                 (SourceCrs::Utm(z), Some([lat, lon])) => match to_utm(lat, lon, Some(*z)) {
@@ -124,6 +147,60 @@ pub fn sample_nodes(
             source.sample(x, y, method)
         })
         .collect())
+}
+
+/// Samples `source` at points given in `crs` (a project's CRS), transformed into the source's
+/// own CRS first (in parallel). A [`SourceCrs::Projected`] source (its CRS unknown) is taken to
+/// be in `crs` already. Points the transformation cannot reach are [`Missing::Outside`].
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_io::dem::DemError> {
+/// use terramesh_core::sampling::Kernel;
+/// use terramesh_crs::Crs;
+/// use terramesh_io::dem::{open_raster, sample_in};
+/// let dem = open_raster(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/haut-barr/srtm-crop.asc")), false)?;
+/// let utm = Crs::parse("EPSG:32632").unwrap();
+/// let z = sample_in(dem.as_ref(), &[[377_700.0, 5_398_000.0]], &utm, Kernel::Bilinear)?;
+/// assert!(z[0].is_ok());
+/// # Ok(()) }
+/// ```
+pub fn sample_in(
+    source: &dyn ElevationSource,
+    points: &[[f64; 2]],
+    crs: &Crs,
+    method: Kernel,
+) -> Result<Vec<Result<f64, Missing>>, DemError> {
+    let Some(own) = source.crs().to_crs().map_err(|e| DemError::Crs {
+        file: source.describe(),
+        message: e.to_string(),
+    })?
+    else {
+        return Ok(points
+            .par_iter()
+            .with_min_len(CHUNK)
+            .map(|p| source.sample(p[0], p[1], method))
+            .collect());
+    };
+    let t = transformer(source, crs, &own)?;
+    Ok(points
+        .par_iter()
+        .with_min_len(CHUNK)
+        .map(|p| match t.transform(p[0], p[1]) {
+            Ok([x, y]) => source.sample(x, y, method),
+            Err(_) => Err(Missing::Outside),
+        })
+        .collect())
+}
+
+fn transformer(
+    source: &dyn ElevationSource,
+    from: &Crs,
+    to: &Crs,
+) -> Result<Transformer, DemError> {
+    Transformer::new(from, to).map_err(|e| DemError::Crs {
+        file: source.describe(),
+        message: e.to_string(),
+    })
 }
 
 fn not_convertible(source: &dyn ElevationSource, name: &str) -> DemError {

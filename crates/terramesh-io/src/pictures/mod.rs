@@ -7,6 +7,7 @@
 mod chart;
 mod colour;
 mod maps;
+mod section;
 mod view3d;
 
 use std::path::{Path, PathBuf};
@@ -16,6 +17,7 @@ use plotters::prelude::*;
 pub use chart::draw_variogram;
 pub use colour::{hillshade, shade, ColourMap};
 pub use maps::{draw_mesh, draw_samples, draw_surface, SurfaceMap};
+pub use section::{draw_section, unit_colour, Section, SectionHole};
 pub use view3d::draw_view3d;
 
 /// Above this many triangles, the build draws mesh pictures as [`SvgMode::Raster`].

@@ -37,7 +37,7 @@ use crate::project::Project;
 #[derive(Debug, Default, Clone)]
 pub struct Timings(pub Vec<(String, f64)>);
 
-/// The number of stages [`build`] reports.
+/// The number of stages [`build`] reports (one more with `[geology]`).
 pub const STAGES: usize = 7;
 
 /// What a build made.
@@ -56,6 +56,7 @@ pub struct Built {
 struct Stages<'a> {
     progress: &'a dyn Progress,
     k: usize,
+    total: usize,
     timings: Timings,
 }
 
@@ -68,7 +69,7 @@ impl Stages<'_> {
     ) -> Result<T> {
         self.check()?;
         self.k += 1;
-        self.progress.stage_start(self.k, STAGES, name);
+        self.progress.stage_start(self.k, self.total, name);
         let t = Instant::now();
         let out = f()?;
         let secs = t.elapsed().as_secs_f64();
@@ -123,6 +124,7 @@ fn build_into(
     let mut st = Stages {
         progress,
         k: 0,
+        total: STAGES + usize::from(project.geology().is_some()),
         timings: Timings::default(),
     };
     let samples = st.run(
@@ -135,9 +137,18 @@ fn build_into(
         || stages::model(project, &samples, base),
         |m| short_numbers(&m.variogram.to_string()),
     )?;
+    let geology = project.geology();
+    let boreholes = match geology {
+        Some(g) => crate::geology::stage::read_boreholes(g, samples.zone)?,
+        None => None,
+    };
+    let collars = boreholes
+        .as_ref()
+        .map(crate::geology::stage::collar_points)
+        .unwrap_or_default();
     let mesh = st.run(
         "mesh",
-        || stages::mesh(project, &samples, &model),
+        || stages::mesh(project, &samples, &model, &collars),
         |m| {
             let adaptive = m.adaptive.as_ref().map_or(String::new(), |a| {
                 format!(
@@ -158,6 +169,37 @@ fn build_into(
         || stages::interpolate(project, &samples, &mesh, &model),
         |i| format!("UK and IDW at {} vertices, cross-validation", i.uk.len()),
     )?;
+    let geo = match geology {
+        Some(g) => Some(st.run(
+            "geology",
+            || {
+                crate::geology::stage::run(
+                    project,
+                    g,
+                    boreholes,
+                    &mesh.mesh,
+                    &interp.dsm,
+                    &interp.grid.0,
+                    Some(samples.zone.epsg()),
+                    out,
+                )
+            },
+            |m| {
+                format!(
+                    "{} units, {} cells, {} contacts within {:.3} m",
+                    m.model.stats.len(),
+                    m.model.mesh.cells.len(),
+                    m.model.misfits.len(),
+                    m.model
+                        .misfits
+                        .iter()
+                        .map(|f| f.misfit.abs())
+                        .fold(0.0, f64::max)
+                )
+            },
+        )?),
+        None => None,
+    };
     let written = st.run(
         "exports",
         || exports::write_all(project, out, &samples, &mesh, &interp),
@@ -171,7 +213,7 @@ fn build_into(
         )?;
         if project.export.report {
             st.k += 1;
-            progress.stage_start(st.k, STAGES, "report");
+            progress.stage_start(st.k, st.total, "report");
             let t = Instant::now();
             st.timings
                 .0
@@ -190,8 +232,12 @@ fn build_into(
         }
     }
     st.check()?;
+    let mut files = written.files;
+    if let Some(g) = geo {
+        files.extend(g.files);
+    }
     Ok(Built {
-        files: written.files,
+        files,
         vertices: mesh.mesh.points.len(),
         triangles: mesh.mesh.triangles.len(),
         timings: st.timings,

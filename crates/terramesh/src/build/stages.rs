@@ -9,7 +9,7 @@ use terramesh_geostat::{
     Neighbourhood, Predictor, Variogram, Weighting,
 };
 use terramesh_io::region::LoadedRegion;
-use terramesh_mesh::{smooth, Mesh, MeshBuilder, Quality, SmoothReport};
+use terramesh_mesh::{smooth_keeping, Mesh, MeshBuilder, Quality, SmoothReport};
 
 use crate::acquire::{acquire, write_table, SamplePlan};
 use crate::error::{bail, Context, Result};
@@ -104,7 +104,10 @@ pub struct Meshed {
 
 /// Step 3: constrained Delaunay refinement of the region, then smoothing; or, with
 /// `mesh.max_error`, terrain-adaptive refinement against the kriged surface.
-pub fn mesh(p: &Project, s: &Samples, model: &Model) -> Result<Meshed> {
+///
+/// `keep` are points to insert as vertices that smoothing does not move (the borehole collars
+/// of `[geology]`; not with `mesh.max_error`, whose mesher places every vertex itself).
+pub fn mesh(p: &Project, s: &Samples, model: &Model, keep: &[[f64; 2]]) -> Result<Meshed> {
     let m = &p.mesh;
     if let Some(target) = m.max_error {
         let (mesh, info) = super::adaptive::adaptive(p, s, model, target)?;
@@ -132,14 +135,20 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model) -> Result<Meshed> {
     if let Some(e) = m.max_edge {
         builder = builder.max_edge(e);
     }
+    let mut points: Vec<[f64; 2]> = Vec::new();
     if m.insert_samples {
-        builder = builder.points(s.xyz.iter().map(|q| [q[0], q[1]]).collect());
+        points.extend(s.xyz.iter().map(|q| [q[0], q[1]]));
+    }
+    points.extend_from_slice(keep);
+    if !points.is_empty() {
+        builder = builder.points(points);
     }
     let (mut mesh, _) = builder.build(&s.region.projected).context("[mesh]")?;
+    let kept = vertices_at(&mesh, keep);
     let unsmoothed = mesh.clone();
     let before = Quality::planar(&mesh);
     let smoothing = if m.smooth > 0 {
-        Some(smooth(&mut mesh, m.smoother, m.smooth))
+        Some(smooth_keeping(&mut mesh, m.smoother, m.smooth, &kept))
     } else {
         None
     };
@@ -153,6 +162,23 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model) -> Result<Meshed> {
         max_area,
         adaptive: None,
     })
+}
+
+/// The vertices of `mesh` at `points` (inserted there; points outside the region have none).
+fn vertices_at(mesh: &Mesh, points: &[[f64; 2]]) -> Vec<u32> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    let mut at: std::collections::HashMap<(i64, i64), u32> = std::collections::HashMap::new();
+    // Millimetre keys: an inserted point is a vertex to rounding of its local coordinates.
+    let key = |p: [f64; 2]| ((p[0] * 1e3).round() as i64, (p[1] * 1e3).round() as i64);
+    for i in 0..mesh.points.len() {
+        at.insert(key(mesh.absolute(i)), i as u32);
+    }
+    points
+        .iter()
+        .filter_map(|&p| at.get(&key(p)).copied())
+        .collect()
 }
 
 /// Step 4: vertex elevations by UK and IDW, a DSM grid, and cross-validation.

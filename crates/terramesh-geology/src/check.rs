@@ -1,0 +1,567 @@
+//! Independent checks of a volume mesh: they read only the [`VolumeMesh`] (and, for
+//! [`CheckSummary::compare_with`], the input surfaces), never the construction's bookkeeping.
+//!
+//! 1. every cell has positive volume ([`cell_volume`]);
+//! 2. every face of a cell is shared by at most two cells, oppositely oriented (interior), or
+//!    belongs to one cell (boundary);
+//! 3. the boundary faces form a closed surface: every edge in two of them or four, as often
+//!    one way as the other;
+//! 4. the tagged faces are exactly the boundary faces (top, bottom, sides) and the interior
+//!    faces between cells of different units (interfaces, on the lower cell, named after its
+//!    unit), each oriented out of its cell; top faces point up, bottom faces down, sides are
+//!    vertical;
+//! 5. every body is watertight by the same edge rule, there is one per unit with cells, and
+//!    its enclosed volume equals its cells' volume to 1e-9 relative;
+//! 6. the sum of the cells' volumes equals the volume under the boundary (the integral of
+//!    z over the boundary faces' projected areas) to 1e-9 relative.
+
+use rayon::prelude::*;
+use terramesh_core::volume::{cell_volume, Cell, CellKind, FaceTag, VolumeMesh};
+
+use crate::buckets::{bucketed, sort_by_node};
+use crate::cells::split_quad;
+use crate::{GeologyError, Planar, Stack};
+
+/// Relative tolerance of the volume checks.
+const RELATIVE: f64 = 1e-9;
+
+/// What [`check`] measured.
+///
+/// ```
+/// let s = terramesh_geology::CheckSummary::default();
+/// assert_eq!(s.volume, 0.0);
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CheckSummary {
+    /// The sum of the cells' volumes, m³.
+    pub volume: f64,
+    /// The volume of every unit's cells, in unit order.
+    pub unit_volumes: Vec<f64>,
+    /// The volume enclosed by every body, in the order of [`VolumeMesh::bodies`].
+    pub body_volumes: Vec<f64>,
+    /// Faces shared by two cells.
+    pub interior_faces: usize,
+    /// Faces of one cell only.
+    pub boundary_faces: usize,
+    /// Edges of the bodies in four of their triangles (where a unit pinches out along a line).
+    pub pinch_edges: usize,
+}
+
+fn fail(mesh: &VolumeMesh, node: u32, what: String) -> GeologyError {
+    let p = mesh
+        .points
+        .get(node as usize)
+        .copied()
+        .unwrap_or([f64::NAN; 3]);
+    GeologyError::Check {
+        what,
+        x: p[0],
+        y: p[1],
+    }
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= RELATIVE * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+}
+
+/// The outward faces of a cell (triangles end with `u32::MAX`).
+fn faces(c: &Cell) -> impl Iterator<Item = [u32; 4]> {
+    const T: u32 = u32::MAX;
+    let n = c.nodes;
+    let list: ([[u32; 4]; 5], usize) = match c.kind {
+        CellKind::Tetra => (
+            [
+                [n[0], n[2], n[1], T],
+                [n[0], n[1], n[3], T],
+                [n[1], n[2], n[3], T],
+                [n[0], n[3], n[2], T],
+                [T; 4],
+            ],
+            4,
+        ),
+        CellKind::Pyramid => (
+            [
+                [n[0], n[3], n[2], n[1]],
+                [n[0], n[1], n[4], T],
+                [n[1], n[2], n[4], T],
+                [n[2], n[3], n[4], T],
+                [n[3], n[0], n[4], T],
+            ],
+            5,
+        ),
+        CellKind::Wedge => (
+            [
+                [n[0], n[2], n[1], T],
+                [n[3], n[4], n[5], T],
+                [n[0], n[1], n[4], n[3]],
+                [n[1], n[2], n[5], n[4]],
+                [n[2], n[0], n[3], n[5]],
+            ],
+            5,
+        ),
+    };
+    list.0.into_iter().take(list.1)
+}
+
+/// A face's key (the same for both orientations) and its orientation.
+fn canonical(f: [u32; 4]) -> ([u32; 4], bool) {
+    let used = if f[3] == u32::MAX { 3 } else { 4 };
+    let m = (0..used).min_by_key(|&i| f[i]).unwrap();
+    let at = |k: usize| f[(m + k) % used];
+    if used == 3 {
+        let (x, y) = (at(1), at(2));
+        ([at(0), x.min(y), x.max(y), u32::MAX], x < y)
+    } else {
+        let (x, z) = (at(1), at(3));
+        ([at(0), x.min(z), at(2), x.max(z)], x < z)
+    }
+}
+
+/// The face back from its key and orientation.
+fn oriented(key: [u32; 4], forward: bool) -> [u32; 4] {
+    match (key[3] == u32::MAX, forward) {
+        (true, true) => key,
+        (true, false) => [key[0], key[2], key[1], u32::MAX],
+        (false, true) => key,
+        (false, false) => [key[0], key[3], key[2], key[1]],
+    }
+}
+
+fn used(f: &[u32; 4]) -> &[u32] {
+    if f[3] == u32::MAX {
+        &f[..3]
+    } else {
+        f
+    }
+}
+
+/// Every edge of the polygons in two of them or four, as often one way as the other; returns
+/// the number of edges in four.
+fn closed<P>(
+    mesh: &VolumeMesh,
+    polygons: &[P],
+    nodes_of: impl Fn(&P) -> &[u32],
+    what: &str,
+) -> Result<usize, GeologyError> {
+    let edges: Vec<u64> = bucketed(
+        polygons,
+        mesh.points.len(),
+        |_, p, out| {
+            let p = nodes_of(p);
+            for i in 0..p.len() {
+                let (a, b) = (p[i] as u64, p[(i + 1) % p.len()] as u64);
+                // (min, max) and the direction in the lowest bit (nodes below 2^31).
+                out[i] = (a.min(b) << 32 | a.max(b)) << 1 | (a < b) as u64;
+            }
+            p.len()
+        },
+        |e| (e >> 33) as u32,
+    );
+    let mut fours = 0;
+    let mut i = 0;
+    while i < edges.len() {
+        let key = edges[i] >> 1;
+        let mut j = i;
+        let mut forward = 0;
+        while j < edges.len() && edges[j] >> 1 == key {
+            forward += (edges[j] & 1) as usize;
+            j += 1;
+        }
+        let count = j - i;
+        if !(count == 2 || count == 4) || 2 * forward != count {
+            let a = (key >> 32) as u32;
+            return Err(fail(
+                mesh,
+                a,
+                format!(
+                    "{what}: the edge of nodes {a} and {} is in {count} faces, {forward} of them \
+                     one way (a closed surface needs two or four, half each way)",
+                    key & 0xffff_ffff
+                ),
+            ));
+        }
+        fours += (count == 4) as usize;
+        i = j;
+    }
+    Ok(fours)
+}
+
+/// Twice the signed projected (xy) area of a triangle times the sum of its z, relative to
+/// `r`: six times its contribution to the volume under a closed surface.
+fn z_flux(p: &[[f64; 3]], r: [f64; 3], t: [u32; 3]) -> f64 {
+    let [a, b, c] = t.map(|i| {
+        let q = p[i as usize];
+        [q[0] - r[0], q[1] - r[1], q[2] - r[2]]
+    });
+    let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    area2 * (a[2] + b[2] + c[2])
+}
+
+/// The triangles of a face (a quadrilateral cut by the diagonal rule).
+fn triangles(f: &[u32; 4]) -> impl Iterator<Item = [u32; 3]> {
+    let (n, t) = if f[3] == u32::MAX {
+        (1, [[f[0], f[1], f[2]], [0; 3]])
+    } else {
+        (2, split_quad(*f))
+    };
+    t.into_iter().take(n)
+}
+
+/// Checks a volume mesh (the module documentation lists the checks).
+///
+/// ```
+/// use terramesh_geology::{check, volume_mesh, Layering, Planar, Stack};
+/// let points = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+/// let planar = Planar::new(&points, &[[0, 1, 2]])?;
+/// let stack = Stack { surfaces: vec![vec![3.0; 3], vec![0.0; 3]] };
+/// let mut mesh = volume_mesh(&planar, &stack, &Layering::new(vec!["a".into()]))?;
+/// assert!((check(&mesh)?.volume - 1.5).abs() < 1e-12);
+/// mesh.faces.pop(); // a boundary face without its tag
+/// assert!(check(&mesh).is_err());
+/// # Ok::<(), terramesh_geology::GeologyError>(())
+/// ```
+///
+/// # Errors
+/// [`GeologyError::Check`] naming the first failure and where it is.
+pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
+    let n = mesh.points.len() as u32;
+    if mesh.points.len() >= 1 << 31 {
+        return Err(fail(mesh, 0, "the check handles up to 2^31 nodes".into()));
+    }
+    if mesh.material.len() != mesh.cells.len() {
+        return Err(fail(mesh, 0, "one material per cell is needed".into()));
+    }
+    // 1. Volumes.
+    let volumes: Vec<f64> = mesh
+        .cells
+        .par_iter()
+        .map(|c| {
+            if c.used().iter().any(|&i| i >= n) {
+                f64::NAN
+            } else {
+                cell_volume(&mesh.points, c)
+            }
+        })
+        .collect();
+    if let Some(c) = volumes.iter().position(|v| v.is_nan() || *v <= 0.0) {
+        return Err(fail(
+            mesh,
+            mesh.cells[c].nodes[0].min(n.saturating_sub(1)),
+            format!(
+                "cell {c} has volume {} (nodes {:?})",
+                volumes[c],
+                mesh.cells[c].used()
+            ),
+        ));
+    }
+    let units = mesh.units.len();
+    let mut unit_volumes = vec![0.0; units];
+    for (c, (&v, &m)) in volumes.iter().zip(&mesh.material).enumerate() {
+        if !(0..units as i32).contains(&m) {
+            return Err(fail(
+                mesh,
+                mesh.cells[c].nodes[0],
+                format!("cell {c} has material {m} but there are {units} units"),
+            ));
+        }
+        unit_volumes[m as usize] += v;
+    }
+    let volume: f64 = unit_volumes.iter().sum();
+    // 2. Faces: shared by two cells, oppositely, or boundary.
+    let all: Vec<([u32; 4], bool, u32)> = bucketed(
+        &mesh.cells,
+        mesh.points.len(),
+        |i, c, out| {
+            let mut k = 0;
+            for f in faces(c) {
+                let (key, o) = canonical(f);
+                out[k] = (key, o, i as u32);
+                k += 1;
+            }
+            k
+        },
+        |f| f.0[0],
+    );
+    let mut boundary = Vec::new();
+    let mut interfaces = Vec::new();
+    let mut interior_faces = 0;
+    let mut i = 0;
+    while i < all.len() {
+        let mut j = i + 1;
+        while j < all.len() && all[j].0 == all[i].0 {
+            j += 1;
+        }
+        match j - i {
+            1 => boundary.push(all[i]),
+            2 if all[i].1 != all[i + 1].1 => {
+                interior_faces += 1;
+                let (p, q) = (all[i], all[i + 1]);
+                let (mp, mq) = (mesh.material[p.2 as usize], mesh.material[q.2 as usize]);
+                if mp != mq {
+                    interfaces.push(if mp > mq { p } else { q });
+                }
+            }
+            k => {
+                return Err(fail(
+                    mesh,
+                    all[i].0[0],
+                    format!(
+                        "the face {:?} is in {k} cells{}",
+                        used(&all[i].0),
+                        if k == 2 {
+                            " with the same orientation"
+                        } else {
+                            ""
+                        }
+                    ),
+                ))
+            }
+        }
+        i = j;
+    }
+    // 3. The boundary is closed.
+    let faces_of_boundary: Vec<[u32; 4]> = boundary.iter().map(|f| oriented(f.0, f.1)).collect();
+    closed(mesh, &faces_of_boundary, used, "the boundary")?;
+    // 4. Tagged faces.
+    check_tags(mesh, &boundary, &interfaces)?;
+    // 6. The volume under the boundary.
+    let r = mesh.points.first().copied().unwrap_or_default();
+    let under: f64 = faces_of_boundary
+        .par_iter()
+        .map(|f| {
+            triangles(f)
+                .map(|t| z_flux(&mesh.points, r, t))
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / 6.0;
+    if !close(under, volume) {
+        return Err(fail(
+            mesh,
+            0,
+            format!("the cells' volume {volume} m³ differs from the volume under the boundary {under} m³"),
+        ));
+    }
+    // 5. Bodies.
+    let mut body_volumes = Vec::with_capacity(mesh.bodies.len());
+    let mut pinch_edges = 0;
+    let with_cells: Vec<usize> = (0..units).filter(|&u| unit_volumes[u] > 0.0).collect();
+    let bodies: Vec<usize> = mesh.bodies.iter().map(|b| b.unit).collect();
+    if bodies != with_cells {
+        return Err(fail(
+            mesh,
+            0,
+            format!(
+                "the bodies are of units {bodies:?} but the units with cells are {with_cells:?}"
+            ),
+        ));
+    }
+    // The bodies in parallel; the first failure in body order is reported.
+    let per_body: Vec<Result<(usize, f64), GeologyError>> = mesh
+        .bodies
+        .par_iter()
+        .map(|b| {
+            let name = &mesh.units[b.unit];
+            if let Some(t) = b.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
+                return Err(fail(
+                    mesh,
+                    0,
+                    format!("body {name}: triangle {t:?} names a missing node"),
+                ));
+            }
+            let fours = closed(
+                mesh,
+                &b.triangles,
+                |t| &t[..],
+                &format!("the body of unit {name}"),
+            )?;
+            let enclosed: f64 = b
+                .triangles
+                .iter()
+                .map(|&t| z_flux(&mesh.points, r, t))
+                .sum::<f64>()
+                / 6.0;
+            if !close(enclosed, unit_volumes[b.unit]) {
+                return Err(fail(
+                    mesh,
+                    b.triangles[0][0],
+                    format!(
+                        "the body of unit {name} encloses {enclosed} m³ but its cells hold {} m³",
+                        unit_volumes[b.unit]
+                    ),
+                ));
+            }
+            Ok((fours, enclosed))
+        })
+        .collect();
+    for r in per_body {
+        let (fours, enclosed) = r?;
+        pinch_edges += fours;
+        body_volumes.push(enclosed);
+    }
+    Ok(CheckSummary {
+        volume,
+        unit_volumes,
+        body_volumes,
+        interior_faces,
+        boundary_faces: boundary.len(),
+        pinch_edges,
+    })
+}
+
+/// Check 4: the tagged faces against the boundary and interface faces found from the cells.
+fn check_tags(
+    mesh: &VolumeMesh,
+    boundary: &[([u32; 4], bool, u32)],
+    interfaces: &[([u32; 4], bool, u32)],
+) -> Result<(), GeologyError> {
+    let mut outer = Vec::with_capacity(boundary.len());
+    let mut inner = Vec::with_capacity(interfaces.len());
+    for (i, f) in mesh.faces.iter().enumerate() {
+        let Some(tag) = mesh.tags.get(f.tag as usize) else {
+            return Err(fail(
+                mesh,
+                0,
+                format!("tagged face {i} has tag {} of {}", f.tag, mesh.tags.len()),
+            ));
+        };
+        let nodes = used(&f.nodes);
+        if nodes.iter().any(|&v| v as usize >= mesh.points.len())
+            || f.cell as usize >= mesh.cells.len()
+        {
+            return Err(fail(
+                mesh,
+                0,
+                format!("tagged face {i} names a missing node or cell"),
+            ));
+        }
+        let (key, o) = canonical(f.nodes);
+        // Its direction: the z of its normal, against its extent.
+        let r = mesh.points[nodes[0] as usize];
+        let nz: f64 = triangles(&f.nodes)
+            .map(|t| {
+                let [a, b, c] = t.map(|k| mesh.points[k as usize]);
+                (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+            })
+            .sum();
+        let ok = match tag {
+            FaceTag::Top => nz > 0.0,
+            FaceTag::Bottom => nz < 0.0,
+            FaceTag::Side(_) => {
+                let scale = nodes
+                    .iter()
+                    .map(|&k| {
+                        let p = mesh.points[k as usize];
+                        (p[0] - r[0]).abs().max((p[1] - r[1]).abs())
+                    })
+                    .fold(0.0, f64::max);
+                nz.abs() <= 1e-9 * scale * scale
+            }
+            FaceTag::Interface(u) => {
+                let m = mesh.material[f.cell as usize];
+                mesh.units.get(m as usize) == Some(u) && m > 0
+            }
+        };
+        if !ok {
+            return Err(fail(
+                mesh,
+                nodes[0],
+                format!(
+                    "tagged face {i} ({}) points the wrong way or names the wrong unit",
+                    tag.name()
+                ),
+            ));
+        }
+        match tag {
+            FaceTag::Interface(_) => inner.push((key, o, f.cell)),
+            _ => outer.push((key, o, f.cell)),
+        }
+    }
+    for (what, tagged, found) in [
+        ("boundary", outer, boundary),
+        ("interface", inner, interfaces),
+    ] {
+        let tagged = sort_by_node(&tagged, mesh.points.len(), |f| f.0[0]);
+        // `found` is in key order already (taken from the sorted faces), keys unique.
+        if tagged.as_slice() != found {
+            let diff = tagged
+                .iter()
+                .zip(found.iter())
+                .find(|(a, b)| a != b)
+                .map(|(a, _)| a.0[0])
+                .unwrap_or(0);
+            return Err(fail(
+                mesh,
+                diff,
+                format!(
+                    "{} {what} faces are tagged but the cells have {} (or one differs in nodes, \
+                     orientation or cell)",
+                    tagged.len(),
+                    found.len()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The volume between the terrain and the base from the input alone: the sum over planar
+/// triangles of area times the mean thickness `surfaces[0] - surfaces[last]`.
+///
+/// ```
+/// use terramesh_geology::{volume_between, Planar, Stack};
+/// let points = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]];
+/// let planar = Planar::new(&points, &[[0, 1, 2]])?;
+/// let stack = Stack { surfaces: vec![vec![3.0, 6.0, 9.0], vec![0.0; 3]] };
+/// assert_eq!(volume_between(&planar, &stack), 12.0);
+/// # Ok::<(), terramesh_geology::GeologyError>(())
+/// ```
+pub fn volume_between(planar: &Planar, stack: &Stack) -> f64 {
+    let (top, base) = (
+        &stack.surfaces[0],
+        &stack.surfaces[stack.surfaces.len() - 1],
+    );
+    (0..planar.triangles.len())
+        .into_par_iter()
+        .map(|t| {
+            let h: f64 = planar.triangles[t]
+                .iter()
+                .map(|&v| top[v as usize] - base[v as usize])
+                .sum();
+            planar.area(t) * h / 3.0
+        })
+        .sum()
+}
+
+impl CheckSummary {
+    /// Compares the cells' volume with [`volume_between`] the input's terrain and base, to
+    /// 1e-9 relative.
+    ///
+    /// ```
+    /// use terramesh_geology::{check, volume_mesh, Layering, Planar, Stack};
+    /// let points = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    /// let planar = Planar::new(&points, &[[0, 1, 2]])?;
+    /// let stack = Stack { surfaces: vec![vec![3.0, 4.0, 5.0], vec![0.0; 3]] };
+    /// let mesh = volume_mesh(&planar, &stack, &Layering::new(vec!["a".into()]))?;
+    /// check(&mesh)?.compare_with(&planar, &stack)?;
+    /// # Ok::<(), terramesh_geology::GeologyError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`GeologyError::Check`] when they differ.
+    pub fn compare_with(&self, planar: &Planar, stack: &Stack) -> Result<(), GeologyError> {
+        let between = volume_between(planar, stack);
+        if close(between, self.volume) {
+            return Ok(());
+        }
+        let p = planar.points.first().copied().unwrap_or([f64::NAN; 2]);
+        Err(GeologyError::Check {
+            what: format!(
+                "the units hold {} m³ but the terrain is {between} m³ above the base",
+                self.volume
+            ),
+            x: p[0],
+            y: p[1],
+        })
+    }
+}

@@ -1,0 +1,106 @@
+//! The sealed bodies: `unit-<name>.ts` (GOCAD TSurf, doubles, through
+//! [`crate::export::write_tsurf`]) and `unit-<name>.stl` (binary STL, float32 relative to
+//! [`stl_origin`], through [`crate::export::write_stl`]), each holding only the body's own
+//! vertices.
+
+use std::io::{self, Write};
+
+use terramesh_core::volume::{Body, VolumeMesh};
+
+use super::ModelInfo;
+use crate::export::{write_stl, write_tsurf, TsurfInfo};
+
+/// A body's own vertices and its triangles renumbered into them (vertices in increasing index
+/// of [`VolumeMesh::points`]).
+///
+/// ```
+/// use terramesh_core::volume::{Body, VolumeMesh};
+/// use terramesh_io::model::body_mesh;
+/// let m = VolumeMesh { points: vec![[0.0; 3], [1.0, 0.0, 0.0], [5.0; 3], [0.0, 1.0, 0.0]], ..Default::default() };
+/// let (v, t) = body_mesh(&m, &Body { unit: 0, triangles: vec![[0, 1, 3]] });
+/// assert_eq!((v.len(), t), (3, vec![[0, 1, 2]]));
+/// ```
+pub fn body_mesh(m: &VolumeMesh, body: &Body) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut nodes: Vec<u32> = body.triangles.iter().flatten().copied().collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let local = |n: u32| nodes.binary_search(&n).expect("a body node") as u32;
+    let tris = body.triangles.iter().map(|t| t.map(local)).collect();
+    (nodes.iter().map(|&n| m.points[n as usize]).collect(), tris)
+}
+
+/// The origin subtracted from the STL coordinates of every body: the lower corner of the
+/// model's points, x and y rounded down to whole metres, z = 0 (so z stays an elevation). It
+/// is written in each STL's header.
+///
+/// ```
+/// use terramesh_core::volume::VolumeMesh;
+/// use terramesh_io::model::stl_origin;
+/// let m = VolumeMesh { points: vec![[377_000.7, 5_397_000.2, 10.0], [377_100.0, 5_396_999.5, 0.0]], ..Default::default() };
+/// assert_eq!(stl_origin(&m), [377_000.0, 5_396_999.0, 0.0]);
+/// ```
+pub fn stl_origin(m: &VolumeMesh) -> [f64; 3] {
+    let (mut x, mut y) = (f64::INFINITY, f64::INFINITY);
+    for p in &m.points {
+        x = x.min(p[0]);
+        y = y.min(p[1]);
+    }
+    if m.points.is_empty() {
+        return [0.0; 3];
+    }
+    [x.floor(), y.floor(), 0.0]
+}
+
+/// Writes a body as GOCAD TSurf (name: the unit's).
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Body, VolumeMesh};
+/// use terramesh_io::model::{write_body_tsurf, ModelInfo};
+/// let m = VolumeMesh { points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], units: vec!["sand".into()], ..Default::default() };
+/// let mut buf = Vec::new();
+/// write_body_tsurf(&mut buf, &m, &Body { unit: 0, triangles: vec![[0, 1, 2]] }, &ModelInfo::default())?;
+/// assert!(String::from_utf8(buf).unwrap().contains("name:sand\n"));
+/// # Ok(()) }
+/// ```
+pub fn write_body_tsurf<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    body: &Body,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    let (v, t) = body_mesh(m, body);
+    let mut w = w;
+    write_tsurf(
+        &mut w,
+        &v,
+        &t,
+        &TsurfInfo {
+            name: &m.units[body.unit],
+            crs_name: &info.crs,
+        },
+    )
+}
+
+/// Writes a body as binary STL relative to `origin` ([`stl_origin`]).
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Body, VolumeMesh};
+/// use terramesh_io::model::write_body_stl;
+/// let m = VolumeMesh { points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], units: vec!["sand".into()], ..Default::default() };
+/// let mut buf = Vec::new();
+/// write_body_stl(&mut buf, &m, &Body { unit: 0, triangles: vec![[0, 1, 2]] }, [0.0; 3])?;
+/// assert_eq!(buf.len(), 84 + 50);
+/// # Ok(()) }
+/// ```
+pub fn write_body_stl<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    body: &Body,
+    origin: [f64; 3],
+) -> io::Result<()> {
+    let (v, t) = body_mesh(m, body);
+    let mut w = w;
+    write_stl(&mut w, &v, &t, origin)
+}

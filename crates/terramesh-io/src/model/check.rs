@@ -1,0 +1,190 @@
+//! The consistency a writer relies on, checked before anything is written.
+
+use terramesh_core::volume::{cell_volume, VolumeMesh};
+
+use super::faces::find_face;
+
+/// What is wrong with a [`VolumeMesh`] handed to the writers.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MeshError {
+    /// `material` does not have one entry per cell.
+    #[error("{cells} cells but {materials} material entries; give every cell its unit")]
+    MaterialCount {
+        /// Cells.
+        cells: usize,
+        /// Material entries.
+        materials: usize,
+    },
+    /// A cell's material is not an index into `units`.
+    #[error("cell {cell} has material {material}, but there are {units} units (0 to {})", units.saturating_sub(1))]
+    Material {
+        /// The cell.
+        cell: usize,
+        /// Its material.
+        material: i32,
+        /// The number of units.
+        units: usize,
+    },
+    /// A node index is out of range.
+    #[error("{what} refers to node {node}, but there are {points} points")]
+    Node {
+        /// The cell, face or body.
+        what: String,
+        /// The node index.
+        node: u32,
+        /// The number of points.
+        points: usize,
+    },
+    /// A point is not finite.
+    #[error("point {point} is not finite: {coords:?}")]
+    Point {
+        /// The point.
+        point: usize,
+        /// Its coordinates.
+        coords: [f64; 3],
+    },
+    /// A cell has zero or negative volume (its node order is not ours, or it is degenerate).
+    #[error(
+        "cell {cell} has volume {volume:e} m³: no cell of zero or negative volume may be written"
+    )]
+    Volume {
+        /// The cell.
+        cell: usize,
+        /// Its volume.
+        volume: f64,
+    },
+    /// A tagged face refers to a cell that does not exist, a tag that does not exist, or nodes
+    /// that are not one of its cell's faces.
+    #[error("tagged face {face}: {why}")]
+    Face {
+        /// The face.
+        face: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// A body's unit is not in `units`, or two bodies have the same unit.
+    #[error("body {body}: {why}")]
+    Body {
+        /// The body.
+        body: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// A unit or side name cannot be a file name or a quoted group name.
+    #[error("the name {name:?} cannot be used in file and group names: use letters, digits, '-', '_' or '.'")]
+    Name {
+        /// The name.
+        name: String,
+    },
+}
+
+fn name_ok(s: &str) -> bool {
+    !s.is_empty()
+        && s != "."
+        && s != ".."
+        && s.chars()
+            .all(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | '.'))
+}
+
+/// Checks what the writers rely on: one material per cell within `units`, node indices in
+/// range, finite points, every cell of positive volume, every tagged face a face of its cell
+/// with a known tag, bodies of distinct known units, names usable in file names.
+///
+/// ```
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{check_mesh, MeshError};
+/// let mut m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 2, 1, 3])], // clockwise: negative volume
+///     material: vec![0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// assert!(matches!(check_mesh(&m), Err(MeshError::Volume { cell: 0, .. })));
+/// m.cells[0] = Cell::tetra([0, 1, 2, 3]);
+/// assert!(check_mesh(&m).is_ok());
+/// ```
+pub fn check_mesh(m: &VolumeMesh) -> Result<(), MeshError> {
+    let np = m.points.len();
+    if m.material.len() != m.cells.len() {
+        return Err(MeshError::MaterialCount {
+            cells: m.cells.len(),
+            materials: m.material.len(),
+        });
+    }
+    for name in m.units.iter().chain(m.tags.iter().filter_map(|t| match t {
+        terramesh_core::volume::FaceTag::Side(s)
+        | terramesh_core::volume::FaceTag::Interface(s) => Some(s),
+        _ => None,
+    })) {
+        if !name_ok(name) {
+            return Err(MeshError::Name { name: name.clone() });
+        }
+    }
+    for (i, p) in m.points.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(MeshError::Point {
+                point: i,
+                coords: *p,
+            });
+        }
+    }
+    for (i, (c, &mat)) in m.cells.iter().zip(&m.material).enumerate() {
+        if mat < 0 || mat as usize >= m.units.len() {
+            return Err(MeshError::Material {
+                cell: i,
+                material: mat,
+                units: m.units.len(),
+            });
+        }
+        if let Some(&n) = c.used().iter().find(|&&n| n as usize >= np) {
+            return Err(MeshError::Node {
+                what: format!("cell {i}"),
+                node: n,
+                points: np,
+            });
+        }
+        let v = cell_volume(&m.points, c);
+        if !(v > 0.0) {
+            return Err(MeshError::Volume { cell: i, volume: v });
+        }
+    }
+    for (i, f) in m.faces.iter().enumerate() {
+        let why = if f.cell as usize >= m.cells.len() {
+            Some(format!("cell {} does not exist", f.cell))
+        } else if f.tag as usize >= m.tags.len() {
+            Some(format!(
+                "tag {} does not exist ({} tags)",
+                f.tag,
+                m.tags.len()
+            ))
+        } else {
+            let c = &m.cells[f.cell as usize];
+            find_face(c.kind, c.used(), f.used())
+                .is_none()
+                .then(|| format!("nodes {:?} are not a face of cell {}", f.used(), f.cell))
+        };
+        if let Some(why) = why {
+            return Err(MeshError::Face { face: i, why });
+        }
+    }
+    let mut seen = vec![false; m.units.len()];
+    for (i, b) in m.bodies.iter().enumerate() {
+        if b.unit >= m.units.len() || seen[b.unit] {
+            return Err(MeshError::Body {
+                body: i,
+                why: format!("unit {} is not a unit or has a body already", b.unit),
+            });
+        }
+        seen[b.unit] = true;
+        if let Some(&n) = b.triangles.iter().flatten().find(|&&n| n as usize >= np) {
+            return Err(MeshError::Node {
+                what: format!("body {i}"),
+                node: n,
+                points: np,
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,128 @@
+//! FLAC3D grid, ASCII (`model.f3grid`), the format of Itasca's `zone import` (its "Grid file
+//! format" page: comment lines start with `*`, `G id x y z` gridpoints, `Z type id gp...`
+//! zones, `F type id gp...` faces, `ZGROUP "name" SLOT s` / `FGROUP "name" SLOT s` followed by
+//! the ids of the group's zones or faces). Zones are `W6`, `P5` and `T4`; zone groups are the
+//! units (slot `1`), face groups the tags (`top`, `bottom`, sides, `interface-<unit>`, slot
+//! `1`). Ids start at 1: gridpoint `i + 1` is point `i`, zone `i + 1` cell `i`, face `j + 1`
+//! tagged face `j`.
+//!
+//! FLAC3D's zones start with four gridpoints that form a right-handed system (the scalar
+//! triple product of `p1 - p0`, `p2 - p0`, `p3 - p0` is positive), its wedge being a brick whose
+//! two triangles are `0 1 3` and `2 4 5` (`4` above `1`, `5` above `3`), its pyramid a brick
+//! with the apex at `3` and the base `0 1 4 2`. From our orders: a wedge `0 1 2 3 4 5` is
+//! written `0 2 3 1 5 4`, a pyramid `0 1 2 3 4` as `0 1 3 4 2`, a tetrahedron as it is (the
+//! same orders as meshio's FLAC3D writer, which is its reader's inverse).
+
+use std::io::{self, Write};
+
+use terramesh_core::volume::{CellKind, VolumeMesh};
+
+use super::write_shortest;
+use super::ModelInfo;
+
+fn ids<W: Write + ?Sized>(w: &mut W, list: &[u64]) -> io::Result<()> {
+    let mut b = itoa::Buffer::new();
+    for chunk in list.chunks(10) {
+        for id in chunk {
+            w.write_all(b" ")?;
+            w.write_all(b.format(*id).as_bytes())?;
+        }
+        w.write_all(b"\n")?;
+    }
+    Ok(())
+}
+
+/// Writes the model as a FLAC3D ASCII grid (see the module documentation).
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{write_model_f3grid, ModelInfo};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3])],
+///     material: vec![0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// let mut buf = Vec::new();
+/// write_model_f3grid(&mut buf, &m, &ModelInfo::default())?;
+/// let s = String::from_utf8(buf).unwrap();
+/// assert!(s.contains("Z T4 1 1 2 3 4\n") && s.contains("ZGROUP \"sand\" SLOT 1\n 1\n"));
+/// # Ok(()) }
+/// ```
+pub fn write_model_f3grid<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    writeln!(w, "* FLAC3D grid of a terramesh geological model")?;
+    writeln!(w, "* CRS: {}", info.crs.replace('\n', " "))?;
+    writeln!(w, "* GRIDPOINTS")?;
+    let mut b = itoa::Buffer::new();
+    for (i, p) in m.points.iter().enumerate() {
+        w.write_all(b"G ")?;
+        w.write_all(b.format(i + 1).as_bytes())?;
+        for c in p {
+            w.write_all(b" ")?;
+            write_shortest(w, *c)?;
+        }
+        w.write_all(b"\n")?;
+    }
+    writeln!(w, "* ZONES")?;
+    for (i, c) in m.cells.iter().enumerate() {
+        let n = c.nodes;
+        let (name, order): (&[u8], &[u32]) = match c.kind {
+            CellKind::Wedge => (b"W6", &[n[0], n[2], n[3], n[1], n[5], n[4]]),
+            CellKind::Pyramid => (b"P5", &[n[0], n[1], n[3], n[4], n[2]]),
+            CellKind::Tetra => (b"T4", &n[..4]),
+        };
+        w.write_all(b"Z ")?;
+        w.write_all(name)?;
+        w.write_all(b" ")?;
+        w.write_all(b.format(i + 1).as_bytes())?;
+        for &k in order {
+            w.write_all(b" ")?;
+            w.write_all(b.format(k as u64 + 1).as_bytes())?;
+        }
+        w.write_all(b"\n")?;
+    }
+    if !m.faces.is_empty() {
+        writeln!(w, "* FACES")?;
+        for (j, f) in m.faces.iter().enumerate() {
+            let nodes = f.used();
+            w.write_all(if nodes.len() == 3 { b"F T3 " } else { b"F Q4 " })?;
+            w.write_all(b.format(j + 1).as_bytes())?;
+            for &k in nodes {
+                w.write_all(b" ")?;
+                w.write_all(b.format(k as u64 + 1).as_bytes())?;
+            }
+            w.write_all(b"\n")?;
+        }
+    }
+    writeln!(w, "* ZONE GROUPS")?;
+    let mut per_unit: Vec<Vec<u64>> = vec![Vec::new(); m.units.len()];
+    for (i, &mat) in m.material.iter().enumerate() {
+        per_unit[mat as usize].push(i as u64 + 1);
+    }
+    for (u, list) in per_unit.iter().enumerate() {
+        if !list.is_empty() {
+            writeln!(w, "ZGROUP \"{}\" SLOT 1", m.units[u])?;
+            ids(w, list)?;
+        }
+    }
+    let mut per_tag: Vec<Vec<u64>> = vec![Vec::new(); m.tags.len()];
+    for (j, f) in m.faces.iter().enumerate() {
+        per_tag[f.tag as usize].push(j as u64 + 1);
+    }
+    if !m.faces.is_empty() {
+        writeln!(w, "* FACE GROUPS")?;
+        for (t, list) in per_tag.iter().enumerate() {
+            if !list.is_empty() {
+                writeln!(w, "FGROUP \"{}\" SLOT 1", m.tags[t].name())?;
+                ids(w, list)?;
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,168 @@
+//! The geological model's files, one module per format, all written from one
+//! [`terramesh_core::volume::VolumeMesh`]:
+//!
+//! | file | module | what |
+//! |---|---|---|
+//! | `model.vtu` | [`write_model_vtu`] | VTK XML unstructured grid, appended base64 binary: Float64 points, int32 `MaterialIDs`, field data `unit_names` and `crs`; an OpenGeoSys bulk mesh |
+//! | `model-top.vtu`, `model-bottom.vtu`, `model-side-<name>.vtu` | [`write_boundary_vtu`] | OpenGeoSys boundary meshes (`bulk_node_ids`, `bulk_element_ids`, `bulk_face_ids`, as its `ExtractBoundary` writes them) |
+//! | `model.msh` | [`write_model_msh`] | Gmsh 4.1 ASCII: a volume entity and physical group per unit, a surface entity and group per tag |
+//! | `model.f3grid` | [`write_model_f3grid`] | FLAC3D ASCII grid: gridpoints, zones W6/P5/T4, zone groups per unit, face groups per tag |
+//! | `unit-<name>.ts`, `unit-<name>.stl` | [`write_body_tsurf`], [`write_body_stl`] | the sealed body of each unit (GOCAD TSurf in doubles; binary STL relative to [`stl_origin`]) |
+//!
+//! [`write_model`] checks the mesh ([`check_mesh`]) and writes every file atomically into a
+//! folder; the per-format functions write to any [`std::io::Write`].
+//!
+//! Node orders: ours are those of [`terramesh_core::volume`]; each writer maps them to its
+//! format's order (VTK's wedge has its first triangle the other way round; FLAC3D's zones start
+//! with four right-handed gridpoints), see each module and `docs/geology.md`.
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use terramesh_core::volume::{Body, Cell, FaceTag, TaggedFace, VolumeMesh};
+//! use terramesh_io::model::{write_model, ModelInfo};
+//! // One tetrahedron of unit "sand", its four faces tagged top, bottom, west and south.
+//! let mesh = VolumeMesh {
+//!     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+//!     cells: vec![Cell::tetra([0, 1, 2, 3])],
+//!     material: vec![0],
+//!     units: vec!["sand".into()],
+//!     faces: vec![
+//!         TaggedFace { nodes: [1, 2, 3, u32::MAX], cell: 0, tag: 0 },
+//!         TaggedFace { nodes: [0, 2, 1, u32::MAX], cell: 0, tag: 1 },
+//!         TaggedFace { nodes: [0, 3, 2, u32::MAX], cell: 0, tag: 2 },
+//!         TaggedFace { nodes: [0, 1, 3, u32::MAX], cell: 0, tag: 3 },
+//!     ],
+//!     tags: vec![FaceTag::Top, FaceTag::Bottom, FaceTag::Side("west".into()), FaceTag::Side("south".into())],
+//!     bodies: vec![Body { unit: 0, triangles: vec![[1, 2, 3], [0, 2, 1], [0, 3, 2], [0, 1, 3]] }],
+//! };
+//! let dir = tempfile::tempdir()?;
+//! let written = write_model(dir.path(), &mesh, &ModelInfo { crs: "EPSG:32632".into() })?;
+//! assert!(written.contains(&"model-side-west.vtu".to_string()));
+//! for f in ["model.vtu", "model-top.vtu", "model.msh", "model.f3grid", "unit-sand.ts", "unit-sand.stl"] {
+//!     assert!(dir.path().join(f).is_file(), "{f}");
+//! }
+//! # Ok(()) }
+//! ```
+
+mod bodies;
+mod boundary;
+mod check;
+mod faces;
+mod flac3d;
+mod gmsh;
+mod vtk;
+
+use std::io;
+use std::path::Path;
+
+use terramesh_core::volume::{FaceTag, VolumeMesh};
+
+use crate::output::Output;
+
+pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
+pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
+pub use check::{check_mesh, MeshError};
+pub use faces::{cell_faces, ogs_face_index};
+pub use flac3d::write_model_f3grid;
+pub use gmsh::write_model_msh;
+pub use vtk::{write_boundary_vtu, write_model_vtu};
+
+/// What the files record besides the mesh.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ModelInfo {
+    /// The model's CRS as text (`EPSG:28992`, a WKT, or `projected`), written into the VTU
+    /// field data `crs`, the TSurf header and the Gmsh/FLAC3D header comments.
+    pub crs: String,
+}
+
+/// Errors of [`write_model`].
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ModelWriteError {
+    /// The mesh is inconsistent (see [`check_mesh`]).
+    #[error("the geological model cannot be written: {0}")]
+    Mesh(#[from] MeshError),
+    /// Writing a file failed.
+    #[error("cannot write {file}: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The error.
+        #[source]
+        source: io::Error,
+    },
+}
+
+/// The file name of the boundary mesh of a tag: `model-top.vtu`, `model-bottom.vtu`,
+/// `model-side-<name>.vtu`; `None` for an interface (not a boundary).
+///
+/// ```
+/// use terramesh_core::volume::FaceTag;
+/// use terramesh_io::model::boundary_file_name;
+/// assert_eq!(boundary_file_name(&FaceTag::Side("north".into())).as_deref(), Some("model-side-north.vtu"));
+/// assert_eq!(boundary_file_name(&FaceTag::Interface("clay".into())), None);
+/// ```
+pub fn boundary_file_name(tag: &FaceTag) -> Option<String> {
+    match tag {
+        FaceTag::Top => Some("model-top.vtu".into()),
+        FaceTag::Bottom => Some("model-bottom.vtu".into()),
+        FaceTag::Side(s) => Some(format!("model-side-{s}.vtu")),
+        FaceTag::Interface(_) => None,
+    }
+}
+
+/// Writes every file of the geological model into the existing folder `dir` (each file
+/// atomically through [`Output`]; the facade makes the build folder atomic as a whole):
+/// `model.vtu`, one boundary mesh per top, bottom and side tag, `model.msh`, `model.f3grid`,
+/// and `unit-<name>.ts` and `unit-<name>.stl` per body. Returns the file names written, in that
+/// order. The mesh is checked first ([`check_mesh`]): nothing is written for a broken one.
+///
+/// The bodies' STL coordinates are relative to [`stl_origin`], written in each STL header.
+pub fn write_model(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    info: &ModelInfo,
+) -> Result<Vec<String>, ModelWriteError> {
+    check_mesh(mesh)?;
+    let mut written = Vec::new();
+    let mut file =
+        |name: String, f: &dyn Fn(&mut Output) -> io::Result<()>| -> Result<(), ModelWriteError> {
+            let path = dir.join(&name);
+            let err = |source| ModelWriteError::Io {
+                file: path.display().to_string(),
+                source,
+            };
+            let mut out = Output::create(Some(&path)).map_err(err)?;
+            f(&mut out).map_err(err)?;
+            out.commit().map_err(err)?;
+            written.push(name);
+            Ok(())
+        };
+    file("model.vtu".into(), &|w| write_model_vtu(w, mesh, info))?;
+    for t in boundary_tags(mesh) {
+        let name = boundary_file_name(&mesh.tags[t as usize]).expect("a boundary tag");
+        let b = boundary_mesh(mesh, t);
+        file(name, &|w| write_boundary_vtu(w, &b))?;
+    }
+    file("model.msh".into(), &|w| write_model_msh(w, mesh, info))?;
+    file("model.f3grid".into(), &|w| {
+        write_model_f3grid(w, mesh, info)
+    })?;
+    let origin = stl_origin(mesh);
+    for body in &mesh.bodies {
+        let unit = &mesh.units[body.unit];
+        file(format!("unit-{unit}.ts"), &|w| {
+            write_body_tsurf(w, mesh, body, info)
+        })?;
+        file(format!("unit-{unit}.stl"), &|w| {
+            write_body_stl(w, mesh, body, origin)
+        })?;
+    }
+    Ok(written)
+}
+
+/// Writes `v` in the shortest form that reads back to the same `f64` (`-0` as `0`).
+fn write_shortest<W: io::Write + ?Sized>(w: &mut W, v: f64) -> io::Result<()> {
+    let v = if v == 0.0 { 0.0 } else { v };
+    write!(w, "{v}")
+}

@@ -1,0 +1,330 @@
+//! VTK XML unstructured grids (`.vtu`) with every array in one appended block
+//! (`<AppendedData encoding="base64">`: each array's UInt64 byte count and its little-endian
+//! values encoded together, offsets in characters): the volume mesh `model.vtu` and the boundary
+//! meshes. Base64 rather than raw bytes: meshio 5.3's reader of raw appended data mistakes one
+//! array's offset for another's when a rewritten offset equals a later raw one (seen on a
+//! boundary mesh here), and ParaView, VTK and OpenGeoSys read both.
+//!
+//! Cell types and node orders (VTK's `vtkCellType.h` and its cell classes' documentation):
+//! `VTK_TETRA` (10) and `VTK_PYRAMID` (14) take our order as it is (the first face's normal
+//! points to the last node); `VTK_WEDGE` (13) wants its first triangle oriented so that its
+//! normal points away from the second, so our wedge `0 1 2 3 4 5` is written `0 2 1 3 5 4`.
+
+use std::io::{self, Write};
+
+use terramesh_core::volume::{CellKind, VolumeMesh};
+
+use super::boundary::BoundaryMesh;
+use super::ModelInfo;
+
+const VTK_TRIANGLE: u8 = 5;
+const VTK_QUAD: u8 = 9;
+const VTK_TETRA: u8 = 10;
+const VTK_WEDGE: u8 = 13;
+const VTK_PYRAMID: u8 = 14;
+
+/// A data array to append: its XML attributes and its bytes.
+struct Array {
+    vtk_type: &'static str,
+    name: &'static str,
+    components: usize,
+    /// `NumberOfTuples` for field data.
+    tuples: Option<usize>,
+    bytes: Vec<u8>,
+}
+
+fn le<T: Copy, const N: usize>(values: impl Iterator<Item = T>, f: fn(T) -> [u8; N]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(values.size_hint().0 * N);
+    for v in values {
+        out.extend_from_slice(&f(v));
+    }
+    out
+}
+
+fn array(vtk_type: &'static str, name: &'static str, components: usize, bytes: Vec<u8>) -> Array {
+    Array {
+        vtk_type,
+        name,
+        components,
+        tuples: None,
+        bytes,
+    }
+}
+
+fn points(p: &[[f64; 3]]) -> Array {
+    array(
+        "Float64",
+        "Points",
+        3,
+        le(p.iter().flatten().copied(), f64::to_le_bytes),
+    )
+}
+
+/// The sections of one piece, each a list of arrays, then the appended block.
+struct Grid {
+    points: usize,
+    cells: usize,
+    field: Vec<Array>,
+    point_data: Vec<Array>,
+    cell_data: Vec<Array>,
+    pts: Array,
+    cell_arrays: Vec<Array>,
+}
+
+impl Grid {
+    fn write<W: Write + ?Sized>(self, w: &mut W) -> io::Result<()> {
+        let encoded: Vec<Vec<u8>> = self
+            .field
+            .iter()
+            .chain(&self.point_data)
+            .chain(&self.cell_data)
+            .chain([&self.pts])
+            .chain(&self.cell_arrays)
+            .map(|a| {
+                let mut block = Vec::with_capacity(8 + a.bytes.len());
+                block.extend_from_slice(&(a.bytes.len() as u64).to_le_bytes());
+                block.extend_from_slice(&a.bytes);
+                base64(&block)
+            })
+            .collect();
+        let mut lengths = encoded.iter().map(|e| e.len());
+        let mut offset = 0usize;
+        let mut header = |w: &mut W, a: &Array| -> io::Result<()> {
+            write!(w, "<DataArray type=\"{}\" Name=\"{}\"", a.vtk_type, a.name)?;
+            if a.components > 1 {
+                write!(w, " NumberOfComponents=\"{}\"", a.components)?;
+            }
+            if let Some(n) = a.tuples {
+                write!(w, " NumberOfTuples=\"{n}\"")?;
+            }
+            writeln!(w, " format=\"appended\" offset=\"{offset}\"/>")?;
+            offset += lengths.next().expect("one encoding per array");
+            Ok(())
+        };
+        writeln!(w, "<?xml version=\"1.0\"?>")?;
+        writeln!(
+            w,
+            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
+        )?;
+        writeln!(w, "<UnstructuredGrid>")?;
+        if !self.field.is_empty() {
+            writeln!(w, "<FieldData>")?;
+            for a in &self.field {
+                header(w, a)?;
+            }
+            writeln!(w, "</FieldData>")?;
+        }
+        writeln!(
+            w,
+            "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+            self.points, self.cells
+        )?;
+        for (tag, arrays) in [
+            ("PointData", &self.point_data),
+            ("CellData", &self.cell_data),
+        ] {
+            if !arrays.is_empty() {
+                writeln!(w, "<{tag}>")?;
+                for a in arrays {
+                    header(w, a)?;
+                }
+                writeln!(w, "</{tag}>")?;
+            }
+        }
+        writeln!(w, "<Points>")?;
+        header(w, &self.pts)?;
+        writeln!(w, "</Points>\n<Cells>")?;
+        for a in &self.cell_arrays {
+            header(w, a)?;
+        }
+        writeln!(w, "</Cells>\n</Piece>\n</UnstructuredGrid>")?;
+        write!(w, "<AppendedData encoding=\"base64\">\n_")?;
+        for e in &encoded {
+            w.write_all(e)?;
+        }
+        writeln!(w, "\n</AppendedData>\n</VTKFile>")
+    }
+}
+
+/// Standard base64 (RFC 4648, with padding).
+fn base64(bytes: &[u8]) -> Vec<u8> {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = Vec::with_capacity(bytes.len().div_ceil(3) * 4);
+    let mut chunks = bytes.chunks_exact(3);
+    for c in &mut chunks {
+        let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
+        out.extend_from_slice(&[
+            A[(n >> 18) as usize & 63],
+            A[(n >> 12) as usize & 63],
+            A[(n >> 6) as usize & 63],
+            A[n as usize & 63],
+        ]);
+    }
+    let r = chunks.remainder();
+    if !r.is_empty() {
+        let n = (u32::from(r[0]) << 16) | (u32::from(*r.get(1).unwrap_or(&0)) << 8);
+        out.push(A[(n >> 18) as usize & 63]);
+        out.push(A[(n >> 12) as usize & 63]);
+        out.push(if r.len() > 1 {
+            A[(n >> 6) as usize & 63]
+        } else {
+            b'='
+        });
+        out.push(b'=');
+    }
+    out
+}
+
+/// Connectivity, offsets and types of cells given as node lists with their VTK type.
+fn cell_arrays<'a>(cells: impl Iterator<Item = (u8, &'a [u32])>) -> Vec<Array> {
+    let (mut conn, mut offs, mut types) = (Vec::new(), Vec::new(), Vec::new());
+    let mut end = 0i64;
+    for (t, nodes) in cells {
+        for &n in nodes {
+            conn.extend_from_slice(&(n as i64).to_le_bytes());
+        }
+        end += nodes.len() as i64;
+        offs.extend_from_slice(&end.to_le_bytes());
+        types.push(t);
+    }
+    vec![
+        array("Int64", "connectivity", 1, conn),
+        array("Int64", "offsets", 1, offs),
+        array("UInt8", "types", 1, types),
+    ]
+}
+
+fn text_field(name: &'static str, bytes: Vec<u8>) -> Array {
+    Array {
+        vtk_type: "UInt8",
+        name,
+        components: 1,
+        tuples: Some(bytes.len()),
+        bytes,
+    }
+}
+
+/// Writes the volume mesh as `model.vtu`: Float64 points, the cells (VTK orders, see the module
+/// documentation), cell data `MaterialIDs` (Int32, 0 = the top unit), and field data
+/// `unit_names` (UInt8: the unit names top to bottom, each followed by a zero byte, so that
+/// name `k` is MaterialID `k`) and `crs` (UInt8: [`ModelInfo::crs`] as UTF-8).
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{write_model_vtu, ModelInfo};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3])],
+///     material: vec![0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// let mut buf = Vec::new();
+/// write_model_vtu(&mut buf, &m, &ModelInfo { crs: "EPSG:32632".into() })?;
+/// let text = String::from_utf8_lossy(&buf);
+/// assert!(text.contains("Name=\"MaterialIDs\"") && text.contains("encoding=\"base64\""));
+/// # Ok(()) }
+/// ```
+pub fn write_model_vtu<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    let mut names = Vec::new();
+    for u in &m.units {
+        names.extend_from_slice(u.as_bytes());
+        names.push(0);
+    }
+    let vtk_nodes: Vec<([u32; 6], u8, usize)> = m
+        .cells
+        .iter()
+        .map(|c| {
+            let n = c.nodes;
+            match c.kind {
+                CellKind::Tetra => (n, VTK_TETRA, 4),
+                CellKind::Pyramid => (n, VTK_PYRAMID, 5),
+                CellKind::Wedge => ([n[0], n[2], n[1], n[3], n[5], n[4]], VTK_WEDGE, 6),
+            }
+        })
+        .collect();
+    Grid {
+        points: m.points.len(),
+        cells: m.cells.len(),
+        field: vec![
+            text_field("unit_names", names),
+            text_field("crs", info.crs.as_bytes().to_vec()),
+        ],
+        point_data: vec![],
+        cell_data: vec![array(
+            "Int32",
+            "MaterialIDs",
+            1,
+            le(m.material.iter().copied(), i32::to_le_bytes),
+        )],
+        pts: points(&m.points),
+        cell_arrays: cell_arrays(vtk_nodes.iter().map(|(n, t, k)| (*t, &n[..*k]))),
+    }
+    .write(w)
+}
+
+/// Writes a boundary mesh ([`super::boundary_mesh`]) as an OpenGeoSys boundary `.vtu`:
+/// triangles and quadrilaterals, point data `bulk_node_ids`, cell data `bulk_element_ids`,
+/// `bulk_face_ids` (UInt64 each) and `MaterialIDs` (Int32), the names and types OpenGeoSys'
+/// `ExtractBoundary` 6.5 writes.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_io::model::{write_boundary_vtu, BoundaryMesh};
+/// let b = BoundaryMesh {
+///     points: vec![[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]],
+///     faces: vec![vec![0, 1, 2]],
+///     bulk_node_ids: vec![3, 4, 5],
+///     bulk_element_ids: vec![0],
+///     bulk_face_ids: vec![0],
+///     material_ids: vec![0],
+/// };
+/// let mut buf = Vec::new();
+/// write_boundary_vtu(&mut buf, &b)?;
+/// assert!(String::from_utf8_lossy(&buf).contains("type=\"UInt64\" Name=\"bulk_face_ids\""));
+/// # Ok(()) }
+/// ```
+pub fn write_boundary_vtu<W: Write + ?Sized>(w: &mut W, b: &BoundaryMesh) -> io::Result<()> {
+    let u64s = |v: &[u64]| le(v.iter().copied(), u64::to_le_bytes);
+    Grid {
+        points: b.points.len(),
+        cells: b.faces.len(),
+        field: vec![],
+        point_data: vec![array("UInt64", "bulk_node_ids", 1, u64s(&b.bulk_node_ids))],
+        cell_data: vec![
+            array(
+                "Int32",
+                "MaterialIDs",
+                1,
+                le(b.material_ids.iter().copied(), i32::to_le_bytes),
+            ),
+            array("UInt64", "bulk_element_ids", 1, u64s(&b.bulk_element_ids)),
+            array("UInt64", "bulk_face_ids", 1, u64s(&b.bulk_face_ids)),
+        ],
+        pts: points(&b.points),
+        cell_arrays: cell_arrays(b.faces.iter().map(|f| {
+            let t = if f.len() == 3 { VTK_TRIANGLE } else { VTK_QUAD };
+            (t, f.as_slice())
+        })),
+    }
+    .write(w)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn base64_matches_the_report_encoder() {
+        for n in 0..10 {
+            let bytes: Vec<u8> = (0..n as u8).map(|b| b.wrapping_mul(97)).collect();
+            assert_eq!(
+                super::base64(&bytes),
+                crate::report::base64(&bytes).into_bytes()
+            );
+        }
+    }
+}

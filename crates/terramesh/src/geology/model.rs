@@ -1,0 +1,284 @@
+//! The geological model on the DSM's planar mesh: fields from the boreholes (or horizon grids)
+//! at every vertex, the rules, the volume mesh and its checks, and the misfit at every
+//! observed contact.
+//!
+//! ```
+//! use terramesh::geology::model::{assemble, Base, ModelInputs};
+//! use terramesh_core::volume::Interpolated;
+//! use terramesh_geology::Layering;
+//! use terramesh_geostat::Method;
+//! use terramesh_mesh::MeshBuilder;
+//! use terramesh_core::geometry::Region;
+//! let region = Region::from_ring(vec![[0.0, 0.0], [1000.0, 0.0], [1000.0, 800.0], [0.0, 800.0]]);
+//! let (mesh, _) = MeshBuilder::new().max_area(5000.0).build(&region)?;
+//! let terrain: Vec<f64> = (0..mesh.points.len()).map(|i| 100.0 + 0.01 * mesh.absolute(i)[0]).collect();
+//! // The top of the second unit given directly (a horizon grid already sampled at the vertices).
+//! let clay_top: Vec<f64> = terrain.iter().map(|z| z - 20.0).collect();
+//! let inputs = ModelInputs {
+//!     boreholes: None,
+//!     grids: vec![(1, clay_top)],
+//!     base: Base::Elevation(0.0),
+//!     min_thickness: 0.5,
+//!     layering: Layering::new(vec!["sand".into(), "clay".into()]),
+//!     interpolate: Interpolated::Tops,
+//!     method: Method::Ordinary,
+//! };
+//! let m = assemble(&mesh, &terrain, &inputs)?;
+//! assert!((m.stats[0].mean_thickness - 20.0).abs() < 1e-9);
+//! assert!((m.check.volume - m.check.unit_volumes.iter().sum::<f64>()).abs() < 1e-6);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use terramesh_core::volume::{Interpolated, VolumeMesh};
+use terramesh_geology::{
+    apply_rules, check, stack_thicknesses, unit_stats, CheckSummary, Layering, Planar, RawSurfaces,
+    RulesReport, Stack, UnitStats,
+};
+use terramesh_geostat::Method;
+use terramesh_io::boreholes::Boreholes;
+use terramesh_mesh::{Mesh, SurfaceLocator};
+
+use super::fields::{interpolate_field, Field, Observation};
+use crate::error::{bail, Context, Result};
+
+/// The model's base.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Base {
+    /// A flat base at this elevation, metres.
+    Elevation(f64),
+    /// One elevation per planar vertex (a base raster sampled at the vertices).
+    PerVertex(Vec<f64>),
+    /// Flat, [`AUTO_BASE_MARGIN`] of the model's relief below the lowest point of every
+    /// interface and observed contact.
+    Auto,
+}
+
+/// The margin of [`Base::Auto`] below the lowest point, as a fraction of the relief between
+/// it and the highest terrain point (at least 1 m).
+pub const AUTO_BASE_MARGIN: f64 = 0.1;
+
+/// Everything the model is made from besides the planar mesh and the terrain.
+#[derive(Debug, Clone)]
+pub struct ModelInputs<'a> {
+    /// The boreholes, if any.
+    pub boreholes: Option<&'a Boreholes>,
+    /// Unit tops given by horizon grids, sampled at the planar vertices: `(unit, values)`,
+    /// `unit` >= 1 (the first unit's top is the terrain). They take the place of the
+    /// boreholes for that unit; the boreholes' contacts are then only compared with it.
+    pub grids: Vec<(usize, Vec<f64>)>,
+    /// The base.
+    pub base: Base,
+    /// Thinner than this, a unit pinches out, metres.
+    pub min_thickness: f64,
+    /// Units, sub-layers, element, side tags.
+    pub layering: Layering,
+    /// What is interpolated between holes.
+    pub interpolate: Interpolated,
+    /// The kriging method of every field.
+    pub method: Method,
+}
+
+/// One observed contact against the model.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Misfit {
+    /// The hole.
+    pub hole: String,
+    /// The unit whose top it is.
+    pub unit: String,
+    /// Where, metres.
+    pub x: f64,
+    /// Where, metres.
+    pub y: f64,
+    /// The observed elevation, metres.
+    pub observed: f64,
+    /// The model's elevation there, metres.
+    pub model: f64,
+    /// `model - observed`, metres.
+    pub misfit: f64,
+}
+
+/// The assembled model.
+#[derive(Debug, Clone)]
+pub struct GeologicalModel {
+    /// The volume mesh, tagged faces and sealed bodies.
+    pub mesh: VolumeMesh,
+    /// The repaired surfaces at the planar vertices (terrain, tops, base).
+    pub stack: Stack,
+    /// What the rules changed.
+    pub rules: RulesReport,
+    /// The interpolated fields, in the order interpolated (tops of units 1.. or
+    /// thicknesses of units 0..n-1).
+    pub fields: Vec<Field>,
+    /// Per-unit figures.
+    pub stats: Vec<UnitStats>,
+    /// The independent checks' summary.
+    pub check: CheckSummary,
+    /// Every observed contact against the model: the collars against the terrain (the top
+    /// of the first unit), then the logged tops of the other units.
+    pub misfits: Vec<Misfit>,
+}
+
+/// Builds the model on `mesh` (the DSM's planar mesh) under `terrain` (its elevations).
+pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<GeologicalModel> {
+    let units = &inputs.layering.units;
+    if units.is_empty() {
+        bail!("the geological column names no unit: list them in [geology] units");
+    }
+    let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
+    let planar = Planar::new(&xy, &mesh.triangles).context("the planar mesh")?;
+    let mut fields = Vec::new();
+    let field_of = |unit: usize, obs: Vec<Observation>| {
+        interpolate_field(&units[unit], &obs, &xy, inputs.method)
+    };
+    let grid_of = |unit: usize| inputs.grids.iter().find(|g| g.0 == unit).map(|g| &g.1);
+    let holes = inputs.boreholes;
+    let base = base_values(inputs, terrain, holes, xy.len())?;
+    let (stack, rules) = match inputs.interpolate {
+        Interpolated::Tops => {
+            let mut tops = Vec::new();
+            for unit in 1..units.len() {
+                if let Some(g) = grid_of(unit) {
+                    tops.push(g.clone());
+                    continue;
+                }
+                let obs = holes.map(|b| tops_of(b, unit)).unwrap_or_default();
+                let f = field_of(unit, obs)?;
+                tops.push(f.values.clone());
+                fields.push(f);
+            }
+            let raw = RawSurfaces {
+                terrain: terrain.to_vec(),
+                tops,
+                base,
+            };
+            apply_rules(&planar, &raw, inputs.min_thickness).context("the geological rules")?
+        }
+        Interpolated::Thickness => {
+            if !inputs.grids.is_empty() {
+                bail!(
+                    "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" to use them"
+                );
+            }
+            let Some(b) = holes else {
+                bail!("interpolate = \"thickness\" needs boreholes: set [geology] collars");
+            };
+            let mut thick = Vec::new();
+            for unit in 0..units.len() - 1 {
+                let obs = b
+                    .thicknesses(unit)
+                    .map(|(h, t, p)| Observation {
+                        hole: h.name.clone(),
+                        x: p[0],
+                        y: p[1],
+                        value: t,
+                    })
+                    .collect();
+                let f = field_of(unit, obs)?;
+                thick.push(f.values.clone());
+                fields.push(f);
+            }
+            stack_thicknesses(&planar, terrain, &thick, &base, inputs.min_thickness)
+                .context("the geological rules")?
+        }
+    };
+    let volume = terramesh_geology::volume_mesh(&planar, &stack, &inputs.layering)
+        .context("the volume mesh")?;
+    let summary = check(&volume).context("checking the model")?;
+    summary
+        .compare_with(&planar, &stack)
+        .context("checking the model's volume")?;
+    let stats = unit_stats(&planar, &stack, &volume);
+    let misfits = holes.map(|b| misfits(b, mesh, &stack)).unwrap_or_default();
+    Ok(GeologicalModel {
+        mesh: volume,
+        stack,
+        rules,
+        fields,
+        stats,
+        check: summary,
+        misfits,
+    })
+}
+
+/// The observed tops of `unit` (every kind of contact: logged, at the collar, absent, repaired).
+fn tops_of(b: &Boreholes, unit: usize) -> Vec<Observation> {
+    b.contacts()
+        .filter(|(_, c)| c.unit == unit)
+        .map(|(h, c)| Observation {
+            hole: h.name.clone(),
+            x: c.position[0],
+            y: c.position[1],
+            value: c.position[2],
+        })
+        .collect()
+}
+
+fn base_values(
+    inputs: &ModelInputs,
+    terrain: &[f64],
+    holes: Option<&Boreholes>,
+    n: usize,
+) -> Result<Vec<f64>> {
+    Ok(match &inputs.base {
+        Base::Elevation(z) => vec![*z; n],
+        Base::PerVertex(v) if v.len() == n => v.clone(),
+        Base::PerVertex(v) => bail!(
+            "the base has {} values for the {n} vertices of the planar mesh",
+            v.len()
+        ),
+        Base::Auto => {
+            let hi = terrain.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let mut lo = terrain.iter().copied().fold(f64::INFINITY, f64::min);
+            for (_, g) in &inputs.grids {
+                lo = g.iter().copied().fold(lo, f64::min);
+            }
+            if let Some(b) = holes {
+                for (_, c) in b.contacts() {
+                    lo = lo.min(c.position[2]);
+                }
+            }
+            let margin = (AUTO_BASE_MARGIN * (hi - lo)).max(1.0);
+            vec![lo - margin; n]
+        }
+    })
+}
+
+fn misfits(b: &Boreholes, mesh: &Mesh, stack: &Stack) -> Vec<Misfit> {
+    let locators: Vec<SurfaceLocator> = stack
+        .surfaces
+        .iter()
+        .map(|s| SurfaceLocator::new(mesh, s))
+        .collect();
+    // The first unit's top is the terrain: it is compared with the collars. Its contacts in
+    // the logs are not (a log that starts below the ground, at the top of a deeper formation,
+    // makes the first unit of the column a cover unit no file names).
+    let collars = b.holes.iter().filter_map(|h| {
+        let model = locators[0].height(h.collar[0], h.collar[1])?;
+        Some(Misfit {
+            hole: h.name.clone(),
+            unit: b.units[0].clone(),
+            x: h.collar[0],
+            y: h.collar[1],
+            observed: h.collar[2],
+            model,
+            misfit: model - h.collar[2],
+        })
+    });
+    let contacts = b
+        .contacts()
+        .filter(|(_, c)| c.unit > 0)
+        .filter_map(|(h, c)| {
+            let loc = locators.get(c.unit)?;
+            let model = loc.height(c.position[0], c.position[1])?;
+            Some(Misfit {
+                hole: h.name.clone(),
+                unit: b.units[c.unit].clone(),
+                x: c.position[0],
+                y: c.position[1],
+                observed: c.position[2],
+                model,
+                misfit: model - c.position[2],
+            })
+        });
+    collars.chain(contacts).collect()
+}

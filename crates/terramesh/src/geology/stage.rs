@@ -1,0 +1,172 @@
+//! The geology stage of a build (`[geology]`): the boreholes read in the project's CRS, the
+//! model assembled on the DSM's planar mesh under the DSM, and its files written into the
+//! build folder: `model.vtu` and the OpenGeoSys boundary meshes, `model.msh`,
+//! `model.f3grid`, `unit-<name>.ts` / `.stl`, `interfaces/<name>.tif`, `model.json`, and the
+//! section and thickness pictures.
+
+use std::path::{Path, PathBuf};
+
+use terramesh_core::coords::{to_utm, Zone};
+use terramesh_geology::Layering;
+use terramesh_io::boreholes::Boreholes;
+use terramesh_io::grid_write::{write_geotiff, RasterGrid};
+use terramesh_io::model::{write_model, ModelInfo};
+use terramesh_io::output::Output;
+use terramesh_mesh::Mesh;
+
+use super::model::{assemble, Base, GeologicalModel, ModelInputs};
+use super::summary::{interface_grid, ModelSummary};
+use crate::error::{bail, Context, Error, Result};
+use crate::project::Project;
+use crate::project::{Base as BaseKey, GeologySettings};
+
+/// What the geology stage made.
+#[derive(Debug)]
+pub struct ModelBuilt {
+    /// The model.
+    pub model: GeologicalModel,
+    /// `model.json`'s content.
+    pub summary: ModelSummary,
+    /// The boreholes, when the project has them.
+    pub boreholes: Option<Boreholes>,
+    /// Every file written.
+    pub files: Vec<PathBuf>,
+}
+
+/// Reads the boreholes of `g`, projecting geographic collars into `zone`.
+pub fn read_boreholes(g: &GeologySettings, zone: Zone) -> Result<Option<Boreholes>> {
+    let project = move |lat: f64, lon: f64| -> std::result::Result<[f64; 2], String> {
+        to_utm(lat, lon, Some(zone))
+            .map(|p| [p.easting, p.northing])
+            .map_err(|e| e.to_string())
+    };
+    g.read_boreholes(Some(&project))
+}
+
+/// The collars inside the region, to insert as vertices of the planar mesh (so that the
+/// interfaces pass through the observed contacts there).
+pub fn collar_points(b: &Boreholes) -> Vec<[f64; 2]> {
+    b.holes.iter().map(|h| [h.collar[0], h.collar[1]]).collect()
+}
+
+/// Builds and writes the model of `g` on `mesh` (the DSM's planar mesh) under `dsm` (its
+/// vertex elevations), into `out`. `grid` is the DSM grid's layout, reused for the
+/// interface grids; `epsg` the project's CRS code.
+#[allow(clippy::too_many_arguments)]
+pub fn run(
+    p: &Project,
+    g: &GeologySettings,
+    boreholes: Option<Boreholes>,
+    mesh: &Mesh,
+    dsm: &[f64],
+    grid: &RasterGrid,
+    epsg: Option<u32>,
+    out: &Path,
+) -> Result<ModelBuilt> {
+    let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
+    let crs = match epsg {
+        Some(e) => terramesh_crs::Crs::parse(&format!("EPSG:{e}"))
+            .map_err(|e| Error::invalid(format!("the project's CRS: {e}")))?,
+        None => bail!("horizon grids need a project CRS to be placed in"),
+    };
+    let crs = &crs;
+    let mut grids = Vec::new();
+    for (unit, path) in g.surfaces.iter().enumerate() {
+        let Some(path) = path else { continue };
+        if unit == 0 {
+            bail!(
+                "geology.surfaces.{}: the top of the first unit is the terrain (the DSM); \
+                 give grids for the units below it",
+                g.units[0]
+            );
+        }
+        grids.push((unit, horizon_at(path, &xy, g.z_unit, crs, &g.units[unit])?));
+    }
+    let base = match &g.base {
+        BaseKey::Auto => Base::Auto,
+        BaseKey::Elevation(z) => Base::Elevation(*z),
+        BaseKey::Raster(path) => Base::PerVertex(horizon_at(path, &xy, g.z_unit, crs, "the base")?),
+    };
+    let inputs = ModelInputs {
+        boreholes: boreholes.as_ref(),
+        grids,
+        base,
+        min_thickness: g.min_thickness,
+        layering: Layering::new(g.units.clone())
+            .layers(g.layers.clone())
+            .element(g.element),
+        interpolate: g.interpolate,
+        method: terramesh_geostat::Method::Universal(p.interpolation.drift),
+    };
+    let model = assemble(mesh, dsm, &inputs).context("[geology]")?;
+    let crs_name = epsg.map_or_else(|| "projected".to_string(), |e| format!("EPSG:{e}"));
+    let mut files: Vec<PathBuf> = write_model(
+        out,
+        &model.mesh,
+        &ModelInfo {
+            crs: crs_name.clone(),
+        },
+    )
+    .map_err(|e| Error::invalid(e.to_string()))?
+    .into_iter()
+    .map(|f| out.join(f))
+    .collect();
+    let dir = out.join("interfaces");
+    std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    for (k, unit) in g.units.iter().enumerate() {
+        let values = interface_grid(mesh, &model.stack.surfaces[k], grid, -9999.0);
+        let path = dir.join(format!("{unit}.tif"));
+        let code = epsg.and_then(|e| u16::try_from(e).ok());
+        write_atomic(&path, |w| {
+            write_geotiff(w, grid, &values, code, Some(-9999.0))
+        })?;
+        files.push(path);
+    }
+    let summary = ModelSummary::of(&model, &crs_name);
+    let path = out.join("model.json");
+    let text = serde_json::to_string_pretty(&summary)?;
+    write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;
+    files.push(path);
+    Ok(ModelBuilt {
+        model,
+        summary,
+        boreholes,
+        files,
+    })
+}
+
+fn write_atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Result<()> {
+    let mut o = Output::create(Some(path))?;
+    f(&mut o).with_context(|| path.display().to_string())?;
+    o.commit().with_context(|| path.display().to_string())?;
+    Ok(())
+}
+
+/// A horizon grid sampled at the planar vertices (project CRS `crs`), converted to metres.
+/// A vertex on a nodata pixel is an error: the grid must cover the whole region.
+fn horizon_at(
+    path: &Path,
+    xy: &[[f64; 2]],
+    z_unit: terramesh_core::volume::ZUnit,
+    crs: &terramesh_crs::Crs,
+    what: &str,
+) -> Result<Vec<f64>> {
+    let grid = crate::horizon::HorizonGrid::open(path, z_unit)?;
+    let values = grid.evaluate(xy, crs)?;
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            v.ok_or_else(|| {
+                Error::invalid(format!(
+                    "{}: the grid of {what} has no value at ({:.1}, {:.1}), a vertex of the \
+                     model's mesh: a horizon grid must cover the whole region (fill its voids \
+                     or shrink the region)",
+                    path.display(),
+                    xy[i][0],
+                    xy[i][1]
+                ))
+            })
+        })
+        .collect()
+}

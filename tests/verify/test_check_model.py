@@ -1,0 +1,212 @@
+"""Negative tests of check_model.py: every check passes on the committed model
+(tests/verify/fixtures/model/, written by terramesh's writers; the Rust test
+`committed_verifier_fixture_is_current` keeps it current) and fails on a copy with one file
+broken.
+
+    .venv-verify/bin/python -m pytest tests/verify/test_check_model.py
+"""
+
+import re
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import check_model as cm  # noqa: E402
+
+FIXTURE = HERE / "fixtures" / "model"
+
+
+@pytest.fixture
+def out(tmp_path):
+    d = tmp_path / "model"
+    shutil.copytree(FIXTURE, d)
+    return d
+
+
+def failures(d, check, capsys):
+    """Runs only the check named `check`; returns its FAIL lines."""
+    assert check in [n for n, _ in cm.CHECKS], check
+    cm.run(d, only=[check])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[-1] in ("1 passed, 0 failed", "0 passed, 1 failed"), lines
+    return [ln for ln in lines if ln.startswith("FAIL")]
+
+
+def rewrite_vtu(path, change):
+    """Reads a .vtu with meshio, lets `change(mesh)` alter it, writes it back (binary)."""
+    import meshio
+    m = meshio.read(path)
+    field = dict(m.field_data)
+    m.point_data = {k: np.array(v) for k, v in m.point_data.items()}
+    m.cell_data = {k: [np.array(a) for a in v] for k, v in m.cell_data.items()}
+    change(m)
+    meshio.write(path, m, binary=True)
+    if field:  # meshio's VTU writer leaves field data out: put it back
+        xml = "".join(f'<DataArray type="UInt8" Name="{k}" NumberOfTuples="{len(v)}" format="ascii">'
+                      f'{" ".join(str(int(x)) for x in v)}</DataArray>' for k, v in field.items())
+        edit(path, "<UnstructuredGrid>", f"<UnstructuredGrid><FieldData>{xml}</FieldData>")
+
+
+def invert_first(kind):
+    """A change that reverses the orientation of the first cell of `kind` (meshio's order)."""
+    def change(m):
+        for c in m.cells:
+            if c.type == kind:
+                c.data[0] = c.data[0][{"wedge": [0, 2, 1, 3, 5, 4], "tetra": [0, 2, 1, 3],
+                                       "pyramid": [0, 3, 2, 1, 4]}[kind]]
+                return
+        raise AssertionError(f"no {kind} in the fixture")
+    return change
+
+
+def edit(path, old, new, count=1):
+    s = path.read_text()
+    assert old in s, old
+    path.write_text(s.replace(old, new, count))
+
+
+def test_fixture_passes_every_check(capsys):
+    cm.run(FIXTURE)
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[-1] == f"{len(cm.CHECKS)} passed, 0 failed", lines
+
+
+def test_fixture_has_every_cell_kind():
+    cells, _ = cm.Model(FIXTURE).cells()
+    assert {t for t, _ in cells} == {"wedge", "pyramid", "tetra"}
+
+
+def test_inverted_wedge_fails_volume_check(out, capsys):
+    rewrite_vtu(out / "model.vtu", invert_first("wedge"))
+    f = failures(out, "model.vtu: cells, faces, closed boundary", capsys)
+    assert f and "volume" in f[0], f
+
+
+def test_duplicated_cell_fails_face_check(out, capsys):
+    def dup(m):
+        m.cells[0].data = np.vstack([m.cells[0].data, m.cells[0].data[:1]])
+        m.cell_data["MaterialIDs"][0] = np.append(m.cell_data["MaterialIDs"][0], m.cell_data["MaterialIDs"][0][0])
+    rewrite_vtu(out / "model.vtu", dup)
+    f = failures(out, "model.vtu: cells, faces, closed boundary", capsys)
+    assert f and "more than two cells" in f[0], f
+
+
+def test_inverted_tetra_fails_vtk_validator(out, capsys):
+    rewrite_vtu(out / "model.vtu", invert_first("tetra"))
+    f = failures(out, "model.vtu: VTK reader, vtkCellValidator", capsys)
+    assert f and "non-positive" in f[0], f
+
+
+def test_inverted_pyramid_fails_vtk_validator(out, capsys):
+    rewrite_vtu(out / "model.vtu", invert_first("pyramid"))
+    f = failures(out, "model.vtu: VTK reader, vtkCellValidator", capsys)
+    assert f and "non-positive" in f[0], f
+
+
+def test_inverted_wedge_fails_ogs_checkmesh(out, capsys):
+    rewrite_vtu(out / "model.vtu", invert_first("wedge"))
+    f = failures(out, "model.vtu: OpenGeoSys checkMesh", capsys)
+    assert f and "wrong node order" in f[0], f
+
+
+def test_wrong_bulk_face_id_fails(out, capsys):
+    def bump(m):
+        m.cell_data["bulk_face_ids"][0][0] += 1
+    rewrite_vtu(out / "model-top.vtu", bump)
+    f = failures(out, "boundary meshes vs ExtractBoundary", capsys)
+    assert f and "ExtractBoundary says" in f[0], f
+
+
+def test_signed_bulk_node_ids_fail(out, capsys):
+    def signed(m):
+        m.point_data["bulk_node_ids"] = m.point_data["bulk_node_ids"].astype(np.int64)
+    rewrite_vtu(out / "model-bottom.vtu", signed)
+    f = failures(out, "boundary meshes vs ExtractBoundary", capsys)
+    assert f and "bulk_node_ids (uint64)" in f[0], f
+
+
+def test_missing_side_mesh_fails(out, capsys):
+    (out / "model-side-east.vtu").unlink()
+    f = failures(out, "boundary meshes vs ExtractBoundary", capsys)
+    assert f and "in no boundary mesh" in f[0], f
+
+
+def test_msh_unit_name_fails(out, capsys):
+    edit(out / "model.msh", '3 2 "sand"', '3 2 "sandy"')
+    f = failures(out, "model.msh (meshio)", capsys)
+    assert f and "'sand'" in f[0], f
+
+
+def first_prism_line(path):
+    lines = path.read_text().splitlines()
+    k = next(i for i, ln in enumerate(lines) if re.fullmatch(r"3 \d+ 6 \d+", ln))
+    return lines, k + 1
+
+
+def test_msh_reversed_prism_fails_gmsh_jacobian(out, capsys):
+    p = out / "model.msh"
+    lines, k = first_prism_line(p)
+    t = lines[k].split()
+    lines[k] = " ".join([t[0], t[1], t[3], t[2], t[4], t[6], t[5]])
+    p.write_text("\n".join(lines) + "\n")
+    f = failures(out, "model.msh (gmsh)", capsys)
+    assert f and "Jacobian" in f[0], f
+    f = failures(out, "model.msh (meshio)", capsys)
+    assert f and "volume" in f[0], f
+
+
+def test_f3grid_left_handed_zone_fails(out, capsys):
+    p = out / "model.f3grid"
+    s = p.read_text()
+    m = re.search(r"^Z W6 1 (\d+) (\d+) (\d+) (\d+) (\d+) (\d+)$", s, re.M)
+    g = m.groups()
+    p.write_text(s.replace(m.group(0), f"Z W6 1 {g[0]} {g[3]} {g[2]} {g[1]} {g[5]} {g[4]}"))
+    f = failures(out, "model.f3grid (meshio)", capsys)
+    assert f and "right-handed" in f[0], f
+
+
+def test_f3grid_missing_zone_group_fails(out, capsys):
+    edit(out / "model.f3grid", 'ZGROUP "clay"', 'ZGROUP "clays"')
+    f = failures(out, "model.f3grid (meshio)", capsys)
+    assert f and "zone group 'clay'" in f[0], f
+
+
+def test_open_body_fails(out, capsys):
+    p = out / "unit-sand.ts"
+    lines = p.read_text().splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("TRGL"))
+    p.write_text("\n".join(lines[:k] + lines[k + 1:]) + "\n")
+    f = failures(out, "bodies: ts, stl", capsys)
+    assert f and "not closed" in f[0], f
+
+
+def test_stl_with_wrong_origin_fails(out, capsys):
+    p = out / "unit-clay.stl"
+    b = bytearray(p.read_bytes())
+    head = b[:80].decode("ascii")
+    m = re.search(r"origin (\S+)", head)
+    new = head.replace(m.group(0), "origin " + str(int(float(m.group(1))) + 1), 1)[:80]
+    b[:80] = new.ljust(80).encode("ascii")
+    p.write_bytes(bytes(b))
+    f = failures(out, "bodies: ts, stl", capsys)
+    assert f and "unit-clay.stl" in f[0], f
+
+
+def test_shifted_bulk_node_ids_fail_ogs_diffusion(out, capsys):
+    def shift(m):
+        m.point_data["bulk_node_ids"] = m.point_data["bulk_node_ids"] - np.uint64(1)
+    rewrite_vtu(out / "model-bottom.vtu", shift)
+    f = failures(out, "ogs: steady diffusion u = z", capsys)
+    assert f and "|u - z|" in f[0], f
+
+
+def test_inverted_wedge_fails_ogs_heat(out, capsys):
+    rewrite_vtu(out / "model.vtu", invert_first("wedge"))
+    f = failures(out, "ogs: heat conduction per MaterialIDs", capsys)
+    assert f, f
