@@ -10,7 +10,7 @@ use crate::table::TableError;
 pub enum BoreholeError {
     /// The file could not be read, or is not a table with the columns needed.
     #[error(transparent)]
-    Table(#[from] TableError),
+    Table(Box<TableError>),
     /// A value of a hole that is not a number (or not a usable one).
     #[error("{source} (hole '{hole}')")]
     Value {
@@ -18,7 +18,7 @@ pub enum BoreholeError {
         hole: String,
         /// The cell, its file, line and column.
         #[source]
-        source: TableError,
+        source: Box<TableError>,
     },
     /// A row without a hole name.
     #[error("{file}, line {line}: the hole name is empty")]
@@ -118,25 +118,8 @@ pub enum BoreholeError {
         above_line: u64,
     },
     /// A top higher than the top of a unit above it by more than the repair tolerance.
-    #[error("{file}, line {line}, hole '{hole}': the top of '{unit}' is {amount} m above the top of '{above}' (line {above_line}), which the column puts above it; inversions up to {max} m are repaired (the lower top is lowered onto the upper one), this one is too large: check the picks, the column order or [geology] max_inversion")]
-    Inversion {
-        /// The tops file.
-        file: String,
-        /// 1-based line of the inverted top.
-        line: u64,
-        /// The hole.
-        hole: String,
-        /// The unit whose top is too high.
-        unit: String,
-        /// The unit above it in the column whose top is lower.
-        above: String,
-        /// Its line.
-        above_line: u64,
-        /// By how much, metres.
-        amount: f64,
-        /// The tolerance, metres.
-        max: f64,
-    },
+    #[error("{0}")]
+    Inversion(Box<Inversion>),
     /// A unit given twice for one hole.
     #[error("{file}, line {line}, hole '{hole}': unit '{unit}' is given twice (first on line {first_line})")]
     DuplicateTop {
@@ -203,4 +186,33 @@ pub enum BoreholeError {
     /// The stratigraphic column is empty or names a unit twice.
     #[error("[geology] units: {0}")]
     Column(String),
+}
+
+impl From<TableError> for BoreholeError {
+    fn from(e: TableError) -> Self {
+        BoreholeError::Table(Box::new(e))
+    }
+}
+
+/// A top higher than the top of a unit above it in the column by more than
+/// [`BoreholeOptions::max_inversion`](super::BoreholeOptions::max_inversion).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}, line {line}, hole '{hole}': the top of '{unit}' is {amount} m above the top of '{above}' (line {above_line}), which the column puts above it; inversions up to {max} m are repaired (the lower top is lowered onto the upper one), this one is too large: check the picks, the column order or [geology] max_inversion")]
+pub struct Inversion {
+    /// The tops file.
+    pub file: String,
+    /// 1-based line of the inverted top.
+    pub line: u64,
+    /// The hole.
+    pub hole: String,
+    /// The unit whose top is too high.
+    pub unit: String,
+    /// The unit above it in the column whose top is lower.
+    pub above: String,
+    /// Its line.
+    pub above_line: u64,
+    /// By how much, metres.
+    pub amount: f64,
+    /// The tolerance, metres.
+    pub max: f64,
 }

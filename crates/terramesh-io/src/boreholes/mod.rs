@@ -61,7 +61,7 @@ mod rules;
 
 use std::path::PathBuf;
 
-pub use error::BoreholeError;
+pub use error::{BoreholeError, Inversion};
 use terramesh_core::desurvey::HolePath;
 use terramesh_core::volume::ZUnit;
 

@@ -58,7 +58,7 @@ fn hole(t: &Table, row: usize, col: usize) -> Result<String, BoreholeError> {
 fn num(t: &Table, row: usize, col: usize, hole: &str) -> Result<f64, BoreholeError> {
     t.number(row, col).map_err(|source| BoreholeError::Value {
         hole: hole.to_string(),
-        source,
+        source: Box::new(source),
     })
 }
 
@@ -133,7 +133,7 @@ pub(crate) fn collars(path: &Path, opts: &BoreholeOptions) -> Result<Vec<Collar>
                 let angle = |col: usize, axis| {
                     parse_angle(&t.records[row][col], axis).map_err(|e| BoreholeError::Value {
                         hole: name.clone(),
-                        source: t.bad_value(row, col, &e.to_string()),
+                        source: Box::new(t.bad_value(row, col, &e.to_string())),
                     })
                 };
                 let (lat, lon) = (angle(ca, Axis::Lat)?, angle(co, Axis::Lon)?);
@@ -159,7 +159,7 @@ pub(crate) fn collars(path: &Path, opts: &BoreholeOptions) -> Result<Vec<Collar>
     Ok(out)
 }
 
-fn collar_index<'c>(collars: &'c [Collar]) -> HashMap<&'c str, &'c Collar> {
+fn collar_index(collars: &[Collar]) -> HashMap<&str, &Collar> {
     collars.iter().map(|c| (c.name.as_str(), c)).collect()
 }
 

@@ -4,6 +4,7 @@
 
 use terramesh_core::desurvey::{DesurveyError, HolePath, Station};
 
+use super::error::Inversion;
 use super::parse::{At, Present};
 use super::{BoreholeError, Contact, ContactKind, Repair, Thickness};
 
@@ -114,8 +115,8 @@ pub(crate) fn contacts(
         match lowest {
             Some(low) if c.position[2] > low.position[2] => {
                 let amount = c.position[2] - low.position[2];
-                if !(amount <= ctx.max_inversion) {
-                    return Err(BoreholeError::Inversion {
+                if amount > ctx.max_inversion || amount.is_nan() {
+                    return Err(BoreholeError::Inversion(Box::new(Inversion {
                         file: ctx.file.to_string(),
                         line: p.line,
                         hole: ctx.hole.to_string(),
@@ -124,7 +125,7 @@ pub(crate) fn contacts(
                         above_line: low.line,
                         amount,
                         max: ctx.max_inversion,
-                    });
+                    })));
                 }
                 repairs.push(Repair {
                     hole: ctx.hole.to_string(),

@@ -79,8 +79,10 @@ impl Project {
                 ))
             })?;
         }
-        if let Some(g) = self.geology() {
-            g.check_inputs()?;
+        // Against `base` like every other path here (the same folder as `geology()`'s when
+        // `base` is the project file's folder, as for `terramesh build`).
+        if let Some(g) = &self.geology {
+            g.lower(base).check_inputs()?;
         }
         Ok(())
     }

@@ -198,7 +198,7 @@ impl GeologySection {
                 "[geology] gives neither boreholes (collars with intervals or tops) nor surfaces: give one".into(),
             );
         }
-        for (k, _) in &self.surfaces {
+        for k in self.surfaces.keys() {
             if !self.units.contains(k) {
                 return bad(
                     &format!("surfaces.{k}"),
