@@ -40,7 +40,7 @@ def forward(lat: ArrayLike, lon: ArrayLike, zone: Optional[str] = None):
 
     >>> import numpy as np
     >>> e, n, z = forward(np.array([48.7224, -33.9]), np.array([7.3368, 18.4]))
-    >>> list(z)
+    >>> z.tolist()
     ['32N', '34S']
     >>> e, n, z = forward([48.7224, 48.726], [7.3368, 7.3404], zone="31N")
     >>> z, bool(e[0] > 800_000)
@@ -89,7 +89,7 @@ def parse_dms(text: str, axis: Optional[str] = None) -> float:
 
     >>> parse_dms("48 43 20.64 S")
     -48.7224
-    >>> parse_dms("7d20m12.48s E", axis="lon")
+    >>> round(parse_dms("7d20m12.48s E", axis="lon"), 10)
     7.3368
     """
     return _core.parse_dms(text, axis)
