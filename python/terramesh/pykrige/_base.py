@@ -225,7 +225,18 @@ class KrigingBase:
                 ainv = np.linalg.pinv(a)
             x = b @ ainv.T
         else:
-            x = np.linalg.solve(a, b.T).T
+            try:
+                x = np.linalg.solve(a, b.T).T
+            except np.linalg.LinAlgError:
+                # PyKrige inverts with scipy, which does not refuse a system singular only up
+                # to rounding (collinear drifts); a pseudo-inverse gives its minimum-norm answer.
+                import warnings
+
+                warnings.warn(
+                    "the kriging system is singular (collinear drift terms?): solved with a pseudo-inverse",
+                    RuntimeWarning,
+                )
+                x = b @ np.linalg.pinv(a).T
         est = x[:, :n] @ Zd
         var = np.sum(x * -b, axis=1)
         return est, var

@@ -51,13 +51,13 @@ def parameter_list(model, params):
 
 
 def adjust(x, y, center, scaling, angle):
-    """PyKrige's anisotropy frame: centred, rotated by -angle (degrees, counter-clockwise),
-    the second axis stretched by ``scaling``."""
+    """PyKrige's anisotropy frame: rotated by -angle (degrees, counter-clockwise) about
+    ``center``, the second axis stretched by ``scaling`` (and the centre added back)."""
     a = np.deg2rad(angle)
     xc, yc = x - center[0], y - center[1]
     xr = np.cos(-a) * xc - np.sin(-a) * yc
     yr = np.sin(-a) * xc + np.cos(-a) * yc
-    return xr, scaling * yr
+    return xr + center[0], scaling * yr + center[1]
 
 
 def great_circle(lon1, lat1, lon2, lat2):

@@ -90,7 +90,11 @@ class UniversalKriging(KrigingBase):
             self._set_point_log()
         self.specified_drift = "specified" in drift_terms
         if self.specified_drift:
-            if not isinstance(specified_drift, list) or not specified_drift:
+            if specified_drift is None:
+                raise ValueError("Must provide a list of arrays for the 'specified' drift terms.")
+            if not isinstance(specified_drift, list):
+                raise TypeError("Arrays for specified drift terms must be encapsulated in a list.")
+            if not specified_drift:
                 raise ValueError("Must provide a list of arrays for the 'specified' drift terms.")
             self.specified_drift_data_arrays = []
             for term in specified_drift:
@@ -100,7 +104,11 @@ class UniversalKriging(KrigingBase):
                 self.specified_drift_data_arrays.append(s)
         self.functional_drift = "functional" in drift_terms
         if self.functional_drift:
-            if not isinstance(functional_drift, list) or not functional_drift:
+            if functional_drift is None:
+                raise ValueError("Must provide a list of functions for the 'functional' drift terms.")
+            if not isinstance(functional_drift, list):
+                raise TypeError("Callables for functional drift terms must be encapsulated in a list.")
+            if not functional_drift:
                 raise ValueError("Must provide a list of functions for the 'functional' drift terms.")
             self.functional_drift_terms = functional_drift
 
@@ -194,7 +202,11 @@ class UniversalKriging(KrigingBase):
         like the grid or the points). Both backends run the same code."""
         extra = None
         if self.specified_drift:
-            if specified_drift_arrays is None or not isinstance(specified_drift_arrays, list):
+            if specified_drift_arrays is None:
+                raise ValueError("Must provide drift values for kriging points when using 'specified' drift capability.")
+            if not isinstance(specified_drift_arrays, list):
+                raise TypeError("Arrays for specified drift terms must be encapsulated in a list.")
+            if False:
                 raise ValueError("Must provide drift values for kriging points when using 'specified' drift capability.")
             if len(specified_drift_arrays) != len(self.specified_drift_data_arrays):
                 raise ValueError("Inconsistent number of specified drift terms supplied.")
