@@ -57,6 +57,11 @@ pub(crate) fn to_py(e: terramesh::Error) -> PyErr {
     match cur {
         E::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err(text),
         E::Geostat(g) if is_numerical(g) => ComputationError::new_err(text),
+        E::Mesh(
+            terramesh_mesh::MeshError::BadParameter { .. }
+            | terramesh_mesh::MeshError::InvalidRegion(_)
+            | terramesh_mesh::MeshError::TooLarge(_),
+        ) => InputError::new_err(text),
         E::Mesh(_) | E::Solid(_) => ComputationError::new_err(text),
         E::Io(_) | E::MeshWrite(_) | E::Terrain(_) | E::Picture(_) | E::Scene(_) => {
             OutputError::new_err(text)

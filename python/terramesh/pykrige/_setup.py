@@ -101,7 +101,7 @@ def experimental(x, y, z, nlags, geographic):
 def fit(lags, sv, model, function, weight):
     """Least squares (soft L1 loss) of ``function`` to the experimental variogram, from
     PyKrige's documented starting point and bounds; ``weight`` favours the short lags with a
-    logistic weight centred on the middle lag."""
+    logistic weight falling from 90 % to 10 % across the lags 60 % to 80 % of the way along."""
     try:
         from scipy.optimize import least_squares
     except ImportError:  # pragma: no cover - scipy is a test dependency
@@ -123,8 +123,8 @@ def fit(lags, sv, model, function, weight):
         r = function(p, lags) - sv
         if weight:
             span = np.amax(lags) - np.amin(lags)
-            k = 2.048 / span
-            mid = span / 2.0 + np.amin(lags)
+            k = 2.1972 / (0.1 * span)
+            mid = 0.7 * span + np.amin(lags)
             w = 1.0 / (1.0 + np.exp(-k * (mid - lags)))
             r = r * (w / np.sum(w))
         return r
