@@ -9,8 +9,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use terramesh_geostat::{
     cross_validate as cv, experimental as lags_of, kriging, Data, Direction, Drift, Duplicates,
-    Estimator, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood,
-    Variogram, VariogramFile, Weighting, DEFAULT_TOLERANCE,
+    Estimator, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood, Variogram,
+    VariogramFile, Weighting, DEFAULT_TOLERANCE,
 };
 
 use crate::errors::{input, kernel, to_py};
@@ -30,8 +30,11 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 fn model(json: &str) -> PyResult<Variogram> {
-    let v: Variogram = serde_json::from_str(json)
-        .map_err(|e| input(format!("variogram: {e} (expected the `model` object of variogram.json)")))?;
+    let v: Variogram = serde_json::from_str(json).map_err(|e| {
+        input(format!(
+            "variogram: {e} (expected the `model` object of variogram.json)"
+        ))
+    })?;
     v.validate().map_err(|e| input(format!("variogram: {e}")))?;
     Ok(v)
 }
@@ -65,7 +68,10 @@ fn data(
     Data::new(xy, zs, d).map_err(kernel)
 }
 
-fn targets(xt: &PyReadonlyArray1<'_, f64>, yt: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec<[f64; 2]>> {
+fn targets(
+    xt: &PyReadonlyArray1<'_, f64>,
+    yt: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<Vec<[f64; 2]>> {
     let (a, b) = pair(("xt", "yt"), xt, yt)?;
     Ok(a.iter().zip(b.iter()).map(|(&x, &y)| [x, y]).collect())
 }
@@ -110,7 +116,9 @@ fn lag_settings(
     tolerance: Option<f64>,
     max_points: Option<usize>,
 ) -> PyResult<LagSettings> {
-    let estimator: Estimator = estimator.parse().map_err(|e| input(format!("estimator: {e}")))?;
+    let estimator: Estimator = estimator
+        .parse()
+        .map_err(|e| input(format!("estimator: {e}")))?;
     Ok(LagSettings {
         lags,
         max_dist,
@@ -145,7 +153,10 @@ fn experimental<'py>(
     let out = PyDict::new(py);
     out.set_item("lo", PyArray1::from_iter(py, l.iter().map(|l| l.lo)))?;
     out.set_item("hi", PyArray1::from_iter(py, l.iter().map(|l| l.hi)))?;
-    out.set_item("distance", PyArray1::from_iter(py, l.iter().map(|l| l.distance)))?;
+    out.set_item(
+        "distance",
+        PyArray1::from_iter(py, l.iter().map(|l| l.distance)),
+    )?;
     out.set_item("gamma", PyArray1::from_iter(py, l.iter().map(|l| l.gamma)))?;
     out.set_item("pairs", PyArray1::from_iter(py, l.iter().map(|l| l.pairs)))?;
     Ok(out)
@@ -172,7 +183,9 @@ fn variogram_fit(
 ) -> PyResult<String> {
     let d = data(&x, &y, &z, "mean")?;
     let s = lag_settings(lags, max_dist, estimator, azimuth, tolerance, max_points)?;
-    let w: Weighting = weighting.parse().map_err(|e| input(format!("weighting: {e}")))?;
+    let w: Weighting = weighting
+        .parse()
+        .map_err(|e| input(format!("weighting: {e}")))?;
     run(py, false, |_| {
         let l = lags_of(&d, &s).map_err(kernel)?;
         let (fit, cands) = terramesh::interpolate::fit_named(&d, &l, model, w).map_err(to_py)?;
@@ -328,7 +341,11 @@ fn cross_validate<'py>(
             search: idw_search(neighbors, radius)?,
         }
     } else {
-        let v = variogram.ok_or_else(|| input(format!("cross_validate: method '{method}' needs a variogram")))?;
+        let v = variogram.ok_or_else(|| {
+            input(format!(
+                "cross_validate: method '{method}' needs a variogram"
+            ))
+        })?;
         Interpolator::Kriging {
             variogram: model(v)?,
             method: self::method(method, drift, mean, &d)?,

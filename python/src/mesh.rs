@@ -46,7 +46,8 @@ pub(crate) fn region(
     if let Some(c) = corners {
         return load(&RegionInput::Corners(c), crs, zone).map_err(kernel);
     }
-    let polygons = polygons.ok_or_else(|| input("region: give rings, a shapely-like geometry or a file path"))?;
+    let polygons = polygons
+        .ok_or_else(|| input("region: give rings, a shapely-like geometry or a file path"))?;
     let mut region = Region::default();
     for (i, rings) in polygons.into_iter().enumerate() {
         let mut rings = rings.into_iter().map(open_ring);
@@ -58,7 +59,11 @@ pub(crate) fn region(
             holes: rings.collect(),
         });
     }
-    let note = if geographic { "longitude latitude" } else { "projected metres" };
+    let note = if geographic {
+        "longitude latitude"
+    } else {
+        "projected metres"
+    };
     let region = validate(&region).map_err(|e| input(format!("region ({note}): {e}")))?;
     if geographic {
         terramesh_io::region::project(region, zone).map_err(kernel)
@@ -153,12 +158,29 @@ fn mesh<'py>(
         "triangles",
         PyArray1::from_vec(py, tri).reshape([m.triangles.len(), 3])?,
     )?;
-    out.set_item("min_angle", PyArray1::from_iter(py, tq.iter().map(|q| q.min_angle)))?;
-    out.set_item("max_angle", PyArray1::from_iter(py, tq.iter().map(|q| q.max_angle)))?;
-    out.set_item("radius_ratio", PyArray1::from_iter(py, tq.iter().map(|q| q.radius_ratio)))?;
-    out.set_item("aspect_ratio", PyArray1::from_iter(py, tq.iter().map(|q| q.aspect_ratio)))?;
+    out.set_item(
+        "min_angle",
+        PyArray1::from_iter(py, tq.iter().map(|q| q.min_angle)),
+    )?;
+    out.set_item(
+        "max_angle",
+        PyArray1::from_iter(py, tq.iter().map(|q| q.max_angle)),
+    )?;
+    out.set_item(
+        "radius_ratio",
+        PyArray1::from_iter(py, tq.iter().map(|q| q.radius_ratio)),
+    )?;
+    out.set_item(
+        "aspect_ratio",
+        PyArray1::from_iter(py, tq.iter().map(|q| q.aspect_ratio)),
+    )?;
     out.set_item("area", PyArray1::from_iter(py, tq.iter().map(|q| q.area)))?;
-    let ce: Vec<i64> = m.constraint_edges.iter().flatten().map(|&i| i as i64).collect();
+    let ce: Vec<i64> = m
+        .constraint_edges
+        .iter()
+        .flatten()
+        .map(|&i| i as i64)
+        .collect();
     out.set_item(
         "constraint_edges",
         PyArray1::from_vec(py, ce).reshape([m.constraint_edges.len(), 2])?,

@@ -19,6 +19,9 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
+/// One sampled point: `[lat, lon]` (geographic output), `[x, y]`, the elevation if any.
+type SampleRow = (Option<[f64; 2]>, [f64; 2], Option<f64>);
+
 /// Samples `source` on a grid over the region: arrays `lat`, `lon` (NaN for projected
 /// output), `x`, `y`, `z` (NaN where missing and `on_missing="skip"` did not drop it) and
 /// the zone.
@@ -87,9 +90,7 @@ fn sample<'py>(
     })?;
     let (zone, rows) = table;
     let d = PyDict::new(py);
-    let col = |f: &dyn Fn(&(Option<[f64; 2]>, [f64; 2], Option<f64>)) -> f64| {
-        PyArray1::from_iter(py, rows.iter().map(f))
-    };
+    let col = |f: &dyn Fn(&SampleRow) -> f64| PyArray1::from_iter(py, rows.iter().map(f));
     d.set_item("lat", col(&|r| r.0.map_or(f64::NAN, |l| l[0])))?;
     d.set_item("lon", col(&|r| r.0.map_or(f64::NAN, |l| l[1])))?;
     d.set_item("x", col(&|r| r.1[0]))?;
@@ -132,7 +133,11 @@ fn build<'py>(
         terramesh::build::build(&project, &base, &out, cancel).map_err(to_py)
     })?;
     let d = PyDict::new(py);
-    let files: Vec<String> = built.files.iter().map(|f| f.display().to_string()).collect();
+    let files: Vec<String> = built
+        .files
+        .iter()
+        .map(|f| f.display().to_string())
+        .collect();
     d.set_item("files", files)?;
     d.set_item("vertices", built.vertices)?;
     d.set_item("triangles", built.triangles)?;

@@ -141,12 +141,15 @@ pub(crate) fn slice<'a>(a: &'a numpy::PyReadonlyArray1<'_, f64>) -> std::borrow:
     }
 }
 
+/// Floats borrowed from numpy, or copied.
+pub(crate) type Floats<'a> = std::borrow::Cow<'a, [f64]>;
+
 /// Two equally long coordinate arrays, or an error naming them.
 pub(crate) fn pair<'a>(
     names: (&str, &str),
     a: &'a numpy::PyReadonlyArray1<'_, f64>,
     b: &'a numpy::PyReadonlyArray1<'_, f64>,
-) -> PyResult<(std::borrow::Cow<'a, [f64]>, std::borrow::Cow<'a, [f64]>)> {
+) -> PyResult<(Floats<'a>, Floats<'a>)> {
     let (a, b) = (slice(a), slice(b));
     if a.len() != b.len() {
         return Err(crate::errors::input(format!(

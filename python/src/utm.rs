@@ -77,12 +77,15 @@ fn point_error(
     lon: &[f64],
     zone: Option<Zone>,
 ) -> terramesh::Error {
-    let bad = (lo..lat.len()).find(|&i| terramesh_core::coords::to_utm(lat[i], lon[i], zone).is_err());
+    let bad =
+        (lo..lat.len()).find(|&i| terramesh_core::coords::to_utm(lat[i], lon[i], zone).is_err());
     let at = bad.map_or(String::new(), |i| {
         format!("point {i} (lat {}, lon {}): ", lat[i], lon[i])
     });
     terramesh::Error::invalid(format!("{at}{err}"))
 }
+
+type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// `(lat, lon)` in degrees of UTM points of one zone.
 #[pyfunction]
@@ -91,7 +94,7 @@ fn utm_inverse<'py>(
     easting: PyReadonlyArray1<'py, f64>,
     northing: PyReadonlyArray1<'py, f64>,
     zone: &str,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<Pair<'py>> {
     let z = self::zone(zone)?;
     let (e, n) = pair(("easting", "northing"), &easting, &northing)?;
     let (e, n) = (&*e, &*n);
@@ -130,11 +133,7 @@ fn parse_dms(text: &str, axis: Option<&str>) -> PyResult<f64> {
         None => None,
         Some(a) if a == "lat" || a == "latitude" => Some(Axis::Lat),
         Some(a) if a == "lon" || a == "longitude" => Some(Axis::Lon),
-        Some(a) => {
-            return Err(input(format!(
-                "axis '{a}': give 'lat', 'lon' or None"
-            )))
-        }
+        Some(a) => return Err(input(format!("axis '{a}': give 'lat', 'lon' or None"))),
     };
     match axis {
         Some(ax) => parse_angle(text, ax).map_err(kernel),
@@ -148,5 +147,7 @@ fn parse_dms(text: &str, axis: Option<&str>) -> PyResult<f64> {
 /// The standard zone of a point, as text (`"32N"`).
 #[pyfunction]
 fn zone_for(lat: f64, lon: f64) -> PyResult<String> {
-    Zone::for_point(lat, lon).map(|z| z.to_string()).map_err(kernel)
+    Zone::for_point(lat, lon)
+        .map(|z| z.to_string())
+        .map_err(kernel)
 }
