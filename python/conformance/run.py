@@ -22,7 +22,9 @@ HERE = pathlib.Path(__file__).resolve().parent
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--version", default="1.7.2")
+    from importlib.metadata import version
+
+    ap.add_argument("--version", default=version("pykrige"), help="default: the installed PyKrige's")
     ap.add_argument("--keep", help="folder to fetch and unpack into (kept)")
     args, rest = ap.parse_known_args()
     work = pathlib.Path(args.keep) if args.keep else pathlib.Path(tempfile.mkdtemp(prefix="pykrige-suite-"))
