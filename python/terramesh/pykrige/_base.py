@@ -118,16 +118,26 @@ class KrigingBase:
         else:
             self.variogram_function = MODELS[model]
         self.variogram_model = model
-        self.lags, self.semivariance = _setup.experimental(
-            self.X_ADJUSTED, self.Y_ADJUSTED, self.Z, self.nlags,
-            self.coordinates_type == "geographic",
-        )
+        self._lags = None
         p = _setup.parameter_list(model, params)
         if p is None:
             p = _setup.fit(self.lags, self.semivariance, model, self.variogram_function, self.weight)
         self.variogram_model_parameters = p
         self._tm = None if model == "custom" else _setup.terramesh_variogram(model, p)
         self._stats = None
+
+    def _experimental(self):
+        # Every pair of data: computed when first needed (a fit, or these attributes), so
+        # that given parameters krige 100,000 data without 5e9 pair distances.
+        if self._lags is None:
+            self._lags = _setup.experimental(
+                self.X_ADJUSTED, self.Y_ADJUSTED, self.Z, self.nlags,
+                self.coordinates_type == "geographic",
+            )
+        return self._lags
+
+    lags = property(lambda self: self._experimental()[0], doc="Mean distance of each lag class.")
+    semivariance = property(lambda self: self._experimental()[1], doc="Semivariance of each lag class.")
 
     def update_variogram_model(
         self,
