@@ -186,11 +186,20 @@ class BuildResult:
         )
 
     def path(self, name: str) -> Path:
-        """The path of output ``name`` (``"dsm.vtu"``) in the build folder."""
+        """The path of output ``name`` (``"dsm.vtu"``) in the build folder.
+
+        >>> BuildResult("out", {"files": [], "vertices": 0, "triangles": 0, "timings": []}).path("dsm.vtu").as_posix()
+        'out/dsm.vtu'
+        """
         return self.out_dir / name
 
     def vertices_table(self) -> Dict[str, np.ndarray]:
-        """``dsm-vertices.csv`` as columns of float64 arrays."""
+        """``dsm-vertices.csv`` as columns of float64 arrays.
+
+        >>> r = terramesh.build("examples/haut-barr/terramesh.toml", "out")  # doctest: +SKIP
+        >>> sorted(r.vertices_table())[:3]  # doctest: +SKIP
+        ['elevation_idw', 'elevation_uk', 'kriging_std']
+        """
         with open(self.out_dir / "dsm-vertices.csv", newline="", encoding="utf-8") as f:
             r = csv.reader(f)
             head = next(r)
@@ -198,7 +207,11 @@ class BuildResult:
         return {h: data[:, i] for i, h in enumerate(head)}
 
     def to_meshio(self):
-        """``dsm.vtu`` read by meshio (needs meshio)."""
+        """``dsm.vtu`` read by meshio (needs meshio).
+
+        >>> r.to_meshio().point_data["elevation_uk"].shape  # doctest: +SKIP
+        (2869,)
+        """
         try:
             import meshio
         except ImportError:
@@ -206,7 +219,11 @@ class BuildResult:
         return meshio.read(self.out_dir / "dsm.vtu")
 
     def to_pyvista(self):
-        """``dsm.vtu`` read by PyVista (needs PyVista)."""
+        """``dsm.vtu`` read by PyVista (needs PyVista).
+
+        >>> r.to_pyvista().n_points  # doctest: +SKIP
+        2869
+        """
         try:
             import pyvista
         except ImportError:
