@@ -98,3 +98,15 @@ def test_ctrl_c_stops_a_build_and_leaves_no_output(root, tmp_path):
     assert not out.exists()
     leftovers = [f for f in os.listdir(tmp_path) if f.startswith(".out") or "tmp" in f]
     assert leftovers == [], leftovers
+
+
+def test_sample_over_rings_equals_sample_over_the_corner_list(root):
+    crop = root / "examples" / "haut-barr" / "srtm-crop.asc"
+    lat = [terramesh.utm.parse_dms(c.split()[0]) for c in CORNERS.split(";")]
+    lon = [terramesh.utm.parse_dms(c.split()[1]) for c in CORNERS.split(";")]
+    a = terramesh.sample(crop, CORNERS, rows=12, cols=6, clip=True)
+    b = terramesh.sample(crop, [list(zip(lon, lat))], rows=12, cols=6, clip=True)
+    np.testing.assert_array_equal(a.z, b.z)
+    np.testing.assert_array_equal(a.x, b.x)
+    with pytest.raises(terramesh.InputError, match="margin"):
+        terramesh.sample(crop, CORNERS, margin="ten")
