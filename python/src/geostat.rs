@@ -1,0 +1,373 @@
+//! Variograms, kriging, IDW and cross-validation over numpy arrays (`terramesh-geostat`).
+//!
+//! A variogram crosses the boundary as the JSON of `variogram.json`'s `model` object
+//! (`{"nugget": .., "structures": [{"type": .., "psill": .., "range": ..}], "anisotropy": ..}`),
+//! which the Python `Variogram` class reads and writes.
+
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use terramesh_geostat::{
+    cross_validate as cv, experimental as lags_of, kriging, Data, Direction, Drift, Duplicates,
+    Estimator, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood, Variogram,
+    VariogramFile, Weighting, DEFAULT_TOLERANCE,
+};
+
+use crate::errors::{input, kernel, to_py};
+use crate::run::{chunked, pair, run, slice};
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(variogram_check, m)?)?;
+    m.add_function(wrap_pyfunction!(variogram_gamma, m)?)?;
+    m.add_function(wrap_pyfunction!(variogram_file_model, m)?)?;
+    m.add_function(wrap_pyfunction!(variogram_file_json, m)?)?;
+    m.add_function(wrap_pyfunction!(experimental, m)?)?;
+    m.add_function(wrap_pyfunction!(variogram_fit, m)?)?;
+    m.add_function(wrap_pyfunction!(krige, m)?)?;
+    m.add_function(wrap_pyfunction!(idw, m)?)?;
+    m.add_function(wrap_pyfunction!(cross_validate, m)?)?;
+    Ok(())
+}
+
+fn model(json: &str) -> PyResult<Variogram> {
+    let v: Variogram = serde_json::from_str(json).map_err(|e| {
+        input(format!(
+            "variogram: {e} (expected the `model` object of variogram.json)"
+        ))
+    })?;
+    v.validate().map_err(|e| input(format!("variogram: {e}")))?;
+    Ok(v)
+}
+
+/// The data of `x, y, z`, validated (finite, no duplicate locations unless `duplicates`).
+fn data(
+    x: &PyReadonlyArray1<'_, f64>,
+    y: &PyReadonlyArray1<'_, f64>,
+    z: &PyReadonlyArray1<'_, f64>,
+    duplicates: &str,
+) -> PyResult<Data> {
+    let (xs, ys) = pair(("x", "y"), x, y)?;
+    let zs = slice(z).into_owned();
+    if zs.len() != xs.len() {
+        return Err(input(format!(
+            "z must have one value per point ({} points, {} values given)",
+            xs.len(),
+            zs.len()
+        )));
+    }
+    let d = match duplicates {
+        "reject" | "error" => Duplicates::Reject,
+        "mean" => Duplicates::Mean,
+        other => {
+            return Err(input(format!(
+                "duplicates '{other}': give 'reject' or 'mean'"
+            )))
+        }
+    };
+    let xy = xs.iter().zip(ys.iter()).map(|(&a, &b)| [a, b]).collect();
+    Data::new(xy, zs, d).map_err(kernel)
+}
+
+fn targets(
+    xt: &PyReadonlyArray1<'_, f64>,
+    yt: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<Vec<[f64; 2]>> {
+    let (a, b) = pair(("xt", "yt"), xt, yt)?;
+    Ok(a.iter().zip(b.iter()).map(|(&x, &y)| [x, y]).collect())
+}
+
+/// The model JSON, validated and written back in its canonical form.
+#[pyfunction]
+fn variogram_check(json: &str) -> PyResult<String> {
+    let v = model(json)?;
+    Ok(serde_json::to_string(&v).expect("a variogram is JSON"))
+}
+
+/// γ(h) at each lag (isotropic lags; γ(0) = 0).
+#[pyfunction]
+fn variogram_gamma<'py>(
+    py: Python<'py>,
+    json: &str,
+    h: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let v = model(json)?;
+    let g: Vec<f64> = slice(&h).iter().map(|&h| v.gamma(h)).collect();
+    Ok(PyArray1::from_vec(py, g))
+}
+
+/// The model object of a variogram file's text (either command's file), as JSON.
+#[pyfunction]
+fn variogram_file_model(text: &str) -> PyResult<String> {
+    let f = VariogramFile::from_json(text).map_err(|e| input(format!("variogram file: {e}")))?;
+    Ok(serde_json::to_string(&f.model).expect("a variogram is JSON"))
+}
+
+/// A variogram file with only this model, pretty-printed as `terramesh` writes them.
+#[pyfunction]
+fn variogram_file_json(json: &str) -> PyResult<String> {
+    Ok(VariogramFile::new(model(json)?).to_json_pretty())
+}
+
+fn lag_settings(
+    lags: usize,
+    max_dist: Option<f64>,
+    estimator: &str,
+    azimuth: Option<f64>,
+    tolerance: Option<f64>,
+    max_points: Option<usize>,
+) -> PyResult<LagSettings> {
+    let estimator: Estimator = estimator
+        .parse()
+        .map_err(|e| input(format!("estimator: {e}")))?;
+    Ok(LagSettings {
+        lags,
+        max_dist,
+        direction: azimuth.map(|azimuth| Direction {
+            azimuth,
+            tolerance: tolerance.unwrap_or(DEFAULT_TOLERANCE),
+        }),
+        estimator,
+        max_points,
+    })
+}
+
+/// The experimental variogram: `{lo, hi, distance, gamma, pairs}` arrays.
+#[pyfunction]
+#[pyo3(signature = (x, y, z, lags, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=None))]
+#[allow(clippy::too_many_arguments)]
+fn experimental<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    z: PyReadonlyArray1<'py, f64>,
+    lags: usize,
+    max_dist: Option<f64>,
+    estimator: &str,
+    azimuth: Option<f64>,
+    tolerance: Option<f64>,
+    max_points: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = data(&x, &y, &z, "mean")?;
+    let s = lag_settings(lags, max_dist, estimator, azimuth, tolerance, max_points)?;
+    let l = run(py, false, |_| lags_of(&d, &s).map_err(kernel))?;
+    let out = PyDict::new(py);
+    out.set_item("lo", PyArray1::from_iter(py, l.iter().map(|l| l.lo)))?;
+    out.set_item("hi", PyArray1::from_iter(py, l.iter().map(|l| l.hi)))?;
+    out.set_item(
+        "distance",
+        PyArray1::from_iter(py, l.iter().map(|l| l.distance)),
+    )?;
+    out.set_item("gamma", PyArray1::from_iter(py, l.iter().map(|l| l.gamma)))?;
+    out.set_item("pairs", PyArray1::from_iter(py, l.iter().map(|l| l.pairs)))?;
+    Ok(out)
+}
+
+/// Fits `model` (or `auto`) to the experimental variogram of the data; returns the variogram
+/// file's JSON (model, lags, fit, candidates, experimental).
+#[pyfunction]
+#[pyo3(signature = (x, y, z, model="auto", weighting="cressie", lags=15, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=Some(10_000)))]
+#[allow(clippy::too_many_arguments)]
+fn variogram_fit(
+    py: Python<'_>,
+    x: PyReadonlyArray1<'_, f64>,
+    y: PyReadonlyArray1<'_, f64>,
+    z: PyReadonlyArray1<'_, f64>,
+    model: &str,
+    weighting: &str,
+    lags: usize,
+    max_dist: Option<f64>,
+    estimator: &str,
+    azimuth: Option<f64>,
+    tolerance: Option<f64>,
+    max_points: Option<usize>,
+) -> PyResult<String> {
+    let d = data(&x, &y, &z, "mean")?;
+    let s = lag_settings(lags, max_dist, estimator, azimuth, tolerance, max_points)?;
+    let w: Weighting = weighting
+        .parse()
+        .map_err(|e| input(format!("weighting: {e}")))?;
+    run(py, false, |_| {
+        let l = lags_of(&d, &s).map_err(kernel)?;
+        let (fit, cands) = terramesh::interpolate::fit_named(&d, &l, model, w).map_err(to_py)?;
+        let mut f = VariogramFile::new(fit.variogram.clone());
+        f.points = d.len();
+        f.lags = Some(terramesh_geostat::LagSummary {
+            classes: s.lags,
+            max_dist: s.max_dist,
+            azimuth: s.direction.map(|d| d.azimuth),
+            tolerance: s.direction.map(|d| d.tolerance),
+            estimator: s.estimator,
+        });
+        f.experimental = l;
+        f.fit = Some(terramesh_geostat::FitSummary {
+            weights: w,
+            objective: fit.objective,
+            rmse: fit.rmse,
+        });
+        f.candidates = cands
+            .into_iter()
+            .map(terramesh_geostat::CandidateEntry::Full)
+            .collect();
+        Ok(f.to_json_pretty())
+    })
+}
+
+/// The kriging method of its name.
+fn method(name: &str, drift: &str, mean: Option<f64>, d: &Data) -> PyResult<Method> {
+    let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
+    match name.to_ascii_lowercase().as_str() {
+        "sk" | "simple" => Ok(Method::Simple {
+            mean: mean.unwrap_or_else(|| d.mean()),
+        }),
+        "ok" | "ordinary" => Ok(Method::Ordinary),
+        "uk" | "universal" => Ok(Method::Universal(drift)),
+        other => Err(input(format!(
+            "method '{other}': give 'ok', 'uk' or 'sk' (or use terramesh.idw)"
+        ))),
+    }
+}
+
+fn hood(neighbors: Option<usize>) -> Neighbourhood {
+    match neighbors {
+        None => Neighbourhood::All,
+        Some(k) => Neighbourhood::Nearest(k),
+    }
+}
+
+type Estimate<'py> = (Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<f64>>>);
+
+/// Kriging estimates (and variances) at the targets.
+#[pyfunction]
+#[pyo3(signature = (x, y, z, xt, yt, variogram, method="uk", drift="linear", mean=None, neighbors=None, return_variance=true))]
+#[allow(clippy::too_many_arguments)]
+fn krige<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    z: PyReadonlyArray1<'py, f64>,
+    xt: PyReadonlyArray1<'py, f64>,
+    yt: PyReadonlyArray1<'py, f64>,
+    variogram: &str,
+    method: &str,
+    drift: &str,
+    mean: Option<f64>,
+    neighbors: Option<usize>,
+    return_variance: bool,
+) -> PyResult<Estimate<'py>> {
+    let d = data(&x, &y, &z, "reject")?;
+    let v = model(variogram)?;
+    let m = self::method(method, drift, mean, &d)?;
+    let t = targets(&xt, &yt)?;
+    let (est, var) = run(py, false, |cancel| {
+        let p = kriging(&d, &v, m, hood(neighbors), return_variance).map_err(kernel)?;
+        let mut est = vec![0.0; t.len()];
+        let mut var = vec![0.0; if return_variance { t.len() } else { 0 }];
+        chunked(t.len(), cancel, |r| {
+            let vr = return_variance.then(|| &mut var[r.clone()]);
+            p.predict(&t[r.clone()], &mut est[r.clone()], vr)
+                .map_err(|e| e.offset_target(r.start).into())
+        })
+        .map_err(to_py)?;
+        Ok((est, var))
+    })?;
+    Ok((
+        PyArray1::from_vec(py, est),
+        return_variance.then(|| PyArray1::from_vec(py, var)),
+    ))
+}
+
+fn idw_search(neighbors: Option<usize>, radius: Option<f64>) -> PyResult<IdwSearch> {
+    match (neighbors, radius) {
+        (None, None) => Ok(IdwSearch::All),
+        (Some(k), None) => Ok(IdwSearch::Nearest(k)),
+        (None, Some(r)) => Ok(IdwSearch::Radius(r)),
+        (Some(_), Some(_)) => Err(input("idw: give neighbors or radius, not both")),
+    }
+}
+
+/// Inverse distance weighting at the targets.
+#[pyfunction]
+#[pyo3(signature = (x, y, z, xt, yt, power=2.0, neighbors=None, radius=None))]
+#[allow(clippy::too_many_arguments)]
+fn idw<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    z: PyReadonlyArray1<'py, f64>,
+    xt: PyReadonlyArray1<'py, f64>,
+    yt: PyReadonlyArray1<'py, f64>,
+    power: f64,
+    neighbors: Option<usize>,
+    radius: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let d = data(&x, &y, &z, "reject")?;
+    let t = targets(&xt, &yt)?;
+    let s = idw_search(neighbors, radius)?;
+    let est = run(py, false, |cancel| {
+        let p = Idw::new(&d, power, s).map_err(kernel)?;
+        let mut est = vec![0.0; t.len()];
+        chunked(t.len(), cancel, |r| {
+            p.predict(&t[r.clone()], &mut est[r.clone()])
+                .map_err(|e| e.offset_target(r.start).into())
+        })
+        .map_err(to_py)?;
+        Ok(est)
+    })?;
+    Ok(PyArray1::from_vec(py, est))
+}
+
+/// Leave-one-out (`folds=None`) or k-fold cross-validation of kriging or IDW.
+#[pyfunction]
+#[pyo3(signature = (x, y, z, method="uk", variogram=None, drift="linear", mean=None, neighbors=None, folds=None, power=2.0, radius=None))]
+#[allow(clippy::too_many_arguments)]
+fn cross_validate<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    z: PyReadonlyArray1<'py, f64>,
+    method: &str,
+    variogram: Option<&str>,
+    drift: &str,
+    mean: Option<f64>,
+    neighbors: Option<usize>,
+    folds: Option<usize>,
+    power: f64,
+    radius: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = data(&x, &y, &z, "reject")?;
+    let how = if method.eq_ignore_ascii_case("idw") {
+        Interpolator::Idw {
+            power,
+            search: idw_search(neighbors, radius)?,
+        }
+    } else {
+        let v = variogram.ok_or_else(|| {
+            input(format!(
+                "cross_validate: method '{method}' needs a variogram"
+            ))
+        })?;
+        Interpolator::Kriging {
+            variogram: model(v)?,
+            method: self::method(method, drift, mean, &d)?,
+            neighbours: hood(neighbors),
+        }
+    };
+    let folds = match folds {
+        None => Folds::LeaveOneOut,
+        Some(k) => Folds::KFold(k),
+    };
+    let r = run(py, false, |_| cv(&d, &how, folds).map_err(kernel))?;
+    let out = PyDict::new(py);
+    out.set_item("estimate", PyArray1::from_vec(py, r.estimate))?;
+    out.set_item(
+        "variance",
+        (!r.variance.is_empty()).then(|| PyArray1::from_vec(py, r.variance)),
+    )?;
+    out.set_item("n", r.stats.n)?;
+    out.set_item("rmse", r.stats.rmse)?;
+    out.set_item("mae", r.stats.mae)?;
+    out.set_item("mean_error", r.stats.mean_error)?;
+    out.set_item("mean_standardized", r.stats.mean_standardized)?;
+    out.set_item("var_standardized", r.stats.var_standardized)?;
+    Ok(out)
+}

@@ -1,0 +1,126 @@
+"""Kriging, IDW, cross-validation and variograms against PyKrige, the independent reference."""
+
+import json
+
+import numpy as np
+import pytest
+from pykrige.ok import OrdinaryKriging as PkOK
+from pykrige.uk import UniversalKriging as PkUK
+
+import terramesh
+from terramesh import Variogram
+
+
+def test_universal_kriging_matches_pykrige(field):
+    x, y, z = field
+    xt, yt = np.meshgrid(np.linspace(100, 1900, 30), np.linspace(100, 1400, 20))
+    xt, yt = xt.ravel(), yt.ravel()
+    pk = PkUK(x, y, z, variogram_model="spherical", variogram_parameters=[120.0, 900.0, 2.0],
+              drift_terms=["regional_linear"])
+    zr, sr = pk.execute("points", xt, yt)
+    v = Variogram("spherical", psill=118.0, range=900.0, nugget=2.0)
+    est, var = terramesh.krige(x, y, z, xt, yt, method="uk", drift="linear", variogram=v)
+    np.testing.assert_allclose(est, zr, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(var, sr, rtol=1e-8, atol=1e-8)
+
+
+def test_ordinary_kriging_with_a_neighbourhood_matches_pykrige(field):
+    x, y, z = field
+    rng = np.random.default_rng(3)
+    xt, yt = rng.uniform(0, 2000, 500), rng.uniform(0, 1500, 500)
+    pk = PkOK(x, y, z, variogram_model="exponential", variogram_parameters=[100.0, 600.0, 0.0])
+    zr, sr = pk.execute("points", xt, yt, n_closest_points=24, backend="loop")
+    v = Variogram("exponential", psill=100.0, range=600.0)
+    est, var = terramesh.krige(x, y, z, xt, yt, method="ok", variogram=v, neighbors=24)
+    np.testing.assert_allclose(est, zr, atol=1e-7)
+    np.testing.assert_allclose(var, sr, rtol=1e-7, atol=1e-7)
+
+
+def test_gaussian_range_is_converted_from_pykrige(field):
+    x, y, z = field
+    pk = PkOK(x, y, z, variogram_model="gaussian", variogram_parameters=[100.0, 700.0, 1.0])
+    zr, _ = pk.execute("points", np.array([555.0]), np.array([444.0]))
+    v = Variogram("gaussian", psill=99.0, range=700.0 * 4 * np.sqrt(3) / 7, nugget=1.0)
+    est = terramesh.krige(x, y, z, [555.0], [444.0], method="ok", variogram=v, return_variance=False)
+    assert est[0] == pytest.approx(zr[0], abs=1e-6)
+
+
+def test_exact_at_data_and_scalar_shapes(field):
+    x, y, z = field
+    v = Variogram("spherical", 100.0, 800.0)
+    est, var = terramesh.krige(x, y, z, x[:5], y[:5], variogram=v)
+    np.testing.assert_allclose(est, z[:5], atol=1e-9)
+    assert np.all(np.abs(var) < 1e-9)
+    e, s = terramesh.krige(x, y, z, 500.0, 500.0, variogram=v)
+    assert isinstance(e, float) and s > 0
+
+
+def test_idw_matches_its_formula(field):
+    x, y, z = field
+    xt, yt = np.array([321.0, 1700.0]), np.array([222.0, 1000.0])
+    d = np.hypot(xt[:, None] - x[None, :], yt[:, None] - y[None, :])
+    w = d**-2.0
+    ref = (w @ z) / w.sum(axis=1)
+    np.testing.assert_allclose(terramesh.idw(x, y, z, xt, yt), ref, rtol=1e-12)
+    near = np.argsort(d, axis=1)[:, :8]
+    wk = np.take_along_axis(w, near, 1)
+    refk = (wk * z[near]).sum(1) / wk.sum(1)
+    np.testing.assert_allclose(terramesh.idw(x, y, z, xt, yt, neighbors=8), refk, rtol=1e-12)
+
+
+def test_leave_one_out_matches_refitting_without_each_point(field):
+    x, y, z = field
+    v = Variogram("exponential", 100.0, 700.0)
+    cv = terramesh.cross_validate(x, y, z, method="ok", variogram=v)
+    for i in (0, 17, 299):
+        keep = np.arange(len(x)) != i
+        e, s = terramesh.krige(x[keep], y[keep], z[keep], x[i], y[i], method="ok", variogram=v)
+        assert cv.estimate[i] == pytest.approx(e, abs=1e-8)
+        assert cv.variance[i] == pytest.approx(s, rel=1e-8)
+    assert cv.n == 300 and cv.rmse == pytest.approx(np.sqrt(np.mean((cv.estimate - z) ** 2)))
+
+
+def test_variogram_fit_recovers_a_known_model():
+    truth = Variogram("spherical", psill=10.0, range=300.0, nugget=2.0)
+    x, y = np.meshgrid(np.arange(0, 1000, 25.0), np.arange(0, 1000, 25.0))
+    x, y = x.ravel(), y.ravel()
+    # Data whose experimental variogram is not needed to be exact: fit the model's own gamma
+    # through the lag classes of a field simulated by the Cholesky factor of its covariance.
+    rng = np.random.default_rng(11)
+    sub = rng.choice(len(x), 700, replace=False)
+    xs, ys = x[sub], y[sub]
+    d = np.hypot(xs[:, None] - xs[None, :], ys[:, None] - ys[None, :])
+    c = 12.0 - truth.gamma(d.ravel()).reshape(d.shape)
+    np.fill_diagonal(c, 12.0)
+    zs = np.linalg.cholesky(c + 1e-9 * np.eye(len(xs))) @ rng.standard_normal(len(xs))
+    v = Variogram.fit(xs, ys, zs, model="spherical", lags=20, max_dist=600.0)
+    assert v.model == "spherical"
+    assert 150 < v.range < 600 and v.sill == pytest.approx(12.0, rel=0.5)
+    assert v.fit_info["fit"]["rmse"] >= 0 and len(v.fit_info["experimental"]) > 10
+    auto = Variogram.fit(xs, ys, zs)
+    assert auto.fit_info["candidates"]
+
+
+def test_variogram_json_round_trips_and_reads_build_files(tmp_path):
+    v = Variogram(structures=[("spherical", 2.0, 50.0), ("matern", 3.0, 400.0, 0.5)],
+                  nugget=0.25, anisotropy_angle=30.0, anisotropy_ratio=0.5)
+    text = v.to_json()
+    assert json.loads(text)["model"]["anisotropy"] == {"angle": 30.0, "ratio": 0.5}
+    assert Variogram.from_json(text) == v
+    v.save(tmp_path / "variogram.json")
+    assert Variogram.from_json(tmp_path / "variogram.json") == v
+    assert Variogram.from_json(v.to_dict()) == v
+
+
+def test_bad_variograms_and_data_raise_input_errors(field):
+    x, y, z = field
+    with pytest.raises(terramesh.InputError, match="range"):
+        Variogram("spherical", 1.0, -5.0)
+    with pytest.raises(terramesh.InputError, match="variogram model"):
+        Variogram("cubic", 1.0, 5.0)
+    with pytest.raises(terramesh.InputError, match="duplicate|same location"):
+        terramesh.krige([0.0, 0.0], [1.0, 1.0], [1.0, 2.0], [0.5], [0.5], variogram=Variogram())
+    with pytest.raises(terramesh.InputError, match="z must have"):
+        terramesh.krige(x, y, z[:-1], [0.0], [0.0], variogram=Variogram())
+    with pytest.raises(terramesh.InputError, match="method"):
+        terramesh.krige(x, y, z, [0.0], [0.0], method="nn", variogram=Variogram())
