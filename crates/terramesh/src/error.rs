@@ -58,16 +58,16 @@ pub enum Error {
     Dem(#[from] terramesh_io::dem::DemError),
     /// A coordinate reference system or a transformation between two.
     #[error(transparent)]
-    Crs(#[from] terramesh_crs::CrsError),
+    Crs(Box<terramesh_crs::CrsError>),
     /// A horizon grid.
     #[error(transparent)]
-    Horizon(#[from] crate::horizon::HorizonError),
+    Horizon(Box<crate::horizon::HorizonError>),
     /// A region file or corner list.
     #[error(transparent)]
     Region(#[from] terramesh_io::region::RegionError),
     /// Borehole files.
     #[error(transparent)]
-    Boreholes(#[from] terramesh_io::boreholes::BoreholeError),
+    Boreholes(Box<terramesh_io::boreholes::BoreholeError>),
     /// A table (CSV) file.
     #[error(transparent)]
     Table(#[from] terramesh_io::table::TableError),
@@ -85,7 +85,7 @@ pub enum Error {
     Scene(#[from] terramesh_io::viewer::SceneError),
     /// The geological model (rules, volume mesh, checks).
     #[error(transparent)]
-    Geology(#[from] terramesh_geology::GeologyError),
+    Geology(Box<terramesh_geology::GeologyError>),
     /// An elevation web service or tile server.
     #[error(transparent)]
     Web(#[from] terramesh_web::WebError),
@@ -117,6 +117,31 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+}
+
+// Large kernel errors are boxed, so that `Result<T>` stays small.
+impl From<terramesh_crs::CrsError> for Error {
+    fn from(e: terramesh_crs::CrsError) -> Self {
+        Error::Crs(Box::new(e))
+    }
+}
+
+impl From<crate::horizon::HorizonError> for Error {
+    fn from(e: crate::horizon::HorizonError) -> Self {
+        Error::Horizon(Box::new(e))
+    }
+}
+
+impl From<terramesh_io::boreholes::BoreholeError> for Error {
+    fn from(e: terramesh_io::boreholes::BoreholeError) -> Self {
+        Error::Boreholes(Box::new(e))
+    }
+}
+
+impl From<terramesh_geology::GeologyError> for Error {
+    fn from(e: terramesh_geology::GeologyError) -> Self {
+        Error::Geology(Box::new(e))
+    }
 }
 
 /// The message of a bad setting: `NAME 'VALUE': WHY`, or `NAME: WHY` without a value. `WHY`
