@@ -4,9 +4,11 @@
 //! overrides a key from the command line (`--set mesh.min_angle=32`).
 
 mod check;
+mod crs;
 mod lower;
 mod parse;
 
+pub use crs::ProjectCrs;
 pub use lower::key_of;
 
 use std::path::PathBuf;
@@ -15,7 +17,6 @@ use serde::Deserialize;
 use terramesh_core::sampling::Kernel;
 use terramesh_geostat::{Drift, InterpolationMethod, ModelKind, DEFAULT_IDW_POWER};
 use terramesh_io::export::{Format, DEFAULT_FORMATS};
-use terramesh_io::region::RegionCrs;
 use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
 /// A whole project.
@@ -53,9 +54,9 @@ pub struct RegionSection {
     pub file: Option<PathBuf>,
     /// UTM zone such as `32N` (default: the zone of the region's centre).
     pub zone: Option<String>,
-    /// `geographic` (default) or `projected`.
+    /// `geographic` (default), `projected`, or a projected CRS `EPSG:<code>` ([`ProjectCrs`]).
     #[serde(default)]
-    pub crs: RegionCrs,
+    pub crs: ProjectCrs,
 }
 
 /// `[source]`: where elevations come from.
