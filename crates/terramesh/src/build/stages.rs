@@ -37,7 +37,15 @@ pub struct Samples {
 pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
     let options = p.sample_options(base, &out.join("samples.csv"))?;
     let plan = SamplePlan::resolve(&options)?;
-    let table = acquire(&plan, progress)?;
+    let mut table = acquire(&plan, progress)?;
+    let metres = p.source.z_unit.metres();
+    if metres != 1.0 {
+        for r in &mut table.rows {
+            if let Ok(z) = &mut r.z {
+                *z *= metres;
+            }
+        }
+    }
     let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
     let zone = match table.zone {
         Some(z) if !own_crs => Some(z),

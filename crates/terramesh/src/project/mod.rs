@@ -69,6 +69,10 @@ pub struct SourceSection {
     pub fallback: Option<String>,
     /// LAS/LAZ classification to keep (2 = ground).
     pub class: Option<u8>,
+    /// The unit of the source's elevations (`m`, `ft`, `us-ft`), converted to metres by
+    /// `build` (default metres).
+    #[serde(default)]
+    pub z_unit: terramesh_core::volume::ZUnit,
 }
 
 /// `[sampling]`: the grid of the paper's step 1.
