@@ -56,12 +56,13 @@ pub enum Error {
     /// An elevation file.
     #[error(transparent)]
     Dem(#[from] terramesh_io::dem::DemError),
-    /// A coordinate reference system or a transformation between two.
+    /// A coordinate reference system or a transformation between two (boxed: its messages
+    /// carry both CRSs).
     #[error(transparent)]
-    Crs(#[from] terramesh_crs::CrsError),
-    /// A horizon grid.
+    Crs(Box<terramesh_crs::CrsError>),
+    /// A horizon grid (boxed, as [`Error::Crs`]).
     #[error(transparent)]
-    Horizon(#[from] crate::horizon::HorizonError),
+    Horizon(Box<crate::horizon::HorizonError>),
     /// A region file or corner list.
     #[error(transparent)]
     Region(#[from] terramesh_io::region::RegionError),
@@ -111,6 +112,18 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+}
+
+impl From<terramesh_crs::CrsError> for Error {
+    fn from(e: terramesh_crs::CrsError) -> Error {
+        Error::Crs(Box::new(e))
+    }
+}
+
+impl From<crate::horizon::HorizonError> for Error {
+    fn from(e: crate::horizon::HorizonError) -> Error {
+        Error::Horizon(Box::new(e))
+    }
 }
 
 /// The message of a bad setting: `NAME 'VALUE': WHY`, or `NAME: WHY` without a value. `WHY`
