@@ -56,7 +56,8 @@ pub enum Error {
     /// An elevation file.
     #[error(transparent)]
     Dem(#[from] terramesh_io::dem::DemError),
-    /// A coordinate reference system or a transformation between two.
+    /// A coordinate reference system or a transformation between two (boxed: its messages
+    /// carry both CRSs).
     #[error(transparent)]
     Crs(Box<terramesh_crs::CrsError>),
     /// A horizon grid.

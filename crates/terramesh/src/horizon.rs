@@ -74,7 +74,7 @@ pub enum HorizonError {
 /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/geology/shellmound/mcaq_surf.tif");
 /// let g = HorizonGrid::open(std::path::Path::new(p), ZUnit::Foot)?; // EPSG:5070, feet
 /// let utm15 = Crs::parse("EPSG:26915").unwrap();
-/// let z = g.evaluate(&[[700_000.0, 3_725_000.0]], &utm15)?; // metres, NAD83 / UTM 15N
+/// let z = g.evaluate(&[[743_000.0, 3_726_000.0]], &utm15)?; // metres, NAD83 / UTM 15N
 /// assert!(z[0].is_some_and(|z| z > -60.0 && z < 20.0), "{z:?}");
 /// assert!(g.evaluate(&[[0.0, 0.0]], &utm15).is_err()); // far off the grid
 /// # Ok(()) }
@@ -155,7 +155,8 @@ impl HorizonGrid {
     /// # use terramesh::horizon::HorizonGrid;
     /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/geology/shellmound/mcaq_surf.tif");
     /// let g = HorizonGrid::open(std::path::Path::new(p), Default::default())?;
-    /// assert!(g.describe().contains("EPSG:5070"), "{}", g.describe());
+    /// // a user-defined CONUS Albers (EPSG:5070's parameters in the GeoKeys)
+    /// assert!(g.describe().contains("+proj=aea"), "{}", g.describe());
     /// # Ok(()) }
     /// ```
     pub fn describe(&self) -> String {

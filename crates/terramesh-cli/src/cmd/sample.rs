@@ -154,6 +154,7 @@ impl Args {
             },
             region_crs: self.region_crs,
             zone: self.zone,
+            project_crs: None,
             rows_cols: self.rows.zip(self.cols),
             spacing: self.spacing,
             margin,

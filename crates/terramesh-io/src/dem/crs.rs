@@ -147,7 +147,8 @@ impl fmt::Display for SourceCrs {
             SourceCrs::Geographic => f.write_str("WGS 84 (EPSG:4326)"),
             SourceCrs::Utm(z) => write!(f, "WGS 84 / UTM zone {z} (EPSG:{})", z.epsg()),
             SourceCrs::Projected { name } => write!(f, "{name} (kept as is)"),
-            SourceCrs::Epsg(c) => write!(f, "{c} ({})", c.definition()),
+            SourceCrs::Epsg(c) if c.epsg().is_some() => write!(f, "{c} ({})", c.definition()),
+            SourceCrs::Epsg(c) => write!(f, "{c}"),
         }
     }
 }

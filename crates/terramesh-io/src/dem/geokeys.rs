@@ -95,6 +95,13 @@ pub(crate) fn crs_of(path: &Path, keys: &GeoKeys) -> Result<SourceCrs, DemError>
         )
     };
     let any = |kind: &str, c: u16| {
+        if matches!(c, 3857 | 3785) {
+            // Pseudo-Mercator: a display projection (spherical formulas on WGS-84 degrees),
+            // not a survey CRS; proj4rs's definition has no datum to transform from.
+            return Err(unsupported(format!(
+                "{kind} CRS EPSG:{c} (Web Mercator, a display projection)"
+            )));
+        }
         SourceCrs::from_any_epsg(u32::from(c))
             .map_err(|e| unsupported(format!("{kind} CRS EPSG:{c} ({e})")))
     };

@@ -161,6 +161,9 @@ pub struct SampleOptions {
     pub region_crs: RegionCrs,
     /// The UTM zone of the output (default: the zone of the region's centre).
     pub zone: Option<Zone>,
+    /// The project's CRS when it is a named projected CRS (`[region] crs = "EPSG:..."`): the
+    /// region is in it, and rasters in another CRS are sampled through a transformation.
+    pub project_crs: Option<terramesh_crs::Crs>,
     /// Grid rows and columns.
     pub rows_cols: Option<(usize, usize)>,
     /// Grid spacing, metres (instead of rows and columns).
@@ -201,6 +204,7 @@ impl SampleOptions {
             region: None,
             region_crs: RegionCrs::Geographic,
             zone: None,
+            project_crs: None,
             rows_cols: None,
             spacing: None,
             margin: MarginSpec::Fraction(0.0),

@@ -4,7 +4,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use terramesh_io::dem::{
-    open_raster_in, sample_nodes, ElevationSource, LatLonBox, SourceCrs, TileMosaic,
+    open_raster_in, sample_in, sample_nodes, ElevationSource, LatLonBox, SourceCrs, TileMosaic,
 };
 use terramesh_web::{fetch_tiles, TileOptions};
 
@@ -30,7 +30,13 @@ fn sample(
     dem: &dyn ElevationSource,
     nodes: Vec<terramesh_core::sampling::Node>,
 ) -> Result<SampleTable> {
-    let z = sample_nodes(dem, &nodes, s.zone, s.options.kernel)?;
+    let z = match &s.options.project_crs {
+        Some(crs) => {
+            let xy: Vec<[f64; 2]> = nodes.iter().map(|n| n.xy).collect();
+            sample_in(dem, &xy, crs, s.options.kernel)?
+        }
+        None => sample_nodes(dem, &nodes, s.zone, s.options.kernel)?,
+    };
     let zone = match dem.crs() {
         SourceCrs::Projected { .. } => None,
         _ => s.zone,

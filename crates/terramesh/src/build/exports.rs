@@ -159,7 +159,7 @@ pub fn write_all(
         })?);
     }
     let zone = s.zone;
-    let crs_name = format!("WGS 84 / UTM zone {zone}");
+    let crs_name = s.crs_name();
     if want("ts") {
         files.push(atomic(&out.join("dsm.ts"), |w| {
             write_tsurf(
@@ -178,61 +178,85 @@ pub fn write_all(
             write_dxf(w, &abs, tris, "DSM")
         })?);
     }
-    let geo: Vec<[f64; 3]> = if want("kml") || want("dae") || want("terrain") {
-        abs.iter()
-            .map(|q| {
-                let (lat, lon) = to_wgs84(q[0], q[1], zone)?;
-                Ok([lon, lat, q[2]])
-            })
-            .collect::<Result<_, terramesh_core::coords::CoordError>>()?
-    } else {
-        Vec::new()
-    };
     let title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
-    if want("kml") {
-        files.push(atomic(&out.join("dsm.kml"), |w| {
-            write_kml(
-                w,
-                &geo,
-                tris,
-                &KmlStyle {
-                    name: &title,
-                    ..KmlStyle::default()
-                },
-            )
-        })?);
+    // Geographic exports need WGS-84 positions: a UTM project's, converted exactly; a project
+    // in its own CRS gets none of them (refused, not approximated).
+    let web: Vec<&str> = ["kml", "dae", "glb", "3dtiles", "terrain"]
+        .into_iter()
+        .filter(|f| want(f))
+        .collect();
+    if zone.is_none() && !web.is_empty() {
+        crate::error::bail!(
+            "export.formats: {} need geographic (WGS-84) positions, which terramesh gives only \
+             for projects in latitude/longitude (worked in UTM); this project is in {}: remove \
+             them from export.formats, e.g. formats = [\"vtu\", \"obj\", \"ply\", \"stl\", \"ts\", \
+             \"msh\", \"dxf\"]",
+            web.join(", "),
+            s.crs_name()
+        );
     }
-    if want("dae") {
-        files.extend(write_dae(out, &abs, &geo, tris, zone, &title)?);
-    }
-    let dsm = crate::gltf::Dsm {
-        mesh,
-        z: &it.dsm,
-        zone,
-        title: &title,
-    };
-    if want("glb") {
-        let path = out.join("dsm.glb");
-        crate::gltf::write_dsm_glb(&path, &dsm)?;
-        files.push(path);
-    }
-    if want("3dtiles") {
-        let settings = terramesh_mesh::LodSettings::default();
-        crate::gltf::write_dsm_tileset(&out.join("3dtiles"), &s.region.projected, &dsm, &settings)?;
-        files.push(out.join("3dtiles").join("tileset.json"));
-    }
-    if want("terrain") {
-        let res = m.after.edge.mean;
-        files.push(super::terrain::write(out, &geo, tris, res, &title)?);
+    if let Some(zone) = zone {
+        let geo: Vec<[f64; 3]> = if want("kml") || want("dae") || want("terrain") {
+            abs.iter()
+                .map(|q| {
+                    let (lat, lon) = to_wgs84(q[0], q[1], zone)?;
+                    Ok([lon, lat, q[2]])
+                })
+                .collect::<Result<_, terramesh_core::coords::CoordError>>()?
+        } else {
+            Vec::new()
+        };
+        if want("kml") {
+            files.push(atomic(&out.join("dsm.kml"), |w| {
+                write_kml(
+                    w,
+                    &geo,
+                    tris,
+                    &KmlStyle {
+                        name: &title,
+                        ..KmlStyle::default()
+                    },
+                )
+            })?);
+        }
+        if want("dae") {
+            files.extend(write_dae(out, &abs, &geo, tris, zone, &title)?);
+        }
+        let dsm = crate::gltf::Dsm {
+            mesh,
+            z: &it.dsm,
+            zone,
+            title: &title,
+        };
+        if want("glb") {
+            let path = out.join("dsm.glb");
+            crate::gltf::write_dsm_glb(&path, &dsm)?;
+            files.push(path);
+        }
+        if want("3dtiles") {
+            let settings = terramesh_mesh::LodSettings::default();
+            crate::gltf::write_dsm_tileset(
+                &out.join("3dtiles"),
+                &s.region.projected,
+                &dsm,
+                &settings,
+            )?;
+            files.push(out.join("3dtiles").join("tileset.json"));
+        }
+        if want("terrain") {
+            let res = m.after.edge.mean;
+            files.push(super::terrain::write(out, &geo, tris, res, &title)?);
+        }
     }
     files.push(atomic(&out.join("dsm-origin.json"), |w| {
         writeln!(
             w,
-            "{{\n  \"x\": {},\n  \"y\": {},\n  \"z\": {},\n  \"crs\": \"EPSG:{}\",\n  \"note\": \"STL coordinates are relative to this origin: add it to get UTM metres\"\n}}",
+            "{{\n  \"x\": {},\n  \"y\": {},\n  \"z\": {},\n  \"crs\": \"{}\",\n  \"note\": \"STL coordinates are relative to this origin: add it to get {} metres\"\n}}",
             origin[0],
             origin[1],
             origin[2],
-            zone.epsg()
+            s.epsg().map_or_else(|| s.crs_name(), |c| format!("EPSG:{c}")),
+            if zone.is_some() { "UTM" } else { "project" }
         )
     })?);
 
@@ -273,7 +297,7 @@ pub fn write_all(
 
     // The DSM grid.
     let (spec, values) = &it.grid;
-    let epsg = u16::try_from(zone.epsg()).ok();
+    let epsg = s.epsg().and_then(|c| u16::try_from(c).ok());
     files.push(atomic(&out.join("dsm.tif"), |w| {
         write_geotiff(w, spec, values, epsg, Some(-9999.0))
     })?);

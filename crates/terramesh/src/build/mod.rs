@@ -178,8 +178,9 @@ fn build_into(
         |m| short_numbers(&m.variogram.to_string()),
     )?;
     let geology = project.geology();
+    let model_crs = crate::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
     let boreholes = match geology {
-        Some(g) => crate::geology::stage::read_boreholes(g, samples.zone)?,
+        Some(g) => crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?,
         None => None,
     };
     let collars = boreholes
@@ -220,7 +221,7 @@ fn build_into(
                     &mesh.mesh,
                     &interp.dsm,
                     &interp.grid.0,
-                    Some(samples.zone.epsg()),
+                    model_crs.as_ref(),
                     out,
                 )
             },

@@ -93,7 +93,10 @@ pub fn write_report(
             header: vec!["setting".into(), "value".into()],
             rows: vec![
                 kv("region", region_text),
-                kv("UTM zone", s.zone.to_string()),
+                match s.zone {
+                    Some(z) => kv("UTM zone", z.to_string()),
+                    None => kv("coordinate reference system", s.crs_name()),
+                },
                 kv("region area (m²)", num(s.region.projected.area(), 1)),
                 kv("elevation source", s.source.clone()),
                 kv(
@@ -157,7 +160,7 @@ pub fn write_report(
     }
     // Table I of the paper, for this region's corners.
     let mut corner_rows = Vec::new();
-    if let Some(geo) = &s.region.geographic {
+    if let (Some(geo), Some(zone)) = (&s.region.geographic, s.zone) {
         for (k, c) in geo
             .polygons
             .iter()
@@ -165,7 +168,7 @@ pub fn write_report(
             .enumerate()
         {
             let (lon, lat) = (c[0], c[1]);
-            let u = to_utm(lat, lon, Some(s.zone)).context("corner")?;
+            let u = to_utm(lat, lon, Some(zone)).context("corner")?;
             corner_rows.push(vec![
                 (k + 1).to_string(),
                 format_dms(lat, Axis::Lat, 2),
@@ -178,10 +181,13 @@ pub fn write_report(
     sections.push(Section {
         heading: "Study area corners".into(),
         blocks: vec![Block::Table {
-            caption: format!(
-                "Coordinates of the corners (WGS-84 and UTM zone {})",
-                s.zone
-            ),
+            caption: match s.zone {
+                Some(z) => format!("Coordinates of the corners (WGS-84 and UTM zone {z})"),
+                None => format!(
+                    "The corners are given in {}: no geographic table",
+                    s.crs_name()
+                ),
+            },
             header: [
                 "point",
                 "latitude",

@@ -16,12 +16,15 @@ use crate::error::{bail, Context, Result};
 use crate::progress::Progress;
 use crate::project::Project;
 
-/// The samples of step 1, in UTM metres.
+/// The samples of step 1, in the project's metres (UTM, or the project's own CRS).
 pub struct Samples {
     /// `[easting, northing, z]`.
     pub xyz: Vec<[f64; 3]>,
-    /// The UTM zone.
-    pub zone: Zone,
+    /// The UTM zone of a geographic project; `None` for a project in its own CRS
+    /// (`[region] crs = "EPSG:..."` or `"projected"`).
+    pub zone: Option<Zone>,
+    /// The project's named CRS (`[region] crs = "EPSG:..."`).
+    pub crs: Option<terramesh_crs::Crs>,
     /// The region, projected and geographic.
     pub region: LoadedRegion,
     /// The source actually used (after the fallback).
@@ -34,11 +37,25 @@ pub struct Samples {
 pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
     let options = p.sample_options(base, &out.join("samples.csv"))?;
     let plan = SamplePlan::resolve(&options)?;
-    let table = acquire(&plan, progress)?;
-    let zone = table.zone.context(
-        "the source is in a projected CRS terramesh does not convert; use a geographic or UTM \
-         source for build",
-    )?;
+    let mut table = acquire(&plan, progress)?;
+    let metres = p.source.z_unit.metres();
+    if metres != 1.0 {
+        for r in &mut table.rows {
+            if let Ok(z) = &mut r.z {
+                *z *= metres;
+            }
+        }
+    }
+    let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
+    let zone = match table.zone {
+        Some(z) if !own_crs => Some(z),
+        _ if own_crs => None,
+        _ => bail!(
+            "the source is in a projected CRS terramesh does not convert; use a geographic or \
+             UTM source for build, or give the project's CRS with [region] crs = \"EPSG:<code>\" \
+             (or \"projected\" when the region and the source share one metric CRS)"
+        ),
+    };
     let region = plan
         .region
         .clone()
@@ -61,10 +78,32 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
     Ok(Samples {
         xyz,
         zone,
+        crs: p.region.crs.crs().cloned(),
         region,
         source: options.source,
         cell,
     })
+}
+
+impl Samples {
+    /// The EPSG code of the project's coordinates (the UTM zone's, or the project CRS's).
+    pub fn epsg(&self) -> Option<u32> {
+        match (&self.zone, &self.crs) {
+            (Some(z), _) => Some(z.epsg()),
+            (None, Some(c)) => c.epsg(),
+            (None, None) => None,
+        }
+    }
+
+    /// The project's CRS in words: `WGS 84 / UTM zone 32N`, `EPSG:28992`, or that it is the
+    /// inputs' own unnamed metric CRS.
+    pub fn crs_name(&self) -> String {
+        match (&self.zone, &self.crs) {
+            (Some(z), _) => format!("WGS 84 / UTM zone {z}"),
+            (None, Some(c)) => c.to_string(),
+            (None, None) => "the inputs' own projected CRS (unnamed)".into(),
+        }
+    }
 }
 
 fn grid_cell(xyz: &[[f64; 3]], rows: usize, cols: usize, spacing: Option<f64>) -> [f64; 2] {

@@ -129,7 +129,7 @@ pub fn scene(s: &Samples, m: &Meshed, it: &Interpolated, base: f64) -> Result<Sc
         clipped: true,
     };
     Ok(Scene {
-        crs: format!("WGS 84 / UTM zone {}", s.zone),
+        crs: s.crs_name(),
         note: (!notes.is_empty()).then(|| notes.join(" ")),
         layers: vec![surface, solid, samples],
     })

@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use terramesh_core::coords::{to_utm, Zone};
+use terramesh_crs::{Crs, Transformer};
 use terramesh_geology::Layering;
 use terramesh_io::boreholes::Boreholes;
 use terramesh_io::grid_write::{write_geotiff, RasterGrid};
@@ -33,12 +34,39 @@ pub struct ModelBuilt {
     pub files: Vec<PathBuf>,
 }
 
-/// Reads the boreholes of `g`, projecting geographic collars into `zone`.
-pub fn read_boreholes(g: &GeologySettings, zone: Zone) -> Result<Option<Boreholes>> {
+/// The project's CRS for the model: the UTM zone of a geographic project, or the named CRS
+/// of `[region] crs = "EPSG:..."` (`None` for `crs = "projected"`).
+pub fn project_crs(zone: Option<Zone>, crs: Option<&Crs>) -> Result<Option<Crs>> {
+    match (crs, zone) {
+        (Some(c), _) => Ok(Some(c.clone())),
+        (None, Some(z)) => Ok(Some(Crs::from_epsg(z.epsg())?)),
+        (None, None) => Ok(None),
+    }
+}
+
+/// Reads the boreholes of `g`, projecting geographic collars into the project's CRS (the UTM
+/// zone, or the named CRS; a `crs = "projected"` project takes `x,y` collars only).
+pub fn read_boreholes(
+    g: &GeologySettings,
+    zone: Option<Zone>,
+    crs: Option<&Crs>,
+) -> Result<Option<Boreholes>> {
+    let to_crs = match (zone, crs) {
+        (None, Some(c)) => Some(Transformer::new(&Crs::wgs84(), c)?),
+        _ => None,
+    };
     let project = move |lat: f64, lon: f64| -> std::result::Result<[f64; 2], String> {
-        to_utm(lat, lon, Some(zone))
-            .map(|p| [p.easting, p.northing])
-            .map_err(|e| e.to_string())
+        match (zone, &to_crs) {
+            (Some(z), _) => to_utm(lat, lon, Some(z))
+                .map(|p| [p.easting, p.northing])
+                .map_err(|e| e.to_string()),
+            (None, Some(t)) => t.transform(lon, lat).map_err(|e| e.to_string()),
+            (None, None) => Err(
+                "a project with [region] crs = \"projected\" takes collars as hole,x,y,z in its \
+                 own coordinates; name the CRS (crs = \"EPSG:...\") to use lat,lon collars"
+                    .into(),
+            ),
+        }
     };
     g.read_boreholes(Some(&project))
 }
@@ -51,7 +79,7 @@ pub fn collar_points(b: &Boreholes) -> Vec<[f64; 2]> {
 
 /// Builds and writes the model of `g` on `mesh` (the DSM's planar mesh) under `dsm` (its
 /// vertex elevations), into `out`. `grid` is the DSM grid's layout, reused for the
-/// interface grids; `epsg` the project's CRS code.
+/// interface grids; `crs` the project's CRS ([`project_crs`]).
 #[allow(clippy::too_many_arguments)]
 pub fn run(
     p: &Project,
@@ -60,16 +88,18 @@ pub fn run(
     mesh: &Mesh,
     dsm: &[f64],
     grid: &RasterGrid,
-    epsg: Option<u32>,
+    crs: Option<&Crs>,
     out: &Path,
 ) -> Result<ModelBuilt> {
+    let epsg = crs.and_then(Crs::epsg);
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
-    let crs = match epsg {
-        Some(e) => terramesh_crs::Crs::parse(&format!("EPSG:{e}"))
-            .map_err(|e| Error::invalid(format!("the project's CRS: {e}")))?,
-        None => bail!("horizon grids need a project CRS to be placed in"),
+    let grid_crs = || match crs {
+        Some(c) => Ok(c),
+        None => Err(Error::invalid(
+            "horizon grids need the project's CRS to be placed in: name it with [region] \
+             crs = \"EPSG:...\"",
+        )),
     };
-    let crs = &crs;
     let mut grids = Vec::new();
     for (unit, path) in g.surfaces.iter().enumerate() {
         let Some(path) = path else { continue };
@@ -80,12 +110,17 @@ pub fn run(
                 g.units[0]
             );
         }
-        grids.push((unit, horizon_at(path, &xy, g.z_unit, crs, &g.units[unit])?));
+        grids.push((
+            unit,
+            horizon_at(path, &xy, g.z_unit, grid_crs()?, &g.units[unit])?,
+        ));
     }
     let base = match &g.base {
         BaseKey::Auto => Base::Auto,
         BaseKey::Elevation(z) => Base::Elevation(*z),
-        BaseKey::Raster(path) => Base::PerVertex(horizon_at(path, &xy, g.z_unit, crs, "the base")?),
+        BaseKey::Raster(path) => {
+            Base::PerVertex(horizon_at(path, &xy, g.z_unit, grid_crs()?, "the base")?)
+        }
     };
     let inputs = ModelInputs {
         boreholes: boreholes.as_ref(),
@@ -99,7 +134,11 @@ pub fn run(
         method: terramesh_geostat::Method::Universal(p.interpolation.drift),
     };
     let model = assemble(mesh, dsm, &inputs).context("[geology]")?;
-    let crs_name = epsg.map_or_else(|| "projected".to_string(), |e| format!("EPSG:{e}"));
+    let crs_name = match (epsg, crs) {
+        (Some(e), _) => format!("EPSG:{e}"),
+        (None, Some(c)) => c.definition().to_string(),
+        (None, None) => "projected".to_string(),
+    };
     let mut files: Vec<PathBuf> = write_model(
         out,
         &model.mesh,
@@ -148,7 +187,7 @@ fn horizon_at(
     path: &Path,
     xy: &[[f64; 2]],
     z_unit: terramesh_core::volume::ZUnit,
-    crs: &terramesh_crs::Crs,
+    crs: &Crs,
     what: &str,
 ) -> Result<Vec<f64>> {
     let grid = crate::horizon::HorizonGrid::open(path, z_unit)?;

@@ -66,7 +66,8 @@ impl Project {
             ),
             None => None,
         };
-        o.region_crs = self.region.crs;
+        o.region_crs = self.region.crs.region_crs();
+        o.project_crs = self.region.crs.crs().cloned();
         let s = &self.sampling;
         match s.spacing {
             Some(sp) => o.spacing = Some(sp),

@@ -4,10 +4,12 @@
 //! overrides a key from the command line (`--set mesh.min_angle=32`).
 
 mod check;
+mod crs;
 mod geology;
 mod lower;
 mod parse;
 
+pub use crs::ProjectCrs;
 pub use geology::{
     Base, BaseSpec, GeologySection, GeologySettings, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS,
     GEOLOGY_TEMPLATE, MAX_LAYERS,
@@ -20,7 +22,6 @@ use serde::Deserialize;
 use terramesh_core::sampling::Kernel;
 use terramesh_geostat::{Drift, InterpolationMethod, ModelKind, DEFAULT_IDW_POWER};
 use terramesh_io::export::{Format, DEFAULT_FORMATS};
-use terramesh_io::region::RegionCrs;
 use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
 /// A whole project.
@@ -79,9 +80,9 @@ pub struct RegionSection {
     pub file: Option<PathBuf>,
     /// UTM zone such as `32N` (default: the zone of the region's centre).
     pub zone: Option<String>,
-    /// `geographic` (default) or `projected`.
+    /// `geographic` (default), `projected`, or a projected CRS `EPSG:<code>` ([`ProjectCrs`]).
     #[serde(default)]
-    pub crs: RegionCrs,
+    pub crs: ProjectCrs,
 }
 
 /// `[source]`: where elevations come from.
@@ -94,6 +95,10 @@ pub struct SourceSection {
     pub fallback: Option<String>,
     /// LAS/LAZ classification to keep (2 = ground).
     pub class: Option<u8>,
+    /// The unit of the source's elevations (`m`, `ft`, `us-ft`), converted to metres by
+    /// `build` (default metres).
+    #[serde(default)]
+    pub z_unit: terramesh_core::volume::ZUnit,
 }
 
 /// `[sampling]`: the grid of the paper's step 1.
