@@ -51,16 +51,22 @@ pub fn read_boreholes(
     zone: Option<Zone>,
     crs: Option<&Crs>,
 ) -> Result<Option<Boreholes>> {
-    let to_crs = match (zone, crs) {
-        (None, Some(c)) => Some(Transformer::new(&Crs::wgs84(), c)?),
-        _ => None,
-    };
+    // Made on the first geographic collar only: x,y collars need no transformation (and a
+    // CRS on a grid-shifted datum, NAD27, has none from WGS 84).
+    let to_crs: std::sync::OnceLock<std::result::Result<Transformer, String>> =
+        std::sync::OnceLock::new();
+    let to_crs = &to_crs;
     let project = move |lat: f64, lon: f64| -> std::result::Result<[f64; 2], String> {
-        match (zone, &to_crs) {
+        match (zone, crs) {
             (Some(z), _) => to_utm(lat, lon, Some(z))
                 .map(|p| [p.easting, p.northing])
                 .map_err(|e| e.to_string()),
-            (None, Some(t)) => t.transform(lon, lat).map_err(|e| e.to_string()),
+            (None, Some(c)) => to_crs
+                .get_or_init(|| Transformer::new(&Crs::wgs84(), c).map_err(|e| e.to_string()))
+                .as_ref()
+                .map_err(|e| e.clone())?
+                .transform(lon, lat)
+                .map_err(|e| e.to_string()),
             (None, None) => Err(
                 "a project with [region] crs = \"projected\" takes collars as hole,x,y,z in its \
                  own coordinates; name the CRS (crs = \"EPSG:...\") to use lat,lon collars"
