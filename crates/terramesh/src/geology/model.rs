@@ -64,7 +64,9 @@ pub struct ModelInputs<'a> {
     pub boreholes: Option<&'a Boreholes>,
     /// Unit tops given by horizon grids, sampled at the planar vertices: `(unit, values)`,
     /// `unit` >= 1 (the first unit's top is the terrain). They take the place of the
-    /// boreholes for that unit; the boreholes' contacts are then only compared with it.
+    /// boreholes for that unit; the boreholes' contacts are then only compared with it. NaN is
+    /// the grid's nodata: the unit is absent there (zero thickness, its top the next top below,
+    /// or the base).
     pub grids: Vec<(usize, Vec<f64>)>,
     /// The base.
     pub base: Base,
@@ -145,6 +147,18 @@ pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<Ge
                 let f = field_of(unit, obs)?;
                 tops.push(f.values.clone());
                 fields.push(f);
+            }
+            // A grid's nodata: the unit is absent there, its top is the next top below.
+            for k in (0..tops.len()).rev() {
+                for v in 0..xy.len() {
+                    if tops[k][v].is_nan() {
+                        tops[k][v] = if k + 1 < tops.len() {
+                            tops[k + 1][v]
+                        } else {
+                            base[v]
+                        };
+                    }
+                }
             }
             let raw = RawSurfaces {
                 terrain: terrain.to_vec(),

@@ -116,16 +116,28 @@ pub fn run(
                 g.units[0]
             );
         }
+        let values = horizon_at(path, &xy, g.z_unit, grid_crs()?, &g.units[unit])?;
+        // Nodata: the unit is absent there (model.rs takes the next top below).
         grids.push((
             unit,
-            horizon_at(path, &xy, g.z_unit, grid_crs()?, &g.units[unit])?,
+            values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
         ));
     }
     let base = match &g.base {
         BaseKey::Auto => Base::Auto,
         BaseKey::Elevation(z) => Base::Elevation(*z),
         BaseKey::Raster(path) => {
-            Base::PerVertex(horizon_at(path, &xy, g.z_unit, grid_crs()?, "the base")?)
+            let v = horizon_at(path, &xy, g.z_unit, grid_crs()?, "the base")?;
+            match v.iter().position(Option::is_none) {
+                Some(i) => bail!(
+                    "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of the model's \
+                     mesh: a base grid must cover the whole region",
+                    path.display(),
+                    xy[i][0],
+                    xy[i][1]
+                ),
+                None => Base::PerVertex(v.into_iter().flatten().collect()),
+            }
         }
     };
     let inputs = ModelInputs {
@@ -187,31 +199,16 @@ fn write_atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>)
     Ok(())
 }
 
-/// A horizon grid sampled at the planar vertices (project CRS `crs`), converted to metres.
-/// A vertex on a nodata pixel is an error: the grid must cover the whole region.
+/// A horizon grid sampled at the planar vertices (project CRS `crs`), converted to metres;
+/// `None` on a nodata pixel. A vertex outside the grid is an error naming it.
 fn horizon_at(
     path: &Path,
     xy: &[[f64; 2]],
     z_unit: terramesh_core::volume::ZUnit,
     crs: &Crs,
     what: &str,
-) -> Result<Vec<f64>> {
+) -> Result<Vec<Option<f64>>> {
     let grid = crate::horizon::HorizonGrid::open(path, z_unit)?;
-    let values = grid.evaluate(xy, crs)?;
-    values
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            v.ok_or_else(|| {
-                Error::invalid(format!(
-                    "{}: the grid of {what} has no value at ({:.1}, {:.1}), a vertex of the \
-                     model's mesh: a horizon grid must cover the whole region (fill its voids \
-                     or shrink the region)",
-                    path.display(),
-                    xy[i][0],
-                    xy[i][1]
-                ))
-            })
-        })
-        .collect()
+    grid.evaluate(xy, crs)
+        .with_context(|| format!("the grid of {what}"))
 }
