@@ -31,7 +31,7 @@ enum Command {
     Init(cmd::init::Args),
     /// Build the whole DSM of a project: samples, mesh, kriging, exports, pictures, report.
     Build(cmd::build::Args),
-    /// Build only the sealed geological model of a project with [geology]: volume mesh,
+    /// Build only the sealed geological model of a project with `[geology]`: volume mesh,
     /// boundary meshes, Gmsh, FLAC3D, unit bodies, interface grids, model.json.
     Model(cmd::model::Args),
     /// Experimental semivariogram and a fitted model (JSON, optional SVG chart).

@@ -18,7 +18,7 @@ pub struct Args {
     /// Overwrite an existing terramesh.toml.
     #[arg(long)]
     force: bool,
-    /// Add a commented [geology] section: boreholes, the stratigraphic column and the
+    /// Add a commented `[geology]` section: boreholes, the stratigraphic column and the
     /// settings of the geological model.
     #[arg(long)]
     geology: bool,

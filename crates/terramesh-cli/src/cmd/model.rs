@@ -9,7 +9,7 @@ use terramesh::project::Project;
 
 use crate::progress::Terminal;
 
-/// Build only the sealed geological model of a project with a [geology] section: model.vtu
+/// Build only the sealed geological model of a project with a `[geology]` section: model.vtu
 /// and its OpenGeoSys boundary meshes, model.msh, model.f3grid, the unit bodies, the
 /// interface grids and model.json (the DSM is made in memory, as build makes it).
 #[derive(clap::Args, Debug)]
@@ -17,7 +17,7 @@ use crate::progress::Terminal;
     terramesh model examples/kimberlina/terramesh.toml -o out/\n  \
     terramesh model site.toml -o out/ --set geology.element=tetra --set geology.min_thickness=1")]
 pub struct Args {
-    /// The project file (terramesh.toml with a [geology] section; `terramesh init --geology`).
+    /// The project file (terramesh.toml with a `[geology]` section; `terramesh init --geology`).
     project: PathBuf,
     /// Output directory (created if needed).
     #[arg(short, long)]
