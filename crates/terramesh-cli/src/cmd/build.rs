@@ -30,15 +30,42 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
+    run_project(
+        &args.project,
+        &args.output,
+        &args.set,
+        args.quiet,
+        terramesh::build::build,
+        "built",
+    )
+}
+
+/// A build function of the library (`build`, `build_model`).
+pub(crate) type Pipeline = fn(
+    &Project,
+    &Path,
+    &Path,
+    &dyn terramesh::progress::Progress,
+) -> terramesh::Result<terramesh::build::Built>;
+
+/// Loads `project` with its `--set`s and runs `pipeline` into `output` with a progress bar,
+/// then prints `done` and the time.
+pub(crate) fn run_project(
+    project: &Path,
+    output: &Path,
+    set: &[String],
+    quiet: bool,
+    pipeline: Pipeline,
+    done: &str,
+) -> Result<()> {
     let t0 = Instant::now();
-    let project = Project::load(&args.project, &args.set).map_err(crate::project_error)?;
-    let base = args.project.parent().unwrap_or(Path::new("."));
-    let progress = Terminal::new(args.quiet, true);
-    terramesh::build::build(&project, base, &args.output, &progress)
-        .map_err(crate::project_error)?;
+    let p = Project::load(project, set).map_err(crate::project_error)?;
+    let base = project.parent().unwrap_or(Path::new("."));
+    let progress = Terminal::new(quiet, true);
+    pipeline(&p, base, output, &progress).map_err(crate::project_error)?;
     progress.finish(&format!(
-        "built {} in {:.2} s",
-        args.output.display(),
+        "{done} {} in {:.2} s",
+        output.display(),
         t0.elapsed().as_secs_f64()
     ));
     Ok(())

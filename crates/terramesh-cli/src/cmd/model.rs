@@ -1,13 +1,9 @@
 //! `terramesh model`: only the sealed geological model of a project with `[geology]`
 //! ([`terramesh::build::build_model`]).
 
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::PathBuf;
 
 use anyhow::Result;
-use terramesh::project::Project;
-
-use crate::progress::Terminal;
 
 /// Build only the sealed geological model of a project with a `[geology]` section: model.vtu
 /// and its OpenGeoSys boundary meshes, model.msh, model.f3grid, the unit bodies, the
@@ -32,16 +28,12 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let t0 = Instant::now();
-    let project = Project::load(&args.project, &args.set).map_err(crate::project_error)?;
-    let base = args.project.parent().unwrap_or(Path::new("."));
-    let progress = Terminal::new(args.quiet, true);
-    terramesh::build::build_model(&project, base, &args.output, &progress)
-        .map_err(crate::project_error)?;
-    progress.finish(&format!(
-        "built the model into {} in {:.2} s",
-        args.output.display(),
-        t0.elapsed().as_secs_f64()
-    ));
-    Ok(())
+    super::build::run_project(
+        &args.project,
+        &args.output,
+        &args.set,
+        args.quiet,
+        terramesh::build::build_model,
+        "built the model into",
+    )
 }
