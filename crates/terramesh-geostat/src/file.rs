@@ -114,6 +114,18 @@ impl From<&Candidate> for CandidateSummary {
     }
 }
 
+/// A JSON syntax error as "line L, column C: what" (serde_json puts the position last).
+fn json_error(e: &serde_json::Error) -> String {
+    let full = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let what = if e.is_eof() {
+        "the text ends before the JSON does (a truncated file?)"
+    } else {
+        full.strip_suffix(&suffix).unwrap_or(&full)
+    };
+    format!("line {}, column {}: {what}", e.line(), e.column())
+}
+
 /// Why a text is not a variogram file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -156,7 +168,7 @@ impl VariogramFile {
     /// Reads a variogram file; the model is validated ([`Variogram::validate`]).
     pub fn from_json(text: &str) -> Result<VariogramFile, VariogramFileError> {
         let json: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| VariogramFileError::NotJson(e.to_string()))?;
+            serde_json::from_str(text).map_err(|e| VariogramFileError::NotJson(json_error(&e)))?;
         let serde_json::Value::Object(mut map) = json else {
             return Err(VariogramFileError::NoModel);
         };

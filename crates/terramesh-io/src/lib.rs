@@ -36,4 +36,5 @@ pub mod region;
 pub mod report;
 pub mod scratch;
 pub mod table;
+pub mod text;
 pub mod viewer;

@@ -21,7 +21,7 @@ use crate::error::{Context, Error, Result};
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn read_variogram_file(path: &Path) -> Result<Variogram> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let text = terramesh_io::text::read_text(path).with_context(|| path.display().to_string())?;
     match VariogramFile::from_json(&text) {
         Ok(f) => Ok(f.model),
         Err(e @ VariogramFileError::NoModel) => Err(Error::invalid(format!(

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use terramesh::project::Project;
+use terramesh_io::region::CORNER_LIST;
 
 use crate::progress::Terminal;
 
@@ -62,11 +63,28 @@ pub(crate) fn run_project(
     let p = Project::load(project, set).map_err(crate::project_error)?;
     let base = project.parent().unwrap_or(Path::new("."));
     let progress = Terminal::new(quiet, true);
-    pipeline(&p, base, output, &progress).map_err(crate::project_error)?;
+    pipeline(&p, base, output, &progress).map_err(|e| build_error(project, e))?;
     progress.finish(&format!(
         "{done} {} in {:.2} s",
         output.display(),
         t0.elapsed().as_secs_f64()
     ));
     Ok(())
+}
+
+/// A build's error, worded with project keys and said of the project file: a build error is
+/// about the file the user wrote, so it names it first (unless the message already does), and
+/// the inline corner list the library calls [`CORNER_LIST`] is the key `region.corners`.
+fn build_error(project: &Path, e: terramesh::Error) -> anyhow::Error {
+    let msg = e.render(&terramesh::project::key_of);
+    let msg = match msg.strip_prefix(CORNER_LIST) {
+        Some(rest) => format!("region.corners{rest}"),
+        None => msg,
+    };
+    let name = project.display().to_string();
+    if msg.contains(&name) {
+        anyhow::anyhow!(msg)
+    } else {
+        anyhow::anyhow!("{name}: {msg}")
+    }
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use terramesh::mesh::{adaptive_dem, mesh_region, read_points, DemHeights, MeshSettings};
 use terramesh_core::coords::Zone;
 use terramesh_io::export::{write_mesh, writer_for, MeshView};
@@ -118,9 +118,25 @@ pub fn run(args: Args) -> Result<()> {
             None => Vec::new(),
         },
     };
-    let m = mesh_region(&region, &settings).map_err(error)?;
+    let m = mesh_region(&region, &settings)
+        .map_err(error)
+        .with_context(|| region_context(&input, &region))?;
     let view = MeshView::planar(m.mesh.origin, &m.mesh.points, &m.mesh.triangles);
     write_and_say(&args.output, &view, m.summary(&region))
+}
+
+/// What a meshing error is about: the region's file (or corners) and its size, so that a
+/// region far larger than meant (a damaged coordinate) shows at once.
+fn region_context(input: &RegionInput, region: &terramesh_io::region::LoadedRegion) -> String {
+    let what = match input {
+        RegionInput::File(p) => format!("the region of {}", p.display()),
+        _ => "the region of --corners".to_string(),
+    };
+    let zone = region
+        .zone
+        .map(|z| format!(" in UTM zone {z}"))
+        .unwrap_or_default();
+    format!("{what} ({:.4e} m2{zone})", region.projected.area())
 }
 
 /// A library error in this command's words: mesh settings and DEM paths as flags.

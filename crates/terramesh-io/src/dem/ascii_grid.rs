@@ -23,7 +23,7 @@ fn offset_of(text: &str, line: &str) -> usize {
 /// # Ok(()) }
 /// ```
 pub fn read_ascii_grid(path: &Path) -> Result<Raster, DemError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DemError::io(path, e))?;
+    let text = crate::text::read_text(path).map_err(|e| DemError::io(path, e))?;
     let fmt = |line: usize, m: String| DemError::format(path, format!("line {line}: {m}"));
     let mut lines = text.lines().enumerate().peekable();
     let (mut ncols, mut nrows, mut cell, mut nodata) = (None, None, None, None);

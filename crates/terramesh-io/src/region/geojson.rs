@@ -16,8 +16,18 @@ use terramesh_core::geometry::{Polygon, Region};
 /// ```
 pub fn parse_geojson(text: &str) -> Result<Region, String> {
     let v: Value = serde_json::from_str(text).map_err(|e| {
+        // serde_json ends its message with the position: say it once, first
+        let full = e.to_string();
+        let what = full
+            .strip_suffix(&format!(" at line {} column {}", e.line(), e.column()))
+            .unwrap_or(&full);
+        let what = if e.is_eof() {
+            "the text ends before the JSON does (a truncated file?)"
+        } else {
+            what
+        };
         format!(
-            "not valid JSON at line {}, column {}: {e}",
+            "not valid JSON at line {}, column {}: {what}",
             e.line(),
             e.column()
         )

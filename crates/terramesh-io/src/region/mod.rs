@@ -230,7 +230,7 @@ fn project_named(
 /// ```
 pub fn read_region_file(path: &Path) -> Result<Region, RegionError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| RegionError::Io {
+    let text = crate::text::read_text(path).map_err(|source| RegionError::Io {
         file: name.clone(),
         source,
     })?;

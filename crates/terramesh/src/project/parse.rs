@@ -69,7 +69,7 @@ fn key_at_line(text: &str, line: usize) -> Option<String> {
 impl Project {
     /// Reads a project file, applying `KEY=VALUE` overrides (`terramesh build --set`).
     pub fn load(path: &Path, sets: &[String]) -> Result<Project> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Project {
+        let text = terramesh_io::text::read_text(path).map_err(|e| Error::Project {
             file: path.display().to_string(),
             line: None,
             why: format!("cannot read the project file: {e}"),
@@ -284,11 +284,21 @@ fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), String
 }
 
 fn one_line(s: &str) -> String {
-    s.lines()
+    let msg = s
+        .lines()
         .map(str::trim)
         .filter(|l| !l.is_empty() && *l != "|")
         .collect::<Vec<_>>()
-        .join(" ")
+        .join("; ");
+    // the toml crate says nothing of an array or string left open at the end of the file, and
+    // only "expected `.`, `=`" of a key without a value
+    if msg.is_empty() {
+        "the file ends before this value does (a truncated file?)".to_string()
+    } else if msg == "expected `.`, `=`" {
+        "expected `.` or `=`: write KEY = VALUE (a truncated line?)".to_string()
+    } else {
+        msg
+    }
 }
 
 #[cfg(test)]
@@ -304,6 +314,26 @@ mod tests {
         assert_eq!(p.sampling.cols, 50);
         assert_eq!(p.mesh.min_angle, 30.0);
         assert_eq!(p.interpolation.methods, crate::project::DEFAULT_METHODS);
+    }
+
+    #[test]
+    fn a_truncated_project_says_what_is_missing() {
+        let e = |text: &str| Project::parse("t.toml", text, &[]).unwrap_err().to_string();
+        let open = e("title = \"x\"\n[export]\nformats = ");
+        assert!(
+            open.contains("the file ends before this value does"),
+            "{open}"
+        );
+        let key = e("title = \"x\"\n[mesh]\nmin_an");
+        assert!(
+            key.ends_with("expected `.` or `=`: write KEY = VALUE (a truncated line?)"),
+            "{key}"
+        );
+        let header = e("[mesh] x\n");
+        assert!(
+            header.contains("invalid table header; expected newline"),
+            "{header}"
+        );
     }
 
     #[test]
