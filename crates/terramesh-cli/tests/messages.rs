@@ -159,3 +159,36 @@ fn a_huge_value_is_cut_in_the_message() {
     assert!(err.len() < 1000, "{} bytes", err.len());
     assert!(err.contains("(100005 characters)"), "{err}");
 }
+
+#[test]
+fn a_mesh_error_names_the_region_file_and_its_size() {
+    // latitude 0 for 48.726 (a damaged digit): a sliver from the equator to 48.7 N
+    let dir = tempfile::tempdir().unwrap();
+    let kml = dir.path().join("big.kml");
+    std::fs::write(
+        &kml,
+        "<kml xmlns=\"http://www.opengis.net/kml/2.2\"><Placemark><Polygon><outerBoundaryIs>\
+         <LinearRing><coordinates>7.33,48.72 7.34,48.72 7.345,0 7.34,48.73 7.33,48.73 \
+         7.33,48.72</coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark></kml>",
+    )
+    .unwrap();
+    let out = dir.path().join("m.vtu");
+    let err = terramesh(&[
+        "mesh",
+        "--region",
+        kml.to_str().unwrap(),
+        "--max-area",
+        "20000",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        err.contains("the region of ") && err.contains("big.kml ("),
+        "{err}"
+    );
+    assert!(
+        err.contains("m2 in UTM zone 32N): refinement reached its cap"),
+        "{err}"
+    );
+    assert!(err.contains("raise --max-vertices"), "{err}");
+}
