@@ -58,7 +58,7 @@ max_area = 400.0
 [interpolation]
 methods = ["uk", "idw"]
 [export]
-formats = ["vtu"]
+formats = ["vtu", "glb"]
 pictures = false
 report = false
 [geology]
@@ -133,6 +133,7 @@ fn model_command_writes_a_sealed_model_that_passes_the_independent_checks() {
         "unit-clay.stl",
         "interfaces/gravel.tif",
         "model.json",
+        "model.glb",
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
