@@ -34,6 +34,7 @@ import check_collada
 import check_model
 import check_model_glb
 import check_gltf
+import check_py3dtiles
 import check_viewer
 import check_programs
 import check_terrain
@@ -457,6 +458,7 @@ CHECKS = [
     ("kml geometry", check_kml_geometry),
     *check_collada.CHECKS,
     *check_gltf.CHECKS,
+    *check_py3dtiles.CHECKS,
     *check_terrain.CHECKS,
     ("solid stl: watertight, volume", check_solid_stl),
     ("solid msh: watertight, volume", check_solid_msh),

@@ -128,7 +128,7 @@ fn report_viewer_shows_the_geological_units() {
         );
     }
     assert!(
-        html.contains("model-view3d"),
+        html.contains("The stacked unit bodies"),
         "the still 3D view of the stacked bodies"
     );
     browser_test(

@@ -67,6 +67,9 @@ pub(crate) fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]
     (out, t)
 }
 
+/// One body's unit, vertices, triangles and vertex colours.
+type BodyArrays = (usize, Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<[f32; 3]>);
+
 /// Writes `model.glb` atomically at `path`: one named mesh (and node) per sealed body of
 /// `model` (its unit's name), with the body's own triangles (closed, oriented outward) and
 /// vertices, float32 relative to the origin (the centre of the model's bounding box at its
@@ -99,7 +102,7 @@ pub fn write_model_glb(path: &Path, model: &VolumeMesh, frame: &GlbFrame) -> Res
     if model.bodies.is_empty() {
         bail!("{}: the model has no unit with volume", path.display());
     }
-    let parts: Vec<(usize, Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<[f32; 3]>)> = model
+    let parts: Vec<BodyArrays> = model
         .bodies
         .iter()
         .map(|b| {
