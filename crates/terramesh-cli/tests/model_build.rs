@@ -120,6 +120,19 @@ fn build_with_geology_writes_the_dsm_and_the_model() {
         "geology.element=tetra",
     ]);
     assert!(out.join("dsm.vtu").is_file() && out.join("model.vtu").is_file());
+    // Every output names the datum of its heights: the DSM's own (EGM96, a geographic project).
+    let origin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("dsm-origin.json")).unwrap())
+            .unwrap();
+    assert_eq!(origin["vertical_datum"], "egm96", "{origin}");
+    let glb = std::fs::read(out.join("model.glb")).unwrap();
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    assert_eq!(
+        doc["asset"]["extras"]["vertical_datum"], "egm96",
+        "{}",
+        doc["asset"]
+    );
     check_model(&out);
 }
 
