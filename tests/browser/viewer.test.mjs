@@ -18,6 +18,8 @@ import { pathToFileURL } from "node:url";
 const args = process.argv.slice(2);
 const report = args[0];
 const shotDir = args.includes("--screenshots") ? args[args.indexOf("--screenshots") + 1] : null;
+// File names of the screenshots start with this (e.g. "viewer-model-" for a geological model).
+const shotPrefix = args.includes("--prefix") ? args[args.indexOf("--prefix") + 1] : "viewer-";
 if (!report || !existsSync(report)) {
   console.error(`usage: node viewer.test.mjs OUT/report.html [--screenshots DIR] (no file ${report})`);
   process.exit(2);
@@ -142,8 +144,9 @@ try {
   async function shot(name) {
     if (!shotDir) return;
     mkdirSync(shotDir, { recursive: true });
-    await page.locator("#tmv").screenshot({ path: join(shotDir, name) });
-    ok(`screenshot ${join(shotDir, name)}`);
+    const file = join(shotDir, name.replace(/^viewer-/, shotPrefix));
+    await page.locator("#tmv").screenshot({ path: file });
+    ok(`screenshot ${file}`);
   }
 
   const first = await snapshot("first");
@@ -194,23 +197,79 @@ try {
   if (exag !== "4" || dExag < 0.02) fail(`the exaggeration slider (now ${exag}) changed ${(100 * dExag).toFixed(2)} % of the pixels`);
   ok(`vertical exaggeration ${exag}x changed ${(100 * dExag).toFixed(1)} % of the pixels`);
 
-  // Hiding the solid layer.
+  // Hiding each geological unit (a project with [geology]): the unit with the most pixels of
+  // its colour in view, then every other unit, each changes the picture and removes its colour.
+  // The DSM surface (whose colours may be shades of a unit's) is hidden meanwhile.
+  const units = scene.layers.filter((l) => l.name.startsWith("unit "));
+  if (units.length) {
+    const dsmInput = page.locator(`input[data-layer="${scene.layers[0].name}"]`);
+    await dsmInput.uncheck();
+    const noDsm = await snapshot("noDsm");
+    let best = null;
+    for (const u of units) {
+      const n = await countShade(noDsm, u.colour);
+      if (!best || n > best.n) best = { u, n };
+    }
+    for (const u of [best.u, ...units.filter((x) => x !== best.u)]) {
+      const before = await countShade(noDsm, u.colour);
+      const input = page.locator(`input[data-layer="${u.name}"]`);
+      await input.uncheck();
+      const hidden = await snapshot(`hidden-${u.name}`);
+      const d = await changed(noDsm, hidden);
+      const after = await countShade(hidden, u.colour);
+      if (u === best.u && (d < 0.005 || before < 500 || after > 0.1 * before)) {
+        fail(`hiding "${u.name}" changed ${(100 * d).toFixed(2)} % of the pixels; its pixels ${before} -> ${after}`);
+      }
+      // (The palette repeats after 12 units: a colour shared with another unit is not checked.)
+      const unique = units.filter((x) => x.colour.join() === u.colour.join()).length === 1;
+      if (unique && before >= 500 && after > 0.1 * before) fail(`hiding "${u.name}" left ${after} of its ${before} pixels`);
+      if (u === best.u) ok(`hiding "${u.name}" changed ${(100 * d).toFixed(1)} % of the pixels; its pixels ${before} -> ${after}`);
+      await input.check();
+    }
+    ok(`hiding any of the ${units.length} units removes its colour from the picture`);
+    await dsmInput.check();
+    const unitsBack = await snapshot("unitsBack");
+    if (await changed(exaggerated, unitsBack) > 0.001) fail("showing the units again did not restore the picture");
+    const holes = scene.layers.find((l) => l.name.startsWith("boreholes"));
+    if (!holes || holes.vertices < 2) fail("the scene has no borehole points");
+    ok(`${holes.name}: ${holes.vertices} points`);
+    if (shotDir) {
+      await page.click("#tmv-reset");
+      await snapshot("unitsReset");
+      await shot("viewer-units.png");
+    }
+  }
+
+  // Hiding the solid layer (shown at first unless the geological units fill it: then it is
+  // shown in their place for this check, and the units come back after it).
   const solidLayer = scene.layers.find((l) => l.name.startsWith("solid"));
   if (!solidLayer) fail("the scene has no solid layer");
+  const solidInput = page.locator(`input[data-layer="${solidLayer.name}"]`);
+  let solidBase = exaggerated;
+  if (!solidLayer.visible) {
+    await solidInput.check();
+    for (const u of units) await page.locator(`input[data-layer="${u.name}"]`).uncheck();
+    solidBase = await snapshot("solidBase");
+  }
   const solidRgb = solidLayer.colour;
-  const withSolid = await countShade(exaggerated, solidRgb);
-  await page.locator(`input[data-layer="${solidLayer.name}"]`).uncheck();
+  const withSolid = await countShade(solidBase, solidRgb);
+  await solidInput.uncheck();
   const noSolid = await snapshot("noSolid");
-  const dSolid = await changed(exaggerated, noSolid);
+  const dSolid = await changed(solidBase, noSolid);
   const withoutSolid = await countShade(noSolid, solidRgb);
   if (dSolid < 0.005 || withSolid < 500 || withoutSolid > 0.1 * withSolid) {
     fail(`hiding "${solidLayer.name}" changed ${(100 * dSolid).toFixed(2)} % of the pixels; solid-coloured pixels ${withSolid} -> ${withoutSolid}`);
   }
   ok(`hiding "${solidLayer.name}" changed ${(100 * dSolid).toFixed(1)} % of the pixels; solid-coloured pixels ${withSolid} -> ${withoutSolid}`);
-  await page.locator(`input[data-layer="${solidLayer.name}"]`).check();
-  const solidBack = await snapshot("solidBack");
-  if (await changed(exaggerated, solidBack) > 0.001) fail("showing the solid again did not restore the picture");
+  await solidInput.check();
+  let solidBack = await snapshot("solidBack");
+  if (await changed(solidBase, solidBack) > 0.001) fail("showing the solid again did not restore the picture");
   ok("showing the solid again restores the picture");
+  if (!solidLayer.visible) {
+    await solidInput.uncheck();
+    for (const u of units) await page.locator(`input[data-layer="${u.name}"]`).check();
+    solidBack = await snapshot("solidBack2");
+  }
 
   // Colour by the other fields.
   let prev = solidBack;

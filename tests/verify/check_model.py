@@ -586,7 +586,8 @@ def run(model_dir, only=None):
     """Runs the checks, prints a line each, returns (passed, failed)."""
     model = Model(model_dir)
     passed = failed = 0
-    for name, fn in CHECKS:
+    import check_model_glb  # model.glb's checks, when the build wrote one
+    for name, fn in CHECKS + (check_model_glb.CHECKS if check_model_glb.glb_present(model) else []):
         if only and not any(name.startswith(s) for s in only):
             continue
         try:

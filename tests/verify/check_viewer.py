@@ -14,6 +14,7 @@ import numpy as np
 from vcommon import F32_EPS, CheckFailed, require
 
 VIEWER_VERTICES = 200_000  # terramesh::build::VIEWER_VERTICES
+VIEWER_MODEL_VERTICES = 400_000  # terramesh::build::VIEWER_MODEL_VERTICES
 
 
 def _array(layer, text, dtype, what):
@@ -64,8 +65,9 @@ def check_viewer(out):
             require(v.size == l["vertices"], f"report.html viewer: layer {l['name']!r} field {key}: {v.size} values for {l['vertices']} vertices")
     pos = _array(surface, surface["positions"], "<f4", "positions").astype(float).reshape(-1, 3) + origin
     idx = _array(surface, surface["indices"], "<u4", "indices").astype(np.int64).reshape(-1, 3)
+    budget = viewer_budget(out)
     if surface["vertices"] != len(pts):
-        require(len(pts) > VIEWER_VERTICES and surface["vertices"] <= VIEWER_VERTICES,
+        require(len(pts) > budget and surface["vertices"] <= budget,
                 f"report.html viewer: {surface['vertices']} surface vertices for a DSM of {len(pts)}")
         require("decimated" in (scene.get("note") or ""), "report.html viewer: a decimated surface without a note saying so")
         lo, hi = pts.min(0), pts.max(0)
@@ -87,4 +89,52 @@ def check_viewer(out):
         require(not bad.any(), f"report.html viewer: field {key} at vertex {int(np.argmax(bad))}: {got[bad][:1]} != {want[bad][:1]}")
 
 
-CHECKS = [("report.html: 3D viewer data", check_viewer)]
+def model_units(out):
+    """The geological model's unit names (model.json), or None for a build without one."""
+    p = out.root / "model.json"
+    return [u["name"] for u in json.loads(p.read_text())["units"]] if p.is_file() else None
+
+
+def viewer_budget(out):
+    """Most DSM vertices the viewer shows: VIEWER_VERTICES, less with a geological model (each
+    unit's shell copies the planar vertices twice: VIEWER_MODEL_VERTICES in all)."""
+    units = model_units(out)
+    if not units:
+        return VIEWER_VERTICES
+    return min(VIEWER_VERTICES, VIEWER_MODEL_VERTICES // (2 * (len(units) + 1) - 1))
+
+
+def check_viewer_model(out):
+    """A build with [geology]: one viewer layer per unit with volume (unit-<name>.ts), named
+    after it, each vertex a point of model.vtu (to float32 rounding of the offsets) unless the
+    view is decimated (then inside model.vtu's bounds); the boreholes as points."""
+    units = model_units(out)
+    if not units:
+        return
+    from check_model import Model
+    from check_model_glb import nearest_index
+    scene = scene_of(out)
+    origin = np.asarray(scene["origin"], dtype=float)
+    layers = {l["name"]: l for l in scene["layers"]}
+    bodies = [u for u in units if (out.root / f"unit-{u}.ts").is_file()]
+    shown = [n[len("unit "):] for n in layers if n.startswith("unit ")]
+    require(shown == bodies, f"report.html viewer: unit layers {shown}, the model's bodies are {bodies}")
+    pts = Model(out.root).vtu()[0]
+    decimated = "decimated" in (scene.get("note") or "")
+    tol = F32_EPS * np.abs(pts - origin).max() + 1e-6
+    for u in bodies:
+        l = layers[f"unit {u}"]
+        p = _array(l, l["positions"], "<f4", "positions").astype(float).reshape(-1, 3) + origin
+        if decimated:
+            require(np.all(p >= pts.min(0) - tol) and np.all(p <= pts.max(0) + tol),
+                    f"report.html viewer: unit {u} outside model.vtu's bounds")
+        else:
+            nearest_index(pts, p, tol, f"report.html viewer: unit {u} vs model.vtu")
+    holes = [l for n, l in layers.items() if n.startswith("boreholes")]
+    if (out.root / "model.json").is_file() and json.loads((out.root / "model.json").read_text()).get("boreholes"):
+        require(holes and holes[0]["kind"] == "points" and holes[0]["vertices"] > 0,
+                "report.html viewer: a model with boreholes but no borehole points")
+
+
+CHECKS = [("report.html: 3D viewer data", check_viewer),
+          ("report.html: 3D viewer geological units", check_viewer_model)]

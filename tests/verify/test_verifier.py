@@ -499,30 +499,38 @@ def edit_tileset(out, change):
     p.write_text(json.dumps(ts))
 
 
-def test_tileset_leaf_with_an_error(out, capsys):
+# Each break of the tree fails our own reader and py3dtiles' alike.
+TREE_CHECKS = ["3dtiles: tree, boxes, errors", "3dtiles: py3dtiles reader"]
+
+
+@pytest.mark.parametrize("check", TREE_CHECKS)
+def test_tileset_leaf_with_an_error(out, capsys, check):
     edit_tileset(out, lambda ts: ts["root"]["children"][0].update(geometricError=0.5))
-    assert "leaf" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+    assert "leaf" in failures(out, check, capsys)[0]
 
 
-def test_tileset_child_error_above_its_parent(out, capsys):
+@pytest.mark.parametrize("check", TREE_CHECKS)
+def test_tileset_child_error_above_its_parent(out, capsys, check):
     edit_tileset(out, lambda ts: ts["root"].update(geometricError=1.0, children=[
         {**ts["root"], "geometricError": 2.0, "children": ts["root"]["children"]}]))
-    assert "exceeds its parent" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+    assert "exceeds its parent" in failures(out, check, capsys)[0]
 
 
-def test_tileset_box_too_small_for_its_content(out, capsys):
+@pytest.mark.parametrize("check", TREE_CHECKS)
+def test_tileset_box_too_small_for_its_content(out, capsys, check):
     def shrink(ts):
         ts["root"]["children"][1]["boundingVolume"]["box"][3] *= 0.9
     edit_tileset(out, shrink)
-    assert "sticks out of its box" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+    assert "sticks out of its box" in failures(out, check, capsys)[0]
 
 
-def test_tileset_content_outside_an_ancestor_box(out, capsys):
+@pytest.mark.parametrize("check", TREE_CHECKS)
+def test_tileset_content_outside_an_ancestor_box(out, capsys, check):
     def shrink(ts):
         ts["root"]["boundingVolume"]["box"][11] = 0.01  # flat root box; the leaves rise above it
         ts["root"].pop("content")
     edit_tileset(out, shrink)
-    assert "an ancestor" in failures(out, "3dtiles: tree, boxes, errors", capsys)[0]
+    assert "an ancestor" in failures(out, check, capsys)[0]
 
 
 def test_tileset_without_the_ellipsoidal_shift(out, capsys):

@@ -32,7 +32,9 @@ from vcommon import (F32_EPS, GRID_OVERSHOOT, KML_ALT, KML_DEG, NOT_DETERMINISTI
                      planar_areas, require, signed_volume, single_triangle_block, watertight, xmllint_schema)
 import check_collada
 import check_model
+import check_model_glb
 import check_gltf
+import check_py3dtiles
 import check_viewer
 import check_programs
 import check_terrain
@@ -456,6 +458,7 @@ CHECKS = [
     ("kml geometry", check_kml_geometry),
     *check_collada.CHECKS,
     *check_gltf.CHECKS,
+    *check_py3dtiles.CHECKS,
     *check_terrain.CHECKS,
     ("solid stl: watertight, volume", check_solid_stl),
     ("solid msh: watertight, volume", check_solid_msh),
@@ -477,6 +480,9 @@ def run(out_dir, compare=None, only=None):
     if (out.root / "model.vtu").exists():  # a build with [geology]: the model's checks too
         checks += [(f"geology model: {n}", lambda o, fn=fn: fn(check_model.Model(o.root)))
                    for n, fn in check_model.CHECKS]
+        if check_model_glb.glb_present(check_model.Model(out.root)):
+            checks += [(f"geology model: {n}", lambda o, fn=fn: fn(check_model.Model(o.root)))
+                       for n, fn in check_model_glb.CHECKS]
     if compare:
         checks.append(("determinism (--compare)", lambda o: check_identical(o, compare)))
     passed = failed = 0

@@ -8,11 +8,18 @@
 //! and chromium. Without them the test fails when the `CI` environment variable is set, and
 //! otherwise prints "skipped: ..." and passes after checking the report alone.
 //!
+//! A second test does the same for a build with `[geology]`: one toggle per unit, hiding a
+//! unit removes its colour, the boreholes are points.
+//!
 //! `TERRAMESH_VIEWER_SCREENSHOTS=docs/images cargo test --release -p terramesh-cli --test
 //! report_viewer` also writes the README's screenshots `docs/images/viewer-*.png`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+#[path = "support/geology_site.rs"]
+mod geology_site;
+use geology_site::site;
 
 fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -82,18 +89,72 @@ fn report_viewer_works_in_chromium() {
         "the still pictures are kept"
     );
 
-    if let Some(why) = missing_tools(&root) {
+    browser_test(&root, &out, "viewer-", "report_viewer_works_in_chromium");
+}
+
+/// The viewer of a build with `[geology]` (the small site of `model_build.rs`, its report
+/// on): besides every check above, hiding any unit removes its colour from the picture, and
+/// the boreholes are points. `TERRAMESH_VIEWER_SCREENSHOTS` writes `viewer-model-*.png`.
+#[test]
+fn report_viewer_shows_the_geological_units() {
+    let root = repo_root();
+    let tmp = tempfile::tempdir().expect("temporary directory");
+    let project = site(tmp.path());
+    let out = tmp.path().join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .arg("build")
+        .arg(&project)
+        .arg("-o")
+        .arg(&out)
+        .args([
+            "--quiet",
+            "--set",
+            "export.report=true",
+            "--set",
+            "export.pictures=true",
+        ])
+        .output()
+        .expect("run terramesh build");
+    assert!(
+        run.status.success(),
+        "terramesh build failed:\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    for unit in ["sand", "clay", "gravel"] {
+        assert!(
+            html.contains(&format!("\"name\":\"unit {unit}\"")),
+            "the viewer has no layer for {unit}"
+        );
+    }
+    assert!(
+        html.contains("The stacked unit bodies"),
+        "the still 3D view of the stacked bodies"
+    );
+    browser_test(
+        &root,
+        &out,
+        "viewer-model-",
+        "report_viewer_shows_the_geological_units",
+    );
+}
+
+/// Runs `tests/browser/viewer.test.mjs` on `out/report.html`, or skips (outside CI) when a
+/// tool is missing.
+fn browser_test(root: &Path, out: &Path, prefix: &str, test: &str) {
+    if let Some(why) = missing_tools(root) {
         assert!(
             std::env::var_os("CI").is_none(),
             "CI is set and {why}: run .ci/verify-setup.sh"
         );
-        eprintln!("report_viewer_works_in_chromium: skipped: {why} (run .ci/verify-setup.sh)");
+        eprintln!("{test}: skipped: {why} (run .ci/verify-setup.sh)");
         return;
     }
     let mut cmd = Command::new("node");
-    cmd.current_dir(&root)
+    cmd.current_dir(root)
         .arg("tests/browser/viewer.test.mjs")
-        .arg(out.join("report.html"));
+        .arg(out.join("report.html"))
+        .args(["--prefix", prefix]);
     if let Some(dir) = std::env::var_os("TERRAMESH_VIEWER_SCREENSHOTS") {
         cmd.arg("--screenshots").arg(root.join(dir));
     }

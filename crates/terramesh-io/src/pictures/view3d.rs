@@ -29,6 +29,82 @@ pub fn draw_view3d<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    draw_facets(
+        root,
+        vertices,
+        triangles,
+        Facets::Terrain,
+        exaggeration,
+        title,
+    )
+}
+
+/// Draws closed bodies as [`draw_view3d`] draws a surface (the same view and light): each
+/// triangle in its own colour (`colours`, one per triangle), triangles facing away from the
+/// viewer left out, so that closed shells oriented outward (e.g. geological units stacked on
+/// each other) hide what lies behind them.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use plotters::style::RGBColor;
+/// // A tetrahedron, oriented outward.
+/// let v = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 10.0, 0.0], [0.0, 0.0, 10.0]];
+/// let t = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+/// let c = [RGBColor(200, 100, 50); 4];
+/// let dir = tempfile::tempdir()?;
+/// terramesh_io::pictures::render_both(&dir.path().join("b"), (300, 200), |root| {
+///     terramesh_io::pictures::draw_bodies_view3d(root, &v, &t, &c, 1.0, "bodies")
+/// })?;
+/// # Ok(()) }
+/// ```
+pub fn draw_bodies_view3d<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    colours: &[RGBColor],
+    exaggeration: f64,
+    title: &str,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    if colours.len() != triangles.len() {
+        return Err(format!(
+            "draw_bodies_view3d: {} colours for {} triangles",
+            colours.len(),
+            triangles.len()
+        )
+        .into());
+    }
+    draw_facets(
+        root,
+        vertices,
+        triangles,
+        Facets::Bodies(colours),
+        exaggeration,
+        title,
+    )
+}
+
+/// How facets are coloured and which are drawn.
+enum Facets<'a> {
+    /// By elevation, every facet (a surface seen from above).
+    Terrain,
+    /// One colour each, back faces culled (closed bodies oriented outward).
+    Bodies(&'a [RGBColor]),
+}
+
+fn draw_facets<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    facets: Facets,
+    exaggeration: f64,
+    title: &str,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE)?;
     let (w, h) = root.dim_in_pixel();
     root.draw(&Text::new(
@@ -110,15 +186,27 @@ where
             u[2] * v[0] - u[0] * v[2],
             u[0] * v[1] - u[1] * v[0],
         ];
-        if nrm[2] < 0.0 {
-            nrm = nrm.map(|x| -x);
-        }
+        let base = match facets {
+            Facets::Terrain => {
+                if nrm[2] < 0.0 {
+                    nrm = nrm.map(|x| -x);
+                }
+                let zt = ((a[2] + b[2] + cc[2]) / 3.0 - zlo) / zspan;
+                ColourMap::Terrain.at(zt)
+            }
+            Facets::Bodies(colours) => {
+                // Towards the viewer (azimuth `az`, elevation `el`): facing away is hidden.
+                if nrm[0] * sa * ce + nrm[1] * ca * ce + nrm[2] * se <= 0.0 {
+                    continue;
+                }
+                colours[k]
+            }
+        };
         let len = (nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2])
             .sqrt()
             .max(1e-300);
         let lambert = ((nrm[0] * light[0] + nrm[1] * light[1] + nrm[2] * light[2]) / len).max(0.0);
-        let zt = ((a[2] + b[2] + cc[2]) / 3.0 - zlo) / zspan;
-        let col = shade(ColourMap::Terrain.at(zt), 0.3 + 0.7 * lambert);
+        let col = shade(base, 0.3 + 0.7 * lambert);
         let pts: Vec<(i32, i32)> = t.iter().map(|&i| to_px(&p[i as usize])).collect();
         root.draw(&Polygon::new(pts, col.filled()))?;
     }

@@ -251,11 +251,18 @@ pub fn write_all(
     files.push(atomic(&out.join("dsm-origin.json"), |w| {
         writeln!(
             w,
-            "{{\n  \"x\": {},\n  \"y\": {},\n  \"z\": {},\n  \"crs\": \"{}\",\n  \"note\": \"STL coordinates are relative to this origin: add it to get {} metres\"\n}}",
+            "{{\n  \"x\": {},\n  \"y\": {},\n  \"z\": {},\n  \"crs\": \"{}\",\n  \"vertical_datum\": \"{}\",\n  \"heights\": \"{}\",\n  \"note\": \"STL coordinates are relative to this origin: add it to get {} metres\"\n}}",
             origin[0],
             origin[1],
             origin[2],
             s.epsg().map_or_else(|| s.crs_name(), |c| format!("EPSG:{c}")),
+            if zone.is_some() { "egm96" } else { "source" },
+            if zone.is_some() {
+                "every file here but 3dtiles/ and terrain/ (WGS-84 ellipsoidal, see their \
+                 metadata): metres above the EGM96 geoid (EPSG:5773), the DEM's own"
+            } else {
+                "metres, the elevations of the project's inputs as given (no datum conversion)"
+            },
             if zone.is_some() { "UTM" } else { "project" }
         )
     })?);

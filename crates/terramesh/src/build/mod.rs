@@ -27,7 +27,7 @@ pub use adaptive::AdaptiveInfo;
 pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
 pub use stages::{Interpolated, Meshed, Model, Samples};
-pub use viewer::{VIEWER_SAMPLES, VIEWER_VERTICES};
+pub use viewer::{VIEWER_MODEL_VERTICES, VIEWER_SAMPLES, VIEWER_VERTICES};
 
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -241,6 +241,23 @@ fn build_into(
         )?),
         None => None,
     };
+    let mut geo = geo;
+    if let Some(g) = geo.as_mut() {
+        if project
+            .export
+            .formats
+            .iter()
+            .any(|f| terramesh_core::vocab::Named::name(*f) == "glb")
+        {
+            g.files.push(crate::geology::web::write_build_glb(
+                out,
+                &g.model.mesh,
+                &g.summary.crs,
+                samples.zone.is_some(),
+                project.title.as_deref(),
+            )?);
+        }
+    }
     if what == What::ModelOnly {
         st.check()?;
         return Ok(Built {
@@ -282,6 +299,7 @@ fn build_into(
                 &pics,
                 &st.timings,
                 extra,
+                geo.as_ref(),
             )?;
             progress.stage_done("report", "report.html", t.elapsed().as_secs_f64());
         }

@@ -67,6 +67,7 @@ pub fn write_report(
     pics: &[Picture],
     timings: &Timings,
     extra: Vec<terramesh_io::report::Section>,
+    geo: Option<&crate::geology::stage::ModelBuilt>,
 ) -> Result<()> {
     let title = p
         .title
@@ -203,7 +204,7 @@ pub fn write_report(
     sections.push(Section {
         heading: "3D view".into(),
         blocks: vec![Block::Viewer(Box::new(super::viewer::scene(
-            s, m, it, w.base,
+            s, m, it, w.base, geo,
         )?))],
     });
     sections.push(Section {

@@ -16,14 +16,27 @@ use terramesh_mesh::{adaptive_mesh, AdaptiveSettings, Fallible, MeshError};
 
 use super::stages::{Interpolated, Meshed, Samples};
 use crate::error::{Context, Result};
+use crate::geology::stage::ModelBuilt;
 
 /// Most DSM vertices the viewer shows; larger surfaces are decimated to fit.
 pub const VIEWER_VERTICES: usize = 200_000;
 /// Most samples the viewer shows as points; more are thinned evenly.
 pub const VIEWER_SAMPLES: usize = 200_000;
 
-/// The viewer's scene of a build, with the solid extruded to `base`.
-pub fn scene(s: &Samples, m: &Meshed, it: &Interpolated, base: f64) -> Result<Scene> {
+/// Most vertices of the geological units' shells together (each unit's top and bottom copy
+/// the planar vertices): a model whose planar mesh needs more is shown on a decimated one.
+pub const VIEWER_MODEL_VERTICES: usize = 400_000;
+
+/// The viewer's scene of a build, with the solid extruded to `base`, and the geological
+/// model's units (one toggle each) and borehole contacts when the project has `[geology]`
+/// (then the solid, which the units fill, starts hidden).
+pub fn scene(
+    s: &Samples,
+    m: &Meshed,
+    it: &Interpolated,
+    base: f64,
+    geo: Option<&ModelBuilt>,
+) -> Result<Scene> {
     let mesh = &m.mesh;
     let abs: Vec<[f64; 3]> = (0..mesh.points.len())
         .map(|i| {
@@ -32,29 +45,46 @@ pub fn scene(s: &Samples, m: &Meshed, it: &Interpolated, base: f64) -> Result<Sc
         })
         .collect();
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
-    let fields: [&[f64]; 3] = [&it.dsm, &it.uk_std, &diff];
+    let mut fields: Vec<&[f64]> = vec![&it.dsm, &it.uk_std, &diff];
+    // The unit tops below the first and the base ride along as fields of the planar mesh.
+    let surfaces = geo.map_or(&[][..], |g| &g.model.stack.surfaces[..]);
+    fields.extend(surfaces.iter().skip(1).map(|v| &v[..]));
+    let budget = match surfaces.len() {
+        0 => VIEWER_VERTICES,
+        n => VIEWER_VERTICES.min(VIEWER_MODEL_VERTICES / (2 * n - 1)),
+    };
     let mut notes = Vec::new();
-    let (positions, triangles, values) = if abs.len() > VIEWER_VERTICES {
-        let d = decimate(
-            &s.region.projected,
-            &abs,
-            &mesh.triangles,
-            &fields,
-            VIEWER_VERTICES,
-        )?;
+    let (positions, triangles, mut values) = if abs.len() > budget {
+        let d = decimate(&s.region.projected, &abs, &mesh.triangles, &fields, budget)?;
         notes.push(format!(
             "The DSM has {} vertices; this view shows a decimated mesh of {} vertices and {} \
-             triangles (the adaptive mesher within {:.3} m of the DSM). The exports and the \
+             triangles (the adaptive mesher within {:.3} m of the DSM{}). The exports and the \
              pictures use the full mesh.",
             abs.len(),
             d.positions.len(),
             d.triangles.len(),
-            d.tolerance
+            d.tolerance,
+            if geo.is_some() {
+                "; the units' surfaces interpolated linearly from the model's at its vertices"
+            } else {
+                ""
+            }
         ));
         (d.positions, d.triangles, d.values)
     } else {
         let values = fields.iter().map(|f| f.to_vec()).collect();
         (abs, mesh.triangles.clone(), values)
+    };
+    let model_layers = match geo {
+        Some(g) => {
+            let mut stack = vec![positions.iter().map(|p| p[2]).collect::<Vec<f64>>()];
+            stack.extend(values.drain(3..));
+            let (layers, note) =
+                crate::geology::web::viewer_layers(g, &positions, &triangles, &stack);
+            notes.push(note);
+            layers
+        }
+        None => Vec::new(),
     };
     let [elevation, std, diff]: [Vec<f64>; 3] = values.try_into().expect("three fields");
     let field = |key: &str, label: String, colours, values| Field {
@@ -101,7 +131,7 @@ pub fn scene(s: &Samples, m: &Meshed, it: &Interpolated, base: f64) -> Result<Sc
         geometry: Geometry::Triangles(solid_t),
         fields: Vec::new(),
         colour: [125, 135, 165],
-        visible: true,
+        visible: geo.is_none(),
         pickable: false,
         clipped: true,
     };
@@ -131,7 +161,7 @@ pub fn scene(s: &Samples, m: &Meshed, it: &Interpolated, base: f64) -> Result<Sc
     Ok(Scene {
         crs: s.crs_name(),
         note: (!notes.is_empty()).then(|| notes.join(" ")),
-        layers: vec![surface, solid, samples],
+        layers: [vec![surface, solid, samples], model_layers].concat(),
     })
 }
 

@@ -9,3 +9,4 @@ pub mod report;
 pub mod section;
 pub mod stage;
 pub mod summary;
+pub mod web;

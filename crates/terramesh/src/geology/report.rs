@@ -6,8 +6,8 @@
 use std::path::Path;
 
 use terramesh_io::pictures::{
-    draw_section, draw_surface, render_both_as, ColourMap, Section as Cut, SectionHole, SurfaceMap,
-    SvgMode, VECTOR_TRIANGLE_LIMIT,
+    draw_bodies_view3d, draw_section, draw_surface, render_both_as, unit_colour, ColourMap,
+    Section as Cut, SectionHole, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
 };
 use terramesh_io::report::{Block, Section};
 use terramesh_mesh::Mesh;
@@ -82,6 +82,7 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
         )?);
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
+    blocks.push(stacked_view(&dir, &xy, mesh, surfaces, units)?);
     for (k, unit) in units.iter().enumerate() {
         let thickness: Vec<f64> = (0..xy.len())
             .map(|v| surfaces[k][v] - surfaces[k + 1][v])
@@ -163,6 +164,58 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
         heading: "Geological model".into(),
         blocks,
     })
+}
+
+/// The still 3D view of the stacked unit bodies (`pictures/model-view3d.png`): each unit's
+/// shell (`super::web::unit_shells`) in its colour, seen from the south-west, with a vertical
+/// exaggeration that makes the model's height about a third of its width.
+fn stacked_view(
+    dir: &Path,
+    xy: &[[f64; 2]],
+    mesh: &Mesh,
+    surfaces: &[Vec<f64>],
+    units: &[String],
+) -> Result<Block> {
+    let shells = super::web::unit_shells(xy, &mesh.triangles, surfaces);
+    let (mut v, mut t, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    for sh in &shells {
+        let off = v.len() as u32;
+        v.extend_from_slice(&sh.vertices);
+        t.extend(sh.triangles.iter().map(|tr| tr.map(|i| i + off)));
+        c.extend(std::iter::repeat_n(
+            unit_colour(sh.unit),
+            sh.triangles.len(),
+        ));
+    }
+    let span = |k: usize| {
+        let (lo, hi) = v.iter().fold(
+            (f64::INFINITY, f64::NEG_INFINITY),
+            |(a, b), p: &[f64; 3]| (a.min(p[k]), b.max(p[k])),
+        );
+        (hi - lo).max(1e-9)
+    };
+    let exaggeration = ((0.3 * span(0).max(span(1)) / span(2)) * 2.0)
+        .round()
+        .max(2.0)
+        / 2.0;
+    let mode = if t.len() > VECTOR_TRIANGLE_LIMIT {
+        SvgMode::Raster
+    } else {
+        SvgMode::Vector
+    };
+    let title = "The stacked unit bodies";
+    let files = render_both_as(&dir.join("model-view3d"), (1000, 700), mode, |r| {
+        draw_bodies_view3d(r, &v, &t, &c, exaggeration, title)
+    })?;
+    let names: Vec<&str> = shells.iter().map(|s| units[s.unit].as_str()).collect();
+    png(
+        &files[0],
+        format!(
+            "{title}, top to bottom: {} (the colours of the sections), each closed by its sides, \
+             vertical exaggeration {exaggeration:.1}x",
+            names.join(", ")
+        ),
+    )
 }
 
 /// The logged intervals of a hole, `(top, bottom, unit)`: from each known top down to the

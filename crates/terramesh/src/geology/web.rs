@@ -1,0 +1,420 @@
+//! The geological model for the web and the 3D viewer: `model.glb` (glTF 2.0 binary, one mesh
+//! per sealed unit body, in the model's own CRS and elevations around a recorded origin) and
+//! the units' closed shells (top, bottom and sides) on any planar mesh, which the report's
+//! viewer and its still 3D picture draw.
+
+use std::path::Path;
+
+use serde_json::json;
+use terramesh_core::volume::VolumeMesh;
+use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
+use terramesh_io::output::Output;
+use terramesh_io::pictures::unit_colour;
+use terramesh_io::viewer::{Geometry, Layer};
+
+use crate::error::{bail, Context, Result};
+
+/// Where `model.glb` is placed and what its heights mean, for its `extras`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlbFrame<'a> {
+    /// The horizontal CRS of the coordinates (e.g. `EPSG:26711`).
+    pub crs: &'a str,
+    /// What the elevations are above (e.g. `egm96`, as the DSM's).
+    pub vertical_datum: &'a str,
+    /// A description of the heights.
+    pub heights: &'a str,
+    /// Names the root node and the scene.
+    pub title: &'a str,
+}
+
+/// The sRGB 8-bit colour of unit `k` (`terramesh_io::pictures::unit_colour`, the sections'
+/// colours) as the linear RGB that glTF's `COLOR_0` holds.
+///
+/// ```
+/// let c = terramesh::geology::web::unit_colour_linear(0);
+/// assert!(c.iter().all(|v| (0.0..=1.0).contains(v)));
+/// ```
+pub fn unit_colour_linear(k: usize) -> [f32; 3] {
+    let c = unit_colour(k);
+    [c.0, c.1, c.2].map(|v| {
+        let s = f64::from(v) / 255.0;
+        let l = if s <= 0.04045 {
+            s / 12.92
+        } else {
+            ((s + 0.055) / 1.055).powf(2.4)
+        };
+        l as f32
+    })
+}
+
+/// The vertices `tris` use, renumbered in order of first use.
+pub(crate) fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut map = vec![u32::MAX; vertices.len()];
+    let mut out = Vec::new();
+    let t = tris
+        .iter()
+        .map(|t| {
+            t.map(|i| {
+                let slot = &mut map[i as usize];
+                if *slot == u32::MAX {
+                    *slot = out.len() as u32;
+                    out.push(vertices[i as usize]);
+                }
+                *slot
+            })
+        })
+        .collect();
+    (out, t)
+}
+
+/// One body's unit, vertices, triangles and vertex colours.
+type BodyArrays = (usize, Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<[f32; 3]>);
+
+/// Writes `model.glb` atomically at `path`: one named mesh (and node) per sealed body of
+/// `model` (its unit's name), with the body's own triangles (closed, oriented outward) and
+/// vertices, float32 relative to the origin (the centre of the model's bounding box at its
+/// lowest point) that the root node's translation holds, every vertex in its unit's colour
+/// ([`unit_colour_linear`]); `extras` with the CRS, origin, units, vertical datum and the
+/// units top to bottom with their `MaterialIDs`. Returns the origin.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use terramesh::geology::web::{write_model_glb, GlbFrame};
+/// use terramesh_core::volume::{Body, VolumeMesh};
+/// // One tetrahedron as a unit's body.
+/// let model = VolumeMesh {
+///     points: vec![[500_000.0, 4_000_000.0, 10.0], [500_010.0, 4_000_000.0, 10.0],
+///                  [500_000.0, 4_000_010.0, 10.0], [500_000.0, 4_000_000.0, 20.0]],
+///     units: vec!["sand".into()],
+///     bodies: vec![Body { unit: 0, triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]] }],
+///     ..VolumeMesh::default()
+/// };
+/// let dir = tempfile::tempdir()?;
+/// let frame = GlbFrame { crs: "EPSG:32611", vertical_datum: "egm96", heights: "metres", title: "m" };
+/// let origin = write_model_glb(&dir.path().join("model.glb"), &model, &frame)?;
+/// assert_eq!(origin, [500_005.0, 4_000_005.0, 10.0]);
+/// # Ok(()) }
+/// ```
+///
+/// # Errors
+/// A model without bodies, or the file cannot be written.
+pub fn write_model_glb(path: &Path, model: &VolumeMesh, frame: &GlbFrame) -> Result<[f64; 3]> {
+    if model.bodies.is_empty() {
+        bail!("{}: the model has no unit with volume", path.display());
+    }
+    let parts: Vec<BodyArrays> = model
+        .bodies
+        .iter()
+        .map(|b| {
+            let (v, t) = compact(&model.points, &b.triangles);
+            let c = vec![unit_colour_linear(b.unit); v.len()];
+            (b.unit, v, t, c)
+        })
+        .collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in parts.iter().flat_map(|p| &p.1) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let origin = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]];
+    let meshes: Vec<GlbMesh> = parts
+        .iter()
+        .map(|(u, v, t, c)| GlbMesh {
+            name: &model.units[*u],
+            vertices: v,
+            triangles: t,
+            colours: Some(c),
+        })
+        .collect();
+    let units: Vec<_> = model
+        .bodies
+        .iter()
+        .map(|b| json!({ "name": model.units[b.unit], "material_id": b.unit }))
+        .collect();
+    let opts = GlbOptions {
+        name: frame.title,
+        origin,
+        extras: json!({
+            "crs": frame.crs,
+            "units": "metre",
+            "vertical_datum": frame.vertical_datum,
+            "heights": frame.heights,
+            "model_units": units,
+            "meshes": "one per geological unit: its sealed body (closed, oriented outward), \
+                       top to bottom; MaterialIDs as in model.vtu (0 = the top unit)",
+            "colours": "COLOR_0: each unit's colour of the report's sections, linear RGB",
+        }),
+    };
+    let mut out =
+        Output::create(Some(path)).with_context(|| format!("cannot write {}", path.display()))?;
+    write_glb(&mut out, &meshes, &opts).with_context(|| format!("writing {}", path.display()))?;
+    out.commit()
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(origin)
+}
+
+/// Writes `out/model.glb` for a build ([`write_model_glb`]) in the model's CRS `crs`; its
+/// heights are the DSM's own: above the EGM96 geoid for a geographic (UTM) project, whose DEM
+/// sources give them so (`egm96`), else the elevations of the project's inputs as given
+/// (`source`). Returns the path.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use terramesh_core::volume::{Body, VolumeMesh};
+/// let model = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     units: vec!["clay".into()],
+///     bodies: vec![Body { unit: 0, triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]] }],
+///     ..VolumeMesh::default()
+/// };
+/// let dir = tempfile::tempdir()?;
+/// let path = terramesh::geology::web::write_build_glb(dir.path(), &model, "EPSG:28992", false, None)?;
+/// assert!(path.ends_with("model.glb") && path.is_file());
+/// # Ok(()) }
+/// ```
+///
+/// # Errors
+/// As [`write_model_glb`].
+pub fn write_build_glb(
+    out: &Path,
+    model: &VolumeMesh,
+    crs: &str,
+    geographic: bool,
+    title: Option<&str>,
+) -> Result<std::path::PathBuf> {
+    let path = out.join("model.glb");
+    let (datum, heights) = if geographic {
+        let d = terramesh_core::coords::VerticalDatum::Egm96;
+        (d.to_string(), d.describe().to_string())
+    } else {
+        (
+            "source".to_string(),
+            "metres, the elevations of the project's inputs as given (no datum conversion)"
+                .to_string(),
+        )
+    };
+    let title = format!("{} geological model", title.unwrap_or("terramesh"));
+    write_model_glb(
+        &path,
+        model,
+        &GlbFrame {
+            crs,
+            vertical_datum: &datum,
+            heights: &heights,
+            title: &title,
+        },
+    )?;
+    Ok(path)
+}
+
+/// The edges of `tris` that belong to one triangle only, in the direction the triangle
+/// walks them (counter-clockwise triangles: the region's outline, counter-clockwise).
+pub(crate) fn boundary_edges(tris: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<([u32; 2], [u32; 2])> = tris
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|e| ([e[0].min(e[1]), e[0].max(e[1])], e))
+        .collect();
+    edges.sort_unstable();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j].0 == edges[i].0 {
+            j += 1;
+        }
+        if j - i == 1 {
+            out.push(edges[i].1);
+        }
+        i = j;
+    }
+    out
+}
+
+/// One unit's closed shell for drawing: its top (facing up), its bottom (facing down) and its
+/// sides along the outline (facing out), without the places where it has no thickness.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shell {
+    /// Index of the unit, 0 the top one.
+    pub unit: usize,
+    /// Absolute positions.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The shells of every unit with any thickness, from the model's surfaces (terrain, tops
+/// below the first unit, base: `surfaces[k]` is unit `k`'s top, `surfaces[k + 1]` its
+/// bottom, one value per planar vertex) on the planar mesh `xy`/`tris` (counter-clockwise).
+/// On the model's own planar mesh, a shell's top and bottom are its sealed body's interface
+/// triangles; triangles where the unit has zero thickness at all three corners are left out
+/// (there the unit above meets the one below), so are side triangles of zero height.
+///
+/// ```
+/// use terramesh::geology::web::unit_shells;
+/// let xy = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+/// let s = unit_shells(&xy, &[[0, 1, 2]], &[vec![3.0; 3], vec![1.0; 3], vec![1.0, 0.0, 1.0]]);
+/// assert_eq!(s.len(), 2);
+/// assert_eq!(s[0].triangles.len(), 2 + 6); // top, bottom, three side quads
+/// assert_eq!(s[1].triangles.len(), 2 + 2); // a wedge: the zero-height side triangles dropped
+/// ```
+pub fn unit_shells(xy: &[[f64; 2]], tris: &[[u32; 3]], surfaces: &[Vec<f64>]) -> Vec<Shell> {
+    let n = xy.len();
+    let outline = boundary_edges(tris);
+    let mut shells = Vec::new();
+    for k in 0..surfaces.len().saturating_sub(1) {
+        let (top, bot) = (&surfaces[k], &surfaces[k + 1]);
+        let thick = |i: u32| top[i as usize] - bot[i as usize] > 0.0;
+        // Vertices 0..n the top, n..2n the bottom.
+        let mut all: Vec<[f64; 3]> = (0..n).map(|i| [xy[i][0], xy[i][1], top[i]]).collect();
+        all.extend((0..n).map(|i| [xy[i][0], xy[i][1], bot[i]]));
+        let b = |i: u32| i + n as u32;
+        let mut t = Vec::new();
+        for tri in tris.iter().filter(|tri| tri.iter().any(|&i| thick(i))) {
+            t.push(*tri);
+            t.push([b(tri[0]), b(tri[2]), b(tri[1])]);
+        }
+        for &[p, q] in &outline {
+            if thick(q) {
+                t.push([b(p), b(q), q]);
+            }
+            if thick(p) {
+                t.push([b(p), q, p]);
+            }
+        }
+        if t.is_empty() {
+            continue;
+        }
+        let (vertices, triangles) = compact(&all, &t);
+        shells.push(Shell {
+            unit: k,
+            vertices,
+            triangles,
+        });
+    }
+    shells
+}
+
+/// The viewer's layers of the model drawn on the planar mesh `positions`/`triangles` (the
+/// DSM's, or the viewer's decimated copy) with `stack` (terrain, tops, base at its vertices):
+/// one toggleable layer per unit with thickness ([`unit_shells`], in its unit's colour), and
+/// the boreholes' collars and logged tops as points; with a sentence for the viewer's note.
+pub(crate) fn viewer_layers(
+    g: &super::stage::ModelBuilt,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    stack: &[Vec<f64>],
+) -> (Vec<Layer>, String) {
+    let xy: Vec<[f64; 2]> = positions.iter().map(|p| [p[0], p[1]]).collect();
+    let units = &g.model.mesh.units;
+    let mut layers: Vec<Layer> = unit_shells(&xy, triangles, stack)
+        .into_iter()
+        .map(|sh| {
+            let c = unit_colour(sh.unit);
+            Layer {
+                name: format!("unit {}", units[sh.unit]),
+                positions: sh.vertices,
+                geometry: Geometry::Triangles(sh.triangles),
+                fields: Vec::new(),
+                colour: [c.0, c.1, c.2],
+                visible: true,
+                pickable: true,
+                clipped: true,
+            }
+        })
+        .collect();
+    let shown = layers.len();
+    let mut points = Vec::new();
+    for h in g.boreholes.iter().flat_map(|b| &b.holes) {
+        points.push(h.collar);
+        points.extend(h.tops.iter().flatten().map(|c| c.position));
+    }
+    let holes = g.boreholes.as_ref().map_or(0, |b| b.holes.len());
+    if !points.is_empty() {
+        layers.push(Layer {
+            name: format!("boreholes ({holes} collars and logged tops)"),
+            positions: points,
+            geometry: Geometry::Points,
+            fields: Vec::new(),
+            colour: [190, 30, 30],
+            visible: true,
+            pickable: false,
+            clipped: true,
+        });
+    }
+    let note = format!(
+        "The geological model: {shown} of its {} units have thickness, each drawn as its top, \
+         bottom and sides (on the full planar mesh: its sealed body's boundary) and toggled on \
+         its own; the cross-section cuts them all.",
+        units.len()
+    );
+    (layers, note)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit square of two triangles, counter-clockwise.
+    fn square() -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+        (
+            vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    /// The volume enclosed by a closed triangle surface (divergence theorem).
+    fn enclosed(v: &[[f64; 3]], t: &[[u32; 3]]) -> f64 {
+        t.iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| v[i as usize]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn shells_are_closed_outward_and_enclose_each_units_volume() {
+        let (xy, tris) = square();
+        // Unit 0 from 5 to 3, unit 1 from 3 down to a tilted base 1 + x.
+        let base: Vec<f64> = xy.iter().map(|p| 1.0 + p[0]).collect();
+        let s = unit_shells(&xy, &tris, &[vec![5.0; 4], vec![3.0; 4], base]);
+        assert_eq!(s.len(), 2);
+        // Exact volumes of the prisms between the (piecewise linear) surfaces.
+        assert!((enclosed(&s[0].vertices, &s[0].triangles) - 2.0).abs() < 1e-12);
+        assert!((enclosed(&s[1].vertices, &s[1].triangles) - 1.5).abs() < 1e-12);
+        // Closed: every edge used by exactly two triangles, once in each direction.
+        for sh in &s {
+            let mut e: Vec<[u32; 2]> = sh
+                .triangles
+                .iter()
+                .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+                .collect();
+            e.sort_unstable();
+            for w in &e {
+                assert!(e.binary_search(&[w[1], w[0]]).is_ok(), "{w:?} has no twin");
+            }
+            assert!(e.windows(2).all(|w| w[0] != w[1]));
+        }
+    }
+
+    #[test]
+    fn a_unit_without_thickness_has_no_shell() {
+        let (xy, tris) = square();
+        let s = unit_shells(&xy, &tris, &[vec![5.0; 4], vec![5.0; 4], vec![1.0; 4]]);
+        assert_eq!(s.len(), 1);
+        assert_eq!(s[0].unit, 1);
+    }
+
+    #[test]
+    fn the_outline_runs_counter_clockwise() {
+        let (_, tris) = square();
+        let mut e = boundary_edges(&tris);
+        e.sort_unstable();
+        assert_eq!(e, vec![[0, 1], [1, 2], [2, 3], [3, 0]]);
+    }
+}
