@@ -77,11 +77,28 @@ pub fn read_boreholes(
     g.read_boreholes(Some(&project))
 }
 
-/// The collars inside the region, to insert as vertices of the planar mesh (so that the
-/// interfaces pass through the observed contacts there).
+/// The points to insert as vertices of the planar mesh, so that the interfaces pass through
+/// the observed contacts there: every collar, and every contact of an inclined hole (where the
+/// desurveyed hole has moved away from its collar), leaving out a contact within
+/// [`CONTACT_SPACING`] of a point already listed (a vertex so close would only make slivers).
 pub fn collar_points(b: &Boreholes) -> Vec<[f64; 2]> {
-    b.holes.iter().map(|h| [h.collar[0], h.collar[1]]).collect()
+    let mut pts: Vec<[f64; 2]> = b.holes.iter().map(|h| [h.collar[0], h.collar[1]]).collect();
+    for h in &b.holes {
+        for c in h.tops.iter().flatten() {
+            let q = [c.position[0], c.position[1]];
+            let near = |p: &[f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]) < CONTACT_SPACING;
+            // the collars are all kept; a contact is checked against them and the contacts
+            // kept before it (few per hole: the quadratic scan stays small)
+            if !pts.iter().any(near) {
+                pts.push(q);
+            }
+        }
+    }
+    pts
 }
+
+/// The smallest distance (m) from an inserted contact to another inserted point.
+pub const CONTACT_SPACING: f64 = 1.0;
 
 /// Builds and writes the model of `g` on `mesh` (the DSM's planar mesh) under `dsm` (its
 /// vertex elevations), into `out`. `grid` is the DSM grid's layout, reused for the
