@@ -148,7 +148,11 @@ mod tests {
             if a != b {
                 // both shortest: the same length, and ours reads back to the same double
                 assert_eq!(a.len(), b.len(), "{v:e}: {a} vs {b}");
-                assert_eq!(a.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{v:e}: {a}");
+                assert_eq!(
+                    a.parse::<f64>().unwrap().to_bits(),
+                    v.to_bits(),
+                    "{v:e}: {a}"
+                );
                 ties += 1;
             }
         };

@@ -33,7 +33,11 @@ pub fn body_mesh(m: &VolumeMesh, body: &Body) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) 
             verts.push(m.points[n]);
         }
     }
-    let tris = body.triangles.iter().map(|t| t.map(|n| local[n as usize])).collect();
+    let tris = body
+        .triangles
+        .iter()
+        .map(|t| t.map(|n| local[n as usize]))
+        .collect();
     (verts, tris)
 }
 
