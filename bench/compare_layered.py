@@ -89,7 +89,7 @@ margin = 0.0
 method = "bilinear"
 [mesh]
 min_angle = 25.0
-max_area = 500.0
+max_area = 440.0
 smooth = 0
 [interpolation]
 methods = ["idw"]
