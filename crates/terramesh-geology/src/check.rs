@@ -521,7 +521,8 @@ pub fn volume_between(planar: &Planar, stack: &Stack) -> f64 {
         &stack.surfaces[0],
         &stack.surfaces[stack.surfaces.len() - 1],
     );
-    (0..planar.triangles.len())
+    // per triangle in parallel, summed in order: the same total on every run
+    let parts: Vec<f64> = (0..planar.triangles.len())
         .into_par_iter()
         .map(|t| {
             let h: f64 = planar.triangles[t]
@@ -530,7 +531,8 @@ pub fn volume_between(planar: &Planar, stack: &Stack) -> f64 {
                 .sum();
             planar.area(t) * h / 3.0
         })
-        .sum()
+        .collect();
+    parts.iter().sum()
 }
 
 impl CheckSummary {

@@ -47,30 +47,31 @@ pub struct UnitStats {
 /// ```
 pub fn unit_stats(planar: &Planar, stack: &Stack, mesh: &VolumeMesh) -> Vec<UnitStats> {
     let units = stack.units();
-    let (volume, cells) = mesh
+    // Fixed chunks summed in order: the same volumes, to the last bit, on every run (a rayon
+    // fold splits its work by what the threads steal, so its float sums vary).
+    const CHUNK: usize = 8192;
+    let partial: Vec<(Vec<f64>, Vec<usize>)> = mesh
         .cells
-        .par_iter()
-        .zip(mesh.material.par_iter())
-        .fold(
-            || (vec![0.0; units], vec![0usize; units]),
-            |(mut v, mut n), (c, &m)| {
+        .par_chunks(CHUNK)
+        .zip(mesh.material.par_chunks(CHUNK))
+        .map(|(cs, ms)| {
+            let (mut v, mut n) = (vec![0.0; units], vec![0usize; units]);
+            for (c, &m) in cs.iter().zip(ms) {
                 if let Some(slot) = v.get_mut(m as usize) {
                     *slot += cell_volume(&mesh.points, c);
                     n[m as usize] += 1;
                 }
-                (v, n)
-            },
-        )
-        .reduce(
-            || (vec![0.0; units], vec![0usize; units]),
-            |(mut v, mut n), (w, k)| {
-                for u in 0..units {
-                    v[u] += w[u];
-                    n[u] += k[u];
-                }
-                (v, n)
-            },
-        );
+            }
+            (v, n)
+        })
+        .collect();
+    let (mut volume, mut cells) = (vec![0.0; units], vec![0usize; units]);
+    for (w, k) in partial {
+        for u in 0..units {
+            volume[u] += w[u];
+            cells[u] += k[u];
+        }
+    }
     (0..units)
         .map(|u| {
             let t: Vec<f64> = (0..planar.points.len())

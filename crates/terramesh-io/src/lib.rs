@@ -29,6 +29,7 @@ pub mod folder;
 pub mod grid_write;
 pub mod model;
 pub mod number;
+mod numtext;
 pub mod output;
 pub mod pictures;
 pub mod quote;

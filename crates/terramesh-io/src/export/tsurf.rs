@@ -2,6 +2,8 @@
 
 use std::io::{self, Write};
 
+use crate::numtext::{write_f64, write_u64};
+
 /// Names written into the TSurf header.
 #[derive(Debug, Clone)]
 pub struct TsurfInfo<'a> {
@@ -42,10 +44,22 @@ pub fn write_tsurf<W: Write>(
     writeln!(w, "END_ORIGINAL_COORDINATE_SYSTEM")?;
     writeln!(w, "TFACE")?;
     for (i, v) in vertices.iter().enumerate() {
-        writeln!(w, "VRTX {} {} {} {}", i + 1, v[0], v[1], v[2])?;
+        // the bytes of `VRTX {} {} {} {}`, without core::fmt (see numtext)
+        w.write_all(b"VRTX ")?;
+        write_u64(w, i as u64 + 1)?;
+        for c in v {
+            w.write_all(b" ")?;
+            write_f64(w, *c)?;
+        }
+        w.write_all(b"\n")?;
     }
     for t in triangles {
-        writeln!(w, "TRGL {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+        w.write_all(b"TRGL")?;
+        for k in t {
+            w.write_all(b" ")?;
+            write_u64(w, u64::from(*k) + 1)?;
+        }
+        w.write_all(b"\n")?;
     }
     writeln!(w, "END")
 }

@@ -21,12 +21,24 @@ use crate::export::{write_stl, write_tsurf, TsurfInfo};
 /// assert_eq!((v.len(), t), (3, vec![[0, 1, 2]]));
 /// ```
 pub fn body_mesh(m: &VolumeMesh, body: &Body) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut nodes: Vec<u32> = body.triangles.iter().flatten().copied().collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    let local = |n: u32| nodes.binary_search(&n).expect("a body node") as u32;
-    let tris = body.triangles.iter().map(|t| t.map(local)).collect();
-    (nodes.iter().map(|&n| m.points[n as usize]).collect(), tris)
+    // a dense map from mesh nodes to body vertices (no sort, no search per corner)
+    let mut local = vec![u32::MAX; m.points.len()];
+    for &n in body.triangles.iter().flatten() {
+        local[n as usize] = 0;
+    }
+    let mut verts = Vec::new();
+    for (n, l) in local.iter_mut().enumerate() {
+        if *l == 0 {
+            *l = verts.len() as u32;
+            verts.push(m.points[n]);
+        }
+    }
+    let tris = body
+        .triangles
+        .iter()
+        .map(|t| t.map(|n| local[n as usize]))
+        .collect();
+    (verts, tris)
 }
 
 /// The origin subtracted from the STL coordinates of every body: the lower corner of the

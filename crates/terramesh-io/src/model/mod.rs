@@ -184,5 +184,5 @@ pub fn write_model(
 /// Writes `v` in the shortest form that reads back to the same `f64` (`-0` as `0`).
 fn write_shortest<W: io::Write + ?Sized>(w: &mut W, v: f64) -> io::Result<()> {
     let v = if v == 0.0 { 0.0 } else { v };
-    write!(w, "{v}")
+    crate::numtext::write_f64(w, v)
 }

@@ -6,6 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
+use rayon::prelude::*;
+
 use terramesh_core::coords::{to_utm, Zone};
 use terramesh_crs::{Crs, Transformer};
 use terramesh_geology::Layering;
@@ -77,11 +79,28 @@ pub fn read_boreholes(
     g.read_boreholes(Some(&project))
 }
 
-/// The collars inside the region, to insert as vertices of the planar mesh (so that the
-/// interfaces pass through the observed contacts there).
+/// The points to insert as vertices of the planar mesh, so that the interfaces pass through
+/// the observed contacts there: every collar, and every contact of an inclined hole (where the
+/// desurveyed hole has moved away from its collar), leaving out a contact within
+/// [`CONTACT_SPACING`] of a point already listed (a vertex so close would only make slivers).
 pub fn collar_points(b: &Boreholes) -> Vec<[f64; 2]> {
-    b.holes.iter().map(|h| [h.collar[0], h.collar[1]]).collect()
+    let mut pts: Vec<[f64; 2]> = b.holes.iter().map(|h| [h.collar[0], h.collar[1]]).collect();
+    for h in &b.holes {
+        for c in h.tops.iter().flatten() {
+            let q = [c.position[0], c.position[1]];
+            let near = |p: &[f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]) < CONTACT_SPACING;
+            // the collars are all kept; a contact is checked against them and the contacts
+            // kept before it (few per hole: the quadratic scan stays small)
+            if !pts.iter().any(near) {
+                pts.push(q);
+            }
+        }
+    }
+    pts
 }
+
+/// The smallest distance (m) from an inserted contact to another inserted point.
+pub const CONTACT_SPACING: f64 = 1.0;
 
 /// Builds and writes the model of `g` on `mesh` (the DSM's planar mesh) under `dsm` (its
 /// vertex elevations), into `out`. `grid` is the DSM grid's layout, reused for the
@@ -106,7 +125,7 @@ pub fn run(
              crs = \"EPSG:...\"",
         )),
     };
-    let mut grids = Vec::new();
+    let mut wanted = Vec::new();
     for (unit, path) in g.surfaces.iter().enumerate() {
         let Some(path) = path else { continue };
         if unit == 0 {
@@ -116,13 +135,22 @@ pub fn run(
                 g.units[0]
             );
         }
-        let values = horizon_at(path, &xy, g.z_unit, grid_crs()?, &g.units[unit])?;
-        // Nodata: the unit is absent there (model.rs takes the next top below).
-        grids.push((
-            unit,
-            values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
-        ));
+        wanted.push((unit, path, grid_crs()?));
     }
+    // The grids are read and evaluated in parallel (each also in parallel over the vertices);
+    // the first error in column order is reported.
+    let read: Vec<Result<(usize, Vec<f64>)>> = wanted
+        .into_par_iter()
+        .map(|(unit, path, crs)| {
+            let values = horizon_at(path, &xy, g.z_unit, crs, &g.units[unit])?;
+            // Nodata: the unit is absent there (model.rs takes the next top below).
+            Ok((
+                unit,
+                values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
+            ))
+        })
+        .collect();
+    let grids = read.into_iter().collect::<Result<Vec<_>>>()?;
     let base = match &g.base {
         BaseKey::Auto => Base::Auto,
         BaseKey::Elevation(z) => Base::Elevation(*z),
@@ -157,27 +185,43 @@ pub fn run(
         (None, Some(c)) => c.definition().to_string(),
         (None, None) => "projected".to_string(),
     };
-    let mut files: Vec<PathBuf> = write_model(
-        out,
-        &model.mesh,
-        &ModelInfo {
-            crs: crs_name.clone(),
-        },
-    )
-    .map_err(|e| Error::invalid(e.to_string()))?
-    .into_iter()
-    .map(|f| out.join(f))
-    .collect();
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
-    for (k, unit) in g.units.iter().enumerate() {
-        let values = interface_grid(mesh, &model.stack.surfaces[k], grid, -9999.0);
-        let path = dir.join(format!("{unit}.tif"));
-        let code = epsg.and_then(|e| u16::try_from(e).ok());
-        write_atomic(&path, |w| {
-            write_geotiff(w, grid, &values, code, Some(-9999.0))
-        })?;
-        files.push(path);
+    // The model's files and the interface grids are written side by side (rayon); errors in
+    // that order.
+    let (written, grids_written) = rayon::join(
+        || {
+            write_model(
+                out,
+                &model.mesh,
+                &ModelInfo {
+                    crs: crs_name.clone(),
+                },
+            )
+        },
+        || {
+            g.units
+                .par_iter()
+                .enumerate()
+                .map(|(k, unit)| {
+                    let values = interface_grid(mesh, &model.stack.surfaces[k], grid, -9999.0);
+                    let path = dir.join(format!("{unit}.tif"));
+                    let code = epsg.and_then(|e| u16::try_from(e).ok());
+                    write_atomic(&path, |w| {
+                        write_geotiff(w, grid, &values, code, Some(-9999.0))
+                    })?;
+                    Ok(path)
+                })
+                .collect::<Vec<Result<PathBuf>>>()
+        },
+    );
+    let mut files: Vec<PathBuf> = written
+        .map_err(|e| Error::invalid(e.to_string()))?
+        .into_iter()
+        .map(|f| out.join(f))
+        .collect();
+    for path in grids_written {
+        files.push(path?);
     }
     let summary = ModelSummary::of(&model, &crs_name);
     let path = out.join("model.json");
