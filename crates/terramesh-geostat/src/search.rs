@@ -100,7 +100,9 @@ mod tests {
     fn ties_are_broken_by_coordinates_whatever_else_the_tree_holds() {
         // A regular grid: the 4 nearest of a cell centre are all at one distance, and so
         // are the next 8; a subset tree must pick and order the same ones.
-        let pts: Vec<[f64; 2]> = (0..400).map(|i| [(i % 20) as f64, (i / 20) as f64]).collect();
+        let pts: Vec<[f64; 2]> = (0..400)
+            .map(|i| [(i % 20) as f64, (i / 20) as f64])
+            .collect();
         let part: Vec<[f64; 2]> = pts
             .iter()
             .copied()

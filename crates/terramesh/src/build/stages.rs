@@ -447,7 +447,12 @@ pub(crate) struct Surface(Box<dyn Predictor>);
 impl Surface {
     /// Kriging: global for `neighbors == 0` (the project's "all samples"), else a moving
     /// neighbourhood of that size.
-    pub(crate) fn kriging(data: &Data, v: &Variogram, method: Method, neighbors: usize) -> Result<Surface> {
+    pub(crate) fn kriging(
+        data: &Data,
+        v: &Variogram,
+        method: Method,
+        neighbors: usize,
+    ) -> Result<Surface> {
         let hood = match neighbors {
             0 => Neighbourhood::All,
             k => Neighbourhood::Nearest(k),

@@ -72,7 +72,7 @@ pub fn build_tile(plan: &Path, id: &str) -> Result<Outcome> {
             Ok(Outcome::Built(summary))
         }
         Err(e) => {
-            let why = crate::error::chain(&e);
+            let why = e.render(&|s| s.to_string());
             update(plan, |m| {
                 let t = m.tiles.iter_mut().find(|t| t.id == id).expect("found");
                 t.state = State::Failed;
@@ -170,8 +170,10 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     // The tile's folder, atomically.
     let t = Instant::now();
     let dir = tile_dir(plan, &tile.id);
-    std::fs::create_dir_all(plan.join("tiles")).context(plan.join("tiles").display().to_string())?;
-    let folder = terramesh_io::folder::OutputFolder::create(&dir).context(dir.display().to_string())?;
+    std::fs::create_dir_all(plan.join("tiles"))
+        .context(plan.join("tiles").display().to_string())?;
+    let folder =
+        terramesh_io::folder::OutputFolder::create(&dir).context(dir.display().to_string())?;
     let vertices: Vec<Vertex> = (0..positions.len())
         .map(|i| Vertex {
             xy: positions[i],
@@ -204,7 +206,11 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
 /// The vertices' absolute positions, with every boundary vertex replaced by the planned ring
 /// vertex it is (the mesh works in local coordinates, which round); an error if a ring vertex
 /// is missing or the boundary has any other vertex.
-fn planned_positions(mesh: &terramesh_mesh::Mesh, ring: &[[f64; 2]], id: &str) -> Result<Vec<[f64; 2]>> {
+fn planned_positions(
+    mesh: &terramesh_mesh::Mesh,
+    ring: &[[f64; 2]],
+    id: &str,
+) -> Result<Vec<[f64; 2]>> {
     use std::collections::HashMap;
     let key = |p: [f64; 2]| ((p[0] * 1e3).round() as i64, (p[1] * 1e3).round() as i64);
     let mut at: HashMap<(i64, i64), usize> = HashMap::with_capacity(ring.len());

@@ -273,7 +273,10 @@ pub fn plan(
                         r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
                         r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
                     ];
-                    let near = tree.nearest_n::<SquaredEuclidean<f64>>(&q, kk);
+                    let near = tree
+                        .query(&q)
+                        .nearest_n::<SquaredEuclidean<f64>>(kk)
+                        .execute();
                     if let Some(last) = near.last() {
                         reach = reach.max(last.distance.sqrt());
                     }
