@@ -75,8 +75,11 @@ pub fn build_tile(plan: &Path, id: &str) -> Result<Outcome> {
             let why = e.render(&|s| s.to_string());
             update(plan, |m| {
                 let t = m.tiles.iter_mut().find(|t| t.id == id).expect("found");
-                t.state = State::Failed;
-                t.error = Some(why.clone());
+                // Another process (a task a scheduler started again) may have finished it.
+                if t.state != State::Done {
+                    t.state = State::Failed;
+                    t.error = Some(why.clone());
+                }
                 Ok(())
             })?;
             Err(e)
