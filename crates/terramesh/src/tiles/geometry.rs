@@ -153,6 +153,9 @@ pub(crate) fn split(a: [f64; 2], b: [f64; 2], spacing: f64) -> Vec<[f64; 2]> {
     out
 }
 
+/// A seam: the side (0 west, 1 south, 2 east, 3 north) and its vertices.
+pub(crate) type Side = (usize, Vec<[f64; 2]>);
+
 /// A tile polygon's ring with every edge split, and its seams: for each edge on a grid line
 /// between two columns (`xs`) or rows (`ys`), the neighbour across it (`across(axis, side)`,
 /// side -1 or +1) and the edge's vertices in canonical order.
@@ -161,7 +164,7 @@ pub(crate) fn ring_and_seams(
     rect: [f64; 4],
     inner: [bool; 4],
     spacing: f64,
-) -> (Vec<[f64; 2]>, Vec<(usize, Vec<[f64; 2]>)>) {
+) -> (Vec<[f64; 2]>, Vec<Side>) {
     let mut ring = Vec::new();
     let mut seams = Vec::new();
     let n = poly.len();

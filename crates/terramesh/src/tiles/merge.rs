@@ -209,6 +209,14 @@ fn min_angle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
         .to_degrees()
 }
 
+/// What a pass over the tiles does with one tile: its vertices, their global indices and
+/// whether this tile writes them, and its triangles.
+type TilePass<'a> =
+    dyn FnMut(&mut Output, &[Vertex], &[(u32, bool)], &[[u32; 3]]) -> std::io::Result<()> + 'a;
+
+/// A point array of `dsm.vtu`: its name and value.
+type PointArray = (&'static str, fn(&Vertex) -> f64);
+
 /// Writes `dsm.vtu`, one pass over the tiles per array.
 fn write_vtu(
     path: &Path,
@@ -228,14 +236,7 @@ fn write_vtu(
     )
     .map_err(io)?;
     // Each pass: for every tile, its vertices (mapped) and triangles.
-    let pass = |w: &mut Output,
-                f: &mut dyn FnMut(
-        &mut Output,
-        &[Vertex],
-        &[(u32, bool)],
-        &[[u32; 3]],
-    ) -> std::io::Result<()>|
-     -> Result<()> {
+    let pass = |w: &mut Output, f: &mut TilePass| -> Result<()> {
         let mut next = 0u32;
         for (k, t) in m.tiles.iter().enumerate() {
             let dir = tile_dir(plan, &t.id);
@@ -246,7 +247,7 @@ fn write_vtu(
         }
         Ok(())
     };
-    let point_arrays: [(&str, fn(&Vertex) -> f64); 4] = [
+    let point_arrays: [PointArray; 4] = [
         ("elevation_uk", |p| p.uk),
         ("kriging_std", |p| p.std),
         ("elevation_idw", |p| p.idw),
