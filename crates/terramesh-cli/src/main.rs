@@ -45,6 +45,8 @@ enum Command {
     Sample(Box<cmd::sample::Args>),
     /// Mesh the study region: quality triangles, optional smoothing, VTU/OBJ/PLY/MSH output.
     Mesh(cmd::mesh::Args),
+    /// Tiled builds for clusters: plan tiles, build one tile, merge, write Slurm scripts.
+    Tiles(cmd::tiles::Args),
 }
 
 fn main() -> ExitCode {
@@ -53,7 +55,7 @@ fn main() -> ExitCode {
     // A project's settings are keys, worded by the library; a command's are flags.
     let flags = !matches!(
         cli.command,
-        Command::Build(_) | Command::Model(_) | Command::Init(_)
+        Command::Build(_) | Command::Model(_) | Command::Init(_) | Command::Tiles(_)
     );
     let crs = if matches!(cli.command, Command::Mesh(_)) {
         "--crs"
@@ -70,6 +72,7 @@ fn main() -> ExitCode {
         Command::Cv(args) => cmd::cv::run(args),
         Command::Sample(args) => cmd::sample::run(*args),
         Command::Mesh(args) => cmd::mesh::run(args),
+        Command::Tiles(args) => cmd::tiles::run(args),
     };
     interrupt::finishing();
     match result {

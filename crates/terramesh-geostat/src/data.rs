@@ -30,6 +30,20 @@ terramesh_core::named_enum!(Duplicates, "duplicate handling", [
 pub struct Data {
     xy: Vec<[f64; 2]>,
     z: Vec<f64>,
+    frame: Option<KrigingFrame>,
+}
+
+/// The centred frame kriging evaluates distances and drift terms in: the centroid of the
+/// (anisotropy-transformed) data and the half extent that divides the drift coordinates.
+/// Kriging does not depend on it mathematically, but its rounding does: a subset of the data
+/// given the whole data's frame ([`Data::with_frame`]) kriges bit for bit like the whole
+/// wherever both see the same neighbours (the tiles of `terramesh tiles`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KrigingFrame {
+    /// The centre subtracted from every transformed point.
+    pub centre: [f64; 2],
+    /// The scale dividing centred coordinates in the drift terms (positive).
+    pub scale: f64,
 }
 
 impl Data {
@@ -69,7 +83,7 @@ impl Data {
         let same = |a: usize, b: usize| xy[a][0] == xy[b][0] && xy[a][1] == xy[b][1];
         let has_dup = order.windows(2).find(|w| same(w[0], w[1]));
         match (has_dup, duplicates) {
-            (None, _) => Ok(Data { xy, z }),
+            (None, _) => Ok(Data { xy, z, frame: None }),
             (Some(w), Duplicates::Reject) => Err(GeostatError::DuplicateLocation {
                 first: w[0],
                 second: w[1],
@@ -101,7 +115,11 @@ impl Data {
                         nz.push(s / c as f64);
                     }
                 }
-                Ok(Data { xy: nxy, z: nz })
+                Ok(Data {
+                    xy: nxy,
+                    z: nz,
+                    frame: None,
+                })
             }
         }
     }
@@ -136,7 +154,37 @@ impl Data {
         Data {
             xy: idx.iter().map(|&i| self.xy[i]).collect(),
             z: idx.iter().map(|&i| self.z[i]).collect(),
+            frame: self.frame,
         }
+    }
+
+    /// The frame kriging of these data with `variogram` works in: the one given by
+    /// [`Data::with_frame`], else the data's own.
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{Data, Duplicates, ModelKind, Variogram};
+    /// let v = Variogram::single(ModelKind::Exponential, 0.0, 1.0, 5.0)?;
+    /// let all = Data::new(vec![[0.0, 0.0], [4.0, 0.0], [2.0, 2.0]], vec![1.0, 2.0, 3.0], Duplicates::Reject)?;
+    /// let frame = all.frame(&v);
+    /// assert_eq!(frame.centre, [2.0, 2.0 / 3.0]);
+    /// let part = all.subset(&[0, 1]).with_frame(frame);
+    /// assert_eq!(part.frame(&v), frame);
+    /// # Ok(()) }
+    /// ```
+    pub fn frame(&self, variogram: &Variogram) -> KrigingFrame {
+        let f = Frame::new(self, variogram);
+        KrigingFrame {
+            centre: f.centre,
+            scale: f.scale,
+        }
+    }
+
+    /// These data kriged in `frame` (from [`Data::frame`] of a larger set) rather than in
+    /// their own. A scale that is not positive and finite is replaced by 1.
+    pub fn with_frame(mut self, frame: KrigingFrame) -> Data {
+        self.frame = Some(frame);
+        self
     }
 }
 
@@ -276,6 +324,13 @@ pub(crate) struct Frame {
 
 impl Frame {
     pub(crate) fn new(data: &Data, v: &Variogram) -> Frame {
+        if let Some(f) = data.frame {
+            let ok = f.scale.is_finite() && f.scale > 0.0;
+            return Frame {
+                centre: f.centre,
+                scale: if ok { f.scale } else { 1.0 },
+            };
+        }
         let n = data.len().max(1) as f64;
         let mut c = [0.0, 0.0];
         for p in data.xy() {

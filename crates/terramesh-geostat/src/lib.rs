@@ -68,7 +68,7 @@ mod special;
 mod system;
 
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
-pub use data::{Data, Drift, Duplicates, InterpolationMethod, Method};
+pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
 pub use error::{GeostatError, Result};
 pub use experimental::{
     diameter, draw_subset, experimental, Direction, Estimator, Lag, LagSettings, DEFAULT_LAGS,

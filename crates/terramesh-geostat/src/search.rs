@@ -10,6 +10,8 @@ use crate::error::{GeostatError, Result};
 pub(crate) struct Tree {
     tree: ImmutableKdTree<f64, 2>,
     len: usize,
+    /// The points, for the tie rule of [`Tree::nearest`].
+    pts: Vec<[f64; 2]>,
 }
 
 impl Tree {
@@ -19,19 +21,41 @@ impl Tree {
         Ok(Tree {
             tree,
             len: points.len(),
+            pts: points.to_vec(),
         })
     }
 
-    /// The `k` nearest points as (squared distance, index), nearest first.
+    /// The `k` nearest points as (squared distance, index), nearest first; points at equal
+    /// distance in the order of their coordinates (x, then y, then index), so that the
+    /// neighbours of a target, and their order, do not depend on which other points the tree
+    /// holds (the tiles of `terramesh tiles` krige like the whole region). kiddo's own order
+    /// among equal distances depends on the tree, so a few more than `k` are asked for, more
+    /// until the `k`-th is strictly nearer than the last one returned.
     pub(crate) fn nearest(&self, q: [f64; 2], k: usize, out: &mut Vec<(f64, usize)>) {
-        out.clear();
-        let k = NonZeroUsize::new(k.min(self.len).max(1)).expect("k >= 1");
-        let r = self
-            .tree
-            .query(&q)
-            .nearest_n::<SquaredEuclidean<f64>>(k)
-            .execute();
-        out.extend(r.into_iter().map(|it| (it.distance, it.item as usize)));
+        let k = k.min(self.len).max(1);
+        let mut want = (k + 4).min(self.len).max(1);
+        loop {
+            out.clear();
+            let n = NonZeroUsize::new(want).expect("want >= 1");
+            let r = self
+                .tree
+                .query(&q)
+                .nearest_n::<SquaredEuclidean<f64>>(n)
+                .execute();
+            out.extend(r.into_iter().map(|it| (it.distance, it.item as usize)));
+            if want >= self.len || out.len() <= k || out[k - 1].0 < out[out.len() - 1].0 {
+                break;
+            }
+            want = (2 * want).min(self.len);
+        }
+        let pts = &self.pts;
+        out.sort_by(|a, b| {
+            a.0.total_cmp(&b.0)
+                .then(pts[a.1][0].total_cmp(&pts[b.1][0]))
+                .then(pts[a.1][1].total_cmp(&pts[b.1][1]))
+                .then(a.1.cmp(&b.1))
+        });
+        out.truncate(k);
     }
 
     /// The nearest point as (squared distance, index).
@@ -70,6 +94,38 @@ mod tests {
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn ties_are_broken_by_coordinates_whatever_else_the_tree_holds() {
+        // A regular grid: the 4 nearest of a cell centre are all at one distance, and so
+        // are the next 8; a subset tree must pick and order the same ones.
+        let pts: Vec<[f64; 2]> = (0..400)
+            .map(|i| [(i % 20) as f64, (i / 20) as f64])
+            .collect();
+        let part: Vec<[f64; 2]> = pts
+            .iter()
+            .copied()
+            .filter(|p| p[0] >= 5.0 && p[1] <= 14.0)
+            .collect();
+        let (a, b) = (Tree::new(&pts).unwrap(), Tree::new(&part).unwrap());
+        let (mut oa, mut ob) = (Vec::new(), Vec::new());
+        for q in [[9.5, 9.5], [10.0, 10.0], [7.0, 8.5]] {
+            for k in [1, 3, 6, 10, 16] {
+                a.nearest(q, k, &mut oa);
+                b.nearest(q, k, &mut ob);
+                let xa: Vec<_> = oa.iter().map(|&(d, i)| (d, pts[i])).collect();
+                let xb: Vec<_> = ob.iter().map(|&(d, i)| (d, part[i])).collect();
+                assert_eq!(xa, xb, "{q:?} k={k}");
+                // Brute force with the same rule.
+                let mut all: Vec<(f64, [f64; 2])> = pts
+                    .iter()
+                    .map(|p| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2), *p))
+                    .collect();
+                all.sort_by(|a, b| a.partial_cmp(b).unwrap());
+                assert_eq!(xa, all[..k].to_vec());
+            }
+        }
     }
 
     #[test]

@@ -70,6 +70,7 @@ pub struct MeshBuilder {
     max_vertices: Option<usize>,
     points: Vec<[f64; 2]>,
     strips: Option<usize>,
+    keep_boundary: bool,
 }
 
 impl Default for MeshBuilder {
@@ -89,6 +90,7 @@ impl MeshBuilder {
             max_vertices: None,
             points: Vec::new(),
             strips: None,
+            keep_boundary: false,
         }
     }
     /// Minimum angle in degrees, `0..=33` (0 turns angle refinement off).
@@ -110,6 +112,36 @@ impl MeshBuilder {
     /// `area / max_area` plus 1,000 per input vertex plus 100,000).
     pub fn max_vertices(mut self, n: usize) -> Self {
         self.max_vertices = Some(n);
+        self
+    }
+    /// Refinement inserts no vertex on the region's rings (default: false): every boundary
+    /// vertex of the mesh is a vertex of a ring, so that meshes of regions that share a side
+    /// split at the same vertices meet vertex to vertex (the tiles of `terramesh tiles`, whose
+    /// seams are split in advance like the strips' cuts). Split the rings into pieces of about
+    /// 0.7 target edge lengths first: refinement cannot shorten a kept edge, so the triangles
+    /// along a long one may miss the angle limit. Meshes in one piece (no strips).
+    ///
+    /// ```
+    /// use terramesh_core::geometry::Region;
+    /// use terramesh_mesh::MeshBuilder;
+    /// let ring: Vec<[f64; 2]> = (0..40)
+    ///     .map(|i| {
+    ///         let t = (i % 10) as f64;
+    ///         [[t, 0.0], [10.0, t], [10.0 - t, 10.0], [0.0, 10.0 - t]][i / 10]
+    ///     })
+    ///     .collect();
+    /// let region = Region::from_ring(ring.clone());
+    /// let (mesh, _) = MeshBuilder::new().max_area(0.5).keep_boundary(true).build(&region)?;
+    /// // The boundary vertices are the ring's 40 and no others.
+    /// let on_edge = (0..mesh.points.len())
+    ///     .map(|i| mesh.absolute(i))
+    ///     .filter(|p| p[0] == 0.0 || p[0] == 10.0 || p[1] == 0.0 || p[1] == 10.0)
+    ///     .count();
+    /// assert_eq!(on_edge, 40);
+    /// # Ok::<(), terramesh_mesh::MeshError>(())
+    /// ```
+    pub fn keep_boundary(mut self, keep: bool) -> Self {
+        self.keep_boundary = keep;
         self
     }
     /// Number of vertical strips meshed in parallel, 1 to 16 (default: from the expected
@@ -201,6 +233,7 @@ impl MeshBuilder {
         // Large meshes: vertical strips meshed in parallel (`crate::strips`), unless the
         // region has no good place for a cut.
         let strips = match (self.strips, budget) {
+            _ if self.keep_boundary => 1,
             (Some(k), Some(_)) => k.clamp(1, crate::strips::MAX_STRIPS),
             (None, Some(a)) => crate::strips::auto_strips(region.area() / a),
             _ => 1,
@@ -222,6 +255,7 @@ impl MeshBuilder {
             }
         }
         let mut state = CdtState::seeded(&region, &self.points, lattice, margin, presplit)?;
+        state.keep = self.keep_boundary;
         let mut report = BuildReport {
             input_vertices: state.cdt.num_vertices() - state.frame,
             points_outside: state.points_outside,

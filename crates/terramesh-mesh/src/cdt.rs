@@ -30,6 +30,8 @@ pub(crate) struct CdtState {
     pub(crate) frame: usize,
     /// spade's excluded faces from the last refinement, while they are current and right.
     excluded: Option<Vec<spade::handles::FixedFaceHandle<spade::handles::InnerTag>>>,
+    /// Refinement splits no constraint edge (see [`crate::MeshBuilder::keep_boundary`]).
+    pub(crate) keep: bool,
 }
 
 /// True if `p` lies within `tol` of segment `a b` (strictly between its ends).
@@ -297,6 +299,7 @@ impl CdtState {
             tol,
             excluded: None,
             frame: corners.len(),
+            keep: false,
         };
         for line in &soup.lines {
             let hs = line
@@ -341,6 +344,9 @@ impl CdtState {
         if let Some(a) = max_area {
             params = params.with_max_allowed_area(a);
         }
+        if self.keep {
+            params = params.keep_constraint_edges();
+        }
         let result = self.cdt.refine(params);
         self.excluded = self.spade_classifies.then_some(result.excluded_faces);
         Ok(result.refinement_complete)
@@ -381,7 +387,9 @@ impl CdtState {
         let mut mids = Vec::new();
         for e in self.cdt.undirected_edges() {
             let [a, b] = e.vertices().map(|v| v.position());
-            if (b.x - a.x).powi(2) + (b.y - a.y).powi(2) <= l2 {
+            if (b.x - a.x).powi(2) + (b.y - a.y).powi(2) <= l2
+                || (self.keep && self.cdt.is_constraint_edge(e.fix()))
+            {
                 continue;
             }
             let faces = e.as_directed();

@@ -15,7 +15,7 @@ mod adaptive;
 mod exports;
 mod pictures;
 mod report;
-mod stages;
+pub(crate) mod stages;
 pub mod staging;
 mod terrain;
 mod viewer;

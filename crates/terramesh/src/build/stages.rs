@@ -356,29 +356,8 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     }
 
     // The DSM grid over the region's bounding box, nodata outside the region.
-    let (lo, hi) = s.region.projected.bbox().context("empty region")?;
-    let step = p
-        .export
-        .grid_spacing
-        .unwrap_or(s.cell[0].min(s.cell[1]))
-        .max(1e-3);
-    // The node count follows from the settings: estimated before the grid is allocated (16
-    // bytes a node: the value and its index), refused with the key that changes it.
-    let (fx, fy) = ((hi[0] - lo[0]) / step + 1.0, (hi[1] - lo[1]) / step + 1.0);
-    terramesh_core::limits::Estimate::new("DSM grid nodes", fx.ceil() * fy.ceil(), 16.0)
-        .remedy(terramesh_core::limits::Remedy::raise("grid_spacing"))
-        .check()
-        .map_err(crate::error::Error::TooLarge)?;
-    let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
-    let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
-    let spec = terramesh_io::grid_write::RasterGrid {
-        xmin: lo[0],
-        ymin: hi[1] - (ny - 1) as f64 * step,
-        xmax: lo[0] + (nx - 1) as f64 * step,
-        ymax: hi[1],
-        nx,
-        ny,
-    };
+    let spec = dsm_grid(p, s)?;
+    let (nx, ny) = (spec.nx, spec.ny);
     let mut inside = Vec::new();
     let mut index = Vec::new();
     for j in 0..ny {
@@ -423,6 +402,35 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     })
 }
 
+/// The DSM grid (`dsm.tif`) of a build: over the region's bounding box, at
+/// `export.grid_spacing` or the finer sampling cell size, north row first (the tiles of
+/// `terramesh tiles` share it).
+pub(crate) fn dsm_grid(p: &Project, s: &Samples) -> Result<terramesh_io::grid_write::RasterGrid> {
+    let (lo, hi) = s.region.projected.bbox().context("empty region")?;
+    let step = p
+        .export
+        .grid_spacing
+        .unwrap_or(s.cell[0].min(s.cell[1]))
+        .max(1e-3);
+    // The node count follows from the settings: estimated before the grid is allocated (16
+    // bytes a node: the value and its index), refused with the key that changes it.
+    let (fx, fy) = ((hi[0] - lo[0]) / step + 1.0, (hi[1] - lo[1]) / step + 1.0);
+    terramesh_core::limits::Estimate::new("DSM grid nodes", fx.ceil() * fy.ceil(), 16.0)
+        .remedy(terramesh_core::limits::Remedy::raise("grid_spacing"))
+        .check()
+        .map_err(crate::error::Error::TooLarge)?;
+    let nx = (((hi[0] - lo[0]) / step).ceil() as usize + 1).max(2);
+    let ny = (((hi[1] - lo[1]) / step).ceil() as usize + 1).max(2);
+    Ok(terramesh_io::grid_write::RasterGrid {
+        xmin: lo[0],
+        ymin: hi[1] - (ny - 1) as f64 * step,
+        xmax: lo[0] + (nx - 1) as f64 * step,
+        ymax: hi[1],
+        nx,
+        ny,
+    })
+}
+
 /// IDW's search for `neighbors` (0: every sample).
 fn idw_search(neighbors: usize) -> IdwSearch {
     if neighbors == 0 {
@@ -434,12 +442,17 @@ fn idw_search(neighbors: usize) -> IdwSearch {
 
 /// An interpolated surface: a predictor set up once (a kriging system factorised, a search
 /// tree built) and evaluated at many targets.
-pub(super) struct Surface(Box<dyn Predictor>);
+pub(crate) struct Surface(Box<dyn Predictor>);
 
 impl Surface {
     /// Kriging: global for `neighbors == 0` (the project's "all samples"), else a moving
     /// neighbourhood of that size.
-    fn kriging(data: &Data, v: &Variogram, method: Method, neighbors: usize) -> Result<Surface> {
+    pub(crate) fn kriging(
+        data: &Data,
+        v: &Variogram,
+        method: Method,
+        neighbors: usize,
+    ) -> Result<Surface> {
         let hood = match neighbors {
             0 => Neighbourhood::All,
             k => Neighbourhood::Nearest(k),
@@ -450,14 +463,14 @@ impl Surface {
     }
 
     /// IDW with `power` over `neighbors` neighbours (0: all).
-    fn idw(data: &Data, power: f64, neighbors: usize) -> Result<Surface> {
+    pub(crate) fn idw(data: &Data, power: f64, neighbors: usize) -> Result<Surface> {
         Ok(Surface(Box::new(
             Idw::new(data, power, idw_search(neighbors)).context("IDW")?,
         )))
     }
 
     /// The surface of the project's first interpolation method, which gives the DSM.
-    pub(super) fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
+    pub(crate) fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
         let ip = &p.interpolation;
         match ip.methods[0].method(ip.drift, None, data) {
             Some(method) => Surface::kriging(data, v, method, ip.neighbors),
@@ -466,7 +479,7 @@ impl Surface {
     }
 
     /// Estimates (and variances on request, kriging only) at `targets`.
-    pub(super) fn predict(
+    pub(crate) fn predict(
         &self,
         targets: &[[f64; 2]],
         variance: bool,

@@ -1,0 +1,182 @@
+//! `terramesh tiles plan|build|merge|slurm`: tiled builds ([`terramesh::tiles`]).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Result;
+use terramesh::project::Project;
+use terramesh::tiles;
+
+use crate::progress::Terminal;
+
+/// Tiled builds: split a project's region into tiles built as independent jobs (on one
+/// machine, Dask, or a Slurm array) and merged without seams.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Example:\n  \
+    terramesh tiles plan examples/fort-worth-1m/terramesh.toml --tile-size 10km -o plan/\n  \
+    terramesh tiles build plan/ --tile x0y0      # one per tile, in any order, in parallel\n  \
+    terramesh tiles merge plan/ -o out/\n  \
+    terramesh tiles slurm plan/ --partition compute   # then: bash plan/slurm/submit.sh\n  \
+    python -m terramesh.dask plan/ --scheduler tcp://host:8786")]
+pub struct Args {
+    #[command(subcommand)]
+    command: Sub,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Sub {
+    /// Sample the region once, fit one variogram, and split the region into tiles with halos
+    /// and fixed seams: writes PLAN/tiles.json.
+    Plan(PlanArgs),
+    /// Build one tile into PLAN/tiles/ID/ (atomically) and mark it done; a done tile is left
+    /// as it is, a failed one records why and can be built again.
+    Build(BuildArgs),
+    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, merge.json, report.html.
+    Merge(MergeArgs),
+    /// Write Slurm scripts: an sbatch array (one tile per task) and a merge job after it.
+    Slurm(SlurmArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct PlanArgs {
+    /// The project file (terramesh.toml).
+    project: PathBuf,
+    /// The tiles' side: metres or kilometres (10km, 2500m, 2500).
+    #[arg(long, value_name = "SIZE")]
+    tile_size: String,
+    /// The halo around each tile's data: `auto`, computed from the kriging neighbourhood (the
+    /// only choice: a halo that is too narrow would change the estimates).
+    #[arg(long, default_value = "auto")]
+    halo: String,
+    /// The plan folder (created if needed).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Override a project key, e.g. --set interpolation.neighbors=32 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// No progress output.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(clap::Args, Debug)]
+struct BuildArgs {
+    /// The plan folder (from terramesh tiles plan).
+    plan: PathBuf,
+    /// The tile's id (as in tiles.json, e.g. x0y0).
+    #[arg(long)]
+    tile: String,
+}
+
+#[derive(clap::Args, Debug)]
+struct MergeArgs {
+    /// The plan folder, every tile built.
+    plan: PathBuf,
+    /// Output directory (created if needed).
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+struct SlurmArgs {
+    /// The plan folder.
+    plan: PathBuf,
+    /// The Slurm partition of every job.
+    #[arg(long)]
+    partition: String,
+    /// Time limit of each job (HH:MM:SS).
+    #[arg(long, default_value = "01:00:00")]
+    time: String,
+    /// CPUs per task.
+    #[arg(long, default_value_t = 2)]
+    cpus: usize,
+    /// Memory per task (e.g. 4G); Slurm's default if not given.
+    #[arg(long)]
+    mem: Option<String>,
+    /// The merge job's output folder (default: PLAN/merged).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let t0 = Instant::now();
+    match args.command {
+        Sub::Plan(a) => {
+            if a.halo != "auto" {
+                anyhow::bail!(
+                    "--halo '{}': only auto is supported (the halo is computed from the \
+                     kriging neighbourhood so that every tile sees the samples it needs)",
+                    a.halo
+                );
+            }
+            let size = tiles::parse_tile_size(&a.tile_size)
+                .map_err(|e| anyhow::anyhow!("--tile-size {e}"))?;
+            let p = Project::load(&a.project, &a.set).map_err(crate::project_error)?;
+            let base = a.project.parent().unwrap_or(Path::new("."));
+            let progress = Terminal::new(a.quiet, true);
+            let planned = tiles::plan(&p, &a.project, &a.set, base, size, &a.output, &progress)
+                .map_err(crate::project_error)?;
+            progress.finish(&format!(
+                "planned {} tiles ({} x {}) of {} samples into {} (widest halo {:.0} m) in {:.2} s",
+                planned.tiles,
+                planned.shape[0],
+                planned.shape[1],
+                planned.samples,
+                a.output.display(),
+                planned.max_halo,
+                t0.elapsed().as_secs_f64()
+            ));
+        }
+        Sub::Build(a) => {
+            match tiles::build_tile(&a.plan, &a.tile).map_err(crate::project_error)? {
+                tiles::Outcome::AlreadyDone => crate::say(&format!(
+                    "tile {} is done already: nothing changed\n",
+                    a.tile
+                ))?,
+                tiles::Outcome::Built(s) => crate::say(&format!(
+                    "built tile {}: {} vertices, {} triangles, {} grid nodes from {} samples in \
+                     {:.2} s\n",
+                    a.tile,
+                    s.vertices,
+                    s.triangles,
+                    s.grid_nodes,
+                    s.samples,
+                    t0.elapsed().as_secs_f64()
+                ))?,
+            }
+        }
+        Sub::Merge(a) => {
+            let m = tiles::merge(&a.plan, &a.output).map_err(crate::project_error)?;
+            crate::say(&format!(
+                "merged into {}: {} vertices, {} triangles, {} seam vertices in {:.2} s\n",
+                a.output.display(),
+                m.vertices,
+                m.triangles,
+                m.seam_vertices,
+                t0.elapsed().as_secs_f64()
+            ))?;
+        }
+        Sub::Slurm(a) => {
+            let binary = std::env::current_exe()?;
+            let output = a.output.unwrap_or_else(|| a.plan.join("merged"));
+            let o = tiles::SlurmOptions {
+                partition: a.partition,
+                time: a.time,
+                cpus: a.cpus,
+                mem: a.mem,
+                binary,
+                output,
+            };
+            let s = tiles::write_slurm(&a.plan, &o).map_err(crate::project_error)?;
+            crate::say(&format!(
+                "wrote {}, {} and {}: submit with bash {}\n",
+                s.tiles.display(),
+                s.merge.display(),
+                s.submit.display(),
+                s.submit.display()
+            ))?;
+        }
+    }
+    Ok(())
+}

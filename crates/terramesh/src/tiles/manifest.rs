@@ -1,0 +1,258 @@
+//! `PLAN/tiles.json`: the manifest of a tiled build, and its lock.
+//!
+//! Several `terramesh tiles build` processes update the manifest at once. Each update holds an
+//! exclusive operating-system lock on `PLAN/tiles.lock` (`std::fs::File::lock`: `flock` on
+//! Unix, `LockFileEx` on Windows, the locks `fs4`/`fs2` wrap; released by the system when a
+//! process dies), reads the manifest, changes it and writes it atomically
+//! ([`terramesh_io::output::write_atomic`]), so that no update is lost and no reader sees half
+//! a file.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Context, Error, Result};
+
+/// The manifest's file name in the plan folder.
+pub const MANIFEST: &str = "tiles.json";
+/// The lock file beside it.
+pub const LOCK: &str = "tiles.lock";
+/// The samples of the whole region, `[x, y, z]` little-endian `f64` triples.
+pub const SAMPLES: &str = "samples.f64";
+/// The variogram every tile uses.
+pub const VARIOGRAM: &str = "variogram.json";
+/// The manifest format's version.
+pub const VERSION: u32 = 1;
+
+/// A tile's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum State {
+    /// Not built yet.
+    Planned,
+    /// A `tiles build` process is on it (or died on it: building again is allowed).
+    Running,
+    /// Built: its folder `tiles/ID/` is complete.
+    Done,
+    /// Its last build failed; `error` says why.
+    Failed,
+}
+
+/// A seam: the polyline a tile shares with one neighbour, with every vertex fixed in advance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Seam {
+    /// The neighbour's id.
+    pub neighbour: String,
+    /// The vertices in order of increasing x, then y (the same list in both tiles).
+    pub vertices: Vec<[f64; 2]>,
+}
+
+/// One tile of the plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Tile {
+    /// `x{column}y{row}`, column 0 at the west, row 0 at the south.
+    pub id: String,
+    /// Column and row in the tile grid.
+    pub index: [usize; 2],
+    /// The tile's square, `[xmin, ymin, xmax, ymax]`: it owns the grid nodes with
+    /// `xmin <= x < xmax`, `ymin <= y < ymax` (the last column and row also their upper edge).
+    pub extent: [f64; 4],
+    /// How far beyond the extent the tile's data reach (metres): at least as far as the
+    /// farthest of the nearest `neighbours` samples of any point of the extent.
+    pub halo: f64,
+    /// The ids of the tiles it shares a seam with.
+    pub neighbours: Vec<String>,
+    /// Its part of the region, counter-clockwise, every edge split in advance: the mesh keeps
+    /// exactly these boundary vertices.
+    pub ring: Vec<[f64; 2]>,
+    /// The seams with its neighbours.
+    pub seams: Vec<Seam>,
+    /// Where its build is.
+    pub state: State,
+    /// Why its last build failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// What its build made and how long it took, when done.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub built: Option<TileSummary>,
+}
+
+/// What a tile's build made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TileSummary {
+    /// Samples in its data window.
+    pub samples: usize,
+    /// Mesh vertices.
+    pub vertices: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// DSM grid nodes it owns.
+    pub grid_nodes: usize,
+    /// Seconds per stage (`data`, `mesh`, `interpolation`, `write`) and `total`.
+    pub seconds: Vec<(String, f64)>,
+    /// Peak resident memory of the process that built it, bytes (Linux; 0 elsewhere).
+    pub peak_rss: u64,
+}
+
+/// The mesh settings every tile uses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeshSettings {
+    /// Minimum angle, degrees.
+    pub min_angle: f64,
+    /// Maximum triangle area, m².
+    pub max_area: Option<f64>,
+    /// Maximum edge length, m.
+    pub max_edge: Option<f64>,
+    /// Smoothing passes (boundary vertices never move).
+    pub smooth: usize,
+    /// The seams' and the outline's vertex spacing (0.7 target edge lengths, as the strips'
+    /// cuts of `terramesh-mesh`).
+    pub seam_spacing: f64,
+}
+
+/// The rule that picks each tile's data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DataRule {
+    /// The samples file in the plan folder.
+    pub samples: String,
+    /// How many.
+    pub count: usize,
+    /// The neighbourhood size the halo covers (the larger of kriging's and IDW's).
+    pub neighbours: usize,
+    /// The rule in words.
+    pub rule: String,
+}
+
+/// The DSM grid of the whole region (the one-piece build's `dsm.tif`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GridSpec {
+    /// West node.
+    pub xmin: f64,
+    /// South node.
+    pub ymin: f64,
+    /// East node.
+    pub xmax: f64,
+    /// North node.
+    pub ymax: f64,
+    /// Columns.
+    pub nx: usize,
+    /// Rows.
+    pub ny: usize,
+}
+
+/// The whole manifest.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`VERSION`].
+    pub version: u32,
+    /// The project file (absolute).
+    pub project: PathBuf,
+    /// Its `--set` overrides.
+    pub set: Vec<String>,
+    /// The tiles' side, metres.
+    pub tile_size: f64,
+    /// The south-west corner of the tile grid.
+    pub origin: [f64; 2],
+    /// Columns and rows of the tile grid.
+    pub shape: [usize; 2],
+    /// The region (projected) as loaded: the outer ring the one-piece build tests grid nodes
+    /// against.
+    pub region: Vec<[f64; 2]>,
+    /// The variogram file in the plan folder, fitted once on the project's fixed sample of all
+    /// the data (the one-piece build's `variogram.json`).
+    pub variogram: String,
+    /// The kriging frame of all the data (centre and scale), which every tile kriges in.
+    pub frame: ([f64; 2], f64),
+    /// The mesh settings.
+    pub mesh: MeshSettings,
+    /// The data-selection rule.
+    pub data: DataRule,
+    /// The DSM grid.
+    pub grid: GridSpec,
+    /// EPSG code of the coordinates, when known.
+    pub epsg: Option<u32>,
+    /// The tiles.
+    pub tiles: Vec<Tile>,
+}
+
+impl Manifest {
+    /// Reads `PLAN/tiles.json`.
+    pub fn read(plan: &Path) -> Result<Manifest> {
+        let path = plan.join(MANIFEST);
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            Error::invalid(format!(
+                "{}: {e}; make a plan first with terramesh tiles plan",
+                path.display()
+            ))
+        })?;
+        let m: Manifest = serde_json::from_str(&text).context(path.display().to_string())?;
+        if m.version != VERSION {
+            return Err(Error::invalid(format!(
+                "{}: manifest version {} (this terramesh reads {VERSION}): plan again",
+                path.display(),
+                m.version
+            )));
+        }
+        Ok(m)
+    }
+
+    /// Writes `PLAN/tiles.json` atomically (callers hold the lock, see [`update`]).
+    pub fn write(&self, plan: &Path) -> Result<()> {
+        let text = serde_json::to_string_pretty(self)?;
+        terramesh_io::output::write_atomic(&plan.join(MANIFEST), text.as_bytes())
+            .context(plan.join(MANIFEST).display().to_string())
+    }
+
+    /// The tile with `id`, or an error listing the ids.
+    pub fn tile(&self, id: &str) -> Result<&Tile> {
+        self.tiles.iter().find(|t| t.id == id).ok_or_else(|| {
+            let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
+            Error::invalid(format!(
+                "no tile '{id}' in the plan; its tiles are {}",
+                crate::cut(&ids.join(", "))
+            ))
+        })
+    }
+}
+
+/// Reads the manifest under the lock, lets `f` change it, writes it back, and returns what `f`
+/// returned. The lock is held from the read to the write.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh::Error> {
+/// let dir = tempfile::tempdir()?;
+/// let e = terramesh::tiles::update(dir.path(), |_| Ok(())).unwrap_err();
+/// assert!(e.to_string().contains("terramesh tiles plan"));
+/// # Ok(()) }
+/// ```
+pub fn update<T>(plan: &Path, f: impl FnOnce(&mut Manifest) -> Result<T>) -> Result<T> {
+    let _lock = Lock::take(plan)?;
+    let mut m = Manifest::read(plan)?;
+    let out = f(&mut m)?;
+    m.write(plan)?;
+    Ok(out)
+}
+
+/// An exclusive lock on `PLAN/tiles.lock`, released on drop.
+struct Lock(File);
+
+impl Lock {
+    fn take(plan: &Path) -> Result<Lock> {
+        let path = plan.join(LOCK);
+        let file = File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .context(path.display().to_string())?;
+        file.lock().context(path.display().to_string())?;
+        Ok(Lock(file))
+    }
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        let _ = self.0.unlock();
+    }
+}

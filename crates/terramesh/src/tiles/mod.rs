@@ -1,0 +1,52 @@
+//! Tiled builds: a region split into square tiles that are built as independent jobs (on one
+//! machine, a Dask cluster or a Slurm array) and merged without seams.
+//!
+//! * [`plan()`]: samples the region once, fits one variogram, cuts the region into tiles with
+//!   their halos (from the kriging neighbourhood) and seams (vertices fixed in advance), and
+//!   writes the manifest `PLAN/tiles.json` ([`Manifest`]).
+//! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
+//!   its state under a lock, so many processes may build at once.
+//! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc` and a report.
+//! * [`write_slurm`]: an `sbatch` array script and the merge job.
+//!
+//! Seams: each tile's mesh keeps its planned boundary vertices and adds none on it
+//! ([`terramesh_mesh::MeshBuilder::keep_boundary`]; the seams are split in advance at the
+//! strips' cut spacing), so neighbours meet vertex to vertex. With the same variogram file and
+//! moving neighbourhood, the tiles' DSM grid equals a one-piece build's at every node: every
+//! tile kriges in the whole data's frame and sees every sample its targets' neighbourhoods
+//! reach.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), terramesh::Error> {
+//! use std::path::Path;
+//! use terramesh::{project::Project, tiles};
+//! let file = Path::new("examples/haut-barr/terramesh.toml");
+//! let p = Project::load(file, &[])?;
+//! let progress = terramesh::progress::Silent;
+//! tiles::plan(&p, file, &[], Path::new("examples/haut-barr"), 100.0, Path::new("plan"), &progress)?;
+//! let m = tiles::Manifest::read(Path::new("plan"))?;
+//! for t in &m.tiles {
+//!     tiles::build_tile(Path::new("plan"), &t.id)?;
+//! }
+//! tiles::merge(Path::new("plan"), Path::new("merged"))?;
+//! # Ok(()) }
+//! ```
+
+mod build;
+mod files;
+mod geometry;
+mod manifest;
+mod merge;
+mod plan;
+mod report;
+mod slurm;
+
+pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
+pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
+pub use manifest::{
+    update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileSummary, LOCK,
+    MANIFEST, SAMPLES, VARIOGRAM, VERSION,
+};
+pub use merge::{merge, Merged};
+pub use plan::{parse_tile_size, plan, Planned};
+pub use slurm::{write_slurm, SlurmOptions, SlurmScripts};

@@ -1,0 +1,345 @@
+//! `terramesh tiles plan`: the region split into tiles, the data-selection rule with its halo
+//! computed from the kriging neighbourhood, and one variogram for every tile.
+
+use std::path::Path;
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use terramesh_geostat::{InterpolationMethod, VariogramFile};
+
+use super::geometry::{clip, convex_ring, ring_and_seams};
+use super::manifest::{
+    DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, SAMPLES, VARIOGRAM, VERSION,
+};
+use crate::build::stages;
+use crate::error::{Context, Error, Result};
+use crate::progress::Progress;
+use crate::project::Project;
+
+/// The seams' vertex spacing in target edge lengths: the strips' cut spacing in
+/// `terramesh-mesh` (short enough that refinement never needs to split them).
+const SEAM_SPACING: f64 = 0.7;
+/// The area of an equilateral triangle of unit side, as `MeshBuilder` takes it.
+const EQUILATERAL_AREA: f64 = 0.433;
+
+/// What a plan was made of, for the front end.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    /// Tiles in the plan.
+    pub tiles: usize,
+    /// Columns and rows.
+    pub shape: [usize; 2],
+    /// Samples of the whole region.
+    pub samples: usize,
+    /// The widest halo, metres.
+    pub max_halo: f64,
+}
+
+/// Parses a tile size: metres (`2500`, `2500m`) or kilometres (`10km`, `2.5km`).
+///
+/// ```
+/// use terramesh::tiles::parse_tile_size;
+/// assert_eq!(parse_tile_size("10km").unwrap(), 10_000.0);
+/// assert_eq!(parse_tile_size("750m").unwrap(), 750.0);
+/// assert_eq!(parse_tile_size("1200").unwrap(), 1200.0);
+/// assert!(parse_tile_size("ten").is_err());
+/// ```
+pub fn parse_tile_size(s: &str) -> std::result::Result<f64, String> {
+    let t = s.trim();
+    let (num, scale) = if let Some(n) = t.strip_suffix("km") {
+        (n, 1000.0)
+    } else if let Some(n) = t.strip_suffix('m') {
+        (n, 1.0)
+    } else {
+        (t, 1.0)
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * scale),
+        _ => Err(format!(
+            "'{s}' is not a tile size: give metres or kilometres, like 10km, 2500m or 2500"
+        )),
+    }
+}
+
+/// The tile grid column or row of coordinate `v` (clamped to the grid).
+pub(crate) fn cell_of(v: f64, origin: f64, size: f64, n: usize) -> usize {
+    let k = ((v - origin) / size).floor();
+    if k < 0.0 {
+        0
+    } else {
+        (k as usize).min(n - 1)
+    }
+}
+
+/// The tile of the grid node or point `q`: exactly one, so that every DSM grid node is kriged
+/// by one tile.
+pub(crate) fn owner(m: &Manifest, q: [f64; 2]) -> [usize; 2] {
+    [
+        cell_of(q[0], m.origin[0], m.tile_size, m.shape[0]),
+        cell_of(q[1], m.origin[1], m.tile_size, m.shape[1]),
+    ]
+}
+
+/// Refuses what tiles cannot reproduce, with the key to change.
+fn check_tileable(p: &Project) -> Result<()> {
+    let ip = &p.interpolation;
+    let refuse = |why: &str| Err(Error::invalid(why.to_string()));
+    if ip.neighbors == 0 {
+        return refuse(
+            "interpolation.neighbors = 0 is global kriging (every sample in every system), \
+             which tiles cannot reproduce: a tiled build needs a moving neighbourhood; set \
+             interpolation.neighbors (e.g. --set interpolation.neighbors=32)",
+        );
+    }
+    if ip.methods.contains(&InterpolationMethod::Idw) && ip.idw_neighbors == 0 {
+        return refuse(
+            "interpolation.idw_neighbors = 0 weighs every sample into IDW, which tiles cannot \
+             reproduce: set interpolation.idw_neighbors (e.g. 16)",
+        );
+    }
+    if p.mesh.max_error.is_some() {
+        return refuse(
+            "mesh.max_error (terrain-adaptive meshes) is not supported by tiled builds yet: \
+             remove it or build in one piece",
+        );
+    }
+    if p.mesh.insert_samples {
+        return refuse(
+            "mesh.insert_samples is not supported by tiled builds (a sample on a seam would \
+             be a vertex the neighbour lacks): set it to false or build in one piece",
+        );
+    }
+    if p.geology().is_some() {
+        return refuse(
+            "tiled builds do not make the [geology] model yet: build it with terramesh build \
+             or terramesh model",
+        );
+    }
+    Ok(())
+}
+
+/// Plans a tiled build of `project` (paths relative to `base`, loaded from `project_file`
+/// with the overrides `set`) into the folder `out`: samples the whole region once
+/// (`out/samples.csv`, `out/samples.f64`), fits the variogram once (`out/variogram.json`),
+/// cuts the region into squares of `tile_size` metres, computes each tile's halo and seams,
+/// and writes `out/tiles.json` with every tile `planned`.
+///
+/// The halo of a tile is computed, not guessed: the distance `R(q)` from a point `q` to its
+/// `k`-th nearest sample (k the larger of kriging's and IDW's neighbourhoods) is measured at
+/// probes on a square lattice of spacing `h` over the tile; for any point `p` of the tile
+/// `R(p) <= R(q) + |p - q| <= max R + h/√2` (the triangle inequality), so every sample any
+/// point of the tile uses lies within that of the tile, equal-distance ties included.
+pub fn plan(
+    project: &Project,
+    project_file: &Path,
+    set: &[String],
+    base: &Path,
+    tile_size: f64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Planned> {
+    check_tileable(project)?;
+    if !(tile_size.is_finite() && tile_size > 0.0) {
+        return Err(Error::invalid(format!(
+            "tile size {tile_size} m: must be a positive number of metres"
+        )));
+    }
+    project.check_inputs(base)?;
+    std::fs::create_dir_all(out).context(out.display().to_string())?;
+    let samples = stages::sample(project, base, out, progress)?;
+    let polys = &samples.region.projected.polygons;
+    if polys.len() != 1 || !polys[0].holes.is_empty() || !samples.region.projected.lines.is_empty()
+    {
+        return Err(Error::invalid(
+            "tiled builds take one convex polygon without holes or constraint lines for now: \
+             build this region in one piece with terramesh build",
+        ));
+    }
+    let outline = polys[0].outer.clone();
+    let region = convex_ring(&outline)?;
+    let model = stages::model(project, &samples, base)?;
+    // The variogram file every tile (and a one-piece build given it) reads.
+    let vpath = out.join(VARIOGRAM);
+    let json = VariogramFile::new(model.variogram.clone()).to_json_pretty();
+    terramesh_io::output::write_atomic(&vpath, json.as_bytes())
+        .context(vpath.display().to_string())?;
+    let variogram = crate::variogram_file::read_variogram_file(&vpath)?;
+    let data = &model.data;
+    let frame = data.frame(&variogram);
+    // The samples, as kriging sees them (duplicates merged), in order.
+    let mut bytes = Vec::with_capacity(24 * data.len());
+    for (p, z) in data.xy().iter().zip(data.z()) {
+        for v in [p[0], p[1], *z] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let spath = out.join(SAMPLES);
+    terramesh_io::output::write_atomic(&spath, &bytes).context(spath.display().to_string())?;
+    drop(bytes);
+
+    let ip = &project.interpolation;
+    let k = if ip.methods.contains(&InterpolationMethod::Idw) {
+        ip.neighbors.max(ip.idw_neighbors)
+    } else {
+        ip.neighbors
+    }
+    .min(data.len());
+    let m = &project.mesh;
+    let max_area = match (m.max_area, m.max_edge) {
+        (Some(a), _) => Some(a),
+        (None, Some(_)) => None,
+        (None, None) => Some(samples.cell[0] * samples.cell[1]),
+    };
+    let budget = match (max_area, m.max_edge) {
+        (Some(a), Some(l)) => a.min(EQUILATERAL_AREA * l * l),
+        (Some(a), None) => a,
+        (None, Some(l)) => EQUILATERAL_AREA * l * l,
+        (None, None) => unreachable!("a size follows from the cell"),
+    };
+    let spacing = SEAM_SPACING * (budget / EQUILATERAL_AREA).sqrt();
+    let spec = stages::dsm_grid(project, &samples)?;
+
+    // The tile grid over the region's bounding box.
+    let (lo, hi) = samples.region.projected.bbox().context("empty region")?;
+    let shape = [
+        (((hi[0] - lo[0]) / tile_size).ceil() as usize).max(1),
+        (((hi[1] - lo[1]) / tile_size).ceil() as usize).max(1),
+    ];
+    if shape[0] * shape[1] > 100_000 {
+        return Err(Error::invalid(format!(
+            "tile size {tile_size} m makes {} x {} tiles: use larger tiles",
+            shape[0], shape[1]
+        )));
+    }
+    let rect = |i: usize, j: usize| {
+        [
+            lo[0] + i as f64 * tile_size,
+            lo[1] + j as f64 * tile_size,
+            lo[0] + (i + 1) as f64 * tile_size,
+            lo[1] + (j + 1) as f64 * tile_size,
+        ]
+    };
+    let id = |i: usize, j: usize| format!("x{i}y{j}");
+    let tol = 1e-9 * tile_size;
+    let mut polys = vec![Vec::new(); shape[0] * shape[1]];
+    for j in 0..shape[1] {
+        for i in 0..shape[0] {
+            polys[j * shape[0] + i] = clip(&region, rect(i, j), tol);
+        }
+    }
+    let present = |i: isize, j: isize| {
+        i >= 0
+            && j >= 0
+            && (i as usize) < shape[0]
+            && (j as usize) < shape[1]
+            && !polys[j as usize * shape[0] + i as usize].is_empty()
+    };
+    let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(data.xy())
+        .map_err(|e| Error::invalid(format!("search tree of the samples: {e:?}")))?;
+    let h = samples.cell[0].min(samples.cell[1]).min(tile_size / 4.0);
+    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
+    let mut tiles = Vec::new();
+    let mut max_halo: f64 = 0.0;
+    for j in 0..shape[1] {
+        for i in 0..shape[0] {
+            let poly = &polys[j * shape[0] + i];
+            if poly.is_empty() {
+                continue;
+            }
+            let r = rect(i, j);
+            let (ii, jj) = (i as isize, j as isize);
+            let dirs = [(-1, 0), (0, -1), (1, 0), (0, 1)];
+            let inner = dirs.map(|(di, dj)| present(ii + di, jj + dj));
+            let (ring, sides) = ring_and_seams(poly, r, inner, spacing);
+            let seams: Vec<Seam> = sides
+                .into_iter()
+                .map(|(s, vertices)| {
+                    let (di, dj) = dirs[s];
+                    Seam {
+                        neighbour: id((ii + di) as usize, (jj + dj) as usize),
+                        vertices,
+                    }
+                })
+                .collect();
+            let neighbours = seams.iter().map(|s| s.neighbour.clone()).collect();
+            // The halo: the farthest k-th neighbour over probes, plus the probes' reach.
+            let n = [
+                ((r[2] - r[0]) / h).ceil() as usize + 1,
+                ((r[3] - r[1]) / h).ceil() as usize + 1,
+            ];
+            let mut reach: f64 = 0.0;
+            for b in 0..n[1] {
+                for a in 0..n[0] {
+                    let q = [
+                        r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
+                        r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
+                    ];
+                    let near = tree
+                        .query(&q)
+                        .nearest_n::<SquaredEuclidean<f64>>(kk)
+                        .execute();
+                    if let Some(last) = near.last() {
+                        reach = reach.max(last.distance.sqrt());
+                    }
+                }
+            }
+            let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
+            let halo = (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6;
+            max_halo = max_halo.max(halo);
+            tiles.push(Tile {
+                id: id(i, j),
+                index: [i, j],
+                extent: r,
+                halo,
+                neighbours,
+                ring,
+                seams,
+                state: State::Planned,
+                error: None,
+                built: None,
+            });
+        }
+    }
+    let manifest = Manifest {
+        version: VERSION,
+        project: std::path::absolute(project_file).context(project_file.display().to_string())?,
+        set: set.to_vec(),
+        tile_size,
+        origin: lo,
+        shape,
+        region: outline,
+        variogram: VARIOGRAM.into(),
+        frame: (frame.centre, frame.scale),
+        mesh: MeshSettings {
+            min_angle: m.min_angle,
+            max_area,
+            max_edge: m.max_edge,
+            smooth: m.smooth,
+            seam_spacing: spacing,
+        },
+        data: DataRule {
+            samples: SAMPLES.into(),
+            count: data.len(),
+            neighbours: k,
+            rule: "a tile uses the samples in its extent grown by its halo on every side; the \
+                   halo reaches past the k-th nearest sample of every point of the extent"
+                .into(),
+        },
+        grid: GridSpec {
+            xmin: spec.xmin,
+            ymin: spec.ymin,
+            xmax: spec.xmax,
+            ymax: spec.ymax,
+            nx: spec.nx,
+            ny: spec.ny,
+        },
+        epsg: samples.epsg(),
+        tiles,
+    };
+    manifest.write(out)?;
+    Ok(Planned {
+        tiles: manifest.tiles.len(),
+        shape,
+        samples: data.len(),
+        max_halo,
+    })
+}
