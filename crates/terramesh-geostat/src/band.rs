@@ -313,14 +313,19 @@ impl Band {
     /// `K^{-1}[i, j]` for `i <= j` where stored (exact), else 0: pairs beyond the stored
     /// extent are farther apart than any two data within the support of one target, so that
     /// every product that uses them has a zero factor.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn zij_or_zero(&self, i: usize, j: usize) -> f64 {
+        let (p0, col) = self.zcol(i);
+        col.get(j - p0).copied().unwrap_or(0.0)
+    }
+
+    /// The stored part of column `i` of `K^{-1}` (rows `i ..` of it, from its panel): the
+    /// first row of the panel and the column's entries from that row on.
+    #[inline]
+    pub(crate) fn zcol(&self, i: usize) -> (usize, &[f64]) {
         let p0 = i / self.nb * self.nb;
-        if j - p0 < self.hz {
-            self.z[p0 * self.hz + (i - p0) * self.hz + (j - p0)]
-        } else {
-            0.0
-        }
+        let at = p0 * self.hz + (i - p0) * self.hz;
+        (p0, &self.z[at..at + self.hz])
     }
 }
 

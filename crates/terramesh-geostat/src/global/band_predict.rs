@@ -6,8 +6,8 @@
 //! `Z[S, S] · K[S, group]` (faer) on the gathered block of the inverse band, instead of a
 //! scattered double loop per target.
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, Par};
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::{Accum, Mat, MatRef, Par};
 use rayon::prelude::*;
 
 use super::GlobalKriging;
@@ -25,6 +25,8 @@ struct Scratch {
     round: u32,
     near: Vec<(f64, usize)>,
     s: Vec<usize>,
+    /// The gathered lower triangle of `Z[S, S]`, column-major.
+    zs: Vec<f64>,
 }
 
 impl GlobalKriging {
@@ -81,16 +83,33 @@ impl GlobalKriging {
                 if !want_var {
                     return;
                 }
-                let mut zs = Mat::<f64>::zeros(ns, ns);
+                // q = kᵀ Z k = 2 kᵀ T k with T the lower triangle of Z[S, S], diagonal halved:
+                // a column-wise gather (each column of an inverse panel is contiguous) and
+                // a triangular product (half the flops of a full one).
+                if s.zs.len() < ns * ns {
+                    s.zs.resize(ns * ns, 0.0);
+                }
                 for b in 0..ns {
-                    for a in 0..=b {
-                        let v = band.zij_or_zero(sd[a], sd[b]);
-                        zs[(a, b)] = v;
-                        zs[(b, a)] = v;
+                    let col = &mut s.zs[b * ns..(b + 1) * ns];
+                    let (p0, zc) = band.zcol(sd[b]);
+                    col[b] = 0.5 * zc[sd[b] - p0];
+                    for a in b + 1..ns {
+                        col[a] = zc.get(sd[a] - p0).copied().unwrap_or(0.0);
                     }
                 }
+                let zs = MatRef::from_column_major_slice(&s.zs[..ns * ns], ns, ns);
                 let mut y = Mat::<f64>::zeros(ns, mt);
-                matmul(y.as_mut(), Accum::Replace, zs.as_ref(), kb.as_ref(), 1.0, Par::Seq);
+                triangular::matmul(
+                    y.as_mut(),
+                    BlockStructure::Rectangular,
+                    Accum::Replace,
+                    zs,
+                    BlockStructure::TriangularLower,
+                    kb.as_ref(),
+                    BlockStructure::Rectangular,
+                    2.0,
+                    Par::Seq,
+                );
                 for (j, o) in out.iter_mut().enumerate() {
                     let (kc, yc) = (kb.col(j), y.col(j));
                     let mut q1 = 0.0;
