@@ -91,7 +91,7 @@ z, s = uk.execute("points", t[:, 0], t[:, 1], backend="vectorized")
 u1 = resource.getrusage(resource.RUSAGE_SELF)
 print(time.perf_counter() - t0, u1.ru_maxrss / 1024, u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime)
 if len(sys.argv) > 4:
-    np.save(sys.argv[4], np.column_stack((z, s)))
+    np.save(sys.argv[4], np.column_stack((np.ma.getdata(z), np.ma.getdata(s))))
 """
 
 

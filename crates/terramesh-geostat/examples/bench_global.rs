@@ -13,7 +13,12 @@ fn read(path: &str, cols: usize) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
     text.lines()
         .skip(1)
-        .map(|l| l.split(',').take(cols).map(|v| v.parse().unwrap()).collect())
+        .map(|l| {
+            l.split(',')
+                .take(cols)
+                .map(|v| v.parse().unwrap())
+                .collect()
+        })
         .collect()
 }
 

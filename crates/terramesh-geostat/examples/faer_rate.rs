@@ -23,7 +23,12 @@ fn best(mut f: impl FnMut()) -> f64 {
 fn main() {
     let threads = rayon::current_num_threads();
     for (label, par) in [("1 thread", Par::Seq), ("all threads", Par::rayon(threads))] {
-        for &(m, k, n) in &[(1024, 1024, 1024), (2048, 2048, 2048), (800, 800, 32), (1100, 128, 1000)] {
+        for &(m, k, n) in &[
+            (1024, 1024, 1024),
+            (2048, 2048, 2048),
+            (800, 800, 32),
+            (1100, 128, 1000),
+        ] {
             let a = Mat::<f64>::from_fn(m, k, |i, j| ((i * 7 + j * 3) % 11) as f64 * 0.1);
             let b = Mat::<f64>::from_fn(k, n, |i, j| ((i * 5 + j) % 13) as f64 * 0.1);
             let mut c = Mat::<f64>::zeros(m, n);

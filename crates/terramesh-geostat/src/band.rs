@@ -101,18 +101,20 @@ impl Band {
         let hl = nb + wl;
         let np = n.div_ceil(nb);
         let mut l = vec![0.0; np * nb * hl];
-        l.par_chunks_mut(nb * hl).enumerate().for_each(|(pj, panel)| {
-            let j0 = pj * nb;
-            for c in 0..nb.min(n - j0) {
-                let j = j0 + c;
-                for r in c..hl.min(n - j0) {
-                    let i = j0 + r;
-                    if i - j <= wl {
-                        panel[c * hl + r] = k(i, j);
+        l.par_chunks_mut(nb * hl)
+            .enumerate()
+            .for_each(|(pj, panel)| {
+                let j0 = pj * nb;
+                for c in 0..nb.min(n - j0) {
+                    let j = j0 + c;
+                    for r in c..hl.min(n - j0) {
+                        let i = j0 + r;
+                        if i - j <= wl {
+                            panel[c * hl + r] = k(i, j);
+                        }
                     }
                 }
-            }
-        });
+            });
         let mut band = Band {
             n,
             wl,
@@ -124,16 +126,16 @@ impl Band {
             z: Vec::new(),
         };
         let par = crate::global::par();
-        let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(nb, par, Default::default()));
+        let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(
+            nb,
+            par,
+            Default::default(),
+        ));
         for pj in 0..np {
             let (before, rest) = l.split_at_mut(pj * nb * hl);
             let (j0, cj, rj) = (pj * nb, band.cols(pj), band.rows(pj, hl));
-            let mut a = MatMut::from_column_major_slice_with_stride_mut(
-                &mut rest[..nb * hl],
-                rj,
-                cj,
-                hl,
-            );
+            let mut a =
+                MatMut::from_column_major_slice_with_stride_mut(&mut rest[..nb * hl], rj, cj, hl);
             for pi in pj.saturating_sub(wl.div_ceil(nb) + 1)..pj {
                 let (i0, ri) = (pi * nb, band.rows(pi, hl));
                 if i0 + ri <= j0 {
@@ -213,11 +215,7 @@ impl Band {
                 -1.0,
                 Par::Seq,
             );
-            solve_upper_triangular_in_place(
-                lp.submatrix(0, 0, cj, cj).transpose(),
-                y,
-                Par::Seq,
-            );
+            solve_upper_triangular_in_place(lp.submatrix(0, 0, cj, cj).transpose(), y, Par::Seq);
         }
     }
 
