@@ -2,7 +2,12 @@
 """Side-by-side timings of terramesh and PyKrige on the same machine; prints ratios.
 
 Run from the repository root after `cargo build --release -p terramesh-cli`:
-    .venv-bench/bin/python bench/compare_kriging.py [--skip-pykrige] [--big]
+    .venv-bench/bin/python bench/compare_kriging.py [--skip-pykrige] [--big] [--check] [--only=TEXT]
+
+`--check` compares terramesh's estimates and variances with PyKrige's (largest differences, on
+stderr); `--only=TEXT` runs only the cases whose label contains TEXT (e.g. `--only=dense`).
+Two geometries: the whole tile (5,000 posts over about 73 x 111 km, about 70 data within the
+6 km range of a target) and a dense 31 x 32 km square (5,000 posts, about 490 within range).
 
 Data: posts of the SRTM tile ../shared/data/srtm/N48E007.hgt projected to UTM 32N with pyproj
 (seeded random subsets), targets uniform in the data's box. Written to $TMPDIR/terramesh-bench.
@@ -85,14 +90,29 @@ u0 = resource.getrusage(resource.RUSAGE_SELF); t0 = time.perf_counter()
 z, s = uk.execute("points", t[:, 0], t[:, 1], backend="vectorized")
 u1 = resource.getrusage(resource.RUSAGE_SELF)
 print(time.perf_counter() - t0, u1.ru_maxrss / 1024, u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime)
+if len(sys.argv) > 4:
+    np.save(sys.argv[4], np.column_stack((np.ma.getdata(z), np.ma.getdata(s))))
 """
 
 
-def pykrige(data, targets, model):
-    p = subprocess.run([sys.executable, "-c", PYK, data, targets, model], capture_output=True, text=True)
+def pykrige(data, targets, model, check=None):
+    """PyKrige's execute time, peak MB and CPU time; with `check` (terramesh's output CSV),
+    also prints the largest differences of the estimates and variances from PyKrige's."""
+    saved = os.path.join(TMP, "pykrige.npy")
+    cmd = [sys.executable, "-c", PYK, data, targets, model] + ([saved] if check else [])
+    p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         return None, (p.stderr.strip().splitlines()[-1] if p.stderr else "failed"), None
     t, mb, cpu = p.stdout.split()
+    if check:
+        ref = np.load(saved)
+        with open(check) as f:
+            names = f.readline().strip().split(",")
+        got = np.loadtxt(check, delimiter=",", skiprows=1)
+        est, var = got[:, names.index("z")], got[:, names.index("variance")]
+        print(f"  check {model}: max |dz| {np.abs(est - ref[:, 0]).max():.2e}, "
+              f"max |dvar| {np.abs(var - ref[:, 1]).max():.2e} (PyKrige's variance up to "
+              f"{ref[:, 1].max():.0f})", file=sys.stderr, flush=True)
     return float(t), float(mb), float(cpu)
 
 
@@ -105,28 +125,42 @@ def main():
     for m in (20000, 100000):
         write(f"targets{m}.csv", (rng.uniform(box[0], box[1], m), rng.uniform(box[2], box[3], m)), "x,y")
     t20, t100 = os.path.join(TMP, "targets20000.csv"), os.path.join(TMP, "targets100000.csv")
+    # The dense geometry: 5,000 posts of a 31 x 32 km square (about 490 data within the 6 km
+    # range of a target, against about 70 in the whole tile), 20,000 targets in that square.
+    sq = (x0 := x.min() + 20000.0, x0 + 31000.0, y0 := y.min() + 40000.0, y0 + 32000.0)
+    inside = np.nonzero((x >= sq[0]) & (x <= sq[1]) & (y >= sq[2]) & (y <= sq[3]))[0]
+    k = rng.choice(inside, 5000, replace=False)
+    dense = write("dense5000.csv", (x[k], y[k], z[k]), "x,y,z")
+    td = write("dense_targets20000.csv", (rng.uniform(sq[0], sq[1], 20000),
+                                          rng.uniform(sq[2], sq[3], 20000)), "x,y")
     common = ["--psill", "12000", "--range", "6000", "--nugget", "50"]
     last_pyk = {}
     print("| case | terramesh wall s | terramesh CPU s | terramesh peak MB | PyKrige execute wall s "
           "| PyKrige CPU s | PyKrige peak MB | ratio wall | ratio CPU |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for label, model, tg, extra in [
-        ("UK linear, spherical, 5k data, 20k targets, variances", "spherical", t20, []),
-        ("UK linear, exponential, 5k data, 20k targets, variances", "exponential", t20, []),
-        ("UK linear, gaussian, 5k data, 20k targets, variances", "gaussian", t20, []),
-        ("UK linear, spherical, 5k data, 20k targets, --no-variance", "spherical", t20, ["--no-variance"]),
-        ("UK linear, spherical, 5k data, 100k targets, variances", "spherical", t100, []),
+    only = [a.split("=", 1)[1] for a in sys.argv if a.startswith("--only=")]
+    for label, model, dt, tg, extra in [
+        ("UK linear, spherical, 5k data, 20k targets, variances", "spherical", data, t20, []),
+        ("UK linear, exponential, 5k data, 20k targets, variances", "exponential", data, t20, []),
+        ("UK linear, gaussian, 5k data, 20k targets, variances", "gaussian", data, t20, []),
+        ("UK linear, spherical, 5k data, 20k targets, --no-variance", "spherical", data, t20, ["--no-variance"]),
+        ("UK linear, spherical, 5k data, 100k targets, variances", "spherical", data, t100, []),
+        ("dense square: UK linear, spherical, 5k data, 20k targets, variances", "spherical", dense, td, []),
+        ("dense square: UK linear, exponential, 5k data, 20k targets, variances", "exponential", dense, td, []),
+        ("dense square: UK linear, gaussian, 5k data, 20k targets, variances", "gaussian", dense, td, []),
     ]:
+        if only and not any(o in label for o in only):
+            continue
         out = os.path.join(TMP, "out.csv")
-        tm, mb, tc = terramesh(["interpolate", "--data", data, "--targets", tg, "--method", "uk",
+        tm, mb, tc = terramesh(["interpolate", "--data", dt, "--targets", tg, "--method", "uk",
                                 "--model", model] + common + extra + ["-o", out])
         if skip or tg == t100:
             pt, pmb, pc = (None, "not run (needs > 24 GB at 100k targets)" if tg == t100 else "skipped", None)
         elif extra:
-            pt, pmb, pc = last_pyk.get(model, (None, "-", None))
+            pt, pmb, pc = last_pyk.get((dt, model), (None, "-", None))
         else:
-            pt, pmb, pc = pykrige(data, tg, model)
-            last_pyk[model] = (pt, pmb, pc)
+            pt, pmb, pc = pykrige(dt, tg, model, out if "--check" in sys.argv else None)
+            last_pyk[(dt, model)] = (pt, pmb, pc)
         rw = f"{tm / pt:.3f}" if pt else "-"
         rc = f"{tc / pc:.3f}" if pc else "-"
         f = lambda v: "-" if v is None else (v if isinstance(v, str) else f"{v:.2f}")

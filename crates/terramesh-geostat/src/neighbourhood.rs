@@ -255,16 +255,17 @@ impl LocalKriging {
         s.b.clear();
         for (a, &(d2, i)) in s.near.iter().enumerate() {
             let row = a * k;
-            for (b, &(_, j)) in s.near.iter().enumerate().take(a) {
+            s.a[row + a] = self.sill;
+            for (b, &(_, j)) in s.near.iter().enumerate().skip(a + 1) {
                 s.a[row + b] = vg.covariance_at(dist(pts[i], pts[j]));
             }
-            s.a[row + a] = self.sill;
             s.b.push(vg.covariance_at(d2.sqrt()));
         }
-        crate::linalg::cholesky(&mut s.a, k).ok()?;
+        // K = Uᵀ U = L Lᵀ with L = Uᵀ.
+        crate::linalg::cholesky_upper(&mut s.a, k).ok()?;
         // y = L^{-1} k0; G = L^{-1} F (column-major k x p)
         s.rhs.clone_from(&s.b);
-        crate::linalg::forward(&s.a, k, &mut s.rhs);
+        crate::linalg::forward_upper(&s.a, k, &mut s.rhs);
         s.g.clear();
         s.g.resize(k * p, 0.0);
         let mut f = [0.0; 6];
@@ -275,7 +276,7 @@ impl LocalKriging {
             }
         }
         for c in 0..p {
-            crate::linalg::forward(&s.a, k, &mut s.g[c * k..(c + 1) * k]);
+            crate::linalg::forward_upper(&s.a, k, &mut s.g[c * k..(c + 1) * k]);
         }
         let mut f0 = [0.0; 6];
         self.prep.drift(x0, &mut f0[..p]);
@@ -302,7 +303,7 @@ impl LocalKriging {
                 s.lam[a] -= s.g[c * k + a] * mu[c];
             }
         }
-        crate::linalg::backward(&s.a, k, &mut s.lam);
+        crate::linalg::backward_upper(&s.a, k, &mut s.lam);
         let mut e = 0.0;
         let mut v = self.sill;
         for (a, &(_, i)) in s.near.iter().enumerate() {

@@ -50,8 +50,8 @@ pub(super) fn band_order(pts: &[[f64; 2]], r: f64) -> Option<Vec<usize>> {
     Some(order)
 }
 
-/// Banded factor with the bandwidth the variances need; `None` when the band is so wide
-/// (over half of n: no saving in memory over dense) that the dense path is cheaper and leaner.
+/// Banded factor with the bandwidth the variances need; `None` when the band's panels would
+/// take as much memory as the dense factor (then the dense path is as lean and simpler).
 pub(super) fn factor_band(
     prep: &Prepared,
     tree: &Tree,
@@ -75,11 +75,12 @@ pub(super) fn factor_band(
             (wl, w)
         })
         .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
-    if w > 0 && 2 * w > n {
+    // The factor's band and the band of its inverse (for variances).
+    let entries = crate::band::entries(n, wl, w);
+    if w > 0 && entries >= n as f64 * n as f64 {
         return Ok(None);
     }
-    // The factor's band and the band of its inverse (for variances).
-    super::check_dense(n as f64 * (wl + 1 + w + 1) as f64)?;
+    super::check_dense(entries)?;
     let vg = &prep.variogram;
     let band = Band::factor(n, wl, |i, j| {
         if i == j {

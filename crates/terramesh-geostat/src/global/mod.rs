@@ -20,6 +20,7 @@ use faer::prelude::*;
 use faer::{Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
+mod band_predict;
 mod factor;
 
 use factor::{band_order, factor_band, factor_dense, factor_gamma};
@@ -277,6 +278,12 @@ impl GlobalKriging {
                 });
             }
         }
+        if let Solver::Band { band, h, support } = &self.solver {
+            // All targets at once: the groups of neighbouring targets span the whole set.
+            let q: Vec<[f64; 2]> = targets.iter().map(|p| self.prep.map(*p)).collect();
+            self.block_band(band, h, *support, &q, est, var.as_deref_mut());
+            return self.finish(&q, est, var);
+        }
         for (b, chunk) in targets.chunks(BLOCK).enumerate() {
             let r = b * BLOCK..b * BLOCK + chunk.len();
             let vslice = var.as_deref_mut().map(|v| &mut v[r.clone()]);
@@ -301,11 +308,18 @@ impl GlobalKriging {
         let q: Vec<[f64; 2]> = t.iter().map(|p| self.prep.map(*p)).collect();
         let v = var.as_deref_mut();
         match &self.solver {
-            Solver::Band { band, h, support } => self.block_band(band, h, *support, t, &q, est, v),
+            Solver::Band { band, h, support } => {
+                self.block_band(band, h, *support, &q, est, v);
+                Ok(())
+            }
             Solver::Dense { l, g } => self.block_dense(l, g, &q, est, v),
             Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
         }?;
-        // Exact at data points; variances are never negative.
+        self.finish(&q, est, var)
+    }
+
+    /// Exact at data points; variances are never negative; every value finite.
+    fn finish(&self, q: &[[f64; 2]], est: &mut [f64], mut var: Option<&mut [f64]>) -> Result<()> {
         for (i, p) in q.iter().enumerate() {
             let (d2, k) = self.tree.nearest_one(*p);
             let at_data = d2.sqrt() <= EXACT_EPS;
@@ -322,76 +336,6 @@ impl GlobalKriging {
             finite_at(v, "variance")?;
         }
         finite_at(est, "estimate")
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn block_band(
-        &self,
-        band: &Band,
-        h: &[f64],
-        r: f64,
-        t: &[[f64; 2]],
-        q: &[[f64; 2]],
-        est: &mut [f64],
-        var: Option<&mut [f64]>,
-    ) -> Result<()> {
-        let p = self.prep.terms();
-        let want_var = var.is_some();
-        let res: Vec<Result<(f64, f64)>> = q
-            .par_iter()
-            .enumerate()
-            .map_init(Vec::new, |near, (j, &x0)| {
-                self.tree.within(x0, r, near);
-                near.sort_unstable_by_key(|a| a.1);
-                let mut f0 = [0.0; 6];
-                self.prep.drift(x0, &mut f0[..p]);
-                let mut e = self.mean + (0..p).map(|k| f0[k] * self.v[k]).sum::<f64>();
-                let ks: Vec<f64> = near.iter().map(|&(d2, _)| self.cov(d2.sqrt())).collect();
-                for (&(_, i), k) in near.iter().zip(&ks) {
-                    e += k * self.w[i];
-                }
-                if !want_var {
-                    return Ok((e, 0.0));
-                }
-                let wb = band.inverse_band();
-                let mut q1 = 0.0;
-                for (a, &(_, ia)) in near.iter().enumerate() {
-                    let mut s = 0.5 * ks[a] * band.zij(ia, ia);
-                    for (b, &(_, ib)) in near.iter().enumerate().skip(a + 1) {
-                        if ib - ia > wb {
-                            return Err(GeostatError::SingularAt {
-                                index: j,
-                                x: t[j][0],
-                                y: t[j][1],
-                                why: format!("internal: data pair ({ia}, {ib}) outside the inverse band {wb}"),
-                            });
-                        }
-                        s += ks[b] * band.zij(ia, ib);
-                    }
-                    q1 += 2.0 * ks[a] * s;
-                }
-                let mut t = [0.0; 6];
-                for (&(_, i), k) in near.iter().zip(&ks) {
-                    for c in 0..p {
-                        t[c] += k * h[i * p + c];
-                    }
-                }
-                for c in 0..p {
-                    t[c] -= f0[c];
-                }
-                let v = self.sill - q1 + small_quad(&self.rs, p, &mut t[..p]);
-                Ok((e, v))
-            })
-            .collect();
-        let mut var = var;
-        for (i, r) in res.into_iter().enumerate() {
-            let (e, v) = r?;
-            est[i] = e;
-            if let Some(vv) = var.as_deref_mut() {
-                vv[i] = v;
-            }
-        }
-        Ok(())
     }
 
     fn block_dense(

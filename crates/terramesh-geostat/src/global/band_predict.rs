@@ -1,0 +1,137 @@
+//! Predictions of the band strategy, in groups of targets that share their data.
+//!
+//! A target's variance needs `k0ᵀ K^{-1} k0`, whose non-zeros are the data within the
+//! support of the target. Targets taken in Morton order come in groups of close neighbours;
+//! the union `S` of their data is small, so the group's quadratic forms are one dense product
+//! `Z[S, S] · K[S, group]` (faer) on the gathered block of the inverse band, instead of a
+//! scattered double loop per target.
+
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::{Accum, Mat, MatRef, Par};
+use rayon::prelude::*;
+
+use super::GlobalKriging;
+use crate::band::Band;
+use crate::system::{dist, small_quad};
+
+/// Targets per group: large enough for the product to run at its matrix rate, small enough
+/// that the group's data are not many more than one target's.
+const GROUP: usize = 32;
+
+/// Per-thread buffers: a stamp per datum to take the union of the group's neighbourhoods.
+#[derive(Default)]
+struct Scratch {
+    stamp: Vec<u32>,
+    round: u32,
+    near: Vec<(f64, usize)>,
+    s: Vec<usize>,
+    /// The gathered lower triangle of `Z[S, S]`, column-major.
+    zs: Vec<f64>,
+}
+
+impl GlobalKriging {
+    /// Estimates (and variances) at the mapped targets `q`, all of them at once.
+    pub(super) fn block_band(
+        &self,
+        band: &Band,
+        h: &[f64],
+        r: f64,
+        q: &[[f64; 2]],
+        est: &mut [f64],
+        var: Option<&mut [f64]>,
+    ) {
+        let n = self.prep.pts.len();
+        let p = self.prep.terms();
+        let want_var = var.is_some();
+        let order = crate::linalg::morton_order(q);
+        let mut res = vec![(0.0, 0.0); q.len()];
+        res.par_chunks_mut(GROUP)
+            .zip(order.par_chunks(GROUP))
+            .for_each_init(Scratch::default, |s, (out, idx)| {
+                if s.stamp.len() != n || s.round == u32::MAX {
+                    s.stamp = vec![0; n];
+                    s.round = 0;
+                }
+                s.round += 1;
+                s.s.clear();
+                for &t in idx {
+                    self.tree.within(q[t as usize], r, &mut s.near);
+                    for &(_, i) in &s.near {
+                        if s.stamp[i] != s.round {
+                            s.stamp[i] = s.round;
+                            s.s.push(i);
+                        }
+                    }
+                }
+                s.s.sort_unstable();
+                let sd = &s.s;
+                let (ns, mt) = (sd.len(), idx.len());
+                let pts = &self.prep.pts;
+                let kb = Mat::<f64>::from_fn(ns, mt, |a, j| {
+                    self.cov(dist(pts[sd[a]], q[idx[j] as usize]))
+                });
+                let mut f0 = vec![[0.0; 6]; mt];
+                for (j, o) in out.iter_mut().enumerate() {
+                    self.prep.drift(q[idx[j] as usize], &mut f0[j][..p]);
+                    let mut e = self.mean + (0..p).map(|k| f0[j][k] * self.v[k]).sum::<f64>();
+                    let col = kb.col(j);
+                    for a in 0..ns {
+                        e += col[a] * self.w[sd[a]];
+                    }
+                    o.0 = e;
+                }
+                if !want_var {
+                    return;
+                }
+                // q = kᵀ Z k = 2 kᵀ T k with T the lower triangle of Z[S, S], diagonal halved:
+                // a column-wise gather (each column of an inverse panel is contiguous) and
+                // a triangular product (half the flops of a full one).
+                if s.zs.len() < ns * ns {
+                    s.zs.resize(ns * ns, 0.0);
+                }
+                for b in 0..ns {
+                    let col = &mut s.zs[b * ns..(b + 1) * ns];
+                    let (p0, zc) = band.zcol(sd[b]);
+                    col[b] = 0.5 * zc[sd[b] - p0];
+                    for a in b + 1..ns {
+                        col[a] = zc.get(sd[a] - p0).copied().unwrap_or(0.0);
+                    }
+                }
+                let zs = MatRef::from_column_major_slice(&s.zs[..ns * ns], ns, ns);
+                let mut y = Mat::<f64>::zeros(ns, mt);
+                triangular::matmul(
+                    y.as_mut(),
+                    BlockStructure::Rectangular,
+                    Accum::Replace,
+                    zs,
+                    BlockStructure::TriangularLower,
+                    kb.as_ref(),
+                    BlockStructure::Rectangular,
+                    2.0,
+                    Par::Seq,
+                );
+                for (j, o) in out.iter_mut().enumerate() {
+                    let (kc, yc) = (kb.col(j), y.col(j));
+                    let mut q1 = 0.0;
+                    let mut t = [0.0; 6];
+                    for a in 0..ns {
+                        q1 += kc[a] * yc[a];
+                        for c in 0..p {
+                            t[c] += kc[a] * h[sd[a] * p + c];
+                        }
+                    }
+                    for c in 0..p {
+                        t[c] -= f0[j][c];
+                    }
+                    o.1 = self.sill - q1 + small_quad(&self.rs, p, &mut t[..p]);
+                }
+            });
+        let mut var = var;
+        for (i, &t) in order.iter().enumerate() {
+            est[t as usize] = res[i].0;
+            if let Some(v) = var.as_deref_mut() {
+                v[t as usize] = res[i].1;
+            }
+        }
+    }
+}
