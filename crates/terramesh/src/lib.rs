@@ -53,4 +53,5 @@ pub mod horizon;
 pub mod interpolate;
 pub mod mesh;
 pub mod project;
+pub mod simulate;
 pub mod variogram_file;

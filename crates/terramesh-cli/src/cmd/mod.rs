@@ -9,4 +9,5 @@ pub mod interpolate;
 pub mod mesh;
 pub mod model;
 pub mod sample;
+pub mod simulate;
 pub mod variogram;
