@@ -79,7 +79,7 @@ pub fn run_simulation(
     }
     simulate(data, v, method, hood, targets, settings).map_err(|e| match e {
         GeostatError::TooLarge(_) => Error::Geostat(e),
-        other => Error::invalid(format!("conditional simulation: {other}")),
+        other => Error::invalid(other),
     })
 }
 
