@@ -166,7 +166,8 @@ impl Ensemble {
 
 /// Conditional simulation of `data` at `targets`: `settings.realisations` Gaussian
 /// realisations with variogram `v`, conditioned by kriging `method` in `neighbourhood`
-/// (see the [module](self) for the method). Needs a bounded variogram.
+/// (spectral fields conditioned by kriging of the residuals, `Z = Y + K[z − Y]`; see
+/// docs/geostatistics.md, "Conditional simulation"). Needs a bounded variogram.
 ///
 /// Errors: the kriging errors (too few data for the drift, a singular system), an unbounded
 /// model ([`GeostatError::Unbounded`](crate::GeostatError::Unbounded)), zero realisations or
