@@ -38,6 +38,9 @@ enum Command {
     Variogram(cmd::variogram::Args),
     /// Kriging (simple, ordinary, universal) or IDW at target points or on a grid.
     Interpolate(cmd::interpolate::Args),
+    /// Conditional simulation: an ensemble of realisations honouring the data, with per-target
+    /// mean, std and P10/P50/P90.
+    Simulate(cmd::simulate::Args),
     /// Cross-validation of kriging or IDW: RMSE, MAE, mean and standardised errors.
     Cv(cmd::cv::Args),
     /// Sample terrain elevations over a region from DEM files, point clouds, terrain tiles or
@@ -69,6 +72,7 @@ fn main() -> ExitCode {
         Command::Model(args) => cmd::model::run(args),
         Command::Variogram(args) => cmd::variogram::run(args),
         Command::Interpolate(args) => cmd::interpolate::run(args),
+        Command::Simulate(args) => cmd::simulate::run(args),
         Command::Cv(args) => cmd::cv::run(args),
         Command::Sample(args) => cmd::sample::run(*args),
         Command::Mesh(args) => cmd::mesh::run(args),

@@ -10,6 +10,8 @@
 //!   ([`Neighbourhood::All`]) or [`LocalKriging`] ([`Neighbourhood::Nearest`]) for a
 //!   [`Method`]; [`Idw`] is inverse distance weighting.
 //! - Validation: [`cross_validate`] an [`Interpolator`].
+//! - Simulation: [`simulate`] an [`Ensemble`] of conditional realisations
+//!   ([`SimulationSettings`]); [`unconditional`] fields.
 //! - Names: every setting with a fixed set of values ([`ModelKind`], [`Drift`],
 //!   [`Estimator`], [`Weighting`], [`Duplicates`], [`InterpolationMethod`]) implements
 //!   [`Named`]: one spelling for parsing, display and serde.
@@ -64,6 +66,7 @@ mod model;
 mod neighbourhood;
 mod predictor;
 mod search;
+mod simulate;
 mod special;
 mod system;
 
@@ -83,5 +86,8 @@ pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use predictor::{kriging, Neighbourhood, Predictor};
+pub use simulate::{
+    simulate, unconditional, Ensemble, PointSummary, SimulationSettings, DEFAULT_MODES,
+};
 /// The vocabulary trait of `terramesh-core`, re-exported: `ModelKind::ALL`, `.name()`, ...
 pub use terramesh_core::vocab::{Named, UnknownName};

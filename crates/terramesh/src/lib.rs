@@ -53,5 +53,6 @@ pub mod horizon;
 pub mod interpolate;
 pub mod mesh;
 pub mod project;
+pub mod simulate;
 pub mod tiles;
 pub mod variogram_file;

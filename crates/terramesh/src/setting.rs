@@ -66,6 +66,8 @@ pub enum Setting {
     Lags,
     /// The cell size of the DSM grid.
     GridSpacing,
+    /// The number of conditional-simulation realisations.
+    Realisations,
 }
 
 impl Setting {
@@ -85,6 +87,7 @@ impl Setting {
             "lags" => Setting::Lags,
             "grid" => Setting::Grid,
             "grid_spacing" => Setting::GridSpacing,
+            "realisations" => Setting::Realisations,
             _ => return None,
         })
     }
@@ -121,4 +124,5 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Neighbors => "neighbors",
     Setting::Lags => "lags",
     Setting::GridSpacing => "grid-spacing",
+    Setting::Realisations => "realisations",
 ]);

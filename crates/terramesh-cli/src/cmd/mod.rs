@@ -9,5 +9,6 @@ pub mod interpolate;
 pub mod mesh;
 pub mod model;
 pub mod sample;
+pub mod simulate;
 pub mod tiles;
 pub mod variogram;

@@ -145,6 +145,11 @@ pub fn write_all(
         ],
         cell_data: vec![("min_angle_deg", &min_angle[..])],
     };
+    let mut view = view;
+    if let Some(e) = &it.ensemble {
+        view.point_data.extend(e.point_data());
+        files.push(e.write_csv(out)?);
+    }
     for ext in ["vtu", "obj", "ply", "msh"] {
         if want(ext) {
             let path = out.join(format!("dsm.{ext}"));

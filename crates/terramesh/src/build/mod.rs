@@ -12,6 +12,7 @@
 //! a crash leaves the previous build as it was.
 
 mod adaptive;
+mod ensemble;
 mod exports;
 mod pictures;
 mod report;
@@ -162,8 +163,12 @@ fn build_into(
         progress,
         k: 0,
         total: match what {
-            What::Everything => STAGES + usize::from(project.geology().is_some()),
-            What::ModelOnly => 5,
+            What::Everything => {
+                STAGES
+                    + usize::from(project.geology().is_some())
+                    + usize::from(project.interpolation.realisations > 0)
+            }
+            What::ModelOnly => 5 + usize::from(project.interpolation.realisations > 0),
         },
         timings: Timings::default(),
     };
@@ -205,11 +210,19 @@ fn build_into(
             )
         },
     )?;
-    let interp = st.run(
+    let mut interp = st.run(
         "interpolation",
         || stages::interpolate(project, &samples, &mesh, &model),
         |i| format!("UK and IDW at {} vertices, cross-validation", i.uk.len()),
     )?;
+    if project.interpolation.realisations > 0 {
+        let e = st.run(
+            "simulation",
+            || ensemble::simulate_vertices(project, &model, &mesh, &interp),
+            |e| format!("{} realisations at {} vertices", e.len(), e.mean.len()),
+        )?;
+        interp.ensemble = Some(e);
+    }
     let geo = match geology {
         Some(g) => Some(st.run(
             "geology",

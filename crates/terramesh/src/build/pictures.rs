@@ -143,7 +143,7 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
 
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
     type Map<'a> = (&'a str, &'a str, &'a [f64], bool, ColourMap, bool, &'a str);
-    let maps: [Map; 4] = [
+    let mut maps: Vec<Map> = vec![
         (
             "elevation-uk",
             "DSM by universal kriging (linear drift)",
@@ -181,6 +181,38 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
             "difference (m)",
         ),
     ];
+    // Conditional simulation (interpolation.realisations): spread and quantiles per vertex.
+    if let Some(e) = &it.ensemble {
+        maps.extend([
+            (
+                "sim-std",
+                "Standard deviation of the realisations",
+                &e.std[..],
+                false,
+                ColourMap::Viridis,
+                false,
+                "std. dev. (m)",
+            ),
+            (
+                "sim-p10",
+                "P10 of the realisations",
+                &e.p10[..],
+                true,
+                ColourMap::Terrain,
+                false,
+                "elevation (m)",
+            ),
+            (
+                "sim-p90",
+                "P90 of the realisations",
+                &e.p90[..],
+                true,
+                ColourMap::Terrain,
+                false,
+                "elevation (m)",
+            ),
+        ] as [Map; 3]);
+    }
     for (name, title, values, shaded, colours, symmetric, unit) in maps {
         let map = SurfaceMap {
             xy: &xy,

@@ -244,6 +244,9 @@ pub struct Interpolated {
     pub dsm: Vec<f64>,
     /// That method.
     pub dsm_method: InterpolationMethod,
+    /// Conditional realisations of the vertex elevations (`interpolation.realisations`),
+    /// set by the build after this stage.
+    pub ensemble: Option<super::ensemble::VertexEnsemble>,
 }
 
 /// The samples as kriging data and the variogram model (fitted, given, or read).
@@ -399,6 +402,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         drift,
         dsm,
         dsm_method: primary,
+        ensemble: None,
     })
 }
 

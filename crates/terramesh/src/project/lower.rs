@@ -32,6 +32,7 @@ pub fn key_of(s: Setting) -> String {
         Setting::MaxEdge => "mesh.max_edge",
         Setting::Neighbors => "interpolation.neighbors",
         Setting::GridSpacing => "export.grid_spacing",
+        Setting::Realisations => "interpolation.realisations",
         other => return other.to_string(),
     }
     .to_string()

@@ -204,6 +204,10 @@ pub struct InterpolationSection {
     pub idw_neighbors: usize,
     /// Cross-validation folds (0: leave-one-out).
     pub cv_folds: usize,
+    /// Conditional-simulation realisations of the vertex elevations (0: none).
+    pub realisations: usize,
+    /// Seed of the realisations' random streams.
+    pub seed: u64,
 }
 
 impl Default for InterpolationSection {
@@ -217,6 +221,8 @@ impl Default for InterpolationSection {
             idw_power: DEFAULT_IDW_POWER,
             idw_neighbors: DEFAULT_IDW_NEIGHBORS,
             cv_folds: 0,
+            realisations: 0,
+            seed: 0,
         }
     }
 }
