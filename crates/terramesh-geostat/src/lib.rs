@@ -5,7 +5,10 @@
 //!
 //! - Data: [`Data`] (validated, duplicates rejected or merged by [`Duplicates`]).
 //! - Variograms: [`Variogram`] of [`Structure`]s of a [`ModelKind`]; [`experimental`] lag
-//!   classes ([`LagSettings`]), [`fit_model`] and [`fit_auto`].
+//!   classes ([`LagSettings`]), [`fit_model`] (weighted least squares), [`fit_reml`]
+//!   (restricted maximum likelihood with the drift), [`fit_auto_reml`] (`--variogram auto`:
+//!   REML over the model family, chosen by AIC) and [`fit_auto`] (WLS, chosen by
+//!   cross-validation).
 //! - Prediction: every interpolator is a [`Predictor`]; [`kriging`] builds [`GlobalKriging`]
 //!   ([`Neighbourhood::All`]) or [`LocalKriging`] ([`Neighbourhood::Nearest`]) for a
 //!   [`Method`]; [`Idw`] is inverse distance weighting.
@@ -50,6 +53,7 @@
 // rejects NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+mod auto;
 mod band;
 mod cv;
 mod data;
@@ -62,11 +66,14 @@ mod idw;
 mod linalg;
 mod model;
 mod neighbourhood;
+mod optim;
 mod predictor;
+mod reml;
 mod search;
 mod special;
 mod system;
 
+pub use auto::{fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection};
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, Method};
 pub use error::{GeostatError, Result};
@@ -83,5 +90,6 @@ pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use predictor::{kriging, Neighbourhood, Predictor};
+pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_POINTS};
 /// The vocabulary trait of `terramesh-core`, re-exported: `ModelKind::ALL`, `.name()`, ...
 pub use terramesh_core::vocab::{Named, UnknownName};

@@ -204,6 +204,10 @@ pub struct InterpolationSection {
     pub idw_neighbors: usize,
     /// Cross-validation folds (0: leave-one-out).
     pub cv_folds: usize,
+    /// How `variogram = "auto"` fits: `reml` (restricted maximum likelihood with the UK
+    /// drift over every model, least AIC; the default) or `wls` (least squares, least
+    /// cross-validation RMSE, as before).
+    pub fit: terramesh_geostat::FitMethod,
 }
 
 impl Default for InterpolationSection {
@@ -217,6 +221,7 @@ impl Default for InterpolationSection {
             idw_power: DEFAULT_IDW_POWER,
             idw_neighbors: DEFAULT_IDW_NEIGHBORS,
             cv_folds: 0,
+            fit: terramesh_geostat::FitMethod::Reml,
         }
     }
 }
