@@ -176,10 +176,12 @@ def main():
         rows = []
         o = os.path.join(OUT, f"{name}-out.csv")
         for fit in ("reml", "wls"):
-            r = terramesh_uk(dpath, tpath, o, ["--variogram", "auto", "--fit", fit])
             vj = os.path.join(OUT, f"{name}-auto-{fit}.json")
             run(["variogram", "--data", dpath, "--fit", fit, "--drift", "linear", "-o", vj])
             m = json.load(open(vj))["model"]
+            # REML: `interpolate --variogram auto` itself (the same fit as the file's)
+            extra = ["--variogram", "auto"] if fit == "reml" else ["--variogram", vj]
+            r = terramesh_uk(dpath, tpath, o, extra)
             rows.append((f"terramesh UK auto ({fit})", rmse(r), describe(m)))
         for model in ("spherical", "exponential", "gaussian", "matern", "power", "linear"):
             vj = os.path.join(OUT, f"{name}-{model}.json")

@@ -2,11 +2,14 @@
 //!
 //! Each model of the family is first fitted by weighted least squares to the experimental
 //! variogram ([`fit_model`]); that fit is only the starting point of a REML fit with the
-//! drift of the kriging that will use it ([`fit_reml`](crate::fit_reml)); Matérn is fitted
-//! for ν = ½, 3/2 and 5/2 and keeps the best. The model with the least AIC (`2k − 2ℓ`,
-//! every candidate's ℓ on the same data and drift) is chosen. Each candidate also gets the
-//! leave-one-out RMSE of kriging with its drift on the likelihood's data (global kriging for a
-//! bounded model, 64 neighbours for an unbounded one), reported beside ℓ.
+//! drift of the kriging that will use it ([`fit_reml`](crate::fit_reml), in blocks of
+//! [`DEFAULT_REML_BLOCK`] data); Matérn is fitted for ν = 3/2 and 5/2 (ν = ½ is the
+//! exponential) and keeps the better. Among the REML fits, the model with the least
+//! leave-one-out RMSE of kriging with the drift on all the data (Dubrule's closed form for a
+//! bounded model, one factorisation; 64 neighbours for an unbounded one; above
+//! [`AutoSettings::loo_points`] data on a fixed pseudo-random subset) is chosen: each
+//! model's parameters by likelihood, the model by its prediction error. ℓ and the AIC
+//! `2k − 2ℓ` of every candidate are reported beside it.
 
 use serde::{Deserialize, Serialize};
 
@@ -17,7 +20,7 @@ use crate::experimental::{draw_subset, Lag};
 use crate::fit::{fit_model, Fit, Weighting};
 use crate::model::{ModelKind, Structure, Variogram};
 use crate::predictor::Neighbourhood;
-use crate::reml::{fit_contrasts, Contrasts, RemlFit, DEFAULT_REML_POINTS};
+use crate::reml::{fit_contrasts, Blocks, RemlFit, DEFAULT_REML_BLOCK};
 
 /// How an automatic fit estimates a model's parameters: `reml` or `wls` (see
 /// [`Named`](crate::Named)).
@@ -50,17 +53,24 @@ pub struct AutoSettings {
     pub drift: Drift,
     /// Weights of the WLS starting fits.
     pub weighting: Weighting,
-    /// Largest number of data in the likelihood (default [`DEFAULT_REML_POINTS`]; above it a
-    /// fixed pseudo-random subset); `None` uses all.
-    pub max_points: Option<usize>,
+    /// Largest number of data in one block of the REML likelihood (default
+    /// [`DEFAULT_REML_BLOCK`]); `None`: exact REML in one block.
+    pub block: Option<usize>,
+    /// Largest number of data in the leave-one-out choice (default [`DEFAULT_LOO_POINTS`]; a
+    /// fixed pseudo-random subset above it); `None` uses all.
+    pub loo_points: Option<usize>,
 }
+
+/// Default of [`AutoSettings::loo_points`].
+pub const DEFAULT_LOO_POINTS: usize = 3000;
 
 impl Default for AutoSettings {
     fn default() -> Self {
         AutoSettings {
             drift: Drift::Linear,
             weighting: Weighting::Cressie,
-            max_points: Some(DEFAULT_REML_POINTS),
+            block: Some(DEFAULT_REML_BLOCK),
+            loo_points: Some(DEFAULT_LOO_POINTS),
         }
     }
 }
@@ -68,18 +78,28 @@ impl Default for AutoSettings {
 /// What chose the model of an automatic fit (the `selection` section of `variogram.json`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Selection {
-    /// `reml` (least AIC) or `wls` (least cross-validation RMSE).
+    /// `reml` (parameters by REML, the model by leave-one-out RMSE) or `wls`.
     pub method: FitMethod,
     /// The drift of the likelihood (REML only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drift: Option<Drift>,
-    /// Number of data in the likelihood and the cross-validation.
+    /// Number of data in the likelihood.
     pub points: usize,
+    /// Number of blocks of the composite likelihood (1: exact REML).
+    #[serde(default = "one")]
+    pub blocks: usize,
+    /// Number of data in the leave-one-out choice (`None` for a single model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cv_points: Option<usize>,
+}
+
+fn one() -> usize {
+    1
 }
 
 /// Fits every model of `kinds` by REML (from its WLS fit to `lags`) and picks the one with
-/// the least AIC. Returns the chosen fit (its `objective` is −ℓ), every candidate (with ℓ,
-/// AIC and the leave-one-out RMSE) and what chose it.
+/// the least leave-one-out RMSE. Returns the chosen fit (its `objective` is −ℓ), every
+/// candidate (with ℓ, AIC and the leave-one-out RMSE) and what chose it.
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
@@ -90,8 +110,9 @@ pub struct Selection {
 /// let lags = experimental(&data, &LagSettings::default())?;
 /// let kinds = [ModelKind::Spherical, ModelKind::Exponential, ModelKind::Gaussian];
 /// let (best, all, _) = fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default())?;
-/// let min = all.iter().filter_map(|c| c.aic).fold(f64::MAX, f64::min);
-/// assert!(all.iter().any(|c| c.fit.as_ref() == Some(&best) && c.aic == Some(min)));
+/// let min = all.iter().filter_map(|c| c.cv_rmse).fold(f64::MAX, f64::min);
+/// assert!(all.iter().any(|c| c.fit.as_ref() == Some(&best) && c.cv_rmse == Some(min)));
+/// assert!(all.iter().all(|c| c.log_likelihood.is_some() && c.aic.is_some()));
 /// assert_eq!(best.variogram.structures[0].kind, ModelKind::Gaussian); // a smooth surface
 /// # Ok(()) }
 /// ```
@@ -101,20 +122,20 @@ pub fn fit_auto_reml(
     kinds: &[ModelKind],
     s: &AutoSettings,
 ) -> Result<(Fit, Vec<Candidate>, Selection)> {
-    let contrasts = Contrasts::new(data, s.drift, s.max_points)?;
-    let sub = match s.max_points {
+    let blocks = Blocks::new(data, s.drift, s.block)?;
+    let sub = match s.loo_points {
         Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
         _ => data.clone(),
     };
     let mut cands = Vec::new();
     let mut best: Option<(f64, Fit)> = None;
     for &kind in kinds {
-        let r = fit_one(&contrasts, &sub, lags, kind, s);
-        match r {
+        match fit_one(&blocks, &sub, lags, kind, s) {
             Ok((fit, reml, cv)) => {
-                let aic = reml.aic();
-                if best.as_ref().is_none_or(|b| aic < b.0) {
-                    best = Some((aic, fit.clone()));
+                if let Some(cv) = cv {
+                    if best.as_ref().is_none_or(|b| cv < b.0) {
+                        best = Some((cv, fit.clone()));
+                    }
                 }
                 cands.push(Candidate {
                     model: kind,
@@ -122,7 +143,7 @@ pub fn fit_auto_reml(
                     cv_rmse: cv,
                     error: None,
                     log_likelihood: Some(reml.log_likelihood),
-                    aic: Some(aic),
+                    aic: Some(reml.aic()),
                 });
             }
             Err(e) => cands.push(Candidate {
@@ -138,7 +159,9 @@ pub fn fit_auto_reml(
     let selection = Selection {
         method: FitMethod::Reml,
         drift: Some(s.drift),
-        points: contrasts.len(),
+        points: blocks.n,
+        blocks: blocks.blocks(),
+        cv_points: Some(sub.len()),
     };
     match best {
         Some((_, f)) => Ok((f, cands, selection)),
@@ -155,14 +178,14 @@ pub fn fit_auto_reml(
 
 /// One candidate: WLS start, REML fit (best ν for Matérn), leave-one-out RMSE.
 fn fit_one(
-    c: &Contrasts,
+    c: &Blocks,
     sub: &Data,
     lags: &[Lag],
     kind: ModelKind,
     s: &AutoSettings,
 ) -> Result<(Fit, RemlFit, Option<f64>)> {
     let starts: Vec<Variogram> = match fit_model(lags, kind, s.weighting) {
-        Ok(f) if kind == ModelKind::Matern => [0.5, 1.5, 2.5]
+        Ok(f) if kind == ModelKind::Matern => [1.5, 2.5]
             .iter()
             .map(|&nu| {
                 let mut v = f.variogram.clone();

@@ -73,7 +73,7 @@ mod search;
 mod special;
 mod system;
 
-pub use auto::{fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection};
+pub use auto::{fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection, DEFAULT_LOO_POINTS};
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, Method};
 pub use error::{GeostatError, Result};
@@ -90,6 +90,6 @@ pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use predictor::{kriging, Neighbourhood, Predictor};
-pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_POINTS};
+pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK};
 /// The vocabulary trait of `terramesh-core`, re-exported: `ModelKind::ALL`, `.name()`, ...
 pub use terramesh_core::vocab::{Named, UnknownName};

@@ -16,8 +16,12 @@
 //! `ln det FᵀF` term is left out), not across drifts.
 //!
 //! The cost is one dense Cholesky of order `m` per evaluation, so above
-//! [`DEFAULT_REML_POINTS`] data the likelihood is that of a fixed pseudo-random subset
-//! ([`draw_subset`](crate::draw_subset), the same on every run).
+//! [`DEFAULT_REML_BLOCK`] data the likelihood is a block composite likelihood (Caragea &
+//! Smith 2007, "big blocks"): the data are split by recursive median bisection of the longer
+//! side into spatial blocks of at most that many, each block with its own drift contrasts,
+//! and their restricted log-likelihoods are summed (one common scale). Every short lag, the
+//! part of the variogram that matters most for interpolation (Stein 1999), is kept; pairs in
+//! different blocks are ignored. Deterministic: the split depends only on the coordinates.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
@@ -27,15 +31,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::data::{drift_row, Data, Drift};
 use crate::error::{GeostatError, Result};
-use crate::experimental::draw_subset;
 use crate::global::par;
 use crate::model::{ModelKind, Variogram};
 use crate::optim::nelder_mead;
 use crate::system::dist;
 
-/// Default largest number of data in the REML likelihood: above it, a fixed pseudo-random
-/// subset of this many (one likelihood evaluation is a Cholesky of this order).
-pub const DEFAULT_REML_POINTS: usize = 1000;
+/// Default largest number of data in one block of the REML likelihood (one evaluation costs
+/// a Cholesky of this order per block).
+pub const DEFAULT_REML_BLOCK: usize = 400;
 
 /// A variogram fitted by REML.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -48,6 +51,8 @@ pub struct RemlFit {
     pub parameters: usize,
     /// Number of data in the likelihood.
     pub points: usize,
+    /// Number of blocks of the composite likelihood (1: exact REML).
+    pub blocks: usize,
 }
 
 impl RemlFit {
@@ -71,12 +76,8 @@ pub(crate) struct Contrasts {
 }
 
 impl Contrasts {
-    /// The contrasts of `data` (at most `max_points` of them) for `drift`.
-    pub(crate) fn new(data: &Data, drift: Drift, max_points: Option<usize>) -> Result<Contrasts> {
-        let data = match max_points {
-            Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
-            _ => data.clone(),
-        };
+    /// The contrasts of `data` for `drift`.
+    fn new(data: &Data, drift: Drift) -> Result<Contrasts> {
         let n = data.len();
         let p = drift.terms();
         if n < p + 2 {
@@ -154,24 +155,24 @@ impl Contrasts {
         })
     }
 
-    /// Number of data.
-    pub(crate) fn len(&self) -> usize {
-        self.n
-    }
-
-    /// `(ℓ, ŝ)`: the restricted log-likelihood of `s·γ₀` at the profiled scale `ŝ`, or `None`
-    /// where `M` is not positive definite.
-    pub(crate) fn profile(&self, g0: &Variogram) -> Option<(f64, f64)> {
+    /// `(ln det M₀, y₀ᵀ M₀⁻¹ y₀, m)` of `γ₀`, or `None` where `M₀` is not positive definite.
+    fn parts(&self, g0: &Variogram) -> Option<(f64, f64, usize)> {
         let (n, p) = (self.n, self.p);
         let m = n - p;
         let pts: Vec<[f64; 2]> = self.xy.iter().map(|q| g0.transform(*q)).collect();
         // K = −Γ, full (column-major, symmetric).
         let mut k = vec![0.0; n * n];
+        // The lower triangle, then mirrored (γ is the costly part).
         k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
-            for (i, c) in col.iter_mut().enumerate() {
-                *c = if i == j { 0.0 } else { -g0.gamma(dist(pts[i], pts[j])) };
+            for i in j + 1..n {
+                col[i] = -g0.gamma(dist(pts[i], pts[j]));
             }
         });
+        for j in 0..n {
+            for i in 0..j {
+                k[j * n + i] = k[i * n + j];
+            }
+        }
         // K ← H K H for each reflector: K −= 2 (v gᵀ + g vᵀ), g = Kv − (vᵀKv) v.
         for v in &self.reflectors {
             let w: Vec<f64> = k
@@ -217,18 +218,95 @@ impl Contrasts {
             }
         }
         let q: f64 = u.iter().map(|x| x * x).sum();
+        logdet.is_finite().then_some((logdet, q, m))
+    }
+}
+
+/// The data split into blocks, each with its contrasts.
+pub(crate) struct Blocks {
+    blocks: Vec<Contrasts>,
+    /// Number of data.
+    pub n: usize,
+    /// Smallest and largest distance between two data of one block.
+    pub hmin: f64,
+    pub hmax: f64,
+}
+
+impl Blocks {
+    /// The blocks of `data` (at most `block` each; `None`: one block) for `drift`.
+    pub(crate) fn new(data: &Data, drift: Drift, block: Option<usize>) -> Result<Blocks> {
+        let mut idx: Vec<usize> = (0..data.len()).collect();
+        let mut groups = Vec::new();
+        split(data.xy(), &mut idx, block.unwrap_or(usize::MAX).max(2 * drift.terms() + 4), &mut groups);
+        let blocks = groups
+            .iter()
+            .map(|g| Contrasts::new(&data.subset(g), drift))
+            .collect::<Result<Vec<_>>>()?;
+        let hmin = blocks.iter().map(|b| b.hmin).fold(f64::INFINITY, f64::min);
+        let hmax = blocks.iter().map(|b| b.hmax).fold(0.0, f64::max);
+        Ok(Blocks {
+            blocks,
+            n: data.len(),
+            hmin,
+            hmax,
+        })
+    }
+
+    /// `(ℓ, ŝ)`: the (composite) restricted log-likelihood of `s·γ₀` at the profiled scale
+    /// `ŝ`, or `None` where a block's `M` is not positive definite.
+    pub(crate) fn profile(&self, g0: &Variogram) -> Option<(f64, f64)> {
+        let (mut logdet, mut q, mut m) = (0.0, 0.0, 0usize);
+        for b in &self.blocks {
+            let (l, qb, mb) = b.parts(g0)?;
+            logdet += l;
+            q += qb;
+            m += mb;
+        }
         let mf = m as f64;
         let s = q / mf;
-        if !(s > 0.0 && logdet.is_finite()) {
+        if !(s > 0.0) {
             return None;
         }
         let ll = -0.5 * (mf * (2.0 * std::f64::consts::PI * s).ln() + logdet + mf);
         Some((ll, s))
     }
+
+    /// Number of blocks.
+    pub(crate) fn blocks(&self) -> usize {
+        self.blocks.len()
+    }
+
+    /// Number of contrasts (data less drift terms, summed over the blocks).
+    fn contrasts(&self) -> usize {
+        self.blocks.iter().map(|b| b.n - b.p).sum()
+    }
+}
+
+/// Recursive median bisection of `idx` along the longer side until each part has at most
+/// `max` points.
+fn split(xy: &[[f64; 2]], idx: &mut [usize], max: usize, out: &mut Vec<Vec<usize>>) {
+    if idx.len() <= max {
+        let mut g = idx.to_vec();
+        g.sort_unstable();
+        out.push(g);
+        return;
+    }
+    let ext = |k: usize| {
+        let (lo, hi) = idx.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
+            (a.min(xy[i][k]), b.max(xy[i][k]))
+        });
+        hi - lo
+    };
+    let k = if ext(0) >= ext(1) { 0 } else { 1 };
+    let mid = idx.len() / 2;
+    idx.select_nth_unstable_by(mid, |&a, &b| xy[a][k].total_cmp(&xy[b][k]).then(a.cmp(&b)));
+    let (a, b) = idx.split_at_mut(mid);
+    split(xy, a, max, out);
+    split(xy, b, max, out);
 }
 
 /// The restricted log-likelihood of `variogram` itself (no scale profiled) for `data` with
-/// `drift`, on at most `max_points` data.
+/// `drift`, in blocks of at most `block` data (`None`: exact, one block).
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
@@ -246,13 +324,13 @@ pub fn reml_log_likelihood(
     data: &Data,
     drift: Drift,
     variogram: &Variogram,
-    max_points: Option<usize>,
+    block: Option<usize>,
 ) -> Result<f64> {
     variogram.validate()?;
-    let c = Contrasts::new(data, drift, max_points)?;
+    let c = Blocks::new(data, drift, block)?;
     let (ll, s) = c.profile(variogram).ok_or_else(not_pd)?;
     // ℓ at scale 1 from ℓ at ŝ: ℓ(1) = ℓ(ŝ) + ½ m (ln ŝ + 1 − ŝ).
-    let m = (c.n - c.p) as f64;
+    let m = c.contrasts() as f64;
     Ok(ll + 0.5 * m * (s.ln() + 1.0 - s))
 }
 
@@ -284,10 +362,10 @@ pub fn fit_reml(
     data: &Data,
     drift: Drift,
     start: &Variogram,
-    max_points: Option<usize>,
+    block: Option<usize>,
 ) -> Result<RemlFit> {
     start.validate()?;
-    let c = Contrasts::new(data, drift, max_points)?;
+    let c = Blocks::new(data, drift, block)?;
     fit_contrasts(&c, start)
 }
 
@@ -363,7 +441,7 @@ impl Layout<'_> {
     }
 }
 
-pub(crate) fn fit_contrasts(c: &Contrasts, start: &Variogram) -> Result<RemlFit> {
+pub(crate) fn fit_contrasts(c: &Blocks, start: &Variogram) -> Result<RemlFit> {
     let scaled = |v: &Variogram, s: f64| {
         let mut v = v.clone();
         v.nugget *= s;
@@ -381,7 +459,8 @@ pub(crate) fn fit_contrasts(c: &Contrasts, start: &Variogram) -> Result<RemlFit>
             variogram: scaled(&v, s),
             log_likelihood: ll,
             parameters: 1,
-            points: c.len(),
+            points: c.n,
+            blocks: c.blocks.len(),
         });
     }
     let bounded = start.structures.iter().all(|t| t.kind.bounded());
@@ -404,12 +483,22 @@ pub(crate) fn fit_contrasts(c: &Contrasts, start: &Variogram) -> Result<RemlFit>
     };
     let mut th = layout.start_theta();
     let d = th.len();
+    // ℓ to 0.01 is far finer than its sampling error (about √(k/2)); a restart from the
+    // optimum with fresh steps guards against a collapsed simplex.
     let mut best = f64::INFINITY;
-    for _ in 0..2 {
-        let (t, v) = nelder_mead(&mut cost, &th, &layout.steps(d), 1e-4, 40 * d + 20);
+    for run in 0..2 {
+        let evals = if run == 0 { 30 * d + 10 } else { 15 * d + 5 };
+        let (t, v) = nelder_mead(&mut cost, &th, &layout.steps(d), 1e-2, evals);
+        let moved = best - v;
         if v <= best {
             best = v;
             th = t;
+        }
+        if run == 0 && !best.is_finite() {
+            break;
+        }
+        if run == 1 && moved < 1e-2 {
+            break;
         }
     }
     if !best.is_finite() {
@@ -423,6 +512,7 @@ pub(crate) fn fit_contrasts(c: &Contrasts, start: &Variogram) -> Result<RemlFit>
         variogram,
         log_likelihood: ll,
         parameters: d + 1,
-        points: c.len(),
+        points: c.n,
+        blocks: c.blocks.len(),
     })
 }

@@ -104,7 +104,7 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             selection: None,
         });
     }
-    let r = fit_reml(data, plan.auto.drift, &wls.variogram, plan.auto.max_points)?;
+    let r = fit_reml(data, plan.auto.drift, &wls.variogram, plan.auto.block)?;
     let rmse = terramesh_geostat::lag_rmse(lags, &r.variogram);
     Ok(Fitted {
         fit: Fit {
@@ -117,6 +117,8 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             method: FitMethod::Reml,
             drift: Some(plan.auto.drift),
             points: r.points,
+            blocks: r.blocks,
+            cv_points: None,
         }),
     })
 }

@@ -41,15 +41,16 @@ pub struct LagArgs {
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
     pub max_points: usize,
     /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
-    /// kriging's drift, from the WLS fit; --model auto then keeps the least AIC) or wls
-    /// (weighted least squares on the lag classes; auto keeps the least leave-one-out RMSE).
-    /// Default: reml for auto, wls for a named model.
+    /// kriging's drift, from the WLS fit) or wls (weighted least squares on the lag classes).
+    /// With auto, both keep the model of least leave-one-out RMSE (REML: of kriging with the
+    /// drift; WLS: of ordinary kriging in 32 neighbours). Default: reml for auto, wls for a
+    /// named model.
     #[arg(long, value_parser = crate::named::<FitMethod>())]
     pub fit: Option<FitMethod>,
-    /// REML on at most this many data, drawn pseudo-randomly (the same draw every run); 0 uses
-    /// all (each likelihood evaluation is a Cholesky of this order).
-    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_REML_POINTS)]
-    pub reml_points: usize,
+    /// REML in spatial blocks of at most this many data (a composite likelihood; each
+    /// evaluation is a Cholesky of this order per block); 0: exact REML on all data.
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_REML_BLOCK)]
+    pub reml_block: usize,
 }
 
 impl LagArgs {
@@ -76,7 +77,8 @@ impl LagArgs {
             auto: AutoSettings {
                 drift,
                 weighting: self.weights,
-                max_points: (self.reml_points > 0).then_some(self.reml_points),
+                block: (self.reml_block > 0).then_some(self.reml_block),
+                ..AutoSettings::default()
             },
         }
     }
