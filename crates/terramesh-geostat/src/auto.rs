@@ -215,7 +215,10 @@ fn fit_one(
     for st in &starts {
         match fit_contrasts(c, st) {
             Ok(r) => {
-                if best.as_ref().is_none_or(|b| r.log_likelihood > b.log_likelihood) {
+                if best
+                    .as_ref()
+                    .is_none_or(|b| r.log_likelihood > b.log_likelihood)
+                {
                     best = Some(r);
                 }
             }

@@ -81,7 +81,9 @@ pub(crate) fn nelder_mead(
             }
         }
     }
-    let best = (0..=d).min_by(|&a, &b| vals[a].total_cmp(&vals[b])).unwrap();
+    let best = (0..=d)
+        .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
+        .unwrap();
     (pts[best].clone(), vals[best])
 }
 
@@ -93,9 +95,18 @@ mod tests {
     fn finds_the_minimum_of_rosenbrock_and_respects_infinite_walls() {
         let mut rosen = |x: &[f64]| (1.0 - x[0]).powi(2) + 100.0 * (x[1] - x[0] * x[0]).powi(2);
         let (x, v) = nelder_mead(&mut rosen, &[-1.2, 1.0], &[0.5, 0.5], 1e-14, 2000);
-        assert!((x[0] - 1.0).abs() < 1e-3 && (x[1] - 1.0).abs() < 1e-3 && v < 1e-6, "{x:?}");
+        assert!(
+            (x[0] - 1.0).abs() < 1e-3 && (x[1] - 1.0).abs() < 1e-3 && v < 1e-6,
+            "{x:?}"
+        );
         // A wall: x < 0.5 is not admissible; the minimum of (x-0)^2 on x >= 0.5 is at 0.5.
-        let mut walled = |x: &[f64]| if x[0] < 0.5 { f64::INFINITY } else { x[0] * x[0] };
+        let mut walled = |x: &[f64]| {
+            if x[0] < 0.5 {
+                f64::INFINITY
+            } else {
+                x[0] * x[0]
+            }
+        };
         let (x, _) = nelder_mead(&mut walled, &[2.0], &[0.5], 1e-12, 500);
         assert!((x[0] - 0.5).abs() < 1e-3, "{x:?}");
     }

@@ -84,12 +84,17 @@ impl Contrasts {
             return Err(GeostatError::TooFewData {
                 n,
                 needed: p + 2,
-                what: format!("a REML fit with a {} drift", terramesh_core::vocab::Named::name(drift)),
+                what: format!(
+                    "a REML fit with a {} drift",
+                    terramesh_core::vocab::Named::name(drift)
+                ),
             });
         }
         let xy = data.xy().to_vec();
         // Drift columns in a centred, scaled frame (as the kriging solvers evaluate them).
-        let c = xy.iter().fold([0.0, 0.0], |a, q| [a[0] + q[0], a[1] + q[1]]);
+        let c = xy
+            .iter()
+            .fold([0.0, 0.0], |a, q| [a[0] + q[0], a[1] + q[1]]);
         let c = [c[0] / n as f64, c[1] / n as f64];
         let s = xy
             .iter()
@@ -99,7 +104,11 @@ impl Contrasts {
         let mut f = vec![0.0; n * p]; // column-major n x p
         let mut row = [0.0; 6];
         for (i, q) in xy.iter().enumerate() {
-            drift_row(Some(drift), [(q[0] - c[0]) / s, (q[1] - c[1]) / s], &mut row);
+            drift_row(
+                Some(drift),
+                [(q[0] - c[0]) / s, (q[1] - c[1]) / s],
+                &mut row,
+            );
             for k in 0..p {
                 f[k * n + i] = row[k];
             }
@@ -237,7 +246,12 @@ impl Blocks {
     pub(crate) fn new(data: &Data, drift: Drift, block: Option<usize>) -> Result<Blocks> {
         let mut idx: Vec<usize> = (0..data.len()).collect();
         let mut groups = Vec::new();
-        split(data.xy(), &mut idx, block.unwrap_or(usize::MAX).max(2 * drift.terms() + 4), &mut groups);
+        split(
+            data.xy(),
+            &mut idx,
+            block.unwrap_or(usize::MAX).max(2 * drift.terms() + 4),
+            &mut groups,
+        );
         let blocks = groups
             .iter()
             .map(|g| Contrasts::new(&data.subset(g), drift))
@@ -292,9 +306,11 @@ fn split(xy: &[[f64; 2]], idx: &mut [usize], max: usize, out: &mut Vec<Vec<usize
         return;
     }
     let ext = |k: usize| {
-        let (lo, hi) = idx.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
-            (a.min(xy[i][k]), b.max(xy[i][k]))
-        });
+        let (lo, hi) = idx
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
+                (a.min(xy[i][k]), b.max(xy[i][k]))
+            });
         hi - lo
     };
     let k = if ext(0) >= ext(1) { 0 } else { 1 };
@@ -448,8 +464,7 @@ pub(crate) fn fit_contrasts(c: &Blocks, start: &Variogram) -> Result<RemlFit> {
         v.structures.iter_mut().for_each(|t| t.psill *= s);
         v
     };
-    if start.structures.is_empty() || start.structures.iter().all(|t| t.kind == ModelKind::Nugget)
-    {
+    if start.structures.is_empty() || start.structures.iter().all(|t| t.kind == ModelKind::Nugget) {
         // A pure nugget: nothing but the scale to fit.
         let mut v = start.clone();
         v.nugget = 1.0;

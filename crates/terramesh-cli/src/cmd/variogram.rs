@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use terramesh::fitting::{fit as fit_plan, FitPlan};
 use terramesh_geostat::{
-    experimental, AutoSettings, CandidateEntry, Direction, Drift, Duplicates, Estimator,
-    FitMethod, FitSummary, LagSettings, LagSummary, VariogramFile, Weighting,
+    experimental, AutoSettings, CandidateEntry, Direction, Drift, Duplicates, Estimator, FitMethod,
+    FitSummary, LagSettings, LagSummary, VariogramFile, Weighting,
 };
 use terramesh_io::output::Output;
 

@@ -4,8 +4,8 @@ use std::path::Path;
 
 use terramesh_core::coords::Zone;
 use terramesh_geostat::{
-    cross_validate, experimental, kriging, CandidateSummary, CvStats, Data, Drift, Duplicates, Folds, Idw,
-    IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, Named,
+    cross_validate, experimental, kriging, CandidateSummary, CvStats, Data, Drift, Duplicates,
+    Folds, Idw, IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, Named,
     Neighbourhood, Predictor, Selection, Variogram,
 };
 use terramesh_io::region::LoadedRegion;
@@ -292,9 +292,12 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
                 ..Default::default()
             },
         };
-        let fitted =
-            crate::fitting::fit(&data, &lags, &plan).context("fitting the variogram")?;
-        candidates = fitted.candidates.iter().map(CandidateSummary::from).collect();
+        let fitted = crate::fitting::fit(&data, &lags, &plan).context("fitting the variogram")?;
+        candidates = fitted
+            .candidates
+            .iter()
+            .map(CandidateSummary::from)
+            .collect();
         selection = fitted.selection;
         fitted.fit.variogram
     } else {
