@@ -5,7 +5,7 @@
 
 use terramesh_geostat::{
     experimental, fit_auto, fit_auto_reml, kriging, AutoSettings, Data, Drift, Duplicates,
-    LagSettings, Method, ModelKind, Neighbourhood, Weighting,
+    LagSettings, Method, ModelKind, Named, Neighbourhood, Weighting,
 };
 
 /// The posts of the crop in local metres (equirectangular about its centre), voids left out.
