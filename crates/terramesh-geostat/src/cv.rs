@@ -275,10 +275,19 @@ pub struct Candidate {
     pub model: ModelKind,
     /// The fit, if it succeeded.
     pub fit: Option<Fit>,
-    /// Leave-one-out RMSE of ordinary kriging with it (the selection criterion).
+    /// Leave-one-out RMSE: of ordinary kriging in 32 neighbours for [`fit_auto`] (its
+    /// selection criterion); of kriging with the drift for
+    /// [`fit_auto_reml`](crate::fit_auto_reml) (reported only).
     pub cv_rmse: Option<f64>,
     /// Why it was not usable, if so.
     pub error: Option<String>,
+    /// Restricted log-likelihood of the REML fit ([`fit_auto_reml`](crate::fit_auto_reml)
+    /// only; left out of the file otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_likelihood: Option<f64>,
+    /// Its AIC `2k − 2ℓ`, the REML selection criterion (REML only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aic: Option<f64>,
 }
 
 /// Fits every model in `kinds` and picks the one with the least leave-one-out RMSE of
@@ -332,6 +341,8 @@ pub fn fit_auto(
                     fit: Some(f),
                     cv_rmse: Some(rmse),
                     error: None,
+                    log_likelihood: None,
+                    aic: None,
                 });
             }
             Err(e) => cands.push(Candidate {
@@ -339,6 +350,8 @@ pub fn fit_auto(
                 fit: None,
                 cv_rmse: None,
                 error: Some(e.to_string()),
+                log_likelihood: None,
+                aic: None,
             }),
         }
     }

@@ -10,6 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::auto::Selection;
 use crate::cv::Candidate;
 use crate::error::GeostatError;
 use crate::experimental::{Estimator, Lag};
@@ -54,6 +55,10 @@ pub struct VariogramFile {
     pub fit: Option<FitSummary>,
     /// The models tried by an automatic fit; empty when the model was given.
     pub candidates: Vec<CandidateEntry>,
+    /// What chose the model among the candidates (written by an automatic REML fit only:
+    /// files without it are as they always were).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub selection: Option<Selection>,
 }
 
 /// The `lags` section: the lag classes asked for.
@@ -102,6 +107,12 @@ pub struct CandidateSummary {
     pub cv_rmse: Option<f64>,
     /// RMSE of its fit to the experimental variogram.
     pub fit_rmse: Option<f64>,
+    /// Restricted log-likelihood of its REML fit (left out for a WLS fit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_likelihood: Option<f64>,
+    /// Its AIC, the REML selection criterion (left out for a WLS fit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aic: Option<f64>,
 }
 
 impl From<&Candidate> for CandidateSummary {
@@ -110,6 +121,8 @@ impl From<&Candidate> for CandidateSummary {
             model: c.model,
             cv_rmse: c.cv_rmse,
             fit_rmse: c.fit.as_ref().map(|f| f.rmse),
+            log_likelihood: c.log_likelihood,
+            aic: c.aic,
         }
     }
 }
@@ -155,6 +168,7 @@ impl VariogramFile {
             model,
             fit: None,
             candidates: Vec::new(),
+            selection: None,
         }
     }
 
@@ -184,6 +198,7 @@ impl VariogramFile {
             model,
             fit: section(&mut map, "fit"),
             candidates: section(&mut map, "candidates"),
+            selection: section(&mut map, "selection"),
         })
     }
 }
@@ -236,12 +251,16 @@ mod tests {
                 }),
                 cv_rmse: Some(1.5),
                 error: None,
+                log_likelihood: None,
+                aic: None,
             },
             Candidate {
                 model: ModelKind::Linear,
                 fit: None,
                 cv_rmse: None,
                 error: Some("no fit".into()),
+                log_likelihood: None,
+                aic: None,
             },
         ]
     }
@@ -287,6 +306,7 @@ mod tests {
                 rmse: 0.0625,
             }),
             candidates: cands.into_iter().map(CandidateEntry::Full).collect(),
+            selection: None,
         };
         let text = f.to_json_pretty();
         assert_eq!(text, serde_json::to_string_pretty(&old).unwrap());

@@ -5,7 +5,10 @@
 //!
 //! - Data: [`Data`] (validated, duplicates rejected or merged by [`Duplicates`]).
 //! - Variograms: [`Variogram`] of [`Structure`]s of a [`ModelKind`]; [`experimental`] lag
-//!   classes ([`LagSettings`]), [`fit_model`] and [`fit_auto`].
+//!   classes ([`LagSettings`]), [`fit_model`] (weighted least squares), [`fit_reml`]
+//!   (restricted maximum likelihood with the drift), [`fit_auto_reml`] (`--variogram auto`:
+//!   REML over the model family, chosen by AIC) and [`fit_auto`] (WLS, chosen by
+//!   cross-validation).
 //! - Prediction: every interpolator is a [`Predictor`]; [`kriging`] builds [`GlobalKriging`]
 //!   ([`Neighbourhood::All`]) or [`LocalKriging`] ([`Neighbourhood::Nearest`]) for a
 //!   [`Method`]; [`Idw`] is inverse distance weighting.
@@ -52,6 +55,7 @@
 // rejects NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+mod auto;
 mod band;
 mod cv;
 mod data;
@@ -64,12 +68,15 @@ mod idw;
 mod linalg;
 mod model;
 mod neighbourhood;
+mod optim;
 mod predictor;
+mod reml;
 mod search;
 mod simulate;
 mod special;
 mod system;
 
+pub use auto::{fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection, DEFAULT_LOO_POINTS};
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
 pub use error::{GeostatError, Result};
@@ -89,5 +96,6 @@ pub use predictor::{kriging, Neighbourhood, Predictor};
 pub use simulate::{
     simulate, unconditional, Ensemble, PointSummary, SimulationSettings, DEFAULT_MODES,
 };
+pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK};
 /// The vocabulary trait of `terramesh-core`, re-exported: `ModelKind::ALL`, `.name()`, ...
 pub use terramesh_core::vocab::{Named, UnknownName};

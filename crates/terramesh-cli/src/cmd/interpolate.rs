@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use terramesh::interpolate::{fit_named, predict_csv, predict_grid, read_data, FileData};
+use terramesh::interpolate::{predict_csv, predict_grid, read_data, FileData};
 use terramesh::variogram_file::read_variogram_file;
 use terramesh_geostat::{
     experimental, kriging, Data, Drift, Duplicates, Idw, IdwSearch, InterpolationMethod, Method,
@@ -29,7 +29,8 @@ pub struct MethodArgs {
     pub mean: Option<f64>,
     #[command(flatten)]
     pub model: ModelArgs,
-    /// auto (fit a model to the data) or a JSON file written by `terramesh variogram`.
+    /// auto (fit a model to the data: by REML with the kriging's drift over every model, the
+    /// least AIC kept; see --fit) or a JSON file written by `terramesh variogram`.
     #[arg(long)]
     pub variogram: Option<String>,
     #[command(flatten)]
@@ -109,8 +110,14 @@ pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
 
 fn auto(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
     let lags = experimental(&fd.data, &m.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
-    let (fit, _) = fit_named(&fd.data, &lags, "auto", m.lag.weighting())
-        .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
+    // REML filters out the drift of the kriging that will use the model.
+    let drift = match m.method {
+        InterpolationMethod::Universal => m.drift.unwrap_or(Drift::Linear),
+        _ => Drift::Constant,
+    };
+    let fit = terramesh::fitting::fit(&fd.data, &lags, &m.lag.plan("auto", drift))
+        .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?
+        .fit;
     eprintln!("terramesh: fitted variogram: {}", fit.variogram);
     Ok(fit.variogram)
 }

@@ -4,13 +4,14 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use terramesh::fitting::{fit as fit_plan, FitPlan};
 use terramesh_geostat::{
-    experimental, CandidateEntry, Direction, Duplicates, Estimator, FitSummary, LagSettings,
-    LagSummary, VariogramFile, Weighting,
+    experimental, AutoSettings, CandidateEntry, Direction, Drift, Duplicates, Estimator, FitMethod,
+    FitSummary, LagSettings, LagSummary, VariogramFile, Weighting,
 };
 use terramesh_io::output::Output;
 
-use terramesh::interpolate::{fit_named, read_data};
+use terramesh::interpolate::read_data;
 
 use super::geodata::in_file;
 
@@ -39,6 +40,16 @@ pub struct LagArgs {
     /// (the same draw every run); 0 uses all (the pair count grows with the square).
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
     pub max_points: usize,
+    /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
+    /// kriging's drift, from the WLS fit) or wls (weighted least squares on the lag classes).
+    /// With auto, both keep the model of least leave-one-out RMSE (REML: of kriging with the
+    /// drift; WLS: of ordinary kriging in 32 neighbours). Default: wls.
+    #[arg(long, value_parser = crate::named::<FitMethod>())]
+    pub fit: Option<FitMethod>,
+    /// REML in spatial blocks of at most this many data (a composite likelihood; each
+    /// evaluation is a Cholesky of this order per block); 0: exact REML on all data.
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_REML_BLOCK)]
+    pub reml_block: usize,
 }
 
 impl LagArgs {
@@ -57,14 +68,29 @@ impl LagArgs {
     pub fn weighting(&self) -> Weighting {
         self.weights
     }
+    /// The fitting plan of `model` (`auto` or a name) for kriging with `drift`.
+    pub fn plan(&self, model: &str, drift: Drift) -> FitPlan {
+        FitPlan {
+            model: model.to_string(),
+            method: self.fit,
+            auto: AutoSettings {
+                drift,
+                weighting: self.weights,
+                block: (self.reml_block > 0).then_some(self.reml_block),
+                ..AutoSettings::default()
+            },
+        }
+    }
 }
 
 /// Compute an experimental semivariogram and fit a model to it.
 ///
 /// Writes JSON with the lag classes (mean distance, semivariance, pair count), the fitted
 /// model (nugget, psill, range: GSLIB practical range) and the fit error; with --model auto
-/// also every candidate with its cross-validation RMSE. The file can be given to
-/// `interpolate --variogram FILE`.
+/// also every candidate with its cross-validation RMSE and, for a REML fit (the default of
+/// auto), its restricted log-likelihood and AIC (`log_likelihood`, `aic`; `fit.objective` is
+/// then −ℓ) and a `selection` section (method, drift, number of data). The file can be given
+/// to `interpolate --variogram FILE`.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:\n  \
     terramesh variogram --data pts.csv -o variogram.json --plot variogram.svg\n  \
@@ -79,6 +105,10 @@ pub struct Args {
     model: String,
     #[command(flatten)]
     lag: LagArgs,
+    /// The drift that a REML fit filters out: that of the kriging that will use the model
+    /// (constant for ok and sk, the --drift of uk).
+    #[arg(long, value_parser = crate::named::<Drift>(), default_value_t = Drift::Linear)]
+    drift: Drift,
     /// Points at one location.
     #[arg(long, value_parser = crate::named::<Duplicates>(), default_value_t = Duplicates::Reject)]
     duplicates: Duplicates,
@@ -107,8 +137,9 @@ pub fn run(args: Args) -> Result<()> {
     let fd = read_data(&args.data, args.duplicates).map_err(crate::flag_error)?;
     let s = args.lag.settings();
     let lags = experimental(&fd.data, &s).map_err(|e| in_file(&fd.name, e))?;
-    let (fit, cands) = fit_named(&fd.data, &lags, &args.model, args.lag.weighting())
+    let fitted = fit_plan(&fd.data, &lags, &args.lag.plan(&args.model, args.drift))
         .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
+    let (fit, cands) = (fitted.fit, fitted.candidates);
     let file = VariogramFile {
         data: fd.name.clone(),
         points: fd.data.len(),
@@ -127,6 +158,7 @@ pub fn run(args: Args) -> Result<()> {
             rmse: fit.rmse,
         }),
         candidates: cands.into_iter().map(CandidateEntry::Full).collect(),
+        selection: fitted.selection,
     };
     let mut out = Output::create(args.output.as_deref())?;
     out.write_all(file.to_json_pretty().as_bytes())?;

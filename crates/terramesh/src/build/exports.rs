@@ -7,7 +7,7 @@ use crate::error::{Context, Result};
 use terramesh_core::coords::{to_wgs84, LocalEnu, Zone};
 use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_core::vocab::Named;
-use terramesh_geostat::{CandidateEntry, CandidateSummary, VariogramFile};
+use terramesh_geostat::{CandidateEntry, VariogramFile};
 use terramesh_io::export::{
     write_collada, write_dxf, write_kml, write_model_kml, write_stl, write_tsurf, ColladaOptions,
     KmlStyle, TsurfInfo,
@@ -377,19 +377,17 @@ pub fn write_all(
         }
         Ok(())
     })?);
-    let mut candidates = Vec::with_capacity(it.candidates.len());
-    for (m, cv, fit) in &it.candidates {
-        candidates.push(CandidateEntry::Summary(CandidateSummary {
-            model: *m,
-            cv_rmse: *cv,
-            fit_rmse: *fit,
-        }));
-    }
+    let candidates = it
+        .candidates
+        .iter()
+        .map(|c| CandidateEntry::Summary(*c))
+        .collect();
     let json = VariogramFile {
         data: "samples.csv".into(),
         points: s.xyz.len(),
         experimental: it.lags.clone(),
         candidates,
+        selection: it.selection,
         ..VariogramFile::new(it.variogram.clone())
     }
     .to_json_pretty();

@@ -273,20 +273,31 @@ pub fn write_report(
         short_numbers(&it.variogram.to_string())
     )));
     if !it.candidates.is_empty() {
+        let reml = it.selection.is_some();
+        let mut header = vec!["model", "cross-validation RMSE (m)", "fit RMSE (m²)"];
+        if reml {
+            header.extend(["restricted log-likelihood", "AIC"]);
+        }
         vb.push(Block::Table {
-            caption: "Models tried by the automatic fit (chosen by leave-one-out RMSE)".into(),
-            header: ["model", "cross-validation RMSE (m)", "fit RMSE (m²)"]
-                .map(String::from)
-                .to_vec(),
+            caption: match it.selection {
+                Some(s) => format!(
+                    "Models tried by the automatic fit: REML with a {} drift on {} samples, chosen by the least AIC",
+                    s.drift.map_or("constant", terramesh_geostat::Named::name),
+                    s.points
+                ),
+                None => "Models tried by the automatic fit (chosen by leave-one-out RMSE)".into(),
+            },
+            header: header.into_iter().map(String::from).collect(),
             rows: it
                 .candidates
                 .iter()
-                .map(|(name, cv, fit)| {
-                    vec![
-                        name.to_string(),
-                        cv.map_or("-".into(), |v| num(v, 4)),
-                        fit.map_or("-".into(), |v| num(v, 4)),
-                    ]
+                .map(|c| {
+                    let opt = |v: Option<f64>| v.map_or("-".into(), |v| num(v, 4));
+                    let mut row = vec![c.model.to_string(), opt(c.cv_rmse), opt(c.fit_rmse)];
+                    if reml {
+                        row.extend([opt(c.log_likelihood), opt(c.aic)]);
+                    }
+                    row
                 })
                 .collect(),
         });

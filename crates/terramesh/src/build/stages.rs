@@ -4,9 +4,9 @@ use std::path::Path;
 
 use terramesh_core::coords::Zone;
 use terramesh_geostat::{
-    cross_validate, experimental, fit_auto, kriging, CvStats, Data, Drift, Duplicates, Folds, Idw,
-    IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, ModelKind, Named,
-    Neighbourhood, Predictor, Variogram, Weighting,
+    cross_validate, experimental, kriging, CandidateSummary, CvStats, Data, Drift, Duplicates,
+    Folds, Idw, IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, Named,
+    Neighbourhood, Predictor, Selection, Variogram,
 };
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{smooth_keeping, Mesh, MeshBuilder, Quality, SmoothReport};
@@ -226,8 +226,10 @@ pub struct Interpolated {
     pub variogram: Variogram,
     /// Experimental variogram of the samples.
     pub lags: Vec<Lag>,
-    /// Candidate models tried by `auto`, as (model, cv rmse, fit rmse).
-    pub candidates: Vec<(ModelKind, Option<f64>, Option<f64>)>,
+    /// Candidate models tried by `auto`.
+    pub candidates: Vec<CandidateSummary>,
+    /// What chose the model (a REML fit only).
+    pub selection: Option<Selection>,
     /// UK elevation at each mesh vertex.
     pub uk: Vec<f64>,
     /// Kriging standard deviation at each vertex.
@@ -257,8 +259,10 @@ pub struct Model {
     pub variogram: Variogram,
     /// Experimental variogram of the samples.
     pub lags: Vec<Lag>,
-    /// Candidate models tried by `auto`, as (model, cv rmse, fit rmse).
-    pub candidates: Vec<(ModelKind, Option<f64>, Option<f64>)>,
+    /// Candidate models tried by `auto`.
+    pub candidates: Vec<CandidateSummary>,
+    /// What chose the model (a REML fit only).
+    pub selection: Option<Selection>,
 }
 
 /// Step 4a: the variogram of the samples (needed before meshing for adaptive refinement).
@@ -273,16 +277,32 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     let lags = experimental(&data, &LagSettings::default())
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
+    let mut selection = None;
     let variogram = if let Some(v) = &ip.model {
         Variogram::single(v.model, v.nugget, v.psill, v.range).context("interpolation.model")?
     } else if ip.variogram == "auto" {
-        let (fit, cands) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL)
-            .context("fitting the variogram")?;
-        candidates = cands
+        // REML filters out the drift of the UK that uses the model (constant without UK).
+        let drift = if ip.methods.contains(&InterpolationMethod::Universal) {
+            ip.drift
+        } else {
+            Drift::Constant
+        };
+        let plan = crate::fitting::FitPlan {
+            model: "auto".into(),
+            method: Some(ip.fit),
+            auto: terramesh_geostat::AutoSettings {
+                drift,
+                ..Default::default()
+            },
+        };
+        let fitted = crate::fitting::fit(&data, &lags, &plan).context("fitting the variogram")?;
+        candidates = fitted
+            .candidates
             .iter()
-            .map(|c| (c.model, c.cv_rmse, c.fit.as_ref().map(|f| f.rmse)))
+            .map(CandidateSummary::from)
             .collect();
-        fit.variogram
+        selection = fitted.selection;
+        fitted.fit.variogram
     } else {
         crate::variogram_file::read_variogram_file(&base.join(&ip.variogram))
             .context("interpolation.variogram")?
@@ -292,6 +312,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         variogram,
         lags,
         candidates,
+        selection,
     })
 }
 
@@ -302,6 +323,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     let variogram = model.variogram.clone();
     let lags = model.lags.clone();
     let candidates = model.candidates.clone();
+    let selection = model.selection;
     let drift = ip.drift;
     let uk_method = Method::Universal(drift);
     let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len())
@@ -394,6 +416,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         variogram,
         lags,
         candidates,
+        selection,
         uk,
         uk_std,
         idw,

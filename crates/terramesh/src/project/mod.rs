@@ -208,6 +208,10 @@ pub struct InterpolationSection {
     pub realisations: usize,
     /// Seed of the realisations' random streams.
     pub seed: u64,
+    /// How `variogram = "auto"` fits: `wls` (least squares, least cross-validation RMSE; the
+    /// default) or `reml` (restricted maximum likelihood with the UK drift over every model,
+    /// the model chosen by leave-one-out RMSE).
+    pub fit: terramesh_geostat::FitMethod,
 }
 
 impl Default for InterpolationSection {
@@ -223,6 +227,7 @@ impl Default for InterpolationSection {
             cv_folds: 0,
             realisations: 0,
             seed: 0,
+            fit: terramesh_geostat::FitMethod::Wls,
         }
     }
 }

@@ -1,0 +1,286 @@
+//! The automatic choice of a variogram by restricted maximum likelihood (`--variogram auto`).
+//!
+//! Each model of the family is first fitted by weighted least squares to the experimental
+//! variogram ([`fit_model`]); that fit is only the starting point of a REML fit with the
+//! drift of the kriging that will use it ([`fit_reml`](crate::fit_reml), in blocks of
+//! [`DEFAULT_REML_BLOCK`] data); Matérn is fitted for ν = 3/2 and 5/2 (ν = ½ is the
+//! exponential) and keeps the better. Among the REML fits, the model with the least
+//! leave-one-out RMSE of kriging with the drift on all the data (Dubrule's closed form for a
+//! bounded model, one factorisation; 64 neighbours for an unbounded one; above
+//! [`AutoSettings::loo_points`] data on a fixed pseudo-random subset) is chosen: each
+//! model's parameters by likelihood, the model by its prediction error. ℓ and the AIC
+//! `2k − 2ℓ` of every candidate are reported beside it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::cv::{cross_validate, Candidate, Folds, Interpolator};
+use crate::data::{Data, Drift, Method};
+use crate::error::{GeostatError, Result};
+use crate::experimental::{draw_subset, Lag};
+use crate::fit::{fit_model, Fit, Weighting};
+use crate::model::{ModelKind, Structure, Variogram};
+use crate::predictor::Neighbourhood;
+use crate::reml::{fit_contrasts, Blocks, RemlFit, DEFAULT_REML_BLOCK};
+
+/// How an automatic fit estimates a model's parameters: `reml` or `wls` (see
+/// [`Named`](crate::Named)).
+///
+/// ```
+/// use terramesh_geostat::{FitMethod, Named};
+/// assert_eq!("REML".parse::<FitMethod>(), Ok(FitMethod::Reml));
+/// assert_eq!(FitMethod::default(), FitMethod::Reml);
+/// assert_eq!(FitMethod::Wls.name(), "wls");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FitMethod {
+    /// Restricted maximum likelihood from the WLS start, chosen by AIC ([`fit_auto_reml`]).
+    #[default]
+    Reml,
+    /// Weighted least squares on the experimental variogram, chosen by leave-one-out RMSE of
+    /// ordinary kriging ([`fit_auto`](crate::fit_auto)).
+    Wls,
+}
+
+terramesh_core::named_enum!(FitMethod, "fit method", [
+    FitMethod::Reml => "reml",
+    FitMethod::Wls => "wls",
+]);
+
+/// Settings of [`fit_auto_reml`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AutoSettings {
+    /// The drift of the kriging that will use the model (constant for OK and SK).
+    pub drift: Drift,
+    /// Weights of the WLS starting fits.
+    pub weighting: Weighting,
+    /// Largest number of data in one block of the REML likelihood (default
+    /// [`DEFAULT_REML_BLOCK`]); `None`: exact REML in one block.
+    pub block: Option<usize>,
+    /// Largest number of data in the leave-one-out choice (default [`DEFAULT_LOO_POINTS`]; a
+    /// fixed pseudo-random subset above it); `None` uses all.
+    pub loo_points: Option<usize>,
+}
+
+/// Default of [`AutoSettings::loo_points`].
+pub const DEFAULT_LOO_POINTS: usize = 3000;
+
+impl Default for AutoSettings {
+    fn default() -> Self {
+        AutoSettings {
+            drift: Drift::Linear,
+            weighting: Weighting::Cressie,
+            block: Some(DEFAULT_REML_BLOCK),
+            loo_points: Some(DEFAULT_LOO_POINTS),
+        }
+    }
+}
+
+/// What chose the model of an automatic fit (the `selection` section of `variogram.json`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Selection {
+    /// `reml` (parameters by REML, the model by leave-one-out RMSE) or `wls`.
+    pub method: FitMethod,
+    /// The drift of the likelihood (REML only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drift: Option<Drift>,
+    /// Number of data in the likelihood.
+    pub points: usize,
+    /// Number of blocks of the composite likelihood (1: exact REML).
+    #[serde(default = "one")]
+    pub blocks: usize,
+    /// Number of data in the leave-one-out choice (`None` for a single model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cv_points: Option<usize>,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// Fits every model of `kinds` by REML (from its WLS fit to `lags`) and picks the one with
+/// the least leave-one-out RMSE. Returns the chosen fit (its `objective` is −ℓ), every
+/// candidate (with ℓ, AIC and the leave-one-out RMSE) and what chose it.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{experimental, fit_auto_reml, AutoSettings, Data, Duplicates, LagSettings, ModelKind};
+/// let xy: Vec<[f64; 2]> = (0..225).map(|i| [(i % 15) as f64 * 10.0, (i / 15) as f64 * 10.0]).collect();
+/// let z: Vec<f64> = xy.iter().map(|p| (p[0] / 40.0).sin() + (p[1] / 55.0).cos()).collect();
+/// let data = Data::new(xy, z, Duplicates::Reject)?;
+/// let lags = experimental(&data, &LagSettings::default())?;
+/// let kinds = [ModelKind::Spherical, ModelKind::Exponential, ModelKind::Gaussian];
+/// let (best, all, _) = fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default())?;
+/// let min = all.iter().filter_map(|c| c.cv_rmse).fold(f64::MAX, f64::min);
+/// assert!(all.iter().any(|c| c.fit.as_ref() == Some(&best) && c.cv_rmse == Some(min)));
+/// assert!(all.iter().all(|c| c.log_likelihood.is_some() && c.aic.is_some()));
+/// assert_eq!(best.variogram.structures[0].kind, ModelKind::Gaussian); // a smooth surface
+/// # Ok(()) }
+/// ```
+pub fn fit_auto_reml(
+    data: &Data,
+    lags: &[Lag],
+    kinds: &[ModelKind],
+    s: &AutoSettings,
+) -> Result<(Fit, Vec<Candidate>, Selection)> {
+    let blocks = Blocks::new(data, s.drift, s.block)?;
+    let sub = match s.loo_points {
+        Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
+        _ => data.clone(),
+    };
+    let mut cands = Vec::new();
+    let mut best: Option<(f64, Fit)> = None;
+    for &kind in kinds {
+        match fit_one(&blocks, &sub, lags, kind, s) {
+            Ok((fit, reml, cv)) => {
+                if let Some(cv) = cv {
+                    if best.as_ref().is_none_or(|b| cv < b.0) {
+                        best = Some((cv, fit.clone()));
+                    }
+                }
+                cands.push(Candidate {
+                    model: kind,
+                    fit: Some(fit),
+                    cv_rmse: cv,
+                    error: None,
+                    log_likelihood: Some(reml.log_likelihood),
+                    aic: Some(reml.aic()),
+                });
+            }
+            Err(e) => cands.push(Candidate {
+                model: kind,
+                fit: None,
+                cv_rmse: None,
+                error: Some(e.to_string()),
+                log_likelihood: None,
+                aic: None,
+            }),
+        }
+    }
+    let selection = Selection {
+        method: FitMethod::Reml,
+        drift: Some(s.drift),
+        points: blocks.n,
+        blocks: blocks.blocks(),
+        cv_points: Some(sub.len()),
+    };
+    match best {
+        Some((_, f)) => Ok((f, cands, selection)),
+        None => Err(GeostatError::Fit(format!(
+            "no model could be fitted: {}",
+            cands
+                .iter()
+                .filter_map(|c| c.error.clone())
+                .collect::<Vec<_>>()
+                .join("; ")
+        ))),
+    }
+}
+
+/// One candidate: WLS start, REML fit (best ν for Matérn), leave-one-out RMSE.
+fn fit_one(
+    c: &Blocks,
+    sub: &Data,
+    lags: &[Lag],
+    kind: ModelKind,
+    s: &AutoSettings,
+) -> Result<(Fit, RemlFit, Option<f64>)> {
+    let starts: Vec<Variogram> = match fit_model(lags, kind, s.weighting) {
+        Ok(f) if kind == ModelKind::Matern => [1.5, 2.5]
+            .iter()
+            .map(|&nu| {
+                let mut v = f.variogram.clone();
+                v.structures[0].shape = nu;
+                v
+            })
+            .collect(),
+        Ok(f) => vec![f.variogram],
+        Err(e) => {
+            // No WLS fit (e.g. too few lag classes): start from the data's variance.
+            let z = sub.z();
+            let m = sub.mean();
+            let var = z.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / z.len() as f64;
+            if !(var > 0.0) {
+                return Err(e);
+            }
+            let st = Structure::new(kind, 0.9 * var, c.hmax / 3.0);
+            vec![Variogram {
+                nugget: 0.1 * var,
+                structures: vec![st],
+                anisotropy: None,
+            }]
+        }
+    };
+    let mut best: Option<RemlFit> = None;
+    let mut last_err = None;
+    for st in &starts {
+        match fit_contrasts(c, st) {
+            Ok(r) => {
+                if best
+                    .as_ref()
+                    .is_none_or(|b| r.log_likelihood > b.log_likelihood)
+                {
+                    best = Some(r);
+                }
+            }
+            Err(e) => last_err = Some(e),
+        }
+    }
+    let Some(mut reml) = best else {
+        return Err(last_err.expect("at least one start"));
+    };
+    if starts.len() > 1 {
+        reml.parameters += 1; // ν chosen among the starts
+    }
+    let rmse = lag_rmse(lags, &reml.variogram);
+    let fit = Fit {
+        variogram: reml.variogram.clone(),
+        objective: -reml.log_likelihood,
+        rmse,
+    };
+    let cv = loo_rmse(sub, &reml.variogram, s.drift);
+    Ok((fit, reml, cv))
+}
+
+/// RMSE of a model against the experimental variogram over the classes with pairs (as
+/// [`Fit::rmse`]).
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{lag_rmse, Lag, ModelKind, Variogram};
+/// let v = Variogram::single(ModelKind::Exponential, 0.0, 1.0, 30.0)?;
+/// let lag = |h: f64, g: f64| Lag { lo: h - 5.0, hi: h + 5.0, distance: h, gamma: g, pairs: 10 };
+/// assert_eq!(lag_rmse(&[lag(10.0, v.gamma(10.0) + 0.5), lag(20.0, v.gamma(20.0) - 0.5)], &v), 0.5);
+/// # Ok(()) }
+/// ```
+pub fn lag_rmse(lags: &[Lag], v: &Variogram) -> f64 {
+    let pts: Vec<&Lag> = lags.iter().filter(|l| l.pairs > 0).collect();
+    if pts.is_empty() {
+        return 0.0;
+    }
+    (pts.iter()
+        .map(|l| (l.gamma - v.gamma(l.distance)).powi(2))
+        .sum::<f64>()
+        / pts.len() as f64)
+        .sqrt()
+}
+
+/// Leave-one-out RMSE of kriging with the drift; `None` when it cannot be computed.
+fn loo_rmse(sub: &Data, v: &Variogram, drift: Drift) -> Option<f64> {
+    let method = match drift {
+        Drift::Constant => Method::Ordinary,
+        d => Method::Universal(d),
+    };
+    let neighbours = if v.sill().is_some() {
+        Neighbourhood::All
+    } else {
+        Neighbourhood::Nearest(64.min(sub.len().saturating_sub(1)).max(1))
+    };
+    let how = Interpolator::Kriging {
+        variogram: v.clone(),
+        method,
+        neighbours,
+    };
+    cross_validate(sub, &how, Folds::LeaveOneOut)
+        .ok()
+        .map(|r| r.stats.rmse)
+}

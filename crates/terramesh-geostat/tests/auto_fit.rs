@@ -1,0 +1,135 @@
+//! Regression: on real terrain (the committed SRTM crop `fixtures/data/srtm/N48E007-r300-c1000.asc`,
+//! 111 x 131 posts of the northern Vosges' eastern edge), universal kriging with the automatic
+//! REML fit ([`fit_auto_reml`]) predicts the posts left out no worse than with the former
+//! automatic WLS fit ([`fit_auto`]). The truth is the DEM itself (no expected number is typed).
+
+use terramesh_geostat::{
+    experimental, fit_auto, fit_auto_reml, kriging, AutoSettings, Data, Drift, Duplicates,
+    LagSettings, Method, ModelKind, Named, Neighbourhood, Weighting,
+};
+
+/// The posts of the crop in local metres (equirectangular about its centre), voids left out.
+fn posts() -> Vec<[f64; 3]> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/data/srtm/N48E007-r300-c1000.asc"
+    );
+    let text = std::fs::read_to_string(path).expect("the committed crop");
+    let mut lines = text.lines();
+    let mut head = std::collections::HashMap::new();
+    for _ in 0..6 {
+        let l = lines.next().unwrap();
+        let mut it = l.split_whitespace();
+        let k = it.next().unwrap().to_ascii_lowercase();
+        head.insert(k, it.next().unwrap().parse::<f64>().unwrap());
+    }
+    let (nc, nr) = (head["ncols"] as usize, head["nrows"] as usize);
+    let (x0, y0, cs, nd) = (
+        head["xllcenter"],
+        head["yllcenter"],
+        head["cellsize"],
+        head["nodata_value"],
+    );
+    let lat0 = y0 + cs * nr as f64 / 2.0;
+    let r = 6_371_008.8f64;
+    let mut out = Vec::new();
+    for (row, l) in lines.enumerate() {
+        for (col, v) in l.split_whitespace().enumerate() {
+            let z: f64 = v.parse().unwrap();
+            if z == nd {
+                continue;
+            }
+            let lon = x0 + cs * col as f64;
+            let lat = y0 + cs * (nr - 1 - row) as f64;
+            out.push([
+                r * lat0.to_radians().cos() * (lon - x0).to_radians(),
+                r * (lat - y0).to_radians(),
+                z,
+            ]);
+        }
+    }
+    assert_eq!(
+        out.len() + 12,
+        nc * nr,
+        "12 voids in the crop (fixtures/data/README.md)"
+    );
+    out
+}
+
+fn key(i: u64) -> u64 {
+    let mut z = i.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+#[test]
+fn reml_auto_fit_predicts_held_out_posts_no_worse_than_the_wls_auto_fit() {
+    let p = posts();
+    // A jittered grid of 20 x 20 cells: one post per cell (seeded); every 5th other post is truth.
+    let (xmax, ymax) = p
+        .iter()
+        .fold((0.0f64, 0.0f64), |a, q| (a.0.max(q[0]), a.1.max(q[1])));
+    let cell = |q: &[f64; 3]| {
+        let cx = ((q[0] / xmax * 20.0) as usize).min(19);
+        let cy = ((q[1] / ymax * 20.0) as usize).min(19);
+        cy * 20 + cx
+    };
+    let mut pick = vec![None::<(u64, usize)>; 400];
+    for (i, q) in p.iter().enumerate() {
+        let k = key(i as u64);
+        let c = cell(q);
+        if pick[c].is_none_or(|(b, _)| k < b) {
+            pick[c] = Some((k, i));
+        }
+    }
+    let mut is_data = vec![false; p.len()];
+    pick.iter().flatten().for_each(|&(_, i)| is_data[i] = true);
+    let (xy, z): (Vec<[f64; 2]>, Vec<f64>) = p
+        .iter()
+        .zip(&is_data)
+        .filter(|(_, d)| **d)
+        .map(|(q, _)| ([q[0], q[1]], q[2]))
+        .unzip();
+    let truth: Vec<[f64; 3]> = p
+        .iter()
+        .zip(&is_data)
+        .enumerate()
+        .filter(|(i, (_, d))| !**d && i % 5 == 0)
+        .map(|(_, (q, _))| *q)
+        .collect();
+    let data = Data::new(xy, z, Duplicates::Reject).unwrap();
+    let lags = experimental(&data, &LagSettings::default()).unwrap();
+    let (wls, _) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL).unwrap();
+    let (reml, cands, sel) =
+        fit_auto_reml(&data, &lags, ModelKind::ALL, &AutoSettings::default()).unwrap();
+    assert_eq!((sel.points, sel.blocks), (data.len(), 1));
+    assert!(cands
+        .iter()
+        .all(|c| c.log_likelihood.is_some() || c.error.is_some()));
+    let t: Vec<[f64; 2]> = truth.iter().map(|q| [q[0], q[1]]).collect();
+    let rmse = |v| {
+        let k = kriging(
+            &data,
+            v,
+            Method::Universal(Drift::Linear),
+            Neighbourhood::All,
+            false,
+        )
+        .unwrap();
+        let mut e = vec![0.0; t.len()];
+        k.predict(&t, &mut e, None).unwrap();
+        (e.iter()
+            .zip(&truth)
+            .map(|(e, q)| (e - q[2]).powi(2))
+            .sum::<f64>()
+            / t.len() as f64)
+            .sqrt()
+    };
+    let (r_reml, r_wls) = (rmse(&reml.variogram), rmse(&wls.variogram));
+    eprintln!(
+        "held-out RMSE: REML {r_reml} ({}), WLS {r_wls} ({})",
+        reml.variogram, wls.variogram
+    );
+    assert!(r_reml <= r_wls, "REML {r_reml} > WLS {r_wls}");
+}
