@@ -93,9 +93,9 @@ pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use predictor::{kriging, Neighbourhood, Predictor};
+pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK};
 pub use simulate::{
     simulate, unconditional, Ensemble, PointSummary, SimulationSettings, DEFAULT_MODES,
 };
-pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK};
 /// The vocabulary trait of `terramesh-core`, re-exported: `ModelKind::ALL`, `.name()`, ...
 pub use terramesh_core::vocab::{Named, UnknownName};
