@@ -75,14 +75,17 @@ mod tests {
 }
 
 /// Cholesky `A = L Lᵀ` in place (row-major `n x n`, lower triangle used and overwritten).
-/// `Err(k)` at the first non-positive pivot.
+/// `Err(k)` at the first pivot that is not positive, or not above [`PIVOT_RTOL`] times its
+/// diagonal entry: a matrix singular in exact arithmetic (drift terms that are proportional,
+/// such as a constant and a coordinate of collinear data) leaves a pivot of rounding size, not
+/// exactly zero, once the coordinates are not centred on the system's own data.
 pub(crate) fn cholesky(a: &mut [f64], n: usize) -> Result<(), usize> {
     for i in 0..n {
         for j in 0..=i {
             let (ri, rj) = (i * n, j * n);
             let s = a[ri + j] - crate::band::dot(&a[ri..ri + j], &a[rj..rj + j]);
             if i == j {
-                if !(s > 0.0) {
+                if !(s > 0.0) || s <= PIVOT_RTOL * a[ri + i] {
                     return Err(i);
                 }
                 a[ri + i] = s.sqrt();
@@ -93,6 +96,10 @@ pub(crate) fn cholesky(a: &mut [f64], n: usize) -> Result<(), usize> {
     }
     Ok(())
 }
+
+/// The smallest pivot of [`cholesky`] relative to its diagonal entry (the square of a
+/// condition number of 1e6 in the factor): below it the matrix is taken as singular.
+pub(crate) const PIVOT_RTOL: f64 = 1e-12;
 
 /// Solves `L y = b` in place.
 pub(crate) fn forward(l: &[f64], n: usize, b: &mut [f64]) {
