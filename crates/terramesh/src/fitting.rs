@@ -1,5 +1,5 @@
-//! Fitting a variogram by plan: a named model or `auto`, by REML (with the drift of the
-//! kriging that will use it) or weighted least squares. One function for `terramesh
+//! Fitting a variogram by plan: a named model or `auto`, by weighted least squares (the
+//! default) or REML (with the drift of the kriging that will use it). One function for `terramesh
 //! variogram`, `interpolate --variogram auto`, `cv` and `build`.
 //!
 //! ```
@@ -9,8 +9,11 @@
 //! let z: Vec<f64> = xy.iter().map(|p| (p[0] / 35.0).sin() + p[1] / 50.0).collect();
 //! let data = Data::new(xy, z, Duplicates::Reject)?;
 //! let lags = experimental(&data, &LagSettings::default())?;
-//! let auto = fit(&data, &lags, &FitPlan::default())?; // auto, REML, linear drift
+//! let reml = FitPlan { method: Some(FitMethod::Reml), ..FitPlan::default() }; // auto, linear drift
+//! let auto = fit(&data, &lags, &reml)?;
 //! assert!(auto.selection.is_some() && auto.candidates.iter().all(|c| c.aic.is_some() || c.error.is_some()));
+//! let default = fit(&data, &lags, &FitPlan::default())?; // auto by WLS, the default
+//! assert!(default.selection.is_none() && !default.candidates.is_empty());
 //! let wls = fit(&data, &lags, &FitPlan { model: "spherical".into(), ..FitPlan::default() })?;
 //! assert!(wls.selection.is_none() && wls.candidates.is_empty()); // a named model: WLS by default
 //! let plan = FitPlan { model: "spherical".into(), method: Some(FitMethod::Reml), ..FitPlan::default() };
