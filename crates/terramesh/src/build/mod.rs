@@ -19,7 +19,7 @@ mod report;
 pub(crate) mod stages;
 pub mod staging;
 mod terrain;
-mod viewer;
+pub(crate) mod viewer;
 
 use std::path::Path;
 use std::time::Instant;

@@ -166,7 +166,7 @@ pub fn scene(
 }
 
 /// The vertices `tris` use, renumbered in order of first use.
-fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+pub(crate) fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let mut map = vec![u32::MAX; vertices.len()];
     let mut out = Vec::new();
     let t = tris

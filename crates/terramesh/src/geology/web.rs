@@ -3,6 +3,7 @@
 //! the units' closed shells (top, bottom and sides) on any planar mesh, which the report's
 //! viewer and its still 3D picture draw.
 
+use crate::build::viewer::compact;
 use std::path::Path;
 
 use serde_json::json;
@@ -45,26 +46,6 @@ pub fn unit_colour_linear(k: usize) -> [f32; 3] {
         };
         l as f32
     })
-}
-
-/// The vertices `tris` use, renumbered in order of first use.
-pub(crate) fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut map = vec![u32::MAX; vertices.len()];
-    let mut out = Vec::new();
-    let t = tris
-        .iter()
-        .map(|t| {
-            t.map(|i| {
-                let slot = &mut map[i as usize];
-                if *slot == u32::MAX {
-                    *slot = out.len() as u32;
-                    out.push(vertices[i as usize]);
-                }
-                *slot
-            })
-        })
-        .collect();
-    (out, t)
 }
 
 /// One body's unit, vertices, triangles and vertex colours.

@@ -13,7 +13,6 @@ use std::time::Instant;
 
 use terramesh_core::geometry::Region;
 use terramesh_geostat::{Data, Duplicates, InterpolationMethod, KrigingFrame, Method};
-use terramesh_io::grid_write::RasterGrid;
 use terramesh_mesh::{smooth_keeping, MeshBuilder};
 
 use super::files::{self, Vertex};
@@ -261,14 +260,7 @@ fn planned_positions(
 /// The DSM grid nodes tile `tile` owns (inside the region), as (index, position).
 fn grid_nodes(m: &Manifest, tile: &Tile) -> Vec<(u64, [f64; 2])> {
     let g = &m.grid;
-    let spec = RasterGrid {
-        xmin: g.xmin,
-        ymin: g.ymin,
-        xmax: g.xmax,
-        ymax: g.ymax,
-        nx: g.nx,
-        ny: g.ny,
-    };
+    let spec = g.raster();
     let region = Region::from_ring(m.region.clone());
     let [x0, y0, x1, y1] = tile.extent;
     let (dx, dy) = (spec.dx(), spec.dy());

@@ -141,6 +141,20 @@ pub struct GridSpec {
     pub ny: usize,
 }
 
+impl GridSpec {
+    /// The grid as the raster writers take it.
+    pub fn raster(&self) -> terramesh_io::grid_write::RasterGrid {
+        terramesh_io::grid_write::RasterGrid {
+            xmin: self.xmin,
+            ymin: self.ymin,
+            xmax: self.xmax,
+            ymax: self.ymax,
+            nx: self.nx,
+            ny: self.ny,
+        }
+    }
+}
+
 /// The whole manifest.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::Serialize;
-use terramesh_io::grid_write::{write_asc, write_geotiff, RasterGrid};
+use terramesh_io::grid_write::{write_asc, write_geotiff};
 use terramesh_io::output::Output;
 
 use super::build::tile_dir;
@@ -106,14 +106,7 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
 
     // The grids.
     let g = &m.grid;
-    let spec = RasterGrid {
-        xmin: g.xmin,
-        ymin: g.ymin,
-        xmax: g.xmax,
-        ymax: g.ymax,
-        nx: g.nx,
-        ny: g.ny,
-    };
+    let spec = g.raster();
     let mut values = vec![NODATA; g.nx * g.ny];
     for t in &m.tiles {
         for (i, z) in files::read_grid(&tile_dir(plan, &t.id))? {
