@@ -3,7 +3,6 @@
 //! the units' closed shells (top, bottom and sides) on any planar mesh, which the report's
 //! viewer and its still 3D picture draw.
 
-use crate::build::viewer::compact;
 use std::path::Path;
 
 use serde_json::json;
@@ -13,6 +12,7 @@ use terramesh_io::output::Output;
 use terramesh_io::pictures::unit_colour;
 use terramesh_io::viewer::{Geometry, Layer};
 
+use crate::build::viewer::compact;
 use crate::error::{bail, Context, Result};
 
 /// Where `model.glb` is placed and what its heights mean, for its `extras`.
