@@ -197,7 +197,11 @@ fn conforming(
         inner > cells.len() && outer > 0,
         "{inner} interior, {outer} side faces"
     );
-    assert_eq!(flat, 2 * triangles, "faces of one cell other than the sides");
+    assert_eq!(
+        flat,
+        2 * triangles,
+        "faces of one cell other than the sides"
+    );
     let units = 1 + *mat.iter().max().unwrap() as usize;
     let mut vol = vec![0.0; units];
     for (c, &m) in cells.iter().zip(mat) {

@@ -6,7 +6,7 @@ use std::path::Path;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
-use super::geometry::{clip, convex_ring, ring_and_seams};
+use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
     DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, SAMPLES, VARIOGRAM, VERSION,
 };
@@ -175,12 +175,13 @@ pub fn plan(
     if polys.len() != 1 || !polys[0].holes.is_empty() || !samples.region.projected.lines.is_empty()
     {
         return Err(Error::invalid(
-            "tiled builds take one convex polygon without holes or constraint lines for now: \
-             build this region in one piece with terramesh build",
+            "tiled builds take one polygon (convex or not) without holes or constraint lines \
+             for now: build this region in one piece with terramesh build",
         ));
     }
     let outline = polys[0].outer.clone();
-    let region = convex_ring(&outline)?;
+    let (region, convex) = ccw_ring(&outline)?;
+    let whole = terramesh_core::geometry::Region::from_ring(region.clone());
     let model = stages::model(project, &samples, base)?;
     // The variogram file every tile (and a one-piece build given it) reads.
     let vpath = out.join(VARIOGRAM);
@@ -248,7 +249,20 @@ pub fn plan(
     let mut polys = vec![Vec::new(); shape[0] * shape[1]];
     for j in 0..shape[1] {
         for i in 0..shape[0] {
-            polys[j * shape[0] + i] = clip(&region, rect(i, j), tol);
+            polys[j * shape[0] + i] = if convex {
+                clip(&region, rect(i, j), tol)
+            } else {
+                let mut parts = clip_concave(&region, rect(i, j), tol);
+                if parts.len() > 1 {
+                    return Err(Error::invalid(format!(
+                        "tile {} holds {} separate parts of the region, which tiles do not \
+                         build yet: choose another --tile-size",
+                        id(i, j),
+                        parts.len()
+                    )));
+                }
+                parts.pop().unwrap_or_default()
+            };
         }
     }
     let present = |i: isize, j: isize| {
@@ -273,7 +287,7 @@ pub fn plan(
             let (ii, jj) = (i as isize, j as isize);
             let dirs = [(-1, 0), (0, -1), (1, 0), (0, 1)];
             let inner = dirs.map(|(di, dj)| present(ii + di, jj + dj));
-            let (ring, sides) = ring_and_seams(poly, r, inner, spacing);
+            let (ring, sides) = ring_and_seams(poly, r, inner, spacing, &|p| whole.contains(p));
             let seams: Vec<Seam> = sides
                 .into_iter()
                 .map(|(s, vertices)| {
