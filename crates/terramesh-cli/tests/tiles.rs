@@ -245,7 +245,7 @@ fn watertight(out: &Path, p: &Path) -> usize {
         edges.values().all(|&c| c <= 2),
         "an edge in three triangles"
     );
-    let m = manifest(&p);
+    let m = manifest(p);
     let region: Vec<[f64; 2]> = m["region"].as_array().unwrap().iter().map(point).collect();
     let whole: f64 = (0..region.len())
         .map(|i| {
