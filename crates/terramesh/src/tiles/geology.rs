@@ -48,7 +48,19 @@ pub const INTERFACES: &str = "interfaces.bin";
 /// The tile's model figures.
 pub const MODEL_JSON: &str = "model.json";
 
-/// How an interface is estimated in every tile.
+/// How an interface is estimated in every tile, as `tiles.json` records it.
+///
+/// ```
+/// use terramesh::tiles::Estimate;
+/// let e: Estimate = serde_json::from_str(
+///     r#"{"kind": "kriged", "variogram": "geology/1-variogram.json",
+///         "frame": [[303247.7, 3933730.3], 28062.7], "universal": true}"#,
+/// )?;
+/// assert!(matches!(e, Estimate::Kriged { universal: true, .. }));
+/// let c = serde_json::to_string(&Estimate::Constant { value: -120.0 })?;
+/// assert_eq!(c, r#"{"kind":"constant","value":-120.0}"#);
+/// # Ok::<(), serde_json::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Estimate {
