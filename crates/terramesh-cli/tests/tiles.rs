@@ -219,6 +219,17 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
     );
 
     // The merged mesh: conforming, watertight, every seam vertex once, the region's area.
+    let seam = watertight(&out, &p);
+    assert!(seam > 100);
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("<svg") && report.contains(bad));
+    independent_check(&out, &p);
+}
+
+/// The merged `dsm.vtu` of `out` against the plan `p`: no edge in three triangles, boundary
+/// edges only on the region's outline, the region's area to 1e-9, every vertex once, every
+/// planned seam vertex present, the counts of `merge.json`; returns the seam vertices.
+fn watertight(out: &Path, p: &Path) -> usize {
     let (points, tris) = vtu(&out.join("dsm.vtu"));
     let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
     let mut area = 0.0;
@@ -234,7 +245,7 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
         edges.values().all(|&c| c <= 2),
         "an edge in three triangles"
     );
-    let m = manifest(&p);
+    let m = manifest(p);
     let region: Vec<[f64; 2]> = m["region"].as_array().unwrap().iter().map(point).collect();
     let whole: f64 = (0..region.len())
         .map(|i| {
@@ -273,7 +284,6 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
         .flat_map(|s| s["vertices"].as_array().unwrap().clone())
         .map(|v| bits(point(&v)))
         .collect();
-    assert!(seam.len() > 100);
     assert!(
         seam.iter().all(|k| count.contains_key(k)),
         "a seam vertex lost"
@@ -285,9 +295,7 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
         seam.len()
     );
     assert_eq!(merged["vertices"].as_u64().unwrap() as usize, points.len());
-    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
-    assert!(report.contains("<svg") && report.contains(bad));
-    independent_check(&out, &p);
+    seam.len()
 }
 
 /// Runs the independent reader `tests/verify/check_tiles.py` (meshio) on the merged `dsm.vtu`.
@@ -438,4 +446,121 @@ fn slurm_script_runs_its_tasks_by_hand() {
         .unwrap();
     ok(&o);
     assert!(out.join("dsm.tif").exists() && out.join("dsm.vtu").exists());
+}
+
+/// An L-shaped region (a WKT polygon inside Haut-Barr's corners): tiles clipped by it, seams only
+/// where the region goes on, tiles outside it dropped; the merged mesh is watertight on the
+/// L's outline with its area, and the grid equals the one-piece build's.
+#[test]
+fn a_concave_region_is_tiled_without_seams_outside_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = example().parent().unwrap().canonicalize().unwrap();
+    let wkt = tmp.path().join("l.wkt");
+    std::fs::write(
+        &wkt,
+        "POLYGON ((7.3368 48.7224, 7.3404 48.7224, 7.3404 48.7240, 7.3385 48.7240, \
+         7.3385 48.7260, 7.3368 48.7260, 7.3368 48.7224))",
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(example()).unwrap();
+    let mut toml = String::new();
+    for line in text.lines() {
+        let l = if line.starts_with("corners =") {
+            format!("file = {:?}", wkt.display().to_string())
+        } else if line.starts_with("path =") {
+            format!(
+                "path = {:?}",
+                dir.join("../../../shared/data/srtm").display().to_string()
+            )
+        } else if line.starts_with("fallback =") {
+            format!(
+                "fallback = {:?}",
+                dir.join("srtm-crop.asc").display().to_string()
+            )
+        } else {
+            line.to_string()
+        };
+        toml.push_str(&l);
+        toml.push('\n');
+    }
+    let project = tmp.path().join("l.toml");
+    std::fs::write(&project, toml).unwrap();
+    let p = tmp.path().join("plan");
+    let (ps, pr) = (p.to_str().unwrap(), project.to_str().unwrap());
+    ok(&terramesh(
+        &[
+            "tiles",
+            "plan",
+            pr,
+            "--tile-size",
+            "60m",
+            "-o",
+            ps,
+            "--quiet",
+        ],
+        &[],
+    ));
+    let m = manifest(&p);
+    let [nx, ny] = [0, 1].map(|k| m["shape"][k].as_u64().unwrap() as usize);
+    let all = ids(&p);
+    assert!(
+        all.len() >= 12 && all.len() < nx * ny,
+        "{} of {nx} x {ny} tiles kept",
+        all.len()
+    );
+    for id in &all {
+        ok(&terramesh(&["tiles", "build", ps, "--tile", id], &[]));
+    }
+    let out = tmp.path().join("merged");
+    ok(&terramesh(
+        &["tiles", "merge", ps, "-o", out.to_str().unwrap()],
+        &[],
+    ));
+    let region: Vec<[f64; 2]> = m["region"].as_array().unwrap().iter().map(point).collect();
+    let concave = (0..region.len()).any(|i| {
+        let [a, b, c] = [0, 1, 2].map(|k| region[(i + k) % region.len()]);
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) < 0.0
+    }) && (0..region.len()).any(|i| {
+        let [a, b, c] = [0, 1, 2].map(|k| region[(i + k) % region.len()]);
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0.0
+    });
+    assert!(concave, "the region is not concave: {region:?}");
+    assert!(watertight(&out, &p) > 50);
+    independent_check(&out, &p);
+
+    let one = tmp.path().join("one");
+    let vario = format!(
+        "interpolation.variogram={}",
+        p.join("variogram.json").display()
+    );
+    ok(&terramesh(
+        &[
+            "build",
+            pr,
+            "-o",
+            one.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            &vario,
+            "--set",
+            "export.formats=[\"vtu\"]",
+            "--set",
+            "export.pictures=false",
+            "--set",
+            "export.report=false",
+        ],
+        &[],
+    ));
+    let (a, b) = (asc(&out.join("dsm.asc")), asc(&one.join("dsm.asc")));
+    assert_eq!(a.len(), b.len());
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(worst <= 1e-9, "grids differ by {worst} m");
+    assert!(
+        a.iter().filter(|v| **v == -9999.0).count() > 100,
+        "no node outside the L"
+    );
 }

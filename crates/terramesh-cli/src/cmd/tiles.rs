@@ -148,8 +148,14 @@ pub fn run(args: Args) -> Result<()> {
         }
         Sub::Merge(a) => {
             let m = tiles::merge(&a.plan, &a.output).map_err(crate::project_error)?;
+            let model = m.model.as_ref().map_or(String::new(), |g| {
+                format!(
+                    ", a geological model of {} cells and {} nodes",
+                    g.cells, g.nodes
+                )
+            });
             crate::say(&format!(
-                "merged into {}: {} vertices, {} triangles, {} seam vertices in {:.2} s\n",
+                "merged into {}: {} vertices, {} triangles, {} seam vertices{model} in {:.2} s\n",
                 a.output.display(),
                 m.vertices,
                 m.triangles,

@@ -137,6 +137,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         smooth_keeping(&mut mesh, project.mesh.smoother, m.mesh.smooth, &[]);
     }
     let positions = planned_positions(&mesh, &tile.ring, &tile.id)?;
+    let (positions, triangles) = sorted(positions, &mesh.triangles);
     seconds.push(("mesh".to_string(), t.elapsed().as_secs_f64()));
 
     // Elevations at the vertices and at the grid nodes the tile owns.
@@ -169,6 +170,18 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     }
     seconds.push(("interpolation".to_string(), t.elapsed().as_secs_f64()));
 
+    // The geological model on the tile's planar mesh, under its DSM.
+    let t = Instant::now();
+    let model = match &m.geology {
+        Some(gp) => Some(super::geology::build_model(
+            plan, gp, &project, tile, &positions, &triangles, &dsm,
+        )?),
+        None => None,
+    };
+    if model.is_some() {
+        seconds.push(("geology".to_string(), t.elapsed().as_secs_f64()));
+    }
+
     // The tile's folder, atomically.
     let t = Instant::now();
     let dir = tile_dir(plan, &tile.id);
@@ -186,7 +199,10 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         })
         .collect();
     files::write_vertices(&folder.path().join(files::VERTICES), &vertices)?;
-    files::write_triangles(&folder.path().join(files::TRIANGLES), &mesh.triangles)?;
+    files::write_triangles(&folder.path().join(files::TRIANGLES), &triangles)?;
+    if let Some(model) = &model {
+        super::geology::write_model(folder.path(), model, &positions, &triangles, &nodes)?;
+    }
     let grid: Vec<(u64, f64)> = nodes.iter().map(|n| n.0).zip(values).collect();
     files::write_grid(&folder.path().join(files::GRID), &grid)?;
     seconds.push(("write".to_string(), t.elapsed().as_secs_f64()));
@@ -194,10 +210,11 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     let summary = TileSummary {
         samples,
         vertices: vertices.len(),
-        triangles: mesh.triangles.len(),
+        triangles: triangles.len(),
         grid_nodes: grid.len(),
         seconds,
         peak_rss: files::peak_rss(),
+        cells: model.as_ref().map_or(0, |m| m.cells.len()),
     };
     let json = serde_json::to_string_pretty(&summary)?;
     std::fs::write(folder.path().join(files::SUMMARY), json)?;
@@ -255,6 +272,27 @@ fn planned_positions(
         )));
     }
     Ok(out)
+}
+
+/// The vertices sorted by position (x, then y) and the triangles renumbered: two tiles then
+/// number their shared seam vertices in the same relative order, so that the geological model's
+/// rule on node numbers (`element = "tetra"`, and the cut of quadrilateral faces) cuts a seam's
+/// faces the same way on both sides.
+fn sorted(positions: Vec<[f64; 2]>, triangles: &[[u32; 3]]) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+    let mut order: Vec<usize> = (0..positions.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (p, q) = (positions[a], positions[b]);
+        p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1]))
+    });
+    let mut new = vec![0u32; positions.len()];
+    for (k, &i) in order.iter().enumerate() {
+        new[i] = k as u32;
+    }
+    let tris = triangles
+        .iter()
+        .map(|t| t.map(|i| new[i as usize]))
+        .collect();
+    (order.iter().map(|&i| positions[i]).collect(), tris)
 }
 
 /// The DSM grid nodes tile `tile` owns (inside the region), as (index, position).

@@ -42,6 +42,27 @@ fn put(w: &mut impl Write, v: &[f64]) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Appends `v` to `buf`, little-endian.
+pub(crate) fn put_f64(buf: &mut Vec<u8>, v: &[f64]) {
+    for x in v {
+        buf.extend_from_slice(&x.to_le_bytes());
+    }
+}
+
+/// Reads a file of little-endian `f64`s, `record` of them a record.
+pub(crate) fn read_f64s(path: &Path, record: usize) -> Result<Vec<f64>> {
+    let b = read_all(path, 8 * record.max(1))?;
+    Ok((0..b.len() / 8).map(|i| f64_at(&b, i)).collect())
+}
+
+/// Reads a file of little-endian `u32`s, `record` of them a record.
+pub(crate) fn read_u32s(path: &Path, record: usize) -> Result<Vec<u32>> {
+    let b = read_all(path, 4 * record.max(1))?;
+    Ok((0..b.len() / 4)
+        .map(|i| u32::from_le_bytes(b[4 * i..4 * i + 4].try_into().expect("4 bytes")))
+        .collect())
+}
+
 /// Writes the vertex file.
 pub(crate) fn write_vertices(path: &Path, v: &[Vertex]) -> Result<()> {
     let mut w = BufWriter::new(std::fs::File::create(path).context(path.display().to_string())?);

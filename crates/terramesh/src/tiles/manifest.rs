@@ -76,6 +76,11 @@ pub struct Tile {
     /// What its build made and how long it took, when done.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub built: Option<TileSummary>,
+    /// The geological model's halo (metres): the farthest of the nearest `neighbours`
+    /// observations of any kriged interface from any point of the extent, computed like
+    /// [`Tile::halo`]; absent without `[geology]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geology_halo: Option<f64>,
 }
 
 /// What a tile's build made.
@@ -93,6 +98,9 @@ pub struct TileSummary {
     pub seconds: Vec<(String, f64)>,
     /// Peak resident memory of the process that built it, bytes (Linux; 0 elsewhere).
     pub peak_rss: u64,
+    /// Cells of its geological model (0 without `[geology]`).
+    #[serde(default)]
+    pub cells: usize,
 }
 
 /// The mesh settings every tile uses.
@@ -186,6 +194,9 @@ pub struct Manifest {
     pub grid: GridSpec,
     /// EPSG code of the coordinates, when known.
     pub epsg: Option<u32>,
+    /// The geological model's plan, when the project has `[geology]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geology: Option<super::geology::GeologyPlan>,
     /// The tiles.
     pub tiles: Vec<Tile>,
 }

@@ -39,12 +39,15 @@ pub struct Merged {
     pub seam_max_difference: f64,
     /// The merged mesh's planar area, m².
     pub area: f64,
+    /// The geological model, when the plan has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<super::model_merge::MergedModel>,
     /// Seconds the merge took.
     pub seconds: f64,
 }
 
 /// The nodata value of the grids.
-const NODATA: f64 = -9999.0;
+pub(super) const NODATA: f64 = -9999.0;
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
@@ -127,6 +130,14 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         written.push(path);
     }
     drop(values);
+    let model = match &m.geology {
+        Some(gp) => {
+            let (model, files) = super::model_merge::merge_model(plan, &m, gp, out)?;
+            written.extend(files);
+            Some(model)
+        }
+        None => None,
+    };
 
     let merged = Merged {
         files: written,
@@ -135,6 +146,7 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         seam_vertices: seams.len(),
         seam_max_difference: diff,
         area,
+        model,
         seconds: t0.elapsed().as_secs_f64(),
     };
     let json = out.join("merge.json");
@@ -205,7 +217,7 @@ fn min_angle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
 /// What a pass over the tiles does with one tile: its vertices, their global indices and
 /// whether this tile writes them, and its triangles.
 type TilePass<'a> =
-    dyn FnMut(&mut Output, &[Vertex], &[(u32, bool)], &[[u32; 3]]) -> std::io::Result<()> + 'a;
+    dyn FnMut(&mut Output, &Path, &[Vertex], &[(u32, bool)], &[[u32; 3]]) -> Result<()> + 'a;
 
 /// A point array of `dsm.vtu`: its name and value.
 type PointArray = (&'static str, fn(&Vertex) -> f64);
@@ -236,7 +248,7 @@ fn write_vtu(
             let v = files::read_vertices(&dir)?;
             let map = mapped(k, t, &v, seams, &mut next);
             let tris = files::read_triangles(&dir)?;
-            f(w, &v, &map, &tris).map_err(io)?;
+            f(w, &dir, &v, &map, &tris)?;
         }
         Ok(())
     };
@@ -253,7 +265,7 @@ fn write_vtu(
             "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
         )
         .map_err(io)?;
-        pass(w, &mut |w, v, map, _| {
+        pass(w, &mut |w, _, v, map, _| {
             for (p, &(_, mine)) in v.iter().zip(map) {
                 if mine {
                     writeln!(w, "{:?}", get(p))?;
@@ -263,13 +275,39 @@ fn write_vtu(
         })?;
         writeln!(w, "</DataArray>").map_err(io)?;
     }
+    // The geological model's surfaces at the planar vertices: the tops below the first unit
+    // and the base.
+    if let Some(gp) = &m.geology {
+        let ns = gp.units.len() + 1;
+        for s in 1..ns {
+            let name = match gp.units.get(s) {
+                Some(u) => format!("top_{u}"),
+                None => "base".to_string(),
+            };
+            writeln!(
+                w,
+                "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
+            )
+            .map_err(io)?;
+            pass(w, &mut |w, dir, _, map, _| {
+                let surf = super::files::read_f64s(&dir.join(super::geology::SURFACES), ns)?;
+                for (k, &(_, mine)) in map.iter().enumerate() {
+                    if mine {
+                        writeln!(w, "{:?}", surf[k * ns + s]).map_err(io)?;
+                    }
+                }
+                Ok(())
+            })?;
+            writeln!(w, "</DataArray>").map_err(io)?;
+        }
+    }
     writeln!(w, "</PointData>\n<CellData>").map_err(io)?;
     writeln!(
         w,
         "<DataArray type=\"Float64\" Name=\"min_angle_deg\" format=\"ascii\">"
     )
     .map_err(io)?;
-    pass(w, &mut |w, v, _, tris| {
+    pass(w, &mut |w, _, v, _, tris| {
         for t in tris {
             let [a, b, c] = t.map(|i| v[i as usize].xy);
             writeln!(w, "{:?}", min_angle(a, b, c))?;
@@ -282,7 +320,7 @@ fn write_vtu(
         "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
     )
     .map_err(io)?;
-    pass(w, &mut |w, v, map, _| {
+    pass(w, &mut |w, _, v, map, _| {
         for (p, &(_, mine)) in v.iter().zip(map) {
             if mine {
                 writeln!(w, "{:?} {:?} {:?}", p.xy[0], p.xy[1], p.dsm)?;
@@ -296,7 +334,7 @@ fn write_vtu(
         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     )
     .map_err(io)?;
-    pass(w, &mut |w, _, map, tris| {
+    pass(w, &mut |w, _, _, map, tris| {
         for t in tris {
             let [a, b, c] = t.map(|i| map[i as usize].0);
             writeln!(w, "{a} {b} {c}")?;

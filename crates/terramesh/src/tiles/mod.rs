@@ -6,7 +6,8 @@
 //!   writes the manifest `PLAN/tiles.json` ([`Manifest`]).
 //! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
 //!   its state under a lock, so many processes may build at once.
-//! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc` and a report.
+//! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc` and a report, and,
+//!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.
 //!
 //! Seams: each tile's mesh keeps its planned boundary vertices and adds none on it
@@ -34,19 +35,26 @@
 
 mod build;
 mod files;
+mod geology;
 mod geometry;
 mod manifest;
 mod merge;
+mod model_merge;
 mod plan;
 mod report;
 mod slurm;
 
 pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
+pub use geology::{
+    Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON,
+    MODEL_POINTS, SURFACES,
+};
 pub use manifest::{
     update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileSummary, LOCK,
     MANIFEST, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
+pub use model_merge::{MergedModel, MergedUnit};
 pub use plan::{parse_tile_size, plan, Planned};
 pub use slurm::{write_slurm, SlurmOptions, SlurmScripts};

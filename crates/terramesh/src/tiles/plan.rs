@@ -6,7 +6,7 @@ use std::path::Path;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
-use super::geometry::{clip, convex_ring, ring_and_seams};
+use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
     DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, SAMPLES, VARIOGRAM, VERSION,
 };
@@ -79,6 +79,37 @@ pub(crate) fn owner(m: &Manifest, q: [f64; 2]) -> [usize; 2] {
     ]
 }
 
+/// The halo of the extent `r`: the distance from any of its points to its `k`-th nearest point
+/// of `tree` is at most this. `R(q)` (the distance from `q` to its `k`-th nearest) is measured
+/// at probes on a lattice of spacing at most `h`; for any point `p` of the extent
+/// `R(p) <= R(q) + |p - q| <= max R + step/√2` (the triangle inequality), so every point any
+/// point of the extent uses lies within it, equal-distance ties included.
+pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f64) -> f64 {
+    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
+    let n = [
+        ((r[2] - r[0]) / h).ceil() as usize + 1,
+        ((r[3] - r[1]) / h).ceil() as usize + 1,
+    ];
+    let mut reach: f64 = 0.0;
+    for b in 0..n[1] {
+        for a in 0..n[0] {
+            let q = [
+                r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
+                r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
+            ];
+            let near = tree
+                .query(&q)
+                .nearest_n::<SquaredEuclidean<f64>>(kk)
+                .execute();
+            if let Some(last) = near.last() {
+                reach = reach.max(last.distance.sqrt());
+            }
+        }
+    }
+    let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
+    (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
+}
+
 /// Refuses what tiles cannot reproduce, with the key to change.
 fn check_tileable(p: &Project) -> Result<()> {
     let ip = &p.interpolation;
@@ -106,12 +137,6 @@ fn check_tileable(p: &Project) -> Result<()> {
         return refuse(
             "mesh.insert_samples is not supported by tiled builds (a sample on a seam would \
              be a vertex the neighbour lacks): set it to false or build in one piece",
-        );
-    }
-    if p.geology().is_some() {
-        return refuse(
-            "tiled builds do not make the [geology] model yet: build it with terramesh build \
-             or terramesh model",
         );
     }
     Ok(())
@@ -150,12 +175,13 @@ pub fn plan(
     if polys.len() != 1 || !polys[0].holes.is_empty() || !samples.region.projected.lines.is_empty()
     {
         return Err(Error::invalid(
-            "tiled builds take one convex polygon without holes or constraint lines for now: \
-             build this region in one piece with terramesh build",
+            "tiled builds take one polygon (convex or not) without holes or constraint lines \
+             for now: build this region in one piece with terramesh build",
         ));
     }
     let outline = polys[0].outer.clone();
-    let region = convex_ring(&outline)?;
+    let (region, convex) = ccw_ring(&outline)?;
+    let whole = terramesh_core::geometry::Region::from_ring(region.clone());
     let model = stages::model(project, &samples, base)?;
     // The variogram file every tile (and a one-piece build given it) reads.
     let vpath = out.join(VARIOGRAM);
@@ -223,7 +249,20 @@ pub fn plan(
     let mut polys = vec![Vec::new(); shape[0] * shape[1]];
     for j in 0..shape[1] {
         for i in 0..shape[0] {
-            polys[j * shape[0] + i] = clip(&region, rect(i, j), tol);
+            polys[j * shape[0] + i] = if convex {
+                clip(&region, rect(i, j), tol)
+            } else {
+                let mut parts = clip_concave(&region, rect(i, j), tol);
+                if parts.len() > 1 {
+                    return Err(Error::invalid(format!(
+                        "tile {} holds {} separate parts of the region, which tiles do not \
+                         build yet: choose another --tile-size",
+                        id(i, j),
+                        parts.len()
+                    )));
+                }
+                parts.pop().unwrap_or_default()
+            };
         }
     }
     let present = |i: isize, j: isize| {
@@ -236,7 +275,6 @@ pub fn plan(
     let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(data.xy())
         .map_err(|e| Error::invalid(format!("search tree of the samples: {e:?}")))?;
     let h = samples.cell[0].min(samples.cell[1]).min(tile_size / 4.0);
-    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
     let mut tiles = Vec::new();
     let mut max_halo: f64 = 0.0;
     for j in 0..shape[1] {
@@ -249,7 +287,7 @@ pub fn plan(
             let (ii, jj) = (i as isize, j as isize);
             let dirs = [(-1, 0), (0, -1), (1, 0), (0, 1)];
             let inner = dirs.map(|(di, dj)| present(ii + di, jj + dj));
-            let (ring, sides) = ring_and_seams(poly, r, inner, spacing);
+            let (ring, sides) = ring_and_seams(poly, r, inner, spacing, &|p| whole.contains(p));
             let seams: Vec<Seam> = sides
                 .into_iter()
                 .map(|(s, vertices)| {
@@ -262,28 +300,7 @@ pub fn plan(
                 .collect();
             let neighbours = seams.iter().map(|s| s.neighbour.clone()).collect();
             // The halo: the farthest k-th neighbour over probes, plus the probes' reach.
-            let n = [
-                ((r[2] - r[0]) / h).ceil() as usize + 1,
-                ((r[3] - r[1]) / h).ceil() as usize + 1,
-            ];
-            let mut reach: f64 = 0.0;
-            for b in 0..n[1] {
-                for a in 0..n[0] {
-                    let q = [
-                        r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
-                        r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
-                    ];
-                    let near = tree
-                        .query(&q)
-                        .nearest_n::<SquaredEuclidean<f64>>(kk)
-                        .execute();
-                    if let Some(last) = near.last() {
-                        reach = reach.max(last.distance.sqrt());
-                    }
-                }
-            }
-            let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
-            let halo = (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6;
+            let halo = reach(&tree, k, r, h);
             max_halo = max_halo.max(halo);
             tiles.push(Tile {
                 id: id(i, j),
@@ -296,9 +313,18 @@ pub fn plan(
                 state: State::Planned,
                 error: None,
                 built: None,
+                geology_halo: None,
             });
         }
     }
+    let rects: Vec<[f64; 4]> = tiles.iter().map(|t| t.extent).collect();
+    let geology = super::geology::plan_geology(project, &samples, data.z(), out, &rects, h)?;
+    let geology = geology.map(|(g, halos)| {
+        for (t, halo) in tiles.iter_mut().zip(halos) {
+            t.geology_halo = Some(halo);
+        }
+        g
+    });
     let manifest = Manifest {
         version: VERSION,
         project: std::path::absolute(project_file).context(project_file.display().to_string())?,
@@ -333,6 +359,7 @@ pub fn plan(
             ny: spec.ny,
         },
         epsg: samples.epsg(),
+        geology,
         tiles,
     };
     manifest.write(out)?;

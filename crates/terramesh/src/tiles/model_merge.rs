@@ -1,0 +1,467 @@
+//! The tiles' geological models joined, streamed: `model.vtu` (ASCII VTK: the nodes, the
+//! cells in VTK's orders as `terramesh model` writes them, `MaterialIDs`, field data
+//! `unit_names`), `interfaces/<unit>.tif` and `model.json` (per unit: volume, cells,
+//! thickness, pinched-out area, summed or taken over the distinct planar vertices).
+//!
+//! A seam vertex's node column is written once, by the first tile that has it; the other
+//! tile's cells name the same nodes. Both tiles computed the column from the same surfaces (the
+//! merge measures the largest difference, `seam_max_difference`, and refuses columns that do
+//! not have the same nodes), so the merged mesh is conforming across the seams. The boundary
+//! meshes, the sealed bodies (`unit-*.ts`, `.stl`), `model.msh`, `model.f3grid` and the glTF
+//! model need the whole model's faces at once and are not made by the merge.
+
+use std::collections::{HashMap, HashSet};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use terramesh_core::volume::{cell_volume, Cell, CellKind};
+use terramesh_io::grid_write::write_geotiff;
+use terramesh_io::output::Output;
+
+use super::build::tile_dir;
+use super::files::{read_f64s, read_u32s, read_vertices};
+use super::geology::{
+    GeologyPlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON, MODEL_POINTS, SURFACES,
+};
+use super::manifest::{Manifest, Tile};
+use crate::error::{Context, Error, Result};
+
+/// One unit of the merged model.
+#[derive(Debug, Clone, Serialize)]
+pub struct MergedUnit {
+    /// Its name.
+    pub name: String,
+    /// Its `MaterialIDs` value (0 = the top unit).
+    pub material_id: usize,
+    /// Volume of its cells in the merged mesh, m³.
+    pub volume: f64,
+    /// The sum of the tiles' volumes of the unit, m³.
+    pub sum_of_tiles: f64,
+    /// Cells.
+    pub cells: usize,
+    /// Thickness over the distinct planar vertices, m.
+    pub min_thickness: f64,
+    /// Mean thickness over the distinct planar vertices, m.
+    pub mean_thickness: f64,
+    /// Largest thickness, m.
+    pub max_thickness: f64,
+    /// Planar area where it has zero thickness (the tiles' sum), m².
+    pub pinched_out_area: f64,
+}
+
+/// What the merge made of the geological models.
+#[derive(Debug, Clone, Serialize)]
+pub struct MergedModel {
+    /// Nodes of `model.vtu`.
+    pub nodes: usize,
+    /// Cells.
+    pub cells: usize,
+    /// Nodes on the seams' columns (each written once).
+    pub seam_nodes: usize,
+    /// The largest difference between two tiles' surfaces (terrain, tops, base) at one seam
+    /// vertex, metres (0: both sides computed the same values).
+    pub seam_max_difference: f64,
+    /// Per unit.
+    pub units: Vec<MergedUnit>,
+    /// The volume between the terrain and the base (the tiles' sum), m³.
+    pub volume_between_terrain_and_base: f64,
+    /// The base elevation every tile used, metres.
+    pub base: f64,
+}
+
+/// A seam vertex's column: its first global node, how many nodes, the tile that writes it,
+/// and its surfaces.
+struct Column {
+    first: u32,
+    count: u32,
+    owner: usize,
+    z: Vec<u64>,
+    surfaces: Vec<f64>,
+}
+
+/// One tile's model as the merge reads it.
+struct TileModel {
+    points: Vec<f64>,
+    cells: Vec<u32>,
+}
+
+fn read_model(plan: &Path, t: &Tile) -> Result<TileModel> {
+    let dir = tile_dir(plan, &t.id);
+    Ok(TileModel {
+        points: read_f64s(&dir.join(MODEL_POINTS), 3)?,
+        cells: read_u32s(&dir.join(MODEL_CELLS), 8)?,
+    })
+}
+
+fn key(x: f64, y: f64) -> (u64, u64) {
+    (x.to_bits(), y.to_bits())
+}
+
+/// The columns of a tile's nodes: `(key, first local node, count)`, in node order.
+fn columns(points: &[f64]) -> Vec<((u64, u64), usize, usize)> {
+    let mut out: Vec<((u64, u64), usize, usize)> = Vec::new();
+    for i in 0..points.len() / 3 {
+        let k = key(points[3 * i], points[3 * i + 1]);
+        match out.last_mut() {
+            Some(c) if c.0 == k => c.2 += 1,
+            _ => out.push((k, i, 1)),
+        }
+    }
+    out
+}
+
+/// The global node of every local node of tile `k`, and whether this tile writes it.
+fn node_map(
+    k: usize,
+    points: &[f64],
+    seams: &HashMap<(u64, u64), Column>,
+    next: &mut u32,
+) -> Vec<(u32, bool)> {
+    let mut map = Vec::with_capacity(points.len() / 3);
+    for (key, _, count) in columns(points) {
+        match seams.get(&key) {
+            Some(c) if c.owner != k => map.extend((0..count as u32).map(|j| (c.first + j, false))),
+            _ => {
+                map.extend((0..count as u32).map(|j| (*next + j, true)));
+                *next += count as u32;
+            }
+        }
+    }
+    map
+}
+
+fn cell_of(rec: &[u32]) -> (Cell, i32) {
+    let kind = match rec[0] {
+        0 => CellKind::Tetra,
+        1 => CellKind::Pyramid,
+        _ => CellKind::Wedge,
+    };
+    let mut nodes = [0u32; 6];
+    nodes.copy_from_slice(&rec[2..8]);
+    (Cell { kind, nodes }, rec[1] as i32)
+}
+
+/// The VTK type and node order of a cell (as `terramesh_io::model::write_model_vtu`).
+fn vtk(c: &Cell) -> (u8, Vec<u32>) {
+    let n = c.nodes;
+    match c.kind {
+        CellKind::Tetra => (10, n[..4].to_vec()),
+        CellKind::Pyramid => (14, n[..5].to_vec()),
+        CellKind::Wedge => (13, vec![n[0], n[2], n[1], n[3], n[5], n[4]]),
+    }
+}
+
+/// Merges the tiles' models of `plan` into `out`; the files written and the figures.
+pub(crate) fn merge_model(
+    plan: &Path,
+    m: &Manifest,
+    gp: &GeologyPlan,
+    out: &Path,
+) -> Result<(MergedModel, Vec<PathBuf>)> {
+    let units = gp.units.len();
+    let ns = units + 1;
+    let mut seams: HashMap<(u64, u64), Column> = HashMap::new();
+    let (mut n, mut nc, mut diff) = (0u32, 0usize, 0.0f64);
+    let mut volume = vec![0.0; units];
+    let mut cells = vec![0usize; units];
+    let mut sum_tiles = vec![0.0; units];
+    let mut pinched = vec![0.0; units];
+    let mut between = 0.0;
+    let mut thick = vec![(f64::INFINITY, 0.0f64, f64::NEG_INFINITY); units];
+    let mut vertices = 0usize;
+    for (k, t) in m.tiles.iter().enumerate() {
+        let dir = tile_dir(plan, &t.id);
+        let on: HashSet<(u64, u64)> = t
+            .seams
+            .iter()
+            .flat_map(|s| s.vertices.iter().map(|p| key(p[0], p[1])))
+            .collect();
+        let v = read_vertices(&dir)?;
+        let surf = read_f64s(&dir.join(SURFACES), ns)?;
+        let tm = read_model(plan, t)?;
+        if surf.len() != v.len() * ns {
+            return Err(Error::invalid(format!(
+                "{}: {} surfaces for {} vertices: build tile {} again",
+                dir.join(SURFACES).display(),
+                surf.len() / ns,
+                v.len(),
+                t.id
+            )));
+        }
+        let mut at: HashMap<(u64, u64), usize> = HashMap::new();
+        for (i, p) in v.iter().enumerate() {
+            at.insert(key(p.xy[0], p.xy[1]), i);
+        }
+        let mut counted = vec![true; v.len()];
+        for (ck, first, count) in columns(&tm.points) {
+            let z: Vec<u64> = (first..first + count)
+                .map(|i| tm.points[3 * i + 2].to_bits())
+                .collect();
+            let vi = *at.get(&ck).ok_or_else(|| {
+                Error::invalid(format!(
+                    "tile {}: a model node column at no planar vertex: build it again",
+                    t.id
+                ))
+            })?;
+            let s = surf[vi * ns..(vi + 1) * ns].to_vec();
+            if !on.contains(&ck) {
+                n += count as u32;
+                continue;
+            }
+            match seams.get(&ck) {
+                Some(c) => {
+                    counted[vi] = false;
+                    for (a, b) in c.surfaces.iter().zip(&s) {
+                        diff = diff.max((a - b).abs());
+                    }
+                    if c.z != z {
+                        return Err(Error::invalid(format!(
+                            "tiles {} and {}: the node columns at ({}, {}) differ ({} and {} \
+                             nodes): the seam would not be conforming; build both again",
+                            m.tiles[c.owner].id,
+                            t.id,
+                            f64::from_bits(ck.0),
+                            f64::from_bits(ck.1),
+                            c.count,
+                            count
+                        )));
+                    }
+                }
+                None => {
+                    seams.insert(
+                        ck,
+                        Column {
+                            first: n,
+                            count: count as u32,
+                            owner: k,
+                            z,
+                            surfaces: s,
+                        },
+                    );
+                    n += count as u32;
+                }
+            }
+        }
+        for (vi, _) in counted.iter().enumerate().filter(|c| *c.1) {
+            vertices += 1;
+            for (u, th) in thick.iter_mut().enumerate() {
+                let d = surf[vi * ns + u] - surf[vi * ns + u + 1];
+                *th = (th.0.min(d), th.1 + d, th.2.max(d));
+            }
+        }
+        let pts: Vec<[f64; 3]> = tm
+            .points
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
+        for rec in tm.cells.chunks_exact(8) {
+            let (c, mat) = cell_of(rec);
+            let u = usize::try_from(mat)
+                .ok()
+                .filter(|&u| u < units)
+                .ok_or_else(|| Error::invalid(format!("tile {}: a cell of unit {mat}", t.id)))?;
+            volume[u] += cell_volume(&pts, &c);
+            cells[u] += 1;
+            nc += 1;
+        }
+        let path = dir.join(MODEL_JSON);
+        let text = std::fs::read_to_string(&path).context(path.display().to_string())?;
+        let f: TileFigures = serde_json::from_str(&text).context(path.display().to_string())?;
+        for u in 0..units.min(f.volumes.len()) {
+            sum_tiles[u] += f.volumes[u];
+            pinched[u] += f.pinched_area.get(u).copied().unwrap_or(0.0);
+        }
+        between += f.volume_between;
+    }
+    let mut written = Vec::new();
+    let path = out.join("model.vtu");
+    write_vtu(&path, plan, m, gp, &seams, n as usize, nc)?;
+    written.push(path);
+    written.extend(write_interfaces(plan, m, gp, out)?);
+    let merged = MergedModel {
+        nodes: n as usize,
+        cells: nc,
+        seam_nodes: seams.values().map(|c| c.count as usize).sum(),
+        seam_max_difference: diff,
+        units: (0..units)
+            .map(|u| MergedUnit {
+                name: gp.units[u].clone(),
+                material_id: u,
+                volume: volume[u],
+                sum_of_tiles: sum_tiles[u],
+                cells: cells[u],
+                min_thickness: thick[u].0,
+                mean_thickness: thick[u].1 / vertices.max(1) as f64,
+                max_thickness: thick[u].2,
+                pinched_out_area: pinched[u],
+            })
+            .collect(),
+        volume_between_terrain_and_base: between,
+        base: gp.base,
+    };
+    let path = out.join("model.json");
+    let text = serde_json::to_string_pretty(&merged)?;
+    terramesh_io::output::write_atomic(&path, text.as_bytes())
+        .context(path.display().to_string())?;
+    written.push(path);
+    Ok((merged, written))
+}
+
+/// `interfaces/<unit>.tif`: the top of every unit (the terrain first) on the DSM grid, one
+/// unit at a time.
+fn write_interfaces(
+    plan: &Path,
+    m: &Manifest,
+    gp: &GeologyPlan,
+    out: &Path,
+) -> Result<Vec<PathBuf>> {
+    let units = gp.units.len();
+    let g = &m.grid;
+    let spec = g.raster();
+    let dir = out.join("interfaces");
+    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
+    let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
+    let mut written = Vec::new();
+    for (u, name) in gp.units.iter().enumerate() {
+        let mut values = vec![super::merge::NODATA; g.nx * g.ny];
+        for t in &m.tiles {
+            let rec = read_f64s(&tile_dir(plan, &t.id).join(INTERFACES), units + 1)?;
+            for r in rec.chunks_exact(units + 1) {
+                let i = r[0].to_bits() as usize;
+                if i < values.len() && r[1 + u].is_finite() {
+                    values[i] = r[1 + u];
+                }
+            }
+        }
+        let path = dir.join(format!("{name}.tif"));
+        let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
+        write_geotiff(&mut o, &spec, &values, epsg, Some(super::merge::NODATA))
+            .and_then(|_| o.commit())
+            .context(path.display().to_string())?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Writes `model.vtu`, one pass over the tiles per array.
+fn write_vtu(
+    path: &Path,
+    plan: &Path,
+    m: &Manifest,
+    gp: &GeologyPlan,
+    seams: &HashMap<(u64, u64), Column>,
+    n: usize,
+    nc: usize,
+) -> Result<()> {
+    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
+    let io = |e: std::io::Error| Error::from(e);
+    let mut names = Vec::new();
+    for u in &gp.units {
+        names.extend_from_slice(u.as_bytes());
+        names.push(0u8);
+    }
+    let crs = m
+        .epsg
+        .map_or("projected".to_string(), |e| format!("EPSG:{e}"));
+    {
+        let w = &mut o;
+        writeln!(w, "<?xml version=\"1.0\"?>").map_err(io)?;
+        writeln!(
+            w,
+            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<FieldData>"
+        )
+        .map_err(io)?;
+        for (name, bytes) in [("unit_names", names), ("crs", crs.into_bytes())] {
+            let text: Vec<String> = bytes.iter().map(|b| b.to_string()).collect();
+            writeln!(
+                w,
+                "<DataArray type=\"UInt8\" Name=\"{name}\" NumberOfTuples=\"{}\" format=\"ascii\">\n{}\n</DataArray>",
+                bytes.len(),
+                text.join(" ")
+            )
+            .map_err(io)?;
+        }
+        writeln!(
+            w,
+            "</FieldData>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{nc}\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+        )
+        .map_err(io)?;
+    }
+    type CellPass<'a> =
+        dyn FnMut(&mut Output, &TileModel, &[(u32, bool)]) -> std::io::Result<()> + 'a;
+    let pass = |w: &mut Output, f: &mut CellPass| -> Result<()> {
+        let mut next = 0u32;
+        for (k, t) in m.tiles.iter().enumerate() {
+            let tm = read_model(plan, t)?;
+            let map = node_map(k, &tm.points, seams, &mut next);
+            f(w, &tm, &map).map_err(io)?;
+        }
+        Ok(())
+    };
+    pass(&mut o, &mut |w, tm, map| {
+        for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(map) {
+            if mine {
+                writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+            }
+        }
+        Ok(())
+    })?;
+    writeln!(
+        o,
+        "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+    )
+    .map_err(io)?;
+    pass(&mut o, &mut |w, tm, map| {
+        for rec in tm.cells.chunks_exact(8) {
+            let (_, nodes) = vtk(&cell_of(rec).0);
+            let g: Vec<String> = nodes
+                .iter()
+                .map(|&i| map[i as usize].0.to_string())
+                .collect();
+            writeln!(w, "{}", g.join(" "))?;
+        }
+        Ok(())
+    })?;
+    writeln!(
+        o,
+        "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+    )
+    .map_err(io)?;
+    let mut offset = 0usize;
+    pass(&mut o, &mut |w, tm, _| {
+        for rec in tm.cells.chunks_exact(8) {
+            offset += cell_of(rec).0.kind.nodes();
+            writeln!(w, "{offset}")?;
+        }
+        Ok(())
+    })?;
+    writeln!(
+        o,
+        "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+    )
+    .map_err(io)?;
+    pass(&mut o, &mut |w, tm, _| {
+        for rec in tm.cells.chunks_exact(8) {
+            writeln!(w, "{}", vtk(&cell_of(rec).0).0)?;
+        }
+        Ok(())
+    })?;
+    writeln!(
+        o,
+        "</DataArray>\n</Cells>\n<CellData>\n<DataArray type=\"Int32\" Name=\"MaterialIDs\" format=\"ascii\">"
+    )
+    .map_err(io)?;
+    pass(&mut o, &mut |w, tm, _| {
+        for rec in tm.cells.chunks_exact(8) {
+            writeln!(w, "{}", rec[1] as i32)?;
+        }
+        Ok(())
+    })?;
+    writeln!(
+        o,
+        "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>"
+    )
+    .map_err(io)?;
+    o.commit().context(path.display().to_string())
+}
