@@ -207,7 +207,9 @@ fn text_field(name: &'static str, bytes: Vec<u8>) -> Array {
 /// Writes the volume mesh as `model.vtu`: Float64 points, the cells (VTK orders, see the module
 /// documentation), cell data `MaterialIDs` (Int32, 0 = the top unit), and field data
 /// `unit_names` (UInt8: the unit names top to bottom, each followed by a zero byte, so that
-/// name `k` is MaterialID `k`) and `crs` (UInt8: [`ModelInfo::crs`] as UTF-8).
+/// name `k` is MaterialID `k`), `crs` (UInt8: [`ModelInfo::crs`] as UTF-8), and, when given,
+/// `vertical_datum` ([`ModelInfo::vertical_datum`]) and `vertical_crs` (`EPSG:<code>`,
+/// [`ModelInfo::vertical_epsg`]), text the same way.
 ///
 /// ```
 /// # fn main() -> std::io::Result<()> {
@@ -221,9 +223,11 @@ fn text_field(name: &'static str, bytes: Vec<u8>) -> Array {
 ///     ..Default::default()
 /// };
 /// let mut buf = Vec::new();
-/// write_model_vtu(&mut buf, &m, &ModelInfo { crs: "EPSG:32632".into() })?;
+/// let info = ModelInfo { crs: "EPSG:32632".into(), vertical_datum: "egm96".into(), vertical_epsg: Some(5773) };
+/// write_model_vtu(&mut buf, &m, &info)?;
 /// let text = String::from_utf8_lossy(&buf);
 /// assert!(text.contains("Name=\"MaterialIDs\"") && text.contains("encoding=\"base64\""));
+/// assert!(text.contains("Name=\"vertical_crs\""));
 /// # Ok(()) }
 /// ```
 pub fn write_model_vtu<W: Write + ?Sized>(
@@ -251,10 +255,7 @@ pub fn write_model_vtu<W: Write + ?Sized>(
     Grid {
         points: m.points.len(),
         cells: m.cells.len(),
-        field: vec![
-            text_field("unit_names", names),
-            text_field("crs", info.crs.as_bytes().to_vec()),
-        ],
+        field: model_fields(names, info),
         point_data: vec![],
         cell_data: vec![array(
             "Int32",
@@ -266,6 +267,24 @@ pub fn write_model_vtu<W: Write + ?Sized>(
         cell_arrays: cell_arrays(vtk_nodes.iter().map(|(n, t, k)| (*t, &n[..*k]))),
     }
     .write(w)
+}
+
+/// The field data of `model.vtu`: the unit names, the CRS and the vertical datum.
+fn model_fields(names: Vec<u8>, info: &ModelInfo) -> Vec<Array> {
+    let mut field = vec![
+        text_field("unit_names", names),
+        text_field("crs", info.crs.as_bytes().to_vec()),
+    ];
+    if !info.vertical_datum.is_empty() {
+        field.push(text_field(
+            "vertical_datum",
+            info.vertical_datum.as_bytes().to_vec(),
+        ));
+    }
+    if let Some(c) = info.vertical_epsg {
+        field.push(text_field("vertical_crs", format!("EPSG:{c}").into_bytes()));
+    }
+    field
 }
 
 /// Writes a boundary mesh ([`super::boundary_mesh`]) as an OpenGeoSys boundary `.vtu`:
