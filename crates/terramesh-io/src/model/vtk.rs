@@ -73,21 +73,18 @@ struct Grid {
 
 impl Grid {
     fn write<W: Write + ?Sized>(self, w: &mut W) -> io::Result<()> {
-        let encoded: Vec<Vec<u8>> = self
+        // Each array is appended as the base64 of its UInt64 byte count and its bytes, encoded
+        // in chunks straight into `w` (no encoded copy of the arrays in memory); its length in
+        // characters is known beforehand.
+        let arrays: Vec<&Array> = self
             .field
             .iter()
             .chain(&self.point_data)
             .chain(&self.cell_data)
             .chain([&self.pts])
             .chain(&self.cell_arrays)
-            .map(|a| {
-                let mut block = Vec::with_capacity(8 + a.bytes.len());
-                block.extend_from_slice(&(a.bytes.len() as u64).to_le_bytes());
-                block.extend_from_slice(&a.bytes);
-                base64(&block)
-            })
             .collect();
-        let mut lengths = encoded.iter().map(|e| e.len());
+        let mut lengths = arrays.iter().map(|a| (8 + a.bytes.len()).div_ceil(3) * 4);
         let mut offset = 0usize;
         let mut header = |w: &mut W, a: &Array| -> io::Result<()> {
             write!(w, "<DataArray type=\"{}\" Name=\"{}\"", a.vtk_type, a.name)?;
@@ -98,7 +95,7 @@ impl Grid {
                 write!(w, " NumberOfTuples=\"{n}\"")?;
             }
             writeln!(w, " format=\"appended\" offset=\"{offset}\"/>")?;
-            offset += lengths.next().expect("one encoding per array");
+            offset += lengths.next().expect("one length per array");
             Ok(())
         };
         writeln!(w, "<?xml version=\"1.0\"?>")?;
@@ -139,17 +136,40 @@ impl Grid {
         }
         writeln!(w, "</Cells>\n</Piece>\n</UnstructuredGrid>")?;
         write!(w, "<AppendedData encoding=\"base64\">\n_")?;
-        for e in &encoded {
-            w.write_all(e)?;
+        let mut buf = Vec::with_capacity(CHUNK / 3 * 4 + 8);
+        for a in arrays {
+            // the 8-byte count and the first byte make 9 bytes: then whole groups of three
+            let mut head = (a.bytes.len() as u64).to_le_bytes().to_vec();
+            let take = a.bytes.len().min(1);
+            head.extend_from_slice(&a.bytes[..take]);
+            buf.clear();
+            base64_into(&head, &mut buf);
+            w.write_all(&buf)?;
+            for chunk in a.bytes[take..].chunks(CHUNK) {
+                buf.clear();
+                base64_into(chunk, &mut buf);
+                w.write_all(&buf)?;
+            }
         }
         writeln!(w, "\n</AppendedData>\n</VTKFile>")
     }
 }
 
+/// Bytes encoded at a time when appending (a multiple of 3, so that only the last chunk of an
+/// array is padded).
+const CHUNK: usize = 3 << 14;
+
 /// Standard base64 (RFC 4648, with padding).
+#[cfg(test)]
 fn base64(bytes: &[u8]) -> Vec<u8> {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = Vec::with_capacity(bytes.len().div_ceil(3) * 4);
+    base64_into(bytes, &mut out);
+    out
+}
+
+/// Appends the standard base64 (RFC 4648, with padding) of `bytes` to `out`.
+fn base64_into(bytes: &[u8], out: &mut Vec<u8>) {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut chunks = bytes.chunks_exact(3);
     for c in &mut chunks {
         let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
@@ -172,7 +192,6 @@ fn base64(bytes: &[u8]) -> Vec<u8> {
         });
         out.push(b'=');
     }
-    out
 }
 
 /// Connectivity, offsets and types of cells given as node lists with their VTK type.
@@ -344,6 +363,30 @@ mod tests {
                 super::base64(&bytes),
                 crate::report::base64(&bytes).into_bytes()
             );
+        }
+    }
+
+    #[test]
+    fn appended_arrays_are_the_base64_of_count_and_bytes_whatever_their_size() {
+        for n in [0usize, 1, 2, 3, 4, super::CHUNK - 1, super::CHUNK + 1, 2 * super::CHUNK + 2] {
+            let bytes: Vec<u8> = (0..n).map(|i| (i * 31 % 251) as u8).collect();
+            let grid = super::Grid {
+                points: 0,
+                cells: 0,
+                field: vec![],
+                point_data: vec![],
+                cell_data: vec![],
+                pts: super::array("UInt8", "Points", 1, bytes.clone()),
+                cell_arrays: vec![],
+            };
+            let mut out = Vec::new();
+            grid.write(&mut out).unwrap();
+            let text = String::from_utf8(out).unwrap();
+            let start = text.find("\n_").unwrap() + 2;
+            let end = text.find("\n</AppendedData>").unwrap();
+            let mut whole = (n as u64).to_le_bytes().to_vec();
+            whole.extend_from_slice(&bytes);
+            assert_eq!(text[start..end].as_bytes(), &super::base64(&whole)[..], "n = {n}");
         }
     }
 }
