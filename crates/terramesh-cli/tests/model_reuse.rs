@@ -73,7 +73,11 @@ fn the_dsm_is_reused_only_when_what_made_it_is_unchanged() {
     // A setting of the DSM, or another terrain file: built again.
     let other = model(&project, &out, &["mesh.max_area=300"]);
     assert!(!reused(&other), "{}", log(&other));
-    assert!(log(&other).contains("other settings or inputs"), "{}", log(&other));
+    assert!(
+        log(&other).contains("other settings or inputs"),
+        "{}",
+        log(&other)
+    );
     let heights = tmp.path().join("heights.csv");
     let text = std::fs::read_to_string(&heights).unwrap();
     model(&project, &out, &[]);

@@ -12,8 +12,8 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
-use super::{vertical_note, write_shortest};
 use super::ModelInfo;
+use super::{vertical_note, write_shortest};
 
 fn gmsh_type(kind: CellKind) -> u8 {
     match kind {

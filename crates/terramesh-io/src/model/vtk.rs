@@ -368,7 +368,16 @@ mod tests {
 
     #[test]
     fn appended_arrays_are_the_base64_of_count_and_bytes_whatever_their_size() {
-        for n in [0usize, 1, 2, 3, 4, super::CHUNK - 1, super::CHUNK + 1, 2 * super::CHUNK + 2] {
+        for n in [
+            0usize,
+            1,
+            2,
+            3,
+            4,
+            super::CHUNK - 1,
+            super::CHUNK + 1,
+            2 * super::CHUNK + 2,
+        ] {
             let bytes: Vec<u8> = (0..n).map(|i| (i * 31 % 251) as u8).collect();
             let grid = super::Grid {
                 points: 0,
@@ -386,7 +395,11 @@ mod tests {
             let end = text.find("\n</AppendedData>").unwrap();
             let mut whole = (n as u64).to_le_bytes().to_vec();
             whole.extend_from_slice(&bytes);
-            assert_eq!(text[start..end].as_bytes(), &super::base64(&whole)[..], "n = {n}");
+            assert_eq!(
+                &text.as_bytes()[start..end],
+                &super::base64(&whole)[..],
+                "n = {n}"
+            );
         }
     }
 }

@@ -42,7 +42,8 @@ fn dsm_field_data(p: &Project, s: &Samples) -> Vec<(&'static str, String)> {
     let mut f = vec![
         (
             "crs",
-            s.epsg().map_or_else(|| s.crs_name(), |c| format!("EPSG:{c}")),
+            s.epsg()
+                .map_or_else(|| s.crs_name(), |c| format!("EPSG:{c}")),
         ),
         ("vertical_datum", d.name()),
     ];

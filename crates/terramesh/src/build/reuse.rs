@@ -157,7 +157,10 @@ impl DsmState {
             b.extend_from_slice(&v.to_le_bytes());
         }
         put_u64(&mut b, self.collars.len() as u64);
-        self.collars.iter().flatten().for_each(|&v| put_f64(&mut b, v));
+        self.collars
+            .iter()
+            .flatten()
+            .for_each(|&v| put_f64(&mut b, v));
         self.dsm.iter().for_each(|&v| put_f64(&mut b, v));
         let g = &self.grid;
         for v in [g.xmin, g.ymin, g.xmax, g.ymax] {
@@ -248,8 +251,8 @@ impl DsmState {
     /// Writes [`FILE`] into `dir`, atomically.
     pub fn write(&self, dir: &Path) -> Result<()> {
         let path = dir.join(FILE);
-        let mut o =
-            Output::create(Some(&path)).with_context(|| format!("cannot write {}", path.display()))?;
+        let mut o = Output::create(Some(&path))
+            .with_context(|| format!("cannot write {}", path.display()))?;
         o.write_all(&self.to_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
         o.commit()
@@ -281,13 +284,16 @@ impl<'a> Reader<'a> {
         self.take(1).map(|s| s[0])
     }
     fn u32(&mut self) -> Option<u32> {
-        self.take(4).map(|s| u32::from_le_bytes(s.try_into().unwrap()))
+        self.take(4)
+            .map(|s| u32::from_le_bytes(s.try_into().unwrap()))
     }
     fn u64(&mut self) -> Option<u64> {
-        self.take(8).map(|s| u64::from_le_bytes(s.try_into().unwrap()))
+        self.take(8)
+            .map(|s| u64::from_le_bytes(s.try_into().unwrap()))
     }
     fn f64(&mut self) -> Option<f64> {
-        self.take(8).map(|s| f64::from_le_bytes(s.try_into().unwrap()))
+        self.take(8)
+            .map(|s| f64::from_le_bytes(s.try_into().unwrap()))
     }
     /// A count of items of `size` bytes each, refused when more than the bytes left hold.
     fn count(&mut self, size: usize) -> Option<usize> {
@@ -356,9 +362,15 @@ mod tests {
         let k0 = key(&parse(&[]), dir.path()).unwrap();
         assert_eq!(k0, key(&parse(&[]), dir.path()).unwrap());
         assert_ne!(k0, key(&parse(&["mesh.min_angle=20"]), dir.path()).unwrap());
-        assert_ne!(k0, key(&parse(&["export.grid_spacing=5"]), dir.path()).unwrap());
+        assert_ne!(
+            k0,
+            key(&parse(&["export.grid_spacing=5"]), dir.path()).unwrap()
+        );
         // export formats and pictures do not change the DSM
-        assert_eq!(k0, key(&parse(&["export.pictures=false"]), dir.path()).unwrap());
+        assert_eq!(
+            k0,
+            key(&parse(&["export.pictures=false"]), dir.path()).unwrap()
+        );
         // the bytes of a local source
         let dem = dir.path().join("dem.asc");
         std::fs::write(&dem, "a").unwrap();
