@@ -3,7 +3,9 @@
     python tests/verify/check_model.py MODEL_DIR [--only NAME]
 
 MODEL_DIR holds model.vtu, the boundary meshes model-top.vtu, model-bottom.vtu and
-model-side-*.vtu, model.msh, model.f3grid and unit-<name>.ts / .stl. Prints `PASS name` or
+model-side-*.vtu, model.msh, model.f3grid and unit-<name>.ts / .stl; in a build folder also
+model.json, interfaces/<unit>.tif and possibly dsm.vtu and dsm.tif, whose vertical datum is
+checked against model.vtu's. Prints `PASS name` or
 `FAIL name: why` per check, then `N passed, M failed`; exits 1 if any failed. The reference is
 model.vtu as meshio reads it; every other file is compared with it. See docs/geology.md.
 """
@@ -21,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from check_datum import check_vertical_datum
 from vcommon import REL_DOUBLE, CheckFailed, close, meshio_read, require
 
 HERE = Path(__file__).resolve().parent
@@ -75,6 +78,8 @@ class Model:
             names = bytes(np.asarray(fd["unit_names"], dtype=np.uint8)).decode().split("\0")
             require(names[-1] == "", "model.vtu: unit_names does not end with a zero byte")
             crs = bytes(np.asarray(fd["crs"], dtype=np.uint8)).decode()
+            self.field_data = {k: bytes(np.asarray(v, dtype=np.uint8)).decode() for k, v in fd.items()
+                               if k != "unit_names"}
             self._vtu = (m.points, blocks, [np.asarray(a).ravel() for a in mats], names[:-1], crs)
         return self._vtu
 
@@ -570,6 +575,7 @@ def check_ogs_heat(model):
 
 CHECKS = [
     ("model.vtu: cells, faces, closed boundary", check_vtu_cells),
+    ("vertical datum: model.vtu, model.json, dsm.vtu, grids", check_vertical_datum),
     ("model.vtu: VTK reader, vtkCellValidator", check_vtu_vtk),
     ("model.vtu: OpenGeoSys checkMesh", check_vtu_ogs),
     ("boundary meshes vs ExtractBoundary", check_boundary_meshes),

@@ -210,3 +210,54 @@ def test_inverted_wedge_fails_ogs_heat(out, capsys):
     rewrite_vtu(out / "model.vtu", invert_first("wedge"))
     f = failures(out, "ogs: heat conduction per MaterialIDs", capsys)
     assert f, f
+
+
+DATUM = "vertical datum: model.vtu, model.json, dsm.vtu, grids"
+
+
+def write_grid(path, crs):
+    """A 2 x 2 float64 GeoTIFF in `crs` (rasterio, so GDAL writes its GeoKeys)."""
+    import rasterio
+    from rasterio.transform import from_origin
+    path.parent.mkdir(exist_ok=True)
+    with rasterio.open(path, "w", driver="GTiff", width=2, height=2, count=1, dtype="float64",
+                       crs=crs, transform=from_origin(500000, 5400000, 10, 10)) as dst:
+        dst.write(np.ones((1, 2, 2)))
+
+
+def test_fixture_names_its_datum():
+    m = cm.Model(FIXTURE)
+    m.vtu()
+    import check_datum
+    assert check_datum.vertical_of(m.field_data, "fixture") == ("navd88", 5703)
+
+
+def test_model_json_with_another_datum_fails(out, capsys):
+    (out / "model.json").write_text('{"vertical_datum": "egm96", "vertical_crs": "EPSG:5773"}')
+    f = failures(out, DATUM, capsys)
+    assert f and "model.json" in f[0], f
+    (out / "model.json").write_text('{"vertical_datum": "navd88", "vertical_crs": "EPSG:5703"}')
+    assert not failures(out, DATUM, capsys)
+
+
+def test_grid_without_or_with_another_vertical_crs_fails(out, capsys):
+    write_grid(out / "interfaces" / "a.tif", "EPSG:32632+5703")
+    assert not failures(out, DATUM, capsys)
+    for crs in ["EPSG:32632", "EPSG:32632+5773"]:
+        write_grid(out / "interfaces" / "a.tif", crs)
+        f = failures(out, DATUM, capsys)
+        assert f and "a.tif" in f[0] and "vertical CRS" in f[0], (crs, f)
+    write_grid(out / "interfaces" / "a.tif", "EPSG:32633+5703")
+    f = failures(out, DATUM, capsys)
+    assert f and "horizontal CRS" in f[0], f
+
+
+def test_vertical_crs_that_is_not_vertical_fails(out, capsys):
+    vtu = out / "model.vtu"
+    # the field data is base64 in the appended block: rewrite_vtu puts it back as text
+    rewrite_vtu(vtu, lambda m: None)
+    text = " ".join(str(b) for b in b"EPSG:5703")
+    edit(vtu, f'Name="vertical_crs" NumberOfTuples="9" format="ascii">{text}<',
+         f'Name="vertical_crs" NumberOfTuples="9" format="ascii">{" ".join(str(b) for b in b"EPSG:4326")}<')
+    f = failures(out, DATUM, capsys)
+    assert f and "not a vertical CRS" in f[0], f

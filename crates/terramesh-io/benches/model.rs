@@ -15,6 +15,8 @@ fn bench(c: &mut Criterion) {
     let mesh = layered::layered(444, 267, false);
     let info = ModelInfo {
         crs: "EPSG:32632".into(),
+        vertical_datum: "egm96".into(),
+        vertical_epsg: Some(5773),
     };
     eprintln!(
         "model: {} points, {} cells, {} tagged faces",

@@ -137,10 +137,50 @@ pub fn write_geotiff<W: Write>(
     epsg: Option<u16>,
     nodata: Option<f64>,
 ) -> io::Result<()> {
+    write_geotiff_heights(w, g, values, epsg, None, nodata)
+}
+
+/// The heights of a grid: their unit is metres, and `Some(code)` names the EPSG vertical CRS
+/// they refer to (5773: EGM96 height; 5703: NAVD88 height).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Heights {
+    /// The vertical CRS, when known.
+    pub vertical_epsg: Option<u16>,
+}
+
+/// [`write_geotiff`] of a grid of heights in metres: the GeoKeys also say
+/// `VerticalUnitsGeoKey = 9001` (metre) and, when `heights` names one,
+/// `VerticalCSTypeGeoKey` = its EPSG vertical CRS (GDAL then reports a compound CRS, with
+/// `GTIFF_REPORT_COMPD_CS=YES`). `heights = None` writes [`write_geotiff`]'s keys.
+///
+/// ```
+/// use terramesh_io::grid_write::{write_geotiff_heights, Heights, RasterGrid};
+/// let g: RasterGrid = "0,0,10,10,2,2".parse().unwrap();
+/// let mut b = Vec::new();
+/// let h = Heights { vertical_epsg: Some(5773) };
+/// write_geotiff_heights(&mut b, &g, &[1.0, 2.0, 3.0, 4.0], Some(32632), Some(h), None).unwrap();
+/// assert_eq!(&b[..4], b"II*\0");
+/// ```
+pub fn write_geotiff_heights<W: Write>(
+    w: &mut W,
+    g: &RasterGrid,
+    values: &[f64],
+    epsg: Option<u16>,
+    heights: Option<Heights>,
+    nodata: Option<f64>,
+) -> io::Result<()> {
     assert_eq!(values.len(), g.nx * g.ny);
+    // GeoKeys in increasing key order: GTModelType, GTRasterType, ProjectedCSType,
+    // VerticalCSType, VerticalUnits.
     let mut keys: Vec<u16> = vec![1, 1, 0, 0, 1024, 0, 1, 1, 1025, 0, 1, 2];
     if let Some(e) = epsg {
         keys.extend_from_slice(&[3072, 0, 1, e]);
+    }
+    if let Some(h) = heights {
+        if let Some(v) = h.vertical_epsg {
+            keys.extend_from_slice(&[4096, 0, 1, v]);
+        }
+        keys.extend_from_slice(&[4099, 0, 1, 9001]);
     }
     keys[3] = (keys.len() / 4 - 1) as u16;
     // (tag, type, count, payload bytes); type 3 SHORT, 4 LONG, 12 DOUBLE
@@ -260,5 +300,36 @@ mod tests {
         let x = f64::from_le_bytes(b[to + 24..to + 32].try_into().unwrap());
         let y = f64::from_le_bytes(b[to + 32..to + 40].try_into().unwrap());
         assert_eq!((x, y), (500000.0, 5400200.0));
+    }
+
+    #[test]
+    fn geotiff_heights_end_with_the_vertical_keys() {
+        let g: RasterGrid = "0,0,30,20,4,3".parse().unwrap();
+        let vals = vec![1.0; 12];
+        for (v, want) in [
+            (
+                Some(5703),
+                vec![3072, 0, 1, 26915, 4096, 0, 1, 5703, 4099, 0, 1, 9001],
+            ),
+            (
+                None,
+                vec![1025, 0, 1, 2, 3072, 0, 1, 26915, 4099, 0, 1, 9001],
+            ),
+        ] {
+            let mut b = Vec::new();
+            let h = Heights { vertical_epsg: v };
+            write_geotiff_heights(&mut b, &g, &vals, Some(26915), Some(h), None).unwrap();
+            let ifd = u32_at(&b, 4) as usize;
+            let n = u16_at(&b, ifd) as usize;
+            let e = (0..n)
+                .map(|k| ifd + 2 + 12 * k)
+                .find(|&e| u16_at(&b, e) == 34735)
+                .unwrap();
+            let count = u32_at(&b, e + 4) as usize;
+            let ko = u32_at(&b, e + 8) as usize;
+            let keys: Vec<u16> = (0..count).map(|i| u16_at(&b, ko + 2 * i)).collect();
+            assert_eq!(keys[3] as usize, count / 4 - 1, "{keys:?}");
+            assert_eq!(keys[count - 12..], want[..], "{keys:?}");
+        }
     }
 }

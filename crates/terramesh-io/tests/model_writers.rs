@@ -27,7 +27,11 @@ fn root() -> PathBuf {
 }
 
 fn info() -> ModelInfo {
-    ModelInfo { crs: CRS.into() }
+    ModelInfo {
+        crs: CRS.into(),
+        vertical_datum: "navd88".into(),
+        vertical_epsg: Some(5703),
+    }
 }
 
 #[test]

@@ -159,6 +159,9 @@ pub struct MeshView<'a> {
     pub point_data: Vec<(&'a str, &'a [f64])>,
     /// Named per-triangle scalar fields (written by VTU), e.g. a quality measure.
     pub cell_data: Vec<(&'a str, &'a [f64])>,
+    /// Named text written as VTU field data (`<FieldData>`: a UInt8 array of the UTF-8 bytes
+    /// each, as in `model.vtu`), e.g. the CRS and the vertical datum.
+    pub field_data: Vec<(&'a str, String)>,
 }
 
 impl<'a> MeshView<'a> {
@@ -171,6 +174,7 @@ impl<'a> MeshView<'a> {
             triangles,
             point_data: Vec::new(),
             cell_data: Vec::new(),
+            field_data: Vec::new(),
         }
     }
 

@@ -1,5 +1,6 @@
 //! VTK XML unstructured grid (`.vtu`), ASCII, Float64 points (float32 would lose about
-//! 0.1 m at UTM northings).
+//! 0.1 m at UTM northings); [`super::MeshView::field_data`] as UInt8 text arrays in
+//! `<FieldData>`.
 
 use std::io::{self, Write};
 
@@ -23,6 +24,19 @@ impl MeshWriter for Vtu {
             "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
         )?;
         writeln!(out, "<UnstructuredGrid>")?;
+        if !m.field_data.is_empty() {
+            writeln!(out, "<FieldData>")?;
+            for (name, text) in &m.field_data {
+                writeln!(
+                    out,
+                    "<DataArray type=\"UInt8\" Name=\"{name}\" NumberOfTuples=\"{}\" format=\"ascii\">",
+                    text.len()
+                )?;
+                let bytes: Vec<String> = text.bytes().map(|b| b.to_string()).collect();
+                writeln!(out, "{}\n</DataArray>", bytes.join(" "))?;
+            }
+            writeln!(out, "</FieldData>")?;
+        }
         writeln!(
             out,
             "<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nt}\">"

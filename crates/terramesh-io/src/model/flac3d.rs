@@ -57,7 +57,12 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
     info: &ModelInfo,
 ) -> io::Result<()> {
     writeln!(w, "* FLAC3D grid of a terramesh geological model")?;
-    writeln!(w, "* CRS: {}", info.crs.replace('\n', " "))?;
+    writeln!(
+        w,
+        "* CRS: {}{}",
+        info.crs.replace('\n', " "),
+        super::vertical_note(info)
+    )?;
     writeln!(w, "* GRIDPOINTS")?;
     let mut b = itoa::Buffer::new();
     for (i, p) in m.points.iter().enumerate() {

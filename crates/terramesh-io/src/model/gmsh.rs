@@ -12,8 +12,8 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
-use super::write_shortest;
 use super::ModelInfo;
+use super::{vertical_note, write_shortest};
 
 fn gmsh_type(kind: CellKind) -> u8 {
     match kind {
@@ -107,8 +107,9 @@ pub fn write_model_msh<W: Write + ?Sized>(
     writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
     writeln!(
         w,
-        "$Comments\nterramesh geological model, CRS {}\n$EndComments",
-        info.crs
+        "$Comments\nterramesh geological model, CRS {}{}\n$EndComments",
+        info.crs,
+        vertical_note(info)
     )?;
     writeln!(w, "$PhysicalNames\n{}", units.len() + tags.len())?;
     for &u in &units {

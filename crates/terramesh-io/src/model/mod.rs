@@ -3,7 +3,7 @@
 //!
 //! | file | module | what |
 //! |---|---|---|
-//! | `model.vtu` | [`write_model_vtu`] | VTK XML unstructured grid, appended base64 binary: Float64 points, int32 `MaterialIDs`, field data `unit_names` and `crs`; an OpenGeoSys bulk mesh |
+//! | `model.vtu` | [`write_model_vtu`] | VTK XML unstructured grid, appended base64 binary: Float64 points, int32 `MaterialIDs`, field data `unit_names`, `crs`, `vertical_datum` (and `vertical_crs` when named); an OpenGeoSys bulk mesh |
 //! | `model-top.vtu`, `model-bottom.vtu`, `model-side-<name>.vtu` | [`write_boundary_vtu`] | OpenGeoSys boundary meshes (`bulk_node_ids`, `bulk_element_ids`, `bulk_face_ids`, as its `ExtractBoundary` writes them) |
 //! | `model.msh` | [`write_model_msh`] | Gmsh 4.1 ASCII: a volume entity and physical group per unit, a surface entity and group per tag |
 //! | `model.f3grid` | [`write_model_f3grid`] | FLAC3D ASCII grid: gridpoints, zones W6/P5/T4, zone groups per unit, face groups per tag |
@@ -36,7 +36,7 @@
 //!     bodies: vec![Body { unit: 0, triangles: vec![[1, 2, 3], [0, 2, 1], [0, 3, 2], [0, 1, 3]] }],
 //! };
 //! let dir = tempfile::tempdir()?;
-//! let written = write_model(dir.path(), &mesh, &ModelInfo { crs: "EPSG:32632".into() })?;
+//! let written = write_model(dir.path(), &mesh, &ModelInfo { crs: "EPSG:32632".into(), ..Default::default() })?;
 //! assert!(written.contains(&"model-side-west.vtu".to_string()));
 //! for f in ["model.vtu", "model-top.vtu", "model.msh", "model.f3grid", "unit-sand.ts", "unit-sand.stl"] {
 //!     assert!(dir.path().join(f).is_file(), "{f}");
@@ -75,6 +75,13 @@ pub struct ModelInfo {
     /// The model's CRS as text (`EPSG:28992`, a WKT, or `projected`), written into the VTU
     /// field data `crs`, the TSurf header and the Gmsh/FLAC3D header comments.
     pub crs: String,
+    /// The vertical datum of the heights in words short enough for a key (`egm96`, `navd88`,
+    /// `EPSG:<code>`, or `source` when the inputs' heights name none): the VTU field data
+    /// `vertical_datum` and the Gmsh/FLAC3D header comments. Empty: not written.
+    pub vertical_datum: String,
+    /// The EPSG code of the vertical CRS when named (5773 for EGM96 heights): the VTU field
+    /// data `vertical_crs` (`EPSG:5773`).
+    pub vertical_epsg: Option<u16>,
 }
 
 /// Errors of [`write_model`].
@@ -179,6 +186,15 @@ pub fn write_model(
         })
         .collect();
     results.into_iter().collect()
+}
+
+/// `, heights: <vertical datum>` for the header comments (nothing when not given).
+fn vertical_note(info: &ModelInfo) -> String {
+    if info.vertical_datum.is_empty() {
+        String::new()
+    } else {
+        format!(", heights: {}", info.vertical_datum)
+    }
 }
 
 /// Writes `v` in the shortest form that reads back to the same `f64` (`-0` as `0`).

@@ -73,21 +73,18 @@ struct Grid {
 
 impl Grid {
     fn write<W: Write + ?Sized>(self, w: &mut W) -> io::Result<()> {
-        let encoded: Vec<Vec<u8>> = self
+        // Each array is appended as the base64 of its UInt64 byte count and its bytes, encoded
+        // in chunks straight into `w` (no encoded copy of the arrays in memory); its length in
+        // characters is known beforehand.
+        let arrays: Vec<&Array> = self
             .field
             .iter()
             .chain(&self.point_data)
             .chain(&self.cell_data)
             .chain([&self.pts])
             .chain(&self.cell_arrays)
-            .map(|a| {
-                let mut block = Vec::with_capacity(8 + a.bytes.len());
-                block.extend_from_slice(&(a.bytes.len() as u64).to_le_bytes());
-                block.extend_from_slice(&a.bytes);
-                base64(&block)
-            })
             .collect();
-        let mut lengths = encoded.iter().map(|e| e.len());
+        let mut lengths = arrays.iter().map(|a| (8 + a.bytes.len()).div_ceil(3) * 4);
         let mut offset = 0usize;
         let mut header = |w: &mut W, a: &Array| -> io::Result<()> {
             write!(w, "<DataArray type=\"{}\" Name=\"{}\"", a.vtk_type, a.name)?;
@@ -98,7 +95,7 @@ impl Grid {
                 write!(w, " NumberOfTuples=\"{n}\"")?;
             }
             writeln!(w, " format=\"appended\" offset=\"{offset}\"/>")?;
-            offset += lengths.next().expect("one encoding per array");
+            offset += lengths.next().expect("one length per array");
             Ok(())
         };
         writeln!(w, "<?xml version=\"1.0\"?>")?;
@@ -139,17 +136,40 @@ impl Grid {
         }
         writeln!(w, "</Cells>\n</Piece>\n</UnstructuredGrid>")?;
         write!(w, "<AppendedData encoding=\"base64\">\n_")?;
-        for e in &encoded {
-            w.write_all(e)?;
+        let mut buf = Vec::with_capacity(CHUNK / 3 * 4 + 8);
+        for a in arrays {
+            // the 8-byte count and the first byte make 9 bytes: then whole groups of three
+            let mut head = (a.bytes.len() as u64).to_le_bytes().to_vec();
+            let take = a.bytes.len().min(1);
+            head.extend_from_slice(&a.bytes[..take]);
+            buf.clear();
+            base64_into(&head, &mut buf);
+            w.write_all(&buf)?;
+            for chunk in a.bytes[take..].chunks(CHUNK) {
+                buf.clear();
+                base64_into(chunk, &mut buf);
+                w.write_all(&buf)?;
+            }
         }
         writeln!(w, "\n</AppendedData>\n</VTKFile>")
     }
 }
 
+/// Bytes encoded at a time when appending (a multiple of 3, so that only the last chunk of an
+/// array is padded).
+const CHUNK: usize = 3 << 14;
+
 /// Standard base64 (RFC 4648, with padding).
+#[cfg(test)]
 fn base64(bytes: &[u8]) -> Vec<u8> {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = Vec::with_capacity(bytes.len().div_ceil(3) * 4);
+    base64_into(bytes, &mut out);
+    out
+}
+
+/// Appends the standard base64 (RFC 4648, with padding) of `bytes` to `out`.
+fn base64_into(bytes: &[u8], out: &mut Vec<u8>) {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut chunks = bytes.chunks_exact(3);
     for c in &mut chunks {
         let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
@@ -172,7 +192,6 @@ fn base64(bytes: &[u8]) -> Vec<u8> {
         });
         out.push(b'=');
     }
-    out
 }
 
 /// Connectivity, offsets and types of cells given as node lists with their VTK type.
@@ -207,7 +226,9 @@ fn text_field(name: &'static str, bytes: Vec<u8>) -> Array {
 /// Writes the volume mesh as `model.vtu`: Float64 points, the cells (VTK orders, see the module
 /// documentation), cell data `MaterialIDs` (Int32, 0 = the top unit), and field data
 /// `unit_names` (UInt8: the unit names top to bottom, each followed by a zero byte, so that
-/// name `k` is MaterialID `k`) and `crs` (UInt8: [`ModelInfo::crs`] as UTF-8).
+/// name `k` is MaterialID `k`), `crs` (UInt8: [`ModelInfo::crs`] as UTF-8), and, when given,
+/// `vertical_datum` ([`ModelInfo::vertical_datum`]) and `vertical_crs` (`EPSG:<code>`,
+/// [`ModelInfo::vertical_epsg`]), text the same way.
 ///
 /// ```
 /// # fn main() -> std::io::Result<()> {
@@ -221,9 +242,11 @@ fn text_field(name: &'static str, bytes: Vec<u8>) -> Array {
 ///     ..Default::default()
 /// };
 /// let mut buf = Vec::new();
-/// write_model_vtu(&mut buf, &m, &ModelInfo { crs: "EPSG:32632".into() })?;
+/// let info = ModelInfo { crs: "EPSG:32632".into(), vertical_datum: "egm96".into(), vertical_epsg: Some(5773) };
+/// write_model_vtu(&mut buf, &m, &info)?;
 /// let text = String::from_utf8_lossy(&buf);
 /// assert!(text.contains("Name=\"MaterialIDs\"") && text.contains("encoding=\"base64\""));
+/// assert!(text.contains("Name=\"vertical_crs\""));
 /// # Ok(()) }
 /// ```
 pub fn write_model_vtu<W: Write + ?Sized>(
@@ -251,10 +274,7 @@ pub fn write_model_vtu<W: Write + ?Sized>(
     Grid {
         points: m.points.len(),
         cells: m.cells.len(),
-        field: vec![
-            text_field("unit_names", names),
-            text_field("crs", info.crs.as_bytes().to_vec()),
-        ],
+        field: model_fields(names, info),
         point_data: vec![],
         cell_data: vec![array(
             "Int32",
@@ -266,6 +286,24 @@ pub fn write_model_vtu<W: Write + ?Sized>(
         cell_arrays: cell_arrays(vtk_nodes.iter().map(|(n, t, k)| (*t, &n[..*k]))),
     }
     .write(w)
+}
+
+/// The field data of `model.vtu`: the unit names, the CRS and the vertical datum.
+fn model_fields(names: Vec<u8>, info: &ModelInfo) -> Vec<Array> {
+    let mut field = vec![
+        text_field("unit_names", names),
+        text_field("crs", info.crs.as_bytes().to_vec()),
+    ];
+    if !info.vertical_datum.is_empty() {
+        field.push(text_field(
+            "vertical_datum",
+            info.vertical_datum.as_bytes().to_vec(),
+        ));
+    }
+    if let Some(c) = info.vertical_epsg {
+        field.push(text_field("vertical_crs", format!("EPSG:{c}").into_bytes()));
+    }
+    field
 }
 
 /// Writes a boundary mesh ([`super::boundary_mesh`]) as an OpenGeoSys boundary `.vtu`:
@@ -324,6 +362,43 @@ mod tests {
             assert_eq!(
                 super::base64(&bytes),
                 crate::report::base64(&bytes).into_bytes()
+            );
+        }
+    }
+
+    #[test]
+    fn appended_arrays_are_the_base64_of_count_and_bytes_whatever_their_size() {
+        for n in [
+            0usize,
+            1,
+            2,
+            3,
+            4,
+            super::CHUNK - 1,
+            super::CHUNK + 1,
+            2 * super::CHUNK + 2,
+        ] {
+            let bytes: Vec<u8> = (0..n).map(|i| (i * 31 % 251) as u8).collect();
+            let grid = super::Grid {
+                points: 0,
+                cells: 0,
+                field: vec![],
+                point_data: vec![],
+                cell_data: vec![],
+                pts: super::array("UInt8", "Points", 1, bytes.clone()),
+                cell_arrays: vec![],
+            };
+            let mut out = Vec::new();
+            grid.write(&mut out).unwrap();
+            let text = String::from_utf8(out).unwrap();
+            let start = text.find("\n_").unwrap() + 2;
+            let end = text.find("\n</AppendedData>").unwrap();
+            let mut whole = (n as u64).to_le_bytes().to_vec();
+            whole.extend_from_slice(&bytes);
+            assert_eq!(
+                &text.as_bytes()[start..end],
+                &super::base64(&whole)[..],
+                "n = {n}"
             );
         }
     }

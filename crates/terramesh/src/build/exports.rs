@@ -13,7 +13,7 @@ use terramesh_io::export::{
     KmlStyle, TsurfInfo,
 };
 use terramesh_io::export::{write_mesh, MeshView};
-use terramesh_io::grid_write::{write_asc, write_geotiff};
+use terramesh_io::grid_write::{write_asc, write_geotiff_heights, Heights};
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 use terramesh_mesh::{triangle_quality, Quality};
@@ -33,6 +33,24 @@ pub struct Written {
     pub volume: f64,
     /// 3D quality of the DSM surface.
     pub quality3d: Quality,
+}
+
+/// `dsm.vtu`'s field data: the CRS and the heights' vertical datum (`vertical_crs` only when
+/// named), as `model.vtu` records them.
+fn dsm_field_data(p: &Project, s: &Samples) -> Vec<(&'static str, String)> {
+    let d = p.height_datum();
+    let mut f = vec![
+        (
+            "crs",
+            s.epsg()
+                .map_or_else(|| s.crs_name(), |c| format!("EPSG:{c}")),
+        ),
+        ("vertical_datum", d.name()),
+    ];
+    if let Some(c) = d.crs_name() {
+        f.push(("vertical_crs", c));
+    }
+    f
 }
 
 /// Opens `path` atomically, runs `f` on it, commits.
@@ -144,6 +162,7 @@ pub fn write_all(
             ("uk_minus_idw", &diff[..]),
         ],
         cell_data: vec![("min_angle_deg", &min_angle[..])],
+        field_data: dsm_field_data(p, s),
     };
     let mut view = view;
     if let Some(e) = &it.ensemble {
@@ -261,12 +280,13 @@ pub fn write_all(
             origin[1],
             origin[2],
             s.epsg().map_or_else(|| s.crs_name(), |c| format!("EPSG:{c}")),
-            if zone.is_some() { "egm96" } else { "source" },
-            if zone.is_some() {
+            p.height_datum(),
+            if zone.is_some() && p.region.vertical_datum.is_none() {
                 "every file here but 3dtiles/ and terrain/ (WGS-84 ellipsoidal, see their \
                  metadata): metres above the EGM96 geoid (EPSG:5773), the DEM's own"
+                    .to_string()
             } else {
-                "metres, the elevations of the project's inputs as given (no datum conversion)"
+                p.height_datum().describe()
             },
             if zone.is_some() { "UTM" } else { "project" }
         )
@@ -294,6 +314,7 @@ pub fn write_all(
         triangles: &solid.triangles,
         point_data: Vec::new(),
         cell_data: Vec::new(),
+        field_data: dsm_field_data(p, s),
     };
     let spath = out.join("dsm-solid.msh");
     write_mesh(&spath, &sview)?;
@@ -310,8 +331,11 @@ pub fn write_all(
     // The DSM grid.
     let (spec, values) = &it.grid;
     let epsg = s.epsg().and_then(|c| u16::try_from(c).ok());
+    let heights = Heights {
+        vertical_epsg: p.height_datum().epsg(),
+    };
     files.push(atomic(&out.join("dsm.tif"), |w| {
-        write_geotiff(w, spec, values, epsg, Some(-9999.0))
+        write_geotiff_heights(w, spec, values, epsg, Some(heights), Some(-9999.0))
     })?);
     files.push(atomic(&out.join("dsm.asc"), |w| {
         write_asc(w, spec, values)

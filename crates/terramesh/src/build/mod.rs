@@ -16,6 +16,7 @@ mod ensemble;
 mod exports;
 mod pictures;
 mod report;
+pub mod reuse;
 pub(crate) mod stages;
 pub mod staging;
 mod terrain;
@@ -30,7 +31,7 @@ pub use pictures::{short_numbers, Picture};
 pub use stages::{Interpolated, Meshed, Model, Samples};
 pub use viewer::{VIEWER_MODEL_VERTICES, VIEWER_SAMPLES, VIEWER_VERTICES};
 
-use crate::error::{Error, Result};
+use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
 
@@ -121,6 +122,146 @@ pub fn build_model(
     build_as(project, base, out, progress, What::ModelOnly)
 }
 
+/// The DSM the geological model stands on.
+struct Dsm<'a> {
+    mesh: &'a terramesh_mesh::Mesh,
+    z: &'a [f64],
+    grid: &'a terramesh_io::grid_write::RasterGrid,
+    /// A geographic project (worked in a UTM zone).
+    geographic: bool,
+}
+
+/// The geology stage on `dsm`, and `model.glb` when the project exports glb.
+#[allow(clippy::too_many_arguments)]
+fn geology_stage(
+    st: &mut Stages,
+    project: &Project,
+    g: &crate::project::GeologySettings,
+    boreholes: Option<terramesh_io::boreholes::Boreholes>,
+    dsm: Dsm,
+    model_crs: Option<&terramesh_crs::Crs>,
+    out: &Path,
+) -> Result<crate::geology::stage::ModelBuilt> {
+    let mut built = st.run(
+        "geology",
+        || {
+            crate::geology::stage::run(
+                project, g, boreholes, dsm.mesh, dsm.z, dsm.grid, model_crs, out,
+            )
+        },
+        |m| {
+            format!(
+                "{} units, {} cells, {} contacts within {:.3} m",
+                m.model.stats.len(),
+                m.model.mesh.cells.len(),
+                m.model.misfits.len(),
+                m.model
+                    .misfits
+                    .iter()
+                    .map(|f| f.misfit.abs())
+                    .fold(0.0, f64::max)
+            )
+        },
+    )?;
+    if project
+        .export
+        .formats
+        .iter()
+        .any(|f| terramesh_core::vocab::Named::name(*f) == "glb")
+    {
+        built.files.push(crate::geology::web::write_build_glb(
+            out,
+            &built.model.mesh,
+            &built.summary.crs,
+            dsm.geographic,
+            project.title.as_deref(),
+        )?);
+    }
+    Ok(built)
+}
+
+/// `terramesh model` on the DSM kept in `previous` ([`reuse`]) when it was made from the same
+/// settings, inputs and borehole points: the geology stage alone, `samples.csv` and the kept
+/// DSM carried over into `out`. `None` when there is no such DSM (the caller builds one).
+fn model_on_kept_dsm(
+    project: &Project,
+    g: &crate::project::GeologySettings,
+    key: u64,
+    out: &Path,
+    previous: &Path,
+    progress: &dyn Progress,
+) -> Result<Option<Built>> {
+    let Some(kept) = reuse::DsmState::read(previous, key) else {
+        if previous.join(reuse::FILE).is_file() {
+            progress.note(&format!(
+                "{} was made from other settings or inputs: building the DSM again",
+                previous.join(reuse::FILE).display()
+            ));
+        }
+        return Ok(None);
+    };
+    let crs = project.region.crs.crs();
+    let boreholes = crate::geology::stage::read_boreholes(g, kept.zone, crs)?;
+    let collars = boreholes
+        .as_ref()
+        .map(crate::geology::stage::collar_points)
+        .unwrap_or_default();
+    if collars != kept.collars {
+        progress.note("the boreholes moved, or others were added: building the DSM again");
+        return Ok(None);
+    }
+    let model_crs = crate::geology::stage::project_crs(kept.zone, crs)?;
+    let mut st = Stages {
+        progress,
+        k: 0,
+        total: 2,
+        timings: Timings::default(),
+    };
+    st.run(
+        "dsm",
+        || {
+            kept.write(out)?;
+            let samples = previous.join("samples.csv");
+            if samples.is_file() {
+                std::fs::copy(&samples, out.join("samples.csv"))
+                    .with_context(|| format!("cannot copy {}", samples.display()))?;
+            }
+            Ok(())
+        },
+        |_| {
+            format!(
+                "reused {} ({} vertices, {} triangles from {} samples of {}; same settings)",
+                previous.join(reuse::FILE).display(),
+                kept.mesh.points.len(),
+                kept.mesh.triangles.len(),
+                kept.samples,
+                kept.source
+            )
+        },
+    )?;
+    let geo = geology_stage(
+        &mut st,
+        project,
+        g,
+        boreholes,
+        Dsm {
+            mesh: &kept.mesh,
+            z: &kept.dsm,
+            grid: &kept.grid,
+            geographic: kept.zone.is_some(),
+        },
+        model_crs.as_ref(),
+        out,
+    )?;
+    st.check()?;
+    Ok(Some(Built {
+        files: geo.files,
+        vertices: kept.mesh.points.len(),
+        triangles: kept.mesh.triangles.len(),
+        timings: st.timings,
+    }))
+}
+
 /// What a build writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum What {
@@ -138,7 +279,7 @@ fn build_as(
     let t0 = Instant::now();
     project.check_inputs(base)?;
     let staging = staging::Staging::begin(out, progress)?;
-    let built = build_into(project, base, staging.dir(), progress, t0, what)?;
+    let built = build_into(project, base, staging.dir(), out, progress, t0, what)?;
     if progress.cancelled() {
         return Err(Error::Cancelled);
     }
@@ -151,14 +292,29 @@ fn build_as(
     Ok(Built { files, ..built })
 }
 
+/// Builds into `out` (the staging folder of `previous`, the build folder as it was).
 fn build_into(
     project: &Project,
     base: &Path,
     out: &Path,
+    previous: &Path,
     progress: &dyn Progress,
     t0: Instant,
     what: What,
 ) -> Result<Built> {
+    // The key of the DSM's settings and inputs (reuse.rs); an input that cannot be read
+    // leaves none, and the DSM is built (and its reading reports the error).
+    let dsm_key = reuse::key(project, base).ok();
+    if let (What::ModelOnly, Some(key), Some(g), 0) = (
+        what,
+        dsm_key,
+        project.geology(),
+        project.interpolation.realisations,
+    ) {
+        if let Some(built) = model_on_kept_dsm(project, g, key, out, previous, progress)? {
+            return Ok(built);
+        }
+    }
     let mut st = Stages {
         progress,
         k: 0,
@@ -215,6 +371,19 @@ fn build_into(
         || stages::interpolate(project, &samples, &mesh, &model),
         |i| format!("UK and IDW at {} vertices, cross-validation", i.uk.len()),
     )?;
+    if let Some(key) = dsm_key {
+        reuse::DsmState {
+            key,
+            zone: samples.zone,
+            mesh: mesh.mesh.clone(),
+            collars: collars.clone(),
+            dsm: interp.dsm.clone(),
+            grid: interp.grid.0,
+            samples: samples.xyz.len() as u64,
+            source: samples.source.clone(),
+        }
+        .write(out)?;
+    }
     if project.interpolation.realisations > 0 {
         let e = st.run(
             "simulation",
@@ -224,53 +393,22 @@ fn build_into(
         interp.ensemble = Some(e);
     }
     let geo = match geology {
-        Some(g) => Some(st.run(
-            "geology",
-            || {
-                crate::geology::stage::run(
-                    project,
-                    g,
-                    boreholes,
-                    &mesh.mesh,
-                    &interp.dsm,
-                    &interp.grid.0,
-                    model_crs.as_ref(),
-                    out,
-                )
+        Some(g) => Some(geology_stage(
+            &mut st,
+            project,
+            g,
+            boreholes,
+            Dsm {
+                mesh: &mesh.mesh,
+                z: &interp.dsm,
+                grid: &interp.grid.0,
+                geographic: samples.zone.is_some(),
             },
-            |m| {
-                format!(
-                    "{} units, {} cells, {} contacts within {:.3} m",
-                    m.model.stats.len(),
-                    m.model.mesh.cells.len(),
-                    m.model.misfits.len(),
-                    m.model
-                        .misfits
-                        .iter()
-                        .map(|f| f.misfit.abs())
-                        .fold(0.0, f64::max)
-                )
-            },
+            model_crs.as_ref(),
+            out,
         )?),
         None => None,
     };
-    let mut geo = geo;
-    if let Some(g) = geo.as_mut() {
-        if project
-            .export
-            .formats
-            .iter()
-            .any(|f| terramesh_core::vocab::Named::name(*f) == "glb")
-        {
-            g.files.push(crate::geology::web::write_build_glb(
-                out,
-                &g.model.mesh,
-                &g.summary.crs,
-                samples.zone.is_some(),
-                project.title.as_deref(),
-            )?);
-        }
-    }
     if what == What::ModelOnly {
         st.check()?;
         return Ok(Built {

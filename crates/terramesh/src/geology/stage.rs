@@ -12,7 +12,7 @@ use terramesh_core::coords::{to_utm, Zone};
 use terramesh_crs::{Crs, Transformer};
 use terramesh_geology::Layering;
 use terramesh_io::boreholes::Boreholes;
-use terramesh_io::grid_write::{write_geotiff, RasterGrid};
+use terramesh_io::grid_write::{write_geotiff_heights, Heights, RasterGrid};
 use terramesh_io::model::{write_model, ModelInfo};
 use terramesh_io::output::Output;
 use terramesh_mesh::Mesh;
@@ -185,6 +185,7 @@ pub fn run(
         (None, Some(c)) => c.definition().to_string(),
         (None, None) => "projected".to_string(),
     };
+    let datum = p.height_datum();
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
     // The model's files and the interface grids are written side by side (rayon); errors in
@@ -196,6 +197,8 @@ pub fn run(
                 &model.mesh,
                 &ModelInfo {
                     crs: crs_name.clone(),
+                    vertical_datum: datum.name(),
+                    vertical_epsg: datum.epsg(),
                 },
             )
         },
@@ -207,8 +210,11 @@ pub fn run(
                     let values = interface_grid(mesh, &model.stack.surfaces[k], grid, -9999.0);
                     let path = dir.join(format!("{unit}.tif"));
                     let code = epsg.and_then(|e| u16::try_from(e).ok());
+                    let heights = Heights {
+                        vertical_epsg: datum.epsg(),
+                    };
                     write_atomic(&path, |w| {
-                        write_geotiff(w, grid, &values, code, Some(-9999.0))
+                        write_geotiff_heights(w, grid, &values, code, Some(heights), Some(-9999.0))
                     })?;
                     Ok(path)
                 })
@@ -223,7 +229,7 @@ pub fn run(
     for path in grids_written {
         files.push(path?);
     }
-    let summary = ModelSummary::of(&model, &crs_name);
+    let summary = ModelSummary::of(&model, &crs_name).with_datum(&datum);
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&summary)?;
     write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;

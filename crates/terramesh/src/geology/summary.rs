@@ -86,6 +86,13 @@ pub struct Checks {
 pub struct ModelSummary {
     /// The model's CRS, e.g. `EPSG:32632`.
     pub crs: String,
+    /// The vertical datum of the heights: `egm96`, `navd88`, `EPSG:<code>`, or `source`
+    /// (the inputs' heights as given, none named); see [`crate::project::HeightDatum`].
+    pub vertical_datum: String,
+    /// The vertical CRS when named, e.g. `EPSG:5773`.
+    pub vertical_crs: Option<String>,
+    /// The heights in words.
+    pub heights: String,
     /// Points of the volume mesh.
     pub points: usize,
     /// Cells of the volume mesh.
@@ -135,8 +142,12 @@ impl ModelSummary {
             .collect();
         let sum: f64 = m.check.unit_volumes.iter().sum();
         let total = m.check.volume;
+        let datum = crate::project::HeightDatum::Source;
         ModelSummary {
             crs: crs.to_string(),
+            vertical_datum: datum.name(),
+            vertical_crs: datum.crs_name(),
+            heights: datum.describe(),
             points: m.mesh.points.len(),
             cells: m.mesh.cells.len(),
             units,
@@ -153,6 +164,28 @@ impl ModelSummary {
                     0.0
                 },
             },
+        }
+    }
+}
+
+impl ModelSummary {
+    /// The summary with `datum` as its heights' vertical datum (what [`ModelSummary::of`]
+    /// leaves `source`).
+    ///
+    /// ```no_run
+    /// # fn f(m: &terramesh::geology::model::GeologicalModel) {
+    /// use terramesh::geology::summary::ModelSummary;
+    /// use terramesh::project::HeightDatum;
+    /// let s = ModelSummary::of(m, "EPSG:26915").with_datum(&HeightDatum::Epsg(5703));
+    /// assert_eq!(s.vertical_crs.as_deref(), Some("EPSG:5703"));
+    /// # }
+    /// ```
+    pub fn with_datum(self, datum: &crate::project::HeightDatum) -> ModelSummary {
+        ModelSummary {
+            vertical_datum: datum.name(),
+            vertical_crs: datum.crs_name(),
+            heights: datum.describe(),
+            ..self
         }
     }
 }

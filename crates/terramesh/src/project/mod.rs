@@ -5,11 +5,13 @@
 
 mod check;
 mod crs;
+mod datum;
 mod geology;
 mod lower;
 mod parse;
 
 pub use crs::ProjectCrs;
+pub use datum::{HeightDatum, KNOWN_VERTICAL_DATUMS};
 pub use geology::{
     Base, BaseSpec, GeologySection, GeologySettings, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS,
     GEOLOGY_TEMPLATE, MAX_LAYERS,
@@ -83,6 +85,10 @@ pub struct RegionSection {
     /// `geographic` (default), `projected`, or a projected CRS `EPSG:<code>` ([`ProjectCrs`]).
     #[serde(default)]
     pub crs: ProjectCrs,
+    /// The vertical datum of the inputs' heights, recorded in the outputs: a name (`egm96`,
+    /// `navd88`, ...) or `EPSG:<code>` of a vertical CRS ([`HeightDatum`]); default EGM96 for
+    /// a geographic project, not named otherwise.
+    pub vertical_datum: Option<HeightDatum>,
 }
 
 /// `[source]`: where elevations come from.

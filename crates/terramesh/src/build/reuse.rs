@@ -1,0 +1,382 @@
+//! The DSM kept in a build folder for `terramesh model` to reuse: `dsm-cache.bin`.
+//!
+//! Every `build` and `model` writes the DSM that the geological model stands on (the planar
+//! mesh, its vertex elevations, the DSM grid's layout, the UTM zone and the borehole points
+//! inserted as vertices) with a key of everything that made it: the `[region]`, `[source]`,
+//! `[sampling]`, `[mesh]` and `[interpolation]` settings, `export.grid_spacing`, the bytes of
+//! every local input file they name (the source or its fallback, a region or corners file, a
+//! variogram file; a web source by its address only) and terramesh's version. `terramesh
+//! model` into a folder whose `dsm-cache.bin` has the same key, and the same borehole points,
+//! reads that DSM instead of sampling, fitting, meshing and interpolating again. Anything else
+//! (no file, another key, other boreholes, a damaged file, realisations asked for) builds the
+//! DSM afresh. The `[geology]` settings other than the boreholes are not in the key: changing
+//! them is what the reuse is for.
+//!
+//! Layout (little-endian): the magic `TMDSM\0\0\x01`, the key (u64), the zone (u8: 0 none,
+//! else its number; u8: 1 north), the origin (2 f64), points (u64 count, 2 f64 each),
+//! triangles (u64, 3 u32 each), constraint edges (u64, 2 u32 each), borehole points (u64, 2
+//! f64 each), elevations (one f64 per point), the grid (4 f64, 2 u64), the sample count
+//! (u64), the source's name (u64 length, UTF-8), and a checksum of all that (u64).
+
+use std::hash::{Hash, Hasher};
+use std::io::Write;
+use std::path::Path;
+
+use terramesh_core::coords::Zone;
+use terramesh_io::grid_write::RasterGrid;
+use terramesh_io::output::Output;
+use terramesh_mesh::Mesh;
+
+use crate::error::{Context, Result};
+use crate::project::Project;
+
+/// The file's name in the build folder.
+pub const FILE: &str = "dsm-cache.bin";
+
+const MAGIC: &[u8; 8] = b"TMDSM\0\0\x01";
+
+/// A DSM as kept in [`FILE`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DsmState {
+    /// The key of the settings and inputs that made it ([`key`]).
+    pub key: u64,
+    /// The UTM zone of a geographic project.
+    pub zone: Option<Zone>,
+    /// The planar mesh.
+    pub mesh: Mesh,
+    /// The borehole points inserted as vertices.
+    pub collars: Vec<[f64; 2]>,
+    /// The DSM elevation at every vertex.
+    pub dsm: Vec<f64>,
+    /// The DSM grid's layout (the interface grids use it).
+    pub grid: RasterGrid,
+    /// How many samples it was made from.
+    pub samples: u64,
+    /// The source actually sampled.
+    pub source: String,
+}
+
+fn hasher() -> std::collections::hash_map::DefaultHasher {
+    std::collections::hash_map::DefaultHasher::new()
+}
+
+/// Feeds a local file's bytes into `h`, or, for a folder of tiles (which may be large), the
+/// name, size and modification time of every entry under it (sorted by name); nothing for a
+/// path that does not exist or is remote (its name is in the settings already).
+fn hash_path(h: &mut impl Hasher, path: &Path) -> Result<()> {
+    if path.is_file() {
+        let bytes =
+            std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+        bytes.hash(h);
+    } else if path.is_dir() {
+        let mut entries: Vec<_> = std::fs::read_dir(path)
+            .with_context(|| format!("cannot list {}", path.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .collect();
+        entries.sort();
+        for e in entries {
+            e.file_name().hash(h);
+            if e.is_dir() {
+                hash_path(h, &e)?;
+            } else if let Ok(m) = e.metadata() {
+                m.len().hash(h);
+                m.modified().ok().hash(h);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The key of what makes `p`'s DSM (paths relative to `base`): see the module documentation.
+pub fn key(p: &Project, base: &Path) -> Result<u64> {
+    let mut h = hasher();
+    env!("CARGO_PKG_VERSION").hash(&mut h);
+    format!(
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        p.region.corners,
+        p.region.file,
+        p.region.zone,
+        p.region.crs,
+        p.source,
+        p.sampling,
+        p.mesh,
+        p.interpolation,
+        p.export.grid_spacing
+    )
+    .hash(&mut h);
+    let mut files = Vec::new();
+    if let Ok(s) = p.source_spec(base) {
+        files.push(std::path::PathBuf::from(s));
+    }
+    if let Some(c) = &p.region.corners {
+        files.push(base.join(c.trim()));
+    }
+    if let Some(f) = &p.region.file {
+        files.push(base.join(f));
+    }
+    if p.interpolation.variogram != "auto" {
+        files.push(base.join(&p.interpolation.variogram));
+    }
+    for f in files {
+        hash_path(&mut h, &f)?;
+    }
+    Ok(h.finish())
+}
+
+fn put_u64(b: &mut Vec<u8>, v: u64) {
+    b.extend_from_slice(&v.to_le_bytes());
+}
+
+fn put_f64(b: &mut Vec<u8>, v: f64) {
+    b.extend_from_slice(&v.to_le_bytes());
+}
+
+impl DsmState {
+    /// The file's bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let m = &self.mesh;
+        let mut b = Vec::with_capacity(
+            64 + 16 * m.points.len() + 12 * m.triangles.len() + 8 * self.dsm.len(),
+        );
+        b.extend_from_slice(MAGIC);
+        put_u64(&mut b, self.key);
+        match self.zone {
+            Some(z) => b.extend_from_slice(&[z.number(), u8::from(z.is_north())]),
+            None => b.extend_from_slice(&[0, 0]),
+        }
+        put_f64(&mut b, m.origin[0]);
+        put_f64(&mut b, m.origin[1]);
+        put_u64(&mut b, m.points.len() as u64);
+        m.points.iter().flatten().for_each(|&v| put_f64(&mut b, v));
+        put_u64(&mut b, m.triangles.len() as u64);
+        for v in m.triangles.iter().flatten() {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        put_u64(&mut b, m.constraint_edges.len() as u64);
+        for v in m.constraint_edges.iter().flatten() {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        put_u64(&mut b, self.collars.len() as u64);
+        self.collars
+            .iter()
+            .flatten()
+            .for_each(|&v| put_f64(&mut b, v));
+        self.dsm.iter().for_each(|&v| put_f64(&mut b, v));
+        let g = &self.grid;
+        for v in [g.xmin, g.ymin, g.xmax, g.ymax] {
+            put_f64(&mut b, v);
+        }
+        put_u64(&mut b, g.nx as u64);
+        put_u64(&mut b, g.ny as u64);
+        put_u64(&mut b, self.samples);
+        put_u64(&mut b, self.source.len() as u64);
+        b.extend_from_slice(self.source.as_bytes());
+        let mut h = hasher();
+        b.hash(&mut h);
+        put_u64(&mut b, h.finish());
+        b
+    }
+
+    /// Reads the bytes of [`DsmState::to_bytes`]; `None` when they are not such a file (another
+    /// version, truncated, damaged: the checksum differs, an index is out of range).
+    pub fn from_bytes(b: &[u8]) -> Option<DsmState> {
+        let body = b.len().checked_sub(8)?;
+        let mut h = hasher();
+        b[..body].hash(&mut h);
+        if h.finish().to_le_bytes() != b[body..] || !b.starts_with(MAGIC) {
+            return None;
+        }
+        let mut r = Reader {
+            b: &b[..body],
+            at: MAGIC.len(),
+        };
+        let key = r.u64()?;
+        let (number, north) = (r.u8()?, r.u8()?);
+        let zone = match number {
+            0 => None,
+            n => Some(Zone::new(n, north == 1).ok()?),
+        };
+        let origin = [r.f64()?, r.f64()?];
+        let np = r.count(16)?;
+        let points = (0..np)
+            .map(|_| Some([r.f64()?, r.f64()?]))
+            .collect::<Option<Vec<_>>>()?;
+        let nt = r.count(12)?;
+        let triangles = (0..nt)
+            .map(|_| Some([r.u32()?, r.u32()?, r.u32()?]))
+            .collect::<Option<Vec<_>>>()?;
+        let ne = r.count(8)?;
+        let constraint_edges = (0..ne)
+            .map(|_| Some([r.u32()?, r.u32()?]))
+            .collect::<Option<Vec<_>>>()?;
+        let in_range = |v: &u32| (*v as usize) < np;
+        if !triangles.iter().flatten().all(in_range)
+            || !constraint_edges.iter().flatten().all(in_range)
+        {
+            return None;
+        }
+        let nc = r.count(16)?;
+        let collars = (0..nc)
+            .map(|_| Some([r.f64()?, r.f64()?]))
+            .collect::<Option<Vec<_>>>()?;
+        let dsm = (0..np).map(|_| r.f64()).collect::<Option<Vec<_>>>()?;
+        let grid = RasterGrid {
+            xmin: r.f64()?,
+            ymin: r.f64()?,
+            xmax: r.f64()?,
+            ymax: r.f64()?,
+            nx: usize::try_from(r.u64()?).ok()?,
+            ny: usize::try_from(r.u64()?).ok()?,
+        };
+        let samples = r.u64()?;
+        let len = r.count(1)?;
+        let source = String::from_utf8(r.take(len)?.to_vec()).ok()?;
+        (r.at == r.b.len()).then_some(DsmState {
+            key,
+            zone,
+            mesh: Mesh {
+                origin,
+                points,
+                triangles,
+                constraint_edges,
+            },
+            collars,
+            dsm,
+            grid,
+            samples,
+            source,
+        })
+    }
+
+    /// Writes [`FILE`] into `dir`, atomically.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let path = dir.join(FILE);
+        let mut o = Output::create(Some(&path))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        o.write_all(&self.to_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        o.commit()
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(())
+    }
+
+    /// The state kept in `dir` when it has the key `key`; `None` when there is none, it was
+    /// made from other settings, or it cannot be read.
+    pub fn read(dir: &Path, key: u64) -> Option<DsmState> {
+        let bytes = std::fs::read(dir.join(FILE)).ok()?;
+        DsmState::from_bytes(&bytes).filter(|s| s.key == key)
+    }
+}
+
+struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let end = self.at.checked_add(n)?;
+        let s = self.b.get(self.at..end)?;
+        self.at = end;
+        Some(s)
+    }
+    fn u8(&mut self) -> Option<u8> {
+        self.take(1).map(|s| s[0])
+    }
+    fn u32(&mut self) -> Option<u32> {
+        self.take(4)
+            .map(|s| u32::from_le_bytes(s.try_into().unwrap()))
+    }
+    fn u64(&mut self) -> Option<u64> {
+        self.take(8)
+            .map(|s| u64::from_le_bytes(s.try_into().unwrap()))
+    }
+    fn f64(&mut self) -> Option<f64> {
+        self.take(8)
+            .map(|s| f64::from_le_bytes(s.try_into().unwrap()))
+    }
+    /// A count of items of `size` bytes each, refused when more than the bytes left hold.
+    fn count(&mut self, size: usize) -> Option<usize> {
+        let n = usize::try_from(self.u64()?).ok()?;
+        (n.checked_mul(size)? <= self.b.len() - self.at).then_some(n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state() -> DsmState {
+        DsmState {
+            key: 42,
+            zone: Some(Zone::new(32, true).unwrap()),
+            mesh: Mesh {
+                origin: [500_000.0, 5_400_000.0],
+                points: vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]],
+                triangles: vec![[0, 1, 2], [0, 2, 3]],
+                constraint_edges: vec![[0, 1], [1, 2], [2, 3], [3, 0]],
+            },
+            collars: vec![[500_005.0, 5_400_005.0]],
+            dsm: vec![1.0, 2.5, -3.25, 1e-300],
+            grid: RasterGrid {
+                xmin: 0.0,
+                ymin: 0.0,
+                xmax: 10.0,
+                ymax: 10.0,
+                nx: 3,
+                ny: 3,
+            },
+            samples: 400,
+            source: "dem.tif".into(),
+        }
+    }
+
+    #[test]
+    fn reads_back_what_it_wrote_and_nothing_damaged() {
+        let s = state();
+        let b = s.to_bytes();
+        assert_eq!(DsmState::from_bytes(&b), Some(s.clone()));
+        // every truncation, and a changed byte anywhere, is refused (not read as another DSM)
+        for n in 0..b.len() {
+            assert_eq!(DsmState::from_bytes(&b[..n]), None, "cut at {n}");
+        }
+        for i in (0..b.len()).step_by(7) {
+            let mut c = b.clone();
+            c[i] ^= 0x10;
+            assert_eq!(DsmState::from_bytes(&c), None, "byte {i}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        s.write(dir.path()).unwrap();
+        assert_eq!(DsmState::read(dir.path(), 42), Some(s));
+        assert_eq!(DsmState::read(dir.path(), 43), None);
+    }
+
+    #[test]
+    fn the_key_follows_the_dsm_settings_and_the_input_bytes_not_the_geology() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = crate::project::TEMPLATE;
+        let parse = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            crate::project::Project::parse("t.toml", text, &sets).unwrap()
+        };
+        let k0 = key(&parse(&[]), dir.path()).unwrap();
+        assert_eq!(k0, key(&parse(&[]), dir.path()).unwrap());
+        assert_ne!(k0, key(&parse(&["mesh.min_angle=20"]), dir.path()).unwrap());
+        assert_ne!(
+            k0,
+            key(&parse(&["export.grid_spacing=5"]), dir.path()).unwrap()
+        );
+        // export formats and pictures do not change the DSM
+        assert_eq!(
+            k0,
+            key(&parse(&["export.pictures=false"]), dir.path()).unwrap()
+        );
+        // the bytes of a local source
+        let dem = dir.path().join("dem.asc");
+        std::fs::write(&dem, "a").unwrap();
+        let p = parse(&["source.path=dem.asc"]);
+        let k1 = key(&p, dir.path()).unwrap();
+        std::fs::write(&dem, "b").unwrap();
+        assert_ne!(k1, key(&p, dir.path()).unwrap());
+    }
+}

@@ -1,0 +1,173 @@
+//! `[region] vertical_datum`: what the heights of a project's inputs refer to, recorded in
+//! its outputs (`model.vtu` and `dsm.vtu` field data, `model.json`, the GeoTIFF grids'
+//! `VerticalCSTypeGeoKey`).
+
+use std::fmt;
+
+use serde::Deserialize;
+
+/// Vertical datums known by name, with their EPSG vertical CRS codes.
+pub const KNOWN_VERTICAL_DATUMS: &[(&str, u16, &str)] = &[
+    ("egm96", 5773, "EGM96 height"),
+    ("egm2008", 3855, "EGM2008 height"),
+    ("navd88", 5703, "NAVD88 height"),
+    ("ngvd29", 5702, "NGVD29 height"),
+    ("nap", 5709, "NAP height"),
+    ("dhhn92", 5783, "DHHN92 height"),
+    ("dhhn2016", 7837, "DHHN2016 height"),
+    ("ign69", 5720, "NGF-IGN69 height"),
+    ("odn", 5701, "ODN height"),
+];
+
+/// The vertical datum of a project's heights: a name of [`KNOWN_VERTICAL_DATUMS`] or an
+/// EPSG vertical CRS code (`EPSG:5703`), or not known (`source`: the inputs' heights as
+/// given, no datum named).
+///
+/// Where it comes from ([`HeightDatum::of_project`]): `[region] vertical_datum` when set;
+/// otherwise EGM96 for a geographic project (the DEMs it samples, SRTM and its kind, give
+/// heights above the EGM96 geoid), and not known for a project in its own CRS (its sources
+/// say nothing terramesh can read about their heights' datum).
+///
+/// ```
+/// use terramesh::project::HeightDatum;
+/// let d: HeightDatum = "navd88".parse()?;
+/// assert_eq!(d.epsg(), Some(5703));
+/// assert_eq!(d.to_string(), "navd88");
+/// assert_eq!(d.crs_name().as_deref(), Some("EPSG:5703"));
+/// let e: HeightDatum = "EPSG:5773".parse()?;
+/// assert_eq!(e.name(), "egm96");
+/// assert_eq!("source".parse::<HeightDatum>()?.epsg(), None);
+/// assert!("msl".parse::<HeightDatum>().unwrap_err().contains("navd88"));
+/// # Ok::<(), String>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum HeightDatum {
+    /// Not named: the inputs' heights as given.
+    #[default]
+    Source,
+    /// A vertical CRS by its EPSG code, with its short name when it is a known one.
+    Epsg(u16),
+}
+
+impl HeightDatum {
+    /// The datum of a project's heights: `key` (`[region] vertical_datum`) when given,
+    /// EGM96 for a `geographic` project, [`HeightDatum::Source`] otherwise.
+    ///
+    /// ```
+    /// use terramesh::project::HeightDatum;
+    /// assert_eq!(HeightDatum::of_project(None, true).epsg(), Some(5773));
+    /// assert_eq!(HeightDatum::of_project(None, false), HeightDatum::Source);
+    /// ```
+    pub fn of_project(key: Option<&HeightDatum>, geographic: bool) -> HeightDatum {
+        match key {
+            Some(d) => d.clone(),
+            None if geographic => HeightDatum::Epsg(5773),
+            None => HeightDatum::Source,
+        }
+    }
+
+    /// The EPSG code of the vertical CRS, when named.
+    pub fn epsg(&self) -> Option<u16> {
+        match self {
+            HeightDatum::Source => None,
+            HeightDatum::Epsg(c) => Some(*c),
+        }
+    }
+
+    /// `EPSG:<code>` when named.
+    pub fn crs_name(&self) -> Option<String> {
+        self.epsg().map(|c| format!("EPSG:{c}"))
+    }
+
+    /// The short name: a known datum's (`egm96`), `EPSG:<code>` for another code, `source`
+    /// when not named.
+    pub fn name(&self) -> String {
+        match self {
+            HeightDatum::Source => "source".into(),
+            HeightDatum::Epsg(c) => KNOWN_VERTICAL_DATUMS
+                .iter()
+                .find(|k| k.1 == *c)
+                .map_or_else(|| format!("EPSG:{c}"), |k| k.0.to_string()),
+        }
+    }
+
+    /// In words, for file metadata: `metres, NAVD88 height (EPSG:5703)`.
+    pub fn describe(&self) -> String {
+        match self {
+            HeightDatum::Source => {
+                "metres, the elevations of the project's inputs as given (no vertical datum \
+                 named: set [region] vertical_datum)"
+                    .into()
+            }
+            HeightDatum::Epsg(c) => match KNOWN_VERTICAL_DATUMS.iter().find(|k| k.1 == *c) {
+                Some(k) => format!("metres, {} (EPSG:{c})", k.2),
+                None => format!("metres, vertical CRS EPSG:{c}"),
+            },
+        }
+    }
+}
+
+impl fmt::Display for HeightDatum {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+impl std::str::FromStr for HeightDatum {
+    type Err = String;
+    fn from_str(s: &str) -> Result<HeightDatum, String> {
+        let t = s.trim();
+        if t.eq_ignore_ascii_case("source") {
+            return Ok(HeightDatum::Source);
+        }
+        if let Some(k) = KNOWN_VERTICAL_DATUMS
+            .iter()
+            .find(|k| k.0.eq_ignore_ascii_case(t))
+        {
+            return Ok(HeightDatum::Epsg(k.1));
+        }
+        let code = t
+            .strip_prefix("EPSG:")
+            .or_else(|| t.strip_prefix("epsg:"))
+            .and_then(|c| c.parse::<u16>().ok())
+            .filter(|&c| (1024..=32766).contains(&c));
+        match code {
+            Some(c) => Ok(HeightDatum::Epsg(c)),
+            None => Err(format!(
+                "'{s}' is not a vertical datum: use one of {}, \"EPSG:<code>\" of a vertical \
+                 CRS (1024 to 32766), or \"source\" (not named)",
+                KNOWN_VERTICAL_DATUMS
+                    .iter()
+                    .map(|k| format!("\"{}\"", k.0))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for HeightDatum {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<HeightDatum, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl super::Project {
+    /// The vertical datum of the project's heights ([`HeightDatum::of_project`]).
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let p = Project::parse("t.toml", TEMPLATE, &[])?;
+    /// assert_eq!(p.height_datum().name(), "egm96"); // a geographic project
+    /// let p = Project::parse("t.toml", TEMPLATE, &["region.vertical_datum=navd88".into()])?;
+    /// assert_eq!(p.height_datum().epsg(), Some(5703));
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn height_datum(&self) -> HeightDatum {
+        HeightDatum::of_project(
+            self.region.vertical_datum.as_ref(),
+            self.region.crs.region_crs() == terramesh_io::region::RegionCrs::Geographic,
+        )
+    }
+}
