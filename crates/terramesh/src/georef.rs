@@ -35,13 +35,9 @@ use crate::error::Result;
 pub enum Georef {
     /// A UTM zone of WGS 84 (a geographic project).
     Utm(Zone),
-    /// A named projected CRS, with its transformation to WGS-84 longitude/latitude.
-    Crs {
-        /// The project's CRS.
-        crs: Crs,
-        /// From `crs` to WGS 84 (EPSG:4326).
-        to_wgs84: Transformer,
-    },
+    /// A named projected CRS: the transformation from it to WGS-84 longitude/latitude
+    /// (EPSG:4326), whose [`Transformer::from`] is the project's CRS.
+    Crs(Box<Transformer>),
 }
 
 impl Georef {
@@ -62,10 +58,7 @@ impl Georef {
                  WGS-84 positions, and {e}; remove them from export.formats"
             ))
         })?;
-        Ok(Georef::Crs {
-            crs: crs.clone(),
-            to_wgs84,
-        })
+        Ok(Georef::Crs(Box::new(to_wgs84)))
     }
 
     /// Geodetic WGS-84 latitude and longitude (degrees) of a point of the project CRS.
@@ -75,7 +68,7 @@ impl Georef {
     pub fn to_wgs84(&self, x: f64, y: f64) -> Result<(f64, f64)> {
         match self {
             Georef::Utm(zone) => Ok(to_wgs84(x, y, *zone)?),
-            Georef::Crs { to_wgs84, .. } => {
+            Georef::Crs(to_wgs84) => {
                 let [lon, lat] = to_wgs84.transform(x, y)?;
                 Ok((lat, lon))
             }
@@ -86,7 +79,7 @@ impl Georef {
     pub fn crs_code(&self) -> String {
         match self {
             Georef::Utm(z) => format!("EPSG:{}", z.epsg()),
-            Georef::Crs { crs, .. } => crs.to_string(),
+            Georef::Crs(t) => t.from().to_string(),
         }
     }
 
@@ -94,7 +87,7 @@ impl Georef {
     pub fn crs_name(&self) -> String {
         match self {
             Georef::Utm(z) => format!("WGS 84 / UTM zone {z}"),
-            Georef::Crs { crs, .. } => crs.to_string(),
+            Georef::Crs(t) => t.from().to_string(),
         }
     }
 
@@ -105,7 +98,7 @@ impl Georef {
     pub fn vertical_datum(&self) -> &'static str {
         match self {
             Georef::Utm(_) => "egm96",
-            Georef::Crs { .. } => "source",
+            Georef::Crs(_) => "source",
         }
     }
 
@@ -113,7 +106,7 @@ impl Georef {
     pub fn heights(&self) -> &'static str {
         match self {
             Georef::Utm(_) => terramesh_core::coords::VerticalDatum::Egm96.describe(),
-            Georef::Crs { .. } => SOURCE_HEIGHTS,
+            Georef::Crs(_) => SOURCE_HEIGHTS,
         }
     }
 
@@ -123,7 +116,7 @@ impl Georef {
             Georef::Utm(_) => {
                 "ellipsoidal = DSM elevation (above the EGM96 geoid) + EGM96 undulation"
             }
-            Georef::Crs { .. } => {
+            Georef::Crs(_) => {
                 "ellipsoidal = elevation + EGM96 undulation: the project's elevations (its inputs' \
                  own vertical datum, not known to terramesh) are taken as heights above mean sea \
                  level, i.e. the EGM96 geoid; a national datum (NAVD88, NAP, ...) differs from it \

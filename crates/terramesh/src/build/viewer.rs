@@ -124,6 +124,8 @@ pub fn scene(
         visible: true,
         pickable: true,
         clipped: true,
+        closed: false,
+        vertex_colours: None,
     };
     let solid = Layer {
         name: format!("solid sides and base ({base:.1} m)"),
@@ -134,6 +136,8 @@ pub fn scene(
         visible: geo.is_none(),
         pickable: false,
         clipped: true,
+        closed: false,
+        vertex_colours: None,
     };
     let stride = s.xyz.len().div_ceil(VIEWER_SAMPLES).max(1);
     let pts: Vec<[f64; 3]> = s.xyz.iter().step_by(stride).copied().collect();
@@ -157,9 +161,16 @@ pub fn scene(
         visible: false,
         pickable: false,
         clipped: true,
+        closed: false,
+        vertex_colours: None,
     };
     Ok(Scene {
         crs: s.crs_name(),
+        heights: if s.zone.is_some() {
+            "above the EGM96 geoid (EPSG:5773)".into()
+        } else {
+            "as the project's inputs give it (their vertical datum, not converted)".into()
+        },
         note: (!notes.is_empty()).then(|| notes.join(" ")),
         layers: [vec![surface, solid, samples], model_layers].concat(),
     })
