@@ -121,7 +121,9 @@ def check_dsm_glb(out):
     extras = g.nodes[g.scenes[g.scene or 0].nodes[0]].extras or {}
     for key in ["crs", "origin", "units", "vertical_datum"]:
         require(key in extras, f"dsm.glb: root node extras lack '{key}' (has {sorted(extras)})")
-    datum = json.loads(out.path("dsm-origin.json").read_text()).get("vertical_datum")
+    # (A dsm-origin.json without the key predates it: glb was then written for UTM projects
+    # only, in EGM96 heights.)
+    datum = json.loads(out.path("dsm-origin.json").read_text()).get("vertical_datum", "egm96")
     require(extras["vertical_datum"] == datum,
             f"dsm.glb: vertical datum {extras['vertical_datum']!r}, dsm-origin.json's is {datum!r}")
     epsg = out.epsg()
