@@ -1,6 +1,7 @@
 //! The scene of the 3D viewer in `report.html` (`terramesh_io::viewer`): the DSM surface
 //! coloured by elevation, kriging standard deviation or UK minus IDW; the sealed solid's sides
-//! and base; the samples as points. Geological units and boreholes become further layers.
+//! and base; the samples as points; with `[geology]`, the units (capped where the
+//! cross-section cuts them) and the boreholes (traces and collars) as further layers.
 //!
 //! A DSM of more than [`VIEWER_VERTICES`] vertices is shown decimated: the adaptive mesher
 //! (`terramesh_mesh::adaptive_mesh`) meshes the region again against the DSM itself (a
