@@ -9,7 +9,10 @@
 // and the cross-section each change the image; hiding the solid removes its colour from the
 // picture; after switching fields the centre pixel is a shade of that field's colour map; the
 // cursor readout shows coordinates and an elevation inside the ranges of dsm-vertices.csv
-// (read here, beside report.html). Exit status 1 with the failed check on stderr.
+// (read here, beside report.html) and says what the elevation is above. With geological
+// units: hiding each removes its colour; the borehole traces show the logged units' colours;
+// the cross-section fills each cut unit with its colour (and not with the filling off).
+// Exit status 1 with the failed check on stderr.
 import { chromium } from "playwright-core";
 import { existsSync, mkdirSync, readFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
@@ -174,7 +177,8 @@ try {
   });
   const inside = (v, [a, b], tol) => v >= a - tol && v <= b + tol;
   if (!/E \d/.test(ro.text) || !/N \d/.test(ro.text) || !/elevation \d/.test(ro.text)
-    || !inside(ro.e, range.x, 1e-3) || !inside(ro.n, range.y, 1e-3) || !inside(ro.z, range.z, 1e-3)) {
+    || !inside(ro.e, range.x, 1e-3) || !inside(ro.n, range.y, 1e-3) || !inside(ro.z, range.z, 1e-3)
+    || !scene.heights || !ro.text.includes(scene.heights)) {
     fail(`the readout "${ro.text}" is not a point of the DSM (x ${range.x}, y ${range.y}, z ${range.z} in dsm-vertices.csv)`);
   }
   ok(`cursor readout: "${ro.text}"`);
@@ -227,16 +231,77 @@ try {
       await input.check();
     }
     ok(`hiding any of the ${units.length} units removes its colour from the picture`);
+
+    // The boreholes as traces coloured by logged unit: with the units hidden, at least two
+    // units' colours show along the holes, and go when the traces are hidden.
+    const traces = scene.layers.find((l) => l.name.startsWith("borehole traces"));
+    if (!traces || !traces.vertex_colours) fail("the scene has no borehole traces with vertex colours");
+    for (const u of units) await page.locator(`input[data-layer="${u.name}"]`).uncheck();
+    const holesOnly = await snapshot("holesOnly");
+    const traceInput = page.locator(`input[data-layer="${traces.name}"]`);
+    await traceInput.uncheck();
+    const noTraces = await snapshot("noTraces");
+    const seen = [];
+    for (const u of units) {
+      const unique = units.filter((x) => x.colour.join() === u.colour.join()).length === 1;
+      const n = await countShade(holesOnly, u.colour), m = await countShade(noTraces, u.colour);
+      if (unique && n >= 100 && m <= 0.1 * n) seen.push(`${u.name} ${n} -> ${m}`);
+    }
+    if (seen.length < Math.min(2, units.length)) {
+      fail(`the borehole traces show fewer than two units' colours (pixels with -> without traces: ${seen.join(", ") || "none"})`);
+    }
+    ok(`borehole traces in the logged units' colours (pixels with -> without traces): ${seen.join(", ")}`);
+    await traceInput.check();
+    for (const u of units) await page.locator(`input[data-layer="${u.name}"]`).check();
+
+    // Cut units capped: with the cross-section on, each cut unit's face is filled with its
+    // colour, unshaded (exactly the colour, which lit or back faces reach only where a face
+    // looks straight at the light); turning the filling off removes those pixels.
+    await page.check("#tmv-clip");
+    const capped = await snapshot("capped");
+    await page.uncheck("#tmv-cap");
+    const uncapped = await snapshot("uncapped");
+    const exact = (snap, rgb) => page.evaluate(([name, rgb]) => {
+      const d = window.__snaps[name];
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (Math.abs(d[i] - rgb[0]) <= 3 && Math.abs(d[i + 1] - rgb[1]) <= 3 && Math.abs(d[i + 2] - rgb[2]) <= 3) n++;
+      }
+      return n;
+    }, [snap.name, rgb]);
+    const caps = [];
+    for (const u of units) {
+      const n = await exact(capped, u.colour), m = await exact(uncapped, u.colour);
+      if (n >= 300 && m <= 0.2 * n) caps.push(`${u.name} ${n} -> ${m}`);
+    }
+    if (caps.length < Math.min(2, units.length)) {
+      fail(`the cross-section fills fewer than two cut units (pixels of the exact unit colour, filled -> not: ${caps.join(", ") || "none"})`);
+    }
+    ok(`the cross-section fills the cut units with their colours (exact-colour pixels, filled -> not): ${caps.join(", ")}`);
+    await page.check("#tmv-cap");
+    await page.uncheck("#tmv-clip");
     await dsmInput.check();
     const unitsBack = await snapshot("unitsBack");
     if (await changed(exaggerated, unitsBack) > 0.001) fail("showing the units again did not restore the picture");
     const holes = scene.layers.find((l) => l.name.startsWith("boreholes"));
-    if (!holes || holes.vertices < 2) fail("the scene has no borehole points");
+    if (!holes || holes.vertices < 2) fail("the scene has no borehole collars");
     ok(`${holes.name}: ${holes.vertices} points`);
     if (shotDir) {
       await page.click("#tmv-reset");
       await snapshot("unitsReset");
       await shot("viewer-units.png");
+      // The units cut by the cross-section, filled, the DSM surface hidden.
+      await dsmInput.uncheck();
+      await page.check("#tmv-clip");
+      await snapshot("unitsSection");
+      await shot("viewer-units-section.png");
+      await page.uncheck("#tmv-clip");
+      // The borehole traces alone (the units hidden).
+      for (const u of units) await page.locator(`input[data-layer="${u.name}"]`).uncheck();
+      await snapshot("tracesOnly");
+      await shot("viewer-boreholes.png");
+      for (const u of units) await page.locator(`input[data-layer="${u.name}"]`).check();
+      await dsmInput.check();
     }
   }
 

@@ -106,7 +106,8 @@ def check_glb_validator(out):
 
 def check_dsm_glb(out):
     """dsm.glb (pygltflib): vertices + origin equal dsm-vertices.csv to 1 mm, same triangles,
-    extras naming the CRS, origin, units and the EGM96 vertical datum."""
+    extras naming the CRS, origin, units and the vertical datum of dsm-origin.json (egm96 for a
+    geographic project, source for one in its own CRS)."""
     cols, ref_pts, tris = out.ref()
     g, meshes = load_glb(out.path("dsm.glb"))
     require(len(meshes) == 1, f"dsm.glb: {len(meshes)} meshes, expected 1")
@@ -120,7 +121,11 @@ def check_dsm_glb(out):
     extras = g.nodes[g.scenes[g.scene or 0].nodes[0]].extras or {}
     for key in ["crs", "origin", "units", "vertical_datum"]:
         require(key in extras, f"dsm.glb: root node extras lack '{key}' (has {sorted(extras)})")
-    require(extras["vertical_datum"] == "egm96", f"dsm.glb: vertical datum {extras['vertical_datum']!r}, the DSM's is egm96")
+    # (A dsm-origin.json without the key predates it: glb was then written for UTM projects
+    # only, in EGM96 heights.)
+    datum = json.loads(out.path("dsm-origin.json").read_text()).get("vertical_datum", "egm96")
+    require(extras["vertical_datum"] == datum,
+            f"dsm.glb: vertical datum {extras['vertical_datum']!r}, dsm-origin.json's is {datum!r}")
     epsg = out.epsg()
     require(extras["crs"] == f"EPSG:{epsg}", f"dsm.glb: extras crs {extras['crs']!r}, dsm.tif is EPSG:{epsg}")
     t0 = np.array(g.nodes[g.scenes[g.scene or 0].nodes[0]].translation or [0, 0, 0])

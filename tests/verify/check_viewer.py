@@ -107,7 +107,8 @@ def viewer_budget(out):
 def check_viewer_model(out):
     """A build with [geology]: one viewer layer per unit with volume (unit-<name>.ts), named
     after it, each vertex a point of model.vtu (to float32 rounding of the offsets) unless the
-    view is decimated (then inside model.vtu's bounds); the boreholes as points."""
+    view is decimated (then inside model.vtu's bounds); the boreholes' collars as points and
+    their traces as triangles coloured per vertex, in at least two of the units' colours."""
     units = model_units(out)
     if not units:
         return
@@ -134,6 +135,18 @@ def check_viewer_model(out):
     if (out.root / "model.json").is_file() and json.loads((out.root / "model.json").read_text()).get("boreholes"):
         require(holes and holes[0]["kind"] == "points" and holes[0]["vertices"] > 0,
                 "report.html viewer: a model with boreholes but no borehole points")
+        traces = [l for n, l in layers.items() if n.startswith("borehole traces")]
+        require(traces and traces[0]["kind"] == "triangles" and traces[0].get("vertex_colours"),
+                "report.html viewer: a model with boreholes but no borehole traces with vertex colours")
+        t = traces[0]
+        c = np.frombuffer(base64.b64decode(t["vertex_colours"]), dtype=np.uint8)
+        require(c.size == 3 * t["vertices"],
+                f"report.html viewer: borehole traces: {c.size} colour bytes for {t['vertices']} vertices")
+        used = {tuple(int(v) for v in x) for x in c.reshape(-1, 3)}
+        unit_colours = {tuple(l["colour"]) for n, l in layers.items() if n.startswith("unit ")}
+        shown = used & unit_colours
+        require(len(shown) >= min(2, len(unit_colours)),
+                f"report.html viewer: the borehole traces show {len(shown)} of the units' colours")
 
 
 CHECKS = [("report.html: 3D viewer data", check_viewer),

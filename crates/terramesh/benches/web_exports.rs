@@ -1,10 +1,19 @@
-//! GLB and 3D Tiles exports of a 1,002,001-vertex DSM (a smooth synthetic terrain on a
-//! 1001 x 1001 lattice of 10 m cells near Haut-Barr, UTM zone 32N), as `terramesh build`
-//! writes them: `cargo bench -p terramesh --bench web_exports`.
+//! GLB, 3D Tiles and terrain-tile exports of a 1,002,001-vertex DSM (a smooth synthetic
+//! terrain on a 1001 x 1001 lattice of 10 m cells near Haut-Barr, UTM zone 32N), as
+//! `terramesh build` writes them: `cargo bench -p terramesh --bench web_exports`.
+//!
+//! After criterion's samples, each export runs once more and its wall-clock and CPU time
+//! (user + system of the whole process, from `/proc/self/stat`) and the load average are
+//! printed, so that a figure taken on a shared machine says how busy it was.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use std::time::Instant;
+
+use terramesh::georef::Georef;
 use terramesh::gltf::{write_dsm_glb, write_dsm_tileset, Dsm};
+use terramesh_core::coords::GeoidGrid;
 use terramesh_core::geometry::Region;
+use terramesh_io::export::{write_terrain, GeoSurface};
 use terramesh_mesh::{LodSettings, Mesh};
 
 const N: usize = 1001;
@@ -54,10 +63,11 @@ fn lattice() -> (Region, Mesh, Vec<f64>) {
 
 fn bench(c: &mut Criterion) {
     let (region, mesh, z) = lattice();
+    let georef = Georef::utm("32N".parse().expect("a zone"));
     let dsm = Dsm {
         mesh: &mesh,
         z: &z,
-        zone: "32N".parse().expect("a zone"),
+        georef: &georef,
         title: "bench",
     };
     let dir = tempfile::tempdir().expect("a temporary folder");
@@ -77,7 +87,48 @@ fn bench(c: &mut Criterion) {
             .expect("written")
         })
     });
+    // The terrain pyramid to the DSM's resolution, as `build` writes it: WGS-84 positions,
+    // EGM96 to ellipsoidal heights, the surface index, the tiles and layer.json.
+    let terrain = || {
+        let geo: Vec<[f64; 3]> = (0..mesh.points.len())
+            .map(|i| {
+                let p = mesh.absolute(i);
+                let (lat, lon) = georef.to_wgs84(p[0], p[1]).expect("in the zone");
+                [lon, lat, z[i]]
+            })
+            .collect();
+        let (mut sw, mut ne) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for g in &geo {
+            sw = [sw[0].min(g[1]), sw[1].min(g[0])];
+            ne = [ne[0].max(g[1]), ne[1].max(g[0])];
+        }
+        let geoid = GeoidGrid::egm96(sw, ne);
+        let ell: Vec<[f64; 3]> = geo
+            .iter()
+            .map(|g| [g[0], g[1], geoid.ellipsoidal(g[1], g[0], g[2])])
+            .collect();
+        let surface = GeoSurface::new(&ell, &mesh.triangles).expect("a surface");
+        // Mean edge of the lattice's triangles: two 10 m sides and a 14.1 m diagonal.
+        let res = CELL * (2.0 + 2f64.sqrt()) / 3.0;
+        write_terrain(&dir.path().join("terrain"), &surface, res, "bench").expect("written")
+    };
+    g.bench_function("terrain", |b| b.iter(&terrain));
     g.finish();
+    once("glb", || {
+        write_dsm_glb(&dir.path().join("dsm.glb"), &dsm).expect("written");
+    });
+    once("3dtiles", || {
+        write_dsm_tileset(
+            &dir.path().join("3dtiles"),
+            &region,
+            &dsm,
+            &LodSettings::default(),
+        )
+        .expect("written");
+    });
+    once("terrain", || {
+        terrain();
+    });
     let info = write_dsm_tileset(
         &dir.path().join("3dtiles"),
         &region,
@@ -92,6 +143,31 @@ fn bench(c: &mut Criterion) {
         );
     }
     eprintln!("{} tiles, {} contents", info.tiles, info.contents);
+}
+
+/// CPU time (user + system) of this process so far, seconds, from `/proc/self/stat` (Linux;
+/// clock ticks of 1/100 s).
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) in parentheses.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split(' ').collect();
+    let (utime, stime): (f64, f64) = (f.get(11)?.parse().ok()?, f.get(12)?.parse().ok()?);
+    Some((utime + stime) / 100.0)
+}
+
+/// Runs `f` once and prints its wall-clock and CPU seconds and the 1-minute load average.
+fn once(name: &str, f: impl FnOnce()) {
+    let (t0, c0) = (Instant::now(), cpu_seconds());
+    f();
+    let wall = t0.elapsed().as_secs_f64();
+    let cpu = c0.zip(cpu_seconds()).map(|(a, b)| b - a);
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    eprintln!(
+        "once {name}: wall {wall:.2} s, cpu {} s, load average {}",
+        cpu.map_or("?".into(), |c| format!("{c:.2}")),
+        load.split(' ').next().unwrap_or("?")
+    );
 }
 
 criterion_group!(benches, bench);

@@ -1,19 +1,19 @@
-//! The DSM for the web: `dsm.glb` (glTF 2.0 binary in the DSM's own UTM coordinates and
-//! elevations, around a recorded origin) and a Cesium 3D Tiles 1.1 tileset (a level-of-detail
-//! tree placed on the WGS-84 ellipsoid, in ellipsoidal heights).
+//! The DSM for the web: `dsm.glb` (glTF 2.0 binary in the DSM's own coordinates, UTM or the
+//! project's CRS, and elevations, around a recorded origin) and a Cesium 3D Tiles 1.1 tileset (a
+//! level-of-detail tree placed on the WGS-84 ellipsoid, in ellipsoidal heights).
 //!
 //! DEM elevations (SRTM) are above the EGM96 geoid; Cesium places 3D Tiles on the ellipsoid.
 //! The tileset adds the EGM96 undulation (`terramesh_core::coords::GeoidGrid`) to every
 //! height; `dsm.glb`, like every other export, keeps the DSM's own elevations. Each file's
-//! `extras` names its vertical datum.
+//! `extras` names its vertical datum. A project in its own CRS ([`Georef::Crs`]) reaches
+//! WGS-84 longitude and latitude through `terramesh_crs`; its elevations are its inputs' own,
+//! taken as above mean sea level (the EGM96 geoid) for the tileset, as its `extras` say.
 
 use std::path::Path;
 
 use rayon::prelude::*;
 use serde_json::json;
-use terramesh_core::coords::{
-    geodetic_to_ecef, to_wgs84, GeoidGrid, LocalEnu, VerticalDatum, Zone,
-};
+use terramesh_core::coords::{geodetic_to_ecef, GeoidGrid, LocalEnu, VerticalDatum};
 use terramesh_core::geometry::Region;
 use terramesh_io::export::tiles3d::{write_tileset, Tile, TileContent, TilesetOptions};
 use terramesh_io::export::{elevation_colours, write_glb, GlbMesh, GlbOptions};
@@ -22,17 +22,19 @@ use terramesh_io::output::Output;
 use terramesh_mesh::{lod_tree, LodLevel, LodSettings, LodTile, Mesh};
 
 use crate::error::{Context, Result};
+use crate::georef::Georef;
 
 /// A DSM to export: its mesh, one elevation per vertex (above the EGM96 geoid, as the DEM
-/// gives them), its UTM zone and a title naming the meshes.
+/// gives them, or as the inputs of a project in its own CRS give them), its CRS and a title
+/// naming the meshes.
 #[derive(Debug, Clone, Copy)]
 pub struct Dsm<'a> {
-    /// The mesh (UTM metres around its origin).
+    /// The mesh (metres of the CRS around its origin).
     pub mesh: &'a Mesh,
-    /// Elevation of each vertex, metres above the EGM96 geoid.
+    /// Elevation of each vertex ([`Georef::heights`]).
     pub z: &'a [f64],
-    /// The mesh's UTM zone.
-    pub zone: Zone,
+    /// The mesh's CRS: a UTM zone or a named projected CRS.
+    pub georef: &'a Georef,
     /// Names the meshes and nodes.
     pub title: &'a str,
 }
@@ -69,18 +71,20 @@ fn centre_low(v: &[[f64; 3]]) -> [f64; 3] {
 }
 
 /// Writes `path` (normally `dsm.glb`) atomically: one mesh named after the title, vertices in
-/// UTM metres and DSM elevations relative to the origin (the centre of the bounding box at
+/// the CRS's metres and DSM elevations relative to the origin (the centre of the bounding box at
 /// the lowest elevation) that the root node's translation holds, colours of the report's
 /// elevation map; `extras` with the CRS, origin, units and vertical datum.
 ///
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use terramesh::gltf::{write_dsm_glb, Dsm};
+/// use terramesh::georef::Georef;
 /// use terramesh_mesh::Mesh;
 /// let mesh = Mesh { origin: [377_000.0, 5_397_000.0], points: vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]],
 ///                   triangles: vec![[0, 1, 2]], constraint_edges: vec![] };
 /// let dir = tempfile::tempdir()?;
-/// let dsm = Dsm { mesh: &mesh, z: &[350.0, 352.0, 351.0], zone: "32N".parse()?, title: "dsm" };
+/// let georef = Georef::utm("32N".parse()?);
+/// let dsm = Dsm { mesh: &mesh, z: &[350.0, 352.0, 351.0], georef: &georef, title: "dsm" };
 /// let origin = write_dsm_glb(&dir.path().join("dsm.glb"), &dsm)?;
 /// assert_eq!(origin, [377_005.0, 5_397_005.0, 350.0]);
 /// # Ok(()) }
@@ -100,11 +104,11 @@ pub fn write_dsm_glb(path: &Path, dsm: &Dsm) -> Result<[f64; 3]> {
         name: dsm.title,
         origin,
         extras: json!({
-            "crs": format!("EPSG:{}", dsm.zone.epsg()),
-            "crs_name": format!("WGS 84 / UTM zone {}", dsm.zone),
+            "crs": dsm.georef.crs_code(),
+            "crs_name": dsm.georef.crs_name(),
             "units": "metre",
-            "vertical_datum": VerticalDatum::Egm96.to_string(),
-            "heights": VerticalDatum::Egm96.describe(),
+            "vertical_datum": dsm.georef.vertical_datum(),
+            "heights": dsm.georef.heights(),
             "colours": "COLOR_0: the report's elevation colour map (terrain), linear RGB",
         }),
     };
@@ -141,6 +145,7 @@ pub struct TilesetInfo {
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use terramesh::gltf::{write_dsm_tileset, Dsm};
+/// use terramesh::georef::Georef;
 /// use terramesh_core::geometry::Region;
 /// use terramesh_mesh::{adaptive_mesh, AdaptiveSettings, LodSettings};
 /// let (x0, y0) = (377_000.0, 5_397_000.0);
@@ -148,7 +153,8 @@ pub struct TilesetInfo {
 /// let hill = |x: f64, y: f64| 300.0 + 40.0 * (-((x - x0 - 150.0).powi(2) + (y - y0 - 90.0).powi(2)) / 5000.0).exp();
 /// let (mesh, z, _) = adaptive_mesh(&r, &AdaptiveSettings::new(0.1), &hill)?;
 /// let dir = tempfile::tempdir()?;
-/// let dsm = Dsm { mesh: &mesh, z: &z, zone: "32N".parse()?, title: "hill" };
+/// let georef = Georef::utm("32N".parse()?);
+/// let dsm = Dsm { mesh: &mesh, z: &z, georef: &georef, title: "hill" };
 /// let info = write_dsm_tileset(&dir.path().join("3dtiles"), &r, &dsm, &LodSettings::default())?;
 /// assert_eq!(info.levels.len(), 3);
 /// assert!((info.undulation - 48.6).abs() < 1.0);
@@ -162,7 +168,7 @@ pub fn write_dsm_tileset(
     settings: &LodSettings,
 ) -> Result<TilesetInfo> {
     let (root, levels) = lod_tree(region, dsm.mesh, dsm.z, settings).context("3D Tiles")?;
-    let zone = dsm.zone;
+    let georef = dsm.georef;
     let abs = dsm.absolute();
     // Geodetic extent of the DSM, for the geoid grid and the origin.
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -179,19 +185,19 @@ pub fn write_dsm_tileset(
         (c[0], y0),
         (c[0], y1),
     ] {
-        let (lat, lon) = to_wgs84(x, y, zone)?;
+        let (lat, lon) = georef.to_wgs84(x, y)?;
         (lo, hi) = (
             [lo[0].min(lat), lo[1].min(lon)],
             [hi[0].max(lat), hi[1].max(lon)],
         );
     }
     let geoid = GeoidGrid::egm96(lo, hi);
-    let (lat0, lon0) = to_wgs84(c[0], c[1], zone)?;
+    let (lat0, lon0) = georef.to_wgs84(c[0], c[1])?;
     let n0 = geoid.undulation(lat0, lon0);
     let h0 = c[2] + n0;
     let frame = LocalEnu::new(lat0, lon0, h0);
     let (zlo, zhi) = dsm.range();
-    let tile = convert(&root, &frame, &geoid, zone, (zlo, zhi))?;
+    let tile = convert(&root, &frame, &geoid, georef, (zlo, zhi))?;
     let transform = enu_to_ecef(lat0, lon0, h0);
     let opts = TilesetOptions {
         transform,
@@ -202,10 +208,10 @@ pub fn write_dsm_tileset(
             "origin": { "latitude": lat0, "longitude": lon0, "ellipsoidal_height": h0 },
             "vertical_datum": VerticalDatum::Ellipsoid.to_string(),
             "heights": VerticalDatum::Ellipsoid.describe(),
-            "geoid": "EGM96 (degree 360), ellipsoidal = DSM elevation + undulation",
+            "geoid": format!("EGM96 (degree 360), {}", georef.ellipsoidal_note()),
             "undulation_at_origin": n0,
-            "source_crs": format!("EPSG:{}", zone.epsg()),
-            "source_vertical_datum": VerticalDatum::Egm96.to_string(),
+            "source_crs": georef.crs_code(),
+            "source_vertical_datum": georef.vertical_datum(),
             "units": "metre",
         }),
     };
@@ -230,14 +236,14 @@ fn convert(
     t: &LodTile,
     frame: &LocalEnu,
     geoid: &GeoidGrid,
-    zone: Zone,
+    georef: &Georef,
     range: (f64, f64),
 ) -> Result<Tile> {
     let vertices = t
         .vertices
         .par_iter()
         .map(|v| -> Result<[f64; 3]> {
-            let (lat, lon) = to_wgs84(v[0], v[1], zone)?;
+            let (lat, lon) = georef.to_wgs84(v[0], v[1])?;
             Ok(frame.to_enu(lat, lon, geoid.ellipsoidal(lat, lon, v[2])))
         })
         .collect::<Result<Vec<_>>>()?;
@@ -250,7 +256,7 @@ fn convert(
     let children = t
         .children
         .iter()
-        .map(|c| convert(c, frame, geoid, zone, range))
+        .map(|c| convert(c, frame, geoid, georef, range))
         .collect::<Result<_>>()?;
     Ok(Tile {
         address: t.address,

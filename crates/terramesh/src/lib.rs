@@ -49,6 +49,7 @@ pub mod build;
 pub mod convert;
 pub mod fitting;
 pub mod geology;
+pub mod georef;
 pub mod gltf;
 pub mod horizon;
 pub mod interpolate;

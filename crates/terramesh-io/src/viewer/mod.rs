@@ -1,14 +1,14 @@
 //! The interactive 3D viewer of `report.html`: a scene of named layers (the DSM surface, the
-//! sealed solid's sides and base, the samples as points; later geological units and
-//! boreholes), embedded compactly in the page and drawn by a small WebGL 2 viewer of our own.
+//! sealed solid's sides and base, the samples as points; the geological units, capped where
+//! the cross-section cuts them, and the boreholes as traces coloured by logged unit), embedded compactly in the page and drawn by a small WebGL 2 viewer of our own.
 //!
 //! **Why our own viewer and not three.js.** The page must stay one file that works offline.
 //! three.js r170's minified module build is 691,648 bytes and its `OrbitControls.js` 32,134
 //! (`npm pack three@0.170.0`; r187 ships no minified module build), and one HTML file can only
 //! load it through an import map with a data: URL, base64, a third larger again. Everything
 //! this viewer needs (orbit, pan, zoom, a vertical exaggeration, colour maps, flat shading,
-//! points, a clipping plane, a cursor readout by ray casting) is one script of about 20 KB,
-//! [`VIEWER_JS`], with nothing to vendor, pin or update. Sizes measured on the example are in
+//! points, a clipping plane with the cut faces of closed layers filled, a cursor readout by ray
+//! casting) is one script of about 23 KB, [`VIEWER_JS`], with nothing to vendor, pin or update. Sizes measured on the example are in
 //! `docs/report.md`.
 //!
 //! **Data.** Positions are written as little-endian `Float32` relative to an origin (the centre
@@ -75,6 +75,12 @@ pub struct Layer {
     pub pickable: bool,
     /// Cut by the cross-section plane.
     pub clipped: bool,
+    /// A closed surface (a unit's body): where the cross-section cuts it, the cut face is
+    /// filled with [`Layer::colour`] (a cap, drawn with the stencil buffer).
+    pub closed: bool,
+    /// One colour (RGB) per position, used instead of the fields and [`Layer::colour`] (e.g.
+    /// borehole traces in the colour of each logged unit); `None` for none.
+    pub vertex_colours: Option<Vec<[u8; 3]>>,
 }
 
 /// A scene for the viewer.
@@ -84,6 +90,9 @@ pub struct Scene {
     pub crs: String,
     /// A note shown under the view (e.g. that the surface is decimated, and to what).
     pub note: Option<String>,
+    /// What the elevations are above, said after each elevation of the readout (e.g.
+    /// `above the EGM96 geoid (EPSG:5773)`); empty for nothing.
+    pub heights: String,
     /// Layers, drawn in order.
     pub layers: Vec<Layer>,
 }
@@ -92,6 +101,16 @@ pub struct Scene {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SceneError {
+    /// A layer's vertex colours are not one per position.
+    #[error("viewer layer {layer:?}: {colours} vertex colours for {positions} positions")]
+    ColourLength {
+        /// The layer.
+        layer: String,
+        /// Colours given.
+        colours: usize,
+        /// Positions of the layer.
+        positions: usize,
+    },
     /// A layer's field has a different number of values than the layer has positions.
     #[error(
         "viewer layer {layer:?}: field {field:?} has {values} values for {positions} positions"
@@ -171,6 +190,13 @@ impl Scene {
                         });
                     }
                 }
+            }
+            if let Some(c) = l.vertex_colours.as_ref().filter(|c| c.len() != n) {
+                return Err(SceneError::ColourLength {
+                    layer: l.name.clone(),
+                    colours: c.len(),
+                    positions: n,
+                });
             }
             for f in &l.fields {
                 if f.values.len() != n {
@@ -291,6 +317,10 @@ impl Scene {
                     .iter()
                     .map(|f| (f.key.clone(), json!(f32_base64(f.values.iter().copied()))))
                     .collect();
+                let colours: Option<String> = l
+                    .vertex_colours
+                    .as_ref()
+                    .map(|c| base64(&c.iter().flatten().copied().collect::<Vec<u8>>()));
                 json!({
                     "name": l.name,
                     "kind": kind,
@@ -303,12 +333,15 @@ impl Scene {
                     "visible": l.visible,
                     "pickable": l.pickable,
                     "clipped": l.clipped,
+                    "closed": l.closed,
+                    "vertex_colours": colours,
                 })
             })
             .collect();
         let scene = json!({
             "crs": self.crs,
             "note": self.note,
+            "heights": self.heights,
             "origin": o,
             "fields": fields,
             "layers": layers,
@@ -328,6 +361,7 @@ impl Scene {
     /// let scene = Scene {
     ///     crs: "WGS 84 / UTM zone 32N".into(),
     ///     note: None,
+    ///     heights: "above the EGM96 geoid (EPSG:5773)".into(),
     ///     layers: vec![Layer {
     ///         name: "DSM surface".into(),
     ///         fields: vec![Field {
@@ -343,6 +377,8 @@ impl Scene {
     ///         visible: true,
     ///         pickable: true,
     ///         clipped: true,
+    ///         closed: false,
+    ///         vertex_colours: None,
     ///     }],
     /// };
     /// let html = scene.to_html()?;
@@ -389,6 +425,8 @@ mod tests {
             visible: true,
             pickable: true,
             clipped: false,
+            closed: false,
+            vertex_colours: None,
         }
     }
 
@@ -448,6 +486,26 @@ mod tests {
     }
 
     #[test]
+    fn vertex_colours_are_three_bytes_a_position() {
+        let mut l = tri_layer();
+        l.vertex_colours = Some(vec![[10, 20, 30], [40, 50, 60], [70, 80, 90]]);
+        let v: Value = serde_json::from_str(
+            &Scene {
+                layers: vec![l],
+                ..Scene::default()
+            }
+            .to_json()
+            .unwrap(),
+        )
+        .unwrap();
+        assert_eq!(
+            decode(v["layers"][0]["vertex_colours"].as_str().unwrap()),
+            vec![10, 20, 30, 40, 50, 60, 70, 80, 90]
+        );
+        assert_eq!(v["layers"][0]["closed"], json!(false));
+    }
+
+    #[test]
     fn diverging_ranges_are_symmetric_and_shared_across_layers() {
         let mut b = tri_layer();
         b.fields[0].values = vec![-3.0, 0.0, 0.0];
@@ -497,6 +555,15 @@ mod tests {
             .validate(),
             Err(SceneError::NotFinite { index: 1, .. })
         ));
+        let mut l = tri_layer();
+        l.vertex_colours = Some(vec![[1, 2, 3]; 2]);
+        let e = Scene {
+            layers: vec![l],
+            ..Scene::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.to_string().contains("2 vertex colours for 3"), "{e}");
         assert_eq!(Scene::default().validate(), Err(SceneError::Empty));
     }
 

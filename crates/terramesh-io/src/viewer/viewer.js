@@ -1,7 +1,8 @@
 // The 3D viewer of terramesh's report.html (WebGL 2, no dependencies). It reads the scene
 // from <script id="tmv-data"> (written by terramesh_io::viewer::Scene::to_json) and builds
 // its controls inside <div id="tmv">: a toggle per layer, colour by field, vertical
-// exaggeration, a cross-section plane, and a readout of the point under the cursor.
+// exaggeration, a cross-section plane (closed layers, the geological units, get their cut
+// faces filled in their colour: stencil capping), and a readout of the point under the cursor.
 (function () {
   "use strict";
   var root = document.getElementById("tmv");
@@ -57,6 +58,12 @@
   el("option", { value: "0" }, clipAxis, "north-south plane");
   el("option", { value: "1" }, clipAxis, "east-west plane");
   var clipPos = el("input", { id: "tmv-clip-pos", type: "range", min: "0", max: "1000", value: "500", "aria-label": "cross-section position" }, g4);
+  var anyClosed = scene.layers.some(function (l) { return l.closed; });
+  var capLab = el("label", {}, g4);
+  var capCb = el("input", { id: "tmv-cap", type: "checkbox" }, capLab);
+  capCb.checked = true;
+  capLab.appendChild(document.createTextNode(" fill cut units"));
+  if (!anyClosed) capLab.style.display = "none";
   var resetBtn = el("button", { id: "tmv-reset", type: "button" }, bar, "Reset view");
 
   var wrap = el("div", { "class": "tmv-wrap" }, root);
@@ -68,7 +75,7 @@
     "Drag: orbit. Shift-drag or right-drag: pan. Wheel: zoom. The still pictures below are for printing.");
   if (scene.note) el("p", { "class": "tmv-note", id: "tmv-note" }, root, scene.note);
 
-  var gl = canvas.getContext("webgl2", { antialias: true, preserveDrawingBuffer: true });
+  var gl = canvas.getContext("webgl2", { antialias: true, preserveDrawingBuffer: true, stencil: true });
   if (!gl) {
     bar.style.display = "none";
     wrap.style.display = "none";
@@ -79,18 +86,19 @@
 
   // ---------------------------------------------------------------- GL programs and buffers
   var VS = "#version 300 es\n" +
-    "in vec3 a_pos; in float a_val; uniform mat4 u_mvp; uniform float u_exag; uniform float u_psize;\n" +
-    "out vec3 v_world; out float v_val;\n" +
-    "void main(){ vec3 p = vec3(a_pos.xy, a_pos.z * u_exag); v_world = p; v_val = a_val;\n" +
+    "in vec3 a_pos; in float a_val; in vec3 a_col; uniform mat4 u_mvp; uniform float u_exag; uniform float u_psize;\n" +
+    "out vec3 v_world; out float v_val; out vec3 v_col;\n" +
+    "void main(){ vec3 p = vec3(a_pos.xy, a_pos.z * u_exag); v_world = p; v_val = a_val; v_col = a_col;\n" +
     "  gl_Position = u_mvp * vec4(p, 1.0); gl_PointSize = u_psize; }\n";
   var FS = "#version 300 es\nprecision highp float;\n" +
-    "in vec3 v_world; in float v_val; uniform sampler2D u_cmap; uniform vec2 u_range;\n" +
+    "in vec3 v_world; in float v_val; in vec3 v_col; uniform sampler2D u_cmap; uniform vec2 u_range;\n" +
     "uniform int u_byField; uniform vec3 u_colour; uniform vec3 u_clip; uniform int u_clipOn;\n" +
-    "uniform int u_points; uniform vec3 u_light; out vec4 o;\n" +
+    "uniform int u_points; uniform int u_vcol; uniform int u_cap; uniform vec3 u_light; out vec4 o;\n" +
     "void main(){\n" +
+    "  if (u_cap == 1) { o = vec4(u_colour, 1.0); return; }\n" +
     "  if (u_clipOn == 1 && dot(u_clip.xy, v_world.xy) > u_clip.z) discard;\n" +
     "  float t = clamp((v_val - u_range.x) / (u_range.y - u_range.x), 0.0, 1.0);\n" +
-    "  vec3 c = u_byField == 1 ? texture(u_cmap, vec2(t * 255.0 / 256.0 + 0.5 / 256.0, 0.5)).rgb : u_colour;\n" +
+    "  vec3 c = u_vcol == 1 ? v_col : u_byField == 1 ? texture(u_cmap, vec2(t * 255.0 / 256.0 + 0.5 / 256.0, 0.5)).rgb : u_colour;\n" +
     "  if (u_points == 1) { vec2 d = gl_PointCoord - 0.5; float r = dot(d, d);\n" +
     "    if (r > 0.25) discard; o = vec4(r > 0.12 ? vec3(0.1) : c, 1.0); return; }\n" +
     "  vec3 n = normalize(cross(dFdx(v_world), dFdy(v_world)));\n" +
@@ -109,11 +117,12 @@
   gl.attachShader(prog, shader(gl.FRAGMENT_SHADER, FS));
   gl.bindAttribLocation(prog, 0, "a_pos");
   gl.bindAttribLocation(prog, 1, "a_val");
+  gl.bindAttribLocation(prog, 2, "a_col");
   gl.linkProgram(prog);
   if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
   var U = {};
   ["u_mvp", "u_exag", "u_psize", "u_cmap", "u_range", "u_byField", "u_colour", "u_clip",
-    "u_clipOn", "u_points", "u_light"].forEach(function (n) { U[n] = gl.getUniformLocation(prog, n); });
+    "u_clipOn", "u_points", "u_vcol", "u_cap", "u_light"].forEach(function (n) { U[n] = gl.getUniformLocation(prog, n); });
 
   // One 256 x 1 texture per field: its anchors interpolated linearly, as ColourMap::at does.
   var cmaps = {};
@@ -138,7 +147,8 @@
   var layers = scene.layers.map(function (l) {
     var pos = new Float32Array(bytes(l.positions));
     var L = { name: l.name, kind: l.kind, pos: pos, n: l.vertices, colour: l.colour.map(function (c) { return c / 255; }),
-      pickable: l.pickable, clipped: l.clipped, fields: {}, vbufs: {}, count: 0 };
+      pickable: l.pickable, clipped: l.clipped, closed: l.closed, vcol: !!l.vertex_colours,
+      fields: {}, vbufs: {}, count: 0 };
     for (var i = 0; i < pos.length; i += 3) {
       for (var k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], pos[i + k]); hi[k] = Math.max(hi[k], pos[i + k]); }
     }
@@ -149,6 +159,13 @@
     gl.bufferData(gl.ARRAY_BUFFER, pos, gl.STATIC_DRAW);
     gl.enableVertexAttribArray(0);
     gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+    if (l.vertex_colours) {
+      var cb2 = gl.createBuffer();
+      gl.bindBuffer(gl.ARRAY_BUFFER, cb2);
+      gl.bufferData(gl.ARRAY_BUFFER, new Uint8Array(bytes(l.vertex_colours)), gl.STATIC_DRAW);
+      gl.enableVertexAttribArray(2);
+      gl.vertexAttribPointer(2, 3, gl.UNSIGNED_BYTE, true, 0, 0);
+    }
     if (l.kind === "triangles") {
       L.idx = new Uint32Array(bytes(l.indices));
       var ib = gl.createBuffer();
@@ -170,6 +187,22 @@
     return L;
   });
   var radius = 0.5 * Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-3);
+  // The cap: a rectangle in the cross-section plane over the scene's box, redrawn per layer.
+  var capVao = gl.createVertexArray(), capBuf = gl.createBuffer();
+  gl.bindVertexArray(capVao);
+  gl.bindBuffer(gl.ARRAY_BUFFER, capBuf);
+  gl.bufferData(gl.ARRAY_BUFFER, 12 * 4, gl.DYNAMIC_DRAW);
+  gl.enableVertexAttribArray(0);
+  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+  gl.bindVertexArray(null);
+  function capQuad(plane) {
+    var m = 0.01 * radius, z0 = lo[2] - m, z1 = hi[2] + m, d = plane[2];
+    var q = plane[0] === 1
+      ? [d, lo[1] - m, z0, d, hi[1] + m, z0, d, hi[1] + m, z1, d, lo[1] - m, z1]
+      : [lo[0] - m, d, z0, hi[0] + m, d, z0, hi[0] + m, d, z1, lo[0] - m, d, z1];
+    gl.bindBuffer(gl.ARRAY_BUFFER, capBuf);
+    gl.bufferSubData(gl.ARRAY_BUFFER, 0, new Float32Array(q));
+  }
 
   // ---------------------------------------------------------------- camera
   var FOV = 40 * Math.PI / 180;
@@ -269,13 +302,55 @@
       gl.uniform3fv(U.u_colour, L.colour);
       gl.uniform1i(U.u_clipOn, clipCb.checked && L.clipped ? 1 : 0);
       gl.uniform1i(U.u_points, L.kind === "points" ? 1 : 0);
+      gl.uniform1i(U.u_vcol, L.vcol ? 1 : 0);
+      gl.uniform1i(U.u_cap, 0);
       if (L.kind === "points") gl.drawArrays(gl.POINTS, 0, L.count);
       else gl.drawElements(gl.TRIANGLES, L.count, gl.UNSIGNED_INT, 0);
     });
+    if (clipCb.checked && capCb.checked) drawCaps();
     gl.bindVertexArray(null);
     frames += 1;
     root.setAttribute("data-frames", String(frames));
     root.setAttribute("data-ready", "1");
+  }
+  // Stencil capping: for each shown closed layer, its clipped triangles count into the stencil
+  // buffer (+1 back faces, -1 front faces, no depth test): along a pixel's ray, the part of a
+  // closed surface on the kept side of the plane leaves a non-zero count exactly where the
+  // plane lies inside the body. The plane's rectangle is then drawn there, depth-tested, in
+  // the layer's colour, unshaded: the cut face filled.
+  function drawCaps() {
+    var plane = clipPlane();
+    capQuad(plane);
+    gl.uniform1i(U.u_byField, 0);
+    gl.uniform1i(U.u_points, 0);
+    gl.uniform1i(U.u_vcol, 0);
+    gl.enable(gl.STENCIL_TEST);
+    layers.forEach(function (L, i) {
+      if (!L.closed || !L.clipped || !layerInputs[i].checked || L.kind !== "triangles") return;
+      gl.clear(gl.STENCIL_BUFFER_BIT);
+      gl.colorMask(false, false, false, false);
+      gl.depthMask(false);
+      gl.disable(gl.DEPTH_TEST);
+      gl.stencilFunc(gl.ALWAYS, 0, 0xff);
+      gl.stencilOpSeparate(gl.FRONT, gl.KEEP, gl.KEEP, gl.DECR_WRAP);
+      gl.stencilOpSeparate(gl.BACK, gl.KEEP, gl.KEEP, gl.INCR_WRAP);
+      gl.uniform1i(U.u_cap, 0);
+      gl.uniform1i(U.u_clipOn, 1);
+      gl.bindVertexArray(L.vao);
+      gl.drawElements(gl.TRIANGLES, L.count, gl.UNSIGNED_INT, 0);
+      gl.colorMask(true, true, true, true);
+      gl.depthMask(true);
+      gl.enable(gl.DEPTH_TEST);
+      gl.stencilFunc(gl.NOTEQUAL, 0, 0xff);
+      gl.stencilOp(gl.KEEP, gl.KEEP, gl.KEEP);
+      gl.uniform1i(U.u_cap, 1);
+      gl.uniform1i(U.u_clipOn, 0);
+      gl.uniform3fv(U.u_colour, L.colour);
+      gl.bindVertexArray(capVao);
+      gl.drawArrays(gl.TRIANGLE_FAN, 0, 4);
+    });
+    gl.disable(gl.STENCIL_TEST);
+    gl.uniform1i(U.u_cap, 0);
   }
   function redraw() {
     if (!pending) { pending = true; requestAnimationFrame(draw); }
@@ -333,7 +408,7 @@
       return hit.w[0] * P[3 * hit.tri[0] + k] + hit.w[1] * P[3 * hit.tri[1] + k] + hit.w[2] * P[3 * hit.tri[2] + k] + origin[k];
     });
     var parts = ["E " + c[0].toFixed(2) + " m, N " + c[1].toFixed(2) + " m (" + scene.crs + ")",
-      "elevation " + c[2].toFixed(2) + " m"];
+      "elevation " + c[2].toFixed(2) + " m" + (scene.heights ? " " + scene.heights : "")];
     Object.keys(hit.layer.fields).forEach(function (k) {
       if (k === "elevation") return;
       parts.push(scene.fields[k].label + " " + at(hit.layer.fields[k], hit).toFixed(3) + " " + scene.fields[k].unit);
@@ -381,7 +456,7 @@
   layerInputs.forEach(function (cb) { cb.addEventListener("change", redraw); });
   fieldSel.addEventListener("change", function () { legendUpdate(); redraw(); });
   exagIn.addEventListener("input", function () { exagOut.textContent = exag() + "x"; redraw(); });
-  [clipCb, clipAxis, clipPos].forEach(function (c) { c.addEventListener("input", redraw); c.addEventListener("change", redraw); });
+  [clipCb, clipAxis, clipPos, capCb].forEach(function (c) { c.addEventListener("input", redraw); c.addEventListener("change", redraw); });
   resetBtn.addEventListener("click", function () { resetCamera(); redraw(); });
   window.addEventListener("resize", redraw);
   canvas.addEventListener("webglcontextlost", function (ev) {

@@ -4,7 +4,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Context, Result};
-use terramesh_core::coords::{to_wgs84, LocalEnu, Zone};
+use rayon::prelude::*;
+use terramesh_core::coords::LocalEnu;
 use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_core::vocab::Named;
 use terramesh_geostat::{CandidateEntry, VariogramFile};
@@ -19,6 +20,7 @@ use terramesh_io::output::Output;
 use terramesh_mesh::{triangle_quality, Quality};
 
 use super::stages::{Interpolated, Meshed, Samples};
+use crate::georef::Georef;
 use crate::project::Project;
 
 /// What was written, for the report.
@@ -71,7 +73,7 @@ fn write_dae(
     abs: &[[f64; 3]],
     geo: &[[f64; 3]],
     tris: &[[u32; 3]],
-    zone: Zone,
+    georef: &Georef,
     title: &str,
 ) -> Result<Vec<PathBuf>> {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -81,7 +83,7 @@ fn write_dae(
             hi[k] = hi[k].max(q[k]);
         }
     }
-    let (lat0, lon0) = to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), zone)?;
+    let (lat0, lon0) = georef.to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))?;
     let frame = LocalEnu::new(lat0, lon0, lo[2]);
     let enu: Vec<[f64; 3]> = geo.iter().map(|g| frame.to_enu(g[1], g[0], g[2])).collect();
     let dae = atomic(&out.join("dsm.dae"), |w| {
@@ -204,29 +206,33 @@ pub fn write_all(
     }
     let title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
     // Geographic exports need WGS-84 positions: a UTM project's, converted exactly; a project
-    // in its own CRS gets none of them (refused, not approximated).
+    // in a named CRS's, through terramesh_crs; a project in an unnamed CRS gets none of them
+    // (refused, not approximated).
     let web: Vec<&str> = ["kml", "dae", "glb", "3dtiles", "terrain"]
         .into_iter()
         .filter(|f| want(f))
         .collect();
-    if zone.is_none() && !web.is_empty() {
-        crate::error::bail!(
-            "export.formats: {} need geographic (WGS-84) positions, which terramesh gives only \
-             for projects in latitude/longitude (worked in UTM); this project is in {}: remove \
-             them from export.formats, e.g. formats = [\"vtu\", \"obj\", \"ply\", \"stl\", \"ts\", \
-             \"msh\", \"dxf\"]",
+    let georef = match (zone, &s.crs) {
+        _ if web.is_empty() => None,
+        (Some(z), _) => Some(Georef::utm(z)),
+        (None, Some(c)) => Some(Georef::crs(c, "region.crs")?),
+        (None, None) => crate::error::bail!(
+            "export.formats: {} need geographic (WGS-84) positions, and this project is in {} \
+             (region.crs = \"projected\"), which terramesh cannot place on the Earth: name the \
+             CRS with region.crs = \"EPSG:<code>\", or remove them from export.formats, e.g. \
+             formats = [\"vtu\", \"obj\", \"ply\", \"stl\", \"ts\", \"msh\", \"dxf\"]",
             web.join(", "),
             s.crs_name()
-        );
-    }
-    if let Some(zone) = zone {
+        ),
+    };
+    if let Some(georef) = &georef {
         let geo: Vec<[f64; 3]> = if want("kml") || want("dae") || want("terrain") {
-            abs.iter()
+            abs.par_iter()
                 .map(|q| {
-                    let (lat, lon) = to_wgs84(q[0], q[1], zone)?;
+                    let (lat, lon) = georef.to_wgs84(q[0], q[1])?;
                     Ok([lon, lat, q[2]])
                 })
-                .collect::<Result<_, terramesh_core::coords::CoordError>>()?
+                .collect::<Result<_>>()?
         } else {
             Vec::new()
         };
@@ -244,12 +250,12 @@ pub fn write_all(
             })?);
         }
         if want("dae") {
-            files.extend(write_dae(out, &abs, &geo, tris, zone, &title)?);
+            files.extend(write_dae(out, &abs, &geo, tris, georef, &title)?);
         }
         let dsm = crate::gltf::Dsm {
             mesh,
             z: &it.dsm,
-            zone,
+            georef,
             title: &title,
         };
         if want("glb") {
@@ -286,7 +292,11 @@ pub fn write_all(
                  metadata): metres above the EGM96 geoid (EPSG:5773), the DEM's own"
                     .to_string()
             } else {
-                p.height_datum().describe()
+                format!(
+                    "every file here but 3dtiles/ and terrain/ (WGS-84 ellipsoidal, the \
+                     elevations taken as above the EGM96 geoid, see their metadata): {}",
+                    p.height_datum().describe()
+                )
             },
             if zone.is_some() { "UTM" } else { "project" }
         )

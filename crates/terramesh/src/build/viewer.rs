@@ -1,6 +1,7 @@
 //! The scene of the 3D viewer in `report.html` (`terramesh_io::viewer`): the DSM surface
 //! coloured by elevation, kriging standard deviation or UK minus IDW; the sealed solid's sides
-//! and base; the samples as points. Geological units and boreholes become further layers.
+//! and base; the samples as points; with `[geology]`, the units (capped where the
+//! cross-section cuts them) and the boreholes (traces and collars) as further layers.
 //!
 //! A DSM of more than [`VIEWER_VERTICES`] vertices is shown decimated: the adaptive mesher
 //! (`terramesh_mesh::adaptive_mesh`) meshes the region again against the DSM itself (a
@@ -124,6 +125,8 @@ pub fn scene(
         visible: true,
         pickable: true,
         clipped: true,
+        closed: false,
+        vertex_colours: None,
     };
     let solid = Layer {
         name: format!("solid sides and base ({base:.1} m)"),
@@ -134,6 +137,8 @@ pub fn scene(
         visible: geo.is_none(),
         pickable: false,
         clipped: true,
+        closed: false,
+        vertex_colours: None,
     };
     let stride = s.xyz.len().div_ceil(VIEWER_SAMPLES).max(1);
     let pts: Vec<[f64; 3]> = s.xyz.iter().step_by(stride).copied().collect();
@@ -157,9 +162,16 @@ pub fn scene(
         visible: false,
         pickable: false,
         clipped: true,
+        closed: false,
+        vertex_colours: None,
     };
     Ok(Scene {
         crs: s.crs_name(),
+        heights: if s.zone.is_some() {
+            "above the EGM96 geoid (EPSG:5773)".into()
+        } else {
+            "as the project's inputs give it (their vertical datum, not converted)".into()
+        },
         note: (!notes.is_empty()).then(|| notes.join(" ")),
         layers: [vec![surface, solid, samples], model_layers].concat(),
     })

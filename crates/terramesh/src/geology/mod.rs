@@ -9,4 +9,5 @@ pub mod report;
 pub mod section;
 pub mod stage;
 pub mod summary;
+mod traces;
 pub mod web;

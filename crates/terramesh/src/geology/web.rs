@@ -7,11 +7,13 @@ use std::path::Path;
 
 use serde_json::json;
 use terramesh_core::volume::VolumeMesh;
+use terramesh_io::boreholes::Hole;
 use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
 use terramesh_io::output::Output;
 use terramesh_io::pictures::unit_colour;
 use terramesh_io::viewer::{Geometry, Layer};
 
+use super::traces::{borehole_traces, STUB_FRACTION_PERCENT, TRACE_RADIUS, UNLOGGED};
 use crate::build::viewer::compact;
 use crate::error::{bail, Context, Result};
 
@@ -280,8 +282,9 @@ pub fn unit_shells(xy: &[[f64; 2]], tris: &[[u32; 3]], surfaces: &[Vec<f64>]) ->
 
 /// The viewer's layers of the model drawn on the planar mesh `positions`/`triangles` (the
 /// DSM's, or the viewer's decimated copy) with `stack` (terrain, tops, base at its vertices):
-/// one toggleable layer per unit with thickness ([`unit_shells`], in its unit's colour), and
-/// the boreholes' collars and logged tops as points; with a sentence for the viewer's note.
+/// one toggleable layer per unit with thickness ([`unit_shells`], in its unit's colour, closed:
+/// the cross-section caps it), and the boreholes as traces coloured by logged unit
+/// ([`borehole_traces`]) and their collars as points; with a sentence for the viewer's note.
 pub(crate) fn viewer_layers(
     g: &super::stage::ModelBuilt,
     positions: &[[f64; 3]],
@@ -303,33 +306,64 @@ pub(crate) fn viewer_layers(
                 visible: true,
                 pickable: true,
                 clipped: true,
+                closed: true,
+                vertex_colours: None,
             }
         })
         .collect();
     let shown = layers.len();
-    let mut points = Vec::new();
-    for h in g.boreholes.iter().flat_map(|b| &b.holes) {
-        points.push(h.collar);
-        points.extend(h.tops.iter().flatten().map(|c| c.position));
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in positions {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
     }
-    let holes = g.boreholes.as_ref().map_or(0, |b| b.holes.len());
-    if !points.is_empty() {
+    let radius = TRACE_RADIUS * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0);
+    let holes: Vec<&Hole> = g.boreholes.iter().flat_map(|b| &b.holes).collect();
+    if !holes.is_empty() {
+        let t = borehole_traces(&holes, radius);
         layers.push(Layer {
-            name: format!("boreholes ({holes} collars and logged tops)"),
-            positions: points,
+            name: format!("borehole traces ({}, coloured by logged unit)", holes.len()),
+            positions: t.positions,
+            geometry: Geometry::Triangles(t.triangles),
+            fields: Vec::new(),
+            colour: UNLOGGED,
+            visible: true,
+            pickable: false,
+            clipped: true,
+            closed: false,
+            vertex_colours: Some(t.colours),
+        });
+        layers.push(Layer {
+            name: format!("boreholes ({} collars)", holes.len()),
+            positions: holes.iter().map(|h| h.collar).collect(),
             geometry: Geometry::Points,
             fields: Vec::new(),
             colour: [190, 30, 30],
             visible: true,
             pickable: false,
             clipped: true,
+            closed: false,
+            vertex_colours: None,
         });
     }
     let note = format!(
         "The geological model: {shown} of its {} units have thickness, each drawn as its top, \
          bottom and sides (on the full planar mesh: its sealed body's boundary) and toggled on \
-         its own; the cross-section cuts them all.",
-        units.len()
+         its own; the cross-section cuts them all and fills each cut with its unit's colour.{}",
+        units.len(),
+        if holes.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " The boreholes are drawn along their desurveyed paths, {:.1} m thick, in the \
+                 colour of each logged unit (grey above the first logged top); a hole whose \
+                 lowest unit has no observed base ends {STUB_FRACTION_PERCENT} % of its logged \
+                 depth below that unit's top.",
+                2.0 * radius
+            )
+        }
     );
     (layers, note)
 }
