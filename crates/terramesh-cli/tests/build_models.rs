@@ -10,7 +10,13 @@ fn example() -> PathBuf {
 
 fn build(dir: &Path, extra: &[&str]) -> Output {
     let ex = example();
-    let mut args = vec!["build", ex.to_str().unwrap(), "-o", dir.to_str().unwrap(), "--quiet"];
+    let mut args = vec![
+        "build",
+        ex.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ];
     for s in [
         "export.formats=[\"obj\"]",
         "export.pictures=false",
@@ -94,12 +100,22 @@ fn nested_anisotropic_fit_and_external_drift_in_a_build() {
     extra.extend(["--set", &set]);
     ok(&build(b.path(), &extra));
     // dsm-vertices.csv: x,y,elevation_uk,kriging_std,elevation_idw: the drift moves UK, not IDW.
-    let (uk_a, uk_b) = (column(a.path(), "dsm-vertices.csv", 2), column(b.path(), "dsm-vertices.csv", 2));
-    let (idw_a, idw_b) = (column(a.path(), "dsm-vertices.csv", 4), column(b.path(), "dsm-vertices.csv", 4));
+    let (uk_a, uk_b) = (
+        column(a.path(), "dsm-vertices.csv", 2),
+        column(b.path(), "dsm-vertices.csv", 2),
+    );
+    let (idw_a, idw_b) = (
+        column(a.path(), "dsm-vertices.csv", 4),
+        column(b.path(), "dsm-vertices.csv", 4),
+    );
     assert_eq!(idw_a, idw_b);
     assert_eq!(uk_a.len(), uk_b.len());
     assert!(uk_a.iter().zip(&uk_b).any(|(p, q)| (p - q).abs() > 1e-6));
-    assert!(std::fs::read_to_string(b.path().join("cross-validation.csv")).unwrap().contains("UK"));
+    assert!(
+        std::fs::read_to_string(b.path().join("cross-validation.csv"))
+            .unwrap()
+            .contains("UK")
+    );
 
     // Errors name the key.
     let bad = |extra: &[&str], needle: &str| {
@@ -108,7 +124,10 @@ fn nested_anisotropic_fit_and_external_drift_in_a_build() {
         assert!(!o.status.success() && e.contains(needle), "{needle}: {e}");
     };
     bad(
-        &["--set", "interpolation.external_drift_grid=\"/nonexistent/g.tif\""],
+        &[
+            "--set",
+            "interpolation.external_drift_grid=\"/nonexistent/g.tif\"",
+        ],
         "interpolation.external_drift_grid /nonexistent/g.tif: no such file",
     );
     bad(

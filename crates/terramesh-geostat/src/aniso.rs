@@ -100,10 +100,7 @@ pub fn fit_anisotropy(
     for k in 0..directions {
         let azimuth = 180.0 * k as f64 / directions as f64;
         let s = LagSettings {
-            direction: Some(Direction {
-                azimuth,
-                tolerance,
-            }),
+            direction: Some(Direction { azimuth, tolerance }),
             ..*settings
         };
         lags.push((azimuth, tolerance, experimental(data, &s)?));

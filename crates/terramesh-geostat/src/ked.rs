@@ -124,7 +124,8 @@ impl ExternalDriftKriging {
         independent(&prep, &g)?;
         let how = match neighbourhood {
             Neighbourhood::All => {
-                let of_drift = GlobalKriging::new(&data.with_values(g.clone()), variogram, method, variance)?;
+                let of_drift =
+                    GlobalKriging::new(&data.with_values(g.clone()), variogram, method, variance)?;
                 let w = of_drift.dual_weights();
                 let gpg: f64 = w.iter().zip(&g).map(|(a, b)| a * b).sum();
                 let gpz: f64 = w.iter().zip(data.z()).map(|(a, b)| a * b).sum();
@@ -133,7 +134,8 @@ impl ExternalDriftKriging {
                 }
                 let beta = gpz / gpg;
                 let r: Vec<f64> = data.z().iter().zip(&g).map(|(z, g)| z - beta * g).collect();
-                let of_residual = GlobalKriging::new(&data.with_values(r), variogram, method, false)?;
+                let of_residual =
+                    GlobalKriging::new(&data.with_values(r), variogram, method, false)?;
                 How::Global {
                     of_drift,
                     of_residual,
@@ -148,7 +150,9 @@ impl ExternalDriftKriging {
                     return Err(GeostatError::TooFewData {
                         n: k,
                         needed: p,
-                        what: format!("a neighbourhood with {p} drift terms (the external drift included)"),
+                        what: format!(
+                            "a neighbourhood with {p} drift terms (the external drift included)"
+                        ),
                     });
                 }
                 let tree = Tree::new(&prep.pts)?;
@@ -206,8 +210,7 @@ impl ExternalDriftKriging {
         } = &self.how
         else {
             return Err(GeostatError::ExternalDrift(
-                "the closed-form leave-one-out is of global kriging only (no neighbourhood)"
-                    .into(),
+                "the closed-form leave-one-out is of global kriging only (no neighbourhood)".into(),
             ));
         };
         let (_, var_g) = of_drift.leave_one_out()?;
@@ -219,7 +222,9 @@ impl ExternalDriftKriging {
             let b = 1.0 / var_g[i] - wg[i] * wg[i] / gpg;
             if !(b > 0.0 && b.is_finite()) {
                 return Err(GeostatError::Singular {
-                    why: format!("leaving out data point {i} leaves the external drift undetermined"),
+                    why: format!(
+                        "leaving out data point {i} leaves the external drift undetermined"
+                    ),
                 });
             }
             err[i] = wr[i] / b;
@@ -288,11 +293,13 @@ impl ExternalDriftKriging {
                     .zip(g0.par_iter())
                     .enumerate()
                     .map(|(t, (&x, &g0))| {
-                        local_one(prep, g, tree, *k, x, g0).map_err(|why| GeostatError::SingularAt {
-                            index: t,
-                            x: x[0],
-                            y: x[1],
-                            why,
+                        local_one(prep, g, tree, *k, x, g0).map_err(|why| {
+                            GeostatError::SingularAt {
+                                index: t,
+                                x: x[0],
+                                y: x[1],
+                                why,
+                            }
                         })
                     })
                     .collect::<Result<_>>()?;
@@ -308,84 +315,6 @@ impl ExternalDriftKriging {
             }
         }
     }
-}
-
-/// Cross-validation of kriging with an external drift (`external[i]` at data point `i`), as
-/// [`crate::cross_validate`] does it for kriging: leave-one-out of global kriging with a
-/// bounded model by the closed form ([`ExternalDriftKriging::leave_one_out`]), otherwise a
-/// refit without each fold (each point for leave-one-out), folds by the same seeded shuffle.
-///
-/// ```
-/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
-/// use terramesh_geostat::{cross_validate_external, Data, Duplicates, Folds, Method, ModelKind, Neighbourhood, Variogram};
-/// let xy: Vec<[f64; 2]> = (0..40).map(|i| [(i % 8) as f64 * 5.0, (i / 8) as f64 * 6.0]).collect();
-/// let g: Vec<f64> = xy.iter().map(|p| (p[0] / 7.0).sin() * 4.0 + p[1] / 10.0).collect();
-/// let z: Vec<f64> = xy.iter().zip(&g).map(|(p, g)| 2.0 * g + (p[1] / 4.0).cos()).collect();
-/// let data = Data::new(xy, z, Duplicates::Reject)?;
-/// let v = Variogram::single(ModelKind::Spherical, 0.01, 1.0, 20.0)?;
-/// let global = cross_validate_external(&data, &g, &v, Method::Ordinary, Neighbourhood::All, Folds::LeaveOneOut)?;
-/// let local = cross_validate_external(&data, &g, &v, Method::Ordinary, Neighbourhood::Nearest(39), Folds::LeaveOneOut)?;
-/// assert!((global.stats.rmse - local.stats.rmse).abs() < 1e-9 * global.stats.rmse);
-/// # Ok(()) }
-/// ```
-pub fn cross_validate_external(
-    data: &Data,
-    external: &[f64],
-    variogram: &Variogram,
-    method: Method,
-    neighbourhood: Neighbourhood,
-    folds: crate::Folds,
-) -> Result<crate::CvResult> {
-    let n = data.len();
-    let mut est = vec![0.0; n];
-    let mut var = vec![0.0; n];
-    let (assign, k) = match folds {
-        crate::Folds::LeaveOneOut => {
-            if neighbourhood == Neighbourhood::All && variogram.sill().is_some() {
-                let ked = ExternalDriftKriging::new(data, external, variogram, method, neighbourhood, true)?;
-                let (e, v) = ked.leave_one_out()?;
-                for i in 0..n {
-                    est[i] = data.z()[i] - e[i];
-                }
-                let stats = crate::cv::summarize(data.z(), &est, Some(&v))?;
-                return Ok(crate::CvResult {
-                    estimate: est,
-                    variance: v,
-                    stats,
-                });
-            }
-            ((0..n).collect::<Vec<_>>(), n)
-        }
-        crate::Folds::KFold(k) => {
-            if k < 2 || k > n {
-                return Err(crate::error::bad("folds", k as f64, &format!("must be in 2..={n}")));
-            }
-            (crate::cv::fold_assignment(n, k), k)
-        }
-    };
-    for f in 0..k {
-        let test: Vec<usize> = (0..n).filter(|&i| assign[i] == f).collect();
-        if test.is_empty() {
-            continue;
-        }
-        let train: Vec<usize> = (0..n).filter(|&i| assign[i] != f).collect();
-        let gt: Vec<f64> = train.iter().map(|&i| external[i]).collect();
-        let ked = ExternalDriftKriging::new(&data.subset(&train), &gt, variogram, method, neighbourhood, true)?;
-        let t: Vec<[f64; 2]> = test.iter().map(|&i| data.xy()[i]).collect();
-        let g0: Vec<f64> = test.iter().map(|&i| external[i]).collect();
-        let (mut e, mut v) = (vec![0.0; t.len()], vec![0.0; t.len()]);
-        ked.predict(&t, &g0, &mut e, Some(&mut v))?;
-        for (a, &i) in test.iter().enumerate() {
-            est[i] = e[a];
-            var[i] = v[a];
-        }
-    }
-    let stats = crate::cv::summarize(data.z(), &est, Some(&var))?;
-    Ok(crate::CvResult {
-        estimate: est,
-        variance: var,
-        stats,
-    })
 }
 
 /// One target of the moving neighbourhood: `[−Γ F g; Fᵀ 0; gᵀ 0] [λ; μ] = [−γ0; f0; g0]`.
@@ -434,7 +363,11 @@ fn local_one(
     lu_solve(&mut a, m, &mut x, 1e-13).map_err(|_| {
         format!("the {k} nearest data cannot support the drift and the external drift: too few, collinear, or their external drift is a combination of the other drift terms; use a larger neighbourhood")
     })?;
-    let e: f64 = near.iter().enumerate().map(|(r, &(_, i))| x[r] * prep.z[i]).sum();
+    let e: f64 = near
+        .iter()
+        .enumerate()
+        .map(|(r, &(_, i))| x[r] * prep.z[i])
+        .sum();
     let v: f64 = -(0..m).map(|r| x[r] * b[r]).sum::<f64>();
     if !(e.is_finite() && v.is_finite()) {
         return Err("the local system is numerically singular".into());
@@ -498,14 +431,21 @@ mod tests {
                 [(t * 37.0) % 101.0, (t * 53.0) % 97.0]
             })
             .collect();
-        let g: Vec<f64> = xy.iter().map(|p| (p[0] / 15.0).sin() * 20.0 + 0.3 * p[1]).collect();
+        let g: Vec<f64> = xy
+            .iter()
+            .map(|p| (p[0] / 15.0).sin() * 20.0 + 0.3 * p[1])
+            .collect();
         let z: Vec<f64> = xy
             .iter()
             .zip(&g)
             .map(|(p, g)| 1.5 * g + (p[1] / 9.0).cos() * 3.0 + 0.05 * p[0])
             .collect();
         let d = Data::new(xy, z, Duplicates::Reject).unwrap();
-        (d, g, Variogram::single(ModelKind::Spherical, 0.5, 10.0, 60.0).unwrap())
+        (
+            d,
+            g,
+            Variogram::single(ModelKind::Spherical, 0.5, 10.0, 60.0).unwrap(),
+        )
     }
 
     /// The neighbourhood of all data solves the full bordered system: the same numbers as the
@@ -513,8 +453,13 @@ mod tests {
     #[test]
     fn global_equals_the_bordered_system_of_all_data() {
         let (d, g, v) = case();
-        let t: Vec<[f64; 2]> = (0..25).map(|i| [4.0 * i as f64 + 1.5, 97.0 - 3.7 * i as f64]).collect();
-        let gt: Vec<f64> = t.iter().map(|p| (p[0] / 15.0).sin() * 20.0 + 0.3 * p[1] + 1.0).collect();
+        let t: Vec<[f64; 2]> = (0..25)
+            .map(|i| [4.0 * i as f64 + 1.5, 97.0 - 3.7 * i as f64])
+            .collect();
+        let gt: Vec<f64> = t
+            .iter()
+            .map(|p| (p[0] / 15.0).sin() * 20.0 + 0.3 * p[1] + 1.0)
+            .collect();
         for m in [Method::Ordinary, Method::Universal(Drift::Linear)] {
             let mut out = Vec::new();
             for hood in [Neighbourhood::All, Neighbourhood::Nearest(d.len())] {
@@ -524,7 +469,10 @@ mod tests {
                 out.push((e, s));
             }
             for i in 0..t.len() {
-                assert!((out[0].0[i] - out[1].0[i]).abs() < 1e-8 * out[0].0[i].abs().max(1.0), "{m:?} {i}");
+                assert!(
+                    (out[0].0[i] - out[1].0[i]).abs() < 1e-8 * out[0].0[i].abs().max(1.0),
+                    "{m:?} {i}"
+                );
                 assert!((out[0].1[i] - out[1].1[i]).abs() < 1e-8 * 10.0, "{m:?} {i}");
             }
         }
@@ -535,21 +483,44 @@ mod tests {
         let (d, g, v) = case();
         let all = Neighbourhood::All;
         let sk = Method::Simple { mean: 0.0 };
-        let e = ExternalDriftKriging::new(&d, &g, &v, sk, all, true).err().unwrap();
+        let e = ExternalDriftKriging::new(&d, &g, &v, sk, all, true)
+            .err()
+            .unwrap();
         assert!(e.to_string().contains("simple kriging"), "{e}");
-        let e = ExternalDriftKriging::new(&d, &g[1..], &v, Method::Ordinary, all, true).err().unwrap();
-        assert!(e.to_string().contains("59 values for 60 data points"), "{e}");
+        let e = ExternalDriftKriging::new(&d, &g[1..], &v, Method::Ordinary, all, true)
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string().contains("59 values for 60 data points"),
+            "{e}"
+        );
         let flat = vec![3.0; d.len()];
-        let e = ExternalDriftKriging::new(&d, &flat, &v, Method::Ordinary, all, true).err().unwrap();
-        assert!(e.to_string().contains("one value at every data point"), "{e}");
+        let e = ExternalDriftKriging::new(&d, &flat, &v, Method::Ordinary, all, true)
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string().contains("one value at every data point"),
+            "{e}"
+        );
         let lin: Vec<f64> = d.xy().iter().map(|p| 2.0 * p[0] - p[1] + 7.0).collect();
         let uk = Method::Universal(Drift::Linear);
-        let e = ExternalDriftKriging::new(&d, &lin, &v, uk, all, true).err().unwrap();
-        assert!(e.to_string().contains("combination of the other drift terms"), "{e}");
+        let e = ExternalDriftKriging::new(&d, &lin, &v, uk, all, true)
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string()
+                .contains("combination of the other drift terms"),
+            "{e}"
+        );
         assert!(ExternalDriftKriging::new(&d, &lin, &v, Method::Ordinary, all, true).is_ok());
         let mut nan = g.clone();
         nan[4] = f64::NAN;
-        let e = ExternalDriftKriging::new(&d, &nan, &v, Method::Ordinary, all, true).err().unwrap();
-        assert!(e.to_string().contains("data point 4: external drift NaN"), "{e}");
+        let e = ExternalDriftKriging::new(&d, &nan, &v, Method::Ordinary, all, true)
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string().contains("data point 4: external drift NaN"),
+            "{e}"
+        );
     }
 }

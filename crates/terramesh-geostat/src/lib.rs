@@ -70,6 +70,7 @@ mod fit;
 mod global;
 mod idw;
 mod ked;
+mod ked_cv;
 mod linalg;
 mod model;
 mod neighbourhood;
@@ -99,7 +100,8 @@ pub use file::{
 pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
-pub use ked::{cross_validate_external, ExternalDriftKriging};
+pub use ked::ExternalDriftKriging;
+pub use ked_cv::cross_validate_external;
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use nested::{fit_nested, MAX_STRUCTURES};

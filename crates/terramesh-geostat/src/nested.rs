@@ -37,10 +37,17 @@ pub(crate) fn solve_sills(pts: &[Point], weighting: Weighting) -> (f64, Vec<f64>
     let floor = 1e-12 * pts.iter().map(|p| p.gamma).fold(0.0, f64::max);
     let mut w: Vec<f64> = match weighting {
         Weighting::Pairs => pts.iter().map(|p| p.pairs).collect(),
-        Weighting::Cressie => pts.iter().map(|p| p.pairs / p.gamma.max(floor).powi(2)).collect(),
+        Weighting::Cressie => pts
+            .iter()
+            .map(|p| p.pairs / p.gamma.max(floor).powi(2))
+            .collect(),
     };
     let model = |c: &[f64], p: &Point| c[0] + (1..k).map(|i| c[i] * p.units[i - 1]).sum::<f64>();
-    let passes = if weighting == Weighting::Cressie { 4 } else { 1 };
+    let passes = if weighting == Weighting::Cressie {
+        4
+    } else {
+        1
+    };
     let mut c = vec![0.0; k];
     for pass in 0..passes {
         c = nnls(pts, &w, k);
@@ -182,7 +189,10 @@ pub fn fit_nested(lags: &[Lag], kinds: &[ModelKind], weighting: Weighting) -> Re
         .filter(|&i| kinds[i] != ModelKind::Linear)
         .collect();
     let structures = |th: &[f64]| -> Vec<Structure> {
-        let mut s: Vec<Structure> = kinds.iter().map(|&k| Structure::new(k, 1.0, hmax)).collect();
+        let mut s: Vec<Structure> = kinds
+            .iter()
+            .map(|&k| Structure::new(k, 1.0, hmax))
+            .collect();
         for (j, &i) in free.iter().enumerate() {
             s[i].range = th[j].exp();
         }
@@ -212,19 +222,24 @@ pub fn fit_nested(lags: &[Lag], kinds: &[ModelKind], weighting: Weighting) -> Re
             let r = fit_model(all, kinds[i], weighting)
                 .map(|f| f.variogram.structures[0].range)
                 .unwrap_or(hmax);
-            (r * 2f64.powi(j as i32 - free.len() as i32 / 2)).ln().clamp(lo, hi)
+            (r * 2f64.powi(j as i32 - free.len() as i32 / 2))
+                .ln()
+                .clamp(lo, hi)
         })
         .collect();
     starts.push(single);
-    let grid: Vec<f64> = (0..8).map(|g| lo + (hi - lo) * (g as f64 + 0.5) / 8.0).collect();
+    let grid: Vec<f64> = (0..8)
+        .map(|g| lo + (hi - lo) * (g as f64 + 0.5) / 8.0)
+        .collect();
     let mut combos: Vec<(f64, Vec<f64>)> = Vec::new();
     let d = free.len();
     for code in 0..8usize.pow(d as u32) {
-        let th: Vec<f64> = (0..d).map(|j| grid[(code / 8usize.pow(j as u32)) % 8]).collect();
+        let th: Vec<f64> = (0..d)
+            .map(|j| grid[(code / 8usize.pow(j as u32)) % 8])
+            .collect();
         // Repeated kinds: one order of their ranges is enough.
-        let ordered = (0..d).all(|a| {
-            (a + 1..d).all(|b| kinds[free[a]] != kinds[free[b]] || th[a] < th[b])
-        });
+        let ordered =
+            (0..d).all(|a| (a + 1..d).all(|b| kinds[free[a]] != kinds[free[b]] || th[a] < th[b]));
         if ordered {
             combos.push((eval(&th).0, th));
         }
@@ -305,13 +320,25 @@ mod tests {
             anisotropy: None,
         };
         let lags = exact_lags(&truth, 50, 50.0);
-        let kinds = [ModelKind::Spherical, ModelKind::Spherical, ModelKind::Gaussian];
+        let kinds = [
+            ModelKind::Spherical,
+            ModelKind::Spherical,
+            ModelKind::Gaussian,
+        ];
         for w in [Weighting::Cressie, Weighting::Pairs] {
             let f = fit_nested(&lags, &kinds, w).unwrap();
             assert!(f.rmse < 1e-3, "{w:?}: {} rmse {}", f.variogram, f.rmse);
             for (a, b) in f.variogram.structures.iter().zip(&truth.structures) {
-                assert!((a.range - b.range).abs() < 0.01 * b.range, "{}", f.variogram);
-                assert!((a.psill - b.psill).abs() < 0.01 * b.psill, "{}", f.variogram);
+                assert!(
+                    (a.range - b.range).abs() < 0.01 * b.range,
+                    "{}",
+                    f.variogram
+                );
+                assert!(
+                    (a.psill - b.psill).abs() < 0.01 * b.psill,
+                    "{}",
+                    f.variogram
+                );
             }
         }
     }
@@ -335,8 +362,15 @@ mod tests {
     fn bad_lists_are_refused() {
         let v = Variogram::single(ModelKind::Spherical, 0.0, 1.0, 100.0).unwrap();
         let lags = exact_lags(&v, 10, 20.0);
-        let e = fit_nested(&lags, &[ModelKind::Spherical, ModelKind::Power], Weighting::Cressie);
-        assert!(e.unwrap_err().to_string().contains("power structure cannot be nested"));
+        let e = fit_nested(
+            &lags,
+            &[ModelKind::Spherical, ModelKind::Power],
+            Weighting::Cressie,
+        );
+        assert!(e
+            .unwrap_err()
+            .to_string()
+            .contains("power structure cannot be nested"));
         let four = [ModelKind::Spherical; 4];
         let e = fit_nested(&lags, &four, Weighting::Cressie).unwrap_err();
         assert!(e.to_string().contains("4 structures"), "{e}");

@@ -31,8 +31,8 @@ fn anisotropy_of_simulated_fields_is_recovered() {
             };
             let omni = experimental(&data, &lags).unwrap();
             let base = fit_model(&omni, ModelKind::Spherical, Weighting::Cressie).unwrap();
-            let f = fit_anisotropy(&data, &lags, &base.variogram, 8, 22.5, Weighting::Cressie)
-                .unwrap();
+            let f =
+                fit_anisotropy(&data, &lags, &base.variogram, 8, 22.5, Weighting::Cressie).unwrap();
             let a = f.fit.variogram.anisotropy.unwrap();
             let d = (a.angle - angle + 90.0).rem_euclid(180.0) - 90.0;
             got.push((d, a.ratio, f.fit.variogram.structures[0].range));

@@ -9,8 +9,8 @@
 mod common;
 use common::*;
 use terramesh_geostat::{
-    Data, Drift, Duplicates, ExternalDriftKriging, GlobalKriging, Method, ModelKind,
-    Neighbourhood, Structure, Variogram,
+    Data, Drift, Duplicates, ExternalDriftKriging, GlobalKriging, Method, ModelKind, Neighbourhood,
+    Structure, Variogram,
 };
 
 const SILL: f64 = 12050.0;
@@ -49,7 +49,12 @@ fn external_drift_matches_pykrige_external_z_and_specified() {
         // (method, data column, target column, fixture)
         let cases = [
             (Method::Ordinary, 3, 2, format!("ked-ok-{model}-grid.csv")),
-            (Method::Universal(Drift::Linear), 3, 2, format!("ked-uk-{model}-grid.csv")),
+            (
+                Method::Universal(Drift::Linear),
+                3,
+                2,
+                format!("ked-uk-{model}-grid.csv"),
+            ),
             (Method::Ordinary, 4, 3, format!("ked-ok-{model}-cover.csv")),
         ];
         for (method, dc, tcol, file) in cases {
@@ -85,8 +90,16 @@ fn the_external_drift_matters() {
         .unwrap();
     let (mut e, mut s) = (vec![0.0; t.len()], vec![0.0; t.len()]);
     k.predict(&t, &tc[2], &mut e, Some(&mut s)).unwrap();
-    let moved = e.iter().zip(&e0).filter(|(a, b)| (*a - *b).abs() > 1.0).count();
-    assert!(moved > t.len() / 2, "{moved} of {} estimates moved", t.len());
+    let moved = e
+        .iter()
+        .zip(&e0)
+        .filter(|(a, b)| (*a - *b).abs() > 1.0)
+        .count();
+    assert!(
+        moved > t.len() / 2,
+        "{moved} of {} estimates moved",
+        t.len()
+    );
     // Adding a drift term never lowers the kriging variance.
     assert!(s.iter().zip(&s0).all(|(a, b)| *a >= *b - 1e-9 * SILL));
     let beta = k.coefficient().unwrap();

@@ -278,11 +278,7 @@ pub enum PredictError {
 /// Values of a named column of a data CSV for the external drift, in the order and with the
 /// merging of duplicates of [`crate::interpolate::read_data`] (a duplicate's values and drifts
 /// both averaged with `mean`).
-pub fn read_drift_column(
-    path: &Path,
-    column: &str,
-    duplicates: Duplicates,
-) -> Result<Vec<f64>> {
+pub fn read_drift_column(path: &Path, column: &str, duplicates: Duplicates) -> Result<Vec<f64>> {
     use terramesh_io::table::{ReadOptions, Table};
     let t = Table::read(path, &ReadOptions::default())?;
     let Some(c) = t.find(&[column]) else {
@@ -324,7 +320,9 @@ pub fn drift_residuals(data: &Data, g: &[f64], method: Method) -> Result<Data> {
     let s = data
         .xy()
         .iter()
-        .fold(0.0f64, |m, p| m.max((p[0] - cx).abs()).max((p[1] - cy).abs()))
+        .fold(0.0f64, |m, p| {
+            m.max((p[0] - cx).abs()).max((p[1] - cy).abs())
+        })
         .max(1e-300);
     let cols = |i: usize| -> Vec<f64> {
         let (x, y) = ((data.xy()[i][0] - cx) / s, (data.xy()[i][1] - cy) / s);

@@ -166,7 +166,12 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     fitted.directions = af.directions;
     fitted.fit = af.fit;
     if plan.method == Some(FitMethod::Reml) {
-        let r = fit_reml(data, plan.auto.drift, &fitted.fit.variogram, plan.auto.block)?;
+        let r = fit_reml(
+            data,
+            plan.auto.drift,
+            &fitted.fit.variogram,
+            plan.auto.block,
+        )?;
         fitted.fit = Fit {
             rmse: terramesh_geostat::lag_rmse(lags, &r.variogram),
             variogram: r.variogram,

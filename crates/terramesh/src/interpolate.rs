@@ -154,7 +154,10 @@ pub fn predict_csv(
             Error::setting(
                 Setting::ExternalDrift,
                 c,
-                format!("{name} has no such column (its header: {})", headers.join(", ")),
+                format!(
+                    "{name} has no such column (its header: {})",
+                    headers.join(", ")
+                ),
             )
         })?),
     };

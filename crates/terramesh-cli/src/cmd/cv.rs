@@ -42,8 +42,12 @@ pub fn run(args: Args) -> Result<()> {
         Some(k) if k < 2 => bail!("--folds {k}: must be at least 2"),
         Some(k) => Folds::KFold(k),
     };
-    let r = if let Some((method, g, v, _)) = external_drift(&args.m, &args.drift, &args.data, &fd)? {
-        let hood = args.m.neighbors.map_or(Neighbourhood::All, Neighbourhood::Nearest);
+    let r = if let Some((method, g, v, _)) = external_drift(&args.m, &args.drift, &args.data, &fd)?
+    {
+        let hood = args
+            .m
+            .neighbors
+            .map_or(Neighbourhood::All, Neighbourhood::Nearest);
         terramesh_geostat::cross_validate_external(&fd.data, &g, &v, method, hood, folds)
     } else {
         let how = if args.m.method == InterpolationMethod::Idw {

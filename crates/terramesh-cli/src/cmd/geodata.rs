@@ -101,7 +101,14 @@ pub fn explicit_or_fit(m: &ModelArgs, fit: bool) -> Result<Option<Variogram>> {
     }
     let psills = match (kinds[0], m.psill.is_empty(), n) {
         (ModelKind::Nugget, true, 1) => vec![0.0],
-        (_, true, _) => bail!("--model {name} needs --psill (the partial sill{})", if n > 1 { "s, one per structure: --psill C1,C2" } else { "" }),
+        (_, true, _) => bail!(
+            "--model {name} needs --psill (the partial sill{})",
+            if n > 1 {
+                "s, one per structure: --psill C1,C2"
+            } else {
+                ""
+            }
+        ),
         _ => per_structure("psill", &m.psill, n, name, false)?,
     };
     for &psill in &psills {
@@ -111,7 +118,14 @@ pub fn explicit_or_fit(m: &ModelArgs, fit: bool) -> Result<Option<Variogram>> {
     }
     let ranges = match (kinds[0], m.range.is_empty(), n) {
         (ModelKind::Nugget, true, 1) => vec![1.0],
-        (_, true, _) => bail!("--model {name} needs --range (the practical range{})", if n > 1 { "s, one per structure: --range A1,A2" } else { "" }),
+        (_, true, _) => bail!(
+            "--model {name} needs --range (the practical range{})",
+            if n > 1 {
+                "s, one per structure: --range A1,A2"
+            } else {
+                ""
+            }
+        ),
         _ => per_structure("range", &m.range, n, name, false)?,
     };
     for &range in &ranges {

@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use terramesh::external_drift::{drift_residuals, read_drift_column, DriftGrid, DriftSource, Engine};
+use terramesh::external_drift::{
+    drift_residuals, read_drift_column, DriftGrid, DriftSource, Engine,
+};
 use terramesh::interpolate::{predict_csv, predict_grid, read_data, FileData};
 use terramesh::variogram_file::read_variogram_file;
 use terramesh_geostat::{
@@ -129,9 +131,15 @@ pub fn external_drift(
         (None, None) => return Ok(None),
         (Some(c), None) => DriftSource::Column(c.clone()),
         (None, Some(g)) => DriftSource::Grid(DriftGrid::open(g).map_err(crate::flag_error)?),
-        (Some(_), Some(_)) => bail!("give --external-drift COLUMN or --external-drift-grid FILE, not both"),
+        (Some(_), Some(_)) => {
+            bail!("give --external-drift COLUMN or --external-drift-grid FILE, not both")
+        }
     };
-    let flag = if d.external_drift.is_some() { "--external-drift" } else { "--external-drift-grid" };
+    let flag = if d.external_drift.is_some() {
+        "--external-drift"
+    } else {
+        "--external-drift-grid"
+    };
     let method = match m.method {
         InterpolationMethod::Ordinary | InterpolationMethod::Universal => method(m, &fd.data)?,
         other => bail!("{flag}: kriging with an external drift is --method ok (the constant and the drift) or uk (the polynomial and the drift), not {other}"),
@@ -143,8 +151,12 @@ pub fn external_drift(
         bail!("--neighbors 0: must be at least 1");
     }
     let g = match &source {
-        DriftSource::Column(c) => read_drift_column(data, c, m.duplicates).map_err(crate::flag_error)?,
-        DriftSource::Grid(grid) => grid.sample_all(fd.data.xy()).map_err(|e| crate::flag_error(e).context(format!("{}: the data", fd.name)))?,
+        DriftSource::Column(c) => {
+            read_drift_column(data, c, m.duplicates).map_err(crate::flag_error)?
+        }
+        DriftSource::Grid(grid) => grid
+            .sample_all(fd.data.xy())
+            .map_err(|e| crate::flag_error(e).context(format!("{}: the data", fd.name)))?,
     };
     // An automatic fit is made to the residuals of the drift (the drift's own variation out).
     let auto = |s: &Option<String>| s.as_deref().is_some_and(|s| s.eq_ignore_ascii_case("auto"));
@@ -171,7 +183,14 @@ fn resolve_for(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram
         .as_deref()
         .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
     let aniso = m.model.anisotropy_auto()?;
-    if aniso && !fitting && !m.model.model.as_deref().is_some_and(|s| s.eq_ignore_ascii_case("auto")) {
+    if aniso
+        && !fitting
+        && !m
+            .model
+            .model
+            .as_deref()
+            .is_some_and(|s| s.eq_ignore_ascii_case("auto"))
+    {
         bail!("--anisotropy auto fits the anisotropy with the variogram: give --variogram auto (the model's angle and ratio are otherwise --anisotropy-angle and --anisotropy-ratio)");
     }
     if let Some(v) = explicit_or_fit(&m.model, fitting)? {
@@ -265,8 +284,15 @@ fn engine_of(args: &Args, fd: &FileData, variance: bool) -> Result<Engine> {
     let Some((method, g, v, source)) = external_drift(&args.m, &args.drift, &args.data, fd)? else {
         return Ok(Engine::Plain(engine(&args.m, fd, variance)?));
     };
-    let flag = if args.drift.external_drift.is_some() { "--external-drift" } else { "--external-drift-grid" };
-    let hood = args.m.neighbors.map_or(Neighbourhood::All, Neighbourhood::Nearest);
+    let flag = if args.drift.external_drift.is_some() {
+        "--external-drift"
+    } else {
+        "--external-drift-grid"
+    };
+    let hood = args
+        .m
+        .neighbors
+        .map_or(Neighbourhood::All, Neighbourhood::Nearest);
     let kriging = ExternalDriftKriging::new(&fd.data, &g, &v, method, hood, variance)
         .map_err(|e| anyhow::anyhow!("{flag}: {}", in_file(&fd.name, e)))?;
     if let Some(b) = kriging.coefficient() {

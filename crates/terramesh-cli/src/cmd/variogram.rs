@@ -167,7 +167,9 @@ pub fn run(args: Args) -> Result<()> {
     let mut plan = args.lag.plan(&args.model, args.drift);
     match args.anisotropy.as_deref() {
         None => {}
-        Some(a) if a.eq_ignore_ascii_case("auto") => plan.anisotropy = Some(args.lag.anisotropy_plan()?),
+        Some(a) if a.eq_ignore_ascii_case("auto") => {
+            plan.anisotropy = Some(args.lag.anisotropy_plan()?)
+        }
         Some(a) => anyhow::bail!("--anisotropy '{a}': expected auto"),
     }
     let fitted = fit_plan(&fd.data, &lags, &plan)

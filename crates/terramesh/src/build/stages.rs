@@ -409,16 +409,21 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
             },
         };
         let r = match (&how, ked) {
-            (Interpolator::Kriging { variogram, method, neighbours }, Some(d)) => {
-                terramesh_geostat::cross_validate_external(
-                    data,
-                    &d.at_data,
+            (
+                Interpolator::Kriging {
                     variogram,
-                    *method,
-                    *neighbours,
-                    folds,
-                )
-            }
+                    method,
+                    neighbours,
+                },
+                Some(d),
+            ) => terramesh_geostat::cross_validate_external(
+                data,
+                &d.at_data,
+                variogram,
+                *method,
+                *neighbours,
+                folds,
+            ),
             _ => cross_validate(data, &how, folds),
         }
         .with_context(|| format!("cross-validation of {name}"))?;

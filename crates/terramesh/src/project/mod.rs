@@ -230,10 +230,17 @@ impl VariogramSpec {
     /// ```
     pub fn variogram(&self) -> std::result::Result<terramesh_geostat::Variogram, String> {
         use terramesh_geostat::{Anisotropy, Structure, Variogram};
-        let kinds = crate::fitting::parse_models(&self.model)
-            .map_err(|e| format!("interpolation.model.model: {}", e.render(&|_| String::new()).trim_start()))?;
+        let kinds = crate::fitting::parse_models(&self.model).map_err(|e| {
+            format!(
+                "interpolation.model.model: {}",
+                e.render(&|_| String::new()).trim_start()
+            )
+        })?;
         let n = kinds.len();
-        let list = |key: &str, v: &Numbers, one_for_all: bool| -> std::result::Result<Vec<f64>, String> {
+        let list = |key: &str,
+                    v: &Numbers,
+                    one_for_all: bool|
+         -> std::result::Result<Vec<f64>, String> {
             let v = v.values();
             match v.len() {
                 k if k == n => Ok(v),
@@ -251,7 +258,11 @@ impl VariogramSpec {
             None => None,
         };
         for (key, vals, ok) in [
-            ("psill", &psill, (|v: f64| v.is_finite() && v > 0.0) as fn(f64) -> bool),
+            (
+                "psill",
+                &psill,
+                (|v: f64| v.is_finite() && v > 0.0) as fn(f64) -> bool,
+            ),
             ("range", &range, |v: f64| v.is_finite() && v > 0.0),
         ] {
             if let Some(v) = vals.iter().find(|v| !ok(**v)) {
@@ -259,7 +270,10 @@ impl VariogramSpec {
             }
         }
         if !(self.nugget.is_finite() && self.nugget >= 0.0) {
-            return Err(format!("interpolation.model.nugget: {} must be 0 or positive", self.nugget));
+            return Err(format!(
+                "interpolation.model.nugget: {} must be 0 or positive",
+                self.nugget
+            ));
         }
         let anisotropy = match (self.anisotropy_angle, self.anisotropy_ratio) {
             (None, None) => None,
@@ -281,7 +295,8 @@ impl VariogramSpec {
                 .collect(),
             anisotropy,
         };
-        v.validate().map_err(|e| format!("interpolation.model: {e}"))?;
+        v.validate()
+            .map_err(|e| format!("interpolation.model: {e}"))?;
         Ok(v)
     }
 }

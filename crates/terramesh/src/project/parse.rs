@@ -226,7 +226,10 @@ impl Project {
         }
         if !i.fit_model.eq_ignore_ascii_case("auto") {
             if let Err(e) = crate::fitting::parse_models(&i.fit_model) {
-                return bad("interpolation.fit_model", e.render(&|_| String::new()).trim_start());
+                return bad(
+                    "interpolation.fit_model",
+                    e.render(&|_| String::new()).trim_start(),
+                );
             }
         }
         match i.anisotropy.to_ascii_lowercase().as_str() {
@@ -242,7 +245,8 @@ impl Project {
             }
         }
         if i.external_drift_grid.is_some()
-            && i.methods.contains(&terramesh_geostat::InterpolationMethod::Simple)
+            && i.methods
+                .contains(&terramesh_geostat::InterpolationMethod::Simple)
         {
             return bad(
                 "interpolation.external_drift_grid",
@@ -464,19 +468,43 @@ mod tests {
             Project::parse("t.toml", TEMPLATE, &sets).map_err(|e| e.to_string())
         };
         let e = p(&["interpolation.model={ model = \"spherical+exponential\", psill = [1.0], range = [10.0, 20.0] }"]).unwrap_err();
-        assert!(e.contains("interpolation.model.psill: 1 values for the 2 structures"), "{e}");
-        let e = p(&["interpolation.model={ model = \"spherical\", psill = 1.0, range = -3.0 }"]).unwrap_err();
-        assert!(e.contains("interpolation.model.range: -3 must be positive"), "{e}");
-        let e = p(&["interpolation.model={ model = \"cubic\", psill = 1.0, range = 3.0 }"]).unwrap_err();
+        assert!(
+            e.contains("interpolation.model.psill: 1 values for the 2 structures"),
+            "{e}"
+        );
+        let e = p(&["interpolation.model={ model = \"spherical\", psill = 1.0, range = -3.0 }"])
+            .unwrap_err();
+        assert!(
+            e.contains("interpolation.model.range: -3 must be positive"),
+            "{e}"
+        );
+        let e = p(&["interpolation.model={ model = \"cubic\", psill = 1.0, range = 3.0 }"])
+            .unwrap_err();
         assert!(e.contains("interpolation.model.model: 'cubic'"), "{e}");
         let e = p(&["interpolation.model={ model = \"spherical\", psill = 1.0, range = 3.0, anisotropy_ratio = 2.0 }"]).unwrap_err();
-        assert!(e.contains("interpolation.model: anisotropy ratio = 2"), "{e}");
+        assert!(
+            e.contains("interpolation.model: anisotropy ratio = 2"),
+            "{e}"
+        );
         let e = p(&["interpolation.fit_model=\"spherical+cubic\""]).unwrap_err();
-        assert!(e.contains("interpolation.fit_model: 'spherical+cubic': 'cubic' is not a model"), "{e}");
+        assert!(
+            e.contains("interpolation.fit_model: 'spherical+cubic': 'cubic' is not a model"),
+            "{e}"
+        );
         let e = p(&["interpolation.anisotropy=\"yes\""]).unwrap_err();
-        assert!(e.contains("interpolation.anisotropy: \"yes\": expected \"none\" or \"auto\""), "{e}");
-        let e = p(&["interpolation.external_drift_grid=\"g.tif\"", "interpolation.methods=[\"sk\"]"]).unwrap_err();
-        assert!(e.contains("interpolation.external_drift_grid: simple kriging"), "{e}");
+        assert!(
+            e.contains("interpolation.anisotropy: \"yes\": expected \"none\" or \"auto\""),
+            "{e}"
+        );
+        let e = p(&[
+            "interpolation.external_drift_grid=\"g.tif\"",
+            "interpolation.methods=[\"sk\"]",
+        ])
+        .unwrap_err();
+        assert!(
+            e.contains("interpolation.external_drift_grid: simple kriging"),
+            "{e}"
+        );
         let ok = p(&[
             "interpolation.fit_model=\"spherical+exponential\"",
             "interpolation.anisotropy=\"auto\"",
