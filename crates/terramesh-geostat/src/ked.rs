@@ -42,19 +42,22 @@ pub struct ExternalDriftKriging {
 enum How {
     Global {
         /// Kriging of the standardised `g` (with variances when asked).
-        of_drift: GlobalKriging,
+        of_drift: Box<GlobalKriging>,
         /// Kriging of `z − β̂ g` (estimates only).
-        of_residual: GlobalKriging,
+        of_residual: Box<GlobalKriging>,
         beta: f64,
         gpg: f64,
     },
-    Local {
-        prep: Prepared,
-        /// Standardised `g` at the data, in data order.
-        g: Vec<f64>,
-        tree: Tree,
-        k: usize,
-    },
+    Local(Box<Local>),
+}
+
+/// A moving neighbourhood's data, drift and search.
+struct Local {
+    prep: Prepared,
+    /// Standardised `g` at the data, in data order.
+    g: Vec<f64>,
+    tree: Tree,
+    k: usize,
 }
 
 impl ExternalDriftKriging {
@@ -137,8 +140,8 @@ impl ExternalDriftKriging {
                 let of_residual =
                     GlobalKriging::new(&data.with_values(r), variogram, method, false)?;
                 How::Global {
-                    of_drift,
-                    of_residual,
+                    of_drift: Box::new(of_drift),
+                    of_residual: Box::new(of_residual),
                     beta,
                     gpg,
                 }
@@ -156,7 +159,7 @@ impl ExternalDriftKriging {
                     });
                 }
                 let tree = Tree::new(&prep.pts)?;
-                How::Local { prep, g, tree, k }
+                How::Local(Box::new(Local { prep, g, tree, k }))
             }
         };
         Ok(ExternalDriftKriging {
@@ -171,7 +174,7 @@ impl ExternalDriftKriging {
     pub fn coefficient(&self) -> Option<f64> {
         match &self.how {
             How::Global { beta, .. } => Some(beta / self.scale),
-            How::Local { .. } => None,
+            How::Local(_) => None,
         }
     }
 
@@ -237,7 +240,7 @@ impl ExternalDriftKriging {
     pub fn has_variance(&self) -> bool {
         match &self.how {
             How::Global { of_drift, .. } => of_drift.has_variance(),
-            How::Local { .. } => true,
+            How::Local(_) => true,
         }
     }
 
@@ -287,7 +290,8 @@ impl ExternalDriftKriging {
                 }
                 Ok(())
             }
-            How::Local { prep, g, tree, k } => {
+            How::Local(l) => {
+                let (prep, g, tree, k) = (&l.prep, &l.g, &l.tree, &l.k);
                 let res: Vec<(f64, f64)> = targets
                     .par_iter()
                     .zip(g0.par_iter())

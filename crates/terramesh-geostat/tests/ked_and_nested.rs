@@ -32,7 +32,10 @@ fn check(what: &str, est: &[f64], var: &[f64], want: &[Vec<f64>]) {
     }
 }
 
-fn ked_case() -> (Data, Vec<Vec<f64>>, Vec<[f64; 2]>, Vec<Vec<f64>>) {
+/// The data, their columns, the targets and the targets' columns.
+type Case = (Data, Vec<Vec<f64>>, Vec<[f64; 2]>, Vec<Vec<f64>>);
+
+fn ked_case() -> Case {
     let d = columns("ked-data.csv");
     let data = Data::new(xy(&d), d[2].clone(), Duplicates::Reject).unwrap();
     let t = columns("ked-targets.csv");

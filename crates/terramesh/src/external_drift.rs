@@ -187,7 +187,7 @@ pub enum DriftSource {
     /// A column of the targets CSV (its name).
     Column(String),
     /// A raster sampled at every target.
-    Grid(DriftGrid),
+    Grid(Box<DriftGrid>),
 }
 
 /// What predicts: any [`Predictor`], or kriging with an external drift and the source of the
@@ -198,7 +198,7 @@ pub enum Engine {
     /// Kriging with an external drift.
     External {
         /// The kriging.
-        kriging: ExternalDriftKriging,
+        kriging: Box<ExternalDriftKriging>,
         /// The targets' drift values.
         source: DriftSource,
     },
@@ -241,7 +241,10 @@ impl Engine {
                     (DriftSource::Grid(grid), _) => {
                         let mut v = Vec::with_capacity(targets.len());
                         for (i, p) in targets.iter().enumerate() {
-                            v.push(grid.sample(*p).map_err(|e| PredictError::Drift(i, e))?);
+                            v.push(
+                                grid.sample(*p)
+                                    .map_err(|e| PredictError::Drift(i, Box::new(e)))?,
+                            );
                         }
                         sampled = v;
                         &sampled
@@ -250,11 +253,11 @@ impl Engine {
                     (DriftSource::Column(c), None) => {
                         return Err(PredictError::Drift(
                             0,
-                            Error::setting(
+                            Box::new(Error::setting(
                                 Setting::ExternalDrift,
                                 c,
                                 "the targets have no such column",
-                            ),
+                            )),
                         ))
                     }
                 };
@@ -272,7 +275,7 @@ pub enum PredictError {
     /// Kriging failed (a target's index inside, if about one).
     Kriging(GeostatError),
     /// The drift of target `.0` could not be sampled.
-    Drift(usize, Error),
+    Drift(usize, Box<Error>),
 }
 
 /// Values of a named column of a data CSV for the external drift, in the order and with the
@@ -360,7 +363,7 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for k in 0..n {
         let p = (k..n).max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))?;
-        if !(a[p * n + k].abs() > 1e-13 * scale) {
+        if a[p * n + k].abs() <= 1e-13 * scale || a[p * n + k].is_nan() {
             return None;
         }
         for j in 0..n {

@@ -209,7 +209,7 @@ pub fn predict_csv(
                     }
                     PredictError::Drift(i, e) => Error::Context {
                         context: format!("{name}, target row {}", first_row + i + 1),
-                        source: Box::new(e),
+                        source: e,
                     },
                 })?;
             buf.clear();
@@ -309,7 +309,7 @@ pub fn predict_grid(
                 PredictError::Kriging(e) => {
                     Error::setting(Setting::Grid, "", format!("{{grid}}: {e}"))
                 }
-                PredictError::Drift(_, e) => e,
+                PredictError::Drift(_, e) => *e,
             })?;
     }
     let mut out = Output::create(Some(out_path))?;

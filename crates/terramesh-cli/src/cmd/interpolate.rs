@@ -118,6 +118,9 @@ pub struct DriftArgs {
     external_drift_grid: Option<PathBuf>,
 }
 
+/// The method, the drift at the data, the variogram and the targets' drift source.
+pub type Ked = (Method, Vec<f64>, Variogram, DriftSource);
+
 /// Kriging with an external drift set up from the flags: the method, the drift at the data,
 /// the variogram (an automatic fit made to the residuals of the drift) and where the
 /// targets' drift comes from; `None` without the flags.
@@ -126,11 +129,13 @@ pub fn external_drift(
     d: &DriftArgs,
     data: &Path,
     fd: &FileData,
-) -> Result<Option<(Method, Vec<f64>, Variogram, DriftSource)>> {
+) -> Result<Option<Ked>> {
     let source = match (&d.external_drift, &d.external_drift_grid) {
         (None, None) => return Ok(None),
         (Some(c), None) => DriftSource::Column(c.clone()),
-        (None, Some(g)) => DriftSource::Grid(DriftGrid::open(g).map_err(crate::flag_error)?),
+        (None, Some(g)) => {
+            DriftSource::Grid(Box::new(DriftGrid::open(g).map_err(crate::flag_error)?))
+        }
         (Some(_), Some(_)) => {
             bail!("give --external-drift COLUMN or --external-drift-grid FILE, not both")
         }
@@ -298,7 +303,10 @@ fn engine_of(args: &Args, fd: &FileData, variance: bool) -> Result<Engine> {
     if let Some(b) = kriging.coefficient() {
         eprintln!("terramesh: external drift coefficient: {b} (z per unit of the drift)");
     }
-    Ok(Engine::External { kriging, source })
+    Ok(Engine::External {
+        kriging: Box::new(kriging),
+        source,
+    })
 }
 
 /// Runs the command.
