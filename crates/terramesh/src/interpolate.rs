@@ -1,6 +1,7 @@
 //! Interpolation of scattered x, y, z data on its own (`terramesh variogram`, `interpolate`,
 //! `cv`): reading the data with line numbers, fitting a variogram by name, and predicting at
-//! the targets of a CSV file or on a grid through any [`Predictor`].
+//! the targets of a CSV file or on a grid through an [`Engine`]: any
+//! [`Predictor`](terramesh_geostat::Predictor), or kriging with an external drift.
 //!
 //! ```
 //! use terramesh::external_drift::Engine;
