@@ -12,11 +12,12 @@
 //! use terramesh::external_drift::DriftGrid;
 //! let dir = tempfile::tempdir()?;
 //! let p = dir.path().join("g.asc");
-//! std::fs::write(&p, "ncols 3\nnrows 2\nxllcenter 100\nyllcenter 200\ncellsize 10\n1 2 4\n0 0 0\n")?;
+//! // Node-centred, rows from the north (y 30, then y 20); coordinates in degrees here.
+//! std::fs::write(&p, "ncols 3\nnrows 2\nxllcenter 100\nyllcenter 20\ncellsize 10\n1 2 4\n0 0 0\n")?;
 //! let g = DriftGrid::open(&p)?;
-//! assert_eq!(g.sample([105.0, 210.0])?, 1.5); // on the northern row, between 1 and 2
-//! assert_eq!(g.sample([115.0, 205.0])?, 1.5); // the middle of a cell: (2 + 4 + 0 + 0) / 4
-//! assert!(g.sample([99.0, 205.0]).unwrap_err().to_string().contains("outside"));
+//! assert_eq!(g.sample([105.0, 30.0])?, 1.5); // on the northern row, between 1 and 2
+//! assert_eq!(g.sample([115.0, 25.0])?, 1.5); // the middle of a cell: (2 + 4 + 0 + 0) / 4
+//! assert!(g.sample([99.0, 25.0]).unwrap_err().to_string().contains("outside"));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 

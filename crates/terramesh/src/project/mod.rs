@@ -222,7 +222,7 @@ impl VariogramSpec {
     /// use terramesh::project::{Project, TEMPLATE};
     /// let set = |s: &str| vec![format!("interpolation.model={s}")];
     /// let p = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = [8.0, 4.0], range = [300.0, 900.0], nugget = 1.0 }"))?;
-    /// let v = p.interpolation.model.unwrap().variogram()?;
+    /// let v = p.interpolation.model.unwrap().variogram().map_err(terramesh::Error::invalid)?;
     /// assert_eq!((v.structures.len(), v.structures[1].range), (2, 900.0));
     /// let e = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = 8.0, range = [300.0, 900.0] }")).unwrap_err();
     /// assert!(e.to_string().contains("interpolation.model.psill"), "{e}");
