@@ -142,20 +142,7 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
                     &format!("must be in 2..={n}"),
                 ));
             }
-            let mut order: Vec<usize> = (0..n).collect();
-            let mut s = 0x9E37_79B9_7F4A_7C15u64;
-            for i in (1..n).rev() {
-                s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-                let mut x = s;
-                x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-                x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-                x ^= x >> 31;
-                order.swap(i, (x % (i as u64 + 1)) as usize);
-            }
-            let mut assign = vec![0; n];
-            for (pos, &i) in order.iter().enumerate() {
-                assign[i] = pos % k;
-            }
+            let assign = fold_assignment(n, k);
             refit(data, how, &assign, k, &mut est, &mut var)?;
         }
     }
@@ -165,6 +152,25 @@ pub fn cross_validate(data: &Data, how: &Interpolator, folds: Folds) -> Result<C
         variance: if kriging { var } else { Vec::new() },
         stats,
     })
+}
+
+/// The fold of each of `n` points for `k` folds: a seeded shuffle (seed 0) dealt in turn.
+pub(crate) fn fold_assignment(n: usize, k: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut s = 0x9E37_79B9_7F4A_7C15u64;
+    for i in (1..n).rev() {
+        s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut x = s;
+        x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        x ^= x >> 31;
+        order.swap(i, (x % (i as u64 + 1)) as usize);
+    }
+    let mut assign = vec![0; n];
+    for (pos, &i) in order.iter().enumerate() {
+        assign[i] = pos % k;
+    }
+    assign
 }
 
 fn refit(
@@ -205,7 +211,7 @@ fn refit(
 /// The statistics of the errors `est - z`. Sums of squares are taken of errors scaled by the
 /// largest one, so that errors of 1e200 give a finite RMSE; a statistic that is still not a
 /// finite number is an error, never written as `inf`.
-fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> Result<CvStats> {
+pub(crate) fn summarize(z: &[f64], est: &[f64], var: Option<&[f64]>) -> Result<CvStats> {
     let n = z.len();
     let err: Vec<f64> = est.iter().zip(z).map(|(e, z)| e - z).collect();
     if let Some(i) = err.iter().position(|e| !e.is_finite()) {

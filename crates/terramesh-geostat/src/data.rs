@@ -158,6 +158,16 @@ impl Data {
         }
     }
 
+    /// The same locations (and frame) with other values, already validated as finite.
+    pub(crate) fn with_values(&self, z: Vec<f64>) -> Data {
+        assert_eq!(z.len(), self.z.len());
+        Data {
+            xy: self.xy.clone(),
+            z,
+            frame: self.frame,
+        }
+    }
+
     /// The frame kriging of these data with `variogram` works in: the one given by
     /// [`Data::with_frame`], else the data's own.
     ///

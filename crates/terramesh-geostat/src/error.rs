@@ -122,6 +122,9 @@ pub enum GeostatError {
     /// Fitting a variogram model failed.
     #[error("cannot fit a variogram: {0}")]
     Fit(String),
+    /// The external drift of kriging with an external drift cannot be used.
+    #[error("the external drift cannot be used: {0}")]
+    ExternalDrift(String),
     /// A cross-validation statistic came out NaN or infinite (data values beyond what
     /// double precision can square).
     #[error("the {what} is not a finite number: the data values are too large for double precision; rescale z (for example to kilometres)")]

@@ -10,6 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::aniso::DirectionalLags;
 use crate::auto::Selection;
 use crate::cv::Candidate;
 use crate::error::GeostatError;
@@ -59,6 +60,10 @@ pub struct VariogramFile {
     /// files without it are as they always were).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub selection: Option<Selection>,
+    /// The directional variograms a fitted anisotropy came from (`--anisotropy auto`); left
+    /// out otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub directions: Vec<DirectionalLags>,
 }
 
 /// The `lags` section: the lag classes asked for.
@@ -169,6 +174,7 @@ impl VariogramFile {
             fit: None,
             candidates: Vec::new(),
             selection: None,
+            directions: Vec::new(),
         }
     }
 
@@ -199,6 +205,7 @@ impl VariogramFile {
             fit: section(&mut map, "fit"),
             candidates: section(&mut map, "candidates"),
             selection: section(&mut map, "selection"),
+            directions: section(&mut map, "directions"),
         })
     }
 }
@@ -307,6 +314,7 @@ mod tests {
             }),
             candidates: cands.into_iter().map(CandidateEntry::Full).collect(),
             selection: None,
+            directions: Vec::new(),
         };
         let text = f.to_json_pretty();
         assert_eq!(text, serde_json::to_string_pretty(&old).unwrap());

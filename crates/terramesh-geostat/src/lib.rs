@@ -6,12 +6,15 @@
 //! - Data: [`Data`] (validated, duplicates rejected or merged by [`Duplicates`]).
 //! - Variograms: [`Variogram`] of [`Structure`]s of a [`ModelKind`]; [`experimental`] lag
 //!   classes ([`LagSettings`]), [`fit_model`] (weighted least squares), [`fit_reml`]
-//!   (restricted maximum likelihood with the drift), [`fit_auto_reml`] (`--variogram auto`:
+//!   (restricted maximum likelihood with the drift), [`fit_nested`] (nested structures
+//!   jointly), [`fit_anisotropy`] (geometric anisotropy from directional variograms),
+//!   [`fit_auto_reml`] (`--variogram auto`:
 //!   REML over the model family, chosen by AIC) and [`fit_auto`] (WLS, chosen by
 //!   cross-validation).
 //! - Prediction: every interpolator is a [`Predictor`]; [`kriging`] builds [`GlobalKriging`]
 //!   ([`Neighbourhood::All`]) or [`LocalKriging`] ([`Neighbourhood::Nearest`]) for a
-//!   [`Method`]; [`Idw`] is inverse distance weighting.
+//!   [`Method`]; [`Idw`] is inverse distance weighting; [`ExternalDriftKriging`] adds an
+//!   external drift (a secondary variable known at the data and the targets).
 //! - Validation: [`cross_validate`] an [`Interpolator`].
 //! - Simulation: [`simulate`] an [`Ensemble`] of conditional realisations
 //!   ([`SimulationSettings`]); [`unconditional`] fields.
@@ -55,6 +58,7 @@
 // rejects NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+mod aniso;
 mod auto;
 mod band;
 mod cv;
@@ -65,9 +69,12 @@ mod file;
 mod fit;
 mod global;
 mod idw;
+mod ked;
+mod ked_cv;
 mod linalg;
 mod model;
 mod neighbourhood;
+mod nested;
 mod optim;
 mod predictor;
 mod reml;
@@ -76,6 +83,9 @@ mod simulate;
 mod special;
 mod system;
 
+pub use aniso::{
+    fit_anisotropy, fit_anisotropy_lags, AnisotropyFit, DirectionalLags, DEFAULT_DIRECTIONS,
+};
 pub use auto::{fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection, DEFAULT_LOO_POINTS};
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
@@ -90,8 +100,11 @@ pub use file::{
 pub use fit::{fit_model, Fit, Weighting};
 pub use global::{GlobalKriging, BLOCK};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
+pub use ked::ExternalDriftKriging;
+pub use ked_cv::cross_validate_external;
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
+pub use nested::{fit_nested, MAX_STRUCTURES};
 pub use predictor::{kriging, Neighbourhood, Predictor};
 pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK};
 pub use simulate::{

@@ -22,8 +22,9 @@
 //! ```
 
 use terramesh_geostat::{
-    fit_auto, fit_auto_reml, fit_model, fit_reml, AutoSettings, Candidate, Data, Fit, FitMethod,
-    Lag, ModelKind, Named, Selection,
+    fit_anisotropy, fit_auto, fit_auto_reml, fit_model, fit_nested, fit_reml, AutoSettings,
+    Candidate, Data, DirectionalLags, Fit, FitMethod, Lag, LagSettings, ModelKind, Named,
+    Selection, DEFAULT_DIRECTIONS, MAX_STRUCTURES,
 };
 
 use crate::error::{Error, Result};
@@ -32,12 +33,15 @@ use crate::setting::Setting;
 /// What to fit and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FitPlan {
-    /// `auto` or a model name ([`ModelKind`]).
+    /// `auto`, a model name ([`ModelKind`]) or a nested sum of up to three names joined by
+    /// `+` (`spherical+exponential`), fitted jointly.
     pub model: String,
     /// REML or WLS; `None`: REML for `auto`, WLS for a named model (as before REML existed).
     pub method: Option<FitMethod>,
     /// The drift, the weights of the WLS fits and the REML subset.
     pub auto: AutoSettings,
+    /// Fit geometric anisotropy too, from directional variograms (`None`: isotropic).
+    pub anisotropy: Option<AnisotropyPlan>,
 }
 
 impl Default for FitPlan {
@@ -46,8 +50,86 @@ impl Default for FitPlan {
             model: "auto".into(),
             method: None,
             auto: AutoSettings::default(),
+            anisotropy: None,
         }
     }
+}
+
+/// How anisotropy is fitted: directional variograms along `directions` azimuths over 180°
+/// (0°, 180°/directions, ...; GSLIB's azimuths, clockwise from north), each with the lag
+/// classes of `lags` within the half-angle `tolerance`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnisotropyPlan {
+    /// Lag classes of each direction (their `direction` is replaced).
+    pub lags: LagSettings,
+    /// Number of azimuths (default [`DEFAULT_DIRECTIONS`]).
+    pub directions: usize,
+    /// Half-angle tolerance, degrees.
+    pub tolerance: f64,
+}
+
+impl Default for AnisotropyPlan {
+    fn default() -> Self {
+        AnisotropyPlan {
+            lags: LagSettings::default(),
+            directions: DEFAULT_DIRECTIONS,
+            tolerance: terramesh_geostat::DEFAULT_TOLERANCE,
+        }
+    }
+}
+
+/// The structures of a model list `a+b+c` (one to three names), or an error naming the
+/// model setting and the value.
+///
+/// ```
+/// use terramesh::fitting::parse_models;
+/// use terramesh_geostat::ModelKind;
+/// assert_eq!(parse_models("spherical+Exponential")?, [ModelKind::Spherical, ModelKind::Exponential]);
+/// let e = parse_models("spherical+cubic").unwrap_err();
+/// assert!(e.to_string().contains("'cubic'"), "{e}");
+/// assert!(parse_models("spherical+spherical+gaussian+exponential").is_err());
+/// # Ok::<(), terramesh::Error>(())
+/// ```
+pub fn parse_models(text: &str) -> Result<Vec<ModelKind>> {
+    let names: Vec<&str> = text.split('+').map(str::trim).collect();
+    let nested = names.len() > 1;
+    if names.len() > MAX_STRUCTURES {
+        return Err(Error::setting(
+            Setting::Model,
+            text,
+            format!(
+                "{} structures: a nested model has at most {MAX_STRUCTURES} besides the nugget",
+                names.len()
+            ),
+        ));
+    }
+    let mut kinds = Vec::with_capacity(names.len());
+    for n in names {
+        let Ok(kind) = n.parse::<ModelKind>() else {
+            return Err(Error::setting(
+                Setting::Model,
+                text,
+                format!(
+                    "'{n}' is not a model: expected auto, {}, or up to {MAX_STRUCTURES} of them joined by + (spherical+exponential)",
+                    terramesh_core::vocab::one_of(&ModelKind::names())
+                ),
+            ));
+        };
+        if nested && matches!(kind, ModelKind::Nugget | ModelKind::Power) {
+            {
+                return Err(Error::setting(
+                    Setting::Model,
+                    text,
+                    format!(
+                        "a {} structure cannot be nested (the nugget is always part of the model; nest spherical, exponential, gaussian, matern or linear)",
+                        kind.name()
+                    ),
+                ));
+            }
+        }
+        kinds.push(kind);
+    }
+    Ok(kinds)
 }
 
 /// A fitted model, the candidates of an automatic fit and what chose it.
@@ -59,10 +141,47 @@ pub struct Fitted {
     pub candidates: Vec<Candidate>,
     /// REML's drift and number of data (`None` for WLS).
     pub selection: Option<Selection>,
+    /// The directional variograms of a fitted anisotropy (empty without one).
+    pub directions: Vec<DirectionalLags>,
 }
 
 /// Fits the plan's model to `data` (and its experimental variogram `lags`).
 pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
+    let mut fitted = fit_isotropic(data, lags, plan)?;
+    let Some(a) = &plan.anisotropy else {
+        return Ok(fitted);
+    };
+    // The shapes of the isotropic fit, the ellipse and the ranges from the directions.
+    let mut base = fitted.fit.variogram.clone();
+    base.anisotropy = None;
+    let af = fit_anisotropy(
+        data,
+        &a.lags,
+        &base,
+        a.directions,
+        a.tolerance,
+        plan.auto.weighting,
+    )
+    .map_err(|e| Error::setting(Setting::Anisotropy, "auto", e.to_string()))?;
+    fitted.directions = af.directions;
+    fitted.fit = af.fit;
+    if plan.method == Some(FitMethod::Reml) {
+        let r = fit_reml(
+            data,
+            plan.auto.drift,
+            &fitted.fit.variogram,
+            plan.auto.block,
+        )?;
+        fitted.fit = Fit {
+            rmse: terramesh_geostat::lag_rmse(lags, &r.variogram),
+            variogram: r.variogram,
+            objective: -r.log_likelihood,
+        };
+    }
+    Ok(fitted)
+}
+
+fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     let auto = plan.model.eq_ignore_ascii_case("auto");
     // WLS unless REML is asked for: REML (opt-in) costs seconds where WLS costs milliseconds
     let method = plan.method.unwrap_or(FitMethod::Wls);
@@ -74,6 +193,7 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
                     fit,
                     candidates,
                     selection: Some(s),
+                    directions: Vec::new(),
                 }
             }
             FitMethod::Wls => {
@@ -82,26 +202,23 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
                     fit,
                     candidates,
                     selection: None,
+                    directions: Vec::new(),
                 }
             }
         });
     }
-    let Ok(kind) = plan.model.parse::<ModelKind>() else {
-        return Err(Error::setting(
-            Setting::Model,
-            &plan.model,
-            format!(
-                "expected auto or {}",
-                terramesh_core::vocab::one_of(&ModelKind::names())
-            ),
-        ));
+    let kinds = parse_models(&plan.model)?;
+    let wls = if kinds.len() == 1 {
+        fit_model(lags, kinds[0], plan.auto.weighting)?
+    } else {
+        fit_nested(lags, &kinds, plan.auto.weighting)?
     };
-    let wls = fit_model(lags, kind, plan.auto.weighting)?;
     if method == FitMethod::Wls {
         return Ok(Fitted {
             fit: wls,
             candidates: Vec::new(),
             selection: None,
+            directions: Vec::new(),
         });
     }
     let r = fit_reml(data, plan.auto.drift, &wls.variogram, plan.auto.block)?;
@@ -120,5 +237,6 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             blocks: r.blocks,
             cv_points: None,
         }),
+        directions: Vec::new(),
     })
 }

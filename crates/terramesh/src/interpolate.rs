@@ -1,8 +1,10 @@
 //! Interpolation of scattered x, y, z data on its own (`terramesh variogram`, `interpolate`,
 //! `cv`): reading the data with line numbers, fitting a variogram by name, and predicting at
-//! the targets of a CSV file or on a grid through any [`Predictor`].
+//! the targets of a CSV file or on a grid through an [`Engine`]: any
+//! [`Predictor`](terramesh_geostat::Predictor), or kriging with an external drift.
 //!
 //! ```
+//! use terramesh::external_drift::Engine;
 //! use terramesh::interpolate::{fit_named, predict_csv, read_data};
 //! use terramesh_geostat::{experimental, kriging, Duplicates, LagSettings, Method, Neighbourhood, Weighting};
 //! let dir = tempfile::tempdir()?;
@@ -19,7 +21,7 @@
 //! let (fit, _) = fit_named(&fd.data, &lags, "spherical", Weighting::Cressie)?;
 //! let eng = kriging(&fd.data, &fit.variogram, Method::Ordinary, Neighbourhood::All, true)?;
 //! let out = dir.path().join("out.csv");
-//! predict_csv(eng.as_ref(), &dir.path().join("t.csv"), true, Some(&out))?;
+//! predict_csv(&Engine::Plain(eng), &dir.path().join("t.csv"), true, Some(&out))?;
 //! assert!(std::fs::read_to_string(&out)?.starts_with("x,y,z,variance\n15,15,"));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -30,7 +32,7 @@ use std::path::Path;
 
 use terramesh_geostat::{
     fit_auto, fit_model, Candidate, Data, Duplicates, Fit, GeostatError, Lag, ModelKind, Named,
-    Predictor, Weighting,
+    Weighting,
 };
 use terramesh_io::grid_write::{write_asc, write_geotiff, RasterGrid};
 use terramesh_io::number::write_shortest;
@@ -38,6 +40,7 @@ use terramesh_io::output::Output;
 use terramesh_io::table::{ReadOptions, Table};
 
 use crate::error::{bail, Context, Error, Result};
+use crate::external_drift::{Engine, PredictError};
 use crate::setting::Setting;
 
 /// Targets read and predicted per block: memory does not grow with the number of targets.
@@ -117,8 +120,9 @@ pub fn fit_named(
 /// Predicts at the `x,y` targets of a CSV file, block by block (memory does not grow with the
 /// number of targets), and writes `x,y,z[,variance]` to `output` (standard output without
 /// one) atomically. Errors name the file, the line, the column, or the 1-based target row.
+/// Kriging with an external drift from a column reads that column of the targets too.
 pub fn predict_csv(
-    eng: &dyn Predictor,
+    eng: &Engine,
     targets: &Path,
     want_var: bool,
     output: Option<&Path>,
@@ -145,6 +149,20 @@ pub fn predict_csv(
             headers.join(", ")
         );
     };
+    let gc = match eng.drift_column() {
+        None => None,
+        Some(c) => Some(find(&[c]).ok_or_else(|| {
+            Error::setting(
+                Setting::ExternalDrift,
+                c,
+                format!(
+                    "{name} has no such column (its header: {})",
+                    headers.join(", ")
+                ),
+            )
+        })?),
+    };
+    let mut gv: Vec<f64> = Vec::new();
     let mut out = Output::create(output).with_context(|| "cannot create the output".to_string())?;
     out.write_all(if want_var {
         b"x,y,z,variance\n"
@@ -173,17 +191,27 @@ pub fn predict_csv(
                 }
             };
             pts.push([num(xc)?, num(yc)?]);
+            if let Some(c) = gc {
+                gv.push(num(c)?);
+            }
         }
         if pts.len() == TARGET_BLOCK || (!more && !pts.is_empty()) {
             let mut est = vec![0.0; pts.len()];
             let mut var = vec![0.0; if want_var { pts.len() } else { 0 }];
-            eng.predict(&pts, &mut est, want_var.then_some(&mut var[..]))
-                .map_err(|e| {
-                    let e = e.offset_target(first_row);
-                    Error::invalid(format!(
-                        "{name}: {}",
-                        e.display_with_target(|i| format!("target row {}", i + 1))
-                    ))
+            let col = gc.map(|_| &gv[..]);
+            eng.predict(&pts, col, &mut est, want_var.then_some(&mut var[..]))
+                .map_err(|e| match e {
+                    PredictError::Kriging(e) => {
+                        let e = e.offset_target(first_row);
+                        Error::invalid(format!(
+                            "{name}: {}",
+                            e.display_with_target(|i| format!("target row {}", i + 1))
+                        ))
+                    }
+                    PredictError::Drift(i, e) => Error::Context {
+                        context: format!("{name}, target row {}", first_row + i + 1),
+                        source: e,
+                    },
                 })?;
             buf.clear();
             for (i, p) in pts.iter().enumerate() {
@@ -202,6 +230,7 @@ pub fn predict_csv(
             first_row += pts.len();
             total += pts.len();
             pts.clear();
+            gv.clear();
         }
         if !more {
             break;
@@ -215,28 +244,42 @@ pub fn predict_csv(
 }
 
 /// Predicts at the nodes of `g` and writes them as an ESRI ASCII grid (`.asc`) or a GeoTIFF
-/// (`.tif`, with `epsg`) at `out_path`, atomically.
+/// (`.tif`, with `epsg`) at `out_path`, atomically; with `variance_path`, the kriging
+/// variances on the same nodes beside them, by the same writer (the format of its own
+/// extension), also atomically: both files are written only when every node has been
+/// predicted.
 pub fn predict_grid(
-    eng: &dyn Predictor,
+    eng: &Engine,
     g: &RasterGrid,
     out_path: &Path,
+    variance_path: Option<&Path>,
     epsg: Option<u16>,
 ) -> Result<()> {
-    let ext = out_path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if ext != "asc" && ext != "tif" && ext != "tiff" {
-        return Err(Error::setting(
-            Setting::Output,
-            out_path.display(),
-            "a grid is written as .asc (ESRI ASCII) or .tif (GeoTIFF)",
-        ));
-    }
-    // The values and the file's buffer: 16 bytes a node.
+    let ext = grid_format(out_path, Setting::Output)?;
+    let var_ext = match variance_path {
+        Some(p) => {
+            if !eng.has_variance() {
+                return Err(Error::setting(
+                    Setting::VarianceGrid,
+                    p.display(),
+                    "this interpolation gives no variance (IDW, or kriging without variances)",
+                ));
+            }
+            if p == out_path {
+                return Err(Error::setting(
+                    Setting::VarianceGrid,
+                    p.display(),
+                    "the same file as the estimates ({output}): give another name",
+                ));
+            }
+            Some(grid_format(p, Setting::VarianceGrid)?)
+        }
+        None => None,
+    };
+    // The values and the file's buffer: 16 bytes a node (24 with variances).
+    let per_node = if variance_path.is_some() { 24.0 } else { 16.0 };
     let nodes =
-        terramesh_core::limits::Estimate::new("grid nodes", g.nx as f64 * g.ny as f64, 16.0)
+        terramesh_core::limits::Estimate::new("grid nodes", g.nx as f64 * g.ny as f64, per_node)
             .check()
             .map_err(|e| {
                 Error::setting(
@@ -246,6 +289,10 @@ pub fn predict_grid(
                 )
             })?;
     let mut values = terramesh_core::limits::try_vec(nodes, 0.0, "grid nodes")?;
+    let mut variances = match variance_path {
+        Some(_) => terramesh_core::limits::try_vec(nodes, 0.0, "grid nodes")?,
+        None => Vec::new(),
+    };
     let rows_per_block = (TARGET_BLOCK / g.nx).max(1);
     let mut pts = Vec::with_capacity(rows_per_block * g.nx);
     for j0 in (0..g.ny).step_by(rows_per_block) {
@@ -256,15 +303,62 @@ pub fn predict_grid(
                 pts.push(g.node(i, j));
             }
         }
-        eng.predict(&pts, &mut values[j0 * g.nx..j1 * g.nx], None)
-            .map_err(|e| Error::setting(Setting::Grid, "", format!("{{grid}}: {e}")))?;
+        let r = j0 * g.nx..j1 * g.nx;
+        let var = variance_path.map(|_| &mut variances[r.clone()]);
+        eng.predict(&pts, None, &mut values[r], var)
+            .map_err(|e| match e {
+                PredictError::Kriging(e) => {
+                    Error::setting(Setting::Grid, "", format!("{{grid}}: {e}"))
+                }
+                PredictError::Drift(_, e) => *e,
+            })?;
     }
     let mut out = Output::create(Some(out_path))?;
-    if ext == "asc" {
-        write_asc(&mut out, g, &values)?;
-    } else {
-        write_geotiff(&mut out, g, &values, epsg, None)?;
-    }
+    write_grid(&mut out, &ext, g, &values, epsg)?;
+    let var_out = match (variance_path, &var_ext) {
+        (Some(p), Some(e)) => {
+            let mut o = Output::create(Some(p))?;
+            write_grid(&mut o, e, g, &variances, epsg)?;
+            Some(o)
+        }
+        _ => None,
+    };
     out.commit()?;
+    if let Some(o) = var_out {
+        o.commit()?;
+    }
+    Ok(())
+}
+
+/// `asc` or `tif` from a grid file's name; anything else is an error naming `setting`.
+fn grid_format(path: &Path, setting: Setting) -> Result<String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "asc" => Ok(ext),
+        "tif" | "tiff" => Ok("tif".into()),
+        _ => Err(Error::setting(
+            setting,
+            path.display(),
+            "a grid is written as .asc (ESRI ASCII) or .tif (GeoTIFF)",
+        )),
+    }
+}
+
+fn write_grid(
+    out: &mut Output,
+    ext: &str,
+    g: &RasterGrid,
+    values: &[f64],
+    epsg: Option<u16>,
+) -> Result<()> {
+    if ext == "asc" {
+        write_asc(out, g, values)?;
+    } else {
+        write_geotiff(out, g, values, epsg, None)?;
+    }
     Ok(())
 }

@@ -47,6 +47,7 @@ pub use error::{cut, Context, Error, Result};
 pub use setting::Setting;
 pub mod build;
 pub mod convert;
+pub mod external_drift;
 pub mod fitting;
 pub mod geology;
 pub mod georef;

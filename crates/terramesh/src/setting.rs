@@ -68,6 +68,14 @@ pub enum Setting {
     GridSpacing,
     /// The number of conditional-simulation realisations.
     Realisations,
+    /// The column of an external drift (kriging with an external drift).
+    ExternalDrift,
+    /// The raster of an external drift.
+    ExternalDriftGrid,
+    /// The file of the kriging variances beside a grid of estimates.
+    VarianceGrid,
+    /// Geometric anisotropy (given or fitted).
+    Anisotropy,
 }
 
 impl Setting {
@@ -125,4 +133,8 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Lags => "lags",
     Setting::GridSpacing => "grid-spacing",
     Setting::Realisations => "realisations",
+    Setting::ExternalDrift => "external-drift",
+    Setting::ExternalDriftGrid => "external-drift-grid",
+    Setting::VarianceGrid => "variance-grid",
+    Setting::Anisotropy => "anisotropy",
 ]);

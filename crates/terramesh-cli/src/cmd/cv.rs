@@ -9,7 +9,7 @@ use terramesh::interpolate::read_data;
 use terramesh_geostat::InterpolationMethod;
 
 use super::geodata::in_file;
-use super::interpolate::{method, resolve_variogram, MethodArgs};
+use super::interpolate::{external_drift, method, resolve_variogram, DriftArgs, MethodArgs};
 
 /// Cross-validate an interpolation method: leave-one-out (default) or k-fold.
 ///
@@ -19,13 +19,16 @@ use super::interpolate::{method, resolve_variogram, MethodArgs};
 #[command(after_help = "Examples:\n  \
     terramesh cv --data D.csv --method uk --variogram auto\n  \
     terramesh cv --data D.csv --method ok --model spherical --psill 12000 --range 6000 --folds 10\n  \
-    terramesh cv --data D.csv --method idw --power 2 --neighbors 16")]
+    terramesh cv --data D.csv --method idw --power 2 --neighbors 16\n  \
+    terramesh cv --data D.csv --method ok --external-drift coarse_dem --variogram auto")]
 pub struct Args {
     /// Data: CSV with columns x, y, z.
     #[arg(long)]
     data: PathBuf,
     #[command(flatten)]
     m: MethodArgs,
+    #[command(flatten)]
+    drift: DriftArgs,
     /// k-fold with this many folds (default: leave-one-out).
     #[arg(long)]
     folds: Option<usize>,
@@ -34,35 +37,45 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let fd = read_data(&args.data, args.m.duplicates).map_err(crate::flag_error)?;
-    let how = if args.m.method == InterpolationMethod::Idw {
-        if !(args.m.power.is_finite() && args.m.power > 0.0) {
-            bail!("--power {}: must be a finite number > 0", args.m.power);
-        }
-        Interpolator::Idw {
-            power: args.m.power,
-            search: match (args.m.neighbors, args.m.radius) {
-                (Some(_), Some(_)) => bail!("IDW takes --neighbors or --radius, not both"),
-                (Some(k), None) => IdwSearch::Nearest(k),
-                (None, Some(r)) => IdwSearch::Radius(r),
-                (None, None) => IdwSearch::All,
-            },
-        }
-    } else {
-        Interpolator::Kriging {
-            variogram: resolve_variogram(&args.m, &fd)?,
-            method: method(&args.m, &fd.data)?,
-            neighbours: args
-                .m
-                .neighbors
-                .map_or(Neighbourhood::All, Neighbourhood::Nearest),
-        }
-    };
     let folds = match args.folds {
         None => Folds::LeaveOneOut,
         Some(k) if k < 2 => bail!("--folds {k}: must be at least 2"),
         Some(k) => Folds::KFold(k),
     };
-    let r = cross_validate(&fd.data, &how, folds).map_err(|e| in_file(&fd.name, e))?;
+    let r = if let Some((method, g, v, _)) = external_drift(&args.m, &args.drift, &args.data, &fd)?
+    {
+        let hood = args
+            .m
+            .neighbors
+            .map_or(Neighbourhood::All, Neighbourhood::Nearest);
+        terramesh_geostat::cross_validate_external(&fd.data, &g, &v, method, hood, folds)
+    } else {
+        let how = if args.m.method == InterpolationMethod::Idw {
+            if !(args.m.power.is_finite() && args.m.power > 0.0) {
+                bail!("--power {}: must be a finite number > 0", args.m.power);
+            }
+            Interpolator::Idw {
+                power: args.m.power,
+                search: match (args.m.neighbors, args.m.radius) {
+                    (Some(_), Some(_)) => bail!("IDW takes --neighbors or --radius, not both"),
+                    (Some(k), None) => IdwSearch::Nearest(k),
+                    (None, Some(r)) => IdwSearch::Radius(r),
+                    (None, None) => IdwSearch::All,
+                },
+            }
+        } else {
+            Interpolator::Kriging {
+                variogram: resolve_variogram(&args.m, &fd)?,
+                method: method(&args.m, &fd.data)?,
+                neighbours: args
+                    .m
+                    .neighbors
+                    .map_or(Neighbourhood::All, Neighbourhood::Nearest),
+            }
+        };
+        cross_validate(&fd.data, &how, folds)
+    }
+    .map_err(|e| in_file(&fd.name, e))?;
     let s = r.stats;
     println!("key,value");
     println!("n,{}", s.n);

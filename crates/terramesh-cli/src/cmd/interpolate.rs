@@ -4,15 +4,18 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use terramesh::external_drift::{
+    drift_residuals, read_drift_column, DriftGrid, DriftSource, Engine,
+};
 use terramesh::interpolate::{predict_csv, predict_grid, read_data, FileData};
 use terramesh::variogram_file::read_variogram_file;
 use terramesh_geostat::{
-    experimental, kriging, Data, Drift, Duplicates, Idw, IdwSearch, InterpolationMethod, Method,
-    Neighbourhood, Predictor, Variogram,
+    experimental, kriging, Data, Drift, Duplicates, ExternalDriftKriging, Idw, IdwSearch,
+    InterpolationMethod, Method, Neighbourhood, Predictor, Variogram,
 };
 use terramesh_io::grid_write::RasterGrid;
 
-use super::geodata::{explicit_variogram, in_file, ModelArgs};
+use super::geodata::{explicit_or_fit, in_file, ModelArgs};
 use super::variogram::LagArgs;
 
 /// Method and variogram flags shared with `cv`.
@@ -63,7 +66,13 @@ pub struct MethodArgs {
     terramesh interpolate --data D.csv --targets T.csv --method uk --variogram auto -o OUT.csv\n  \
     terramesh interpolate --data D.csv --targets T.csv --method idw --power 2 --neighbors 16 -o OUT.csv\n  \
     terramesh interpolate --data D.csv --grid 380000,5390000,390000,5400000,201,201 --method ok \\\n      \
-    --variogram variogram.json --epsg 32632 -o dem.tif")]
+    --variogram variogram.json --epsg 32632 -o dem.tif --variance-grid dem-variance.tif\n  \
+    terramesh interpolate --data D.csv --targets T.csv --method ok --variogram auto \\\n      \
+    --model spherical+exponential --anisotropy auto -o OUT.csv\n  \
+    terramesh interpolate --data D.csv --targets T.csv --method ok --external-drift coarse_dem \\\n      \
+    --model exponential --psill 12000 --range 6000 --nugget 50 -o OUT.csv\n  \
+    terramesh interpolate --data D.csv --grid 380000,5390000,390000,5400000,201,201 --method uk \\\n      \
+    --external-drift-grid coarse.tif --variogram auto -o dem.tif")]
 pub struct Args {
     /// Data: CSV with columns x, y, z (projected coordinates, e.g. UTM metres).
     #[arg(long)]
@@ -82,14 +91,114 @@ pub struct Args {
     /// EPSG code written into a GeoTIFF grid (e.g. 32632 for UTM 32N).
     #[arg(long)]
     epsg: Option<u16>,
+    /// With --grid: also write the kriging variances on the same nodes to this file (.asc or
+    /// .tif, by the same writer as -o); both files are written only when every node is done.
+    #[arg(long)]
+    variance_grid: Option<PathBuf>,
+    #[command(flatten)]
+    drift: DriftArgs,
     /// Output file (default: standard output; required for --grid).
     #[arg(short, long)]
     output: Option<PathBuf>,
 }
 
+/// The external drift flags, shared with `cv`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct DriftArgs {
+    /// Kriging with an external drift (--method ok or uk): the secondary variable is this
+    /// column of the data CSV and of the targets CSV (e.g. a coarse DEM's height at each
+    /// point); PyKrige's `specified` drift.
+    #[arg(long, conflicts_with = "external_drift_grid")]
+    external_drift: Option<String>,
+    /// Kriging with an external drift (--method ok or uk): the secondary variable sampled from
+    /// this raster (.tif or .asc, in the data's coordinates) at the data, the targets and the
+    /// grid nodes, bilinearly between pixel centres (PyKrige's `external_Z`); every point
+    /// must lie within the pixel centres.
+    #[arg(long)]
+    external_drift_grid: Option<PathBuf>,
+}
+
+/// The method, the drift at the data, the variogram and the targets' drift source.
+pub type Ked = (Method, Vec<f64>, Variogram, DriftSource);
+
+/// Kriging with an external drift set up from the flags: the method, the drift at the data,
+/// the variogram (an automatic fit made to the residuals of the drift) and where the
+/// targets' drift comes from; `None` without the flags.
+pub fn external_drift(
+    m: &MethodArgs,
+    d: &DriftArgs,
+    data: &Path,
+    fd: &FileData,
+) -> Result<Option<Ked>> {
+    let source = match (&d.external_drift, &d.external_drift_grid) {
+        (None, None) => return Ok(None),
+        (Some(c), None) => DriftSource::Column(c.clone()),
+        (None, Some(g)) => {
+            DriftSource::Grid(Box::new(DriftGrid::open(g).map_err(crate::flag_error)?))
+        }
+        (Some(_), Some(_)) => {
+            bail!("give --external-drift COLUMN or --external-drift-grid FILE, not both")
+        }
+    };
+    let flag = if d.external_drift.is_some() {
+        "--external-drift"
+    } else {
+        "--external-drift-grid"
+    };
+    let method = match m.method {
+        InterpolationMethod::Ordinary | InterpolationMethod::Universal => method(m, &fd.data)?,
+        other => bail!("{flag}: kriging with an external drift is --method ok (the constant and the drift) or uk (the polynomial and the drift), not {other}"),
+    };
+    if m.radius.is_some() {
+        bail!("--radius applies to --method idw; kriging takes --neighbors");
+    }
+    if let Some(0) = m.neighbors {
+        bail!("--neighbors 0: must be at least 1");
+    }
+    let g = match &source {
+        DriftSource::Column(c) => {
+            read_drift_column(data, c, m.duplicates).map_err(crate::flag_error)?
+        }
+        DriftSource::Grid(grid) => grid
+            .sample_all(fd.data.xy())
+            .map_err(|e| crate::flag_error(e).context(format!("{}: the data", fd.name)))?,
+    };
+    // An automatic fit is made to the residuals of the drift (the drift's own variation out).
+    let auto = |s: &Option<String>| s.as_deref().is_some_and(|s| s.eq_ignore_ascii_case("auto"));
+    let v = if auto(&m.variogram) || auto(&m.model.model) {
+        let residuals = drift_residuals(&fd.data, &g, method)
+            .map_err(|e| crate::flag_error(e).context(format!("{flag}: {}", fd.name)))?;
+        resolve_for(m, fd, &residuals)?
+    } else {
+        resolve_for(m, fd, &fd.data)?
+    };
+    Ok(Some((method, g, v, source)))
+}
+
 /// The variogram from --model/--psill/..., --variogram FILE or auto.
 pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
-    if let Some(v) = explicit_variogram(&m.model)? {
+    resolve_for(m, fd, &fd.data)
+}
+
+/// [`resolve_variogram`], an automatic fit made to `fit_to` (the data, or the residuals of
+/// their drift for kriging with an external drift).
+fn resolve_for(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram> {
+    let fitting = m
+        .variogram
+        .as_deref()
+        .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
+    let aniso = m.model.anisotropy_auto()?;
+    if aniso
+        && !fitting
+        && !m
+            .model
+            .model
+            .as_deref()
+            .is_some_and(|s| s.eq_ignore_ascii_case("auto"))
+    {
+        bail!("--anisotropy auto fits the anisotropy with the variogram: give --variogram auto (the model's angle and ratio are otherwise --anisotropy-angle and --anisotropy-ratio)");
+    }
+    if let Some(v) = explicit_or_fit(&m.model, fitting)? {
         if m.variogram.is_some() {
             bail!("give either --variogram or --model with --psill/--range, not both");
         }
@@ -101,21 +210,26 @@ pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
         .as_deref()
         .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
     match m.variogram.as_deref() {
-        Some(s) if s.eq_ignore_ascii_case("auto") => auto(m, fd),
+        Some(s) if s.eq_ignore_ascii_case("auto") => auto(m, fd, fit_to),
         Some(file) => read_variogram_file(Path::new(file)).map_err(crate::flag_error),
-        None if auto_model => auto(m, fd),
+        None if auto_model => auto(m, fd, fit_to),
         None => bail!("kriging needs a variogram: --variogram auto, --variogram FILE.json, or --model NAME --psill C --range A [--nugget C0]"),
     }
 }
 
-fn auto(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
-    let lags = experimental(&fd.data, &m.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
+fn auto(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram> {
+    let lags = experimental(fit_to, &m.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
     // REML filters out the drift of the kriging that will use the model.
     let drift = match m.method {
         InterpolationMethod::Universal => m.drift.unwrap_or(Drift::Linear),
         _ => Drift::Constant,
     };
-    let fit = terramesh::fitting::fit(&fd.data, &lags, &m.lag.plan("auto", drift))
+    let model = m.model.model.as_deref().unwrap_or("auto");
+    let mut plan = m.lag.plan(model, drift);
+    if m.model.anisotropy_auto()? {
+        plan.anisotropy = Some(m.lag.anisotropy_plan()?);
+    }
+    let fit = terramesh::fitting::fit(fit_to, &lags, &plan)
         .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?
         .fit;
     eprintln!("terramesh: fitted variogram: {}", fit.variogram);
@@ -170,21 +284,61 @@ pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Box<dyn P
     kriging(&fd.data, &v, method, hood, variance).map_err(|e| in_file(&fd.name, e))
 }
 
+/// The engine of `interpolate`: [`engine`], or kriging with an external drift.
+fn engine_of(args: &Args, fd: &FileData, variance: bool) -> Result<Engine> {
+    let Some((method, g, v, source)) = external_drift(&args.m, &args.drift, &args.data, fd)? else {
+        return Ok(Engine::Plain(engine(&args.m, fd, variance)?));
+    };
+    let flag = if args.drift.external_drift.is_some() {
+        "--external-drift"
+    } else {
+        "--external-drift-grid"
+    };
+    let hood = args
+        .m
+        .neighbors
+        .map_or(Neighbourhood::All, Neighbourhood::Nearest);
+    let kriging = ExternalDriftKriging::new(&fd.data, &g, &v, method, hood, variance)
+        .map_err(|e| anyhow::anyhow!("{flag}: {}", in_file(&fd.name, e)))?;
+    if let Some(b) = kriging.coefficient() {
+        eprintln!("terramesh: external drift coefficient: {b} (z per unit of the drift)");
+    }
+    Ok(Engine::External {
+        kriging: Box::new(kriging),
+        source,
+    })
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let fd = read_data(&args.data, args.m.duplicates).map_err(crate::flag_error)?;
     let want_var = args.m.method != InterpolationMethod::Idw && !args.no_variance;
-    let eng = engine(&args.m, &fd, want_var)?;
+    if args.variance_grid.is_some() {
+        if args.grid.is_none() {
+            bail!("--variance-grid writes the variances beside --grid's estimates: give --grid (with --targets the variances are a column of -o)");
+        }
+        if args.m.method == InterpolationMethod::Idw {
+            bail!("--variance-grid: IDW has no variance; give --method sk, ok or uk");
+        }
+        if args.no_variance {
+            bail!("--variance-grid and --no-variance contradict each other: give one");
+        }
+    }
+    let eng = engine_of(&args, &fd, want_var)?;
     match (&args.targets, &args.grid) {
         (Some(t), None) => {
-            predict_csv(&*eng, t, want_var, args.output.as_deref()).map_err(crate::flag_error)
+            predict_csv(&eng, t, want_var, args.output.as_deref()).map_err(crate::flag_error)
         }
         (None, Some(g)) => {
             let spec: RasterGrid = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
             let Some(out) = &args.output else {
                 bail!("--grid needs -o FILE.asc or -o FILE.tif");
             };
-            predict_grid(&*eng, &spec, out, args.epsg).map_err(crate::flag_error)
+            if args.drift.external_drift.is_some() {
+                bail!("--grid with --external-drift: grid nodes have no column; sample the drift from a raster with --external-drift-grid");
+            }
+            predict_grid(&eng, &spec, out, args.variance_grid.as_deref(), args.epsg)
+                .map_err(crate::flag_error)
         }
         _ => bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
     }

@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use terramesh::fitting::{fit as fit_plan, FitPlan};
+use terramesh::fitting::{fit as fit_plan, AnisotropyPlan, FitPlan};
 use terramesh_geostat::{
     experimental, AutoSettings, CandidateEntry, Direction, Drift, Duplicates, Estimator, FitMethod,
     FitSummary, LagSettings, LagSummary, VariogramFile, Weighting,
@@ -68,7 +68,7 @@ impl LagArgs {
     pub fn weighting(&self) -> Weighting {
         self.weights
     }
-    /// The fitting plan of `model` (`auto` or a name) for kriging with `drift`.
+    /// The fitting plan of `model` (`auto`, a name or a nested sum) for kriging with `drift`.
     pub fn plan(&self, model: &str, drift: Drift) -> FitPlan {
         FitPlan {
             model: model.to_string(),
@@ -79,7 +79,24 @@ impl LagArgs {
                 block: (self.reml_block > 0).then_some(self.reml_block),
                 ..AutoSettings::default()
             },
+            anisotropy: None,
         }
+    }
+
+    /// The anisotropy fit of `--anisotropy auto`: 8 azimuths, these lag classes and
+    /// `--tolerance`; a directional `--azimuth` contradicts it.
+    pub fn anisotropy_plan(&self) -> Result<AnisotropyPlan> {
+        if let Some(a) = self.azimuth {
+            anyhow::bail!("--azimuth {a} and --anisotropy auto: the anisotropy fit makes its own directional variograms (8 azimuths within --tolerance); give one of them");
+        }
+        if !(self.tolerance > 0.0 && self.tolerance <= 90.0) {
+            anyhow::bail!("--tolerance {}: must be in (0, 90] degrees", self.tolerance);
+        }
+        Ok(AnisotropyPlan {
+            lags: self.settings(),
+            tolerance: self.tolerance,
+            ..AnisotropyPlan::default()
+        })
     }
 }
 
@@ -95,14 +112,24 @@ impl LagArgs {
 #[command(after_help = "Examples:\n  \
     terramesh variogram --data pts.csv -o variogram.json --plot variogram.svg\n  \
     terramesh variogram --data pts.csv --model spherical --lags 20 --max-dist 8000 -o v.json\n  \
-    terramesh variogram --data pts.csv --azimuth 45 --tolerance 22.5 --estimator cressie")]
+    terramesh variogram --data pts.csv --azimuth 45 --tolerance 22.5 --estimator cressie\n  \
+    terramesh variogram --data pts.csv --model spherical+exponential --fit reml -o v.json\n  \
+    terramesh variogram --data pts.csv --model gaussian --anisotropy auto -o v.json")]
 pub struct Args {
     /// Data: CSV with columns x, y, z (projected coordinates, e.g. UTM metres).
     #[arg(long)]
     data: PathBuf,
-    /// Model to fit: auto (default), spherical, exponential, gaussian, matern, power, linear, nugget.
+    /// Model to fit: auto (default), spherical, exponential, gaussian, matern, power, linear,
+    /// nugget, or a nested sum of up to three joined by + (spherical+exponential: nugget and
+    /// every structure fitted jointly by WLS, then REML with --fit reml).
     #[arg(long, default_value = "auto")]
     model: String,
+    /// auto: fit geometric anisotropy too, from directional variograms along 8 azimuths (0,
+    /// 22.5, ..., 157.5 degrees clockwise from north, each within --tolerance); the model's
+    /// angle is then degrees counter-clockwise from +x, and `directions` in the JSON holds
+    /// each azimuth's lags and fitted range.
+    #[arg(long)]
+    anisotropy: Option<String>,
     #[command(flatten)]
     lag: LagArgs,
     /// The drift that a REML fit filters out: that of the kriging that will use the model
@@ -137,9 +164,17 @@ pub fn run(args: Args) -> Result<()> {
     let fd = read_data(&args.data, args.duplicates).map_err(crate::flag_error)?;
     let s = args.lag.settings();
     let lags = experimental(&fd.data, &s).map_err(|e| in_file(&fd.name, e))?;
-    let fitted = fit_plan(&fd.data, &lags, &args.lag.plan(&args.model, args.drift))
+    let mut plan = args.lag.plan(&args.model, args.drift);
+    match args.anisotropy.as_deref() {
+        None => {}
+        Some(a) if a.eq_ignore_ascii_case("auto") => {
+            plan.anisotropy = Some(args.lag.anisotropy_plan()?)
+        }
+        Some(a) => anyhow::bail!("--anisotropy '{a}': expected auto"),
+    }
+    let fitted = fit_plan(&fd.data, &lags, &plan)
         .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
-    let (fit, cands) = (fitted.fit, fitted.candidates);
+    let (fit, cands, directions) = (fitted.fit, fitted.candidates, fitted.directions);
     let file = VariogramFile {
         data: fd.name.clone(),
         points: fd.data.len(),
@@ -159,6 +194,7 @@ pub fn run(args: Args) -> Result<()> {
         }),
         candidates: cands.into_iter().map(CandidateEntry::Full).collect(),
         selection: fitted.selection,
+        directions,
     };
     let mut out = Output::create(args.output.as_deref())?;
     out.write_all(file.to_json_pretty().as_bytes())?;

@@ -247,6 +247,16 @@ impl GlobalKriging {
         })
     }
 
+    /// The dual weights of the data values (`w` of `[K F; Fᵀ 0][w; v] = [z; 0]`, which is
+    /// `P z` for the projector `P` of the kriging), in the input order of the data.
+    pub(crate) fn dual_weights(&self) -> Vec<f64> {
+        let mut w = vec![0.0; self.w.len()];
+        for (i, &p) in self.perm.iter().enumerate() {
+            w[p] = self.w[i];
+        }
+        w
+    }
+
     /// Which strategy was chosen: `"band"`, `"dense"` or `"gamma"`.
     pub fn strategy(&self) -> &'static str {
         match self.solver {

@@ -56,7 +56,7 @@ pub fn adaptive(
         bail!("[mesh]: insert_samples cannot be combined with max_error");
     }
     // The surface of the first interpolation method, which gives the DSM heights.
-    let engine = Surface::primary(p, &model.data, &model.variogram)?;
+    let engine = Surface::primary_with(p, &model.data, &model.variogram, model.drift.as_ref())?;
     let (lo, hi) = s.region.projected.bbox().context("empty region")?;
     let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
     // Half the sampling cell resolves what was sampled; the node cap bounds the work.

@@ -255,6 +255,9 @@ pub struct Interpolated {
 pub struct Model {
     /// The samples.
     pub data: Data,
+    /// The external drift (`interpolation.external_drift_grid`): the raster and its values at
+    /// the samples.
+    pub drift: Option<crate::external_drift::ModelDrift>,
     /// The variogram used.
     pub variogram: Variogram,
     /// Experimental variogram of the samples.
@@ -274,12 +277,36 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         Duplicates::Mean,
     )
     .context("samples")?;
-    let lags = experimental(&data, &LagSettings::default())
+    // Kriging with an external drift: the raster at the samples, and a variogram fitted to
+    // the residuals of the drift (its own variation taken out).
+    let drift = match &ip.external_drift_grid {
+        None => None,
+        Some(g) => {
+            let grid = crate::external_drift::DriftGrid::open(&base.join(g))
+                .context("interpolation.external_drift_grid")?;
+            let at_data = grid
+                .sample_all(data.xy())
+                .context("interpolation.external_drift_grid: at the samples")?;
+            Some(crate::external_drift::ModelDrift { grid, at_data })
+        }
+    };
+    let fit_to = match &drift {
+        None => data.clone(),
+        Some(d) => {
+            let method = match ip.methods.contains(&InterpolationMethod::Universal) {
+                true => Method::Universal(ip.drift),
+                false => Method::Ordinary,
+            };
+            crate::external_drift::drift_residuals(&data, &d.at_data, method)
+                .context("interpolation.external_drift_grid")?
+        }
+    };
+    let lags = experimental(&fit_to, &LagSettings::default())
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let mut selection = None;
     let variogram = if let Some(v) = &ip.model {
-        Variogram::single(v.model, v.nugget, v.psill, v.range).context("interpolation.model")?
+        v.variogram().map_err(crate::Error::invalid)?
     } else if ip.variogram == "auto" {
         // REML filters out the drift of the UK that uses the model (constant without UK).
         let drift = if ip.methods.contains(&InterpolationMethod::Universal) {
@@ -288,14 +315,18 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
             Drift::Constant
         };
         let plan = crate::fitting::FitPlan {
-            model: "auto".into(),
+            model: ip.fit_model.clone(),
             method: Some(ip.fit),
             auto: terramesh_geostat::AutoSettings {
                 drift,
                 ..Default::default()
             },
+            anisotropy: ip
+                .anisotropy
+                .eq_ignore_ascii_case("auto")
+                .then(crate::fitting::AnisotropyPlan::default),
         };
-        let fitted = crate::fitting::fit(&data, &lags, &plan).context("fitting the variogram")?;
+        let fitted = crate::fitting::fit(&fit_to, &lags, &plan).context("fitting the variogram")?;
         candidates = fitted
             .candidates
             .iter()
@@ -309,6 +340,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     };
     Ok(Model {
         data,
+        drift,
         variogram,
         lags,
         candidates,
@@ -329,7 +361,8 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len())
         .map(|i| m.mesh.absolute(i))
         .collect();
-    let uk_engine = Surface::kriging(data, &variogram, uk_method, ip.neighbors)?;
+    let ked = model.drift.as_ref();
+    let uk_engine = Surface::kriging_with(data, &variogram, uk_method, ip.neighbors, ked)?;
     let (uk, var) = uk_engine.predict(&vertices, true)?;
     let uk_std: Vec<f64> = var.iter().map(|v| v.max(0.0).sqrt()).collect();
     let search = idw_search(ip.idw_neighbors);
@@ -344,7 +377,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         InterpolationMethod::Universal => (uk.clone(), &uk_engine),
         InterpolationMethod::Idw => (idw.clone(), &idw_engine),
         _ => {
-            other = Surface::primary(p, data, &variogram)?;
+            other = Surface::primary_with(p, data, &variogram, ked)?;
             (other.predict(&vertices, false)?.0, &other)
         }
     };
@@ -375,8 +408,25 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
                 search,
             },
         };
-        let r = cross_validate(data, &how, folds)
-            .with_context(|| format!("cross-validation of {name}"))?;
+        let r = match (&how, ked) {
+            (
+                Interpolator::Kriging {
+                    variogram,
+                    method,
+                    neighbours,
+                },
+                Some(d),
+            ) => terramesh_geostat::cross_validate_external(
+                data,
+                &d.at_data,
+                variogram,
+                *method,
+                *neighbours,
+                folds,
+            ),
+            _ => cross_validate(data, &how, folds),
+        }
+        .with_context(|| format!("cross-validation of {name}"))?;
         cv.push((name.name().to_uppercase(), r.stats));
     }
 
@@ -480,10 +530,27 @@ impl Surface {
         method: Method,
         neighbors: usize,
     ) -> Result<Surface> {
+        Surface::kriging_with(data, v, method, neighbors, None)
+    }
+
+    /// [`Surface::kriging`], with the external drift when there is one.
+    pub(crate) fn kriging_with(
+        data: &Data,
+        v: &Variogram,
+        method: Method,
+        neighbors: usize,
+        drift: Option<&crate::external_drift::ModelDrift>,
+    ) -> Result<Surface> {
         let hood = match neighbors {
             0 => Neighbourhood::All,
             k => Neighbourhood::Nearest(k),
         };
+        if let Some(d) = drift {
+            return Ok(Surface(Box::new(
+                d.kriging(data, v, method, hood)
+                    .context("kriging system with the external drift")?,
+            )));
+        }
         Ok(Surface(
             kriging(data, v, method, hood, true).context("kriging system")?,
         ))
@@ -498,9 +565,19 @@ impl Surface {
 
     /// The surface of the project's first interpolation method, which gives the DSM.
     pub(crate) fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
+        Surface::primary_with(p, data, v, None)
+    }
+
+    /// [`Surface::primary`], with the external drift when there is one.
+    pub(crate) fn primary_with(
+        p: &Project,
+        data: &Data,
+        v: &Variogram,
+        drift: Option<&crate::external_drift::ModelDrift>,
+    ) -> Result<Surface> {
         let ip = &p.interpolation;
         match ip.methods[0].method(ip.drift, None, data) {
-            Some(method) => Surface::kriging(data, v, method, ip.neighbors),
+            Some(method) => Surface::kriging_with(data, v, method, ip.neighbors, drift),
             None => Surface::idw(data, ip.idw_power, ip.idw_neighbors),
         }
     }

@@ -62,6 +62,16 @@ impl Project {
             readable("region.file", &path)?;
         }
         let ip = &self.interpolation;
+        if let Some(g) = &ip.external_drift_grid {
+            let path = base.join(g);
+            if !path.is_file() {
+                return Err(Error::invalid(format!(
+                    "interpolation.external_drift_grid {}: no such file: give a GeoTIFF (.tif) or ESRI ASCII grid (.asc) of the drift, in the project's coordinates",
+                    path.display()
+                )));
+            }
+            readable("interpolation.external_drift_grid", &path)?;
+        }
         if ip.model.is_none() && ip.variogram != "auto" {
             let path = base.join(&ip.variogram);
             if !path.is_file() {

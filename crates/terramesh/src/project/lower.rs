@@ -33,6 +33,8 @@ pub fn key_of(s: Setting) -> String {
         Setting::Neighbors => "interpolation.neighbors",
         Setting::GridSpacing => "export.grid_spacing",
         Setting::Realisations => "interpolation.realisations",
+        Setting::ExternalDriftGrid => "interpolation.external_drift_grid",
+        Setting::Anisotropy => "interpolation.anisotropy",
         other => return other.to_string(),
     }
     .to_string()

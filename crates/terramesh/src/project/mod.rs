@@ -22,7 +22,7 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 use terramesh_core::sampling::Kernel;
-use terramesh_geostat::{Drift, InterpolationMethod, ModelKind, DEFAULT_IDW_POWER};
+use terramesh_geostat::{Drift, InterpolationMethod, DEFAULT_IDW_POWER};
 use terramesh_io::export::{Format, DEFAULT_FORMATS};
 use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
@@ -174,19 +174,137 @@ impl Default for MeshSection {
     }
 }
 
-/// A variogram given in the project file.
+/// A variogram given in the project file: `model = { model = "spherical", psill = 1200.0,
+/// range = 600.0, nugget = 1.0 }`, or nested, `model = { model = "spherical+exponential",
+/// psill = [800.0, 400.0], range = [300.0, 900.0], nugget = 1.0 }`, with optional
+/// `shape` (one or a list), `anisotropy_angle` and `anisotropy_ratio`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VariogramSpec {
-    /// Model name: `spherical`, `exponential`, `gaussian`, ...
-    pub model: ModelKind,
-    /// Partial sill.
-    pub psill: f64,
-    /// Practical range, metres.
-    pub range: f64,
+    /// Model name (`spherical`, `exponential`, `gaussian`, ...), or up to three joined by `+`.
+    pub model: String,
+    /// Partial sill, or one per structure.
+    pub psill: Numbers,
+    /// Practical range, metres, or one per structure.
+    pub range: Numbers,
     /// Nugget.
     #[serde(default)]
     pub nugget: f64,
+    /// Power exponent or Matérn ν: one for every structure, or one per structure.
+    #[serde(default)]
+    pub shape: Option<Numbers>,
+    /// Geometric anisotropy: the major axis, degrees counter-clockwise from +x.
+    #[serde(default)]
+    pub anisotropy_angle: Option<f64>,
+    /// Geometric anisotropy: minor / major range, in (0, 1].
+    #[serde(default)]
+    pub anisotropy_ratio: Option<f64>,
+}
+
+/// A number, or a list of numbers (one per nested structure).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum Numbers {
+    /// One value.
+    One(f64),
+    /// One value per structure.
+    Many(Vec<f64>),
+}
+
+impl Numbers {
+    /// The values.
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            Numbers::One(v) => vec![*v],
+            Numbers::Many(v) => v.clone(),
+        }
+    }
+}
+
+impl VariogramSpec {
+    /// The variogram, or an error naming the key (`interpolation.model.psill`, ...).
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let set = |s: &str| vec![format!("interpolation.model={s}")];
+    /// let p = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = [8.0, 4.0], range = [300.0, 900.0], nugget = 1.0 }"))?;
+    /// let v = p.interpolation.model.unwrap().variogram().map_err(terramesh::Error::invalid)?;
+    /// assert_eq!((v.structures.len(), v.structures[1].range), (2, 900.0));
+    /// let e = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = 8.0, range = [300.0, 900.0] }")).unwrap_err();
+    /// assert!(e.to_string().contains("interpolation.model.psill"), "{e}");
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn variogram(&self) -> std::result::Result<terramesh_geostat::Variogram, String> {
+        use terramesh_geostat::{Anisotropy, Structure, Variogram};
+        let kinds = crate::fitting::parse_models(&self.model).map_err(|e| {
+            format!(
+                "interpolation.model.model: {}",
+                e.render(&|_| String::new()).trim_start()
+            )
+        })?;
+        let n = kinds.len();
+        let list = |key: &str,
+                    v: &Numbers,
+                    one_for_all: bool|
+         -> std::result::Result<Vec<f64>, String> {
+            let v = v.values();
+            match v.len() {
+                k if k == n => Ok(v),
+                1 if one_for_all => Ok(vec![v[0]; n]),
+                k => Err(format!(
+                    "interpolation.model.{key}: {k} values for the {n} structures of \"{}\": give a list of {n}",
+                    self.model
+                )),
+            }
+        };
+        let psill = list("psill", &self.psill, false)?;
+        let range = list("range", &self.range, false)?;
+        let shape = match &self.shape {
+            Some(s) => Some(list("shape", s, true)?),
+            None => None,
+        };
+        for (key, vals, ok) in [
+            (
+                "psill",
+                &psill,
+                (|v: f64| v.is_finite() && v > 0.0) as fn(f64) -> bool,
+            ),
+            ("range", &range, |v: f64| v.is_finite() && v > 0.0),
+        ] {
+            if let Some(v) = vals.iter().find(|v| !ok(**v)) {
+                return Err(format!("interpolation.model.{key}: {v} must be positive"));
+            }
+        }
+        if !(self.nugget.is_finite() && self.nugget >= 0.0) {
+            return Err(format!(
+                "interpolation.model.nugget: {} must be 0 or positive",
+                self.nugget
+            ));
+        }
+        let anisotropy = match (self.anisotropy_angle, self.anisotropy_ratio) {
+            (None, None) => None,
+            (a, r) => Some(Anisotropy {
+                angle: a.unwrap_or(0.0),
+                ratio: r.unwrap_or(1.0),
+            }),
+        };
+        let v = Variogram {
+            nugget: self.nugget,
+            structures: (0..n)
+                .map(|i| {
+                    let mut s = Structure::new(kinds[i], psill[i], range[i]);
+                    if let Some(sh) = &shape {
+                        s.shape = sh[i];
+                    }
+                    s
+                })
+                .collect(),
+            anisotropy,
+        };
+        v.validate()
+            .map_err(|e| format!("interpolation.model: {e}"))?;
+        Ok(v)
+    }
 }
 
 /// `[interpolation]`: step 4.
@@ -218,6 +336,16 @@ pub struct InterpolationSection {
     /// default) or `reml` (restricted maximum likelihood with the UK drift over every model,
     /// the model chosen by leave-one-out RMSE).
     pub fit: terramesh_geostat::FitMethod,
+    /// What `variogram = "auto"` fits: `auto` (every model, the best kept), a model name, or a
+    /// nested sum of up to three joined by `+` (`spherical+exponential`, fitted jointly).
+    pub fit_model: String,
+    /// `none`, or `auto`: `variogram = "auto"` fits geometric anisotropy too, from directional
+    /// variograms along 8 azimuths.
+    pub anisotropy: String,
+    /// Kriging with an external drift: a raster (GeoTIFF or ESRI ASCII grid, in the project's
+    /// projected coordinates) sampled bilinearly at the samples and the mesh vertices, as a
+    /// drift of the kriging methods (uk: the polynomial and it; ok: the constant and it).
+    pub external_drift_grid: Option<PathBuf>,
 }
 
 impl Default for InterpolationSection {
@@ -234,6 +362,9 @@ impl Default for InterpolationSection {
             realisations: 0,
             seed: 0,
             fit: terramesh_geostat::FitMethod::Wls,
+            fit_model: "auto".into(),
+            anisotropy: "none".into(),
+            external_drift_grid: None,
         }
     }
 }

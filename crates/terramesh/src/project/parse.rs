@@ -219,15 +219,39 @@ impl Project {
             return bad("interpolation.idw_power", "must be positive");
         }
         if let Some(v) = &i.model {
-            if !positive(v.range) {
-                return bad("interpolation.model.range", "must be positive");
+            if let Err(e) = v.variogram() {
+                let (key, why) = e.split_once(": ").unwrap_or(("interpolation.model", &e));
+                return bad(key, why);
             }
-            if !positive(v.psill) {
-                return bad("interpolation.model.psill", "must be positive");
+        }
+        if !i.fit_model.eq_ignore_ascii_case("auto") {
+            if let Err(e) = crate::fitting::parse_models(&i.fit_model) {
+                return bad(
+                    "interpolation.fit_model",
+                    e.render(&|_| String::new()).trim_start(),
+                );
             }
-            if !(v.nugget.is_finite() && v.nugget >= 0.0) {
-                return bad("interpolation.model.nugget", "must be 0 or positive");
+        }
+        match i.anisotropy.to_ascii_lowercase().as_str() {
+            "none" | "auto" => {}
+            _ => {
+                return bad(
+                    "interpolation.anisotropy",
+                    &format!(
+                        "\"{}\": expected \"none\" or \"auto\" (a given model's anisotropy is model.anisotropy_angle and model.anisotropy_ratio)",
+                        i.anisotropy
+                    ),
+                )
             }
+        }
+        if i.external_drift_grid.is_some()
+            && i.methods
+                .contains(&terramesh_geostat::InterpolationMethod::Simple)
+        {
+            return bad(
+                "interpolation.external_drift_grid",
+                "simple kriging (\"sk\" in interpolation.methods) has a known mean and no drift: krige with \"uk\" or \"ok\"",
+            );
         }
         let x = &self.export;
         if let Some(b) = x.base_elevation {
@@ -435,6 +459,61 @@ mod tests {
                 assert!(l.contains(n), "{l} lacks {n}");
             }
         }
+    }
+
+    #[test]
+    fn nested_anisotropy_and_drift_keys_name_the_key() {
+        let p = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            Project::parse("t.toml", TEMPLATE, &sets).map_err(|e| e.to_string())
+        };
+        let e = p(&["interpolation.model={ model = \"spherical+exponential\", psill = [1.0], range = [10.0, 20.0] }"]).unwrap_err();
+        assert!(
+            e.contains("interpolation.model.psill: 1 values for the 2 structures"),
+            "{e}"
+        );
+        let e = p(&["interpolation.model={ model = \"spherical\", psill = 1.0, range = -3.0 }"])
+            .unwrap_err();
+        assert!(
+            e.contains("interpolation.model.range: -3 must be positive"),
+            "{e}"
+        );
+        let e = p(&["interpolation.model={ model = \"cubic\", psill = 1.0, range = 3.0 }"])
+            .unwrap_err();
+        assert!(e.contains("interpolation.model.model: 'cubic'"), "{e}");
+        let e = p(&["interpolation.model={ model = \"spherical\", psill = 1.0, range = 3.0, anisotropy_ratio = 2.0 }"]).unwrap_err();
+        assert!(
+            e.contains("interpolation.model: anisotropy ratio = 2"),
+            "{e}"
+        );
+        let e = p(&["interpolation.fit_model=\"spherical+cubic\""]).unwrap_err();
+        assert!(
+            e.contains("interpolation.fit_model: 'spherical+cubic': 'cubic' is not a model"),
+            "{e}"
+        );
+        let e = p(&["interpolation.anisotropy=\"yes\""]).unwrap_err();
+        assert!(
+            e.contains("interpolation.anisotropy: \"yes\": expected \"none\" or \"auto\""),
+            "{e}"
+        );
+        let e = p(&[
+            "interpolation.external_drift_grid=\"g.tif\"",
+            "interpolation.methods=[\"sk\"]",
+        ])
+        .unwrap_err();
+        assert!(
+            e.contains("interpolation.external_drift_grid: simple kriging"),
+            "{e}"
+        );
+        let ok = p(&[
+            "interpolation.fit_model=\"spherical+exponential\"",
+            "interpolation.anisotropy=\"auto\"",
+            "interpolation.model={ model = \"gaussian+spherical\", psill = [1.0, 2.0], range = [5.0, 50.0], shape = 1.5, anisotropy_angle = 30.0, anisotropy_ratio = 0.5 }",
+        ])
+        .unwrap();
+        let v = ok.interpolation.model.unwrap().variogram().unwrap();
+        assert_eq!(v.structures.len(), 2);
+        assert_eq!(v.anisotropy.unwrap().ratio, 0.5);
     }
 
     #[test]

@@ -127,6 +127,12 @@ fn check_tileable(p: &Project) -> Result<()> {
              reproduce: set interpolation.idw_neighbors (e.g. 16)",
         );
     }
+    if ip.external_drift_grid.is_some() {
+        return refuse(
+            "interpolation.external_drift_grid: tiles do not krige with an external drift yet; \
+             build the project in one piece",
+        );
+    }
     if p.mesh.max_error.is_some() {
         return refuse(
             "mesh.max_error (terrain-adaptive meshes) is not supported by tiled builds yet: \
