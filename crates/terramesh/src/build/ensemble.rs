@@ -35,6 +35,8 @@ pub struct VertexEnsemble {
     pub p50: Vec<f64>,
     /// 90th percentile.
     pub p90: Vec<f64>,
+    /// The bounded variogram simulated with, where the automatic fit has no sill.
+    pub refit: Option<terramesh_geostat::Variogram>,
     ensemble: Ensemble,
     vertices: Vec<[f64; 2]>,
 }
@@ -60,8 +62,26 @@ pub fn simulate_vertices(
         .map(|i| m.mesh.absolute(i))
         .collect();
     let settings = SimulationSettings::new(ip.realisations, ip.seed);
-    let ensemble =
-        crate::simulate::run_simulation(data, &it.variogram, method, hood, &vertices, &settings)
+    // An automatic fit without a sill (power, linear) has no covariance to simulate with:
+    // the best bounded model fitted to the same experimental variogram instead. A model the
+    // project names is used as it is (and an unbounded one is refused).
+    let auto = ip.model.is_none() && ip.variogram == "auto";
+    let variogram = match it.variogram.sill() {
+        None if auto => {
+            let v = crate::geology::ensemble::bounded_variogram(data, &model.lags)
+                .context("a bounded variogram for the simulation")?;
+            Some(v)
+        }
+        _ => None,
+    };
+    let ensemble = crate::simulate::run_simulation(
+        data,
+        variogram.as_ref().unwrap_or(&it.variogram),
+        method,
+        hood,
+        &vertices,
+        &settings,
+    )
             .context(
                 "conditional simulation of the vertex elevations (interpolation.realisations)",
             )?;
@@ -81,6 +101,7 @@ pub fn simulate_vertices(
         p90: col(|s| s.p90),
         ensemble,
         vertices,
+        refit: variogram,
     })
 }
 
