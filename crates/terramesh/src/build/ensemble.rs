@@ -1,6 +1,10 @@
 //! `[interpolation] realisations = N`: conditional realisations of the DSM vertex elevations
 //! on the same mesh (identical topology), by [`terramesh_geostat::simulate`] with the DSM's
 //! kriging method (universal kriging when the DSM is IDW) and the project's neighbourhood.
+//! An automatic variogram without a sill (power, linear) is replaced, for the simulation
+//! only, by the best bounded model fitted to the same experimental variogram
+//! ([`crate::geology::ensemble::bounded_variogram`]); a model the project names is used as
+//! it is.
 //!
 //! Outputs: point-data arrays `z_1..z_N`, `sim_mean`, `sim_std`, `sim_p10`, `sim_p50`,
 //! `sim_p90` in `dsm.vtu` (see `exports.rs`), `realisations.csv` (one row per vertex, in the
