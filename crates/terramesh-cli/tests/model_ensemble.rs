@@ -25,7 +25,12 @@ const N: usize = 6;
 /// Builds with N realisations; `interpolate` the geology's fields (`tops` or `thickness`).
 fn build(project: &Path, out: &Path, seed: u64, threads: &str, interpolate: &str) {
     let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
-        .args(["build", project.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .args([
+            "build",
+            project.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
         .args(["--set", &format!("geology.interpolate={interpolate}")])
         .args(["-q", "--set", &format!("interpolation.realisations={N}")])
         .args(["--set", &format!("interpolation.seed={seed}")])
@@ -86,7 +91,10 @@ fn read_dsm(p: &Path) -> Dsm {
             "points" => points.push([v[0], v[1], v[2]]),
             "connectivity" => triangles.push([v[0] as usize, v[1] as usize, v[2] as usize]),
             "offsets" | "types" => {}
-            _ => arrays.entry(name.clone()).or_insert_with(Vec::new).push(v[0]),
+            _ => arrays
+                .entry(name.clone())
+                .or_insert_with(Vec::new)
+                .push(v[0]),
         }
     }
     Dsm {
@@ -134,7 +142,10 @@ fn build_writes_the_dsm_ensemble_and_an_ensemble_of_sealed_models() {
     assert!(spread > 0.0, "the realisations differ somewhere");
     for map in ["sim-std", "sim-p10", "sim-p90"] {
         let found = std::fs::read_dir(out.join("pictures"))
-            .map(|d| d.flatten().any(|e| e.file_name().to_string_lossy().contains(map)))
+            .map(|d| {
+                d.flatten()
+                    .any(|e| e.file_name().to_string_lossy().contains(map))
+            })
             .unwrap_or(false);
         assert!(found, "the {map} map is missing from {}", out.display());
     }
@@ -198,7 +209,10 @@ fn build_writes_the_dsm_ensemble_and_an_ensemble_of_sealed_models() {
         let mean = v.iter().sum::<f64>() / N as f64;
         assert!(v.iter().any(|x| (x - mean).abs() > 1e-6 * mean), "{v:?}");
         let s = &ens["units"][u]["volume"];
-        assert!((s["mean"].as_f64().unwrap() - mean).abs() < 1e-9 * mean, "{s}");
+        assert!(
+            (s["mean"].as_f64().unwrap() - mean).abs() < 1e-9 * mean,
+            "{s}"
+        );
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let (p10, p90) = (s["p10"].as_f64().unwrap(), s["p90"].as_f64().unwrap());
@@ -233,7 +247,10 @@ fn build_writes_the_dsm_ensemble_and_an_ensemble_of_sealed_models() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 24, "the clay's and gravel's tops in 12 holes: {ens}");
+    assert_eq!(
+        checked, 24,
+        "the clay's and gravel's tops in 12 holes: {ens}"
+    );
 }
 
 #[test]

@@ -120,12 +120,14 @@ fn kimberlina_ensemble_is_sealed_honours_the_contacts_and_repeats_from_its_seed(
     for (k, r) in e.realisations.iter().enumerate() {
         // The model's planar mesh and column in every realisation.
         assert_eq!(r.stack.surfaces.len(), layers + 1);
-        assert!(r.stack.surfaces.iter().all(|s| s.len() == mesh.points.len()));
-        assert!(r.size.1 <= mesh.triangles.len() * layers, "realisation {k}");
-        // Its terrain is the one given: the model's + k m.
         assert!(r
             .stack
-            .surfaces[0]
+            .surfaces
+            .iter()
+            .all(|s| s.len() == mesh.points.len()));
+        assert!(r.size.1 <= mesh.triangles.len() * layers, "realisation {k}");
+        // Its terrain is the one given: the model's + k m.
+        assert!(r.stack.surfaces[0]
             .iter()
             .zip(&terrain)
             .all(|(a, t)| *a == t + k as f64));
@@ -150,7 +152,8 @@ fn kimberlina_ensemble_is_sealed_honours_the_contacts_and_repeats_from_its_seed(
     // The realisations differ, in the units' volumes.
     let varies = (1..layers).filter(|&u| {
         let v: Vec<f64> = e.realisations.iter().map(|r| r.stats[u].volume).collect();
-        v.iter().any(|x| (x - v[0]).abs() > 1e-6 * v[0].abs().max(1.0))
+        v.iter()
+            .any(|x| (x - v[0]).abs() > 1e-6 * v[0].abs().max(1.0))
     });
     assert!(varies.count() >= 5);
     // The same seed, one thread: the same ensemble to the bit; another seed, another one.

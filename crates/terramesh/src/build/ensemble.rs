@@ -86,9 +86,7 @@ pub fn simulate_vertices(
         &vertices,
         &settings,
     )
-            .context(
-                "conditional simulation of the vertex elevations (interpolation.realisations)",
-            )?;
+    .context("conditional simulation of the vertex elevations (interpolation.realisations)")?;
     let stats = ensemble.summaries();
     let col = |f: fn(&terramesh_geostat::PointSummary) -> f64| stats.iter().map(f).collect();
     Ok(VertexEnsemble {

@@ -223,7 +223,10 @@ fn build_into(
             || ensemble::simulate_vertices(project, &model, &mesh, &interp),
             |e| {
                 let refit = e.refit.as_ref().map_or(String::new(), |v| {
-                    format!(", with {} (the fit has no sill)", short_numbers(&v.to_string()))
+                    format!(
+                        ", with {} (the fit has no sill)",
+                        short_numbers(&v.to_string())
+                    )
                 });
                 format!(
                     "{} realisations at {} vertices{refit}",
@@ -269,16 +272,7 @@ fn build_into(
     if let (Some(g), Some(built), Some(e)) = (geology, geo.as_mut(), interp.ensemble.as_ref()) {
         st.run(
             "geology realisations",
-            || {
-                crate::geology::ensemble::run(
-                    project,
-                    g,
-                    built,
-                    &mesh.mesh,
-                    &e.realisations,
-                    out,
-                )
-            },
+            || crate::geology::ensemble::run(project, g, built, &mesh.mesh, &e.realisations, out),
             |_| format!("{} sealed models", e.len()),
         )?;
     }

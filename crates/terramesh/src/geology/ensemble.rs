@@ -21,15 +21,20 @@
 //! distance (too few holes, or no variogram fitted), and the tops given by horizon grids. The
 //! base is the model's base.
 //!
-//! Seeds: the DSM's realisations use `seed`; the field of unit `u` uses
-//! [`field_seed`]`(seed, u)`. The simulation is the same for any thread count, and so is
-//! everything built from it (the rules, meshes and volumes are computed per realisation in
-//! a fixed order): the same seed gives byte-identical files.
+//! Seeds: the DSM's realisations use `seed`; every field uses [`field_seed`]`(seed)`, the
+//! same streams for all (common random numbers). So the interfaces of realisation k are
+//! cross-correlated between the holes: two tops observed alike, with the same variogram,
+//! stay alike (a unit absent from every hole stays absent instead of opening wherever two
+//! independent fields cross), and tops with similar variograms move together, as conformable
+//! strata do. Each field still has its own variogram and passes through its own
+//! observations. The simulation is the same for any thread count, and so is everything
+//! built from it (the rules, meshes and volumes are computed per realisation in a fixed
+//! order): the same seed gives byte-identical files.
 //!
 //! ```
 //! use terramesh::geology::ensemble::field_seed;
-//! assert_ne!(field_seed(1, 1), field_seed(1, 2));
-//! assert_eq!(field_seed(7, 3), field_seed(7, 3));
+//! assert_ne!(field_seed(1), 1);
+//! assert_ne!(field_seed(1), field_seed(2));
 //! ```
 
 use std::io::Write;
@@ -41,8 +46,8 @@ use terramesh_core::limits::{Estimate, Remedy};
 use terramesh_core::volume::VolumeMesh;
 use terramesh_geology::{volume_between, Planar, Stack, UnitStats};
 use terramesh_geostat::{
-    experimental, fit_auto, simulate, Data, Duplicates, Lag, LagSettings, Method, ModelKind,
-    Named, Neighbourhood, SimulationSettings, Variogram, Weighting,
+    experimental, fit_auto, simulate, Data, Duplicates, Lag, LagSettings, Method, ModelKind, Named,
+    Neighbourhood, SimulationSettings, Variogram, Weighting,
 };
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
@@ -57,10 +62,10 @@ use super::stage::ModelBuilt;
 use crate::error::{bail, Context, Error, Result};
 use crate::project::{GeologySettings, Project};
 
-/// The seed of the field of unit `unit` given the project's `seed` (SplitMix64 of both), so
-/// that no two fields, nor a field and the DSM, share their random streams.
-pub fn field_seed(seed: u64, unit: usize) -> u64 {
-    let mut z = seed ^ (unit as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+/// The seed of the fields' random streams given the project's `seed` (SplitMix64), so that
+/// the fields and the DSM do not share their streams.
+pub fn field_seed(seed: u64) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
@@ -142,8 +147,8 @@ pub fn simulate_models(
     let mut fields = Vec::new();
     // Realisation r of field f at vertex v: values[f][v * nr + r] (or the model's field).
     let mut values: Vec<Option<Vec<f64>>> = Vec::new();
-    for ((unit, obs), field) in observed.iter().zip(&central.fields) {
-        let (how, sims) = simulate_field(*unit, obs, &field.model, &xy, inputs.method, nr, seed)
+    for ((_, obs), field) in observed.iter().zip(&central.fields) {
+        let (how, sims) = simulate_field(obs, &field.model, &xy, inputs.method, nr, seed)
             .with_context(|| format!("simulating the field of {}", field.name))?;
         fields.push(FieldSimulation {
             name: field.name.clone(),
@@ -221,8 +226,7 @@ pub fn bounded_variogram(data: &Data, lags: &[Lag]) -> Result<Variogram> {
         .copied()
         .filter(|k| k.bounded())
         .collect();
-    let (fit, _) =
-        fit_auto(data, lags, Weighting::Cressie, &kinds).map_err(Error::invalid)?;
+    let (fit, _) = fit_auto(data, lags, Weighting::Cressie, &kinds).map_err(Error::invalid)?;
     Ok(fit.variogram)
 }
 
@@ -230,7 +234,6 @@ type Simulated = (FieldSimulation, Option<Vec<f64>>);
 
 /// The realisations of one field (vertex-major), or `None` where it is not simulated.
 fn simulate_field(
-    unit: usize,
     obs: &[Observation],
     model: &FieldModel,
     xy: &[[f64; 2]],
@@ -304,7 +307,7 @@ fn simulate_field(
         Method::Universal(d) if data.len() <= 2 * d.terms() => Method::Ordinary,
         m => m,
     };
-    let s = field_seed(seed, unit);
+    let s = field_seed(seed);
     let settings = SimulationSettings::new(nr, s);
     let e = simulate(&data, variogram, method, Neighbourhood::All, xy, &settings)
         .map_err(Error::invalid)?;
@@ -559,7 +562,14 @@ pub fn run(
         o.commit().with_context(|| path.display().to_string())?;
         Ok(())
     };
-    let e = simulate_models(mesh, terrains, central, &inputs, p.interpolation.seed, &each)?;
+    let e = simulate_models(
+        mesh,
+        terrains,
+        central,
+        &inputs,
+        p.interpolation.seed,
+        &each,
+    )?;
     let mut files = vec![
         e.write_volumes(out)?,
         e.write_interfaces(mesh, &g.units, out)?,
