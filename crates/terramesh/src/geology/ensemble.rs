@@ -550,6 +550,8 @@ pub fn run(
     };
     let dir = out.join("realisations");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    // The model's other writer settings keep their defaults (none today but the CRS).
+    #[allow(clippy::needless_update)]
     let info = ModelInfo {
         crs: built.summary.crs.clone(),
         ..Default::default()
