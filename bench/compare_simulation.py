@@ -2,8 +2,8 @@
 """Conditional simulation, terramesh against GSTools' CondSRF on the same case; prints ratios.
 
 Run from the repository root after `cargo build --release -p terramesh-cli`:
-    python3 -m venv .venv-bench && .venv-bench/bin/pip install gstools numpy
-    .venv-bench/bin/python bench/compare_simulation.py [--data 5000] [--targets 20000] [--realisations 100]
+    python3 -m venv .venv-bench && .venv-bench/bin/pip install gstools==1.7.0 numpy==2.4.6 scipy==1.17.1
+    .venv-bench/bin/python bench/compare_simulation.py [--data 5000] [--targets 20000] [--realisations 100] [--gstools-chunk 1000] [--skip-gstools]
 
 Case (issue 15's dense geometry): 5,000 SRTM posts of ../shared/data/srtm/N48E007.hgt in a
 31 x 32 km window (a local equirectangular projection to metres, seeded random subset),
