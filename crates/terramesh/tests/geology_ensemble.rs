@@ -122,7 +122,10 @@ fn kimberlina_ensemble_is_sealed_honours_the_contacts_and_repeats_from_its_seed(
     // numbers its top and Vedder's (the same observations) stay one surface.
     let temblor = m.stats.iter().position(|s| s.name == "temblor").unwrap();
     assert_eq!(m.stats[temblor].volume, 0.0);
-    assert!(e.realisations.iter().all(|r| r.stats[temblor].volume == 0.0));
+    assert!(e
+        .realisations
+        .iter()
+        .all(|r| r.stats[temblor].volume == 0.0));
     let layers = m.stats.len();
     for (k, r) in e.realisations.iter().enumerate() {
         // The model's planar mesh and column in every realisation.
