@@ -1,6 +1,10 @@
 //! `[interpolation] realisations = N`: conditional realisations of the DSM vertex elevations
 //! on the same mesh (identical topology), by [`terramesh_geostat::simulate`] with the DSM's
 //! kriging method (universal kriging when the DSM is IDW) and the project's neighbourhood.
+//! An automatic variogram without a sill (power, linear) is replaced, for the simulation
+//! only, by the best bounded model fitted to the same experimental variogram
+//! ([`crate::geology::ensemble::bounded_variogram`]); a model the project names is used as
+//! it is.
 //!
 //! Outputs: point-data arrays `z_1..z_N`, `sim_mean`, `sim_std`, `sim_p10`, `sim_p50`,
 //! `sim_p90` in `dsm.vtu` (see `exports.rs`), `realisations.csv` (one row per vertex, in the
@@ -35,6 +39,8 @@ pub struct VertexEnsemble {
     pub p50: Vec<f64>,
     /// 90th percentile.
     pub p90: Vec<f64>,
+    /// The bounded variogram simulated with, where the automatic fit has no sill.
+    pub refit: Option<terramesh_geostat::Variogram>,
     ensemble: Ensemble,
     vertices: Vec<[f64; 2]>,
 }
@@ -60,11 +66,27 @@ pub fn simulate_vertices(
         .map(|i| m.mesh.absolute(i))
         .collect();
     let settings = SimulationSettings::new(ip.realisations, ip.seed);
-    let ensemble =
-        crate::simulate::run_simulation(data, &it.variogram, method, hood, &vertices, &settings)
-            .context(
-                "conditional simulation of the vertex elevations (interpolation.realisations)",
-            )?;
+    // An automatic fit without a sill (power, linear) has no covariance to simulate with:
+    // the best bounded model fitted to the same experimental variogram instead. A model the
+    // project names is used as it is (and an unbounded one is refused).
+    let auto = ip.model.is_none() && ip.variogram == "auto";
+    let variogram = match it.variogram.sill() {
+        None if auto => {
+            let v = crate::geology::ensemble::bounded_variogram(data, &model.lags)
+                .context("a bounded variogram for the simulation")?;
+            Some(v)
+        }
+        _ => None,
+    };
+    let ensemble = crate::simulate::run_simulation(
+        data,
+        variogram.as_ref().unwrap_or(&it.variogram),
+        method,
+        hood,
+        &vertices,
+        &settings,
+    )
+    .context("conditional simulation of the vertex elevations (interpolation.realisations)")?;
     let stats = ensemble.summaries();
     let col = |f: fn(&terramesh_geostat::PointSummary) -> f64| stats.iter().map(f).collect();
     Ok(VertexEnsemble {
@@ -81,6 +103,7 @@ pub fn simulate_vertices(
         p90: col(|s| s.p90),
         ensemble,
         vertices,
+        refit: variogram,
     })
 }
 

@@ -320,11 +320,13 @@ fn build_into(
         k: 0,
         total: match what {
             What::Everything => {
-                STAGES
-                    + usize::from(project.geology().is_some())
-                    + usize::from(project.interpolation.realisations > 0)
+                let (geo, sim) = (
+                    project.geology().is_some(),
+                    project.interpolation.realisations > 0,
+                );
+                STAGES + usize::from(geo) + usize::from(sim) + usize::from(geo && sim)
             }
-            What::ModelOnly => 5 + usize::from(project.interpolation.realisations > 0),
+            What::ModelOnly => 5 + 2 * usize::from(project.interpolation.realisations > 0),
         },
         timings: Timings::default(),
     };
@@ -388,7 +390,19 @@ fn build_into(
         let e = st.run(
             "simulation",
             || ensemble::simulate_vertices(project, &model, &mesh, &interp),
-            |e| format!("{} realisations at {} vertices", e.len(), e.mean.len()),
+            |e| {
+                let refit = e.refit.as_ref().map_or(String::new(), |v| {
+                    format!(
+                        ", with {} (the fit has no sill)",
+                        short_numbers(&v.to_string())
+                    )
+                });
+                format!(
+                    "{} realisations at {} vertices{refit}",
+                    e.len(),
+                    e.mean.len()
+                )
+            },
         )?;
         interp.ensemble = Some(e);
     }
@@ -409,6 +423,14 @@ fn build_into(
         )?),
         None => None,
     };
+    let mut geo = geo;
+    if let (Some(g), Some(built), Some(e)) = (geology, geo.as_mut(), interp.ensemble.as_ref()) {
+        st.run(
+            "geology realisations",
+            || crate::geology::ensemble::run(project, g, built, &mesh.mesh, &e.realisations, out),
+            |_| format!("{} sealed models", e.len()),
+        )?;
+    }
     if what == What::ModelOnly {
         st.check()?;
         return Ok(Built {

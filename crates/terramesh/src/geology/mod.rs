@@ -3,6 +3,7 @@
 //! geological rules and meshed into layered cells and sealed bodies by `terramesh-geology`,
 //! written by `terramesh_io::model`.
 
+pub mod ensemble;
 pub mod fields;
 pub mod model;
 pub mod report;

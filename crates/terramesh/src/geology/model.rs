@@ -118,6 +118,9 @@ pub struct GeologicalModel {
     /// Every observed contact against the model: the collars against the terrain (the top
     /// of the first unit), then the logged tops of the other units.
     pub misfits: Vec<Misfit>,
+    /// The horizon grids of the inputs as given (`(unit, values)`, before the rules): the
+    /// realisations of [`super::ensemble`] use them unchanged.
+    pub grids: Vec<(usize, Vec<f64>)>,
 }
 
 /// Builds the model on `mesh` (the DSM's planar mesh) under `terrain` (its elevations).
@@ -128,29 +131,89 @@ pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<Ge
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let planar = Planar::new(&xy, &mesh.triangles).context("the planar mesh")?;
-    let mut fields = Vec::new();
-    let field_of = |unit: usize, obs: Vec<Observation>| {
-        interpolate_field(&units[unit], &obs, &xy, inputs.method)
-    };
-    let grid_of = |unit: usize| inputs.grids.iter().find(|g| g.0 == unit).map(|g| &g.1);
     let holes = inputs.boreholes;
     let base = base_values(inputs, terrain, holes, xy.len())?;
-    let (stack, rules) = match inputs.interpolate {
+    let mut fields = Vec::new();
+    for (unit, obs) in field_observations(inputs)? {
+        fields.push(interpolate_field(&units[unit], &obs, &xy, inputs.method)?);
+    }
+    let values: Vec<&[f64]> = fields.iter().map(|f| &f.values[..]).collect();
+    let (stack, rules) = stack_of(&planar, terrain, &base, inputs, &values)?;
+    let (volume, summary, stats) = seal(&planar, &stack, &inputs.layering)?;
+    let misfits = holes.map(|b| misfits(b, mesh, &stack)).unwrap_or_default();
+    Ok(GeologicalModel {
+        mesh: volume,
+        stack,
+        rules,
+        fields,
+        stats,
+        check: summary,
+        misfits,
+        grids: inputs.grids.clone(),
+    })
+}
+
+/// The fields a model interpolates, in order, as `(unit, observations)`: the tops of units
+/// 1.. that no horizon grid gives, or the thicknesses of units 0..n-1.
+pub(crate) fn field_observations(inputs: &ModelInputs) -> Result<Vec<(usize, Vec<Observation>)>> {
+    let n = inputs.layering.units.len();
+    let holes = inputs.boreholes;
+    Ok(match inputs.interpolate {
+        Interpolated::Tops => (1..n)
+            .filter(|u| !inputs.grids.iter().any(|g| g.0 == *u))
+            .map(|u| (u, holes.map(|b| tops_of(b, u)).unwrap_or_default()))
+            .collect(),
+        Interpolated::Thickness => {
+            if !inputs.grids.is_empty() {
+                bail!(
+                    "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" to use them"
+                );
+            }
+            let Some(b) = holes else {
+                bail!("interpolate = \"thickness\" needs boreholes: set [geology] collars");
+            };
+            (0..n - 1)
+                .map(|u| {
+                    let obs = b
+                        .thicknesses(u)
+                        .map(|(h, t, p)| Observation {
+                            hole: h.name.clone(),
+                            x: p[0],
+                            y: p[1],
+                            value: t,
+                        })
+                        .collect();
+                    (u, obs)
+                })
+                .collect()
+        }
+    })
+}
+
+/// The repaired surfaces from the interpolated `values` of the fields of
+/// [`field_observations`] (in its order), the horizon grids of `inputs`, the terrain and the
+/// base: the geological rules of `terramesh_geology`.
+pub(crate) fn stack_of(
+    planar: &Planar,
+    terrain: &[f64],
+    base: &[f64],
+    inputs: &ModelInputs,
+    values: &[&[f64]],
+) -> Result<(Stack, RulesReport)> {
+    let n = planar.points.len();
+    let mut values = values.iter();
+    match inputs.interpolate {
         Interpolated::Tops => {
             let mut tops = Vec::new();
-            for unit in 1..units.len() {
-                if let Some(g) = grid_of(unit) {
-                    tops.push(g.clone());
-                    continue;
+            for unit in 1..inputs.layering.units.len() {
+                match inputs.grids.iter().find(|g| g.0 == unit) {
+                    Some(g) => tops.push(g.1.clone()),
+                    None => tops.push(values.next().map(|v| v.to_vec()).unwrap_or_default()),
                 }
-                let obs = holes.map(|b| tops_of(b, unit)).unwrap_or_default();
-                let f = field_of(unit, obs)?;
-                tops.push(f.values.clone());
-                fields.push(f);
             }
             // A grid's nodata: the unit is absent there, its top is the next top below.
             for k in (0..tops.len()).rev() {
-                for v in 0..xy.len() {
+                for v in 0..n {
                     if tops[k][v].is_nan() {
                         tops[k][v] = if k + 1 < tops.len() {
                             tops[k + 1][v]
@@ -163,55 +226,34 @@ pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<Ge
             let raw = RawSurfaces {
                 terrain: terrain.to_vec(),
                 tops,
-                base,
+                base: base.to_vec(),
             };
-            apply_rules(&planar, &raw, inputs.min_thickness).context("the geological rules")?
+            apply_rules(planar, &raw, inputs.min_thickness).context("the geological rules")
         }
         Interpolated::Thickness => {
-            if !inputs.grids.is_empty() {
-                bail!(
-                    "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" to use them"
-                );
-            }
-            let Some(b) = holes else {
-                bail!("interpolate = \"thickness\" needs boreholes: set [geology] collars");
-            };
-            let mut thick = Vec::new();
-            for unit in 0..units.len() - 1 {
-                let obs = b
-                    .thicknesses(unit)
-                    .map(|(h, t, p)| Observation {
-                        hole: h.name.clone(),
-                        x: p[0],
-                        y: p[1],
-                        value: t,
-                    })
-                    .collect();
-                let f = field_of(unit, obs)?;
-                thick.push(f.values.clone());
-                fields.push(f);
-            }
-            stack_thicknesses(&planar, terrain, &thick, &base, inputs.min_thickness)
-                .context("the geological rules")?
+            let thick: Vec<Vec<f64>> = values.map(|v| v.to_vec()).collect();
+            stack_thicknesses(planar, terrain, &thick, base, inputs.min_thickness)
+                .context("the geological rules")
         }
-    };
-    let volume = terramesh_geology::volume_mesh(&planar, &stack, &inputs.layering)
-        .context("the volume mesh")?;
+    }
+}
+
+/// The volume mesh of `stack`, its independent checks (sealed, conformal, positive cells,
+/// the units' volume equal to the volume between the terrain and the base) and the per-unit
+/// figures.
+pub(crate) fn seal(
+    planar: &Planar,
+    stack: &Stack,
+    layering: &Layering,
+) -> Result<(VolumeMesh, CheckSummary, Vec<UnitStats>)> {
+    let volume =
+        terramesh_geology::volume_mesh(planar, stack, layering).context("the volume mesh")?;
     let summary = check(&volume).context("checking the model")?;
     summary
-        .compare_with(&planar, &stack)
+        .compare_with(planar, stack)
         .context("checking the model's volume")?;
-    let stats = unit_stats(&planar, &stack, &volume);
-    let misfits = holes.map(|b| misfits(b, mesh, &stack)).unwrap_or_default();
-    Ok(GeologicalModel {
-        mesh: volume,
-        stack,
-        rules,
-        fields,
-        stats,
-        check: summary,
-        misfits,
-    })
+    let stats = unit_stats(planar, stack, &volume);
+    Ok((volume, summary, stats))
 }
 
 /// The observed tops of `unit` (every kind of contact: logged, at the collar, absent, repaired).
@@ -227,7 +269,7 @@ fn tops_of(b: &Boreholes, unit: usize) -> Vec<Observation> {
         .collect()
 }
 
-fn base_values(
+pub(crate) fn base_values(
     inputs: &ModelInputs,
     terrain: &[f64],
     holes: Option<&Boreholes>,
@@ -257,7 +299,7 @@ fn base_values(
     })
 }
 
-fn misfits(b: &Boreholes, mesh: &Mesh, stack: &Stack) -> Vec<Misfit> {
+pub(crate) fn misfits(b: &Boreholes, mesh: &Mesh, stack: &Stack) -> Vec<Misfit> {
     let locators: Vec<SurfaceLocator> = stack
         .surfaces
         .iter()

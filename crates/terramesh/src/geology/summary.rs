@@ -103,6 +103,9 @@ pub struct ModelSummary {
     pub boreholes: Vec<Misfit>,
     /// The checks.
     pub checks: Checks,
+    /// The ensemble of realisations (`interpolation.realisations`), when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub realisations: Option<super::ensemble::EnsembleSummary>,
 }
 
 impl ModelSummary {
@@ -164,6 +167,7 @@ impl ModelSummary {
                     0.0
                 },
             },
+            realisations: None,
         }
     }
 }
