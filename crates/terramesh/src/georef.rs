@@ -32,7 +32,15 @@ use crate::error::Result;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone)]
-pub enum Georef {
+pub struct Georef {
+    place: Place,
+    /// The vertical datum named by the project (`[region] vertical_datum`): its name and its
+    /// description; `None`: the default of [`Georef::vertical_datum`].
+    datum: Option<(String, String)>,
+}
+
+#[derive(Debug, Clone)]
+enum Place {
     /// A UTM zone of WGS 84 (a geographic project).
     Utm(Zone),
     /// A named projected CRS: the transformation from it to WGS-84 longitude/latitude
@@ -43,7 +51,10 @@ pub enum Georef {
 impl Georef {
     /// A UTM zone of WGS 84.
     pub fn utm(zone: Zone) -> Georef {
-        Georef::Utm(zone)
+        Georef {
+            place: Place::Utm(zone),
+            datum: None,
+        }
     }
 
     /// A named projected CRS; refused when terramesh cannot shift its datum to WGS 84 (a grid
@@ -58,7 +69,25 @@ impl Georef {
                  WGS-84 positions, and {e}; remove them from export.formats"
             ))
         })?;
-        Ok(Georef::Crs(Box::new(to_wgs84)))
+        Ok(Georef {
+            place: Place::Crs(Box::new(to_wgs84)),
+            datum: None,
+        })
+    }
+
+    /// The same place with the vertical datum the project names (`[region] vertical_datum`):
+    /// its short name (`navd88`, `EPSG:5703`) and its description, for file metadata.
+    ///
+    /// ```
+    /// use terramesh::georef::Georef;
+    /// let g = Georef::utm("32N".parse()?).with_datum("navd88", "metres, NAVD88 height (EPSG:5703)");
+    /// assert_eq!(g.vertical_datum(), "navd88");
+    /// assert_eq!(g.heights(), "metres, NAVD88 height (EPSG:5703)");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn with_datum(mut self, name: impl Into<String>, describe: impl Into<String>) -> Georef {
+        self.datum = Some((name.into(), describe.into()));
+        self
     }
 
     /// Geodetic WGS-84 latitude and longitude (degrees) of a point of the project CRS.
@@ -66,9 +95,9 @@ impl Georef {
     /// # Errors
     /// The point is outside the projection's domain or not finite.
     pub fn to_wgs84(&self, x: f64, y: f64) -> Result<(f64, f64)> {
-        match self {
-            Georef::Utm(zone) => Ok(to_wgs84(x, y, *zone)?),
-            Georef::Crs(to_wgs84) => {
+        match &self.place {
+            Place::Utm(zone) => Ok(to_wgs84(x, y, *zone)?),
+            Place::Crs(to_wgs84) => {
                 let [lon, lat] = to_wgs84.transform(x, y)?;
                 Ok((lat, lon))
             }
@@ -77,17 +106,17 @@ impl Georef {
 
     /// The CRS as `EPSG:<code>` (or its definition when it has no code).
     pub fn crs_code(&self) -> String {
-        match self {
-            Georef::Utm(z) => format!("EPSG:{}", z.epsg()),
-            Georef::Crs(t) => t.from().to_string(),
+        match &self.place {
+            Place::Utm(z) => format!("EPSG:{}", z.epsg()),
+            Place::Crs(t) => t.from().to_string(),
         }
     }
 
     /// The CRS in words: `WGS 84 / UTM zone 32N`, `EPSG:26915`.
     pub fn crs_name(&self) -> String {
-        match self {
-            Georef::Utm(z) => format!("WGS 84 / UTM zone {z}"),
-            Georef::Crs(t) => t.from().to_string(),
+        match &self.place {
+            Place::Utm(z) => format!("WGS 84 / UTM zone {z}"),
+            Place::Crs(t) => t.from().to_string(),
         }
     }
 
@@ -95,28 +124,41 @@ impl Georef {
     /// geographic project (its DEM sources give heights above the EGM96 geoid), `source` for a
     /// project in its own CRS (the inputs' elevations as given: terramesh does not know their
     /// datum).
-    pub fn vertical_datum(&self) -> &'static str {
-        match self {
-            Georef::Utm(_) => "egm96",
-            Georef::Crs(_) => "source",
+    pub fn vertical_datum(&self) -> &str {
+        if let Some((name, _)) = &self.datum {
+            return name;
+        }
+        match &self.place {
+            Place::Utm(_) => "egm96",
+            Place::Crs(_) => "source",
         }
     }
 
     /// What the project's elevations are, in words (see [`Georef::vertical_datum`]).
-    pub fn heights(&self) -> &'static str {
-        match self {
-            Georef::Utm(_) => terramesh_core::coords::VerticalDatum::Egm96.describe(),
-            Georef::Crs(_) => SOURCE_HEIGHTS,
+    pub fn heights(&self) -> &str {
+        if let Some((_, describe)) = &self.datum {
+            return describe;
+        }
+        match &self.place {
+            Place::Utm(_) => terramesh_core::coords::VerticalDatum::Egm96.describe(),
+            Place::Crs(_) => SOURCE_HEIGHTS,
         }
     }
 
     /// How the geographic exports that need ellipsoidal heights (3D Tiles, terrain) got them.
     pub fn ellipsoidal_note(&self) -> &'static str {
-        match self {
-            Georef::Utm(_) => {
+        let named_other = self.datum.as_ref().is_some_and(|(n, _)| n != "egm96");
+        match &self.place {
+            Place::Utm(_) if !named_other => {
                 "ellipsoidal = DSM elevation (above the EGM96 geoid) + EGM96 undulation"
             }
-            Georef::Crs(_) => {
+            _ if named_other => {
+                "ellipsoidal = elevation + EGM96 undulation: the project's elevations, in the \
+                 vertical datum it names (region.vertical_datum), are taken as heights above the \
+                 EGM96 geoid; terramesh does not convert between vertical datums, which differ \
+                 by up to about 2 m"
+            }
+            _ => {
                 "ellipsoidal = elevation + EGM96 undulation: the project's elevations (its inputs' \
                  own vertical datum, not known to terramesh) are taken as heights above mean sea \
                  level, i.e. the EGM96 geoid; a national datum (NAVD88, NAP, ...) differs from it \

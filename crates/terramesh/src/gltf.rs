@@ -5,7 +5,7 @@
 //! DEM elevations (SRTM) are above the EGM96 geoid; Cesium places 3D Tiles on the ellipsoid.
 //! The tileset adds the EGM96 undulation (`terramesh_core::coords::GeoidGrid`) to every
 //! height; `dsm.glb`, like every other export, keeps the DSM's own elevations. Each file's
-//! `extras` names its vertical datum. A project in its own CRS ([`Georef::Crs`]) reaches
+//! `extras` names its vertical datum. A project in its own CRS ([`Georef::crs`]) reaches
 //! WGS-84 longitude and latitude through `terramesh_crs`; its elevations are its inputs' own,
 //! taken as above mean sea level (the EGM96 geoid) for the tileset, as its `extras` say.
 

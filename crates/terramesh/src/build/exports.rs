@@ -212,10 +212,15 @@ pub fn write_all(
         .into_iter()
         .filter(|f| want(f))
         .collect();
+    let datum = p.height_datum();
+    let named = |g: Georef| match &p.region.vertical_datum {
+        Some(_) => g.with_datum(datum.name(), datum.describe()),
+        None => g,
+    };
     let georef = match (zone, &s.crs) {
         _ if web.is_empty() => None,
-        (Some(z), _) => Some(Georef::utm(z)),
-        (None, Some(c)) => Some(Georef::crs(c, "region.crs")?),
+        (Some(z), _) => Some(named(Georef::utm(z))),
+        (None, Some(c)) => Some(named(Georef::crs(c, "region.crs")?)),
         (None, None) => crate::error::bail!(
             "export.formats: {} need geographic (WGS-84) positions, and this project is in {} \
              (region.crs = \"projected\"), which terramesh cannot place on the Earth: name the \

@@ -141,7 +141,8 @@ pub fn write_model_glb(path: &Path, model: &VolumeMesh, frame: &GlbFrame) -> Res
 /// Writes `out/model.glb` for a build ([`write_model_glb`]) in the model's CRS `crs`; its
 /// heights are the DSM's own: above the EGM96 geoid for a geographic (UTM) project, whose DEM
 /// sources give them so (`egm96`), else the elevations of the project's inputs as given
-/// (`source`). Returns the path.
+/// (`source`); `named`, the vertical datum the project names (`[region] vertical_datum`),
+/// replaces that default. Returns the path.
 ///
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -153,7 +154,7 @@ pub fn write_model_glb(path: &Path, model: &VolumeMesh, frame: &GlbFrame) -> Res
 ///     ..VolumeMesh::default()
 /// };
 /// let dir = tempfile::tempdir()?;
-/// let path = terramesh::geology::web::write_build_glb(dir.path(), &model, "EPSG:28992", false, None)?;
+/// let path = terramesh::geology::web::write_build_glb(dir.path(), &model, "EPSG:28992", false, None, None)?;
 /// assert!(path.ends_with("model.glb") && path.is_file());
 /// # Ok(()) }
 /// ```
@@ -165,10 +166,13 @@ pub fn write_build_glb(
     model: &VolumeMesh,
     crs: &str,
     geographic: bool,
+    named: Option<&crate::project::HeightDatum>,
     title: Option<&str>,
 ) -> Result<std::path::PathBuf> {
     let path = out.join("model.glb");
-    let (datum, heights) = if geographic {
+    let (datum, heights) = if let Some(d) = named {
+        (d.name(), d.describe())
+    } else if geographic {
         let d = terramesh_core::coords::VerticalDatum::Egm96;
         (d.to_string(), d.describe().to_string())
     } else {
