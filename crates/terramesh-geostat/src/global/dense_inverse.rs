@@ -179,7 +179,12 @@ mod tests {
             let (mut e2, mut var2) = (vec![0.0; 60], vec![0.0; 60]);
             l.predict(&t, &mut e2, Some(&mut var2)).unwrap();
             for i in 0..60 {
-                assert!((e[i] - e2[i]).abs() < 1e-9, "{m:?} estimate {i}: {} {}", e[i], e2[i]);
+                assert!(
+                    (e[i] - e2[i]).abs() < 1e-9,
+                    "{m:?} estimate {i}: {} {}",
+                    e[i],
+                    e2[i]
+                );
                 assert!((var[i] - var2[i]).abs() < 1e-9, "{m:?} variance {i}");
             }
             // Estimates alone (dense factor, grouped estimates) are the same numbers.

@@ -217,7 +217,15 @@ impl GlobalKriging {
                         let mut z = l;
                         dense_inverse::invert_in_place(&mut z, n);
                         let hs = h.clone();
-                        (Solver::DenseInverse { z, h: hs, support: r }, h, kz)
+                        (
+                            Solver::DenseInverse {
+                                z,
+                                h: hs,
+                                support: r,
+                            },
+                            h,
+                            kz,
+                        )
                     }
                     _ => (Solver::Dense { l, g, support }, h, kz),
                 }
@@ -510,7 +518,9 @@ impl GlobalKriging {
                 }
                 ((0..n).map(|i| band.zij(i, i)).collect(), h.clone())
             }
-            Solver::DenseInverse { z, h, .. } => ((0..n).map(|i| z[i * n + i]).collect(), h.clone()),
+            Solver::DenseInverse { z, h, .. } => {
+                ((0..n).map(|i| z[i * n + i]).collect(), h.clone())
+            }
             Solver::Dense { l, g, .. } => {
                 // The inverse of the factor beside the factor itself.
                 check_dense(2.0 * n as f64 * n as f64)?;
