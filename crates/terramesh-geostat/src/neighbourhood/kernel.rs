@@ -253,7 +253,7 @@ impl Kernel {
 #[inline(always)]
 fn exp_neg(x: f64) -> f64 {
     const SHIFT: f64 = 6755399441055744.0; // 1.5 · 2^52
-    const LN2_HI: f64 = 0.693_147_180_369_123_816_49;
+    const LN2_HI: f64 = 0.693_147_180_369_123_8; // 0x3FE62E42FEE00000: n·LN2_HI is exact
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
     let x = x.max(-708.0);
     let t = x * std::f64::consts::LOG2_E + SHIFT;
