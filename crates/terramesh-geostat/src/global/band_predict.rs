@@ -55,6 +55,24 @@ struct Scratch {
 }
 
 impl GlobalKriging {
+    /// The inverse (`None`: estimates only), `K^{-1} F` and the support, for the strategies
+    /// that predict in groups of targets.
+    pub(super) fn grouped(&self, want_var: bool) -> Option<(Option<Inverse<'_>>, &[f64], f64)> {
+        match &self.solver {
+            super::Solver::Band { band, h, support } => {
+                Some((Some(Inverse::Band(band)), h, *support))
+            }
+            super::Solver::DenseInverse { z, h, support } => {
+                let n = self.prep.pts.len();
+                Some((Some(Inverse::Dense { z, n }), h, *support))
+            }
+            super::Solver::Dense {
+                support: Some(r), ..
+            } if !want_var => Some((None, &[], *r)),
+            _ => None,
+        }
+    }
+
     /// Estimates (and variances) at the mapped targets `q`, all of them at once.
     pub(super) fn block_band(
         &self,

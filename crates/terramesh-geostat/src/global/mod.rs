@@ -27,8 +27,6 @@ mod band_predict;
 mod dense_inverse;
 mod factor;
 
-use band_predict::Inverse;
-
 use factor::{band_order, factor_band, factor_dense, factor_gamma};
 
 use crate::band::Band;
@@ -335,22 +333,6 @@ impl GlobalKriging {
     /// or with a strategy that needs nothing more for them.
     pub fn has_variance(&self) -> bool {
         self.variance || !matches!(self.solver, Solver::Band { .. })
-    }
-
-    /// The inverse (`None`: estimates only), `K^{-1} F` and the support, for the strategies
-    /// that predict in groups of targets.
-    fn grouped(&self, want_var: bool) -> Option<(Option<Inverse<'_>>, &[f64], f64)> {
-        match &self.solver {
-            Solver::Band { band, h, support } => Some((Some(Inverse::Band(band)), h, *support)),
-            Solver::DenseInverse { z, h, support } => {
-                let n = self.prep.pts.len();
-                Some((Some(Inverse::Dense { z, n }), h, *support))
-            }
-            Solver::Dense {
-                support: Some(r), ..
-            } if !want_var => Some((None, &[], *r)),
-            _ => None,
-        }
     }
 
     fn predict_block(
