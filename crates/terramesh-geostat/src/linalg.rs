@@ -120,58 +120,6 @@ pub(crate) fn backward(l: &[f64], n: usize, b: &mut [f64]) {
     }
 }
 
-/// Cholesky `A = Uᵀ U` in place (row-major `n x n`, upper triangle used and overwritten),
-/// right-looking: every update is a contiguous row operation that the compiler vectorises,
-/// which small systems (a moving neighbourhood's) need far more than a blocked algorithm.
-/// `Err(k)` at the first non-positive pivot.
-pub(crate) fn cholesky_upper(a: &mut [f64], n: usize) -> Result<(), usize> {
-    for k in 0..n {
-        let (head, tail) = a.split_at_mut((k + 1) * n);
-        let row = &mut head[k * n..];
-        let d = row[k];
-        if !(d > 0.0) {
-            return Err(k);
-        }
-        let d = d.sqrt();
-        row[k] = d;
-        let inv = 1.0 / d;
-        for v in &mut row[k + 1..] {
-            *v *= inv;
-        }
-        for (r, i) in (k + 1..n).enumerate() {
-            let f = row[i];
-            if f != 0.0 {
-                let dst = &mut tail[r * n + i..(r + 1) * n];
-                for (x, &u) in dst.iter_mut().zip(&row[i..]) {
-                    *x -= f * u;
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Solves `Uᵀ y = b` in place for the factor of [`cholesky_upper`].
-pub(crate) fn forward_upper(u: &[f64], n: usize, b: &mut [f64]) {
-    for k in 0..n {
-        let row = &u[k * n..(k + 1) * n];
-        let y = b[k] / row[k];
-        b[k] = y;
-        for (x, &v) in b[k + 1..].iter_mut().zip(&row[k + 1..]) {
-            *x -= v * y;
-        }
-    }
-}
-
-/// Solves `U x = y` in place for the factor of [`cholesky_upper`].
-pub(crate) fn backward_upper(u: &[f64], n: usize, b: &mut [f64]) {
-    for i in (0..n).rev() {
-        let row = &u[i * n..(i + 1) * n];
-        let s = b[i] - crate::band::dot(&row[i + 1..], &b[i + 1..]);
-        b[i] = s / row[i];
-    }
-}
-
 /// Morton (Z-order) permutation of points: neighbouring targets become neighbours in memory
 /// order, so consecutive k-d tree queries reuse cached leaves.
 pub(crate) fn morton_order(pts: &[[f64; 2]]) -> Vec<u32> {
@@ -242,19 +190,6 @@ mod chol_tests {
         }
         let mut bad = vec![1.0, 2.0, 2.0, 1.0];
         assert_eq!(cholesky(&mut bad, 2), Err(1));
-        // The right-looking upper factor solves the same system.
-        let mut u = a.clone();
-        cholesky_upper(&mut u, n).unwrap();
-        let mut c: Vec<f64> = (0..n)
-            .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
-            .collect();
-        forward_upper(&u, n, &mut c);
-        backward_upper(&u, n, &mut c);
-        for i in 0..n {
-            assert!((c[i] - x[i]).abs() < 1e-13);
-        }
-        let mut bad = vec![1.0, 2.0, 2.0, 1.0];
-        assert_eq!(cholesky_upper(&mut bad, 2), Err(1));
         let o = morton_order(&[[0.0, 0.0], [10.0, 10.0], [0.1, 0.1], [9.0, 9.9]]);
         assert_eq!(o, [0, 2, 3, 1]);
     }

@@ -7,6 +7,9 @@
 //!   (`O(s²)` for `s` such data), so cost does not grow with `n` per target.
 //! - **dense** (other bounded models): dense Cholesky of the covariance matrix with faer;
 //!   targets in blocks of [`BLOCK`]: one triangular solve per block for the variances.
+//!   With compact support over much of the data and variances asked, **dense-inverse**: the
+//!   factor becomes `K^{-1}` once and the targets' variances are gathered products in
+//!   groups, as in the band strategy (`dense_inverse.rs`).
 //! - **gamma** (unbounded models: linear, power): PyKrige's bordered variogram system, LU.
 //!
 //! Estimates come from the dual form: `ẑ(x0) = k0ᵀ w + f0ᵀ v` with `[K F; Fᵀ 0][w; v] = [z; 0]`.
@@ -21,6 +24,7 @@ use faer::{Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 mod band_predict;
+mod dense_inverse;
 mod factor;
 
 use factor::{band_order, factor_band, factor_dense, factor_gamma};
@@ -41,6 +45,9 @@ enum Solver {
         l: Vec<f64>,
         /// `L^{-1} F`, column-major n x p.
         g: Vec<f64>,
+        /// The compact support when estimates alone go in groups (built without variances
+        /// where [`Solver::DenseInverse`] would be chosen with them: the same estimates).
+        support: Option<f64>,
     },
     Band {
         band: Band,
@@ -50,6 +57,14 @@ enum Solver {
     },
     Gamma {
         lu: faer::linalg::solvers::PartialPivLu<f64>,
+    },
+    /// Compact support over much of the data: the lower triangle of `K^{-1}` (column-major
+    /// n x n) for grouped variances (`dense_inverse.rs`).
+    DenseInverse {
+        z: Vec<f64>,
+        /// `K^{-1} F`, row-major n x p.
+        h: Vec<f64>,
+        support: f64,
     },
 }
 
@@ -191,7 +206,27 @@ impl GlobalKriging {
                     solve_lower_triangular_in_place(lm, m.rb_mut(), par());
                     solve_upper_triangular_in_place(lm.transpose(), m, par());
                 }
-                (Solver::Dense { l, g }, h, kz)
+                let support = prep
+                    .variogram
+                    .compact_support()
+                    .filter(|&r| dense_inverse::pays_off(&prep.pts, &tree, r));
+                match support {
+                    Some(r) if variance => {
+                        let mut z = l;
+                        dense_inverse::invert_in_place(&mut z, n);
+                        let hs = h.clone();
+                        (
+                            Solver::DenseInverse {
+                                z,
+                                h: hs,
+                                support: r,
+                            },
+                            h,
+                            kz,
+                        )
+                    }
+                    _ => (Solver::Dense { l, g, support }, h, kz),
+                }
             }
             (None, _) => {
                 let lu = factor_gamma(&prep, &f)?;
@@ -257,10 +292,11 @@ impl GlobalKriging {
         w
     }
 
-    /// Which strategy was chosen: `"band"`, `"dense"` or `"gamma"`.
+    /// Which strategy was chosen: `"band"`, `"dense"`, `"dense-inverse"` or `"gamma"`.
     pub fn strategy(&self) -> &'static str {
         match self.solver {
             Solver::Dense { .. } => "dense",
+            Solver::DenseInverse { .. } => "dense-inverse",
             Solver::Band { .. } => "band",
             Solver::Gamma { .. } => "gamma",
         }
@@ -288,10 +324,10 @@ impl GlobalKriging {
                 });
             }
         }
-        if let Solver::Band { band, h, support } = &self.solver {
+        if let Some((z, h, support)) = self.grouped(var.is_some()) {
             // All targets at once: the groups of neighbouring targets span the whole set.
             let q: Vec<[f64; 2]> = targets.iter().map(|p| self.prep.map(*p)).collect();
-            self.block_band(band, h, *support, &q, est, var.as_deref_mut());
+            self.block_band(z, h, support, &q, est, var.as_deref_mut());
             return self.finish(&q, est, var);
         }
         for (b, chunk) in targets.chunks(BLOCK).enumerate() {
@@ -317,14 +353,15 @@ impl GlobalKriging {
     ) -> Result<()> {
         let q: Vec<[f64; 2]> = t.iter().map(|p| self.prep.map(*p)).collect();
         let v = var.as_deref_mut();
-        match &self.solver {
-            Solver::Band { band, h, support } => {
-                self.block_band(band, h, *support, &q, est, v);
-                Ok(())
-            }
-            Solver::Dense { l, g } => self.block_dense(l, g, &q, est, v),
-            Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
-        }?;
+        if let Some((z, h, support)) = self.grouped(v.is_some()) {
+            self.block_band(z, h, support, &q, est, v);
+        } else {
+            match &self.solver {
+                Solver::Dense { l, g, .. } => self.block_dense(l, g, &q, est, v),
+                Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
+                Solver::Band { .. } | Solver::DenseInverse { .. } => unreachable!("grouped"),
+            }?;
+        }
         self.finish(&q, est, var)
     }
 
@@ -473,7 +510,10 @@ impl GlobalKriging {
                 }
                 ((0..n).map(|i| band.zij(i, i)).collect(), h.clone())
             }
-            Solver::Dense { l, g } => {
+            Solver::DenseInverse { z, h, .. } => {
+                ((0..n).map(|i| z[i * n + i]).collect(), h.clone())
+            }
+            Solver::Dense { l, g, .. } => {
                 // The inverse of the factor beside the factor itself.
                 check_dense(2.0 * n as f64 * n as f64)?;
                 let lm = MatRef::from_column_major_slice(l, n, n);
