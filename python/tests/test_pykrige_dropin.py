@@ -38,8 +38,8 @@ def test_fitted_variogram_and_statistics_match_pykrige(field):
     b = PkOK(x, y, z, variogram_model="spherical", nlags=8, weight=True, enable_statistics=True)
     np.testing.assert_allclose(a.lags, b.lags, rtol=1e-12)
     np.testing.assert_allclose(a.semivariance, b.semivariance, rtol=1e-12)
-    # The fitted nugget sits at its bound 0 (about 5e-10 in both, where the sill is about
-    # 1e2): a parameter at rounding size is compared absolutely, relative to the sill.
+    # The fitted nugget sits at its bound 0 (about 5e-10 in both, orders of magnitude below the
+    # sill): a parameter at rounding size is compared absolutely, relative to the largest.
     scale = 1e-9 * max(b.variogram_model_parameters)
     np.testing.assert_allclose(a.variogram_model_parameters, b.variogram_model_parameters, rtol=1e-5, atol=scale)
     np.testing.assert_allclose(a.get_statistics(), b.get_statistics(), rtol=1e-6)
