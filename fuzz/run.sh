@@ -34,11 +34,15 @@ for t in "${targets[@]}"; do
   for f in $(seeds_of "$t"); do cp "../$f" "$scratch/$t/"; done
   rm -f "$scratch/$t/.gitkeep"
   start=$(date +%s)
-  if cargo +nightly fuzz run -O "$t" "$scratch/$t" -- -max_total_time="$secs" -timeout=30 \
+  # The CPU seconds the target got (the wall-clock seconds overstate it on a loaded machine).
+  timer=()
+  [ -x /usr/bin/time ] && timer=(/usr/bin/time -f "%U %S" -o "$scratch/$t.cpu")
+  if "${timer[@]}" cargo +nightly fuzz run -O "$t" "$scratch/$t" -- -max_total_time="$secs" -timeout=30 \
       -rss_limit_mb=4096 -malloc_limit_mb=4096 -artifact_prefix="artifacts/$t/" \
       -print_final_stats=1 >"$scratch/$t.log" 2>&1; then
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$scratch/$t.log" | tail -1)
-    echo "fuzz: $t: ${runs:-?} inputs in $(( $(date +%s) - start )) s, no crash"
+    cpu=$(awk '{printf "%.0f", $1 + $2}' "$scratch/$t.cpu" 2>/dev/null || echo "?")
+    echo "fuzz: $t: ${runs:-?} inputs in $(( $(date +%s) - start )) s (${cpu} s of CPU), no crash"
   else
     echo "fuzz: $t: FAILED after $(( $(date +%s) - start )) s; the input is in fuzz/artifacts/$t/:" >&2
     grep -E "ERROR|panicked|SUMMARY|Test unit written" "$scratch/$t.log" | head -8 >&2

@@ -27,6 +27,7 @@ use std::path::Path;
 
 use terramesh_core::coords::{parse_angle, Axis};
 use terramesh_core::sampling::Kernel;
+use terramesh_io::boreholes::{BoreholeFiles, BoreholeOptions, LogFile, Thickness};
 use terramesh_io::dem::{
     read_ascii_grid, read_geotiff, read_las, read_points, terrarium_decode, ElevationSource,
     HgtMosaic, LasOptions, Raster,
@@ -59,6 +60,8 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("png_tile", png_tile),
     ("web_reply", web_reply),
     ("mesher", mesher),
+    ("boreholes", boreholes),
+    ("crs", crs),
 ];
 
 /// Committed data crops (in `fixtures/data/`, paths from the repository root) that also seed a
@@ -250,5 +253,86 @@ pub fn web_reply(data: &[u8]) {
     }
     if let Ok(e) = terramesh_web::Endpoint::parse("google:", Some("KEY".into())) {
         let _ = e.parse_reply(body, &points);
+    }
+}
+
+/// A borehole data set (`[geology]` collars, log and survey). The first byte is a flag (bit 0:
+/// the log is intervals `hole,from,to,unit`, else tops `hole,unit,depth|elevation`; bit 1: the
+/// vertical unit is feet, so that `'0'` to `'3'` make readable seeds); the rest is split at
+/// lines `---` into the collars file, the log and an optional survey. Every collar, contact
+/// and known thickness read must be finite, and every thickness at least 0.
+pub fn boreholes(data: &[u8]) {
+    let Some((&flags, rest)) = data.split_first() else {
+        return;
+    };
+    let Some(s) = text(rest) else { return };
+    let feet = flags & 2 == 2;
+    let mut parts = s.splitn(3, "\n---\n");
+    let collars = files::write("collars.csv", parts.next().unwrap_or("").as_bytes());
+    let log_text = parts.next().unwrap_or("");
+    let log = if flags & 1 == 1 {
+        LogFile::Intervals(files::write("intervals.csv", log_text.as_bytes()))
+    } else {
+        LogFile::Tops(files::write("tops.csv", log_text.as_bytes()))
+    };
+    let survey = parts
+        .next()
+        .map(|t| files::write("survey.csv", t.as_bytes()));
+    let set = BoreholeFiles {
+        collars,
+        log,
+        survey,
+    };
+    let units = ["fill", "sand", "clay", "gravel"]
+        .map(String::from)
+        .to_vec();
+    let mut opts = BoreholeOptions::new(units);
+    if feet {
+        opts.z_unit = terramesh_core::volume::ZUnit::Foot;
+    }
+    let Ok(b) = terramesh_io::boreholes::read(&set, &opts) else {
+        return;
+    };
+    for h in &b.holes {
+        assert!(h.collar.iter().all(|v| v.is_finite()), "{}: collar", h.name);
+        for t in &h.thickness {
+            if let Thickness::Known(t) = t {
+                assert!(t.is_finite() && *t >= 0.0, "{}: thickness {t}", h.name);
+            }
+        }
+    }
+    for (h, c) in b.contacts() {
+        assert!(
+            c.md.is_finite() && c.position.iter().all(|v| v.is_finite()),
+            "{}: contact of unit {} not finite",
+            h.name,
+            c.unit
+        );
+    }
+}
+
+/// A CRS as a project's `[region] crs` or a source's `crs` gives it (`EPSG:<code>` or a PROJ
+/// string), then a transformer to and from WGS-84 applied to a few points: each result is
+/// finite or an error.
+pub fn crs(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    let Ok(c) = terramesh_crs::Crs::parse(s) else {
+        return;
+    };
+    let wgs84 = terramesh_crs::Crs::wgs84();
+    let points = [
+        [500_000.0, 5_000_000.0],
+        [7.3, 48.7],
+        [0.0, 0.0],
+        [-1e7, 1e7],
+    ];
+    for (from, to) in [(&c, &wgs84), (&wgs84, &c)] {
+        if let Ok(t) = terramesh_crs::Transformer::new(from, to) {
+            for [x, y] in points {
+                if let Ok(p) = t.transform(x, y) {
+                    assert!(p.iter().all(|v| v.is_finite()), "{s}: ({x}, {y}) -> {p:?}");
+                }
+            }
+        }
     }
 }
