@@ -66,3 +66,27 @@ def test_numpy_engine_for_what_terramesh_has_no_kernel_for(field):
     assert a.engine == "numpy"
     np.testing.assert_allclose(za, zb, rtol=1e-9)
     np.testing.assert_allclose(sa, sb, rtol=1e-9)
+
+
+def test_a_gstools_covmodel_as_pykrige_takes_it(field):
+    # PyKrige 1.7 takes a GSTools CovModel as variogram_model: its pykrige_vario as a custom
+    # function, its anisotropy as the frame. The same numbers through terramesh.pykrige.
+    gs = pytest.importorskip("gstools")
+    x, y, z = field
+    gx, gy = np.linspace(0, 2000, 15), np.linspace(0, 1500, 12)
+    model = gs.Gaussian(dim=2, var=100.0, len_scale=[500.0, 250.0], angles=0.4, nugget=0.5)
+    for ours, ref, extra in ((OrdinaryKriging, PkOK, {}), (UniversalKriging, PkUK, {"drift_terms": ["regional_linear"]})):
+        a = ours(x, y, z, variogram_model=model, **extra)
+        b = ref(x, y, z, variogram_model=model, **extra)
+        assert a.model is model and a.variogram_model == "custom"
+        assert (a.anisotropy_scaling, a.anisotropy_angle) == (b.anisotropy_scaling, b.anisotropy_angle)
+        za, sa = a.execute("grid", gx, gy)
+        zb, sb = b.execute("grid", gx, gy)
+        np.testing.assert_allclose(za, zb, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(sa, sb, rtol=1e-9, atol=1e-9)
+    # A latlon model needs geographic coordinates, and universal kriging takes none.
+    latlon = gs.Gaussian(latlon=True, var=1.0, len_scale=0.2)
+    with pytest.raises(ValueError, match="latlon"):
+        OrdinaryKriging(x, y, z, variogram_model=latlon)
+    with pytest.raises(ValueError, match="latlon"):
+        UniversalKriging(x, y, z, variogram_model=latlon)

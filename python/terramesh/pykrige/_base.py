@@ -57,11 +57,17 @@ class KrigingBase:
             raise ValueError(f"pseudo_inv_type '{pseudo_inv_type}' not known: give 'pinv' or 'pinvh'")
         if coordinates_type not in ("euclidean", "geographic"):
             raise ValueError("Only 'euclidean' and 'geographic' are valid values for coordinates-keyword.")
+        self.coordinates_type = coordinates_type
+        self.model = None
+        if hasattr(variogram_model, "pykrige_kwargs"):
+            self.model = variogram_model
+            variogram_model, variogram_function, variogram_parameters = self._covmodel(variogram_model)
+            anisotropy_scaling = self.model.pykrige_anis
+            anisotropy_angle = self.model.pykrige_angle
         if not isinstance(variogram_model, str):
             raise ValueError(
                 "terramesh.pykrige takes variogram models by name ('linear', 'power', 'gaussian', "
-                "'spherical', 'exponential', 'hole-effect', 'custom'); GSTools CovModel objects are "
-                "not supported"
+                "'spherical', 'exponential', 'hole-effect', 'custom') or as a GSTools CovModel"
             )
         self.exact_values = exact_values
         self.pseudo_inv = bool(pseudo_inv)
@@ -69,7 +75,6 @@ class KrigingBase:
         self.verbose = verbose
         self.enable_plotting = enable_plotting
         self.enable_statistics = enable_statistics
-        self.coordinates_type = coordinates_type
         self.X_ORIG = np.atleast_1d(np.squeeze(np.array(x, copy=True, dtype=np.float64)))
         self.Y_ORIG = np.atleast_1d(np.squeeze(np.array(y, copy=True, dtype=np.float64)))
         self.Z = np.atleast_1d(np.squeeze(np.array(z, copy=True, dtype=np.float64)))
@@ -89,6 +94,25 @@ class KrigingBase:
         self._set_model(variogram_model, variogram_parameters, variogram_function)
         self.engine = None
         self._stats = None
+
+    def _covmodel(self, model):
+        """A GSTools ``CovModel`` as PyKrige 1.7 takes it: a ``'custom'`` model whose function
+        is the model's ``pykrige_vario``, no parameters to fit, and the model's anisotropy
+        (``pykrige_anis``, ``pykrige_angle``); kriged by the numpy engine. The same checks and
+        messages as PyKrige's."""
+        try:
+            import gstools as gs
+        except ImportError as e:  # pragma: no cover - pykrige_kwargs comes from gstools
+            raise ValueError("GSTools needs to be installed in order to use their CovModel class.") from e
+        if not isinstance(model, gs.CovModel):
+            raise ValueError("GSTools: given variogram model is not a CovModel instance.")
+        if model.field_dim == 3:
+            raise ValueError("GSTools: model dim is not 1 or 2")
+        if self._uk and model.latlon:
+            raise ValueError("GSTools: latlon models not supported for universal kriging")
+        if model.latlon and self.coordinates_type == "euclidean":
+            raise ValueError("GSTools: latlon models require geographic coordinates")
+        return "custom", model.pykrige_vario, []
 
     # -- geometry ---------------------------------------------------------------------------
     def _frame(self):
@@ -149,9 +173,16 @@ class KrigingBase:
         anisotropy_scaling=1.0,
         anisotropy_angle=0.0,
     ):
-        """Changes the variogram model (and the anisotropy), as PyKrige's method."""
+        """Changes the variogram model (and the anisotropy), as PyKrige's method; a GSTools
+        ``CovModel`` brings its own function and anisotropy."""
+        self.model = None
+        if hasattr(variogram_model, "pykrige_kwargs"):
+            self.model = variogram_model
+            variogram_model, variogram_function, variogram_parameters = self._covmodel(variogram_model)
+            anisotropy_scaling = self.model.pykrige_anis
+            anisotropy_angle = self.model.pykrige_angle
         if not isinstance(variogram_model, str):
-            raise ValueError("variogram_model must be a name")
+            raise ValueError("variogram_model must be a name or a GSTools CovModel")
         if self.coordinates_type == "euclidean" and (
             anisotropy_scaling != self.anisotropy_scaling or anisotropy_angle != self.anisotropy_angle
         ):

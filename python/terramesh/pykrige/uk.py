@@ -24,6 +24,7 @@ class UniversalKriging(KrigingBase):
     :mod:`terramesh.pykrige._base` for what runs where)."""
 
     _method = "uk"
+    _uk = True
     _backends = ("vectorized", "loop")
 
     def __init__(
