@@ -194,6 +194,10 @@ pub struct Manifest {
     pub grid: GridSpec,
     /// EPSG code of the coordinates, when known.
     pub epsg: Option<u32>,
+    /// EPSG code of the heights' vertical CRS (`[region] vertical_datum`, or EGM96 for a
+    /// geographic project), recorded in the merged GeoTIFF grids as a one-piece build does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertical_epsg: Option<u16>,
     /// The geological model's plan, when the project has `[geology]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geology: Option<super::geology::GeologyPlan>,

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::Serialize;
-use terramesh_io::grid_write::{write_asc, write_geotiff};
+use terramesh_io::grid_write::{write_asc, write_geotiff_heights, Heights};
 use terramesh_io::output::Output;
 
 use super::build::tile_dir;
@@ -117,11 +117,14 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         }
     }
     let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
+    let heights = Heights {
+        vertical_epsg: m.vertical_epsg,
+    };
     for (name, tif) in [("dsm.tif", true), ("dsm.asc", false)] {
         let path = out.join(name);
         let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
         if tif {
-            write_geotiff(&mut o, &spec, &values, epsg, Some(NODATA))
+            write_geotiff_heights(&mut o, &spec, &values, epsg, Some(heights), Some(NODATA))
         } else {
             write_asc(&mut o, &spec, &values)
         }

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use terramesh_core::volume::{cell_volume, Cell, CellKind};
-use terramesh_io::grid_write::write_geotiff;
+use terramesh_io::grid_write::{write_geotiff_heights, Heights};
 use terramesh_io::output::Output;
 
 use super::build::tile_dir;
@@ -322,6 +322,9 @@ fn write_interfaces(
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
     let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
+    let heights = Heights {
+        vertical_epsg: m.vertical_epsg,
+    };
     let mut written = Vec::new();
     for (u, name) in gp.units.iter().enumerate() {
         let mut values = vec![super::merge::NODATA; g.nx * g.ny];
@@ -336,7 +339,14 @@ fn write_interfaces(
         }
         let path = dir.join(format!("{name}.tif"));
         let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
-        write_geotiff(&mut o, &spec, &values, epsg, Some(super::merge::NODATA))
+        write_geotiff_heights(
+            &mut o,
+            &spec,
+            &values,
+            epsg,
+            Some(heights),
+            Some(super::merge::NODATA),
+        )
             .and_then(|_| o.commit())
             .context(path.display().to_string())?;
         written.push(path);

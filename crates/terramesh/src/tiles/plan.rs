@@ -365,6 +365,7 @@ pub fn plan(
             ny: spec.ny,
         },
         epsg: samples.epsg(),
+        vertical_epsg: project.height_datum().epsg(),
         geology,
         tiles,
     };
