@@ -347,8 +347,8 @@ fn write_interfaces(
             Some(heights),
             Some(super::merge::NODATA),
         )
-            .and_then(|_| o.commit())
-            .context(path.display().to_string())?;
+        .and_then(|_| o.commit())
+        .context(path.display().to_string())?;
         written.push(path);
     }
     Ok(written)
