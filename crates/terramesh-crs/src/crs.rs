@@ -153,6 +153,18 @@ impl Crs {
     }
 
     fn from_proj4(definition: &str, epsg: Option<u32>) -> Result<Crs, CrsError> {
+        // PROJ strings are ASCII. proj4rs 0.3 slices a value at a byte after its last
+        // non-digit, which panics inside a multi-byte character (`+lat_0=48°30'`, or any
+        // non-ASCII text: found by the `crs` fuzz target), so such a string is refused here.
+        if let Some(c) = definition.chars().find(|c| !c.is_ascii()) {
+            return Err(CrsError::Definition {
+                definition: definition.to_string(),
+                reason: format!(
+                    "the character '{c}' is not ASCII: a PROJ string is plain ASCII, with angles \
+                     in decimal degrees (+lat_0=48.5) or as 48d30'"
+                ),
+            });
+        }
         let tokens: Vec<(String, Option<String>)> = definition
             .split_whitespace()
             .map(|t| {

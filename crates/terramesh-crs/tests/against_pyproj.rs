@@ -164,3 +164,27 @@ fn feet_come_out_in_feet() {
         "{yf} ft vs {ym} m"
     );
 }
+
+#[test]
+fn non_ascii_proj_strings_are_refused_not_a_panic_in_proj4rs() {
+    // The input the `crs` fuzz target found (fuzz/regressions/crs/), and a degree sign, which
+    // proj4rs 0.3 slices inside (a panic): both refused by name.
+    let found = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/regressions/crs/crash-86c40f558b0ea80f4225c8e87355d96be8c6a709"
+    ))
+    .unwrap();
+    let found = String::from_utf8_lossy(&found).into_owned();
+    for text in [
+        found.as_str(),
+        "+proj=tmerc +lat_0=48°30' +lon_0=9 +ellps=GRS80 +units=m",
+    ] {
+        let e = terramesh_crs::Crs::parse(text).unwrap_err().to_string();
+        assert!(e.contains("is not ASCII"), "{e}");
+    }
+    // The same in the ASCII spelling is read.
+    assert!(
+        terramesh_crs::Crs::parse("+proj=tmerc +lat_0=48d30' +lon_0=9 +ellps=GRS80 +units=m")
+            .is_ok()
+    );
+}
