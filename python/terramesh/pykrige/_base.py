@@ -60,10 +60,8 @@ class KrigingBase:
         self.coordinates_type = coordinates_type
         self.model = None
         if hasattr(variogram_model, "pykrige_kwargs"):
-            self.model = variogram_model
-            variogram_model, variogram_function, variogram_parameters = self._covmodel(variogram_model)
-            anisotropy_scaling = self.model.pykrige_anis
-            anisotropy_angle = self.model.pykrige_angle
+            (variogram_model, variogram_function, variogram_parameters,
+             anisotropy_scaling, anisotropy_angle) = self._covmodel(variogram_model)
         if not isinstance(variogram_model, str):
             raise ValueError(
                 "terramesh.pykrige takes variogram models by name ('linear', 'power', 'gaussian', "
@@ -99,7 +97,8 @@ class KrigingBase:
         """A GSTools ``CovModel`` as PyKrige 1.7 takes it: a ``'custom'`` model whose function
         is the model's ``pykrige_vario``, no parameters to fit, and the model's anisotropy
         (``pykrige_anis``, ``pykrige_angle``); kriged by the numpy engine. The same checks and
-        messages as PyKrige's."""
+        messages as PyKrige's. Keeps the model as :attr:`model` and returns the model name,
+        function, parameters, anisotropy scaling and angle."""
         try:
             import gstools as gs
         except ImportError as e:  # pragma: no cover - pykrige_kwargs comes from gstools
@@ -112,7 +111,8 @@ class KrigingBase:
             raise ValueError("GSTools: latlon models not supported for universal kriging")
         if model.latlon and self.coordinates_type == "euclidean":
             raise ValueError("GSTools: latlon models require geographic coordinates")
-        return "custom", model.pykrige_vario, []
+        self.model = model
+        return "custom", model.pykrige_vario, [], model.pykrige_anis, model.pykrige_angle
 
     # -- geometry ---------------------------------------------------------------------------
     def _frame(self):
@@ -177,10 +177,8 @@ class KrigingBase:
         ``CovModel`` brings its own function and anisotropy."""
         self.model = None
         if hasattr(variogram_model, "pykrige_kwargs"):
-            self.model = variogram_model
-            variogram_model, variogram_function, variogram_parameters = self._covmodel(variogram_model)
-            anisotropy_scaling = self.model.pykrige_anis
-            anisotropy_angle = self.model.pykrige_angle
+            (variogram_model, variogram_function, variogram_parameters,
+             anisotropy_scaling, anisotropy_angle) = self._covmodel(variogram_model)
         if not isinstance(variogram_model, str):
             raise ValueError("variogram_model must be a name or a GSTools CovModel")
         if self.coordinates_type == "euclidean" and (

@@ -118,6 +118,23 @@ pub struct DriftArgs {
     external_drift_grid: Option<PathBuf>,
 }
 
+/// Whether a variogram or model flag says `auto`.
+fn is_auto(flag: &Option<String>) -> bool {
+    flag.as_deref()
+        .is_some_and(|s| s.eq_ignore_ascii_case("auto"))
+}
+
+impl DriftArgs {
+    /// The flag that asked for the external drift, for messages.
+    fn flag(&self) -> &'static str {
+        if self.external_drift.is_some() {
+            "--external-drift"
+        } else {
+            "--external-drift-grid"
+        }
+    }
+}
+
 /// The method, the drift at the data, the variogram and the targets' drift source.
 pub type Ked = (Method, Vec<f64>, Variogram, DriftSource);
 
@@ -140,11 +157,7 @@ pub fn external_drift(
             bail!("give --external-drift COLUMN or --external-drift-grid FILE, not both")
         }
     };
-    let flag = if d.external_drift.is_some() {
-        "--external-drift"
-    } else {
-        "--external-drift-grid"
-    };
+    let flag = d.flag();
     let method = match m.method {
         InterpolationMethod::Ordinary | InterpolationMethod::Universal => method(m, &fd.data)?,
         other => bail!("{flag}: kriging with an external drift is --method ok (the constant and the drift) or uk (the polynomial and the drift), not {other}"),
@@ -164,8 +177,7 @@ pub fn external_drift(
             .map_err(|e| crate::flag_error(e).context(format!("{}: the data", fd.name)))?,
     };
     // An automatic fit is made to the residuals of the drift (the drift's own variation out).
-    let auto = |s: &Option<String>| s.as_deref().is_some_and(|s| s.eq_ignore_ascii_case("auto"));
-    let v = if auto(&m.variogram) || auto(&m.model.model) {
+    let v = if is_auto(&m.variogram) || is_auto(&m.model.model) {
         let residuals = drift_residuals(&fd.data, &g, method)
             .map_err(|e| crate::flag_error(e).context(format!("{flag}: {}", fd.name)))?;
         resolve_for(m, fd, &residuals)?
@@ -183,19 +195,9 @@ pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
 /// [`resolve_variogram`], an automatic fit made to `fit_to` (the data, or the residuals of
 /// their drift for kriging with an external drift).
 fn resolve_for(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram> {
-    let fitting = m
-        .variogram
-        .as_deref()
-        .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
-    let aniso = m.model.anisotropy_auto()?;
-    if aniso
-        && !fitting
-        && !m
-            .model
-            .model
-            .as_deref()
-            .is_some_and(|s| s.eq_ignore_ascii_case("auto"))
-    {
+    let fitting = is_auto(&m.variogram);
+    let auto_model = is_auto(&m.model.model);
+    if m.model.anisotropy_auto()? && !fitting && !auto_model {
         bail!("--anisotropy auto fits the anisotropy with the variogram: give --variogram auto (the model's angle and ratio are otherwise --anisotropy-angle and --anisotropy-ratio)");
     }
     if let Some(v) = explicit_or_fit(&m.model, fitting)? {
@@ -204,13 +206,8 @@ fn resolve_for(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram
         }
         return Ok(v);
     }
-    let auto_model = m
-        .model
-        .model
-        .as_deref()
-        .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
     match m.variogram.as_deref() {
-        Some(s) if s.eq_ignore_ascii_case("auto") => auto(m, fd, fit_to),
+        _ if fitting => auto(m, fd, fit_to),
         Some(file) => read_variogram_file(Path::new(file)).map_err(crate::flag_error),
         None if auto_model => auto(m, fd, fit_to),
         None => bail!("kriging needs a variogram: --variogram auto, --variogram FILE.json, or --model NAME --psill C --range A [--nugget C0]"),
@@ -289,11 +286,7 @@ fn engine_of(args: &Args, fd: &FileData, variance: bool) -> Result<Engine> {
     let Some((method, g, v, source)) = external_drift(&args.m, &args.drift, &args.data, fd)? else {
         return Ok(Engine::Plain(engine(&args.m, fd, variance)?));
     };
-    let flag = if args.drift.external_drift.is_some() {
-        "--external-drift"
-    } else {
-        "--external-drift-grid"
-    };
+    let flag = args.drift.flag();
     let hood = args
         .m
         .neighbors

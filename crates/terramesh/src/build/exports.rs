@@ -212,9 +212,8 @@ pub fn write_all(
         .into_iter()
         .filter(|f| want(f))
         .collect();
-    let datum = p.height_datum();
-    let named = |g: Georef| match &p.region.vertical_datum {
-        Some(_) => g.with_datum(datum.name(), datum.describe()),
+    let named = |g: Georef| match p.named_height_datum() {
+        Some(d) => g.with_datum(d.name(), d.describe()),
         None => g,
     };
     let georef = match (zone, &s.crs) {

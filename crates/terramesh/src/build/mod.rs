@@ -174,12 +174,7 @@ fn geology_stage(
             &built.model.mesh,
             &built.summary.crs,
             dsm.geographic,
-            project
-                .region
-                .vertical_datum
-                .as_ref()
-                .map(|_| project.height_datum())
-                .as_ref(),
+            project.named_height_datum().as_ref(),
             project.title.as_deref(),
         )?);
     }

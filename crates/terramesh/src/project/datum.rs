@@ -170,4 +170,22 @@ impl super::Project {
             self.region.crs.region_crs() == terramesh_io::region::RegionCrs::Geographic,
         )
     }
+
+    /// The vertical datum the project names (`[region] vertical_datum`), `None` when it names
+    /// none (then each output keeps its own default: EGM96 for the DEM-derived web files).
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let p = Project::parse("t.toml", TEMPLATE, &[])?;
+    /// assert!(p.named_height_datum().is_none());
+    /// let p = Project::parse("t.toml", TEMPLATE, &["region.vertical_datum=navd88".into()])?;
+    /// assert_eq!(p.named_height_datum().map(|d| d.name()), Some("navd88".into()));
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn named_height_datum(&self) -> Option<HeightDatum> {
+        self.region
+            .vertical_datum
+            .as_ref()
+            .map(|_| self.height_datum())
+    }
 }
