@@ -6,6 +6,7 @@ import json
 import os
 import pathlib
 import signal
+import struct
 import subprocess
 import threading
 import time
@@ -45,14 +46,20 @@ def asc(path):
 
 
 def vtu(path):
-    text = pathlib.Path(path).read_text()
+    """Points and triangles of the merged dsm.vtu (raw appended binary, UInt64 headers)."""
+    raw = pathlib.Path(path).read_bytes()
+    mark = b'<AppendedData encoding="raw">'
+    start = raw.index(b"_", raw.index(mark) + len(mark)) + 1
+    xml = raw[:start].decode()
 
-    def block(tag):
-        i = text.index(tag) + len(tag)
-        return text[i : text.index("</DataArray>", i)].split()
+    def block(tag, fmt, size):
+        head = xml[xml.rindex("<DataArray", 0, xml.index(tag)) : xml.index(">", xml.index(tag))]
+        off = start + int(head.split('offset="')[1].split('"')[0])
+        (n,) = struct.unpack_from("<Q", raw, off)
+        return list(struct.unpack_from(f"<{n // size}{fmt}", raw, off + 8))
 
-    p = [float(x) for x in block('NumberOfComponents="3" format="ascii">')]
-    c = [int(x) for x in block('Name="connectivity" format="ascii">')]
+    p = block('NumberOfComponents="3"', "d", 8)
+    c = block('Name="connectivity"', "q", 8)
     points = [tuple(p[i : i + 3]) for i in range(0, len(p), 3)]
     tris = [tuple(c[i : i + 3]) for i in range(0, len(c), 3)]
     return points, tris

@@ -11,7 +11,8 @@ are that the merged surface is conforming and covers exactly the region:
   boundary's length is the outline's perimeter;
 * the planar area is the region's (shoelace formula) to 1e-9 relative;
 * every planned seam vertex is a vertex of the mesh exactly once (no two vertices share x, y),
-  and the counts agree with `merge.json`.
+  and the counts agree with `merge.json`;
+* VTK's own reader (ParaView's) reads the same points, triangles and point arrays as meshio.
 
 Prints `PASS name` or `FAIL name: why` per check, then `N passed, M failed`; exits 1 on failure.
 """
@@ -157,8 +158,34 @@ def check_seam_vertices(d):
             f"merge.json: seam_vertices {s['seam_vertices']}, tiles.json plans {len(seam)}")
 
 
+def check_vtk(d):
+    """VTK (ParaView's reader) reads dsm.vtu to the same points, triangles and point arrays."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(str(d.merged / "dsm.vtu"))
+    r.Update()
+    g = r.GetOutput()
+    pts, tris = d.mesh()
+    require(g.GetNumberOfPoints() == len(pts) and g.GetNumberOfCells() == len(tris),
+            f"VTK reads {g.GetNumberOfPoints()} points and {g.GetNumberOfCells()} cells, "
+            f"meshio {len(pts)} and {len(tris)}")
+    vp = vtk_to_numpy(g.GetPoints().GetData())
+    require(np.array_equal(vp, pts), "VTK's points differ from meshio's")
+    conn = vtk_to_numpy(g.GetCells().GetConnectivityArray()).reshape(-1, 3)
+    require(np.array_equal(conn, tris), "VTK's triangles differ from meshio's")
+    import meshio
+    m = meshio.read(d.merged / "dsm.vtu")
+    pd = g.GetPointData()
+    for name, values in m.point_data.items():
+        a = pd.GetArray(name)
+        require(a is not None, f"VTK does not read point array {name}")
+        require(np.array_equal(vtk_to_numpy(a), values), f"point array {name}: VTK and meshio differ")
+
+
 CHECKS = [
     ("readable", check_readable),
+    ("vtk", check_vtk),
     ("edges", check_edges),
     ("boundary", check_boundary),
     ("area", check_area),

@@ -44,6 +44,10 @@ fn plan(dir: &Path, size: &str, extra: &[&str]) -> Output {
     terramesh(&args, &[])
 }
 
+fn manifest_of(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
 fn manifest(plan: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(plan.join("tiles.json")).unwrap()).unwrap()
 }
@@ -84,28 +88,56 @@ fn asc(p: &Path) -> Vec<f64> {
         .collect()
 }
 
-/// Points and triangles of an ASCII VTU.
+#[path = "support/vtu_read.rs"]
+mod vtu_read;
+
+/// Points and triangles of a VTU (the merge's: raw appended binary).
 fn vtu(p: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-    let text = std::fs::read_to_string(p).unwrap();
-    let block = |start: &str| {
-        let i = text.find(start).unwrap() + start.len();
-        let j = i + text[i..].find("</DataArray>").unwrap();
-        text[i..j]
-            .split_whitespace()
-            .map(str::to_string)
-            .collect::<Vec<_>>()
-    };
-    let pts = block("NumberOfComponents=\"3\" format=\"ascii\">");
-    let con = block("Name=\"connectivity\" format=\"ascii\">");
-    let points = pts
-        .chunks(3)
-        .map(|c| [0, 1, 2].map(|k| c[k].parse::<f64>().unwrap()))
-        .collect();
-    let tris = con
-        .chunks(3)
-        .map(|c| [0, 1, 2].map(|k| c[k].parse::<usize>().unwrap()))
-        .collect();
-    (points, tris)
+    vtu_read::Vtu::read(p).triangles()
+}
+
+/// The records of a samples file (`[x, y, z]` little-endian `f64` triples).
+fn samples(p: &Path) -> Vec<[f64; 3]> {
+    std::fs::read(p)
+        .unwrap()
+        .chunks_exact(24)
+        .map(|c| [0, 1, 2].map(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap())))
+        .collect()
+}
+
+/// Every tile read only the samples of its window (its extent grown by its halo), from its
+/// own file, which holds exactly the whole samples file's records in the window, in order.
+fn tiles_read_only_their_windows(p: &Path) {
+    let m = manifest(p);
+    let all = samples(&p.join("samples.f64"));
+    assert_eq!(all.len() as u64, m["data"]["count"].as_u64().unwrap());
+    let mut fewer = 0;
+    for t in m["tiles"].as_array().unwrap() {
+        let e: Vec<f64> = t["extent"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let h = t["halo"].as_f64().unwrap();
+        let window: Vec<[f64; 3]> = all
+            .iter()
+            .filter(|s| {
+                s[0] >= e[0] - h && s[0] <= e[2] + h && s[1] >= e[1] - h && s[1] <= e[3] + h
+            })
+            .copied()
+            .collect();
+        let own = samples(&p.join(t["data"]["file"].as_str().unwrap()));
+        let bits = |v: &[[f64; 3]]| v.iter().map(|s| s.map(f64::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&own), bits(&window), "tile {}'s samples file", t["id"]);
+        let b = &t["built"];
+        let read = b["samples_read"].as_u64().unwrap() as usize;
+        assert_eq!(read, window.len(), "tile {} read {read} samples", t["id"]);
+        assert_eq!(b["samples"].as_u64().unwrap() as usize, window.len());
+        assert_eq!(t["data"]["count"].as_u64().unwrap() as usize, window.len());
+        fewer += usize::from(read < all.len());
+    }
+    assert!(fewer > 0, "every tile read every sample");
 }
 
 fn seg_dist(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
@@ -218,8 +250,21 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
         std::fs::read(one.join("dsm.tif")).unwrap()
     );
 
+    tiles_read_only_their_windows(&p);
     // The merged mesh: conforming, watertight, every seam vertex once, the region's area.
     let seam = watertight(&out, &p);
+    let merged = manifest_of(&out.join("merge.json"));
+    let g = &m["grid"];
+    assert_eq!(
+        merged["grid"]["row_bytes"].as_u64().unwrap(),
+        8 * g["nx"].as_u64().unwrap(),
+        "the grid merge holds one row"
+    );
+    assert_eq!(
+        merged["grid"]["nodes"].as_u64().unwrap() as usize,
+        a.iter().filter(|v| **v != -9999.0).count()
+    );
+    assert!(merged["grid"]["open_max"].as_u64().unwrap() <= 2 * m["shape"][0].as_u64().unwrap());
     assert!(seam > 100);
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("<svg") && report.contains(bad));
@@ -322,7 +367,7 @@ fn independent_check(merged: &Path, plan: &Path) {
     let stdout = String::from_utf8_lossy(&run.stdout);
     println!("{stdout}");
     assert!(
-        run.status.success() && stdout.contains("5 passed, 0 failed"),
+        run.status.success() && stdout.contains("6 passed, 0 failed"),
         "check_tiles.py failed:\n{stdout}\n{}",
         String::from_utf8_lossy(&run.stderr)
     );

@@ -71,17 +71,6 @@ fn json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
-/// The named `DataArray`'s values of an ASCII VTU (the first whose opening tag contains `tag`).
-fn array(text: &str, tag: &str) -> Vec<f64> {
-    let i = text.find(tag).unwrap_or_else(|| panic!("no {tag}"));
-    let i = i + text[i..].find('>').unwrap() + 1;
-    let j = i + text[i..].find("</DataArray>").unwrap();
-    text[i..j]
-        .split_whitespace()
-        .map(|x| x.parse::<f64>().unwrap())
-        .collect()
-}
-
 fn f64s(p: &Path) -> Vec<f64> {
     std::fs::read(p)
         .unwrap()
@@ -92,12 +81,12 @@ fn f64s(p: &Path) -> Vec<f64> {
 
 /// The merged volume mesh: points, cells (our node orders), materials.
 fn model(p: &Path) -> (Vec<[f64; 3]>, Vec<Cell>, Vec<i32>) {
-    let text = std::fs::read_to_string(p).unwrap();
-    let pts = array(&text, "NumberOfComponents=\"3\"");
-    let con = array(&text, "Name=\"connectivity\"");
-    let off = array(&text, "Name=\"offsets\"");
-    let types = array(&text, "Name=\"types\"");
-    let mat = array(&text, "Name=\"MaterialIDs\"");
+    let v = vtu_read::Vtu::read(p);
+    let pts = v.array("NumberOfComponents=\"3\"");
+    let con = v.array("Name=\"connectivity\"");
+    let off = v.array("Name=\"offsets\"");
+    let types = v.array("Name=\"types\"");
+    let mat = v.array("Name=\"MaterialIDs\"");
     let points: Vec<[f64; 3]> = pts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     let mut cells = Vec::new();
     let mut start = 0usize;
@@ -212,10 +201,15 @@ fn conforming(
     vol
 }
 
+#[path = "support/vtu_read.rs"]
+mod vtu_read;
+
 /// The merged `dsm.vtu`'s triangles.
 fn triangles(merged: &Path) -> usize {
-    let text = std::fs::read_to_string(merged.join("dsm.vtu")).unwrap();
-    array(&text, "Name=\"connectivity\"").len() / 3
+    vtu_read::Vtu::read(&merged.join("dsm.vtu"))
+        .triangles()
+        .1
+        .len()
 }
 
 fn outline(m: &serde_json::Value) -> [f64; 4] {
@@ -380,11 +374,12 @@ fn tiled_geological_model_is_conforming_and_equals_a_one_piece_model_on_the_same
     );
 
     // 3. A one-piece model on the merged planar mesh, from all the boreholes.
-    let dsm = std::fs::read_to_string(merged.join("dsm.vtu")).unwrap();
-    let pts = array(&dsm, "NumberOfComponents=\"3\"");
+    let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
+    let pts = dsm.array("NumberOfComponents=\"3\"");
     let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
     let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
-    let tris: Vec<[u32; 3]> = array(&dsm, "Name=\"connectivity\"")
+    let tris: Vec<[u32; 3]> = dsm
+        .array("Name=\"connectivity\"")
         .chunks(3)
         .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
         .collect();
@@ -439,7 +434,7 @@ fn tiled_geological_model_is_conforming_and_equals_a_one_piece_model_on_the_same
         let name = units
             .get(s)
             .map_or("base".to_string(), |u| format!("top_{u}"));
-        let merged_s = array(&dsm, &format!("Name=\"{name}\""));
+        let merged_s = dsm.array(&format!("Name=\"{name}\""));
         assert_eq!(merged_s.len(), xy.len());
         for (a, b) in merged_s.iter().zip(&stack.surfaces[s]) {
             worst = worst.max((a - b).abs());

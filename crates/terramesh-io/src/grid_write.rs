@@ -1,5 +1,6 @@
 //! Grid writers: ESRI ASCII (`.asc`) and GeoTIFF (`.tif`, baseline TIFF, float64, one strip,
-//! georeferenced by ModelPixelScale / ModelTiepoint and EPSG GeoKeys).
+//! georeferenced by ModelPixelScale / ModelTiepoint and EPSG GeoKeys), of a whole grid in
+//! memory or row by row ([`GridRows`], the same bytes, one row in memory).
 //!
 //! A grid's values sit on its nodes (pixel-is-point): node (i, j) is at
 //! `(xmin + i·dx, ymax − j·dy)`, row 0 the northernmost, as DEMs such as SRTM are posted.
@@ -106,6 +107,14 @@ impl std::str::FromStr for RasterGrid {
 /// ```
 pub fn write_asc<W: Write>(w: &mut W, g: &RasterGrid, values: &[f64]) -> io::Result<()> {
     assert_eq!(values.len(), g.nx * g.ny);
+    asc_header(w, g)?;
+    for row in values.chunks(g.nx) {
+        asc_row(w, row)?;
+    }
+    Ok(())
+}
+
+fn asc_header<W: Write>(w: &mut W, g: &RasterGrid) -> io::Result<()> {
     writeln!(w, "ncols {}\nnrows {}", g.nx, g.ny)?;
     writeln!(w, "xllcenter {}\nyllcenter {}", g.xmin, g.ymin)?;
     let (dx, dy) = (g.dx(), g.dy());
@@ -114,17 +123,116 @@ pub fn write_asc<W: Write>(w: &mut W, g: &RasterGrid, values: &[f64]) -> io::Res
     } else {
         writeln!(w, "dx {dx}\ndy {dy}")?;
     }
-    writeln!(w, "NODATA_value -9999")?;
-    for row in values.chunks(g.nx) {
-        for (i, v) in row.iter().enumerate() {
-            if i > 0 {
-                w.write_all(b" ")?;
-            }
-            crate::number::write_shortest(w, *v)?;
+    writeln!(w, "NODATA_value -9999")
+}
+
+fn asc_row<W: Write>(w: &mut W, row: &[f64]) -> io::Result<()> {
+    for (i, v) in row.iter().enumerate() {
+        if i > 0 {
+            w.write_all(b" ")?;
         }
-        w.write_all(b"\n")?;
+        crate::number::write_shortest(w, *v)?;
     }
-    Ok(())
+    w.write_all(b"\n")
+}
+
+/// The format of a grid written row by row by [`GridRows`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RowFormat {
+    /// ESRI ASCII, as [`write_asc`].
+    Asc,
+    /// Float64 GeoTIFF of one strip, as [`write_geotiff_heights`] with these keys.
+    GeoTiff {
+        /// `ProjectedCSTypeGeoKey`.
+        epsg: Option<u16>,
+        /// The heights' keys.
+        heights: Option<Heights>,
+        /// GDAL's nodata tag.
+        nodata: Option<f64>,
+    },
+}
+
+/// A grid written row by row, north row first, holding one row at a time: the same bytes as
+/// [`write_asc`] or [`write_geotiff_heights`] of the whole grid (a GeoTIFF's single strip is
+/// the rows in order after a header that depends only on the grid's shape), for writers that
+/// cannot hold the grid (`terramesh tiles merge`).
+///
+/// ```
+/// use terramesh_io::grid_write::{write_asc, GridRows, RasterGrid, RowFormat};
+/// let g: RasterGrid = "0,0,2,1,3,2".parse().unwrap();
+/// let mut rows = GridRows::new(Vec::new(), &g, RowFormat::Asc).unwrap();
+/// rows.row(&[1.0, 2.0, 3.0]).unwrap();
+/// rows.row(&[4.0, 5.0, 6.5]).unwrap();
+/// let streamed = rows.finish().unwrap();
+/// let mut whole = Vec::new();
+/// write_asc(&mut whole, &g, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.5]).unwrap();
+/// assert_eq!(streamed, whole);
+/// ```
+pub struct GridRows<W: Write> {
+    w: W,
+    format: RowFormat,
+    nx: usize,
+    left: usize,
+    buf: Vec<u8>,
+}
+
+impl<W: Write> GridRows<W> {
+    /// Writes the header of grid `g` in `format` to `w`. A GeoTIFF larger than a classic
+    /// TIFF's 4 GiB is refused.
+    pub fn new(mut w: W, g: &RasterGrid, format: RowFormat) -> io::Result<GridRows<W>> {
+        match format {
+            RowFormat::Asc => asc_header(&mut w, g)?,
+            RowFormat::GeoTiff {
+                epsg,
+                heights,
+                nodata,
+            } => w.write_all(&geotiff_header(g, epsg, heights, nodata)?)?,
+        }
+        Ok(GridRows {
+            w,
+            format,
+            nx: g.nx,
+            left: g.ny,
+            buf: Vec::with_capacity(8 * g.nx),
+        })
+    }
+
+    /// Writes the next row (`nx` values, west first).
+    pub fn row(&mut self, values: &[f64]) -> io::Result<()> {
+        if values.len() != self.nx || self.left == 0 {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "a grid row of {} values where {} are expected ({} rows left)",
+                    values.len(),
+                    self.nx,
+                    self.left
+                ),
+            ));
+        }
+        self.left -= 1;
+        match self.format {
+            RowFormat::Asc => asc_row(&mut self.w, values),
+            RowFormat::GeoTiff { .. } => {
+                self.buf.clear();
+                for v in values {
+                    self.buf.extend_from_slice(&v.to_le_bytes());
+                }
+                self.w.write_all(&self.buf)
+            }
+        }
+    }
+
+    /// Checks that every row was written and returns the writer.
+    pub fn finish(self) -> io::Result<W> {
+        if self.left > 0 {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("the grid is {} rows short", self.left),
+            ));
+        }
+        Ok(self.w)
+    }
 }
 
 /// Writes a float64 GeoTIFF (little-endian baseline TIFF, one strip), pixel-is-point, with
@@ -170,6 +278,22 @@ pub fn write_geotiff_heights<W: Write>(
     nodata: Option<f64>,
 ) -> io::Result<()> {
     assert_eq!(values.len(), g.nx * g.ny);
+    w.write_all(&geotiff_header(g, epsg, heights, nodata)?)?;
+    let mut buf = Vec::with_capacity(values.len() * 8);
+    for v in values {
+        buf.extend_from_slice(&v.to_le_bytes());
+    }
+    w.write_all(&buf)
+}
+
+/// The header of [`write_geotiff_heights`]'s file, up to its one strip of `nx * ny` float64
+/// values (north row first); an error when the strip does not fit a classic TIFF (4 GiB).
+fn geotiff_header(
+    g: &RasterGrid,
+    epsg: Option<u16>,
+    heights: Option<Heights>,
+    nodata: Option<f64>,
+) -> io::Result<Vec<u8>> {
     // GeoKeys in increasing key order: GTModelType, GTRasterType, ProjectedCSType,
     // VerticalCSType, VerticalUnits.
     let mut keys: Vec<u16> = vec![1, 1, 0, 0, 1024, 0, 1, 1, 1025, 0, 1, 2];
@@ -184,7 +308,21 @@ pub fn write_geotiff_heights<W: Write>(
     }
     keys[3] = (keys.len() / 4 - 1) as u16;
     // (tag, type, count, payload bytes); type 3 SHORT, 4 LONG, 12 DOUBLE
-    let image_bytes = (values.len() * 8) as u32;
+    let image_bytes =
+        g.nx.checked_mul(g.ny)
+            .and_then(|n| n.checked_mul(8))
+            .and_then(|b| u32::try_from(b).ok())
+            .filter(|b| b.checked_add(4096).is_some())
+            .ok_or_else(|| {
+                io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!(
+                        "a grid of {} x {} float64 nodes does not fit a classic TIFF (4 GiB): \
+                     use a coarser grid (export.grid_spacing) or write .asc",
+                        g.nx, g.ny
+                    ),
+                )
+            })?;
     let mut entries: Vec<(u16, u16, u32, Vec<u8>)> = Vec::new();
     let short = |v: u16| v.to_le_bytes().to_vec();
     let long = |v: u32| v.to_le_bytes().to_vec();
@@ -246,15 +384,12 @@ pub fn write_geotiff_heights<W: Write>(
     for o in offsets {
         ifd[o..o + 4].copy_from_slice(&data_off.to_le_bytes());
     }
-    w.write_all(b"II*\0")?;
-    w.write_all(&8u32.to_le_bytes())?;
-    w.write_all(&ifd)?;
-    w.write_all(&extra)?;
-    let mut buf = Vec::with_capacity(values.len() * 8);
-    for v in values {
-        buf.extend_from_slice(&v.to_le_bytes());
-    }
-    w.write_all(&buf)
+    let mut head = Vec::with_capacity(8 + ifd.len() + extra.len());
+    head.extend_from_slice(b"II*\0");
+    head.extend_from_slice(&8u32.to_le_bytes());
+    head.extend_from_slice(&ifd);
+    head.extend_from_slice(&extra);
+    Ok(head)
 }
 
 #[cfg(test)]
@@ -300,6 +435,73 @@ mod tests {
         let x = f64::from_le_bytes(b[to + 24..to + 32].try_into().unwrap());
         let y = f64::from_le_bytes(b[to + 32..to + 40].try_into().unwrap());
         assert_eq!((x, y), (500000.0, 5400200.0));
+    }
+
+    /// The row writer holds one row and writes the whole-grid writers' bytes.
+    #[test]
+    fn rows_write_the_bytes_of_the_whole_grid_writers() {
+        for spec in ["500000,5400000,500300,5400200,7,5", "0,0,30,10,4,3"] {
+            let g: RasterGrid = spec.parse().unwrap();
+            // Values with long decimal expansions, negatives and the nodata value.
+            let vals: Vec<f64> = (0..g.nx * g.ny)
+                .map(|i| match i % 5 {
+                    0 => -9999.0,
+                    k => (i as f64).sin() * 10f64.powi(k as i32) / 3.0,
+                })
+                .collect();
+            let h = Some(Heights {
+                vertical_epsg: Some(5703),
+            });
+            for format in [
+                RowFormat::Asc,
+                RowFormat::GeoTiff {
+                    epsg: Some(32632),
+                    heights: h,
+                    nodata: Some(-9999.0),
+                },
+                RowFormat::GeoTiff {
+                    epsg: None,
+                    heights: None,
+                    nodata: None,
+                },
+            ] {
+                let mut whole = Vec::new();
+                match format {
+                    RowFormat::Asc => write_asc(&mut whole, &g, &vals),
+                    RowFormat::GeoTiff {
+                        epsg,
+                        heights,
+                        nodata,
+                    } => write_geotiff_heights(&mut whole, &g, &vals, epsg, heights, nodata),
+                }
+                .unwrap();
+                let mut rows = GridRows::new(Vec::new(), &g, format).unwrap();
+                for r in vals.chunks(g.nx) {
+                    rows.row(r).unwrap();
+                }
+                let streamed = rows.finish().unwrap();
+                assert_eq!(streamed, whole, "{spec} {format:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn rows_refuse_a_wrong_row_a_short_grid_and_a_grid_too_large_for_tiff() {
+        let g: RasterGrid = "0,0,2,1,3,2".parse().unwrap();
+        let mut rows = GridRows::new(Vec::new(), &g, RowFormat::Asc).unwrap();
+        let e = rows.row(&[1.0, 2.0]).unwrap_err();
+        assert!(e.to_string().contains("2 values where 3"), "{e}");
+        rows.row(&[1.0, 2.0, 3.0]).unwrap();
+        let e = rows.finish().unwrap_err();
+        assert!(e.to_string().contains("1 rows short"), "{e}");
+        let big: RasterGrid = "0,0,1,1,30000,30000".parse().unwrap();
+        let tif = RowFormat::GeoTiff {
+            epsg: None,
+            heights: None,
+            nodata: None,
+        };
+        let e = GridRows::new(Vec::new(), &big, tif).err().unwrap();
+        assert!(e.to_string().contains("classic TIFF"), "{e}");
     }
 
     #[test]

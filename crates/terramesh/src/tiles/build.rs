@@ -17,6 +17,7 @@ use terramesh_mesh::{smooth_keeping, MeshBuilder};
 
 use super::files::{self, Vertex};
 use super::manifest::{update, Manifest, State, Tile, TileSummary, SAMPLES};
+use super::partition::in_window;
 use super::plan::owner;
 use crate::build::stages::Surface;
 use crate::error::{Context, Error, Result};
@@ -99,17 +100,32 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     }
     let project = Project::load(&m.project, &m.set)?;
     let ip = &project.interpolation;
-    // The data window: the extent grown by the halo.
-    let [x0, y0, x1, y1] = tile.extent;
-    let h = tile.halo;
-    let (mut xy, mut z) = (Vec::new(), Vec::new());
-    files::stream_samples(&plan.join(SAMPLES), |s| {
-        if s[0] >= x0 - h && s[0] <= x1 + h && s[1] >= y0 - h && s[1] <= y1 + h {
+    // The data window: the extent grown by the halo. The tile reads its own samples file
+    // (plans before it existed: the whole region's, keeping its window).
+    let file = match &tile.data {
+        Some(d) => plan.join(&d.file),
+        None => plan.join(SAMPLES),
+    };
+    let (mut xy, mut z, mut read) = (Vec::new(), Vec::new(), 0usize);
+    files::stream_samples(&file, |s| {
+        read += 1;
+        if in_window(tile.extent, tile.halo, [s[0], s[1]]) {
             xy.push([s[0], s[1]]);
             z.push(s[2]);
         }
     })?;
     let samples = xy.len();
+    if let Some(d) = &tile.data {
+        if read != d.count || samples != d.count {
+            return Err(Error::invalid(format!(
+                "{}: {read} samples, {samples} of them in tile {}'s window, where the plan \
+                 wrote {}: the plan folder is damaged; plan again",
+                file.display(),
+                tile.id,
+                d.count
+            )));
+        }
+    }
     let data = Data::new(xy, z, Duplicates::Reject)
         .context("the tile's samples")?
         .with_frame(KrigingFrame {
@@ -209,6 +225,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     seconds.push(("total".to_string(), t0.elapsed().as_secs_f64()));
     let summary = TileSummary {
         samples,
+        samples_read: read,
         vertices: vertices.len(),
         triangles: triangles.len(),
         grid_nodes: grid.len(),

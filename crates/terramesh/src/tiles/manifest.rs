@@ -18,7 +18,8 @@ use crate::error::{Context, Error, Result};
 pub const MANIFEST: &str = "tiles.json";
 /// The lock file beside it.
 pub const LOCK: &str = "tiles.lock";
-/// The samples of the whole region, `[x, y, z]` little-endian `f64` triples.
+/// The samples of the whole region, `[x, y, z]` little-endian `f64` triples (the tiles read
+/// their own part, [`Tile::data`]).
 pub const SAMPLES: &str = "samples.f64";
 /// The variogram every tile uses.
 pub const VARIOGRAM: &str = "variogram.json";
@@ -81,6 +82,21 @@ pub struct Tile {
     /// [`Tile::halo`]; absent without `[geology]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geology_halo: Option<f64>,
+    /// Its own samples, the ones in its data window, written by the plan
+    /// (`samples/ID.f64`); absent in plans made before the samples were partitioned, whose
+    /// tiles stream the whole [`SAMPLES`] file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data: Option<TileData>,
+}
+
+/// A tile's own samples file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TileData {
+    /// The file, relative to the plan folder (`samples/ID.f64`, `[x, y, z]` little-endian
+    /// `f64` triples in the order of [`SAMPLES`]).
+    pub file: String,
+    /// How many samples it holds.
+    pub count: usize,
 }
 
 /// What a tile's build made.
@@ -88,6 +104,10 @@ pub struct Tile {
 pub struct TileSummary {
     /// Samples in its data window.
     pub samples: usize,
+    /// Sample records it read from disk to find them: `samples` when the plan partitioned the
+    /// samples (it reads its own file), every sample of the region otherwise.
+    #[serde(default)]
+    pub samples_read: usize,
     /// Mesh vertices.
     pub vertices: usize,
     /// Triangles.

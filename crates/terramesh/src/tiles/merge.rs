@@ -2,10 +2,10 @@
 //!
 //! The merge reads one tile at a time. Seam vertices are recognised by their planned
 //! positions (bit for bit) and written once, by the first tile that has them; every other
-//! vertex belongs to one tile. `dsm.vtu` (ASCII VTK, the arrays of `terramesh build`'s) is
-//! written array by array, each a pass over the tiles, so that the merge holds one tile's mesh
-//! and the seam vertices' index, never the region's mesh. `dsm.tif` and `dsm.asc` hold the
-//! region's grid (8 bytes a node), filled tile by tile. The formats that need the whole mesh
+//! vertex belongs to one tile. `dsm.vtu` (raw appended binary VTK, the arrays of `terramesh
+//! build`'s) is written array by array, each a pass over the tiles, so that the merge holds one tile's mesh
+//! and the seam vertices' index, never the region's mesh. `dsm.tif` and `dsm.asc` are written
+//! row by row, one row in memory (`grid_merge.rs`). The formats that need the whole mesh
 //! at once (the sealed solid, glTF and 3D Tiles, Cesium terrain, the report's 3D view, the
 //! pictures) are not made by the merge: build them from `dsm.vtu` or in one piece.
 
@@ -15,9 +15,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::Serialize;
-use terramesh_io::grid_write::{write_asc, write_geotiff_heights, Heights};
 use terramesh_io::output::Output;
 
+use super::appended::{self, put_f64, Array, Section, Values};
 use super::build::tile_dir;
 use super::files::{self, Vertex};
 use super::manifest::{Manifest, State, Tile};
@@ -39,6 +39,8 @@ pub struct Merged {
     pub seam_max_difference: f64,
     /// The merged mesh's planar area, m².
     pub area: f64,
+    /// What writing the grids held: one row at a time.
+    pub grid: super::grid_merge::GridFigures,
     /// The geological model, when the plan has one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<super::model_merge::MergedModel>,
@@ -107,32 +109,9 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
     write_vtu(&vtu, plan, &m, &seams, n as usize, nt)?;
     written.push(vtu);
 
-    // The grids.
-    let g = &m.grid;
-    let spec = g.raster();
-    let mut values = vec![NODATA; g.nx * g.ny];
-    for t in &m.tiles {
-        for (i, z) in files::read_grid(&tile_dir(plan, &t.id))? {
-            values[i as usize] = z;
-        }
-    }
-    let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
-    let heights = Heights {
-        vertical_epsg: m.vertical_epsg,
-    };
-    for (name, tif) in [("dsm.tif", true), ("dsm.asc", false)] {
-        let path = out.join(name);
-        let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
-        if tif {
-            write_geotiff_heights(&mut o, &spec, &values, epsg, Some(heights), Some(NODATA))
-        } else {
-            write_asc(&mut o, &spec, &values)
-        }
-        .and_then(|_| o.commit())
-        .context(path.display().to_string())?;
-        written.push(path);
-    }
-    drop(values);
+    // The grids, row by row.
+    let (grid_files, grid) = super::grid_merge::write_grids(plan, &m, out)?;
+    written.extend(grid_files);
     let model = match &m.geology {
         Some(gp) => {
             let (model, files) = super::model_merge::merge_model(plan, &m, gp, out)?;
@@ -149,6 +128,7 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         seam_vertices: seams.len(),
         seam_max_difference: diff,
         area,
+        grid,
         model,
         seconds: t0.elapsed().as_secs_f64(),
     };
@@ -220,12 +200,13 @@ fn min_angle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
 /// What a pass over the tiles does with one tile: its vertices, their global indices and
 /// whether this tile writes them, and its triangles.
 type TilePass<'a> =
-    dyn FnMut(&mut Output, &Path, &[Vertex], &[(u32, bool)], &[[u32; 3]]) -> Result<()> + 'a;
+    dyn FnMut(&mut dyn Write, &Path, &[Vertex], &[(u32, bool)], &[[u32; 3]]) -> Result<()> + 'a;
 
 /// A point array of `dsm.vtu`: its name and value.
 type PointArray = (&'static str, fn(&Vertex) -> f64);
 
-/// Writes `dsm.vtu`, one pass over the tiles per array.
+/// Writes `dsm.vtu` (raw appended binary, [`super::appended`]), one pass over the tiles per
+/// array.
 fn write_vtu(
     path: &Path,
     plan: &Path,
@@ -234,17 +215,8 @@ fn write_vtu(
     n: usize,
     nt: usize,
 ) -> Result<()> {
-    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
-    let w = &mut o;
-    let io = |e: std::io::Error| Error::from(e);
-    writeln!(w, "<?xml version=\"1.0\"?>").map_err(io)?;
-    writeln!(
-        w,
-        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{nt}\">"
-    )
-    .map_err(io)?;
     // Each pass: for every tile, its vertices (mapped) and triangles.
-    let pass = |w: &mut Output, f: &mut TilePass| -> Result<()> {
+    let pass = |w: &mut dyn Write, f: &mut TilePass| -> Result<()> {
         let mut next = 0u32;
         for (k, t) in m.tiles.iter().enumerate() {
             let dir = tile_dir(plan, &t.id);
@@ -255,28 +227,35 @@ fn write_vtu(
         }
         Ok(())
     };
+    let (n8, nt8) = (8 * n as u64, 8 * nt as u64);
+    let array = |section, vtk_type, name: String, components, bytes, values| Array {
+        section,
+        vtk_type,
+        name,
+        components,
+        tuples: None,
+        bytes,
+        values,
+    };
     let point_arrays: [PointArray; 4] = [
         ("elevation_uk", |p| p.uk),
         ("kriging_std", |p| p.std),
         ("elevation_idw", |p| p.idw),
         ("uk_minus_idw", |p| p.uk - p.idw),
     ];
-    writeln!(w, "<PointData>").map_err(io)?;
+    let mut arrays = Vec::new();
     for (name, get) in point_arrays {
-        writeln!(
-            w,
-            "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-        )
-        .map_err(io)?;
-        pass(w, &mut |w, _, v, map, _| {
-            for (p, &(_, mine)) in v.iter().zip(map) {
-                if mine {
-                    writeln!(w, "{:?}", get(p))?;
+        let values: Values = Box::new(move |w| {
+            pass(w, &mut |w, _, v, map, _| {
+                for (p, &(_, mine)) in v.iter().zip(map) {
+                    if mine {
+                        put_f64(w, get(p))?;
+                    }
                 }
-            }
-            Ok(())
-        })?;
-        writeln!(w, "</DataArray>").map_err(io)?;
+                Ok(())
+            })
+        });
+        arrays.push(array(Section::Point, "Float64", name.into(), 1, n8, values));
     }
     // The geological model's surfaces at the planar vertices: the tops below the first unit
     // and the base.
@@ -287,83 +266,108 @@ fn write_vtu(
                 Some(u) => format!("top_{u}"),
                 None => "base".to_string(),
             };
-            writeln!(
-                w,
-                "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-            )
-            .map_err(io)?;
-            pass(w, &mut |w, dir, _, map, _| {
-                let surf = super::files::read_f64s(&dir.join(super::geology::SURFACES), ns)?;
-                for (k, &(_, mine)) in map.iter().enumerate() {
-                    if mine {
-                        writeln!(w, "{:?}", surf[k * ns + s]).map_err(io)?;
+            let values: Values = Box::new(move |w| {
+                pass(w, &mut |w, dir, _, map, _| {
+                    let surf = super::files::read_f64s(&dir.join(super::geology::SURFACES), ns)?;
+                    for (k, &(_, mine)) in map.iter().enumerate() {
+                        if mine {
+                            put_f64(w, surf[k * ns + s])?;
+                        }
+                    }
+                    Ok(())
+                })
+            });
+            arrays.push(array(Section::Point, "Float64", name, 1, n8, values));
+        }
+    }
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, _, v, _, tris| {
+            for t in tris {
+                let [a, b, c] = t.map(|i| v[i as usize].xy);
+                put_f64(w, min_angle(a, b, c))?;
+            }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Cell,
+        "Float64",
+        "min_angle_deg".into(),
+        1,
+        nt8,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, _, v, map, _| {
+            for (p, &(_, mine)) in v.iter().zip(map) {
+                if mine {
+                    for x in [p.xy[0], p.xy[1], p.dsm] {
+                        put_f64(w, x)?;
                     }
                 }
-                Ok(())
-            })?;
-            writeln!(w, "</DataArray>").map_err(io)?;
-        }
-    }
-    writeln!(w, "</PointData>\n<CellData>").map_err(io)?;
-    writeln!(
-        w,
-        "<DataArray type=\"Float64\" Name=\"min_angle_deg\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    pass(w, &mut |w, _, v, _, tris| {
-        for t in tris {
-            let [a, b, c] = t.map(|i| v[i as usize].xy);
-            writeln!(w, "{:?}", min_angle(a, b, c))?;
-        }
-        Ok(())
-    })?;
-    writeln!(w, "</DataArray>\n</CellData>\n<Points>").map_err(io)?;
-    writeln!(
-        w,
-        "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    pass(w, &mut |w, _, v, map, _| {
-        for (p, &(_, mine)) in v.iter().zip(map) {
-            if mine {
-                writeln!(w, "{:?} {:?} {:?}", p.xy[0], p.xy[1], p.dsm)?;
             }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Points,
+        "Float64",
+        "Points".into(),
+        3,
+        3 * n8,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, _, _, map, tris| {
+            for t in tris {
+                for i in t {
+                    w.write_all(&i64::from(map[*i as usize].0).to_le_bytes())?;
+                }
+            }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Cells,
+        "Int64",
+        "connectivity".into(),
+        1,
+        3 * nt8,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        for k in 1..=nt as i64 {
+            w.write_all(&(3 * k).to_le_bytes())?;
         }
         Ok(())
-    })?;
-    writeln!(w, "</DataArray>\n</Points>\n<Cells>").map_err(io)?;
-    writeln!(
-        w,
-        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    pass(w, &mut |w, _, _, map, tris| {
-        for t in tris {
-            let [a, b, c] = t.map(|i| map[i as usize].0);
-            writeln!(w, "{a} {b} {c}")?;
+    });
+    arrays.push(array(
+        Section::Cells,
+        "Int64",
+        "offsets".into(),
+        1,
+        nt8,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        let fives = vec![5u8; nt.min(1 << 16)];
+        let mut left = nt;
+        while left > 0 {
+            let k = left.min(fives.len());
+            w.write_all(&fives[..k])?;
+            left -= k;
         }
         Ok(())
-    })?;
-    writeln!(
-        w,
-        "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    for k in 1..=nt {
-        writeln!(w, "{}", 3 * k).map_err(io)?;
-    }
-    writeln!(
-        w,
-        "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    for _ in 0..nt {
-        writeln!(w, "5").map_err(io)?;
-    }
-    writeln!(
-        w,
-        "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>"
-    )
-    .map_err(io)?;
+    });
+    arrays.push(array(
+        Section::Cells,
+        "UInt8",
+        "types".into(),
+        1,
+        nt as u64,
+        values,
+    ));
+    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
+    appended::write(&mut o, n, nt, arrays).context(path.display().to_string())?;
     o.commit().context(path.display().to_string())
 }

@@ -33,13 +33,16 @@
 //! # Ok(()) }
 //! ```
 
+mod appended;
 mod build;
 mod files;
 mod geology;
 mod geometry;
+mod grid_merge;
 mod manifest;
 mod merge;
 mod model_merge;
+mod partition;
 mod plan;
 mod report;
 mod slurm;
@@ -50,11 +53,13 @@ pub use geology::{
     Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON,
     MODEL_POINTS, SURFACES,
 };
+pub use grid_merge::GridFigures;
 pub use manifest::{
-    update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileSummary, LOCK,
-    MANIFEST, SAMPLES, VARIOGRAM, VERSION,
+    update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, TileSummary,
+    LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
 pub use model_merge::{MergedModel, MergedUnit};
+pub use partition::{in_window, samples_file, SAMPLES_DIR};
 pub use plan::{parse_tile_size, plan, Planned};
 pub use slurm::{write_slurm, SlurmOptions, SlurmScripts};

@@ -1,6 +1,6 @@
-//! The tiles' geological models joined, streamed: `model.vtu` (ASCII VTK: the nodes, the
-//! cells in VTK's orders as `terramesh model` writes them, `MaterialIDs`, field data
-//! `unit_names`), `interfaces/<unit>.tif` and `model.json` (per unit: volume, cells,
+//! The tiles' geological models joined, streamed: `model.vtu` (raw appended binary VTK: the
+//! nodes, the cells in VTK's orders as `terramesh model` writes them, `MaterialIDs`, field
+//! data `unit_names`), `interfaces/<unit>.tif` and `model.json` (per unit: volume, cells,
 //! thickness, pinched-out area, summed or taken over the distinct planar vertices).
 //!
 //! A seam vertex's node column is written once, by the first tile that has it; the other
@@ -19,6 +19,7 @@ use terramesh_core::volume::{cell_volume, Cell, CellKind};
 use terramesh_io::grid_write::{write_geotiff_heights, Heights};
 use terramesh_io::output::Output;
 
+use super::appended::{put_f64, Array, Section, Values};
 use super::build::tile_dir;
 use super::files::{read_f64s, read_u32s, read_vertices};
 use super::geology::{
@@ -354,7 +355,8 @@ fn write_interfaces(
     Ok(written)
 }
 
-/// Writes `model.vtu`, one pass over the tiles per array.
+/// Writes `model.vtu` (raw appended binary, [`super::appended`]), one pass over the tiles per
+/// array.
 fn write_vtu(
     path: &Path,
     plan: &Path,
@@ -364,8 +366,6 @@ fn write_vtu(
     n: usize,
     nc: usize,
 ) -> Result<()> {
-    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
-    let io = |e: std::io::Error| Error::from(e);
     let mut names = Vec::new();
     for u in &gp.units {
         names.extend_from_slice(u.as_bytes());
@@ -374,104 +374,131 @@ fn write_vtu(
     let crs = m
         .epsg
         .map_or("projected".to_string(), |e| format!("EPSG:{e}"));
-    {
-        let w = &mut o;
-        writeln!(w, "<?xml version=\"1.0\"?>").map_err(io)?;
-        writeln!(
-            w,
-            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<FieldData>"
-        )
-        .map_err(io)?;
-        for (name, bytes) in [("unit_names", names), ("crs", crs.into_bytes())] {
-            let text: Vec<String> = bytes.iter().map(|b| b.to_string()).collect();
-            writeln!(
-                w,
-                "<DataArray type=\"UInt8\" Name=\"{name}\" NumberOfTuples=\"{}\" format=\"ascii\">\n{}\n</DataArray>",
-                bytes.len(),
-                text.join(" ")
-            )
-            .map_err(io)?;
-        }
-        writeln!(
-            w,
-            "</FieldData>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{nc}\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
-        )
-        .map_err(io)?;
-    }
-    type CellPass<'a> =
-        dyn FnMut(&mut Output, &TileModel, &[(u32, bool)]) -> std::io::Result<()> + 'a;
-    let pass = |w: &mut Output, f: &mut CellPass| -> Result<()> {
+    type CellPass<'a> = dyn FnMut(&mut dyn Write, &TileModel, &[(u32, bool)]) -> Result<()> + 'a;
+    let pass = |w: &mut dyn Write, f: &mut CellPass| -> Result<()> {
         let mut next = 0u32;
         for (k, t) in m.tiles.iter().enumerate() {
             let tm = read_model(plan, t)?;
             let map = node_map(k, &tm.points, seams, &mut next);
-            f(w, &tm, &map).map_err(io)?;
+            f(w, &tm, &map)?;
         }
         Ok(())
     };
-    pass(&mut o, &mut |w, tm, map| {
-        for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(map) {
-            if mine {
-                writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+    // The connectivity's length: the cells' nodes.
+    let mut conn = 0u64;
+    for t in &m.tiles {
+        let cells = read_u32s(&tile_dir(plan, &t.id).join(MODEL_CELLS), 8)?;
+        conn += cells
+            .chunks_exact(8)
+            .map(|rec| cell_of(rec).0.kind.nodes() as u64)
+            .sum::<u64>();
+    }
+    let array = |section, vtk_type, name: &str, components, bytes, values| Array {
+        section,
+        vtk_type,
+        name: name.to_string(),
+        components,
+        tuples: None,
+        bytes,
+        values,
+    };
+    let mut arrays = Vec::new();
+    for (name, bytes) in [("unit_names", names), ("crs", crs.into_bytes())] {
+        let len = bytes.len();
+        let values: Values = Box::new(move |w| Ok(w.write_all(&bytes)?));
+        let mut a = array(Section::Field, "UInt8", name, 1, len as u64, values);
+        a.tuples = Some(len);
+        arrays.push(a);
+    }
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, tm, map| {
+            for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(map) {
+                if mine {
+                    for &x in p {
+                        put_f64(w, x)?;
+                    }
+                }
             }
-        }
-        Ok(())
-    })?;
-    writeln!(
-        o,
-        "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    pass(&mut o, &mut |w, tm, map| {
-        for rec in tm.cells.chunks_exact(8) {
-            let (_, nodes) = vtk(&cell_of(rec).0);
-            let g: Vec<String> = nodes
-                .iter()
-                .map(|&i| map[i as usize].0.to_string())
-                .collect();
-            writeln!(w, "{}", g.join(" "))?;
-        }
-        Ok(())
-    })?;
-    writeln!(
-        o,
-        "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    let mut offset = 0usize;
-    pass(&mut o, &mut |w, tm, _| {
-        for rec in tm.cells.chunks_exact(8) {
-            offset += cell_of(rec).0.kind.nodes();
-            writeln!(w, "{offset}")?;
-        }
-        Ok(())
-    })?;
-    writeln!(
-        o,
-        "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    pass(&mut o, &mut |w, tm, _| {
-        for rec in tm.cells.chunks_exact(8) {
-            writeln!(w, "{}", vtk(&cell_of(rec).0).0)?;
-        }
-        Ok(())
-    })?;
-    writeln!(
-        o,
-        "</DataArray>\n</Cells>\n<CellData>\n<DataArray type=\"Int32\" Name=\"MaterialIDs\" format=\"ascii\">"
-    )
-    .map_err(io)?;
-    pass(&mut o, &mut |w, tm, _| {
-        for rec in tm.cells.chunks_exact(8) {
-            writeln!(w, "{}", rec[1] as i32)?;
-        }
-        Ok(())
-    })?;
-    writeln!(
-        o,
-        "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>"
-    )
-    .map_err(io)?;
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Points,
+        "Float64",
+        "Points",
+        3,
+        24 * n as u64,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, tm, map| {
+            for rec in tm.cells.chunks_exact(8) {
+                for i in vtk(&cell_of(rec).0).1 {
+                    w.write_all(&i64::from(map[i as usize].0).to_le_bytes())?;
+                }
+            }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Cells,
+        "Int64",
+        "connectivity",
+        1,
+        8 * conn,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        let mut offset = 0i64;
+        pass(w, &mut |w, tm, _| {
+            for rec in tm.cells.chunks_exact(8) {
+                offset += cell_of(rec).0.kind.nodes() as i64;
+                w.write_all(&offset.to_le_bytes())?;
+            }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Cells,
+        "Int64",
+        "offsets",
+        1,
+        8 * nc as u64,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, tm, _| {
+            for rec in tm.cells.chunks_exact(8) {
+                w.write_all(&[vtk(&cell_of(rec).0).0])?;
+            }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Cells,
+        "UInt8",
+        "types",
+        1,
+        nc as u64,
+        values,
+    ));
+    let values: Values = Box::new(move |w| {
+        pass(w, &mut |w, tm, _| {
+            for rec in tm.cells.chunks_exact(8) {
+                w.write_all(&(rec[1] as i32).to_le_bytes())?;
+            }
+            Ok(())
+        })
+    });
+    arrays.push(array(
+        Section::Cell,
+        "Int32",
+        "MaterialIDs",
+        1,
+        4 * nc as u64,
+        values,
+    ));
+    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
+    super::appended::write(&mut o, n, nc, arrays).context(path.display().to_string())?;
     o.commit().context(path.display().to_string())
 }

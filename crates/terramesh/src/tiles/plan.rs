@@ -8,7 +8,8 @@ use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
-    DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, SAMPLES, VARIOGRAM, VERSION,
+    DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM,
+    VERSION,
 };
 use crate::build::stages;
 use crate::error::{Context, Error, Result};
@@ -150,7 +151,8 @@ fn check_tileable(p: &Project) -> Result<()> {
 
 /// Plans a tiled build of `project` (paths relative to `base`, loaded from `project_file`
 /// with the overrides `set`) into the folder `out`: samples the whole region once
-/// (`out/samples.csv`, `out/samples.f64`), fits the variogram once (`out/variogram.json`),
+/// (`out/samples.csv`, `out/samples.f64`, and each tile's window of them in
+/// `out/samples/ID.f64`), fits the variogram once (`out/variogram.json`),
 /// cuts the region into squares of `tile_size` metres, computes each tile's halo and seams,
 /// and writes `out/tiles.json` with every tile `planned`.
 ///
@@ -198,15 +200,7 @@ pub fn plan(
     let data = &model.data;
     let frame = data.frame(&variogram);
     // The samples, as kriging sees them (duplicates merged), in order.
-    let mut bytes = Vec::with_capacity(24 * data.len());
-    for (p, z) in data.xy().iter().zip(data.z()) {
-        for v in [p[0], p[1], *z] {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    let spath = out.join(SAMPLES);
-    terramesh_io::output::write_atomic(&spath, &bytes).context(spath.display().to_string())?;
-    drop(bytes);
+    super::partition::write_all_samples(&out.join(SAMPLES), data.xy(), data.z())?;
 
     let ip = &project.interpolation;
     let k = if ip.methods.contains(&InterpolationMethod::Idw) {
@@ -320,6 +314,7 @@ pub fn plan(
                 error: None,
                 built: None,
                 geology_halo: None,
+                data: None,
             });
         }
     }
@@ -331,7 +326,7 @@ pub fn plan(
         }
         g
     });
-    let manifest = Manifest {
+    let mut manifest = Manifest {
         version: VERSION,
         project: std::path::absolute(project_file).context(project_file.display().to_string())?,
         set: set.to_vec(),
@@ -353,7 +348,8 @@ pub fn plan(
             count: data.len(),
             neighbours: k,
             rule: "a tile uses the samples in its extent grown by its halo on every side; the \
-                   halo reaches past the k-th nearest sample of every point of the extent"
+                   halo reaches past the k-th nearest sample of every point of the extent; the \
+                   plan writes each tile's samples to its own file (tiles[].data)"
                 .into(),
         },
         grid: GridSpec {
@@ -369,6 +365,14 @@ pub fn plan(
         geology,
         tiles,
     };
+    // Every tile's own samples, so that a tile reads only its window.
+    let counts = super::partition::write_tile_samples(out, &manifest, data.xy(), data.z())?;
+    for (t, count) in manifest.tiles.iter_mut().zip(counts) {
+        t.data = Some(TileData {
+            file: super::partition::samples_file(&t.id),
+            count,
+        });
+    }
     manifest.write(out)?;
     Ok(Planned {
         tiles: manifest.tiles.len(),
