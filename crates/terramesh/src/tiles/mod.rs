@@ -39,6 +39,7 @@ mod geology;
 mod geometry;
 mod manifest;
 mod merge;
+mod model_export;
 mod model_merge;
 mod plan;
 mod report;
@@ -47,14 +48,15 @@ mod slurm;
 pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
-    Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON,
-    MODEL_POINTS, SURFACES,
+    tag_of_name, Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_BODIES,
+    MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
 };
 pub use manifest::{
     update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileSummary, LOCK,
     MANIFEST, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
+pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use plan::{parse_tile_size, plan, Planned};
 pub use slurm::{write_slurm, SlurmOptions, SlurmScripts};
