@@ -7,7 +7,8 @@
 //! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
 //!   its state under a lock, so many processes may build at once.
 //! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc` and a report, and,
-//!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`.
+//!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`, and from the
+//!   merged volume mesh the boundary meshes, `model.msh`, `model.f3grid` and the bodies.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.
 //!
 //! Seams: each tile's mesh keeps its planned boundary vertices and adds none on it
@@ -40,6 +41,7 @@ mod geometry;
 mod manifest;
 mod merge;
 mod model_export;
+mod model_files;
 mod model_merge;
 mod plan;
 mod report;
