@@ -25,13 +25,13 @@ use std::path::Path;
 
 use kiddo::ImmutableKdTree;
 use serde::{Deserialize, Serialize};
-use terramesh_core::volume::{Body, Cell, CellKind, FaceTag, Interpolated, TaggedFace};
+use terramesh_core::volume::{Body, Cell, FaceTag, Interpolated, TaggedFace};
 use terramesh_geology::Layering;
 use terramesh_geostat::{
     experimental, fit_auto, Data, Duplicates, Idw, IdwSearch, KrigingFrame, LagSettings, Method,
     ModelKind, Named, Predictor, VariogramFile, Weighting,
 };
-use terramesh_mesh::{Mesh, SurfaceLocator};
+use terramesh_mesh::Mesh;
 
 use super::files::put_f64;
 pub(crate) use super::model_files::write_model;

@@ -117,7 +117,7 @@ fn merged_mesh(
         // Whether each local node is on a seam's column: only faces all on seams can pair.
         let mut seam = Vec::with_capacity(map.len());
         for (ck, _, count) in columns(&tm.points) {
-            seam.extend(std::iter::repeat(seams.contains_key(&ck)).take(count));
+            seam.extend(std::iter::repeat_n(seams.contains_key(&ck), count));
         }
         for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(&map) {
             if mine {

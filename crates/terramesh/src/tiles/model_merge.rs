@@ -71,7 +71,7 @@ pub struct MergedModel {
     /// at its vertices).
     pub base: Option<f64>,
     /// The boundary meshes, `model.msh`, `model.f3grid` and the bodies
-    /// ([`super::model_export`]).
+    /// (`tiles/model_export.rs`).
     pub exports: super::model_export::MergedExports,
 }
 
