@@ -1,5 +1,8 @@
-//! The geological model of a tiled build (`[geology]` with `interpolate = "tops"` from
-//! boreholes): what the plan fixes for every tile, and one tile's model.
+//! The geological model of a tiled build (`[geology]`: unit tops from boreholes or horizon
+//! grids, or `interpolate = "thickness"`): what the plan fixes for every tile, and one tile's
+//! model. A unit top a horizon grid gives (and a base grid) is sampled by every tile at its
+//! own vertices, each on its own, so seams agree; thicknesses are planned and kriged like the
+//! tops below and stacked down from the terrain.
 //!
 //! At plan time every interface (the top of each unit below the first) gets, from all the
 //! boreholes' contacts of that unit (duplicates merged by their mean, as the one-piece model
@@ -22,15 +25,16 @@ use std::path::Path;
 
 use kiddo::ImmutableKdTree;
 use serde::{Deserialize, Serialize};
-use terramesh_core::volume::{Cell, CellKind, Interpolated};
+use terramesh_core::volume::{Body, Cell, FaceTag, Interpolated, TaggedFace};
 use terramesh_geology::Layering;
 use terramesh_geostat::{
     experimental, fit_auto, Data, Duplicates, Idw, IdwSearch, KrigingFrame, LagSettings, Method,
     ModelKind, Named, Predictor, VariogramFile, Weighting,
 };
-use terramesh_mesh::{Mesh, SurfaceLocator};
+use terramesh_mesh::Mesh;
 
 use super::files::put_f64;
+pub(crate) use super::model_files::write_model;
 use crate::build::stages::{Samples, Surface};
 use crate::error::{Context, Error, Result};
 use crate::geology::fields::MIN_KRIGED;
@@ -47,6 +51,10 @@ pub const MODEL_CELLS: &str = "model-cells.u32";
 pub const INTERFACES: &str = "interfaces.bin";
 /// The tile's model figures.
 pub const MODEL_JSON: &str = "model.json";
+/// The volume mesh's tagged faces (per face: four nodes, the cell, the tag; `u32`).
+pub const MODEL_FACES: &str = "model-faces.u32";
+/// The units' sealed bodies (per triangle: the unit, three nodes; `u32`).
+pub const MODEL_BODIES: &str = "model-bodies.u32";
 
 /// How an interface is estimated in every tile, as `tiles.json` records it.
 ///
@@ -84,6 +92,13 @@ pub enum Estimate {
         /// Why not kriging.
         reason: String,
     },
+    /// A horizon grid (`[geology] surfaces`), sampled by every tile at its own vertices as the
+    /// one-piece model samples it (each vertex on its own, so a seam vertex gets the same
+    /// value from both tiles); nodata: the unit is absent there.
+    Grid {
+        /// The grid file, as the project names it (the tiles read the project's).
+        path: String,
+    },
 }
 
 /// One interface of the plan.
@@ -104,14 +119,24 @@ pub struct InterfacePlan {
 pub struct GeologyPlan {
     /// The units, top to bottom.
     pub units: Vec<String>,
-    /// The base elevation, metres, fixed once.
-    pub base: f64,
+    /// The base elevation, metres, fixed once; `None` for a base grid (`geology.base` a raster
+    /// path), which every tile samples at its vertices.
+    pub base: Option<f64>,
     /// How the base was fixed, in words.
     pub base_rule: String,
     /// The kriging neighbourhood of every kriged interface (observations).
     pub neighbours: usize,
-    /// The interfaces, top to bottom (units 1..).
+    /// The fields, top to bottom: the tops of units 1.., or with `thickness` the thicknesses
+    /// of units 0..n-1.
     pub interfaces: Vec<InterfacePlan>,
+    /// `interpolate = "thickness"`: the fields are the units' thicknesses, stacked down from
+    /// the terrain (`terramesh_geology::stack_thicknesses`) as in a one-piece model.
+    #[serde(default)]
+    pub thickness: bool,
+    /// The EPSG code of the project's CRS, in which the tiles sample the horizon and base
+    /// grids.
+    #[serde(default)]
+    pub crs_epsg: Option<u32>,
 }
 
 /// The plan of the geological model of `p` (None without `[geology]`), its files written
@@ -129,29 +154,64 @@ pub(crate) fn plan_geology(
         return Ok(None);
     };
     check_supported(g)?;
-    let holes = crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?
-        .ok_or_else(|| {
-            Error::invalid(
-                "a tiled geological model is kriged from boreholes: set [geology] collars and \
-                 tops",
-            )
-        })?;
+    let holes = crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?;
+    let gridded = |unit: usize| g.surfaces.get(unit).and_then(Option::as_ref);
+    match &holes {
+        Some(_) => {}
+        None if (1..g.units.len()).all(|u| gridded(u).is_some()) => {}
+        None => {
+            return Err(Error::invalid(
+                "a tiled geological model is kriged from boreholes where no horizon grid gives a \
+                 unit's top: set [geology] collars and tops, or surfaces for every unit below \
+                 the first",
+            ))
+        }
+    }
+    let contacts = || holes.iter().flat_map(|h| h.contacts());
+    let crs_epsg = samples.epsg();
+    // The horizon grids' lowest value at the samples (for an auto base).
+    let mut grid_low = f64::INFINITY;
+    let sample_xy: Vec<[f64; 2]> = samples.xyz.iter().map(|p| [p[0], p[1]]).collect();
     let dir = out.join("geology");
     std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
     let k_project = p.interpolation.neighbors;
     let mut interfaces = Vec::new();
     let mut halos = vec![0.0f64; rects.len()];
-    for unit in 1..g.units.len() {
+    let thickness = g.interpolate == Interpolated::Thickness;
+    let fields: Vec<usize> = if thickness {
+        (0..g.units.len() - 1).collect()
+    } else {
+        (1..g.units.len()).collect()
+    };
+    for unit in fields {
         let name = &g.units[unit];
-        let obs: Vec<[f64; 3]> = holes
-            .contacts()
-            .filter(|(_, c)| c.unit == unit)
-            .map(|(_, c)| c.position)
-            .collect();
+        if let Some(path) = gridded(unit).filter(|_| !thickness) {
+            let values = horizon_at(path, &sample_xy, g, crs_epsg, name)?;
+            grid_low = values.into_iter().flatten().fold(grid_low, f64::min);
+            interfaces.push(InterfacePlan {
+                unit: name.clone(),
+                observations: String::new(),
+                count: 0,
+                estimate: Estimate::Grid {
+                    path: path.display().to_string(),
+                },
+            });
+            continue;
+        }
+        let obs: Vec<[f64; 3]> = match &holes {
+            Some(h) if thickness => h
+                .thicknesses(unit)
+                .map(|(_, t, p)| [p[0], p[1], t])
+                .collect(),
+            _ => contacts()
+                .filter(|(_, c)| c.unit == unit)
+                .map(|(_, c)| c.position)
+                .collect(),
+        };
         if obs.is_empty() {
             return Err(Error::invalid(format!(
-                "no observation of {name}: no borehole meets it (a tiled model takes unit tops \
-                 from boreholes only)"
+                "no observation of {name}: no borehole meets it and [geology] surfaces gives \
+                 no grid for it (a tiled model takes unit tops from boreholes or horizon grids)"
             )));
         }
         let data = Data::new(
@@ -221,24 +281,41 @@ pub(crate) fn plan_geology(
         });
     }
     let (base, base_rule) = match &g.base {
-        BaseKey::Elevation(z) => (*z, "geology.base".to_string()),
+        BaseKey::Elevation(z) => (Some(*z), "geology.base".to_string()),
         BaseKey::Auto => {
             let hi = sample_z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let mut lo = sample_z.iter().copied().fold(f64::INFINITY, f64::min);
-            for (_, c) in holes.contacts() {
+            let mut lo = sample_z.iter().copied().fold(grid_low, f64::min);
+            for (_, c) in contacts() {
                 lo = lo.min(c.position[2]);
             }
             let margin = (AUTO_BASE_MARGIN * (hi - lo)).max(1.0);
             (
-                lo - margin,
+                Some(lo - margin),
                 format!(
                     "auto, fixed at plan time: {AUTO_BASE_MARGIN} of the relief between the \
-                     lowest sample or contact and the highest sample below the lowest (a \
-                     one-piece build takes the DSM at its vertices instead of the samples)"
+                     lowest sample, contact or horizon grid value at the samples and the \
+                     highest sample below the lowest (a one-piece build takes the DSM and the \
+                     grids at its vertices instead of at the samples)"
                 ),
             )
         }
-        BaseKey::Raster(_) => unreachable!("refused by check_supported"),
+        BaseKey::Raster(path) => {
+            // Read once here, so that a grid that cannot be read fails the plan, not the tiles.
+            horizon_at(
+                path,
+                &sample_xy[..sample_xy.len().min(1)],
+                g,
+                crs_epsg,
+                "the base",
+            )?;
+            (
+                None,
+                format!(
+                    "the grid {}, sampled by every tile at its vertices",
+                    path.display()
+                ),
+            )
+        }
     };
     Ok(Some((
         GeologyPlan {
@@ -247,6 +324,8 @@ pub(crate) fn plan_geology(
             base_rule,
             neighbours: k_project,
             interfaces,
+            thickness,
+            crs_epsg,
         },
         halos,
     )))
@@ -262,25 +341,41 @@ fn fitted(data: &Data) -> Result<terramesh_geostat::Variogram> {
 
 /// Refuses the geology a tiled build does not make yet, with the key to change.
 fn check_supported(g: &GeologySettings) -> Result<()> {
-    if g.interpolate != Interpolated::Tops {
+    if g.interpolate == Interpolated::Thickness && g.surfaces.iter().any(Option::is_some) {
         return Err(Error::invalid(
-            "tiled builds make the geological model from unit tops only: set [geology] \
-             interpolate = \"tops\", or build in one piece with terramesh build",
+            "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" \
+             to use them",
         ));
     }
-    if g.surfaces.iter().any(Option::is_some) {
-        return Err(Error::invalid(
-            "tiled builds do not read horizon grids ([geology] surfaces) yet: build this model \
-             in one piece with terramesh build",
-        ));
-    }
-    if matches!(g.base, BaseKey::Raster(_)) {
-        return Err(Error::invalid(
-            "tiled builds take a flat base (geology.base = \"auto\" or an elevation), not a \
-             base grid, for now: build this model in one piece with terramesh build",
-        ));
+    if let (Some(Some(_)), Some(first)) = (g.surfaces.first(), g.units.first()) {
+        return Err(Error::invalid(format!(
+            "geology.surfaces.{first}: the top of the first unit is the terrain (the DSM); give \
+             grids for the units below it"
+        )));
     }
     Ok(())
+}
+
+/// A horizon grid (`[geology] surfaces` or the base) at `xy` in the project's CRS
+/// (`epsg`), in metres; `None` on a nodata pixel. Each point on its own (per vertex), as the
+/// one-piece model samples it.
+fn horizon_at(
+    path: &Path,
+    xy: &[[f64; 2]],
+    g: &GeologySettings,
+    epsg: Option<u32>,
+    what: &str,
+) -> Result<Vec<Option<f64>>> {
+    let code = epsg.ok_or_else(|| {
+        Error::invalid(
+            "horizon grids need the project's CRS to be placed in: name it with [region] crs = \
+             \"EPSG:...\"",
+        )
+    })?;
+    let crs = terramesh_crs::Crs::from_epsg(code)?;
+    let grid = crate::horizon::HorizonGrid::open(path, g.z_unit)?;
+    grid.evaluate(xy, &crs)
+        .with_context(|| format!("the grid of {what}"))
 }
 
 /// One tile's geological model.
@@ -291,6 +386,10 @@ pub(crate) struct TileModel {
     pub points: Vec<[f64; 3]>,
     /// Its cells and their units.
     pub cells: Vec<(Cell, i32)>,
+    /// Its tagged faces (tags in [`TileFigures::tags`]).
+    pub faces: Vec<TaggedFace>,
+    /// The units' sealed bodies over the tile (closed by the tile's sides, seams included).
+    pub bodies: Vec<Body>,
     /// The figures merged into `model.json`.
     pub figures: TileFigures,
 }
@@ -306,6 +405,28 @@ pub struct TileFigures {
     pub pinched_area: Vec<f64>,
     /// The volume between the terrain and the base over the tile, m³.
     pub volume_between: f64,
+    /// The names of the tags of `model-faces.u32` (`top`, `bottom`, a side, `interface-<unit>`).
+    #[serde(default)]
+    pub tags: Vec<String>,
+}
+
+/// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
+///
+/// ```
+/// use terramesh::tiles::tag_of_name;
+/// use terramesh_core::volume::FaceTag;
+/// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
+/// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
+/// ```
+pub fn tag_of_name(name: &str) -> FaceTag {
+    match name {
+        "top" => FaceTag::Top,
+        "bottom" => FaceTag::Bottom,
+        _ => match name.strip_prefix("interface-") {
+            Some(u) => FaceTag::Interface(u.to_string()),
+            None => FaceTag::Side(name.to_string()),
+        },
+    }
 }
 
 /// Builds the model of one tile on its planar mesh (`xy`, its absolute positions, the planned
@@ -327,6 +448,27 @@ pub(crate) fn build_model(
     let mut grids = Vec::new();
     for (k, it) in gp.interfaces.iter().enumerate() {
         let values = match &it.estimate {
+            Estimate::Grid { .. } => {
+                let path = g
+                    .surfaces
+                    .get(k + 1)
+                    .and_then(Option::as_ref)
+                    .ok_or_else(|| {
+                        Error::invalid(format!(
+                            "the plan samples a grid for the top of {} but the project's \
+                         [geology] surfaces names none: plan again",
+                            it.unit
+                        ))
+                    })?;
+                let v = horizon_at(path, xy, g, gp.crs_epsg, &it.unit)
+                    .with_context(|| format!("tile {}", tile.id))?;
+                // Nodata: the unit is absent there (as in a one-piece model).
+                grids.push((
+                    k + 1,
+                    v.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
+                ));
+                continue;
+            }
             Estimate::Constant { value } => vec![*value; xy.len()],
             Estimate::Idw { .. } => {
                 let (oxy, oz) = observations(&plan.join(&it.observations), |_| true)?;
@@ -370,7 +512,7 @@ pub(crate) fn build_model(
                 tile.id, it.unit, xy[i][0], xy[i][1]
             )));
         }
-        grids.push((k + 1, values));
+        grids.push((if gp.thickness { k } else { k + 1 }, values));
     }
     // The origin at zero: the model's nodes take the planned positions bit for bit.
     let mesh = Mesh {
@@ -379,10 +521,34 @@ pub(crate) fn build_model(
         triangles: triangles.to_vec(),
         constraint_edges: vec![],
     };
+    let base =
+        match (gp.base, &g.base) {
+            (Some(z), _) => Base::Elevation(z),
+            (None, BaseKey::Raster(path)) => {
+                let v = horizon_at(path, xy, g, gp.crs_epsg, "the base")
+                    .with_context(|| format!("tile {}", tile.id))?;
+                match v.iter().position(Option::is_none) {
+                    Some(i) => {
+                        return Err(Error::invalid(format!(
+                        "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of tile {}: \
+                         a base grid must cover the whole region",
+                        path.display(),
+                        xy[i][0],
+                        xy[i][1],
+                        tile.id
+                    )))
+                    }
+                    None => Base::PerVertex(v.into_iter().flatten().collect()),
+                }
+            }
+            (None, _) => return Err(Error::invalid(
+                "the plan samples a base grid but the project's geology.base is none: plan again",
+            )),
+        };
     let inputs = ModelInputs {
         boreholes: None,
         grids,
-        base: Base::Elevation(gp.base),
+        base,
         min_thickness: g.min_thickness,
         layering: Layering::new(g.units.clone())
             .layers(g.layers.clone())
@@ -390,8 +556,12 @@ pub(crate) fn build_model(
         interpolate: Interpolated::Tops,
         method: Method::Ordinary,
     };
-    let model = assemble(&mesh, terrain, &inputs)
-        .with_context(|| format!("tile {}: [geology]", tile.id))?;
+    let model = if gp.thickness {
+        thickness_model(&mesh, terrain, &inputs)
+    } else {
+        assemble(&mesh, terrain, &inputs)
+    }
+    .with_context(|| format!("tile {}: [geology]", tile.id))?;
     let figures = TileFigures {
         volumes: model.check.unit_volumes.clone(),
         cells: (0..g.units.len())
@@ -406,6 +576,7 @@ pub(crate) fn build_model(
             .collect(),
         pinched_area: model.stats.iter().map(|s| s.pinched_area).collect(),
         volume_between: model.check.volume,
+        tags: model.mesh.tags.iter().map(FaceTag::name).collect(),
     };
     Ok(TileModel {
         surfaces: model.stack.surfaces,
@@ -416,7 +587,36 @@ pub(crate) fn build_model(
             .into_iter()
             .zip(model.mesh.material)
             .collect(),
+        faces: model.mesh.faces,
+        bodies: model.mesh.bodies,
         figures,
+    })
+}
+
+/// The model from thickness fields (`inputs.grids`, units 0..n-1, in order) stacked down from
+/// the terrain, as a one-piece model stacks its kriged thicknesses (`stack_of`, `seal`).
+fn thickness_model(
+    mesh: &Mesh,
+    terrain: &[f64],
+    inputs: &ModelInputs,
+) -> Result<crate::geology::model::GeologicalModel> {
+    let planar =
+        terramesh_geology::Planar::new(&mesh.points, &mesh.triangles).context("the planar mesh")?;
+    let base = crate::geology::model::base_values(inputs, terrain, None, mesh.points.len())?;
+    let thick: Vec<Vec<f64>> = inputs.grids.iter().map(|g| g.1.clone()).collect();
+    let (stack, rules) =
+        terramesh_geology::stack_thicknesses(&planar, terrain, &thick, &base, inputs.min_thickness)
+            .context("the geological rules")?;
+    let (volume, check, stats) = crate::geology::model::seal(&planar, &stack, &inputs.layering)?;
+    Ok(crate::geology::model::GeologicalModel {
+        mesh: volume,
+        stack,
+        rules,
+        fields: Vec::new(),
+        stats,
+        check,
+        misfits: Vec::new(),
+        grids: Vec::new(),
     })
 }
 
@@ -430,68 +630,4 @@ fn observations(path: &Path, keep: impl Fn([f64; 2]) -> bool) -> Result<(Vec<[f6
         }
     })?;
     Ok((xy, z))
-}
-
-/// Writes a tile's model files into `dir`: `surfaces.f64` (per planar vertex, every surface),
-/// `model-points.f64` (`x, y, z`), `model-cells.u32` (per cell: kind 0 tetra, 1 pyramid, 2
-/// wedge; its unit; six nodes), `interfaces.bin` (per grid node it owns: index `u64`, then the
-/// top of every unit, `f64`) and `model.json`.
-pub(crate) fn write_model(
-    dir: &Path,
-    model: &TileModel,
-    xy: &[[f64; 2]],
-    triangles: &[[u32; 3]],
-    nodes: &[(u64, [f64; 2])],
-) -> Result<()> {
-    let n = xy.len();
-    let mut b = Vec::with_capacity(8 * n * model.surfaces.len());
-    for v in 0..n {
-        for s in &model.surfaces {
-            put_f64(&mut b, &[s[v]]);
-        }
-    }
-    write(&dir.join(SURFACES), &b)?;
-    b.clear();
-    for p in &model.points {
-        put_f64(&mut b, p);
-    }
-    write(&dir.join(MODEL_POINTS), &b)?;
-    b.clear();
-    for (c, m) in &model.cells {
-        let kind: u32 = match c.kind {
-            CellKind::Tetra => 0,
-            CellKind::Pyramid => 1,
-            CellKind::Wedge => 2,
-        };
-        for v in [kind, *m as u32].iter().chain(&c.nodes) {
-            b.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    write(&dir.join(MODEL_CELLS), &b)?;
-    b.clear();
-    // The unit tops (terrain first) at the grid nodes, linear on the planar triangles.
-    let mesh = Mesh {
-        origin: [0.0, 0.0],
-        points: xy.to_vec(),
-        triangles: triangles.to_vec(),
-        constraint_edges: vec![],
-    };
-    let units = model.surfaces.len() - 1;
-    let loc: Vec<SurfaceLocator> = model.surfaces[..units]
-        .iter()
-        .map(|s| SurfaceLocator::new(&mesh, s))
-        .collect();
-    for (i, q) in nodes {
-        b.extend_from_slice(&i.to_le_bytes());
-        for l in &loc {
-            put_f64(&mut b, &[l.height(q[0], q[1]).unwrap_or(f64::NAN)]);
-        }
-    }
-    write(&dir.join(INTERFACES), &b)?;
-    let json = serde_json::to_string_pretty(&model.figures)?;
-    write(&dir.join(MODEL_JSON), json.as_bytes())
-}
-
-fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).context(path.display().to_string())
 }

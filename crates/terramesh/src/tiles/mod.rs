@@ -7,7 +7,8 @@
 //! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
 //!   its state under a lock, so many processes may build at once.
 //! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc` and a report, and,
-//!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`.
+//!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`, and from the
+//!   merged volume mesh the boundary meshes, `model.msh`, `model.f3grid` and the bodies.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.
 //!
 //! Seams: each tile's mesh keeps its planned boundary vertices and adds none on it
@@ -41,6 +42,8 @@ mod geometry;
 mod grid_merge;
 mod manifest;
 mod merge;
+mod model_export;
+mod model_files;
 mod model_merge;
 mod partition;
 mod plan;
@@ -50,8 +53,8 @@ mod slurm;
 pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
-    Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON,
-    MODEL_POINTS, SURFACES,
+    tag_of_name, Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_BODIES,
+    MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
@@ -59,6 +62,7 @@ pub use manifest::{
     LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
+pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};
 pub use plan::{parse_tile_size, plan, Planned};

@@ -7,8 +7,9 @@
 //! tile's cells name the same nodes. Both tiles computed the column from the same surfaces (the
 //! merge measures the largest difference, `seam_max_difference`, and refuses columns that do
 //! not have the same nodes), so the merged mesh is conforming across the seams. The boundary
-//! meshes, the sealed bodies (`unit-*.ts`, `.stl`), `model.msh`, `model.f3grid` and the glTF
-//! model need the whole model's faces at once and are not made by the merge.
+//! meshes, the sealed bodies (`unit-*.ts`, `.stl`), `model.msh` and `model.f3grid` are
+//! written by [`super::model_export`] from the merged mesh in memory; the glTF model is not
+//! made by the merge.
 
 use std::collections::{HashMap, HashSet};
 use std::io::Write;
@@ -67,27 +68,31 @@ pub struct MergedModel {
     pub units: Vec<MergedUnit>,
     /// The volume between the terrain and the base (the tiles' sum), m³.
     pub volume_between_terrain_and_base: f64,
-    /// The base elevation every tile used, metres.
-    pub base: f64,
+    /// The base elevation every tile used, metres (`null`: a base grid, sampled by every tile
+    /// at its vertices).
+    pub base: Option<f64>,
+    /// The boundary meshes, `model.msh`, `model.f3grid` and the bodies
+    /// (`tiles/model_export.rs`).
+    pub exports: super::model_export::MergedExports,
 }
 
 /// A seam vertex's column: its first global node, how many nodes, the tile that writes it,
 /// and its surfaces.
-struct Column {
-    first: u32,
-    count: u32,
-    owner: usize,
+pub(super) struct Column {
+    pub(super) first: u32,
+    pub(super) count: u32,
+    pub(super) owner: usize,
     z: Vec<u64>,
     surfaces: Vec<f64>,
 }
 
 /// One tile's model as the merge reads it.
-struct TileModel {
-    points: Vec<f64>,
-    cells: Vec<u32>,
+pub(super) struct TileModel {
+    pub(super) points: Vec<f64>,
+    pub(super) cells: Vec<u32>,
 }
 
-fn read_model(plan: &Path, t: &Tile) -> Result<TileModel> {
+pub(super) fn read_model(plan: &Path, t: &Tile) -> Result<TileModel> {
     let dir = tile_dir(plan, &t.id);
     Ok(TileModel {
         points: read_f64s(&dir.join(MODEL_POINTS), 3)?,
@@ -95,12 +100,12 @@ fn read_model(plan: &Path, t: &Tile) -> Result<TileModel> {
     })
 }
 
-fn key(x: f64, y: f64) -> (u64, u64) {
+pub(super) fn key(x: f64, y: f64) -> (u64, u64) {
     (x.to_bits(), y.to_bits())
 }
 
 /// The columns of a tile's nodes: `(key, first local node, count)`, in node order.
-fn columns(points: &[f64]) -> Vec<((u64, u64), usize, usize)> {
+pub(super) fn columns(points: &[f64]) -> Vec<((u64, u64), usize, usize)> {
     let mut out: Vec<((u64, u64), usize, usize)> = Vec::new();
     for i in 0..points.len() / 3 {
         let k = key(points[3 * i], points[3 * i + 1]);
@@ -113,7 +118,7 @@ fn columns(points: &[f64]) -> Vec<((u64, u64), usize, usize)> {
 }
 
 /// The global node of every local node of tile `k`, and whether this tile writes it.
-fn node_map(
+pub(super) fn node_map(
     k: usize,
     points: &[f64],
     seams: &HashMap<(u64, u64), Column>,
@@ -132,7 +137,7 @@ fn node_map(
     map
 }
 
-fn cell_of(rec: &[u32]) -> (Cell, i32) {
+pub(super) fn cell_of(rec: &[u32]) -> (Cell, i32) {
     let kind = match rec[0] {
         0 => CellKind::Tetra,
         1 => CellKind::Pyramid,
@@ -280,6 +285,8 @@ pub(crate) fn merge_model(
     write_vtu(&path, plan, m, gp, &seams, n as usize, nc)?;
     written.push(path);
     written.extend(write_interfaces(plan, m, gp, out)?);
+    let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, out)?;
+    written.extend(files);
     let merged = MergedModel {
         nodes: n as usize,
         cells: nc,
@@ -300,6 +307,7 @@ pub(crate) fn merge_model(
             .collect(),
         volume_between_terrain_and_base: between,
         base: gp.base,
+        exports,
     };
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&merged)?;

@@ -1,0 +1,588 @@
+//! The merged geological model's other files (`terramesh tiles merge` with `[geology]`): the
+//! OpenGeoSys boundary meshes, `model.msh`, `model.f3grid` and the sealed bodies, on Kimberlina
+//! (69 wells, 16 units) in 2 x 2 tiles; and a tiled model from horizon grids (Shellmound's six
+//! grids, with an auto base and with a base grid) against a one-piece model on the merged mesh.
+//!
+//! Here: the FLAC3D face groups (the tagged faces, in `model.vtu`'s numbering) are faces of
+//! `model.vtu`'s cells, the top, bottom and sides form a closed surface with no face on a seam,
+//! and the bodies' enclosed volumes (`merge.json`) equal `model.json`'s unit volumes. The
+//! independent verifier (`tests/verify/check_model.py`: meshio, Gmsh, OpenGeoSys'
+//! `ExtractBoundary`) then checks the boundary meshes' bulk ids against OpenGeoSys' own
+//! extraction from `model.vtu`, Gmsh's physical volumes against the cells to 1e-9, the
+//! FLAC3D grid and the bodies' volumes to 1e-9; without `.venv-verify` that part is skipped
+//! outside CI and fails in CI.
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use terramesh_core::volume::{cell_volume, Cell};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn run(args: &[&str]) {
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args(args)
+        .env_remove("TERRAMESH_TILES_FAIL")
+        .output()
+        .expect("run terramesh");
+    assert!(
+        o.status.success(),
+        "terramesh {args:?} failed: {}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// Plans `project` in tiles of `size` with the overrides `set`, builds every tile, merges.
+fn tiled(dir: &Path, project: &Path, size: &str, set: &[&str]) -> (PathBuf, PathBuf) {
+    let (plan, merged) = (dir.join("plan"), dir.join("merged"));
+    let mut args = vec![
+        "tiles",
+        "plan",
+        project.to_str().unwrap(),
+        "--tile-size",
+        size,
+    ];
+    args.extend(["-o", plan.to_str().unwrap(), "--quiet"]);
+    for s in set {
+        args.extend(["--set", s]);
+    }
+    run(&args);
+    for t in json(&plan.join("tiles.json"))["tiles"].as_array().unwrap() {
+        let id = t["id"].as_str().unwrap();
+        run(&["tiles", "build", plan.to_str().unwrap(), "--tile", id]);
+    }
+    run(&[
+        "tiles",
+        "merge",
+        plan.to_str().unwrap(),
+        "-o",
+        merged.to_str().unwrap(),
+    ]);
+    (plan, merged)
+}
+
+/// The named `DataArray`'s values of an ASCII VTU (the first whose opening tag contains `tag`).
+fn array(text: &str, tag: &str) -> Vec<f64> {
+    let i = text.find(tag).unwrap_or_else(|| panic!("no {tag}"));
+    let i = i + text[i..].find('>').unwrap() + 1;
+    let j = i + text[i..].find("</DataArray>").unwrap();
+    text[i..j]
+        .split_whitespace()
+        .map(|x| x.parse::<f64>().unwrap())
+        .collect()
+}
+
+/// `model.vtu` (ASCII): points, cells in our node orders, materials.
+fn model(p: &Path) -> (Vec<[f64; 3]>, Vec<Cell>, Vec<i32>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let pts = array(&text, "NumberOfComponents=\"3\"");
+    let con = array(&text, "Name=\"connectivity\"");
+    let off = array(&text, "Name=\"offsets\"");
+    let types = array(&text, "Name=\"types\"");
+    let mat = array(&text, "Name=\"MaterialIDs\"");
+    let mut cells = Vec::new();
+    let mut start = 0usize;
+    for (k, &o) in off.iter().enumerate() {
+        let n: Vec<u32> = con[start..o as usize].iter().map(|&v| v as u32).collect();
+        start = o as usize;
+        cells.push(match types[k] as u8 {
+            10 => Cell::tetra([n[0], n[1], n[2], n[3]]),
+            14 => Cell::pyramid([n[0], n[1], n[2], n[3], n[4]]),
+            13 => Cell::wedge([n[0], n[2], n[1], n[3], n[5], n[4]]),
+            t => panic!("cell type {t}"),
+        });
+    }
+    let points = pts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    (points, cells, mat.iter().map(|&m| m as i32).collect())
+}
+
+/// The faces of a cell as sorted node sets.
+fn cell_faces(c: &Cell) -> Vec<Vec<u32>> {
+    let n = c.nodes;
+    let f: &[&[usize]] = match c.kind.nodes() {
+        4 => &[&[0, 1, 2], &[0, 1, 3], &[1, 2, 3], &[0, 2, 3]],
+        5 => &[
+            &[0, 1, 2, 3],
+            &[0, 1, 4],
+            &[1, 2, 4],
+            &[2, 3, 4],
+            &[3, 0, 4],
+        ],
+        _ => &[
+            &[0, 1, 2],
+            &[3, 4, 5],
+            &[0, 1, 4, 3],
+            &[1, 2, 5, 4],
+            &[2, 0, 3, 5],
+        ],
+    };
+    f.iter()
+        .map(|f| {
+            let mut v: Vec<u32> = f.iter().map(|&i| n[i]).collect();
+            v.sort_unstable();
+            v
+        })
+        .collect()
+}
+
+/// `model.f3grid`'s faces (`F` lines: 0-based nodes) and face groups (name: 1-based face ids).
+fn f3grid_faces(p: &Path) -> (Vec<Vec<u32>>, HashMap<String, Vec<usize>>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let (mut faces, mut groups) = (Vec::new(), HashMap::new());
+    let mut group: Option<String> = None;
+    for line in text.lines() {
+        let s: Vec<&str> = line.split_whitespace().collect();
+        match s.first() {
+            Some(&"F") => faces.push(
+                s[3..]
+                    .iter()
+                    .map(|v| v.parse::<u32>().unwrap() - 1)
+                    .collect(),
+            ),
+            Some(&"FGROUP") => {
+                group = Some(s[1].trim_matches('"').to_string());
+                groups.insert(group.clone().unwrap(), Vec::new());
+            }
+            Some(&"ZGROUP") | Some(&"*") => group = None,
+            Some(_) if group.is_some() => groups
+                .get_mut(group.as_ref().unwrap())
+                .unwrap()
+                .extend(s.iter().map(|v| v.parse::<usize>().unwrap())),
+            _ => {}
+        }
+    }
+    (faces, groups)
+}
+
+/// Runs the independent verifier's checks on `dir` (skipped without `.venv-verify` outside CI).
+fn verify(dir: &Path, only: &[&str]) {
+    let py = root().join(".venv-verify/bin/python");
+    if !py.exists() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set but .venv-verify is missing: run .ci/verify-setup.sh"
+        );
+        println!("skipped: the independent model checks need .venv-verify (.ci/verify-setup.sh)");
+        return;
+    }
+    let mut c = Command::new(py);
+    c.arg(root().join("tests/verify/check_model.py")).arg(dir);
+    for o in only {
+        c.args(["--only", o]);
+    }
+    let o = c.output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "check_model.py failed:\n{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        text.contains(&format!("{} passed, 0 failed", only.len())),
+        "{text}"
+    );
+}
+
+#[test]
+fn merged_boundary_meshes_msh_f3grid_and_bodies_are_the_merged_models() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = root().join("examples/kimberlina/terramesh.toml");
+    // min_thickness 1 m: at 0, the kernel keeps wedges a few picometres thick (surfaces equal
+    // but for rounding) whose Jacobian is negative at some Gauss points (Gmsh and OpenGeoSys
+    // refuse them); the one-piece kernel's matter, not the merge's.
+    let set = ["interpolation.neighbors=8", "geology.min_thickness=1.0"];
+    let (plan, merged) = tiled(tmp.path(), &ex, "26km", &set);
+    let m = json(&plan.join("tiles.json"));
+    assert_eq!(m["tiles"].as_array().unwrap().len(), 4, "2 x 2 tiles");
+    let (points, cells, mat) = model(&merged.join("model.vtu"));
+    let mj = json(&merged.join("model.json"));
+    let ex_fig = &json(&merged.join("merge.json"))["model"]["exports"];
+    assert!(
+        ex_fig["seam_faces_dropped"].as_u64().unwrap() > 0,
+        "{ex_fig}"
+    );
+    assert!(
+        ex_fig["seam_triangles_dropped"].as_u64().unwrap() > 0,
+        "{ex_fig}"
+    );
+
+    // The tagged faces (FLAC3D's), in model.vtu's numbering: each a face of the cells.
+    let (faces, groups) = f3grid_faces(&merged.join("model.f3grid"));
+    let mut of_cells: HashMap<Vec<u32>, usize> = HashMap::new();
+    for c in &cells {
+        for f in cell_faces(c) {
+            *of_cells.entry(f).or_default() += 1;
+        }
+    }
+    for f in &faces {
+        let mut s = f.clone();
+        s.sort_unstable();
+        assert!(
+            of_cells.contains_key(&s),
+            "face {f:?} is no face of model.vtu's cells"
+        );
+    }
+    // Top, bottom and sides: exactly the faces of one cell, a closed surface (every directed
+    // edge once, its reverse once), none on a seam (a vertical face off the outline).
+    let mut boundary = Vec::new();
+    for (name, ids) in &groups {
+        if name == "top"
+            || name == "bottom"
+            || ["north", "east", "south", "west"].contains(&name.as_str())
+        {
+            boundary.extend(ids.iter().map(|&i| faces[i - 1].clone()));
+        } else {
+            assert!(name.starts_with("interface-"), "face group {name}");
+        }
+    }
+    let open: HashSet<Vec<u32>> = of_cells
+        .iter()
+        .filter(|(_, &n)| n == 1)
+        .map(|(f, _)| f.clone())
+        .collect();
+    let tagged: HashSet<Vec<u32>> = boundary
+        .iter()
+        .map(|f| {
+            let mut s = f.clone();
+            s.sort_unstable();
+            s
+        })
+        .collect();
+    assert_eq!(tagged.len(), boundary.len(), "a boundary face tagged twice");
+    assert_eq!(
+        tagged, open,
+        "the boundary faces are not exactly the faces of one cell"
+    );
+    let mut edges: HashMap<(u32, u32), i64> = HashMap::new();
+    for f in &boundary {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *edges.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+        }
+    }
+    assert!(
+        edges.values().all(|&d| d == 0),
+        "the boundary is not closed and oriented"
+    );
+    let r = m["region"].as_array().unwrap();
+    let (xs, ys): (Vec<f64>, Vec<f64>) = r
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .unzip();
+    let lo = [
+        xs.iter().cloned().fold(f64::MAX, f64::min),
+        ys.iter().cloned().fold(f64::MAX, f64::min),
+    ];
+    let hi = [
+        xs.iter().cloned().fold(f64::MIN, f64::max),
+        ys.iter().cloned().fold(f64::MIN, f64::max),
+    ];
+    let t = 1e-6 * (hi[0] - lo[0]);
+    let on_outline =
+        |p: [f64; 3]| (0..2).any(|k| (p[k] - lo[k]).abs() < t || (p[k] - hi[k]).abs() < t);
+    for name in ["north", "east", "south", "west"] {
+        for &i in groups.get(name).into_iter().flatten() {
+            let f = &faces[i - 1];
+            assert!(
+                f.iter().all(|&n| on_outline(points[n as usize])),
+                "side face {f:?} ({name}) is not on the region's outline: a seam face left over"
+            );
+        }
+    }
+
+    // The bodies enclose the units' volumes (model.json, the merged cells') to 1e-9.
+    let mut vol = vec![0.0; mj["units"].as_array().unwrap().len()];
+    for (c, &u) in cells.iter().zip(&mat) {
+        vol[u as usize] += cell_volume(&points, c);
+    }
+    let total: f64 = vol.iter().sum();
+    let bodies = ex_fig["bodies"].as_array().unwrap();
+    assert!(bodies.len() >= 10, "{} bodies", bodies.len());
+    for b in bodies {
+        let name = b[0].as_str().unwrap();
+        let u = mj["units"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|x| x["name"] == name)
+            .unwrap();
+        let want = mj["units"][u]["volume"].as_f64().unwrap();
+        let got = b[1].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= 1e-9 * want,
+            "{name}: body {got} vs model.json {want}"
+        );
+        assert!(
+            (want - vol[u]).abs() <= 1e-9 * total,
+            "{name}: {want} vs cells {}",
+            vol[u]
+        );
+        assert!(merged.join(format!("unit-{name}.ts")).is_file());
+        assert!(merged.join(format!("unit-{name}.stl")).is_file());
+    }
+    for f in ["model-top.vtu", "model-bottom.vtu", "model.msh"] {
+        assert!(merged.join(f).is_file(), "{f}");
+    }
+
+    // The independent readers.
+    verify(
+        &merged,
+        &[
+            "model.vtu: cells",
+            "boundary meshes",
+            "model.msh (meshio)",
+            "model.msh (gmsh)",
+            "model.f3grid",
+            "bodies",
+            "ogs: steady diffusion",
+        ],
+    );
+}
+
+/// Shellmound (six horizon grids, no boreholes) in 2 x 2 tiles with the overrides `set`: the
+/// merged surfaces equal a one-piece model's (`terramesh::geology::model::assemble`, the grids
+/// sampled at the merged mesh's vertices) to 1e-9 m, and so do the unit volumes and the
+/// cells; the plan's base (`None`: the base grid `base`).
+fn grids_against_one_piece(set: &[&str], base: Option<&Path>) {
+    use terramesh::geology::model::{assemble, Base, ModelInputs};
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = root().join("examples/shellmound/terramesh.toml");
+    let mut all = vec![
+        "sampling.rows=25",
+        "sampling.cols=25",
+        "export.pictures=false",
+    ];
+    all.extend(set);
+    let (plan, merged) = tiled(tmp.path(), &ex, "3.3km", &all);
+    let m = json(&plan.join("tiles.json"));
+    assert_eq!(m["tiles"].as_array().unwrap().len(), 4, "2 x 2 tiles");
+    let gp = &m["geology"];
+    for it in gp["interfaces"].as_array().unwrap() {
+        assert_eq!(it["estimate"]["kind"], "grid", "{it}");
+    }
+    let dsm = std::fs::read_to_string(merged.join("dsm.vtu")).unwrap();
+    let pts = array(&dsm, "NumberOfComponents=\"3\"");
+    let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
+    let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
+    let tris: Vec<[u32; 3]> = array(&dsm, "Name=\"connectivity\"")
+        .chunks(3)
+        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
+        .collect();
+    let owned: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    let mut with = vec![
+        "sampling.rows=25".to_string(),
+        "sampling.cols=25".to_string(),
+    ];
+    with.extend(owned);
+    let p = terramesh::project::Project::load(&ex, &with).unwrap();
+    let g = p.geology().unwrap();
+    let crs = terramesh_crs::Crs::from_epsg(26915).unwrap();
+    let sample = |path: &Path| {
+        terramesh::horizon::HorizonGrid::open(path, g.z_unit)
+            .unwrap()
+            .evaluate(&xy, &crs)
+            .unwrap()
+    };
+    let grids: Vec<(usize, Vec<f64>)> = (1..g.units.len())
+        .map(|u| {
+            let v = sample(g.surfaces[u].as_ref().unwrap());
+            (u, v.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
+        })
+        .collect();
+    let base = match base {
+        Some(b) => {
+            assert!(gp["base"].is_null(), "{}", gp["base"]);
+            Base::PerVertex(sample(b).into_iter().map(Option::unwrap).collect())
+        }
+        None => Base::Elevation(gp["base"].as_f64().unwrap()),
+    };
+    let mesh = terramesh_mesh::Mesh {
+        origin: [0.0, 0.0],
+        points: xy.clone(),
+        triangles: tris,
+        constraint_edges: vec![],
+    };
+    let inputs = ModelInputs {
+        boreholes: None,
+        grids,
+        base,
+        min_thickness: g.min_thickness,
+        layering: terramesh_geology::Layering::new(g.units.clone())
+            .layers(g.layers.clone())
+            .element(g.element),
+        interpolate: g.interpolate,
+        method: terramesh_geostat::Method::Ordinary,
+    };
+    let one = assemble(&mesh, &terrain, &inputs).unwrap();
+    let mut worst: f64 = 0.0;
+    for s in 1..=g.units.len() {
+        let name = g
+            .units
+            .get(s)
+            .map_or("base".to_string(), |u| format!("top_{u}"));
+        let merged_s = array(&dsm, &format!("Name=\"{name}\""));
+        assert_eq!(merged_s.len(), xy.len());
+        for (a, b) in merged_s.iter().zip(&one.stack.surfaces[s]) {
+            worst = worst.max((a - b).abs());
+        }
+    }
+    assert!(
+        worst <= 1e-9,
+        "merged surfaces differ from the one-piece model by {worst} m"
+    );
+    let (points, cells, mat) = model(&merged.join("model.vtu"));
+    assert_eq!(
+        cells.len(),
+        one.mesh.cells.len(),
+        "the same cells in one piece"
+    );
+    let mut vol = vec![0.0; g.units.len()];
+    for (c, &u) in cells.iter().zip(&mat) {
+        vol[u as usize] += cell_volume(&points, c);
+    }
+    let total = one.check.volume;
+    for (u, v) in one.check.unit_volumes.iter().enumerate() {
+        assert!(
+            (v - vol[u]).abs() <= 1e-9 * total,
+            "{}: one piece {v}, tiles {}",
+            g.units[u],
+            vol[u]
+        );
+    }
+    verify(&merged, &["model.vtu: cells", "boundary meshes", "bodies"]);
+}
+
+#[test]
+fn tiles_sample_horizon_grids_as_a_one_piece_model_does() {
+    grids_against_one_piece(&[], None);
+}
+
+#[test]
+fn tiles_sample_a_base_grid_as_a_one_piece_model_does() {
+    // The deepest horizon as the base: the lowest unit pinches out where the base meets it.
+    let grid = root().join("fixtures/data/geology/shellmound/mdwy_surf.tif");
+    let set = format!("geology.base={}", grid.display());
+    grids_against_one_piece(&[&set], Some(&grid));
+}
+
+/// `interpolate = "thickness"` in 2 x 2 tiles of Kimberlina: the merged surfaces equal a
+/// one-piece model's on the merged mesh to 1e-9 m (every thickness kriged at every vertex
+/// from all its observations with the plan's variogram files, frames and neighbourhood, then
+/// stacked down from the terrain by `terramesh_geology::stack_thicknesses`), and so do the
+/// unit volumes and the cells.
+#[test]
+fn tiled_thickness_model_equals_a_one_piece_model_on_the_same_mesh() {
+    use terramesh_geostat::{kriging, Data, Duplicates, KrigingFrame, Method, Neighbourhood};
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = root().join("examples/kimberlina/terramesh.toml");
+    let set = [
+        "interpolation.neighbors=8",
+        "geology.interpolate=thickness",
+        "geology.min_thickness=1.0",
+    ];
+    let (plan, merged) = tiled(tmp.path(), &ex, "26km", &set);
+    let m = json(&plan.join("tiles.json"));
+    let gp = &m["geology"];
+    assert_eq!(gp["thickness"], true);
+    let dsm = std::fs::read_to_string(merged.join("dsm.vtu")).unwrap();
+    let pts = array(&dsm, "NumberOfComponents=\"3\"");
+    let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
+    let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
+    let tris: Vec<[u32; 3]> = array(&dsm, "Name=\"connectivity\"")
+        .chunks(3)
+        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
+        .collect();
+    let owned: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    let p = terramesh::project::Project::load(&ex, &owned).unwrap();
+    let g = p.geology().unwrap();
+    let k_plan = gp["neighbours"].as_u64().unwrap() as usize;
+    let mut kriged = 0;
+    let mut thick = Vec::new();
+    for it in gp["interfaces"].as_array().unwrap() {
+        let obs: Vec<f64> = std::fs::read(plan.join(it["observations"].as_str().unwrap()))
+            .unwrap()
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        let oxy: Vec<[f64; 2]> = obs.chunks(3).map(|c| [c[0], c[1]]).collect();
+        let oz: Vec<f64> = obs.chunks(3).map(|c| c[2]).collect();
+        let e = &it["estimate"];
+        thick.push(match e["kind"].as_str().unwrap() {
+            "constant" => vec![e["value"].as_f64().unwrap(); xy.len()],
+            "kriged" => {
+                kriged += 1;
+                let f = &e["frame"];
+                let frame = KrigingFrame {
+                    centre: [f[0][0].as_f64().unwrap(), f[0][1].as_f64().unwrap()],
+                    scale: f[1].as_f64().unwrap(),
+                };
+                let data = Data::new(oxy, oz, Duplicates::Reject)
+                    .unwrap()
+                    .with_frame(frame);
+                let v = terramesh::variogram_file::read_variogram_file(
+                    &plan.join(e["variogram"].as_str().unwrap()),
+                )
+                .unwrap();
+                let method = if e["universal"].as_bool().unwrap() {
+                    Method::Universal(p.interpolation.drift)
+                } else {
+                    Method::Ordinary
+                };
+                let k = k_plan.min(data.len());
+                let engine = kriging(&data, &v, method, Neighbourhood::Nearest(k), true).unwrap();
+                let mut est = vec![0.0; xy.len()];
+                engine.predict(&xy, &mut est, None).unwrap();
+                est
+            }
+            other => panic!("Kimberlina's thicknesses are kriged or constant, not {other}"),
+        });
+    }
+    assert!(kriged >= 5, "{kriged} kriged thicknesses");
+    let planar = terramesh_geology::Planar::new(&xy, &tris).unwrap();
+    let base = vec![gp["base"].as_f64().unwrap(); xy.len()];
+    let (stack, _) =
+        terramesh_geology::stack_thicknesses(&planar, &terrain, &thick, &base, g.min_thickness)
+            .unwrap();
+    let mut worst: f64 = 0.0;
+    for s in 1..=g.units.len() {
+        let name = g
+            .units
+            .get(s)
+            .map_or("base".to_string(), |u| format!("top_{u}"));
+        let merged_s = array(&dsm, &format!("Name=\"{name}\""));
+        for (a, b) in merged_s.iter().zip(&stack.surfaces[s]) {
+            worst = worst.max((a - b).abs());
+        }
+    }
+    assert!(
+        worst <= 1e-9,
+        "merged surfaces differ from the one-piece model by {worst} m"
+    );
+    let layering = terramesh_geology::Layering::new(g.units.clone())
+        .layers(g.layers.clone())
+        .element(g.element);
+    let one = terramesh_geology::volume_mesh(&planar, &stack, &layering).unwrap();
+    let summary = terramesh_geology::check(&one).unwrap();
+    let (points, cells, mat) = model(&merged.join("model.vtu"));
+    assert_eq!(one.cells.len(), cells.len(), "the same cells in one piece");
+    let mut vol = vec![0.0; g.units.len()];
+    for (c, &u) in cells.iter().zip(&mat) {
+        vol[u as usize] += cell_volume(&points, c);
+    }
+    for (u, v) in summary.unit_volumes.iter().enumerate() {
+        assert!(
+            (v - vol[u]).abs() <= 1e-9 * summary.volume,
+            "{}: {v} vs {}",
+            g.units[u],
+            vol[u]
+        );
+    }
+}
