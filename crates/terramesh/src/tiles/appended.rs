@@ -161,7 +161,13 @@ mod tests {
         Box::new(move |w| v.iter().try_for_each(|x| put_f64(w, *x)))
     }
 
-    fn array(section: Section, name: &str, vtk_type: &'static str, b: u64, v: Values) -> Array {
+    fn array<'a>(
+        section: Section,
+        name: &str,
+        vtk_type: &'static str,
+        b: u64,
+        v: Values<'a>,
+    ) -> Array<'a> {
         Array {
             section,
             vtk_type,
