@@ -23,10 +23,13 @@
 
 use std::path::Path;
 
-use terramesh_geostat::{Data, Duplicates, ExternalDriftKriging, GeostatError, Method, Predictor};
+use terramesh_geostat::{
+    Data, Duplicates, ExternalDriftKriging, GeostatError, Method, Predictor, Variogram,
+};
 use terramesh_io::dem::Raster;
 
-use crate::error::{Error, Result};
+use crate::error::{Context, Error, Result};
+use crate::interpolate::{FileData, VariogramSource};
 use crate::setting::Setting;
 
 /// A raster of external drift values, sampled bilinearly between pixel centres.
@@ -189,6 +192,97 @@ pub enum DriftSource {
     Column(String),
     /// A raster sampled at every target.
     Grid(Box<DriftGrid>),
+}
+
+impl DriftSource {
+    /// The drift a command asks for: a `column` of the data and targets CSVs, or a `grid`
+    /// raster (opened here); `None` with neither, an error with both.
+    ///
+    /// ```
+    /// use terramesh::external_drift::DriftSource;
+    /// assert!(DriftSource::choose(None, None)?.is_none());
+    /// let c = DriftSource::choose(Some("coarse"), None)?.unwrap();
+    /// assert_eq!(c.setting(), terramesh::Setting::ExternalDrift);
+    /// let both = DriftSource::choose(Some("coarse"), Some("g.tif".as_ref()));
+    /// assert!(both.is_err());
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn choose(column: Option<&str>, grid: Option<&Path>) -> Result<Option<DriftSource>> {
+        match (column, grid) {
+            (None, None) => Ok(None),
+            (Some(c), None) => Ok(Some(DriftSource::Column(c.to_string()))),
+            (None, Some(g)) => Ok(Some(DriftSource::Grid(Box::new(DriftGrid::open(g)?)))),
+            (Some(_), Some(_)) => Err(Error::setting(
+                Setting::ExternalDrift,
+                "",
+                "give {external-drift} COLUMN or {external-drift-grid} FILE, not both",
+            )),
+        }
+    }
+
+    /// The setting that asked for this drift, for messages.
+    pub fn setting(&self) -> Setting {
+        match self {
+            DriftSource::Column(_) => Setting::ExternalDrift,
+            DriftSource::Grid(_) => Setting::ExternalDriftGrid,
+        }
+    }
+
+    /// The drift at the data `fd` read from `path`, in data order: the column (its duplicates
+    /// merged as the data's were with `duplicates`), or the raster sampled at every datum.
+    pub fn at_data(&self, path: &Path, fd: &FileData, duplicates: Duplicates) -> Result<Vec<f64>> {
+        match self {
+            DriftSource::Column(c) => read_drift_column(path, c, duplicates),
+            DriftSource::Grid(grid) => grid
+                .sample_all(fd.data.xy())
+                .with_context(|| format!("{}: the data", fd.name)),
+        }
+    }
+}
+
+/// The variogram of kriging `fd`'s data with the external drift `g` (its values at the data)
+/// by `method`: a fitted variogram is fitted to the residuals of the drift
+/// ([`drift_residuals`]: the drift's own variation out, as gstat's `variogram(z ~ g)`), a
+/// given or read one is used as it is. `setting` (the drift's, [`DriftSource::setting`])
+/// names the drift in the residuals' errors.
+///
+/// ```
+/// use terramesh::external_drift::drift_variogram;
+/// use terramesh::fitting::FitPlan;
+/// use terramesh::interpolate::{FileData, VariogramSource};
+/// use terramesh::Setting;
+/// use terramesh_geostat::{Data, Duplicates, LagSettings, Method};
+/// // z is 3 x the drift (a smooth ramp of 10 units) plus a small wave.
+/// let xy: Vec<[f64; 2]> = (0..144).map(|i| [(i % 12) as f64 * 10.0, (i / 12) as f64 * 10.0]).collect();
+/// let g: Vec<f64> = xy.iter().map(|p| ((p[0] + p[1]) / 22.0).sin() * 10.0).collect();
+/// let z: Vec<f64> = xy.iter().zip(&g).map(|(p, g)| 3.0 * g + (p[0] / 25.0).cos()).collect();
+/// let fd = FileData { data: Data::new(xy, z, Duplicates::Reject)?, name: "d.csv".into() };
+/// let auto = VariogramSource::Fit { lags: LagSettings::default(), plan: FitPlan::default() };
+/// let on_residuals = drift_variogram(&auto, &fd, &g, Method::Ordinary, Setting::ExternalDrift)?;
+/// let on_data = auto.resolve("d.csv", &fd.data)?;
+/// // The drift's own variation (variance about 450) is out of the residuals' (about 0.5).
+/// assert!(on_residuals.gamma(50.0) < 0.01 * on_data.gamma(50.0), "{on_residuals} {on_data}");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn drift_variogram(
+    source: &VariogramSource,
+    fd: &FileData,
+    g: &[f64],
+    method: Method,
+    setting: Setting,
+) -> Result<Variogram> {
+    if !source.fits() {
+        return source.resolve(&fd.name, &fd.data);
+    }
+    let residuals = drift_residuals(&fd.data, g, method).map_err(|e| {
+        use terramesh_core::vocab::Named;
+        Error::setting(
+            setting,
+            "",
+            format!("{{{}}}: {}: {e}", setting.name(), fd.name),
+        )
+    })?;
+    source.resolve(&fd.name, &residuals)
 }
 
 /// What predicts: any [`Predictor`], or kriging with an external drift and the source of the

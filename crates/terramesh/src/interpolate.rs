@@ -28,11 +28,11 @@
 
 use std::fs::File;
 use std::io::{BufReader, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use terramesh_geostat::{
-    fit_auto, fit_model, Candidate, Data, Duplicates, Fit, GeostatError, Lag, ModelKind, Named,
-    Weighting,
+    experimental, fit_auto, fit_model, Candidate, Data, Duplicates, Fit, GeostatError, Lag,
+    LagSettings, ModelKind, Named, Variogram, Weighting,
 };
 use terramesh_io::grid_write::{write_asc, write_geotiff, RasterGrid};
 use terramesh_io::number::write_shortest;
@@ -41,6 +41,7 @@ use terramesh_io::table::{ReadOptions, Table};
 
 use crate::error::{bail, Context, Error, Result};
 use crate::external_drift::{Engine, PredictError};
+use crate::fitting::FitPlan;
 use crate::setting::Setting;
 
 /// Targets read and predicted per block: memory does not grow with the number of targets.
@@ -115,6 +116,67 @@ pub fn fit_named(
         ));
     };
     Ok((fit_model(lags, kind, w)?, Vec::new()))
+}
+
+/// Where the variogram of a kriging comes from: what a front end's variogram settings come
+/// down to (`terramesh interpolate`, `cv` and `simulate`: `--model` with `--psill` and
+/// `--range`, `--variogram FILE.json`, or `--variogram auto`).
+///
+/// ```
+/// use terramesh::fitting::FitPlan;
+/// use terramesh::interpolate::VariogramSource;
+/// use terramesh_geostat::{Data, Duplicates, LagSettings};
+/// let xy: Vec<[f64; 2]> = (0..100).map(|i| [(i % 10) as f64 * 10.0, (i / 10) as f64 * 10.0]).collect();
+/// let z: Vec<f64> = xy.iter().map(|p| (p[0] / 30.0).sin() + p[1] / 40.0).collect();
+/// let data = Data::new(xy, z, Duplicates::Reject)?;
+/// let auto = VariogramSource::Fit { lags: LagSettings::default(), plan: FitPlan::default() };
+/// assert!(auto.fits());
+/// let v = auto.resolve("d.csv", &data)?;
+/// assert!(v.validate().is_ok());
+/// assert_eq!(VariogramSource::Given(v.clone()).resolve("d.csv", &data)?, v);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub enum VariogramSource {
+    /// A model given in full.
+    Given(Variogram),
+    /// A JSON file written by `terramesh variogram`
+    /// ([`read_variogram_file`](crate::variogram_file::read_variogram_file)).
+    File(PathBuf),
+    /// Fitted to the data ([`crate::fitting::fit`]): the lag classes of the experimental
+    /// variogram and the fit's plan.
+    Fit {
+        /// The experimental variogram's settings.
+        lags: LagSettings,
+        /// The models, method and drift of the fit.
+        plan: FitPlan,
+    },
+}
+
+impl VariogramSource {
+    /// Whether the variogram is fitted to the data.
+    pub fn fits(&self) -> bool {
+        matches!(self, VariogramSource::Fit { .. })
+    }
+
+    /// The variogram: the given one, the file's, or the one fitted to `fit_to` (the data of
+    /// the file `name`, or the residuals of their external drift,
+    /// [`crate::external_drift::drift_variogram`]). A fit's errors name `name`.
+    pub fn resolve(&self, name: &str, fit_to: &Data) -> Result<Variogram> {
+        match self {
+            VariogramSource::Given(v) => Ok(v.clone()),
+            VariogramSource::File(path) => crate::variogram_file::read_variogram_file(path),
+            VariogramSource::Fit { lags, plan } => {
+                let lags = experimental(fit_to, lags)
+                    .map_err(Error::from)
+                    .context(name)?;
+                Ok(crate::fitting::fit(fit_to, &lags, plan)
+                    .context(name)?
+                    .fit
+                    .variogram)
+            }
+        }
+    }
 }
 
 /// Predicts at the `x,y` targets of a CSV file, block by block (memory does not grow with the

@@ -4,14 +4,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use terramesh::external_drift::{
-    drift_residuals, read_drift_column, DriftGrid, DriftSource, Engine,
-};
-use terramesh::interpolate::{predict_csv, predict_grid, read_data, FileData};
-use terramesh::variogram_file::read_variogram_file;
+use terramesh::external_drift::{drift_variogram, DriftSource, Engine};
+use terramesh::interpolate::{predict_csv, predict_grid, read_data, FileData, VariogramSource};
 use terramesh_geostat::{
-    experimental, kriging, Data, Drift, Duplicates, ExternalDriftKriging, Idw, IdwSearch,
-    InterpolationMethod, Method, Neighbourhood, Predictor, Variogram,
+    kriging, Data, Drift, Duplicates, ExternalDriftKriging, Idw, IdwSearch, InterpolationMethod,
+    Method, Neighbourhood, Predictor, Variogram,
 };
 use terramesh_io::grid_write::RasterGrid;
 
@@ -138,24 +135,22 @@ impl DriftArgs {
 /// The method, the drift at the data, the variogram and the targets' drift source.
 pub type Ked = (Method, Vec<f64>, Variogram, DriftSource);
 
-/// Kriging with an external drift set up from the flags: the method, the drift at the data,
-/// the variogram (an automatic fit made to the residuals of the drift) and where the
-/// targets' drift comes from; `None` without the flags.
+/// Kriging with an external drift set up from the flags (the library chooses and reads the
+/// drift and fits an automatic variogram to its residuals): the method, the drift at the
+/// data, the variogram and where the targets' drift comes from; `None` without the flags.
 pub fn external_drift(
     m: &MethodArgs,
     d: &DriftArgs,
     data: &Path,
     fd: &FileData,
 ) -> Result<Option<Ked>> {
-    let source = match (&d.external_drift, &d.external_drift_grid) {
-        (None, None) => return Ok(None),
-        (Some(c), None) => DriftSource::Column(c.clone()),
-        (None, Some(g)) => {
-            DriftSource::Grid(Box::new(DriftGrid::open(g).map_err(crate::flag_error)?))
-        }
-        (Some(_), Some(_)) => {
-            bail!("give --external-drift COLUMN or --external-drift-grid FILE, not both")
-        }
+    let Some(source) = DriftSource::choose(
+        d.external_drift.as_deref(),
+        d.external_drift_grid.as_deref(),
+    )
+    .map_err(crate::flag_error)?
+    else {
+        return Ok(None);
     };
     let flag = d.flag();
     let method = match m.method {
@@ -168,33 +163,31 @@ pub fn external_drift(
     if let Some(0) = m.neighbors {
         bail!("--neighbors 0: must be at least 1");
     }
-    let g = match &source {
-        DriftSource::Column(c) => {
-            read_drift_column(data, c, m.duplicates).map_err(crate::flag_error)?
-        }
-        DriftSource::Grid(grid) => grid
-            .sample_all(fd.data.xy())
-            .map_err(|e| crate::flag_error(e).context(format!("{}: the data", fd.name)))?,
-    };
-    // An automatic fit is made to the residuals of the drift (the drift's own variation out).
-    let v = if is_auto(&m.variogram) || is_auto(&m.model.model) {
-        let residuals = drift_residuals(&fd.data, &g, method)
-            .map_err(|e| crate::flag_error(e).context(format!("{flag}: {}", fd.name)))?;
-        resolve_for(m, fd, &residuals)?
-    } else {
-        resolve_for(m, fd, &fd.data)?
-    };
+    let g = source
+        .at_data(data, fd, m.duplicates)
+        .map_err(crate::flag_error)?;
+    let vs = variogram_source(m)?;
+    let v = drift_variogram(&vs, fd, &g, method, source.setting()).map_err(crate::flag_error)?;
+    print_fit(&vs, &v);
     Ok(Some((method, g, v, source)))
 }
 
 /// The variogram from --model/--psill/..., --variogram FILE or auto.
 pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
-    resolve_for(m, fd, &fd.data)
+    let vs = variogram_source(m)?;
+    let v = vs.resolve(&fd.name, &fd.data).map_err(crate::flag_error)?;
+    print_fit(&vs, &v);
+    Ok(v)
 }
 
-/// [`resolve_variogram`], an automatic fit made to `fit_to` (the data, or the residuals of
-/// their drift for kriging with an external drift).
-fn resolve_for(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram> {
+fn print_fit(vs: &VariogramSource, v: &Variogram) {
+    if vs.fits() {
+        eprintln!("terramesh: fitted variogram: {v}");
+    }
+}
+
+/// The variogram flags as a [`VariogramSource`].
+fn variogram_source(m: &MethodArgs) -> Result<VariogramSource> {
     let fitting = is_auto(&m.variogram);
     let auto_model = is_auto(&m.model.model);
     if m.model.anisotropy_auto()? && !fitting && !auto_model {
@@ -204,19 +197,19 @@ fn resolve_for(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram
         if m.variogram.is_some() {
             bail!("give either --variogram or --model with --psill/--range, not both");
         }
-        return Ok(v);
+        return Ok(VariogramSource::Given(v));
     }
     match m.variogram.as_deref() {
-        _ if fitting => auto(m, fd, fit_to),
-        Some(file) => read_variogram_file(Path::new(file)).map_err(crate::flag_error),
-        None if auto_model => auto(m, fd, fit_to),
+        _ if fitting => fit_plan(m),
+        Some(file) => Ok(VariogramSource::File(PathBuf::from(file))),
+        None if auto_model => fit_plan(m),
         None => bail!("kriging needs a variogram: --variogram auto, --variogram FILE.json, or --model NAME --psill C --range A [--nugget C0]"),
     }
 }
 
-fn auto(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram> {
-    let lags = experimental(fit_to, &m.lag.settings()).map_err(|e| in_file(&fd.name, e))?;
-    // REML filters out the drift of the kriging that will use the model.
+/// The fit of --variogram auto (or --model auto): lag classes, models, REML's drift (that of
+/// the kriging that will use the model) and --anisotropy auto.
+fn fit_plan(m: &MethodArgs) -> Result<VariogramSource> {
     let drift = match m.method {
         InterpolationMethod::Universal => m.drift.unwrap_or(Drift::Linear),
         _ => Drift::Constant,
@@ -226,11 +219,10 @@ fn auto(m: &MethodArgs, fd: &FileData, fit_to: &Data) -> Result<Variogram> {
     if m.model.anisotropy_auto()? {
         plan.anisotropy = Some(m.lag.anisotropy_plan()?);
     }
-    let fit = terramesh::fitting::fit(fit_to, &lags, &plan)
-        .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?
-        .fit;
-    eprintln!("terramesh: fitted variogram: {}", fit.variogram);
-    Ok(fit.variogram)
+    Ok(VariogramSource::Fit {
+        lags: m.lag.settings(),
+        plan,
+    })
 }
 
 /// The kriging method of the flags.

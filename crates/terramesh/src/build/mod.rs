@@ -452,10 +452,13 @@ fn build_into(
             || pictures::draw_all(out, &samples, &mesh, &interp),
             |p| format!("{} pictures", p.len()),
         )?;
-        let extra = match &geo {
-            Some(g) => vec![crate::geology::report::model_section(out, g, &mesh.mesh)?],
-            None => Vec::new(),
-        };
+        let mut extra = Vec::new();
+        if let Some(g) = &geo {
+            extra.push(crate::geology::report::model_section(out, g, &mesh.mesh)?);
+            extra.extend(crate::geology::ensemble_report::ensemble_section(
+                out, g, &mesh.mesh,
+            )?);
+        }
         if project.export.report {
             st.k += 1;
             progress.stage_start(st.k, st.total, "report");

@@ -308,7 +308,9 @@ pub fn write_report(
     });
     sections.push(Section {
         heading: "Interpolated surfaces".into(),
-        blocks: vec![png(4)?, png(5)?, png(6)?, png(7)?, png(8)?],
+        // The four maps, the realisations' std and P10/P90 maps when there are realisations,
+        // and the 3D view.
+        blocks: (4..pics.len()).map(png).collect::<Result<_>>()?,
     });
     sections.push(Section {
         heading: "Cross-validation".into(),

@@ -587,6 +587,7 @@ pub fn run(
         })
         .collect();
     built.summary.realisations = Some(e.summary(mesh, names));
+    built.ensemble = Some(super::ensemble_report::interface_spreads(&e, &g.units));
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&built.summary)?;
     write_csv(&path, |w| w.write_all(text.as_bytes()))?;

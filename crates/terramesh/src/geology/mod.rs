@@ -4,6 +4,7 @@
 //! written by `terramesh_io::model`.
 
 pub mod ensemble;
+pub mod ensemble_report;
 pub mod fields;
 pub mod model;
 pub mod report;

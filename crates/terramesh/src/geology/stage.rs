@@ -34,6 +34,9 @@ pub struct ModelBuilt {
     pub boreholes: Option<Boreholes>,
     /// Every file written.
     pub files: Vec<PathBuf>,
+    /// The spread of every interface over the realisations (`interpolation.realisations`),
+    /// for the report; `None` without realisations.
+    pub ensemble: Option<Vec<super::ensemble_report::InterfaceSpread>>,
 }
 
 /// The project's CRS for the model: the UTM zone of a geographic project, or the named CRS
@@ -239,6 +242,7 @@ pub fn run(
         summary,
         boreholes,
         files,
+        ensemble: None,
     })
 }
 
