@@ -79,7 +79,12 @@ fn the_model_command_writes_what_a_full_build_writes() {
         let o = model(&project, &modelled, &[&set]);
         assert!(!reused(&o), "{}", log(&o));
         let idw = methods.starts_with(r#"["idw""#);
-        assert_eq!(log(&o).contains("variogram: not fitted"), idw, "{}", log(&o));
+        assert_eq!(
+            log(&o).contains("variogram: not fitted"),
+            idw,
+            "{}",
+            log(&o)
+        );
         let written = files(&modelled);
         assert!(
             written.iter().any(|f| f.ends_with("dsm-cache.bin")),
