@@ -10,8 +10,12 @@ mod geology_site;
 use geology_site::site;
 
 fn model(project: &Path, out: &Path, sets: &[&str]) -> Output {
+    terramesh("model", project, out, sets)
+}
+
+fn terramesh(command: &str, project: &Path, out: &Path, sets: &[&str]) -> Output {
     let mut args = vec![
-        "model".to_string(),
+        command.to_string(),
         project.display().to_string(),
         "-o".into(),
         out.display().to_string(),
@@ -45,6 +49,57 @@ fn reused(o: &Output) -> bool {
 
 fn read(p: &Path) -> Vec<u8> {
     std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// Every file under `dir` (its path below `dir`).
+fn files(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut all = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            all.extend(files(&p));
+        } else {
+            all.push(p);
+        }
+    }
+    all
+}
+
+/// `terramesh model` computes only the part of the DSM the model stands on (no other
+/// method, no DSM grid, no cross-validation; the variogram only for a kriged DSM): every file
+/// it writes, the kept DSM included, is the same to the byte as `terramesh build`'s.
+#[test]
+fn the_model_command_writes_what_a_full_build_writes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let project = site(tmp.path());
+    for methods in [r#"["uk", "idw"]"#, r#"["idw", "uk"]"#, r#"["ok"]"#] {
+        let set = format!("interpolation.methods={methods}");
+        let (built, modelled) = (tmp.path().join("built"), tmp.path().join("modelled"));
+        terramesh("build", &project, &built, &[&set]);
+        let o = model(&project, &modelled, &[&set]);
+        assert!(!reused(&o), "{}", log(&o));
+        let idw = methods.starts_with(r#"["idw""#);
+        assert_eq!(
+            log(&o).contains("variogram: not fitted"),
+            idw,
+            "{}",
+            log(&o)
+        );
+        let written = files(&modelled);
+        assert!(
+            written.iter().any(|f| f.ends_with("dsm-cache.bin")),
+            "{written:?}"
+        );
+        for f in written {
+            let name = f.strip_prefix(&modelled).unwrap();
+            assert_eq!(
+                read(&f),
+                read(&built.join(name)),
+                "{} differs from the build's ({methods})",
+                name.display()
+            );
+        }
+    }
 }
 
 #[test]

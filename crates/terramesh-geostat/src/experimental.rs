@@ -237,6 +237,8 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
     // Fixed blocks of rows, summed in block order: the result does not depend on how rayon
     // schedules the work (a fold/reduce would regroup the sums from run to run).
     const ROWS: usize = 256;
+    // The sum of |dz|^½ is Cressie-Hawkins' only: Matheron's lags skip that root.
+    let robust = s.estimator == Estimator::CressieHawkins;
     let blocks: Vec<Vec<[f64; 4]>> = (0..n.div_ceil(ROWS))
         .into_par_iter()
         .map(|blk| {
@@ -275,7 +277,9 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
                     a[0] += 1.0;
                     a[1] += d;
                     a[2] += 0.5 * dz * dz;
-                    a[3] += dz.abs().sqrt();
+                    if robust {
+                        a[3] += dz.abs().sqrt();
+                    }
                 }
             }
             acc

@@ -14,6 +14,7 @@
 mod adaptive;
 mod ensemble;
 mod exports;
+mod model_dsm;
 mod pictures;
 mod report;
 pub mod reuse;
@@ -263,6 +264,22 @@ fn model_on_kept_dsm(
     }))
 }
 
+/// The mesh stage's line of the log.
+fn mesh_detail(m: &Meshed) -> String {
+    let adaptive = m.adaptive.as_ref().map_or(String::new(), |a| {
+        format!(
+            ", adaptive: within {:.3} m of kriging (target {} m), min 3D angle {:.1} deg",
+            a.verified_error, a.target, a.report.min_angle_3d
+        )
+    });
+    format!(
+        "{} vertices, {} triangles, min angle {:.1} deg{adaptive}",
+        m.mesh.points.len(),
+        m.mesh.triangles.len(),
+        m.after.min_angle
+    )
+}
+
 /// What a build writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum What {
@@ -336,6 +353,10 @@ fn build_into(
         || stages::sample(project, base, out, progress),
         |s| format!("{} samples from {}", s.xyz.len(), s.source),
     )?;
+    // `terramesh model` makes only what the geological model stands on (model_dsm.rs).
+    if what == What::ModelOnly && project.interpolation.realisations == 0 {
+        return model_dsm::build_rest(&mut st, project, base, out, &samples, dsm_key);
+    }
     let model = st.run(
         "variogram",
         || stages::model(project, &samples, base),
@@ -354,20 +375,7 @@ fn build_into(
     let mesh = st.run(
         "mesh",
         || stages::mesh(project, &samples, &model, &collars),
-        |m| {
-            let adaptive = m.adaptive.as_ref().map_or(String::new(), |a| {
-                format!(
-                    ", adaptive: within {:.3} m of kriging (target {} m), min 3D angle {:.1} deg",
-                    a.verified_error, a.target, a.report.min_angle_3d
-                )
-            });
-            format!(
-                "{} vertices, {} triangles, min angle {:.1} deg{adaptive}",
-                m.mesh.points.len(),
-                m.mesh.triangles.len(),
-                m.after.min_angle
-            )
-        },
+        mesh_detail,
     )?;
     let mut interp = st.run(
         "interpolation",

@@ -161,6 +161,13 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model, keep: &[[f64; 2]]) -> Resul
             adaptive: Some(info),
         });
     }
+    mesh_refined(p, s, keep)
+}
+
+/// [`mesh`] without `mesh.max_error`: constrained Delaunay refinement, then smoothing (no
+/// variogram needed).
+pub fn mesh_refined(p: &Project, s: &Samples, keep: &[[f64; 2]]) -> Result<Meshed> {
+    let m = &p.mesh;
     let mut builder = MeshBuilder::new().min_angle(m.min_angle);
     // Default size: one triangle per sampling cell, so the mesh resolves what was sampled.
     let max_area = match (m.max_area, m.max_edge) {
@@ -191,7 +198,11 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model, keep: &[[f64; 2]]) -> Resul
     } else {
         None
     };
-    let after = Quality::planar(&mesh);
+    // Unsmoothed, the mesh is the one measured already.
+    let after = match smoothing {
+        Some(_) => Quality::planar(&mesh),
+        None => before.clone(),
+    };
     Ok(Meshed {
         mesh,
         unsmoothed,
@@ -268,15 +279,20 @@ pub struct Model {
     pub selection: Option<Selection>,
 }
 
-/// Step 4a: the variogram of the samples (needed before meshing for adaptive refinement).
-pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
-    let ip = &p.interpolation;
-    let data = Data::new(
+/// The samples as kriging data (duplicates averaged).
+pub fn sample_data(s: &Samples) -> Result<Data> {
+    Data::new(
         s.xyz.iter().map(|q| [q[0], q[1]]).collect(),
         s.xyz.iter().map(|q| q[2]).collect(),
         Duplicates::Mean,
     )
-    .context("samples")?;
+    .context("samples")
+}
+
+/// Step 4a: the variogram of the samples (needed before meshing for adaptive refinement).
+pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
+    let ip = &p.interpolation;
+    let data = sample_data(s)?;
     // Kriging with an external drift: the raster at the samples, and a variogram fitted to
     // the residuals of the drift (its own variation taken out).
     let drift = match &ip.external_drift_grid {
