@@ -69,25 +69,18 @@ fn tiled(dir: &Path, project: &Path, size: &str, set: &[&str]) -> (PathBuf, Path
     (plan, merged)
 }
 
-/// The named `DataArray`'s values of an ASCII VTU (the first whose opening tag contains `tag`).
-fn array(text: &str, tag: &str) -> Vec<f64> {
-    let i = text.find(tag).unwrap_or_else(|| panic!("no {tag}"));
-    let i = i + text[i..].find('>').unwrap() + 1;
-    let j = i + text[i..].find("</DataArray>").unwrap();
-    text[i..j]
-        .split_whitespace()
-        .map(|x| x.parse::<f64>().unwrap())
-        .collect()
-}
+#[allow(dead_code)] // (`triangles` is for the DSM tests)
+#[path = "support/vtu_read.rs"]
+mod vtu_read;
 
-/// `model.vtu` (ASCII): points, cells in our node orders, materials.
+/// `model.vtu` (raw appended binary, as the merge writes it): points, cells in our node orders, materials.
 fn model(p: &Path) -> (Vec<[f64; 3]>, Vec<Cell>, Vec<i32>) {
-    let text = std::fs::read_to_string(p).unwrap();
-    let pts = array(&text, "NumberOfComponents=\"3\"");
-    let con = array(&text, "Name=\"connectivity\"");
-    let off = array(&text, "Name=\"offsets\"");
-    let types = array(&text, "Name=\"types\"");
-    let mat = array(&text, "Name=\"MaterialIDs\"");
+    let v = vtu_read::Vtu::read(p);
+    let pts = v.array("NumberOfComponents=\"3\"");
+    let con = v.array("Name=\"connectivity\"");
+    let off = v.array("Name=\"offsets\"");
+    let types = v.array("Name=\"types\"");
+    let mat = v.array("Name=\"MaterialIDs\"");
     let mut cells = Vec::new();
     let mut start = 0usize;
     for (k, &o) in off.iter().enumerate() {
@@ -368,11 +361,12 @@ fn grids_against_one_piece(set: &[&str], base: Option<&Path>) {
     for it in gp["interfaces"].as_array().unwrap() {
         assert_eq!(it["estimate"]["kind"], "grid", "{it}");
     }
-    let dsm = std::fs::read_to_string(merged.join("dsm.vtu")).unwrap();
-    let pts = array(&dsm, "NumberOfComponents=\"3\"");
+    let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
+    let pts = dsm.array("NumberOfComponents=\"3\"");
     let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
     let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
-    let tris: Vec<[u32; 3]> = array(&dsm, "Name=\"connectivity\"")
+    let tris: Vec<[u32; 3]> = dsm
+        .array("Name=\"connectivity\"")
         .chunks(3)
         .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
         .collect();
@@ -428,7 +422,7 @@ fn grids_against_one_piece(set: &[&str], base: Option<&Path>) {
             .units
             .get(s)
             .map_or("base".to_string(), |u| format!("top_{u}"));
-        let merged_s = array(&dsm, &format!("Name=\"{name}\""));
+        let merged_s = dsm.array(&format!("Name=\"{name}\""));
         assert_eq!(merged_s.len(), xy.len());
         for (a, b) in merged_s.iter().zip(&one.stack.surfaces[s]) {
             worst = worst.max((a - b).abs());
@@ -492,11 +486,12 @@ fn tiled_thickness_model_equals_a_one_piece_model_on_the_same_mesh() {
     let m = json(&plan.join("tiles.json"));
     let gp = &m["geology"];
     assert_eq!(gp["thickness"], true);
-    let dsm = std::fs::read_to_string(merged.join("dsm.vtu")).unwrap();
-    let pts = array(&dsm, "NumberOfComponents=\"3\"");
+    let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
+    let pts = dsm.array("NumberOfComponents=\"3\"");
     let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
     let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
-    let tris: Vec<[u32; 3]> = array(&dsm, "Name=\"connectivity\"")
+    let tris: Vec<[u32; 3]> = dsm
+        .array("Name=\"connectivity\"")
         .chunks(3)
         .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
         .collect();
@@ -557,7 +552,7 @@ fn tiled_thickness_model_equals_a_one_piece_model_on_the_same_mesh() {
             .units
             .get(s)
             .map_or("base".to_string(), |u| format!("top_{u}"));
-        let merged_s = array(&dsm, &format!("Name=\"{name}\""));
+        let merged_s = dsm.array(&format!("Name=\"{name}\""));
         for (a, b) in merged_s.iter().zip(&stack.surfaces[s]) {
             worst = worst.max((a - b).abs());
         }
