@@ -364,14 +364,8 @@ fn build_into(
     )?;
     let geology = project.geology();
     let model_crs = crate::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
-    let boreholes = match geology {
-        Some(g) => crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?,
-        None => None,
-    };
-    let collars = boreholes
-        .as_ref()
-        .map(crate::geology::stage::collar_points)
-        .unwrap_or_default();
+    let (boreholes, collars) =
+        crate::geology::stage::boreholes_and_collars(geology, samples.zone, samples.crs.as_ref())?;
     let mesh = st.run(
         "mesh",
         || stages::mesh(project, &samples, &model, &collars),

@@ -54,11 +54,8 @@ pub(super) fn build_rest(
         (None, None) => bail!("internal: neither a variogram nor the samples' data"),
     };
     let model_crs = crate::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
-    let boreholes = crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?;
-    let collars = boreholes
-        .as_ref()
-        .map(crate::geology::stage::collar_points)
-        .unwrap_or_default();
+    let (boreholes, collars) =
+        crate::geology::stage::boreholes_and_collars(Some(g), samples.zone, samples.crs.as_ref())?;
     let mesh = st.run(
         "mesh",
         || match &model {

@@ -82,6 +82,21 @@ pub fn read_boreholes(
     g.read_boreholes(Some(&project))
 }
 
+/// The boreholes of `g` when there is a `[geology]` section ([`read_boreholes`]) and the points
+/// they insert into the planar mesh ([`collar_points`]; none without boreholes).
+pub fn boreholes_and_collars(
+    g: Option<&GeologySettings>,
+    zone: Option<Zone>,
+    crs: Option<&Crs>,
+) -> Result<(Option<Boreholes>, Vec<[f64; 2]>)> {
+    let boreholes = match g {
+        Some(g) => read_boreholes(g, zone, crs)?,
+        None => None,
+    };
+    let collars = boreholes.as_ref().map(collar_points).unwrap_or_default();
+    Ok((boreholes, collars))
+}
+
 /// The points to insert as vertices of the planar mesh, so that the interfaces pass through
 /// the observed contacts there: every collar, and every contact of an inclined hole (where the
 /// desurveyed hole has moved away from its collar), leaving out a contact within
