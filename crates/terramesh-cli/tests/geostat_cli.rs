@@ -395,3 +395,34 @@ fn variogram_plot_is_png_or_svg_by_extension() {
     );
     assert!(!gif.exists());
 }
+
+/// `cv` checks its flags as `interpolate` does: a setting it would ignore is refused.
+#[test]
+fn cv_refuses_flags_it_would_ignore() {
+    let data = fx("data-srtm.csv");
+    let d = data.to_str().unwrap();
+    let sph = [
+        "--model",
+        "spherical",
+        "--psill",
+        "12000",
+        "--range",
+        "6000",
+    ];
+    let mut a = vec!["cv", "--data", d, "--method", "ok", "--radius", "500"];
+    a.extend(sph);
+    fails_with(
+        &a,
+        &["--radius applies to --method idw; kriging takes --neighbors"],
+    );
+    fails_with(
+        &["cv", "--data", d, "--method", "idw", "--neighbors", "0"],
+        &["--neighbors 0: must be at least 1"],
+    );
+    // The same flags without the contradiction run.
+    let mut ok = vec!["cv", "--data", d, "--method", "ok", "--neighbors", "16"];
+    ok.extend(sph);
+    let (pass, out, err) = run(&ok);
+    assert!(pass, "{err}");
+    assert!(out.contains("rmse,"), "{out}");
+}

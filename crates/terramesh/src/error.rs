@@ -197,6 +197,20 @@ impl Error {
         Error::Invalid(why.to_string())
     }
 
+    /// `source` within `context` (a file name, a stage): rendered `context: source`.
+    ///
+    /// ```
+    /// use terramesh::Error;
+    /// let e = Error::within("d.csv", Error::invalid("no data"));
+    /// assert_eq!(e.render(&|s| s.to_string()), "d.csv: no data");
+    /// ```
+    pub fn within(context: impl Display, source: impl Into<Error>) -> Error {
+        Error::Context {
+            context: context.to_string(),
+            source: Box::new(source.into()),
+        }
+    }
+
     /// The whole chain on one line, `context: cause: cause`, with each [`Setting`] written as
     /// `name` words it (a flag, a project key).
     ///

@@ -76,6 +76,44 @@ pub enum Setting {
     VarianceGrid,
     /// Geometric anisotropy (given or fitted).
     Anisotropy,
+    /// The interpolation method (sk, ok, uk, idw).
+    Method,
+    /// The polynomial drift of universal kriging.
+    Drift,
+    /// The known mean of simple kriging.
+    Mean,
+    /// The search radius of IDW.
+    Radius,
+    /// The power of IDW.
+    Power,
+    /// The partial sill(s) of a variogram model.
+    Psill,
+    /// The practical range(s) of a variogram model.
+    Range,
+    /// The nugget of a variogram model.
+    Nugget,
+    /// The shape (power exponent, Matérn ν) of a variogram model.
+    Shape,
+    /// The major axis angle of a given geometric anisotropy.
+    AnisotropyAngle,
+    /// The minor/major range ratio of a given geometric anisotropy.
+    AnisotropyRatio,
+    /// Where a variogram comes from (`auto` or a file).
+    Variogram,
+    /// The azimuth of a directional variogram.
+    Azimuth,
+    /// The angular tolerance of a directional variogram.
+    Tolerance,
+    /// The targets of an interpolation (a CSV of x, y).
+    Targets,
+    /// Estimates without kriging variances.
+    NoVariance,
+    /// The folds of a k-fold cross-validation.
+    Folds,
+    /// The spectral modes per realisation of a simulation.
+    Modes,
+    /// The chart of an experimental variogram.
+    Plot,
 }
 
 impl Setting {
@@ -137,4 +175,23 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::ExternalDriftGrid => "external-drift-grid",
     Setting::VarianceGrid => "variance-grid",
     Setting::Anisotropy => "anisotropy",
+    Setting::Method => "method",
+    Setting::Drift => "drift",
+    Setting::Mean => "mean",
+    Setting::Radius => "radius",
+    Setting::Power => "power",
+    Setting::Psill => "psill",
+    Setting::Range => "range",
+    Setting::Nugget => "nugget",
+    Setting::Shape => "shape",
+    Setting::AnisotropyAngle => "anisotropy-angle",
+    Setting::AnisotropyRatio => "anisotropy-ratio",
+    Setting::Variogram => "variogram",
+    Setting::Azimuth => "azimuth",
+    Setting::Tolerance => "tolerance",
+    Setting::Targets => "targets",
+    Setting::NoVariance => "no-variance",
+    Setting::Folds => "folds",
+    Setting::Modes => "modes",
+    Setting::Plot => "plot",
 ]);

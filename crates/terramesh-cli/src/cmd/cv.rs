@@ -3,13 +3,10 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use terramesh_geostat::{cross_validate, Folds, IdwSearch, Interpolator, Neighbourhood};
-
 use terramesh::interpolate::read_data;
-use terramesh_geostat::InterpolationMethod;
+use terramesh_geostat::{cross_validate, cross_validate_external, Folds};
 
-use super::geodata::in_file;
-use super::interpolate::{external_drift, method, resolve_variogram, DriftArgs, MethodArgs};
+use super::interpolate::{say, DriftArgs, MethodArgs};
 
 /// Cross-validate an interpolation method: leave-one-out (default) or k-fold.
 ///
@@ -42,40 +39,27 @@ pub fn run(args: Args) -> Result<()> {
         Some(k) if k < 2 => bail!("--folds {k}: must be at least 2"),
         Some(k) => Folds::KFold(k),
     };
-    let r = if let Some((method, g, v, _)) = external_drift(&args.m, &args.drift, &args.data, &fd)?
+    let m = args.m.options();
+    let e = |e| crate::flag_error(terramesh::Error::within(&fd.name, e));
+    let r = match m
+        .external_drift(&args.drift.options(), &args.data, &fd, &say)
+        .map_err(crate::flag_error)?
     {
-        let hood = args
-            .m
-            .neighbors
-            .map_or(Neighbourhood::All, Neighbourhood::Nearest);
-        terramesh_geostat::cross_validate_external(&fd.data, &g, &v, method, hood, folds)
-    } else {
-        let how = if args.m.method == InterpolationMethod::Idw {
-            if !(args.m.power.is_finite() && args.m.power > 0.0) {
-                bail!("--power {}: must be a finite number > 0", args.m.power);
-            }
-            Interpolator::Idw {
-                power: args.m.power,
-                search: match (args.m.neighbors, args.m.radius) {
-                    (Some(_), Some(_)) => bail!("IDW takes --neighbors or --radius, not both"),
-                    (Some(k), None) => IdwSearch::Nearest(k),
-                    (None, Some(r)) => IdwSearch::Radius(r),
-                    (None, None) => IdwSearch::All,
-                },
-            }
-        } else {
-            Interpolator::Kriging {
-                variogram: resolve_variogram(&args.m, &fd)?,
-                method: method(&args.m, &fd.data)?,
-                neighbours: args
-                    .m
-                    .neighbors
-                    .map_or(Neighbourhood::All, Neighbourhood::Nearest),
-            }
-        };
-        cross_validate(&fd.data, &how, folds)
+        Some(k) => cross_validate_external(
+            &fd.data,
+            &k.at_data,
+            &k.variogram,
+            k.method,
+            m.neighbourhood(),
+            folds,
+        ),
+        None => cross_validate(
+            &fd.data,
+            &m.interpolator(&fd, &say).map_err(crate::flag_error)?,
+            folds,
+        ),
     }
-    .map_err(|e| in_file(&fd.name, e))?;
+    .map_err(e)?;
     let s = r.stats;
     println!("key,value");
     println!("n,{}", s.n);

@@ -1,8 +1,9 @@
-//! Shared by `variogram`, `interpolate` and `cv`: the variogram flags and error messages that
-//! name the file or the flag.
+//! The flags of the variogram model and of the lag classes, shared by `variogram`,
+//! `interpolate`, `cv` and `simulate`, lowered to the library's settings
+//! ([`ModelOptions`], [`LagOptions`]), which check them.
 
-use anyhow::{bail, Result};
-use terramesh_geostat::{Anisotropy, GeostatError, ModelKind, Structure, Variogram};
+use terramesh::interpolate::{LagOptions, ModelOptions};
+use terramesh_geostat::{Estimator, FitMethod, Weighting};
 
 /// Variogram flags shared by the commands.
 #[derive(clap::Args, Debug, Clone)]
@@ -42,140 +43,71 @@ pub struct ModelArgs {
 }
 
 impl ModelArgs {
-    /// Whether `--anisotropy auto` was given (any other value is an error).
-    pub fn anisotropy_auto(&self) -> Result<bool> {
-        match self.anisotropy.as_deref() {
-            None => Ok(false),
-            Some(a) if a.eq_ignore_ascii_case("auto") => {
-                if self.anisotropy_angle.is_some() || self.anisotropy_ratio.is_some() {
-                    bail!("--anisotropy auto fits the angle and ratio: give it or --anisotropy-angle/--anisotropy-ratio, not both");
-                }
-                Ok(true)
-            }
-            Some(a) => bail!("--anisotropy '{a}': expected auto (give a known anisotropy by --anisotropy-angle DEG --anisotropy-ratio R)"),
+    /// The library's settings of these flags.
+    pub fn options(&self) -> ModelOptions {
+        ModelOptions {
+            model: self.model.clone(),
+            psill: self.psill.clone(),
+            range: self.range.clone(),
+            nugget: self.nugget,
+            shape: self.shape.clone(),
+            anisotropy_angle: self.anisotropy_angle,
+            anisotropy_ratio: self.anisotropy_ratio,
+            anisotropy: self.anisotropy.clone(),
         }
     }
 }
 
-/// One value per structure from a list flag: `n` values, or one for all when `one_for_all`.
-fn per_structure(
-    flag: &str,
-    values: &[f64],
-    n: usize,
-    name: &str,
-    one_for_all: bool,
-) -> Result<Vec<f64>> {
-    match values.len() {
-        k if k == n => Ok(values.to_vec()),
-        1 if one_for_all => Ok(vec![values[0]; n]),
-        k => {
-            let list: Vec<String> = values.iter().map(|v| v.to_string()).collect();
-            bail!(
-                "--{flag} {}: --model {name} has {n} structures: give {n} values separated by commas (got {k})",
-                list.join(",")
-            )
-        }
-    }
+/// Lag and fitting flags, shared with `interpolate --variogram auto` and `cv`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct LagArgs {
+    /// Number of lag classes.
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_LAGS)]
+    pub lags: usize,
+    /// Largest lag distance (default: half the data diameter).
+    #[arg(long, allow_hyphen_values = true)]
+    pub max_dist: Option<f64>,
+    /// Directional variogram: azimuth in degrees clockwise from north.
+    #[arg(long, allow_hyphen_values = true)]
+    pub azimuth: Option<f64>,
+    /// Angular tolerance of --azimuth, degrees.
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+    /// Semivariance estimator.
+    #[arg(long, value_parser = crate::named::<Estimator>(), default_value_t = Estimator::Matheron)]
+    pub estimator: Estimator,
+    /// Least-squares weights of the fit.
+    #[arg(long, value_parser = crate::named::<Weighting>(), default_value_t = Weighting::Cressie)]
+    pub weights: Weighting,
+    /// Compute the experimental variogram on at most this many data, drawn pseudo-randomly
+    /// (the same draw every run); 0 uses all (the pair count grows with the square).
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
+    pub max_points: usize,
+    /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
+    /// kriging's drift, from the WLS fit) or wls (weighted least squares on the lag classes).
+    /// With auto, both keep the model of least leave-one-out RMSE (REML: of kriging with the
+    /// drift; WLS: of ordinary kriging in 32 neighbours). Default: wls.
+    #[arg(long, value_parser = crate::named::<FitMethod>())]
+    pub fit: Option<FitMethod>,
+    /// REML in spatial blocks of at most this many data (a composite likelihood; each
+    /// evaluation is a Cholesky of this order per block); 0: exact REML on all data.
+    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_REML_BLOCK)]
+    pub reml_block: usize,
 }
 
-/// Builds the variogram from explicit flags; `None` when --model is absent or auto, or (with
-/// `fit`: --variogram auto) names models without --psill and --range, which are then fitted.
-pub fn explicit_or_fit(m: &ModelArgs, fit: bool) -> Result<Option<Variogram>> {
-    let Some(name) = m.model.as_deref() else {
-        if !m.psill.is_empty() || !m.range.is_empty() {
-            bail!("--psill/--range need --model (e.g. --model spherical)");
+impl LagArgs {
+    /// The library's settings of these flags.
+    pub fn options(&self) -> LagOptions {
+        LagOptions {
+            lags: self.lags,
+            max_dist: self.max_dist,
+            azimuth: self.azimuth,
+            tolerance: self.tolerance,
+            estimator: self.estimator,
+            weights: self.weights,
+            max_points: self.max_points,
+            fit: self.fit,
+            reml_block: self.reml_block,
         }
-        return Ok(None);
-    };
-    if name.eq_ignore_ascii_case("auto") {
-        return Ok(None);
-    }
-    if fit && m.psill.is_empty() && m.range.is_empty() {
-        return Ok(None);
-    }
-    let kinds = terramesh::fitting::parse_models(name).map_err(crate::flag_error)?;
-    let n = kinds.len();
-    let nugget = m.nugget.unwrap_or(0.0);
-    if !(nugget.is_finite() && nugget >= 0.0) {
-        bail!("--nugget {nugget}: must be a finite number >= 0");
-    }
-    let psills = match (kinds[0], m.psill.is_empty(), n) {
-        (ModelKind::Nugget, true, 1) => vec![0.0],
-        (_, true, _) => bail!(
-            "--model {name} needs --psill (the partial sill{})",
-            if n > 1 {
-                "s, one per structure: --psill C1,C2"
-            } else {
-                ""
-            }
-        ),
-        _ => per_structure("psill", &m.psill, n, name, false)?,
-    };
-    for &psill in &psills {
-        if !(psill.is_finite() && psill >= 0.0) {
-            bail!("--psill {psill}: must be a finite number >= 0");
-        }
-    }
-    let ranges = match (kinds[0], m.range.is_empty(), n) {
-        (ModelKind::Nugget, true, 1) => vec![1.0],
-        (_, true, _) => bail!(
-            "--model {name} needs --range (the practical range{})",
-            if n > 1 {
-                "s, one per structure: --range A1,A2"
-            } else {
-                ""
-            }
-        ),
-        _ => per_structure("range", &m.range, n, name, false)?,
-    };
-    for &range in &ranges {
-        if !(range.is_finite() && range > 0.0) {
-            bail!("--range {range}: must be a finite number > 0");
-        }
-    }
-    let total: f64 = psills.iter().sum();
-    if nugget + total == 0.0 {
-        let p: Vec<String> = psills.iter().map(|v| v.to_string()).collect();
-        bail!("--psill {} and --nugget {nugget}: the sill is zero, so kriging weights are undefined; give a positive --psill", p.join(","));
-    }
-    let shapes = if m.shape.is_empty() {
-        None
-    } else {
-        Some(per_structure("shape", &m.shape, n, name, true)?)
-    };
-    let structures = (0..n)
-        .map(|i| {
-            let mut s = Structure::new(kinds[i], psills[i], ranges[i]);
-            if let Some(sh) = &shapes {
-                s.shape = sh[i];
-            }
-            s
-        })
-        .collect();
-    let anisotropy = match (m.anisotropy_angle, m.anisotropy_ratio) {
-        (None, None) => None,
-        (a, r) => Some(Anisotropy {
-            angle: a.unwrap_or(0.0),
-            ratio: r.unwrap_or(1.0),
-        }),
-    };
-    let v = Variogram {
-        nugget,
-        structures,
-        anisotropy,
-    };
-    v.validate()
-        .map_err(|e| anyhow::anyhow!("variogram flags: {e}"))?;
-    Ok(Some(v))
-}
-
-/// Wraps a library error with the data file name.
-pub fn in_file(name: &str, e: GeostatError) -> anyhow::Error {
-    match e {
-        // A size refused before allocation names the setting to change as its flag.
-        GeostatError::TooLarge(t) => {
-            anyhow::anyhow!("{name}: {}", t.describe(&crate::wording::flag_of_field))
-        }
-        e => anyhow::anyhow!("{name}: {e}"),
     }
 }

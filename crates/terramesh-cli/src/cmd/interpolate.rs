@@ -1,21 +1,15 @@
 //! `terramesh interpolate`: kriging (simple, ordinary, universal) or IDW at target points or
 //! on a grid.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
-use terramesh::external_drift::{drift_variogram, DriftSource, Engine};
-use terramesh::interpolate::{predict_csv, predict_grid, read_data, FileData, VariogramSource};
-use terramesh_geostat::{
-    kriging, Data, Drift, Duplicates, ExternalDriftKriging, Idw, IdwSearch, InterpolationMethod,
-    Method, Neighbourhood, Predictor, Variogram,
-};
-use terramesh_io::grid_write::RasterGrid;
+use anyhow::Result;
+use terramesh::interpolate::{DriftOptions, InterpolateJob, MethodOptions, Targets};
+use terramesh_geostat::{Drift, Duplicates, InterpolationMethod};
 
-use super::geodata::{explicit_or_fit, in_file, ModelArgs};
-use super::variogram::LagArgs;
+use super::geodata::{LagArgs, ModelArgs};
 
-/// Method and variogram flags shared with `cv`.
+/// Method and variogram flags shared with `cv` and `simulate`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct MethodArgs {
     /// sk, ok, uk (kriging) or idw.
@@ -115,216 +109,55 @@ pub struct DriftArgs {
     external_drift_grid: Option<PathBuf>,
 }
 
-/// Whether a variogram or model flag says `auto`.
-fn is_auto(flag: &Option<String>) -> bool {
-    flag.as_deref()
-        .is_some_and(|s| s.eq_ignore_ascii_case("auto"))
+impl MethodArgs {
+    /// The library's settings of these flags (checked there).
+    pub fn options(&self) -> MethodOptions {
+        MethodOptions {
+            method: self.method,
+            drift: self.drift,
+            mean: self.mean,
+            model: self.model.options(),
+            variogram: self.variogram.clone(),
+            lag: self.lag.options(),
+            neighbors: self.neighbors,
+            radius: self.radius,
+            power: self.power,
+            duplicates: self.duplicates,
+        }
+    }
 }
 
 impl DriftArgs {
-    /// The flag that asked for the external drift, for messages.
-    fn flag(&self) -> &'static str {
-        if self.external_drift.is_some() {
-            "--external-drift"
-        } else {
-            "--external-drift-grid"
+    /// The library's settings of these flags.
+    pub fn options(&self) -> DriftOptions {
+        DriftOptions {
+            column: self.external_drift.clone(),
+            grid: self.external_drift_grid.clone(),
         }
     }
 }
 
-/// The method, the drift at the data, the variogram and the targets' drift source.
-pub type Ked = (Method, Vec<f64>, Variogram, DriftSource);
-
-/// Kriging with an external drift set up from the flags (the library chooses and reads the
-/// drift and fits an automatic variogram to its residuals): the method, the drift at the
-/// data, the variogram and where the targets' drift comes from; `None` without the flags.
-pub fn external_drift(
-    m: &MethodArgs,
-    d: &DriftArgs,
-    data: &Path,
-    fd: &FileData,
-) -> Result<Option<Ked>> {
-    let Some(source) = DriftSource::choose(
-        d.external_drift.as_deref(),
-        d.external_drift_grid.as_deref(),
-    )
-    .map_err(crate::flag_error)?
-    else {
-        return Ok(None);
-    };
-    let flag = d.flag();
-    let method = match m.method {
-        InterpolationMethod::Ordinary | InterpolationMethod::Universal => method(m, &fd.data)?,
-        other => bail!("{flag}: kriging with an external drift is --method ok (the constant and the drift) or uk (the polynomial and the drift), not {other}"),
-    };
-    if m.radius.is_some() {
-        bail!("--radius applies to --method idw; kriging takes --neighbors");
-    }
-    if let Some(0) = m.neighbors {
-        bail!("--neighbors 0: must be at least 1");
-    }
-    let g = source
-        .at_data(data, fd, m.duplicates)
-        .map_err(crate::flag_error)?;
-    let vs = variogram_source(m)?;
-    let v = drift_variogram(&vs, fd, &g, method, source.setting()).map_err(crate::flag_error)?;
-    print_fit(&vs, &v);
-    Ok(Some((method, g, v, source)))
-}
-
-/// The variogram from --model/--psill/..., --variogram FILE or auto.
-pub fn resolve_variogram(m: &MethodArgs, fd: &FileData) -> Result<Variogram> {
-    let vs = variogram_source(m)?;
-    let v = vs.resolve(&fd.name, &fd.data).map_err(crate::flag_error)?;
-    print_fit(&vs, &v);
-    Ok(v)
-}
-
-fn print_fit(vs: &VariogramSource, v: &Variogram) {
-    if vs.fits() {
-        eprintln!("terramesh: fitted variogram: {v}");
-    }
-}
-
-/// The variogram flags as a [`VariogramSource`].
-fn variogram_source(m: &MethodArgs) -> Result<VariogramSource> {
-    let fitting = is_auto(&m.variogram);
-    let auto_model = is_auto(&m.model.model);
-    if m.model.anisotropy_auto()? && !fitting && !auto_model {
-        bail!("--anisotropy auto fits the anisotropy with the variogram: give --variogram auto (the model's angle and ratio are otherwise --anisotropy-angle and --anisotropy-ratio)");
-    }
-    if let Some(v) = explicit_or_fit(&m.model, fitting)? {
-        if m.variogram.is_some() {
-            bail!("give either --variogram or --model with --psill/--range, not both");
-        }
-        return Ok(VariogramSource::Given(v));
-    }
-    match m.variogram.as_deref() {
-        _ if fitting => fit_plan(m),
-        Some(file) => Ok(VariogramSource::File(PathBuf::from(file))),
-        None if auto_model => fit_plan(m),
-        None => bail!("kriging needs a variogram: --variogram auto, --variogram FILE.json, or --model NAME --psill C --range A [--nugget C0]"),
-    }
-}
-
-/// The fit of --variogram auto (or --model auto): lag classes, models, REML's drift (that of
-/// the kriging that will use the model) and --anisotropy auto.
-fn fit_plan(m: &MethodArgs) -> Result<VariogramSource> {
-    let drift = match m.method {
-        InterpolationMethod::Universal => m.drift.unwrap_or(Drift::Linear),
-        _ => Drift::Constant,
-    };
-    let model = m.model.model.as_deref().unwrap_or("auto");
-    let mut plan = m.lag.plan(model, drift);
-    if m.model.anisotropy_auto()? {
-        plan.anisotropy = Some(m.lag.anisotropy_plan()?);
-    }
-    Ok(VariogramSource::Fit {
-        lags: m.lag.settings(),
-        plan,
-    })
-}
-
-/// The kriging method of the flags.
-pub fn method(m: &MethodArgs, data: &Data) -> Result<Method> {
-    if m.drift.is_some() && m.method != InterpolationMethod::Universal {
-        bail!("--drift applies to --method uk only");
-    }
-    if m.mean.is_some() && m.method != InterpolationMethod::Simple {
-        bail!("--mean applies to --method sk only");
-    }
-    m.method
-        .method(m.drift.unwrap_or(Drift::Linear), m.mean, data)
-        .context("IDW has no kriging method")
-}
-
-/// Builds the interpolator for the flags.
-pub fn engine(m: &MethodArgs, fd: &FileData, variance: bool) -> Result<Box<dyn Predictor>> {
-    if let Some(k) = m.neighbors {
-        if k == 0 {
-            bail!("--neighbors 0: must be at least 1");
-        }
-    }
-    if m.method == InterpolationMethod::Idw {
-        if !(m.power.is_finite() && m.power > 0.0) {
-            bail!("--power {}: must be a finite number > 0", m.power);
-        }
-        let search = match (m.neighbors, m.radius) {
-            (Some(_), Some(_)) => bail!("IDW takes --neighbors or --radius, not both"),
-            (Some(k), None) => IdwSearch::Nearest(k),
-            (None, Some(r)) if !(r.is_finite() && r > 0.0) => {
-                bail!("--radius {r}: must be a finite number > 0")
-            }
-            (None, Some(r)) => IdwSearch::Radius(r),
-            (None, None) => IdwSearch::All,
-        };
-        return Ok(Box::new(
-            Idw::new(&fd.data, m.power, search).map_err(|e| in_file(&fd.name, e))?,
-        ));
-    }
-    if m.radius.is_some() {
-        bail!("--radius applies to --method idw; kriging takes --neighbors");
-    }
-    let method = method(m, &fd.data)?;
-    let v = resolve_variogram(m, fd)?;
-    let hood = m
-        .neighbors
-        .map_or(Neighbourhood::All, Neighbourhood::Nearest);
-    kriging(&fd.data, &v, method, hood, variance).map_err(|e| in_file(&fd.name, e))
-}
-
-/// The engine of `interpolate`: [`engine`], or kriging with an external drift.
-fn engine_of(args: &Args, fd: &FileData, variance: bool) -> Result<Engine> {
-    let Some((method, g, v, source)) = external_drift(&args.m, &args.drift, &args.data, fd)? else {
-        return Ok(Engine::Plain(engine(&args.m, fd, variance)?));
-    };
-    let flag = args.drift.flag();
-    let hood = args
-        .m
-        .neighbors
-        .map_or(Neighbourhood::All, Neighbourhood::Nearest);
-    let kriging = ExternalDriftKriging::new(&fd.data, &g, &v, method, hood, variance)
-        .map_err(|e| anyhow::anyhow!("{flag}: {}", in_file(&fd.name, e)))?;
-    if let Some(b) = kriging.coefficient() {
-        eprintln!("terramesh: external drift coefficient: {b} (z per unit of the drift)");
-    }
-    Ok(Engine::External {
-        kriging: Box::new(kriging),
-        source,
-    })
+/// What the library tells the user while it works, on standard error.
+pub fn say(text: &str) {
+    eprintln!("terramesh: {text}");
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let fd = read_data(&args.data, args.m.duplicates).map_err(crate::flag_error)?;
-    let want_var = args.m.method != InterpolationMethod::Idw && !args.no_variance;
-    if args.variance_grid.is_some() {
-        if args.grid.is_none() {
-            bail!("--variance-grid writes the variances beside --grid's estimates: give --grid (with --targets the variances are a column of -o)");
-        }
-        if args.m.method == InterpolationMethod::Idw {
-            bail!("--variance-grid: IDW has no variance; give --method sk, ok or uk");
-        }
-        if args.no_variance {
-            bail!("--variance-grid and --no-variance contradict each other: give one");
-        }
-    }
-    let eng = engine_of(&args, &fd, want_var)?;
-    match (&args.targets, &args.grid) {
-        (Some(t), None) => {
-            predict_csv(&eng, t, want_var, args.output.as_deref()).map_err(crate::flag_error)
-        }
-        (None, Some(g)) => {
-            let spec: RasterGrid = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
-            let Some(out) = &args.output else {
-                bail!("--grid needs -o FILE.asc or -o FILE.tif");
-            };
-            if args.drift.external_drift.is_some() {
-                bail!("--grid with --external-drift: grid nodes have no column; sample the drift from a raster with --external-drift-grid");
-            }
-            predict_grid(&eng, &spec, out, args.variance_grid.as_deref(), args.epsg)
-                .map_err(crate::flag_error)
-        }
-        _ => bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
-    }
+    let targets = match (args.targets, args.grid) {
+        (Some(t), None) => Targets::Csv(t),
+        (None, Some(g)) => Targets::Grid(g),
+        _ => anyhow::bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
+    };
+    let job = InterpolateJob {
+        data: args.data,
+        targets,
+        method: args.m.options(),
+        drift: args.drift.options(),
+        no_variance: args.no_variance,
+        epsg: args.epsg,
+        variance_grid: args.variance_grid,
+        output: args.output,
+    };
+    job.run(&say).map_err(crate::flag_error)
 }

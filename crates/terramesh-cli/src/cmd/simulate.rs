@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use terramesh::interpolate::read_data;
 use terramesh::simulate::{read_targets, run_simulation, write_ensemble};
-use terramesh_geostat::{InterpolationMethod, Neighbourhood, SimulationSettings, DEFAULT_MODES};
+use terramesh_geostat::{SimulationSettings, DEFAULT_MODES};
 use terramesh_io::grid_write::RasterGrid;
 
-use super::interpolate::{method, resolve_variogram, MethodArgs};
+use super::interpolate::{say, MethodArgs};
 
 /// Conditional simulation: N realisations of a Gaussian field with the variogram, each equal
 /// to the data at the data, whose mean is the kriging estimate and whose variance is the
@@ -57,24 +57,17 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    if args.m.method == InterpolationMethod::Idw {
-        bail!("--method idw: simulation conditions by kriging; give sk, ok or uk");
-    }
-    if args.m.radius.is_some() {
-        bail!("--radius applies to --method idw; simulation takes --neighbors");
-    }
+    let m = args.m.options();
+    m.check_simulation().map_err(crate::flag_error)?;
     if args.realisations == 0 {
         bail!("--realisations 0: give at least 1");
     }
     if args.modes == 0 {
         bail!("--modes 0: give at least 1");
     }
-    if let Some(0) = args.m.neighbors {
-        bail!("--neighbors 0: must be at least 1");
-    }
-    let fd = read_data(&args.data, args.m.duplicates).map_err(crate::flag_error)?;
-    let method = method(&args.m, &fd.data)?;
-    let v = resolve_variogram(&args.m, &fd)?;
+    let fd = read_data(&args.data, m.duplicates).map_err(crate::flag_error)?;
+    let method = m.method(&fd.data).map_err(crate::flag_error)?;
+    let v = m.resolve_variogram(&fd, &say).map_err(crate::flag_error)?;
     let targets = match (&args.targets, &args.grid) {
         (Some(t), None) => read_targets(t).map_err(crate::flag_error)?,
         (None, Some(g)) => {
@@ -101,10 +94,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         _ => bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
     };
-    let hood = args
-        .m
-        .neighbors
-        .map_or(Neighbourhood::All, Neighbourhood::Nearest);
+    let hood = m.neighbourhood();
     let mut settings = SimulationSettings::new(args.realisations, args.seed);
     settings.modes = args.modes;
     let e = run_simulation(&fd.data, &v, method, hood, &targets, &settings)

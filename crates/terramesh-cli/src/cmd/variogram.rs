@@ -1,104 +1,12 @@
 //! `terramesh variogram`: experimental semivariogram of x,y,z data and a fitted model.
 
-use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
-use terramesh::fitting::{fit as fit_plan, AnisotropyPlan, FitPlan};
-use terramesh_geostat::{
-    experimental, AutoSettings, CandidateEntry, Direction, Drift, Duplicates, Estimator, FitMethod,
-    FitSummary, LagSettings, LagSummary, VariogramFile, Weighting,
-};
-use terramesh_io::output::Output;
+use anyhow::Result;
+use terramesh::interpolate::VariogramJob;
+use terramesh_geostat::{Drift, Duplicates};
 
-use terramesh::interpolate::read_data;
-
-use super::geodata::in_file;
-
-/// Lag and fitting flags, shared with `interpolate --variogram auto` and `cv`.
-#[derive(clap::Args, Debug, Clone)]
-pub struct LagArgs {
-    /// Number of lag classes.
-    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_LAGS)]
-    pub lags: usize,
-    /// Largest lag distance (default: half the data diameter).
-    #[arg(long, allow_hyphen_values = true)]
-    pub max_dist: Option<f64>,
-    /// Directional variogram: azimuth in degrees clockwise from north.
-    #[arg(long, allow_hyphen_values = true)]
-    pub azimuth: Option<f64>,
-    /// Angular tolerance of --azimuth, degrees.
-    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_TOLERANCE)]
-    pub tolerance: f64,
-    /// Semivariance estimator.
-    #[arg(long, value_parser = crate::named::<Estimator>(), default_value_t = Estimator::Matheron)]
-    pub estimator: Estimator,
-    /// Least-squares weights of the fit.
-    #[arg(long, value_parser = crate::named::<Weighting>(), default_value_t = Weighting::Cressie)]
-    pub weights: Weighting,
-    /// Compute the experimental variogram on at most this many data, drawn pseudo-randomly
-    /// (the same draw every run); 0 uses all (the pair count grows with the square).
-    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
-    pub max_points: usize,
-    /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
-    /// kriging's drift, from the WLS fit) or wls (weighted least squares on the lag classes).
-    /// With auto, both keep the model of least leave-one-out RMSE (REML: of kriging with the
-    /// drift; WLS: of ordinary kriging in 32 neighbours). Default: wls.
-    #[arg(long, value_parser = crate::named::<FitMethod>())]
-    pub fit: Option<FitMethod>,
-    /// REML in spatial blocks of at most this many data (a composite likelihood; each
-    /// evaluation is a Cholesky of this order per block); 0: exact REML on all data.
-    #[arg(long, default_value_t = terramesh_geostat::DEFAULT_REML_BLOCK)]
-    pub reml_block: usize,
-}
-
-impl LagArgs {
-    pub fn settings(&self) -> LagSettings {
-        LagSettings {
-            lags: self.lags,
-            max_dist: self.max_dist,
-            direction: self.azimuth.map(|a| Direction {
-                azimuth: a,
-                tolerance: self.tolerance,
-            }),
-            estimator: self.estimator,
-            max_points: (self.max_points > 0).then_some(self.max_points),
-        }
-    }
-    pub fn weighting(&self) -> Weighting {
-        self.weights
-    }
-    /// The fitting plan of `model` (`auto`, a name or a nested sum) for kriging with `drift`.
-    pub fn plan(&self, model: &str, drift: Drift) -> FitPlan {
-        FitPlan {
-            model: model.to_string(),
-            method: self.fit,
-            auto: AutoSettings {
-                drift,
-                weighting: self.weights,
-                block: (self.reml_block > 0).then_some(self.reml_block),
-                ..AutoSettings::default()
-            },
-            anisotropy: None,
-        }
-    }
-
-    /// The anisotropy fit of `--anisotropy auto`: 8 azimuths, these lag classes and
-    /// `--tolerance`; a directional `--azimuth` contradicts it.
-    pub fn anisotropy_plan(&self) -> Result<AnisotropyPlan> {
-        if let Some(a) = self.azimuth {
-            anyhow::bail!("--azimuth {a} and --anisotropy auto: the anisotropy fit makes its own directional variograms (8 azimuths within --tolerance); give one of them");
-        }
-        if !(self.tolerance > 0.0 && self.tolerance <= 90.0) {
-            anyhow::bail!("--tolerance {}: must be in (0, 90] degrees", self.tolerance);
-        }
-        Ok(AnisotropyPlan {
-            lags: self.settings(),
-            tolerance: self.tolerance,
-            ..AnisotropyPlan::default()
-        })
-    }
-}
+use super::geodata::LagArgs;
 
 /// Compute an experimental semivariogram and fit a model to it.
 ///
@@ -150,76 +58,19 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    if let Some(p) = &args.plot {
-        let ext = p
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase());
-        if !matches!(ext.as_deref(), Some("svg" | "png")) {
-            anyhow::bail!(
-                "--plot {}: the file name must end in .svg or .png",
-                p.display()
-            );
-        }
-    }
-    let fd = read_data(&args.data, args.duplicates).map_err(crate::flag_error)?;
-    let s = args.lag.settings();
-    let lags = experimental(&fd.data, &s).map_err(|e| in_file(&fd.name, e))?;
-    let mut plan = args.lag.plan(&args.model, args.drift);
-    match args.anisotropy.as_deref() {
-        None => {}
-        Some(a) if a.eq_ignore_ascii_case("auto") => {
-            plan.anisotropy = Some(args.lag.anisotropy_plan()?)
-        }
-        Some(a) => anyhow::bail!("--anisotropy '{a}': expected auto"),
-    }
-    let fitted = fit_plan(&fd.data, &lags, &plan)
-        .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
-    let (fit, cands, directions) = (fitted.fit, fitted.candidates, fitted.directions);
-    let file = VariogramFile {
-        data: fd.name.clone(),
-        points: fd.data.len(),
-        lags: Some(LagSummary {
-            classes: s.lags,
-            max_dist: lags.last().map(|l| l.hi),
-            azimuth: args.lag.azimuth,
-            tolerance: args.lag.azimuth.map(|_| args.lag.tolerance),
-            estimator: s.estimator,
-        }),
-        experimental: lags.clone(),
-        model: fit.variogram.clone(),
-        fit: Some(FitSummary {
-            weights: args.lag.weighting(),
-            objective: fit.objective,
-            rmse: fit.rmse,
-        }),
-        candidates: cands.into_iter().map(CandidateEntry::Full).collect(),
-        selection: fitted.selection,
-        directions,
+    let job = VariogramJob {
+        data: args.data,
+        model: args.model,
+        anisotropy: args.anisotropy,
+        lag: args.lag.options(),
+        drift: args.drift,
+        duplicates: args.duplicates,
+        output: args.output,
+        plot: args.plot,
     };
-    let mut out = Output::create(args.output.as_deref())?;
-    out.write_all(file.to_json_pretty().as_bytes())?;
-    out.write_all(b"\n")?;
-    out.commit()?;
-    if let Some(p) = &args.plot {
-        let title = format!("{}: {} points", fd.name, fd.data.len());
-        let pts: Vec<(f64, f64, u64)> = lags
-            .iter()
-            .map(|l| (l.distance, l.gamma, l.pairs))
-            .collect();
-        let label = fit.variogram.to_string();
-        terramesh_io::pictures::render_file(p, (900, 600), |root| {
-            terramesh_io::pictures::draw_variogram(
-                root,
-                &pts,
-                &|h| fit.variogram.gamma(h),
-                &title,
-                &label,
-            )
-        })
-        .with_context(|| format!("--plot {}", p.display()))?;
-    }
-    if args.output.is_some() {
-        eprintln!("terramesh: variogram model: {}", fit.variogram);
+    let file = job.run().map_err(crate::flag_error)?;
+    if job.output.is_some() {
+        eprintln!("terramesh: variogram model: {}", file.model);
     }
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! Interpolation of scattered x, y, z data on its own (`terramesh variogram`, `interpolate`,
-//! `cv`): reading the data with line numbers, fitting a variogram by name, and predicting at
+//! `cv`): the settings of each command checked and lowered ([`MethodOptions`],
+//! [`ModelOptions`], [`LagOptions`]; whole runs: [`InterpolateJob`], [`VariogramJob`]),
+//! reading the data with line numbers, fitting a variogram by name, and predicting at
 //! the targets of a CSV file or on a grid through an [`Engine`]: any
 //! [`Predictor`](terramesh_geostat::Predictor), or kriging with an external drift.
 //!
@@ -25,6 +27,16 @@
 //! assert!(std::fs::read_to_string(&out)?.starts_with("x,y,z,variance\n15,15,"));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+
+mod job;
+mod method_options;
+mod model_options;
+mod variogram_job;
+
+pub use job::{InterpolateJob, Targets};
+pub use method_options::{DriftOptions, ExternalDriftSetup, MethodOptions};
+pub use model_options::{LagOptions, ModelOptions};
+pub use variogram_job::VariogramJob;
 
 use std::fs::File;
 use std::io::{BufReader, Write};

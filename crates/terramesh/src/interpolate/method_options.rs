@@ -1,0 +1,506 @@
+//! The method settings of a standalone interpolation (`terramesh interpolate`, `cv`,
+//! `simulate`): kriging or IDW, its drift, neighbourhood and variogram, checked together and
+//! lowered to the kernels' types: a [`Predictor`], an [`Interpolator`] for cross-validation,
+//! or kriging with an external drift.
+//!
+//! A front end fills a [`MethodOptions`] from its own words (flags, keywords) and renders the
+//! [`Error::Setting`]s these checks return in them ([`Error::render`]).
+//!
+//! ```
+//! use terramesh::interpolate::MethodOptions;
+//! use terramesh_geostat::{Data, Duplicates, InterpolationMethod};
+//! let mut m = MethodOptions::new(InterpolationMethod::Ordinary);
+//! m.model.model = Some("spherical".into());
+//! m.model.psill = vec![1.0];
+//! m.model.range = vec![30.0];
+//! let xy: Vec<[f64; 2]> = (0..25).map(|i| [(i % 5) as f64 * 10.0, (i / 5) as f64 * 10.0]).collect();
+//! let z: Vec<f64> = xy.iter().map(|p| p[0] / 10.0 + p[1] / 20.0).collect();
+//! let fd = terramesh::interpolate::FileData { data: Data::new(xy, z, Duplicates::Reject)?, name: "d.csv".into() };
+//! let kriging = m.engine(&fd, true, &|_| {})?;
+//! let (mut est, mut var) = ([0.0], [0.0]);
+//! kriging.predict(&[[15.0, 15.0]], &mut est, Some(&mut var))?;
+//! assert!(est[0].is_finite() && var[0] > 0.0);
+//!
+//! // IDW takes a number of neighbours or a radius, not both.
+//! m.method = InterpolationMethod::Idw;
+//! m.neighbors = Some(4);
+//! m.radius = Some(20.0);
+//! let e = m.engine(&fd, false, &|_| {}).map(|_| ()).unwrap_err();
+//! assert_eq!(e.render(&|s| format!("--{s}")), "IDW takes --neighbors or --radius, not both");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use terramesh_geostat::{
+    kriging, Data, Drift, Duplicates, ExternalDriftKriging, GeostatError, Idw, IdwSearch,
+    InterpolationMethod, Interpolator, Method, Neighbourhood, Predictor, Variogram,
+};
+
+use super::{FileData, LagOptions, ModelOptions, VariogramSource};
+use crate::error::{Context, Error, Result};
+use crate::external_drift::{drift_variogram, DriftSource, Engine};
+use crate::setting::Setting;
+
+/// The settings of one kriging or IDW, as a front end gives them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MethodOptions {
+    /// sk, ok, uk or idw.
+    pub method: InterpolationMethod,
+    /// The drift of universal kriging (default linear).
+    pub drift: Option<Drift>,
+    /// The known mean of simple kriging (default: the data mean).
+    pub mean: Option<f64>,
+    /// The variogram model's settings.
+    pub model: ModelOptions,
+    /// `auto` (fit the model) or a JSON file written by `terramesh variogram`.
+    pub variogram: Option<String>,
+    /// The lag classes and the fit of an automatic variogram.
+    pub lag: LagOptions,
+    /// A moving neighbourhood of this many nearest data (default: all data).
+    pub neighbors: Option<usize>,
+    /// IDW: the data within this radius.
+    pub radius: Option<f64>,
+    /// IDW power.
+    pub power: f64,
+    /// What to do with data at one location.
+    pub duplicates: Duplicates,
+}
+
+/// The external drift's secondary variable: a column of the data and targets, or a raster.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DriftOptions {
+    /// The column of the data CSV and of the targets CSV.
+    pub column: Option<String>,
+    /// The raster sampled at the data, the targets and the grid nodes.
+    pub grid: Option<PathBuf>,
+}
+
+impl DriftOptions {
+    /// The setting that asked for the external drift.
+    pub fn setting(&self) -> Setting {
+        if self.column.is_some() {
+            Setting::ExternalDrift
+        } else {
+            Setting::ExternalDriftGrid
+        }
+    }
+}
+
+/// Kriging with an external drift, set up: the method, the drift at the data, the variogram
+/// and where the targets' drift comes from.
+pub struct ExternalDriftSetup {
+    /// The kriging method (ordinary or universal, with the drift).
+    pub method: Method,
+    /// The secondary variable at the data.
+    pub at_data: Vec<f64>,
+    /// The variogram (of the residuals, when fitted).
+    pub variogram: Variogram,
+    /// Where the targets' secondary variable comes from.
+    pub source: DriftSource,
+}
+
+fn own(setting: Setting, message: impl Into<String>) -> Error {
+    Error::setting(setting, "", message.into())
+}
+
+/// The error of a kernel with the data file's name.
+fn in_file(name: &str, e: GeostatError) -> Error {
+    Error::within(name, e)
+}
+
+impl MethodOptions {
+    /// The settings of `method` with every other setting at its default.
+    pub fn new(method: InterpolationMethod) -> MethodOptions {
+        MethodOptions {
+            method,
+            drift: None,
+            mean: None,
+            model: ModelOptions::default(),
+            variogram: None,
+            lag: LagOptions::default(),
+            neighbors: None,
+            radius: None,
+            power: terramesh_geostat::DEFAULT_IDW_POWER,
+            duplicates: Duplicates::Reject,
+        }
+    }
+
+    /// The kriging method; the drift and the mean only where they apply.
+    pub fn method(&self, data: &Data) -> Result<Method> {
+        if self.drift.is_some() && self.method != InterpolationMethod::Universal {
+            return Err(own(Setting::Drift, "{drift} applies to {method} uk only"));
+        }
+        if self.mean.is_some() && self.method != InterpolationMethod::Simple {
+            return Err(own(Setting::Mean, "{mean} applies to {method} sk only"));
+        }
+        self.method
+            .method(self.drift.unwrap_or(Drift::Linear), self.mean, data)
+            .context("IDW has no kriging method")
+    }
+
+    /// The moving neighbourhood (or all data).
+    pub fn neighbourhood(&self) -> Neighbourhood {
+        self.neighbors
+            .map_or(Neighbourhood::All, Neighbourhood::Nearest)
+    }
+
+    /// A moving neighbourhood of at least one datum.
+    fn check_neighbors(&self) -> Result<()> {
+        if let Some(0) = self.neighbors {
+            return Err(own(Setting::Neighbors, "{neighbors} 0: must be at least 1"));
+        }
+        Ok(())
+    }
+
+    /// Kriging takes no radius.
+    fn check_no_radius(&self, who: &str) -> Result<()> {
+        if self.radius.is_some() {
+            return Err(own(
+                Setting::Radius,
+                format!("{{radius}} applies to {{method}} idw; {who} takes {{neighbors}}"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// IDW's power and search.
+    pub fn idw(&self) -> Result<(f64, IdwSearch)> {
+        self.check_neighbors()?;
+        if !(self.power.is_finite() && self.power > 0.0) {
+            return Err(own(
+                Setting::Power,
+                format!("{{power}} {}: must be a finite number > 0", self.power),
+            ));
+        }
+        let search = match (self.neighbors, self.radius) {
+            (Some(_), Some(_)) => {
+                return Err(own(
+                    Setting::Radius,
+                    "IDW takes {neighbors} or {radius}, not both",
+                ))
+            }
+            (Some(k), None) => IdwSearch::Nearest(k),
+            (None, Some(r)) if !(r.is_finite() && r > 0.0) => {
+                return Err(own(
+                    Setting::Radius,
+                    format!("{{radius}} {r}: must be a finite number > 0"),
+                ))
+            }
+            (None, Some(r)) => IdwSearch::Radius(r),
+            (None, None) => IdwSearch::All,
+        };
+        Ok((self.power, search))
+    }
+
+    /// Where the variogram comes from: given in full, a file, or fitted.
+    pub fn variogram_source(&self) -> Result<VariogramSource> {
+        let fitting = self
+            .variogram
+            .as_deref()
+            .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
+        let auto_model = self.model.is_auto();
+        if self.model.anisotropy_auto()? && !fitting && !auto_model {
+            return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the anisotropy with the variogram: give {variogram} auto (the model's angle and ratio are otherwise {anisotropy-angle} and {anisotropy-ratio})"));
+        }
+        if let Some(v) = self.model.explicit_or_fit(fitting)? {
+            if self.variogram.is_some() {
+                return Err(own(
+                    Setting::Variogram,
+                    "give either {variogram} or {model} with {psill}/{range}, not both",
+                ));
+            }
+            return Ok(VariogramSource::Given(v));
+        }
+        match self.variogram.as_deref() {
+            _ if fitting => self.fit_plan(),
+            Some(file) => Ok(VariogramSource::File(PathBuf::from(file))),
+            None if auto_model => self.fit_plan(),
+            None => Err(own(Setting::Variogram, "kriging needs a variogram: {variogram} auto, {variogram} FILE.json, or {model} NAME {psill} C {range} A [{nugget} C0]")),
+        }
+    }
+
+    /// The fit of an automatic variogram: lag classes, models, REML's drift (that of the
+    /// kriging that will use the model) and the anisotropy fit.
+    fn fit_plan(&self) -> Result<VariogramSource> {
+        let drift = match self.method {
+            InterpolationMethod::Universal => self.drift.unwrap_or(Drift::Linear),
+            _ => Drift::Constant,
+        };
+        let model = self.model.model.as_deref().unwrap_or("auto");
+        let mut plan = self.lag.plan(model, drift);
+        if self.model.anisotropy_auto()? {
+            plan.anisotropy = Some(self.lag.anisotropy_plan()?);
+        }
+        Ok(VariogramSource::Fit {
+            lags: self.lag.settings(),
+            plan,
+        })
+    }
+
+    /// The variogram; a fitted one is told to `say` (`fitted variogram: ...`).
+    pub fn resolve_variogram(&self, fd: &FileData, say: &dyn Fn(&str)) -> Result<Variogram> {
+        let vs = self.variogram_source()?;
+        let v = vs.resolve(&fd.name, &fd.data)?;
+        if vs.fits() {
+            say(&format!("fitted variogram: {v}"));
+        }
+        Ok(v)
+    }
+
+    /// The interpolator of these settings on the data of `fd` (with kriging variances when
+    /// `variance`).
+    pub fn engine(
+        &self,
+        fd: &FileData,
+        variance: bool,
+        say: &dyn Fn(&str),
+    ) -> Result<Box<dyn Predictor>> {
+        self.check_neighbors()?;
+        if self.method == InterpolationMethod::Idw {
+            let (power, search) = self.idw()?;
+            return Idw::new(&fd.data, power, search)
+                .map(|i| Box::new(i) as Box<dyn Predictor>)
+                .map_err(|e| in_file(&fd.name, e));
+        }
+        self.check_no_radius("kriging")?;
+        let method = self.method(&fd.data)?;
+        let v = self.resolve_variogram(fd, say)?;
+        kriging(&fd.data, &v, method, self.neighbourhood(), variance)
+            .map_err(|e| in_file(&fd.name, e))
+    }
+
+    /// The interpolator of a cross-validation ([`terramesh_geostat::cross_validate`]).
+    pub fn interpolator(&self, fd: &FileData, say: &dyn Fn(&str)) -> Result<Interpolator> {
+        if self.method == InterpolationMethod::Idw {
+            let (power, search) = self.idw()?;
+            return Ok(Interpolator::Idw { power, search });
+        }
+        self.check_neighbors()?;
+        self.check_no_radius("kriging")?;
+        Ok(Interpolator::Kriging {
+            variogram: self.resolve_variogram(fd, say)?,
+            method: self.method(&fd.data)?,
+            neighbours: self.neighbourhood(),
+        })
+    }
+
+    /// The checks of a conditional simulation's method, before any file is read.
+    pub fn check_simulation(&self) -> Result<()> {
+        if self.method == InterpolationMethod::Idw {
+            return Err(own(
+                Setting::Method,
+                "{method} idw: simulation conditions by kriging; give sk, ok or uk",
+            ));
+        }
+        self.check_no_radius("simulation")?;
+        self.check_neighbors()
+    }
+
+    /// Kriging with an external drift set up from `drift` (the drift chosen and read at the
+    /// data of `fd`, from the file `data`, and an automatic variogram fitted to its
+    /// residuals); `None` without a drift.
+    pub fn external_drift(
+        &self,
+        drift: &DriftOptions,
+        data: &Path,
+        fd: &FileData,
+        say: &dyn Fn(&str),
+    ) -> Result<Option<ExternalDriftSetup>> {
+        let Some(source) = DriftSource::choose(drift.column.as_deref(), drift.grid.as_deref())?
+        else {
+            return Ok(None);
+        };
+        let method = match self.method {
+            InterpolationMethod::Ordinary | InterpolationMethod::Universal => {
+                self.method(&fd.data)?
+            }
+            other => {
+                let s = drift.setting();
+                return Err(own(s, format!("{{{s}}}: kriging with an external drift is {{method}} ok (the constant and the drift) or uk (the polynomial and the drift), not {other}")));
+            }
+        };
+        self.check_no_radius("kriging")?;
+        self.check_neighbors()?;
+        let at_data = source.at_data(data, fd, self.duplicates)?;
+        let vs = self.variogram_source()?;
+        let variogram = drift_variogram(&vs, fd, &at_data, method, source.setting())?;
+        if vs.fits() {
+            say(&format!("fitted variogram: {variogram}"));
+        }
+        Ok(Some(ExternalDriftSetup {
+            method,
+            at_data,
+            variogram,
+            source,
+        }))
+    }
+
+    /// The engine of an interpolation: [`MethodOptions::engine`], or kriging with the
+    /// external drift of `drift` (its coefficient told to `say`).
+    pub fn engine_with_drift(
+        &self,
+        drift: &DriftOptions,
+        data: &Path,
+        fd: &FileData,
+        variance: bool,
+        say: &dyn Fn(&str),
+    ) -> Result<Engine> {
+        let Some(k) = self.external_drift(drift, data, fd, say)? else {
+            return Ok(Engine::Plain(self.engine(fd, variance, say)?));
+        };
+        let s = drift.setting();
+        let kriging = ExternalDriftKriging::new(
+            &fd.data,
+            &k.at_data,
+            &k.variogram,
+            k.method,
+            self.neighbourhood(),
+            variance,
+        )
+        .map_err(|e| {
+            // The message names the settings as tags, so that the front end words them.
+            let text = match &e {
+                GeostatError::TooLarge(t) => t.describe(&|f| {
+                    Setting::of_field(f).map_or(f.to_string(), |s| format!("{{{s}}}"))
+                }),
+                e => e.to_string(),
+            };
+            own(s, format!("{{{s}}}: {}: {text}", fd.name))
+        })?;
+        if let Some(b) = kriging.coefficient() {
+            say(&format!(
+                "external drift coefficient: {b} (z per unit of the drift)"
+            ));
+        }
+        Ok(Engine::External {
+            kriging: Box::new(kriging),
+            source: k.source,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn flags(e: Error) -> String {
+        e.render(&|s| format!("--{s}"))
+    }
+
+    fn data() -> FileData {
+        let xy: Vec<[f64; 2]> = (0..16)
+            .map(|i| [(i % 4) as f64 * 10.0, (i / 4) as f64 * 10.0])
+            .collect();
+        let z = xy.iter().map(|p| p[0] * 0.1 + (p[1] * 0.2).sin()).collect();
+        FileData {
+            data: Data::new(xy, z, Duplicates::Reject).unwrap(),
+            name: "d.csv".into(),
+        }
+    }
+
+    fn spherical(method: InterpolationMethod) -> MethodOptions {
+        let mut m = MethodOptions::new(method);
+        m.model = ModelOptions {
+            model: Some("spherical".into()),
+            psill: vec![1.0],
+            range: vec![25.0],
+            ..ModelOptions::default()
+        };
+        m
+    }
+
+    #[test]
+    fn settings_that_would_be_ignored_are_refused_naming_them() {
+        let fd = data();
+        let mut m = spherical(InterpolationMethod::Ordinary);
+        m.drift = Some(Drift::Quadratic);
+        assert_eq!(
+            flags(m.method(&fd.data).unwrap_err()),
+            "--drift applies to --method uk only"
+        );
+        let mut m = spherical(InterpolationMethod::Universal);
+        m.mean = Some(3.0);
+        assert_eq!(
+            flags(m.method(&fd.data).unwrap_err()),
+            "--mean applies to --method sk only"
+        );
+        // A radius is IDW's: kriging and cross-validation of kriging refuse it.
+        let mut m = spherical(InterpolationMethod::Ordinary);
+        m.radius = Some(5.0);
+        let want = "--radius applies to --method idw; kriging takes --neighbors";
+        assert_eq!(flags(m.interpolator(&fd, &|_| {}).unwrap_err()), want);
+        assert_eq!(
+            flags(m.engine(&fd, true, &|_| {}).map(|_| ()).unwrap_err()),
+            want
+        );
+        assert_eq!(
+            flags(m.check_simulation().unwrap_err()),
+            "--radius applies to --method idw; simulation takes --neighbors"
+        );
+        let m = MethodOptions::new(InterpolationMethod::Idw);
+        assert!(flags(m.check_simulation().unwrap_err()).starts_with("--method idw: "));
+    }
+
+    #[test]
+    fn the_variogram_comes_from_exactly_one_place() {
+        let fd = data();
+        let mut m = MethodOptions::new(InterpolationMethod::Ordinary);
+        assert!(flags(m.variogram_source().unwrap_err())
+            .starts_with("kriging needs a variogram: --variogram auto, --variogram FILE.json"));
+        m.variogram = Some("auto".into());
+        assert!(m.variogram_source().unwrap().fits());
+        // A named model with --variogram auto is fitted; with its parameters it is given.
+        m.model.model = Some("exponential".into());
+        match m.variogram_source().unwrap() {
+            VariogramSource::Fit { plan, .. } => assert_eq!(plan.model, "exponential"),
+            other => panic!("{other:?}"),
+        }
+        let mut given = spherical(InterpolationMethod::Ordinary);
+        assert!(matches!(
+            given.variogram_source().unwrap(),
+            VariogramSource::Given(_)
+        ));
+        given.variogram = Some("v.json".into());
+        assert_eq!(
+            flags(given.variogram_source().unwrap_err()),
+            "give either --variogram or --model with --psill/--range, not both"
+        );
+        // A fitted variogram is told.
+        let told = std::cell::RefCell::new(Vec::new());
+        m.resolve_variogram(&fd, &|t| told.borrow_mut().push(t.to_string()))
+            .unwrap();
+        assert!(
+            told.borrow()[0].starts_with("fitted variogram: "),
+            "{told:?}"
+        );
+    }
+
+    #[test]
+    fn idw_search_settings_are_checked() {
+        let mut m = MethodOptions::new(InterpolationMethod::Idw);
+        assert!(matches!(m.idw().unwrap(), (_, IdwSearch::All)));
+        m.power = -1.0;
+        assert_eq!(
+            flags(m.idw().unwrap_err()),
+            "--power -1: must be a finite number > 0"
+        );
+        m.power = 2.0;
+        m.neighbors = Some(0);
+        assert_eq!(
+            flags(m.idw().unwrap_err()),
+            "--neighbors 0: must be at least 1"
+        );
+        m.neighbors = None;
+        m.radius = Some(f64::NAN);
+        assert_eq!(
+            flags(m.idw().unwrap_err()),
+            "--radius NaN: must be a finite number > 0"
+        );
+        // Neutral wording names the settings without flag syntax.
+        assert_eq!(
+            m.idw().unwrap_err().to_string(),
+            "radius NaN: must be a finite number > 0"
+        );
+    }
+}

@@ -1,0 +1,442 @@
+//! The variogram settings of a standalone interpolation as a front end gives them (the
+//! command line's `--model`, `--psill`, `--range`, ...; Python's keywords), checked and
+//! lowered to the kernel's [`Variogram`] or to a fit's [`FitPlan`].
+//!
+//! Every error is an [`Error::Setting`] that names the settings involved, so that each front
+//! end words them its own way ([`Error::render`]).
+//!
+//! ```
+//! use terramesh::interpolate::ModelOptions;
+//! let m = ModelOptions {
+//!     model: Some("spherical+exponential".into()),
+//!     psill: vec![8000.0, 4000.0],
+//!     range: vec![3000.0, 9000.0],
+//!     nugget: Some(50.0),
+//!     ..ModelOptions::default()
+//! };
+//! let v = m.explicit_or_fit(false)?.expect("a model given in full");
+//! assert_eq!(v.structures.len(), 2);
+//! assert_eq!(v.nugget, 50.0);
+//!
+//! // One partial sill for two structures is refused, naming both settings.
+//! let bad = ModelOptions { psill: vec![8000.0], ..m };
+//! let e = bad.explicit_or_fit(false).unwrap_err();
+//! assert_eq!(
+//!     e.render(&|s| format!("--{s}")),
+//!     "--psill 8000: --model spherical+exponential has 2 structures: give 2 values separated by commas (got 1)"
+//! );
+//! # Ok::<(), terramesh::Error>(())
+//! ```
+
+use terramesh_geostat::{
+    Anisotropy, AutoSettings, Direction, Drift, Estimator, FitMethod, LagSettings, ModelKind,
+    Structure, Variogram, Weighting,
+};
+
+use crate::error::{Context, Error, Result};
+use crate::fitting::{AnisotropyPlan, FitPlan};
+use crate::setting::Setting;
+
+/// The settings of a variogram model: given in full (`model`, `psill`, `range`, ...), named
+/// for a fit, or `auto`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ModelOptions {
+    /// A model name, a nested sum `a+b[+c]`, or `auto`.
+    pub model: Option<String>,
+    /// Partial sill per structure.
+    pub psill: Vec<f64>,
+    /// Practical range per structure (GSLIB).
+    pub range: Vec<f64>,
+    /// Nugget (default 0).
+    pub nugget: Option<f64>,
+    /// Power exponent or Matérn ν: one per structure, or one for all.
+    pub shape: Vec<f64>,
+    /// A given anisotropy's major axis angle, degrees counter-clockwise from +x.
+    pub anisotropy_angle: Option<f64>,
+    /// A given anisotropy's minor/major range ratio in (0, 1].
+    pub anisotropy_ratio: Option<f64>,
+    /// `auto`: fit the anisotropy with the variogram.
+    pub anisotropy: Option<String>,
+}
+
+/// The error of a setting whose message names its own setting (and maybe others) as `{name}`.
+fn own(setting: Setting, message: String) -> Error {
+    Error::setting(setting, "", message)
+}
+
+/// Numbers as a front end lists them: `1,2.5`.
+fn list(values: &[f64]) -> String {
+    let v: Vec<String> = values.iter().map(|v| v.to_string()).collect();
+    v.join(",")
+}
+
+/// One value per structure of a list setting: `n` values, or one for all when `one_for_all`.
+fn per_structure(
+    setting: Setting,
+    values: &[f64],
+    n: usize,
+    name: &str,
+    one_for_all: bool,
+) -> Result<Vec<f64>> {
+    match values.len() {
+        k if k == n => Ok(values.to_vec()),
+        1 if one_for_all => Ok(vec![values[0]; n]),
+        k => Err(own(
+            setting,
+            format!(
+                "{{{setting}}} {}: {{model}} {name} has {n} structures: give {n} values separated by commas (got {k})",
+                list(values)
+            ),
+        )),
+    }
+}
+
+impl ModelOptions {
+    /// Whether `anisotropy` is `auto` (any other value is an error, and so is a given angle
+    /// or ratio beside it).
+    pub fn anisotropy_auto(&self) -> Result<bool> {
+        match self.anisotropy.as_deref() {
+            None => Ok(false),
+            Some(a) if a.eq_ignore_ascii_case("auto") => {
+                if self.anisotropy_angle.is_some() || self.anisotropy_ratio.is_some() {
+                    return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the angle and ratio: give it or {anisotropy-angle}/{anisotropy-ratio}, not both".into()));
+                }
+                Ok(true)
+            }
+            Some(a) => Err(own(
+                Setting::Anisotropy,
+                format!("{{anisotropy}} '{a}': expected auto (give a known anisotropy by {{anisotropy-angle}} DEG {{anisotropy-ratio}} R)"),
+            )),
+        }
+    }
+
+    /// Whether `model` is `auto`.
+    pub fn is_auto(&self) -> bool {
+        self.model
+            .as_deref()
+            .is_some_and(|s| s.eq_ignore_ascii_case("auto"))
+    }
+
+    /// The variogram given in full; `None` when `model` is absent or `auto`, or (with `fit`:
+    /// the variogram is fitted) names models without partial sills and ranges, which are
+    /// then fitted.
+    pub fn explicit_or_fit(&self, fit: bool) -> Result<Option<Variogram>> {
+        let Some(name) = self.model.as_deref() else {
+            if !self.psill.is_empty() || !self.range.is_empty() {
+                return Err(own(
+                    Setting::Psill,
+                    "{psill}/{range} need {model} (e.g. {model} spherical)".into(),
+                ));
+            }
+            return Ok(None);
+        };
+        if name.eq_ignore_ascii_case("auto")
+            || (fit && self.psill.is_empty() && self.range.is_empty())
+        {
+            return Ok(None);
+        }
+        let kinds = crate::fitting::parse_models(name)?;
+        let n = kinds.len();
+        let nugget = self.nugget.unwrap_or(0.0);
+        if !(nugget.is_finite() && nugget >= 0.0) {
+            return Err(own(
+                Setting::Nugget,
+                format!("{{nugget}} {nugget}: must be a finite number >= 0"),
+            ));
+        }
+        let psills = self.per_structure_or_needed(
+            Setting::Psill,
+            &self.psill,
+            (kinds[0], n),
+            name,
+            ("the partial sill", "{psill} C1,C2", 0.0),
+        )?;
+        for &psill in &psills {
+            if !(psill.is_finite() && psill >= 0.0) {
+                return Err(own(
+                    Setting::Psill,
+                    format!("{{psill}} {psill}: must be a finite number >= 0"),
+                ));
+            }
+        }
+        let ranges = self.per_structure_or_needed(
+            Setting::Range,
+            &self.range,
+            (kinds[0], n),
+            name,
+            ("the practical range", "{range} A1,A2", 1.0),
+        )?;
+        for &range in &ranges {
+            if !(range.is_finite() && range > 0.0) {
+                return Err(own(
+                    Setting::Range,
+                    format!("{{range}} {range}: must be a finite number > 0"),
+                ));
+            }
+        }
+        let total: f64 = psills.iter().sum();
+        if nugget + total == 0.0 {
+            return Err(own(Setting::Psill, format!("{{psill}} {} and {{nugget}} {nugget}: the sill is zero, so kriging weights are undefined; give a positive {{psill}}", list(&psills))));
+        }
+        let shapes = if self.shape.is_empty() {
+            None
+        } else {
+            Some(per_structure(Setting::Shape, &self.shape, n, name, true)?)
+        };
+        let structures = (0..n)
+            .map(|i| {
+                let mut s = Structure::new(kinds[i], psills[i], ranges[i]);
+                if let Some(sh) = &shapes {
+                    s.shape = sh[i];
+                }
+                s
+            })
+            .collect();
+        if let Some(r) = self.anisotropy_ratio.filter(|r| !(*r > 0.0 && *r <= 1.0)) {
+            return Err(own(
+                Setting::AnisotropyRatio,
+                format!(
+                    "{{anisotropy-ratio}} {r}: must be in (0, 1] (the minor range over the major)"
+                ),
+            ));
+        }
+        if let Some(a) = self.anisotropy_angle.filter(|a| !a.is_finite()) {
+            return Err(own(
+                Setting::AnisotropyAngle,
+                format!("{{anisotropy-angle}} {a}: must be a finite number of degrees"),
+            ));
+        }
+        let anisotropy = match (self.anisotropy_angle, self.anisotropy_ratio) {
+            (None, None) => None,
+            (a, r) => Some(Anisotropy {
+                angle: a.unwrap_or(0.0),
+                ratio: r.unwrap_or(1.0),
+            }),
+        };
+        let v = Variogram {
+            nugget,
+            structures,
+            anisotropy,
+        };
+        v.validate().context("the variogram")?;
+        Ok(Some(v))
+    }
+
+    /// The values of the list setting `setting` (psill or range) for `n` structures; a lone
+    /// nugget model needs none (`fill`).
+    fn per_structure_or_needed(
+        &self,
+        setting: Setting,
+        values: &[f64],
+        (first, n): (ModelKind, usize),
+        name: &str,
+        (what, example, fill): (&str, &str, f64),
+    ) -> Result<Vec<f64>> {
+        match (first, values.is_empty(), n) {
+            (ModelKind::Nugget, true, 1) => Ok(vec![fill]),
+            (_, true, _) => {
+                let many = if n > 1 {
+                    format!("s, one per structure: {example}")
+                } else {
+                    String::new()
+                };
+                Err(own(
+                    setting,
+                    format!("{{model}} {name} needs {{{setting}}} ({what}{many})"),
+                ))
+            }
+            _ => per_structure(setting, values, n, name, false),
+        }
+    }
+}
+
+/// The lag classes and fitting settings of an experimental variogram and its fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LagOptions {
+    /// Number of lag classes.
+    pub lags: usize,
+    /// Largest lag distance (default: half the data diameter).
+    pub max_dist: Option<f64>,
+    /// A directional variogram's azimuth, degrees clockwise from north.
+    pub azimuth: Option<f64>,
+    /// The angular tolerance of `azimuth`, degrees.
+    pub tolerance: f64,
+    /// The semivariance estimator.
+    pub estimator: Estimator,
+    /// The least-squares weights of the fit.
+    pub weights: Weighting,
+    /// At most this many data for the experimental variogram (0: all).
+    pub max_points: usize,
+    /// REML or WLS (`None`: the default of [`FitPlan`]).
+    pub fit: Option<FitMethod>,
+    /// REML in blocks of at most this many data (0: exact REML).
+    pub reml_block: usize,
+}
+
+impl Default for LagOptions {
+    fn default() -> Self {
+        LagOptions {
+            lags: terramesh_geostat::DEFAULT_LAGS,
+            max_dist: None,
+            azimuth: None,
+            tolerance: terramesh_geostat::DEFAULT_TOLERANCE,
+            estimator: Estimator::Matheron,
+            weights: Weighting::Cressie,
+            max_points: terramesh_geostat::DEFAULT_MAX_POINTS,
+            fit: None,
+            reml_block: terramesh_geostat::DEFAULT_REML_BLOCK,
+        }
+    }
+}
+
+impl LagOptions {
+    /// The experimental variogram's settings.
+    pub fn settings(&self) -> LagSettings {
+        LagSettings {
+            lags: self.lags,
+            max_dist: self.max_dist,
+            direction: self.azimuth.map(|a| Direction {
+                azimuth: a,
+                tolerance: self.tolerance,
+            }),
+            estimator: self.estimator,
+            max_points: (self.max_points > 0).then_some(self.max_points),
+        }
+    }
+
+    /// The fitting plan of `model` (`auto`, a name or a nested sum) for kriging with `drift`.
+    pub fn plan(&self, model: &str, drift: Drift) -> FitPlan {
+        FitPlan {
+            model: model.to_string(),
+            method: self.fit,
+            auto: AutoSettings {
+                drift,
+                weighting: self.weights,
+                block: (self.reml_block > 0).then_some(self.reml_block),
+                ..AutoSettings::default()
+            },
+            anisotropy: None,
+        }
+    }
+
+    /// The anisotropy fit (8 azimuths, these lag classes, `tolerance`); a directional
+    /// `azimuth` contradicts it.
+    pub fn anisotropy_plan(&self) -> Result<AnisotropyPlan> {
+        if let Some(a) = self.azimuth {
+            return Err(own(Setting::Azimuth, format!("{{azimuth}} {a} and {{anisotropy}} auto: the anisotropy fit makes its own directional variograms (8 azimuths within {{tolerance}}); give one of them")));
+        }
+        if !(self.tolerance > 0.0 && self.tolerance <= 90.0) {
+            return Err(own(
+                Setting::Tolerance,
+                format!(
+                    "{{tolerance}} {}: must be in (0, 90] degrees",
+                    self.tolerance
+                ),
+            ));
+        }
+        Ok(AnisotropyPlan {
+            lags: self.settings(),
+            tolerance: self.tolerance,
+            ..AnisotropyPlan::default()
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn flags(e: Error) -> String {
+        e.render(&|s| format!("--{s}"))
+    }
+
+    fn nested() -> ModelOptions {
+        ModelOptions {
+            model: Some("matern+spherical".into()),
+            psill: vec![1.0, 2.0],
+            range: vec![10.0, 30.0],
+            ..ModelOptions::default()
+        }
+    }
+
+    #[test]
+    fn a_model_given_in_full_is_checked_value_by_value() {
+        let v = nested().explicit_or_fit(false).unwrap().unwrap();
+        assert_eq!(v.structures.len(), 2);
+        assert_eq!(v.structures[1].range, 30.0);
+        let mut m = nested();
+        m.shape = vec![2.5];
+        let v = m.explicit_or_fit(false).unwrap().unwrap();
+        assert_eq!(v.structures[0].shape, 2.5);
+        assert_eq!(v.structures[1].shape, 2.5);
+        m.shape = vec![2.5, 1.0, 3.0];
+        assert!(flags(m.explicit_or_fit(false).unwrap_err())
+            .starts_with("--shape 2.5,1,3: --model matern+spherical has 2 structures"));
+        let m = ModelOptions {
+            psill: vec![],
+            ..nested()
+        };
+        assert_eq!(
+            flags(m.explicit_or_fit(false).unwrap_err()),
+            "--model matern+spherical needs --psill (the partial sills, one per structure: --psill C1,C2)"
+        );
+        // Fitted when the parameters are left out and the variogram is fitted.
+        let m = ModelOptions {
+            psill: vec![],
+            range: vec![],
+            ..nested()
+        };
+        assert_eq!(m.explicit_or_fit(true).unwrap(), None);
+        let m = ModelOptions {
+            psill: vec![0.0, 0.0],
+            ..nested()
+        };
+        assert!(flags(m.explicit_or_fit(false).unwrap_err()).contains("the sill is zero"));
+        let m = ModelOptions {
+            anisotropy_ratio: Some(1.5),
+            ..nested()
+        };
+        assert!(
+            flags(m.explicit_or_fit(false).unwrap_err()).starts_with("--anisotropy-ratio 1.5: ")
+        );
+        let m = ModelOptions {
+            model: None,
+            ..nested()
+        };
+        assert_eq!(
+            flags(m.explicit_or_fit(false).unwrap_err()),
+            "--psill/--range need --model (e.g. --model spherical)"
+        );
+    }
+
+    #[test]
+    fn the_anisotropy_fit_is_asked_for_by_auto_only() {
+        let mut m = nested();
+        assert!(!m.anisotropy_auto().unwrap());
+        m.anisotropy = Some("AUTO".into());
+        assert!(m.anisotropy_auto().unwrap());
+        m.anisotropy_angle = Some(30.0);
+        assert!(flags(m.anisotropy_auto().unwrap_err()).contains("not both"));
+        m.anisotropy = Some("yes".into());
+        assert!(flags(m.anisotropy_auto().unwrap_err())
+            .starts_with("--anisotropy 'yes': expected auto"));
+        let l = LagOptions {
+            azimuth: Some(30.0),
+            ..LagOptions::default()
+        };
+        assert!(flags(l.anisotropy_plan().unwrap_err())
+            .starts_with("--azimuth 30 and --anisotropy auto"));
+        let l = LagOptions {
+            tolerance: 100.0,
+            ..LagOptions::default()
+        };
+        assert_eq!(
+            flags(l.anisotropy_plan().unwrap_err()),
+            "--tolerance 100: must be in (0, 90] degrees"
+        );
+        assert_eq!(
+            LagOptions::default().anisotropy_plan().unwrap().tolerance,
+            terramesh_geostat::DEFAULT_TOLERANCE
+        );
+    }
+}
