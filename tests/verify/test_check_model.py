@@ -261,3 +261,53 @@ def test_vertical_crs_that_is_not_vertical_fails(out, capsys):
          f'Name="vertical_crs" NumberOfTuples="9" format="ascii">{" ".join(str(b) for b in b"EPSG:4326")}<')
     f = failures(out, DATUM, capsys)
     assert f and "not a vertical CRS" in f[0], f
+
+
+# A sound pyramid from the Kimberlina model (terramesh model with interpolation.neighbors=8):
+# a vertical base of two node columns, 1.5 km across and 26-32 m high.
+FLAT_PYRAMID = np.array([
+    [297180.733, 3927228.51, -1943.02819],
+    [297180.733, 3927228.51, -1916.83423],
+    [295686.848, 3927843.29, -2000.49349],
+    [295686.848, 3927843.29, -2032.88765],
+    [295971.000, 3926399.00, -2024.08650],
+])
+
+
+def vtk_state(pts):
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    g = vtk.vtkUnstructuredGrid()
+    p = vtk.vtkPoints()
+    for r in pts - pts.mean(axis=0):
+        p.InsertNextPoint(*r)
+    g.SetPoints(p)
+    g.InsertNextCell(cm.VTK_PYRAMID, 5, [0, 1, 2, 3, 4])
+    v = vtk.vtkCellValidator()
+    v.SetInputData(g)
+    v.SetTolerance(1e-9)
+    v.Update()
+    return int(vtk_to_numpy(v.GetOutput().GetCellData().GetArray("ValidityState"))[0])
+
+
+def test_vtk_convexity_of_a_flat_pyramid_depends_on_its_scale():
+    """Why check_model replaces VTK's convexity bit for pyramids: the same cell, scaled."""
+    states = {s: vtk_state(FLAT_PYRAMID / s) for s in (1, 10, 1000)}
+    assert len(set(states.values())) > 1, states
+    assert cm.convex_pyramids(FLAT_PYRAMID, [("pyramid", (0, 1, 2, 3, 4))]) == []
+
+
+def test_nonconvex_pyramid_fails_our_convexity_check():
+    # A warped base: one node off the plane of the other three.
+    bent = FLAT_PYRAMID.copy()
+    bent[2] += [0.0, 5.0, 0.0]  # one node moved 5 m off the base's (vertical) plane
+    assert cm.convex_pyramids(bent, [("pyramid", (0, 1, 2, 3, 4))]) == [0]
+    # A dart-shaped base (a reflex corner at its fourth node), planar, apex above.
+    dart = np.array([[0.0, 0.0, 0.0], [2.0, 1.0, 0.0], [0.0, 2.0, 0.0], [0.5, 1.0, 0.0],
+                     [0.8, 1.0, 1.0]])
+    assert cm.convex_pyramids(dart, [("pyramid", (0, 1, 2, 3, 4))]) == [0]
+    # Counter-clockwise seen from the apex (VTK's order): convex; the other way round, not.
+    square = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0], [0.0, 2.0, 0.0],
+                       [1.0, 1.0, 1.0]])
+    assert cm.convex_pyramids(square, [("pyramid", (0, 1, 2, 3, 4))]) == []
+    assert cm.convex_pyramids(square, [("pyramid", (0, 3, 2, 1, 4))]) == [0]

@@ -61,7 +61,10 @@ mod volume;
 pub use check::{check, volume_between, CheckSummary};
 pub use error::GeologyError;
 pub use planar::Planar;
-pub use rules::{apply_rules, stack_thicknesses, InterfaceReport, RawSurfaces, RulesReport, Stack};
+pub use rules::{
+    apply_rules, stack_thicknesses, InterfaceReport, RawSurfaces, RulesReport, Stack,
+    THICKNESS_FLOOR,
+};
 pub use sides::SideTags;
 pub use stats::{unit_stats, UnitStats};
 pub use volume::{volume_mesh, Layering};

@@ -12,8 +12,17 @@
 //!
 //! The terrain and the base never move. A column whose terrain is less than `min_thickness`
 //! above the base keeps that thin top unit (the only unit with thickness there).
+//!
+//! A unit thinner than [`THICKNESS_FLOOR`] (1 µm) pinches out whatever `min_thickness` is,
+//! `0` included: interfaces interpolated through contacts of zero thickness come out equal
+//! only to rounding (1e-12 m apart), and a cell that thin has Jacobians of rounding noise,
+//! negative at some integration points, which Gmsh and OpenGeoSys reject.
 
 use crate::{GeologyError, Planar};
+
+/// The thinnest unit a model keeps, in metres: thinner is zero thickness (a pinch-out), even
+/// with `min_thickness = 0` (see the module's documentation).
+pub const THICKNESS_FLOOR: f64 = 1e-6;
 
 /// The surfaces before the rules, one value per planar vertex each.
 ///
@@ -209,6 +218,7 @@ pub fn apply_rules(
             terrain: raw.terrain[v],
         });
     }
+    let min_thickness = min_thickness.max(THICKNESS_FLOOR);
     let m = raw.tops.len();
     let n = raw.terrain.len();
     let mut surfaces = Vec::with_capacity(m + 2);
@@ -324,4 +334,43 @@ pub fn stack_thicknesses(
         r.negative_thickness = n;
     }
     Ok((stack, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Interfaces equal but for rounding make no sliver cells, even with `min_thickness = 0`;
+    /// a thin unit above the floor is kept.
+    #[test]
+    fn rounding_slivers_pinch_out_with_min_thickness_zero() {
+        let points = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let planar = Planar::new(&points, &[[0, 1, 2]]).unwrap();
+        let raw = RawSurfaces {
+            terrain: vec![1000.0; 3],
+            // unit 0 is 1e-12 m, 2e-7 m and 1e-5 m thick at the three vertices
+            tops: vec![
+                vec![1000.0 - 1e-12, 1000.0 - 2e-7, 1000.0 - 1e-5],
+                vec![500.0; 3],
+            ],
+            base: vec![0.0; 3],
+        };
+        let (stack, report) = apply_rules(&planar, &raw, 0.0).unwrap();
+        assert_eq!(stack.surfaces[1][0], 1000.0);
+        assert_eq!(stack.surfaces[1][1], 1000.0);
+        assert_eq!(stack.surfaces[1][2], 1000.0 - 1e-5);
+        assert_eq!(report.interfaces[0].pinch_out, 2);
+        // Just above the base, too.
+        let raw = RawSurfaces {
+            terrain: vec![1000.0; 3],
+            tops: vec![vec![500.0; 3], vec![1e-9, 5e-7, 2e-6]],
+            base: vec![0.0; 3],
+        };
+        let (stack, report) = apply_rules(&planar, &raw, 0.0).unwrap();
+        assert_eq!(stack.surfaces[2], [0.0, 0.0, 2e-6]);
+        assert_eq!(report.interfaces[1].pinch_out, 2);
+        // A larger min_thickness still rules.
+        let (stack, _) = apply_rules(&planar, &raw, 1e-5).unwrap();
+        assert_eq!(stack.surfaces[2], [0.0; 3]);
+    }
 }
