@@ -38,6 +38,8 @@ mod appended;
 mod build;
 mod files;
 mod geology;
+mod geology_plan;
+mod geology_tile;
 mod geometry;
 mod grid_merge;
 mod manifest;
@@ -58,8 +60,8 @@ pub use geology::{
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
-    update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, TileSummary,
-    LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
+    update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData,
+    TileSummary, LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
 pub use model_export::MergedExports;

@@ -42,7 +42,6 @@ use super::geology::{
 use super::manifest::Manifest;
 use super::model_merge::{cell_of, columns, node_map, read_model, Column};
 use crate::error::{Context, Error, Result};
-use crate::project::HeightDatum;
 
 /// What the merge found making the merged model's other files (`exports` in `merge.json`'s
 /// `model`).
@@ -252,13 +251,9 @@ pub(crate) fn merge_exports(
     check_mesh(&mesh).map_err(|e| Error::invalid(format!("the merged geological model: {e}")))?;
     let summary = terramesh_geology::check(&mesh)
         .map_err(|e| Error::invalid(format!("the merged geological model: {e}")))?;
-    let datum = m
-        .vertical_epsg
-        .map_or(HeightDatum::Source, HeightDatum::Epsg);
+    let datum = m.height_datum();
     let info = ModelInfo {
-        crs: m
-            .epsg
-            .map_or("projected".to_string(), |e| format!("EPSG:{e}")),
+        crs: m.model_crs(),
         vertical_datum: datum.name(),
         vertical_epsg: datum.epsg(),
     };

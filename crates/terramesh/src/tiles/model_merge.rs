@@ -379,9 +379,6 @@ fn write_vtu(
         names.extend_from_slice(u.as_bytes());
         names.push(0u8);
     }
-    let crs = m
-        .epsg
-        .map_or("projected".to_string(), |e| format!("EPSG:{e}"));
     type CellPass<'a> = dyn FnMut(&mut dyn Write, &TileModel, &[(u32, bool)]) -> Result<()> + 'a;
     let pass = |w: &mut dyn Write, f: &mut CellPass| -> Result<()> {
         let mut next = 0u32;
@@ -410,14 +407,11 @@ fn write_vtu(
         bytes,
         values,
     };
-    let mut arrays = Vec::new();
-    for (name, bytes) in [("unit_names", names), ("crs", crs.into_bytes())] {
-        let len = bytes.len();
-        let values: Values = Box::new(move |w| Ok(w.write_all(&bytes)?));
-        let mut a = array(Section::Field, "UInt8", name, 1, len as u64, values);
-        a.tuples = Some(len);
-        arrays.push(a);
-    }
+    let mut arrays = vec![super::appended::text_field("unit_names", names)];
+    arrays.extend(super::appended::datum_fields(
+        &m.model_crs(),
+        &m.height_datum(),
+    ));
     let values: Values = Box::new(move |w| {
         pass(w, &mut |w, tm, map| {
             for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(map) {

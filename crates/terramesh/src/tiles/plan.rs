@@ -362,6 +362,16 @@ pub fn plan(
         },
         epsg: samples.epsg(),
         vertical_epsg: project.height_datum().epsg(),
+        crs_text: Some(super::manifest::CrsText {
+            dsm: samples
+                .epsg()
+                .map_or_else(|| samples.crs_name(), |c| format!("EPSG:{c}")),
+            model: match (samples.epsg(), &samples.crs) {
+                (Some(e), _) => format!("EPSG:{e}"),
+                (None, Some(c)) => c.definition().to_string(),
+                (None, None) => "projected".to_string(),
+            },
+        }),
         geology,
         tiles,
     };
