@@ -124,4 +124,9 @@ pub struct GeologyPlan {
     /// grids.
     #[serde(default)]
     pub crs_epsg: Option<u32>,
+    /// The boreholes' contacts file in the plan folder ([`super::boreholes::CONTACTS`]), each
+    /// contact evaluated by the tile that owns its position for `model.json`'s `boreholes`;
+    /// `None` without boreholes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contacts: Option<String>,
 }

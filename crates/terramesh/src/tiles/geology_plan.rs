@@ -195,6 +195,10 @@ pub(crate) fn plan_geology(
             )
         }
     };
+    let contacts_file = match &holes {
+        Some(b) => Some(super::boreholes::plan_contacts(b, out)?),
+        None => None,
+    };
     Ok(Some((
         GeologyPlan {
             units: g.units.clone(),
@@ -204,6 +208,7 @@ pub(crate) fn plan_geology(
             interfaces,
             thickness,
             crs_epsg,
+            contacts: contacts_file,
         },
         halos,
     )))

@@ -35,6 +35,7 @@
 //! ```
 
 mod appended;
+mod boreholes;
 mod build;
 mod files;
 mod geology;
@@ -52,6 +53,7 @@ mod plan;
 mod report;
 mod slurm;
 
+pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
 pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{

@@ -55,6 +55,15 @@ pub struct MergedUnit {
 /// What the merge made of the geological models.
 #[derive(Debug, Clone, Serialize)]
 pub struct MergedModel {
+    /// The model's CRS, as a one-piece build's `model.json` names it (`EPSG:32632`).
+    pub crs: String,
+    /// The vertical datum of the heights (`egm96`, `navd88`, `EPSG:<code>`, or `source`), as
+    /// a one-piece build's `model.json` and `model.vtu` record it.
+    pub vertical_datum: String,
+    /// The vertical CRS when named (`EPSG:5703`).
+    pub vertical_crs: Option<String>,
+    /// The heights in words.
+    pub heights: String,
     /// Nodes of `model.vtu`.
     pub nodes: usize,
     /// Cells.
@@ -71,6 +80,9 @@ pub struct MergedModel {
     /// The base elevation every tile used, metres (`null`: a base grid, sampled by every tile
     /// at its vertices).
     pub base: Option<f64>,
+    /// One entry per observed contact, as a one-piece model lists them: the collars against
+    /// the terrain, then the logged tops (`tiles/boreholes.rs`).
+    pub boreholes: Vec<crate::geology::model::Misfit>,
     /// The boundary meshes, `model.msh`, `model.f3grid` and the bodies
     /// (`tiles/model_export.rs`).
     pub exports: super::model_export::MergedExports,
@@ -287,7 +299,12 @@ pub(crate) fn merge_model(
     written.extend(write_interfaces(plan, m, gp, out)?);
     let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, out)?;
     written.extend(files);
+    let datum = m.height_datum();
     let merged = MergedModel {
+        crs: m.model_crs(),
+        vertical_datum: datum.name(),
+        vertical_crs: datum.crs_name(),
+        heights: datum.describe(),
         nodes: n as usize,
         cells: nc,
         seam_nodes: seams.values().map(|c| c.count as usize).sum(),
@@ -307,6 +324,7 @@ pub(crate) fn merge_model(
             .collect(),
         volume_between_terrain_and_base: between,
         base: gp.base,
+        boreholes: super::boreholes::merged_misfits(plan, m, gp)?,
         exports,
     };
     let path = out.join("model.json");
