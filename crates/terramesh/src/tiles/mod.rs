@@ -48,6 +48,7 @@ mod merge;
 mod model_export;
 mod model_files;
 mod model_merge;
+mod model_stream;
 mod partition;
 mod plan;
 mod report;

@@ -297,7 +297,7 @@ pub(crate) fn merge_model(
     write_vtu(&path, plan, m, gp, &seams, n as usize, nc)?;
     written.push(path);
     written.extend(write_interfaces(plan, m, gp, out)?);
-    let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, out)?;
+    let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, &volume, out)?;
     written.extend(files);
     let datum = m.height_datum();
     let merged = MergedModel {
