@@ -13,6 +13,7 @@ use std::process::Command;
 use terramesh_core::volume::{cell_volume, Cell, CellKind};
 use terramesh_geostat::{kriging, Data, Duplicates, KrigingFrame, Method, Neighbourhood};
 
+#[allow(dead_code)] // (the field-data readers are for tiles_geology_files.rs)
 #[path = "support/vtu_read.rs"]
 mod vtu_read;
 

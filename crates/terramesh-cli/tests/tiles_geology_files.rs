@@ -608,4 +608,8 @@ fn merged_outputs_carry_the_datum_and_the_misfits_of_one_piece() {
         "{per_tile:?}"
     );
     assert_eq!(per_tile.iter().sum::<usize>(), got.len());
+    // No model.glb, and the report says why.
+    assert!(!merged.join("model.glb").exists());
+    let report = std::fs::read_to_string(merged.join("report.html")).unwrap();
+    assert!(report.contains("model.glb is not merged: a GLB file is at most 4 GiB"));
 }

@@ -17,15 +17,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use terramesh_core::volume::{cell_volume, Cell, CellKind};
-use terramesh_io::grid_write::{write_geotiff_heights, Heights};
 use terramesh_io::output::Output;
 
 use super::appended::{put_f64, Array, Section, Values};
 use super::build::tile_dir;
 use super::files::{read_f64s, read_u32s, read_vertices};
-use super::geology::{
-    GeologyPlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON, MODEL_POINTS, SURFACES,
-};
+use super::geology::{GeologyPlan, TileFigures, MODEL_CELLS, MODEL_JSON, MODEL_POINTS, SURFACES};
 use super::manifest::{Manifest, Tile};
 use crate::error::{Context, Error, Result};
 
@@ -296,7 +293,9 @@ pub(crate) fn merge_model(
     let path = out.join("model.vtu");
     write_vtu(&path, plan, m, gp, &seams, n as usize, nc)?;
     written.push(path);
-    written.extend(write_interfaces(plan, m, gp, out)?);
+    written.extend(super::grid_merge::write_interfaces(
+        plan, m, &gp.units, out,
+    )?);
     let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, &volume, out)?;
     written.extend(files);
     let datum = m.height_datum();
@@ -333,52 +332,6 @@ pub(crate) fn merge_model(
         .context(path.display().to_string())?;
     written.push(path);
     Ok((merged, written))
-}
-
-/// `interfaces/<unit>.tif`: the top of every unit (the terrain first) on the DSM grid, one
-/// unit at a time.
-fn write_interfaces(
-    plan: &Path,
-    m: &Manifest,
-    gp: &GeologyPlan,
-    out: &Path,
-) -> Result<Vec<PathBuf>> {
-    let units = gp.units.len();
-    let g = &m.grid;
-    let spec = g.raster();
-    let dir = out.join("interfaces");
-    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
-    let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
-    let heights = Heights {
-        vertical_epsg: m.vertical_epsg,
-    };
-    let mut written = Vec::new();
-    for (u, name) in gp.units.iter().enumerate() {
-        let mut values = vec![super::merge::NODATA; g.nx * g.ny];
-        for t in &m.tiles {
-            let rec = read_f64s(&tile_dir(plan, &t.id).join(INTERFACES), units + 1)?;
-            for r in rec.chunks_exact(units + 1) {
-                let i = r[0].to_bits() as usize;
-                if i < values.len() && r[1 + u].is_finite() {
-                    values[i] = r[1 + u];
-                }
-            }
-        }
-        let path = dir.join(format!("{name}.tif"));
-        let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
-        write_geotiff_heights(
-            &mut o,
-            &spec,
-            &values,
-            epsg,
-            Some(heights),
-            Some(super::merge::NODATA),
-        )
-        .and_then(|_| o.commit())
-        .context(path.display().to_string())?;
-        written.push(path);
-    }
-    Ok(written)
 }
 
 /// Writes `model.vtu` (raw appended binary, [`super::appended`]), one pass over the tiles per

@@ -326,12 +326,16 @@ impl<'a> TiledModel<'a> {
         Ok(())
     }
 
-    /// Every kept face of the merged model with its cell and material, in order.
+    /// Every kept face of the merged model in order, with its cell, material and the cell's
+    /// points when `cells` (otherwise an empty tetrahedron, unit 0, no points: a pass that
+    /// reads no cells).
     fn faces_with_cells(
         &self,
+        cells: bool,
         f: &mut dyn FnMut(&TaggedFace, &[[f64; 3]], &Cell, i32, &[[f64; 3]]) -> Result<()>,
     ) -> Result<()> {
-        self.pass(true, &mut |k, t, l| {
+        let none = Cell::tetra([0; 4]);
+        self.pass(cells, &mut |k, t, l| {
             let path = tile_dir(self.plan, &t.id).join(MODEL_FACES);
             let (mut fp, mut cp) = ([[0.0; 3]; 4], [[0.0; 3]; 6]);
             for (j, rec) in read_u32s(&path, 6)?.chunks_exact(6).enumerate() {
@@ -347,17 +351,21 @@ impl<'a> TiledModel<'a> {
                         used += 1;
                     }
                 }
+                let face = TaggedFace {
+                    nodes,
+                    cell: self.first_cell[k] + rec[4],
+                    tag: self.tag_map[k][rec[5] as usize],
+                };
+                if !cells {
+                    f(&face, &fp[..used], &none, 0, &[])?;
+                    continue;
+                }
                 let (mut c, mat) = cell_of(&l.cells[8 * rec[4] as usize..][..8]);
                 let kn = c.kind.nodes();
                 for (i, n) in c.nodes.iter_mut().take(kn).enumerate() {
                     cp[i] = l.point(*n);
                     *n = l.map[*n as usize].0;
                 }
-                let face = TaggedFace {
-                    nodes,
-                    cell: self.first_cell[k] + rec[4],
-                    tag: self.tag_map[k][rec[5] as usize],
-                };
                 f(&face, &fp[..used], &c, mat, &cp[..kn])?;
             }
             Ok(())
@@ -393,7 +401,7 @@ impl<'a> TiledModel<'a> {
         let mut coords: HashMap<u32, [f64; 3]> = HashMap::new();
         let mut faces: Vec<TaggedFace> = Vec::new();
         let mut cells: Vec<(Cell, i32, u32)> = Vec::new();
-        self.faces_with_cells(&mut |f, _, c, mat, cp| {
+        self.faces_with_cells(true, &mut |f, _, c, mat, cp| {
             if f.tag == tag {
                 for (&n, p) in c.used().iter().zip(cp) {
                     coords.insert(n, *p);
@@ -523,7 +531,7 @@ impl ModelPasses for TiledModel<'_> {
         .map_err(io_err)
     }
     fn each_face(&self, f: &mut FaceVisit) -> io::Result<()> {
-        self.faces_with_cells(&mut |face, fp, _, _, _| Ok(f(face, fp)?))
+        self.faces_with_cells(false, &mut |face, fp, _, _, _| Ok(f(face, fp)?))
             .map_err(io_err)
     }
 }
