@@ -171,7 +171,7 @@ impl<'w, W: Write + ?Sized> Ids<'w, W> {
         self.w.write_all(b" ")?;
         self.w.write_all(self.b.format(id).as_bytes())?;
         self.done += 1;
-        if self.done % 10 == 0 || self.done == self.count {
+        if self.done.is_multiple_of(10) || self.done == self.count {
             self.w.write_all(b"\n")?;
         }
         Ok(())

@@ -27,6 +27,11 @@ use crate::error::{Context, Error, Result};
 
 type Key = (u64, u64);
 
+/// What a pass over the faces calls: the face, its points, its cell, the cell's material and
+/// points.
+type FaceAndCell<'a> =
+    dyn FnMut(&TaggedFace, &[[f64; 3]], &Cell, i32, &[[f64; 3]]) -> Result<()> + 'a;
+
 /// The merged model as passes over the tiles (see the module documentation).
 pub(super) struct TiledModel<'a> {
     plan: &'a Path,
@@ -329,11 +334,7 @@ impl<'a> TiledModel<'a> {
     /// Every kept face of the merged model in order, with its cell, material and the cell's
     /// points when `cells` (otherwise an empty tetrahedron, unit 0, no points: a pass that
     /// reads no cells).
-    fn faces_with_cells(
-        &self,
-        cells: bool,
-        f: &mut dyn FnMut(&TaggedFace, &[[f64; 3]], &Cell, i32, &[[f64; 3]]) -> Result<()>,
-    ) -> Result<()> {
+    fn faces_with_cells(&self, cells: bool, f: &mut FaceAndCell) -> Result<()> {
         let none = Cell::tetra([0; 4]);
         self.pass(cells, &mut |k, t, l| {
             let path = tile_dir(self.plan, &t.id).join(MODEL_FACES);
