@@ -5,12 +5,12 @@
 #   bench/tiles_fort_worth.sh [TILE_SIZE] [OUT_DIR]
 # ONE_PIECE=0 skips the one-piece build (per-tile figures only, e.g. at other tile sizes).
 # The machine's load (`uptime`) is printed before and after: ratios measured under load.
-# Needs ../shared/data/grids/fort-worth-3arcsec.tif and target/release/terramesh.
+# Needs ../shared/data/grids/fort-worth-3arcsec.tif and target/release/terramesh (or BIN=path).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 size=${1:-10km}
 out=${2:-bench-out/tiles}
-bin=target/release/terramesh
+bin=${BIN:-target/release/terramesh}
 ex=examples/fort-worth-1m/terramesh.toml
 rm -rf "$out" && mkdir -p "$out"
 peak() { awk -F': ' '/Maximum resident/ {print $2}' "$1"; }

@@ -88,6 +88,7 @@ fn asc(p: &Path) -> Vec<f64> {
         .collect()
 }
 
+#[allow(dead_code)] // (the field-data readers are for tiles_geology_files.rs)
 #[path = "support/vtu_read.rs"]
 mod vtu_read;
 

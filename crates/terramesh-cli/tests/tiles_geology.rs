@@ -13,62 +13,27 @@ use std::process::Command;
 use terramesh_core::volume::{cell_volume, Cell, CellKind};
 use terramesh_geostat::{kriging, Data, Duplicates, KrigingFrame, Method, Neighbourhood};
 
-fn example() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/kimberlina/terramesh.toml")
-}
+#[allow(dead_code)] // (the field-data readers are for tiles_geology_files.rs)
+#[path = "support/vtu_read.rs"]
+mod vtu_read;
 
-fn run(args: &[&str]) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
-        .args(args)
-        .env_remove("TERRAMESH_TILES_FAIL")
-        .output()
-        .expect("run terramesh");
-    assert!(
-        o.status.success(),
-        "terramesh {args:?} failed: {}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+#[allow(dead_code)]
+#[path = "support/tiles_model.rs"]
+mod tiles_model;
+use tiles_model::{json, kimberlina as example, model, planar};
 
 const SET: &str = "interpolation.neighbors=8";
 
-/// Plans with `extra` overrides, builds every tile and merges; the plan and merged folders.
+/// Plans Kimberlina in 17 km tiles with [`SET`] and `extra`, builds every tile and merges; the
+/// plan and merged folders.
 fn tiled(dir: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
-    let (plan, merged) = (dir.join("plan"), dir.join("merged"));
-    let ex = example();
-    let mut args = vec!["tiles", "plan", ex.to_str().unwrap(), "--tile-size", "17km"];
-    args.extend(["-o", plan.to_str().unwrap(), "--quiet", "--set", SET]);
-    for e in extra {
-        args.extend(["--set", e]);
-    }
-    run(&args);
-    for t in manifest(&plan)["tiles"].as_array().unwrap() {
-        run(&[
-            "tiles",
-            "build",
-            plan.to_str().unwrap(),
-            "--tile",
-            t["id"].as_str().unwrap(),
-        ]);
-    }
-    run(&[
-        "tiles",
-        "merge",
-        plan.to_str().unwrap(),
-        "-o",
-        merged.to_str().unwrap(),
-    ]);
-    (plan, merged)
+    let mut set = vec![SET];
+    set.extend(extra);
+    tiles_model::tiled(dir, &example(), "17km", &set)
 }
 
 fn manifest(plan: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(plan.join("tiles.json")).unwrap()).unwrap()
-}
-
-fn json(p: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    json(&plan.join("tiles.json"))
 }
 
 fn f64s(p: &Path) -> Vec<f64> {
@@ -77,30 +42,6 @@ fn f64s(p: &Path) -> Vec<f64> {
         .chunks_exact(8)
         .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
         .collect()
-}
-
-/// The merged volume mesh: points, cells (our node orders), materials.
-fn model(p: &Path) -> (Vec<[f64; 3]>, Vec<Cell>, Vec<i32>) {
-    let v = vtu_read::Vtu::read(p);
-    let pts = v.array("NumberOfComponents=\"3\"");
-    let con = v.array("Name=\"connectivity\"");
-    let off = v.array("Name=\"offsets\"");
-    let types = v.array("Name=\"types\"");
-    let mat = v.array("Name=\"MaterialIDs\"");
-    let points: Vec<[f64; 3]> = pts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
-    let mut cells = Vec::new();
-    let mut start = 0usize;
-    for (k, &o) in off.iter().enumerate() {
-        let n: Vec<u32> = con[start..o as usize].iter().map(|&v| v as u32).collect();
-        start = o as usize;
-        cells.push(match types[k] as u8 {
-            10 => Cell::tetra([n[0], n[1], n[2], n[3]]),
-            14 => Cell::pyramid([n[0], n[1], n[2], n[3], n[4]]),
-            13 => Cell::wedge([n[0], n[2], n[1], n[3], n[5], n[4]]),
-            t => panic!("cell type {t}"),
-        });
-    }
-    (points, cells, mat.iter().map(|&m| m as i32).collect())
 }
 
 /// The faces of a cell (our node orders, as `terramesh_io::model::cell_faces`).
@@ -200,9 +141,6 @@ fn conforming(
     }
     vol
 }
-
-#[path = "support/vtu_read.rs"]
-mod vtu_read;
 
 /// The merged `dsm.vtu`'s triangles.
 fn triangles(merged: &Path) -> usize {
@@ -375,14 +313,7 @@ fn tiled_geological_model_is_conforming_and_equals_a_one_piece_model_on_the_same
 
     // 3. A one-piece model on the merged planar mesh, from all the boreholes.
     let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
-    let pts = dsm.array("NumberOfComponents=\"3\"");
-    let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
-    let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
-    let tris: Vec<[u32; 3]> = dsm
-        .array("Name=\"connectivity\"")
-        .chunks(3)
-        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
-        .collect();
+    let (xy, terrain, tris) = planar(&dsm);
     let p = terramesh::project::Project::load(&example(), &[SET.to_string()]).unwrap();
     let k_plan = gp["neighbours"].as_u64().unwrap() as usize;
     let mut tops = Vec::new();

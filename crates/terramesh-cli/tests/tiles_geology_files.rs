@@ -13,89 +13,19 @@
 //! outside CI and fails in CI.
 
 use std::collections::{HashMap, HashSet};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use terramesh_core::volume::{cell_volume, Cell};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn run(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
-        .args(args)
-        .env_remove("TERRAMESH_TILES_FAIL")
-        .output()
-        .expect("run terramesh");
-    assert!(
-        o.status.success(),
-        "terramesh {args:?} failed: {}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
-fn json(p: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
-/// Plans `project` in tiles of `size` with the overrides `set`, builds every tile, merges.
-fn tiled(dir: &Path, project: &Path, size: &str, set: &[&str]) -> (PathBuf, PathBuf) {
-    let (plan, merged) = (dir.join("plan"), dir.join("merged"));
-    let mut args = vec![
-        "tiles",
-        "plan",
-        project.to_str().unwrap(),
-        "--tile-size",
-        size,
-    ];
-    args.extend(["-o", plan.to_str().unwrap(), "--quiet"]);
-    for s in set {
-        args.extend(["--set", s]);
-    }
-    run(&args);
-    for t in json(&plan.join("tiles.json"))["tiles"].as_array().unwrap() {
-        let id = t["id"].as_str().unwrap();
-        run(&["tiles", "build", plan.to_str().unwrap(), "--tile", id]);
-    }
-    run(&[
-        "tiles",
-        "merge",
-        plan.to_str().unwrap(),
-        "-o",
-        merged.to_str().unwrap(),
-    ]);
-    (plan, merged)
-}
 
 #[allow(dead_code)] // (`triangles` is for the DSM tests)
 #[path = "support/vtu_read.rs"]
 mod vtu_read;
 
-/// `model.vtu` (raw appended binary, as the merge writes it): points, cells in our node orders, materials.
-fn model(p: &Path) -> (Vec<[f64; 3]>, Vec<Cell>, Vec<i32>) {
-    let v = vtu_read::Vtu::read(p);
-    let pts = v.array("NumberOfComponents=\"3\"");
-    let con = v.array("Name=\"connectivity\"");
-    let off = v.array("Name=\"offsets\"");
-    let types = v.array("Name=\"types\"");
-    let mat = v.array("Name=\"MaterialIDs\"");
-    let mut cells = Vec::new();
-    let mut start = 0usize;
-    for (k, &o) in off.iter().enumerate() {
-        let n: Vec<u32> = con[start..o as usize].iter().map(|&v| v as u32).collect();
-        start = o as usize;
-        cells.push(match types[k] as u8 {
-            10 => Cell::tetra([n[0], n[1], n[2], n[3]]),
-            14 => Cell::pyramid([n[0], n[1], n[2], n[3], n[4]]),
-            13 => Cell::wedge([n[0], n[2], n[1], n[3], n[5], n[4]]),
-            t => panic!("cell type {t}"),
-        });
-    }
-    let points = pts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
-    (points, cells, mat.iter().map(|&m| m as i32).collect())
-}
+#[allow(dead_code)]
+#[path = "support/tiles_model.rs"]
+mod tiles_model;
+use tiles_model::{json, model, planar, root, tiled};
 
 /// The faces of a cell as sorted node sets.
 fn cell_faces(c: &Cell) -> Vec<Vec<u32>> {
@@ -187,7 +117,7 @@ fn verify(dir: &Path, only: &[&str]) {
 #[test]
 fn merged_boundary_meshes_msh_f3grid_and_bodies_are_the_merged_models() {
     let tmp = tempfile::tempdir().unwrap();
-    let ex = root().join("examples/kimberlina/terramesh.toml");
+    let ex = tiles_model::kimberlina();
     // min_thickness 1 m: at 0, the kernel keeps wedges a few picometres thick (surfaces equal
     // but for rounding) whose Jacobian is negative at some Gauss points (Gmsh and OpenGeoSys
     // refuse them); the one-piece kernel's matter, not the merge's.
@@ -362,14 +292,7 @@ fn grids_against_one_piece(set: &[&str], base: Option<&Path>) {
         assert_eq!(it["estimate"]["kind"], "grid", "{it}");
     }
     let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
-    let pts = dsm.array("NumberOfComponents=\"3\"");
-    let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
-    let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
-    let tris: Vec<[u32; 3]> = dsm
-        .array("Name=\"connectivity\"")
-        .chunks(3)
-        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
-        .collect();
+    let (xy, terrain, tris) = planar(&dsm);
     let owned: Vec<String> = set.iter().map(|s| s.to_string()).collect();
     let mut with = vec![
         "sampling.rows=25".to_string(),
@@ -476,7 +399,7 @@ fn tiles_sample_a_base_grid_as_a_one_piece_model_does() {
 fn tiled_thickness_model_equals_a_one_piece_model_on_the_same_mesh() {
     use terramesh_geostat::{kriging, Data, Duplicates, KrigingFrame, Method, Neighbourhood};
     let tmp = tempfile::tempdir().unwrap();
-    let ex = root().join("examples/kimberlina/terramesh.toml");
+    let ex = tiles_model::kimberlina();
     let set = [
         "interpolation.neighbors=8",
         "geology.interpolate=thickness",
@@ -487,14 +410,7 @@ fn tiled_thickness_model_equals_a_one_piece_model_on_the_same_mesh() {
     let gp = &m["geology"];
     assert_eq!(gp["thickness"], true);
     let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
-    let pts = dsm.array("NumberOfComponents=\"3\"");
-    let xy: Vec<[f64; 2]> = pts.chunks(3).map(|c| [c[0], c[1]]).collect();
-    let terrain: Vec<f64> = pts.chunks(3).map(|c| c[2]).collect();
-    let tris: Vec<[u32; 3]> = dsm
-        .array("Name=\"connectivity\"")
-        .chunks(3)
-        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
-        .collect();
+    let (xy, terrain, tris) = planar(&dsm);
     let owned: Vec<String> = set.iter().map(|s| s.to_string()).collect();
     let p = terramesh::project::Project::load(&ex, &owned).unwrap();
     let g = p.geology().unwrap();
@@ -580,4 +496,120 @@ fn tiled_thickness_model_equals_a_one_piece_model_on_the_same_mesh() {
             vol[u]
         );
     }
+}
+
+/// The merged `model.vtu`, `dsm.vtu` and `model.json` record the CRS and the vertical datum as
+/// a one-piece build of the same project does (field data in the same order, the same text),
+/// and `model.json` lists every observed contact with the misfit of a one-piece model on the
+/// merged mesh (`terramesh::geology::model::misfits` on the merged `dsm.vtu`'s surfaces).
+#[test]
+fn merged_outputs_carry_the_datum_and_the_misfits_of_one_piece() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tiles_model::kimberlina();
+    let set = [
+        "interpolation.neighbors=8",
+        "geology.min_thickness=1.0",
+        "region.vertical_datum=navd88",
+    ];
+    let (plan, merged) = tiled(tmp.path(), &ex, "26km", &set);
+    let one = tmp.path().join("one");
+    let mut args = vec!["build", ex.to_str().unwrap(), "-o", one.to_str().unwrap()];
+    args.extend(["--quiet", "--set", "export.formats=[\"vtu\"]"]);
+    args.extend([
+        "--set",
+        "export.pictures=false",
+        "--set",
+        "export.report=false",
+    ]);
+    for s in &set {
+        args.extend(["--set", s]);
+    }
+    tiles_model::run(&args);
+
+    // The datum: model.json's keys, model.vtu's and dsm.vtu's field data.
+    let (mj, oj) = (
+        json(&merged.join("model.json")),
+        json(&one.join("model.json")),
+    );
+    for k in ["crs", "vertical_datum", "vertical_crs", "heights"] {
+        assert_eq!(mj[k], oj[k], "model.json {k}");
+    }
+    assert_eq!(oj["vertical_crs"], "EPSG:5703", "the test names a datum");
+    for f in ["model.vtu", "dsm.vtu"] {
+        let (a, b) = (
+            vtu_read::Vtu::read(&merged.join(f)),
+            vtu_read::Vtu::read(&one.join(f)),
+        );
+        assert_eq!(a.field_names(), b.field_names(), "{f}'s field data");
+        assert!(b.field_names().contains(&"vertical_crs".to_string()));
+        for name in b.field_names() {
+            assert_eq!(a.text(&name), b.text(&name), "{f}: {name}");
+        }
+    }
+
+    // The boreholes: every contact once, the misfits of one piece on the merged mesh.
+    let p = terramesh::project::Project::load(&ex, &set.map(String::from)).unwrap();
+    let crs = terramesh_crs::Crs::from_epsg(26711).unwrap();
+    let holes = terramesh::geology::stage::read_boreholes(p.geology().unwrap(), None, Some(&crs))
+        .unwrap()
+        .unwrap();
+    let dsm = vtu_read::Vtu::read(&merged.join("dsm.vtu"));
+    let (xy, terrain, triangles) = planar(&dsm);
+    let units = &p.geology().unwrap().units;
+    let mut surfaces = vec![terrain];
+    for u in &units[1..] {
+        surfaces.push(dsm.array(&format!("Name=\"top_{u}\"")));
+    }
+    surfaces.push(dsm.array("Name=\"base\""));
+    let mesh = terramesh_mesh::Mesh {
+        origin: [0.0, 0.0],
+        points: xy,
+        triangles,
+        constraint_edges: vec![],
+    };
+    let want =
+        terramesh::geology::model::misfits(&holes, &mesh, &terramesh_geology::Stack { surfaces });
+    let got = mj["boreholes"].as_array().unwrap();
+    assert_eq!(got.len(), want.len(), "one entry per observed contact");
+    assert_eq!(got.len(), oj["boreholes"].as_array().unwrap().len());
+    let mut worst: f64 = 0.0;
+    for (g, w) in got.iter().zip(&want) {
+        assert_eq!(
+            (g["hole"].as_str(), g["unit"].as_str()),
+            (Some(&*w.hole), Some(&*w.unit))
+        );
+        for (k, v) in [("x", w.x), ("y", w.y), ("observed", w.observed)] {
+            assert_eq!(g[k].as_f64(), Some(v), "{} {}: {k}", w.hole, w.unit);
+        }
+        let m = g["model"].as_f64().unwrap();
+        assert_eq!(g["misfit"].as_f64(), Some(m - w.observed));
+        worst = worst.max((m - w.model).abs());
+    }
+    assert!(
+        worst <= 1e-9,
+        "misfits differ from one piece's by {worst} m"
+    );
+    // The contacts spread over the tiles, each evaluated by the tile that owns it.
+    let m = json(&plan.join("tiles.json"));
+    let per_tile: Vec<usize> = m["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| {
+            let f = plan
+                .join("tiles")
+                .join(t["id"].as_str().unwrap())
+                .join("misfits.json");
+            json(&f).as_array().unwrap().len()
+        })
+        .collect();
+    assert!(
+        per_tile.iter().filter(|&&n| n > 0).count() >= 3,
+        "{per_tile:?}"
+    );
+    assert_eq!(per_tile.iter().sum::<usize>(), got.len());
+    // No model.glb, and the report says why.
+    assert!(!merged.join("model.glb").exists());
+    let report = std::fs::read_to_string(merged.join("report.html")).unwrap();
+    assert!(report.contains("model.glb is not merged: a GLB file is at most 4 GiB"));
 }

@@ -17,20 +17,9 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
+use super::passes::ModelPasses;
 use super::write_shortest;
 use super::ModelInfo;
-
-fn ids<W: Write + ?Sized>(w: &mut W, list: &[u64]) -> io::Result<()> {
-    let mut b = itoa::Buffer::new();
-    for chunk in list.chunks(10) {
-        for id in chunk {
-            w.write_all(b" ")?;
-            w.write_all(b.format(*id).as_bytes())?;
-        }
-        w.write_all(b"\n")?;
-    }
-    Ok(())
-}
 
 /// Writes the model as a FLAC3D ASCII grid (see the module documentation).
 ///
@@ -56,6 +45,17 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
+    write_f3grid_passes(w, m, info)
+}
+
+/// Writes a model read in passes ([`ModelPasses`]) as a FLAC3D ASCII grid, the bytes of
+/// [`write_model_f3grid`] for the same mesh: one pass each over the points, cells and faces,
+/// then one per zone group (unit) and face group (tag).
+pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
+    w: &mut W,
+    m: &M,
+    info: &ModelInfo,
+) -> io::Result<()> {
     writeln!(w, "* FLAC3D grid of a terramesh geological model")?;
     writeln!(
         w,
@@ -65,17 +65,23 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
     )?;
     writeln!(w, "* GRIDPOINTS")?;
     let mut b = itoa::Buffer::new();
-    for (i, p) in m.points.iter().enumerate() {
+    let mut i = 0usize;
+    m.each_point(&mut |p| {
+        i += 1;
         w.write_all(b"G ")?;
-        w.write_all(b.format(i + 1).as_bytes())?;
+        w.write_all(b.format(i).as_bytes())?;
         for c in p {
             w.write_all(b" ")?;
             write_shortest(w, *c)?;
         }
-        w.write_all(b"\n")?;
-    }
+        w.write_all(b"\n")
+    })?;
     writeln!(w, "* ZONES")?;
-    for (i, c) in m.cells.iter().enumerate() {
+    let mut per_unit = vec![0usize; m.units().len()];
+    let mut i = 0usize;
+    m.each_cell(&mut |c, mat, _| {
+        i += 1;
+        per_unit[mat as usize] += 1;
         let n = c.nodes;
         let (name, order): (&[u8], &[u32]) = match c.kind {
             CellKind::Wedge => (b"W6", &[n[0], n[2], n[3], n[1], n[5], n[4]]),
@@ -85,49 +91,89 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
         w.write_all(b"Z ")?;
         w.write_all(name)?;
         w.write_all(b" ")?;
-        w.write_all(b.format(i + 1).as_bytes())?;
+        w.write_all(b.format(i).as_bytes())?;
         for &k in order {
             w.write_all(b" ")?;
             w.write_all(b.format(k as u64 + 1).as_bytes())?;
         }
-        w.write_all(b"\n")?;
-    }
-    if !m.faces.is_empty() {
+        w.write_all(b"\n")
+    })?;
+    let mut per_tag = vec![0usize; m.tags().len()];
+    if m.face_count() > 0 {
         writeln!(w, "* FACES")?;
-        for (j, f) in m.faces.iter().enumerate() {
+        let mut j = 0usize;
+        m.each_face(&mut |f, _| {
+            j += 1;
+            per_tag[f.tag as usize] += 1;
             let nodes = f.used();
             w.write_all(if nodes.len() == 3 { b"F T3 " } else { b"F Q4 " })?;
-            w.write_all(b.format(j + 1).as_bytes())?;
+            w.write_all(b.format(j).as_bytes())?;
             for &k in nodes {
                 w.write_all(b" ")?;
                 w.write_all(b.format(k as u64 + 1).as_bytes())?;
             }
-            w.write_all(b"\n")?;
-        }
+            w.write_all(b"\n")
+        })?;
     }
     writeln!(w, "* ZONE GROUPS")?;
-    let mut per_unit: Vec<Vec<u64>> = vec![Vec::new(); m.units.len()];
-    for (i, &mat) in m.material.iter().enumerate() {
-        per_unit[mat as usize].push(i as u64 + 1);
-    }
-    for (u, list) in per_unit.iter().enumerate() {
-        if !list.is_empty() {
-            writeln!(w, "ZGROUP \"{}\" SLOT 1", m.units[u])?;
-            ids(w, list)?;
+    for (u, &count) in per_unit.iter().enumerate() {
+        if count > 0 {
+            writeln!(w, "ZGROUP \"{}\" SLOT 1", m.units()[u])?;
+            let mut ids = Ids::new(w, count);
+            let mut i = 0u64;
+            m.each_cell(&mut |_, mat, _| {
+                i += 1;
+                if mat as usize == u {
+                    ids.push(i)?;
+                }
+                Ok(())
+            })?;
         }
     }
-    let mut per_tag: Vec<Vec<u64>> = vec![Vec::new(); m.tags.len()];
-    for (j, f) in m.faces.iter().enumerate() {
-        per_tag[f.tag as usize].push(j as u64 + 1);
-    }
-    if !m.faces.is_empty() {
+    if m.face_count() > 0 {
         writeln!(w, "* FACE GROUPS")?;
-        for (t, list) in per_tag.iter().enumerate() {
-            if !list.is_empty() {
-                writeln!(w, "FGROUP \"{}\" SLOT 1", m.tags[t].name())?;
-                ids(w, list)?;
+        for (t, &count) in per_tag.iter().enumerate() {
+            if count > 0 {
+                writeln!(w, "FGROUP \"{}\" SLOT 1", m.tags()[t].name())?;
+                let mut ids = Ids::new(w, count);
+                let mut j = 0u64;
+                m.each_face(&mut |f, _| {
+                    j += 1;
+                    if f.tag as usize == t {
+                        ids.push(j)?;
+                    }
+                    Ok(())
+                })?;
             }
         }
     }
     Ok(())
+}
+
+/// A group's ids, ten a line, the last line ended after the group's `count`-th id.
+struct Ids<'w, W: Write + ?Sized> {
+    w: &'w mut W,
+    count: usize,
+    done: usize,
+    b: itoa::Buffer,
+}
+
+impl<'w, W: Write + ?Sized> Ids<'w, W> {
+    fn new(w: &'w mut W, count: usize) -> Self {
+        Ids {
+            w,
+            count,
+            done: 0,
+            b: itoa::Buffer::new(),
+        }
+    }
+    fn push(&mut self, id: u64) -> io::Result<()> {
+        self.w.write_all(b" ")?;
+        self.w.write_all(self.b.format(id).as_bytes())?;
+        self.done += 1;
+        if self.done.is_multiple_of(10) || self.done == self.count {
+            self.w.write_all(b"\n")?;
+        }
+        Ok(())
+    }
 }

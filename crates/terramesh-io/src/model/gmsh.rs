@@ -12,6 +12,7 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
+use super::passes::ModelPasses;
 use super::ModelInfo;
 use super::{vertical_note, write_shortest};
 
@@ -75,33 +76,47 @@ pub fn write_model_msh<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    let nu = m.units.len();
-    let nt = m.tags.len();
+    write_msh_passes(w, m, info)
+}
+
+/// Writes a model read in passes ([`ModelPasses`]) as Gmsh MSH 4.1 ASCII, the bytes of
+/// [`write_model_msh`] for the same mesh: a pass over the cells and one over the faces for
+/// the blocks' sizes and bounding boxes, one over the points, then one per block (a unit's
+/// cells of one kind, a tag's faces of one size).
+pub fn write_msh_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
+    w: &mut W,
+    m: &M,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    let nu = m.units().len();
+    let nt = m.tags().len();
     // Cells per unit and kind, faces per tag and size.
     let kinds = [CellKind::Wedge, CellKind::Pyramid, CellKind::Tetra];
-    let mut vol_blocks: Vec<[Vec<u32>; 3]> = vec![Default::default(); nu];
+    let mut vol_blocks = vec![[0usize; 3]; nu];
     let mut vol_box: Vec<Bbox> = (0..nu).map(|_| Bbox::new()).collect();
-    for (i, (c, &mat)) in m.cells.iter().zip(&m.material).enumerate() {
+    m.each_cell(&mut |c, mat, pts| {
         let k = kinds.iter().position(|&k| k == c.kind).expect("a kind");
-        vol_blocks[mat as usize][k].push(i as u32);
-        for &n in c.used() {
-            vol_box[mat as usize].add(m.points[n as usize]);
+        vol_blocks[mat as usize][k] += 1;
+        for p in pts {
+            vol_box[mat as usize].add(*p);
         }
-    }
-    let mut surf_blocks: Vec<[Vec<u32>; 2]> = vec![Default::default(); nt];
+        Ok(())
+    })?;
+    let mut surf_blocks = vec![[0usize; 2]; nt];
     let mut surf_box: Vec<Bbox> = (0..nt).map(|_| Bbox::new()).collect();
-    for (j, f) in m.faces.iter().enumerate() {
+    m.each_face(&mut |f, pts| {
         let t = f.tag as usize;
-        surf_blocks[t][f.used().len() - 3].push(j as u32);
-        for &n in f.used() {
-            surf_box[t].add(m.points[n as usize]);
+        surf_blocks[t][f.used().len() - 3] += 1;
+        for p in pts {
+            surf_box[t].add(*p);
         }
-    }
+        Ok(())
+    })?;
     let units: Vec<usize> = (0..nu)
-        .filter(|&u| vol_blocks[u].iter().any(|b| !b.is_empty()))
+        .filter(|&u| vol_blocks[u].iter().any(|&b| b > 0))
         .collect();
     let tags: Vec<usize> = (0..nt)
-        .filter(|&t| surf_blocks[t].iter().any(|b| !b.is_empty()))
+        .filter(|&t| surf_blocks[t].iter().any(|&b| b > 0))
         .collect();
 
     writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
@@ -113,10 +128,10 @@ pub fn write_model_msh<W: Write + ?Sized>(
     )?;
     writeln!(w, "$PhysicalNames\n{}", units.len() + tags.len())?;
     for &u in &units {
-        writeln!(w, "3 {} \"{}\"", u + 1, quote(&m.units[u]))?;
+        writeln!(w, "3 {} \"{}\"", u + 1, quote(&m.units()[u]))?;
     }
     for &t in &tags {
-        writeln!(w, "2 {} \"{}\"", t + 1, quote(&m.tags[t].name()))?;
+        writeln!(w, "2 {} \"{}\"", t + 1, quote(&m.tags()[t].name()))?;
     }
     writeln!(w, "$EndPhysicalNames")?;
     writeln!(w, "$Entities\n0 0 {} {}", tags.len(), units.len())?;
@@ -131,7 +146,7 @@ pub fn write_model_msh<W: Write + ?Sized>(
         writeln!(w, " 1 {} 0", u + 1)?;
     }
     writeln!(w, "$EndEntities")?;
-    let np = m.points.len();
+    let np = m.point_count();
     let node_entity = units.first().map_or(1, |u| u + 1);
     writeln!(w, "$Nodes\n1 {np} 1 {np}\n3 {node_entity} 0 {np}")?;
     let mut ib = itoa::Buffer::new();
@@ -139,56 +154,63 @@ pub fn write_model_msh<W: Write + ?Sized>(
         w.write_all(ib.format(i).as_bytes())?;
         w.write_all(b"\n")?;
     }
-    for p in &m.points {
+    m.each_point(&mut |p| {
         write_shortest(w, p[0])?;
         w.write_all(b" ")?;
         write_shortest(w, p[1])?;
         w.write_all(b" ")?;
         write_shortest(w, p[2])?;
-        w.write_all(b"\n")?;
-    }
+        w.write_all(b"\n")
+    })?;
     writeln!(w, "$EndNodes")?;
-    let nblocks = vol_blocks
-        .iter()
-        .flatten()
-        .filter(|b| !b.is_empty())
-        .count()
-        + surf_blocks
-            .iter()
-            .flatten()
-            .filter(|b| !b.is_empty())
-            .count();
-    let ne = m.cells.len() + m.faces.len();
+    let nblocks = vol_blocks.iter().flatten().filter(|&&b| b > 0).count()
+        + surf_blocks.iter().flatten().filter(|&&b| b > 0).count();
+    let nc = m.cell_count();
+    let ne = nc + m.face_count();
     writeln!(w, "$Elements\n{nblocks} {ne} 1 {ne}")?;
-    let mut line = |w: &mut W, tag: usize, nodes: &[u32]| -> io::Result<()> {
+    fn line<W: Write + ?Sized>(
+        w: &mut W,
+        ib: &mut itoa::Buffer,
+        tag: usize,
+        nodes: &[u32],
+    ) -> io::Result<()> {
         w.write_all(ib.format(tag).as_bytes())?;
         for &n in nodes {
             w.write_all(b" ")?;
             w.write_all(ib.format(n as u64 + 1).as_bytes())?;
         }
         w.write_all(b"\n")
-    };
+    }
     for &u in &units {
-        for (k, block) in vol_blocks[u].iter().enumerate() {
-            if block.is_empty() {
+        for (k, &count) in vol_blocks[u].iter().enumerate() {
+            if count == 0 {
                 continue;
             }
-            writeln!(w, "3 {} {} {}", u + 1, gmsh_type(kinds[k]), block.len())?;
-            for &i in block {
-                line(w, i as usize + 1, m.cells[i as usize].used())?;
-            }
+            writeln!(w, "3 {} {} {}", u + 1, gmsh_type(kinds[k]), count)?;
+            let mut i = 0usize;
+            m.each_cell(&mut |c, mat, _| {
+                i += 1;
+                if mat as usize == u && c.kind == kinds[k] {
+                    line(w, &mut ib, i, c.used())?;
+                }
+                Ok(())
+            })?;
         }
     }
-    let nc = m.cells.len();
     for &t in &tags {
-        for (k, block) in surf_blocks[t].iter().enumerate() {
-            if block.is_empty() {
+        for (k, &count) in surf_blocks[t].iter().enumerate() {
+            if count == 0 {
                 continue;
             }
-            writeln!(w, "2 {} {} {}", t + 1, 2 + k, block.len())?;
-            for &j in block {
-                line(w, nc + j as usize + 1, m.faces[j as usize].used())?;
-            }
+            writeln!(w, "2 {} {} {}", t + 1, 2 + k, count)?;
+            let mut j = 0usize;
+            m.each_face(&mut |f, _| {
+                j += 1;
+                if f.tag as usize == t && f.used().len() - 3 == k {
+                    line(w, &mut ib, nc + j, f.used())?;
+                }
+                Ok(())
+            })?;
         }
     }
     writeln!(w, "$EndElements")

@@ -50,6 +50,7 @@ mod check;
 mod faces;
 mod flac3d;
 mod gmsh;
+mod passes;
 mod vtk;
 
 use std::io;
@@ -65,8 +66,9 @@ pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
 pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
 pub use check::{check_mesh, MeshError};
 pub use faces::{cell_faces, ogs_face_index};
-pub use flac3d::write_model_f3grid;
-pub use gmsh::write_model_msh;
+pub use flac3d::{write_f3grid_passes, write_model_f3grid};
+pub use gmsh::{write_model_msh, write_msh_passes};
+pub use passes::{CellVisit, FaceVisit, ModelPasses};
 pub use vtk::{write_boundary_vtu, write_model_vtu};
 
 /// What the files record besides the mesh.

@@ -299,7 +299,10 @@ pub(crate) fn base_values(
     })
 }
 
-pub(crate) fn misfits(b: &Boreholes, mesh: &Mesh, stack: &Stack) -> Vec<Misfit> {
+/// Every observed contact of `b` against the surfaces `stack` on the planar `mesh` (linear
+/// on its triangles): the collars against the terrain, then the logged tops of the other
+/// units, hole by hole (`model.json`'s `boreholes`); a contact outside the mesh is left out.
+pub fn misfits(b: &Boreholes, mesh: &Mesh, stack: &Stack) -> Vec<Misfit> {
     let locators: Vec<SurfaceLocator> = stack
         .surfaces
         .iter()

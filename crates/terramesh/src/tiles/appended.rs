@@ -55,6 +55,34 @@ pub(crate) struct Array<'a> {
     pub values: Values<'a>,
 }
 
+/// A field-data array of text (`UInt8`, its UTF-8 bytes), as the one-piece writers record
+/// `unit_names`, `crs` and the vertical datum.
+pub(crate) fn text_field<'a>(name: &str, bytes: Vec<u8>) -> Array<'a> {
+    let len = bytes.len();
+    Array {
+        section: Section::Field,
+        vtk_type: "UInt8",
+        name: name.to_string(),
+        components: 1,
+        tuples: Some(len),
+        bytes: len as u64,
+        values: Box::new(move |w| Ok(w.write_all(&bytes)?)),
+    }
+}
+
+/// The field data `crs`, `vertical_datum` and (when named) `vertical_crs` that a one-piece
+/// build writes into `dsm.vtu` and `model.vtu` (`terramesh_io::model::ModelInfo`).
+pub(crate) fn datum_fields<'a>(crs: &str, datum: &crate::project::HeightDatum) -> Vec<Array<'a>> {
+    let mut f = vec![
+        text_field("crs", crs.as_bytes().to_vec()),
+        text_field("vertical_datum", datum.name().into_bytes()),
+    ];
+    if let Some(c) = datum.crs_name() {
+        f.push(text_field("vertical_crs", c.into_bytes()));
+    }
+    f
+}
+
 /// Counts what passes through.
 struct Counting<'w> {
     w: &'w mut dyn Write,

@@ -216,8 +216,20 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         .collect();
     files::write_vertices(&folder.path().join(files::VERTICES), &vertices)?;
     files::write_triangles(&folder.path().join(files::TRIANGLES), &triangles)?;
-    if let Some(model) = &model {
+    if let (Some(model), Some(gp)) = (&model, &m.geology) {
         super::geology::write_model(folder.path(), model, &positions, &triangles, &nodes)?;
+        let misfits = super::boreholes::tile_misfits(
+            plan,
+            m,
+            gp,
+            tile,
+            &positions,
+            &triangles,
+            &model.surfaces,
+        )?;
+        if let Some(values) = misfits {
+            super::boreholes::write_tile_misfits(folder.path(), &values)?;
+        }
     }
     let grid: Vec<(u64, f64)> = nodes.iter().map(|n| n.0).zip(values).collect();
     files::write_grid(&folder.path().join(files::GRID), &grid)?;

@@ -1,7 +1,9 @@
-//! The merged DSM grids (`dsm.tif`, `dsm.asc`), written row by row with one row in memory.
+//! The merged grids, written row by row with one row in memory: the DSM (`dsm.tif`,
+//! `dsm.asc`) and, with `[geology]`, every unit's top (`interfaces/<unit>.tif`, one row of
+//! each in memory).
 //!
-//! Each tile's `grid.bin` lists the grid nodes it owns in increasing index `j * nx + i` (its
-//! build walks its nodes row by row), so the grid's rows, north first, are a merge of the
+//! Each tile's `grid.bin` (and `interfaces.bin`) lists the grid nodes it owns in increasing
+//! index `j * nx + i` (its build walks its nodes row by row), so the grid's rows, north first, are a merge of the
 //! tiles' files: row `r` takes, from every tile whose nodes span it, the records of that row.
 //! A tile's file is opened when the merge reaches its first row and closed after its last, so
 //! the merge holds one row of the grid and a read buffer per tile that spans the current row
@@ -33,29 +35,35 @@ pub struct GridFigures {
     pub row_bytes: usize,
 }
 
-/// One tile's `grid.bin`, read in order.
+/// One tile's records (a `u64` node index, then `width` `f64` values), read in order.
 struct Stream {
     path: PathBuf,
     first_row: usize,
     r: Option<BufReader<File>>,
     left: u64,
-    pending: Option<(u64, f64)>,
+    rec: Vec<u8>,
+    pending: Option<u64>,
 }
 
 impl Stream {
-    /// The next record, without taking it.
-    fn peek(&mut self) -> Result<Option<(u64, f64)>> {
+    /// The next record's node, without taking it (its values: [`Stream::value`]).
+    fn peek(&mut self) -> Result<Option<u64>> {
         if self.pending.is_none() && self.left > 0 {
             let r = self.r.as_mut().expect("opened");
-            let mut rec = [0u8; 16];
-            r.read_exact(&mut rec)
+            r.read_exact(&mut self.rec)
                 .context(self.path.display().to_string())?;
             self.left -= 1;
-            let i = u64::from_le_bytes(rec[..8].try_into().expect("8 bytes"));
-            let v = f64::from_le_bytes(rec[8..].try_into().expect("8 bytes"));
-            self.pending = Some((i, v));
+            self.pending = Some(u64::from_le_bytes(
+                self.rec[..8].try_into().expect("8 bytes"),
+            ));
         }
         Ok(self.pending)
+    }
+
+    /// Value `k` of the record peeked.
+    fn value(&self, k: usize) -> f64 {
+        let at = 8 + 8 * k;
+        f64::from_le_bytes(self.rec[at..at + 8].try_into().expect("8 bytes"))
     }
 }
 
@@ -73,6 +81,56 @@ pub(crate) fn write_grids(
     m: &Manifest,
     out: &Path,
 ) -> Result<(Vec<PathBuf>, GridFigures)> {
+    let paths = [out.join("dsm.tif"), out.join("dsm.asc")];
+    let outputs = [
+        (paths[0].clone(), geotiff(m), 0),
+        (paths[1].clone(), RowFormat::Asc, 0),
+    ];
+    let figures = merge_rows(plan, m, files::GRID, 1, &outputs)?;
+    Ok((paths.to_vec(), figures))
+}
+
+/// The merged grids' GeoTIFF format (the CRS, the heights' datum, nodata).
+fn geotiff(m: &Manifest) -> RowFormat {
+    RowFormat::GeoTiff {
+        epsg: m.epsg.and_then(|c| u16::try_from(c).ok()),
+        heights: Some(Heights {
+            vertical_epsg: m.vertical_epsg,
+        }),
+        nodata: Some(NODATA),
+    }
+}
+
+/// Writes `interfaces/<unit>.tif` (the top of every unit, the terrain first) of the built
+/// tiles of `plan` into `out`, row by row: one row of every unit in memory.
+pub(crate) fn write_interfaces(
+    plan: &Path,
+    m: &Manifest,
+    units: &[String],
+    out: &Path,
+) -> Result<Vec<PathBuf>> {
+    let dir = out.join("interfaces");
+    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
+    let outputs: Vec<(PathBuf, RowFormat, usize)> = units
+        .iter()
+        .enumerate()
+        .map(|(u, name)| (dir.join(format!("{name}.tif")), geotiff(m), u))
+        .collect();
+    merge_rows(plan, m, super::geology::INTERFACES, units.len(), &outputs)?;
+    Ok(outputs.into_iter().map(|o| o.0).collect())
+}
+
+/// Merges the tiles' files `file` (records of a node index and `width` values) into the
+/// grids `outputs` (path, format, which value), row by row; a value that is not finite is
+/// nodata.
+fn merge_rows(
+    plan: &Path,
+    m: &Manifest,
+    file: &str,
+    width: usize,
+    outputs: &[(PathBuf, RowFormat, usize)],
+) -> Result<GridFigures> {
+    let size = 8 * (1 + width) as u64;
     let g = &m.grid;
     let nx = g.nx as u64;
     let total = nx * g.ny as u64;
@@ -86,13 +144,13 @@ pub(crate) fn write_grids(
     // Every tile's file: its records and its first node's row.
     let mut streams = Vec::new();
     for t in &m.tiles {
-        let path = tile_dir(plan, &t.id).join(files::GRID);
+        let path = tile_dir(plan, &t.id).join(file);
         let mut f = File::open(&path).context(path.display().to_string())?;
         let len = f.metadata().context(path.display().to_string())?.len();
-        if len % 16 != 0 {
+        if len % size != 0 {
             return Err(damaged(
                 &path,
-                format!("{len} bytes, not whole 16-byte records"),
+                format!("{len} bytes, not whole {size}-byte records"),
             ));
         }
         if len == 0 {
@@ -100,7 +158,7 @@ pub(crate) fn write_grids(
         }
         let (first, last) = (
             index_at(&mut f, 0, &path)?,
-            index_at(&mut f, len - 16, &path)?,
+            index_at(&mut f, len - size, &path)?,
         );
         if last >= total || first > last {
             return Err(damaged(
@@ -113,7 +171,8 @@ pub(crate) fn write_grids(
             path,
             first_row: (first / nx) as usize,
             r: None,
-            left: len / 16,
+            left: len / size,
+            rec: vec![0u8; size as usize],
             pending: None,
         });
     }
@@ -121,21 +180,12 @@ pub(crate) fn write_grids(
     streams.sort_by_key(|s| std::cmp::Reverse(s.first_row));
 
     let spec = g.raster();
-    let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
-    let tif = RowFormat::GeoTiff {
-        epsg,
-        heights: Some(Heights {
-            vertical_epsg: m.vertical_epsg,
-        }),
-        nodata: Some(NODATA),
-    };
-    let paths = [out.join("dsm.tif"), out.join("dsm.asc")];
     let mut writers = Vec::new();
-    for (path, format) in paths.iter().zip([tif, RowFormat::Asc]) {
+    for (path, format, _) in outputs {
         let o = Output::create(Some(path)).context(path.display().to_string())?;
-        writers.push(GridRows::new(o, &spec, format).context(path.display().to_string())?);
+        writers.push(GridRows::new(o, &spec, *format).context(path.display().to_string())?);
     }
-    let mut row = vec![NODATA; g.nx];
+    let mut rows = vec![vec![NODATA; g.nx]; width];
     let mut seen = vec![false; g.nx];
     let (mut active, mut nodes, mut open_max) = (Vec::<Stream>::new(), 0, 0);
     for r in 0..g.ny {
@@ -146,11 +196,13 @@ pub(crate) fn write_grids(
             active.push(s);
         }
         open_max = open_max.max(active.len());
-        row.fill(NODATA);
+        for row in rows.iter_mut() {
+            row.fill(NODATA);
+        }
         seen.fill(false);
         let (lo, hi) = (r as u64 * nx, (r as u64 + 1) * nx);
         for s in active.iter_mut() {
-            while let Some((i, v)) = s.peek()? {
+            while let Some(i) = s.peek()? {
                 if i >= hi {
                     break;
                 }
@@ -168,25 +220,27 @@ pub(crate) fn write_grids(
                     ));
                 }
                 seen[c] = true;
-                row[c] = v;
+                for (k, row) in rows.iter_mut().enumerate() {
+                    let v = s.value(k);
+                    row[c] = if v.is_finite() { v } else { NODATA };
+                }
                 nodes += 1;
                 s.pending = None;
             }
         }
         active.retain(|s| s.pending.is_some() || s.left > 0);
-        for (w, path) in writers.iter_mut().zip(&paths) {
-            w.row(&row).context(path.display().to_string())?;
+        for (w, (path, _, k)) in writers.iter_mut().zip(outputs) {
+            w.row(&rows[*k]).context(path.display().to_string())?;
         }
     }
-    for (w, path) in writers.into_iter().zip(&paths) {
+    for (w, (path, _, _)) in writers.into_iter().zip(outputs) {
         w.finish()
             .and_then(|o| o.commit())
             .context(path.display().to_string())?;
     }
-    let figures = GridFigures {
+    Ok(GridFigures {
         nodes,
         open_max,
-        row_bytes: 8 * g.nx,
-    };
-    Ok((paths.to_vec(), figures))
+        row_bytes: 8 * g.nx * width,
+    })
 }

@@ -218,6 +218,11 @@ pub struct Manifest {
     /// geographic project), recorded in the merged GeoTIFF grids as a one-piece build does.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vertical_epsg: Option<u16>,
+    /// The CRS as the one-piece build's files name it (field data `crs` of `dsm.vtu` and of
+    /// `model.vtu`, `model.json`'s `crs`); plans made before it have none, and the merge names
+    /// the CRS from `epsg` ([`Manifest::dsm_crs`], [`Manifest::model_crs`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crs_text: Option<CrsText>,
     /// The geological model's plan, when the project has `[geology]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geology: Option<super::geology::GeologyPlan>,
@@ -225,7 +230,42 @@ pub struct Manifest {
     pub tiles: Vec<Tile>,
 }
 
+/// The CRS in the words of a one-piece build's files (see [`Manifest::crs_text`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CrsText {
+    /// `dsm.vtu`'s field data `crs`: `EPSG:<code>`, else the CRS in words.
+    pub dsm: String,
+    /// `model.vtu`'s field data `crs` and `model.json`'s: `EPSG:<code>`, else the CRS's
+    /// definition, else `projected`.
+    pub model: String,
+}
+
 impl Manifest {
+    /// `dsm.vtu`'s `crs`, as a one-piece build writes it.
+    pub fn dsm_crs(&self) -> String {
+        match &self.crs_text {
+            Some(c) => c.dsm.clone(),
+            None => self.model_crs(),
+        }
+    }
+
+    /// `model.vtu`'s and `model.json`'s `crs`, as a one-piece build writes it.
+    pub fn model_crs(&self) -> String {
+        match (&self.crs_text, self.epsg) {
+            (Some(c), _) => c.model.clone(),
+            (None, Some(e)) => format!("EPSG:{e}"),
+            (None, None) => "projected".into(),
+        }
+    }
+
+    /// The vertical datum of the heights, as the project names it ([`Manifest::vertical_epsg`]).
+    pub fn height_datum(&self) -> crate::project::HeightDatum {
+        self.vertical_epsg.map_or(
+            crate::project::HeightDatum::Source,
+            crate::project::HeightDatum::Epsg,
+        )
+    }
+
     /// Reads `PLAN/tiles.json`.
     pub fn read(plan: &Path) -> Result<Manifest> {
         let path = plan.join(MANIFEST);

@@ -243,7 +243,8 @@ fn write_vtu(
         ("elevation_idw", |p| p.idw),
         ("uk_minus_idw", |p| p.uk - p.idw),
     ];
-    let mut arrays = Vec::new();
+    // The CRS and the vertical datum, as the one-piece build's `dsm.vtu` records them.
+    let mut arrays = appended::datum_fields(&m.dsm_crs(), &m.height_datum());
     for (name, get) in point_arrays {
         let values: Values = Box::new(move |w| {
             pass(w, &mut |w, _, v, map, _| {

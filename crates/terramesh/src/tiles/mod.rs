@@ -35,9 +35,12 @@
 //! ```
 
 mod appended;
+mod boreholes;
 mod build;
 mod files;
 mod geology;
+mod geology_plan;
+mod geology_tile;
 mod geometry;
 mod grid_merge;
 mod manifest;
@@ -45,11 +48,13 @@ mod merge;
 mod model_export;
 mod model_files;
 mod model_merge;
+mod model_stream;
 mod partition;
 mod plan;
 mod report;
 mod slurm;
 
+pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
 pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
@@ -58,8 +63,8 @@ pub use geology::{
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
-    update, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, TileSummary,
-    LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
+    update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData,
+    TileSummary, LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
 pub use model_export::MergedExports;

@@ -17,32 +17,37 @@
 //! the boundary and the interfaces, every body watertight with its enclosed volume equal to
 //! its cells' to 1e-9), so a seam face left over or missing fails the merge with its place.
 //!
-//! Memory: these formats group the cells by unit and the faces by tag (Gmsh's entity blocks,
-//! FLAC3D's groups after the zones, a boundary mesh's points before its faces), so the merge
-//! holds the whole model here: about 24 bytes per node, 32 per cell, 24 per tagged face and 12
-//! per body triangle, and a hash entry per face and body triangle on a seam.
+//! Memory: nothing holds the whole merged mesh. `model.msh` and `model.f3grid` are written
+//! in passes over the tiles ([`super::model_stream::TiledModel`], one tile in memory at a time;
+//! Gmsh's blocks group the cells by unit and kind, FLAC3D's groups follow the zones, so each
+//! block or group is a pass). A boundary mesh lists its points (in increasing `model.vtu`
+//! number) before its faces, and a body its vertices before its triangles, so each is
+//! gathered on its own, one at a time: its faces (or triangles), their cells and nodes. Then
+//! the one-piece writers (`terramesh_io::model`) write it, byte for byte as from the whole mesh.
+//!
+//! The merged mesh is not checked as a whole (`terramesh_io::model::check_mesh`,
+//! `terramesh_geology::check` need it in memory). What the checks would find is checked where
+//! it can arise: every tile's model passed them when it was built; the merge refuses seam
+//! columns that differ ([`super::model_merge`]) and a seam face or body triangle without its
+//! twin ([`super::model_stream`]); each body, once gathered, must be closed and consistently
+//! oriented (every directed edge once, its reverse once, or twice each where a unit pinches
+//! out) and enclose its unit's cells' volume to 1e-9.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use rayon::prelude::*;
 use serde::Serialize;
-use terramesh_core::volume::{Body, FaceTag, TaggedFace, VolumeMesh};
 use terramesh_io::model::{
-    boundary_file_name, boundary_mesh, boundary_tags, check_mesh, stl_origin, write_body_stl,
-    write_body_tsurf, write_boundary_vtu, write_model_f3grid, write_model_msh, ModelInfo,
+    boundary_file_name, stl_origin, write_body_stl, write_body_tsurf, write_boundary_vtu,
+    write_f3grid_passes, write_msh_passes, ModelInfo,
 };
 use terramesh_io::output::Output;
 
-use super::build::tile_dir;
-use super::files::read_u32s;
-use super::geology::{
-    tag_of_name, GeologyPlan, TileFigures, MODEL_BODIES, MODEL_FACES, MODEL_JSON,
-};
+use super::geology::GeologyPlan;
 use super::manifest::Manifest;
-use super::model_merge::{cell_of, columns, node_map, read_model, Column};
+use super::model_merge::Column;
+use super::model_stream::TiledModel;
 use crate::error::{Context, Error, Result};
-use crate::project::HeightDatum;
 
 /// What the merge found making the merged model's other files (`exports` in `merge.json`'s
 /// `model`).
@@ -60,267 +65,128 @@ pub struct MergedExports {
     pub boundaries: Vec<(String, usize)>,
 }
 
-/// The tags of the merged model in the one-piece order: top, bottom, the sides (north, east,
-/// south, west), then the interfaces in unit order; only those some tile has.
-fn merged_tags(names: &[Vec<String>], units: &[String]) -> Vec<FaceTag> {
-    let mut all = vec![FaceTag::Top, FaceTag::Bottom];
-    all.extend(["north", "east", "south", "west"].map(|s| FaceTag::Side(s.into())));
-    all.extend(units.iter().skip(1).map(|u| FaceTag::Interface(u.clone())));
-    let used: Vec<FaceTag> = names.iter().flatten().map(|n| tag_of_name(n)).collect();
-    let mut out: Vec<FaceTag> = all.into_iter().filter(|t| used.contains(t)).collect();
-    // Any other (none today): after, in the order met.
-    for t in used {
-        if !out.contains(&t) {
-            out.push(t);
-        }
-    }
-    out
+/// Writes `path` atomically with `f`.
+fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Result<PathBuf> {
+    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
+    f(&mut o).context(path.display().to_string())?;
+    o.commit().context(path.display().to_string())?;
+    Ok(path.to_path_buf())
 }
 
-fn sorted<const N: usize>(mut a: [u32; N]) -> [u32; N] {
-    a.sort_unstable();
-    a
-}
-
-/// The merged volume mesh of the tiles (the numbering of `model.vtu`), its seam faces and seam
-/// body triangles dropped; and how many of each were dropped.
-fn merged_mesh(
-    plan: &Path,
-    m: &Manifest,
-    gp: &GeologyPlan,
-    seams: &HashMap<(u64, u64), Column>,
-) -> Result<(VolumeMesh, usize, usize)> {
-    let mut figures = Vec::with_capacity(m.tiles.len());
-    for t in &m.tiles {
-        let path = tile_dir(plan, &t.id).join(MODEL_JSON);
-        let text = std::fs::read_to_string(&path).context(path.display().to_string())?;
-        let f: TileFigures = serde_json::from_str(&text).context(path.display().to_string())?;
-        figures.push(f.tags);
-    }
-    let tags = merged_tags(&figures, &gp.units);
-    let mut mesh = VolumeMesh {
-        units: gp.units.clone(),
-        tags,
-        ..Default::default()
-    };
-    let mut next = 0u32;
-    // Side faces and body triangles by their sorted nodes: (tile, index).
-    let mut side_at: HashMap<[u32; 4], (usize, usize)> = HashMap::new();
-    let mut tri_at: HashMap<(usize, [u32; 3]), (usize, usize)> = HashMap::new();
-    let mut dead_face = Vec::new();
-    let mut bodies: Vec<Vec<[u32; 3]>> = vec![Vec::new(); gp.units.len()];
-    let mut dead_tri: Vec<Vec<bool>> = vec![Vec::new(); gp.units.len()];
-    for (k, t) in m.tiles.iter().enumerate() {
-        let dir = tile_dir(plan, &t.id);
-        let tm = read_model(plan, t)?;
-        let map = node_map(k, &tm.points, seams, &mut next);
-        // Whether each local node is on a seam's column: only faces all on seams can pair.
-        let mut seam = Vec::with_capacity(map.len());
-        for (ck, _, count) in columns(&tm.points) {
-            seam.extend(std::iter::repeat_n(seams.contains_key(&ck), count));
-        }
-        for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(&map) {
-            if mine {
-                mesh.points.push([p[0], p[1], p[2]]);
-            }
-        }
-        let first_cell = mesh.cells.len() as u32;
-        for rec in tm.cells.chunks_exact(8) {
-            let (mut c, mat) = cell_of(rec);
-            for n in c.nodes.iter_mut().take(c.kind.nodes()) {
-                *n = map[*n as usize].0;
-            }
-            mesh.cells.push(c);
-            mesh.material.push(mat);
-        }
-        let bad = |what: &str| {
-            Error::invalid(format!(
-                "{}: {what}: build tile {} again (tiles built before the merge wrote the \
-                 boundary meshes lack it)",
-                dir.display(),
-                t.id
-            ))
-        };
-        let path = dir.join(MODEL_FACES);
-        if !path.is_file() {
-            return Err(bad(&format!("no {MODEL_FACES}")));
-        }
-        let local_cells = tm.cells.len() / 8;
-        let names = &figures[k];
-        for rec in read_u32s(&path, 6)?.chunks_exact(6) {
-            let tag = names
-                .get(rec[5] as usize)
-                .map(|n| tag_of_name(n))
-                .ok_or_else(|| bad(&format!("a face of tag {} of {}", rec[5], names.len())))?;
-            let tag = mesh
-                .tags
-                .iter()
-                .position(|x| *x == tag)
-                .expect("a merged tag") as u16;
-            if rec[4] as usize >= local_cells
-                || rec[..4]
-                    .iter()
-                    .any(|&n| n != u32::MAX && n as usize >= map.len())
-            {
-                return Err(bad("a face out of range"));
-            }
-            let mut nodes = [u32::MAX; 4];
-            for (g, &n) in nodes.iter_mut().zip(&rec[..4]) {
-                if n != u32::MAX {
-                    *g = map[n as usize].0;
-                }
-            }
-            let j = mesh.faces.len();
-            mesh.faces.push(TaggedFace {
-                nodes,
-                cell: first_cell + rec[4],
-                tag,
-            });
-            dead_face.push(false);
-            let all_on_seams = rec[..4].iter().all(|&n| n == u32::MAX || seam[n as usize]);
-            if all_on_seams && matches!(mesh.tags[tag as usize], FaceTag::Side(_)) {
-                match side_at.get(&sorted(nodes)) {
-                    Some(&(other, i)) if other != k => {
-                        dead_face[i] = true;
-                        dead_face[j] = true;
-                    }
-                    _ => {
-                        side_at.insert(sorted(nodes), (k, j));
-                    }
-                }
-            }
-        }
-        let path = dir.join(MODEL_BODIES);
-        if !path.is_file() {
-            return Err(bad(&format!("no {MODEL_BODIES}")));
-        }
-        for rec in read_u32s(&path, 4)?.chunks_exact(4) {
-            let u = rec[0] as usize;
-            if u >= bodies.len() || rec[1..].iter().any(|&n| n as usize >= map.len()) {
-                return Err(bad("a body triangle out of range"));
-            }
-            let tri = [rec[1], rec[2], rec[3]].map(|n| map[n as usize].0);
-            let j = bodies[u].len();
-            bodies[u].push(tri);
-            dead_tri[u].push(false);
-            if !rec[1..].iter().all(|&n| seam[n as usize]) {
-                continue;
-            }
-            // Keyed by unit too: two units' bodies share their interface triangles.
-            let key = (u, sorted(tri));
-            match tri_at.get(&key) {
-                Some(&(other, i)) if other != k => {
-                    dead_tri[u][i] = true;
-                    dead_tri[u][j] = true;
-                }
-                _ => {
-                    tri_at.insert(key, (k, j));
-                }
+/// The volume a closed, outward-oriented surface encloses (the divergence theorem over z,
+/// relative to its first point), and the sum of its triangles' contributions' magnitudes;
+/// an error naming `what` if an edge is not met once each way (or twice each way, where a
+/// unit pinches out to an edge).
+fn enclosed(points: &[[f64; 3]], triangles: &[[u32; 3]], what: &str) -> Result<(f64, f64)> {
+    let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::with_capacity(3 * triangles.len());
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let e = edges.entry((a.min(b), a.max(b))).or_default();
+            if a < b {
+                e.0 += 1;
+            } else {
+                e.1 += 1;
             }
         }
     }
-    let dropped_faces = dead_face.iter().filter(|d| **d).count();
-    let mut keep = dead_face.iter();
-    mesh.faces
-        .retain(|_| !*keep.next().expect("one flag a face"));
-    let mut dropped_tris = 0;
-    for (u, (tris, dead)) in bodies.into_iter().zip(dead_tri).enumerate() {
-        dropped_tris += dead.iter().filter(|d| **d).count();
-        let triangles: Vec<[u32; 3]> = tris
-            .into_iter()
-            .zip(dead)
-            .filter(|(_, d)| !d)
-            .map(|(t, _)| t)
-            .collect();
-        if !triangles.is_empty() {
-            mesh.bodies.push(Body { unit: u, triangles });
-        }
+    if let Some((&(a, b), &(f, r))) = edges.iter().find(|(_, &(f, r))| f != r || f == 0 || f > 2) {
+        return Err(Error::invalid(format!(
+            "the merged {what}: its edge {:?}-{:?} is met {f} and {r} times each way: it is not              closed there",
+            points[a as usize], points[b as usize]
+        )));
     }
-    Ok((mesh, dropped_faces, dropped_tris))
+    let r = points.first().copied().unwrap_or_default();
+    let (mut sum, mut magnitude) = (0.0, 0.0);
+    for t in triangles {
+        let [a, b, c] = t.map(|i| {
+            let q = points[i as usize];
+            [q[0] - r[0], q[1] - r[1], q[2] - r[2]]
+        });
+        let f =
+            ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) * (a[2] + b[2] + c[2]);
+        sum += f;
+        magnitude += f.abs();
+    }
+    Ok((sum / 6.0, magnitude / 6.0))
 }
 
 /// Writes the merged model's boundary meshes, `model.msh`, `model.f3grid` and bodies into
-/// `out`, after checking the merged mesh; the figures and the files written.
+/// `out` in passes over the tiles, checking each body against `unit_volumes` (its cells'); the
+/// figures and the files written.
 pub(crate) fn merge_exports(
     plan: &Path,
     m: &Manifest,
     gp: &GeologyPlan,
     seams: &HashMap<(u64, u64), Column>,
+    unit_volumes: &[f64],
     out: &Path,
 ) -> Result<(MergedExports, Vec<PathBuf>)> {
-    let (mesh, seam_faces_dropped, seam_triangles_dropped) = merged_mesh(plan, m, gp, seams)?;
-    check_mesh(&mesh).map_err(|e| Error::invalid(format!("the merged geological model: {e}")))?;
-    let summary = terramesh_geology::check(&mesh)
-        .map_err(|e| Error::invalid(format!("the merged geological model: {e}")))?;
-    let datum = m
-        .vertical_epsg
-        .map_or(HeightDatum::Source, HeightDatum::Epsg);
+    let tm = TiledModel::prepare(plan, m, gp, seams)?;
+    let datum = m.height_datum();
     let info = ModelInfo {
-        crs: m
-            .epsg
-            .map_or("projected".to_string(), |e| format!("EPSG:{e}")),
+        crs: m.model_crs(),
         vertical_datum: datum.name(),
         vertical_epsg: datum.epsg(),
     };
-    type Job<'a> = (
-        String,
-        Box<dyn Fn(&mut Output) -> std::io::Result<()> + Send + Sync + 'a>,
+    // Gmsh and FLAC3D side by side, each one tile at a time.
+    let (msh, f3) = rayon::join(
+        || atomic(&out.join("model.msh"), |w| write_msh_passes(w, &tm, &info)),
+        || {
+            atomic(&out.join("model.f3grid"), |w| {
+                write_f3grid_passes(w, &tm, &info)
+            })
+        },
     );
-    let mut jobs: Vec<Job> = Vec::new();
+    let mut written = Vec::new();
     let mut boundaries = Vec::new();
-    let (mr, ir) = (&mesh, &info);
-    for t in boundary_tags(&mesh) {
-        let name = boundary_file_name(&mesh.tags[t as usize]).expect("a boundary tag");
-        boundaries.push((
-            name.clone(),
-            mesh.faces.iter().filter(|f| f.tag == t).count(),
-        ));
-        jobs.push((
-            name,
-            Box::new(move |w| write_boundary_vtu(w, &boundary_mesh(mr, t))),
-        ));
+    for t in tm.boundary_tags()? {
+        let name = boundary_file_name(&tm.tag_list()[t as usize]).expect("a boundary tag");
+        let b = tm.boundary(t)?;
+        boundaries.push((name.clone(), b.faces.len()));
+        written.push(atomic(&out.join(&name), |w| write_boundary_vtu(w, &b))?);
     }
-    jobs.push((
-        "model.msh".into(),
-        Box::new(move |w| write_model_msh(w, mr, ir)),
-    ));
-    jobs.push((
-        "model.f3grid".into(),
-        Box::new(move |w| write_model_f3grid(w, mr, ir)),
-    ));
-    let origin = stl_origin(&mesh);
-    for body in &mesh.bodies {
-        let unit = &mesh.units[body.unit];
-        jobs.push((
-            format!("unit-{unit}.ts"),
-            Box::new(move |w| write_body_tsurf(w, mr, body, ir)),
-        ));
-        jobs.push((
-            format!("unit-{unit}.stl"),
-            Box::new(move |w| write_body_stl(w, mr, body, origin)),
-        ));
+    written.push(msh?);
+    written.push(f3?);
+    // The STL origin of the whole model's points (`stl_origin`'s rule on their lowest x, y).
+    let origin = stl_origin(&terramesh_core::volume::VolumeMesh {
+        points: vec![[tm.low[0], tm.low[1], 0.0]],
+        ..Default::default()
+    });
+    let mut bodies = Vec::new();
+    for u in (0..gp.units.len()).filter(|&u| tm.body_triangles[u] > 0) {
+        let unit = &gp.units[u];
+        let (mesh, body) = tm.body(u)?;
+        let what = format!("body of unit {unit}");
+        let (volume, magnitude) = enclosed(&mesh.points, &body.triangles, &what)?;
+        let cells = unit_volumes.get(u).copied().unwrap_or(0.0);
+        if (volume - cells).abs() > 1e-9 * volume.abs().max(cells.abs()).max(magnitude) {
+            return Err(Error::invalid(format!(
+                "the merged {what} encloses {volume} m³ but its cells hold {cells} m³"
+            )));
+        }
+        bodies.push((unit.clone(), volume));
+        let (mr, br, ir) = (&mesh, &body, &info);
+        let (ts, stl) = rayon::join(
+            || {
+                atomic(&out.join(format!("unit-{unit}.ts")), |w| {
+                    write_body_tsurf(w, mr, br, ir)
+                })
+            },
+            || {
+                atomic(&out.join(format!("unit-{unit}.stl")), |w| {
+                    write_body_stl(w, mr, br, origin)
+                })
+            },
+        );
+        written.push(ts?);
+        written.push(stl?);
     }
-    let written: Vec<Result<PathBuf>> = jobs
-        .into_par_iter()
-        .map(|(name, f)| {
-            let path = out.join(&name);
-            let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
-            f(&mut o).context(path.display().to_string())?;
-            o.commit().context(path.display().to_string())?;
-            Ok(path)
-        })
-        .collect();
-    let written = written.into_iter().collect::<Result<Vec<_>>>()?;
     let exports = MergedExports {
-        faces: mesh.faces.len(),
-        seam_faces_dropped,
-        seam_triangles_dropped,
-        bodies: mesh
-            .bodies
-            .iter()
-            .zip(&summary.body_volumes)
-            .map(|(b, v)| (mesh.units[b.unit].clone(), *v))
-            .collect(),
+        faces: tm.face_count_kept(),
+        seam_faces_dropped: tm.seam_faces_dropped,
+        seam_triangles_dropped: tm.seam_triangles_dropped,
+        bodies,
         boundaries,
     };
     Ok((exports, written))

@@ -17,15 +17,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use terramesh_core::volume::{cell_volume, Cell, CellKind};
-use terramesh_io::grid_write::{write_geotiff_heights, Heights};
 use terramesh_io::output::Output;
 
 use super::appended::{put_f64, Array, Section, Values};
 use super::build::tile_dir;
 use super::files::{read_f64s, read_u32s, read_vertices};
-use super::geology::{
-    GeologyPlan, TileFigures, INTERFACES, MODEL_CELLS, MODEL_JSON, MODEL_POINTS, SURFACES,
-};
+use super::geology::{GeologyPlan, TileFigures, MODEL_CELLS, MODEL_JSON, MODEL_POINTS, SURFACES};
 use super::manifest::{Manifest, Tile};
 use crate::error::{Context, Error, Result};
 
@@ -55,6 +52,15 @@ pub struct MergedUnit {
 /// What the merge made of the geological models.
 #[derive(Debug, Clone, Serialize)]
 pub struct MergedModel {
+    /// The model's CRS, as a one-piece build's `model.json` names it (`EPSG:32632`).
+    pub crs: String,
+    /// The vertical datum of the heights (`egm96`, `navd88`, `EPSG:<code>`, or `source`), as
+    /// a one-piece build's `model.json` and `model.vtu` record it.
+    pub vertical_datum: String,
+    /// The vertical CRS when named (`EPSG:5703`).
+    pub vertical_crs: Option<String>,
+    /// The heights in words.
+    pub heights: String,
     /// Nodes of `model.vtu`.
     pub nodes: usize,
     /// Cells.
@@ -71,6 +77,9 @@ pub struct MergedModel {
     /// The base elevation every tile used, metres (`null`: a base grid, sampled by every tile
     /// at its vertices).
     pub base: Option<f64>,
+    /// One entry per observed contact, as a one-piece model lists them: the collars against
+    /// the terrain, then the logged tops (`tiles/boreholes.rs`).
+    pub boreholes: Vec<crate::geology::model::Misfit>,
     /// The boundary meshes, `model.msh`, `model.f3grid` and the bodies
     /// (`tiles/model_export.rs`).
     pub exports: super::model_export::MergedExports,
@@ -284,10 +293,17 @@ pub(crate) fn merge_model(
     let path = out.join("model.vtu");
     write_vtu(&path, plan, m, gp, &seams, n as usize, nc)?;
     written.push(path);
-    written.extend(write_interfaces(plan, m, gp, out)?);
-    let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, out)?;
+    written.extend(super::grid_merge::write_interfaces(
+        plan, m, &gp.units, out,
+    )?);
+    let (exports, files) = super::model_export::merge_exports(plan, m, gp, &seams, &volume, out)?;
     written.extend(files);
+    let datum = m.height_datum();
     let merged = MergedModel {
+        crs: m.model_crs(),
+        vertical_datum: datum.name(),
+        vertical_crs: datum.crs_name(),
+        heights: datum.describe(),
         nodes: n as usize,
         cells: nc,
         seam_nodes: seams.values().map(|c| c.count as usize).sum(),
@@ -307,6 +323,7 @@ pub(crate) fn merge_model(
             .collect(),
         volume_between_terrain_and_base: between,
         base: gp.base,
+        boreholes: super::boreholes::merged_misfits(plan, m, gp)?,
         exports,
     };
     let path = out.join("model.json");
@@ -315,52 +332,6 @@ pub(crate) fn merge_model(
         .context(path.display().to_string())?;
     written.push(path);
     Ok((merged, written))
-}
-
-/// `interfaces/<unit>.tif`: the top of every unit (the terrain first) on the DSM grid, one
-/// unit at a time.
-fn write_interfaces(
-    plan: &Path,
-    m: &Manifest,
-    gp: &GeologyPlan,
-    out: &Path,
-) -> Result<Vec<PathBuf>> {
-    let units = gp.units.len();
-    let g = &m.grid;
-    let spec = g.raster();
-    let dir = out.join("interfaces");
-    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
-    let epsg = m.epsg.and_then(|c| u16::try_from(c).ok());
-    let heights = Heights {
-        vertical_epsg: m.vertical_epsg,
-    };
-    let mut written = Vec::new();
-    for (u, name) in gp.units.iter().enumerate() {
-        let mut values = vec![super::merge::NODATA; g.nx * g.ny];
-        for t in &m.tiles {
-            let rec = read_f64s(&tile_dir(plan, &t.id).join(INTERFACES), units + 1)?;
-            for r in rec.chunks_exact(units + 1) {
-                let i = r[0].to_bits() as usize;
-                if i < values.len() && r[1 + u].is_finite() {
-                    values[i] = r[1 + u];
-                }
-            }
-        }
-        let path = dir.join(format!("{name}.tif"));
-        let mut o = Output::create(Some(&path)).context(path.display().to_string())?;
-        write_geotiff_heights(
-            &mut o,
-            &spec,
-            &values,
-            epsg,
-            Some(heights),
-            Some(super::merge::NODATA),
-        )
-        .and_then(|_| o.commit())
-        .context(path.display().to_string())?;
-        written.push(path);
-    }
-    Ok(written)
 }
 
 /// Writes `model.vtu` (raw appended binary, [`super::appended`]), one pass over the tiles per
@@ -379,9 +350,6 @@ fn write_vtu(
         names.extend_from_slice(u.as_bytes());
         names.push(0u8);
     }
-    let crs = m
-        .epsg
-        .map_or("projected".to_string(), |e| format!("EPSG:{e}"));
     type CellPass<'a> = dyn FnMut(&mut dyn Write, &TileModel, &[(u32, bool)]) -> Result<()> + 'a;
     let pass = |w: &mut dyn Write, f: &mut CellPass| -> Result<()> {
         let mut next = 0u32;
@@ -410,14 +378,11 @@ fn write_vtu(
         bytes,
         values,
     };
-    let mut arrays = Vec::new();
-    for (name, bytes) in [("unit_names", names), ("crs", crs.into_bytes())] {
-        let len = bytes.len();
-        let values: Values = Box::new(move |w| Ok(w.write_all(&bytes)?));
-        let mut a = array(Section::Field, "UInt8", name, 1, len as u64, values);
-        a.tuples = Some(len);
-        arrays.push(a);
-    }
+    let mut arrays = vec![super::appended::text_field("unit_names", names)];
+    arrays.extend(super::appended::datum_fields(
+        &m.model_crs(),
+        &m.height_datum(),
+    ));
     let values: Values = Box::new(move |w| {
         pass(w, &mut |w, tm, map| {
             for (p, &(_, mine)) in tm.points.chunks_exact(3).zip(map) {

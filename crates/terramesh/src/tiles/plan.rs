@@ -180,12 +180,18 @@ pub fn plan(
     std::fs::create_dir_all(out).context(out.display().to_string())?;
     let samples = stages::sample(project, base, out, progress)?;
     let polys = &samples.region.projected.polygons;
-    if polys.len() != 1 || !polys[0].holes.is_empty() || !samples.region.projected.lines.is_empty()
-    {
-        return Err(Error::invalid(
-            "tiled builds take one polygon (convex or not) without holes or constraint lines \
-             for now: build this region in one piece with terramesh build",
-        ));
+    let holes: usize = polys.iter().map(|p| p.holes.len()).sum();
+    let lines = samples.region.projected.lines.len();
+    if polys.len() != 1 || holes > 0 || lines > 0 {
+        return Err(Error::invalid(format!(
+            "{}: [region] has {} polygon(s), {holes} hole(s) and {lines} constraint line(s); \
+             tiled builds take one polygon (convex or not) without holes or constraint lines \
+             (a tile's ring would have to follow a hole's edge, and a line's vertices would \
+             have to be planned on every seam it crosses; not done): build this region in \
+             one piece with terramesh build, or tile its outer ring alone",
+            project_file.display(),
+            polys.len()
+        )));
     }
     let outline = polys[0].outer.clone();
     let (region, convex) = ccw_ring(&outline)?;
@@ -362,6 +368,16 @@ pub fn plan(
         },
         epsg: samples.epsg(),
         vertical_epsg: project.height_datum().epsg(),
+        crs_text: Some(super::manifest::CrsText {
+            dsm: samples
+                .epsg()
+                .map_or_else(|| samples.crs_name(), |c| format!("EPSG:{c}")),
+            model: match (samples.epsg(), &samples.crs) {
+                (Some(e), _) => format!("EPSG:{e}"),
+                (None, Some(c)) => c.definition().to_string(),
+                (None, None) => "projected".to_string(),
+            },
+        }),
         geology,
         tiles,
     };

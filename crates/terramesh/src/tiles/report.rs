@@ -12,6 +12,13 @@ fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// Why the merge makes no `model.glb` (the report and `docs/scaling.md` say so).
+pub(crate) const NO_GLB: &str = "model.glb is not merged: a GLB file is at most 4 GiB (its \
+    chunk lengths are 32-bit) and a browser viewer loads it whole into memory, which a \
+    region too large for one process exceeds; view the merged model.vtu (ParaView) or the \
+    units' unit-*.stl and .ts instead, or build a part of the region in one piece for a \
+    model.glb.";
+
 /// The page, self-contained.
 pub(crate) fn html(m: &Manifest, merged: &Merged) -> String {
     let total = |t: &super::manifest::Tile| {
@@ -68,12 +75,22 @@ pub(crate) fn html(m: &Manifest, merged: &Merged) -> String {
             b.peak_rss as f64 / 1e6
         );
     }
+    let model = match &merged.model {
+        Some(g) => format!(
+            "<p>Geological model: {} nodes, {} cells, {} boreholes' contacts in model.json. \
+             {NO_GLB}</p>",
+            g.nodes,
+            g.cells,
+            g.boreholes.len()
+        ),
+        None => String::new(),
+    };
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Tiled DSM</title>\
          <style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 8px;border-bottom:1px solid #ddd}}</style></head><body>\
          <h1>Tiled DSM: {nt} tiles of {size} m</h1>\
          <p>{v} vertices, {tr} triangles, {sv} seam vertices (each once; largest difference between \
-         two tiles' elevations at one: {d} m), planar area {a:.3} m²; merged in {ms:.2} s.</p>\
+         two tiles' elevations at one: {d} m), planar area {a:.3} m²; merged in {ms:.2} s.</p>{model}\
          <h2>Tile map (north up; darker took longer)</h2>{svg}\
          <h2>Tiles</h2><table><tr><th>tile</th><th>samples</th><th>vertices</th><th>triangles</th>\
          <th>grid nodes</th><th>halo m</th><th>seconds</th><th>peak MB</th></tr>{rows}</table>\

@@ -1,0 +1,272 @@
+//! One tile's geological model: its interfaces estimated at its own planar vertices as the
+//! plan says ([`super::geology::Estimate`]), the one-piece model's rules and volume mesh on the
+//! tile's mesh under its DSM, and the figures the merge sums.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use terramesh_core::volume::{Body, Cell, FaceTag, Interpolated, TaggedFace};
+use terramesh_geology::Layering;
+use terramesh_geostat::{Data, Duplicates, Idw, IdwSearch, KrigingFrame, Method, Predictor};
+use terramesh_mesh::Mesh;
+
+use super::geology::{Estimate, GeologyPlan};
+use super::geology_plan::horizon_at;
+use crate::build::stages::Surface;
+use crate::error::{Context, Error, Result};
+use crate::geology::model::{assemble, Base, ModelInputs};
+use crate::project::{Base as BaseKey, Project};
+
+/// One tile's geological model.
+pub(crate) struct TileModel {
+    /// Every surface at every planar vertex: `surfaces[s][v]` (terrain, tops, base).
+    pub surfaces: Vec<Vec<f64>>,
+    /// The volume mesh's nodes.
+    pub points: Vec<[f64; 3]>,
+    /// Its cells and their units.
+    pub cells: Vec<(Cell, i32)>,
+    /// Its tagged faces (tags in [`TileFigures::tags`]).
+    pub faces: Vec<TaggedFace>,
+    /// The units' sealed bodies over the tile (closed by the tile's sides, seams included).
+    pub bodies: Vec<Body>,
+    /// The figures merged into `model.json`.
+    pub figures: TileFigures,
+}
+
+/// A tile's model figures (`PLAN/tiles/ID/model.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TileFigures {
+    /// Per unit, top to bottom: volume (m³).
+    pub volumes: Vec<f64>,
+    /// Per unit: cells.
+    pub cells: Vec<usize>,
+    /// Per unit: planar area where it has zero thickness, m².
+    pub pinched_area: Vec<f64>,
+    /// The volume between the terrain and the base over the tile, m³.
+    pub volume_between: f64,
+    /// The names of the tags of `model-faces.u32` (`top`, `bottom`, a side, `interface-<unit>`).
+    #[serde(default)]
+    pub tags: Vec<String>,
+}
+
+/// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
+///
+/// ```
+/// use terramesh::tiles::tag_of_name;
+/// use terramesh_core::volume::FaceTag;
+/// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
+/// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
+/// ```
+pub fn tag_of_name(name: &str) -> FaceTag {
+    match name {
+        "top" => FaceTag::Top,
+        "bottom" => FaceTag::Bottom,
+        _ => match name.strip_prefix("interface-") {
+            Some(u) => FaceTag::Interface(u.to_string()),
+            None => FaceTag::Side(name.to_string()),
+        },
+    }
+}
+
+/// Builds the model of one tile on its planar mesh (`xy`, its absolute positions, the planned
+/// ones on the boundary; `triangles`) under `terrain`.
+pub(crate) fn build_model(
+    plan: &Path,
+    gp: &GeologyPlan,
+    project: &Project,
+    tile: &super::Tile,
+    xy: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+    terrain: &[f64],
+) -> Result<TileModel> {
+    let g = project.geology().ok_or_else(|| {
+        Error::invalid("the plan has a geological model but the project no [geology]: plan again")
+    })?;
+    let [x0, y0, x1, y1] = tile.extent;
+    let hh = tile.geology_halo.unwrap_or(0.0);
+    let mut grids = Vec::new();
+    for (k, it) in gp.interfaces.iter().enumerate() {
+        let values = match &it.estimate {
+            Estimate::Grid { .. } => {
+                let path = g
+                    .surfaces
+                    .get(k + 1)
+                    .and_then(Option::as_ref)
+                    .ok_or_else(|| {
+                        Error::invalid(format!(
+                            "the plan samples a grid for the top of {} but the project's \
+                         [geology] surfaces names none: plan again",
+                            it.unit
+                        ))
+                    })?;
+                let v = horizon_at(path, xy, g, gp.crs_epsg, &it.unit)
+                    .with_context(|| format!("tile {}", tile.id))?;
+                // Nodata: the unit is absent there (as in a one-piece model).
+                grids.push((
+                    k + 1,
+                    v.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
+                ));
+                continue;
+            }
+            Estimate::Constant { value } => vec![*value; xy.len()],
+            Estimate::Idw { .. } => {
+                let (oxy, oz) = observations(&plan.join(&it.observations), |_| true)?;
+                let data = Data::new(oxy, oz, Duplicates::Reject)
+                    .with_context(|| format!("the observations of {}", it.unit))?;
+                let idw = Idw::new(&data, 2.0, IdwSearch::All).context("IDW")?;
+                let mut v = vec![0.0; xy.len()];
+                Predictor::predict(&idw, xy, &mut v, None)
+                    .with_context(|| format!("inverse-distance weighting of {}", it.unit))?;
+                v
+            }
+            Estimate::Kriged {
+                variogram,
+                frame,
+                universal,
+            } => {
+                let (oxy, oz) = observations(&plan.join(&it.observations), |q| {
+                    q[0] >= x0 - hh && q[0] <= x1 + hh && q[1] >= y0 - hh && q[1] <= y1 + hh
+                })?;
+                let data = Data::new(oxy, oz, Duplicates::Reject)
+                    .with_context(|| format!("tile {}: the observations of {}", tile.id, it.unit))?
+                    .with_frame(KrigingFrame {
+                        centre: frame.0,
+                        scale: frame.1,
+                    });
+                let v = crate::variogram_file::read_variogram_file(&plan.join(variogram))?;
+                let method = if *universal {
+                    Method::Universal(project.interpolation.drift)
+                } else {
+                    Method::Ordinary
+                };
+                let k = gp.neighbours.min(it.count);
+                Surface::kriging(&data, &v, method, k)?
+                    .predict(xy, false)?
+                    .0
+            }
+        };
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::invalid(format!(
+                "tile {}: the top of {} is not finite at ({:.1}, {:.1})",
+                tile.id, it.unit, xy[i][0], xy[i][1]
+            )));
+        }
+        grids.push((if gp.thickness { k } else { k + 1 }, values));
+    }
+    // The origin at zero: the model's nodes take the planned positions bit for bit.
+    let mesh = Mesh {
+        origin: [0.0, 0.0],
+        points: xy.to_vec(),
+        triangles: triangles.to_vec(),
+        constraint_edges: vec![],
+    };
+    let base =
+        match (gp.base, &g.base) {
+            (Some(z), _) => Base::Elevation(z),
+            (None, BaseKey::Raster(path)) => {
+                let v = horizon_at(path, xy, g, gp.crs_epsg, "the base")
+                    .with_context(|| format!("tile {}", tile.id))?;
+                match v.iter().position(Option::is_none) {
+                    Some(i) => {
+                        return Err(Error::invalid(format!(
+                        "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of tile {}: \
+                         a base grid must cover the whole region",
+                        path.display(),
+                        xy[i][0],
+                        xy[i][1],
+                        tile.id
+                    )))
+                    }
+                    None => Base::PerVertex(v.into_iter().flatten().collect()),
+                }
+            }
+            (None, _) => return Err(Error::invalid(
+                "the plan samples a base grid but the project's geology.base is none: plan again",
+            )),
+        };
+    let inputs = ModelInputs {
+        boreholes: None,
+        grids,
+        base,
+        min_thickness: g.min_thickness,
+        layering: Layering::new(g.units.clone())
+            .layers(g.layers.clone())
+            .element(g.element),
+        interpolate: Interpolated::Tops,
+        method: Method::Ordinary,
+    };
+    let model = if gp.thickness {
+        thickness_model(&mesh, terrain, &inputs)
+    } else {
+        assemble(&mesh, terrain, &inputs)
+    }
+    .with_context(|| format!("tile {}: [geology]", tile.id))?;
+    let figures = TileFigures {
+        volumes: model.check.unit_volumes.clone(),
+        cells: (0..g.units.len())
+            .map(|u| {
+                model
+                    .mesh
+                    .material
+                    .iter()
+                    .filter(|&&m| m == u as i32)
+                    .count()
+            })
+            .collect(),
+        pinched_area: model.stats.iter().map(|s| s.pinched_area).collect(),
+        volume_between: model.check.volume,
+        tags: model.mesh.tags.iter().map(FaceTag::name).collect(),
+    };
+    Ok(TileModel {
+        surfaces: model.stack.surfaces,
+        points: model.mesh.points,
+        cells: model
+            .mesh
+            .cells
+            .into_iter()
+            .zip(model.mesh.material)
+            .collect(),
+        faces: model.mesh.faces,
+        bodies: model.mesh.bodies,
+        figures,
+    })
+}
+
+/// The model from thickness fields (`inputs.grids`, units 0..n-1, in order) stacked down from
+/// the terrain, as a one-piece model stacks its kriged thicknesses (`stack_of`, `seal`).
+fn thickness_model(
+    mesh: &Mesh,
+    terrain: &[f64],
+    inputs: &ModelInputs,
+) -> Result<crate::geology::model::GeologicalModel> {
+    let planar =
+        terramesh_geology::Planar::new(&mesh.points, &mesh.triangles).context("the planar mesh")?;
+    let base = crate::geology::model::base_values(inputs, terrain, None, mesh.points.len())?;
+    let thick: Vec<Vec<f64>> = inputs.grids.iter().map(|g| g.1.clone()).collect();
+    let (stack, rules) =
+        terramesh_geology::stack_thicknesses(&planar, terrain, &thick, &base, inputs.min_thickness)
+            .context("the geological rules")?;
+    let (volume, check, stats) = crate::geology::model::seal(&planar, &stack, &inputs.layering)?;
+    Ok(crate::geology::model::GeologicalModel {
+        mesh: volume,
+        stack,
+        rules,
+        fields: Vec::new(),
+        stats,
+        check,
+        misfits: Vec::new(),
+        grids: Vec::new(),
+    })
+}
+
+/// Reads an observations file, keeping the records `keep` accepts.
+fn observations(path: &Path, keep: impl Fn([f64; 2]) -> bool) -> Result<(Vec<[f64; 2]>, Vec<f64>)> {
+    let (mut xy, mut z) = (Vec::new(), Vec::new());
+    super::files::stream_samples(path, |s| {
+        if keep([s[0], s[1]]) {
+            xy.push([s[0], s[1]]);
+            z.push(s[2]);
+        }
+    })?;
+    Ok((xy, z))
+}
