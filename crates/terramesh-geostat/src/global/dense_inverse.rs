@@ -39,6 +39,49 @@ pub(super) fn pays_off(pts: &[[f64; 2]], tree: &Tree, support: f64) -> bool {
     (seen as f64) < 0.5 * n as f64 * count as f64
 }
 
+/// How much more a flop of the grouped products costs than one of the triangular solve
+/// (the gather of `Z[S, S]` and smaller products), measured with `bench_global`'s forced
+/// routes (docs/geostatistics.md).
+const GROUPED_COST: f64 = 1.5;
+
+/// The cost model of the variances with a dense factor, for the mapped targets `q`: the
+/// solve route costs `m n²` flops (`L^{-1} K_t`), the inverse route `2n³/3` (the factor
+/// turned into `K^{-1}`) plus `|S|² g` per group of `g` targets whose data within `radius`
+/// are `S`, estimated on up to 48 groups spread over the Morton order. `true` when the
+/// inverse costs less.
+pub(super) fn inverse_pays(tree: &Tree, n: usize, q: &[[f64; 2]], radius: f64) -> bool {
+    let m = q.len();
+    let (nf, mf) = (n as f64, m as f64);
+    let inverse = 2.0 / 3.0 * nf * nf * nf;
+    let solve = mf * nf * nf;
+    if m == 0 || inverse >= solve {
+        return false;
+    }
+    let order = crate::linalg::morton_order(q);
+    let groups: Vec<&[u32]> = order.chunks(super::band_predict::DENSE_GROUP).collect();
+    let step = groups.len().div_ceil(48).max(1);
+    let mut stamp = vec![false; n];
+    let mut near = Vec::new();
+    let (mut flops, mut sampled) = (0.0, 0usize);
+    for g in groups.iter().step_by(step) {
+        stamp.iter_mut().for_each(|s| *s = false);
+        let mut s = 0usize;
+        for &t in g.iter() {
+            tree.within(q[t as usize], radius, &mut near);
+            for &(_, i) in &near {
+                if !stamp[i] {
+                    stamp[i] = true;
+                    s += 1;
+                }
+            }
+        }
+        flops += (s as f64).powi(2) * g.len() as f64;
+        sampled += 1;
+    }
+    let grouped = flops * groups.len() as f64 / sampled as f64;
+    inverse + GROUPED_COST * grouped < solve
+}
+
 /// Overwrites the lower Cholesky factor `L` (column-major `n x n`, lower triangle; the strict
 /// upper triangle zero) with the lower triangle of `K^{-1} = L^{-T} L^{-1}`, by blocked
 /// in-place steps (LAPACK's `trtri` then `lauum`), with one `n x NB` panel of scratch.
