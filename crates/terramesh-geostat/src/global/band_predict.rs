@@ -25,6 +25,13 @@ const GROUP: usize = 32;
 /// (5,000 data, 20,000 targets, `bench_global`: 3.3 s CPU with 32, 2.4 s with 128).
 pub(super) const DENSE_GROUP: usize = 128;
 
+/// The most data a group gathers `Z[S, S]` for (the scratch of all threads together under
+/// about 128 MB); a group of the dense inverse with more uses `Z` in place over all data.
+pub(super) fn gather_max() -> usize {
+    let threads = rayon::current_num_threads().max(1) as f64;
+    (128e6 / 8.0 / threads).sqrt() as usize
+}
+
 /// Where the columns of `K^{-1}` come from: the band strategy's inverse band, or the lower
 /// triangle of the dense inverse (column-major `n x n`, `dense_inverse.rs`).
 #[derive(Clone, Copy)]
@@ -148,10 +155,7 @@ impl GlobalKriging {
                     Some(_) => {
                         let mut f = vec![0.0; n * mt];
                         for (j, col) in f.chunks_mut(n).enumerate() {
-                            let x0 = q[idx[j] as usize];
-                            for (c, &xi) in col.iter_mut().zip(pts) {
-                                *c = self.cov(dist(xi, x0));
-                            }
+                            self.all_covariances(q[idx[j] as usize], col);
                         }
                         f
                     }
@@ -179,6 +183,14 @@ impl GlobalKriging {
                     }
                 }
                 s.s.sort_unstable();
+                // Too many to gather: all the data, with Z in place.
+                let whole = matches!(band, Some(Inverse::Dense { .. }))
+                    && want_var
+                    && s.s.len() > gather_max();
+                if whole {
+                    s.s.clear();
+                    s.s.extend(0..n);
+                }
                 let sd = &s.s;
                 let ns = sd.len();
                 let kb = match trunc {
@@ -203,18 +215,24 @@ impl GlobalKriging {
                 // q = kᵀ Z k = 2 kᵀ T k with T the lower triangle of Z[S, S], diagonal halved:
                 // a column-wise gather (each column of an inverse panel is contiguous) and
                 // a triangular product (half the flops of a full one).
-                if s.zs.len() < ns * ns {
-                    s.zs.resize(ns * ns, 0.0);
-                }
-                for b in 0..ns {
-                    let col = &mut s.zs[b * ns..(b + 1) * ns];
-                    let (p0, zc) = band.col(sd[b]);
-                    col[b] = 0.5 * zc[sd[b] - p0];
-                    for a in b + 1..ns {
-                        col[a] = zc.get(sd[a] - p0).copied().unwrap_or(0.0);
+                // In place (all data), the diagonal is whole: q = kᵀ(2T)k − Σ Z_ii k_i².
+                let zs = match band {
+                    Inverse::Dense { z, .. } if whole => MatRef::from_column_major_slice(z, n, n),
+                    _ => {
+                        if s.zs.len() < ns * ns {
+                            s.zs.resize(ns * ns, 0.0);
+                        }
+                        for b in 0..ns {
+                            let col = &mut s.zs[b * ns..(b + 1) * ns];
+                            let (p0, zc) = band.col(sd[b]);
+                            col[b] = 0.5 * zc[sd[b] - p0];
+                            for a in b + 1..ns {
+                                col[a] = zc.get(sd[a] - p0).copied().unwrap_or(0.0);
+                            }
+                        }
+                        MatRef::from_column_major_slice(&s.zs[..ns * ns], ns, ns)
                     }
-                }
-                let zs = MatRef::from_column_major_slice(&s.zs[..ns * ns], ns, ns);
+                };
                 let mut y = Mat::<f64>::zeros(ns, mt);
                 triangular::matmul(
                     y.as_mut(),
@@ -230,6 +248,11 @@ impl GlobalKriging {
                 for (j, o) in out.iter_mut().enumerate() {
                     let (kc, yc) = (kb.col(j), y.col(j));
                     let mut q1 = 0.0;
+                    if whole {
+                        for a in 0..ns {
+                            q1 -= zs[(a, a)] * kc[a] * kc[a];
+                        }
+                    }
                     let mut t = [0.0; 6];
                     for a in 0..ns {
                         q1 += kc[a] * yc[a];

@@ -44,6 +44,7 @@ use crate::band::Band;
 use crate::data::{Data, Method};
 use crate::error::{GeostatError, Result};
 use crate::model::Variogram;
+use crate::neighbourhood::kernel::Kernel;
 use crate::search::Tree;
 use crate::system::{dist, small_cholesky, small_quad, small_solve, Prepared, EXACT_EPS};
 
@@ -111,6 +112,8 @@ pub struct GlobalKriging {
     /// prediction with variances for which the cost model prefers it.
     solver: RwLock<Solver>,
     route: DenseRoute,
+    /// The covariances of a target with all the data, vectorised.
+    kernel: Kernel,
     sill: f64,
     mean: f64,
     /// Dual weights (length n) and drift coefficients (length p).
@@ -180,6 +183,7 @@ impl GlobalKriging {
             prep.z = perm.iter().map(|&i| prep.z[i]).collect();
         }
         let tree = Tree::new(&prep.pts)?;
+        let kernel = Kernel::new(&prep.variogram, sill.unwrap_or(0.0));
         let zc: Vec<f64> = prep.z.iter().map(|z| z - mean).collect();
         let mut f = vec![0.0; n * p]; // row-major n x p
         for i in 0..n {
@@ -272,6 +276,7 @@ impl GlobalKriging {
                     tree,
                     solver: RwLock::new(Solver::Gamma { lu }),
                     route: DenseRoute::Auto,
+                    kernel,
                     sill: 0.0,
                     mean,
                     w,
@@ -303,6 +308,7 @@ impl GlobalKriging {
             tree,
             solver: RwLock::new(solver),
             route: DenseRoute::Auto,
+            kernel,
             sill: sill.unwrap_or(0.0),
             mean,
             w,
@@ -377,7 +383,11 @@ impl GlobalKriging {
         } = &mut *w
         {
             let mut z = std::mem::take(l);
+            let t0 = std::time::Instant::now();
             dense_inverse::invert_in_place(&mut z, n);
+            if std::env::var_os("TM_DEBUG").is_some() {
+                eprintln!("inverse {:.2} s", t0.elapsed().as_secs_f64());
+            }
             let (h, trunc) = (
                 std::mem::take(h),
                 if support.is_some() { None } else { *trunc },
@@ -513,11 +523,7 @@ impl GlobalKriging {
         let mut b = vec![0.0; n * m];
         b.par_chunks_mut(n)
             .zip(q.par_iter())
-            .for_each(|(col, &x0)| {
-                for (c, &xi) in col.iter_mut().zip(&self.prep.pts) {
-                    *c = self.cov(dist(xi, x0));
-                }
-            });
+            .for_each(|(col, &x0)| self.all_covariances(x0, col));
         let mut f0 = vec![0.0; 6 * m];
         f0.par_chunks_mut(6)
             .enumerate()
@@ -592,6 +598,13 @@ impl GlobalKriging {
         self.mean
             + crate::band::dot(k0, &self.w)
             + f0.iter().zip(&self.v).map(|(f, v)| f * v).sum::<f64>()
+    }
+
+    /// The covariances of the mapped target `x0` with all the data, into `out`.
+    #[inline]
+    fn all_covariances(&self, x0: [f64; 2], out: &mut [f64]) {
+        self.kernel
+            .covariances(&self.prep.variogram, &self.prep.pts, x0, out);
     }
 
     #[inline]
