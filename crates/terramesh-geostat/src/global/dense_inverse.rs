@@ -87,9 +87,6 @@ pub(super) fn inverse_pays(tree: &Tree, n: usize, q: &[[f64; 2]], radius: f64) -
         sampled += 1;
     }
     let grouped = flops * groups.len() as f64 / sampled as f64;
-    if std::env::var_os("TM_DEBUG").is_some() {
-        eprintln!("cost: inverse {inverse:.3e} grouped {grouped:.3e} solve {solve:.3e}");
-    }
     inverse + GROUPED_COST * grouped < solve
 }
 

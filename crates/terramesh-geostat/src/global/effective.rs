@@ -84,6 +84,50 @@ mod tests {
     use crate::model::{ModelKind, Structure};
 
     #[test]
+    fn targets_that_fail_the_bound_get_the_exact_form() {
+        use crate::{Data, DenseRoute, Drift, Duplicates, GlobalKriging, Method};
+        let mut s = 3u64;
+        let mut u = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let xy: Vec<[f64; 2]> = (0..400).map(|_| [10.0 * u(), 10.0 * u()]).collect();
+        let z: Vec<f64> = xy.iter().map(|p| p[0] + (p[1] * 0.8).sin()).collect();
+        let t: Vec<[f64; 2]> = (0..200).map(|_| [10.0 * u(), 10.0 * u()]).collect();
+        let data = Data::new(xy, z, Duplicates::Reject).unwrap();
+        let v = Variogram::single(ModelKind::Gaussian, 0.05, 1.0, 1.0).unwrap();
+        let m = Method::Universal(Drift::Linear);
+        let mut exact = GlobalKriging::new(&data, &v, m, true).unwrap();
+        exact.set_dense_route(DenseRoute::Solve);
+        let (mut e0, mut s0) = (vec![0.0; 200], vec![0.0; 200]);
+        exact.predict(&t, &mut e0, Some(&mut s0)).unwrap();
+        let mut g = GlobalKriging::new(&data, &v, m, true).unwrap();
+        g.set_dense_route(DenseRoute::Inverse);
+        let (mut e, mut s) = (vec![0.0; 200], vec![0.0; 200]);
+        g.predict(&t[..1], &mut e[..1], Some(&mut s[..1])).unwrap();
+        assert_eq!(g.strategy(), "dense-inverse-effective");
+        // A truncation at half a range, where the covariance is still e^{-0.75} of the
+        // sill: every target fails the bound, so every variance must be the exact one.
+        if let crate::global::Solver::DenseInverse {
+            trunc: Some(tr),
+            support,
+            ..
+        } = &mut *g.solver.write().unwrap()
+        {
+            tr.radius = 0.5;
+            tr.c_r = v.covariance_at(0.5);
+            *support = 0.5;
+        }
+        g.predict(&t, &mut e, Some(&mut s)).unwrap();
+        assert_eq!(e, e0);
+        for i in 0..200 {
+            assert!((s[i] - s0[i]).abs() < 1e-12, "{i}: {} {}", s[i], s0[i]);
+        }
+    }
+
+    #[test]
     fn the_cut_off_is_what_the_bound_allows() {
         let v = Variogram::single(ModelKind::Gaussian, 50.0, 12000.0, 6000.0).unwrap();
         let t = Truncation::new(&v, 12050.0, 5000).unwrap();

@@ -383,11 +383,7 @@ impl GlobalKriging {
         } = &mut *w
         {
             let mut z = std::mem::take(l);
-            let t0 = std::time::Instant::now();
             dense_inverse::invert_in_place(&mut z, n);
-            if std::env::var_os("TM_DEBUG").is_some() {
-                eprintln!("inverse {:.2} s", t0.elapsed().as_secs_f64());
-            }
             let (h, trunc) = (
                 std::mem::take(h),
                 if support.is_some() { None } else { *trunc },
