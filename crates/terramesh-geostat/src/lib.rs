@@ -98,7 +98,7 @@ pub use file::{
     CandidateEntry, CandidateSummary, FitSummary, LagSummary, VariogramFile, VariogramFileError,
 };
 pub use fit::{fit_model, Fit, Weighting};
-pub use global::{GlobalKriging, BLOCK};
+pub use global::{DenseRoute, GlobalKriging, BLOCK, TRUNCATION_TOLERANCE};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use ked::ExternalDriftKriging;
 pub use ked_cv::cross_validate_external;

@@ -335,6 +335,78 @@ impl Variogram {
         Some(r)
     }
 
+    /// The white noise of the covariance: the nugget plus the partial sills of nugget
+    /// structures. Every covariance matrix of distinct points is at least this times the
+    /// identity (the other structures are positive semi-definite).
+    pub fn nugget_total(&self) -> f64 {
+        self.nugget
+            + self
+                .structures
+                .iter()
+                .filter(|s| s.kind == ModelKind::Nugget)
+                .map(|s| s.psill)
+                .sum::<f64>()
+    }
+
+    /// A lag `h` beyond which the covariance (nugget excluded) is at most `c > 0`: for
+    /// bounded models whose structures all decrease with the lag (nugget, spherical,
+    /// exponential, Gaussian, Matérn); `None` for other models. Found by doubling then
+    /// bisection on [`Variogram::covariance_at`], returning the upper end of the bracket, so
+    /// `covariance_at(h') <= c` for every `h' >= h` holds for the computed covariance.
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{ModelKind, Variogram};
+    /// let v = Variogram::single(ModelKind::Gaussian, 50.0, 12000.0, 6000.0)?;
+    /// let h = v.effective_support(1e-10).unwrap();
+    /// assert!(v.covariance_at(h) <= 1e-10 && v.covariance_at(0.999 * h) > 1e-10);
+    /// # Ok(()) }
+    /// ```
+    pub fn effective_support(&self, c: f64) -> Option<f64> {
+        let monotone = self.structures.iter().all(|s| {
+            matches!(
+                s.kind,
+                ModelKind::Nugget
+                    | ModelKind::Spherical
+                    | ModelKind::Exponential
+                    | ModelKind::Gaussian
+                    | ModelKind::Matern
+            )
+        });
+        if !monotone || !(c > 0.0) {
+            return None;
+        }
+        let at = |h: f64| self.covariance_at(h.max(f64::MIN_POSITIVE));
+        let mut hi = self
+            .structures
+            .iter()
+            .map(|s| s.range)
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let mut lo = 0.0;
+        let mut doublings = 0;
+        while at(hi) > c {
+            lo = hi;
+            hi *= 2.0;
+            doublings += 1;
+            if doublings > 2000 || !hi.is_finite() {
+                return None;
+            }
+        }
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if at(mid) > c {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Some(hi)
+    }
+
     /// Maps a point to the space where the variogram is isotropic: rotation by −angle, then
     /// the minor axis divided by `ratio`.
     #[inline]

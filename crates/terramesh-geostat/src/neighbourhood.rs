@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 mod grid;
-mod kernel;
+pub(crate) mod kernel;
 
 use crate::data::{Data, Method};
 use crate::error::{GeostatError, Result};

@@ -39,6 +39,57 @@ pub(super) fn pays_off(pts: &[[f64; 2]], tree: &Tree, support: f64) -> bool {
     (seen as f64) < 0.5 * n as f64 * count as f64
 }
 
+/// How much more a flop of the grouped products costs than one of the triangular solve
+/// (the gather of `Z[S, S]` and smaller products), and one of the inversion (its serial
+/// diagonal blocks and copies), measured with `bench_global`'s forced routes
+/// (docs/geostatistics.md: 37, 26 and 24 GFLOP per CPU second).
+const GROUPED_COST: f64 = 1.4;
+const INVERSE_COST: f64 = 1.5;
+
+/// The cost model of the variances with a dense factor, for the mapped targets `q`: the
+/// solve route costs `m n²` flops (`L^{-1} K_t`); the inverse route `2n³/3` (the factor
+/// turned into `K^{-1}`, weighted by [`INVERSE_COST`]) plus `|S|² g` per group of `g`
+/// targets whose data within `radius` are `S` (`n²g` where `S` is too large to gather),
+/// weighted by [`GROUPED_COST`] and estimated on up to 48 groups spread over the Morton
+/// order. `true` when the inverse route costs less.
+pub(super) fn inverse_pays(tree: &Tree, n: usize, q: &[[f64; 2]], radius: f64) -> bool {
+    let m = q.len();
+    let (nf, mf) = (n as f64, m as f64);
+    let inverse = INVERSE_COST * 2.0 / 3.0 * nf * nf * nf;
+    let solve = mf * nf * nf;
+    if m == 0 || inverse >= solve {
+        return false;
+    }
+    let order = crate::linalg::morton_order(q);
+    let groups: Vec<&[u32]> = order.chunks(super::band_predict::DENSE_GROUP).collect();
+    let step = groups.len().div_ceil(48).max(1);
+    let mut stamp = vec![false; n];
+    let mut near = Vec::new();
+    let (mut flops, mut sampled) = (0.0, 0usize);
+    for g in groups.iter().step_by(step) {
+        stamp.iter_mut().for_each(|s| *s = false);
+        let mut s = 0usize;
+        for &t in g.iter() {
+            tree.within(q[t as usize], radius, &mut near);
+            for &(_, i) in &near {
+                if !stamp[i] {
+                    stamp[i] = true;
+                    s += 1;
+                }
+            }
+        }
+        let s = if s > super::band_predict::gather_max() {
+            n
+        } else {
+            s
+        };
+        flops += (s as f64).powi(2) * g.len() as f64;
+        sampled += 1;
+    }
+    let grouped = flops * groups.len() as f64 / sampled as f64;
+    inverse + GROUPED_COST * grouped < solve
+}
+
 /// Overwrites the lower Cholesky factor `L` (column-major `n x n`, lower triangle; the strict
 /// upper triangle zero) with the lower triangle of `K^{-1} = L^{-T} L^{-1}`, by blocked
 /// in-place steps (LAPACK's `trtri` then `lauum`), with one `n x NB` panel of scratch.
@@ -170,10 +221,16 @@ mod tests {
         let data = Data::new(xy, z, Duplicates::Reject).unwrap();
         let v = Variogram::single(ModelKind::Spherical, 0.01, 1.0, 3.0).unwrap();
         for m in [Method::Ordinary, Method::Universal(Drift::Linear)] {
-            let g = GlobalKriging::new(&data, &v, m, true).unwrap();
-            assert_eq!(g.strategy(), "dense-inverse");
+            // 60 targets: the solves cost less than the inverse (60 · 400² against
+            // 1.5 · 2/3 · 400³ flops), so the inverse is asked for.
+            let mut g = GlobalKriging::new(&data, &v, m, true).unwrap();
             let (mut e, mut var) = (vec![0.0; 60], vec![0.0; 60]);
+            g.predict(&t[..1], &mut e[..1], Some(&mut var[..1]))
+                .unwrap();
+            assert_eq!(g.strategy(), "dense");
+            g.set_dense_route(crate::DenseRoute::Inverse);
             g.predict(&t, &mut e, Some(&mut var)).unwrap();
+            assert_eq!(g.strategy(), "dense-inverse");
             // All 400 data as one moving neighbourhood: each target's own Cholesky.
             let l = LocalKriging::new(&data, &v, m, 400).unwrap();
             let (mut e2, mut var2) = (vec![0.0; 60], vec![0.0; 60]);
@@ -193,12 +250,21 @@ mod tests {
             let mut e3 = vec![0.0; 60];
             g2.predict(&t, &mut e3, None).unwrap();
             assert_eq!(e, e3);
-            // And its variances, asked anyway, come from the factor.
+            // And its variances, asked anyway, come from the factor by solves (few targets),
+            // the estimates still in groups.
             let mut var3 = vec![0.0; 60];
             g2.predict(&t, &mut e3, Some(&mut var3)).unwrap();
+            assert_eq!(g2.strategy(), "dense");
+            assert_eq!(e, e3);
             for i in 0..60 {
                 assert!((var[i] - var3[i]).abs() < 1e-9, "{m:?} dense variance {i}");
             }
+            // 20,000 targets: the cost model takes the inverse by itself.
+            let many: Vec<[f64; 2]> = (0..20_000).map(|_| [10.0 * u(), 10.0 * u()]).collect();
+            let g3 = GlobalKriging::new(&data, &v, m, true).unwrap();
+            let (mut e4, mut var4) = (vec![0.0; many.len()], vec![0.0; many.len()]);
+            g3.predict(&many, &mut e4, Some(&mut var4)).unwrap();
+            assert_eq!(g3.strategy(), "dense-inverse");
         }
     }
 }

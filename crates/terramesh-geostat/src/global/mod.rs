@@ -7,9 +7,11 @@
 //!   (`O(s²)` for `s` such data), so cost does not grow with `n` per target.
 //! - **dense** (other bounded models): dense Cholesky of the covariance matrix with faer;
 //!   targets in blocks of [`BLOCK`]: one triangular solve per block for the variances.
-//!   With compact support over much of the data and variances asked, **dense-inverse**: the
-//!   factor becomes `K^{-1}` once and the targets' variances are gathered products in
-//!   groups, as in the band strategy (`dense_inverse.rs`).
+//!   With compact support over much of the data, or an effective support (a nugget and a
+//!   covariance that decays, `effective.rs`), and variances asked of enough targets that the
+//!   cost model says so (`dense_inverse::inverse_pays`, decided at the first prediction
+//!   with variances), **dense-inverse**: the factor becomes `K^{-1}` in place and the
+//!   targets' variances are gathered products in groups, as in the band strategy.
 //! - **gamma** (unbounded models: linear, power): PyKrige's bordered variogram system, LU.
 //!
 //! Estimates come from the dual form: `ẑ(x0) = k0ᵀ w + f0ᵀ v` with `[K F; Fᵀ 0][w; v] = [z; 0]`.
@@ -25,7 +27,16 @@ use rayon::prelude::*;
 
 mod band_predict;
 mod dense_inverse;
+mod effective;
 mod factor;
+mod loo;
+
+pub use effective::REL_TOL as TRUNCATION_TOLERANCE;
+
+use std::sync::{PoisonError, RwLock, RwLockReadGuard};
+
+use band_predict::Grouped;
+use effective::Truncation;
 
 use factor::{band_order, factor_band, factor_dense, factor_gamma};
 
@@ -33,11 +44,25 @@ use crate::band::Band;
 use crate::data::{Data, Method};
 use crate::error::{GeostatError, Result};
 use crate::model::Variogram;
+use crate::neighbourhood::kernel::Kernel;
 use crate::search::Tree;
 use crate::system::{dist, small_cholesky, small_quad, small_solve, Prepared, EXACT_EPS};
 
 /// Targets per block: bounds memory (`n x BLOCK` doubles) whatever the number of targets.
 pub const BLOCK: usize = 2048;
+
+/// How the variances of the dense strategy are computed ([`GlobalKriging::set_dense_route`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DenseRoute {
+    /// By the cost model, at the first prediction with variances (the default).
+    #[default]
+    Auto,
+    /// Always by triangular solves with the factor.
+    Solve,
+    /// By the inverse and grouped products whenever there is a support to group by
+    /// (compact, or effective with a nugget); otherwise by solves.
+    Inverse,
+}
 
 enum Solver {
     Dense {
@@ -45,9 +70,15 @@ enum Solver {
         l: Vec<f64>,
         /// `L^{-1} F`, column-major n x p.
         g: Vec<f64>,
-        /// The compact support when estimates alone go in groups (built without variances
-        /// where [`Solver::DenseInverse`] would be chosen with them: the same estimates).
+        /// `K^{-1} F`, row-major n x p (for [`Solver::DenseInverse`]).
+        h: Vec<f64>,
+        /// The compact support when it covers well under half the data: the estimates go in
+        /// groups (the same bits whatever the route of the variances), and the variances
+        /// may go by the inverse.
         support: Option<f64>,
+        /// The effective support of a decaying covariance with a nugget: the variances may
+        /// go by the inverse, truncated.
+        trunc: Option<Truncation>,
     },
     Band {
         band: Band,
@@ -64,7 +95,10 @@ enum Solver {
         z: Vec<f64>,
         /// `K^{-1} F`, row-major n x p.
         h: Vec<f64>,
+        /// The compact support, or the effective one of `trunc`.
         support: f64,
+        /// Set for an effective support: the variances' truncation and its bound.
+        trunc: Option<Truncation>,
     },
 }
 
@@ -74,7 +108,12 @@ pub struct GlobalKriging {
     /// `prep.pts[i]` is input point `perm[i]`.
     perm: Vec<usize>,
     tree: Tree,
-    solver: Solver,
+    /// Turned from [`Solver::Dense`] into [`Solver::DenseInverse`] in place by the first
+    /// prediction with variances for which the cost model prefers it.
+    solver: RwLock<Solver>,
+    route: DenseRoute,
+    /// The covariances of a target with all the data, vectorised.
+    kernel: Kernel,
     sill: f64,
     mean: f64,
     /// Dual weights (length n) and drift coefficients (length p).
@@ -144,6 +183,7 @@ impl GlobalKriging {
             prep.z = perm.iter().map(|&i| prep.z[i]).collect();
         }
         let tree = Tree::new(&prep.pts)?;
+        let kernel = Kernel::new(&prep.variogram, sill.unwrap_or(0.0));
         let zc: Vec<f64> = prep.z.iter().map(|z| z - mean).collect();
         let mut f = vec![0.0; n * p]; // row-major n x p
         for i in 0..n {
@@ -210,23 +250,15 @@ impl GlobalKriging {
                     .variogram
                     .compact_support()
                     .filter(|&r| dense_inverse::pays_off(&prep.pts, &tree, r));
-                match support {
-                    Some(r) if variance => {
-                        let mut z = l;
-                        dense_inverse::invert_in_place(&mut z, n);
-                        let hs = h.clone();
-                        (
-                            Solver::DenseInverse {
-                                z,
-                                h: hs,
-                                support: r,
-                            },
-                            h,
-                            kz,
-                        )
-                    }
-                    _ => (Solver::Dense { l, g, support }, h, kz),
-                }
+                let trunc = Truncation::new(&prep.variogram, s, n);
+                let solver = Solver::Dense {
+                    l,
+                    g,
+                    h: h.clone(),
+                    support,
+                    trunc,
+                };
+                (solver, h, kz)
             }
             (None, _) => {
                 let lu = factor_gamma(&prep, &f)?;
@@ -242,7 +274,9 @@ impl GlobalKriging {
                     prep,
                     perm,
                     tree,
-                    solver: Solver::Gamma { lu },
+                    solver: RwLock::new(Solver::Gamma { lu }),
+                    route: DenseRoute::Auto,
+                    kernel,
                     sill: 0.0,
                     mean,
                     w,
@@ -272,7 +306,9 @@ impl GlobalKriging {
             prep,
             perm,
             tree,
-            solver,
+            solver: RwLock::new(solver),
+            route: DenseRoute::Auto,
+            kernel,
             sill: sill.unwrap_or(0.0),
             mean,
             w,
@@ -292,13 +328,72 @@ impl GlobalKriging {
         w
     }
 
-    /// Which strategy was chosen: `"band"`, `"dense"`, `"dense-inverse"` or `"gamma"`.
+    /// Which strategy is in use: `"band"`, `"dense"`, `"dense-inverse"` (compact support),
+    /// `"dense-inverse-effective"` (truncated at an effective support) or `"gamma"`. A
+    /// dense factor turns into a dense inverse at the first prediction with variances for
+    /// which the cost model prefers it (or [`DenseRoute::Inverse`] asks it).
     pub fn strategy(&self) -> &'static str {
-        match self.solver {
+        match &*self.solver() {
             Solver::Dense { .. } => "dense",
-            Solver::DenseInverse { .. } => "dense-inverse",
+            Solver::DenseInverse { trunc: None, .. } => "dense-inverse",
+            Solver::DenseInverse { .. } => "dense-inverse-effective",
             Solver::Band { .. } => "band",
             Solver::Gamma { .. } => "gamma",
+        }
+    }
+
+    /// Chooses how the dense strategy's variances are computed from now on (the default,
+    /// [`DenseRoute::Auto`], weighs the targets of each prediction): for benchmarks and
+    /// tests. A factor already turned into an inverse stays one.
+    pub fn set_dense_route(&mut self, route: DenseRoute) {
+        self.route = route;
+    }
+
+    fn solver(&self) -> RwLockReadGuard<'_, Solver> {
+        self.solver.read().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Turns the dense factor into the inverse when the route or the cost model says so for
+    /// these targets.
+    fn choose_route(&self, targets: &[[f64; 2]]) {
+        let radius = match &*self.solver() {
+            Solver::Dense { support, trunc, .. } => support.or(trunc.map(|t| t.radius)),
+            _ => None,
+        };
+        let Some(r) = radius else { return };
+        let n = self.prep.pts.len();
+        let go = match self.route {
+            DenseRoute::Solve => false,
+            DenseRoute::Inverse => true,
+            DenseRoute::Auto => {
+                let q: Vec<[f64; 2]> = targets.iter().map(|p| self.prep.map(*p)).collect();
+                dense_inverse::inverse_pays(&self.tree, n, &q, r)
+            }
+        };
+        if !go {
+            return;
+        }
+        let mut w = self.solver.write().unwrap_or_else(PoisonError::into_inner);
+        if let Solver::Dense {
+            l,
+            h,
+            support,
+            trunc,
+            ..
+        } = &mut *w
+        {
+            let mut z = std::mem::take(l);
+            dense_inverse::invert_in_place(&mut z, n);
+            let (h, trunc) = (
+                std::mem::take(h),
+                if support.is_some() { None } else { *trunc },
+            );
+            *w = Solver::DenseInverse {
+                z,
+                h,
+                support: r,
+                trunc,
+            };
         }
     }
 
@@ -324,16 +419,39 @@ impl GlobalKriging {
                 });
             }
         }
-        if let Some((z, h, support)) = self.grouped(var.is_some()) {
-            // All targets at once: the groups of neighbouring targets span the whole set.
+        if var.is_some() {
+            self.choose_route(targets);
+        }
+        let solver = self.solver();
+        // All targets at once where they go in groups: the groups of neighbouring targets
+        // span the whole set.
+        if let Some(g) = self.grouped(&solver, var.is_some()) {
             let q: Vec<[f64; 2]> = targets.iter().map(|p| self.prep.map(*p)).collect();
-            self.block_band(z, h, support, &q, est, var.as_deref_mut());
+            self.block_band(g, &q, est, var.as_deref_mut());
             return self.finish(&q, est, var);
         }
+        // A compact support with variances by solves: the estimates in groups all the same,
+        // so that they do not depend on the route.
+        let grouped_est = match &*solver {
+            Solver::Dense {
+                support: Some(r), ..
+            } if var.is_some() => {
+                let q: Vec<[f64; 2]> = targets.iter().map(|p| self.prep.map(*p)).collect();
+                let g = Grouped {
+                    inv: None,
+                    h: &[],
+                    radius: *r,
+                    trunc: None,
+                };
+                self.block_band(g, &q, est, None);
+                true
+            }
+            _ => false,
+        };
         for (b, chunk) in targets.chunks(BLOCK).enumerate() {
             let r = b * BLOCK..b * BLOCK + chunk.len();
             let vslice = var.as_deref_mut().map(|v| &mut v[r.clone()]);
-            self.predict_block(chunk, &mut est[r], vslice)
+            self.predict_block(&solver, chunk, &mut est[r], vslice, grouped_est)
                 .map_err(|e| e.offset_target(b * BLOCK))?;
         }
         Ok(())
@@ -342,26 +460,28 @@ impl GlobalKriging {
     /// Whether [`GlobalKriging::predict`] can give variances: built with `variance = true`,
     /// or with a strategy that needs nothing more for them.
     pub fn has_variance(&self) -> bool {
-        self.variance || !matches!(self.solver, Solver::Band { .. })
+        self.variance || !matches!(&*self.solver(), Solver::Band { .. })
     }
 
+    /// One block of targets by solves (dense) or the bordered LU (gamma); the estimates are
+    /// left as they are when `estimated` (done in groups).
     fn predict_block(
         &self,
+        solver: &Solver,
         t: &[[f64; 2]],
         est: &mut [f64],
         mut var: Option<&mut [f64]>,
+        estimated: bool,
     ) -> Result<()> {
         let q: Vec<[f64; 2]> = t.iter().map(|p| self.prep.map(*p)).collect();
         let v = var.as_deref_mut();
-        if let Some((z, h, support)) = self.grouped(v.is_some()) {
-            self.block_band(z, h, support, &q, est, v);
-        } else {
-            match &self.solver {
-                Solver::Dense { l, g, .. } => self.block_dense(l, g, &q, est, v),
-                Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
-                Solver::Band { .. } | Solver::DenseInverse { .. } => unreachable!("grouped"),
-            }?;
-        }
+        match solver {
+            Solver::Dense { l, g, .. } => {
+                self.block_dense(l, g, &q, (!estimated).then_some(&mut *est), v)
+            }
+            Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
+            Solver::Band { .. } | Solver::DenseInverse { .. } => unreachable!("grouped"),
+        }?;
         self.finish(&q, est, var)
     }
 
@@ -390,7 +510,7 @@ impl GlobalKriging {
         l: &[f64],
         g: &[f64],
         q: &[[f64; 2]],
-        est: &mut [f64],
+        est: Option<&mut [f64]>,
         var: Option<&mut [f64]>,
     ) -> Result<()> {
         let n = self.prep.pts.len();
@@ -399,21 +519,16 @@ impl GlobalKriging {
         let mut b = vec![0.0; n * m];
         b.par_chunks_mut(n)
             .zip(q.par_iter())
-            .for_each(|(col, &x0)| {
-                for (c, &xi) in col.iter_mut().zip(&self.prep.pts) {
-                    *c = self.cov(dist(xi, x0));
-                }
-            });
+            .for_each(|(col, &x0)| self.all_covariances(x0, col));
         let mut f0 = vec![0.0; 6 * m];
-        est.par_iter_mut()
-            .zip(f0.par_chunks_mut(6))
+        f0.par_chunks_mut(6)
             .enumerate()
-            .for_each(|(j, (e, f))| {
-                self.prep.drift(q[j], &mut f[..p]);
-                *e = self.mean
-                    + crate::band::dot(&b[j * n..(j + 1) * n], &self.w)
-                    + (0..p).map(|k| f[k] * self.v[k]).sum::<f64>();
+            .for_each(|(j, f)| self.prep.drift(q[j], &mut f[..p]));
+        if let Some(est) = est {
+            est.par_iter_mut().enumerate().for_each(|(j, e)| {
+                *e = self.dual_estimate(&b[j * n..(j + 1) * n], &f0[j * 6..j * 6 + p]);
             });
+        }
         let Some(var) = var else { return Ok(()) };
         let lm = MatRef::from_column_major_slice(l, n, n);
         solve_lower_triangular_in_place(
@@ -472,79 +587,25 @@ impl GlobalKriging {
         Ok(())
     }
 
+    /// The dual-kriging estimate from a target's covariances with all the data and its drift
+    /// terms (one expression, so that every route gives the same bits).
+    #[inline]
+    fn dual_estimate(&self, k0: &[f64], f0: &[f64]) -> f64 {
+        self.mean
+            + crate::band::dot(k0, &self.w)
+            + f0.iter().zip(&self.v).map(|(f, v)| f * v).sum::<f64>()
+    }
+
+    /// The covariances of the mapped target `x0` with all the data, into `out`.
+    #[inline]
+    fn all_covariances(&self, x0: [f64; 2], out: &mut [f64]) {
+        self.kernel
+            .covariances(&self.prep.variogram, &self.prep.pts, x0, out);
+    }
+
     #[inline]
     fn cov(&self, d: f64) -> f64 {
         self.prep.variogram.covariance_at(d)
-    }
-
-    /// Leave-one-out errors `z_i − ẑ_{−i}` and kriging variances of the left-out predictions,
-    /// in input order, from one factorisation (Dubrule 1983: `e_i = w_i / B_ii`,
-    /// `σ²_i = 1 / B_ii` with `B` the data block of the inverse kriging matrix).
-    ///
-    /// Needs a bounded variogram (built with `variance = true` for the band strategy).
-    ///
-    /// ```
-    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
-    /// use terramesh_geostat::{Data, Duplicates, GlobalKriging, Method, ModelKind, Variogram};
-    /// let xy = vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0], [10.0, 10.0], [4.0, 6.0]];
-    /// let z = vec![1.0, 2.0, 3.0, 5.0, 2.5];
-    /// let data = Data::new(xy.clone(), z.clone(), Duplicates::Reject)?;
-    /// let v = Variogram::single(ModelKind::Exponential, 0.1, 2.0, 20.0)?;
-    /// let (err, var) = GlobalKriging::new(&data, &v, Method::Ordinary, true)?.leave_one_out()?;
-    /// // The same as kriging point 4 from the other four:
-    /// let rest = Data::new(xy[..4].to_vec(), z[..4].to_vec(), Duplicates::Reject)?;
-    /// let (mut e, mut s) = ([0.0], [0.0]);
-    /// GlobalKriging::new(&rest, &v, Method::Ordinary, true)?.predict(&[xy[4]], &mut e, Some(&mut s))?;
-    /// assert!((z[4] - e[0] - err[4]).abs() < 1e-12 && (s[0] - var[4]).abs() < 1e-12);
-    /// # Ok(()) }
-    /// ```
-    pub fn leave_one_out(&self) -> Result<(Vec<f64>, Vec<f64>)> {
-        let n = self.prep.pts.len();
-        let p = self.prep.terms();
-        let (diag, h): (Vec<f64>, Vec<f64>) = match &self.solver {
-            Solver::Band { band, h, .. } => {
-                if !self.variance {
-                    return Err(GeostatError::Singular {
-                        why: "leave-one-out needs the inverse band (build with variance)".into(),
-                    });
-                }
-                ((0..n).map(|i| band.zij(i, i)).collect(), h.clone())
-            }
-            Solver::DenseInverse { z, h, .. } => {
-                ((0..n).map(|i| z[i * n + i]).collect(), h.clone())
-            }
-            Solver::Dense { l, g, .. } => {
-                // The inverse of the factor beside the factor itself.
-                check_dense(2.0 * n as f64 * n as f64)?;
-                let lm = MatRef::from_column_major_slice(l, n, n);
-                let mut inv = Mat::<f64>::zeros(n, n);
-                faer::linalg::triangular_inverse::invert_lower_triangular(inv.as_mut(), lm, par());
-                let diag = (0..n)
-                    .into_par_iter()
-                    .map(|i| (i..n).map(|k| inv[(k, i)] * inv[(k, i)]).sum())
-                    .collect();
-                // H = L^{-T} G
-                let h = upper_solve_rows(lm, g, n, p);
-                (diag, h)
-            }
-            Solver::Gamma { .. } => {
-                return Err(GeostatError::Unbounded {
-                    what: "fast leave-one-out",
-                    model: self.prep.variogram.unbounded_name().unwrap_or("unbounded"),
-                })
-            }
-        };
-        let mut err = vec![0.0; n];
-        let mut var = vec![0.0; n];
-        for i in 0..n {
-            let mut t = [0.0; 6];
-            t[..p].copy_from_slice(&h[i * p..(i + 1) * p]);
-            let bii = diag[i] - small_quad(&self.rs, p, &mut t[..p]);
-            err[self.perm[i]] = self.w[i] / bii;
-            var[self.perm[i]] = 1.0 / bii;
-        }
-        check_finite(&err)?;
-        Ok((err, var))
     }
 }
 

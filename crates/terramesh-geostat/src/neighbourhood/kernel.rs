@@ -26,7 +26,7 @@ enum Shape {
 }
 
 /// The model and the machine, fixed at construction.
-pub(super) struct Kernel {
+pub(crate) struct Kernel {
     shape: Shape,
     sill: f64,
     fma: bool,
@@ -54,7 +54,7 @@ pub(super) struct Buffers {
 }
 
 impl Kernel {
-    pub(super) fn new(vg: &Variogram, sill: f64) -> Kernel {
+    pub(crate) fn new(vg: &Variogram, sill: f64) -> Kernel {
         let shape = match vg.structures.as_slice() {
             [s] => match s.kind {
                 ModelKind::Spherical => Shape::Spherical {
@@ -109,6 +109,46 @@ impl Kernel {
         s: &mut Buffers,
     ) -> Option<(f64, f64)> {
         self.body::<true>(prep, near, x0, s)
+    }
+
+    /// The covariances of the points `pts` with `x0` (in the isotropic frame), into `out`:
+    /// the same numbers as the per-target kernel's (`exp_neg` for the exponential and
+    /// Gaussian models), vectorised with AVX2 + FMA where the processor has them (no fused
+    /// operations, so both builds give the same bits).
+    pub(crate) fn covariances(
+        &self,
+        vg: &Variogram,
+        pts: &[[f64; 2]],
+        x0: [f64; 2],
+        out: &mut [f64],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if self.fma {
+            // SAFETY: `fma` is true only where the processor has AVX2 and FMA.
+            return unsafe { self.covariances_fma(vg, pts, x0, out) };
+        }
+        self.covariances_body(vg, pts, x0, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn covariances_fma(
+        &self,
+        vg: &Variogram,
+        pts: &[[f64; 2]],
+        x0: [f64; 2],
+        out: &mut [f64],
+    ) {
+        self.covariances_body(vg, pts, x0, out)
+    }
+
+    #[inline(always)]
+    fn covariances_body(&self, vg: &Variogram, pts: &[[f64; 2]], x0: [f64; 2], out: &mut [f64]) {
+        for (h, p) in out.iter_mut().zip(pts) {
+            let (dx, dy) = (p[0] - x0[0], p[1] - x0[1]);
+            *h = (dx * dx + dy * dy).sqrt();
+        }
+        self.cov_row(vg, out);
     }
 
     /// Covariances of the distances in `h`, in place.
