@@ -17,17 +17,15 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
-use super::write_shortest;
 use super::ModelInfo;
+use crate::textsink::{PointText, TextSink};
 
-fn ids<W: Write + ?Sized>(w: &mut W, list: &[u64]) -> io::Result<()> {
-    let mut b = itoa::Buffer::new();
+fn ids<W: Write + ?Sized>(w: &mut TextSink<W>, list: &[u64]) -> io::Result<()> {
     for chunk in list.chunks(10) {
         for id in chunk {
-            w.write_all(b" ")?;
-            w.write_all(b.format(*id).as_bytes())?;
+            w.space_u64(*id)?;
         }
-        w.write_all(b"\n")?;
+        w.byte(b'\n')?;
     }
     Ok(())
 }
@@ -56,6 +54,18 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
+    write_f3grid(w, m, info, &PointText::new(&m.points))
+}
+
+/// [`write_model_f3grid`] with the points' text made already.
+pub(super) fn write_f3grid<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    info: &ModelInfo,
+    pts: &PointText,
+) -> io::Result<()> {
+    let mut sink = TextSink::new(w);
+    let w = &mut sink;
     writeln!(w, "* FLAC3D grid of a terramesh geological model")?;
     writeln!(
         w,
@@ -64,15 +74,12 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
         super::vertical_note(info)
     )?;
     writeln!(w, "* GRIDPOINTS")?;
-    let mut b = itoa::Buffer::new();
-    for (i, p) in m.points.iter().enumerate() {
-        w.write_all(b"G ")?;
-        w.write_all(b.format(i + 1).as_bytes())?;
-        for c in p {
-            w.write_all(b" ")?;
-            write_shortest(w, *c)?;
-        }
-        w.write_all(b"\n")?;
+    for i in 0..m.points.len() {
+        w.bytes(b"G")?;
+        w.space_u64(i as u64 + 1)?;
+        w.byte(b' ')?;
+        w.bytes(pts.get(i))?;
+        w.byte(b'\n')?;
     }
     writeln!(w, "* ZONES")?;
     for (i, c) in m.cells.iter().enumerate() {
@@ -82,27 +89,24 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
             CellKind::Pyramid => (b"P5", &[n[0], n[1], n[3], n[4], n[2]]),
             CellKind::Tetra => (b"T4", &n[..4]),
         };
-        w.write_all(b"Z ")?;
-        w.write_all(name)?;
-        w.write_all(b" ")?;
-        w.write_all(b.format(i + 1).as_bytes())?;
+        w.bytes(b"Z ")?;
+        w.bytes(name)?;
+        w.space_u64(i as u64 + 1)?;
         for &k in order {
-            w.write_all(b" ")?;
-            w.write_all(b.format(k as u64 + 1).as_bytes())?;
+            w.space_u64(u64::from(k) + 1)?;
         }
-        w.write_all(b"\n")?;
+        w.byte(b'\n')?;
     }
     if !m.faces.is_empty() {
         writeln!(w, "* FACES")?;
         for (j, f) in m.faces.iter().enumerate() {
             let nodes = f.used();
-            w.write_all(if nodes.len() == 3 { b"F T3 " } else { b"F Q4 " })?;
-            w.write_all(b.format(j + 1).as_bytes())?;
+            w.bytes(if nodes.len() == 3 { b"F T3" } else { b"F Q4" })?;
+            w.space_u64(j as u64 + 1)?;
             for &k in nodes {
-                w.write_all(b" ")?;
-                w.write_all(b.format(k as u64 + 1).as_bytes())?;
+                w.space_u64(u64::from(k) + 1)?;
             }
-            w.write_all(b"\n")?;
+            w.byte(b'\n')?;
         }
     }
     writeln!(w, "* ZONE GROUPS")?;
@@ -129,5 +133,5 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
             }
         }
     }
-    Ok(())
+    sink.finish()
 }

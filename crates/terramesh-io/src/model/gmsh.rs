@@ -14,6 +14,7 @@ use terramesh_core::volume::{CellKind, VolumeMesh};
 
 use super::ModelInfo;
 use super::{vertical_note, write_shortest};
+use crate::textsink::{PointText, TextSink};
 
 fn gmsh_type(kind: CellKind) -> u8 {
     match kind {
@@ -75,6 +76,18 @@ pub fn write_model_msh<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
+    write_msh(w, m, info, &PointText::new(&m.points))
+}
+
+/// [`write_model_msh`] with the points' text made already.
+pub(super) fn write_msh<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    info: &ModelInfo,
+    pts: &PointText,
+) -> io::Result<()> {
+    let mut sink = TextSink::new(w);
+    let w = &mut sink;
     let nu = m.units.len();
     let nt = m.tags.len();
     // Cells per unit and kind, faces per tag and size.
@@ -134,18 +147,13 @@ pub fn write_model_msh<W: Write + ?Sized>(
     let np = m.points.len();
     let node_entity = units.first().map_or(1, |u| u + 1);
     writeln!(w, "$Nodes\n1 {np} 1 {np}\n3 {node_entity} 0 {np}")?;
-    let mut ib = itoa::Buffer::new();
     for i in 1..=np {
-        w.write_all(ib.format(i).as_bytes())?;
-        w.write_all(b"\n")?;
+        w.u64(i as u64)?;
+        w.byte(b'\n')?;
     }
-    for p in &m.points {
-        write_shortest(w, p[0])?;
-        w.write_all(b" ")?;
-        write_shortest(w, p[1])?;
-        w.write_all(b" ")?;
-        write_shortest(w, p[2])?;
-        w.write_all(b"\n")?;
+    for i in 0..np {
+        w.bytes(pts.get(i))?;
+        w.byte(b'\n')?;
     }
     writeln!(w, "$EndNodes")?;
     let nblocks = vol_blocks
@@ -160,13 +168,12 @@ pub fn write_model_msh<W: Write + ?Sized>(
             .count();
     let ne = m.cells.len() + m.faces.len();
     writeln!(w, "$Elements\n{nblocks} {ne} 1 {ne}")?;
-    let mut line = |w: &mut W, tag: usize, nodes: &[u32]| -> io::Result<()> {
-        w.write_all(ib.format(tag).as_bytes())?;
+    let line = |w: &mut TextSink<W>, tag: usize, nodes: &[u32]| -> io::Result<()> {
+        w.u64(tag as u64)?;
         for &n in nodes {
-            w.write_all(b" ")?;
-            w.write_all(ib.format(n as u64 + 1).as_bytes())?;
+            w.space_u64(u64::from(n) + 1)?;
         }
-        w.write_all(b"\n")
+        w.byte(b'\n')
     };
     for &u in &units {
         for (k, block) in vol_blocks[u].iter().enumerate() {
@@ -191,5 +198,6 @@ pub fn write_model_msh<W: Write + ?Sized>(
             }
         }
     }
-    writeln!(w, "$EndElements")
+    writeln!(w, "$EndElements")?;
+    sink.finish()
 }

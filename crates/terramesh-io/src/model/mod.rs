@@ -135,6 +135,8 @@ pub fn write_model(
     info: &ModelInfo,
 ) -> Result<Vec<String>, ModelWriteError> {
     check_mesh(mesh)?;
+    // the points' text, for model.msh, model.f3grid and the bodies' TSurf
+    let pts = &crate::textsink::PointText::new(&mesh.points);
     type Job<'a> = (
         String,
         Box<dyn Fn(&mut Output) -> io::Result<()> + Send + Sync + 'a>,
@@ -152,18 +154,20 @@ pub fn write_model(
     }
     jobs.push((
         "model.msh".into(),
-        Box::new(|w: &mut Output| write_model_msh(w, mesh, info)),
+        Box::new(move |w: &mut Output| gmsh::write_msh(w, mesh, info, pts)),
     ));
     jobs.push((
         "model.f3grid".into(),
-        Box::new(|w: &mut Output| write_model_f3grid(w, mesh, info)),
+        Box::new(move |w: &mut Output| flac3d::write_f3grid(w, mesh, info, pts)),
     ));
     let origin = stl_origin(mesh);
     for body in &mesh.bodies {
         let unit = &mesh.units[body.unit];
         jobs.push((
             format!("unit-{unit}.ts"),
-            Box::new(move |w: &mut Output| write_body_tsurf(w, mesh, body, info)),
+            Box::new(move |w: &mut Output| {
+                bodies::write_tsurf_shared(w, mesh, body, info, Some(pts))
+            }),
         ));
         jobs.push((
             format!("unit-{unit}.stl"),
