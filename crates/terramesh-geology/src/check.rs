@@ -105,15 +105,30 @@ fn faces(c: &Cell) -> impl Iterator<Item = [u32; 4]> {
     list.0.into_iter().take(list.1)
 }
 
-/// A face's key (the same for both orientations) and its orientation.
+/// A face's key (the same for both orientations) and its orientation: the face turned to
+/// start at its least node (the first of equal least ones), the rest of the key in increasing
+/// order.
+#[inline]
 fn canonical(f: [u32; 4]) -> ([u32; 4], bool) {
-    let used = if f[3] == u32::MAX { 3 } else { 4 };
-    let m = (0..used).min_by_key(|&i| f[i]).unwrap();
-    let at = |k: usize| f[(m + k) % used];
-    if used == 3 {
-        let (x, y) = (at(1), at(2));
-        ([at(0), x.min(y), x.max(y), u32::MAX], x < y)
+    // the rotations written out, not taken modulo the face's size (a division per node)
+    if f[3] == u32::MAX {
+        let [a, b, c, _] = f;
+        let (m, x, y) = if a <= b && a <= c {
+            (a, b, c)
+        } else if b <= c {
+            (b, c, a)
+        } else {
+            (c, a, b)
+        };
+        ([m, x.min(y), x.max(y), u32::MAX], x < y)
     } else {
+        let mut m = 0;
+        for i in 1..4 {
+            if f[i] < f[m] {
+                m = i;
+            }
+        }
+        let at = |k: usize| f[(m + k) & 3];
         let (x, z) = (at(1), at(3));
         ([at(0), x.min(z), at(2), x.max(z)], x < z)
     }
@@ -151,7 +166,8 @@ fn closed<P>(
         |_, p, out| {
             let p = nodes_of(p);
             for i in 0..p.len() {
-                let (a, b) = (p[i] as u64, p[(i + 1) % p.len()] as u64);
+                let next = if i + 1 == p.len() { 0 } else { i + 1 };
+                let (a, b) = (p[i] as u64, p[next] as u64);
                 // (min, max) and the direction in the lowest bit (nodes below 2^31).
                 out[i] = (a.min(b) << 32 | a.max(b)) << 1 | (a < b) as u64;
             }
@@ -573,5 +589,45 @@ impl CheckSummary {
             x: p[0],
             y: p[1],
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The key as first written: rotations taken modulo the face's size.
+    fn canonical_by_modulo(f: [u32; 4]) -> ([u32; 4], bool) {
+        let used = if f[3] == u32::MAX { 3 } else { 4 };
+        let m = (0..used).min_by_key(|&i| f[i]).unwrap();
+        let at = |k: usize| f[(m + k) % used];
+        if used == 3 {
+            let (x, y) = (at(1), at(2));
+            ([at(0), x.min(y), x.max(y), u32::MAX], x < y)
+        } else {
+            let (x, z) = (at(1), at(3));
+            ([at(0), x.min(z), at(2), x.max(z)], x < z)
+        }
+    }
+
+    #[test]
+    fn face_keys_are_those_of_the_rotation_by_modulo_repeated_nodes_included() {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s % 5) as u32 // few values: many ties
+        };
+        for _ in 0..20_000 {
+            let tri = [next(), next(), next(), u32::MAX];
+            let quad = [next(), next(), next(), next()];
+            assert_eq!(canonical(tri), canonical_by_modulo(tri), "{tri:?}");
+            assert_eq!(canonical(quad), canonical_by_modulo(quad), "{quad:?}");
+            for f in [tri, quad] {
+                let (key, o) = canonical(f);
+                assert_eq!(canonical(oriented(key, o)), (key, o));
+            }
+        }
     }
 }
