@@ -63,7 +63,7 @@ use crate::output::Output;
 
 pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
 pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
-pub use check::{check_mesh, MeshError};
+pub use check::{check_mesh, check_mesh_with, MeshError};
 pub use faces::{cell_faces, ogs_face_index};
 pub use flac3d::write_model_f3grid;
 pub use gmsh::write_model_msh;
@@ -134,7 +134,18 @@ pub fn write_model(
     mesh: &VolumeMesh,
     info: &ModelInfo,
 ) -> Result<Vec<String>, ModelWriteError> {
-    check_mesh(mesh)?;
+    write_model_with(dir, mesh, info, None)
+}
+
+/// [`write_model`], with the cells' volumes when the caller has computed them from this mesh
+/// already (see [`check_mesh_with`]), so that they are not computed again.
+pub fn write_model_with(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    info: &ModelInfo,
+    volumes: Option<&[f64]>,
+) -> Result<Vec<String>, ModelWriteError> {
+    check_mesh_with(mesh, volumes)?;
     // the points' text, for model.msh, model.f3grid and the bodies' TSurf
     let pts = &crate::textsink::PointText::new(&mesh.points);
     type Job<'a> = (
