@@ -18,10 +18,11 @@
 //!    z over the boundary faces' projected areas) to 1e-9 relative.
 
 use rayon::prelude::*;
-use terramesh_core::volume::{cell_volume, Cell, CellKind, FaceTag, VolumeMesh};
+use terramesh_core::volume::{cell_volume, VolumeMesh};
 
-use crate::buckets::{bucketed, sort_by_node};
-use crate::cells::split_quad;
+use crate::buckets::bucketed;
+use crate::check_faces::{canonical, faces, oriented, triangles, used};
+use crate::check_tags::check_tags;
 use crate::{GeologyError, Planar, Stack};
 
 /// Relative tolerance of the volume checks.
@@ -49,7 +50,7 @@ pub struct CheckSummary {
     pub pinch_edges: usize,
 }
 
-fn fail(mesh: &VolumeMesh, node: u32, what: String) -> GeologyError {
+pub(crate) fn fail(mesh: &VolumeMesh, node: u32, what: String) -> GeologyError {
     let p = mesh
         .points
         .get(node as usize)
@@ -66,77 +67,6 @@ fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= RELATIVE * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
 }
 
-/// The outward faces of a cell (triangles end with `u32::MAX`).
-fn faces(c: &Cell) -> impl Iterator<Item = [u32; 4]> {
-    const T: u32 = u32::MAX;
-    let n = c.nodes;
-    let list: ([[u32; 4]; 5], usize) = match c.kind {
-        CellKind::Tetra => (
-            [
-                [n[0], n[2], n[1], T],
-                [n[0], n[1], n[3], T],
-                [n[1], n[2], n[3], T],
-                [n[0], n[3], n[2], T],
-                [T; 4],
-            ],
-            4,
-        ),
-        CellKind::Pyramid => (
-            [
-                [n[0], n[3], n[2], n[1]],
-                [n[0], n[1], n[4], T],
-                [n[1], n[2], n[4], T],
-                [n[2], n[3], n[4], T],
-                [n[3], n[0], n[4], T],
-            ],
-            5,
-        ),
-        CellKind::Wedge => (
-            [
-                [n[0], n[2], n[1], T],
-                [n[3], n[4], n[5], T],
-                [n[0], n[1], n[4], n[3]],
-                [n[1], n[2], n[5], n[4]],
-                [n[2], n[0], n[3], n[5]],
-            ],
-            5,
-        ),
-    };
-    list.0.into_iter().take(list.1)
-}
-
-/// A face's key (the same for both orientations) and its orientation.
-fn canonical(f: [u32; 4]) -> ([u32; 4], bool) {
-    let used = if f[3] == u32::MAX { 3 } else { 4 };
-    let m = (0..used).min_by_key(|&i| f[i]).unwrap();
-    let at = |k: usize| f[(m + k) % used];
-    if used == 3 {
-        let (x, y) = (at(1), at(2));
-        ([at(0), x.min(y), x.max(y), u32::MAX], x < y)
-    } else {
-        let (x, z) = (at(1), at(3));
-        ([at(0), x.min(z), at(2), x.max(z)], x < z)
-    }
-}
-
-/// The face back from its key and orientation.
-fn oriented(key: [u32; 4], forward: bool) -> [u32; 4] {
-    match (key[3] == u32::MAX, forward) {
-        (true, true) => key,
-        (true, false) => [key[0], key[2], key[1], u32::MAX],
-        (false, true) => key,
-        (false, false) => [key[0], key[3], key[2], key[1]],
-    }
-}
-
-fn used(f: &[u32; 4]) -> &[u32] {
-    if f[3] == u32::MAX {
-        &f[..3]
-    } else {
-        f
-    }
-}
-
 /// Every edge of the polygons in two of them or four, as often one way as the other; returns
 /// the number of edges in four.
 fn closed<P>(
@@ -151,7 +81,8 @@ fn closed<P>(
         |_, p, out| {
             let p = nodes_of(p);
             for i in 0..p.len() {
-                let (a, b) = (p[i] as u64, p[(i + 1) % p.len()] as u64);
+                let next = if i + 1 == p.len() { 0 } else { i + 1 };
+                let (a, b) = (p[i] as u64, p[next] as u64);
                 // (min, max) and the direction in the lowest bit (nodes below 2^31).
                 out[i] = (a.min(b) << 32 | a.max(b)) << 1 | (a < b) as u64;
             }
@@ -199,16 +130,6 @@ fn z_flux(p: &[[f64; 3]], r: [f64; 3], t: [u32; 3]) -> f64 {
     area2 * (a[2] + b[2] + c[2])
 }
 
-/// The triangles of a face (a quadrilateral cut by the diagonal rule).
-fn triangles(f: &[u32; 4]) -> impl Iterator<Item = [u32; 3]> {
-    let (n, t) = if f[3] == u32::MAX {
-        (1, [[f[0], f[1], f[2]], [0; 3]])
-    } else {
-        (2, split_quad(*f))
-    };
-    t.into_iter().take(n)
-}
-
 /// Checks a volume mesh (the module documentation lists the checks).
 ///
 /// ```
@@ -226,6 +147,58 @@ fn triangles(f: &[u32; 4]) -> impl Iterator<Item = [u32; 3]> {
 /// # Errors
 /// [`GeologyError::Check`] naming the first failure and where it is.
 pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
+    check_with_volumes(mesh, &cell_volumes(mesh))
+}
+
+/// The volume of every cell ([`cell_volume`]), in parallel; NaN for a cell that names a
+/// missing node. [`check_with_volumes`] takes them, so that a caller that needs them too (the
+/// writers' own checks) computes them once.
+///
+/// ```
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 3.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3]), Cell::tetra([0, 1, 2, 9])],
+///     ..Default::default()
+/// };
+/// let v = terramesh_geology::cell_volumes(&m);
+/// assert!((v[0] - 0.5).abs() < 1e-15 && v[1].is_nan());
+/// ```
+pub fn cell_volumes(mesh: &VolumeMesh) -> Vec<f64> {
+    let n = mesh.points.len();
+    mesh.cells
+        .par_iter()
+        .map(|c| {
+            if c.used().iter().any(|&i| i as usize >= n) {
+                f64::NAN
+            } else {
+                cell_volume(&mesh.points, c)
+            }
+        })
+        .collect()
+}
+
+/// [`check`] with the cells' volumes computed already: `volumes` must be
+/// [`cell_volumes`]`(mesh)` (its length is checked; its values are what check 1 judges).
+///
+/// ```
+/// use terramesh_geology::{cell_volumes, check_with_volumes, volume_mesh, Layering, Planar, Stack};
+/// let points = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+/// let planar = Planar::new(&points, &[[0, 1, 2]])?;
+/// let stack = Stack { surfaces: vec![vec![3.0; 3], vec![0.0; 3]] };
+/// let mesh = volume_mesh(&planar, &stack, &Layering::new(vec!["a".into()]))?;
+/// let v = cell_volumes(&mesh);
+/// assert!((check_with_volumes(&mesh, &v)?.volume - 1.5).abs() < 1e-12);
+/// assert!(check_with_volumes(&mesh, &v[1..]).is_err()); // one volume per cell
+/// # Ok::<(), terramesh_geology::GeologyError>(())
+/// ```
+///
+/// # Errors
+/// As [`check`]'s.
+pub fn check_with_volumes(
+    mesh: &VolumeMesh,
+    volumes: &[f64],
+) -> Result<CheckSummary, GeologyError> {
     let n = mesh.points.len() as u32;
     if mesh.points.len() >= 1 << 31 {
         return Err(fail(mesh, 0, "the check handles up to 2^31 nodes".into()));
@@ -233,18 +206,18 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
     if mesh.material.len() != mesh.cells.len() {
         return Err(fail(mesh, 0, "one material per cell is needed".into()));
     }
+    if volumes.len() != mesh.cells.len() {
+        return Err(fail(
+            mesh,
+            0,
+            format!(
+                "{} cell volumes given for {} cells",
+                volumes.len(),
+                mesh.cells.len()
+            ),
+        ));
+    }
     // 1. Volumes.
-    let volumes: Vec<f64> = mesh
-        .cells
-        .par_iter()
-        .map(|c| {
-            if c.used().iter().any(|&i| i >= n) {
-                f64::NAN
-            } else {
-                cell_volume(&mesh.points, c)
-            }
-        })
-        .collect();
     if let Some(c) = volumes.iter().position(|v| v.is_nan() || *v <= 0.0) {
         return Err(fail(
             mesh,
@@ -415,102 +388,6 @@ pub fn check(mesh: &VolumeMesh) -> Result<CheckSummary, GeologyError> {
         boundary_faces: boundary.len(),
         pinch_edges,
     })
-}
-
-/// Check 4: the tagged faces against the boundary and interface faces found from the cells.
-fn check_tags(
-    mesh: &VolumeMesh,
-    boundary: &[([u32; 4], bool, u32)],
-    interfaces: &[([u32; 4], bool, u32)],
-) -> Result<(), GeologyError> {
-    let mut outer = Vec::with_capacity(boundary.len());
-    let mut inner = Vec::with_capacity(interfaces.len());
-    for (i, f) in mesh.faces.iter().enumerate() {
-        let Some(tag) = mesh.tags.get(f.tag as usize) else {
-            return Err(fail(
-                mesh,
-                0,
-                format!("tagged face {i} has tag {} of {}", f.tag, mesh.tags.len()),
-            ));
-        };
-        let nodes = used(&f.nodes);
-        if nodes.iter().any(|&v| v as usize >= mesh.points.len())
-            || f.cell as usize >= mesh.cells.len()
-        {
-            return Err(fail(
-                mesh,
-                0,
-                format!("tagged face {i} names a missing node or cell"),
-            ));
-        }
-        let (key, o) = canonical(f.nodes);
-        // Its direction: the z of its normal, against its extent.
-        let r = mesh.points[nodes[0] as usize];
-        let nz: f64 = triangles(&f.nodes)
-            .map(|t| {
-                let [a, b, c] = t.map(|k| mesh.points[k as usize]);
-                (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-            })
-            .sum();
-        let ok = match tag {
-            FaceTag::Top => nz > 0.0,
-            FaceTag::Bottom => nz < 0.0,
-            FaceTag::Side(_) => {
-                let scale = nodes
-                    .iter()
-                    .map(|&k| {
-                        let p = mesh.points[k as usize];
-                        (p[0] - r[0]).abs().max((p[1] - r[1]).abs())
-                    })
-                    .fold(0.0, f64::max);
-                nz.abs() <= 1e-9 * scale * scale
-            }
-            FaceTag::Interface(u) => {
-                let m = mesh.material[f.cell as usize];
-                mesh.units.get(m as usize) == Some(u) && m > 0
-            }
-        };
-        if !ok {
-            return Err(fail(
-                mesh,
-                nodes[0],
-                format!(
-                    "tagged face {i} ({}) points the wrong way or names the wrong unit",
-                    tag.name()
-                ),
-            ));
-        }
-        match tag {
-            FaceTag::Interface(_) => inner.push((key, o, f.cell)),
-            _ => outer.push((key, o, f.cell)),
-        }
-    }
-    for (what, tagged, found) in [
-        ("boundary", outer, boundary),
-        ("interface", inner, interfaces),
-    ] {
-        let tagged = sort_by_node(&tagged, mesh.points.len(), |f| f.0[0]);
-        // `found` is in key order already (taken from the sorted faces), keys unique.
-        if tagged.as_slice() != found {
-            let diff = tagged
-                .iter()
-                .zip(found.iter())
-                .find(|(a, b)| a != b)
-                .map(|(a, _)| a.0[0])
-                .unwrap_or(0);
-            return Err(fail(
-                mesh,
-                diff,
-                format!(
-                    "{} {what} faces are tagged but the cells have {} (or one differs in nodes, \
-                     orientation or cell)",
-                    tagged.len(),
-                    found.len()
-                ),
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// The volume between the terrain and the base from the input alone: the sum over planar

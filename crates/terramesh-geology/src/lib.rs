@@ -43,6 +43,10 @@ mod buckets;
 mod cells;
 /// Independent checks of a volume mesh.
 mod check;
+/// The faces of the cells and their keys, for the check.
+mod check_faces;
+/// The check of the tagged faces.
+mod check_tags;
 /// Node columns: one per planar vertex, coincident elevations sharing one node.
 mod columns;
 /// The error type.
@@ -58,7 +62,7 @@ mod stats;
 /// The volume mesh driver: cells, tagged faces, bodies.
 mod volume;
 
-pub use check::{check, volume_between, CheckSummary};
+pub use check::{cell_volumes, check, check_with_volumes, volume_between, CheckSummary};
 pub use error::GeologyError;
 pub use planar::Planar;
 pub use rules::{

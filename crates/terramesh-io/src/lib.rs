@@ -38,4 +38,5 @@ pub mod report;
 pub mod scratch;
 pub mod table;
 pub mod text;
+mod textsink;
 pub mod viewer;

@@ -96,12 +96,6 @@ fn parse_exp(s: &[u8]) -> i32 {
     }
 }
 
-/// Writes `v` in decimal (as `Display` does).
-#[inline]
-pub(crate) fn write_u64<W: Write + ?Sized>(w: &mut W, v: u64) -> io::Result<()> {
-    w.write_all(itoa::Buffer::new().format(v).as_bytes())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,8 +163,5 @@ mod tests {
             same((next() >> 11) as f64 / (1u64 << 53) as f64 * 1e7 - 5e6);
         }
         assert!(ties < 1000, "{ties} of 1,000,000 differ from Display");
-        let mut b = Vec::new();
-        write_u64(&mut b, u64::MAX).unwrap();
-        assert_eq!(b, u64::MAX.to_string().as_bytes());
     }
 }

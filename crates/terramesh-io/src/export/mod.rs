@@ -23,7 +23,7 @@ mod ply;
 mod stl;
 mod terrain;
 pub mod tiles3d;
-mod tsurf;
+pub(crate) mod tsurf;
 mod vtu;
 
 use std::io::{self, Write};

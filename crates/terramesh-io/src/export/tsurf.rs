@@ -2,7 +2,7 @@
 
 use std::io::{self, Write};
 
-use crate::numtext::{write_f64, write_u64};
+use crate::textsink::TextSink;
 
 /// Names written into the TSurf header.
 #[derive(Debug, Clone)]
@@ -32,6 +32,32 @@ pub fn write_tsurf<W: Write>(
     triangles: &[[u32; 3]],
     info: &TsurfInfo,
 ) -> io::Result<()> {
+    write_tsurf_with(
+        w,
+        vertices.len(),
+        |s, i| {
+            for c in vertices[i] {
+                s.byte(b' ')?;
+                s.f64(c)?;
+            }
+            Ok(())
+        },
+        triangles,
+        info,
+    )
+}
+
+/// [`write_tsurf`] of `count` vertices whose coordinates `vertex(sink, i)` writes (` x y z`,
+/// each after a space), so that a caller with the text made already copies it.
+pub(crate) fn write_tsurf_with<W: Write + ?Sized>(
+    w: &mut W,
+    count: usize,
+    vertex: impl Fn(&mut TextSink<W>, usize) -> io::Result<()>,
+    triangles: &[[u32; 3]],
+    info: &TsurfInfo,
+) -> io::Result<()> {
+    let mut sink = TextSink::new(w);
+    let w = &mut sink;
     writeln!(w, "GOCAD TSurf 1")?;
     writeln!(w, "HEADER {{")?;
     writeln!(w, "name:{}", info.name)?;
@@ -43,23 +69,20 @@ pub fn write_tsurf<W: Write>(
     writeln!(w, "ZPOSITIVE Elevation")?;
     writeln!(w, "END_ORIGINAL_COORDINATE_SYSTEM")?;
     writeln!(w, "TFACE")?;
-    for (i, v) in vertices.iter().enumerate() {
-        // the bytes of `VRTX {} {} {} {}`, without core::fmt (see numtext)
-        w.write_all(b"VRTX ")?;
-        write_u64(w, i as u64 + 1)?;
-        for c in v {
-            w.write_all(b" ")?;
-            write_f64(w, *c)?;
-        }
-        w.write_all(b"\n")?;
+    for i in 0..count {
+        // the bytes of `VRTX {} {} {} {}`, without core::fmt
+        w.bytes(b"VRTX")?;
+        w.space_u64(i as u64 + 1)?;
+        vertex(w, i)?;
+        w.byte(b'\n')?;
     }
     for t in triangles {
-        w.write_all(b"TRGL")?;
+        w.bytes(b"TRGL")?;
         for k in t {
-            w.write_all(b" ")?;
-            write_u64(w, u64::from(*k) + 1)?;
+            w.space_u64(u64::from(*k) + 1)?;
         }
-        w.write_all(b"\n")?;
+        w.byte(b'\n')?;
     }
-    writeln!(w, "END")
+    writeln!(w, "END")?;
+    sink.finish()
 }

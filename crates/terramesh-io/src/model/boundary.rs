@@ -75,22 +75,33 @@ pub fn boundary_tags(m: &VolumeMesh) -> Vec<u16> {
 /// ```
 pub fn boundary_mesh(m: &VolumeMesh, tag: u16) -> BoundaryMesh {
     let faces: Vec<_> = m.faces.iter().filter(|f| f.tag == tag).collect();
-    let mut nodes: Vec<u32> = faces
-        .iter()
-        .flat_map(|f| f.used().iter().copied())
-        .collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    let local = |n: u32| nodes.binary_search(&n).expect("a face node") as u32;
+    // a dense map from mesh nodes to the boundary mesh's points, in increasing node order
+    let mut local = vec![u32::MAX; m.points.len()];
+    for f in &faces {
+        for &n in f.used() {
+            local[n as usize] = 0;
+        }
+    }
+    let mut nodes = Vec::new();
+    for (n, l) in local.iter_mut().enumerate() {
+        if *l == 0 {
+            *l = nodes.len() as u32;
+            nodes.push(n);
+        }
+    }
     let mut b = BoundaryMesh {
-        points: nodes.iter().map(|&n| m.points[n as usize]).collect(),
+        points: nodes.iter().map(|&n| m.points[n]).collect(),
         bulk_node_ids: nodes.iter().map(|&n| n as u64).collect(),
-        ..Default::default()
+        faces: Vec::with_capacity(faces.len()),
+        bulk_element_ids: Vec::with_capacity(faces.len()),
+        bulk_face_ids: Vec::with_capacity(faces.len()),
+        material_ids: Vec::with_capacity(faces.len()),
     };
     for f in faces {
         let c = &m.cells[f.cell as usize];
         let k = find_face(c.kind, c.used(), f.used()).expect("a face of its cell");
-        b.faces.push(f.used().iter().map(|&n| local(n)).collect());
+        b.faces
+            .push(f.used().iter().map(|&n| local[n as usize]).collect());
         b.bulk_element_ids.push(f.cell as u64);
         b.bulk_face_ids.push(ogs_face_index(c.kind, k));
         b.material_ids.push(m.material[f.cell as usize]);

@@ -1,5 +1,6 @@
 //! The consistency a writer relies on, checked before anything is written.
 
+use rayon::prelude::*;
 use terramesh_core::volume::{cell_volume, VolumeMesh};
 
 use super::faces::find_face;
@@ -106,6 +107,30 @@ fn name_ok(s: &str) -> bool {
 /// assert!(check_mesh(&m).is_ok());
 /// ```
 pub fn check_mesh(m: &VolumeMesh) -> Result<(), MeshError> {
+    check_mesh_with(m, None)
+}
+
+/// [`check_mesh`], taking the cells' volumes when the caller has computed them from this mesh
+/// already (`terramesh_geology::cell_volumes`, whose own check judges them too): then each is
+/// checked to be positive instead of computed again, and there must be one per cell (a
+/// missing one is a [`MeshError::Volume`] of NaN). The checks run in parallel; the first
+/// failure is the one a serial pass in [`check_mesh`]'s order would meet.
+///
+/// ```
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::check_mesh_with;
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3])],
+///     material: vec![0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// assert!(check_mesh_with(&m, Some(&[1.0 / 6.0])).is_ok());
+/// assert!(check_mesh_with(&m, Some(&[-1.0])).is_err());
+/// assert!(check_mesh_with(&m, Some(&[])).is_err());
+/// ```
+pub fn check_mesh_with(m: &VolumeMesh, volumes: Option<&[f64]>) -> Result<(), MeshError> {
     let np = m.points.len();
     if m.material.len() != m.cells.len() {
         return Err(MeshError::MaterialCount {
@@ -122,35 +147,52 @@ pub fn check_mesh(m: &VolumeMesh) -> Result<(), MeshError> {
             return Err(MeshError::Name { name: name.clone() });
         }
     }
-    for (i, p) in m.points.iter().enumerate() {
-        if !p.iter().all(|c| c.is_finite()) {
-            return Err(MeshError::Point {
-                point: i,
-                coords: *p,
-            });
-        }
+    if let Some(i) = m
+        .points
+        .par_iter()
+        .position_first(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(MeshError::Point {
+            point: i,
+            coords: m.points[i],
+        });
     }
-    for (i, (c, &mat)) in m.cells.iter().zip(&m.material).enumerate() {
-        if mat < 0 || mat as usize >= m.units.len() {
-            return Err(MeshError::Material {
-                cell: i,
-                material: mat,
-                units: m.units.len(),
-            });
-        }
-        if let Some(&n) = c.used().iter().find(|&&n| n as usize >= np) {
-            return Err(MeshError::Node {
-                what: format!("cell {i}"),
-                node: n,
-                points: np,
-            });
-        }
-        let v = cell_volume(&m.points, c);
-        if v.is_nan() || v <= 0.0 {
-            return Err(MeshError::Volume { cell: i, volume: v });
-        }
+    let cell_error = m
+        .cells
+        .par_iter()
+        .zip(m.material.par_iter())
+        .enumerate()
+        .find_map_first(|(i, (c, &mat))| {
+            if mat < 0 || mat as usize >= m.units.len() {
+                return Some(MeshError::Material {
+                    cell: i,
+                    material: mat,
+                    units: m.units.len(),
+                });
+            }
+            if let Some(&n) = c.used().iter().find(|&&n| n as usize >= np) {
+                return Some(MeshError::Node {
+                    what: format!("cell {i}"),
+                    node: n,
+                    points: np,
+                });
+            }
+            let v = match volumes {
+                Some(v) => v.get(i).copied().unwrap_or(f64::NAN),
+                None => cell_volume(&m.points, c),
+            };
+            (v.is_nan() || v <= 0.0).then_some(MeshError::Volume { cell: i, volume: v })
+        });
+    if let Some(e) = cell_error {
+        return Err(e);
     }
-    for (i, f) in m.faces.iter().enumerate() {
+    if let Some(v) = volumes.filter(|v| v.len() > m.cells.len()) {
+        return Err(MeshError::Volume {
+            cell: m.cells.len(),
+            volume: v[m.cells.len()],
+        });
+    }
+    let face_error = m.faces.par_iter().enumerate().find_map_first(|(i, f)| {
         let why = if f.cell as usize >= m.cells.len() {
             Some(format!("cell {} does not exist", f.cell))
         } else if f.tag as usize >= m.tags.len() {
@@ -165,9 +207,10 @@ pub fn check_mesh(m: &VolumeMesh) -> Result<(), MeshError> {
                 .is_none()
                 .then(|| format!("nodes {:?} are not a face of cell {}", f.used(), f.cell))
         };
-        if let Some(why) = why {
-            return Err(MeshError::Face { face: i, why });
-        }
+        why.map(|why| MeshError::Face { face: i, why })
+    });
+    if let Some(e) = face_error {
+        return Err(e);
     }
     let mut seen = vec![false; m.units.len()];
     for (i, b) in m.bodies.iter().enumerate() {

@@ -17,9 +17,9 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
-use super::passes::ModelPasses;
-use super::write_shortest;
+use super::passes::{Indexed, ModelPasses};
 use super::ModelInfo;
+use crate::textsink::{PointText, TextSink};
 
 /// Writes the model as a FLAC3D ASCII grid (see the module documentation).
 ///
@@ -45,7 +45,7 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_f3grid_passes(w, m, info)
+    write_f3grid(w, &Indexed::new(m), info, Some(&PointText::new(&m.points)))
 }
 
 /// Writes a model read in passes ([`ModelPasses`]) as a FLAC3D ASCII grid, the bytes of
@@ -56,6 +56,18 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     m: &M,
     info: &ModelInfo,
 ) -> io::Result<()> {
+    write_f3grid(w, m, info, None)
+}
+
+/// [`write_f3grid_passes`], with the points' text made already where `pts` is given.
+pub(super) fn write_f3grid<W: Write + ?Sized, M: ModelPasses + ?Sized>(
+    w: &mut W,
+    m: &M,
+    info: &ModelInfo,
+    pts: Option<&PointText>,
+) -> io::Result<()> {
+    let mut sink = TextSink::new(w);
+    let w = &mut sink;
     writeln!(w, "* FLAC3D grid of a terramesh geological model")?;
     writeln!(
         w,
@@ -64,17 +76,24 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         super::vertical_note(info)
     )?;
     writeln!(w, "* GRIDPOINTS")?;
-    let mut b = itoa::Buffer::new();
     let mut i = 0usize;
     m.each_point(&mut |p| {
         i += 1;
-        w.write_all(b"G ")?;
-        w.write_all(b.format(i).as_bytes())?;
-        for c in p {
-            w.write_all(b" ")?;
-            write_shortest(w, *c)?;
+        w.bytes(b"G")?;
+        w.space_u64(i as u64)?;
+        match pts {
+            Some(pts) => {
+                w.byte(b' ')?;
+                w.bytes(pts.get(i - 1))?;
+            }
+            None => {
+                for &c in p {
+                    w.byte(b' ')?;
+                    w.f64(if c == 0.0 { 0.0 } else { c })?;
+                }
+            }
         }
-        w.write_all(b"\n")
+        w.byte(b'\n')
     })?;
     writeln!(w, "* ZONES")?;
     let mut per_unit = vec![0usize; m.units().len()];
@@ -88,15 +107,13 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             CellKind::Pyramid => (b"P5", &[n[0], n[1], n[3], n[4], n[2]]),
             CellKind::Tetra => (b"T4", &n[..4]),
         };
-        w.write_all(b"Z ")?;
-        w.write_all(name)?;
-        w.write_all(b" ")?;
-        w.write_all(b.format(i).as_bytes())?;
+        w.bytes(b"Z ")?;
+        w.bytes(name)?;
+        w.space_u64(i as u64)?;
         for &k in order {
-            w.write_all(b" ")?;
-            w.write_all(b.format(k as u64 + 1).as_bytes())?;
+            w.space_u64(u64::from(k) + 1)?;
         }
-        w.write_all(b"\n")
+        w.byte(b'\n')
     })?;
     let mut per_tag = vec![0usize; m.tags().len()];
     if m.face_count() > 0 {
@@ -106,13 +123,12 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             j += 1;
             per_tag[f.tag as usize] += 1;
             let nodes = f.used();
-            w.write_all(if nodes.len() == 3 { b"F T3 " } else { b"F Q4 " })?;
-            w.write_all(b.format(j).as_bytes())?;
+            w.bytes(if nodes.len() == 3 { b"F T3" } else { b"F Q4" })?;
+            w.space_u64(j as u64)?;
             for &k in nodes {
-                w.write_all(b" ")?;
-                w.write_all(b.format(k as u64 + 1).as_bytes())?;
+                w.space_u64(u64::from(k) + 1)?;
             }
-            w.write_all(b"\n")
+            w.byte(b'\n')
         })?;
     }
     writeln!(w, "* ZONE GROUPS")?;
@@ -120,14 +136,7 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         if count > 0 {
             writeln!(w, "ZGROUP \"{}\" SLOT 1", m.units()[u])?;
             let mut ids = Ids::new(w, count);
-            let mut i = 0u64;
-            m.each_cell(&mut |_, mat, _| {
-                i += 1;
-                if mat as usize == u {
-                    ids.push(i)?;
-                }
-                Ok(())
-            })?;
+            m.each_cell_of(u as i32, None, &mut |i, _| ids.push(i as u64 + 1))?;
         }
     }
     if m.face_count() > 0 {
@@ -136,43 +145,29 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             if count > 0 {
                 writeln!(w, "FGROUP \"{}\" SLOT 1", m.tags()[t].name())?;
                 let mut ids = Ids::new(w, count);
-                let mut j = 0u64;
-                m.each_face(&mut |f, _| {
-                    j += 1;
-                    if f.tag as usize == t {
-                        ids.push(j)?;
-                    }
-                    Ok(())
-                })?;
+                m.each_face_of(t as u16, None, &mut |j, _| ids.push(j as u64 + 1))?;
             }
         }
     }
-    Ok(())
+    sink.finish()
 }
 
 /// A group's ids, ten a line, the last line ended after the group's `count`-th id.
-struct Ids<'w, W: Write + ?Sized> {
-    w: &'w mut W,
+struct Ids<'w, 's, W: Write + ?Sized> {
+    w: &'w mut TextSink<'s, W>,
     count: usize,
     done: usize,
-    b: itoa::Buffer,
 }
 
-impl<'w, W: Write + ?Sized> Ids<'w, W> {
-    fn new(w: &'w mut W, count: usize) -> Self {
-        Ids {
-            w,
-            count,
-            done: 0,
-            b: itoa::Buffer::new(),
-        }
+impl<'w, 's, W: Write + ?Sized> Ids<'w, 's, W> {
+    fn new(w: &'w mut TextSink<'s, W>, count: usize) -> Self {
+        Ids { w, count, done: 0 }
     }
     fn push(&mut self, id: u64) -> io::Result<()> {
-        self.w.write_all(b" ")?;
-        self.w.write_all(self.b.format(id).as_bytes())?;
+        self.w.space_u64(id)?;
         self.done += 1;
         if self.done.is_multiple_of(10) || self.done == self.count {
-            self.w.write_all(b"\n")?;
+            self.w.byte(b'\n')?;
         }
         Ok(())
     }

@@ -12,9 +12,10 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
-use super::passes::ModelPasses;
+use super::passes::{Indexed, ModelPasses};
 use super::ModelInfo;
 use super::{vertical_note, write_shortest};
+use crate::textsink::{PointText, TextSink};
 
 fn gmsh_type(kind: CellKind) -> u8 {
     match kind {
@@ -76,7 +77,7 @@ pub fn write_model_msh<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_msh_passes(w, m, info)
+    write_msh(w, &Indexed::new(m), info, Some(&PointText::new(&m.points)))
 }
 
 /// Writes a model read in passes ([`ModelPasses`]) as Gmsh MSH 4.1 ASCII, the bytes of
@@ -88,6 +89,18 @@ pub fn write_msh_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     m: &M,
     info: &ModelInfo,
 ) -> io::Result<()> {
+    write_msh(w, m, info, None)
+}
+
+/// [`write_msh_passes`], with the points' text made already where `pts` is given.
+pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
+    w: &mut W,
+    m: &M,
+    info: &ModelInfo,
+    pts: Option<&PointText>,
+) -> io::Result<()> {
+    let mut sink = TextSink::new(w);
+    let w = &mut sink;
     let nu = m.units().len();
     let nt = m.tags().len();
     // Cells per unit and kind, faces per tag and size.
@@ -149,51 +162,48 @@ pub fn write_msh_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     let np = m.point_count();
     let node_entity = units.first().map_or(1, |u| u + 1);
     writeln!(w, "$Nodes\n1 {np} 1 {np}\n3 {node_entity} 0 {np}")?;
-    let mut ib = itoa::Buffer::new();
     for i in 1..=np {
-        w.write_all(ib.format(i).as_bytes())?;
-        w.write_all(b"\n")?;
+        w.u64(i as u64)?;
+        w.byte(b'\n')?;
     }
-    m.each_point(&mut |p| {
-        write_shortest(w, p[0])?;
-        w.write_all(b" ")?;
-        write_shortest(w, p[1])?;
-        w.write_all(b" ")?;
-        write_shortest(w, p[2])?;
-        w.write_all(b"\n")
-    })?;
+    match pts {
+        Some(pts) => {
+            for i in 0..np {
+                w.bytes(pts.get(i))?;
+                w.byte(b'\n')?;
+            }
+        }
+        None => m.each_point(&mut |p| {
+            for (k, &c) in p.iter().enumerate() {
+                if k > 0 {
+                    w.byte(b' ')?;
+                }
+                w.f64(if c == 0.0 { 0.0 } else { c })?;
+            }
+            w.byte(b'\n')
+        })?,
+    }
     writeln!(w, "$EndNodes")?;
     let nblocks = vol_blocks.iter().flatten().filter(|&&b| b > 0).count()
         + surf_blocks.iter().flatten().filter(|&&b| b > 0).count();
     let nc = m.cell_count();
     let ne = nc + m.face_count();
     writeln!(w, "$Elements\n{nblocks} {ne} 1 {ne}")?;
-    fn line<W: Write + ?Sized>(
-        w: &mut W,
-        ib: &mut itoa::Buffer,
-        tag: usize,
-        nodes: &[u32],
-    ) -> io::Result<()> {
-        w.write_all(ib.format(tag).as_bytes())?;
+    let line = |w: &mut TextSink<W>, tag: usize, nodes: &[u32]| -> io::Result<()> {
+        w.u64(tag as u64)?;
         for &n in nodes {
-            w.write_all(b" ")?;
-            w.write_all(ib.format(n as u64 + 1).as_bytes())?;
+            w.space_u64(u64::from(n) + 1)?;
         }
-        w.write_all(b"\n")
-    }
+        w.byte(b'\n')
+    };
     for &u in &units {
         for (k, &count) in vol_blocks[u].iter().enumerate() {
             if count == 0 {
                 continue;
             }
             writeln!(w, "3 {} {} {}", u + 1, gmsh_type(kinds[k]), count)?;
-            let mut i = 0usize;
-            m.each_cell(&mut |c, mat, _| {
-                i += 1;
-                if mat as usize == u && c.kind == kinds[k] {
-                    line(w, &mut ib, i, c.used())?;
-                }
-                Ok(())
+            m.each_cell_of(u as i32, Some(kinds[k]), &mut |i, c| {
+                line(w, i + 1, c.used())
             })?;
         }
     }
@@ -203,15 +213,11 @@ pub fn write_msh_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
                 continue;
             }
             writeln!(w, "2 {} {} {}", t + 1, 2 + k, count)?;
-            let mut j = 0usize;
-            m.each_face(&mut |f, _| {
-                j += 1;
-                if f.tag as usize == t && f.used().len() - 3 == k {
-                    line(w, &mut ib, nc + j, f.used())?;
-                }
-                Ok(())
+            m.each_face_of(t as u16, Some(k + 3), &mut |j, f| {
+                line(w, nc + j + 1, f.used())
             })?;
         }
     }
-    writeln!(w, "$EndElements")
+    writeln!(w, "$EndElements")?;
+    sink.finish()
 }

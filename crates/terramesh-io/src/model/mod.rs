@@ -64,7 +64,7 @@ use crate::output::Output;
 
 pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
 pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
-pub use check::{check_mesh, MeshError};
+pub use check::{check_mesh, check_mesh_with, MeshError};
 pub use faces::{cell_faces, ogs_face_index};
 pub use flac3d::{write_f3grid_passes, write_model_f3grid};
 pub use gmsh::{write_model_msh, write_msh_passes};
@@ -136,7 +136,21 @@ pub fn write_model(
     mesh: &VolumeMesh,
     info: &ModelInfo,
 ) -> Result<Vec<String>, ModelWriteError> {
-    check_mesh(mesh)?;
+    write_model_with(dir, mesh, info, None)
+}
+
+/// [`write_model`], with the cells' volumes when the caller has computed them from this mesh
+/// already (see [`check_mesh_with`]), so that they are not computed again.
+pub fn write_model_with(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    info: &ModelInfo,
+    volumes: Option<&[f64]>,
+) -> Result<Vec<String>, ModelWriteError> {
+    check_mesh_with(mesh, volumes)?;
+    // the points' text, for model.msh, model.f3grid and the bodies' TSurf
+    let pts = &crate::textsink::PointText::new(&mesh.points);
+    let blocks = &passes::Indexed::new(mesh);
     type Job<'a> = (
         String,
         Box<dyn Fn(&mut Output) -> io::Result<()> + Send + Sync + 'a>,
@@ -154,18 +168,20 @@ pub fn write_model(
     }
     jobs.push((
         "model.msh".into(),
-        Box::new(|w: &mut Output| write_model_msh(w, mesh, info)),
+        Box::new(move |w: &mut Output| gmsh::write_msh(w, blocks, info, Some(pts))),
     ));
     jobs.push((
         "model.f3grid".into(),
-        Box::new(|w: &mut Output| write_model_f3grid(w, mesh, info)),
+        Box::new(move |w: &mut Output| flac3d::write_f3grid(w, blocks, info, Some(pts))),
     ));
     let origin = stl_origin(mesh);
     for body in &mesh.bodies {
         let unit = &mesh.units[body.unit];
         jobs.push((
             format!("unit-{unit}.ts"),
-            Box::new(move |w: &mut Output| write_body_tsurf(w, mesh, body, info)),
+            Box::new(move |w: &mut Output| {
+                bodies::write_tsurf_shared(w, mesh, body, info, Some(pts))
+            }),
         ));
         jobs.push((
             format!("unit-{unit}.stl"),

@@ -171,14 +171,15 @@ fn base64(bytes: &[u8]) -> Vec<u8> {
 fn base64_into(bytes: &[u8], out: &mut Vec<u8>) {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut chunks = bytes.chunks_exact(3);
-    for c in &mut chunks {
+    // the whole groups into place (no capacity check per group)
+    let start = out.len();
+    out.resize(start + bytes.len() / 3 * 4, 0);
+    for (o, c) in out[start..].chunks_exact_mut(4).zip(&mut chunks) {
         let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
-        out.extend_from_slice(&[
-            A[(n >> 18) as usize & 63],
-            A[(n >> 12) as usize & 63],
-            A[(n >> 6) as usize & 63],
-            A[n as usize & 63],
-        ]);
+        o[0] = A[(n >> 18) as usize & 63];
+        o[1] = A[(n >> 12) as usize & 63];
+        o[2] = A[(n >> 6) as usize & 63];
+        o[3] = A[n as usize & 63];
     }
     let r = chunks.remainder();
     if !r.is_empty() {

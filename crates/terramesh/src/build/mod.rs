@@ -26,6 +26,8 @@ pub(crate) mod viewer;
 use std::path::Path;
 use std::time::Instant;
 
+use crate::geology::stage::OpenedGrids;
+
 pub use adaptive::AdaptiveInfo;
 pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
@@ -142,12 +144,13 @@ fn geology_stage(
     dsm: Dsm,
     model_crs: Option<&terramesh_crs::Crs>,
     out: &Path,
+    grids: OpenedGrids,
 ) -> Result<crate::geology::stage::ModelBuilt> {
     let mut built = st.run(
         "geology",
         || {
             crate::geology::stage::run(
-                project, g, boreholes, dsm.mesh, dsm.z, dsm.grid, model_crs, out,
+                project, g, boreholes, dsm.mesh, dsm.z, dsm.grid, model_crs, out, grids,
             )
         },
         |m| {
@@ -192,6 +195,7 @@ fn model_on_kept_dsm(
     out: &Path,
     previous: &Path,
     progress: &dyn Progress,
+    grids: &mut GridsAhead,
 ) -> Result<Option<Built>> {
     let Some(kept) = reuse::DsmState::read(previous, key) else {
         if previous.join(reuse::FILE).is_file() {
@@ -254,6 +258,7 @@ fn model_on_kept_dsm(
         },
         model_crs.as_ref(),
         out,
+        grids.take(),
     )?;
     st.check()?;
     Ok(Some(Built {
@@ -310,6 +315,20 @@ fn build_as(
     Ok(Built { files, ..built })
 }
 
+/// The horizon grids being read on a thread of their own ([`OpenedGrids`]), for `terramesh
+/// model`; none for the full build (its DSM keeps both cores busy).
+pub(super) struct GridsAhead<'scope>(Option<std::thread::ScopedJoinHandle<'scope, OpenedGrids>>);
+
+impl GridsAhead<'_> {
+    /// The grids read (waiting for them), or none when nothing was read ahead.
+    pub(super) fn take(&mut self) -> OpenedGrids {
+        match self.0.take() {
+            Some(h) => h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)),
+            None => OpenedGrids::default(),
+        }
+    }
+}
+
 /// Builds into `out` (the staging folder of `previous`, the build folder as it was).
 fn build_into(
     project: &Project,
@@ -320,6 +339,32 @@ fn build_into(
     t0: Instant,
     what: What,
 ) -> Result<Built> {
+    match (&what, project.geology()) {
+        // `terramesh model`: the horizon grids need nothing of the DSM; they are read while
+        // the DSM is made (its mesh is one core's work) or read
+        (What::ModelOnly, Some(g)) => std::thread::scope(|s| {
+            let mut ahead = GridsAhead(Some(s.spawn(|| OpenedGrids::open(g))));
+            build_into_with(project, base, out, previous, progress, t0, what, &mut ahead)
+        }),
+        _ => {
+            let mut none = GridsAhead(None);
+            build_into_with(project, base, out, previous, progress, t0, what, &mut none)
+        }
+    }
+}
+
+/// [`build_into`], with the grids read ahead.
+#[allow(clippy::too_many_arguments)]
+fn build_into_with(
+    project: &Project,
+    base: &Path,
+    out: &Path,
+    previous: &Path,
+    progress: &dyn Progress,
+    t0: Instant,
+    what: What,
+    grids: &mut GridsAhead,
+) -> Result<Built> {
     // The key of the DSM's settings and inputs (reuse.rs); an input that cannot be read
     // leaves none, and the DSM is built (and its reading reports the error).
     let dsm_key = reuse::key(project, base).ok();
@@ -329,7 +374,7 @@ fn build_into(
         project.geology(),
         project.interpolation.realisations,
     ) {
-        if let Some(built) = model_on_kept_dsm(project, g, key, out, previous, progress)? {
+        if let Some(built) = model_on_kept_dsm(project, g, key, out, previous, progress, grids)? {
             return Ok(built);
         }
     }
@@ -355,7 +400,7 @@ fn build_into(
     )?;
     // `terramesh model` makes only what the geological model stands on (model_dsm.rs).
     if what == What::ModelOnly && project.interpolation.realisations == 0 {
-        return model_dsm::build_rest(&mut st, project, base, out, &samples, dsm_key);
+        return model_dsm::build_rest(&mut st, project, base, out, &samples, dsm_key, grids);
     }
     let model = st.run(
         "variogram",
@@ -423,6 +468,7 @@ fn build_into(
             },
             model_crs.as_ref(),
             out,
+            OpenedGrids::default(),
         )?),
         None => None,
     };

@@ -29,6 +29,7 @@ pub(super) fn build_rest(
     out: &Path,
     samples: &Samples,
     dsm_key: Option<u64>,
+    grids: &mut super::GridsAhead,
 ) -> Result<Built> {
     let g = project
         .geology()
@@ -102,6 +103,7 @@ pub(super) fn build_rest(
         },
         model_crs.as_ref(),
         out,
+        grids.take(),
     )?;
     st.check()?;
     Ok(Built {

@@ -31,8 +31,8 @@
 
 use terramesh_core::volume::{Interpolated, VolumeMesh};
 use terramesh_geology::{
-    apply_rules, check, stack_thicknesses, unit_stats, CheckSummary, Layering, Planar, RawSurfaces,
-    RulesReport, Stack, UnitStats,
+    apply_rules, cell_volumes, check_with_volumes, stack_thicknesses, unit_stats, CheckSummary,
+    Layering, Planar, RawSurfaces, RulesReport, Stack, UnitStats,
 };
 use terramesh_geostat::Method;
 use terramesh_io::boreholes::Boreholes;
@@ -125,6 +125,21 @@ pub struct GeologicalModel {
 
 /// Builds the model on `mesh` (the DSM's planar mesh) under `terrain` (its elevations).
 pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<GeologicalModel> {
+    assemble_beside(mesh, terrain, inputs, |_, _, _| ()).map(|(m, ())| m)
+}
+
+/// [`assemble`], running `beside` (the writing of the model's files) on the volume mesh, the
+/// repaired surfaces and the cells' volumes at the same time as the model's independent
+/// checks instead of after them: the two cores of a small machine then share the checks and
+/// the writing. When a check fails its error is returned, whatever `beside` did, so `beside`
+/// must write where a failed build is thrown away (the build's staging folder, which replaces
+/// the output folder only when the whole build succeeds).
+pub(crate) fn assemble_beside<R: Send>(
+    mesh: &Mesh,
+    terrain: &[f64],
+    inputs: &ModelInputs,
+    beside: impl FnOnce(&VolumeMesh, &Stack, &[f64]) -> R + Send,
+) -> Result<(GeologicalModel, R)> {
     let units = &inputs.layering.units;
     if units.is_empty() {
         bail!("the geological column names no unit: list them in [geology] units");
@@ -139,9 +154,9 @@ pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<Ge
     }
     let values: Vec<&[f64]> = fields.iter().map(|f| &f.values[..]).collect();
     let (stack, rules) = stack_of(&planar, terrain, &base, inputs, &values)?;
-    let (volume, summary, stats) = seal(&planar, &stack, &inputs.layering)?;
+    let (volume, summary, stats, r) = seal_beside(&planar, &stack, &inputs.layering, beside)?;
     let misfits = holes.map(|b| misfits(b, mesh, &stack)).unwrap_or_default();
-    Ok(GeologicalModel {
+    let model = GeologicalModel {
         mesh: volume,
         stack,
         rules,
@@ -150,7 +165,8 @@ pub fn assemble(mesh: &Mesh, terrain: &[f64], inputs: &ModelInputs) -> Result<Ge
         check: summary,
         misfits,
         grids: inputs.grids.clone(),
-    })
+    };
+    Ok((model, r))
 }
 
 /// The fields a model interpolates, in order, as `(unit, observations)`: the tops of units
@@ -246,14 +262,32 @@ pub(crate) fn seal(
     stack: &Stack,
     layering: &Layering,
 ) -> Result<(VolumeMesh, CheckSummary, Vec<UnitStats>)> {
+    seal_beside(planar, stack, layering, |_, _, _| ()).map(|(v, c, s, ())| (v, c, s))
+}
+
+/// [`seal`], running `beside` at the same time as the checks (see [`assemble_beside`]).
+fn seal_beside<R: Send>(
+    planar: &Planar,
+    stack: &Stack,
+    layering: &Layering,
+    beside: impl FnOnce(&VolumeMesh, &Stack, &[f64]) -> R + Send,
+) -> Result<(VolumeMesh, CheckSummary, Vec<UnitStats>, R)> {
     let volume =
         terramesh_geology::volume_mesh(planar, stack, layering).context("the volume mesh")?;
-    let summary = check(&volume).context("checking the model")?;
-    summary
-        .compare_with(planar, stack)
-        .context("checking the model's volume")?;
-    let stats = unit_stats(planar, stack, &volume);
-    Ok((volume, summary, stats))
+    // computed once, for the checks here and the writers' own
+    let volumes = cell_volumes(&volume);
+    let (checked, r) = rayon::join(
+        || -> Result<(CheckSummary, Vec<UnitStats>)> {
+            let summary = check_with_volumes(&volume, &volumes).context("checking the model")?;
+            summary
+                .compare_with(planar, stack)
+                .context("checking the model's volume")?;
+            Ok((summary, unit_stats(planar, stack, &volume)))
+        },
+        || beside(&volume, stack, &volumes),
+    );
+    let (summary, stats) = checked?;
+    Ok((volume, summary, stats, r))
 }
 
 /// The observed tops of `unit` (every kind of contact: logged, at the collar, absent, repaired).

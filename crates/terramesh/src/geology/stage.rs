@@ -9,17 +9,20 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use terramesh_core::coords::{to_utm, Zone};
+use terramesh_core::volume::VolumeMesh;
 use terramesh_crs::{Crs, Transformer};
 use terramesh_geology::Layering;
+use terramesh_geology::Stack;
 use terramesh_io::boreholes::Boreholes;
 use terramesh_io::grid_write::{write_geotiff_heights, Heights, RasterGrid};
-use terramesh_io::model::{write_model, ModelInfo};
+use terramesh_io::model::{write_model_with, ModelInfo};
 use terramesh_io::output::Output;
 use terramesh_mesh::Mesh;
 
-use super::model::{assemble, Base, GeologicalModel, ModelInputs};
+use super::model::{assemble_beside, Base, GeologicalModel, ModelInputs};
 use super::summary::{interface_grid, ModelSummary};
 use crate::error::{bail, Context, Error, Result};
+use crate::horizon::{HorizonError, HorizonGrid};
 use crate::project::Project;
 use crate::project::{Base as BaseKey, GeologySettings};
 
@@ -120,9 +123,40 @@ pub fn collar_points(b: &Boreholes) -> Vec<[f64; 2]> {
 /// The smallest distance (m) from an inserted contact to another inserted point.
 pub const CONTACT_SPACING: f64 = 1.0;
 
+/// The horizon grids of a `[geology]` section (the unit tops' and a base raster), opened ahead
+/// of [`run`]: reading them needs nothing of the DSM, so `terramesh model` reads them on a
+/// thread of their own while it makes or reads the DSM. A grid not in it is opened by [`run`];
+/// an error opening one is reported by [`run`], where it would have been met.
+#[derive(Debug, Default)]
+pub struct OpenedGrids(Vec<(PathBuf, std::result::Result<HorizonGrid, HorizonError>)>);
+
+impl OpenedGrids {
+    /// Opens every grid of `g`, one after the other (beside other work: one core).
+    pub fn open(g: &GeologySettings) -> OpenedGrids {
+        let base = match &g.base {
+            BaseKey::Raster(p) => Some(p),
+            _ => None,
+        };
+        // the first unit's top is the terrain: a grid for it is refused by `run`, not read
+        let paths = g.surfaces.iter().skip(1).flatten().chain(base);
+        OpenedGrids(
+            paths
+                .map(|p| (p.clone(), HorizonGrid::open(p, g.z_unit)))
+                .collect(),
+        )
+    }
+
+    /// The grid opened from `path`, taken out.
+    fn take(&mut self, path: &Path) -> Option<std::result::Result<HorizonGrid, HorizonError>> {
+        let i = self.0.iter().position(|(p, _)| p == path)?;
+        Some(self.0.swap_remove(i).1)
+    }
+}
+
 /// Builds and writes the model of `g` on `mesh` (the DSM's planar mesh) under `dsm` (its
 /// vertex elevations), into `out`. `grid` is the DSM grid's layout, reused for the
-/// interface grids; `crs` the project's CRS ([`project_crs`]).
+/// interface grids; `crs` the project's CRS ([`project_crs`]); `opened` the horizon grids
+/// read already, if any.
 #[allow(clippy::too_many_arguments)]
 pub fn run(
     p: &Project,
@@ -133,6 +167,7 @@ pub fn run(
     grid: &RasterGrid,
     crs: Option<&Crs>,
     out: &Path,
+    mut opened: OpenedGrids,
 ) -> Result<ModelBuilt> {
     let epsg = crs.and_then(Crs::epsg);
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
@@ -153,14 +188,14 @@ pub fn run(
                 g.units[0]
             );
         }
-        wanted.push((unit, path, grid_crs()?));
+        wanted.push((unit, path, grid_crs()?, opened.take(path)));
     }
     // The grids are read and evaluated in parallel (each also in parallel over the vertices);
     // the first error in column order is reported.
     let read: Vec<Result<(usize, Vec<f64>)>> = wanted
         .into_par_iter()
-        .map(|(unit, path, crs)| {
-            let values = horizon_at(path, &xy, g.z_unit, crs, &g.units[unit])?;
+        .map(|(unit, path, crs, ready)| {
+            let values = horizon_at(path, &xy, g.z_unit, crs, &g.units[unit], ready)?;
             // Nodata: the unit is absent there (model.rs takes the next top below).
             Ok((
                 unit,
@@ -173,7 +208,8 @@ pub fn run(
         BaseKey::Auto => Base::Auto,
         BaseKey::Elevation(z) => Base::Elevation(*z),
         BaseKey::Raster(path) => {
-            let v = horizon_at(path, &xy, g.z_unit, grid_crs()?, "the base")?;
+            let ready = opened.take(path);
+            let v = horizon_at(path, &xy, g.z_unit, grid_crs()?, "the base", ready)?;
             match v.iter().position(Option::is_none) {
                 Some(i) => bail!(
                     "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of the model's \
@@ -197,7 +233,6 @@ pub fn run(
         interpolate: g.interpolate,
         method: terramesh_geostat::Method::Universal(p.interpolation.drift),
     };
-    let model = assemble(mesh, dsm, &inputs).context("[geology]")?;
     let crs_name = match (epsg, crs) {
         (Some(e), _) => format!("EPSG:{e}"),
         (None, Some(c)) => c.definition().to_string(),
@@ -206,39 +241,52 @@ pub fn run(
     let datum = p.height_datum();
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
-    // The model's files and the interface grids are written side by side (rayon); errors in
-    // that order.
-    let (written, grids_written) = rayon::join(
-        || {
-            write_model(
-                out,
-                &model.mesh,
-                &ModelInfo {
-                    crs: crs_name.clone(),
-                    vertical_datum: datum.name(),
-                    vertical_epsg: datum.epsg(),
-                },
-            )
-        },
-        || {
-            g.units
-                .par_iter()
-                .enumerate()
-                .map(|(k, unit)| {
-                    let values = interface_grid(mesh, &model.stack.surfaces[k], grid, -9999.0);
-                    let path = dir.join(format!("{unit}.tif"));
-                    let code = epsg.and_then(|e| u16::try_from(e).ok());
-                    let heights = Heights {
+    // The model's files and the interface grids are written side by side (rayon), and beside
+    // the model's independent checks: `out` is the build's staging folder, thrown away when a
+    // check fails. Errors in that order.
+    let write = |volume: &VolumeMesh, stack: &Stack, volumes: &[f64]| {
+        rayon::join(
+            || {
+                write_model_with(
+                    out,
+                    volume,
+                    &ModelInfo {
+                        crs: crs_name.clone(),
+                        vertical_datum: datum.name(),
                         vertical_epsg: datum.epsg(),
-                    };
-                    write_atomic(&path, |w| {
-                        write_geotiff_heights(w, grid, &values, code, Some(heights), Some(-9999.0))
-                    })?;
-                    Ok(path)
-                })
-                .collect::<Vec<Result<PathBuf>>>()
-        },
-    );
+                    },
+                    Some(volumes),
+                )
+            },
+            || {
+                g.units
+                    .par_iter()
+                    .enumerate()
+                    .map(|(k, unit)| {
+                        let values = interface_grid(mesh, &stack.surfaces[k], grid, -9999.0);
+                        let path = dir.join(format!("{unit}.tif"));
+                        let code = epsg.and_then(|e| u16::try_from(e).ok());
+                        let heights = Heights {
+                            vertical_epsg: datum.epsg(),
+                        };
+                        write_atomic(&path, |w| {
+                            write_geotiff_heights(
+                                w,
+                                grid,
+                                &values,
+                                code,
+                                Some(heights),
+                                Some(-9999.0),
+                            )
+                        })?;
+                        Ok(path)
+                    })
+                    .collect::<Vec<Result<PathBuf>>>()
+            },
+        )
+    };
+    let (model, (written, grids_written)) =
+        assemble_beside(mesh, dsm, &inputs, write).context("[geology]")?;
     let mut files: Vec<PathBuf> = written
         .map_err(|e| Error::invalid(e.to_string()))?
         .into_iter()
@@ -269,15 +317,20 @@ fn write_atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>)
 }
 
 /// A horizon grid sampled at the planar vertices (project CRS `crs`), converted to metres;
-/// `None` on a nodata pixel. A vertex outside the grid is an error naming it.
+/// `None` on a nodata pixel. A vertex outside the grid is an error naming it. `ready`: the
+/// grid opened already ([`OpenedGrids`]), else it is opened here.
 fn horizon_at(
     path: &Path,
     xy: &[[f64; 2]],
     z_unit: terramesh_core::volume::ZUnit,
     crs: &Crs,
     what: &str,
+    ready: Option<std::result::Result<HorizonGrid, HorizonError>>,
 ) -> Result<Vec<Option<f64>>> {
-    let grid = crate::horizon::HorizonGrid::open(path, z_unit)?;
+    let grid = match ready {
+        Some(opened) => opened?,
+        None => HorizonGrid::open(path, z_unit)?,
+    };
     grid.evaluate(xy, crs)
         .with_context(|| format!("the grid of {what}"))
 }

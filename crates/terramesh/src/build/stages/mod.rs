@@ -1,0 +1,233 @@
+//! The computing stages of `terramesh build`: samples, planar mesh (here), vertex elevations
+//! ([`interpolation`]: the variogram, the predictors, the DSM grid).
+
+mod interpolation;
+
+pub(crate) use interpolation::{dsm_grid, interpolate, model, sample_data, Surface};
+pub use interpolation::{Interpolated, Model};
+
+use std::path::Path;
+
+use terramesh_core::coords::Zone;
+use terramesh_io::region::LoadedRegion;
+use terramesh_mesh::{smooth_keeping, Mesh, MeshBuilder, Quality, SmoothReport};
+
+use crate::acquire::{acquire, write_table, SamplePlan};
+use crate::error::{bail, Context, Result};
+use crate::progress::Progress;
+use crate::project::Project;
+
+/// The samples of step 1, in the project's metres (UTM, or the project's own CRS).
+pub struct Samples {
+    /// `[easting, northing, z]`.
+    pub xyz: Vec<[f64; 3]>,
+    /// The UTM zone of a geographic project; `None` for a project in its own CRS
+    /// (`[region] crs = "EPSG:..."` or `"projected"`).
+    pub zone: Option<Zone>,
+    /// The project's named CRS (`[region] crs = "EPSG:..."`).
+    pub crs: Option<terramesh_crs::Crs>,
+    /// The region, projected and geographic.
+    pub region: LoadedRegion,
+    /// The source actually used (after the fallback).
+    pub source: String,
+    /// Sampling grid cell size, metres `[dx, dy]` (from the samples' extent).
+    pub cell: [f64; 2],
+}
+
+/// Step 1: samples on the project's grid, also written to `out/samples.csv`.
+pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
+    let options = p.sample_options(base, &out.join("samples.csv"))?;
+    let plan = SamplePlan::resolve(&options)?;
+    let mut table = acquire(&plan, progress)?;
+    let metres = p.source.z_unit.metres();
+    if metres != 1.0 {
+        for r in &mut table.rows {
+            if let Ok(z) = &mut r.z {
+                *z *= metres;
+            }
+        }
+    }
+    let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
+    let zone = match table.zone {
+        Some(z) if !own_crs => Some(z),
+        _ if own_crs => None,
+        _ => bail!(
+            "the source is in a projected CRS terramesh does not convert; use a geographic or \
+             UTM source for build, or give the project's CRS with [region] crs = \"EPSG:<code>\" \
+             (or \"projected\" when the region and the source share one metric CRS)"
+        ),
+    };
+    let region = plan
+        .region
+        .clone()
+        .context("a region is needed for build")?;
+    let mut xyz = Vec::with_capacity(table.rows.len());
+    for r in &table.rows {
+        if let Ok(z) = r.z {
+            xyz.push([r.xy[0], r.xy[1], z]);
+        }
+    }
+    if xyz.len() < 10 {
+        bail!(
+            "only {} samples with an elevation: enlarge the grid or check the source",
+            xyz.len()
+        );
+    }
+    let s = &p.sampling;
+    let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
+    write_table(&plan, table, progress)?;
+    Ok(Samples {
+        xyz,
+        zone,
+        crs: p.region.crs.crs().cloned(),
+        region,
+        source: options.source,
+        cell,
+    })
+}
+
+impl Samples {
+    /// The EPSG code of the project's coordinates (the UTM zone's, or the project CRS's).
+    pub fn epsg(&self) -> Option<u32> {
+        match (&self.zone, &self.crs) {
+            (Some(z), _) => Some(z.epsg()),
+            (None, Some(c)) => c.epsg(),
+            (None, None) => None,
+        }
+    }
+
+    /// The project's CRS in words: `WGS 84 / UTM zone 32N`, `EPSG:28992`, or that it is the
+    /// inputs' own unnamed metric CRS.
+    pub fn crs_name(&self) -> String {
+        match (&self.zone, &self.crs) {
+            (Some(z), _) => format!("WGS 84 / UTM zone {z}"),
+            (None, Some(c)) => c.to_string(),
+            (None, None) => "the inputs' own projected CRS (unnamed)".into(),
+        }
+    }
+}
+
+fn grid_cell(xyz: &[[f64; 3]], rows: usize, cols: usize, spacing: Option<f64>) -> [f64; 2] {
+    if let Some(s) = spacing {
+        return [s, s];
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in xyz {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    [
+        (hi[0] - lo[0]) / (cols.max(2) - 1) as f64,
+        (hi[1] - lo[1]) / (rows.max(2) - 1) as f64,
+    ]
+}
+
+/// The planar mesh of step 3 with its quality before and after smoothing.
+pub struct Meshed {
+    /// The smoothed mesh.
+    pub mesh: Mesh,
+    /// The mesh before smoothing (for the picture).
+    pub unsmoothed: Mesh,
+    /// 2D quality before smoothing.
+    pub before: Quality,
+    /// 2D quality after smoothing.
+    pub after: Quality,
+    /// What smoothing did.
+    pub smoothing: Option<SmoothReport>,
+    /// The maximum area used.
+    pub max_area: Option<f64>,
+    /// Terrain-adaptive refinement, when `mesh.max_error` is set.
+    pub adaptive: Option<super::adaptive::AdaptiveInfo>,
+}
+
+/// Step 3: constrained Delaunay refinement of the region, then smoothing; or, with
+/// `mesh.max_error`, terrain-adaptive refinement against the kriged surface.
+///
+/// `keep` are points to insert as vertices that smoothing does not move (the borehole collars
+/// of `[geology]`; not with `mesh.max_error`, whose mesher places every vertex itself).
+pub fn mesh(p: &Project, s: &Samples, model: &Model, keep: &[[f64; 2]]) -> Result<Meshed> {
+    let m = &p.mesh;
+    if let Some(target) = m.max_error {
+        let (mesh, info) = super::adaptive::adaptive(p, s, model, target)?;
+        let q = Quality::planar(&mesh);
+        return Ok(Meshed {
+            unsmoothed: mesh.clone(),
+            mesh,
+            before: q.clone(),
+            after: q,
+            smoothing: None,
+            max_area: m.max_area,
+            adaptive: Some(info),
+        });
+    }
+    mesh_refined(p, s, keep)
+}
+
+/// [`mesh`] without `mesh.max_error`: constrained Delaunay refinement, then smoothing (no
+/// variogram needed).
+pub fn mesh_refined(p: &Project, s: &Samples, keep: &[[f64; 2]]) -> Result<Meshed> {
+    let m = &p.mesh;
+    let mut builder = MeshBuilder::new().min_angle(m.min_angle);
+    // Default size: one triangle per sampling cell, so the mesh resolves what was sampled.
+    let max_area = match (m.max_area, m.max_edge) {
+        (Some(a), _) => Some(a),
+        (None, Some(_)) => None,
+        (None, None) => Some(s.cell[0] * s.cell[1]),
+    };
+    if let Some(a) = max_area {
+        builder = builder.max_area(a);
+    }
+    if let Some(e) = m.max_edge {
+        builder = builder.max_edge(e);
+    }
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    if m.insert_samples {
+        points.extend(s.xyz.iter().map(|q| [q[0], q[1]]));
+    }
+    points.extend_from_slice(keep);
+    if !points.is_empty() {
+        builder = builder.points(points);
+    }
+    let (mut mesh, _) = builder.build(&s.region.projected).context("[mesh]")?;
+    let kept = vertices_at(&mesh, keep);
+    let unsmoothed = mesh.clone();
+    let before = Quality::planar(&mesh);
+    let smoothing = if m.smooth > 0 {
+        Some(smooth_keeping(&mut mesh, m.smoother, m.smooth, &kept))
+    } else {
+        None
+    };
+    // Unsmoothed, the mesh is the one measured already.
+    let after = match smoothing {
+        Some(_) => Quality::planar(&mesh),
+        None => before.clone(),
+    };
+    Ok(Meshed {
+        mesh,
+        unsmoothed,
+        before,
+        after,
+        smoothing,
+        max_area,
+        adaptive: None,
+    })
+}
+
+/// The vertices of `mesh` at `points` (inserted there; points outside the region have none).
+fn vertices_at(mesh: &Mesh, points: &[[f64; 2]]) -> Vec<u32> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    let mut at: std::collections::HashMap<(i64, i64), u32> = std::collections::HashMap::new();
+    // Millimetre keys: an inserted point is a vertex to rounding of its local coordinates.
+    let key = |p: [f64; 2]| ((p[0] * 1e3).round() as i64, (p[1] * 1e3).round() as i64);
+    for i in 0..mesh.points.len() {
+        at.insert(key(mesh.absolute(i)), i as u32);
+    }
+    points
+        .iter()
+        .filter_map(|&p| at.get(&key(p)).copied())
+        .collect()
+}
