@@ -118,10 +118,10 @@ fn verify(dir: &Path, only: &[&str]) {
 fn merged_boundary_meshes_msh_f3grid_and_bodies_are_the_merged_models() {
     let tmp = tempfile::tempdir().unwrap();
     let ex = tiles_model::kimberlina();
-    // min_thickness 1 m: at 0, the kernel keeps wedges a few picometres thick (surfaces equal
-    // but for rounding) whose Jacobian is negative at some Gauss points (Gmsh and OpenGeoSys
-    // refuse them); the one-piece kernel's matter, not the merge's.
-    let set = ["interpolation.neighbors=8", "geology.min_thickness=1.0"];
+    // min_thickness 0: before THICKNESS_FLOOR the kernel kept wedges a few picometres thick
+    // here (surfaces equal but for rounding), with zero volume for VTK and negative Jacobians
+    // for Gmsh; the volumes below are the regression test.
+    let set = ["interpolation.neighbors=8", "geology.min_thickness=0"];
     let (plan, merged) = tiled(tmp.path(), &ex, "26km", &set);
     let m = json(&plan.join("tiles.json"));
     assert_eq!(m["tiles"].as_array().unwrap().len(), 4, "2 x 2 tiles");
@@ -223,8 +223,10 @@ fn merged_boundary_meshes_msh_f3grid_and_bodies_are_the_merged_models() {
 
     // The bodies enclose the units' volumes (model.json, the merged cells') to 1e-9.
     let mut vol = vec![0.0; mj["units"].as_array().unwrap().len()];
-    for (c, &u) in cells.iter().zip(&mat) {
-        vol[u as usize] += cell_volume(&points, c);
+    for (i, (c, &u)) in cells.iter().zip(&mat).enumerate() {
+        let v = cell_volume(&points, c);
+        assert!(v > 1e-9, "cell {i} ({c:?}) has volume {v} m3");
+        vol[u as usize] += v;
     }
     let total: f64 = vol.iter().sum();
     let bodies = ex_fig["bodies"].as_array().unwrap();
