@@ -80,6 +80,10 @@ PYK = r"""
 import sys, time, resource, numpy as np, pykrige
 d = np.loadtxt(sys.argv[1], delimiter=",", skiprows=1); t = np.loadtxt(sys.argv[2], delimiter=",", skiprows=1)
 model = sys.argv[3]; psill, rng_, nug = 12000.0, 6000.0, 50.0
+# terramesh's range is the practical range (GSLIB): for the Gaussian, 1 - exp(-3 h^2 / a^2).
+# PyKrige's Gaussian is 1 - exp(-h^2 / (4 r / 7)^2), so the same model has r = a * 7 / (4 sqrt 3).
+if model == "gaussian":
+    rng_ = rng_ * 7.0 / (4.0 * np.sqrt(3.0))
 # The constructor's fit statistics (an O(n^4) loop of growing solves, about an hour at 5,000
 # points) are not used by execute(): skip them.
 import pykrige.uk
