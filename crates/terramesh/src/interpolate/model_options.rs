@@ -138,12 +138,7 @@ impl ModelOptions {
         let kinds = crate::fitting::parse_models(name)?;
         let n = kinds.len();
         let nugget = self.nugget.unwrap_or(0.0);
-        if !(nugget.is_finite() && nugget >= 0.0) {
-            return Err(own(
-                Setting::Nugget,
-                format!("{{nugget}} {nugget}: must be a finite number >= 0"),
-            ));
-        }
+        finite_at_least(Setting::Nugget, "{nugget}", &[nugget], false)?;
         let psills = self.per_structure_or_needed(
             Setting::Psill,
             &self.psill,
@@ -151,14 +146,7 @@ impl ModelOptions {
             name,
             ("the partial sill", "{psill} C1,C2", 0.0),
         )?;
-        for &psill in &psills {
-            if !(psill.is_finite() && psill >= 0.0) {
-                return Err(own(
-                    Setting::Psill,
-                    format!("{{psill}} {psill}: must be a finite number >= 0"),
-                ));
-            }
-        }
+        finite_at_least(Setting::Psill, "{psill}", &psills, false)?;
         let ranges = self.per_structure_or_needed(
             Setting::Range,
             &self.range,
@@ -166,14 +154,7 @@ impl ModelOptions {
             name,
             ("the practical range", "{range} A1,A2", 1.0),
         )?;
-        for &range in &ranges {
-            if !(range.is_finite() && range > 0.0) {
-                return Err(own(
-                    Setting::Range,
-                    format!("{{range}} {range}: must be a finite number > 0"),
-                ));
-            }
-        }
+        finite_at_least(Setting::Range, "{range}", &ranges, true)?;
         let total: f64 = psills.iter().sum();
         if nugget + total == 0.0 {
             return Err(own(Setting::Psill, format!("{{psill}} {} and {{nugget}} {nugget}: the sill is zero, so kriging weights are undefined; give a positive {{psill}}", list(&psills))));
@@ -342,6 +323,22 @@ impl LagOptions {
     }
 }
 
+/// Refuses a value of `values` that is not finite, or below zero (`positive`: zero too),
+/// naming the setting (`flag`, as the error's placeholder).
+fn finite_at_least(setting: Setting, flag: &str, values: &[f64], positive: bool) -> Result<()> {
+    for &v in values {
+        let ok = v.is_finite() && if positive { v > 0.0 } else { v >= 0.0 };
+        if !ok {
+            let bound = if positive { "> 0" } else { ">= 0" };
+            return Err(own(
+                setting,
+                format!("{flag} {v}: must be a finite number {bound}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -357,6 +354,52 @@ mod tests {
             range: vec![10.0, 30.0],
             ..ModelOptions::default()
         }
+    }
+
+    #[test]
+    fn sills_ranges_and_the_nugget_out_of_bounds_are_named() {
+        let cases = [
+            (
+                vec![1.0, -1.0],
+                vec![10.0, 30.0],
+                None,
+                "--psill -1: must be a finite number >= 0",
+            ),
+            (
+                vec![1.0, 2.0],
+                vec![10.0, 0.0],
+                None,
+                "--range 0: must be a finite number > 0",
+            ),
+            (
+                vec![1.0, 2.0],
+                vec![f64::NAN, 1.0],
+                None,
+                "--range NaN: must be a finite number > 0",
+            ),
+            (
+                vec![1.0, 2.0],
+                vec![10.0, 30.0],
+                Some(-0.5),
+                "--nugget -0.5: must be a finite number >= 0",
+            ),
+        ];
+        for (psill, range, nugget, want) in cases {
+            let m = ModelOptions {
+                psill,
+                range,
+                nugget,
+                ..nested()
+            };
+            assert_eq!(flags(m.explicit_or_fit(false).unwrap_err()), want);
+        }
+        // zero is a valid partial sill and nugget (not a valid range)
+        let m = ModelOptions {
+            psill: vec![0.0, 2.0],
+            nugget: Some(0.0),
+            ..nested()
+        };
+        assert!(m.explicit_or_fit(false).unwrap().is_some());
     }
 
     #[test]
