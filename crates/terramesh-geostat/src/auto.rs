@@ -33,7 +33,8 @@ use crate::reml::{fit_contrasts, Blocks, RemlFit, DEFAULT_REML_BLOCK};
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FitMethod {
-    /// Restricted maximum likelihood from the WLS start, chosen by AIC ([`fit_auto_reml`]).
+    /// Restricted maximum likelihood from the WLS start, the model chosen by leave-one-out
+    /// RMSE ([`fit_auto_reml`]).
     #[default]
     Reml,
     /// Weighted least squares on the experimental variogram, chosen by leave-one-out RMSE of
