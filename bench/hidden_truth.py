@@ -12,8 +12,9 @@ metres (equirectangular about the DEM's centre: the same coordinates for every m
 seeded). The truth is the other valid posts inside the data's convex hull (a seeded random
 N of them, default 20,000, so that every method predicts the same points). Methods:
 
-- terramesh `interpolate --method uk --drift linear --variogram auto` (REML, the default
-  `--fit reml`) and `--fit wls` (the former automatic fit);
+- terramesh `interpolate --method uk --drift linear --variogram auto` with `--fit reml` (its
+  block composite likelihood, the default `--reml-block`), `--fit reml --reml-block 0` (exact
+  REML on all data) and `--fit wls` (the former automatic fit);
 - terramesh UK with each model fitted alone by REML (`variogram --model M --fit reml`);
 - terramesh IDW, 16 neighbours, power 2;
 - PyKrige `UniversalKriging(..., drift_terms=["regional_linear"])` with its own automatic fit
@@ -175,14 +176,16 @@ def main():
         rmse = lambda e: float(np.sqrt(np.mean((e - t[:, 2]) ** 2)))
         rows = []
         o = os.path.join(OUT, f"{name}-out.csv")
-        for fit in ("reml", "wls"):
-            vj = os.path.join(OUT, f"{name}-auto-{fit}.json")
-            run(["variogram", "--data", dpath, "--fit", fit, "--drift", "linear", "-o", vj])
+        for label, flags in (("reml", ["--fit", "reml"]),
+                             ("reml, exact", ["--fit", "reml", "--reml-block", "0"]),
+                             ("wls", ["--fit", "wls"])):
+            vj = os.path.join(OUT, f"{name}-auto-{label.replace(', ', '-')}.json")
+            run(["variogram", "--data", dpath, "--drift", "linear", "-o", vj] + flags)
             m = json.load(open(vj))["model"]
-            # REML: `interpolate --variogram auto --fit reml` itself (the same fit as the file's)
-            extra = ["--variogram", "auto", "--fit", "reml"] if fit == "reml" else ["--variogram", vj]
+            # REML: `interpolate --variogram auto` itself (the same fit as the file's)
+            extra = ["--variogram", "auto"] + flags if label != "wls" else ["--variogram", vj]
             r = terramesh_uk(dpath, tpath, o, extra)
-            rows.append((f"terramesh UK auto ({fit})", rmse(r), describe(m)))
+            rows.append((f"terramesh UK auto ({label})", rmse(r), describe(m)))
         for model in ("spherical", "exponential", "gaussian", "matern", "power", "linear"):
             vj = os.path.join(OUT, f"{name}-{model}.json")
             try:

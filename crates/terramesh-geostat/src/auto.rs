@@ -28,16 +28,18 @@ use crate::reml::{fit_contrasts, Blocks, RemlFit, DEFAULT_REML_BLOCK};
 /// ```
 /// use terramesh_geostat::{FitMethod, Named};
 /// assert_eq!("REML".parse::<FitMethod>(), Ok(FitMethod::Reml));
-/// assert_eq!(FitMethod::default(), FitMethod::Reml);
+/// assert_eq!(FitMethod::default(), FitMethod::Wls); // REML is opt-in: it costs seconds
 /// assert_eq!(FitMethod::Wls.name(), "wls");
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FitMethod {
-    /// Restricted maximum likelihood from the WLS start, chosen by AIC ([`fit_auto_reml`]).
-    #[default]
+    /// Restricted maximum likelihood from the WLS start, the model chosen by leave-one-out
+    /// RMSE ([`fit_auto_reml`]).
     Reml,
     /// Weighted least squares on the experimental variogram, chosen by leave-one-out RMSE of
-    /// ordinary kriging ([`fit_auto`](crate::fit_auto)).
+    /// ordinary kriging ([`fit_auto`](crate::fit_auto)); the default of the library, the CLI's
+    /// `--fit` and the project file's `fit` (REML costs seconds where WLS costs milliseconds).
+    #[default]
     Wls,
 }
 

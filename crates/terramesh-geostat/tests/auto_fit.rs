@@ -4,8 +4,9 @@
 //! automatic WLS fit ([`fit_auto`]). The truth is the DEM itself (no expected number is typed).
 
 use terramesh_geostat::{
-    experimental, fit_auto, fit_auto_reml, kriging, AutoSettings, Data, Drift, Duplicates,
-    LagSettings, Method, ModelKind, Named, Neighbourhood, Weighting,
+    experimental, fit_auto, fit_auto_reml, fit_reml, kriging, reml_log_likelihood, AutoSettings,
+    Data, Drift, Duplicates, LagSettings, Method, ModelKind, Named, Neighbourhood, Variogram,
+    Weighting, DEFAULT_REML_BLOCK,
 };
 
 /// The posts of the crop in local metres (equirectangular about its centre), voids left out.
@@ -132,4 +133,62 @@ fn reml_auto_fit_predicts_held_out_posts_no_worse_than_the_wls_auto_fit() {
         reml.variogram, wls.variogram
     );
     assert!(r_reml <= r_wls, "REML {r_reml} > WLS {r_wls}");
+}
+
+/// `n` data on a jittered grid of a smooth surface with a trend (seeded, deterministic).
+fn jittered(n: usize) -> Data {
+    let side = (n as f64).sqrt().ceil() as usize;
+    let (mut xy, mut z) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        let u = |k: u64| (key(k) >> 11) as f64 / (1u64 << 53) as f64;
+        let p = [
+            ((i % side) as f64 + u(2 * i as u64)) * 100.0,
+            ((i / side) as f64 + u(2 * i as u64 + 1)) * 100.0,
+        ];
+        z.push((p[0] / 700.0).sin() * (p[1] / 900.0).cos() * 50.0 + p[0] / 40.0);
+        xy.push(p);
+    }
+    Data::new(xy, z, Duplicates::Reject).unwrap()
+}
+
+#[test]
+fn reml_is_exact_up_to_the_block_size_and_a_composite_of_halved_blocks_above() {
+    let v = Variogram::single(ModelKind::Exponential, 1.0, 400.0, 1500.0).unwrap();
+    let ll = |d: &Data, b| reml_log_likelihood(d, Drift::Linear, &v, b).unwrap();
+    // Up to the block size the default likelihood is the exact one.
+    let small = jittered(DEFAULT_REML_BLOCK);
+    let (exact, default) = (ll(&small, None), ll(&small, Some(DEFAULT_REML_BLOCK)));
+    assert!(
+        (exact - default).abs() <= 1e-9 * exact.abs(),
+        "{exact} {default}"
+    );
+    // Above it, recursive median bisection: 2^k blocks of at most the block size, whose
+    // likelihood ignores the pairs across blocks (so it differs from the exact one).
+    let n = 3 * DEFAULT_REML_BLOCK;
+    let big = jittered(n);
+    let (exact, composite) = (ll(&big, None), ll(&big, Some(DEFAULT_REML_BLOCK)));
+    assert!(
+        (exact - composite).abs() > 1e-6 * exact.abs(),
+        "{exact} {composite}"
+    );
+    let start = Variogram::single(ModelKind::Exponential, 1.0, 300.0, 1000.0).unwrap();
+    let fit = fit_reml(&big, Drift::Linear, &start, Some(DEFAULT_REML_BLOCK)).unwrap();
+    let k = (n as f64 / DEFAULT_REML_BLOCK as f64).log2().ceil() as u32;
+    assert_eq!((fit.points, fit.blocks), (n, 2usize.pow(k)));
+    assert!(n.div_ceil(fit.blocks) <= DEFAULT_REML_BLOCK);
+    let lags = experimental(&big, &LagSettings::default()).unwrap();
+    let (_, _, sel) = fit_auto_reml(
+        &big,
+        &lags,
+        &[ModelKind::Exponential],
+        &AutoSettings::default(),
+    )
+    .unwrap();
+    assert_eq!((sel.points, sel.blocks), (n, fit.blocks));
+    let exact = AutoSettings {
+        block: None,
+        ..AutoSettings::default()
+    };
+    let (_, _, sel) = fit_auto_reml(&small, &lags, &[ModelKind::Exponential], &exact).unwrap();
+    assert_eq!((sel.points, sel.blocks), (DEFAULT_REML_BLOCK, 1));
 }

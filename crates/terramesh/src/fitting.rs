@@ -36,7 +36,7 @@ pub struct FitPlan {
     /// `auto`, a model name ([`ModelKind`]) or a nested sum of up to three names joined by
     /// `+` (`spherical+exponential`), fitted jointly.
     pub model: String,
-    /// REML or WLS; `None`: REML for `auto`, WLS for a named model (as before REML existed).
+    /// REML or WLS; `None`: [`FitMethod`]'s default (WLS).
     pub method: Option<FitMethod>,
     /// The drift, the weights of the WLS fits and the REML subset.
     pub auto: AutoSettings,
@@ -183,8 +183,8 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
 
 fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     let auto = plan.model.eq_ignore_ascii_case("auto");
-    // WLS unless REML is asked for: REML (opt-in) costs seconds where WLS costs milliseconds
-    let method = plan.method.unwrap_or(FitMethod::Wls);
+    // WLS unless REML is asked for (FitMethod's default)
+    let method = plan.method.unwrap_or_default();
     if auto {
         return Ok(match method {
             FitMethod::Reml => {

@@ -23,8 +23,9 @@ pub struct MethodArgs {
     pub mean: Option<f64>,
     #[command(flatten)]
     pub model: ModelArgs,
-    /// auto (fit a model to the data: by REML with the kriging's drift over every model, the
-    /// least AIC kept; see --fit) or a JSON file written by `terramesh variogram`.
+    /// auto (fit a model to the data: every model's parameters by REML with the kriging's
+    /// drift, the least leave-one-out RMSE kept; see --fit) or a JSON file written by
+    /// `terramesh variogram`.
     #[arg(long)]
     pub variogram: Option<String>,
     #[command(flatten)]

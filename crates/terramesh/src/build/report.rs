@@ -281,9 +281,14 @@ pub fn write_report(
         vb.push(Block::Table {
             caption: match it.selection {
                 Some(s) => format!(
-                    "Models tried by the automatic fit: REML with a {} drift on {} samples, chosen by the least AIC",
+                    "Models tried by the automatic fit: REML with a {} drift on {} samples ({}), chosen by the least leave-one-out RMSE",
                     s.drift.map_or("constant", terramesh_geostat::Named::name),
-                    s.points
+                    s.points,
+                    if s.blocks > 1 {
+                        format!("a composite likelihood of {} spatial blocks", s.blocks)
+                    } else {
+                        "exact likelihood".into()
+                    }
                 ),
                 None => "Models tried by the automatic fit (chosen by leave-one-out RMSE)".into(),
             },

@@ -361,7 +361,7 @@ impl Default for InterpolationSection {
             cv_folds: 0,
             realisations: 0,
             seed: 0,
-            fit: terramesh_geostat::FitMethod::Wls,
+            fit: terramesh_geostat::FitMethod::default(),
             fit_model: "auto".into(),
             anisotropy: "none".into(),
             external_drift_grid: None,
