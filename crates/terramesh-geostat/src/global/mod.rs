@@ -231,7 +231,7 @@ impl GlobalKriging {
                 )
             }
             (Some(s), None) => {
-                let l = factor_dense(&prep, s)?;
+                let l = factor_dense(&prep, &kernel)?;
                 let lm = MatRef::from_column_major_slice(&l, n, n);
                 let mut g: Vec<f64> = (0..p)
                     .flat_map(|k| (0..n).map(move |i| (i, k)))
