@@ -11,13 +11,21 @@ use rayon::prelude::*;
 
 fn cpu() -> f64 {
     let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let f: Vec<&str> = s.rsplit(')').next().unwrap_or("").split_whitespace().collect();
+    let f: Vec<&str> = s
+        .rsplit(')')
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .collect();
     let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
     (t(11) + t(12)) / 100.0
 }
 
 fn main() {
-    let a: Vec<usize> = std::env::args().skip(1).map(|s| s.parse().unwrap()).collect();
+    let a: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|s| s.parse().unwrap())
+        .collect();
     let n = a.first().copied().unwrap_or(5000);
     let m = a.get(1).copied().unwrap_or(4096);
     let threads = rayon::current_num_threads();
@@ -54,18 +62,29 @@ fn main() {
         );
     };
     for blk in [2048usize, 4096] {
-        report(&format!("faer rayon({threads}) blocks of {blk}"), &mut |b| {
-            for c in b.chunks_mut(n * blk) {
-                let w = c.len() / n;
-                solve_lower_triangular_in_place(lm, MatMut::from_column_major_slice_mut(c, n, w), Par::rayon(threads));
-            }
-        });
+        report(
+            &format!("faer rayon({threads}) blocks of {blk}"),
+            &mut |b| {
+                for c in b.chunks_mut(n * blk) {
+                    let w = c.len() / n;
+                    solve_lower_triangular_in_place(
+                        lm,
+                        MatMut::from_column_major_slice_mut(c, n, w),
+                        Par::rayon(threads),
+                    );
+                }
+            },
+        );
     }
     for ch in [128usize, 256, 512, 1024, 2048] {
         report(&format!("rayon over chunks of {ch}, Seq"), &mut |b| {
             b.par_chunks_mut(n * ch).for_each(|c| {
                 let w = c.len() / n;
-                solve_lower_triangular_in_place(lm, MatMut::from_column_major_slice_mut(c, n, w), Par::Seq);
+                solve_lower_triangular_in_place(
+                    lm,
+                    MatMut::from_column_major_slice_mut(c, n, w),
+                    Par::Seq,
+                );
             });
         });
     }

@@ -556,7 +556,12 @@ mod tests {
     fn covariances_have_the_same_bits_in_every_build() {
         use crate::model::ModelKind;
         let pts: Vec<[f64; 2]> = (0..203)
-            .map(|i| [(i as f64 * 0.37).sin() * 900.0, (i as f64 * 0.11).cos() * 700.0])
+            .map(|i| {
+                [
+                    (i as f64 * 0.37).sin() * 900.0,
+                    (i as f64 * 0.11).cos() * 700.0,
+                ]
+            })
             .collect();
         let x0 = pts[17];
         for kind in [
