@@ -63,12 +63,16 @@ pub(super) fn inverse_pays(tree: &Tree, n: usize, q: &[[f64; 2]], radius: f64) -
     let order = crate::linalg::morton_order(q);
     let groups: Vec<&[u32]> = order.chunks(super::band_predict::DENSE_GROUP).collect();
     let step = groups.len().div_ceil(48).max(1);
+    let samples = groups.len().div_ceil(step);
+    let scale = GROUPED_COST * groups.len() as f64 / samples as f64;
+    let gather_max = super::band_predict::gather_max();
     let mut stamp = vec![false; n];
     let mut near = Vec::new();
-    let (mut flops, mut sampled) = (0.0, 0usize);
+    let mut flops = 0.0;
     for g in groups.iter().step_by(step) {
         stamp.iter_mut().for_each(|s| *s = false);
         let mut s = 0usize;
+        // Past `gather_max` the group counts as all the data: no need to count further.
         for &t in g.iter() {
             tree.within(q[t as usize], radius, &mut near);
             for &(_, i) in &near {
@@ -77,17 +81,18 @@ pub(super) fn inverse_pays(tree: &Tree, n: usize, q: &[[f64; 2]], radius: f64) -
                     s += 1;
                 }
             }
+            if s > gather_max {
+                break;
+            }
         }
-        let s = if s > super::band_predict::gather_max() {
-            n
-        } else {
-            s
-        };
+        let s = if s > gather_max { n } else { s };
         flops += (s as f64).powi(2) * g.len() as f64;
-        sampled += 1;
+        // The sampled flops only grow: once they decide, the rest cannot change it.
+        if inverse + scale * flops >= solve {
+            return false;
+        }
     }
-    let grouped = flops * groups.len() as f64 / sampled as f64;
-    inverse + GROUPED_COST * grouped < solve
+    inverse + scale * flops < solve
 }
 
 /// Overwrites the lower Cholesky factor `L` (column-major `n x n`, lower triangle; the strict

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use super::par;
 use crate::band::Band;
 use crate::error::{GeostatError, Result};
+use crate::neighbourhood::kernel::Kernel;
 use crate::search::Tree;
 use crate::system::{dist, Prepared};
 
@@ -106,18 +107,15 @@ fn not_pd(i: usize) -> GeostatError {
     }
 }
 
-pub(super) fn factor_dense(prep: &Prepared, sill: f64) -> Result<Vec<f64>> {
+/// The lower Cholesky factor of the data's covariance matrix (column-major `n x n`, the
+/// strict upper triangle zero), its lower triangle filled a column at a time by `kernel`
+/// (vectorised; the diagonal, at distance zero, is the sill of `kernel`).
+pub(super) fn factor_dense(prep: &Prepared, kernel: &Kernel) -> Result<Vec<f64>> {
     let n = prep.pts.len();
     let vg = &prep.variogram;
     let mut k = vec![0.0; n * n];
     k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
-        for (i, c) in col.iter_mut().enumerate().skip(j) {
-            *c = if i == j {
-                sill
-            } else {
-                vg.covariance_at(dist(prep.pts[i], prep.pts[j]))
-            };
-        }
+        kernel.covariances(vg, &prep.pts[j..], prep.pts[j], &mut col[j..]);
     });
     let par = par();
     let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, Default::default()));

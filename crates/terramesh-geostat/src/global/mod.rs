@@ -6,7 +6,8 @@
 //!   Takahashi's recurrence; each target touches only the data within one range
 //!   (`O(s²)` for `s` such data), so cost does not grow with `n` per target.
 //! - **dense** (other bounded models): dense Cholesky of the covariance matrix with faer;
-//!   targets in blocks of [`BLOCK`]: one triangular solve per block for the variances.
+//!   targets in chunks spread over the threads, one sequential triangular solve per chunk
+//!   for the variances (`dense_solve.rs`).
 //!   With compact support over much of the data, or an effective support (a nugget and a
 //!   covariance that decays, `effective.rs`), and variances asked of enough targets that the
 //!   cost model says so (`dense_inverse::inverse_pays`, decided at the first prediction
@@ -23,10 +24,10 @@ use faer::linalg::triangular_solve::{
 };
 use faer::prelude::*;
 use faer::{Mat, MatMut, MatRef, Par};
-use rayon::prelude::*;
 
 mod band_predict;
 mod dense_inverse;
+mod dense_solve;
 mod effective;
 mod factor;
 mod loo;
@@ -46,9 +47,11 @@ use crate::error::{GeostatError, Result};
 use crate::model::Variogram;
 use crate::neighbourhood::kernel::Kernel;
 use crate::search::Tree;
-use crate::system::{dist, small_cholesky, small_quad, small_solve, Prepared, EXACT_EPS};
+use crate::system::{dist, small_cholesky, small_solve, Prepared, EXACT_EPS};
 
-/// Targets per block: bounds memory (`n x BLOCK` doubles) whatever the number of targets.
+/// Targets per block of the gamma strategy, and the columns of right-hand sides the dense
+/// strategy's solves hold at once (with few threads): bounds memory (`n x BLOCK` doubles)
+/// whatever the number of targets.
 pub const BLOCK: usize = 2048;
 
 /// How the variances of the dense strategy are computed ([`GlobalKriging::set_dense_route`]).
@@ -194,11 +197,11 @@ impl GlobalKriging {
             _ => None,
         };
         if banded.is_none() {
-            // The dense system: n x n covariances factored in place and an n x BLOCK block of
+            // The dense system: n x n covariances factored in place and the chunks' n-long
             // right-hand sides, or the (n + p)-square variogram system and its LU factors.
             let entries = match sill {
                 Some(_) if loo => 2.0 * n as f64 * n as f64,
-                Some(_) => n as f64 * (n + BLOCK) as f64,
+                Some(_) => n as f64 * (n + dense_solve::buffer_columns()) as f64,
                 None => 2.0 * ((n + p) as f64).powi(2),
             };
             check_dense(entries)?;
@@ -228,7 +231,7 @@ impl GlobalKriging {
                 )
             }
             (Some(s), None) => {
-                let l = factor_dense(&prep, s)?;
+                let l = factor_dense(&prep, &kernel)?;
                 let lm = MatRef::from_column_major_slice(&l, n, n);
                 let mut g: Vec<f64> = (0..p)
                     .flat_map(|k| (0..n).map(move |i| (i, k)))
@@ -448,10 +451,15 @@ impl GlobalKriging {
             }
             _ => false,
         };
+        if let Solver::Dense { l, g, .. } = &*solver {
+            let q: Vec<[f64; 2]> = targets.iter().map(|p| self.prep.map(*p)).collect();
+            self.predict_dense(l, g, &q, est, var.as_deref_mut(), grouped_est);
+            return self.finish(&q, est, var);
+        }
         for (b, chunk) in targets.chunks(BLOCK).enumerate() {
             let r = b * BLOCK..b * BLOCK + chunk.len();
             let vslice = var.as_deref_mut().map(|v| &mut v[r.clone()]);
-            self.predict_block(&solver, chunk, &mut est[r], vslice, grouped_est)
+            self.predict_block(&solver, chunk, &mut est[r], vslice)
                 .map_err(|e| e.offset_target(b * BLOCK))?;
         }
         Ok(())
@@ -463,24 +471,18 @@ impl GlobalKriging {
         self.variance || !matches!(&*self.solver(), Solver::Band { .. })
     }
 
-    /// One block of targets by solves (dense) or the bordered LU (gamma); the estimates are
-    /// left as they are when `estimated` (done in groups).
+    /// One block of targets by the bordered LU (gamma).
     fn predict_block(
         &self,
         solver: &Solver,
         t: &[[f64; 2]],
         est: &mut [f64],
         mut var: Option<&mut [f64]>,
-        estimated: bool,
     ) -> Result<()> {
         let q: Vec<[f64; 2]> = t.iter().map(|p| self.prep.map(*p)).collect();
-        let v = var.as_deref_mut();
         match solver {
-            Solver::Dense { l, g, .. } => {
-                self.block_dense(l, g, &q, (!estimated).then_some(&mut *est), v)
-            }
-            Solver::Gamma { lu } => self.block_gamma(lu, &q, est, v),
-            Solver::Band { .. } | Solver::DenseInverse { .. } => unreachable!("grouped"),
+            Solver::Gamma { lu } => self.block_gamma(lu, &q, est, var.as_deref_mut()),
+            _ => unreachable!("dense and grouped strategies go by chunks or groups"),
         }?;
         self.finish(&q, est, var)
     }
@@ -503,49 +505,6 @@ impl GlobalKriging {
             finite_at(v, "variance")?;
         }
         finite_at(est, "estimate")
-    }
-
-    fn block_dense(
-        &self,
-        l: &[f64],
-        g: &[f64],
-        q: &[[f64; 2]],
-        est: Option<&mut [f64]>,
-        var: Option<&mut [f64]>,
-    ) -> Result<()> {
-        let n = self.prep.pts.len();
-        let p = self.prep.terms();
-        let m = q.len();
-        let mut b = vec![0.0; n * m];
-        b.par_chunks_mut(n)
-            .zip(q.par_iter())
-            .for_each(|(col, &x0)| self.all_covariances(x0, col));
-        let mut f0 = vec![0.0; 6 * m];
-        f0.par_chunks_mut(6)
-            .enumerate()
-            .for_each(|(j, f)| self.prep.drift(q[j], &mut f[..p]));
-        if let Some(est) = est {
-            est.par_iter_mut().enumerate().for_each(|(j, e)| {
-                *e = self.dual_estimate(&b[j * n..(j + 1) * n], &f0[j * 6..j * 6 + p]);
-            });
-        }
-        let Some(var) = var else { return Ok(()) };
-        let lm = MatRef::from_column_major_slice(l, n, n);
-        solve_lower_triangular_in_place(
-            lm,
-            MatMut::from_column_major_slice_mut(&mut b, n, m),
-            par(),
-        );
-        var.par_iter_mut().enumerate().for_each(|(j, v)| {
-            let y = &b[j * n..(j + 1) * n];
-            let q1 = crate::band::dot(y, y);
-            let mut t = [0.0; 6];
-            for c in 0..p {
-                t[c] = crate::band::dot(&g[c * n..(c + 1) * n], y) - f0[j * 6 + c];
-            }
-            *v = self.sill - q1 + small_quad(&self.rs, p, &mut t[..p]);
-        });
-        Ok(())
     }
 
     fn block_gamma(
