@@ -135,3 +135,59 @@ fn nested_anisotropic_fit_and_external_drift_in_a_build() {
         "interpolation.fit_model",
     );
 }
+
+/// `fit = "reml"` in a build: the report's table of the automatic fit names its likelihood,
+/// a composite of the spatial blocks that recursive median bisection makes (halves until a
+/// block has at most `DEFAULT_REML_BLOCK` samples).
+#[test]
+fn the_report_names_the_reml_likelihood_of_the_automatic_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let ex = example();
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args(["build", ex.to_str().unwrap(), "-o"])
+        .arg(dir.path())
+        .arg("--quiet")
+        .args(["--set", "export.formats=[\"obj\"]"])
+        .args(["--set", "export.pictures=false"])
+        .args(["--set", "interpolation.methods=[\"uk\"]"])
+        .args(["--set", "interpolation.fit=\"reml\""])
+        .output()
+        .expect("run terramesh");
+    ok(&o);
+    let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+    let at = html
+        .find("Models tried by the automatic fit: REML with a ")
+        .expect("the REML caption in report.html");
+    let caption = &html[at..at + html[at..].find("</").unwrap()];
+    assert!(
+        caption.ends_with("chosen by the least leave-one-out RMSE"),
+        "{caption}"
+    );
+    let number_after = |word: &str| -> usize {
+        let i = caption
+            .find(word)
+            .unwrap_or_else(|| panic!("{word:?} in {caption}"));
+        let rest = &caption[..i];
+        rest.rsplit(' ')
+            .find(|w| !w.is_empty())
+            .unwrap()
+            .replace(',', "")
+            .parse()
+            .unwrap_or_else(|e| panic!("{e}: {caption}"))
+    };
+    let n = number_after(" samples");
+    let block = terramesh_geostat::DEFAULT_REML_BLOCK;
+    if n > block {
+        fn blocks(n: usize, block: usize) -> usize {
+            if n <= block {
+                1
+            } else {
+                blocks(n / 2, block) + blocks(n - n / 2, block)
+            }
+        }
+        let b = number_after(" spatial blocks");
+        assert_eq!(b, blocks(n, block), "{caption}");
+    } else {
+        assert!(caption.contains("(exact likelihood)"), "{caption}");
+    }
+}
