@@ -162,8 +162,8 @@ fn reml_is_exact_up_to_the_block_size_and_a_composite_of_halved_blocks_above() {
         (exact - default).abs() <= 1e-9 * exact.abs(),
         "{exact} {default}"
     );
-    // Above it, recursive median bisection: 2^k blocks of at most the block size, whose
-    // likelihood ignores the pairs across blocks (so it differs from the exact one).
+    // Above it, recursive median bisection into blocks of at most the block size (here
+    // 1,200 -> 600 -> 300: four), whose likelihood ignores the pairs across blocks (so it differs from the exact one).
     let n = 3 * DEFAULT_REML_BLOCK;
     let big = jittered(n);
     let (exact, composite) = (ll(&big, None), ll(&big, Some(DEFAULT_REML_BLOCK)));
@@ -173,8 +173,14 @@ fn reml_is_exact_up_to_the_block_size_and_a_composite_of_halved_blocks_above() {
     );
     let start = Variogram::single(ModelKind::Exponential, 1.0, 300.0, 1000.0).unwrap();
     let fit = fit_reml(&big, Drift::Linear, &start, Some(DEFAULT_REML_BLOCK)).unwrap();
-    let k = (n as f64 / DEFAULT_REML_BLOCK as f64).log2().ceil() as u32;
-    assert_eq!((fit.points, fit.blocks), (n, 2usize.pow(k)));
+    fn halves(n: usize, b: usize) -> usize {
+        if n <= b {
+            1
+        } else {
+            halves(n / 2, b) + halves(n - n / 2, b)
+        }
+    }
+    assert_eq!((fit.points, fit.blocks), (n, halves(n, DEFAULT_REML_BLOCK)));
     assert!(n.div_ceil(fit.blocks) <= DEFAULT_REML_BLOCK);
     let lags = experimental(&big, &LagSettings::default()).unwrap();
     let (_, _, sel) = fit_auto_reml(
