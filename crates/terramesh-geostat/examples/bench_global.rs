@@ -26,18 +26,8 @@ fn read(path: &str, cols: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// CPU seconds (user + system) of this process so far, from /proc/self/stat (Linux; 0 elsewhere).
-fn cpu() -> f64 {
-    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let f: Vec<&str> = s
-        .rsplit(')')
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .collect();
-    let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    (t(11) + t(12)) / 100.0
-}
+mod common;
+use common::cpu;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
