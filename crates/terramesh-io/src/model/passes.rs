@@ -125,15 +125,27 @@ impl<'a> Indexed<'a> {
     }
 }
 
-/// Calls `f` with every index of the sorted lists `lists`, in increasing order.
-fn merged(lists: &[&[u32]], f: &mut dyn FnMut(usize) -> io::Result<()>) -> io::Result<()> {
+/// Calls `f` with every index (and its item of `items`) of the block `pick` of `blocks`, or
+/// of all the blocks (sorted lists) in increasing order where `pick` is `None`; a `pick`
+/// past the blocks visits nothing.
+fn visit<T>(
+    blocks: &[Vec<u32>],
+    pick: Option<usize>,
+    items: &[T],
+    f: &mut dyn FnMut(usize, &T) -> io::Result<()>,
+) -> io::Result<()> {
+    let lists: &[Vec<u32>] = match pick {
+        Some(k) => blocks.get(k..=k).unwrap_or(&[]),
+        None => blocks,
+    };
     let mut at = vec![0usize; lists.len()];
     loop {
         let next = (0..lists.len())
             .filter(|&l| at[l] < lists[l].len())
             .min_by_key(|&l| lists[l][at[l]]);
         let Some(l) = next else { return Ok(()) };
-        f(lists[l][at[l]] as usize)?;
+        let i = lists[l][at[l]] as usize;
+        f(i, &items[i])?;
         at[l] += 1;
     }
 }
@@ -169,17 +181,9 @@ impl ModelPasses for Indexed<'_> {
         kind: Option<CellKind>,
         f: &mut dyn FnMut(usize, &Cell) -> io::Result<()>,
     ) -> io::Result<()> {
-        let Some(blocks) = usize::try_from(mat).ok().and_then(|m| self.cells.get(m)) else {
-            return Ok(());
-        };
-        let cells = &self.mesh.cells;
-        match kind {
-            Some(k) => blocks[kind_index(k)]
-                .iter()
-                .try_for_each(|&i| f(i as usize, &cells[i as usize])),
-            None => merged(&[&blocks[0], &blocks[1], &blocks[2]], &mut |i| {
-                f(i, &cells[i])
-            }),
+        match usize::try_from(mat).ok().and_then(|m| self.cells.get(m)) {
+            Some(blocks) => visit(blocks, kind.map(kind_index), &self.mesh.cells, f),
+            None => Ok(()),
         }
     }
     fn each_face_of(
@@ -188,16 +192,10 @@ impl ModelPasses for Indexed<'_> {
         size: Option<usize>,
         f: &mut dyn FnMut(usize, &TaggedFace) -> io::Result<()>,
     ) -> io::Result<()> {
-        let Some(blocks) = self.faces.get(tag as usize) else {
-            return Ok(());
-        };
-        let faces = &self.mesh.faces;
-        match size {
-            Some(n @ 3..=4) => blocks[n - 3]
-                .iter()
-                .try_for_each(|&j| f(j as usize, &faces[j as usize])),
-            Some(_) => Ok(()),
-            None => merged(&[&blocks[0], &blocks[1]], &mut |j| f(j, &faces[j])),
+        match self.faces.get(tag as usize) {
+            // triangles are block 0, quadrilaterals block 1; other sizes none
+            Some(blocks) => visit(blocks, size.map(|n| n.wrapping_sub(3)), &self.mesh.faces, f),
+            None => Ok(()),
         }
     }
 }
