@@ -5,6 +5,13 @@ Run from the repository root after `cargo build --release -p terramesh-cli`, in 
 own (`bench/hidden_truth-requirements.txt`):
     python3 -m venv .venv-hidden && .venv-hidden/bin/pip install -r bench/hidden_truth-requirements.txt
     .venv-hidden/bin/python bench/hidden_truth.py [TERRAIN ...] [--truth N] [--skip-pykrige]
+        [--seeds S1,S2,...] [--quick]
+
+`--seeds` draws the data and truth again with each seed (default 15, the seed of the tables in
+docs/geostatistics.md) and ends with a summary per terrain: for each draw, terramesh UK auto
+(`--fit reml` and `--fit wls`) against the best of PyKrige's auto fits, and their means over the
+draws. `--quick` runs only the methods of that summary (no exact REML, no per-model REML, no IDW,
+no griddata).
 
 For each terrain (a DEM of ../shared/data, see TERRAINS below) the posts are put in local
 metres (equirectangular about the DEM's centre: the same coordinates for every method), and
@@ -163,11 +170,18 @@ def main():
         i = argv.index("--truth")
         n_truth = int(argv[i + 1])
         del argv[i:i + 2]
+    seeds = [15]
+    if "--seeds" in argv:
+        i = argv.index("--seeds")
+        seeds = [int(v) for v in argv[i + 1].split(",")]
+        del argv[i:i + 2]
     skip_pyk = "--skip-pykrige" in argv
+    quick = "--quick" in argv
     names = [a for a in argv if not a.startswith("--")] or list(TERRAINS)
     os.makedirs(OUT, exist_ok=True)
-    for name in names:
-        rng = np.random.default_rng(15)
+    summary = {}
+    for name, seed in ((n, s) for n in names for s in seeds):
+        rng = np.random.default_rng(seed)
         d, t = split(*TERRAINS[name](), rng, n_truth)
         dpath, tpath = os.path.join(OUT, f"{name}-data.csv"), os.path.join(OUT, f"{name}-targets.csv")
         np.savetxt(dpath, d, delimiter=",", header="x,y,z", comments="", fmt="%.10g")
@@ -176,9 +190,10 @@ def main():
         rmse = lambda e: float(np.sqrt(np.mean((e - t[:, 2]) ** 2)))
         rows = []
         o = os.path.join(OUT, f"{name}-out.csv")
-        for label, flags in (("reml", ["--fit", "reml"]),
-                             ("reml, exact", ["--fit", "reml", "--reml-block", "0"]),
-                             ("wls", ["--fit", "wls"])):
+        autos = (("reml", ["--fit", "reml"]),
+                 ("reml, exact", ["--fit", "reml", "--reml-block", "0"]),
+                 ("wls", ["--fit", "wls"]))
+        for label, flags in (a for a in autos if not (quick and a[0] == "reml, exact")):
             vj = os.path.join(OUT, f"{name}-auto-{label.replace(', ', '-')}.json")
             run(["variogram", "--data", dpath, "--drift", "linear", "-o", vj] + flags)
             m = json.load(open(vj))["model"]
@@ -186,7 +201,8 @@ def main():
             extra = ["--variogram", "auto"] + flags if label != "wls" else ["--variogram", vj]
             r = terramesh_uk(dpath, tpath, o, extra)
             rows.append((f"terramesh UK auto ({label})", rmse(r), describe(m)))
-        for model in ("spherical", "exponential", "gaussian", "matern", "power", "linear"):
+        for model in () if quick else ("spherical", "exponential", "gaussian", "matern", "power",
+                                       "linear"):
             vj = os.path.join(OUT, f"{name}-{model}.json")
             try:
                 run(["variogram", "--data", dpath, "--model", model, "--fit", "reml", "--drift",
@@ -196,24 +212,49 @@ def main():
                              describe(json.load(open(vj))["model"])))
             except RuntimeError as e:
                 rows.append((f"terramesh UK {model} (REML)", float("nan"), str(e)[-80:]))
-        run(["interpolate", "--data", dpath, "--targets", tpath, "--method", "idw", "--neighbors",
-             "16", "--power", "2", "-o", o])
-        rows.append(("terramesh IDW 16 neighbours", rmse(predict_csv(o)), ""))
+        if not quick:
+            run(["interpolate", "--data", dpath, "--targets", tpath, "--method", "idw",
+                 "--neighbors", "16", "--power", "2", "-o", o])
+            rows.append(("terramesh IDW 16 neighbours", rmse(predict_csv(o)), ""))
         if not skip_pyk:
             for model in ("spherical", "exponential", "gaussian", "power", "linear"):
                 e, par = pykrige_uk(d, t, model)
                 rows.append((f"PyKrige UK {model} (its auto fit)", rmse(e),
                              ", ".join(f"{v:.4g}" for v in par)))
-        c = griddata(d[:, :2], d[:, 2], t[:, :2], method="cubic")
-        ok = np.isfinite(c)
-        rows.append(("scipy griddata cubic", rmse(np.where(ok, c, t[:, 2])),
-                     f"{(~ok).sum()} targets outside"))
-        print(f"\n### {name}: {len(d)} data, {len(t)} truth posts, {ext[0]:.1f} x {ext[1]:.1f} km, "
+        if not quick:
+            c = griddata(d[:, :2], d[:, 2], t[:, :2], method="cubic")
+            ok = np.isfinite(c)
+            rows.append(("scipy griddata cubic", rmse(np.where(ok, c, t[:, 2])),
+                         f"{(~ok).sum()} targets outside"))
+        summary.setdefault(name, []).append((seed, dict((r[0], r[1]) for r in rows)))
+        print(f"\n### {name} (seed {seed}): {len(d)} data, {len(t)} truth posts, {ext[0]:.1f} x {ext[1]:.1f} km, "
               f"z {t[:, 2].min():.0f}-{t[:, 2].max():.0f} m\n")
         print("| method | RMSE m | model |\n|---|---|---|")
         for label, v, m in rows:
             print(f"| {label} | {v:.2f} | {m} |")
         sys.stdout.flush()
+    if len(seeds) > 1 and not skip_pyk:
+        print_summary(summary)
+
+
+def print_summary(summary):
+    """Per terrain and draw: terramesh UK auto (REML, WLS) against the best PyKrige auto fit."""
+    print("\n### Summary over the draws (RMSE m)\n")
+    print("| terrain | seed | terramesh UK auto (reml) | terramesh UK auto (wls) | best PyKrige auto fit "
+          "| reml minus best PyKrige |\n|---|---|---|---|---|---|")
+    for name, draws in summary.items():
+        acc = []
+        for seed, r in draws:
+            pyk = {k: v for k, v in r.items() if k.startswith("PyKrige")}
+            best = min(pyk, key=pyk.get)
+            a, w, b = r["terramesh UK auto (reml)"], r["terramesh UK auto (wls)"], pyk[best]
+            acc.append((a, w, b))
+            model = best.split()[2]
+            print(f"| {name} | {seed} | {a:.3f} | {w:.3f} | {b:.3f} ({model}) | {a - b:+.3f} |")
+        a, w, b = (float(np.mean(v)) for v in zip(*acc))
+        wins = sum(x[0] <= x[2] for x in acc)
+        print(f"| {name} | mean of {len(acc)} | {a:.3f} | {w:.3f} | {b:.3f} | {a - b:+.3f} "
+              f"(reml at least as good in {wins} of {len(acc)}) |")
 
 
 def describe(m):
