@@ -13,9 +13,9 @@ use super::geodata::LagArgs;
 /// Writes JSON with the lag classes (mean distance, semivariance, pair count), the fitted
 /// model (nugget, psill, range: GSLIB practical range) and the fit error; with --model auto
 /// also every candidate with its cross-validation RMSE and, for a REML fit (`--fit reml`;
-/// the default is wls), its restricted log-likelihood and AIC (`log_likelihood`, `aic`; `fit.objective` is
-/// then −ℓ) and a `selection` section (method, drift, number of data). The file can be given
-/// to `interpolate --variogram FILE`.
+/// the default is wls), its restricted log-likelihood and AIC (`log_likelihood`, `aic`;
+/// `fit.objective` is then −ℓ) and a `selection` section (method, drift, number of data). The
+/// file can be given to `interpolate --variogram FILE`.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:\n  \
     terramesh variogram --data pts.csv -o variogram.json --plot variogram.svg\n  \
