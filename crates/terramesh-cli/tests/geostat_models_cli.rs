@@ -400,3 +400,74 @@ fn variance_grid_is_the_variance_column_on_the_same_nodes() {
         }
     }
 }
+
+/// `--fit loo`: the file's objective is the leave-one-out RMSE that `terramesh cv` finds for
+/// the written model, with the same drift; `interpolate --variogram auto --fit loo` uses it.
+#[test]
+fn loo_fit_writes_the_loo_rmse_that_cv_recomputes() {
+    let dir = tempfile::tempdir().unwrap();
+    let v = dir.path().join("v.json");
+    let data = fx("data-srtm.csv");
+    ok(&[
+        "variogram",
+        "--data",
+        &data,
+        "--model",
+        "exponential",
+        "--fit",
+        "loo",
+        "--drift",
+        "linear",
+        "-o",
+        v.to_str().unwrap(),
+    ]);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&v).unwrap()).unwrap();
+    assert_eq!(json["selection"]["method"].as_str(), Some("loo"), "{json}");
+    let objective = json["fit"]["objective"].as_f64().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "cv",
+            "--data",
+            &data,
+            "--method",
+            "uk",
+            "--drift",
+            "linear",
+            "--variogram",
+        ])
+        .arg(&v)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let rmse: f64 = out
+        .lines()
+        .find_map(|l| l.strip_prefix("rmse,"))
+        .unwrap_or_else(|| panic!("an rmse line in {out}"))
+        .parse()
+        .unwrap();
+    assert!(
+        (rmse - objective).abs() <= 1e-9 * rmse,
+        "{rmse} {objective}"
+    );
+    let est = dir.path().join("out.csv");
+    ok(&[
+        "interpolate",
+        "--data",
+        &data,
+        "--targets",
+        &fx("targets-srtm.csv"),
+        "--method",
+        "uk",
+        "--variogram",
+        "auto",
+        "--fit",
+        "loo",
+        "-o",
+        est.to_str().unwrap(),
+    ]);
+    assert_eq!(rows(&est).len(), 205);
+    let (bad, err) = run(&["variogram", "--data", &data, "--fit", "lo"]);
+    assert!(!bad && err.contains("lo") && err.contains("loo"), "{err}");
+}

@@ -41,11 +41,16 @@ pub enum FitMethod {
     /// `--fit` and the project file's `fit` (REML costs seconds where WLS costs milliseconds).
     #[default]
     Wls,
+    /// The parameters that minimise the leave-one-out RMSE of kriging with the drift, from
+    /// the WLS start ([`fit_loo`](crate::fit_loo)), the model chosen by the same RMSE
+    /// ([`fit_auto_loo`]).
+    Loo,
 }
 
 terramesh_core::named_enum!(FitMethod, "fit method", [
     FitMethod::Reml => "reml",
     FitMethod::Wls => "wls",
+    FitMethod::Loo => "loo",
 ]);
 
 /// Settings of [`fit_auto_reml`].
@@ -124,6 +129,46 @@ pub fn fit_auto_reml(
     kinds: &[ModelKind],
     s: &AutoSettings,
 ) -> Result<(Fit, Vec<Candidate>, Selection)> {
+    fit_auto_by(data, lags, kinds, s, FitMethod::Reml)
+}
+
+/// Fits every model of `kinds` by minimising its leave-one-out RMSE of kriging with the
+/// drift (from its WLS fit to `lags`; [`fit_loo`](crate::fit_loo)) and picks the one with
+/// the least. Returns the chosen fit (its `objective` is that RMSE), every candidate (with
+/// its RMSE and the restricted log-likelihood ℓ of the fitted model) and what chose it.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{experimental, fit_auto_loo, fit_auto_reml, AutoSettings, Data, Duplicates, LagSettings, ModelKind};
+/// let xy: Vec<[f64; 2]> = (0..225).map(|i| [(i % 15) as f64 * 10.0, (i / 15) as f64 * 10.0]).collect();
+/// let z: Vec<f64> = xy.iter().map(|p| (p[0] / 40.0).sin() + (p[1] / 55.0).cos()).collect();
+/// let data = Data::new(xy, z, Duplicates::Reject)?;
+/// let lags = experimental(&data, &LagSettings::default())?;
+/// let kinds = [ModelKind::Spherical, ModelKind::Exponential, ModelKind::Gaussian];
+/// let (best, all, _) = fit_auto_loo(&data, &lags, &kinds, &AutoSettings::default())?;
+/// let min = all.iter().filter_map(|c| c.cv_rmse).fold(f64::MAX, f64::min);
+/// assert_eq!(best.objective, min);
+/// // Its leave-one-out RMSE is at most REML's, which it minimises rather than reports.
+/// let (_, reml, _) = fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default())?;
+/// assert!(min <= reml.iter().filter_map(|c| c.cv_rmse).fold(f64::MAX, f64::min));
+/// # Ok(()) }
+/// ```
+pub fn fit_auto_loo(
+    data: &Data,
+    lags: &[Lag],
+    kinds: &[ModelKind],
+    s: &AutoSettings,
+) -> Result<(Fit, Vec<Candidate>, Selection)> {
+    fit_auto_by(data, lags, kinds, s, FitMethod::Loo)
+}
+
+fn fit_auto_by(
+    data: &Data,
+    lags: &[Lag],
+    kinds: &[ModelKind],
+    s: &AutoSettings,
+    method: FitMethod,
+) -> Result<(Fit, Vec<Candidate>, Selection)> {
     let blocks = Blocks::new(data, s.drift, s.block)?;
     let sub = match s.loo_points {
         Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
@@ -132,8 +177,12 @@ pub fn fit_auto_reml(
     let mut cands = Vec::new();
     let mut best: Option<(f64, Fit)> = None;
     for &kind in kinds {
-        match fit_one(&blocks, &sub, lags, kind, s) {
-            Ok((fit, reml, cv)) => {
+        let one = match method {
+            FitMethod::Loo => fit_one_loo(&blocks, &sub, lags, kind, s),
+            _ => fit_one(&blocks, &sub, lags, kind, s),
+        };
+        match one {
+            Ok((fit, ll, aic, cv)) => {
                 if let Some(cv) = cv {
                     if best.as_ref().is_none_or(|b| cv < b.0) {
                         best = Some((cv, fit.clone()));
@@ -144,8 +193,8 @@ pub fn fit_auto_reml(
                     fit: Some(fit),
                     cv_rmse: cv,
                     error: None,
-                    log_likelihood: Some(reml.log_likelihood),
-                    aic: Some(reml.aic()),
+                    log_likelihood: ll,
+                    aic,
                 });
             }
             Err(e) => cands.push(Candidate {
@@ -159,7 +208,7 @@ pub fn fit_auto_reml(
         }
     }
     let selection = Selection {
-        method: FitMethod::Reml,
+        method,
         drift: Some(s.drift),
         points: blocks.n,
         blocks: blocks.blocks(),
@@ -178,15 +227,19 @@ pub fn fit_auto_reml(
     }
 }
 
-/// One candidate: WLS start, REML fit (best ν for Matérn), leave-one-out RMSE.
-fn fit_one(
+/// One candidate's fit, restricted log-likelihood, AIC and leave-one-out RMSE.
+type Fitted = (Fit, Option<f64>, Option<f64>, Option<f64>);
+
+/// The WLS starting fits of `kind` (Matérn at ν = 3/2 and 5/2), or one from the data's
+/// variance where WLS fails.
+fn starts(
     c: &Blocks,
     sub: &Data,
     lags: &[Lag],
     kind: ModelKind,
     s: &AutoSettings,
-) -> Result<(Fit, RemlFit, Option<f64>)> {
-    let starts: Vec<Variogram> = match fit_model(lags, kind, s.weighting) {
+) -> Result<Vec<Variogram>> {
+    Ok(match fit_model(lags, kind, s.weighting) {
         Ok(f) if kind == ModelKind::Matern => [1.5, 2.5]
             .iter()
             .map(|&nu| {
@@ -211,7 +264,51 @@ fn fit_one(
                 anisotropy: None,
             }]
         }
+    })
+}
+
+/// One candidate by leave-one-out: WLS starts, each minimised, the least RMSE kept.
+fn fit_one_loo(
+    c: &Blocks,
+    sub: &Data,
+    lags: &[Lag],
+    kind: ModelKind,
+    s: &AutoSettings,
+) -> Result<Fitted> {
+    let starts = starts(c, sub, lags, kind, s)?;
+    let mut best: Option<crate::LooFit> = None;
+    let mut last_err = None;
+    for st in &starts {
+        match crate::loo_fit::fit_loo_within(sub, s.drift, st, c.hmin, c.hmax) {
+            Ok(r) => {
+                if best.as_ref().is_none_or(|b| r.cv_rmse < b.cv_rmse) {
+                    best = Some(r);
+                }
+            }
+            Err(e) => last_err = Some(e),
+        }
+    }
+    let Some(f) = best else {
+        return Err(last_err.expect("at least one start"));
     };
+    let ll = c.log_likelihood(&f.variogram);
+    let fit = Fit {
+        rmse: lag_rmse(lags, &f.variogram),
+        variogram: f.variogram,
+        objective: f.cv_rmse,
+    };
+    Ok((fit, ll, None, Some(f.cv_rmse)))
+}
+
+/// One candidate: WLS start, REML fit (best ν for Matérn), leave-one-out RMSE.
+fn fit_one(
+    c: &Blocks,
+    sub: &Data,
+    lags: &[Lag],
+    kind: ModelKind,
+    s: &AutoSettings,
+) -> Result<Fitted> {
+    let starts = starts(c, sub, lags, kind, s)?;
     let mut best: Option<RemlFit> = None;
     let mut last_err = None;
     for st in &starts {
@@ -240,7 +337,7 @@ fn fit_one(
         rmse,
     };
     let cv = loo_rmse(sub, &reml.variogram, s.drift);
-    Ok((fit, reml, cv))
+    Ok((fit, Some(reml.log_likelihood), Some(reml.aic()), cv))
 }
 
 /// RMSE of a model against the experimental variogram over the classes with pairs (as

@@ -72,6 +72,7 @@ mod idw;
 mod ked;
 mod ked_cv;
 mod linalg;
+mod loo_fit;
 mod model;
 mod neighbourhood;
 mod nested;
@@ -86,7 +87,9 @@ mod system;
 pub use aniso::{
     fit_anisotropy, fit_anisotropy_lags, AnisotropyFit, DirectionalLags, DEFAULT_DIRECTIONS,
 };
-pub use auto::{fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection, DEFAULT_LOO_POINTS};
+pub use auto::{
+    fit_auto_loo, fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection, DEFAULT_LOO_POINTS,
+};
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
 pub use error::{GeostatError, Result};
@@ -102,6 +105,7 @@ pub use global::{DenseRoute, GlobalKriging, BLOCK, TRUNCATION_TOLERANCE};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use ked::ExternalDriftKriging;
 pub use ked_cv::cross_validate_external;
+pub use loo_fit::{fit_loo, LooFit};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use nested::{fit_nested, MAX_STRUCTURES};

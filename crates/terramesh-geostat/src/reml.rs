@@ -285,6 +285,15 @@ impl Blocks {
         Some((ll, s))
     }
 
+    /// The (composite) restricted log-likelihood of `v` itself, no scale profiled; `None`
+    /// where a block's `M` is not positive definite.
+    pub(crate) fn log_likelihood(&self, v: &Variogram) -> Option<f64> {
+        let (ll, s) = self.profile(v)?;
+        // ℓ at scale 1 from ℓ at ŝ: ℓ(1) = ℓ(ŝ) + ½ m (ln ŝ + 1 − ŝ).
+        let m = self.contrasts() as f64;
+        Some(ll + 0.5 * m * (s.ln() + 1.0 - s))
+    }
+
     /// Number of blocks.
     pub(crate) fn blocks(&self) -> usize {
         self.blocks.len()
@@ -344,10 +353,7 @@ pub fn reml_log_likelihood(
 ) -> Result<f64> {
     variogram.validate()?;
     let c = Blocks::new(data, drift, block)?;
-    let (ll, s) = c.profile(variogram).ok_or_else(not_pd)?;
-    // ℓ at scale 1 from ℓ at ŝ: ℓ(1) = ℓ(ŝ) + ½ m (ln ŝ + 1 − ŝ).
-    let m = c.contrasts() as f64;
-    Ok(ll + 0.5 * m * (s.ln() + 1.0 - s))
+    c.log_likelihood(variogram).ok_or_else(not_pd)
 }
 
 fn not_pd() -> GeostatError {
@@ -385,18 +391,18 @@ pub fn fit_reml(
     fit_contrasts(&c, start)
 }
 
-/// How the free parameters map to a unit-scale variogram.
-struct Layout<'a> {
-    start: &'a Variogram,
-    bounded: bool,
+/// How the free parameters map to a unit-scale variogram (shared with the leave-one-out fit).
+pub(crate) struct Layout<'a> {
+    pub(crate) start: &'a Variogram,
+    pub(crate) bounded: bool,
     /// log-range bounds.
-    lo: f64,
-    hi: f64,
+    pub(crate) lo: f64,
+    pub(crate) hi: f64,
 }
 
 impl Layout<'_> {
     /// θ = [ln(c0/c1), ln(c_i/c1) for i >= 2, ln a_i...] (bounded) or [ln(c0/c1), α?].
-    fn start_theta(&self) -> Vec<f64> {
+    pub(crate) fn start_theta(&self) -> Vec<f64> {
         let s = self.start;
         let c1 = s.structures.first().map_or(1.0, |t| t.psill).max(1e-300);
         let nug = (s.nugget.max(1e-4 * c1) / c1).ln();
@@ -414,7 +420,7 @@ impl Layout<'_> {
         th
     }
 
-    fn steps(&self, d: usize) -> Vec<f64> {
+    pub(crate) fn steps(&self, d: usize) -> Vec<f64> {
         let k = self.start.structures.len();
         (0..d)
             .map(|i| {
@@ -429,7 +435,7 @@ impl Layout<'_> {
             .collect()
     }
 
-    fn variogram(&self, th: &[f64]) -> Option<Variogram> {
+    pub(crate) fn variogram(&self, th: &[f64]) -> Option<Variogram> {
         let s = self.start;
         let k = s.structures.len();
         let mut v = s.clone();

@@ -1,6 +1,7 @@
 //! Fitting a variogram by plan: a named model or `auto`, by weighted least squares (the
-//! default) or REML (with the drift of the kriging that will use it). One function for `terramesh
-//! variogram`, `interpolate --variogram auto`, `cv` and `build`.
+//! default), REML (with the drift of the kriging that will use it) or the least leave-one-out
+//! RMSE of that kriging (`loo`). One function for `terramesh variogram`, `interpolate
+//! --variogram auto`, `cv` and `build`.
 //!
 //! ```
 //! use terramesh::fitting::{fit, FitPlan};
@@ -18,13 +19,17 @@
 //! assert!(wls.selection.is_none() && wls.candidates.is_empty()); // a named model: WLS by default
 //! let plan = FitPlan { model: "spherical".into(), method: Some(FitMethod::Reml), ..FitPlan::default() };
 //! assert_eq!(fit(&data, &lags, &plan)?.selection.unwrap().points, 144);
+//! let loo = FitPlan { model: "spherical".into(), method: Some(FitMethod::Loo), ..FitPlan::default() };
+//! let f = fit(&data, &lags, &loo)?;
+//! assert_eq!(f.selection.unwrap().method, FitMethod::Loo);
+//! assert!(f.fit.objective > 0.0); // its leave-one-out RMSE
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 use terramesh_geostat::{
-    fit_anisotropy, fit_auto, fit_auto_reml, fit_model, fit_nested, fit_reml, AutoSettings,
-    Candidate, Data, DirectionalLags, Fit, FitMethod, Lag, LagSettings, ModelKind, Named,
-    Selection, DEFAULT_DIRECTIONS, MAX_STRUCTURES,
+    fit_anisotropy, fit_auto, fit_auto_loo, fit_auto_reml, fit_loo, fit_model, fit_nested,
+    fit_reml, AutoSettings, Candidate, Data, DirectionalLags, Fit, FitMethod, Lag, LagSettings,
+    ModelKind, Named, Selection, Variogram, DEFAULT_DIRECTIONS, MAX_STRUCTURES,
 };
 
 use crate::error::{Error, Result};
@@ -36,7 +41,7 @@ pub struct FitPlan {
     /// `auto`, a model name ([`ModelKind`]) or a nested sum of up to three names joined by
     /// `+` (`spherical+exponential`), fitted jointly.
     pub model: String,
-    /// REML or WLS; `None`: [`FitMethod`]'s default (WLS).
+    /// REML, loo or WLS; `None`: [`FitMethod`]'s default (WLS).
     pub method: Option<FitMethod>,
     /// The drift, the weights of the WLS fits and the REML subset.
     pub auto: AutoSettings,
@@ -165,7 +170,10 @@ pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     .map_err(|e| Error::setting(Setting::Anisotropy, "auto", e.to_string()))?;
     fitted.directions = af.directions;
     fitted.fit = af.fit;
-    if plan.method == Some(FitMethod::Reml) {
+    if plan.method == Some(FitMethod::Loo) {
+        let (f, _) = loo(data, lags, plan, &fitted.fit.variogram)?;
+        fitted.fit = f;
+    } else if plan.method == Some(FitMethod::Reml) {
         let r = fit_reml(
             data,
             plan.auto.drift,
@@ -189,6 +197,15 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
         return Ok(match method {
             FitMethod::Reml => {
                 let (fit, candidates, s) = fit_auto_reml(data, lags, ModelKind::ALL, &plan.auto)?;
+                Fitted {
+                    fit,
+                    candidates,
+                    selection: Some(s),
+                    directions: Vec::new(),
+                }
+            }
+            FitMethod::Loo => {
+                let (fit, candidates, s) = fit_auto_loo(data, lags, ModelKind::ALL, &plan.auto)?;
                 Fitted {
                     fit,
                     candidates,
@@ -221,6 +238,15 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             directions: Vec::new(),
         });
     }
+    if method == FitMethod::Loo {
+        let (fit, selection) = loo(data, lags, plan, &wls.variogram)?;
+        return Ok(Fitted {
+            fit,
+            candidates: Vec::new(),
+            selection: Some(selection),
+            directions: Vec::new(),
+        });
+    }
     let r = fit_reml(data, plan.auto.drift, &wls.variogram, plan.auto.block)?;
     let rmse = terramesh_geostat::lag_rmse(lags, &r.variogram);
     Ok(Fitted {
@@ -239,4 +265,24 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
         }),
         directions: Vec::new(),
     })
+}
+
+/// `start`'s model fitted by leave-one-out (its `objective` is the leave-one-out RMSE).
+fn loo(data: &Data, lags: &[Lag], plan: &FitPlan, start: &Variogram) -> Result<(Fit, Selection)> {
+    let f = fit_loo(data, start, &plan.auto)?;
+    let selection = Selection {
+        method: FitMethod::Loo,
+        drift: Some(plan.auto.drift),
+        points: f.points,
+        blocks: 1,
+        cv_points: Some(f.points),
+    };
+    Ok((
+        Fit {
+            rmse: terramesh_geostat::lag_rmse(lags, &f.variogram),
+            variogram: f.variogram,
+            objective: f.cv_rmse,
+        },
+        selection,
+    ))
 }

@@ -84,9 +84,11 @@ pub struct LagArgs {
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
     pub max_points: usize,
     /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
-    /// kriging's drift, from the WLS fit) or wls (weighted least squares on the lag classes).
-    /// With auto, both keep the model of least leave-one-out RMSE (REML: of kriging with the
-    /// drift; WLS: of ordinary kriging in 32 neighbours). Default: wls.
+    /// kriging's drift, from the WLS fit), loo (the parameters of least leave-one-out RMSE of
+    /// kriging with the drift, from the WLS fit; the scale from the standardised errors) or
+    /// wls (weighted least squares on the lag classes). With auto, all keep the model of least
+    /// leave-one-out RMSE (REML and loo: of kriging with the drift; WLS: of ordinary kriging
+    /// in 32 neighbours). Default: wls.
     #[arg(long, value_parser = crate::named::<FitMethod>())]
     pub fit: Option<FitMethod>,
     /// REML in spatial blocks of at most this many data (a composite likelihood; each

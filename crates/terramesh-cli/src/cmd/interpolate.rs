@@ -23,9 +23,9 @@ pub struct MethodArgs {
     pub mean: Option<f64>,
     #[command(flatten)]
     pub model: ModelArgs,
-    /// auto (fit every model to the data by --fit's method, wls by default or reml with the
-    /// kriging's drift, and keep the one of least leave-one-out RMSE) or a JSON file written
-    /// by `terramesh variogram`.
+    /// auto (fit every model to the data by --fit's method, wls by default, reml or loo with
+    /// the kriging's drift, and keep the one of least leave-one-out RMSE) or a JSON file
+    /// written by `terramesh variogram`.
     #[arg(long)]
     pub variogram: Option<String>,
     #[command(flatten)]

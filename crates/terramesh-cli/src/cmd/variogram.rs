@@ -14,7 +14,9 @@ use super::geodata::LagArgs;
 /// model (nugget, psill, range: GSLIB practical range) and the fit error; with --model auto
 /// also every candidate with its cross-validation RMSE and, for a REML fit (`--fit reml`;
 /// the default is wls), its restricted log-likelihood and AIC (`log_likelihood`, `aic`;
-/// `fit.objective` is then −ℓ) and a `selection` section (method, drift, number of data). The
+/// `fit.objective` is then −ℓ), for a leave-one-out fit (`--fit loo`) the restricted
+/// log-likelihood of the fitted model (`fit.objective` is then its leave-one-out RMSE), and
+/// for both a `selection` section (method, drift, number of data). The
 /// file can be given to `interpolate --variogram FILE`.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:\n  \
@@ -29,7 +31,8 @@ pub struct Args {
     data: PathBuf,
     /// Model to fit: auto (default), spherical, exponential, gaussian, matern, power, linear,
     /// nugget, or a nested sum of up to three joined by + (spherical+exponential: nugget and
-    /// every structure fitted jointly by WLS, then REML with --fit reml).
+    /// every structure fitted jointly by WLS, then REML with --fit reml or leave-one-out with
+    /// --fit loo).
     #[arg(long, default_value = "auto")]
     model: String,
     /// auto: fit geometric anisotropy too, from directional variograms along 8 azimuths (0,
@@ -40,8 +43,8 @@ pub struct Args {
     anisotropy: Option<String>,
     #[command(flatten)]
     lag: LagArgs,
-    /// The drift that a REML fit filters out: that of the kriging that will use the model
-    /// (constant for ok and sk, the --drift of uk).
+    /// The drift that a REML fit filters out and a leave-one-out fit kriges with: that of the
+    /// kriging that will use the model (constant for ok and sk, the --drift of uk).
     #[arg(long, value_parser = crate::named::<Drift>(), default_value_t = Drift::Linear)]
     drift: Drift,
     /// Points at one location.

@@ -280,6 +280,16 @@ pub fn write_report(
         }
         vb.push(Block::Table {
             caption: match it.selection {
+                Some(s) if s.method == terramesh_geostat::FitMethod::Loo => format!(
+                    "Models tried by the automatic fit: each model's parameters by the least leave-one-out RMSE of kriging with a {} drift on {} samples, the model chosen by the same RMSE (the likelihood is that of the fitted model, in {})",
+                    s.drift.map_or("constant", terramesh_geostat::Named::name),
+                    s.cv_points.unwrap_or(s.points),
+                    if s.blocks > 1 {
+                        format!("{} spatial blocks", s.blocks)
+                    } else {
+                        "one block".into()
+                    }
+                ),
                 Some(s) => format!(
                     "Models tried by the automatic fit: REML with a {} drift on {} samples ({}), chosen by the least leave-one-out RMSE",
                     s.drift.map_or("constant", terramesh_geostat::Named::name),

@@ -248,7 +248,7 @@ pub struct LagOptions {
     pub weights: Weighting,
     /// At most this many data for the experimental variogram (0: all).
     pub max_points: usize,
-    /// REML or WLS (`None`: the default of [`FitPlan`]).
+    /// REML, loo or WLS (`None`: the default of [`FitPlan`]).
     pub fit: Option<FitMethod>,
     /// REML in blocks of at most this many data (0: exact REML).
     pub reml_block: usize,

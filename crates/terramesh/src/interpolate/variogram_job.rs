@@ -48,7 +48,7 @@ pub struct VariogramJob {
     pub anisotropy: Option<String>,
     /// The lag classes and the fit.
     pub lag: LagOptions,
-    /// The drift a REML fit filters out.
+    /// The drift a REML fit filters out (and a leave-one-out fit kriges with).
     pub drift: Drift,
     /// What to do with data at one location.
     pub duplicates: Duplicates,

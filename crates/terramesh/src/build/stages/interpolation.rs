@@ -22,7 +22,7 @@ pub struct Interpolated {
     pub lags: Vec<Lag>,
     /// Candidate models tried by `auto`.
     pub candidates: Vec<CandidateSummary>,
-    /// What chose the model (a REML fit only).
+    /// What chose the model (a REML or leave-one-out fit only).
     pub selection: Option<Selection>,
     /// UK elevation at each mesh vertex.
     pub uk: Vec<f64>,
@@ -58,7 +58,7 @@ pub struct Model {
     pub lags: Vec<Lag>,
     /// Candidate models tried by `auto`.
     pub candidates: Vec<CandidateSummary>,
-    /// What chose the model (a REML fit only).
+    /// What chose the model (a REML or leave-one-out fit only).
     pub selection: Option<Selection>,
 }
 
@@ -107,7 +107,8 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     let variogram = if let Some(v) = &ip.model {
         v.variogram().map_err(crate::Error::invalid)?
     } else if ip.variogram == "auto" {
-        // REML filters out the drift of the UK that uses the model (constant without UK).
+        // REML filters out, and loo kriges with, the drift of the UK that uses the model
+        // (constant without UK).
         let drift = if ip.methods.contains(&InterpolationMethod::Universal) {
             ip.drift
         } else {
