@@ -5,13 +5,13 @@ Run from the repository root after `cargo build --release -p terramesh-cli`, in 
 own (`bench/hidden_truth-requirements.txt`):
     python3 -m venv .venv-hidden && .venv-hidden/bin/pip install -r bench/hidden_truth-requirements.txt
     .venv-hidden/bin/python bench/hidden_truth.py [TERRAIN ...] [--truth N] [--skip-pykrige]
-        [--seeds S1,S2,...] [--quick]
+        [--seeds S1,S2,...] [--quick] [--loo]
 
 `--seeds` draws the data and truth again with each seed (default 15, the seed of the tables in
 docs/geostatistics.md) and ends with a summary per terrain: for each draw, terramesh UK auto
 (`--fit reml` and `--fit wls`) against the best of PyKrige's auto fits, and their means over the
 draws. `--quick` runs only the methods of that summary (no exact REML, no per-model REML, no IDW,
-no griddata).
+no griddata). `--loo` adds terramesh UK auto with `--fit loo` (its column is nan without it).
 
 For each terrain (a DEM of ../shared/data, see TERRAINS below) the posts are put in local
 metres (equirectangular about the DEM's centre: the same coordinates for every method), and
@@ -21,7 +21,7 @@ N of them, default 20,000, so that every method predicts the same points). Metho
 
 - terramesh `interpolate --method uk --drift linear --variogram auto` with `--fit reml` (its
   block composite likelihood, the default `--reml-block`), `--fit reml --reml-block 0` (exact
-  REML on all data) and `--fit wls` (the former automatic fit);
+  REML on all data), `--fit wls` (the former automatic fit) and, with `--loo`, `--fit loo`;
 - terramesh UK with each model fitted alone by REML (`variogram --model M --fit reml`);
 - terramesh IDW, 16 neighbours, power 2;
 - PyKrige `UniversalKriging(..., drift_terms=["regional_linear"])` with its own automatic fit
@@ -177,6 +177,7 @@ def main():
         del argv[i:i + 2]
     skip_pyk = "--skip-pykrige" in argv
     quick = "--quick" in argv
+    with_loo = "--loo" in argv
     names = [a for a in argv if not a.startswith("--")] or list(TERRAINS)
     os.makedirs(OUT, exist_ok=True)
     summary = {}
@@ -194,13 +195,13 @@ def main():
                  ("reml, exact", ["--fit", "reml", "--reml-block", "0"]),
                  ("wls", ["--fit", "wls"]),
                  ("loo", ["--fit", "loo"]))
-        for label, flags in (a for a in autos if not (quick and a[0] == "reml, exact")):
+        for label, flags in (a for a in autos
+                             if not (quick and a[0] == "reml, exact") and (a[0] != "loo" or with_loo)):
             vj = os.path.join(OUT, f"{name}-auto-{label.replace(', ', '-')}.json")
             run(["variogram", "--data", dpath, "--drift", "linear", "-o", vj] + flags)
             m = json.load(open(vj))["model"]
-            # REML: `interpolate --variogram auto` itself (the same fit as the file's)
-            extra = ["--variogram", "auto"] + flags if label != "wls" else ["--variogram", vj]
-            r = terramesh_uk(dpath, tpath, o, extra)
+            # the file's model: `interpolate --variogram auto` makes the same fit (deterministic)
+            r = terramesh_uk(dpath, tpath, o, ["--variogram", vj])
             rows.append((f"terramesh UK auto ({label})", rmse(r), describe(m)))
         for model in () if quick else ("spherical", "exponential", "gaussian", "matern", "power",
                                        "linear"):
@@ -249,7 +250,7 @@ def print_summary(summary):
         for seed, r in draws:
             pyk = {k: v for k, v in r.items() if k.startswith("PyKrige")}
             best = min(pyk, key=pyk.get)
-            lo, a, w, b = (r["terramesh UK auto (loo)"], r["terramesh UK auto (reml)"],
+            lo, a, w, b = (r.get("terramesh UK auto (loo)", float("nan")), r["terramesh UK auto (reml)"],
                            r["terramesh UK auto (wls)"], pyk[best])
             acc.append((lo, a, w, b))
             model = best.split()[2]

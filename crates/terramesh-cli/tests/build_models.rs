@@ -160,7 +160,7 @@ fn the_report_names_the_reml_likelihood_of_the_automatic_fit() {
         .expect("the REML caption in report.html");
     let caption = &html[at..at + html[at..].find("</").unwrap()];
     assert!(
-        caption.ends_with("chosen by the least leave-one-out RMSE"),
+        caption.ends_with("every model alone and every pair nested, chosen by the least AIC"),
         "{caption}"
     );
     let number_after = |word: &str| -> usize {

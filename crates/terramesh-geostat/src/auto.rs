@@ -4,12 +4,18 @@
 //! variogram ([`fit_model`]); that fit is only the starting point of a REML fit with the
 //! drift of the kriging that will use it ([`fit_reml`](crate::fit_reml), in blocks of
 //! [`DEFAULT_REML_BLOCK`] data); Matérn is fitted for ν = 3/2 and 5/2 (ν = ½ is the
-//! exponential) and keeps the better. Among the REML fits, the model with the least
-//! leave-one-out RMSE of kriging with the drift on all the data (Dubrule's closed form for a
-//! bounded model, one factorisation; 64 neighbours for an unbounded one; above
-//! [`AutoSettings::loo_points`] data on a fixed pseudo-random subset) is chosen: each
-//! model's parameters by likelihood, the model by its prediction error. ℓ and the AIC
-//! `2k − 2ℓ` of every candidate are reported beside it.
+//! exponential) and keeps the better. The family is every model alone and every pair of
+//! bounded structures nested (nugget + two structures fitted jointly, from their joint WLS
+//! fit): a short structure beside a long one lets the variability below the data spacing be
+//! continuous rather than all nugget. Among the REML fits, the one of least AIC `2k − 2ℓ`
+//! (ℓ comparable across models, which share the data, the drift and the blocks) is chosen:
+//! parameters and model by likelihood. Each candidate's ℓ, AIC and leave-one-out RMSE of
+//! kriging with the drift (Dubrule's closed form for a bounded model, one factorisation; 64
+//! neighbours for an unbounded one; above [`AutoSettings::loo_points`] data on a fixed
+//! pseudo-random subset) are reported beside it.
+//!
+//! The other principled route, [`FitMethod::Loo`] ([`fit_auto_loo`]), takes each model's
+//! parameters, and the model, by the least leave-one-out RMSE.
 
 use serde::{Deserialize, Serialize};
 
@@ -33,8 +39,8 @@ use crate::reml::{fit_contrasts, Blocks, RemlFit, DEFAULT_REML_BLOCK};
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FitMethod {
-    /// Restricted maximum likelihood from the WLS start, the model chosen by leave-one-out
-    /// RMSE ([`fit_auto_reml`]).
+    /// Restricted maximum likelihood from the WLS start over every model and every nested
+    /// pair, the model chosen by AIC ([`fit_auto_reml`]).
     Reml,
     /// Weighted least squares on the experimental variogram, chosen by leave-one-out RMSE of
     /// ordinary kriging ([`fit_auto`](crate::fit_auto)); the default of the library, the CLI's
@@ -85,7 +91,8 @@ impl Default for AutoSettings {
 /// What chose the model of an automatic fit (the `selection` section of `variogram.json`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Selection {
-    /// `reml` (parameters by REML, the model by leave-one-out RMSE) or `wls`.
+    /// `reml` (parameters and model by REML: the least AIC), `loo` (both by leave-one-out
+    /// RMSE) or `wls`.
     pub method: FitMethod,
     /// The drift of the likelihood (REML only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -104,9 +111,10 @@ fn one() -> usize {
     1
 }
 
-/// Fits every model of `kinds` by REML (from its WLS fit to `lags`) and picks the one with
-/// the least leave-one-out RMSE. Returns the chosen fit (its `objective` is −ℓ), every
-/// candidate (with ℓ, AIC and the leave-one-out RMSE) and what chose it.
+/// Fits every model of `kinds`, and every pair of its bounded models nested, by REML (from
+/// their WLS fits to `lags`) and picks the one of least AIC. Returns the chosen fit (its
+/// `objective` is −ℓ), every candidate (with ℓ, AIC and the leave-one-out RMSE; a nested
+/// one names its second structure in `with`) and what chose it.
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
@@ -117,10 +125,12 @@ fn one() -> usize {
 /// let lags = experimental(&data, &LagSettings::default())?;
 /// let kinds = [ModelKind::Spherical, ModelKind::Exponential, ModelKind::Gaussian];
 /// let (best, all, _) = fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default())?;
-/// let min = all.iter().filter_map(|c| c.cv_rmse).fold(f64::MAX, f64::min);
-/// assert!(all.iter().any(|c| c.fit.as_ref() == Some(&best) && c.cv_rmse == Some(min)));
+/// assert_eq!(all.len(), 3 + 6); // three alone, six nested pairs
+/// assert_eq!(all.iter().filter(|c| c.with.is_some()).count(), 6);
+/// let min = all.iter().filter_map(|c| c.aic).fold(f64::MAX, f64::min);
+/// assert!(all.iter().any(|c| c.fit.as_ref() == Some(&best) && c.aic == Some(min)));
 /// assert!(all.iter().all(|c| c.log_likelihood.is_some() && c.aic.is_some()));
-/// assert_eq!(best.variogram.structures[0].kind, ModelKind::Gaussian); // a smooth surface
+/// assert!(best.variogram.structures.iter().any(|t| t.kind == ModelKind::Gaussian)); // a smooth surface
 /// # Ok(()) }
 /// ```
 pub fn fit_auto_reml(
@@ -174,18 +184,35 @@ fn fit_auto_by(
         Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
         _ => data.clone(),
     };
+    // REML: every model alone, then every pair of bounded structures (nested, fitted
+    // jointly), chosen by AIC; loo: every model alone, chosen by leave-one-out RMSE.
+    let mut jobs: Vec<(ModelKind, Option<ModelKind>)> = kinds.iter().map(|&k| (k, None)).collect();
+    if method == FitMethod::Reml {
+        let b: Vec<ModelKind> = kinds
+            .iter()
+            .copied()
+            .filter(|k| k.bounded() && *k != ModelKind::Nugget)
+            .collect();
+        for i in 0..b.len() {
+            for j in i..b.len() {
+                jobs.push((b[i], Some(b[j])));
+            }
+        }
+    }
     let mut cands = Vec::new();
     let mut best: Option<(f64, Fit)> = None;
-    for &kind in kinds {
-        let one = match method {
-            FitMethod::Loo => fit_one_loo(&blocks, &sub, lags, kind, s),
+    for (kind, with) in jobs {
+        let one = match (method, with) {
+            (FitMethod::Loo, _) => fit_one_loo(&blocks, &sub, lags, kind, s),
+            (_, Some(w)) => fit_one_nested(&blocks, &sub, lags, [kind, w], s),
             _ => fit_one(&blocks, &sub, lags, kind, s),
         };
         match one {
             Ok((fit, ll, aic, cv)) => {
-                if let Some(cv) = cv {
-                    if best.as_ref().is_none_or(|b| cv < b.0) {
-                        best = Some((cv, fit.clone()));
+                let score = if method == FitMethod::Reml { aic } else { cv };
+                if let Some(v) = score {
+                    if best.as_ref().is_none_or(|b| v < b.0) {
+                        best = Some((v, fit.clone()));
                     }
                 }
                 cands.push(Candidate {
@@ -195,6 +222,7 @@ fn fit_auto_by(
                     error: None,
                     log_likelihood: ll,
                     aic,
+                    with,
                 });
             }
             Err(e) => cands.push(Candidate {
@@ -204,6 +232,7 @@ fn fit_auto_by(
                 error: Some(e.to_string()),
                 log_likelihood: None,
                 aic: None,
+                with,
             }),
         }
     }
@@ -298,6 +327,26 @@ fn fit_one_loo(
         objective: f.cv_rmse,
     };
     Ok((fit, ll, None, Some(f.cv_rmse)))
+}
+
+/// One nested candidate of two structures: the joint WLS fit as the start, the REML fit,
+/// its leave-one-out RMSE.
+fn fit_one_nested(
+    c: &Blocks,
+    sub: &Data,
+    lags: &[Lag],
+    kinds: [ModelKind; 2],
+    s: &AutoSettings,
+) -> Result<Fitted> {
+    let start = crate::nested::fit_nested(lags, &kinds, s.weighting)?.variogram;
+    let reml = fit_contrasts(c, &start)?;
+    let fit = Fit {
+        rmse: lag_rmse(lags, &reml.variogram),
+        variogram: reml.variogram.clone(),
+        objective: -reml.log_likelihood,
+    };
+    let cv = loo_rmse(sub, &reml.variogram, s.drift);
+    Ok((fit, Some(reml.log_likelihood), Some(reml.aic()), cv))
 }
 
 /// One candidate: WLS start, REML fit (best ν for Matérn), leave-one-out RMSE.

@@ -294,6 +294,24 @@ pub struct Candidate {
     /// Its AIC `2k − 2ℓ`, the REML selection criterion (REML only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aic: Option<f64>,
+    /// The second structure of a nested candidate (`model` + `with`; REML's automatic fit
+    /// only; left out of the file otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub with: Option<ModelKind>,
+}
+
+impl Candidate {
+    /// The candidate's name: `spherical`, or `matern+exponential` for a nested one.
+    ///
+    /// ```
+    /// use terramesh_geostat::{Candidate, ModelKind};
+    /// let c = Candidate { model: ModelKind::Matern, fit: None, cv_rmse: None, error: None,
+    ///     log_likelihood: None, aic: None, with: Some(ModelKind::Exponential) };
+    /// assert_eq!(c.name(), "matern+exponential");
+    /// ```
+    pub fn name(&self) -> String {
+        crate::file::candidate_name(self.model, self.with)
+    }
 }
 
 /// Fits every model in `kinds` and picks the one with the least leave-one-out RMSE of
@@ -349,6 +367,7 @@ pub fn fit_auto(
                     error: None,
                     log_likelihood: None,
                     aic: None,
+                    with: None,
                 });
             }
             Err(e) => cands.push(Candidate {
@@ -358,6 +377,7 @@ pub fn fit_auto(
                 error: Some(e.to_string()),
                 log_likelihood: None,
                 aic: None,
+                with: None,
             }),
         }
     }

@@ -118,6 +118,25 @@ pub struct CandidateSummary {
     /// Its AIC, the REML selection criterion (left out for a WLS fit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aic: Option<f64>,
+    /// The second structure of a nested candidate (left out otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub with: Option<ModelKind>,
+}
+
+impl CandidateSummary {
+    /// The candidate's name: `spherical`, or `matern+exponential` for a nested one.
+    pub fn name(&self) -> String {
+        candidate_name(self.model, self.with)
+    }
+}
+
+/// `model`, or `model+with` for a nested candidate.
+pub(crate) fn candidate_name(model: ModelKind, with: Option<ModelKind>) -> String {
+    use crate::Named;
+    match with {
+        Some(w) => format!("{}+{}", model.name(), w.name()),
+        None => model.name().to_string(),
+    }
 }
 
 impl From<&Candidate> for CandidateSummary {
@@ -128,6 +147,7 @@ impl From<&Candidate> for CandidateSummary {
             fit_rmse: c.fit.as_ref().map(|f| f.rmse),
             log_likelihood: c.log_likelihood,
             aic: c.aic,
+            with: c.with,
         }
     }
 }
@@ -260,6 +280,7 @@ mod tests {
                 error: None,
                 log_likelihood: None,
                 aic: None,
+                with: None,
             },
             Candidate {
                 model: ModelKind::Linear,
@@ -268,6 +289,7 @@ mod tests {
                 error: Some("no fit".into()),
                 log_likelihood: None,
                 aic: None,
+                with: None,
             },
         ]
     }

@@ -86,9 +86,10 @@ pub struct LagArgs {
     /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
     /// kriging's drift, from the WLS fit), loo (the parameters of least leave-one-out RMSE of
     /// kriging with the drift, from the WLS fit; the scale from the standardised errors) or
-    /// wls (weighted least squares on the lag classes). With auto, all keep the model of least
-    /// leave-one-out RMSE (REML and loo: of kriging with the drift; WLS: of ordinary kriging
-    /// in 32 neighbours). Default: wls.
+    /// wls (weighted least squares on the lag classes). With auto, reml tries every model
+    /// and every pair nested and keeps the least AIC; loo and wls keep the model of least
+    /// leave-one-out RMSE (loo: of kriging with the drift; wls: of ordinary kriging in 32
+    /// neighbours). Default: wls.
     #[arg(long, value_parser = crate::named::<FitMethod>())]
     pub fit: Option<FitMethod>,
     /// REML in spatial blocks of at most this many data (a composite likelihood; each

@@ -24,8 +24,9 @@ pub struct MethodArgs {
     #[command(flatten)]
     pub model: ModelArgs,
     /// auto (fit every model to the data by --fit's method, wls by default, reml or loo with
-    /// the kriging's drift, and keep the one of least leave-one-out RMSE) or a JSON file
-    /// written by `terramesh variogram`.
+    /// the kriging's drift, and keep the best: least AIC for reml, which also tries every
+    /// pair nested, least leave-one-out RMSE otherwise) or a JSON file written by `terramesh
+    /// variogram`.
     #[arg(long)]
     pub variogram: Option<String>,
     #[command(flatten)]

@@ -291,7 +291,7 @@ pub fn write_report(
                     }
                 ),
                 Some(s) => format!(
-                    "Models tried by the automatic fit: REML with a {} drift on {} samples ({}), chosen by the least leave-one-out RMSE",
+                    "Models tried by the automatic fit: REML with a {} drift on {} samples ({}), every model alone and every pair nested, chosen by the least AIC",
                     s.drift.map_or("constant", terramesh_geostat::Named::name),
                     s.points,
                     if s.blocks > 1 {
@@ -308,7 +308,7 @@ pub fn write_report(
                 .iter()
                 .map(|c| {
                     let opt = |v: Option<f64>| v.map_or("-".into(), |v| num(v, 4));
-                    let mut row = vec![c.model.to_string(), opt(c.cv_rmse), opt(c.fit_rmse)];
+                    let mut row = vec![c.name(), opt(c.cv_rmse), opt(c.fit_rmse)];
                     if reml {
                         row.extend([opt(c.log_likelihood), opt(c.aic)]);
                     }

@@ -333,8 +333,8 @@ pub struct InterpolationSection {
     /// Seed of the realisations' random streams.
     pub seed: u64,
     /// How `variogram = "auto"` fits: `wls` (least squares, least cross-validation RMSE; the
-    /// default), `reml` (restricted maximum likelihood with the UK drift over every model,
-    /// the model chosen by leave-one-out RMSE) or `loo` (the parameters, then the model, of
+    /// default), `reml` (restricted maximum likelihood with the UK drift over every model and
+    /// every nested pair, the model chosen by AIC) or `loo` (the parameters, then the model, of
     /// least leave-one-out RMSE of kriging with the UK drift).
     pub fit: terramesh_geostat::FitMethod,
     /// What `variogram = "auto"` fits: `auto` (every model, the best kept), a model name, or a
