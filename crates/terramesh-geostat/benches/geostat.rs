@@ -4,8 +4,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use terramesh_geostat::{
-    experimental, Data, Drift, Duplicates, GlobalKriging, Idw, IdwSearch, LagSettings,
-    LocalKriging, Method, ModelKind, Variogram,
+    experimental, fit_auto_reml, fit_reml, AutoSettings, Data, Drift, Duplicates, GlobalKriging,
+    Idw, IdwSearch, LagSettings, LocalKriging, Method, ModelKind, Named, Variogram,
+    DEFAULT_REML_BLOCK,
 };
 
 fn points(n: usize, seed: u64) -> Vec<[f64; 2]> {
@@ -77,6 +78,16 @@ fn benches(c: &mut Criterion) {
             ..Default::default()
         };
         b.iter(|| experimental(&d20k, &s).unwrap())
+    });
+    // The automatic REML fit (every model and nested pair, chosen by AIC) on 1,200 data of
+    // the benchmarks' 100 km square: four blocks of the default size, as `--variogram auto --fit reml`.
+    let d1200 = data(1200);
+    let lags = experimental(&d1200, &LagSettings::default()).unwrap();
+    g.bench_function("reml_auto_fit_1200_data_all_models", |b| {
+        b.iter(|| fit_auto_reml(&d1200, &lags, ModelKind::ALL, &AutoSettings::default()).unwrap())
+    });
+    g.bench_function("reml_fit_exponential_1200_data", |b| {
+        b.iter(|| fit_reml(&d1200, Drift::Linear, &exp, Some(DEFAULT_REML_BLOCK)).unwrap())
     });
     g.finish();
 }

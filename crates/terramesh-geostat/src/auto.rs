@@ -17,6 +17,7 @@
 //! The other principled route, [`FitMethod::Loo`] ([`fit_auto_loo`]), takes each model's
 //! parameters, and the model, by the least leave-one-out RMSE.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::cv::{cross_validate, Candidate, Folds, Interpolator};
@@ -201,14 +202,19 @@ fn fit_auto_by(
             }
         }
     }
-    let mut cands = Vec::new();
-    let mut best: Option<(f64, Fit)> = None;
-    for (kind, with) in jobs {
-        let one = match (method, with) {
+    // The candidates are independent: fitted over the threads, then taken in the jobs'
+    // order (the first of equal scores wins), so the choice does not depend on the threads.
+    let fits: Vec<Result<Fitted>> = jobs
+        .par_iter()
+        .map(|&(kind, with)| match (method, with) {
             (FitMethod::Loo, _) => fit_one_loo(&blocks, &sub, lags, kind, s),
             (_, Some(w)) => fit_one_nested(&blocks, &sub, lags, [kind, w], s),
             _ => fit_one(&blocks, &sub, lags, kind, s),
-        };
+        })
+        .collect();
+    let mut cands = Vec::new();
+    let mut best: Option<(f64, Fit)> = None;
+    for ((kind, with), one) in jobs.into_iter().zip(fits) {
         match one {
             Ok((fit, ll, aic, cv)) => {
                 let score = if method == FitMethod::Reml { aic } else { cv };

@@ -25,13 +25,12 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
-use faer::MatMut;
+use faer::{MatMut, Par};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::data::{drift_row, Data, Drift};
 use crate::error::{GeostatError, Result};
-use crate::global::par;
 use crate::model::{ModelKind, Variogram};
 use crate::optim::nelder_mead;
 use crate::system::dist;
@@ -70,6 +69,10 @@ pub(crate) struct Contrasts {
     /// Unit reflectors `v_j` (length n, zero before j): `H_j = I − 2 v_j v_jᵀ`.
     reflectors: Vec<Vec<f64>>,
     y: Vec<f64>,
+    /// Distances between the data below the diagonal, column by column (column `j` holds
+    /// rows `j + 1..n`, from [`Contrasts::column`]): computed once, reused by every
+    /// evaluation of an isotropic model.
+    dist: Vec<f64>,
     /// Smallest and largest distance between two data.
     pub hmin: f64,
     pub hmax: f64,
@@ -145,38 +148,53 @@ impl Contrasts {
             y.iter_mut().zip(v).for_each(|(x, a)| *x -= 2.0 * d * a);
         }
         let y = y[p..].to_vec();
-        let (mut hmin, mut hmax) = (f64::INFINITY, 0.0f64);
-        for i in 0..n {
-            for j in i + 1..n {
-                let d = dist(xy[i], xy[j]);
-                hmin = hmin.min(d);
-                hmax = hmax.max(d);
-            }
+        let mut d = Vec::with_capacity(n * n.saturating_sub(1) / 2);
+        for j in 0..n {
+            d.extend((j + 1..n).map(|i| dist(xy[i], xy[j])));
         }
+        let hmin = d.iter().copied().fold(f64::INFINITY, f64::min);
+        let hmax = d.iter().copied().fold(0.0f64, f64::max);
         Ok(Contrasts {
             n,
             p,
             xy,
             reflectors,
             y,
+            dist: d,
             hmin,
             hmax,
         })
     }
 
+    /// Offset of column `j` in [`Contrasts::dist`].
+    fn column(&self, j: usize) -> usize {
+        j * (2 * self.n - j - 1) / 2
+    }
+
     /// `(ln det M₀, y₀ᵀ M₀⁻¹ y₀, m)` of `γ₀`, or `None` where `M₀` is not positive definite.
-    fn parts(&self, g0: &Variogram) -> Option<(f64, f64, usize)> {
+    /// `par`: split the work of this one block over the threads (otherwise sequential, for
+    /// callers that run blocks in parallel); the arithmetic is the same either way.
+    fn parts(&self, g0: &Variogram, par: bool) -> Option<(f64, f64, usize)> {
         let (n, p) = (self.n, self.p);
         let m = n - p;
-        let pts: Vec<[f64; 2]> = self.xy.iter().map(|q| g0.transform(*q)).collect();
-        // K = −Γ, full (column-major, symmetric).
+        // K = −Γ, full (column-major, symmetric): the lower triangle (γ is the costly
+        // part), then mirrored.
         let mut k = vec![0.0; n * n];
-        // The lower triangle, then mirrored (γ is the costly part).
-        k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
-            for i in j + 1..n {
-                col[i] = -g0.gamma(dist(pts[i], pts[j]));
-            }
-        });
+        if g0.anisotropy.is_none() {
+            columns(&mut k, n, par, |j, col| {
+                let d = &self.dist[self.column(j)..];
+                for i in j + 1..n {
+                    col[i] = -g0.gamma(d[i - j - 1]);
+                }
+            });
+        } else {
+            let pts: Vec<[f64; 2]> = self.xy.iter().map(|q| g0.transform(*q)).collect();
+            columns(&mut k, n, par, |j, col| {
+                for i in j + 1..n {
+                    col[i] = -g0.gamma(dist(pts[i], pts[j]));
+                }
+            });
+        }
         for j in 0..n {
             for i in 0..j {
                 k[j * n + i] = k[i * n + j];
@@ -184,13 +202,15 @@ impl Contrasts {
         }
         // K ← H K H for each reflector: K −= 2 (v gᵀ + g vᵀ), g = Kv − (vᵀKv) v.
         for v in &self.reflectors {
-            let w: Vec<f64> = k
-                .par_chunks(n)
-                .map(|col| col.iter().zip(v).map(|(a, b)| a * b).sum())
-                .collect();
+            let dot = |col: &[f64]| col.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+            let w: Vec<f64> = if par {
+                k.par_chunks(n).map(dot).collect()
+            } else {
+                k.chunks(n).map(dot).collect()
+            };
             let alpha: f64 = w.iter().zip(v).map(|(a, b)| a * b).sum();
             let g: Vec<f64> = w.iter().zip(v).map(|(a, b)| a - alpha * b).collect();
-            k.par_chunks_mut(n).enumerate().for_each(|(j, col)| {
+            columns(&mut k, n, par, |j, col| {
                 let (vj, gj) = (v[j], g[j]);
                 for i in 0..n {
                     col[i] -= 2.0 * (v[i] * gj + g[i] * vj);
@@ -203,7 +223,7 @@ impl Contrasts {
             mm[j * m..(j + 1) * m].copy_from_slice(&k[(j + p) * n + p..(j + p + 1) * n]);
         }
         drop(k);
-        let par = par();
+        let par = if par { crate::global::par() } else { Par::Seq };
         let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(m, par, Default::default()));
         cholesky_in_place(
             MatMut::from_column_major_slice_mut(&mut mm, m, m),
@@ -228,6 +248,16 @@ impl Contrasts {
         }
         let q: f64 = u.iter().map(|x| x * x).sum();
         logdet.is_finite().then_some((logdet, q, m))
+    }
+}
+
+/// Calls `f(j, column j)` for every column of the column-major `n`-row matrix `k`, over the
+/// threads where `par`.
+fn columns(k: &mut [f64], n: usize, par: bool, f: impl Fn(usize, &mut [f64]) + Sync + Send) {
+    if par {
+        k.par_chunks_mut(n).enumerate().for_each(|(j, c)| f(j, c));
+    } else {
+        k.chunks_mut(n).enumerate().for_each(|(j, c)| f(j, c));
     }
 }
 
@@ -269,9 +299,18 @@ impl Blocks {
     /// `(ℓ, ŝ)`: the (composite) restricted log-likelihood of `s·γ₀` at the profiled scale
     /// `ŝ`, or `None` where a block's `M` is not positive definite.
     pub(crate) fn profile(&self, g0: &Variogram) -> Option<(f64, f64)> {
+        // One block: its own work over the threads; several: a block per task (summed in
+        // block order either way, so the result does not depend on the thread count).
+        let parts: Vec<(f64, f64, usize)> = if self.blocks.len() == 1 {
+            vec![self.blocks[0].parts(g0, true)?]
+        } else {
+            self.blocks
+                .par_iter()
+                .map(|b| b.parts(g0, false))
+                .collect::<Option<_>>()?
+        };
         let (mut logdet, mut q, mut m) = (0.0, 0.0, 0usize);
-        for b in &self.blocks {
-            let (l, qb, mb) = b.parts(g0)?;
+        for (l, qb, mb) in parts {
             logdet += l;
             q += qb;
             m += mb;

@@ -198,3 +198,52 @@ fn reml_is_exact_up_to_the_block_size_and_a_composite_of_halved_blocks_above() {
     let (_, _, sel) = fit_auto_reml(&small, &lags, &[ModelKind::Exponential], &exact).unwrap();
     assert_eq!((sel.points, sel.blocks), (DEFAULT_REML_BLOCK, 1));
 }
+
+/// The automatic REML fit runs its candidates and the blocks of its likelihood over the
+/// threads; every candidate's parameters, ℓ and AIC, and the choice, must be the same, bit for
+/// bit, on one thread and on several. (The reported leave-one-out RMSE comes from one
+/// factorisation of all the data by faer, whose parallel blocking may round the last bit
+/// differently: equal to 1e-12.)
+#[test]
+fn reml_auto_fit_is_the_same_on_one_thread_and_on_several() {
+    let data = jittered(900); // 900 -> 450 -> 225: four blocks of the default size
+    let lags = experimental(&data, &LagSettings::default()).unwrap();
+    let kinds = [
+        ModelKind::Spherical,
+        ModelKind::Exponential,
+        ModelKind::Power,
+    ];
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default()).unwrap())
+    };
+    let (best1, all1, sel1) = run(1);
+    let (best4, all4, sel4) = run(4);
+    assert_eq!(sel1.blocks, 4);
+    assert_eq!(all1.len(), 3 + 3); // three alone, three pairs of the two bounded ones
+    assert!(all1.iter().all(|c| c.aic.is_some()), "{all1:?}");
+    assert_eq!(best1, best4);
+    assert_eq!(sel1, sel4);
+    assert_eq!(all1.len(), all4.len());
+    for (a, b) in all1.iter().zip(&all4) {
+        assert_eq!((a.model, a.with, &a.fit), (b.model, b.with, &b.fit));
+        assert_eq!((a.log_likelihood, a.aic), (b.log_likelihood, b.aic));
+        let (x, y) = (a.cv_rmse.unwrap(), b.cv_rmse.unwrap());
+        assert!((x - y).abs() <= 1e-12 * x, "{x} {y}");
+    }
+    // The likelihood alone, exact (one block: its own work over the threads) and composite.
+    let v = Variogram::single(ModelKind::Exponential, 1.0, 400.0, 1500.0).unwrap();
+    for block in [None, Some(DEFAULT_REML_BLOCK)] {
+        let ll = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| reml_log_likelihood(&data, Drift::Linear, &v, block).unwrap())
+        };
+        assert_eq!(ll(1).to_bits(), ll(3).to_bits(), "block {block:?}");
+    }
+}
