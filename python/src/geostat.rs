@@ -7,10 +7,11 @@
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use terramesh::fitting::FitPlan;
 use terramesh_geostat::{
-    cross_validate as cv, experimental as lags_of, kriging, Data, Direction, Drift, Duplicates,
-    Estimator, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood, Variogram,
-    VariogramFile, Weighting, DEFAULT_TOLERANCE,
+    cross_validate as cv, experimental as lags_of, kriging, AutoSettings, Data, Direction, Drift,
+    Duplicates, Estimator, FitMethod, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method,
+    Neighbourhood, Variogram, VariogramFile, Weighting, DEFAULT_TOLERANCE,
 };
 
 use crate::errors::{input, kernel, to_py};
@@ -162,10 +163,12 @@ fn experimental<'py>(
     Ok(out)
 }
 
-/// Fits `model` (or `auto`) to the experimental variogram of the data; returns the variogram
-/// file's JSON (model, lags, fit, candidates, experimental).
+/// Fits `model` (`auto`, a name or a nested sum `a+b[+c]`) to the data by `fit` (`wls`,
+/// `reml` with `drift`, `loo`; the library's [`FitMethod`] names), through the facade's
+/// [`terramesh::fitting::fit`] as `terramesh variogram` does; returns the variogram file's
+/// JSON (model, lags, fit, candidates, selection, experimental).
 #[pyfunction]
-#[pyo3(signature = (x, y, z, model="auto", weighting="cressie", lags=15, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=Some(10_000)))]
+#[pyo3(signature = (x, y, z, model="auto", weighting="cressie", lags=15, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=Some(10_000), fit=None, drift="linear", reml_block=terramesh_geostat::DEFAULT_REML_BLOCK))]
 #[allow(clippy::too_many_arguments)]
 fn variogram_fit(
     py: Python<'_>,
@@ -180,16 +183,34 @@ fn variogram_fit(
     azimuth: Option<f64>,
     tolerance: Option<f64>,
     max_points: Option<usize>,
+    fit: Option<&str>,
+    drift: &str,
+    reml_block: usize,
 ) -> PyResult<String> {
     let d = data(&x, &y, &z, "mean")?;
     let s = lag_settings(lags, max_dist, estimator, azimuth, tolerance, max_points)?;
     let w: Weighting = weighting
         .parse()
         .map_err(|e| input(format!("weighting: {e}")))?;
+    let method: Option<FitMethod> = fit
+        .map(|f| f.parse().map_err(|e| input(format!("fit: {e}"))))
+        .transpose()?;
+    let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
+    let plan = FitPlan {
+        model: model.to_string(),
+        method,
+        auto: AutoSettings {
+            drift,
+            weighting: w,
+            block: (reml_block > 0).then_some(reml_block),
+            ..AutoSettings::default()
+        },
+        anisotropy: None,
+    };
     run(py, false, |_| {
         let l = lags_of(&d, &s).map_err(kernel)?;
-        let (fit, cands) = terramesh::interpolate::fit_named(&d, &l, model, w).map_err(to_py)?;
-        let mut f = VariogramFile::new(fit.variogram.clone());
+        let fitted = terramesh::fitting::fit(&d, &l, &plan).map_err(to_py)?;
+        let mut f = VariogramFile::new(fitted.fit.variogram.clone());
         f.points = d.len();
         f.lags = Some(terramesh_geostat::LagSummary {
             classes: s.lags,
@@ -201,13 +222,15 @@ fn variogram_fit(
         f.experimental = l;
         f.fit = Some(terramesh_geostat::FitSummary {
             weights: w,
-            objective: fit.objective,
-            rmse: fit.rmse,
+            objective: fitted.fit.objective,
+            rmse: fitted.fit.rmse,
         });
-        f.candidates = cands
+        f.candidates = fitted
+            .candidates
             .into_iter()
             .map(terramesh_geostat::CandidateEntry::Full)
             .collect();
+        f.selection = fitted.selection;
         Ok(f.to_json_pretty())
     })
 }

@@ -62,7 +62,8 @@ def variogram_fit(
     x: F64, y: F64, z: F64, model: str = "auto", weighting: str = "cressie", lags: int = 15,
     max_dist: Optional[float] = None, estimator: str = "matheron",
     azimuth: Optional[float] = None, tolerance: Optional[float] = None,
-    max_points: Optional[int] = 10000,
+    max_points: Optional[int] = 10000, fit: Optional[str] = None, drift: str = "linear",
+    reml_block: int = 400,
 ) -> str:
     """The ``variogram.json`` text of the fitted model (see :meth:`terramesh.Variogram.fit`)."""
 

@@ -228,7 +228,10 @@ class Variogram:
         model = json.loads(_core.variogram_file_model(text))
         v = cls._from_model(model)
         if isinstance(parsed, dict) and ("fit" in parsed or "experimental" in parsed):
-            v.fit_info = {k: parsed.get(k) for k in ("lags", "fit", "candidates", "experimental")}
+            v.fit_info = {
+                k: parsed.get(k)
+                for k in ("lags", "fit", "candidates", "selection", "experimental")
+            }
         return v
 
     @classmethod
@@ -297,11 +300,29 @@ class Variogram:
         azimuth: Optional[float] = None,
         tolerance: Optional[float] = None,
         max_points: Optional[int] = 10_000,
+        fit: str = "wls",
+        drift: str = "linear",
+        reml_block: int = 400,
     ) -> "Variogram":
-        """Fits ``model`` (a name, or ``"auto"``: every model, the best by leave-one-out
-        cross-validation) to the experimental variogram (arguments as :meth:`experimental`)
-        by weighted least squares (``"cressie"`` or ``"pairs"`` weights). The result's
-        :attr:`fit_info` holds the fit's RMSE, the candidates and the lag classes.
+        """Fits ``model`` (a name, a nested sum such as ``"spherical+exponential"`` fitted
+        jointly, or ``"auto"``: every model, the best kept) to the data, as ``terramesh
+        variogram`` does. ``fit`` is how (the CLI's ``--fit``, the project file's ``fit``):
+
+        - ``"wls"`` (default): weighted least squares on the experimental variogram
+          (arguments as :meth:`experimental`; ``"cressie"`` or ``"pairs"`` weights); ``auto``
+          keeps the model of least leave-one-out RMSE of ordinary kriging;
+        - ``"reml"``: restricted maximum likelihood with ``drift`` filtered out (the drift of
+          the universal kriging that will use it: ``"linear"``, ``"quadratic"``; ``"constant"``
+          for ordinary kriging), from the WLS fit, in blocks of at most ``reml_block`` data
+          (0: exact); ``auto`` tries every model and every pair of bounded ones nested and keeps
+          the least AIC. The fit that beat PyKrige's automatic fits on real terrain
+          (docs/geostatistics.md, "Hidden-truth check"); it costs seconds where WLS costs
+          milliseconds;
+        - ``"loo"``: the parameters of least leave-one-out RMSE of kriging with ``drift``.
+
+        The result's :attr:`fit_info` holds the fit's RMSE, the candidates (with the
+        likelihood, AIC and leave-one-out RMSE of each, for ``reml``), what chose the model
+        (``selection``) and the lag classes.
 
         >>> import numpy as np
         >>> rng = np.random.default_rng(0)
@@ -309,9 +330,16 @@ class Variogram:
         >>> v = Variogram.fit(x, y, np.sin(x / 150) + np.cos(y / 200), model="gaussian")
         >>> v.model, v.fit_info["fit"]["rmse"] < 0.1
         ('gaussian', True)
+        >>> r = Variogram.fit(x, y, np.sin(x / 150) + np.cos(y / 200) + x / 500, fit="reml")
+        >>> r.fit_info["selection"]["method"], r.fit_info["selection"]["blocks"]
+        ('reml', 1)
+        >>> cands = [c for c in r.fit_info["candidates"] if c["fit"] is not None]
+        >>> chosen = min(cands, key=lambda c: c["aic"])  # the least AIC is the model
+        >>> chosen["fit"]["variogram"]["nugget"] == r.nugget and len(cands) > 6
+        True
         """
         text = _core.variogram_fit(
             vec(x, "x"), vec(y, "y"), vec(z, "z"), model, weighting, int(lags), max_dist,
-            estimator, azimuth, tolerance, max_points,
+            estimator, azimuth, tolerance, max_points, fit, drift, int(reml_block),
         )
         return cls.from_json(text)

@@ -101,6 +101,54 @@ def test_variogram_fit_recovers_a_known_model():
     assert auto.fit_info["candidates"]
 
 
+def test_variogram_fit_by_reml_is_the_clis_fit(tmp_path):
+    # The same data through `terramesh variogram --fit reml` (the binary CI builds) and
+    # through Variogram.fit(fit="reml"): one library function, so the same model and the
+    # same candidates, and the model is the candidate of least AIC.
+    import os
+    import pathlib
+    import subprocess
+
+    root = pathlib.Path(__file__).resolve().parents[2]
+    binary = os.environ.get("TERRAMESH_BIN") or str(root / "target" / "release" / "terramesh")
+    rng = np.random.default_rng(5)
+    x, y = rng.uniform(0, 2000, 500), rng.uniform(0, 2000, 500)
+    z = 40 * np.sin(x / 300) * np.cos(y / 400) + x / 50 + rng.normal(0, 0.5, 500)
+    kinds = ["spherical", "exponential", "gaussian", "matern", "power", "linear", "nugget"]
+    v = Variogram.fit(x, y, z, fit="reml", drift="linear")
+    sel = v.fit_info["selection"]
+    assert (sel["method"], sel["drift"], sel["points"], sel["blocks"]) == ("reml", "linear", 500, 2)
+    cands = [c for c in v.fit_info["candidates"] if c["fit"] is not None]
+    assert len(cands) > len(kinds)  # the models alone and the nested pairs
+    chosen = min(cands, key=lambda c: c["aic"])
+    assert chosen["fit"]["variogram"]["nugget"] == v.nugget
+    exact = Variogram.fit(x, y, z, fit="reml", reml_block=0)
+    assert exact.fit_info["selection"]["blocks"] == 1
+    if not os.path.exists(binary):
+        if os.environ.get("CI"):
+            pytest.fail(f"{binary} missing: cargo build --release -p terramesh-cli first")
+        pytest.skip(f"skipped: {binary} missing (cargo build --release -p terramesh-cli)")
+    csv = tmp_path / "d.csv"
+    np.savetxt(csv, np.column_stack([x, y, z]), delimiter=",", header="x,y,z", comments="",
+               fmt="%.17g")
+    out = tmp_path / "v.json"
+    p = subprocess.run([binary, "variogram", "--data", str(csv), "--fit", "reml", "--drift",
+                        "linear", "-o", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    cli = json.loads(out.read_text())
+    assert Variogram.from_json(out) == v
+    assert cli["selection"] == sel
+    assert [c.get("aic") for c in cli["candidates"]] == [c.get("aic") for c in v.fit_info["candidates"]]
+
+
+def test_variogram_fit_refuses_a_bad_fit_or_drift_naming_it():
+    x, y = np.arange(50.0), np.arange(50.0) % 7
+    with pytest.raises(terramesh.InputError, match='fit: .*"mle".*reml, wls or loo'):
+        Variogram.fit(x, y, x, fit="mle")
+    with pytest.raises(terramesh.InputError, match='drift: .*"cubic"'):
+        Variogram.fit(x, y, x, fit="reml", drift="cubic")
+
+
 def test_variogram_json_round_trips_and_reads_build_files(tmp_path):
     v = Variogram(structures=[("spherical", 2.0, 50.0), ("matern", 3.0, 400.0, 0.5)],
                   nugget=0.25, anisotropy_angle=30.0, anisotropy_ratio=0.5)
