@@ -48,7 +48,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// The exception of a facade error: the class follows the innermost cause, the message is
 /// the whole chain with settings named as Python keywords (`min_angle`).
 pub(crate) fn to_py(e: terramesh::Error) -> PyErr {
-    let text = e.render(&|s| s.to_string().replace(' ', "_"));
+    let text = e.render(&|s| s.to_string().replace([' ', '-'], "_"));
     let mut cur = &e;
     while let terramesh::Error::Context { source, .. } = cur {
         cur = source;

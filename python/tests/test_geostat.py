@@ -149,6 +149,34 @@ def test_variogram_fit_refuses_a_bad_fit_or_drift_naming_it():
         Variogram.fit(x, y, x, fit="reml", drift="cubic")
 
 
+def test_exact_reml_beyond_memory_is_refused_naming_reml_block():
+    # In a child process: the memory ceiling is read once per process.
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np, terramesh\n"
+        "i = np.arange(3000)\n"
+        "x, y = (i % 60) * 7.0, (i // 60) * 7.0 + (i % 7) * 0.3\n"
+        "z = np.sin(x * 0.01) + y * 0.002\n"
+        "for block in (0, 400):\n"
+        "    try:\n"
+        "        v = terramesh.Variogram.fit(x, y, z, model='exponential', fit='reml',\n"
+        "                                    reml_block=block)\n"
+        "        print('blocks', v.fit_info['selection']['blocks'])\n"
+        "    except terramesh.InputError as e:\n"
+        "        print('refused', e)\n"
+    )
+    env = {**os.environ, "TERRAMESH_MAX_MEMORY": "64M"}
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    lines = p.stdout.splitlines()
+    assert len(lines) == 2, p.stdout + p.stderr
+    assert lines[0].startswith("refused") and "REML matrix entries" in lines[0], lines[0]
+    assert lines[0].endswith("lower reml_block"), lines[0]
+    assert lines[1] == "blocks 8"
+
+
 def test_variogram_json_round_trips_and_reads_build_files(tmp_path):
     v = Variogram(structures=[("spherical", 2.0, 50.0), ("matern", 3.0, 400.0, 0.5)],
                   nugget=0.25, anisotropy_angle=30.0, anisotropy_ratio=0.5)

@@ -310,6 +310,52 @@ fn leave_one_out_of_30000_data_by_global_kriging_is_refused_before_the_matrix() 
 }
 
 #[test]
+fn exact_reml_beyond_memory_is_refused_before_its_matrices_naming_reml_block() {
+    let dir = tempfile::tempdir().unwrap();
+    // Exact REML (one block) of 3,000 data holds 4.5e6 distances and, per thread, two
+    // 3,000-square matrices: about 320 MB on two threads, more than a 64 MB ceiling.
+    let mut text = String::from("x,y,z\n");
+    for i in 0..3000 {
+        let (x, y) = (
+            (i % 60) as f64 * 7.0,
+            (i / 60) as f64 * 7.0 + (i % 7) as f64 * 0.3,
+        );
+        text += &format!("{x},{y},{}\n", (x * 0.01).sin() + y * 0.002);
+    }
+    let data = write(dir.path(), "grid3000.csv", text);
+    let reml = |block: &str| {
+        Command::new(env!("CARGO_BIN_EXE_terramesh"))
+            .env("TERRAMESH_MAX_MEMORY", "64M")
+            .args([
+                "variogram",
+                "--data",
+                &data,
+                "--model",
+                "exponential",
+                "--fit",
+                "reml",
+                "--reml-block",
+                block,
+                "-o",
+                s(&dir.path().join("v.json")),
+            ])
+            .output()
+            .unwrap()
+    };
+    refused(
+        &reml("0"),
+        &["REML matrix entries", "MB", "lower --reml-block"],
+    );
+    assert!(!dir.path().join("v.json").exists());
+    // In blocks of at most 400 (the default) it fits within the same ceiling.
+    let o = reml("400");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("v.json")).unwrap()).unwrap();
+    assert_eq!(v["selection"]["blocks"], 8, "{v}");
+}
+
+#[test]
 fn mesh_size_limits_beyond_memory_are_refused_naming_the_flag() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("m.vtu");

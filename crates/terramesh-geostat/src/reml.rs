@@ -282,6 +282,20 @@ impl Blocks {
             block.unwrap_or(usize::MAX).max(2 * drift.terms() + 4),
             &mut groups,
         );
+        // Refused before anything is allocated: every block's distances are kept, and each
+        // thread may hold one block's K and M at a time.
+        let largest = groups.iter().map(Vec::len).max().unwrap_or(0) as f64;
+        let kept: f64 = groups
+            .iter()
+            .map(|g| g.len() as f64 * (g.len() as f64 - 1.0) / 2.0)
+            .sum();
+        terramesh_core::limits::Estimate::new(
+            "REML matrix entries",
+            kept + 2.0 * largest * largest * rayon::current_num_threads() as f64,
+            8.0,
+        )
+        .remedy(terramesh_core::limits::Remedy::lower("reml_block"))
+        .check()?;
         let blocks = groups
             .iter()
             .map(|g| Contrasts::new(&data.subset(g), drift))

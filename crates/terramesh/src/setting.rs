@@ -114,6 +114,8 @@ pub enum Setting {
     Modes,
     /// The chart of an experimental variogram.
     Plot,
+    /// The largest block of the REML likelihood (0: exact, one block).
+    RemlBlock,
 }
 
 impl Setting {
@@ -134,6 +136,7 @@ impl Setting {
             "grid" => Setting::Grid,
             "grid_spacing" => Setting::GridSpacing,
             "realisations" => Setting::Realisations,
+            "reml_block" => Setting::RemlBlock,
             _ => return None,
         })
     }
@@ -194,4 +197,5 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Folds => "folds",
     Setting::Modes => "modes",
     Setting::Plot => "plot",
+    Setting::RemlBlock => "reml-block",
 ]);
