@@ -110,7 +110,7 @@ pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use nested::{fit_nested, MAX_STRUCTURES};
 pub use predictor::{kriging, Neighbourhood, Predictor};
-pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK};
+pub use reml::{fit_reml, reml_log_likelihood, RemlFit, DEFAULT_REML_BLOCK, MAX_REML_BLOCKS};
 pub use simulate::{
     simulate, unconditional, Ensemble, PointSummary, SimulationSettings, DEFAULT_MODES,
 };

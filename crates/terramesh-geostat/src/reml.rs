@@ -22,6 +22,10 @@
 //! and their restricted log-likelihoods are summed (one common scale). Every short lag, the
 //! part of the variogram that matters most for interpolation (Stein 1999), is kept; pairs in
 //! different blocks are ignored. Deterministic: the split depends only on the coordinates.
+//! Above [`MAX_REML_BLOCKS`] blocks only every k-th block of the split enters the likelihood
+//! (a composite likelihood of fewer blocks is still an unbiased estimating equation), so that
+//! a fit costs at most that many blocks' Cholesky factors per evaluation however many data
+//! there are.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
@@ -38,6 +42,11 @@ use crate::system::dist;
 /// Default largest number of data in one block of the REML likelihood (one evaluation costs
 /// a Cholesky of this order per block).
 pub const DEFAULT_REML_BLOCK: usize = 400;
+
+/// Most blocks in one composite likelihood: above it, every k-th block of the bisection (an
+/// even spatial spread; each block keeps the data's own spacing) is kept, so that the cost of
+/// a fit stops growing with the data (64 blocks of 400: about 25,600 data).
+pub const MAX_REML_BLOCKS: usize = 64;
 
 /// A variogram fitted by REML.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -264,7 +273,8 @@ fn columns(k: &mut [f64], n: usize, par: bool, f: impl Fn(usize, &mut [f64]) + S
 /// The data split into blocks, each with its contrasts.
 pub(crate) struct Blocks {
     blocks: Vec<Contrasts>,
-    /// Number of data.
+    /// Number of data in the likelihood (all, unless there were more than
+    /// [`MAX_REML_BLOCKS`] blocks).
     pub n: usize,
     /// Smallest and largest distance between two data of one block.
     pub hmin: f64,
@@ -282,6 +292,12 @@ impl Blocks {
             block.unwrap_or(usize::MAX).max(2 * drift.terms() + 4),
             &mut groups,
         );
+        if groups.len() > MAX_REML_BLOCKS {
+            // The bisection's order keeps neighbouring blocks together: every k-th is spread
+            // evenly over the data.
+            let k = groups.len().div_ceil(MAX_REML_BLOCKS);
+            groups = groups.into_iter().step_by(k).collect();
+        }
         // Refused before anything is allocated: every block's distances are kept, and each
         // thread may hold one block's K and M at a time.
         let largest = groups.iter().map(Vec::len).max().unwrap_or(0) as f64;
@@ -303,8 +319,8 @@ impl Blocks {
         let hmin = blocks.iter().map(|b| b.hmin).fold(f64::INFINITY, f64::min);
         let hmax = blocks.iter().map(|b| b.hmax).fold(0.0, f64::max);
         Ok(Blocks {
+            n: blocks.iter().map(|b| b.n).sum(),
             blocks,
-            n: data.len(),
             hmin,
             hmax,
         })

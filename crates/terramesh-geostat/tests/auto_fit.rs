@@ -6,7 +6,7 @@
 use terramesh_geostat::{
     experimental, fit_auto, fit_auto_reml, fit_reml, kriging, reml_log_likelihood, AutoSettings,
     Data, Drift, Duplicates, LagSettings, Method, ModelKind, Named, Neighbourhood, Variogram,
-    Weighting, DEFAULT_REML_BLOCK,
+    Weighting, DEFAULT_REML_BLOCK, MAX_REML_BLOCKS,
 };
 
 /// The posts of the crop in local metres (equirectangular about its centre), voids left out.
@@ -246,4 +246,20 @@ fn reml_auto_fit_is_the_same_on_one_thread_and_on_several() {
         };
         assert_eq!(ll(1).to_bits(), ll(3).to_bits(), "block {block:?}");
     }
+}
+
+/// Above [`MAX_REML_BLOCKS`] blocks only every k-th block enters the likelihood: the fit's
+/// cost stops growing with the data.
+#[test]
+fn reml_keeps_at_most_the_largest_number_of_blocks_spread_over_the_data() {
+    // 2,000 data in blocks of at most 10: 2000 -> 1000 -> ... -> 7 or 8, 256 blocks, of which
+    // every fourth (64) is kept: 64 blocks of 7 or 8 data.
+    let data = jittered(2000);
+    let start = Variogram::single(ModelKind::Exponential, 1.0, 300.0, 1000.0).unwrap();
+    let fit = fit_reml(&data, Drift::Linear, &start, Some(10)).unwrap();
+    assert_eq!(fit.blocks, MAX_REML_BLOCKS);
+    assert!((64 * 7..=64 * 8).contains(&fit.points), "{}", fit.points);
+    // Below the cap every datum counts.
+    let fit = fit_reml(&data, Drift::Linear, &start, Some(40)).unwrap();
+    assert_eq!((fit.blocks, fit.points), (64, 2000));
 }

@@ -93,7 +93,8 @@ pub struct LagArgs {
     #[arg(long, value_parser = crate::named::<FitMethod>())]
     pub fit: Option<FitMethod>,
     /// REML in spatial blocks of at most this many data (a composite likelihood; each
-    /// evaluation is a Cholesky of this order per block); 0: exact REML on all data.
+    /// evaluation is a Cholesky of this order per block; above 64 blocks, every k-th block
+    /// spread over the data); 0: exact REML on all data.
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_REML_BLOCK)]
     pub reml_block: usize,
 }
