@@ -7,11 +7,11 @@
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use terramesh::fitting::FitPlan;
+use terramesh::interpolate::LagOptions;
 use terramesh_geostat::{
-    cross_validate as cv, experimental as lags_of, kriging, AutoSettings, Data, Direction, Drift,
-    Duplicates, Estimator, FitMethod, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method,
-    Neighbourhood, Variogram, VariogramFile, Weighting, DEFAULT_TOLERANCE,
+    cross_validate as cv, experimental as lags_of, kriging, Data, Direction, Drift, Duplicates,
+    Estimator, FitMethod, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood,
+    Variogram, VariogramFile, Weighting, DEFAULT_TOLERANCE,
 };
 
 use crate::errors::{input, kernel, to_py};
@@ -196,17 +196,13 @@ fn variogram_fit(
         .map(|f| f.parse().map_err(|e| input(format!("fit: {e}"))))
         .transpose()?;
     let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
-    let plan = FitPlan {
-        model: model.to_string(),
-        method,
-        auto: AutoSettings {
-            drift,
-            weighting: w,
-            block: (reml_block > 0).then_some(reml_block),
-            ..AutoSettings::default()
-        },
-        anisotropy: None,
-    };
+    let plan = LagOptions {
+        weights: w,
+        fit: method,
+        reml_block,
+        ..LagOptions::default()
+    }
+    .plan(model, drift);
     run(py, false, |_| {
         let l = lags_of(&d, &s).map_err(kernel)?;
         let fitted = terramesh::fitting::fit(&d, &l, &plan).map_err(to_py)?;

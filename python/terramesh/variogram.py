@@ -314,8 +314,8 @@ class Variogram:
         - ``"reml"``: restricted maximum likelihood with ``drift`` filtered out (the drift of
           the universal kriging that will use it: ``"linear"``, ``"quadratic"``; ``"constant"``
           for ordinary kriging), from the WLS fit, in blocks of at most ``reml_block`` data
-          (0: exact; above 64 blocks every k-th block, spread over the data); ``auto`` tries every model and every pair of bounded ones nested and keeps
-          the least AIC. The fit that beat PyKrige's automatic fits on real terrain
+          (0: exact; above 64 blocks every k-th block, spread over the data); ``auto``
+          tries every model and every pair of bounded ones nested and keeps the least AIC. The fit that beat PyKrige's automatic fits on real terrain
           (docs/geostatistics.md, "Hidden-truth check"); it costs seconds where WLS costs
           milliseconds;
         - ``"loo"``: the parameters of least leave-one-out RMSE of kriging with ``drift``.

@@ -1,6 +1,10 @@
 """Kriging, IDW, cross-validation and variograms against PyKrige, the independent reference."""
 
 import json
+import os
+import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -105,10 +109,6 @@ def test_variogram_fit_by_reml_is_the_clis_fit(tmp_path):
     # The same data through `terramesh variogram --fit reml` (the binary CI builds) and
     # through Variogram.fit(fit="reml"): one library function, so the same model and the
     # same candidates, and the model is the candidate of least AIC.
-    import os
-    import pathlib
-    import subprocess
-
     root = pathlib.Path(__file__).resolve().parents[2]
     binary = os.environ.get("TERRAMESH_BIN") or str(root / "target" / "release" / "terramesh")
     rng = np.random.default_rng(5)
@@ -151,10 +151,6 @@ def test_variogram_fit_refuses_a_bad_fit_or_drift_naming_it():
 
 def test_exact_reml_beyond_memory_is_refused_naming_reml_block():
     # In a child process: the memory ceiling is read once per process.
-    import os
-    import subprocess
-    import sys
-
     code = (
         "import numpy as np, terramesh\n"
         "i = np.arange(3000)\n"

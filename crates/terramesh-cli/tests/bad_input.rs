@@ -42,6 +42,20 @@ fn refused(o: &Output, wants: &[&str]) -> String {
     e
 }
 
+/// 3,000 data on a slightly sheared 60 x 50 grid (7 m spacing) of a smooth surface, as
+/// `dir/grid3000.csv`.
+fn grid3000(dir: &Path) -> String {
+    let mut text = String::from("x,y,z\n");
+    for i in 0..3000 {
+        let (x, y) = (
+            (i % 60) as f64 * 7.0,
+            (i / 60) as f64 * 7.0 + (i % 7) as f64 * 0.3,
+        );
+        text += &format!("{x},{y},{}\n", (x * 0.01).sin() + y * 0.002);
+    }
+    write(dir, "grid3000.csv", text)
+}
+
 fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> String {
     let p = dir.join(name);
     std::fs::write(&p, bytes).unwrap();
@@ -237,15 +251,7 @@ fn global_kriging_beyond_the_memory_ceiling_is_refused_naming_the_neighbourhood(
     let dir = tempfile::tempdir().unwrap();
     // 3,000 data: a dense system of 3000 x (3000 + 2048) doubles, 121 MB, against a ceiling
     // of 64 MB set through the environment; the same check refuses 30,000 data at 8 GiB.
-    let mut text = String::from("x,y,z\n");
-    for i in 0..3000 {
-        let (x, y) = (
-            (i % 60) as f64 * 7.0,
-            (i / 60) as f64 * 7.0 + (i % 7) as f64 * 0.3,
-        );
-        text += &format!("{x},{y},{}\n", (x * 0.01).sin() + y * 0.002);
-    }
-    let data = write(dir.path(), "grid3000.csv", text);
+    let data = grid3000(dir.path());
     let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
         .env("TERRAMESH_MAX_MEMORY", "64M")
         .args([
@@ -314,15 +320,7 @@ fn exact_reml_beyond_memory_is_refused_before_its_matrices_naming_reml_block() {
     let dir = tempfile::tempdir().unwrap();
     // Exact REML (one block) of 3,000 data holds 4.5e6 distances and, per thread, two
     // 3,000-square matrices: about 320 MB on two threads, more than a 64 MB ceiling.
-    let mut text = String::from("x,y,z\n");
-    for i in 0..3000 {
-        let (x, y) = (
-            (i % 60) as f64 * 7.0,
-            (i / 60) as f64 * 7.0 + (i % 7) as f64 * 0.3,
-        );
-        text += &format!("{x},{y},{}\n", (x * 0.01).sin() + y * 0.002);
-    }
-    let data = write(dir.path(), "grid3000.csv", text);
+    let data = grid3000(dir.path());
     let reml = |block: &str| {
         Command::new(env!("CARGO_BIN_EXE_terramesh"))
             .env("TERRAMESH_MAX_MEMORY", "64M")

@@ -199,6 +199,15 @@ fn reml_is_exact_up_to_the_block_size_and_a_composite_of_halved_blocks_above() {
     assert_eq!((sel.points, sel.blocks), (DEFAULT_REML_BLOCK, 1));
 }
 
+/// `f` run in a pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 /// The automatic REML fit runs its candidates and the blocks of its likelihood over the
 /// threads; every candidate's parameters, ℓ and AIC, and the choice, must be the same, bit for
 /// bit, on one thread and on several. (The reported leave-one-out RMSE comes from one
@@ -213,12 +222,10 @@ fn reml_auto_fit_is_the_same_on_one_thread_and_on_several() {
         ModelKind::Exponential,
         ModelKind::Power,
     ];
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default()).unwrap())
+    let run = |threads| {
+        on_threads(threads, || {
+            fit_auto_reml(&data, &lags, &kinds, &AutoSettings::default()).unwrap()
+        })
     };
     let (best1, all1, sel1) = run(1);
     let (best4, all4, sel4) = run(4);
@@ -237,12 +244,10 @@ fn reml_auto_fit_is_the_same_on_one_thread_and_on_several() {
     // The likelihood alone, exact (one block: its own work over the threads) and composite.
     let v = Variogram::single(ModelKind::Exponential, 1.0, 400.0, 1500.0).unwrap();
     for block in [None, Some(DEFAULT_REML_BLOCK)] {
-        let ll = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| reml_log_likelihood(&data, Drift::Linear, &v, block).unwrap())
+        let ll = |threads| {
+            on_threads(threads, || {
+                reml_log_likelihood(&data, Drift::Linear, &v, block).unwrap()
+            })
         };
         assert_eq!(ll(1).to_bits(), ll(3).to_bits(), "block {block:?}");
     }
