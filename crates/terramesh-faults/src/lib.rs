@@ -1,0 +1,94 @@
+//! The fault kernel of **terramesh**: fault surfaces, fault blocks and the conformal
+//! tetrahedral volume mesh of a faulted geological model, with its checks. No files, no
+//! printing; the facade will plug it into its plan (issue 31).
+//!
+//! # Fault surfaces ([`FaultSet`], [`Fault::side`])
+//! A fault given by a trace (a plan polyline, which may extend beyond the region), a dip δ in
+//! (0, 90] and a dip direction (degrees clockwise from grid north, unit plan vector u) is the
+//! surface through the trace at the terrain's elevation descending at δ towards u: below the
+//! trace point p, at a depth d under the terrain's elevation H(p) there, it passes through
+//! p + d cot(δ) u, at z = H(p) − d. It is ruled by lines of direction w = (cot δ u, −1), so
+//! moving every point along w to a reference elevation z_ref maps the surface onto one plan
+//! polyline (the trace resampled at half the DSM's median edge, each sample moved by
+//! (H − z_ref) cot δ u): the side of a point is the side of its image against that polyline,
+//! an exact `orient2d` test (one segment, so one exact test against a plane, when the trace
+//! is straight over a planar terrain). The end segments go on as rays, so every fault
+//! crosses the whole region. A fault may also be a triangulated surface that is a graph seen
+//! along its mean normal: the side is an exact `orient3d` test against the triangle under the
+//! point. Bad input is a typed [`FaultError`]: a trace that never enters the region, a dip
+//! outside (0, 90], a dip direction within [`ALONG_TRACE_DEGREES`] of a trace segment,
+//! `ends_at` naming an unknown fault or one it never meets.
+//!
+//! # Fault blocks ([`BlockKey`], [`FaultSet::block_key`])
+//! A block is named by its side of every fault that counts there. A fault that ends at
+//! another (`ends_at`, a Y junction) exists on one side of it only (the side of most of its
+//! surface inside the region) and does not count beyond it; crossing faults (X) count
+//! everywhere. A fault that ends at depth (`depth`) keeps separating blocks below its tip for
+//! the interfaces (their throw does not fade), but its faces stop at the tip: below it, its
+//! surface is meshed as plain faces between the two blocks.
+//!
+//! # The volume mesh ([`faulted_mesh`])
+//! 1. A background mesh: one column of nodes per planar vertex of the DSM, the same number of
+//!    levels in every column (enough for `max_cell_height` in the thickest column), every
+//!    prism split into three tetrahedra by the lowest-global-index diagonal rule, so that
+//!    neighbours agree on their shared quadrilaterals.
+//! 2. Every fault, then every interface (per fault block, `height(k, block, xy)`) cuts the
+//!    mesh in turn as an implicit field: a node within [`ON_SURFACE`] of the surface lies on
+//!    it; a node whose crossing edge is cut within `snap` (a quarter) of the edge from it is
+//!    moved onto the surface if it may move (not on the terrain, base or an earlier surface;
+//!    not on a side for faults, vertically only for interfaces) and if no cell of its star
+//!    would invert or fall below the smaller of `guard_degrees` and its current smallest
+//!    dihedral angle; then every edge that still crosses is split at its crossing (found by
+//!    regula falsi on the field) and every cell is split at its split edges, the lowest edge
+//!    first: exactly what splitting those edges one after another through the whole mesh
+//!    would give, so the mesh stays conformal, every child keeps a positive volume, and
+//!    afterwards no cell has nodes on both sides of the surface. An interface is cut block by
+//!    block, in rounds, because a fault face between two blocks must carry both blocks'
+//!    interface lines.
+//! 3. Every cell then lies on one side of every fault and interface: its side bits give its
+//!    block, the number of interfaces above it its unit. A fault's faces are the faces
+//!    between cells on its two sides where it is active.
+//!
+//! # What is guaranteed and what is measured
+//! Guaranteed by construction and verified by [`check`]: conformity (every interior face in
+//! two cells, oppositely oriented), a closed boundary on the terrain, base and sides only, the
+//! volume (to 1e-9 relative: the terrain and base are never moved), positive volumes (exact
+//! orientation test), no cell straddling a fault, fault faces within 1 cm of their fault.
+//! Measured, not guaranteed: the dihedral angles ([`quality`]: cells cut near nodes that may
+//! not move, on the terrain where a fault crosses it, or at the crossing of two surfaces, can
+//! be slivers; see `docs/geology.md`), and cells left straddling an interface where two
+//! blocks' interface lines cross on a fault face after the last round
+//! ([`BuildReport::unresolved`]; [`CheckSummary::straddling_interfaces`]).
+//!
+//! [`split_nodes`] duplicates the nodes on the faults (one copy per side) and
+//! [`check_split`] verifies that every fault face then appears twice. [`Site`] builds a
+//! synthetic site with a known truth.
+#![warn(missing_docs)]
+
+/// The checks of a faulted mesh.
+mod check;
+/// The error type.
+mod error;
+/// Fault surfaces, their side tests, fault sets and block keys.
+mod fault;
+/// The conformal volume mesh.
+mod mesh;
+/// Dihedral angles.
+mod quality;
+/// Split nodes.
+mod split;
+/// The synthetic site generator.
+mod synth;
+/// The terrain and point location.
+mod terrain;
+
+pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
+pub use error::FaultError;
+pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG_TRACE_DEGREES};
+pub use mesh::{
+    faulted_mesh, BuildReport, FaultFace, FaultedMesh, InterfaceFn, MeshSettings, ON_SURFACE,
+};
+pub use quality::{min_dihedral, quality, Quality, BINS};
+pub use split::{check_split, split_nodes, SplitMesh};
+pub use synth::{Site, SynthFault};
+pub use terrain::Terrain;

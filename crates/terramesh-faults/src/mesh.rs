@@ -1,0 +1,756 @@
+//! The conformal volume mesh: a background mesh of prism columns under the terrain, each prism
+//! split into three tetrahedra by the lowest-global-index diagonal rule, then cut by every
+//! fault and every interface in turn by splitting the edges that cross each surface, after
+//! snapping the vertices that lie close to it (see the crate documentation).
+
+use rayon::prelude::*;
+use robust::{orient3d, Coord3D};
+
+use crate::quality::min_dihedral;
+use crate::{BlockKey, Fault, FaultError, FaultSet, Terrain};
+
+/// A vertex on the terrain.
+const TOP: u8 = 1;
+/// A vertex on the base.
+const BASE: u8 = 2;
+/// A vertex on a side of the region.
+const SIDE: u8 = 4;
+/// A vertex on a fault or interface already cut: it never moves again.
+const PINNED: u8 = 8;
+
+/// A vertex within this distance of a surface (metres) is taken to lie on it.
+pub const ON_SURFACE: f64 = 1e-6;
+/// Rounds of cutting an interface block by block (where two blocks' interfaces meet on a
+/// fault face, each cut can leave a new crossing for the other).
+const ROUNDS: usize = 6;
+
+/// The settings of [`faulted_mesh`].
+///
+/// ```
+/// let s = terramesh_faults::MeshSettings::new(0.0, 10.0);
+/// assert_eq!(s.snap, 0.25);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshSettings {
+    /// The base's elevation, metres.
+    pub base: f64,
+    /// The largest vertical size of a background cell, metres (`geology.max_cell_height`).
+    pub max_cell_height: f64,
+    /// A vertex whose crossing edge is cut within this fraction of its length from it is moved
+    /// onto the surface instead, where it may move (default 0.25).
+    pub snap: f64,
+    /// A move is refused if it would bring the smallest dihedral angle of the vertex's cells
+    /// below the smaller of this and what it was, degrees (default 10).
+    pub guard_degrees: f64,
+}
+
+impl MeshSettings {
+    /// The defaults for a base and a vertical cell size.
+    pub fn new(base: f64, max_cell_height: f64) -> MeshSettings {
+        MeshSettings {
+            base,
+            max_cell_height,
+            snap: 0.25,
+            guard_degrees: 10.0,
+        }
+    }
+}
+
+/// A triangle of a fault: a face shared by two cells, one on each side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FaultFace {
+    /// The fault, an index into [`FaultedMesh::faults`].
+    pub fault: u32,
+    /// Its nodes, counter-clockwise seen from the positive side (its normal points out of
+    /// `cells[0]`).
+    pub nodes: [u32; 3],
+    /// The cell on the negative side, then the cell on the positive side.
+    pub cells: [u32; 2],
+}
+
+/// What the construction did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BuildReport {
+    /// Cells of the background mesh.
+    pub background_cells: usize,
+    /// Vertices moved onto a surface.
+    pub snapped: usize,
+    /// Edges split at a surface.
+    pub split_edges: usize,
+    /// Cells whose vertices still lie on both sides of their block's interface after the
+    /// last round (their unit is taken at their centroid).
+    pub unresolved: usize,
+}
+
+/// A tetrahedral volume mesh cut by faults and interfaces.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FaultedMesh {
+    /// Nodes.
+    pub points: Vec<[f64; 3]>,
+    /// Tetrahedra, `0, 1, 2` counter-clockwise seen from `3` (positive volume), as
+    /// `terramesh_core::volume::CellKind::Tetra`.
+    pub tets: Vec<[u32; 4]>,
+    /// The unit of every cell: the number of interfaces above it (0 the top unit).
+    pub unit: Vec<u32>,
+    /// The fault block of every cell, an index into `blocks`.
+    pub block: Vec<u32>,
+    /// The blocks' keys, sorted.
+    pub blocks: Vec<BlockKey>,
+    /// Every cell's side of every fault (bit f: positive side of fault f).
+    pub positive: Vec<u64>,
+    /// The faults' faces.
+    pub fault_faces: Vec<FaultFace>,
+    /// The faults' names.
+    pub faults: Vec<String>,
+    /// The number of units (interfaces + 1).
+    pub units: usize,
+    /// What the construction did.
+    pub report: BuildReport,
+}
+
+struct State {
+    points: Vec<[f64; 3]>,
+    flags: Vec<u8>,
+    tets: Vec<[u32; 4]>,
+    positive: Vec<u64>,
+    below: Vec<u32>,
+    block: Vec<u32>,
+    report: BuildReport,
+}
+
+/// The height of interface `k` (the top of unit `k + 1`) in a fault block, at a plan point.
+pub type InterfaceFn<'a> = &'a (dyn Fn(usize, BlockKey, [f64; 2]) -> f64 + Sync);
+
+enum Field<'a> {
+    Fault(&'a Fault),
+    Interface(InterfaceFn<'a>, usize, BlockKey),
+}
+
+impl Field<'_> {
+    /// The signed distance and its sign, 0 within [`ON_SURFACE`].
+    fn eval(&self, q: [f64; 3]) -> (f64, i8) {
+        let (v, s) = match self {
+            Field::Fault(f) => {
+                let s = f.side(q);
+                (s.distance, s.sign)
+            }
+            Field::Interface(h, k, key) => {
+                let v = q[2] - h(*k, *key, [q[0], q[1]]);
+                (
+                    v,
+                    if v > 0.0 {
+                        1
+                    } else if v < 0.0 {
+                        -1
+                    } else {
+                        0
+                    },
+                )
+            }
+        };
+        if v.abs() <= ON_SURFACE || s == 0 || !v.is_finite() {
+            (0.0, 0)
+        } else {
+            (v, s)
+        }
+    }
+
+    fn target(&self, q: [f64; 3]) -> [f64; 3] {
+        match self {
+            Field::Fault(f) => {
+                let s = f.side(q);
+                let d = s.distance;
+                [
+                    q[0] - d * s.normal[0],
+                    q[1] - d * s.normal[1],
+                    q[2] - d * s.normal[2],
+                ]
+            }
+            Field::Interface(h, k, key) => [q[0], q[1], h(*k, *key, [q[0], q[1]])],
+        }
+    }
+
+    fn movable(&self, flags: u8) -> bool {
+        match self {
+            Field::Fault(_) => flags & (TOP | BASE | SIDE | PINNED) == 0,
+            // Vertical moves keep a side vertex on its side.
+            Field::Interface(..) => flags & (TOP | BASE | PINNED) == 0,
+        }
+    }
+
+    /// The crossing on segment ab (values of opposite signs): Illinois regula falsi.
+    fn crossing(&self, a: [f64; 3], b: [f64; 3], va: f64, vb: f64) -> [f64; 3] {
+        let at = |t: f64| {
+            [
+                a[0] + t * (b[0] - a[0]),
+                a[1] + t * (b[1] - a[1]),
+                a[2] + t * (b[2] - a[2]),
+            ]
+        };
+        let (mut t0, mut t1, mut f0, mut f1) = (0.0, 1.0, va, vb);
+        let mut t = f0 / (f0 - f1);
+        let mut last = 0i8;
+        for _ in 0..60 {
+            t = (t0 - f0 * (t1 - t0) / (f1 - f0)).clamp(t0, t1);
+            let (v, s) = self.eval(at(t));
+            if s == 0 || v.abs() < 1e-10 {
+                break;
+            }
+            if (v > 0.0) == (f0 > 0.0) {
+                t0 = t;
+                f0 = v;
+                if last == 1 {
+                    f1 *= 0.5;
+                }
+                last = 1;
+            } else {
+                t1 = t;
+                f1 = v;
+                if last == -1 {
+                    f0 *= 0.5;
+                }
+                last = -1;
+            }
+        }
+        at(t.clamp(1e-12, 1.0 - 1e-12))
+    }
+}
+
+fn c3(p: [f64; 3]) -> Coord3D<f64> {
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
+}
+
+/// Positive volume in our node order (`terramesh_core::volume`): orient3d is negative.
+fn positive(p: [[f64; 3]; 4]) -> bool {
+    orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3])) < 0.0
+}
+
+fn key(a: u32, b: u32) -> u64 {
+    (a.min(b) as u64) << 32 | a.max(b) as u64
+}
+
+const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// The three tetrahedra of a prism, upper triangle `t` above lower `b`, by the
+/// lowest-global-index rule: every quadrilateral is split by the diagonal through its lowest
+/// node, so that neighbouring prisms agree.
+pub(crate) fn split_prism(t: [u32; 3], b: [u32; 3], points: &[[f64; 3]]) -> [[u32; 4]; 3] {
+    let all = [t[0], t[1], t[2], b[0], b[1], b[2]];
+    let m = (0..6).min_by_key(|&i| all[i]).unwrap();
+    let (t, b) = if m < 3 { (t, b) } else { (b, t) };
+    let r = m % 3;
+    let t = [t[r], t[(r + 1) % 3], t[(r + 2) % 3]];
+    let b = [b[r], b[(r + 1) % 3], b[(r + 2) % 3]];
+    let mut out = if t[1].min(b[2]) < t[2].min(b[1]) {
+        [
+            [t[0], b[0], b[1], b[2]],
+            [t[0], t[1], t[2], b[2]],
+            [t[0], t[1], b[2], b[1]],
+        ]
+    } else {
+        [
+            [t[0], b[0], b[1], b[2]],
+            [t[0], t[1], t[2], b[1]],
+            [t[0], t[2], b[2], b[1]],
+        ]
+    };
+    for tet in &mut out {
+        if !positive(tet.map(|v| points[v as usize])) {
+            tet.swap(0, 1);
+        }
+    }
+    out
+}
+
+fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> {
+    if !s.base.is_finite() {
+        return Err(FaultError::Setting {
+            name: "base".into(),
+            value: s.base,
+            why: "must be a finite elevation",
+        });
+    }
+    if !(s.max_cell_height > 0.0 && s.max_cell_height.is_finite()) {
+        return Err(FaultError::Setting {
+            name: "max_cell_height".into(),
+            value: s.max_cell_height,
+            why: "must be a positive number of metres",
+        });
+    }
+    if !(s.snap >= 0.0 && s.snap < 0.5) {
+        return Err(FaultError::Setting {
+            name: "snap".into(),
+            value: s.snap,
+            why: "must be in [0, 0.5)",
+        });
+    }
+    let mut thickest: f64 = 0.0;
+    for (v, &h) in terrain.heights.iter().enumerate() {
+        if h <= s.base {
+            let p = terrain.points[v];
+            return Err(FaultError::TerrainBelowBase {
+                vertex: v,
+                x: p[0],
+                y: p[1],
+                terrain: h,
+                base: s.base,
+            });
+        }
+        thickest = thickest.max(h - s.base);
+    }
+    let levels = ((thickest / s.max_cell_height).ceil() as usize).max(1) + 1;
+    let n = terrain.points.len();
+    if (n * levels) as u64 >= u32::MAX as u64 / 4
+        || terrain.triangles.len() * (levels - 1) * 3 > 400_000_000
+    {
+        return Err(FaultError::Setting {
+            name: "max_cell_height".into(),
+            value: s.max_cell_height,
+            why: "makes too many cells for this terrain; raise it",
+        });
+    }
+    let mut side = vec![false; n];
+    for &[a, b] in &terrain.outline {
+        side[a as usize] = true;
+        side[b as usize] = true;
+    }
+    let l = (levels - 1) as f64;
+    let mut points = Vec::with_capacity(n * levels);
+    let mut flags = Vec::with_capacity(n * levels);
+    for v in 0..n {
+        let [x, y] = terrain.points[v];
+        let h = terrain.heights[v];
+        for k in 0..levels {
+            let z = if k == levels - 1 {
+                s.base
+            } else {
+                h - (h - s.base) * k as f64 / l
+            };
+            points.push([x, y, z]);
+            flags.push(
+                if k == 0 { TOP } else { 0 }
+                    | if k == levels - 1 { BASE } else { 0 }
+                    | if side[v] { SIDE } else { 0 },
+            );
+        }
+    }
+    let node = |v: u32, k: usize| v * levels as u32 + k as u32;
+    let tets: Vec<[u32; 4]> = terrain
+        .triangles
+        .par_iter()
+        .flat_map_iter(|tri| {
+            let points = &points;
+            (0..levels - 1).flat_map(move |k| {
+                split_prism(tri.map(|v| node(v, k)), tri.map(|v| node(v, k + 1)), points)
+            })
+        })
+        .collect();
+    let m = tets.len();
+    Ok(State {
+        points,
+        flags,
+        tets,
+        positive: vec![0; m],
+        below: vec![0; m],
+        block: vec![0; m],
+        report: BuildReport {
+            background_cells: m,
+            ..BuildReport::default()
+        },
+    })
+}
+
+/// Splits `t` at every edge in `keys` (sorted), the lowest key first, as splitting those
+/// edges one after another through the whole mesh would: neighbours agree.
+fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
+    let mut best: Option<(usize, usize, usize)> = None;
+    for &(i, j) in &EDGES {
+        if let Ok(pos) = keys.binary_search(&key(t[i], t[j])) {
+            if best.map_or(true, |b| pos < b.2) {
+                best = Some((i, j, pos));
+            }
+        }
+    }
+    match best {
+        None => out.push(t),
+        Some((i, j, pos)) => {
+            let m = first + pos as u32;
+            let (mut a, mut b) = (t, t);
+            a[j] = m;
+            b[i] = m;
+            split_tet(a, keys, first, out);
+            split_tet(b, keys, first, out);
+        }
+    }
+}
+
+/// Cuts the selected cells by a field: snaps, then splits every crossing edge. Returns the
+/// values at the nodes (new nodes: on the surface) and the number of edges split.
+fn cut(
+    st: &mut State,
+    select: &(dyn Fn(usize) -> bool + Sync),
+    field: &Field,
+    s: &MeshSettings,
+) -> (Vec<(f64, i8)>, usize) {
+    let mut values: Vec<(f64, i8)> = st.points.par_iter().map(|&q| field.eval(q)).collect();
+    let crossing = |values: &[(f64, i8)], t: &[u32; 4]| {
+        EDGES
+            .iter()
+            .filter(|&&(i, j)| values[t[i] as usize].1 * values[t[j] as usize].1 < 0)
+            .map(|&(i, j)| key(t[i], t[j]))
+            .collect::<Vec<u64>>()
+    };
+    let mut keys: Vec<u64> = st
+        .tets
+        .par_iter()
+        .enumerate()
+        .filter(|(c, _)| select(*c))
+        .flat_map_iter(|(_, t)| crossing(&values, t))
+        .collect();
+    keys.par_sort_unstable();
+    keys.dedup();
+    // Snap the vertices close to the surface.
+    let mut cand: Vec<(f64, u32)> = Vec::new();
+    for &k in &keys {
+        let (a, b) = ((k >> 32) as u32, k as u32);
+        let (va, vb) = (values[a as usize].0, values[b as usize].0);
+        let t = va / (va - vb);
+        if t < s.snap && field.movable(st.flags[a as usize]) {
+            cand.push((va.abs(), a));
+        }
+        if t > 1.0 - s.snap && field.movable(st.flags[b as usize]) {
+            cand.push((vb.abs(), b));
+        }
+    }
+    if !cand.is_empty() {
+        cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let mut is_cand = vec![false; st.points.len()];
+        for &(_, v) in &cand {
+            is_cand[v as usize] = true;
+        }
+        let mut star: Vec<(u32, u32)> = st
+            .tets
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(c, t)| {
+                let is_cand = &is_cand;
+                t.iter()
+                    .filter(move |&&v| is_cand[v as usize])
+                    .map(move |&v| (v, c as u32))
+            })
+            .collect();
+        star.par_sort_unstable();
+        for &(_, v) in &cand {
+            if values[v as usize].1 == 0 {
+                continue;
+            }
+            let lo = star.partition_point(|e| e.0 < v);
+            let hi = star.partition_point(|e| e.0 <= v);
+            let cells: Vec<[u32; 4]> = star[lo..hi].iter().map(|e| st.tets[e.1 as usize]).collect();
+            let q = st.points[v as usize];
+            let target = field.target(q);
+            if field.eval(target).1 != 0 {
+                continue;
+            }
+            let geo = |t: &[u32; 4], at: [f64; 3]| {
+                t.map(|w| if w == v { at } else { st.points[w as usize] })
+            };
+            let old = cells
+                .iter()
+                .map(|t| min_dihedral(geo(t, q)))
+                .fold(f64::MAX, f64::min);
+            let ok = cells.iter().all(|t| {
+                let g = geo(t, target);
+                positive(g) && min_dihedral(g) >= old.min(s.guard_degrees)
+            });
+            if ok {
+                st.points[v as usize] = target;
+                values[v as usize] = (0.0, 0);
+                st.report.snapped += 1;
+            }
+        }
+        keys.retain(|&k| values[(k >> 32) as usize].1 * values[k as u32 as usize].1 < 0);
+    }
+    // Pin the vertices on the surface.
+    let zeros: Vec<u32> = st
+        .tets
+        .par_iter()
+        .enumerate()
+        .filter(|(c, _)| select(*c))
+        .flat_map_iter(|(_, t)| {
+            let values = &values;
+            t.iter()
+                .copied()
+                .filter(move |&v| values[v as usize].1 == 0)
+        })
+        .collect();
+    for v in zeros {
+        st.flags[v as usize] |= PINNED;
+    }
+    if keys.is_empty() {
+        return (values, 0);
+    }
+    let first = st.points.len() as u32;
+    let new: Vec<([f64; 3], u8)> = keys
+        .par_iter()
+        .map(|&k| {
+            let (a, b) = ((k >> 32) as usize, k as u32 as usize);
+            let p = field.crossing(st.points[a], st.points[b], values[a].0, values[b].0);
+            let f = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE) | PINNED;
+            (p, f)
+        })
+        .collect();
+    for (p, f) in new {
+        st.points.push(p);
+        st.flags.push(f);
+        values.push((0.0, 0));
+    }
+    let children: Vec<(usize, Vec<[u32; 4]>)> = st
+        .tets
+        .par_iter()
+        .enumerate()
+        .filter(|(_, t)| {
+            EDGES
+                .iter()
+                .any(|&(i, j)| keys.binary_search(&key(t[i], t[j])).is_ok())
+        })
+        .map(|(c, &t)| {
+            let mut out = Vec::with_capacity(8);
+            split_tet(t, &keys, first, &mut out);
+            (c, out)
+        })
+        .collect();
+    for (c, kids) in children {
+        st.tets[c] = kids[0];
+        for &k in &kids[1..] {
+            st.tets.push(k);
+            st.positive.push(st.positive[c]);
+            st.below.push(st.below[c]);
+            st.block.push(st.block[c]);
+        }
+    }
+    st.report.split_edges += keys.len();
+    (values, keys.len())
+}
+
+/// The side of every selected cell from its nodes' values: +1, -1, or 0 for a cell with
+/// nodes on both sides (unresolved); a cell with every node on the surface takes the side
+/// of its centroid.
+fn sides(st: &State, values: &[(f64, i8)], field: &Field, cell: usize) -> i8 {
+    let t = st.tets[cell];
+    let (mut p, mut n) = (false, false);
+    for &v in &t {
+        match values[v as usize].1 {
+            1 => p = true,
+            -1 => n = true,
+            _ => {}
+        }
+    }
+    match (p, n) {
+        (true, false) => 1,
+        (false, true) => -1,
+        (true, true) => 0,
+        (false, false) => {
+            let c = centroid(&st.points, &t);
+            match field.eval(c).1 {
+                0 => -1,
+                s => s,
+            }
+        }
+    }
+}
+
+pub(crate) fn centroid(points: &[[f64; 3]], t: &[u32; 4]) -> [f64; 3] {
+    let mut c = [0.0; 3];
+    for &v in t {
+        for k in 0..3 {
+            c[k] += points[v as usize][k] * 0.25;
+        }
+    }
+    c
+}
+
+/// Builds the conformal tetrahedral mesh of the volume between the terrain and the base, cut
+/// by every fault and by `interfaces` interfaces, `height(k, block, xy)` the top of unit
+/// `k + 1` in a fault block (top to bottom: apply the geology rules first).
+///
+/// ```
+/// use terramesh_faults::{check, faulted_mesh, FaultSet, FaultSpec, MeshSettings, Terrain};
+/// let t = Terrain::new(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]],
+///     vec![[0, 1, 2], [0, 2, 3]], vec![100.0; 4])?;
+/// let set = FaultSet::new(&[FaultSpec::trace("F1", vec![[40.0, -10.0], [60.0, 110.0]], 70.0, 90.0)], &t, 0.0)?;
+/// // One interface, 20 m lower on the hanging wall (the positive side of F1).
+/// let h = |_k: usize, b: terramesh_faults::BlockKey, _p: [f64; 2]| if b.side(0) == Some(1) { 30.0 } else { 50.0 };
+/// let settings = MeshSettings::new(0.0, 25.0);
+/// let mesh = faulted_mesh(&t, &set, 1, &h, &settings)?;
+/// let summary = check(&mesh, &t, &set, &settings, &h)?;
+/// assert!((summary.volume - 100.0 * 100.0 * 100.0).abs() < 1e-3);
+/// assert!(!mesh.fault_faces.is_empty());
+/// # Ok::<(), terramesh_faults::FaultError>(())
+/// ```
+///
+/// # Errors
+/// [`FaultError::Setting`] or [`FaultError::TerrainBelowBase`] for bad settings.
+pub fn faulted_mesh(
+    terrain: &Terrain,
+    faults: &FaultSet,
+    interfaces: usize,
+    height: InterfaceFn,
+    settings: &MeshSettings,
+) -> Result<FaultedMesh, FaultError> {
+    let mut st = background(terrain, settings)?;
+    let all = |_: usize| true;
+    for (f, fault) in faults.faults.iter().enumerate() {
+        let field = Field::Fault(fault);
+        let (values, _) = cut(&mut st, &all, &field, settings);
+        let bits: Vec<u64> = (0..st.tets.len())
+            .into_par_iter()
+            .map(|c| {
+                let side = match sides(&st, &values, &field, c) {
+                    0 => field.eval(centroid(&st.points, &st.tets[c])).1,
+                    s => s,
+                };
+                ((side > 0) as u64) << f
+            })
+            .collect();
+        for (p, b) in st.positive.iter_mut().zip(bits) {
+            *p |= b;
+        }
+    }
+    // The blocks.
+    let keys: Vec<BlockKey> = st
+        .positive
+        .par_iter()
+        .map(|&p| faults.key_of_sides(p))
+        .collect();
+    let mut blocks = keys.clone();
+    blocks.par_sort_unstable();
+    blocks.dedup();
+    st.block = keys
+        .par_iter()
+        .map(|k| blocks.binary_search(k).unwrap() as u32)
+        .collect();
+    for k in 0..interfaces {
+        for _round in 0..ROUNDS {
+            let mut splits = 0;
+            for (b, &bk) in blocks.iter().enumerate() {
+                let field = Field::Interface(height, k, bk);
+                let block = st.block.clone();
+                let select = move |c: usize| block[c] == b as u32;
+                splits += cut(&mut st, &select, &field, settings).1;
+            }
+            if splits == 0 {
+                break;
+            }
+        }
+        for (b, &bk) in blocks.iter().enumerate() {
+            let field = Field::Interface(height, k, bk);
+            let values: Vec<(f64, i8)> = st.points.par_iter().map(|&q| field.eval(q)).collect();
+            let res: Vec<(usize, i8)> = (0..st.tets.len())
+                .into_par_iter()
+                .filter(|&c| st.block[c] == b as u32)
+                .map(|c| (c, sides(&st, &values, &field, c)))
+                .collect();
+            for (c, s) in res {
+                let s = if s == 0 {
+                    st.report.unresolved += 1;
+                    field.eval(centroid(&st.points, &st.tets[c])).1
+                } else {
+                    s
+                };
+                st.below[c] += (s < 0) as u32;
+            }
+        }
+    }
+    let fault_faces = fault_faces(&st, faults);
+    Ok(FaultedMesh {
+        points: st.points,
+        tets: st.tets,
+        unit: st.below,
+        block: st.block,
+        blocks,
+        positive: st.positive,
+        fault_faces,
+        faults: faults.faults.iter().map(|f| f.name.clone()).collect(),
+        units: interfaces + 1,
+        report: st.report,
+    })
+}
+
+/// The faces of a tetrahedron, each counter-clockwise seen from outside.
+pub(crate) fn outward_faces(t: &[u32; 4]) -> [[u32; 3]; 4] {
+    [
+        [t[0], t[2], t[1]],
+        [t[0], t[1], t[3]],
+        [t[1], t[2], t[3]],
+        [t[0], t[3], t[2]],
+    ]
+}
+
+/// A face's sorted nodes packed in one key.
+pub(crate) fn face_key(f: &[u32; 3]) -> u128 {
+    let mut s = *f;
+    s.sort_unstable();
+    (s[0] as u128) << 64 | (s[1] as u128) << 32 | s[2] as u128
+}
+
+/// Every face of the mesh: (key, cell, local face), sorted by key.
+pub(crate) fn all_faces(tets: &[[u32; 4]]) -> Vec<(u128, u32, u8)> {
+    let mut faces: Vec<(u128, u32, u8)> = tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(c, t)| {
+            let f = outward_faces(t);
+            (0..4u8).map(move |k| (face_key(&f[k as usize]), c as u32, k))
+        })
+        .collect();
+    faces.par_sort_unstable();
+    faces
+}
+
+fn fault_faces(st: &State, faults: &FaultSet) -> Vec<FaultFace> {
+    let faces = all_faces(&st.tets);
+    let pairs: Vec<(usize, usize)> = (0..faces.len().saturating_sub(1))
+        .filter(|&i| faces[i].0 == faces[i + 1].0)
+        .map(|i| (i, i + 1))
+        .collect();
+    let mut out: Vec<FaultFace> = pairs
+        .par_iter()
+        .flat_map_iter(|&(i, j)| {
+            let (c1, c2) = (faces[i].1 as usize, faces[j].1 as usize);
+            let diff = st.positive[c1] ^ st.positive[c2];
+            let mut v = Vec::new();
+            for f in 0..faults.faults.len() {
+                if diff >> f & 1 == 0 {
+                    continue;
+                }
+                let (neg, pos, k) = if st.positive[c1] >> f & 1 == 0 {
+                    (c1, c2, faces[i].2)
+                } else {
+                    (c2, c1, faces[j].2)
+                };
+                let nodes = outward_faces(&st.tets[neg])[k as usize];
+                let mut c = [0.0; 3];
+                for &n in &nodes {
+                    for d in 0..3 {
+                        c[d] += st.points[n as usize][d] / 3.0;
+                    }
+                }
+                if faults.active(f, st.positive[neg], c) {
+                    v.push(FaultFace {
+                        fault: f as u32,
+                        nodes,
+                        cells: [neg as u32, pos as u32],
+                    });
+                }
+            }
+            v
+        })
+        .collect();
+    out.sort_unstable_by_key(|f| (f.fault, f.cells));
+    out
+}
