@@ -572,6 +572,15 @@ impl Fault {
         }
     }
 
+    /// For a trace fault, the direction of its dip lines, (cot(dip) u, -1): the surface is
+    /// ruled by them, so a point moved along it stays on the surface (or on its side).
+    pub fn dip_line(&self) -> Option<[f64; 3]> {
+        match &self.shape {
+            Shape::Trace(s) => Some([s.c[0], s.c[1], -1.0]),
+            Shape::Mesh(_) => None,
+        }
+    }
+
     /// Whether the fault's surface is a single plane (then the side test is one orientation
     /// test against it).
     pub fn is_plane(&self) -> bool {

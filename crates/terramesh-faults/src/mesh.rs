@@ -15,8 +15,8 @@ const TOP: u8 = 1;
 const BASE: u8 = 2;
 /// A vertex on a side of the region.
 const SIDE: u8 = 4;
-/// A vertex on a fault or interface already cut: it never moves again.
-const PINNED: u8 = 8;
+/// A vertex on an interface already cut: it never moves again.
+const ON_INTERFACE: u8 = 8;
 
 /// A vertex within this distance of a surface (metres) is taken to lie on it.
 pub const ON_SURFACE: f64 = 1e-6;
@@ -28,7 +28,7 @@ const ROUNDS: usize = 6;
 ///
 /// ```
 /// let s = terramesh_faults::MeshSettings::new(0.0, 10.0);
-/// assert_eq!(s.snap, 0.25);
+/// assert_eq!(s.snap, 0.35);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshSettings {
@@ -37,7 +37,7 @@ pub struct MeshSettings {
     /// The largest vertical size of a background cell, metres (`geology.max_cell_height`).
     pub max_cell_height: f64,
     /// A vertex whose crossing edge is cut within this fraction of its length from it is moved
-    /// onto the surface instead, where it may move (default 0.25).
+    /// onto the surface instead, where it may move (default 0.35).
     pub snap: f64,
     /// A move is refused if it would bring the smallest dihedral angle of the vertex's cells
     /// below the smaller of this and what it was, degrees (default 10).
@@ -50,7 +50,7 @@ impl MeshSettings {
         MeshSettings {
             base,
             max_cell_height,
-            snap: 0.25,
+            snap: 0.35,
             guard_degrees: 10.0,
         }
     }
@@ -111,6 +111,8 @@ pub struct FaultedMesh {
 struct State {
     points: Vec<[f64; 3]>,
     flags: Vec<u8>,
+    /// Bit f: the vertex lies on fault f (or may: set on both ends of a split edge).
+    on_fault: Vec<u64>,
     tets: Vec<[u32; 4]>,
     positive: Vec<u64>,
     below: Vec<u32>,
@@ -122,15 +124,36 @@ struct State {
 pub type InterfaceFn<'a> = &'a (dyn Fn(usize, BlockKey, [f64; 2]) -> f64 + Sync);
 
 enum Field<'a> {
-    Fault(&'a Fault),
+    Fault(usize, &'a Fault),
     Interface(InterfaceFn<'a>, usize, BlockKey),
 }
 
+/// Finds s with g(s) = 0 near s0 by the secant method from 0 and s0; `None` if it does not
+/// converge within [`ON_SURFACE`] / 10.
+fn secant(g: impl Fn(f64) -> f64, s0: f64) -> Option<f64> {
+    let (mut a, mut b) = (0.0, s0);
+    let (mut ga, mut gb) = (g(a), g(b));
+    for _ in 0..40 {
+        if gb.abs() <= 0.1 * ON_SURFACE {
+            return Some(b);
+        }
+        if gb == ga || !gb.is_finite() {
+            return None;
+        }
+        let c = b - gb * (b - a) / (gb - ga);
+        (a, ga) = (b, gb);
+        b = c;
+        gb = g(b);
+    }
+    None
+}
+
 impl Field<'_> {
-    /// The signed distance and its sign, 0 within [`ON_SURFACE`].
-    fn eval(&self, q: [f64; 3]) -> (f64, i8) {
-        let (v, s) = match self {
-            Field::Fault(f) => {
+    /// The signed distance to the surface (a fault: to the plane of its nearest piece; an
+    /// interface: vertically) and its sign.
+    fn raw(&self, q: [f64; 3]) -> (f64, i8) {
+        match self {
+            Field::Fault(_, f) => {
                 let s = f.side(q);
                 (s.distance, s.sign)
             }
@@ -147,7 +170,12 @@ impl Field<'_> {
                     },
                 )
             }
-        };
+        }
+    }
+
+    /// The signed distance and its sign, 0 within [`ON_SURFACE`].
+    fn eval(&self, q: [f64; 3]) -> (f64, i8) {
+        let (v, s) = self.raw(q);
         if v.abs() <= ON_SURFACE || s == 0 || !v.is_finite() {
             (0.0, 0)
         } else {
@@ -155,26 +183,67 @@ impl Field<'_> {
         }
     }
 
-    fn target(&self, q: [f64; 3]) -> [f64; 3] {
+    /// Where a vertex may move onto the surface, if it may: never on the terrain or an
+    /// interface; onto a fault along its normal, vertically on a side, horizontally on the
+    /// base (not on a side then), and not if on another fault; onto an interface vertically, or along the dip line of the one trace
+    /// fault it lies on (so it stays on that fault), not on a side then.
+    fn target(&self, q: [f64; 3], flags: u8, on_fault: u64, faults: &FaultSet) -> Option<[f64; 3]> {
+        if flags & (TOP | ON_INTERFACE) != 0 {
+            return None;
+        }
+        let along = |d: [f64; 3]| {
+            let at = |s: f64| [q[0] + s * d[0], q[1] + s * d[1], q[2] + s * d[2]];
+            let v = self.raw(q).0;
+            // The first step: the distance over the rate of change along d.
+            let e = 1e-3;
+            let rate = (self.raw(at(e)).0 - v) / e;
+            if rate.abs() < 1e-6 {
+                return None;
+            }
+            secant(|s| self.raw(at(s)).0, -v / rate).map(at)
+        };
         match self {
-            Field::Fault(f) => {
+            Field::Fault(_, f) => {
+                if on_fault != 0 {
+                    return None;
+                }
+                if flags & BASE != 0 {
+                    // Horizontally: the base is a plane.
+                    if flags & SIDE != 0 {
+                        return None;
+                    }
+                    let n = f.side(q).normal;
+                    let l = (n[0] * n[0] + n[1] * n[1]).sqrt();
+                    return if l < 1e-9 {
+                        None
+                    } else {
+                        along([n[0] / l, n[1] / l, 0.0])
+                    };
+                }
+                if flags & SIDE != 0 {
+                    return along([0.0, 0.0, 1.0]);
+                }
                 let s = f.side(q);
                 let d = s.distance;
-                [
+                Some([
                     q[0] - d * s.normal[0],
                     q[1] - d * s.normal[1],
                     q[2] - d * s.normal[2],
-                ]
+                ])
             }
-            Field::Interface(h, k, key) => [q[0], q[1], h(*k, *key, [q[0], q[1]])],
-        }
-    }
-
-    fn movable(&self, flags: u8) -> bool {
-        match self {
-            Field::Fault(_) => flags & (TOP | BASE | SIDE | PINNED) == 0,
-            // Vertical moves keep a side vertex on its side.
-            Field::Interface(..) => flags & (TOP | BASE | PINNED) == 0,
+            Field::Interface(h, k, key) => {
+                if flags & BASE != 0 {
+                    return None;
+                }
+                if on_fault == 0 {
+                    return Some([q[0], q[1], h(*k, *key, [q[0], q[1]])]);
+                }
+                if flags & SIDE != 0 || on_fault.count_ones() != 1 {
+                    return None;
+                }
+                let f = on_fault.trailing_zeros() as usize;
+                faults.faults[f].dip_line().and_then(along)
+            }
         }
     }
 
@@ -352,6 +421,7 @@ fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> 
     let m = tets.len();
     Ok(State {
         points,
+        on_fault: vec![0; flags.len()],
         flags,
         tets,
         positive: vec![0; m],
@@ -395,6 +465,7 @@ fn cut(
     select: &(dyn Fn(usize) -> bool + Sync),
     field: &Field,
     s: &MeshSettings,
+    faults: &FaultSet,
 ) -> (Vec<(f64, i8)>, usize) {
     let mut values: Vec<(f64, i8)> = st.points.par_iter().map(|&q| field.eval(q)).collect();
     let crossing = |values: &[(f64, i8)], t: &[u32; 4]| {
@@ -419,10 +490,11 @@ fn cut(
         let (a, b) = ((k >> 32) as u32, k as u32);
         let (va, vb) = (values[a as usize].0, values[b as usize].0);
         let t = va / (va - vb);
-        if t < s.snap && field.movable(st.flags[a as usize]) {
+        let movable = |v: u32| st.flags[v as usize] & (TOP | ON_INTERFACE) == 0;
+        if t < s.snap && movable(a) {
             cand.push((va.abs(), a));
         }
-        if t > 1.0 - s.snap && field.movable(st.flags[b as usize]) {
+        if t > 1.0 - s.snap && movable(b) {
             cand.push((vb.abs(), b));
         }
     }
@@ -452,7 +524,11 @@ fn cut(
             let hi = star.partition_point(|e| e.0 <= v);
             let cells: Vec<[u32; 4]> = star[lo..hi].iter().map(|e| st.tets[e.1 as usize]).collect();
             let q = st.points[v as usize];
-            let target = field.target(q);
+            let Some(target) =
+                field.target(q, st.flags[v as usize], st.on_fault[v as usize], faults)
+            else {
+                continue;
+            };
             if field.eval(target).1 != 0 {
                 continue;
             }
@@ -488,25 +564,31 @@ fn cut(
                 .filter(move |&v| values[v as usize].1 == 0)
         })
         .collect();
+    let (flag, bit) = match field {
+        Field::Fault(f, _) => (0, 1u64 << f),
+        Field::Interface(..) => (ON_INTERFACE, 0),
+    };
     for v in zeros {
-        st.flags[v as usize] |= PINNED;
+        st.flags[v as usize] |= flag;
+        st.on_fault[v as usize] |= bit;
     }
     if keys.is_empty() {
         return (values, 0);
     }
     let first = st.points.len() as u32;
-    let new: Vec<([f64; 3], u8)> = keys
+    let new: Vec<([f64; 3], u8, u64)> = keys
         .par_iter()
         .map(|&k| {
             let (a, b) = ((k >> 32) as usize, k as u32 as usize);
             let p = field.crossing(st.points[a], st.points[b], values[a].0, values[b].0);
-            let f = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE) | PINNED;
-            (p, f)
+            let f = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE) | flag;
+            (p, f, st.on_fault[a] & st.on_fault[b] | bit)
         })
         .collect();
-    for (p, f) in new {
+    for (p, f, b) in new {
         st.points.push(p);
         st.flags.push(f);
+        st.on_fault.push(b);
         values.push((0.0, 0));
     }
     let children: Vec<(usize, Vec<[u32; 4]>)> = st
@@ -605,8 +687,8 @@ pub fn faulted_mesh(
     let mut st = background(terrain, settings)?;
     let all = |_: usize| true;
     for (f, fault) in faults.faults.iter().enumerate() {
-        let field = Field::Fault(fault);
-        let (values, _) = cut(&mut st, &all, &field, settings);
+        let field = Field::Fault(f, fault);
+        let (values, _) = cut(&mut st, &all, &field, settings, faults);
         let bits: Vec<u64> = (0..st.tets.len())
             .into_par_iter()
             .map(|c| {
@@ -641,7 +723,7 @@ pub fn faulted_mesh(
                 let field = Field::Interface(height, k, bk);
                 let block = st.block.clone();
                 let select = move |c: usize| block[c] == b as u32;
-                splits += cut(&mut st, &select, &field, settings).1;
+                splits += cut(&mut st, &select, &field, settings, faults).1;
             }
             if splits == 0 {
                 break;

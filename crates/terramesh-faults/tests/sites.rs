@@ -4,8 +4,14 @@
 use terramesh_faults::*;
 
 fn build(site: &Site, max_cell_height: f64) -> (FaultSet, FaultedMesh, CheckSummary, MeshSettings) {
+    build_with(site, MeshSettings::new(site.base, max_cell_height))
+}
+
+fn build_with(
+    site: &Site,
+    settings: MeshSettings,
+) -> (FaultSet, FaultedMesh, CheckSummary, MeshSettings) {
     let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
-    let settings = MeshSettings::new(site.base, max_cell_height);
     let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
     let mesh = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &settings).unwrap();
     let summary = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
@@ -78,4 +84,62 @@ fn one_dipping_fault() {
     assert!(s.fault_faces[0] > 0);
     assert_eq!(mesh.blocks.len(), 2);
     assert!(fraction >= 0.99, "{fraction}");
+}
+
+/// Where the slivers come from: the background alone, one fault, interfaces, both.
+#[test]
+fn quality_by_surface() {
+    let mk = |faults: Vec<SynthFault>, tops: Vec<f64>| {
+        Site::new(
+            200.0,
+            10,
+            0.2,
+            1,
+            [120.0, 0.02, -0.01],
+            0.0,
+            tops,
+            [0.01, 0.0],
+            faults,
+        )
+        .unwrap()
+    };
+    let f = || {
+        vec![SynthFault::new(
+            "F1",
+            [80.0, -50.0],
+            [120.0, 250.0],
+            60.0,
+            90.0,
+            12.0,
+        )]
+    };
+    for (name, site) in [
+        ("background", mk(vec![], vec![])),
+        ("fault only", mk(f(), vec![])),
+        ("interfaces only", mk(vec![], vec![90.0, 60.0, 30.0])),
+        ("both", mk(f(), vec![90.0, 60.0, 30.0])),
+    ] {
+        let (_, mesh, s, _) = build(&site, 10.0);
+        report(name, &mesh, &s, truth(&site, &mesh));
+        let on_terrain = |v: u32| {
+            let p = mesh.points[v as usize];
+            (site.terrain.height([p[0], p[1]]).unwrap() - p[2]).abs() < 1e-9
+        };
+        let bad: Vec<usize> = (0..mesh.tets.len())
+            .filter(|&c| min_dihedral(mesh.tets[c].map(|v| mesh.points[v as usize])) < 5.0)
+            .collect();
+        let top = bad
+            .iter()
+            .filter(|&&c| mesh.tets[c].iter().any(|&v| on_terrain(v)))
+            .count();
+        println!(
+            "  below 5 degrees: {}, of which touching the terrain: {top}",
+            bad.len()
+        );
+        assert!(s.quality.min > 0.0);
+        assert!((bad.len() as f64) < 0.01 * mesh.tets.len() as f64);
+        if name == "background" || name == "interfaces only" {
+            assert!(s.quality.min >= 5.0, "{name}: {}", s.quality.min);
+        }
+    }
 }
