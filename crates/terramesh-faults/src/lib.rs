@@ -89,6 +89,6 @@ pub use mesh::{
     faulted_mesh, BuildReport, FaultFace, FaultedMesh, InterfaceFn, MeshSettings, ON_SURFACE,
 };
 pub use quality::{min_dihedral, quality, Quality, BINS};
-pub use split::{check_split, split_nodes, SplitMesh};
+pub use split::{check_split, split_nodes, SplitMesh, SplitSummary};
 pub use synth::{Site, SynthFault};
 pub use terrain::Terrain;

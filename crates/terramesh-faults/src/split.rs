@@ -51,7 +51,8 @@ impl Dsu {
 /// let mesh = faulted_mesh(&t, &set, 0, &|_, _, _| 0.0, &MeshSettings::new(0.0, 50.0))?;
 /// let split = split_nodes(&mesh);
 /// assert!(split.points.len() > mesh.points.len());
-/// check_split(&mesh, &split)?;
+/// let summary = check_split(&mesh, &split)?;
+/// assert_eq!(summary.opened, mesh.fault_faces.len());
 /// # Ok::<(), terramesh_faults::FaultError>(())
 /// ```
 pub fn split_nodes(mesh: &FaultedMesh) -> SplitMesh {
@@ -168,13 +169,25 @@ pub fn split_nodes(mesh: &FaultedMesh) -> SplitMesh {
     }
 }
 
+/// What [`check_split`] counted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SplitSummary {
+    /// Fault faces that now appear twice, one per side.
+    pub opened: usize,
+    /// Fault faces at a fault's tip inside the volume (where it ends at depth or where its
+    /// surface ends) whose three nodes all lie on the tip, where the two sides join: no node
+    /// of theirs is split, so they stay one interior face.
+    pub tip: usize,
+}
+
 /// Checks a split mesh against its mesh: the same cells on copies of the same nodes, each of
 /// positive volume; every fault face now twice, as two boundary faces (one per side, on
-/// different nodes); every other face as before (the new boundary is the fault faces only).
+/// different nodes), except the faces whose three nodes all lie on a fault's tip, counted;
+/// every other face as before (the new boundary is the opened fault faces only).
 ///
 /// # Errors
 /// [`FaultError::Check`] naming the first failure.
-pub fn check_split(mesh: &FaultedMesh, split: &SplitMesh) -> Result<(), FaultError> {
+pub fn check_split(mesh: &FaultedMesh, split: &SplitMesh) -> Result<SplitSummary, FaultError> {
     let fail = |p: [f64; 3], what: String| FaultError::Check {
         what,
         x: p[0],
@@ -226,27 +239,28 @@ pub fn check_split(mesh: &FaultedMesh, split: &SplitMesh) -> Result<(), FaultErr
     };
     let before = boundary(all_faces(&mesh.tets));
     let after = boundary(all_faces(&split.tets));
-    let mut fault_keys: Vec<u128> = mesh
-        .fault_faces
-        .iter()
-        .map(|f| face_key(&f.nodes))
-        .collect();
-    fault_keys.sort_unstable();
-    fault_keys.dedup();
-    if after.len() != before.len() + 2 * fault_keys.len() {
-        return Err(fail(
-            [0.0; 3],
-            format!(
-                "the split mesh has {} boundary faces, not {} + 2 x {} fault faces",
-                after.len(),
-                before.len(),
-                fault_keys.len()
-            ),
-        ));
+    let mut copies = vec![0u32; mesh.points.len()];
+    for &o in &split.original {
+        copies[o as usize] += 1;
     }
+    let mut opened: Vec<u128> = Vec::new();
+    let mut tip: Vec<u128> = Vec::new();
     for &(f, a, b) in &split.fault_faces {
+        let key = face_key(&a.map(|v| split.original[v as usize]));
         let (ka, kb) = (face_key(&a), face_key(&b));
-        if ka == kb || after.binary_search(&ka).is_err() || after.binary_search(&kb).is_err() {
+        if ka == kb {
+            if a.iter()
+                .any(|&v| copies[split.original[v as usize] as usize] > 1)
+            {
+                return Err(fail(
+                    split.points[a[0] as usize],
+                    format!("a face of fault {f} with a split node did not open"),
+                ));
+            }
+            tip.push(key);
+            continue;
+        }
+        if after.binary_search(&ka).is_err() || after.binary_search(&kb).is_err() {
             return Err(fail(
                 split.points[a[0] as usize],
                 format!(
@@ -254,6 +268,25 @@ pub fn check_split(mesh: &FaultedMesh, split: &SplitMesh) -> Result<(), FaultErr
                 ),
             ));
         }
+        opened.push(key);
     }
-    Ok(())
+    opened.sort_unstable();
+    opened.dedup();
+    tip.sort_unstable();
+    tip.dedup();
+    if after.len() != before.len() + 2 * opened.len() {
+        return Err(fail(
+            [0.0; 3],
+            format!(
+                "the split mesh has {} boundary faces, not {} + 2 x {} opened fault faces",
+                after.len(),
+                before.len(),
+                opened.len()
+            ),
+        ));
+    }
+    Ok(SplitSummary {
+        opened: opened.len(),
+        tip: tip.len(),
+    })
 }

@@ -143,3 +143,200 @@ fn quality_by_surface() {
         }
     }
 }
+
+fn site(faults: Vec<SynthFault>, tops: Vec<f64>, jitter: f64) -> Site {
+    Site::new(
+        200.0,
+        10,
+        jitter,
+        3,
+        [120.0, 0.03, 0.01],
+        0.0,
+        tops,
+        [0.02, -0.01],
+        faults,
+    )
+    .unwrap()
+}
+
+fn assert_site(name: &str, site: &Site, blocks: usize) -> (FaultSet, FaultedMesh, CheckSummary) {
+    let (set, mesh, s, _) = build(site, 8.0);
+    let fraction = truth(site, &mesh);
+    report(name, &mesh, &s, fraction);
+    assert!(fraction >= 0.99, "{name}: {fraction}");
+    assert_eq!(mesh.blocks.len(), blocks, "{name}");
+    assert!(
+        s.fault_faces.iter().all(|&n| n > 0),
+        "{name}: {:?}",
+        s.fault_faces
+    );
+    assert_eq!(s.wrong_unit, 0, "{name}");
+    assert!(s.quality.min > 0.0);
+    let split = split_nodes(&mesh);
+    let opened = check_split(&mesh, &split).unwrap();
+    println!(
+        "  split nodes: {} nodes -> {}, fault faces opened {}, at a tip {}",
+        mesh.points.len(),
+        split.points.len(),
+        opened.opened,
+        opened.tip
+    );
+    assert!(opened.opened > 0);
+    if mesh
+        .fault_faces
+        .iter()
+        .all(|f| set.faults[f.fault as usize].depth.is_none())
+    {
+        assert_eq!(opened.tip, 0, "{name}");
+    }
+    (set, mesh, s)
+}
+
+#[test]
+fn vertical_fault() {
+    let s = site(
+        vec![SynthFault::new(
+            "V",
+            [95.0, -20.0],
+            [105.0, 220.0],
+            90.0,
+            90.0,
+            7.0,
+        )],
+        vec![90.0, 50.0],
+        0.2,
+    );
+    assert_site("dip 90", &s, 2);
+}
+
+#[test]
+fn two_faults_one_metre_apart() {
+    let s = site(
+        vec![
+            SynthFault::new("A", [100.0, -20.0], [100.0, 220.0], 70.0, 90.0, 5.0),
+            SynthFault::new("B", [101.0, -20.0], [101.0, 220.0], 70.0, 90.0, 8.0),
+        ],
+        vec![90.0, 50.0],
+        0.2,
+    );
+    assert_site("two faults 1 m apart", &s, 3);
+}
+
+#[test]
+fn fault_one_metre_from_a_vertex_and_through_vertices() {
+    // No jitter: a column of vertices at x = 100.
+    let s = site(
+        vec![SynthFault::new(
+            "N",
+            [101.0, -20.0],
+            [101.0, 220.0],
+            90.0,
+            90.0,
+            6.0,
+        )],
+        vec![90.0, 50.0],
+        0.0,
+    );
+    assert_site("1 m from vertices", &s, 2);
+    let s = site(
+        vec![SynthFault::new(
+            "T",
+            [100.0, -20.0],
+            [100.0, 220.0],
+            90.0,
+            270.0,
+            6.0,
+        )],
+        vec![90.0, 50.0],
+        0.0,
+    );
+    assert_site("through vertices", &s, 2);
+}
+
+#[test]
+fn x_junction() {
+    let s = site(
+        vec![
+            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
+            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
+        ],
+        vec![95.0, 60.0, 30.0],
+        0.2,
+    );
+    assert_site("X junction", &s, 4);
+}
+
+#[test]
+fn y_junction() {
+    // F2 runs west to east, dips north and ends at F1 (which dips east): it exists to the
+    // west of F1, where most of its trace lies.
+    let mut f2 = SynthFault::new("F2", [-20.0, 100.0], [140.0, 110.0], 65.0, 0.0, 9.0);
+    f2.ends_at = Some((0, -1));
+    let s = site(
+        vec![
+            SynthFault::new("F1", [100.0, -20.0], [100.0, 220.0], 75.0, 90.0, 10.0),
+            f2,
+        ],
+        vec![95.0, 60.0, 30.0],
+        0.2,
+    );
+    let (set, mesh, _) = assert_site("Y junction", &s, 3);
+    assert_eq!(set.faults[1].ends_at, vec![(0, -1)]);
+    // No face of F2 east of F1.
+    for f in mesh.fault_faces.iter().filter(|f| f.fault == 1) {
+        let c = [0, 1, 2].map(|k| {
+            f.nodes
+                .iter()
+                .map(|&v| mesh.points[v as usize][k])
+                .sum::<f64>()
+                / 3.0
+        });
+        assert!(s.true_side(0, c) < 1e-6, "{c:?}");
+    }
+}
+
+#[test]
+fn fault_ending_at_depth() {
+    let mut f = SynthFault::new("D", [100.0, -20.0], [100.0, 220.0], 80.0, 90.0, 5.0);
+    f.depth = Some(40.0);
+    let s = site(vec![f], vec![90.0, 50.0], 0.2);
+    let (set, mesh, _) = assert_site("ending at depth", &s, 2);
+    let mut deepest: f64 = 0.0;
+    for face in &mesh.fault_faces {
+        let c = [0, 1, 2].map(|k| {
+            face.nodes
+                .iter()
+                .map(|&v| mesh.points[v as usize][k])
+                .sum::<f64>()
+                / 3.0
+        });
+        deepest = deepest.max(set.faults[0].side(c).depth.unwrap());
+    }
+    assert!(deepest <= 40.0 && deepest > 30.0, "{deepest}");
+}
+
+#[test]
+fn thin_interbed() {
+    let s = site(
+        vec![SynthFault::new(
+            "F",
+            [60.0, -20.0],
+            [140.0, 220.0],
+            55.0,
+            100.0,
+            3.0,
+        )],
+        vec![90.0, 89.5, 45.0],
+        0.2,
+    );
+    let (_, mesh, summary) = assert_site("0.5 m interbed", &s, 2);
+    // The interbed (unit 1) has cells and about its volume: 0.5 m over 200 m x 200 m, less
+    // the gap the normal fault opens in plan (throw x cot(dip) wide, about 1 %).
+    assert!(mesh.unit.contains(&1));
+    let full = 0.5 * 200.0 * 200.0;
+    assert!(
+        summary.unit_volumes[1] < full && summary.unit_volumes[1] > 0.97 * full,
+        "{}",
+        summary.unit_volumes[1]
+    );
+}
