@@ -308,9 +308,13 @@ impl TraceSurface {
                 let (a, b) = (moved[i].0, moved[j + 1].0);
                 let e = [b[0] - a[0], b[1] - a[1]];
                 let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+                // Straight in plan and linear in elevation (the depth below the trace).
+                let (ha, hb) = (moved[i].1, moved[j + 1].1);
                 let straight = (i + 1..=j).all(|k| {
                     let p = moved[k].0;
+                    let t = ((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / (l * l);
                     ((p[0] - a[0]) * e[1] - (p[1] - a[1]) * e[0]).abs() / l < 1e-7
+                        && (moved[k].1 - (ha + t * (hb - ha))).abs() < 1e-7
                 });
                 if !straight {
                     break;
