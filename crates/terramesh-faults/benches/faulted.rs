@@ -1,5 +1,122 @@
-//! Builds and checks a synthetic site of about 1,000,000 cells with 5 faults and 8 units.
+//! A synthetic site of about 1,000,000 cells with 5 faults (one ending at another, one at
+//! depth, one vertical) and 8 units (a 1 m interbed among them): the time to build the mesh,
+//! to check it and to split its nodes, printed once; then criterion times the build.
+//!
+//! `cargo bench -p terramesh-faults --bench faulted -- --test` builds it once.
+
+use std::time::Instant;
+
 use criterion::{criterion_group, criterion_main, Criterion};
-fn bench(_c: &mut Criterion) {}
+use terramesh_faults::*;
+
+fn site() -> Site {
+    let mut f4 = SynthFault::new("F4", [-100.0, 900.0], [1300.0, 1000.0], 65.0, 0.0, 12.0);
+    f4.ends_at = Some((1, 1));
+    let mut f5 = SynthFault::new("F5", [1500.0, -100.0], [1600.0, 2100.0], 75.0, 270.0, 6.0);
+    f5.depth = Some(150.0);
+    Site::new(
+        2000.0,
+        90,
+        0.2,
+        2026,
+        [300.0, 0.02, 0.01],
+        0.0,
+        vec![270.0, 240.0, 200.0, 199.0, 160.0, 110.0, 60.0],
+        [0.01, -0.005],
+        vec![
+            SynthFault::new("F1", [300.0, -100.0], [500.0, 2100.0], 60.0, 95.0, 15.0),
+            SynthFault::new("F2", [1100.0, -100.0], [1000.0, 2100.0], 70.0, 265.0, 20.0),
+            SynthFault::new("F3", [-100.0, 400.0], [2100.0, 300.0], 90.0, 0.0, 8.0),
+            f4,
+            f5,
+        ],
+    )
+    .unwrap()
+}
+
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kib| kib / 1024.0)
+}
+
+fn bench(c: &mut Criterion) {
+    let site = site();
+    let settings = MeshSettings::new(site.base, 20.0);
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    let t0 = Instant::now();
+    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
+    let mesh = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &settings).unwrap();
+    let build = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let s = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
+    let checked = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let split = split_nodes(&mesh);
+    let opened = check_split(&mesh, &split).unwrap();
+    let split_s = t2.elapsed().as_secs_f64();
+    let (mut good, mut all) = (0.0, 0.0);
+    for (c, t) in mesh.tets.iter().enumerate() {
+        let q = t.map(|v| mesh.points[v as usize]);
+        let v = terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3]);
+        let centre = [0, 1, 2].map(|k| q.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        all += v;
+        if site.true_unit(centre) == mesh.unit[c] as usize {
+            good += v;
+        }
+    }
+    // The quality inside the 1 m interbed (unit 4) and elsewhere.
+    let inner: Vec<[u32; 4]> = (0..mesh.tets.len())
+        .filter(|&c| mesh.unit[c] == 4)
+        .map(|c| mesh.tets[c])
+        .collect();
+    let outer: Vec<[u32; 4]> = (0..mesh.tets.len())
+        .filter(|&c| mesh.unit[c] != 4)
+        .map(|c| mesh.tets[c])
+        .collect();
+    let (qi, qo) = (quality(&mesh.points, &inner), quality(&mesh.points, &outer));
+    println!(
+        "1 m interbed: {} cells, min {:.2} deg, below 5 deg {}; other units: {} cells, min {:.2} deg, below 5 deg {} ({:.3} %)",
+        inner.len(), qi.min, qi.below_5, outer.len(), qo.min, qo.below_5, 100.0 * qo.below_5 as f64 / outer.len() as f64
+    );
+    println!(
+        "faulted site: {} cells ({} background), {} nodes, {} blocks, 5 faults ({:?} faces), 8 \
+         units; build {build:.2} s, check {checked:.2} s, split nodes + check {split_s:.2} s \
+         ({} opened, {} at a tip); peak RSS {:.0} MiB; volume in its true unit {:.5}; \
+         snapped {}, split edges {}, unresolved {}, straddling interfaces {}; min dihedral \
+         {:.2} deg, mean {:.1}, below 5 deg {} ({:.3} %), histogram {:?} over bins {:?}",
+        mesh.tets.len(),
+        mesh.report.background_cells,
+        mesh.points.len(),
+        mesh.blocks.len(),
+        s.fault_faces,
+        opened.opened,
+        opened.tip,
+        peak_rss_mib(),
+        good / all,
+        mesh.report.snapped,
+        mesh.report.split_edges,
+        mesh.report.unresolved,
+        s.straddling_interfaces,
+        s.quality.min,
+        s.quality.mean,
+        s.quality.below_5,
+        100.0 * s.quality.below_5 as f64 / mesh.tets.len() as f64,
+        s.quality.histogram.iter().map(|b| b.2).collect::<Vec<_>>(),
+        BINS
+    );
+    let mut g = c.benchmark_group("faulted");
+    g.sample_size(10);
+    g.bench_function("faulted_mesh 1M cells, 5 faults, 8 units", |b| {
+        b.iter(|| faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &settings).unwrap())
+    });
+    g.finish();
+}
+
 criterion_group!(benches, bench);
 criterion_main!(benches);

@@ -458,16 +458,34 @@ fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
     }
 }
 
-/// Cuts the selected cells by a field: snaps, then splits every crossing edge. Returns the
-/// values at the nodes (new nodes: on the surface) and the number of edges split.
+/// Cuts the selected cells (all if `None`) by a field: snaps, then splits every crossing
+/// edge. Returns the values at the nodes of the selected cells (new nodes: on the surface;
+/// other nodes: 0) and the number of edges split.
 fn cut(
     st: &mut State,
-    select: &(dyn Fn(usize) -> bool + Sync),
+    cells: Option<&[u32]>,
     field: &Field,
     s: &MeshSettings,
     faults: &FaultSet,
 ) -> (Vec<(f64, i8)>, usize) {
-    let mut values: Vec<(f64, i8)> = st.points.par_iter().map(|&q| field.eval(q)).collect();
+    let mut need = vec![cells.is_none(); st.points.len()];
+    if let Some(cells) = cells {
+        for &c in cells {
+            for &v in &st.tets[c as usize] {
+                need[v as usize] = true;
+            }
+        }
+    }
+    let selected: Vec<u32> = match cells {
+        Some(c) => c.to_vec(),
+        None => (0..st.tets.len() as u32).collect(),
+    };
+    let mut values: Vec<(f64, i8)> = st
+        .points
+        .par_iter()
+        .zip(&need)
+        .map(|(&q, &n)| if n { field.eval(q) } else { (0.0, 0) })
+        .collect();
     let crossing = |values: &[(f64, i8)], t: &[u32; 4]| {
         EDGES
             .iter()
@@ -475,12 +493,9 @@ fn cut(
             .map(|&(i, j)| key(t[i], t[j]))
             .collect::<Vec<u64>>()
     };
-    let mut keys: Vec<u64> = st
-        .tets
+    let mut keys: Vec<u64> = selected
         .par_iter()
-        .enumerate()
-        .filter(|(c, _)| select(*c))
-        .flat_map_iter(|(_, t)| crossing(&values, t))
+        .flat_map_iter(|&c| crossing(&values, &st.tets[c as usize]))
         .collect();
     keys.par_sort_unstable();
     keys.dedup();
@@ -552,15 +567,12 @@ fn cut(
         keys.retain(|&k| values[(k >> 32) as usize].1 * values[k as u32 as usize].1 < 0);
     }
     // Pin the vertices on the surface.
-    let zeros: Vec<u32> = st
-        .tets
+    let zeros: Vec<u32> = selected
         .par_iter()
-        .enumerate()
-        .filter(|(c, _)| select(*c))
-        .flat_map_iter(|(_, t)| {
+        .flat_map_iter(|&c| {
             let values = &values;
-            t.iter()
-                .copied()
+            st.tets[c as usize]
+                .into_iter()
                 .filter(move |&v| values[v as usize].1 == 0)
         })
         .collect();
@@ -591,14 +603,21 @@ fn cut(
         st.on_fault.push(b);
         values.push((0.0, 0));
     }
+    // Only cells with two ends of split edges can hold one.
+    let mut end = vec![false; first as usize];
+    for &k in &keys {
+        end[(k >> 32) as usize] = true;
+        end[k as u32 as usize] = true;
+    }
     let children: Vec<(usize, Vec<[u32; 4]>)> = st
         .tets
         .par_iter()
         .enumerate()
         .filter(|(_, t)| {
-            EDGES
-                .iter()
-                .any(|&(i, j)| keys.binary_search(&key(t[i], t[j])).is_ok())
+            t.iter().filter(|&&v| end[v as usize]).count() >= 2
+                && EDGES
+                    .iter()
+                    .any(|&(i, j)| keys.binary_search(&key(t[i], t[j])).is_ok())
         })
         .map(|(c, &t)| {
             let mut out = Vec::with_capacity(8);
@@ -685,10 +704,9 @@ pub fn faulted_mesh(
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
     let mut st = background(terrain, settings)?;
-    let all = |_: usize| true;
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
-        let (values, _) = cut(&mut st, &all, &field, settings, faults);
+        let (values, _) = cut(&mut st, None, &field, settings, faults);
         let bits: Vec<u64> = (0..st.tets.len())
             .into_par_iter()
             .map(|c| {
@@ -716,14 +734,20 @@ pub fn faulted_mesh(
         .par_iter()
         .map(|k| blocks.binary_search(k).unwrap() as u32)
         .collect();
+    let mut by_block: Vec<Vec<u32>> = vec![Vec::new(); blocks.len()];
+    for (c, &b) in st.block.iter().enumerate() {
+        by_block[b as usize].push(c as u32);
+    }
     for k in 0..interfaces {
         for _round in 0..ROUNDS {
             let mut splits = 0;
             for (b, &bk) in blocks.iter().enumerate() {
                 let field = Field::Interface(height, k, bk);
-                let block = st.block.clone();
-                let select = move |c: usize| block[c] == b as u32;
-                splits += cut(&mut st, &select, &field, settings, faults).1;
+                let before = st.tets.len();
+                splits += cut(&mut st, Some(&by_block[b]), &field, settings, faults).1;
+                for c in before..st.tets.len() {
+                    by_block[st.block[c] as usize].push(c as u32);
+                }
             }
             if splits == 0 {
                 break;
@@ -731,11 +755,21 @@ pub fn faulted_mesh(
         }
         for (b, &bk) in blocks.iter().enumerate() {
             let field = Field::Interface(height, k, bk);
-            let values: Vec<(f64, i8)> = st.points.par_iter().map(|&q| field.eval(q)).collect();
-            let res: Vec<(usize, i8)> = (0..st.tets.len())
-                .into_par_iter()
-                .filter(|&c| st.block[c] == b as u32)
-                .map(|c| (c, sides(&st, &values, &field, c)))
+            let mut need = vec![false; st.points.len()];
+            for &c in &by_block[b] {
+                for &v in &st.tets[c as usize] {
+                    need[v as usize] = true;
+                }
+            }
+            let values: Vec<(f64, i8)> = st
+                .points
+                .par_iter()
+                .zip(&need)
+                .map(|(&q, &n)| if n { field.eval(q) } else { (0.0, 0) })
+                .collect();
+            let res: Vec<(usize, i8)> = by_block[b]
+                .par_iter()
+                .map(|&c| (c as usize, sides(&st, &values, &field, c as usize)))
                 .collect();
             for (c, s) in res {
                 let s = if s == 0 {
