@@ -16,7 +16,7 @@ fn site() -> Site {
     f5.depth = Some(150.0);
     Site::new(
         2000.0,
-        90,
+        72,
         0.2,
         2026,
         [300.0, 0.02, 0.01],
@@ -70,19 +70,43 @@ fn bench(c: &mut Criterion) {
             good += v;
         }
     }
-    // The quality inside the 1 m interbed (unit 4) and elsewhere.
+    // The quality inside the 1 m interbed (unit 3, between 200 and 199 m) and elsewhere.
     let inner: Vec<[u32; 4]> = (0..mesh.tets.len())
-        .filter(|&c| mesh.unit[c] == 4)
+        .filter(|&c| mesh.unit[c] == 3)
         .map(|c| mesh.tets[c])
         .collect();
     let outer: Vec<[u32; 4]> = (0..mesh.tets.len())
-        .filter(|&c| mesh.unit[c] != 4)
+        .filter(|&c| mesh.unit[c] != 3)
         .map(|c| mesh.tets[c])
         .collect();
     let (qi, qo) = (quality(&mesh.points, &inner), quality(&mesh.points, &outer));
     println!(
         "1 m interbed: {} cells, min {:.2} deg, below 5 deg {}; other units: {} cells, min {:.2} deg, below 5 deg {} ({:.3} %)",
         inner.len(), qi.min, qi.below_5, outer.len(), qo.min, qo.below_5, 100.0 * qo.below_5 as f64 / outer.len() as f64
+    );
+    // Where the cells below 5 degrees are: per unit, and how many touch a fault or the terrain.
+    let mut on_fault = vec![false; mesh.points.len()];
+    for f in &mesh.fault_faces {
+        for &v in &f.nodes {
+            on_fault[v as usize] = true;
+        }
+    }
+    let on_terrain = |v: u32| {
+        let p = mesh.points[v as usize];
+        site.terrain
+            .height([p[0], p[1]])
+            .is_some_and(|h| (h - p[2]).abs() < 1e-9)
+    };
+    let (mut per_unit, mut fault_touch, mut terrain_touch) = (vec![0usize; 8], 0, 0);
+    for (c, t) in mesh.tets.iter().enumerate() {
+        if min_dihedral(t.map(|v| mesh.points[v as usize])) < 5.0 {
+            per_unit[mesh.unit[c] as usize] += 1;
+            fault_touch += t.iter().any(|&v| on_fault[v as usize]) as usize;
+            terrain_touch += t.iter().any(|&v| on_terrain(v)) as usize;
+        }
+    }
+    println!(
+        "below 5 deg per unit {per_unit:?}; touching a fault {fault_touch}, the terrain {terrain_touch}"
     );
     println!(
         "faulted site: {} cells ({} background), {} nodes, {} blocks, 5 faults ({:?} faces), 8 \

@@ -226,7 +226,7 @@ pub fn check(
                     let on = q.iter().all(|r| {
                         let d = ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
                         let t = ((r[0] - pa[0]) * e[0] + (r[1] - pa[1]) * e[1]) / (l * l);
-                        d.abs() <= scale && t >= -1e-12 && t <= 1.0 + 1e-12
+                        d.abs() <= scale && (-1e-12..=1.0 + 1e-12).contains(&t)
                     });
                     if on {
                         // Outward: to the right of the outline edge.
@@ -295,13 +295,10 @@ pub fn check(
         .map(|c| {
             let t = mesh.tets[c];
             let q = centroid(p, &t);
-            for f in 0..nf {
+            for (f, fault) in faults.faults.iter().enumerate() {
                 let s: Vec<i8> = t.iter().map(|&v| node_sides[v as usize][f]).collect();
                 if s.contains(&1) && s.contains(&-1) {
-                    return Err(fail(
-                        q,
-                        format!("cell {c} straddles fault {}", faults.faults[f].name),
-                    ));
+                    return Err(fail(q, format!("cell {c} straddles fault {}", fault.name)));
                 }
                 let centre = cell_sides[c] >> f & 1;
                 if (mesh.positive[c] >> f & 1) != centre && s.iter().any(|&x| x != 0) {
@@ -309,7 +306,7 @@ pub fn check(
                         q,
                         format!(
                             "cell {c} is recorded on the wrong side of fault {}",
-                            faults.faults[f].name
+                            fault.name
                         ),
                     ));
                 }

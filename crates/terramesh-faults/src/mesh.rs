@@ -335,6 +335,7 @@ pub(crate) fn split_prism(t: [u32; 3], b: [u32; 3], points: &[[f64; 3]]) -> [[u3
     out
 }
 
+#[allow(clippy::needless_range_loop)] // vertex v indexes points, heights and sides
 fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> {
     if !s.base.is_finite() {
         return Err(FaultError::Setting {
@@ -440,7 +441,7 @@ fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
     let mut best: Option<(usize, usize, usize)> = None;
     for &(i, j) in &EDGES {
         if let Ok(pos) = keys.binary_search(&key(t[i], t[j])) {
-            if best.map_or(true, |b| pos < b.2) {
+            if !matches!(best, Some(b) if pos >= b.2) {
                 best = Some((i, j, pos));
             }
         }
@@ -852,8 +853,8 @@ fn fault_faces(st: &State, faults: &FaultSet) -> Vec<FaultFace> {
                 let nodes = outward_faces(&st.tets[neg])[k as usize];
                 let mut c = [0.0; 3];
                 for &n in &nodes {
-                    for d in 0..3 {
-                        c[d] += st.points[n as usize][d] / 3.0;
+                    for (cd, pd) in c.iter_mut().zip(st.points[n as usize]) {
+                        *cd += pd / 3.0;
                     }
                 }
                 if faults.active(f, st.positive[neg], c) {

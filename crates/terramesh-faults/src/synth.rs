@@ -51,13 +51,13 @@ impl SynthFault {
 pub struct Site {
     /// The terrain.
     pub terrain: Terrain,
-    /// The terrain plane: z = t[0] + t[1] x + t[2] y.
+    /// The terrain plane: `z = plane[0] + plane[1] x + plane[2] y`.
     pub plane: [f64; 3],
     /// The base.
     pub base: f64,
     /// The faults.
     pub faults: Vec<SynthFault>,
-    /// The interfaces in the block that no fault moved: z = tops[k] + dip[0] x + dip[1] y.
+    /// The interfaces in the block that no fault moved: `z = tops[k] + dip[0] x + dip[1] y`.
     pub tops: Vec<f64>,
     /// The strata's gradient.
     pub dip: [f64; 2],

@@ -236,8 +236,8 @@ fn a_triangulated_surface_fault_is_tested_exactly() {
     assert_eq!(a, -b);
     assert_eq!(f.side([50.0, 30.0, 40.0]).sign, 0);
     assert!((f.side([53.0, 30.0, 40.0]).distance.abs() - 3.0).abs() < 1e-12);
-    assert!(f.is_plane() == false);
-    // Its mesh.
+    assert!(!f.is_plane()); // two triangles (coplanar, but tested triangle by triangle)
+                            // Its mesh.
     let settings = MeshSettings::new(0.0, 20.0);
     let h = |_k: usize, b: BlockKey, _p: [f64; 2]| if b.side(0) == Some(1) { 40.0 } else { 55.0 };
     let mesh = faulted_mesh(&set_terrain(), &set, 1, &h, &settings).unwrap();
