@@ -696,7 +696,9 @@ pub(crate) fn centroid(points: &[[f64; 3]], t: &[u32; 4]) -> [f64; 3] {
 /// ```
 ///
 /// # Errors
-/// [`FaultError::Setting`] or [`FaultError::TerrainBelowBase`] for bad settings.
+/// [`FaultError::Setting`] or [`FaultError::TerrainBelowBase`] for bad settings, and
+/// [`FaultError::Setting`] naming the interface, the block and the place where `height` is
+/// not a finite number.
 pub fn faulted_mesh(
     terrain: &Terrain,
     faults: &FaultSet,
@@ -740,6 +742,28 @@ pub fn faulted_mesh(
         by_block[b as usize].push(c as u32);
     }
     for k in 0..interfaces {
+        // A height that is not a number would read as "on the interface": refuse it.
+        for (b, &bk) in blocks.iter().enumerate() {
+            let bad = by_block[b].par_iter().find_map_any(|&c| {
+                st.tets[c as usize].iter().find_map(|&v| {
+                    let p = st.points[v as usize];
+                    let z = height(k, bk, [p[0], p[1]]);
+                    (!z.is_finite()).then_some((p, z))
+                })
+            });
+            if let Some((p, z)) = bad {
+                return Err(FaultError::Setting {
+                    name: format!(
+                        "the height of interface {k} (the top of unit {}) in fault block {b} at ({}, {})",
+                        k + 1,
+                        p[0],
+                        p[1]
+                    ),
+                    value: z,
+                    why: "must be a finite elevation",
+                });
+            }
+        }
         for _round in 0..ROUNDS {
             let mut splits = 0;
             for (b, &bk) in blocks.iter().enumerate() {

@@ -301,6 +301,11 @@ fn settings_and_terrain_errors() {
     for (base, mch) in [(0.0, 0.0), (0.0, f64::NAN), (f64::NAN, 10.0), (150.0, 10.0)] {
         assert!(faulted_mesh(&t, &set, 0, &h, &MeshSettings::new(base, mch)).is_err());
     }
+    // An interface that is not a number somewhere is refused, naming it (it would otherwise
+    // read as lying on every node there).
+    let nan = |_: usize, _: BlockKey, p: [f64; 2]| if p[0] > 50.0 { f64::NAN } else { 50.0 };
+    let e = faulted_mesh(&t, &set, 1, &nan, &MeshSettings::new(0.0, 10.0)).unwrap_err();
+    assert!(e.to_string().contains("interface 0"), "{e}");
     let e = faulted_mesh(&t, &set, 0, &h, &MeshSettings::new(150.0, 10.0)).unwrap_err();
     assert!(
         matches!(e, FaultError::TerrainBelowBase { vertex: 0, .. }),
