@@ -34,11 +34,13 @@
 //!    neighbours agree on their shared quadrilaterals.
 //! 2. Every fault, then every interface (per fault block, `height(k, block, xy)`) cuts the
 //!    mesh in turn as an implicit field: a node within [`ON_SURFACE`] of the surface lies on
-//!    it; a node whose crossing edge is cut within `snap` (a quarter) of the edge from it is
-//!    moved onto the surface if it may move (not on the terrain, base or an earlier surface;
-//!    not on a side for faults, vertically only for interfaces) and if no cell of its star
-//!    would invert or fall below the smaller of `guard_degrees` and its current smallest
-//!    dihedral angle; then every edge that still crosses is split at its crossing (found by
+//!    it; a node whose crossing edge is cut within `snap` (default 0.35) of the edge from it
+//!    is moved onto the surface if it may move (never a terrain node or a node on an earlier
+//!    interface; onto a fault along its normal, vertically on a side, horizontally on the
+//!    base, not if on an earlier fault; onto an interface vertically, or along the dip line
+//!    of the one fault it lies on so that it stays on it) and if no cell of its star would
+//!    invert or fall below the smaller of `guard_degrees` and its current smallest dihedral
+//!    angle; then every edge that still crosses is split at its crossing (found by
 //!    regula falsi on the field) and every cell is split at its split edges, the lowest edge
 //!    first: exactly what splitting those edges one after another through the whole mesh
 //!    would give, so the mesh stays conformal, every child keeps a positive volume, and
