@@ -122,6 +122,44 @@ struct TraceSurface {
     zref: f64,
     /// The unit normal of every segment's plane, to the positive (left) side.
     normals: Vec<[f64; 3]>,
+    /// A bounding-box tree over the interior segments (not the two end rays).
+    bvh: Vec<BvhNode>,
+}
+
+/// A node of the tree over segments `lo..hi`: its bounding box and its children (leaves have
+/// none).
+#[derive(Debug, Clone)]
+struct BvhNode {
+    lo: usize,
+    hi: usize,
+    bbox: [f64; 4],
+    children: Option<(usize, usize)>,
+}
+
+fn build_bvh(poly: &[[f64; 2]], lo: usize, hi: usize, out: &mut Vec<BvhNode>) -> usize {
+    let mut bbox = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
+    for p in &poly[lo..=hi] {
+        bbox = [
+            bbox[0].min(p[0]),
+            bbox[1].min(p[1]),
+            bbox[2].max(p[0]),
+            bbox[3].max(p[1]),
+        ];
+    }
+    let at = out.len();
+    out.push(BvhNode {
+        lo,
+        hi,
+        bbox,
+        children: None,
+    });
+    if hi - lo > 8 {
+        let mid = (lo + hi) / 2;
+        let l = build_bvh(poly, lo, mid, out);
+        let r = build_bvh(poly, mid, hi, out);
+        out[at].children = Some((l, r));
+    }
+    at
 }
 
 #[derive(Debug, Clone)]
@@ -378,13 +416,98 @@ impl TraceSurface {
                 }
             }
         }
+        let mut bvh = Vec::new();
+        if m > 2 {
+            build_bvh(&poly, 1, m - 1, &mut bvh);
+        }
         Ok(TraceSurface {
             poly,
             h,
             c,
             zref,
             normals,
+            bvh,
         })
+    }
+
+    /// The squared distance from `p` to segment `i` (the end segments are rays) and the
+    /// parameter of the nearest point.
+    fn segment(&self, i: usize, p: [f64; 2]) -> (f64, f64) {
+        let m = self.poly.len() - 1;
+        let (a, b) = (self.poly[i], self.poly[i + 1]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let mut t = ((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / (e[0] * e[0] + e[1] * e[1]);
+        if i > 0 {
+            t = t.max(0.0);
+        }
+        if i < m - 1 {
+            t = t.min(1.0);
+        }
+        (
+            (a[0] + t * e[0] - p[0]).powi(2) + (a[1] + t * e[1] - p[1]).powi(2),
+            t,
+        )
+    }
+
+    /// The nearest segment to `p` by brute force: (squared distance, segment, parameter), the
+    /// lowest segment on a tie.
+    fn nearest_brute(&self, p: [f64; 2]) -> (f64, usize, f64) {
+        let mut best = (f64::MAX, 0usize, 0.0f64);
+        for i in 0..self.poly.len() - 1 {
+            let (d, t) = self.segment(i, p);
+            if d < best.0 {
+                best = (d, i, t);
+            }
+        }
+        best
+    }
+
+    /// The nearest segment to `p` through the tree (the same answer as [`Self::nearest_brute`]
+    /// up to ties).
+    fn nearest(&self, p: [f64; 2]) -> (f64, usize, f64) {
+        let m = self.poly.len() - 1;
+        if self.bvh.is_empty() {
+            return self.nearest_brute(p);
+        }
+        let mut best = (f64::MAX, 0usize, 0.0f64);
+        let consider = |i: usize, best: &mut (f64, usize, f64)| {
+            let (d, t) = self.segment(i, p);
+            if d < best.0 || d == best.0 && i < best.1 {
+                *best = (d, i, t);
+            }
+        };
+        consider(0, &mut best);
+        consider(m - 1, &mut best);
+        let boxd = |b: &[f64; 4]| {
+            let dx = (b[0] - p[0]).max(p[0] - b[2]).max(0.0);
+            let dy = (b[1] - p[1]).max(p[1] - b[3]).max(0.0);
+            dx * dx + dy * dy
+        };
+        let mut stack = vec![0usize];
+        while let Some(n) = stack.pop() {
+            let node = &self.bvh[n];
+            if boxd(&node.bbox) > best.0 {
+                continue;
+            }
+            match node.children {
+                None => {
+                    for i in node.lo..node.hi {
+                        consider(i, &mut best);
+                    }
+                }
+                Some((l, r)) => {
+                    let (dl, dr) = (boxd(&self.bvh[l].bbox), boxd(&self.bvh[r].bbox));
+                    if dl <= dr {
+                        stack.push(r);
+                        stack.push(l);
+                    } else {
+                        stack.push(l);
+                        stack.push(r);
+                    }
+                }
+            }
+        }
+        best
     }
 
     fn side(&self, q: [f64; 3]) -> Side {
@@ -393,22 +516,7 @@ impl TraceSurface {
             q[1] + (q[2] - self.zref) * self.c[1],
         ];
         let m = self.poly.len() - 1;
-        let mut best = (f64::MAX, 0usize, 0.0f64);
-        for i in 0..m {
-            let (a, b) = (self.poly[i], self.poly[i + 1]);
-            let e = [b[0] - a[0], b[1] - a[1]];
-            let mut t = ((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / (e[0] * e[0] + e[1] * e[1]);
-            if i > 0 {
-                t = t.max(0.0);
-            }
-            if i < m - 1 {
-                t = t.min(1.0);
-            }
-            let d = (a[0] + t * e[0] - p[0]).powi(2) + (a[1] + t * e[1] - p[1]).powi(2);
-            if d < best.0 {
-                best = (d, i, t);
-            }
-        }
+        let best = self.nearest(p);
         let (_, i, t) = best;
         let o = |k: usize| orient2d(c2(self.poly[k]), c2(self.poly[k + 1]), c2(p));
         let sign = if t <= 0.0 && i > 0 || t >= 1.0 && i < m - 1 {
@@ -824,5 +932,59 @@ impl FaultSet {
         }
         let side = fault.side(q);
         side.within && !matches!((fault.depth, side.depth), (Some(d), Some(x)) if x > d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tree finds the same nearest segment as brute force (seeded points around a
+    /// wiggly trace over a bumpy terrain).
+    #[test]
+    fn nearest_segment_through_the_tree_matches_brute_force() {
+        let n = 40;
+        let mut points = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                points.push([i as f64 * 5.0, j as f64 * 5.0]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let heights = points
+            .iter()
+            .map(|p| 50.0 + 6.0 * (p[0] / 9.0).sin() * (p[1] / 13.0).cos())
+            .collect();
+        let terrain = Terrain::new(points, triangles, heights).unwrap();
+        let trace: Vec<[f64; 2]> = (0..12)
+            .map(|k| {
+                [
+                    100.0 + 15.0 * (k as f64 * 1.3).sin(),
+                    -20.0 + 20.0 * k as f64,
+                ]
+            })
+            .collect();
+        let s = TraceSurface::build("F", &trace, 55.0, 90.0, &terrain).unwrap();
+        assert!(s.poly.len() > 20, "{}", s.poly.len());
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let p = [-50.0 + 300.0 * next(), -50.0 + 300.0 * next()];
+            let (a, b) = (s.nearest(p), s.nearest_brute(p));
+            assert_eq!(a.0, b.0, "{p:?}");
+            assert_eq!(a.1, b.1, "{p:?}");
+        }
     }
 }
