@@ -112,7 +112,7 @@ fn bench(c: &mut Criterion) {
         "faulted site: {} cells ({} background), {} nodes, {} blocks, 5 faults ({:?} faces), 8 \
          units; build {build:.2} s, check {checked:.2} s, split nodes + check {split_s:.2} s \
          ({} opened, {} at a tip); peak RSS {:.0} MiB; volume in its true unit {:.5}; \
-         snapped {}, split edges {}, unresolved {}, straddling interfaces {}; min dihedral \
+         snapped {}, split edges {}, unresolved {}; min dihedral \
          {:.2} deg, mean {:.1}, below 5 deg {} ({:.3} %), histogram {:?} over bins {:?}",
         mesh.tets.len(),
         mesh.report.background_cells,
@@ -126,7 +126,6 @@ fn bench(c: &mut Criterion) {
         mesh.report.snapped,
         mesh.report.split_edges,
         mesh.report.unresolved,
-        s.straddling_interfaces,
         s.quality.min,
         s.quality.mean,
         s.quality.below_5,

@@ -31,14 +31,6 @@ pub struct CheckSummary {
     pub fault_areas: Vec<f64>,
     /// The largest distance of a fault face's node or centroid from its fault, metres.
     pub fault_distance: f64,
-    /// Cells whose nodes lie more than [`FAULT_TOLERANCE`] on both sides of their block's
-    /// interface (none is allowed for faults).
-    pub straddling_interfaces: usize,
-    /// The volume of those cells, m³.
-    pub straddling_volume: f64,
-    /// Cells whose unit differs from the unit at their centroid (by more than
-    /// [`FAULT_TOLERANCE`] vertically).
-    pub wrong_unit: usize,
     /// Cells per block.
     pub block_cells: Vec<usize>,
     /// Volume per unit, m³.
@@ -85,7 +77,10 @@ fn rotated(f: [u32; 3]) -> [u32; 3] {
 ///    where it is active, each with the negative cell first, its nodes and centroid within
 ///    [`FAULT_TOLERANCE`] of the fault.
 ///
-/// It also measures the quality and counts the cells straddling an interface.
+/// 8. no cell with nodes more than [`FAULT_TOLERANCE`] on both sides of its block's
+///    interfaces (vertically).
+///
+/// It also measures the quality.
 ///
 /// # Errors
 /// [`FaultError::Check`] naming the first failure and where.
@@ -339,16 +334,24 @@ pub fn check(
             Ok((straddles, wrong))
         })
         .collect();
-    let mut straddling_interfaces = 0;
-    let mut straddling_volume = 0.0;
-    let mut wrong_unit = 0;
     for (c, r) in per_cell.into_iter().enumerate() {
-        let (s, w) = r?;
-        if s {
-            straddling_interfaces += 1;
-            straddling_volume += vols[c];
+        let (straddles, wrong) = r?;
+        let q = centroid(p, &mesh.tets[c]);
+        if wrong {
+            return Err(fail(
+                q,
+                format!(
+                    "cell {c} is recorded in unit {}, not the unit at its centroid",
+                    mesh.unit[c]
+                ),
+            ));
         }
-        wrong_unit += w as usize;
+        if straddles {
+            return Err(fail(
+                q,
+                format!("cell {c} straddles an interface of its block"),
+            ));
+        }
     }
     // 7. Fault faces.
     let mut expected: Vec<(u128, u32)> = interior
@@ -460,9 +463,6 @@ pub fn check(
         fault_faces,
         fault_areas,
         fault_distance,
-        straddling_interfaces,
-        straddling_volume,
-        wrong_unit,
         block_cells,
         unit_volumes,
         quality: quality(p, &mesh.tets),

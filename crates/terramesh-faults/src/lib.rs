@@ -60,7 +60,7 @@
 //! not move, on the terrain where a fault crosses it, or at the crossing of two surfaces, can
 //! be slivers; see `docs/geology.md`), and cells left straddling an interface where two
 //! blocks' interface lines cross on a fault face after the last round
-//! ([`BuildReport::unresolved`]; [`CheckSummary::straddling_interfaces`]).
+//! ([`BuildReport::unresolved`]; [`check`] refuses a cell that straddles one).
 //!
 //! [`split_nodes`] duplicates the nodes on the faults (one copy per side) and
 //! [`check_split`] verifies that every fault face then appears twice. [`Site`] builds a
