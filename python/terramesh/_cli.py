@@ -37,7 +37,8 @@ def command() -> List[str]:
     """The command line that runs this package's ``terramesh`` in a new process (its console
     script, or ``python -m terramesh`` where none is installed).
 
-    >>> command()[-1] in ("terramesh", "terramesh.exe") or command()[1:] == ["-m", "terramesh"]
+    >>> c = command()
+    >>> os.path.basename(c[0]) in ("terramesh", "terramesh.exe") or c[1:] == ["-m", "terramesh"]
     True
     """
     scripts = sysconfig.get_path("scripts")
