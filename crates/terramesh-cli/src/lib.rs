@@ -59,7 +59,7 @@ enum Command {
 /// [`std::env::args_os`] gives them) and returns its exit code: 0 on success, 1 on an error
 /// (printed on standard error), 2 on a usage error, 130 when stopped by Ctrl-C or SIGTERM.
 /// Help and `--version` are printed on standard output. Installs the Ctrl-C handler
-/// ([`interrupt`]): call it once per process, as its `main` (the binary, the Python package's
+/// (`interrupt`): call it once per process, as its `main` (the binary, the Python package's
 /// `terramesh` console script).
 ///
 /// ```no_run
