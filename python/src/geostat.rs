@@ -15,7 +15,7 @@ use terramesh_geostat::{
 };
 
 use crate::errors::{input, kernel, to_py};
-use crate::run::{chunked, pair, run, slice};
+use crate::run::{chunked, fits, floats, pair, room, run, Floats};
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(variogram_check, m)?)?;
@@ -48,12 +48,12 @@ fn data(
     duplicates: &str,
 ) -> PyResult<Data> {
     let (xs, ys) = pair(("x", "y"), x, y)?;
-    let zs = slice(z).into_owned();
-    if zs.len() != xs.len() {
+    let z = floats("z", z)?;
+    if z.len() != xs.len() {
         return Err(input(format!(
             "z must have one value per point ({} points, {} values given)",
             xs.len(),
-            zs.len()
+            z.len()
         )));
     }
     let d = match duplicates {
@@ -65,16 +65,38 @@ fn data(
             )))
         }
     };
-    let xy = xs.iter().zip(ys.iter()).map(|(&a, &b)| [a, b]).collect();
+    // The points, their values and the library's search tree, checked before allocating.
+    fits("x", "data points", xs.len(), 64.0)?;
+    let mut xy = room("x", xs.len())?;
+    xy.extend(xs.iter().zip(ys.iter()).map(|(&a, &b)| [a, b]));
+    let mut zs = room("z", z.len())?;
+    zs.extend_from_slice(&z);
     Data::new(xy, zs, d).map_err(kernel)
 }
 
-fn targets(
-    xt: &PyReadonlyArray1<'_, f64>,
-    yt: &PyReadonlyArray1<'_, f64>,
-) -> PyResult<Vec<[f64; 2]>> {
+/// The target coordinates `xt, yt` (finite, equally long; borrowed from numpy), after checking
+/// that `results_each` result values per target fit in memory. The targets are paired chunk
+/// by chunk (`chunk`), never copied whole.
+fn targets<'a>(
+    xt: &'a PyReadonlyArray1<'_, f64>,
+    yt: &'a PyReadonlyArray1<'_, f64>,
+    results_each: usize,
+) -> PyResult<(Floats<'a>, Floats<'a>)> {
     let (a, b) = pair(("xt", "yt"), xt, yt)?;
-    Ok(a.iter().zip(b.iter()).map(|(&x, &y)| [x, y]).collect())
+    fits("xt", "targets", a.len(), (8 * results_each) as f64)?;
+    Ok((a, b))
+}
+
+/// The targets `r` of `xt, yt` as points (at most `run::CHUNK` of them).
+fn chunk(xt: &[f64], yt: &[f64], r: std::ops::Range<usize>) -> Vec<[f64; 2]> {
+    r.map(|i| [xt[i], yt[i]]).collect()
+}
+
+/// `n` zeros for the results at the targets of `xt`, reserved fallibly.
+fn results(n: usize) -> PyResult<Vec<f64>> {
+    let mut v = room("xt", n)?;
+    v.resize(n, 0.0);
+    Ok(v)
 }
 
 /// The model JSON, validated and written back in its canonical form.
@@ -92,7 +114,9 @@ fn variogram_gamma<'py>(
     h: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let v = model(json)?;
-    let g: Vec<f64> = slice(&h).iter().map(|&h| v.gamma(h)).collect();
+    let h = floats("h", &h)?;
+    let mut g = room("h", h.len())?;
+    g.extend(h.iter().map(|&h| v.gamma(h)));
     Ok(PyArray1::from_vec(py, g))
 }
 
@@ -168,7 +192,7 @@ fn experimental<'py>(
 /// [`terramesh::fitting::fit`] as `terramesh variogram` does; returns the variogram file's
 /// JSON (model, lags, fit, candidates, selection, experimental).
 #[pyfunction]
-#[pyo3(signature = (x, y, z, model="auto", weighting="cressie", lags=15, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=Some(10_000), fit=None, drift="linear", reml_block=terramesh_geostat::DEFAULT_REML_BLOCK))]
+#[pyo3(signature = (x, y, z, model="auto", weighting="cressie", lags=terramesh_geostat::DEFAULT_LAGS, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=Some(terramesh_geostat::DEFAULT_MAX_POINTS), fit=None, drift="linear", reml_block=terramesh_geostat::DEFAULT_REML_BLOCK))]
 #[allow(clippy::too_many_arguments)]
 fn variogram_fit(
     py: Python<'_>,
@@ -276,14 +300,15 @@ fn krige<'py>(
     let d = data(&x, &y, &z, "reject")?;
     let v = model(variogram)?;
     let m = self::method(method, drift, mean, &d)?;
-    let t = targets(&xt, &yt)?;
+    let (txs, tys) = targets(&xt, &yt, 1 + usize::from(return_variance))?;
+    let n = txs.len();
+    let mut est = results(n)?;
+    let mut var = results(if return_variance { n } else { 0 })?;
     let (est, var) = run(py, false, |cancel| {
         let p = kriging(&d, &v, m, hood(neighbors), return_variance).map_err(kernel)?;
-        let mut est = vec![0.0; t.len()];
-        let mut var = vec![0.0; if return_variance { t.len() } else { 0 }];
-        chunked(t.len(), cancel, |r| {
+        chunked(n, cancel, |r| {
             let vr = return_variance.then(|| &mut var[r.clone()]);
-            p.predict(&t[r.clone()], &mut est[r.clone()], vr)
+            p.predict(&chunk(&txs, &tys, r.clone()), &mut est[r.clone()], vr)
                 .map_err(|e| e.offset_target(r.start).into())
         })
         .map_err(to_py)?;
@@ -306,7 +331,7 @@ fn idw_search(neighbors: Option<usize>, radius: Option<f64>) -> PyResult<IdwSear
 
 /// Inverse distance weighting at the targets.
 #[pyfunction]
-#[pyo3(signature = (x, y, z, xt, yt, power=2.0, neighbors=None, radius=None))]
+#[pyo3(signature = (x, y, z, xt, yt, power=terramesh_geostat::DEFAULT_IDW_POWER, neighbors=None, radius=None))]
 #[allow(clippy::too_many_arguments)]
 fn idw<'py>(
     py: Python<'py>,
@@ -320,13 +345,14 @@ fn idw<'py>(
     radius: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let d = data(&x, &y, &z, "reject")?;
-    let t = targets(&xt, &yt)?;
+    let (txs, tys) = targets(&xt, &yt, 1)?;
+    let n = txs.len();
     let s = idw_search(neighbors, radius)?;
+    let mut est = results(n)?;
     let est = run(py, false, |cancel| {
         let p = Idw::new(&d, power, s).map_err(kernel)?;
-        let mut est = vec![0.0; t.len()];
-        chunked(t.len(), cancel, |r| {
-            p.predict(&t[r.clone()], &mut est[r.clone()])
+        chunked(n, cancel, |r| {
+            p.predict(&chunk(&txs, &tys, r.clone()), &mut est[r.clone()])
                 .map_err(|e| e.offset_target(r.start).into())
         })
         .map_err(to_py)?;
@@ -337,7 +363,7 @@ fn idw<'py>(
 
 /// Leave-one-out (`folds=None`) or k-fold cross-validation of kriging or IDW.
 #[pyfunction]
-#[pyo3(signature = (x, y, z, method="uk", variogram=None, drift="linear", mean=None, neighbors=None, folds=None, power=2.0, radius=None))]
+#[pyo3(signature = (x, y, z, method="uk", variogram=None, drift="linear", mean=None, neighbors=None, folds=None, power=terramesh_geostat::DEFAULT_IDW_POWER, radius=None))]
 #[allow(clippy::too_many_arguments)]
 fn cross_validate<'py>(
     py: Python<'py>,

@@ -7,6 +7,7 @@
 //! reaches Python. The pure-Python package (`python/terramesh/`) gives these functions their
 //! public names, defaults and docstrings.
 
+mod cli;
 mod errors;
 mod geostat;
 mod mesh;
@@ -24,6 +25,34 @@ fn _terramesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     geostat::register(m)?;
     mesh::register(m)?;
     pipeline::register(m)?;
+    cli::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULTS", defaults(m.py())?)?;
     Ok(())
+}
+
+/// The library's defaults that the Python signatures show, each from the one constant or
+/// `Default` of the facade and its kernels (never restated in Python): `min_angle`,
+/// `max_min_angle`, `smooth`, `smoother`, `lags`, `max_points`, `tolerance`, `estimator`,
+/// `weighting`, `reml_block`, `idw_power`, `rows`, `cols`, `margin`.
+fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
+    use terramesh_core::vocab::Named;
+    let d = pyo3::types::PyDict::new(py);
+    let mesh = terramesh::mesh::MeshSettings::default();
+    d.set_item("min_angle", mesh.min_angle)?;
+    d.set_item("max_min_angle", terramesh_mesh::MAX_MIN_ANGLE)?;
+    d.set_item("smooth", mesh.smooth)?;
+    d.set_item("smoother", mesh.smoother.name())?;
+    let lags = terramesh::interpolate::LagOptions::default();
+    d.set_item("lags", lags.lags)?;
+    d.set_item("max_points", lags.max_points)?;
+    d.set_item("tolerance", lags.tolerance)?;
+    d.set_item("estimator", lags.estimator.name())?;
+    d.set_item("weighting", lags.weights.name())?;
+    d.set_item("reml_block", lags.reml_block)?;
+    d.set_item("idw_power", terramesh_geostat::DEFAULT_IDW_POWER)?;
+    d.set_item("rows", terramesh::project::DEFAULT_ROWS)?;
+    d.set_item("cols", terramesh::project::DEFAULT_COLS)?;
+    d.set_item("margin", terramesh::project::DEFAULT_MARGIN)?;
+    Ok(d)
 }

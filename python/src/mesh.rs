@@ -99,7 +99,7 @@ fn quality<'py>(py: Python<'py>, q: &Quality) -> PyResult<Bound<'py, PyDict>> {
 /// Meshes a region; returns points (n x 2, absolute), triangles (m x 3), per-triangle quality
 /// and the quality before and after smoothing.
 #[pyfunction]
-#[pyo3(signature = (polygons=None, path=None, corners=None, geographic=false, zone=None, min_angle=30.0, max_area=None, max_edge=None, max_vertices=None, smooth=0, smoother="smart", points=None, strips=None))]
+#[pyo3(signature = (polygons=None, path=None, corners=None, geographic=false, zone=None, min_angle=terramesh_mesh::DEFAULT_MIN_ANGLE, max_area=None, max_edge=None, max_vertices=None, smooth=0, smoother=None, points=None, strips=None))]
 #[allow(clippy::too_many_arguments)]
 fn mesh<'py>(
     py: Python<'py>,
@@ -113,13 +113,24 @@ fn mesh<'py>(
     max_edge: Option<f64>,
     max_vertices: Option<usize>,
     smooth: usize,
-    smoother: &str,
+    smoother: Option<&str>,
     points: Option<Vec<[f64; 2]>>,
     strips: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let smoother: Smoother = smoother
-        .parse()
-        .map_err(|e| input(format!("smoother: {e}")))?;
+    let smoother: Smoother = match smoother {
+        None => terramesh_mesh::DEFAULT_SMOOTHER,
+        Some(s) => s.parse().map_err(|e| input(format!("smoother: {e}")))?,
+    };
+    let points = points.unwrap_or_default();
+    if let Some(i) = points
+        .iter()
+        .position(|p| !p[0].is_finite() || !p[1].is_finite())
+    {
+        return Err(input(format!(
+            "points[{i}] is ({}, {}): every coordinate must be a finite number",
+            points[i][0], points[i][1]
+        )));
+    }
     let settings = MeshSettings {
         min_angle,
         max_area,
@@ -128,7 +139,7 @@ fn mesh<'py>(
         strips,
         smooth,
         smoother,
-        points: points.unwrap_or_default(),
+        points,
     };
     let (region, planar, tq) = run(py, false, |cancel| {
         let region = region(polygons, path, corners, geographic, zone)?;

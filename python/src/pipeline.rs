@@ -26,7 +26,7 @@ type SampleRow = (Option<[f64; 2]>, [f64; 2], Option<f64>);
 /// output), `x`, `y`, `z` (NaN where missing and `on_missing="skip"` did not drop it) and
 /// the zone.
 #[pyfunction]
-#[pyo3(signature = (source, region=None, region_file=None, geographic=true, zone=None, rows=Some(100), cols=Some(50), spacing=None, margin="0.1", clip=false, on_missing="error", output=None, progress=false))]
+#[pyo3(signature = (source, region=None, region_file=None, geographic=true, zone=None, rows=Some(terramesh::project::DEFAULT_ROWS), cols=Some(terramesh::project::DEFAULT_COLS), spacing=None, margin=None, clip=false, on_missing="error", output=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 fn sample<'py>(
     py: Python<'py>,
@@ -38,7 +38,7 @@ fn sample<'py>(
     rows: Option<usize>,
     cols: Option<usize>,
     spacing: Option<f64>,
-    margin: &str,
+    margin: Option<&str>,
     clip: bool,
     on_missing: &str,
     output: Option<String>,
@@ -63,9 +63,12 @@ fn sample<'py>(
         (None, Some(r), Some(c)) => Some((r, c)),
         (None, _, _) => return Err(input("sample: give rows and cols, or spacing")),
     };
-    o.margin = margin
-        .parse::<MarginSpec>()
-        .map_err(|e| input(format!("margin '{margin}': {e}")))?;
+    o.margin = match margin {
+        None => MarginSpec::Fraction(terramesh::project::DEFAULT_MARGIN),
+        Some(m) => m
+            .parse::<MarginSpec>()
+            .map_err(|e| input(format!("margin '{m}': {e}")))?,
+    };
     o.clip = clip;
     o.on_missing = on_missing
         .parse::<OnMissing>()

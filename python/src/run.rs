@@ -133,24 +133,65 @@ pub(crate) fn chunked(
     cancel.check()
 }
 
-/// A float64 numpy array as a slice: borrowed when contiguous, else copied.
-pub(crate) fn slice<'a>(a: &'a numpy::PyReadonlyArray1<'_, f64>) -> std::borrow::Cow<'a, [f64]> {
-    match a.as_slice() {
-        Ok(s) => std::borrow::Cow::Borrowed(s),
-        Err(_) => std::borrow::Cow::Owned(a.as_array().to_vec()),
-    }
-}
-
 /// Floats borrowed from numpy, or copied.
 pub(crate) type Floats<'a> = std::borrow::Cow<'a, [f64]>;
 
-/// Two equally long coordinate arrays, or an error naming them.
+/// The float64 numpy array of the argument `name` as a slice: borrowed when contiguous, else
+/// copied (its size checked first: a `TooLargeError`, never an abort). Every value must be
+/// finite: a NaN or an infinity is refused naming the argument and the index.
+pub(crate) fn floats<'a>(
+    name: &str,
+    a: &'a numpy::PyReadonlyArray1<'_, f64>,
+) -> PyResult<Floats<'a>> {
+    let s = match a.as_slice() {
+        Ok(s) => std::borrow::Cow::Borrowed(s),
+        Err(_) => {
+            let view = a.as_array();
+            let mut v = terramesh_core::limits::try_with_capacity(view.len(), "values")
+                .map_err(|e| crate::errors::too_large_for(name, e))?;
+            v.extend(view.iter().copied());
+            std::borrow::Cow::Owned(v)
+        }
+    };
+    finite(name, &s)?;
+    Ok(s)
+}
+
+/// An error naming `name[i]` for the first value of `values` that is not finite.
+pub(crate) fn finite(name: &str, values: &[f64]) -> PyResult<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(crate::errors::input(format!(
+            "{name}[{i}] is {}: every value must be a finite number (drop or fill missing \
+             values first)",
+            values[i]
+        ))),
+    }
+}
+
+/// Room for `n` values of `T` for the results of the argument `name`, reserved after checking
+/// the size: a `TooLargeError` naming `name`, never an abort.
+pub(crate) fn room<T>(name: &str, n: usize) -> PyResult<Vec<T>> {
+    terramesh_core::limits::try_with_capacity(n, "values")
+        .map_err(|e| crate::errors::too_large_for(name, e))
+}
+
+/// Checks that `n` items of `bytes_each` bytes (`what`, for the argument `name`) fit the
+/// memory ceiling before any of them is allocated.
+pub(crate) fn fits(name: &str, what: &'static str, n: usize, bytes_each: f64) -> PyResult<()> {
+    terramesh_core::limits::Estimate::new(what, n as f64, bytes_each)
+        .check()
+        .map(|_| ())
+        .map_err(|e| crate::errors::too_large_for(name, e))
+}
+
+/// Two equally long, finite coordinate arrays, or an error naming them.
 pub(crate) fn pair<'a>(
     names: (&str, &str),
     a: &'a numpy::PyReadonlyArray1<'_, f64>,
     b: &'a numpy::PyReadonlyArray1<'_, f64>,
 ) -> PyResult<(Floats<'a>, Floats<'a>)> {
-    let (a, b) = (slice(a), slice(b));
+    let (a, b) = (floats(names.0, a)?, floats(names.1, b)?);
     if a.len() != b.len() {
         return Err(crate::errors::input(format!(
             "{} and {} must have the same length ({} and {} given)",

@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use terramesh_core::coords::{parse_angle, to_utm_many, to_wgs84_many, Axis, Parallelism, Zone};
 
 use crate::errors::{input, kernel};
-use crate::run::{chunked, pair, run};
+use crate::run::{chunked, fits, pair, room, run};
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(utm_forward, m)?)?;
@@ -43,9 +43,10 @@ fn utm_forward<'py>(
     let (lat, lon) = pair(("lat", "lon"), &lat, &lon)?;
     let (lat, lon) = (&*lat, &*lon);
     let n = lat.len();
+    fits("lat", "points", n, 18.0)?;
+    let (mut e, mut no) = (room("lat", n)?, room("lat", n)?);
+    let (mut z, mut north) = (room("lat", n)?, room("lat", n)?);
     let (e, no, z, north) = run(py, false, |cancel| {
-        let (mut e, mut no) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        let (mut z, mut north) = (Vec::with_capacity(n), Vec::with_capacity(n));
         chunked(n, cancel, |r| {
             let lo = r.start;
             let out = to_utm_many(&lat[r.clone()], &lon[r], forced, Parallelism::default())
@@ -98,8 +99,9 @@ fn utm_inverse<'py>(
     let z = self::zone(zone)?;
     let (e, n) = pair(("easting", "northing"), &easting, &northing)?;
     let (e, n) = (&*e, &*n);
+    fits("easting", "points", e.len(), 16.0)?;
+    let (mut lat, mut lon) = (room("easting", e.len())?, room("easting", e.len())?);
     let (lat, lon) = run(py, false, |cancel| {
-        let (mut lat, mut lon) = (Vec::with_capacity(e.len()), Vec::with_capacity(e.len()));
         chunked(e.len(), cancel, |r| {
             let lo = r.start;
             let out = to_wgs84_many(&e[r.clone()], &n[r.clone()], z, Parallelism::default())

@@ -23,6 +23,7 @@ from ._terramesh import (
     InputError,
     InternalError,
     OutputError,
+    TooLargeError,
     __version__,
 )
 from . import utm
@@ -37,6 +38,7 @@ __all__ = [
     "ComputationError",
     "OutputError",
     "InternalError",
+    "TooLargeError",
     "utm",
     "Variogram",
     "Experimental",

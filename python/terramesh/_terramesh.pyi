@@ -10,6 +10,12 @@ F64 = npt.NDArray[np.float64]
 
 __version__: str
 
+DEFAULTS: Dict[str, Any]
+"""The library's defaults the Python signatures show (``min_angle``, ``max_min_angle``,
+``smooth``, ``smoother``, ``lags``, ``max_points``, ``tolerance``, ``estimator``,
+``weighting``, ``reml_block``, ``idw_power``, ``rows``, ``cols``, ``margin``), each from the
+facade's constant."""
+
 class Error(Exception):
     """Every error terramesh raises (its message is the library's)."""
 
@@ -24,6 +30,13 @@ class OutputError(Error):
 
 class InternalError(Error):
     """A bug in terramesh (a caught panic)."""
+
+class TooLargeError(InputError, MemoryError):
+    """A size that follows from the input would not fit in memory: refused before allocating."""
+
+def cli(argv: Sequence[str], program: Optional[str] = None) -> int:
+    """Runs the ``terramesh`` command with ``argv`` (program name first) and returns its exit
+    code; a process's main only (see :mod:`terramesh._cli`)."""
 
 def utm_forward(
     lat: F64, lon: F64, zone: Optional[str] = None
@@ -59,11 +72,11 @@ def experimental(
     """The lag classes: ``lo``, ``hi``, ``distance``, ``gamma``, ``pairs`` arrays."""
 
 def variogram_fit(
-    x: F64, y: F64, z: F64, model: str = "auto", weighting: str = "cressie", lags: int = 15,
+    x: F64, y: F64, z: F64, model: str = "auto", weighting: str = "cressie", lags: int = ...,
     max_dist: Optional[float] = None, estimator: str = "matheron",
     azimuth: Optional[float] = None, tolerance: Optional[float] = None,
-    max_points: Optional[int] = 10000, fit: Optional[str] = None, drift: str = "linear",
-    reml_block: int = 400,
+    max_points: Optional[int] = ..., fit: Optional[str] = None, drift: str = "linear",
+    reml_block: int = ...,
 ) -> str:
     """The ``variogram.json`` text of the fitted model (see :meth:`terramesh.Variogram.fit`)."""
 
@@ -75,7 +88,7 @@ def krige(
     """Kriging estimates and variances (see :func:`terramesh.krige`)."""
 
 def idw(
-    x: F64, y: F64, z: F64, xt: F64, yt: F64, power: float = 2.0,
+    x: F64, y: F64, z: F64, xt: F64, yt: F64, power: float = ...,
     neighbors: Optional[int] = None, radius: Optional[float] = None,
 ) -> F64:
     """IDW estimates (see :func:`terramesh.idw`)."""
@@ -83,23 +96,23 @@ def idw(
 def cross_validate(
     x: F64, y: F64, z: F64, method: str = "uk", variogram: Optional[str] = None,
     drift: str = "linear", mean: Optional[float] = None, neighbors: Optional[int] = None,
-    folds: Optional[int] = None, power: float = 2.0, radius: Optional[float] = None,
+    folds: Optional[int] = None, power: float = ..., radius: Optional[float] = None,
 ) -> Dict[str, Any]:
     """Cross-validation estimates, variances and statistics (see :func:`terramesh.cross_validate`)."""
 
 def mesh(
     polygons: Optional[List[List[List[Sequence[float]]]]] = None, path: Optional[str] = None,
     corners: Optional[str] = None, geographic: bool = False, zone: Optional[str] = None,
-    min_angle: float = 30.0, max_area: Optional[float] = None, max_edge: Optional[float] = None,
-    max_vertices: Optional[int] = None, smooth: int = 0, smoother: str = "smart",
+    min_angle: float = ..., max_area: Optional[float] = None, max_edge: Optional[float] = None,
+    max_vertices: Optional[int] = None, smooth: int = 0, smoother: Optional[str] = None,
     points: Optional[List[Sequence[float]]] = None, strips: Optional[int] = None,
 ) -> Dict[str, Any]:
     """Points, triangles and quality of a mesh (see :func:`terramesh.mesh`)."""
 
 def sample(
     source: str, region: Optional[str] = None, region_file: Optional[str] = None,
-    geographic: bool = True, zone: Optional[str] = None, rows: Optional[int] = 100,
-    cols: Optional[int] = 50, spacing: Optional[float] = None, margin: str = "0.1",
+    geographic: bool = True, zone: Optional[str] = None, rows: Optional[int] = ...,
+    cols: Optional[int] = ..., spacing: Optional[float] = None, margin: Optional[str] = None,
     clip: bool = False, on_missing: str = "error", output: Optional[str] = None,
     progress: bool = False,
 ) -> Dict[str, Any]:

@@ -1,9 +1,10 @@
 """Tiled builds on a Dask cluster: one task per tile of a plan, with retries, then the merge.
 
 A plan is made by ``terramesh tiles plan PROJECT.toml --tile-size 10km -o PLAN/``; each task
-runs ``terramesh tiles build PLAN/ --tile ID`` on a worker (the ``terramesh`` command-line
-binary, found as the ``binary`` argument, ``$TERRAMESH_BIN`` or on ``PATH``), and the merge
-task ``terramesh tiles merge PLAN/ -o OUT/``. The plan folder must be on a file system every
+runs ``terramesh tiles build PLAN/ --tile ID`` on a worker, and the merge task ``terramesh
+tiles merge PLAN/ -o OUT/``. The command is the ``binary`` argument or ``$TERRAMESH_BIN``
+when given, else the ``terramesh`` command of this package as installed where the task runs
+(``pip install`` puts it beside the worker's Python: no cargo, no separate binary). The plan folder must be on a file system every
 worker sees. Tiles are independent and their builds atomic: a task that dies with its worker
 is run again by Dask elsewhere, and a tile that fails is reported and can be built again alone
 (``build_tiles(plan, client, tiles=["x1y1"])``).
@@ -36,35 +37,53 @@ __all__ = ["TileReport", "build_tiles", "find_binary", "main"]
 
 
 def find_binary(binary: str | None = None) -> str:
-    """The ``terramesh`` binary: ``binary``, else ``$TERRAMESH_BIN``, else ``terramesh`` on
-    ``PATH``; a ``FileNotFoundError`` saying how to give it otherwise.
+    """The ``terramesh`` command: ``binary``, else ``$TERRAMESH_BIN``, else the console script
+    this package installed beside the running Python, else ``terramesh`` on ``PATH``; a
+    ``FileNotFoundError`` saying how to give it otherwise.
 
     >>> find_binary("/bin/sh")
     '/bin/sh'
     """
-    for candidate in (binary, os.environ.get("TERRAMESH_BIN"), shutil.which("terramesh")):
+    from ._cli import command
+
+    script = command()
+    for candidate in (
+        binary,
+        os.environ.get("TERRAMESH_BIN"),
+        script[0] if len(script) == 1 else None,
+        shutil.which("terramesh"),
+    ):
         if candidate:
             return candidate
     raise FileNotFoundError(
-        "no terramesh binary: install it (cargo install --path crates/terramesh-cli), put it "
+        "no terramesh command: pip install the terramesh package (it installs one), put one "
         "on PATH, set TERRAMESH_BIN, or pass binary="
     )
 
 
-def _run(args: list[str]) -> str:
-    """Runs the binary; a ``RuntimeError`` with its message when it fails."""
-    p = subprocess.run(args, capture_output=True, text=True)
+def _command(binary: str | None) -> list[str]:
+    """The command line of ``terramesh`` where this runs (on a worker for a task):
+    ``binary``, else ``$TERRAMESH_BIN``, else this package's own command."""
+    from ._cli import command
+
+    given = binary or os.environ.get("TERRAMESH_BIN")
+    return [given] if given else command()
+
+
+def _run(command: list[str], args: list[str]) -> str:
+    """Runs ``command`` with ``args``; a ``RuntimeError`` with its message when it fails."""
+    p = subprocess.run([*command, *args], capture_output=True, text=True)
     if p.returncode != 0:
-        raise RuntimeError(f"{' '.join(args[1:4])} {' '.join(args[4:])}: {p.stderr.strip()}")
+        raise RuntimeError(f"{' '.join(args[:3])} {' '.join(args[3:])}: {p.stderr.strip()}")
     return p.stdout.strip()
 
 
-def _build_one(binary: str, plan: str, tile: str) -> str:
-    return _run([binary, "tiles", "build", plan, "--tile", tile])
+def _build_one(binary: str | None, plan: str, tile: str) -> str:
+    return _run(_command(binary), ["tiles", "build", plan, "--tile", tile])
 
 
-def _merge(binary: str, plan: str, out: str, _built: list) -> str:
-    return _run([binary, "tiles", "merge", plan, "-o", out])
+def _merge(binary: str | None, plan: str, out: str, _built: list) -> str:
+    return _run(_command(binary), ["tiles", "merge", plan, "-o", out])
 
 
 @dataclass
@@ -115,7 +134,8 @@ def build_tiles(
     from dask.distributed import wait
 
     plan = os.path.abspath(os.fspath(plan))
-    exe = find_binary(binary)
+    # The client's TERRAMESH_BIN, as before; else each worker runs its own package's command.
+    exe = binary or os.environ.get("TERRAMESH_BIN")
     ids = list(tiles) if tiles is not None else _tile_ids(plan)
     futures = {
         tid: client.submit(
@@ -153,7 +173,10 @@ def main(argv=None) -> int:
     ap.add_argument("-o", "--output", help="merge into this folder when every tile is built")
     ap.add_argument("--tile", action="append", help="build only this tile (repeatable)")
     ap.add_argument("--retries", type=int, default=2, help="more tries per tile (default 2)")
-    ap.add_argument("--binary", help="the terramesh binary (default: $TERRAMESH_BIN or PATH)")
+    ap.add_argument(
+        "--binary",
+        help="the terramesh command (default: $TERRAMESH_BIN, else this package's own)",
+    )
     a = ap.parse_args(argv)
     _tile_ids(a.plan)  # a missing plan is reported before a cluster is started
     from dask.distributed import Client

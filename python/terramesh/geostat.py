@@ -9,8 +9,8 @@ from typing import Any, NamedTuple, Optional, Union
 import numpy as np
 
 from . import _terramesh as _core
-from ._arrays import reshape, shaped, vec
-from ._terramesh import InputError
+from ._arrays import count, number, reshape, shaped, vec
+from ._terramesh import DEFAULTS, InputError
 from .variogram import Variogram
 
 __all__ = ["krige", "idw", "cross_validate", "CrossValidation"]
@@ -25,6 +25,8 @@ def _variogram(v: VariogramLike, x, y, z) -> Variogram:
         return v
     if isinstance(v, dict):
         return Variogram.from_json(v if "model" in v else {"model": v})
+    if isinstance(v, bytes):
+        v = v.decode("utf-8", "replace")
     if isinstance(v, (str, os.PathLike)):
         return Variogram.from_json(v)
     raise InputError(
@@ -35,10 +37,16 @@ def _variogram(v: VariogramLike, x, y, z) -> Variogram:
 def _neighbors(k: Optional[int]) -> Optional[int]:
     if k is None:
         return None
-    k = int(k)
+    k = count(k, "neighbors")
     if k < 1:
         raise InputError(f"neighbors {k}: give at least 1, or None for all the data")
     return k
+
+
+def _name(v, name: str) -> str:
+    if not isinstance(v, str):
+        raise InputError(f"{name}: give a name (a str), not a {type(v).__name__}")
+    return v
 
 
 def krige(
@@ -77,8 +85,8 @@ def krige(
     ytv, _ = shaped(yt, "yt")
     v = _variogram(variogram, xs, ys, zs)
     est, var = _core.krige(
-        xs, ys, zs, xtv, ytv, v._json, method, drift, mean, _neighbors(neighbors),
-        bool(return_variance),
+        xs, ys, zs, xtv, ytv, v._json, _name(method, "method"), _name(drift, "drift"),
+        number(mean, "mean", none=True), _neighbors(neighbors), bool(return_variance),
     )
     if return_variance:
         return reshape(est, shape), reshape(var, shape)
@@ -91,7 +99,7 @@ def idw(
     z,
     xt,
     yt,
-    power: float = 2.0,
+    power: float = DEFAULTS["idw_power"],
     neighbors: Optional[int] = None,
     radius: Optional[float] = None,
 ):
@@ -104,8 +112,8 @@ def idw(
     xtv, shape = shaped(xt, "xt")
     ytv, _ = shaped(yt, "yt")
     est = _core.idw(
-        vec(x, "x"), vec(y, "y"), vec(z, "z"), xtv, ytv, float(power), _neighbors(neighbors),
-        radius,
+        vec(x, "x"), vec(y, "y"), vec(z, "z"), xtv, ytv, number(power, "power"),
+        _neighbors(neighbors), number(radius, "radius", none=True),
     )
     return reshape(est, shape)
 
@@ -140,7 +148,7 @@ def cross_validate(
     drift: str = "linear",
     neighbors: Optional[int] = None,
     folds: Optional[int] = None,
-    power: float = 2.0,
+    power: float = DEFAULTS["idw_power"],
     radius: Optional[float] = None,
     mean: Optional[float] = None,
 ) -> CrossValidation:
@@ -157,9 +165,11 @@ def cross_validate(
     """
     xs, ys, zs = vec(x, "x"), vec(y, "y"), vec(z, "z")
     vj = None
-    if method.lower() != "idw":
+    if _name(method, "method").lower() != "idw":
         vj = _variogram(variogram, xs, ys, zs)._json
     d = _core.cross_validate(
-        xs, ys, zs, method, vj, drift, mean, _neighbors(neighbors), folds, float(power), radius
+        xs, ys, zs, method, vj, _name(drift, "drift"), number(mean, "mean", none=True),
+        _neighbors(neighbors), count(folds, "folds", 2, none=True), number(power, "power"),
+        number(radius, "radius", none=True),
     )
     return CrossValidation(**d)

@@ -8,7 +8,8 @@ from typing import Any, Dict, List, Optional, Sequence, Union
 import numpy as np
 
 from . import _terramesh as _core
-from ._terramesh import InputError
+from ._arrays import count, number, points as _points, vec
+from ._terramesh import DEFAULTS, InputError
 
 __all__ = ["Mesh", "mesh"]
 
@@ -59,7 +60,7 @@ class Mesh:
         >>> m.with_heights([1.0, 2.0, 3.0]).points[:, 2].tolist()
         [1.0, 2.0, 3.0]
         """
-        z = np.asarray(z, dtype=np.float64).reshape(-1)
+        z = vec(z, "z")
         if len(z) != len(self.points):
             raise InputError(f"with_heights: {len(z)} heights for {len(self.points)} vertices")
         return Mesh(self._d, z)
@@ -97,28 +98,54 @@ class Mesh:
 
 
 def _ring(r: Any, what: str) -> List[List[float]]:
-    a = np.asarray(r, dtype=np.float64)
-    if a.ndim != 2 or a.shape[1] < 2:
-        raise InputError(f"region: {what} must be an n x 2 array or a list of (x, y) pairs")
-    return a[:, :2].tolist()
+    return _points(r, f"region: {what}")
+
+
+def _geometry(geo: Any, where: str) -> Dict[str, Any]:
+    if not isinstance(geo, dict):
+        raise InputError(f"region: {where} is a {type(geo).__name__}, not a GeoJSON object")
+    return geo
+
+
+def _key(geo: Dict[str, Any], key: str, where: str) -> Any:
+    if key not in geo:
+        raise InputError(
+            f"region: the {geo.get('type')} {where} has no {key!r} key (GeoJSON expected)"
+        )
+    return geo[key]
 
 
 def _polygons(region: Any) -> List[List[List[List[float]]]]:
     """Rings of a region given as rings, a polygon list or a ``__geo_interface__``."""
+    if region is None:
+        raise InputError(
+            "region: None given: give a list of rings (n x 2 arrays or lists of (x, y) "
+            "pairs), a shapely-like geometry, a GeoJSON dict or the path of a region file"
+        )
     geo = getattr(region, "__geo_interface__", None)
     if geo is None and isinstance(region, dict) and "type" in region:
         geo = region
     if geo is not None:
+        geo = _geometry(geo, "geometry")
         t = geo.get("type")
         if t == "Feature":
-            return _polygons(geo["geometry"])
+            return _polygons(_geometry(_key(geo, "geometry", "object"), "a Feature's geometry"))
         if t == "FeatureCollection":
-            return [p for f in geo["features"] for p in _polygons(f["geometry"])]
+            return [
+                p
+                for f in _key(geo, "features", "object")
+                for p in _polygons(_geometry(_key(_geometry(f, "a feature"), "geometry", "feature"), "a feature's geometry"))
+            ]
         if t == "Polygon":
-            return [[_ring(r, "a ring") for r in geo["coordinates"]]]
+            return [[_ring(r, "a ring") for r in _key(geo, "coordinates", "geometry")]]
         if t == "MultiPolygon":
-            return [[_ring(r, "a ring") for r in p] for p in geo["coordinates"]]
+            return [[_ring(r, "a ring") for r in p] for p in _key(geo, "coordinates", "geometry")]
         raise InputError(f"region: a {t} geometry is not an area (give a Polygon or MultiPolygon)")
+    if isinstance(region, (dict, bytes, int, float)) or not hasattr(region, "__iter__"):
+        raise InputError(
+            f"region: a {type(region).__name__} given: give a list of rings, a shapely-like "
+            "geometry, a GeoJSON dict or the path of a region file"
+        )
     rings = list(region)
     if not rings:
         raise InputError("region: no rings given")
@@ -127,12 +154,12 @@ def _polygons(region: Any) -> List[List[List[List[float]]]]:
 
 def mesh(
     region: Union[Sequence, Any, str, os.PathLike],
-    min_angle: float = 30.0,
+    min_angle: float = DEFAULTS["min_angle"],
     max_area: Optional[float] = None,
     max_edge: Optional[float] = None,
     max_vertices: Optional[int] = None,
-    smooth: int = 0,
-    smoother: str = "smart",
+    smooth: int = DEFAULTS["smooth"],
+    smoother: str = DEFAULTS["smoother"],
     points=None,
     crs: str = "projected",
     zone: Optional[str] = None,
@@ -161,14 +188,14 @@ def mesh(
     kw = dict(
         geographic=crs == "geographic",
         zone=zone,
-        min_angle=float(min_angle),
-        max_area=max_area,
-        max_edge=max_edge,
-        max_vertices=max_vertices,
-        smooth=int(smooth),
+        min_angle=number(min_angle, "min_angle"),
+        max_area=number(max_area, "max_area", none=True),
+        max_edge=number(max_edge, "max_edge", none=True),
+        max_vertices=count(max_vertices, "max_vertices", none=True),
+        smooth=count(smooth, "smooth"),
         smoother=smoother,
-        points=None if points is None else np.asarray(points, dtype=np.float64)[:, :2].tolist(),
-        strips=strips,
+        points=None if points is None else _points(points, "points"),
+        strips=count(strips, "strips", 1, none=True),
     )
     if isinstance(region, (str, os.PathLike)):
         d = _core.mesh(path=os.fspath(region), **kw)

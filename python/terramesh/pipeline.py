@@ -12,7 +12,8 @@ from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Union
 import numpy as np
 
 from . import _terramesh as _core
-from ._terramesh import InputError
+from ._arrays import count, number
+from ._terramesh import DEFAULTS, InputError
 from .variogram import Variogram
 
 __all__ = ["sample", "Samples", "build", "BuildResult"]
@@ -64,9 +65,9 @@ def _region_args(region: Any, crs: str) -> Dict[str, Any]:
 def sample(
     source: Union[str, os.PathLike],
     region: Any = None,
-    rows: Optional[int] = 100,
-    cols: Optional[int] = 50,
-    margin: Union[float, str] = 0.1,
+    rows: Optional[int] = DEFAULTS["rows"],
+    cols: Optional[int] = DEFAULTS["cols"],
+    margin: Union[float, str] = DEFAULTS["margin"],
     spacing: Optional[float] = None,
     clip: bool = False,
     crs: str = "geographic",
@@ -98,9 +99,9 @@ def sample(
         d = _core.sample(
             os.fspath(source),
             zone=zone,
-            rows=rows,
-            cols=cols,
-            spacing=spacing,
+            rows=count(rows, "rows", 1, none=True),
+            cols=count(cols, "cols", 1, none=True),
+            spacing=number(spacing, "spacing", none=True),
             margin=str(margin),
             clip=bool(clip),
             on_missing=on_missing,

@@ -27,8 +27,8 @@ from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Union
 import numpy as np
 
 from . import _terramesh as _core
-from ._arrays import reshape, shaped, vec
-from ._terramesh import InputError
+from ._arrays import count, number, reshape, shaped, vec
+from ._terramesh import DEFAULTS, InputError
 
 __all__ = ["Variogram", "Experimental"]
 
@@ -53,22 +53,36 @@ def _structure(s: Any) -> Dict[str, Any]:
         d = dict(s)
         if "model" in d and "type" not in d:
             d["type"] = d.pop("model")
+        missing = [k for k in ("type", "psill") if k not in d]
+        if missing:
+            raise InputError(
+                f"structure {s!r}: no {' or '.join(repr(k) for k in missing)} key: give a "
+                "dict with 'type' (or 'model'), 'psill', 'range' and, for power and matern, "
+                "'shape'"
+            )
     else:
-        s = tuple(s)
+        try:
+            s = tuple(s)
+        except TypeError:
+            raise InputError(
+                f"structure {s!r}: give (model, psill, range[, shape]) or a dict"
+            ) from None
         if len(s) not in (3, 4):
             raise InputError(f"structure {s!r}: give (model, psill, range[, shape]) or a dict")
         d = {"type": s[0], "psill": s[1], "range": s[2]}
         if len(s) == 4:
             d["shape"] = s[3]
-    d["type"] = str(d["type"]).lower()
-    d["psill"] = float(d["psill"])
-    d["range"] = float(d.get("range", 0.0))
+    if not isinstance(d["type"], str):
+        raise InputError(f"structure {s!r}: the model must be a name such as 'spherical'")
+    d["type"] = d["type"].lower()
+    d["psill"] = number(d["psill"], "psill")
+    d["range"] = number(d.get("range", 0.0), "range")
     if d.get("shape") is None:
         d.pop("shape", None)
         if d["type"] in ("power", "matern"):
             d["shape"] = 1.5
     else:
-        d["shape"] = float(d["shape"])
+        d["shape"] = number(d["shape"], "shape")
     return d
 
 
@@ -103,14 +117,21 @@ class Variogram:
     ):
         if structures is None:
             structures = [(model, psill, range, shape)]
+        elif isinstance(structures, (str, bytes, dict)) or not hasattr(structures, "__iter__"):
+            raise InputError(
+                f"structures: give a list of (model, psill, range[, shape]) or of dicts, not "
+                f"a {type(structures).__name__}"
+            )
         model_obj: Dict[str, Any] = {
-            "nugget": float(nugget),
+            "nugget": number(nugget, "nugget"),
             "structures": [_structure(s) for s in structures],
         }
         if anisotropy_angle is not None or anisotropy_ratio is not None:
             model_obj["anisotropy"] = {
-                "angle": float(anisotropy_angle or 0.0),
-                "ratio": float(1.0 if anisotropy_ratio is None else anisotropy_ratio),
+                "angle": number(anisotropy_angle or 0.0, "anisotropy_angle"),
+                "ratio": number(
+                    1.0 if anisotropy_ratio is None else anisotropy_ratio, "anisotropy_ratio"
+                ),
             }
         self._json = _core.variogram_check(json.dumps(model_obj))
         self._model = json.loads(self._json)
@@ -212,7 +233,15 @@ class Variogram:
         4.0
         """
         if isinstance(source, dict):
-            text = json.dumps(source)
+            try:
+                text = json.dumps(source)
+            except (TypeError, ValueError) as e:
+                raise InputError(f"variogram: the dict is not JSON ({e})") from None
+        elif not isinstance(source, (str, os.PathLike)):
+            raise InputError(
+                "variogram: expected variogram.json's text, its path or its dict, not a "
+                f"{type(source).__name__}"
+            )
         else:
             s = os.fspath(source)
             text = s
@@ -220,9 +249,13 @@ class Variogram:
                 try:
                     with open(s, encoding="utf-8") as f:
                         text = f.read()
-                except OSError as e:
-                    raise InputError(f"variogram file {s}: {e.strerror or e}") from None
-        parsed = json.loads(text) if text.strip().startswith("{") else None
+                except (OSError, ValueError) as e:
+                    why = getattr(e, "strerror", None) or e
+                    raise InputError(f"variogram file {s}: {why}") from None
+        try:
+            parsed = json.loads(text) if text.strip().startswith("{") else None
+        except ValueError:
+            parsed = None  # the library says what is wrong with the text
         if isinstance(parsed, dict) and "model" not in parsed and "structures" in parsed:
             text = json.dumps({"model": parsed})
         model = json.loads(_core.variogram_file_model(text))
@@ -262,12 +295,12 @@ class Variogram:
         x,
         y,
         z,
-        lags: int = 15,
+        lags: int = DEFAULTS["lags"],
         max_dist: Optional[float] = None,
-        estimator: str = "matheron",
+        estimator: str = DEFAULTS["estimator"],
         azimuth: Optional[float] = None,
         tolerance: Optional[float] = None,
-        max_points: Optional[int] = 10_000,
+        max_points: Optional[int] = DEFAULTS["max_points"],
     ) -> Experimental:
         """The experimental variogram of data ``x, y, z``: ``lags`` equal classes on
         ``[0, max_dist)`` (default half the data's diameter), Matheron's or Cressie-Hawkins'
@@ -281,8 +314,10 @@ class Variogram:
         (5, True)
         """
         d = _core.experimental(
-            vec(x, "x"), vec(y, "y"), vec(z, "z"), int(lags), max_dist, estimator, azimuth,
-            tolerance, max_points,
+            vec(x, "x"), vec(y, "y"), vec(z, "z"), count(lags, "lags", 1),
+            number(max_dist, "max_dist", none=True), estimator,
+            number(azimuth, "azimuth", none=True), number(tolerance, "tolerance", none=True),
+            count(max_points, "max_points", 0, none=True),
         )
         return Experimental(d["lo"], d["hi"], d["distance"], d["gamma"], d["pairs"])
 
@@ -293,16 +328,16 @@ class Variogram:
         y,
         z,
         model: str = "auto",
-        weighting: str = "cressie",
-        lags: int = 15,
+        weighting: str = DEFAULTS["weighting"],
+        lags: int = DEFAULTS["lags"],
         max_dist: Optional[float] = None,
-        estimator: str = "matheron",
+        estimator: str = DEFAULTS["estimator"],
         azimuth: Optional[float] = None,
         tolerance: Optional[float] = None,
-        max_points: Optional[int] = 10_000,
+        max_points: Optional[int] = DEFAULTS["max_points"],
         fit: str = "wls",
         drift: str = "linear",
-        reml_block: int = 400,
+        reml_block: int = DEFAULTS["reml_block"],
     ) -> "Variogram":
         """Fits ``model`` (a name, a nested sum such as ``"spherical+exponential"`` fitted
         jointly, or ``"auto"``: every model, the best kept) to the data, as ``terramesh
@@ -339,7 +374,10 @@ class Variogram:
         True
         """
         text = _core.variogram_fit(
-            vec(x, "x"), vec(y, "y"), vec(z, "z"), model, weighting, int(lags), max_dist,
-            estimator, azimuth, tolerance, max_points, fit, drift, int(reml_block),
+            vec(x, "x"), vec(y, "y"), vec(z, "z"), model, weighting, count(lags, "lags", 1),
+            number(max_dist, "max_dist", none=True), estimator,
+            number(azimuth, "azimuth", none=True), number(tolerance, "tolerance", none=True),
+            count(max_points, "max_points", 0, none=True), fit, drift,
+            count(reml_block, "reml_block"),
         )
         return cls.from_json(text)

@@ -26,6 +26,18 @@ from .variogram_models import MODELS
 BACKENDS = ("vectorized", "loop", "C")
 
 
+def _unmasked(a, name):
+    """``a`` without a mask hiding nothing; a ``ValueError`` (PyKrige's class for bad input)
+    for a masked array with masked values, whose hidden values PyKrige would krige with."""
+    from .._arrays import _unmasked as check
+    from .._terramesh import InputError
+
+    try:
+        return check(a, name)
+    except InputError as e:
+        raise ValueError(str(e)) from None
+
+
 class KrigingBase:
     """Common constructor and methods; see the subclasses."""
 
@@ -73,6 +85,7 @@ class KrigingBase:
         self.verbose = verbose
         self.enable_plotting = enable_plotting
         self.enable_statistics = enable_statistics
+        x, y, z = _unmasked(x, "x"), _unmasked(y, "y"), _unmasked(z, "z")
         self.X_ORIG = np.atleast_1d(np.squeeze(np.array(x, copy=True, dtype=np.float64)))
         self.Y_ORIG = np.atleast_1d(np.squeeze(np.array(y, copy=True, dtype=np.float64)))
         self.Z = np.atleast_1d(np.squeeze(np.array(z, copy=True, dtype=np.float64)))
@@ -344,6 +357,7 @@ class KrigingBase:
     def _targets(self, style, xpoints, ypoints, mask):
         if style not in ("grid", "masked", "points"):
             raise ValueError(f"style argument must be 'grid', 'points', or 'masked', not '{style}'")
+        xpoints, ypoints = _unmasked(xpoints, "xpoints"), _unmasked(ypoints, "ypoints")
         xp = np.atleast_1d(np.squeeze(np.array(xpoints, copy=True, dtype=np.float64)))
         yp = np.atleast_1d(np.squeeze(np.array(ypoints, copy=True, dtype=np.float64)))
         if style in ("grid", "masked"):

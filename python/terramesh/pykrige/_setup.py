@@ -22,16 +22,26 @@ def parameter_list(model, params):
         if model == "custom":
             raise TypeError("variogram_parameters for a custom model must be a list")
         if model == "linear":
-            return [params["slope"], params["nugget"]]
-        if model == "power":
-            return [params["scale"], params["exponent"], params["nugget"]]
-        if model in MODELS:
-            if "psill" in params:
-                psill = params["psill"]
-            else:
-                psill = params["sill"] - params["nugget"]
-            return [psill, params["range"], params["nugget"]]
-        raise ValueError(f"variogram model '{model}' not supported")
+            keys = ("slope", "nugget")
+        elif model == "power":
+            keys = ("scale", "exponent", "nugget")
+        elif model in MODELS:
+            keys = ("psill" if "psill" in params else "sill", "range", "nugget")
+        else:
+            raise ValueError(f"variogram model '{model}' not supported")
+        missing = [k for k in keys if k not in params]
+        if missing:
+            # A KeyError, as PyKrige raises, that says what the dict needs.
+            need = " and ".join(repr(k) for k in keys)
+            if keys[0] in ("psill", "sill"):
+                need = "'sill' (or 'psill'), 'range' and 'nugget'"
+            raise KeyError(
+                f"variogram_parameters for the {model} model: no "
+                f"{', '.join(repr(k) for k in missing)} key; give {need}"
+            )
+        if keys[0] == "sill":
+            return [params["sill"] - params["nugget"], params["range"], params["nugget"]]
+        return [params[k] for k in keys]
     if isinstance(params, (list, tuple, np.ndarray)):
         params = list(params)
         if model == "custom":

@@ -164,7 +164,7 @@ pub fn run(args: Args) -> Result<()> {
             ))?;
         }
         Sub::Slurm(a) => {
-            let binary = std::env::current_exe()?;
+            let binary = crate::program()?;
             let output = a.output.unwrap_or_else(|| a.plan.join("merged"));
             let o = tiles::SlurmOptions {
                 partition: a.partition,
