@@ -156,6 +156,8 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
          # One tile per array task: task i builds the i-th tile of tiles.json.\n\
          set -euo pipefail\n{bin}PLAN={plan_q}\nTILES=({})\n\
          : \"${{SLURM_ARRAY_TASK_ID:?run me with sbatch, or set SLURM_ARRAY_TASK_ID to 0-{last}}}\"\n\
+         case \"$SLURM_ARRAY_TASK_ID\" in *[!0-9]*) echo \"SLURM_ARRAY_TASK_ID must be a number \
+         from 0 to {last}\" >&2; exit 2;; esac\n\
          ID=\"${{TILES[$SLURM_ARRAY_TASK_ID]}}\"\n\
          export RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-{}}}\"\n\
          exec \"$TERRAMESH\" tiles build \"$PLAN\" --tile \"$ID\"\n",
