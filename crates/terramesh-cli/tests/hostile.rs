@@ -116,7 +116,9 @@ fn run_case(program: &Path, case: &Case) -> Result<(), String> {
     for (name, text) in &case.files {
         let p = dir.join(name);
         if !p.starts_with(&dir) || name.contains("..") {
-            return Err(format!("[files] {name:?}: a case's files stay in its folder"));
+            return Err(format!(
+                "[files] {name:?}: a case's files stay in its folder"
+            ));
         }
         if let Some(parent) = p.parent() {
             std::fs::create_dir_all(parent).unwrap();
@@ -214,7 +216,12 @@ fn every_hostile_case_is_refused_cleanly() {
         .collect();
     files.sort();
     assert!(!files.is_empty(), "no case in {}", cases_dir().display());
-    let bin = Path::new(env!("CARGO_BIN_EXE_terramesh"));
+    // `TERRAMESH_HOSTILE_BIN` replays the cases against another build (one from before a
+    // fix, to see each case fail there).
+    let other = std::env::var_os("TERRAMESH_HOSTILE_BIN").map(PathBuf::from);
+    let bin = other
+        .as_deref()
+        .unwrap_or(Path::new(env!("CARGO_BIN_EXE_terramesh")));
     let mut failed = Vec::new();
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap();

@@ -125,7 +125,13 @@ fn untrusted_plan_files_damaged_tiles_and_clean_slurm_environments() {
     let mut b = std::fs::read(&tris).unwrap();
     b[4..8].copy_from_slice(&4_000_000u32.to_le_bytes());
     std::fs::write(&tris, &b).unwrap();
-    let e = refused(&terramesh(&["tiles", "merge", ps, "-o", out.to_str().unwrap()]));
+    let e = refused(&terramesh(&[
+        "tiles",
+        "merge",
+        ps,
+        "-o",
+        out.to_str().unwrap(),
+    ]));
     assert!(
         e.contains(victim.as_str()) && e.contains("triangles.u32") && e.contains("4000000"),
         "{e}"
@@ -138,7 +144,13 @@ fn untrusted_plan_files_damaged_tiles_and_clean_slurm_environments() {
     let home = tmp.path().join("home");
     std::fs::create_dir(&home).unwrap();
     std::fs::write(home.join("thesis.tex"), "years of work").unwrap();
-    let e = refused(&terramesh(&["tiles", "merge", ps, "-o", home.to_str().unwrap()]));
+    let e = refused(&terramesh(&[
+        "tiles",
+        "merge",
+        ps,
+        "-o",
+        home.to_str().unwrap(),
+    ]));
     assert!(e.contains("not a terramesh build folder"), "{e}");
     assert_eq!(std::fs::read_dir(&home).unwrap().count(), 1);
 

@@ -189,7 +189,15 @@ mod tests {
                 .problem,
             NameProblem::TooLong
         );
-        for ok in ["sand", "x0y12", "unit-1_b.c", "Löss", "COM10", "console", "nul_"] {
+        for ok in [
+            "sand",
+            "x0y12",
+            "unit-1_b.c",
+            "Löss",
+            "COM10",
+            "console",
+            "nul_",
+        ] {
             check_name(ok).unwrap_or_else(|e| panic!("{ok}: {e}"));
         }
     }
@@ -197,14 +205,7 @@ mod tests {
     #[test]
     fn relative_paths_stay_inside() {
         for bad in [
-            "",
-            "/abs",
-            "\\abs",
-            "a//b",
-            "a/../b",
-            "a/./b",
-            "a/",
-            "a\\..\\b",
+            "", "/abs", "\\abs", "a//b", "a/../b", "a/./b", "a/", "a\\..\\b",
         ] {
             assert!(check_relative(bad).is_err(), "{bad:?}");
         }

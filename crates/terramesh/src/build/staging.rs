@@ -179,12 +179,7 @@ impl Staging {
             .with_context(|| format!("cannot create the folder {}", parent.display()))?;
         // This build's lock, taken before its folder exists.
         let serial = SERIAL.fetch_add(1, Ordering::Relaxed);
-        let lock = lock_path(
-            &parent,
-            &name,
-            std::process::id(),
-            &serial.to_string(),
-        );
+        let lock = lock_path(&parent, &name, std::process::id(), &serial.to_string());
         let lock_guard = scratch::register(&lock);
         let lock_file = std::fs::File::options()
             .create(true)
@@ -456,7 +451,10 @@ mod tests {
         let tmp = dir.path().join(format!(".out.terramesh-tmp-{pid}-0"));
         let t0 = Instant::now();
         while !tmp.join("ready").exists() {
-            assert!(t0.elapsed() < Duration::from_secs(60), "the child never began");
+            assert!(
+                t0.elapsed() < Duration::from_secs(60),
+                "the child never began"
+            );
             std::thread::sleep(Duration::from_millis(20));
         }
         // Running: its folder is kept.
@@ -471,10 +469,17 @@ mod tests {
         };
         let t0 = Instant::now();
         while !state().starts_with('Z') {
-            assert!(t0.elapsed() < Duration::from_secs(60), "not a zombie: {}", state());
+            assert!(
+                t0.elapsed() < Duration::from_secs(60),
+                "not a zombie: {}",
+                state()
+            );
             std::thread::sleep(Duration::from_millis(20));
         }
-        assert!(alive(pid), "a zombie's /proc entry is what fooled the PID test");
+        assert!(
+            alive(pid),
+            "a zombie's /proc entry is what fooled the PID test"
+        );
         let s = Staging::begin(&out, &Silent).unwrap();
         assert!(!tmp.exists(), "the zombie's staging folder survived");
         let left = names(dir.path());

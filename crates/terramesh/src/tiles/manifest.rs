@@ -300,7 +300,8 @@ impl Manifest {
     pub fn check(&self) -> std::result::Result<(), String> {
         use terramesh_core::names::{check_name, check_relative, same_file_name};
         let rel = |field: &str, p: &str| {
-            check_relative(p).map_err(|e| format!("{field} {p:?} is not a file inside the plan folder: {e}"))
+            check_relative(p)
+                .map_err(|e| format!("{field} {p:?} is not a file inside the plan folder: {e}"))
         };
         let [sx, sy] = self.shape;
         let cells = sx.checked_mul(sy).filter(|&c| c > 0 && c <= MAX_TILES);
@@ -333,7 +334,9 @@ impl Manifest {
         terramesh_core::limits::Estimate::new("grid columns", g.nx as f64, 8.0 * width as f64)
             .check()
             .map_err(|e| format!("grid: {}", e.describe(&|s| s.to_string())))?;
-        if ![g.xmin, g.ymin, g.xmax, g.ymax].iter().all(|v| v.is_finite())
+        if ![g.xmin, g.ymin, g.xmax, g.ymax]
+            .iter()
+            .all(|v| v.is_finite())
             || g.xmin > g.xmax
             || g.ymin > g.ymax
         {

@@ -120,9 +120,8 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
         ("mem", o.mem.as_ref()),
     ] {
         if let Some(v) = value {
-            check_sbatch_value(v).map_err(|why| {
-                Error::invalid(format!("the Slurm {field} {v:?}: {why}"))
-            })?;
+            check_sbatch_value(v)
+                .map_err(|why| Error::invalid(format!("the Slurm {field} {v:?}: {why}")))?;
         }
     }
     let plan_abs = std::path::absolute(plan).context(plan.display().to_string())?;
