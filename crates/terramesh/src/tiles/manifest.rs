@@ -316,7 +316,8 @@ impl Manifest {
                 self.tiles.len()
             ));
         }
-        if !(self.tile_size.is_finite() && self.tile_size > 0.0)
+        if !self.tile_size.is_finite()
+            || self.tile_size <= 0.0
             || !self.origin.iter().all(|v| v.is_finite())
         {
             return Err(format!(
@@ -355,7 +356,7 @@ impl Manifest {
                     t.index
                 )));
             }
-            if !t.extent.iter().all(|v| v.is_finite()) || !(t.halo.is_finite() && t.halo >= 0.0) {
+            if !t.extent.iter().all(|v| v.is_finite()) || !t.halo.is_finite() || t.halo < 0.0 {
                 return Err(tile("its extent and halo must be finite".into()));
             }
             if let Some(d) = &t.data {
@@ -384,7 +385,7 @@ impl Manifest {
                     gp.units[a], gp.units[b]
                 ));
             }
-            if gp.interfaces.len() >= gp.units.len().max(1) + 1 {
+            if gp.interfaces.len() > gp.units.len().max(1) {
                 return Err(format!(
                     "geology: {} interfaces for {} units",
                     gp.interfaces.len(),

@@ -124,15 +124,15 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
     }
     let mut written = Vec::new();
     let vtu = out.join("dsm.vtu");
-    write_vtu(&vtu, plan, &m, &seams, n as usize, nt)?;
+    write_vtu(&vtu, plan, m, &seams, n as usize, nt)?;
     written.push(vtu);
 
     // The grids, row by row.
-    let (grid_files, grid) = super::grid_merge::write_grids(plan, &m, out)?;
+    let (grid_files, grid) = super::grid_merge::write_grids(plan, m, out)?;
     written.extend(grid_files);
     let model = match &m.geology {
         Some(gp) => {
-            let (model, files) = super::model_merge::merge_model(plan, &m, gp, out)?;
+            let (model, files) = super::model_merge::merge_model(plan, m, gp, out)?;
             written.extend(files);
             Some(model)
         }
@@ -155,7 +155,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
     terramesh_io::output::write_atomic(&json, text.as_bytes())
         .context(json.display().to_string())?;
     let report = out.join("report.html");
-    let html = super::report::html(&m, &merged);
+    let html = super::report::html(m, &merged);
     terramesh_io::output::write_atomic(&report, html.as_bytes())
         .context(report.display().to_string())?;
     let mut merged = merged;
