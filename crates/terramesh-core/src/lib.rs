@@ -29,6 +29,7 @@ pub mod coords;
 pub mod desurvey;
 pub mod geometry;
 pub mod limits;
+pub mod names;
 pub mod sampling;
 pub mod solid;
 pub mod vocab;

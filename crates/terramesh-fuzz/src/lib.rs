@@ -62,6 +62,7 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("mesher", mesher),
     ("boreholes", boreholes),
     ("crs", crs),
+    ("tiles_plan", tiles_plan),
 ];
 
 /// Committed data crops (in `fixtures/data/`, paths from the repository root) that also seed a
@@ -161,6 +162,56 @@ pub fn project_toml(data: &[u8]) {
 pub fn variogram_json(data: &[u8]) {
     if let Some(s) = text(data) {
         let _ = terramesh_geostat::VariogramFile::from_json(s);
+    }
+}
+
+/// A tiled build's manifest, `PLAN/tiles.json`, read as `tiles build`, `merge` and `slurm`
+/// read it (`Manifest::read`, which checks it): an accepted manifest names only tile folders
+/// directly in `PLAN/tiles/` and files inside the plan folder, and every tile lies in the tile
+/// grid.
+pub fn tiles_plan(data: &[u8]) {
+    use std::path::Component;
+    use terramesh::tiles::{tile_dir, Estimate, Manifest};
+    let path = files::write(terramesh::tiles::MANIFEST, data);
+    let plan = path.parent().expect("a folder");
+    let Ok(m) = Manifest::read(plan) else { return };
+    let inside = |rel: &str| {
+        let p = plan.join(rel);
+        let parts: Vec<Component> = p.strip_prefix(plan).expect("joined").components().collect();
+        assert!(
+            !parts.is_empty() && parts.iter().all(|c| matches!(c, Component::Normal(_))),
+            "{rel:?} leaves the plan folder"
+        );
+    };
+    for t in &m.tiles {
+        assert_eq!(
+            tile_dir(plan, &t.id).parent(),
+            Some(plan.join("tiles").as_path()),
+            "tile {:?}",
+            t.id
+        );
+        assert!(t.index[0] < m.shape[0] && t.index[1] < m.shape[1]);
+        if let Some(d) = &t.data {
+            inside(&d.file);
+        }
+    }
+    inside(&m.variogram);
+    inside(&m.data.samples);
+    if let Some(g) = &m.geology {
+        for u in &g.units {
+            assert!(terramesh_core::names::check_name(u).is_ok(), "unit {u:?}");
+        }
+        for i in &g.interfaces {
+            if !i.observations.is_empty() {
+                inside(&i.observations);
+            }
+            if let Estimate::Kriged { variogram, .. } = &i.estimate {
+                inside(variogram);
+            }
+        }
+        if let Some(c) = &g.contacts {
+            inside(c);
+        }
     }
 }
 

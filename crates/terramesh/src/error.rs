@@ -44,6 +44,10 @@ pub enum Error {
     /// Coordinates.
     #[error(transparent)]
     Coord(#[from] terramesh_core::coords::CoordError),
+    /// A name that would become a file, folder or group name and cannot
+    /// ([`terramesh_core::names`]).
+    #[error(transparent)]
+    Name(#[from] terramesh_core::names::NameError),
     /// A sampling grid.
     #[error(transparent)]
     Grid(#[from] terramesh_core::sampling::GridError),

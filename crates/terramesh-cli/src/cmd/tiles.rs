@@ -164,6 +164,17 @@ pub fn run(args: Args) -> Result<()> {
             ))?;
         }
         Sub::Slurm(a) => {
+            // Each value becomes an #SBATCH line: refused before anything is written.
+            for (flag, value) in [
+                ("--partition", Some(&a.partition)),
+                ("--time", Some(&a.time)),
+                ("--mem", a.mem.as_ref()),
+            ] {
+                if let Some(v) = value {
+                    tiles::check_sbatch_value(v)
+                        .map_err(|why| anyhow::anyhow!("{flag} {v:?}: {why}"))?;
+                }
+            }
             let binary = crate::program()?;
             let output = a.output.unwrap_or_else(|| a.plan.join("merged"));
             let o = tiles::SlurmOptions {

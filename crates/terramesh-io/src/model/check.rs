@@ -73,19 +73,16 @@ pub enum MeshError {
         why: String,
     },
     /// A unit or side name cannot be a file name or a quoted group name.
-    #[error("the name {name:?} cannot be used in file and group names: use letters, digits, '-', '_' or '.'")]
+    #[error("the name {name:?} cannot be used in file and group names: use 1 to 128 letters, digits, '-', '_' or '.', not beginning or ending with '.'")]
     Name {
         /// The name.
         name: String,
     },
 }
 
+/// The one rule for names that become file and group names ([`terramesh_core::names`]).
 fn name_ok(s: &str) -> bool {
-    !s.is_empty()
-        && s != "."
-        && s != ".."
-        && s.chars()
-            .all(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | '.'))
+    terramesh_core::names::check_name(s).is_ok()
 }
 
 /// Checks what the writers rely on: one material per cell within `units`, node indices in

@@ -169,6 +169,11 @@ pub fn run(
     out: &Path,
     mut opened: OpenedGrids,
 ) -> Result<ModelBuilt> {
+    // Every unit's name becomes file names below `out` (`interfaces/<unit>.tif`): checked
+    // before the first write, whoever built `g`.
+    for u in &g.units {
+        terramesh_core::names::check_name(u).context("geology.units")?;
+    }
     let epsg = crs.and_then(Crs::epsg);
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let grid_crs = || match crs {

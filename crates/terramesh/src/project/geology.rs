@@ -166,6 +166,21 @@ impl GeologySection {
                     format!("'{u}' is listed twice: every unit once, top to bottom"),
                 );
             }
+            // A unit's name becomes file names (`interfaces/<unit>.tif`, `unit-<unit>.stl`)
+            // and group names: checked here, before the first write.
+            if let Err(e) = terramesh_core::names::check_name(u) {
+                return bad("units", format!("unit {} {e}", i + 1));
+            }
+        }
+        if let Some((a, b)) = terramesh_core::names::same_file_name(&self.units) {
+            return bad(
+                "units",
+                format!(
+                    "'{}' and '{}' differ only in case, and would be one file on Windows and \
+                     macOS (interfaces/<unit>.tif): rename one",
+                    self.units[a], self.units[b]
+                ),
+            );
         }
         let column = || self.units.join(", ");
         match (&self.collars, &self.intervals, &self.tops) {

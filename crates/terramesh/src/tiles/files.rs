@@ -141,6 +141,45 @@ pub fn read_triangles(dir: &Path) -> Result<Vec<[u32; 3]>> {
         .collect())
 }
 
+/// Reads a tile's vertices and triangles and checks that every triangle's indices are
+/// vertices of the tile: a damaged `triangles.u32` is an error naming the tile and the file,
+/// never an index out of range.
+pub(crate) fn read_mesh(dir: &Path, id: &str) -> Result<(Vec<Vertex>, Vec<[u32; 3]>)> {
+    let v = read_vertices(dir)?;
+    let t = read_triangles(dir)?;
+    check_indices(
+        t.iter().flatten().copied(),
+        v.len(),
+        &dir.join(TRIANGLES),
+        id,
+        "vertices",
+    )?;
+    Ok((v, t))
+}
+
+/// Checks that every index of `indices` (read from `path` of tile `id`) is below `n`, the
+/// count of its `what`.
+pub(crate) fn check_indices(
+    indices: impl IntoIterator<Item = u32>,
+    n: usize,
+    path: &Path,
+    id: &str,
+    what: &str,
+) -> Result<()> {
+    if let Some((k, i)) = indices
+        .into_iter()
+        .enumerate()
+        .find(|&(_, i)| i as usize >= n)
+    {
+        return Err(crate::Error::invalid(format!(
+            "{}: tile {id}: index {i} (record value {k}) refers past its {n} {what}: the tile \
+             is damaged; build it again (terramesh tiles build PLAN --tile {id})",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Reads a tile's grid nodes.
 pub fn read_grid(dir: &Path) -> Result<Vec<(u64, f64)>> {
     let b = read_all(&dir.join(GRID), 16)?;

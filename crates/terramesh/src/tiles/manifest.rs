@@ -25,6 +25,8 @@ pub const SAMPLES: &str = "samples.f64";
 pub const VARIOGRAM: &str = "variogram.json";
 /// The manifest format's version.
 pub const VERSION: u32 = 1;
+/// The most tiles a plan holds (`tiles plan` refuses a tile size that makes more).
+pub const MAX_TILES: usize = 100_000;
 
 /// A tile's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -283,7 +285,130 @@ impl Manifest {
                 m.version
             )));
         }
+        m.check()
+            .map_err(|why| Error::invalid(format!("{}: {why}: plan again", path.display())))?;
         Ok(m)
+    }
+
+    /// Checks what the plan's files say before any of it reaches a path or an allocation: the
+    /// manifest is untrusted input (a folder from elsewhere, a hand edit, a damaged disk).
+    /// Every tile id and unit name is a name [`terramesh_core::names::check_name`] accepts and
+    /// is unique (ignoring case); every file named is a path inside the plan folder
+    /// ([`terramesh_core::names::check_relative`]); the tile grid, the DSM grid and the tiles'
+    /// indices are consistent and of a size the merge can hold. The error names the tile, the
+    /// unit or the field.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        use terramesh_core::names::{check_name, check_relative, same_file_name};
+        let rel = |field: &str, p: &str| {
+            check_relative(p)
+                .map_err(|e| format!("{field} {p:?} is not a file inside the plan folder: {e}"))
+        };
+        let [sx, sy] = self.shape;
+        let cells = sx.checked_mul(sy).filter(|&c| c > 0 && c <= MAX_TILES);
+        let Some(cells) = cells else {
+            return Err(format!(
+                "shape {sx} x {sy}: a plan has 1 to {MAX_TILES} tiles"
+            ));
+        };
+        if self.tiles.len() > cells {
+            return Err(format!(
+                "{} tiles in a grid of {sx} x {sy}",
+                self.tiles.len()
+            ));
+        }
+        if !self.tile_size.is_finite()
+            || self.tile_size <= 0.0
+            || !self.origin.iter().all(|v| v.is_finite())
+        {
+            return Err(format!(
+                "tile_size {} and origin {:?}: a positive size and a finite corner are needed",
+                self.tile_size, self.origin
+            ));
+        }
+        rel("variogram", &self.variogram)?;
+        rel("data.samples", &self.data.samples)?;
+        let g = &self.grid;
+        if g.nx == 0 || g.ny == 0 || g.nx.checked_mul(g.ny).is_none() {
+            return Err(format!("grid of {} x {} nodes", g.nx, g.ny));
+        }
+        let width = 1 + self.geology.as_ref().map_or(0, |gp| gp.units.len());
+        terramesh_core::limits::Estimate::new("grid columns", g.nx as f64, 8.0 * width as f64)
+            .check()
+            .map_err(|e| format!("grid: {}", e.describe(&|s| s.to_string())))?;
+        if ![g.xmin, g.ymin, g.xmax, g.ymax]
+            .iter()
+            .all(|v| v.is_finite())
+            || g.xmin > g.xmax
+            || g.ymin > g.ymax
+        {
+            return Err(format!(
+                "grid [{}, {}] x [{}, {}]: not an extent",
+                g.xmin, g.xmax, g.ymin, g.ymax
+            ));
+        }
+        let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
+        for t in &self.tiles {
+            let tile = |why: String| format!("tile {:?}: {why}", t.id);
+            check_name(&t.id).map_err(|e| tile(format!("its id cannot be a folder name: {e}")))?;
+            if t.index[0] >= sx || t.index[1] >= sy {
+                return Err(tile(format!(
+                    "index {:?} outside the grid of {sx} x {sy}",
+                    t.index
+                )));
+            }
+            if !t.extent.iter().all(|v| v.is_finite()) || !t.halo.is_finite() || t.halo < 0.0 {
+                return Err(tile("its extent and halo must be finite".into()));
+            }
+            if let Some(d) = &t.data {
+                rel("data.file", &d.file).map_err(tile)?;
+            }
+            for n in &t.neighbours {
+                if !ids.contains(&n.as_str()) {
+                    return Err(tile(format!("neighbour {n:?} is not a tile of the plan")));
+                }
+            }
+        }
+        if let Some((a, b)) = same_file_name(&ids) {
+            return Err(format!(
+                "tiles {:?} and {:?} would share one folder (ids are unique, ignoring case)",
+                ids[a], ids[b]
+            ));
+        }
+        if let Some(gp) = &self.geology {
+            for u in &gp.units {
+                check_name(u).map_err(|e| format!("geology.units: {e}"))?;
+            }
+            if let Some((a, b)) = same_file_name(&gp.units) {
+                return Err(format!(
+                    "geology.units {:?} and {:?} would be one file (names are unique, ignoring \
+                     case)",
+                    gp.units[a], gp.units[b]
+                ));
+            }
+            if gp.interfaces.len() > gp.units.len().max(1) {
+                return Err(format!(
+                    "geology: {} interfaces for {} units",
+                    gp.interfaces.len(),
+                    gp.units.len()
+                ));
+            }
+            for it in &gp.interfaces {
+                if !gp.units.contains(&it.unit) {
+                    return Err(format!("geology.interfaces: {:?} is not a unit", it.unit));
+                }
+                let grid = matches!(it.estimate, super::geology::Estimate::Grid { .. });
+                if !(grid && it.observations.is_empty()) {
+                    rel("geology.interfaces.observations", &it.observations)?;
+                }
+                if let super::geology::Estimate::Kriged { variogram, .. } = &it.estimate {
+                    rel("geology.interfaces.estimate.variogram", variogram)?;
+                }
+            }
+            if let Some(c) = &gp.contacts {
+                rel("geology.contacts", c)?;
+            }
+        }
+        Ok(())
     }
 
     /// Writes `PLAN/tiles.json` atomically (callers hold the lock, see [`update`]).

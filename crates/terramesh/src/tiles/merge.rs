@@ -53,7 +53,10 @@ pub(super) const NODATA: f64 = -9999.0;
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
-/// tile must be `done`; the error lists those that are not.
+/// tile must be `done`; the error lists those that are not. The merge is atomic as a build
+/// is ([`crate::build::staging`]): written into a sibling of `out` and swapped in at the end,
+/// so a failing merge leaves an existing `out` as it was; an existing `out` that is not a
+/// build folder (no [`MARKER`](crate::build::staging::MARKER), not empty) is refused.
 pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
     let t0 = Instant::now();
     let m = Manifest::read(plan)?;
@@ -75,13 +78,29 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
             plan.display()
         )));
     }
-    std::fs::create_dir_all(out).context(out.display().to_string())?;
+    // Staged like a build (`build/staging.rs`): written into a sibling folder, swapped in
+    // at the end, so that a failing merge leaves `out` as it was; an existing `out` without
+    // the build marker (and not empty) is refused.
+    let staging = crate::build::staging::Staging::begin(out, &crate::progress::Silent)?;
+    let merged = merge_into(plan, &m, staging.dir(), t0)?;
+    let dir = staging.dir().to_path_buf();
+    staging.commit()?;
+    let mut merged = merged;
+    for f in &mut merged.files {
+        if let Ok(rel) = f.strip_prefix(&dir) {
+            *f = out.join(rel);
+        }
+    }
+    Ok(merged)
+}
 
+/// The merge of the checked manifest `m` into the staging folder `out`.
+fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merged> {
     // The seam vertices' global indices, their owner tile and its elevation.
     let mut seams: HashMap<(u64, u64), (u32, usize, f64)> = HashMap::new();
     let (mut n, mut nt, mut diff, mut area) = (0u32, 0usize, 0.0f64, 0.0f64);
     for (k, t) in m.tiles.iter().enumerate() {
-        let v = files::read_vertices(&tile_dir(plan, &t.id))?;
+        let (v, tris) = files::read_mesh(&tile_dir(plan, &t.id), &t.id)?;
         let on = seam_keys(t);
         for p in &v {
             let key = bits(p.xy);
@@ -97,7 +116,6 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
                 n += 1;
             }
         }
-        let tris = files::read_triangles(&tile_dir(plan, &t.id))?;
         nt += tris.len();
         for tri in &tris {
             let [a, b, c] = tri.map(|i| v[i as usize].xy);
@@ -106,15 +124,15 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
     }
     let mut written = Vec::new();
     let vtu = out.join("dsm.vtu");
-    write_vtu(&vtu, plan, &m, &seams, n as usize, nt)?;
+    write_vtu(&vtu, plan, m, &seams, n as usize, nt)?;
     written.push(vtu);
 
     // The grids, row by row.
-    let (grid_files, grid) = super::grid_merge::write_grids(plan, &m, out)?;
+    let (grid_files, grid) = super::grid_merge::write_grids(plan, m, out)?;
     written.extend(grid_files);
     let model = match &m.geology {
         Some(gp) => {
-            let (model, files) = super::model_merge::merge_model(plan, &m, gp, out)?;
+            let (model, files) = super::model_merge::merge_model(plan, m, gp, out)?;
             written.extend(files);
             Some(model)
         }
@@ -137,7 +155,7 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
     terramesh_io::output::write_atomic(&json, text.as_bytes())
         .context(json.display().to_string())?;
     let report = out.join("report.html");
-    let html = super::report::html(&m, &merged);
+    let html = super::report::html(m, &merged);
     terramesh_io::output::write_atomic(&report, html.as_bytes())
         .context(report.display().to_string())?;
     let mut merged = merged;
@@ -164,20 +182,26 @@ fn mapped(
     v: &[Vertex],
     seams: &HashMap<(u64, u64), (u32, usize, f64)>,
     next: &mut u32,
-) -> Vec<(u32, bool)> {
+) -> Result<Vec<(u32, bool)>> {
     let on = seam_keys(t);
     v.iter()
         .map(|p| {
             let key = bits(p.xy);
             if on.contains(&key) {
-                let (g, owner, _) = seams[&key];
+                let &(g, owner, _) = seams.get(&key).ok_or_else(|| {
+                    Error::invalid(format!(
+                        "tile {}: a seam vertex at ({}, {}) changed between two reads of its \
+                         files: do not build tiles during a merge",
+                        t.id, p.xy[0], p.xy[1]
+                    ))
+                })?;
                 if owner == k {
                     *next += 1;
                 }
-                (g, owner == k)
+                Ok((g, owner == k))
             } else {
                 *next += 1;
-                (*next - 1, true)
+                Ok((*next - 1, true))
             }
         })
         .collect()
@@ -220,9 +244,8 @@ fn write_vtu(
         let mut next = 0u32;
         for (k, t) in m.tiles.iter().enumerate() {
             let dir = tile_dir(plan, &t.id);
-            let v = files::read_vertices(&dir)?;
-            let map = mapped(k, t, &v, seams, &mut next);
-            let tris = files::read_triangles(&dir)?;
+            let (v, tris) = files::read_mesh(&dir, &t.id)?;
+            let map = mapped(k, t, &v, seams, &mut next)?;
             f(w, &dir, &v, &map, &tris)?;
         }
         Ok(())
@@ -269,7 +292,17 @@ fn write_vtu(
             };
             let values: Values = Box::new(move |w| {
                 pass(w, &mut |w, dir, _, map, _| {
-                    let surf = super::files::read_f64s(&dir.join(super::geology::SURFACES), ns)?;
+                    let path = dir.join(super::geology::SURFACES);
+                    let surf = super::files::read_f64s(&path, ns)?;
+                    if surf.len() != map.len() * ns {
+                        return Err(Error::invalid(format!(
+                            "{}: {} surfaces for {} vertices: the tile is damaged; build it \
+                             again",
+                            path.display(),
+                            surf.len() / ns,
+                            map.len()
+                        )));
+                    }
                     for (k, &(_, mine)) in map.iter().enumerate() {
                         if mine {
                             put_f64(w, surf[k * ns + s])?;

@@ -64,11 +64,11 @@ pub use geology::{
 pub use grid_merge::GridFigures;
 pub use manifest::{
     update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData,
-    TileSummary, LOCK, MANIFEST, SAMPLES, VARIOGRAM, VERSION,
+    TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::{merge, Merged};
 pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};
 pub use plan::{parse_tile_size, plan, Planned};
-pub use slurm::{write_slurm, SlurmOptions, SlurmScripts};
+pub use slurm::{check_sbatch_value, write_slurm, SlurmOptions, SlurmScripts};

@@ -103,10 +103,26 @@ pub(super) struct TileModel {
 
 pub(super) fn read_model(plan: &Path, t: &Tile) -> Result<TileModel> {
     let dir = tile_dir(plan, &t.id);
-    Ok(TileModel {
-        points: read_f64s(&dir.join(MODEL_POINTS), 3)?,
-        cells: read_u32s(&dir.join(MODEL_CELLS), 8)?,
-    })
+    let points = read_f64s(&dir.join(MODEL_POINTS), 3)?;
+    let cells = read_cells(&dir, &t.id, points.len() / 3)?;
+    Ok(TileModel { points, cells })
+}
+
+/// A tile's cells (`model-cells.u32`), every node index checked against its `points` nodes:
+/// a damaged file is an error naming the tile and the file.
+pub(super) fn read_cells(dir: &Path, id: &str, points: usize) -> Result<Vec<u32>> {
+    let path = dir.join(MODEL_CELLS);
+    let cells = read_u32s(&path, 8)?;
+    super::files::check_indices(
+        cells
+            .chunks_exact(8)
+            .flat_map(|rec| rec[2..2 + cell_of(rec).0.kind.nodes()].iter().copied()),
+        points,
+        &path,
+        id,
+        "model nodes",
+    )?;
+    Ok(cells)
 }
 
 pub(super) fn key(x: f64, y: f64) -> (u64, u64) {

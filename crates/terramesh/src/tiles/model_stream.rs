@@ -20,7 +20,7 @@ use terramesh_io::model::{boundary_mesh, BoundaryMesh, CellVisit, FaceVisit, Mod
 use super::build::tile_dir;
 use super::files::{read_f64s, read_u32s};
 use super::geology::{tag_of_name, GeologyPlan, TileFigures, MODEL_BODIES, MODEL_FACES};
-use super::geology::{MODEL_CELLS, MODEL_JSON, MODEL_POINTS};
+use super::geology::{MODEL_JSON, MODEL_POINTS};
 use super::manifest::{Manifest, Tile};
 use super::model_merge::{cell_of, columns, key, node_map, Column};
 use crate::error::{Context, Error, Result};
@@ -309,7 +309,7 @@ impl<'a> TiledModel<'a> {
         let dir = tile_dir(self.plan, &t.id);
         let points = read_f64s(&dir.join(MODEL_POINTS), 3)?;
         let cells = if cells {
-            read_u32s(&dir.join(MODEL_CELLS), 8)?
+            super::model_merge::read_cells(&dir, &t.id, points.len() / 3)?
         } else {
             Vec::new()
         };

@@ -111,6 +111,33 @@ pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f6
     (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
 }
 
+/// A plan writes many files into its folder (`tiles.json`, `samples.csv`, `variogram.json`,
+/// `samples/`, ...): an existing folder is taken only when it is empty or holds a plan
+/// already (its `tiles.json`), never a folder of other files such as a home folder.
+fn check_plan_folder(out: &Path) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(());
+    };
+    let names: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    if names.is_empty() || names.iter().any(|n| n == super::manifest::MANIFEST) {
+        return Ok(());
+    }
+    Err(Error::setting(
+        crate::setting::Setting::Output,
+        out.display(),
+        format!(
+            "exists and is not a plan folder (no {}; it holds '{}' among {} entries): name a \
+             new or empty folder",
+            super::manifest::MANIFEST,
+            crate::error::cut(&names[0]),
+            names.len()
+        ),
+    ))
+}
+
 /// Refuses what tiles cannot reproduce, with the key to change.
 fn check_tileable(p: &Project) -> Result<()> {
     let ip = &p.interpolation;
@@ -177,6 +204,7 @@ pub fn plan(
         )));
     }
     project.check_inputs(base)?;
+    check_plan_folder(out)?;
     std::fs::create_dir_all(out).context(out.display().to_string())?;
     let samples = stages::sample(project, base, out, progress)?;
     let polys = &samples.region.projected.polygons;
@@ -236,7 +264,7 @@ pub fn plan(
         (((hi[0] - lo[0]) / tile_size).ceil() as usize).max(1),
         (((hi[1] - lo[1]) / tile_size).ceil() as usize).max(1),
     ];
-    if shape[0] * shape[1] > 100_000 {
+    if shape[0] * shape[1] > super::manifest::MAX_TILES {
         return Err(Error::invalid(format!(
             "tile size {tile_size} m makes {} x {} tiles: use larger tiles",
             shape[0], shape[1]

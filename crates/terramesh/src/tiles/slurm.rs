@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::manifest::Manifest;
-use crate::error::{Context, Result};
+use crate::error::{Context, Error, Result};
 
 /// The settings of the generated jobs.
 #[derive(Debug, Clone)]
@@ -34,8 +34,76 @@ pub struct SlurmScripts {
     pub submit: PathBuf,
 }
 
-fn quote(p: &Path) -> String {
-    format!("'{}'", p.display().to_string().replace('\'', "'\\''"))
+/// `s` as one bash word in single quotes (a `'` written `'\''`).
+fn quote_str(s: &str) -> String {
+    format!("'{}'", s.replace('\'', "'\\''"))
+}
+
+/// A path as one bash word, or an error when it cannot be written into a script line (a
+/// control character such as a newline would end the line; a path that is not UTF-8 would be
+/// changed).
+fn quote(field: &str, p: &Path) -> Result<String> {
+    Ok(quote_str(script_path(field, p)?))
+}
+
+/// The path as text fit for a script line.
+fn script_path<'a>(field: &str, p: &'a Path) -> Result<&'a str> {
+    let text = p.to_str().ok_or_else(|| {
+        Error::invalid(format!(
+            "{field} {}: not UTF-8, so it cannot be written into a script unchanged: move or \
+             rename it",
+            p.display()
+        ))
+    })?;
+    if let Some(c) = text.chars().find(|c| c.is_control()) {
+        return Err(Error::invalid(format!(
+            "{field} {text:?}: holds the control character {c:?}, which would break the \
+             script's line: move or rename it"
+        )));
+    }
+    Ok(text)
+}
+
+/// A path for an `#SBATCH` line, to be put in double quotes (sbatch reads quoted option
+/// values), with `%` doubled (a literal `%` in Slurm's file name patterns); `"` cannot be
+/// written there.
+fn sbatch_path(field: &str, p: &Path) -> Result<String> {
+    let text = script_path(field, p)?;
+    if text.contains('"') {
+        return Err(Error::invalid(format!(
+            "{field} {text:?}: holds '\"', which an #SBATCH line cannot quote: move or rename it"
+        )));
+    }
+    Ok(text.replace('%', "%%"))
+}
+
+/// Checks a value written into an `#SBATCH` line (`--partition`, `--time`, `--mem`): 1 to
+/// 128 characters among letters, digits and `_ . , : + -`, so that it can neither end the line
+/// nor be read as shell syntax. `Err` says what is wrong; the caller names the option.
+///
+/// ```
+/// use terramesh::tiles::check_sbatch_value;
+/// assert!(check_sbatch_value("compute,debug").is_ok());
+/// assert!(check_sbatch_value("1-00:00:00").is_ok());
+/// assert!(check_sbatch_value("4G").is_ok());
+/// assert!(check_sbatch_value("debug\nrm -rf ~").is_err());
+/// assert!(check_sbatch_value("$(id)").is_err());
+/// assert!(check_sbatch_value("").is_err());
+/// ```
+pub fn check_sbatch_value(v: &str) -> std::result::Result<(), String> {
+    if v.is_empty() || v.len() > 128 {
+        return Err("give 1 to 128 characters".into());
+    }
+    match v
+        .chars()
+        .find(|&c| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | ',' | ':' | '+' | '-')))
+    {
+        Some(c) => Err(format!(
+            "the character {c:?} cannot be written into an #SBATCH line: use letters, digits \
+             and _ . , : + -"
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Writes `PLAN/slurm/tiles.sbatch`, `merge.sbatch` and `submit.sh` for the plan in `plan`.
@@ -45,10 +113,29 @@ fn quote(p: &Path) -> String {
 /// `SLURM_ARRAY_TASK_ID=3 bash PLAN/slurm/tiles.sbatch`.
 pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
     let m = Manifest::read(plan)?;
+    // Every value written into a script line is checked (or quoted) first.
+    for (field, value) in [
+        ("partition", Some(&o.partition)),
+        ("time", Some(&o.time)),
+        ("mem", o.mem.as_ref()),
+    ] {
+        if let Some(v) = value {
+            check_sbatch_value(v)
+                .map_err(|why| Error::invalid(format!("the Slurm {field} {v:?}: {why}")))?;
+        }
+    }
     let plan_abs = std::path::absolute(plan).context(plan.display().to_string())?;
+    let out_abs = std::path::absolute(&o.output).context(o.output.display().to_string())?;
+    let plan_q = quote("the plan folder", &plan_abs)?;
+    let out_q = quote("the merge's output folder", &out_abs)?;
+    let bin_q = quote("the terramesh binary", &o.binary)?;
+    let logs = sbatch_path("the plan folder", &plan_abs.join("slurm"))?;
+    let sep = std::path::MAIN_SEPARATOR;
+    let tile_log = format!("\"{logs}{sep}tile-%a.log\"");
+    let merge_log = format!("\"{logs}{sep}merge.log\"");
     let dir = plan.join("slurm");
     std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
-    let ids: Vec<String> = m.tiles.iter().map(|t| format!("'{}'", t.id)).collect();
+    let ids: Vec<String> = m.tiles.iter().map(|t| quote_str(&t.id)).collect();
     let last = m.tiles.len().saturating_sub(1);
     let mem = o
         .mem
@@ -61,27 +148,26 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
             o.partition, o.time, o.cpus
         )
     };
-    let bin = format!("TERRAMESH=\"${{TERRAMESH:-{}}}\"\n", quote(&o.binary));
-    let plan_q = quote(&plan_abs);
+    // `$TERRAMESH` overrides the binary; unset or empty, the one that wrote the script.
+    let bin = format!("if [ -z \"${{TERRAMESH:-}}\" ]; then TERRAMESH={bin_q}; fi\n");
     let tiles = format!(
-        "{}#SBATCH --array=0-{last}\n#SBATCH --output={}/slurm/tile-%a.log\n\
+        "{}#SBATCH --array=0-{last}\n#SBATCH --output={tile_log}\n\
          # One tile per array task: task i builds the i-th tile of tiles.json.\n\
          set -euo pipefail\n{bin}PLAN={plan_q}\nTILES=({})\n\
          : \"${{SLURM_ARRAY_TASK_ID:?run me with sbatch, or set SLURM_ARRAY_TASK_ID to 0-{last}}}\"\n\
+         case \"$SLURM_ARRAY_TASK_ID\" in *[!0-9]*) echo \"SLURM_ARRAY_TASK_ID must be a number \
+         from 0 to {last}\" >&2; exit 2;; esac\n\
          ID=\"${{TILES[$SLURM_ARRAY_TASK_ID]}}\"\n\
          export RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-{}}}\"\n\
          exec \"$TERRAMESH\" tiles build \"$PLAN\" --tile \"$ID\"\n",
         head("terramesh-tiles"),
-        plan_abs.display(),
         ids.join(" "),
         o.cpus
     );
     let merge = format!(
-        "{}#SBATCH --output={}/slurm/merge.log\nset -euo pipefail\n{bin}\
-         exec \"$TERRAMESH\" tiles merge {plan_q} -o {}\n",
+        "{}#SBATCH --output={merge_log}\nset -euo pipefail\n{bin}\
+         exec \"$TERRAMESH\" tiles merge {plan_q} -o {out_q}\n",
         head("terramesh-merge"),
-        plan_abs.display(),
-        quote(&std::path::absolute(&o.output).context(o.output.display().to_string())?)
     );
     let submit =
         "#!/bin/bash\n# Submits the tile array, then the merge once every tile succeeded.\n\
