@@ -73,6 +73,8 @@ mod check;
 mod error;
 /// Fault surfaces, their side tests, fault sets and block keys.
 mod fault;
+/// The quality pass: edge collapses and node moves.
+mod improve;
 /// The conformal volume mesh.
 mod mesh;
 /// Dihedral angles.

@@ -36,7 +36,7 @@ fn truth(site: &Site, mesh: &FaultedMesh) -> f64 {
 fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
     println!(
         "{name}: {} cells ({} background), {} blocks, fault faces {:?}, snapped {}, split {}, \
-         unresolved {}, truth {:.6}, max fault \
+         unresolved {}, collapsed {}, moved {}, truth {:.6}, max fault \
          distance {:.2e} m, min dihedral {:.2} deg, mean {:.1}, below 5: {}, histogram {:?}",
         mesh.tets.len(),
         mesh.report.background_cells,
@@ -45,6 +45,8 @@ fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
         mesh.report.snapped,
         mesh.report.split_edges,
         mesh.report.unresolved,
+        mesh.report.collapsed,
+        mesh.report.moved,
         fraction,
         s.fault_distance,
         s.quality.min,
