@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use crate::mesh::{positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
 use crate::quality::min_dihedral;
-use crate::{BlockKey, FaultSet, ON_SURFACE};
+use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
 
 /// What the quality pass did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -33,6 +33,11 @@ struct Pass<'a> {
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
     height: InterfaceFn<'a>,
+    terrain: &'a Terrain,
+    /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
+    background: usize,
+    /// Half the tolerance of `check` for a boundary node on the terrain, a side or the base.
+    tol: f64,
 }
 
 fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -71,7 +76,9 @@ impl Pass<'_> {
     /// Collapses node `a` into its neighbour `b` if allowed and better.
     fn collapse(&mut self, a: u32, b: u32) -> bool {
         let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
-        if fa & (TOP | SIDE) != 0 || (fa & BASE != 0 && fb & BASE == 0) {
+        let bound = fa & (TOP | BASE | SIDE);
+        // A boundary node only into a node on the same boundaries; never a DSM vertex.
+        if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) {
             return false;
         }
         let ca = self.cells(a);
@@ -108,6 +115,9 @@ impl Pass<'_> {
             if q <= old {
                 return false;
             }
+            if bound != 0 && !self.boundary_kept(t, b) {
+                return false;
+            }
             let mut k = t;
             k.sort_unstable();
             if keys.binary_search(&k).is_ok() {
@@ -126,6 +136,51 @@ impl Pass<'_> {
             self.star[b as usize].push(c);
         }
         self.star[a as usize].clear();
+        true
+    }
+
+    /// Whether every face of `t` through `b` whose nodes all lie on the terrain (or all on a
+    /// side) lies on the DSM (on one edge of the outline): its centroid and edge midpoints
+    /// on the DSM, its nodes on the outline edge.
+    fn boundary_kept(&self, t: [u32; 4], b: u32) -> bool {
+        for skip in 0..4 {
+            let f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
+            if !f.contains(&b) || t[skip] == b {
+                continue;
+            }
+            let all = |bit: u8| f.iter().all(|&v| self.st.flags[v as usize] & bit != 0);
+            let q: Vec<[f64; 3]> = f.iter().map(|&v| self.st.points[v as usize]).collect();
+            if all(TOP) {
+                let mid = |i: usize, j: usize| [0, 1, 2].map(|k| 0.5 * (q[i][k] + q[j][k]));
+                let c = [0, 1, 2].map(|k| (q[0][k] + q[1][k] + q[2][k]) / 3.0);
+                let on = |r: [f64; 3]| {
+                    self.terrain
+                        .height([r[0], r[1]])
+                        .is_some_and(|h| (h - r[2]).abs() <= self.tol)
+                };
+                if ![c, mid(0, 1), mid(1, 2), mid(0, 2)].into_iter().all(on) {
+                    return false;
+                }
+            }
+            if all(SIDE) {
+                let on_one = self.terrain.outline.iter().any(|&[i, j]| {
+                    let (pa, pb) = (
+                        self.terrain.points[i as usize],
+                        self.terrain.points[j as usize],
+                    );
+                    let e = [pb[0] - pa[0], pb[1] - pa[1]];
+                    let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+                    q.iter().all(|r| {
+                        let d = ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
+                        let s = ((r[0] - pa[0]) * e[0] + (r[1] - pa[1]) * e[1]) / (l * l);
+                        d.abs() <= self.tol && (-1e-12..=1.0 + 1e-12).contains(&s)
+                    })
+                });
+                if !on_one {
+                    return false;
+                }
+            }
+        }
         true
     }
 
@@ -229,6 +284,8 @@ pub(crate) fn improve(
     faults: &FaultSet,
     blocks: &[BlockKey],
     height: InterfaceFn,
+    terrain: &Terrain,
+    background: usize,
     below: f64,
     passes: usize,
 ) -> Improved {
@@ -255,6 +312,14 @@ pub(crate) fn improve(
         faults,
         blocks,
         height,
+        terrain,
+        background,
+        tol: 0.5e-9
+            * terrain
+                .heights
+                .iter()
+                .fold(0.0f64, |s, h| s.max(h.abs()))
+                .max(1.0),
     };
     for _ in 0..passes {
         let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)

@@ -43,9 +43,9 @@ pub struct MeshSettings {
     /// below the smaller of this and what it was, degrees (default 10).
     pub guard_degrees: f64,
     /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
-    /// by edge collapses and node moves that keep every label (default 10; 0 turns it off).
+    /// by edge collapses and node moves that keep every label (default 5; 0 turns it off).
     pub improve_degrees: f64,
-    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 4).
+    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 2).
     pub improve_passes: usize,
 }
 
@@ -57,8 +57,8 @@ impl MeshSettings {
             max_cell_height,
             snap: 0.35,
             guard_degrees: 10.0,
-            improve_degrees: 10.0,
-            improve_passes: 4,
+            improve_degrees: 5.0,
+            improve_passes: 2,
         }
     }
 }
@@ -718,6 +718,7 @@ pub fn faulted_mesh(
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
     let mut st = background(terrain, settings)?;
+    let background_nodes = st.points.len();
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
         let (values, _) = cut(&mut st, None, &field, settings, faults);
@@ -823,6 +824,8 @@ pub fn faulted_mesh(
         faults,
         &blocks,
         height,
+        terrain,
+        background_nodes,
         settings.improve_degrees,
         settings.improve_passes,
     );
