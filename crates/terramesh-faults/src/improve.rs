@@ -46,14 +46,13 @@ fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 impl Pass<'_> {
     fn cells(&self, v: u32) -> Vec<u32> {
-        let mut c: Vec<u32> = self.star[v as usize]
+        // A cell enters a node's list once: when it is made, or when the node replaces one
+        // of its nodes (it did not hold the node before).
+        self.star[v as usize]
             .iter()
             .copied()
             .filter(|&c| self.alive[c as usize] && self.st.tets[c as usize].contains(&v))
-            .collect();
-        c.sort_unstable();
-        c.dedup();
-        c
+            .collect()
     }
 
     fn labels(&self, cells: &[u32]) -> Vec<(u64, u32, u32)> {
@@ -77,8 +76,9 @@ impl Pass<'_> {
     fn collapse(&mut self, a: u32, b: u32) -> bool {
         let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
         let bound = fa & (TOP | BASE | SIDE);
-        // A boundary node only into a node on the same boundaries; never a DSM vertex.
-        if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) {
+        // A boundary node only into a node on the same boundaries; never a DSM vertex, never
+        // a side node (collapsing those broke the sides on random sites: not understood yet).
+        if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) || fa & SIDE != 0 {
             return false;
         }
         let ca = self.cells(a);
@@ -91,7 +91,25 @@ impl Pass<'_> {
             .iter()
             .map(|&c| self.angle[c as usize])
             .fold(f64::MAX, f64::min);
+        // Positive volumes first (cheap, and most refusals), then the angles.
         let mut new = Vec::with_capacity(ca.len());
+        for &c in &ca {
+            let t = self.st.tets[c as usize];
+            if t.contains(&b) {
+                continue;
+            }
+            let t = t.map(|w| if w == a { b } else { w });
+            if !positive(self.geo(t)) {
+                return false;
+            }
+            new.push((c, t, 0.0));
+        }
+        for e in &mut new {
+            e.2 = min_dihedral(self.geo(e.1));
+            if e.2 <= old || (bound != 0 && !self.boundary_kept(e.1, b)) {
+                return false;
+            }
+        }
         let mut keys: Vec<[u32; 4]> = cb
             .iter()
             .map(|&c| {
@@ -101,29 +119,12 @@ impl Pass<'_> {
             })
             .collect();
         keys.sort_unstable();
-        for &c in &ca {
-            let t = self.st.tets[c as usize];
-            if t.contains(&b) {
-                continue;
-            }
-            let t = t.map(|w| if w == a { b } else { w });
-            let g = self.geo(t);
-            if !positive(g) {
-                return false;
-            }
-            let q = min_dihedral(g);
-            if q <= old {
-                return false;
-            }
-            if bound != 0 && !self.boundary_kept(t, b) {
-                return false;
-            }
-            let mut k = t;
+        if new.iter().any(|e| {
+            let mut k = e.1;
             k.sort_unstable();
-            if keys.binary_search(&k).is_ok() {
-                return false;
-            }
-            new.push((c, t, q));
+            keys.binary_search(&k).is_ok()
+        }) {
+            return false;
         }
         for &c in &ca {
             if self.st.tets[c as usize].contains(&b) {
@@ -235,8 +236,8 @@ impl Pass<'_> {
         nb.dedup();
         let mut mean = [0.0; 3];
         for &w in &nb {
-            for k in 0..3 {
-                mean[k] += self.st.points[w as usize][k] / nb.len() as f64;
+            for (m, x) in mean.iter_mut().zip(self.st.points[w as usize]) {
+                *m += x / nb.len() as f64;
             }
         }
         let old = cells
@@ -279,6 +280,7 @@ impl Pass<'_> {
 
 /// Improves the cells whose smallest dihedral angle is below `below` degrees, in at most
 /// `passes` sweeps (worst first), then drops the collapsed cells and unused nodes.
+#[allow(clippy::too_many_arguments)] // the state, its surfaces and the pass's two settings
 pub(crate) fn improve(
     st: &mut State,
     faults: &FaultSet,
@@ -371,8 +373,8 @@ pub(crate) fn improve(
     let alive = p.alive;
     let st = p.st;
     let mut k = 0;
-    for c in 0..st.tets.len() {
-        if alive[c] {
+    for (c, &live) in alive.iter().enumerate() {
+        if live {
             st.tets[k] = st.tets[c];
             st.positive[k] = st.positive[c];
             st.below[k] = st.below[c];

@@ -43,14 +43,14 @@ pub fn min_dihedral(p: [[f64; 3]; 4]) -> f64 {
         }
         *ni = [m[0] / l, m[1] / l, m[2] / l];
     }
-    let mut best = f64::MAX;
+    // The largest cosine is the smallest angle: one arc cosine.
+    let mut most = -1.0f64;
     for i in 0..4 {
         for j in i + 1..4 {
-            let c = (-dot(n[i], n[j])).clamp(-1.0, 1.0);
-            best = best.min(c.acos().to_degrees());
+            most = most.max(-dot(n[i], n[j]));
         }
     }
-    best
+    most.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 /// The distribution of the cells' smallest dihedral angles.
