@@ -53,6 +53,26 @@ fn bench(c: &mut Criterion) {
     let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
     let mesh = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &settings).unwrap();
     let build = t0.elapsed().as_secs_f64();
+    // The same without the quality pass, for its cost and its gain.
+    let mut off = settings;
+    off.improve_degrees = 0.0;
+    let t3 = Instant::now();
+    let raw = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &off).unwrap();
+    let raw_s = t3.elapsed().as_secs_f64();
+    let q0 = quality(&raw.points, &raw.tets);
+    println!(
+        "without the quality pass: {} cells, build {raw_s:.2} s, min dihedral {:.2} deg, below 5 deg {} ({:.3} %), histogram {:?}",
+        raw.tets.len(),
+        q0.min,
+        q0.below_5,
+        100.0 * q0.below_5 as f64 / raw.tets.len() as f64,
+        q0.histogram.iter().map(|b| b.2).collect::<Vec<_>>()
+    );
+    drop(raw);
+    println!(
+        "the quality pass: {} collapses, {} moves",
+        mesh.report.collapsed, mesh.report.moved
+    );
     let t1 = Instant::now();
     let s = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
     let checked = t1.elapsed().as_secs_f64();

@@ -10,13 +10,13 @@ use crate::quality::min_dihedral;
 use crate::{BlockKey, Fault, FaultError, FaultSet, Terrain};
 
 /// A vertex on the terrain.
-const TOP: u8 = 1;
+pub(crate) const TOP: u8 = 1;
 /// A vertex on the base.
-const BASE: u8 = 2;
+pub(crate) const BASE: u8 = 2;
 /// A vertex on a side of the region.
-const SIDE: u8 = 4;
+pub(crate) const SIDE: u8 = 4;
 /// A vertex on an interface already cut: it never moves again.
-const ON_INTERFACE: u8 = 8;
+pub(crate) const ON_INTERFACE: u8 = 8;
 
 /// A vertex within this distance of a surface (metres) is taken to lie on it.
 pub const ON_SURFACE: f64 = 1e-6;
@@ -42,6 +42,11 @@ pub struct MeshSettings {
     /// A move is refused if it would bring the smallest dihedral angle of the vertex's cells
     /// below the smaller of this and what it was, degrees (default 10).
     pub guard_degrees: f64,
+    /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
+    /// by edge collapses and node moves that keep every label (default 5; 0 turns it off).
+    pub improve_degrees: f64,
+    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 2).
+    pub improve_passes: usize,
 }
 
 impl MeshSettings {
@@ -52,6 +57,8 @@ impl MeshSettings {
             max_cell_height,
             snap: 0.35,
             guard_degrees: 10.0,
+            improve_degrees: 5.0,
+            improve_passes: 2,
         }
     }
 }
@@ -80,6 +87,10 @@ pub struct BuildReport {
     /// Cells whose vertices still lie on both sides of their block's interface after the
     /// last round (their unit is taken at their centroid).
     pub unresolved: usize,
+    /// Nodes removed by collapsing an edge of a poor cell (the quality pass).
+    pub collapsed: usize,
+    /// Nodes moved by the quality pass.
+    pub moved: usize,
 }
 
 /// A tetrahedral volume mesh cut by faults and interfaces.
@@ -108,16 +119,16 @@ pub struct FaultedMesh {
     pub report: BuildReport,
 }
 
-struct State {
-    points: Vec<[f64; 3]>,
-    flags: Vec<u8>,
+pub(crate) struct State {
+    pub(crate) points: Vec<[f64; 3]>,
+    pub(crate) flags: Vec<u8>,
     /// Bit f: the vertex lies on fault f (or may: set on both ends of a split edge).
-    on_fault: Vec<u64>,
-    tets: Vec<[u32; 4]>,
-    positive: Vec<u64>,
-    below: Vec<u32>,
-    block: Vec<u32>,
-    report: BuildReport,
+    pub(crate) on_fault: Vec<u64>,
+    pub(crate) tets: Vec<[u32; 4]>,
+    pub(crate) positive: Vec<u64>,
+    pub(crate) below: Vec<u32>,
+    pub(crate) block: Vec<u32>,
+    pub(crate) report: BuildReport,
 }
 
 /// The height of interface `k` (the top of unit `k + 1`) in a fault block, at a plan point.
@@ -294,7 +305,7 @@ fn c3(p: [f64; 3]) -> Coord3D<f64> {
 }
 
 /// Positive volume in our node order (`terramesh_core::volume`): orient3d is negative.
-fn positive(p: [[f64; 3]; 4]) -> bool {
+pub(crate) fn positive(p: [[f64; 3]; 4]) -> bool {
     orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3])) < 0.0
 }
 
@@ -302,7 +313,7 @@ fn key(a: u32, b: u32) -> u64 {
     (a.min(b) as u64) << 32 | a.max(b) as u64
 }
 
-const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+pub(crate) const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// The three tetrahedra of a prism, upper triangle `t` above lower `b`, by the
 /// lowest-global-index rule: every quadrilateral is split by the diagonal through its lowest
@@ -707,6 +718,7 @@ pub fn faulted_mesh(
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
     let mut st = background(terrain, settings)?;
+    let background_nodes = st.points.len();
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
         let (values, _) = cut(&mut st, None, &field, settings, faults);
@@ -807,6 +819,18 @@ pub fn faulted_mesh(
             }
         }
     }
+    let done = crate::improve::improve(
+        &mut st,
+        faults,
+        &blocks,
+        height,
+        terrain,
+        background_nodes,
+        settings.improve_degrees,
+        settings.improve_passes,
+    );
+    st.report.collapsed = done.collapsed;
+    st.report.moved = done.moved;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,

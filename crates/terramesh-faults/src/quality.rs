@@ -27,9 +27,14 @@ pub fn min_dihedral(p: [[f64; 3]; 4]) -> f64 {
     // The normal of the face opposite vertex i, pointing out of the tetrahedron.
     let mut n = [[0.0; 3]; 4];
     for (i, ni) in n.iter_mut().enumerate() {
-        let f: Vec<[f64; 3]> = (0..4).filter(|&j| j != i).map(|j| p[j]).collect();
-        let mut m = cross(sub(f[1], f[0]), sub(f[2], f[0]));
-        if dot(m, sub(p[i], f[0])) > 0.0 {
+        let (a, b, c) = match i {
+            0 => (p[1], p[2], p[3]),
+            1 => (p[0], p[2], p[3]),
+            2 => (p[0], p[1], p[3]),
+            _ => (p[0], p[1], p[2]),
+        };
+        let mut m = cross(sub(b, a), sub(c, a));
+        if dot(m, sub(p[i], a)) > 0.0 {
             m = [-m[0], -m[1], -m[2]];
         }
         let l = dot(m, m).sqrt();
@@ -38,14 +43,14 @@ pub fn min_dihedral(p: [[f64; 3]; 4]) -> f64 {
         }
         *ni = [m[0] / l, m[1] / l, m[2] / l];
     }
-    let mut best = f64::MAX;
+    // The largest cosine is the smallest angle: one arc cosine.
+    let mut most = -1.0f64;
     for i in 0..4 {
         for j in i + 1..4 {
-            let c = (-dot(n[i], n[j])).clamp(-1.0, 1.0);
-            best = best.min(c.acos().to_degrees());
+            most = most.max(-dot(n[i], n[j]));
         }
     }
-    best
+    most.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 /// The distribution of the cells' smallest dihedral angles.

@@ -36,7 +36,7 @@ fn truth(site: &Site, mesh: &FaultedMesh) -> f64 {
 fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
     println!(
         "{name}: {} cells ({} background), {} blocks, fault faces {:?}, snapped {}, split {}, \
-         unresolved {}, truth {:.6}, max fault \
+         unresolved {}, collapsed {}, moved {}, truth {:.6}, max fault \
          distance {:.2e} m, min dihedral {:.2} deg, mean {:.1}, below 5: {}, histogram {:?}",
         mesh.tets.len(),
         mesh.report.background_cells,
@@ -45,6 +45,8 @@ fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
         mesh.report.snapped,
         mesh.report.split_edges,
         mesh.report.unresolved,
+        mesh.report.collapsed,
+        mesh.report.moved,
         fraction,
         s.fault_distance,
         s.quality.min,
@@ -335,4 +337,93 @@ fn thin_interbed() {
         "{}",
         summary.unit_volumes[1]
     );
+}
+
+/// The quality pass (edge collapses and node moves after cutting) keeps every check and
+/// lowers the cells below 5 degrees on every faulted site; what it reaches is asserted.
+/// The 5-degree floor of issue 31 is reached only without faults (see `quality_by_surface`):
+/// thin slabs (a 0.5 m interbed, two faults 1 m apart) under 20 m wide planar cells cannot
+/// reach it without refining the planar mesh.
+#[test]
+fn quality_pass() {
+    let one = Site::new(
+        200.0,
+        10,
+        0.2,
+        1,
+        [120.0, 0.02, -0.01],
+        0.0,
+        vec![90.0, 60.0, 30.0],
+        [0.01, 0.0],
+        vec![SynthFault::new(
+            "F1",
+            [80.0, -50.0],
+            [120.0, 250.0],
+            60.0,
+            90.0,
+            12.0,
+        )],
+    )
+    .unwrap();
+    let x = site(
+        vec![
+            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
+            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
+        ],
+        vec![95.0, 60.0, 30.0],
+        0.2,
+    );
+    let apart = site(
+        vec![
+            SynthFault::new("A", [100.0, -20.0], [100.0, 220.0], 70.0, 90.0, 5.0),
+            SynthFault::new("B", [101.0, -20.0], [101.0, 220.0], 70.0, 90.0, 8.0),
+        ],
+        vec![90.0, 50.0],
+        0.2,
+    );
+    let thin = site(
+        vec![SynthFault::new(
+            "F",
+            [60.0, -20.0],
+            [140.0, 220.0],
+            55.0,
+            100.0,
+            3.0,
+        )],
+        vec![90.0, 89.5, 45.0],
+        0.2,
+    );
+    // (name, site, cell height, most cells below 5 degrees after the pass (a fraction)).
+    for (name, s, hcell, most) in [
+        ("one fault", &one, 10.0, 0.002),
+        ("X junction", &x, 8.0, 0.015),
+        ("two faults 1 m apart", &apart, 8.0, 0.04),
+        ("0.5 m interbed", &thin, 8.0, 0.12),
+    ] {
+        let mut off = MeshSettings::new(s.base, hcell);
+        off.improve_degrees = 0.0;
+        let (_, raw, q0, _) = build_with(s, off);
+        let (_, mesh, q1, _) = build(s, hcell);
+        assert!(truth(s, &mesh) >= 0.99, "{name}");
+        let share = q1.quality.below_5 as f64 / mesh.tets.len() as f64;
+        println!(
+            "{name}: below 5 degrees {} of {} cells without the pass, {} of {} ({:.2} %) with \
+             it; min {:.2} -> {:.2} deg; cells per smallest angle over {:?}: {:?} -> {:?}",
+            q0.quality.below_5,
+            raw.tets.len(),
+            q1.quality.below_5,
+            mesh.tets.len(),
+            100.0 * share,
+            q0.quality.min,
+            q1.quality.min,
+            BINS,
+            q0.quality.histogram.iter().map(|b| b.2).collect::<Vec<_>>(),
+            q1.quality.histogram.iter().map(|b| b.2).collect::<Vec<_>>(),
+        );
+        assert_eq!(raw.report.collapsed + raw.report.moved, 0, "{name}");
+        assert!(mesh.report.collapsed + mesh.report.moved > 0, "{name}");
+        assert!(q1.quality.below_5 < q0.quality.below_5, "{name}");
+        assert!(q1.quality.min >= q0.quality.min, "{name}");
+        assert!(share <= most, "{name}: {share}");
+    }
 }

@@ -1,0 +1,412 @@
+//! The quality pass after cutting: slivers removed by collapsing one of their edges, and nodes
+//! moved (free nodes anywhere inside their star, nodes on one interface along it, nodes on one
+//! fault along it), each operation kept only if every cell it makes has a positive volume
+//! (exact `orient3d`) and the smallest dihedral angle of the cells it touches improves.
+//!
+//! What an operation may change is decided from the cells' labels (their side of every fault
+//! and their unit): a node whose cells all carry one label lies on no fault and no interface;
+//! a node may be collapsed into a neighbour only if every label around it is found around the
+//! neighbour too (so the neighbour lies on every surface the node lies on), and never if it
+//! lies on the terrain or a side (the DSM and the region's outline stay as they are); a node
+//! on the base only into a node on the base. The cells of a collapsed node's star are then
+//! cones from the neighbour over the star's boundary: with every cone positive they tile the
+//! same region, so conformity, the volume and every label are kept.
+
+use rayon::prelude::*;
+
+use crate::mesh::{positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
+use crate::quality::min_dihedral;
+use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
+
+/// What the quality pass did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct Improved {
+    pub collapsed: usize,
+    pub moved: usize,
+}
+
+struct Pass<'a> {
+    st: &'a mut State,
+    alive: Vec<bool>,
+    star: Vec<Vec<u32>>,
+    angle: Vec<f64>,
+    faults: &'a FaultSet,
+    blocks: &'a [BlockKey],
+    height: InterfaceFn<'a>,
+    terrain: &'a Terrain,
+    /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
+    background: usize,
+    /// Half the tolerance of `check` for a boundary node on the terrain, a side or the base.
+    tol: f64,
+}
+
+fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+}
+
+impl Pass<'_> {
+    fn cells(&self, v: u32) -> Vec<u32> {
+        // A cell enters a node's list once: when it is made, or when the node replaces one
+        // of its nodes (it did not hold the node before).
+        self.star[v as usize]
+            .iter()
+            .copied()
+            .filter(|&c| self.alive[c as usize] && self.st.tets[c as usize].contains(&v))
+            .collect()
+    }
+
+    fn labels(&self, cells: &[u32]) -> Vec<(u64, u32, u32)> {
+        let mut l: Vec<(u64, u32, u32)> = cells
+            .iter()
+            .map(|&c| {
+                let c = c as usize;
+                (self.st.positive[c], self.st.below[c], self.st.block[c])
+            })
+            .collect();
+        l.sort_unstable();
+        l.dedup();
+        l
+    }
+
+    fn geo(&self, t: [u32; 4]) -> [[f64; 3]; 4] {
+        t.map(|w| self.st.points[w as usize])
+    }
+
+    /// Collapses node `a` into its neighbour `b` if allowed and better.
+    fn collapse(&mut self, a: u32, b: u32) -> bool {
+        let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
+        let bound = fa & (TOP | BASE | SIDE);
+        // A boundary node only into a node on the same boundaries; never a DSM vertex, never
+        // a side node (collapsing those broke the sides on random sites: not understood yet).
+        if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) || fa & SIDE != 0 {
+            return false;
+        }
+        let ca = self.cells(a);
+        let cb = self.cells(b);
+        let (la, lb) = (self.labels(&ca), self.labels(&cb));
+        if !la.iter().all(|l| lb.binary_search(l).is_ok()) {
+            return false;
+        }
+        let old = ca
+            .iter()
+            .map(|&c| self.angle[c as usize])
+            .fold(f64::MAX, f64::min);
+        // Positive volumes first (cheap, and most refusals), then the angles.
+        let mut new = Vec::with_capacity(ca.len());
+        for &c in &ca {
+            let t = self.st.tets[c as usize];
+            if t.contains(&b) {
+                continue;
+            }
+            let t = t.map(|w| if w == a { b } else { w });
+            if !positive(self.geo(t)) {
+                return false;
+            }
+            new.push((c, t, 0.0));
+        }
+        for e in &mut new {
+            e.2 = min_dihedral(self.geo(e.1));
+            if e.2 <= old || (bound != 0 && !self.boundary_kept(e.1, b)) {
+                return false;
+            }
+        }
+        let mut keys: Vec<[u32; 4]> = cb
+            .iter()
+            .map(|&c| {
+                let mut t = self.st.tets[c as usize];
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        keys.sort_unstable();
+        if new.iter().any(|e| {
+            let mut k = e.1;
+            k.sort_unstable();
+            keys.binary_search(&k).is_ok()
+        }) {
+            return false;
+        }
+        for &c in &ca {
+            if self.st.tets[c as usize].contains(&b) {
+                self.alive[c as usize] = false;
+            }
+        }
+        for (c, t, q) in new {
+            self.st.tets[c as usize] = t;
+            self.angle[c as usize] = q;
+            self.star[b as usize].push(c);
+        }
+        self.star[a as usize].clear();
+        true
+    }
+
+    /// Whether every face of `t` through `b` whose nodes all lie on the terrain (or all on a
+    /// side) lies on the DSM (on one edge of the outline): its centroid and edge midpoints
+    /// on the DSM, its nodes on the outline edge.
+    fn boundary_kept(&self, t: [u32; 4], b: u32) -> bool {
+        for skip in 0..4 {
+            let f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
+            if !f.contains(&b) || t[skip] == b {
+                continue;
+            }
+            let all = |bit: u8| f.iter().all(|&v| self.st.flags[v as usize] & bit != 0);
+            let q: Vec<[f64; 3]> = f.iter().map(|&v| self.st.points[v as usize]).collect();
+            if all(TOP) {
+                let mid = |i: usize, j: usize| [0, 1, 2].map(|k| 0.5 * (q[i][k] + q[j][k]));
+                let c = [0, 1, 2].map(|k| (q[0][k] + q[1][k] + q[2][k]) / 3.0);
+                let on = |r: [f64; 3]| {
+                    self.terrain
+                        .height([r[0], r[1]])
+                        .is_some_and(|h| (h - r[2]).abs() <= self.tol)
+                };
+                if ![c, mid(0, 1), mid(1, 2), mid(0, 2)].into_iter().all(on) {
+                    return false;
+                }
+            }
+            if all(SIDE) {
+                let on_one = self.terrain.outline.iter().any(|&[i, j]| {
+                    let (pa, pb) = (
+                        self.terrain.points[i as usize],
+                        self.terrain.points[j as usize],
+                    );
+                    let e = [pb[0] - pa[0], pb[1] - pa[1]];
+                    let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+                    q.iter().all(|r| {
+                        let d = ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
+                        let s = ((r[0] - pa[0]) * e[0] + (r[1] - pa[1]) * e[1]) / (l * l);
+                        d.abs() <= self.tol && (-1e-12..=1.0 + 1e-12).contains(&s)
+                    })
+                });
+                if !on_one {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// Where node `v` may go towards `to`: anywhere if free, along its one interface or its
+    /// one fault; `None` if it may not move.
+    fn slide(&self, v: u32, labels: &[(u64, u32, u32)], to: [f64; 3]) -> Option<[f64; 3]> {
+        let f = self.st.flags[v as usize];
+        if f & (TOP | BASE | SIDE) != 0 {
+            return None;
+        }
+        match labels {
+            [_] if f & ON_INTERFACE == 0 => Some(to),
+            [x, y] if x.0 == y.0 && x.2 == y.2 && y.1 == x.1 + 1 => {
+                // On interface x.1 of block x.2 only.
+                let z = (self.height)(x.1 as usize, self.blocks[x.2 as usize], [to[0], to[1]]);
+                z.is_finite().then_some([to[0], to[1], z])
+            }
+            [x, y] if f & ON_INTERFACE == 0 && x.1 == y.1 && (x.0 ^ y.0).count_ones() == 1 => {
+                let fault = &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize];
+                let mut q = to;
+                for _ in 0..4 {
+                    let s = fault.side(q);
+                    if s.distance.abs() <= 0.1 * ON_SURFACE {
+                        return Some(q);
+                    }
+                    q = [
+                        q[0] - s.distance * s.normal[0],
+                        q[1] - s.distance * s.normal[1],
+                        q[2] - s.distance * s.normal[2],
+                    ];
+                }
+                (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
+            }
+            _ => None,
+        }
+    }
+
+    /// Moves node `v` towards the mean of its neighbours (along its surface) if better.
+    fn smooth(&mut self, v: u32) -> bool {
+        let cells = self.cells(v);
+        if cells.is_empty() {
+            return false;
+        }
+        let labels = self.labels(&cells);
+        let p = self.st.points[v as usize];
+        let mut nb: Vec<u32> = cells
+            .iter()
+            .flat_map(|&c| self.st.tets[c as usize])
+            .filter(|&w| w != v)
+            .collect();
+        nb.sort_unstable();
+        nb.dedup();
+        let mut mean = [0.0; 3];
+        for &w in &nb {
+            for (m, x) in mean.iter_mut().zip(self.st.points[w as usize]) {
+                *m += x / nb.len() as f64;
+            }
+        }
+        let old = cells
+            .iter()
+            .map(|&c| self.angle[c as usize])
+            .fold(f64::MAX, f64::min);
+        for s in [1.0, 0.5, 0.25] {
+            let to = [0, 1, 2].map(|k| p[k] + s * (mean[k] - p[k]));
+            let Some(q) = self.slide(v, &labels, to) else {
+                return false;
+            };
+            let mut new = Vec::with_capacity(cells.len());
+            let mut ok = true;
+            for &c in &cells {
+                let g = self.st.tets[c as usize].map(|w| {
+                    if w == v {
+                        q
+                    } else {
+                        self.st.points[w as usize]
+                    }
+                });
+                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                if a <= old {
+                    ok = false;
+                    break;
+                }
+                new.push(a);
+            }
+            if ok {
+                self.st.points[v as usize] = q;
+                for (&c, a) in cells.iter().zip(new) {
+                    self.angle[c as usize] = a;
+                }
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// Improves the cells whose smallest dihedral angle is below `below` degrees, in at most
+/// `passes` sweeps (worst first), then drops the collapsed cells and unused nodes.
+#[allow(clippy::too_many_arguments)] // the state, its surfaces and the pass's two settings
+pub(crate) fn improve(
+    st: &mut State,
+    faults: &FaultSet,
+    blocks: &[BlockKey],
+    height: InterfaceFn,
+    terrain: &Terrain,
+    background: usize,
+    below: f64,
+    passes: usize,
+) -> Improved {
+    let mut done = Improved::default();
+    if passes == 0 || below <= 0.0 {
+        return done;
+    }
+    let angle: Vec<f64> = st
+        .tets
+        .par_iter()
+        .map(|t| min_dihedral(t.map(|v| st.points[v as usize])))
+        .collect();
+    let mut star: Vec<Vec<u32>> = vec![Vec::new(); st.points.len()];
+    for (c, t) in st.tets.iter().enumerate() {
+        for &v in t {
+            star[v as usize].push(c as u32);
+        }
+    }
+    let mut p = Pass {
+        alive: vec![true; st.tets.len()],
+        st,
+        star,
+        angle,
+        faults,
+        blocks,
+        height,
+        terrain,
+        background,
+        tol: 0.5e-9
+            * terrain
+                .heights
+                .iter()
+                .fold(0.0f64, |s, h| s.max(h.abs()))
+                .max(1.0),
+    };
+    for _ in 0..passes {
+        let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
+            .filter(|&c| p.alive[c as usize] && p.angle[c as usize] < below)
+            .collect();
+        bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
+        let before = done;
+        for c in bad {
+            let c = c as usize;
+            if !p.alive[c] || p.angle[c] >= below {
+                continue;
+            }
+            let t = p.st.tets[c];
+            let mut edges: Vec<(f64, u32, u32)> = EDGES
+                .iter()
+                .map(|&(i, j)| {
+                    (
+                        d2(p.st.points[t[i] as usize], p.st.points[t[j] as usize]),
+                        t[i],
+                        t[j],
+                    )
+                })
+                .collect();
+            edges.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut fixed = false;
+            'edges: for &(_, u, v) in &edges {
+                for (a, b) in [(u, v), (v, u)] {
+                    if p.collapse(a, b) {
+                        done.collapsed += 1;
+                        fixed = true;
+                        break 'edges;
+                    }
+                }
+            }
+            if !fixed {
+                for v in t {
+                    if p.smooth(v) {
+                        done.moved += 1;
+                        break;
+                    }
+                }
+            }
+        }
+        if done == before {
+            break;
+        }
+    }
+    // Drop the dead cells and renumber the nodes still used.
+    let alive = p.alive;
+    let st = p.st;
+    let mut k = 0;
+    for (c, &live) in alive.iter().enumerate() {
+        if live {
+            st.tets[k] = st.tets[c];
+            st.positive[k] = st.positive[c];
+            st.below[k] = st.below[c];
+            st.block[k] = st.block[c];
+            k += 1;
+        }
+    }
+    st.tets.truncate(k);
+    st.positive.truncate(k);
+    st.below.truncate(k);
+    st.block.truncate(k);
+    let mut used = vec![u32::MAX; st.points.len()];
+    for t in &st.tets {
+        for &v in t {
+            used[v as usize] = 0;
+        }
+    }
+    let mut n = 0u32;
+    for (v, u) in used.iter_mut().enumerate() {
+        if *u == 0 {
+            *u = n;
+            st.points[n as usize] = st.points[v];
+            st.flags[n as usize] = st.flags[v];
+            st.on_fault[n as usize] = st.on_fault[v];
+            n += 1;
+        }
+    }
+    st.points.truncate(n as usize);
+    st.flags.truncate(n as usize);
+    st.on_fault.truncate(n as usize);
+    for t in &mut st.tets {
+        *t = t.map(|v| used[v as usize]);
+    }
+    done
+}
