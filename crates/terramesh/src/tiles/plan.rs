@@ -115,7 +115,7 @@ pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f6
 fn check_tileable(p: &Project) -> Result<()> {
     let ip = &p.interpolation;
     let refuse = |why: &str| Err(Error::invalid(why.to_string()));
-    if ip.neighbors == 0 {
+    if ip.neighbors.or(0) == 0 {
         return refuse(
             "interpolation.neighbors = 0 is global kriging (every sample in every system), \
              which tiles cannot reproduce: a tiled build needs a moving neighbourhood; set \
@@ -210,9 +210,9 @@ pub fn plan(
 
     let ip = &project.interpolation;
     let k = if ip.methods.contains(&InterpolationMethod::Idw) {
-        ip.neighbors.max(ip.idw_neighbors)
+        ip.neighbors.or(0).max(ip.idw_neighbors)
     } else {
-        ip.neighbors
+        ip.neighbors.or(0)
     }
     .min(data.len());
     let m = &project.mesh;
