@@ -74,6 +74,8 @@ pub fn write_report(
         .clone()
         .unwrap_or_else(|| "terramesh discrete surface model".into());
     let mut sections = Vec::new();
+    // Above the threshold the build chose a moving neighbourhood and k folds (scale.rs).
+    let big = it.choice.samples > super::scale::MAX_GLOBAL_SAMPLES;
     let png = |k: usize| -> Result<Block> {
         let pic = &pics[k];
         Ok(Block::Png {
@@ -139,10 +141,10 @@ pub fn write_report(
                                 super::scale::Neighbours::All => "all samples".to_string(),
                                 super::scale::Neighbours::Nearest(k) => format!("{k} neighbours"),
                             },
-                            // Why, when the build chose it.
-                            match p.interpolation.neighbors.get() {
-                                None => format!(" ({})", it.choice.neighbours_why),
-                                Some(_) => String::new(),
+                            // Why, when the build chose other than before the rule.
+                            match (p.interpolation.neighbors.get(), big) {
+                                (None, true) => format!(" ({})", it.choice.neighbours_why),
+                                _ => String::new(),
                             }
                         ),
                     },
@@ -354,10 +356,10 @@ pub fn write_report(
                     terramesh_geostat::Folds::LeaveOneOut => "Leave-one-out".to_string(),
                     terramesh_geostat::Folds::KFold(k) => format!("{k}-fold"),
                 },
-                // Why, when the build chose it.
-                match p.interpolation.cv_folds.get() {
-                    None => format!(" ({})", it.choice.folds_why),
-                    Some(_) => String::new(),
+                // Why, when the build chose other than before the rule.
+                match (p.interpolation.cv_folds.get(), big) {
+                    (None, true) => format!(" ({})", it.choice.folds_why),
+                    _ => String::new(),
                 }
             ),
             header: [
