@@ -143,10 +143,15 @@ fn above_the_threshold_the_defaults_use_a_moving_neighbourhood_and_k_folds() {
     assert_eq!(ip["cross_validation"], format!("{DEFAULT_CV_FOLDS}-fold"));
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains(&format!("{DEFAULT_NEIGHBORS} neighbours")));
-    assert!(html.contains(&format!("{DEFAULT_CV_FOLDS}-fold cross-validation of the samples")));
+    assert!(html.contains(&format!(
+        "{DEFAULT_CV_FOLDS}-fold cross-validation of the samples"
+    )));
     // Every sample predicted once, by every method.
     let cv = std::fs::read_to_string(out.join("cross-validation.csv")).unwrap();
-    assert!(cv.contains(&format!("UK,{n},")) && cv.contains(&format!("IDW,{n},")), "{cv}");
+    assert!(
+        cv.contains(&format!("UK,{n},")) && cv.contains(&format!("IDW,{n},")),
+        "{cv}"
+    );
 
     // What the project asks for is kept at this size: leave-one-out, 32 neighbours.
     let asked = d.path().join("asked");
@@ -159,7 +164,11 @@ fn above_the_threshold_the_defaults_use_a_moving_neighbourhood_and_k_folds() {
     let ip = &json(&asked.join("build.json"))["interpolation"];
     assert_eq!(ip["neighbors"], 32, "{ip}");
     assert_eq!(ip["cross_validation"], "leave-one-out", "{ip}");
-    assert!(log(&o).contains("interpolation.cv_folds = 0"), "{}", log(&o));
+    assert!(
+        log(&o).contains("interpolation.cv_folds = 0"),
+        "{}",
+        log(&o)
+    );
 }
 
 /// Every build records each stage's time and peak memory: in the log, `build.json` and the
@@ -180,7 +189,15 @@ fn every_stage_has_its_time_and_peak_memory() {
         .collect();
     assert_eq!(
         stages,
-        ["samples", "variogram", "mesh", "interpolation", "exports", "pictures", "report"]
+        [
+            "samples",
+            "variogram",
+            "mesh",
+            "interpolation",
+            "exports",
+            "pictures",
+            "report"
+        ]
     );
     let linux = cfg!(target_os = "linux");
     let mut last = 0;
