@@ -58,7 +58,7 @@ pub fn simulate_vertices(
         Some(k) => (ip.methods[0], k),
         None => (InterpolationMethod::Universal, Method::Universal(ip.drift)),
     };
-    let hood = match ip.neighbors {
+    let hood = match it.choice.neighbours.count() {
         0 => Neighbourhood::All,
         k => Neighbourhood::Nearest(k),
     };
@@ -70,7 +70,8 @@ pub fn simulate_vertices(
     // the best bounded model fitted to the same experimental variogram instead. A model the
     // project names is used as it is (and an unbounded one is refused).
     let auto = ip.model.is_none() && ip.variogram == "auto";
-    let variogram = match it.variogram.sill() {
+    let fitted = &model.variogram;
+    let variogram = match fitted.sill() {
         None if auto => {
             let v = crate::geology::ensemble::bounded_variogram(data, &model.lags)
                 .context("a bounded variogram for the simulation")?;
@@ -80,7 +81,7 @@ pub fn simulate_vertices(
     };
     let ensemble = crate::simulate::run_simulation(
         data,
-        variogram.as_ref().unwrap_or(&it.variogram),
+        variogram.as_ref().unwrap_or(fitted),
         method,
         hood,
         &vertices,

@@ -134,14 +134,19 @@ pub fn write_all(
     let mut files = Vec::new();
     let want = |f: &str| p.export.formats.iter().any(|x| x.name() == f);
 
-    // Per-vertex values as the library computed them.
+    // Per-vertex values as the library computed them (IDW alone when nothing was kriged).
+    let kriged = it.kriged();
     files.push(atomic(&out.join("dsm-vertices.csv"), |w| {
-        w.write_all(b"x,y,elevation_uk,kriging_std,elevation_idw\n")?;
+        w.write_all(match kriged {
+            true => b"x,y,elevation_uk,kriging_std,elevation_idw\n".as_slice(),
+            false => b"x,y,elevation_idw\n".as_slice(),
+        })?;
         for (i, a) in abs.iter().enumerate() {
-            for (k, v) in [a[0], a[1], it.uk[i], it.uk_std[i], it.idw[i]]
-                .iter()
-                .enumerate()
-            {
+            let row = match kriged {
+                true => vec![a[0], a[1], it.uk[i], it.uk_std[i], it.idw[i]],
+                false => vec![a[0], a[1], it.idw[i]],
+            };
+            for (k, v) in row.iter().enumerate() {
                 if k > 0 {
                     w.write_all(b",")?;
                 }
@@ -157,12 +162,15 @@ pub fn write_all(
         points: &mesh.points,
         z: Some(&it.dsm),
         triangles: tris,
-        point_data: vec![
-            ("elevation_uk", &it.uk[..]),
-            ("kriging_std", &it.uk_std[..]),
-            ("elevation_idw", &it.idw[..]),
-            ("uk_minus_idw", &diff[..]),
-        ],
+        point_data: match kriged {
+            true => vec![
+                ("elevation_uk", &it.uk[..]),
+                ("kriging_std", &it.uk_std[..]),
+                ("elevation_idw", &it.idw[..]),
+                ("uk_minus_idw", &diff[..]),
+            ],
+            false => vec![("elevation_idw", &it.idw[..])],
+        },
         cell_data: vec![("min_angle_deg", &min_angle[..])],
         field_data: dsm_field_data(p, s),
     };
@@ -415,24 +423,27 @@ pub fn write_all(
         }
         Ok(())
     })?);
-    let candidates = it
-        .candidates
-        .iter()
-        .map(|c| CandidateEntry::Summary(*c))
-        .collect();
-    let json = VariogramFile {
-        data: "samples.csv".into(),
-        points: s.xyz.len(),
-        experimental: it.lags.clone(),
-        candidates,
-        selection: it.selection,
-        ..VariogramFile::new(it.variogram.clone())
+    // The variogram, when one was fitted or read (none for IDW alone).
+    if let Some(v) = &it.variogram {
+        let candidates = it
+            .candidates
+            .iter()
+            .map(|c| CandidateEntry::Summary(*c))
+            .collect();
+        let json = VariogramFile {
+            data: "samples.csv".into(),
+            points: s.xyz.len(),
+            experimental: it.lags.clone(),
+            candidates,
+            selection: it.selection,
+            ..VariogramFile::new(v.clone())
+        }
+        .to_json_pretty();
+        files.push(atomic(&out.join("variogram.json"), |w| {
+            w.write_all(json.as_bytes())?;
+            w.write_all(b"\n")
+        })?);
     }
-    .to_json_pretty();
-    files.push(atomic(&out.join("variogram.json"), |w| {
-        w.write_all(json.as_bytes())?;
-        w.write_all(b"\n")
-    })?);
     Ok(Written {
         files,
         origin,

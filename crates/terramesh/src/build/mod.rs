@@ -18,6 +18,7 @@ mod model_dsm;
 mod pictures;
 mod report;
 pub mod reuse;
+pub mod scale;
 pub(crate) mod stages;
 pub mod staging;
 mod terrain;
@@ -38,9 +39,99 @@ use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
 
-/// Time spent in each stage, for the report.
+/// Time spent in each stage (`.0`: name and seconds), and the process's peak resident memory
+/// after it (`.1`, bytes, in the same order; `None` where the system does not say), for the
+/// log, `build.json` and the report.
 #[derive(Debug, Default, Clone)]
-pub struct Timings(pub Vec<(String, f64)>);
+pub struct Timings(pub Vec<(String, f64)>, pub Vec<Option<u64>>);
+
+impl Timings {
+    /// Records a stage: its seconds and the peak memory now.
+    pub fn push(&mut self, name: &str, seconds: f64) -> Option<u64> {
+        let peak = peak_memory();
+        self.0.push((name.to_string(), seconds));
+        self.1.push(peak);
+        peak
+    }
+
+    /// The peak memory after stage `k`, `None` where unknown.
+    pub fn peak(&self, k: usize) -> Option<u64> {
+        self.1.get(k).copied().flatten()
+    }
+}
+
+/// The peak resident memory of this process so far, in bytes: `VmHWM` of `/proc/self/status`
+/// on Linux, `None` elsewhere (or where it cannot be read).
+pub fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// A peak memory in words: `123.4 MB`, or `unknown`.
+pub fn memory_text(bytes: Option<u64>) -> String {
+    bytes.map_or("unknown".into(), |b| format!("{:.1} MB", b as f64 / 1e6))
+}
+
+/// The file of every build's stages, times and peak memory, and what it computed.
+pub const BUILD_JSON: &str = "build.json";
+
+/// `build.json`: every stage's seconds and peak memory after it, the whole build's, and what
+/// the interpolation computed and why ([`scale`]).
+fn write_build_json(
+    out: &Path,
+    timings: &Timings,
+    total: f64,
+    interpolation: Option<&scale::Record>,
+) -> Result<std::path::PathBuf> {
+    #[derive(serde::Serialize)]
+    struct Stage<'a> {
+        stage: &'a str,
+        seconds: f64,
+        peak_memory_bytes: Option<u64>,
+    }
+    #[derive(serde::Serialize)]
+    struct File<'a> {
+        stages: Vec<Stage<'a>>,
+        seconds: f64,
+        peak_memory_bytes: Option<u64>,
+        peak_memory: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        interpolation: Option<&'a scale::Record>,
+    }
+    let stages: Vec<Stage> = timings
+        .0
+        .iter()
+        .enumerate()
+        .filter(|(_, (n, _))| n != TOTAL_BEFORE_REPORT)
+        .map(|(k, (n, t))| Stage {
+            stage: n,
+            seconds: *t,
+            peak_memory_bytes: timings.peak(k),
+        })
+        .collect();
+    let peak = peak_memory();
+    let how = match peak {
+        Some(_) => "VmHWM of /proc/self/status after each stage",
+        None => "unknown on this system",
+    };
+    let json = serde_json::to_string_pretty(&File {
+        stages,
+        seconds: total,
+        peak_memory_bytes: peak,
+        peak_memory: how,
+        interpolation,
+    })
+    .map_err(|e| Error::invalid(format!("build.json: {e}")))?;
+    let path = out.join(BUILD_JSON);
+    terramesh_io::output::write_atomic(&path, format!("{json}\n").as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path)
+}
+
+/// The report's row of the time up to it.
+const TOTAL_BEFORE_REPORT: &str = "total before report";
 
 /// The number of stages [`build`] reports (one more with `[geology]`).
 pub const STAGES: usize = 7;
@@ -54,8 +145,10 @@ pub struct Built {
     pub vertices: usize,
     /// Triangles of the DSM.
     pub triangles: usize,
-    /// Seconds per stage.
+    /// Seconds and peak memory per stage.
     pub timings: Timings,
+    /// What the interpolation computed and why ([`scale`]); `None` for `terramesh model`.
+    pub interpolation: Option<scale::Record>,
 }
 
 struct Stages<'a> {
@@ -78,8 +171,9 @@ impl Stages<'_> {
         let t = Instant::now();
         let out = f()?;
         let secs = t.elapsed().as_secs_f64();
-        self.progress.stage_done(name, &detail(&out), secs);
-        self.timings.0.push((name.to_string(), secs));
+        let peak = self.timings.push(name, secs);
+        let detail = format!("{}; peak memory {}", detail(&out), memory_text(peak));
+        self.progress.stage_done(name, &detail, secs);
         self.check()?;
         Ok(out)
     }
@@ -266,6 +360,7 @@ fn model_on_kept_dsm(
         vertices: kept.mesh.points.len(),
         triangles: kept.mesh.triangles.len(),
         timings: st.timings,
+        interpolation: None,
     }))
 }
 
@@ -302,10 +397,16 @@ fn build_as(
     let t0 = Instant::now();
     project.check_inputs(base)?;
     let staging = staging::Staging::begin(out, progress)?;
-    let built = build_into(project, base, staging.dir(), out, progress, t0, what)?;
+    let mut built = build_into(project, base, staging.dir(), out, progress, t0, what)?;
     if progress.cancelled() {
         return Err(Error::Cancelled);
     }
+    built.files.push(write_build_json(
+        staging.dir(),
+        &built.timings,
+        t0.elapsed().as_secs_f64(),
+        built.interpolation.as_ref(),
+    )?);
     let files = built
         .files
         .iter()
@@ -402,24 +503,64 @@ fn build_into_with(
     if what == What::ModelOnly && project.interpolation.realisations == 0 {
         return model_dsm::build_rest(&mut st, project, base, out, &samples, dsm_key, grids);
     }
-    let model = st.run(
-        "variogram",
-        || stages::model(project, &samples, base),
-        |m| short_numbers(&m.variogram.to_string()),
-    )?;
+    // What is computed: kriging only when something reported needs it; the neighbourhood
+    // and the cross-validation by the number of samples (scale.rs).
+    let (model, data) = if scale::needs_kriging(project) {
+        let m = st.run(
+            "variogram",
+            || stages::model(project, &samples, base),
+            |m| short_numbers(&m.variogram.to_string()),
+        )?;
+        (Some(m), None)
+    } else {
+        let d = st.run(
+            "variogram",
+            || stages::sample_data(&samples),
+            |_| "not fitted: interpolation.methods is idw alone".to_string(),
+        )?;
+        (None, Some(d))
+    };
+    let data = match (&model, &data) {
+        (Some(m), _) => &m.data,
+        (None, Some(d)) => d,
+        (None, None) => return Err(Error::invalid("internal: no samples' data")),
+    };
+    let choice = scale::choose(project, data.len());
+    progress.note(&choice.describe());
     let geology = project.geology();
     let model_crs = crate::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
     let (boreholes, collars) =
         crate::geology::stage::boreholes_and_collars(geology, samples.zone, samples.crs.as_ref())?;
     let mesh = st.run(
         "mesh",
-        || stages::mesh(project, &samples, &model, &collars),
+        || match &model {
+            Some(m) => stages::mesh(project, &samples, m, &collars),
+            None => stages::mesh_refined(project, &samples, &collars),
+        },
         mesh_detail,
     )?;
     let mut interp = st.run(
         "interpolation",
-        || stages::interpolate(project, &samples, &mesh, &model),
-        |i| format!("UK and IDW at {} vertices, cross-validation", i.uk.len()),
+        || stages::interpolate(project, &samples, &mesh, model.as_ref(), data, &choice),
+        |i| {
+            let hood = match i.choice.neighbours {
+                scale::Neighbours::All => "all samples".to_string(),
+                scale::Neighbours::Nearest(k) => format!("{k} neighbours"),
+            };
+            if i.kriged() {
+                format!(
+                    "UK ({hood}) and IDW at {} vertices, {} cross-validation",
+                    i.idw.len(),
+                    i.choice.folds_name()
+                )
+            } else {
+                format!(
+                    "IDW at {} vertices (nothing kriged), {} cross-validation",
+                    i.idw.len(),
+                    i.choice.folds_name()
+                )
+            }
+        },
     )?;
     if let Some(key) = dsm_key {
         reuse::DsmState {
@@ -434,10 +575,10 @@ fn build_into_with(
         }
         .write(out)?;
     }
-    if project.interpolation.realisations > 0 {
+    if let (true, Some(model)) = (project.interpolation.realisations > 0, &model) {
         let e = st.run(
             "simulation",
-            || ensemble::simulate_vertices(project, &model, &mesh, &interp),
+            || ensemble::simulate_vertices(project, model, &mesh, &interp),
             |e| {
                 let refit = e.refit.as_ref().map_or(String::new(), |v| {
                     format!(
@@ -487,6 +628,7 @@ fn build_into_with(
             vertices: mesh.mesh.points.len(),
             triangles: mesh.mesh.triangles.len(),
             timings: st.timings,
+            interpolation: Some(interp.choice.record()),
         });
     }
     let written = st.run(
@@ -512,8 +654,7 @@ fn build_into_with(
             progress.stage_start(st.k, st.total, "report");
             let t = Instant::now();
             st.timings
-                .0
-                .push(("total before report".into(), t0.elapsed().as_secs_f64()));
+                .push(TOTAL_BEFORE_REPORT, t0.elapsed().as_secs_f64());
             report::write_report(
                 out,
                 project,
@@ -526,7 +667,13 @@ fn build_into_with(
                 extra,
                 geo.as_ref(),
             )?;
-            progress.stage_done("report", "report.html", t.elapsed().as_secs_f64());
+            let secs = t.elapsed().as_secs_f64();
+            let peak = st.timings.push("report", secs);
+            progress.stage_done(
+                "report",
+                &format!("report.html; peak memory {}", memory_text(peak)),
+                secs,
+            );
         }
     }
     st.check()?;
@@ -539,5 +686,6 @@ fn build_into_with(
         vertices: mesh.mesh.points.len(),
         triangles: mesh.mesh.triangles.len(),
         timings: st.timings,
+        interpolation: Some(interp.choice.record()),
     })
 }

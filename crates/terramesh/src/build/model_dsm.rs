@@ -111,6 +111,7 @@ pub(super) fn build_rest(
         vertices: mesh.mesh.points.len(),
         triangles: mesh.mesh.triangles.len(),
         timings: std::mem::take(&mut st.timings),
+        interpolation: None,
     })
 }
 
@@ -165,7 +166,7 @@ pub fn dsm_heights(
                 data,
                 &model.variogram,
                 Method::Universal(ip.drift),
-                ip.neighbors,
+                super::scale::choose(p, data.len()).neighbours.count(),
                 model.drift.as_ref(),
             )?;
             let (uk, var) = engine.predict(&vertices, true)?;

@@ -120,26 +120,29 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
         SvgMode::Vector
     };
 
-    let pts: Vec<(f64, f64, u64)> = it
-        .lags
-        .iter()
-        .map(|l| (l.distance, l.gamma, l.pairs))
-        .collect();
-    let label = short_numbers(&it.variogram.to_string());
-    let f = render_both(&dir.join("variogram"), (900, 600), |r| {
-        draw_variogram(
-            r,
-            &pts,
-            &|h| it.variogram.gamma(h),
-            "Experimental variogram and fitted model",
-            &label,
-        )
-    })?;
-    add(
-        "variogram",
-        format!("Variogram of the samples and the fitted model: {label}"),
-        f,
-    );
+    // The variogram, when one was fitted or read (none for IDW alone).
+    if let Some(variogram) = &it.variogram {
+        let pts: Vec<(f64, f64, u64)> = it
+            .lags
+            .iter()
+            .map(|l| (l.distance, l.gamma, l.pairs))
+            .collect();
+        let label = short_numbers(&variogram.to_string());
+        let f = render_both(&dir.join("variogram"), (900, 600), |r| {
+            draw_variogram(
+                r,
+                &pts,
+                &|h| variogram.gamma(h),
+                "Experimental variogram and fitted model",
+                &label,
+            )
+        })?;
+        add(
+            "variogram",
+            format!("Variogram of the samples and the fitted model: {label}"),
+            f,
+        );
+    }
 
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
     type Map<'a> = (&'a str, &'a str, &'a [f64], bool, ColourMap, bool, &'a str);
@@ -181,6 +184,10 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
             "difference (m)",
         ),
     ];
+    // IDW alone: nothing kriged, its map only.
+    if !it.kriged() {
+        maps.retain(|m| m.0 == "elevation-idw");
+    }
     // Conditional simulation (interpolation.realisations): spread and quantiles per vertex.
     if let Some(e) = &it.ensemble {
         maps.extend([
@@ -217,7 +224,7 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
         let map = SurfaceMap {
             xy: &xy,
             values,
-            shade_z: shaded.then_some(&it.uk[..]),
+            shade_z: shaded.then_some(if it.kriged() { &it.uk[..] } else { &it.idw[..] }),
             triangles: &m.mesh.triangles,
             title,
             unit,

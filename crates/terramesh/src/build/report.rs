@@ -74,6 +74,8 @@ pub fn write_report(
         .clone()
         .unwrap_or_else(|| "terramesh discrete surface model".into());
     let mut sections = Vec::new();
+    // Above the threshold the build chose a moving neighbourhood and k folds (scale.rs).
+    let big = it.choice.samples > super::scale::MAX_GLOBAL_SAMPLES;
     let png = |k: usize| -> Result<Block> {
         let pic = &pics[k];
         Ok(Block::Png {
@@ -130,15 +132,22 @@ pub fn write_report(
                 ),
                 kv(
                     "kriging",
-                    format!(
-                        "universal, drift {:?}, {}",
-                        it.drift,
-                        if p.interpolation.neighbors == 0 {
-                            "all samples".to_string()
-                        } else {
-                            format!("{} neighbours", p.interpolation.neighbors)
-                        }
-                    ),
+                    match (it.kriged(), it.choice.neighbours) {
+                        (false, _) => format!("none ({})", it.choice.krige_why),
+                        (true, n) => format!(
+                            "universal, drift {:?}, {}{}",
+                            it.drift,
+                            match n {
+                                super::scale::Neighbours::All => "all samples".to_string(),
+                                super::scale::Neighbours::Nearest(k) => format!("{k} neighbours"),
+                            },
+                            // Why, when the build chose other than before the rule.
+                            match (p.interpolation.neighbors.get(), big) {
+                                (None, true) => format!(" ({})", it.choice.neighbours_why),
+                                _ => String::new(),
+                            }
+                        ),
+                    },
                 ),
                 kv(
                     "IDW",
@@ -267,11 +276,22 @@ pub fn write_report(
         heading: "Planar mesh".into(),
         blocks: mesh_blocks,
     });
-    let mut vb = vec![png(3)?];
-    vb.push(Block::Text(format!(
-        "Model: {}. Ranges are practical ranges (GSLIB convention).",
-        short_numbers(&it.variogram.to_string())
-    )));
+    // The variogram's picture is the fourth, when there is one (IDW alone has none).
+    let first_map = if it.kriged() { 4 } else { 3 };
+    let mut vb = Vec::new();
+    match &it.variogram {
+        Some(v) => {
+            vb.push(png(3)?);
+            vb.push(Block::Text(format!(
+                "Model: {}. Ranges are practical ranges (GSLIB convention).",
+                short_numbers(&v.to_string())
+            )));
+        }
+        None => vb.push(Block::Text(format!(
+            "No variogram: {}.",
+            it.choice.krige_why
+        ))),
+    }
     if !it.candidates.is_empty() {
         let reml = it.selection.is_some();
         let mut header = vec!["model", "cross-validation RMSE (m)", "fit RMSE (m²)"];
@@ -325,17 +345,21 @@ pub fn write_report(
         heading: "Interpolated surfaces".into(),
         // The four maps, the realisations' std and P10/P90 maps when there are realisations,
         // and the 3D view.
-        blocks: (4..pics.len()).map(png).collect::<Result<_>>()?,
+        blocks: (first_map..pics.len()).map(png).collect::<Result<_>>()?,
     });
     sections.push(Section {
         heading: "Cross-validation".into(),
         blocks: vec![Block::Table {
             caption: format!(
-                "{} cross-validation of the samples",
-                if p.interpolation.cv_folds == 0 {
-                    "Leave-one-out".to_string()
-                } else {
-                    format!("{}-fold", p.interpolation.cv_folds)
+                "{} cross-validation of the samples{}",
+                match it.choice.folds {
+                    terramesh_geostat::Folds::LeaveOneOut => "Leave-one-out".to_string(),
+                    terramesh_geostat::Folds::KFold(k) => format!("{k}-fold"),
+                },
+                // Why, when the build chose other than before the rule.
+                match (p.interpolation.cv_folds.get(), big) {
+                    (None, true) => format!(" ({})", it.choice.folds_why),
+                    _ => String::new(),
                 }
             ),
             header: [
@@ -389,12 +413,15 @@ pub fn write_report(
     sections.push(Section {
         heading: "Timings".into(),
         blocks: vec![Block::Table {
-            caption: "Time per stage (this machine, this run)".into(),
-            header: vec!["stage".into(), "seconds".into()],
+            caption: "Time per stage and the process's peak memory after it (VmHWM; this \
+                      machine, this run)"
+                .into(),
+            header: vec!["stage".into(), "seconds".into(), "peak memory".into()],
             rows: timings
                 .0
                 .iter()
-                .map(|(n, t)| vec![n.clone(), num(*t, 3)])
+                .enumerate()
+                .map(|(k, (n, t))| vec![n.clone(), num(*t, 3), super::memory_text(timings.peak(k))])
                 .collect(),
         }],
     });

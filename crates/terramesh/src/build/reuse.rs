@@ -104,6 +104,13 @@ pub fn key(p: &Project, base: &Path) -> Result<u64> {
         p.export.grid_spacing
     )
     .hash(&mut h);
+    // `interpolation.neighbors` and `cv_folds` print 0 whether set to 0 or unset (left to the
+    // build, `scale.rs`), so that the keys of projects setting neither are what they were; an
+    // explicit 0 (asked for at every size) is told apart here.
+    let ip = &p.interpolation;
+    if ip.neighbors.get() == Some(0) || ip.cv_folds.get() == Some(0) {
+        (ip.neighbors.get(), ip.cv_folds.get()).hash(&mut h);
+    }
     let mut files = Vec::new();
     if let Ok(s) = p.source_spec(base) {
         files.push(std::path::PathBuf::from(s));

@@ -46,7 +46,12 @@ pub fn scene(
         })
         .collect();
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
-    let mut fields: Vec<&[f64]> = vec![&it.dsm, &it.uk_std, &diff];
+    // The DSM, and the kriging's fields when the samples were kriged.
+    let mut fields: Vec<&[f64]> = vec![&it.dsm];
+    if it.kriged() {
+        fields.extend([&it.uk_std[..], &diff[..]]);
+    }
+    let own = fields.len();
     // The unit tops below the first and the base ride along as fields of the planar mesh.
     let surfaces = geo.map_or(&[][..], |g| &g.model.stack.surfaces[..]);
     fields.extend(surfaces.iter().skip(1).map(|v| &v[..]));
@@ -79,7 +84,7 @@ pub fn scene(
     let model_layers = match geo {
         Some(g) => {
             let mut stack = vec![positions.iter().map(|p| p[2]).collect::<Vec<f64>>()];
-            stack.extend(values.drain(3..));
+            stack.extend(values.drain(own..));
             let (layers, note) =
                 crate::geology::web::viewer_layers(g, &positions, &triangles, &stack);
             notes.push(note);
@@ -87,7 +92,8 @@ pub fn scene(
         }
         None => Vec::new(),
     };
-    let [elevation, std, diff]: [Vec<f64>; 3] = values.try_into().expect("three fields");
+    let mut values = values.into_iter();
+    let elevation = values.next().unwrap_or_default();
     let field = |key: &str, label: String, colours, values| Field {
         key: key.into(),
         label,
@@ -99,26 +105,29 @@ pub fn scene(
     let (solid_v, solid_t) = compact(&solid.vertices, &solid.triangles[solid.top_triangles..]);
     let surface = Layer {
         name: "DSM surface".into(),
-        fields: vec![
-            field(
+        fields: {
+            let mut f = vec![field(
                 "elevation",
                 format!("elevation ({})", it.dsm_method),
                 ColourMap::Terrain,
                 elevation,
-            ),
-            field(
-                "kriging_std",
-                "kriging standard deviation".into(),
-                ColourMap::Viridis,
-                std,
-            ),
-            field(
-                "uk_minus_idw",
-                "UK minus IDW".into(),
-                ColourMap::Diverging,
-                diff,
-            ),
-        ],
+            )];
+            if let (Some(std), Some(diff)) = (values.next(), values.next()) {
+                f.push(field(
+                    "kriging_std",
+                    "kriging standard deviation".into(),
+                    ColourMap::Viridis,
+                    std,
+                ));
+                f.push(field(
+                    "uk_minus_idw",
+                    "UK minus IDW".into(),
+                    ColourMap::Diverging,
+                    diff,
+                ));
+            }
+            f
+        },
         positions,
         geometry: Geometry::Triangles(triangles),
         colour: [200, 200, 200],

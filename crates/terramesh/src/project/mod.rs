@@ -320,14 +320,20 @@ pub struct InterpolationSection {
     pub variogram: String,
     /// An explicit variogram (overrides `variogram`).
     pub model: Option<VariogramSpec>,
-    /// Kriging neighbours per target (0: all data, global kriging).
-    pub neighbors: usize,
+    /// Kriging neighbours per target (0: all data, global kriging). Unset: chosen by the
+    /// number of samples ([`crate::build::scale`]): global up to
+    /// [`MAX_GLOBAL_SAMPLES`](crate::build::scale::MAX_GLOBAL_SAMPLES), else
+    /// [`DEFAULT_NEIGHBORS`](crate::build::scale::DEFAULT_NEIGHBORS).
+    pub neighbors: Auto,
     /// IDW power.
     pub idw_power: f64,
     /// IDW neighbours.
     pub idw_neighbors: usize,
-    /// Cross-validation folds (0: leave-one-out).
-    pub cv_folds: usize,
+    /// Cross-validation folds (0: leave-one-out). Unset: chosen by the number of samples
+    /// ([`crate::build::scale`]): leave-one-out up to
+    /// [`MAX_GLOBAL_SAMPLES`](crate::build::scale::MAX_GLOBAL_SAMPLES), else
+    /// [`DEFAULT_CV_FOLDS`](crate::build::scale::DEFAULT_CV_FOLDS) folds.
+    pub cv_folds: Auto,
     /// Conditional-simulation realisations of the vertex elevations (0: none).
     pub realisations: usize,
     /// Seed of the realisations' random streams.
@@ -356,10 +362,10 @@ impl Default for InterpolationSection {
             drift: Drift::Linear,
             variogram: "auto".into(),
             model: None,
-            neighbors: 0,
+            neighbors: Auto::UNSET,
             idw_power: DEFAULT_IDW_POWER,
             idw_neighbors: DEFAULT_IDW_NEIGHBORS,
-            cv_folds: 0,
+            cv_folds: Auto::UNSET,
             realisations: 0,
             seed: 0,
             fit: terramesh_geostat::FitMethod::default(),
@@ -367,6 +373,50 @@ impl Default for InterpolationSection {
             anisotropy: "none".into(),
             external_drift_grid: None,
         }
+    }
+}
+
+/// A count of `[interpolation]` that the build chooses when the project leaves it unset
+/// (`interpolation.neighbors`, `interpolation.cv_folds`; [`crate::build::scale`]).
+///
+/// Its `Debug` prints the number, and `0` when unset (what these keys meant before the
+/// choice), so that the key of a kept DSM (`build::reuse::key`) of a project that sets
+/// neither is what it was; `reuse::key` tells an explicit 0 apart.
+///
+/// ```
+/// use terramesh::project::Auto;
+/// assert_eq!(Auto::UNSET.get(), None);
+/// assert_eq!(Auto::from(0).get(), Some(0)); // asked for: global kriging, leave-one-out
+/// assert_eq!(format!("{:?} {:?}", Auto::UNSET, Auto::from(64)), "0 64");
+/// ```
+#[derive(Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(transparent)]
+pub struct Auto(Option<usize>);
+
+impl Auto {
+    /// Left to the build.
+    pub const UNSET: Auto = Auto(None);
+
+    /// The value the project gives, `None` when unset.
+    pub fn get(self) -> Option<usize> {
+        self.0
+    }
+
+    /// The value given, or `unset` when none is.
+    pub fn or(self, unset: usize) -> usize {
+        self.0.unwrap_or(unset)
+    }
+}
+
+impl From<usize> for Auto {
+    fn from(v: usize) -> Auto {
+        Auto(Some(v))
+    }
+}
+
+impl std::fmt::Debug for Auto {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(&self.0.unwrap_or(0), f)
     }
 }
 

@@ -197,19 +197,20 @@ impl Project {
                 "name at least one of \"uk\", \"ok\", \"sk\", \"idw\" (the first gives the DSM)",
             );
         }
-        if i.neighbors != 0 && i.neighbors < i.drift.terms() {
+        let neighbors = i.neighbors.or(0);
+        if neighbors != 0 && neighbors < i.drift.terms() {
             return bad(
                 "interpolation.neighbors",
                 &format!(
                     "{} is too few: universal kriging with a {} drift needs at least {} \
                      neighbours (or 0 for all samples)",
-                    i.neighbors,
+                    neighbors,
                     i.drift,
                     i.drift.terms()
                 ),
             );
         }
-        if i.cv_folds == 1 {
+        if i.cv_folds.get() == Some(1) {
             return bad(
                 "interpolation.cv_folds",
                 "1 fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more folds",
@@ -441,6 +442,12 @@ mod tests {
             format!("{:?}", p.interpolation),
             format!("{:?}", InterpolationSection::default())
         );
+        // Left to the build, as by default (their Debug prints 0 either way).
+        assert_eq!(
+            p.interpolation.neighbors,
+            InterpolationSection::default().neighbors
+        );
+        assert_eq!(p.interpolation.cv_folds.get(), None);
         assert_eq!(
             format!("{:?}", p.export),
             format!("{:?}", ExportSection::default())

@@ -158,7 +158,12 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
 
     // Elevations at the vertices and at the grid nodes the tile owns.
     let t = Instant::now();
-    let uk_engine = Surface::kriging(&data, &variogram, Method::Universal(ip.drift), ip.neighbors)?;
+    let uk_engine = Surface::kriging(
+        &data,
+        &variogram,
+        Method::Universal(ip.drift),
+        ip.neighbors.or(0),
+    )?;
     let (uk, var) = uk_engine.predict(&positions, true)?;
     let idw_engine = Surface::idw(&data, ip.idw_power, ip.idw_neighbors)?;
     let (idw, _) = idw_engine.predict(&positions, false)?;

@@ -52,7 +52,7 @@ pub(crate) fn plan_geology(
     let sample_xy: Vec<[f64; 2]> = samples.xyz.iter().map(|p| [p[0], p[1]]).collect();
     let dir = out.join("geology");
     std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
-    let k_project = p.interpolation.neighbors;
+    let k_project = p.interpolation.neighbors.or(0);
     let mut interfaces = Vec::new();
     let mut halos = vec![0.0f64; rects.len()];
     let thickness = g.interpolate == Interpolated::Thickness;

@@ -142,7 +142,7 @@ fn check_plan_folder(out: &Path) -> Result<()> {
 fn check_tileable(p: &Project) -> Result<()> {
     let ip = &p.interpolation;
     let refuse = |why: &str| Err(Error::invalid(why.to_string()));
-    if ip.neighbors == 0 {
+    if ip.neighbors.or(0) == 0 {
         return refuse(
             "interpolation.neighbors = 0 is global kriging (every sample in every system), \
              which tiles cannot reproduce: a tiled build needs a moving neighbourhood; set \
@@ -238,9 +238,9 @@ pub fn plan(
 
     let ip = &project.interpolation;
     let k = if ip.methods.contains(&InterpolationMethod::Idw) {
-        ip.neighbors.max(ip.idw_neighbors)
+        ip.neighbors.or(0).max(ip.idw_neighbors)
     } else {
-        ip.neighbors
+        ip.neighbors.or(0)
     }
     .min(data.len());
     let m = &project.mesh;

@@ -6,27 +6,28 @@ use super::{Meshed, Samples};
 use std::path::Path;
 
 use terramesh_geostat::{
-    cross_validate, experimental, kriging, CandidateSummary, CvStats, Data, Drift, Duplicates,
-    Folds, Idw, IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, Named,
-    Neighbourhood, Predictor, Selection, Variogram,
+    cross_validate, experimental, kriging, CandidateSummary, CvStats, Data, Drift, Duplicates, Idw,
+    IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, Named, Neighbourhood,
+    Predictor, Selection, Variogram,
 };
 
+use crate::build::scale::Choice;
 use crate::error::{bail, Context, Result};
 use crate::project::Project;
 
 /// Step 4: vertex elevations by UK and IDW, a DSM grid, and cross-validation.
 pub struct Interpolated {
-    /// The variogram used.
-    pub variogram: Variogram,
-    /// Experimental variogram of the samples.
+    /// The variogram used; `None` when nothing was kriged ([`Choice::krige`]).
+    pub variogram: Option<Variogram>,
+    /// Experimental variogram of the samples (empty when nothing was kriged).
     pub lags: Vec<Lag>,
     /// Candidate models tried by `auto`.
     pub candidates: Vec<CandidateSummary>,
     /// What chose the model (a REML or leave-one-out fit only).
     pub selection: Option<Selection>,
-    /// UK elevation at each mesh vertex.
+    /// UK elevation at each mesh vertex (empty when nothing was kriged).
     pub uk: Vec<f64>,
-    /// Kriging standard deviation at each vertex.
+    /// Kriging standard deviation at each vertex (empty when nothing was kriged).
     pub uk_std: Vec<f64>,
     /// IDW elevation at each vertex.
     pub idw: Vec<f64>,
@@ -43,6 +44,15 @@ pub struct Interpolated {
     /// Conditional realisations of the vertex elevations (`interpolation.realisations`),
     /// set by the build after this stage.
     pub ensemble: Option<crate::build::ensemble::VertexEnsemble>,
+    /// What was computed and why ([`crate::build::scale`]).
+    pub choice: Choice,
+}
+
+impl Interpolated {
+    /// Whether the samples were kriged (UK at the vertices, a variogram).
+    pub fn kriged(&self) -> bool {
+        self.variogram.is_some()
+    }
 }
 
 /// The samples as kriging data and the variogram model (fitted, given, or read).
@@ -148,49 +158,62 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     })
 }
 
-/// Step 4b: vertex elevations by UK and IDW, the DSM grid, cross-validation.
-pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Result<Interpolated> {
+/// Step 4b: vertex elevations by UK and IDW, the DSM grid, cross-validation. `model` is the
+/// variogram stage's result, `None` when [`Choice::krige`] is false (then nothing is kriged);
+/// `data` the samples.
+pub fn interpolate(
+    p: &Project,
+    s: &Samples,
+    m: &Meshed,
+    model: Option<&Model>,
+    data: &Data,
+    choice: &Choice,
+) -> Result<Interpolated> {
     let ip = &p.interpolation;
-    let data = &model.data;
-    let variogram = model.variogram.clone();
-    let lags = model.lags.clone();
-    let candidates = model.candidates.clone();
-    let selection = model.selection;
     let drift = ip.drift;
     let uk_method = Method::Universal(drift);
     let vertices: Vec<[f64; 2]> = (0..m.mesh.points.len())
         .map(|i| m.mesh.absolute(i))
         .collect();
-    let ked = model.drift.as_ref();
-    let uk_engine = Surface::kriging_with(data, &variogram, uk_method, ip.neighbors, ked)?;
-    let (uk, var) = uk_engine.predict(&vertices, true)?;
+    let ked = model.and_then(|m| m.drift.as_ref());
+    let neighbors = choice.neighbours.count();
+    let (uk_engine, uk, var) = match model {
+        Some(model) => {
+            let e = Surface::kriging_with(data, &model.variogram, uk_method, neighbors, ked)?;
+            let (uk, var) = e.predict(&vertices, true)?;
+            (Some(e), uk, var)
+        }
+        None => (None, Vec::new(), Vec::new()),
+    };
     let uk_std: Vec<f64> = var.iter().map(|v| v.max(0.0).sqrt()).collect();
     let search = idw_search(ip.idw_neighbors);
     let idw_engine = Surface::idw(data, ip.idw_power, ip.idw_neighbors)?;
     let (idw, _) = idw_engine
         .predict(&vertices, false)
         .context("IDW at the mesh vertices")?;
+    let variogram = || {
+        model
+            .map(|m| &m.variogram)
+            .context("internal: kriging without a variogram")
+    };
     // The first method gives the DSM (its heights and its grid).
     let primary = ip.methods[0];
     let other;
-    let (dsm, engine) = match primary {
-        InterpolationMethod::Universal => (uk.clone(), &uk_engine),
-        InterpolationMethod::Idw => (idw.clone(), &idw_engine),
+    let (dsm, engine) = match (primary, &uk_engine) {
+        (InterpolationMethod::Universal, Some(e)) => (uk.clone(), e),
+        (InterpolationMethod::Idw, _) => (idw.clone(), &idw_engine),
         _ => {
-            other = Surface::primary_with(p, data, &variogram, ked)?;
+            other = Surface::primary_with(p, data, variogram()?, ked)?;
             (other.predict(&vertices, false)?.0, &other)
         }
     };
 
     // Cross-validation of the methods compared in the report.
-    let folds = if ip.cv_folds == 0 {
-        Folds::LeaveOneOut
-    } else {
-        Folds::KFold(ip.cv_folds)
-    };
+    let folds = choice.folds;
     // Global leave-one-out has a closed form only for models with a sill; for the others
     // (power, linear) it would refit n systems, so they are cross-validated with 64 neighbours.
-    let neighbours = match (ip.neighbors, variogram.sill()) {
+    let sill = model.and_then(|m| m.variogram.sill());
+    let neighbours = match (neighbors, sill) {
         (0, Some(_)) => Neighbourhood::All,
         (0, None) => Neighbourhood::Nearest(64.min(data.len() - 1)),
         (k, _) => Neighbourhood::Nearest(k),
@@ -199,7 +222,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
     for &name in &ip.methods {
         let how = match name.method(drift, None, data) {
             Some(method) => Interpolator::Kriging {
-                variogram: variogram.clone(),
+                variogram: variogram()?.clone(),
                 method,
                 neighbours,
             },
@@ -263,10 +286,10 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         }
     }
     Ok(Interpolated {
-        variogram,
-        lags,
-        candidates,
-        selection,
+        variogram: model.map(|m| m.variogram.clone()),
+        lags: model.map(|m| m.lags.clone()).unwrap_or_default(),
+        candidates: model.map(|m| m.candidates.clone()).unwrap_or_default(),
+        selection: model.and_then(|m| m.selection),
         uk,
         uk_std,
         idw,
@@ -276,6 +299,7 @@ pub fn interpolate(p: &Project, s: &Samples, m: &Meshed, model: &Model) -> Resul
         dsm,
         dsm_method: primary,
         ensemble: None,
+        choice: choice.clone(),
     })
 }
 
@@ -376,8 +400,11 @@ impl Surface {
         drift: Option<&crate::external_drift::ModelDrift>,
     ) -> Result<Surface> {
         let ip = &p.interpolation;
+        let neighbors = crate::build::scale::choose(p, data.len())
+            .neighbours
+            .count();
         match ip.methods[0].method(ip.drift, None, data) {
-            Some(method) => Surface::kriging_with(data, v, method, ip.neighbors, drift),
+            Some(method) => Surface::kriging_with(data, v, method, neighbors, drift),
             None => Surface::idw(data, ip.idw_power, ip.idw_neighbors),
         }
     }
