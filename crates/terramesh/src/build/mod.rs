@@ -405,7 +405,7 @@ fn build_into_with(
     let model = st.run(
         "variogram",
         || stages::model(project, &samples, base),
-        |m| short_numbers(&m.variogram.to_string()),
+        |m| m.detail(),
     )?;
     let geology = project.geology();
     let model_crs = crate::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
