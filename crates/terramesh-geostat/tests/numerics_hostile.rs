@@ -162,3 +162,69 @@ fn a_leave_one_out_fit_names_itself_in_its_errors() {
         .to_string();
     assert!(e.contains("a REML fit"), "{e}");
 }
+
+/// A Gaussian model without nugget on close data: between the ranges whose factor is fine
+/// and those where a pivot is not positive lie ranges where the factor succeeds with a
+/// condition number above 1e12; those are refused with the condition and the nugget that
+/// cures them, and every system that is solved gives estimates within the data's span.
+/// With the nugget the message asks for, the widest range is solved.
+#[test]
+fn ill_conditioned_gaussian_systems_are_refused_with_the_cure() {
+    use terramesh_geostat::{
+        Anisotropy, Drift, GlobalKriging, Method, ModelKind, Structure, Variogram,
+    };
+    let (xy, z) = site(150, 21);
+    let d = Data::new(xy, z.clone(), Duplicates::Reject).unwrap();
+    let (t, _) = site(60, 22);
+    let (lo, hi) = z
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, v| (a.0.min(*v), a.1.max(*v)));
+    let span = hi - lo;
+    let mut refused = 0;
+    for k in 0..24 {
+        let range = 300.0 + 100.0 * k as f64;
+        let v = Variogram {
+            nugget: 0.0,
+            structures: vec![Structure::new(ModelKind::Gaussian, 30.0, range)],
+            anisotropy: Some(Anisotropy {
+                angle: 30.0,
+                ratio: 0.5,
+            }),
+        };
+        match GlobalKriging::new(&d, &v, Method::Universal(Drift::Linear), true) {
+            Ok(g) => {
+                let mut est = vec![0.0; t.len()];
+                let mut var = vec![0.0; t.len()];
+                g.predict(&t, &mut est, Some(&mut var)).unwrap();
+                for e in &est {
+                    assert!(
+                        *e > lo - 0.5 * span && *e < hi + 0.5 * span,
+                        "range {range}: estimate {e} for data within {lo}..{hi}"
+                    );
+                }
+            }
+            Err(e) => {
+                let m = e.to_string();
+                if m.contains("condition number is at least") {
+                    assert!(m.contains("add a nugget of at least"), "{m}");
+                    refused += 1;
+                }
+            }
+        }
+    }
+    assert!(refused > 0, "no system was refused for its condition");
+    let v = Variogram {
+        nugget: 30.0 * 1e-6,
+        structures: vec![Structure::new(ModelKind::Gaussian, 30.0, 2600.0)],
+        anisotropy: Some(Anisotropy {
+            angle: 30.0,
+            ratio: 0.5,
+        }),
+    };
+    let g = GlobalKriging::new(&d, &v, Method::Universal(Drift::Linear), true).unwrap();
+    let mut est = vec![0.0; t.len()];
+    g.predict(&t, &mut est, None).unwrap();
+    assert!(est
+        .iter()
+        .all(|e| *e > lo - 0.5 * span && *e < hi + 0.5 * span));
+}
