@@ -182,7 +182,18 @@ fn fit_auto_by(
     s: &AutoSettings,
     method: FitMethod,
 ) -> Result<(Fit, Vec<Candidate>, Selection)> {
-    let blocks = Blocks::new(data, s.drift, s.block)?;
+    // The likelihood's blocks serve both fits (a leave-one-out fit reports each candidate's
+    // likelihood too): their errors name the fit that was asked for.
+    let blocks = Blocks::new(data, s.drift, s.block).map_err(|e| match e {
+        GeostatError::TooFewData { n, needed, what } if method != FitMethod::Reml => {
+            GeostatError::TooFewData {
+                n,
+                needed,
+                what: what.replacen("a REML fit", "a leave-one-out fit", 1),
+            }
+        }
+        other => other,
+    })?;
     let sub = match s.loo_points {
         Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
         _ => data.clone(),

@@ -133,20 +133,18 @@ impl Idw {
     fn one(&self, q: [f64; 2], exclude: usize, near: &mut Vec<(f64, usize)>) -> Option<f64> {
         match self.search {
             Search::All => {
-                let (mut sw, mut swz) = (0.0, 0.0);
-                for (i, p) in self.xy.iter().enumerate() {
-                    if i == exclude {
-                        continue;
-                    }
-                    let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
-                    if d2 == 0.0 {
-                        return Some(self.z[i]);
-                    }
-                    let w = self.weight(d2);
-                    sw += w;
-                    swz += w * self.z[i];
+                let d2 = |p: &[f64; 2]| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
+                let others = || {
+                    self.xy
+                        .iter()
+                        .enumerate()
+                        .filter(move |&(i, _)| i != exclude)
+                        .map(|(i, p)| (d2(p), i))
+                };
+                if let Some((_, i)) = others().find(|a| a.0 == 0.0) {
+                    return Some(self.z[i]);
                 }
-                (sw > 0.0).then(|| swz / sw)
+                self.weigh(others)
             }
             Search::Nearest(k) => {
                 let want = k + usize::from(exclude != usize::MAX);
@@ -179,9 +177,34 @@ impl Idw {
                 return Some(self.z[i]);
             }
         }
+        self.weigh(|| near.iter().copied())
+    }
+
+    /// The weighted mean of the data `(d², index)` that `near` lists (none at distance
+    /// zero). The weights `d^-power` underflow to zero or overflow to infinity for a large
+    /// power (`1e6`: any distance but 1 is out of range), so a sum that is not a positive
+    /// finite number is taken again with every weight divided by the nearest one's,
+    /// `(d_min/d)^power`, which is at most 1 and is 1 at the nearest: the same mean, in
+    /// range for any finite power. The plain form stays first, so that the usual powers keep
+    /// their bits.
+    fn weigh<I: Iterator<Item = (f64, usize)>>(&self, near: impl Fn() -> I) -> Option<f64> {
         let (mut sw, mut swz) = (0.0, 0.0);
-        for &(d2, i) in near {
+        for (d2, i) in near() {
             let w = self.weight(d2);
+            sw += w;
+            swz += w * self.z[i];
+        }
+        let mean = swz / sw;
+        if sw > 0.0 && sw.is_finite() && mean.is_finite() {
+            return Some(mean);
+        }
+        let d2min = near().map(|a| a.0).fold(f64::INFINITY, f64::min);
+        if !(d2min > 0.0 && d2min.is_finite()) {
+            return None;
+        }
+        let (mut sw, mut swz) = (0.0, 0.0);
+        for (d2, i) in near() {
+            let w = (d2min / d2).powf(0.5 * self.power);
             sw += w;
             swz += w * self.z[i];
         }

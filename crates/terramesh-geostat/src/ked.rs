@@ -107,21 +107,7 @@ impl ExternalDriftKriging {
                 data.len()
             )));
         }
-        if let Some(i) = external.iter().position(|g| !g.is_finite()) {
-            return Err(GeostatError::NonFinite {
-                index: i,
-                what: "external drift",
-                value: external[i],
-            });
-        }
-        let n = external.len() as f64;
-        let shift = external.iter().sum::<f64>() / n.max(1.0);
-        let sd = (external.iter().map(|g| (g - shift).powi(2)).sum::<f64>() / n.max(1.0)).sqrt();
-        if !(sd > 0.0) {
-            return Err(GeostatError::ExternalDrift(
-                "it has one value at every data point, so it is the constant drift again; give a drift that varies".into(),
-            ));
-        }
+        let (shift, sd) = external_scale(external)?;
         let g: Vec<f64> = external.iter().map(|v| (v - shift) / sd).collect();
         let prep = Prepared::new(data, variogram, method)?;
         independent(&prep, &g)?;
@@ -378,6 +364,53 @@ fn local_one(
     }
     Ok((e, v.max(0.0)))
 }
+
+/// The mean and standard deviation of external drift values at the data, which kriging
+/// with an external drift standardises them by; the one rule for every source of the drift
+/// (a column, a raster, a Python array).
+///
+/// Errors: a value that is not finite ([`GeostatError::NonFinite`]), and a drift that is
+/// constant at the data ([`GeostatError::ExternalDrift`]): every value the same, or a spread
+/// within [`CONSTANT_DRIFT_RTOL`] of the largest magnitude. A constant raster sampled
+/// bilinearly differs from its value by rounding (a few units in the last place); scaled to
+/// unit spread, that noise became a drift with a coefficient of 1e14 and estimates off by
+/// 0.14 m where the same constant in a column was refused.
+///
+/// ```
+/// use terramesh_geostat::external_scale;
+/// assert_eq!(external_scale(&[1.0, 2.0, 3.0])?, (2.0, (2.0f64 / 3.0).sqrt()));
+/// let flat = [300.0, 300.0 + 300.0 * f64::EPSILON, 300.0 - 300.0 * f64::EPSILON];
+/// assert!(external_scale(&flat).unwrap_err().to_string().contains("constant"));
+/// assert!(external_scale(&[5.0, 5.0]).is_err());
+/// # Ok::<(), terramesh_geostat::GeostatError>(())
+/// ```
+pub fn external_scale(external: &[f64]) -> Result<(f64, f64)> {
+    if let Some(i) = external.iter().position(|g| !g.is_finite()) {
+        return Err(GeostatError::NonFinite {
+            index: i,
+            what: "external drift",
+            value: external[i],
+        });
+    }
+    let n = external.len() as f64;
+    let shift = external.iter().sum::<f64>() / n.max(1.0);
+    let sd = (external.iter().map(|g| (g - shift).powi(2)).sum::<f64>() / n.max(1.0)).sqrt();
+    let magnitude = external.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+    if !(sd > CONSTANT_DRIFT_RTOL * magnitude) {
+        return Err(GeostatError::ExternalDrift(format!(
+            "it has one value at every data point, to within rounding (spread {sd:.1e} for \
+             values up to {magnitude}), so it is the constant drift again; give a drift that \
+             varies"
+        )));
+    }
+    Ok((shift, sd))
+}
+
+/// The spread of external drift values, relative to their largest magnitude, at or below
+/// which the drift is taken as constant ([`external_scale`]): far above the rounding of
+/// sampled or computed values (1e-16 to 1e-14), far below any drift that carries
+/// information.
+pub const CONSTANT_DRIFT_RTOL: f64 = 1e-9;
 
 fn dependent() -> GeostatError {
     GeostatError::ExternalDrift(

@@ -101,9 +101,10 @@ pub use file::{
     CandidateEntry, CandidateSummary, FitSummary, LagSummary, VariogramFile, VariogramFileError,
 };
 pub use fit::{fit_model, Fit, Weighting};
+pub use global::MIN_RELATIVE_PIVOT;
 pub use global::{DenseRoute, GlobalKriging, BLOCK, TRUNCATION_TOLERANCE};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
-pub use ked::ExternalDriftKriging;
+pub use ked::{external_scale, ExternalDriftKriging, CONSTANT_DRIFT_RTOL};
 pub use ked_cv::cross_validate_external;
 pub use loo_fit::{fit_loo, LooFit};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};

@@ -409,6 +409,9 @@ pub fn read_drift_column(path: &Path, column: &str, duplicates: Duplicates) -> R
 /// drift `g`: what a variogram fitted for kriging with an external drift is fitted to (the
 /// drift's own variation removed, as gstat's `variogram(z ~ g)`).
 pub fn drift_residuals(data: &Data, g: &[f64], method: Method) -> Result<Data> {
+    // The rule of kriging itself, so that a constant drift is refused alike from a column and
+    // from a raster, with or without a fitted variogram.
+    terramesh_geostat::external_scale(g).map_err(|e| Error::invalid(e.to_string()))?;
     let n = data.len();
     let (mut cx, mut cy) = (0.0, 0.0);
     for p in data.xy() {

@@ -148,10 +148,92 @@ pub struct Fitted {
     pub selection: Option<Selection>,
     /// The directional variograms of a fitted anisotropy (empty without one).
     pub directions: Vec<DirectionalLags>,
+    /// What the fit changed for kriging to be solvable, for the user (a nugget floor under
+    /// a Gaussian structure, a nominal model for data without variation); empty usually.
+    pub notes: Vec<String>,
 }
 
 /// Fits the plan's model to `data` (and its experimental variogram `lags`).
 pub fn fit(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
+    if let Some(flat) = constant_field(data) {
+        return Ok(flat);
+    }
+    let mut fitted = fit_anisotropic(data, lags, plan)?;
+    floor_nugget(&mut fitted);
+    Ok(fitted)
+}
+
+/// The smallest nugget of a fitted model with a Gaussian structure, relative to its total
+/// sill ([`fit`]).
+///
+/// A Gaussian covariance without nugget makes the kriging matrix of close data numerically
+/// singular (its eigenvalues decay faster than any power), so that the fit that the data
+/// chose could not be kriged ("add a small nugget"). With a nugget `c0` the smallest
+/// eigenvalue is at least `c0` and the condition number at most `1 + n C(0)/c0`: 1e-6 of the
+/// sill keeps it below about 1e11 for a million data, and smooths the surface by a noise of
+/// a thousandth of the field's standard deviation (kriging stays exact at the data).
+pub const GAUSSIAN_NUGGET_FLOOR: f64 = 1e-6;
+
+/// Raises the nugget of a fitted model with a Gaussian structure to
+/// [`GAUSSIAN_NUGGET_FLOOR`] of its sill, with a note.
+fn floor_nugget(fitted: &mut Fitted) {
+    let v = &mut fitted.fit.variogram;
+    if !v.structures.iter().any(|s| s.kind == ModelKind::Gaussian) {
+        return;
+    }
+    let Some(sill) = v.sill() else { return };
+    let floor = GAUSSIAN_NUGGET_FLOOR * sill;
+    if v.nugget >= floor || !floor.is_finite() || floor <= 0.0 {
+        return;
+    }
+    fitted.notes.push(format!(
+        "the fitted Gaussian model had a nugget of {} (a kriging system that is numerically \
+         singular); its nugget is raised to {floor:.3e}, {GAUSSIAN_NUGGET_FLOOR:e} of its sill",
+        v.nugget
+    ));
+    v.nugget = floor;
+}
+
+/// Data without variation (every value the same): no variogram can be fitted (every
+/// semivariance is zero), and kriging them gives their value everywhere whatever the model.
+/// The model is then a nominal exponential one, with a sill at the rounding of the values
+/// (`(1e-6 max(|z|, 1))²`, so that the kriging standard deviation says "nothing varies") and
+/// a range of a third of the data's extent, with a note.
+fn constant_field(data: &Data) -> Option<Fitted> {
+    let z = data.z();
+    let first = *z.first()?;
+    if z.iter().any(|v| *v != first) {
+        return None;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in data.xy() {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt();
+    let range = if extent > 0.0 { extent / 3.0 } else { 1.0 };
+    let psill = (1e-6 * first.abs().max(1.0)).powi(2);
+    let variogram = Variogram::single(ModelKind::Exponential, 0.0, psill, range).ok()?;
+    Some(Fitted {
+        fit: Fit {
+            variogram,
+            objective: 0.0,
+            rmse: 0.0,
+        },
+        candidates: Vec::new(),
+        selection: None,
+        directions: Vec::new(),
+        notes: vec![format!(
+            "every value is {first}: the data have no variation, so no variogram can be \
+             fitted; they are kriged as a constant (a nominal exponential model of sill \
+             {psill:e} and range {range:.1})"
+        )],
+    })
+}
+
+fn fit_anisotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     let mut fitted = fit_isotropic(data, lags, plan)?;
     let Some(a) = &plan.anisotropy else {
         return Ok(fitted);
@@ -202,6 +284,7 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
                     candidates,
                     selection: Some(s),
                     directions: Vec::new(),
+                    notes: Vec::new(),
                 }
             }
             FitMethod::Loo => {
@@ -211,6 +294,7 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
                     candidates,
                     selection: Some(s),
                     directions: Vec::new(),
+                    notes: Vec::new(),
                 }
             }
             FitMethod::Wls => {
@@ -220,6 +304,7 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
                     candidates,
                     selection: None,
                     directions: Vec::new(),
+                    notes: Vec::new(),
                 }
             }
         });
@@ -236,6 +321,7 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             candidates: Vec::new(),
             selection: None,
             directions: Vec::new(),
+            notes: Vec::new(),
         });
     }
     if method == FitMethod::Loo {
@@ -245,6 +331,7 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             candidates: Vec::new(),
             selection: Some(selection),
             directions: Vec::new(),
+            notes: Vec::new(),
         });
     }
     let r = fit_reml(data, plan.auto.drift, &wls.variogram, plan.auto.block)?;
@@ -264,6 +351,7 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             cv_points: None,
         }),
         directions: Vec::new(),
+        notes: Vec::new(),
     })
 }
 

@@ -137,6 +137,7 @@ impl Setting {
             "grid_spacing" => Setting::GridSpacing,
             "realisations" => Setting::Realisations,
             "reml_block" => Setting::RemlBlock,
+            "modes" => Setting::Modes,
             _ => return None,
         })
     }

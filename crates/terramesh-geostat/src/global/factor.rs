@@ -129,7 +129,43 @@ pub(super) fn factor_dense(prep: &Prepared, kernel: &Kernel) -> Result<Vec<f64>>
     .map_err(|e| match e {
         faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => not_pd(index),
     })?;
+    well_conditioned(&k, n, prep.variogram.sill().unwrap_or(0.0))?;
     Ok(k)
+}
+
+/// The smallest squared pivot of the covariance matrix's Cholesky factor, relative to the
+/// sill, below which the system is refused as numerically singular.
+///
+/// `C(0) / min L_ii²` is a lower bound of the condition number of `K` (its largest
+/// eigenvalue is at least `C(0)`, its smallest at most any squared pivot). Above 1e12, a
+/// rounding error of 1e-16 in the covariances can move the dual weights by 1e-4 of their
+/// size, and their sum at a target, where they cancel, by far more than the data vary: a
+/// Gaussian model without nugget gave estimates of 27,137 m for data between 290 and 312 m
+/// with a variance of 0.007. The factor succeeds there (every pivot positive) and nothing
+/// else in the solve is wrong, so only the condition tells.
+pub const MIN_RELATIVE_PIVOT: f64 = 1e-12;
+
+/// Refuses a factor whose smallest squared pivot is below [`MIN_RELATIVE_PIVOT`] of the
+/// sill, naming the estimated condition number and the nugget that would cure it.
+pub(crate) fn well_conditioned(l: &[f64], n: usize, sill: f64) -> Result<()> {
+    let (i, min) = (0..n)
+        .map(|i| (i, l[i * n + i] * l[i * n + i]))
+        .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+    if n == 0 || min >= MIN_RELATIVE_PIVOT * sill {
+        return Ok(());
+    }
+    Err(GeostatError::Singular {
+        why: format!(
+            "the covariance matrix is numerically singular (its condition number is at least \
+             {:.1e}, at pivot {i}; at most {:.0e} can be solved reliably): data points too \
+             close for the variogram, or a Gaussian model without nugget; add a nugget of at \
+             least {:.1e} ({:.0e} of the sill)",
+            sill / min,
+            1.0 / MIN_RELATIVE_PIVOT,
+            1e-6 * sill,
+            1e-6
+        ),
+    })
 }
 
 pub(super) fn factor_gamma(

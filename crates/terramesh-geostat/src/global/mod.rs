@@ -39,6 +39,8 @@ use std::sync::{PoisonError, RwLock, RwLockReadGuard};
 use band_predict::Grouped;
 use effective::Truncation;
 
+pub(crate) use factor::well_conditioned;
+pub use factor::MIN_RELATIVE_PIVOT;
 use factor::{band_order, factor_band, factor_dense, factor_gamma};
 
 use crate::band::Band;

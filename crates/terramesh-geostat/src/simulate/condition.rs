@@ -24,8 +24,12 @@ use crate::linalg::lu_solve;
 use crate::search::Tree;
 use crate::system::{dist, small_cholesky, small_solve, Prepared};
 
-/// Targets per matrix product of the global path: bounds the `TARGET_BLOCK x n` block.
-pub(crate) const TARGET_BLOCK: usize = 1024;
+/// Targets per matrix product of the global path: each thread holds one `TARGET_BLOCK x n`
+/// block of covariances.
+pub(crate) const TARGET_BLOCK: usize = 256;
+
+/// Realisations per chunk of the global path's solves (one thread each, faer sequential).
+pub(crate) const COLUMNS: usize = 32;
 
 fn par() -> Par {
     faer::get_global_parallelism()
@@ -76,13 +80,12 @@ pub(crate) fn global(
             }
         }
     })?;
+    crate::global::well_conditioned(&l, n, sill)?;
     let lm = MatRef::from_column_major_slice(&l, n, n);
-    // A = L⁻¹ R.
-    solve_lower_triangular_in_place(lm, MatMut::from_column_major_slice_mut(res, n, nr), par());
-    // Drift: G = L⁻¹ F, S = Gᵀ G, V = S⁻¹ Gᵀ A, A −= G V.
-    let mut v = Mat::<f64>::zeros(p, nr);
+    // Drift: G = L⁻¹ F and the factor of S = Gᵀ G.
+    let mut g = Mat::<f64>::zeros(n, p);
+    let mut s = vec![0.0; p * p];
     if p > 0 {
-        let mut g = Mat::<f64>::zeros(n, p);
         let mut row = [0.0; 6];
         for i in 0..n {
             prep.drift(prep.pts[i], &mut row[..p]);
@@ -90,69 +93,84 @@ pub(crate) fn global(
                 g[(i, k)] = row[k];
             }
         }
-        solve_lower_triangular_in_place(lm, g.as_mut(), par());
-        let mut s = vec![0.0; p * p];
+        solve_lower_triangular_in_place(lm, g.as_mut(), Par::Seq);
         for a in 0..p {
             for b in 0..p {
                 s[a * p + b] = (0..n).map(|i| g[(i, a)] * g[(i, b)]).sum();
             }
         }
         small_cholesky(&mut s, p)?;
-        let am = MatRef::from_column_major_slice(res, n, nr);
-        matmul(v.as_mut(), Accum::Replace, g.transpose(), am, 1.0, par());
-        let mut col = vec![0.0; p];
-        for r in 0..nr {
-            (0..p).for_each(|k| col[k] = v[(k, r)]);
-            small_solve(&s, p, &mut col);
-            (0..p).for_each(|k| v[(k, r)] = col[k]);
-        }
-        let am = MatMut::from_column_major_slice_mut(res, n, nr);
-        matmul(am, Accum::Add, g.as_ref(), v.as_ref(), -1.0, par());
     }
-    // W = L⁻ᵀ A.
-    solve_upper_triangular_in_place(
-        lm.transpose(),
-        MatMut::from_column_major_slice_mut(res, n, nr),
-        par(),
-    );
+    // Per chunk of COLUMNS realisations, sequentially within it: A = L⁻¹ R,
+    // V = S⁻¹ Gᵀ A, A −= G V, W = L⁻ᵀ A. The chunks are fixed by the realisations, not by
+    // the threads, and faer runs sequentially inside one, so that every value is the same
+    // bits for any thread count (faer's parallel products split their sums by the threads).
+    let v_chunks: Vec<Vec<f64>> = res
+        .par_chunks_mut(n.max(1) * COLUMNS)
+        .map(|chunk| {
+            let c = chunk.len() / n.max(1);
+            let mut a = MatMut::from_column_major_slice_mut(chunk, n, c);
+            solve_lower_triangular_in_place(lm, a.rb_mut(), Par::Seq);
+            let mut v = Mat::<f64>::zeros(p, c);
+            if p > 0 {
+                matmul(
+                    v.as_mut(),
+                    Accum::Replace,
+                    g.transpose(),
+                    a.rb(),
+                    1.0,
+                    Par::Seq,
+                );
+                let mut col = [0.0; 6];
+                for r in 0..c {
+                    (0..p).for_each(|k| col[k] = v[(k, r)]);
+                    small_solve(&s, p, &mut col[..p]);
+                    (0..p).for_each(|k| v[(k, r)] = col[k]);
+                }
+                matmul(
+                    a.rb_mut(),
+                    Accum::Add,
+                    g.as_ref(),
+                    v.as_ref(),
+                    -1.0,
+                    Par::Seq,
+                );
+            }
+            solve_upper_triangular_in_place(lm.transpose(), a, Par::Seq);
+            (0..c)
+                .flat_map(|r| (0..p).map(move |k| (k, r)))
+                .map(|(k, r)| v[(k, r)])
+                .collect()
+        })
+        .collect();
     drop(l);
+    let v_all: Vec<f64> = v_chunks.concat(); // column-major p x N
+    let v = MatRef::from_column_major_slice(&v_all, p, nr);
     let w = MatRef::from_column_major_slice(res, n, nr);
+    // Targets in blocks of TARGET_BLOCK, each block by one thread: `K₀ W + F₀ V` written
+    // straight into its rows of the result (target-major: a row-major m x N block).
     let mut out = vec![0.0; q.len() * nr];
-    let mut k0 = Mat::<f64>::zeros(TARGET_BLOCK.min(q.len()), n);
-    let mut f0 = Mat::<f64>::zeros(TARGET_BLOCK.min(q.len()), p);
-    let mut prod = Mat::<f64>::zeros(TARGET_BLOCK.min(q.len()), nr);
-    for (b, block) in q.chunks(TARGET_BLOCK).enumerate() {
-        let m = block.len();
-        let mut k0b = k0.as_mut().subrows_mut(0, m);
-        // Column j of K₀ is contiguous: fill data-major, targets in parallel per column.
-        k0b.rb_mut()
-            .par_col_iter_mut()
-            .enumerate()
-            .for_each(|(j, mut col)| {
+    out.par_chunks_mut(TARGET_BLOCK * nr.max(1))
+        .enumerate()
+        .for_each(|(b, rows)| {
+            let block = &q[b * TARGET_BLOCK..(b * TARGET_BLOCK + rows.len() / nr.max(1))];
+            let m = block.len();
+            let k0 =
+                Mat::<f64>::from_fn(m, n, |t, j| vg.covariance_at(dist(block[t], prep.pts[j])));
+            let mut pm = MatMut::from_row_major_slice_mut(rows, m, nr);
+            matmul(pm.rb_mut(), Accum::Replace, k0.as_ref(), w, 1.0, Par::Seq);
+            if p > 0 {
+                let mut f0 = Mat::<f64>::zeros(m, p);
+                let mut row = [0.0; 6];
                 for (t, x) in block.iter().enumerate() {
-                    col[t] = vg.covariance_at(dist(*x, prep.pts[j]));
+                    prep.drift(*x, &mut row[..p]);
+                    for k in 0..p {
+                        f0[(t, k)] = row[k];
+                    }
                 }
-            });
-        let mut pm = prod.as_mut().subrows_mut(0, m);
-        matmul(pm.rb_mut(), Accum::Replace, k0b.rb(), w, 1.0, par());
-        if p > 0 {
-            let mut f0b = f0.as_mut().subrows_mut(0, m);
-            let mut row = [0.0; 6];
-            for (t, x) in block.iter().enumerate() {
-                prep.drift(*x, &mut row[..p]);
-                for k in 0..p {
-                    f0b[(t, k)] = row[k];
-                }
+                matmul(pm, Accum::Add, f0.as_ref(), v, 1.0, Par::Seq);
             }
-            matmul(pm.rb_mut(), Accum::Add, f0b.rb(), v.as_ref(), 1.0, par());
-        }
-        let base = b * TARGET_BLOCK * nr;
-        for t in 0..m {
-            for r in 0..nr {
-                out[base + t * nr + r] = pm[(t, r)];
-            }
-        }
-    }
+        });
     Ok(out)
 }
 

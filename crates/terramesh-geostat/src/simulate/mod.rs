@@ -187,8 +187,10 @@ pub fn simulate(
     let sill = require_bounded(&prep.variogram, "conditional simulation")?;
     let (n, m, nr) = (prep.pts.len(), targets.len(), settings.realisations);
     let matrix = match neighbourhood {
+        // The factor, and each thread's block of target covariances.
         Neighbourhood::All => {
-            n as f64 * n as f64 + condition::TARGET_BLOCK as f64 * (n + nr) as f64
+            n as f64 * n as f64
+                + (rayon::current_num_threads() * condition::TARGET_BLOCK) as f64 * n as f64
         }
         Neighbourhood::Nearest(k) => ((k + 7) * (k + 7) * rayon::current_num_threads()) as f64,
     };
@@ -201,6 +203,7 @@ pub fn simulate(
     )
     .remedy(Remedy::lower("realisations"))
     .check()?;
+    check_modes(settings)?;
     let q: Vec<[f64; 2]> = targets.iter().map(|p| prep.map(*p)).collect();
     // Targets at a data point share its nugget noise, so that they honour the datum.
     let tree = Tree::new(&prep.pts)?;
@@ -286,6 +289,7 @@ pub fn unconditional(
     )
     .remedy(Remedy::lower("realisations"))
     .check()?;
+    check_modes(settings)?;
     let c = points.iter().fold([0.0, 0.0], |c, p| {
         let t = v.transform(*p);
         [c[0] + t[0], c[1] + t[1]]
@@ -312,6 +316,22 @@ pub fn unconditional(
     })
 }
 
+/// Refuses more spectral modes than memory holds: each thread draws one realisation's
+/// modes at a time, 32 bytes a mode (a wave vector and two amplitudes).
+fn check_modes(settings: &SimulationSettings) -> Result<()> {
+    let held = settings
+        .realisations
+        .min(rayon::current_num_threads().max(1));
+    Estimate::new(
+        "spectral modes held at once",
+        settings.modes as f64 * held as f64,
+        32.0,
+    )
+    .remedy(Remedy::lower("modes"))
+    .check()?;
+    Ok(())
+}
+
 /// The field at `pts` (mapped), realisation-major (`out[r * pts.len() + i]`). Points from
 /// `n_data` on with `alias[i - n_data] = Some(k)` reuse data point `k`'s nugget noise.
 fn unconditional_field(
@@ -327,14 +347,19 @@ fn unconditional_field(
         .iter()
         .fold(0.0f64, |e, p| e.max(p[0].abs()).max(p[1].abs()));
     let sd = spectrum.noise.sqrt();
+    let xs: Vec<f64> = pts.iter().map(|p| p[0]).collect();
+    let ys: Vec<f64> = pts.iter().map(|p| p[1]).collect();
     let mut out = vec![0.0; npts * nr];
-    // Random draws: sequential within each realisation's stream.
-    let modes: Vec<spectral::Modes> = out
-        .par_chunks_mut(npts.max(1))
+    let split_points = nr < rayon::current_num_threads();
+    // Each realisation draws its modes and its noise from its own stream, sequentially, then
+    // evaluates them; its modes are dropped as soon as it is done, so that no more than one
+    // realisation's modes per thread are held (32 bytes a mode: 32 KB a realisation at the
+    // default 1,000, held for every realisation at once before).
+    out.par_chunks_mut(npts.max(1))
         .enumerate()
-        .map(|(r, row)| {
+        .for_each(|(r, row)| {
             let mut rng = Stream::new(settings.seed, r as u64);
-            let modes = spectrum.modes(settings.modes, extent, &mut rng);
+            let md = spectrum.modes(settings.modes, extent, &mut rng);
             if sd > 0.0 {
                 for (i, z) in row.iter_mut().enumerate() {
                     let shared = i >= n_data && matches!(alias.get(i - n_data), Some(Some(_)));
@@ -346,18 +371,18 @@ fn unconditional_field(
                     }
                 }
             }
-            modes
-        })
-        .collect();
-    let xs: Vec<f64> = pts.iter().map(|p| p[0]).collect();
-    let ys: Vec<f64> = pts.iter().map(|p| p[1]).collect();
-    out.par_chunks_mut(npts.max(1))
-        .zip(modes.par_iter())
-        .for_each(|(row, md)| {
-            row.par_chunks_mut(CHUNK).enumerate().for_each(|(c, acc)| {
+            let eval = |(c, acc): (usize, &mut [f64])| {
                 let lo = c * CHUNK;
-                spectral::accumulate(md, &xs[lo..], &ys[lo..], acc);
-            });
+                spectral::accumulate(&md, &xs[lo..], &ys[lo..], acc);
+            };
+            // Points in parallel only when the realisations are too few to keep the threads
+            // busy: a thread waiting on nested tasks could take up another realisation (and
+            // its modes). The same bits either way: each point is evaluated alone.
+            if split_points {
+                row.par_chunks_mut(CHUNK).enumerate().for_each(eval);
+            } else {
+                row.chunks_mut(CHUNK).enumerate().for_each(eval);
+            }
         });
     out
 }

@@ -509,7 +509,7 @@ fn build_into_with(
         let m = st.run(
             "variogram",
             || stages::model(project, &samples, base),
-            |m| short_numbers(&m.variogram.to_string()),
+            |m| m.detail(),
         )?;
         (Some(m), None)
     } else {

@@ -15,7 +15,7 @@ use terramesh_geostat::{Data, InterpolationMethod, Method, Named};
 use terramesh_io::grid_write::RasterGrid;
 
 use super::stages::{self, dsm_grid, Meshed, Model, Samples, Surface};
-use super::{geology_stage, mesh_detail, reuse, short_numbers, Built, Dsm, Stages};
+use super::{geology_stage, mesh_detail, reuse, Built, Dsm, Stages};
 use crate::error::{bail, Context, Result};
 use crate::project::Project;
 
@@ -38,7 +38,7 @@ pub(super) fn build_rest(
         let m = st.run(
             "variogram",
             || stages::model(project, samples, base),
-            |m| short_numbers(&m.variogram.to_string()),
+            |m| m.detail(),
         )?;
         (Some(m), None)
     } else {

@@ -70,6 +70,20 @@ pub struct Model {
     pub candidates: Vec<CandidateSummary>,
     /// What chose the model (a REML or leave-one-out fit only).
     pub selection: Option<Selection>,
+    /// What the fit changed for kriging to be solvable ([`crate::fitting::Fitted::notes`]).
+    pub notes: Vec<String>,
+}
+
+impl Model {
+    /// The variogram stage's line: the model, then the fit's notes.
+    pub fn detail(&self) -> String {
+        let mut d = crate::build::short_numbers(&self.variogram.to_string());
+        for n in &self.notes {
+            d += "; ";
+            d += n;
+        }
+        d
+    }
 }
 
 /// The samples as kriging data (duplicates averaged).
@@ -114,6 +128,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let mut selection = None;
+    let mut notes = Vec::new();
     let variogram = if let Some(v) = &ip.model {
         v.variogram().map_err(crate::Error::invalid)?
     } else if ip.variogram == "auto" {
@@ -143,6 +158,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
             .map(CandidateSummary::from)
             .collect();
         selection = fitted.selection;
+        notes = fitted.notes;
         fitted.fit.variogram
     } else {
         crate::variogram_file::read_variogram_file(&base.join(&ip.variogram))
@@ -155,6 +171,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         lags,
         candidates,
         selection,
+        notes,
     })
 }
 
