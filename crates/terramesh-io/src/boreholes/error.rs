@@ -146,6 +146,24 @@ pub enum BoreholeError {
         /// What is wrong.
         what: String,
     },
+    /// A coordinate, depth, elevation or angle beyond any a borehole on Earth has (a typo, a
+    /// unit mistake, `1e308`): refused rather than built into an absurd model. The bounds are
+    /// those of [`terramesh_core::limits`].
+    #[error("{file}, line {line}, hole '{hole}': {column} = {value} is {why}", value = terramesh_core::limits::short(*value))]
+    OutOfRange {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// The hole.
+        hole: String,
+        /// The column, as the file names it (`x`, `z`, `depth`, ...).
+        column: String,
+        /// The value as written (in the file's unit).
+        value: f64,
+        /// What the column accepts.
+        why: String,
+    },
     /// The survey of a hole cannot be desurveyed.
     #[error("{file}, line {line}, hole '{hole}': {source}")]
     Survey {
