@@ -18,7 +18,7 @@ mod srtm;
 mod tiles;
 mod window;
 
-pub use ascii_grid::read_ascii_grid;
+pub use ascii_grid::{read_ascii_grid, NO_PRJ};
 pub use crs::SourceCrs;
 pub use error::DemError;
 pub use geotiff::{read_geotiff, read_geotiff_in};
