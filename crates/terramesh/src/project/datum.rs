@@ -159,8 +159,8 @@ fn vertical_code(code: u32) -> Result<u16, String> {
     let Some(v) = vertical::lookup(code) else {
         return Err(match terramesh_crs::Crs::from_epsg(code) {
             Ok(c) => format!(
-                "EPSG:{code} is a horizontal CRS ({}), not a vertical one: give it as \
-                 [region] crs; {accepted}",
+                "EPSG:{code} is a horizontal CRS ({}), not a vertical one: it says where \
+                 points are, not what their heights refer to; {accepted}",
                 if c.is_geographic() {
                     "geographic"
                 } else {
