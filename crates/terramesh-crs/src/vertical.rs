@@ -103,15 +103,17 @@ mod tests {
     use super::*;
 
     /// The table is whole: every row parsed, sorted by code, and the datums terramesh names
-    /// (`KNOWN_VERTICAL_DATUMS` of the facade) are metre heights.
+    /// (`KNOWN_VERTICAL_DATUMS` of the facade) are metre heights but NGVD29's.
     #[test]
     fn the_table_parses_whole_and_sorted() {
         let rows = include_str!("vertical.csv").lines().count() - 1;
         assert_eq!(all().len(), rows);
         assert!(all().windows(2).all(|w| w[0].code < w[1].code));
-        for c in [5773, 3855, 5703, 5702, 5709, 5783, 7837, 5720, 5701] {
+        for c in [5773, 3855, 5703, 5709, 5783, 7837, 5720, 5701] {
             assert!(lookup(c).is_some_and(|v| v.is_metre_height()), "{c}");
         }
+        // `ngvd29` names EPSG:5702, NGVD29 height in US survey feet (EPSG:7968 is the metre one).
+        assert_eq!(lookup(5702).map(|v| v.unit), Some("US survey foot"));
         assert_eq!(
             lookup(5715).and_then(|v| v.metre_twin()).map(|v| v.code),
             Some(5714)
