@@ -139,6 +139,35 @@ fn points_without_elevation_name_the_source_and_where_they_are() {
     assert!(err.contains("the points span lat 9.9"), "{err}");
 }
 
+/// Issue 34: a sample needing two SRTM tiles, one of them missing from the directory, names
+/// the missing tile's file, not only how many points have no elevation.
+#[test]
+fn points_off_the_srtm_tiles_name_the_missing_tile() {
+    let dir = tempfile::tempdir().unwrap();
+    let srtm = dir.path().join("srtm");
+    std::fs::create_dir(&srtm).unwrap();
+    std::fs::write(srtm.join("N48E007.hgt"), vec![0u8; 1201 * 1201 * 2]).unwrap();
+    // Straddles 8° E: half the points fall on N48E008, which is not there.
+    let err = terramesh(&[
+        "sample",
+        "--source",
+        srtm.to_str().unwrap(),
+        "--corners",
+        "48.50 7.95; 48.50 8.05; 48.52 8.05; 48.52 7.95",
+        "--rows",
+        "4",
+        "--cols",
+        "4",
+        "-o",
+        dir.path().join("o.csv").to_str().unwrap(),
+    ]);
+    assert!(err.contains("have no elevation"), "{err}");
+    assert!(
+        err.contains("N48E008.hgt") && !err.contains("N48E007.hgt,"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_huge_value_is_cut_in_the_message() {
     let dir = tempfile::tempdir().unwrap();

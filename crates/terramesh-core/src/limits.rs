@@ -86,6 +86,103 @@ pub fn parse_bytes(text: &str) -> Option<u64> {
     (bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64).then_some(bytes as u64)
 }
 
+/// The lowest elevation accepted anywhere, metres: below the deepest point of the oceans, the
+/// Challenger Deep at about 10,935 m below sea level (Greenaway et al., 2021, Geoscience
+/// Letters 8:33). Every elevation read from input (a collar's `z`, a top's elevation, a horizon
+/// grid's cells, a model base, `export.base_elevation`) lies within
+/// [`MIN_ELEVATION`]`..=`[`MAX_ELEVATION`]; a value outside is refused as a typo or a unit
+/// mistake rather than built into an absurd model.
+///
+/// ```
+/// use terramesh_core::limits::{elevation_ok, MAX_ELEVATION, MIN_ELEVATION};
+/// assert!(elevation_ok(-10_935.0) && elevation_ok(8_848.86));
+/// assert!(!elevation_ok(1e308) && !elevation_ok(f64::NAN) && !elevation_ok(MIN_ELEVATION - 1.0));
+/// assert!(MAX_ELEVATION > 8_848.86);
+/// ```
+pub const MIN_ELEVATION: f64 = -11_000.0;
+
+/// The highest elevation accepted anywhere, metres: above Mount Everest, 8,848.86 m (the 2020
+/// survey of China and Nepal). See [`MIN_ELEVATION`].
+pub const MAX_ELEVATION: f64 = 9_000.0;
+
+/// The largest depth along a borehole accepted, metres: the longest boreholes drilled reach
+/// about 15 km along the hole (extended-reach wells of Sakhalin-1; the deepest vertical one,
+/// Kola SG-3, 12,262 m). Every depth of a borehole file (`from`, `to`, a top's `depth`, a survey
+/// station's `depth`) lies within `0..=MAX_DEPTH`.
+pub const MAX_DEPTH: f64 = 20_000.0;
+
+/// The largest horizontal coordinate accepted (absolute value), metres: above the largest
+/// projected coordinates in use, such as the 32,500,000 m eastings of ETRS89 / UTM zone 32N
+/// with the zone prefixed (EPSG:4647), and far below the range where the mesher's exact
+/// predicates give up. Every `x`/`y` of a borehole collar lies within `-MAX_COORDINATE..=
+/// MAX_COORDINATE`.
+pub const MAX_COORDINATE: f64 = 1e8;
+
+/// Whether `z` (metres) is an elevation of [`MIN_ELEVATION`]`..=`[`MAX_ELEVATION`] (never NaN).
+pub fn elevation_ok(z: f64) -> bool {
+    (MIN_ELEVATION..=MAX_ELEVATION).contains(&z)
+}
+
+/// Whether `d` (metres) is a depth along a hole of `0..=`[`MAX_DEPTH`] (never NaN).
+///
+/// ```
+/// use terramesh_core::limits::depth_ok;
+/// assert!(depth_ok(0.0) && depth_ok(12_262.0) && !depth_ok(-1.0) && !depth_ok(1e300));
+/// ```
+pub fn depth_ok(d: f64) -> bool {
+    (0.0..=MAX_DEPTH).contains(&d)
+}
+
+/// Whether `v` (metres) is a horizontal coordinate within [`MAX_COORDINATE`] (never NaN).
+///
+/// ```
+/// use terramesh_core::limits::coordinate_ok;
+/// assert!(coordinate_ok(32_500_000.0) && coordinate_ok(-5e6) && !coordinate_ok(1e308));
+/// ```
+pub fn coordinate_ok(v: f64) -> bool {
+    (-MAX_COORDINATE..=MAX_COORDINATE).contains(&v)
+}
+
+/// A number for a message, short whatever its size: as written for ordinary values (`12.5`,
+/// `-110`), in scientific notation with up to six significant digits beyond 1e9 or below 1e-6
+/// (`1e308`, `-3.5e12`), `NaN`, `inf`, `-inf`. A message never spells out 309 digits.
+///
+/// ```
+/// use terramesh_core::limits::short;
+/// assert_eq!(short(1e308).to_string(), "1e308");
+/// assert_eq!(short(-110.0).to_string(), "-110");
+/// assert_eq!(short(12.5).to_string(), "12.5");
+/// assert_eq!(short(-3.5e12).to_string(), "-3.5e12");
+/// assert_eq!(short(1.234567891e20).to_string(), "1.23457e20");
+/// assert_eq!(short(2e-9).to_string(), "2e-9");
+/// ```
+pub fn short(v: f64) -> Short {
+    Short(v)
+}
+
+/// A number shown by [`short`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Short(pub f64);
+
+impl std::fmt::Display for Short {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = self.0;
+        let a = v.abs();
+        if !v.is_finite() || a == 0.0 || (1e-6..1e9).contains(&a) {
+            return write!(f, "{v}");
+        }
+        // Six significant digits, trailing zeros of the mantissa dropped.
+        let s = format!("{v:.5e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = if m.contains('.') {
+            m.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            m
+        };
+        write!(f, "{m}e{e}")
+    }
+}
+
 /// What changes a size: a library setting to raise or lower, named as the library's field
 /// (`max_area`); front ends word it as their flag or key ([`TooLarge::describe`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

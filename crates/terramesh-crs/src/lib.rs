@@ -29,6 +29,7 @@
 mod crs;
 mod error;
 mod transform;
+pub mod vertical;
 
 pub use crs::{Crs, Datum};
 pub use error::CrsError;

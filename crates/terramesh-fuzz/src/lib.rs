@@ -61,6 +61,7 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("web_reply", web_reply),
     ("mesher", mesher),
     ("boreholes", boreholes),
+    ("geology_toml", geology_toml),
     ("crs", crs),
     ("tiles_plan", tiles_plan),
 ];
@@ -311,7 +312,9 @@ pub fn web_reply(data: &[u8]) {
 /// the log is intervals `hole,from,to,unit`, else tops `hole,unit,depth|elevation`; bit 1: the
 /// vertical unit is feet, so that `'0'` to `'3'` make readable seeds); the rest is split at
 /// lines `---` into the collars file, the log and an optional survey. Every collar, contact
-/// and known thickness read must be finite, and every thickness at least 0.
+/// and known thickness read must be finite, every thickness at least 0, and every collar and
+/// contact within the bounds of `terramesh_core::limits` (a collar at `1e308` or a top at
+/// `-1e308` is an error, never a model: issue 34).
 pub fn boreholes(data: &[u8]) {
     let Some((&flags, rest)) = data.split_first() else {
         return;
@@ -344,8 +347,17 @@ pub fn boreholes(data: &[u8]) {
     let Ok(b) = terramesh_io::boreholes::read(&set, &opts) else {
         return;
     };
+    use terramesh_core::limits::{
+        coordinate_ok, elevation_ok, MAX_COORDINATE, MAX_DEPTH, MAX_ELEVATION, MIN_ELEVATION,
+    };
     for h in &b.holes {
         assert!(h.collar.iter().all(|v| v.is_finite()), "{}: collar", h.name);
+        assert!(
+            coordinate_ok(h.collar[0]) && coordinate_ok(h.collar[1]) && elevation_ok(h.collar[2]),
+            "{}: collar {:?} beyond the limits",
+            h.name,
+            h.collar
+        );
         for t in &h.thickness {
             if let Thickness::Known(t) = t {
                 assert!(t.is_finite() && *t >= 0.0, "{}: thickness {t}", h.name);
@@ -359,7 +371,60 @@ pub fn boreholes(data: &[u8]) {
             h.name,
             c.unit
         );
+        // A contact lies on its hole: at most MAX_DEPTH along it from a collar in bounds.
+        let reach = MAX_COORDINATE + MAX_DEPTH;
+        assert!(
+            (0.0..=MAX_DEPTH).contains(&c.md)
+                && c.position[0].abs() <= reach
+                && c.position[1].abs() <= reach
+                && (MIN_ELEVATION - MAX_DEPTH..=MAX_ELEVATION).contains(&c.position[2]),
+            "{}: contact of unit {} at md {}, {:?}, beyond the limits",
+            h.name,
+            c.unit,
+            c.md,
+            c.position
+        );
     }
+}
+
+/// A `[geology]` section, appended to a minimal projected project (lines after a line `---`
+/// are `--set key=value` overrides, as in [`project_toml`]). When the project parses, every
+/// value of [`terramesh::project::GeologySettings`] that reaches a coordinate or an allocation
+/// is within its documented bound: the base elevation within `terramesh_core::limits`'
+/// elevations, `min_thickness` and `max_inversion` finite, 0 or more and at most the range of
+/// elevations, every unit's sub-layers 1 to `MAX_LAYERS`, one entry per unit.
+pub fn geology_toml(data: &[u8]) {
+    use terramesh::project::{Base, MAX_LAYERS};
+    use terramesh_core::limits::{elevation_ok, MAX_ELEVATION, MIN_ELEVATION};
+    let Some(s) = text(data) else { return };
+    let (section, sets) = s.split_once("\n---\n").unwrap_or((s, ""));
+    let sets: Vec<String> = sets.lines().map(str::to_string).collect();
+    let toml = format!(
+        "[region]\ncrs = \"projected\"\ncorners = \"0 0; 0 100; 100 100; 100 0\"\n\
+         [source]\npath = \"heights.csv\"\n{section}"
+    );
+    let Ok(p) = terramesh::project::Project::parse("fuzz.toml", &toml, &sets) else {
+        return;
+    };
+    let Some(g) = p.geology() else { return };
+    let range = MAX_ELEVATION - MIN_ELEVATION;
+    for (what, v) in [
+        ("min_thickness", g.min_thickness),
+        ("max_inversion", g.max_inversion),
+    ] {
+        assert!((0.0..=range).contains(&v), "{what} = {v}");
+    }
+    if let Base::Elevation(z) = g.base {
+        assert!(elevation_ok(z), "base = {z}");
+    }
+    assert_eq!(g.layers.len(), g.units.len());
+    assert_eq!(g.surfaces.len(), g.units.len());
+    assert!(
+        g.layers.iter().all(|n| (1..=MAX_LAYERS).contains(n)),
+        "layers {:?}",
+        g.layers
+    );
+    assert!(!g.units.is_empty());
 }
 
 /// A CRS as a project's `[region] crs` or a source's `crs` gives it (`EPSG:<code>` or a PROJ

@@ -303,3 +303,91 @@ fn other_bad_input() {
     o.max_inversion = 1.0;
     assert!(read(&files, &o).unwrap_err().to_string().contains("twice"));
 }
+
+/// Issue 34 item 5: finite but absurd values (a collar at `1e308`, a top at `-1e308` or
+/// `1e300`, a survey depth or azimuth beyond any hole) are refused, naming the file, line,
+/// hole and column, with the value short; the bounds are `terramesh_core::limits`'.
+#[test]
+fn absurd_coordinates_depths_and_elevations_are_refused() {
+    use terramesh_core::limits::{MAX_DEPTH, MAX_ELEVATION};
+    // Collars: x, y, z.
+    for (row, column) in [
+        ("B2,1e308,200,52", "x = 1e308"),
+        ("B2,110,-1e300,52", "y = -1e300"),
+        ("B2,110,200,1e308", "z = 1e308"),
+        ("B2,110,200,-12000", "z = -12000"),
+    ] {
+        let s = Set::new(&format!("hole,x,y,z\nB1,100,200,50\n{row}\n"));
+        let e = s
+            .tops("hole,unit,depth\nB1,sand,1\nB2,sand,1\n")
+            .unwrap_err();
+        assert!(matches!(e, BoreholeError::OutOfRange { .. }), "{e}");
+        let m = names(&e, "collars.csv", 3, "B2");
+        assert!(m.contains(column) && !m.contains("00000000"), "{m}");
+    }
+    let s = Set::new(COLLARS);
+    // Tops as depths and as elevations.
+    let e = s
+        .tops("hole,unit,depth\nB1,sand,1\nB1,clay,1e300\n")
+        .unwrap_err();
+    let m = names(&e, "tops.csv", 3, "B1");
+    assert!(
+        m.contains("depth = 1e300") && m.contains(&format!("{MAX_DEPTH}")),
+        "{m}"
+    );
+    let e = s
+        .tops("hole,unit,elevation\nB1,sand,40\nB1,clay,-1e308\n")
+        .unwrap_err();
+    let m = names(&e, "tops.csv", 3, "B1");
+    assert!(
+        m.contains("elevation = -1e308") && m.contains("not an elevation"),
+        "{m}"
+    );
+    // Intervals: a `to` far below any hole; a `from` below zero is said short too.
+    let e = s
+        .intervals("hole,from,to,unit\nB1,0,3,fill\nB1,3,1e300,sand\n")
+        .unwrap_err();
+    let m = names(&e, "intervals.csv", 3, "B1");
+    assert!(m.contains("to = 1e300"), "{m}");
+    let e = s
+        .intervals("hole,from,to,unit\nB1,-1e300,3,fill\n")
+        .unwrap_err();
+    let m = names(&e, "intervals.csv", 2, "B1");
+    assert!(m.contains("from -1e300 is above"), "{m}");
+    // A `from` beyond the bound that is also past its `to` is refused by range first.
+    let e = s
+        .intervals("hole,from,to,unit\nB1,1e301,1e300,fill\n")
+        .unwrap_err();
+    assert!(e.to_string().contains("from = 1e301"), "{e}");
+    // Survey: a station's depth and azimuth.
+    for (station, what) in [
+        ("B1,1e300,0,-60", "depth = 1e300"),
+        ("B1,5,1e300,-60", "azimuth = 1e300"),
+    ] {
+        let files = BoreholeFiles {
+            collars: s.collars(),
+            log: LogFile::Intervals(s.file("intervals.csv", "hole,from,to,unit\nB1,0,3,fill\n")),
+            survey: Some(s.file(
+                "survey.csv",
+                &format!("hole,depth,azimuth,dip\n{station}\n"),
+            )),
+        };
+        let e = read(&files, &BoreholeOptions::new(units())).unwrap_err();
+        let m = names(&e, "survey.csv", 2, "B1");
+        assert!(m.contains(what), "{m}");
+    }
+    // In feet the bounds are said in feet too; the bound itself is accepted.
+    let s = Set::new(&format!(
+        "hole,x,y,z\nB1,0,0,{MAX_ELEVATION}\nB2,0,0,40000\n"
+    ));
+    let mut o = BoreholeOptions::new(units());
+    o.z_unit = ZUnit::Foot;
+    let files = BoreholeFiles {
+        collars: s.collars(),
+        log: LogFile::Tops(s.file("tops.csv", "hole,unit,depth\nB1,sand,1\n")),
+        survey: None,
+    };
+    let e = read(&files, &o).unwrap_err();
+    let m = names(&e, "collars.csv", 3, "B2");
+    assert!(m.contains("z = 40000") && m.contains("29528 ft"), "{m}");
+}

@@ -152,3 +152,112 @@ fn random_logs_give_errors_or_contacts_that_obey_the_rules() {
     // Both paths are exercised.
     assert!(oks > 50 && errs > 50, "{oks} read, {errs} refused");
 }
+
+/// Issue 34 item 5 (seeded): one value of an otherwise ordinary data set replaced by an
+/// extreme one (±1e308, ±1e300, 1e20, a depth past any hole, an elevation below the ocean
+/// floor, and the bounds themselves) in a random column. The reader either refuses it with an
+/// error naming the file, line and hole, or gives collars and contacts within the bounds of
+/// `terramesh_core::limits`, never a model of absurd numbers.
+#[test]
+fn random_extreme_values_are_refused_or_kept_within_the_bounds() {
+    use terramesh_core::limits::{
+        coordinate_ok, elevation_ok, MAX_COORDINATE, MAX_DEPTH, MAX_ELEVATION, MIN_ELEVATION,
+    };
+    let extremes = [
+        "1e308", "-1e308", "1e300", "-1e300", "1e20", "20001", "-11001", "9001", "20000", "-11000",
+        "9000", "1e8", "-1e8", "4.9e-324",
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = Rng(34_5);
+    let (mut refused, mut kept) = (0, 0);
+    for case in 0..300 {
+        let tops = case % 3 == 0;
+        // 0..3 collar x, y, z; 3, 4: the log's two numbers; 5, 6: survey depth, azimuth.
+        let target = rng.below(7);
+        let v = extremes[rng.below(extremes.len() as u64) as usize];
+        let pick = |k: u64, normal: &str| {
+            if k == target {
+                v.to_string()
+            } else {
+                normal.to_string()
+            }
+        };
+        let collars = format!(
+            "hole,x,y,z\nA,{},{},{}\n",
+            pick(0, "500000"),
+            pick(1, "4000000"),
+            pick(2, "300")
+        );
+        let log = if tops {
+            format!(
+                "hole,unit,depth\nA,a,{}\nA,b,{}\n",
+                pick(3, "2"),
+                pick(4, "8")
+            )
+        } else {
+            format!(
+                "hole,from,to,unit\nA,0,{},a\nA,{},30,b\n",
+                pick(3, "5"),
+                pick(4, "5")
+            )
+        };
+        let survey = format!(
+            "hole,depth,azimuth,dip\nA,0,0,-90\nA,{},{},-80\n",
+            pick(5, "10"),
+            pick(6, "45")
+        );
+        let write = |name: &str, text: &str| {
+            let p = dir.path().join(format!("x{case}-{name}"));
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        let log_path = write(if tops { "tops.csv" } else { "intervals.csv" }, &log);
+        let files = BoreholeFiles {
+            collars: write("collars.csv", &collars),
+            log: if tops {
+                LogFile::Tops(log_path)
+            } else {
+                LogFile::Intervals(log_path)
+            },
+            survey: Some(write("survey.csv", &survey)),
+        };
+        let units: Vec<String> = UNITS.map(String::from).to_vec();
+        match read(&files, &BoreholeOptions::new(units)) {
+            Err(e) => {
+                refused += 1;
+                let m = e.to_string();
+                assert!(
+                    m.contains(&format!("x{case}-")) && m.contains("line ") && m.contains("'A'"),
+                    "case {case} ({v} in column {target}): {m}"
+                );
+                assert!(
+                    !m.contains("0000000000000"),
+                    "case {case}: a long number: {m}"
+                );
+            }
+            Ok(b) => {
+                kept += 1;
+                let h = &b.holes[0];
+                assert!(
+                    coordinate_ok(h.collar[0])
+                        && coordinate_ok(h.collar[1])
+                        && elevation_ok(h.collar[2]),
+                    "case {case} ({v} in column {target}): collar {:?}",
+                    h.collar
+                );
+                for (_, c) in b.contacts() {
+                    let reach = MAX_COORDINATE + MAX_DEPTH;
+                    assert!(
+                        (0.0..=MAX_DEPTH).contains(&c.md)
+                            && c.position[0].abs() <= reach
+                            && c.position[1].abs() <= reach
+                            && (MIN_ELEVATION - MAX_DEPTH..=MAX_ELEVATION).contains(&c.position[2]),
+                        "case {case} ({v} in column {target}): contact {c:?}"
+                    );
+                }
+            }
+        }
+    }
+    // Both outcomes occur: the extremes are refused, the bounds themselves are not.
+    assert!(refused > 100 && kept > 20, "{refused} refused, {kept} kept");
+}

@@ -310,11 +310,29 @@ fn ascii_grid_crs_comes_from_its_prj_or_its_extent() {
     let grid = "ncols 2\nnrows 2\nxllcorner 377000\nyllcorner 5397000\ncellsize 30\n1 2\n3 4\n";
     let p = dir.path().join("utm.asc");
     std::fs::write(&p, grid).unwrap();
-    let e = read_ascii_grid(&p).unwrap_err().to_string();
+    // Without a .prj and not in degrees: an unnamed projected CRS, which a project in its own
+    // coordinates takes as is (issue 34 item 15) and a geographic one refuses, naming the
+    // file and the .prj.
+    let r = read_ascii_grid(&p).unwrap();
+    assert_eq!(
+        r.crs,
+        SourceCrs::Projected {
+            name: terramesh_io::dem::NO_PRJ.into()
+        }
+    );
+    let e = terramesh_io::dem::sample_latlon(&r, &[[48.7, 7.3]], Kernel::Nearest)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("utm.asc") && e.contains("unknown CRS") && e.contains(".prj"),
         "{e}"
     );
+    let as_is = terramesh_core::sampling::Node {
+        xy: [377015.0, 5397045.0],
+        latlon: None,
+    };
+    let z = terramesh_io::dem::sample_nodes(&r, &[as_is], None, Kernel::Nearest).unwrap();
+    assert_eq!(z, [Ok(1.0)]);
     std::fs::write(
         dir.path().join("utm.prj"),
         r#"PROJCS["WGS_1984_UTM_Zone_32N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],UNIT["Meter",1]]"#,
@@ -322,6 +340,9 @@ fn ascii_grid_crs_comes_from_its_prj_or_its_extent() {
     .unwrap();
     let r = read_ascii_grid(&p).unwrap();
     assert_eq!(r.crs, SourceCrs::from_epsg(32632).unwrap());
+    // A project in its own coordinates takes the UTM grid as is too (issue 34 item 15).
+    let z = terramesh_io::dem::sample_nodes(&r, &[as_is], None, Kernel::Nearest).unwrap();
+    assert_eq!(z, [Ok(1.0)]);
     // post (0, 0) is the centre of the north-west cell; the south-east post holds 4
     assert_eq!(r.sample(377015.0, 5397045.0, Kernel::Nearest), Ok(1.0));
     assert_eq!(r.sample(377045.0, 5397015.0, Kernel::Bilinear), Ok(4.0));

@@ -355,7 +355,7 @@ fn convex_delaunay(
         dt.insert(Point2::new(p[0], p[1]))
             .map_err(|e| MeshError::Insertion {
                 at: p,
-                why: format!("{e:?}"),
+                why: crate::cdt::insertion_why(&e),
             })?;
     }
     drop(verts);

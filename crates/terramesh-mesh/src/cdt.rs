@@ -49,13 +49,30 @@ pub(crate) fn near_segment(a: Point2<f64>, b: Point2<f64>, p: Point2<f64>, tol: 
     ex * ex + ey * ey <= tol * tol
 }
 
+/// spade's reason for refusing a vertex, in words.
+pub(crate) fn insertion_why(e: &spade::InsertionError) -> String {
+    match e {
+        spade::InsertionError::TooLarge => format!(
+            "a coordinate is too large for the mesher's exact predicates (beyond ±{}): check \
+             the input coordinates and their unit",
+            terramesh_core::limits::short(spade::MAX_ALLOWED_VALUE)
+        ),
+        spade::InsertionError::TooSmall => format!(
+            "a coordinate is too close to 0 for the mesher's exact predicates (below {} but \
+             not 0): round it to 0",
+            terramesh_core::limits::short(spade::MIN_ALLOWED_VALUE)
+        ),
+        spade::InsertionError::NAN => "a coordinate is not a number (NaN)".into(),
+    }
+}
+
 /// Rejects coordinates the exact predicates cannot handle (spade's `validate_coordinate`).
 pub(crate) fn check_coordinate(p: [f64; 2]) -> Result<(), MeshError> {
     spade::validate_coordinate(p[0])
         .and_then(|_| spade::validate_coordinate(p[1]))
         .map_err(|e| MeshError::Insertion {
             at: p,
-            why: format!("{e:?}"),
+            why: insertion_why(&e),
         })
 }
 
@@ -63,7 +80,7 @@ fn insert(cdt: &mut Cdt, p: [f64; 2]) -> Result<spade::handles::FixedVertexHandl
     cdt.insert(Point2::new(p[0], p[1]))
         .map_err(|e| MeshError::Insertion {
             at: p,
-            why: format!("{e:?}"),
+            why: insertion_why(&e),
         })
 }
 
@@ -285,7 +302,7 @@ impl CdtState {
         let cdt = Cdt::try_bulk_load_cdt(verts, soup.edges, |_| conflicts += 1).map_err(|e| {
             MeshError::Insertion {
                 at: [f64::NAN, f64::NAN],
-                why: format!("{e:?}"),
+                why: insertion_why(&e),
             }
         })?;
         debug_assert_eq!(conflicts, 0, "validated rings do not cross");
@@ -539,6 +556,23 @@ impl CdtState {
 
 #[cfg(test)]
 mod tests {
+    /// Issue 34: a vertex out of the predicates' range is worded readably, its
+    /// coordinates short (was `(1000…0 [309 digits], -110) ...: TooLarge`).
+    #[test]
+    fn an_insertion_error_is_worded_with_short_numbers() {
+        let m = check_coordinate([1e308, -110.0]).unwrap_err().to_string();
+        assert_eq!(
+            m,
+            format!(
+                "cannot insert a vertex at (1e308, -110) (local coordinates): a coordinate is \
+                 too large for the mesher's exact predicates (beyond ±{}): check the input \
+                 coordinates and their unit",
+                terramesh_core::limits::short(spade::MAX_ALLOWED_VALUE)
+            )
+        );
+        assert!(m.len() < 300, "{m}");
+    }
+
     use super::*;
 
     #[test]

@@ -82,7 +82,11 @@ pub enum MeshError {
         why: String,
     },
     /// A vertex could not be inserted (coordinates too large or too small for the predicates).
-    #[error("cannot insert a vertex at ({}, {}) (local coordinates): {why}", at[0], at[1])]
+    #[error(
+        "cannot insert a vertex at ({}, {}) (local coordinates): {why}",
+        terramesh_core::limits::short(at[0]),
+        terramesh_core::limits::short(at[1])
+    )]
     Insertion {
         /// The position.
         at: [f64; 2],
@@ -107,7 +111,11 @@ pub enum MeshError {
     #[error(transparent)]
     TooLarge(#[from] terramesh_core::limits::TooLarge),
     /// The height function of [`adaptive_mesh`] failed; refinement stopped there.
-    #[error("no height at ({}, {}): {why}", at[0], at[1])]
+    #[error(
+        "no height at ({}, {}): {why}",
+        terramesh_core::limits::short(at[0]),
+        terramesh_core::limits::short(at[1])
+    )]
     Height {
         /// The point, in the region's (absolute) coordinates.
         at: [f64; 2],

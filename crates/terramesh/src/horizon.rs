@@ -29,6 +29,36 @@ pub enum HorizonError {
     /// The file cannot be read.
     #[error(transparent)]
     Read(#[from] DemError),
+    /// A cell whose value, in metres, is not an elevation on Earth
+    /// ([`terramesh_core::limits::MIN_ELEVATION`] to [`MAX_ELEVATION`](terramesh_core::limits::MAX_ELEVATION)):
+    /// a typo, a unit mistake or an undeclared nodata value, refused rather than built into
+    /// an absurd model.
+    #[error(
+        "{file}, row {row}, column {col} (at {x}, {y} in the grid's CRS): the value {value} \
+         {unit} is not an elevation on Earth: a horizon grid's values are elevations between \
+         {lo} and {hi} m; check the grid (an undeclared nodata value?) and [geology] z_unit",
+        value = terramesh_core::limits::short(*value),
+        x = terramesh_core::limits::short(*x),
+        y = terramesh_core::limits::short(*y),
+        lo = terramesh_core::limits::MIN_ELEVATION,
+        hi = terramesh_core::limits::MAX_ELEVATION,
+    )]
+    Value {
+        /// The grid file.
+        file: String,
+        /// 1-based row, from the north.
+        row: usize,
+        /// 1-based column, from the west.
+        col: usize,
+        /// The cell's centre in the grid's CRS.
+        x: f64,
+        /// The cell's centre in the grid's CRS.
+        y: f64,
+        /// The value as stored.
+        value: f64,
+        /// Its unit (`[geology] z_unit`).
+        unit: ZUnit,
+    },
     /// The grid's CRS cannot be reached from the project's.
     #[error("{file}: {source}")]
     Crs {
@@ -118,6 +148,25 @@ impl HorizonGrid {
         };
         let (source, extent): (Box<dyn ElevationSource>, _) = match raster {
             Some(r) => {
+                let scale = z_unit.metres();
+                // NaN is nodata; every other value must be an elevation.
+                let bad = r
+                    .data
+                    .iter()
+                    .position(|&v| !v.is_nan() && !terramesh_core::limits::elevation_ok(v * scale));
+                if let Some(i) = bad {
+                    let (row, col) = (i / r.cols.max(1), i % r.cols.max(1));
+                    let t = r.transform;
+                    return Err(HorizonError::Value {
+                        file: path.display().to_string(),
+                        row: row + 1,
+                        col: col + 1,
+                        x: t.x0 + col as f64 * t.dx,
+                        y: t.y0 + row as f64 * t.dy,
+                        value: r.data[i],
+                        unit: z_unit,
+                    });
+                }
                 let t = r.transform;
                 let (xa, xb) = (t.x0, t.x0 + (r.cols.max(1) - 1) as f64 * t.dx);
                 let (ya, yb) = (t.y0, t.y0 + (r.rows.max(1) - 1) as f64 * t.dy);
@@ -175,15 +224,29 @@ impl HorizonGrid {
         points: &[[f64; 2]],
         project: &Crs,
     ) -> Result<Vec<Option<f64>>, HorizonError> {
+        self.evaluate_in(points, Some(project))
+    }
+
+    /// [`HorizonGrid::evaluate`] in a project whose CRS is named (`Some`), or in a project in
+    /// its own unnamed coordinates (`None`, `crs = "projected"`), where the grid is taken as is,
+    /// whatever CRS its file declares (docs/crs.md).
+    ///
+    /// # Errors
+    /// As [`HorizonGrid::evaluate`].
+    pub fn evaluate_in(
+        &self,
+        points: &[[f64; 2]],
+        project: Option<&Crs>,
+    ) -> Result<Vec<Option<f64>>, HorizonError> {
         use rayon::prelude::*;
         let file = self.path.display().to_string();
         let crs_err = |source| HorizonError::Crs {
             file: file.clone(),
             source,
         };
-        let t = match self.source.crs().to_crs().map_err(crs_err)? {
-            Some(own) => Some(Transformer::new(project, &own).map_err(crs_err)?),
-            None => None,
+        let t = match (project, self.source.crs().to_crs().map_err(crs_err)?) {
+            (Some(project), Some(own)) => Some(Transformer::new(project, &own).map_err(crs_err)?),
+            _ => None,
         };
         let scale = self.z_unit.metres();
         let results: Vec<Result<Option<f64>, [f64; 2]>> = points
@@ -223,12 +286,52 @@ impl HorizonGrid {
                         y: points[index][1],
                         gx,
                         gy,
-                        project: project.to_string(),
+                        project: project.map_or_else(
+                            || "its own coordinates, crs = \"projected\"".into(),
+                            ToString::to_string,
+                        ),
                         extent,
                     });
                 }
             }
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 34 item 5: a horizon grid with a finite absurd cell (`1e300`) is refused when
+    /// opened, naming the file and the cell; nodata stays allowed, the bound itself too.
+    #[test]
+    fn a_grid_with_an_absurd_cell_is_refused_naming_the_cell() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("top.asc");
+        let grid = |v: &str| {
+            format!(
+                "ncols 3\nnrows 2\nxllcorner 7.0\nyllcorner 48.0\ncellsize 0.001\n\
+                 NODATA_value -9999\n10 11 12\n13 -9999 {v}\n"
+            )
+        };
+        std::fs::write(&p, grid("1e300")).unwrap();
+        let e = HorizonGrid::open(&p, ZUnit::Metre).unwrap_err();
+        assert!(
+            matches!(e, HorizonError::Value { row: 2, col: 3, .. }),
+            "{e}"
+        );
+        let m = e.to_string();
+        assert!(
+            m.contains("top.asc, row 2, column 3") && m.contains("1e300 m") && m.len() < 400,
+            "{m}"
+        );
+        std::fs::write(&p, grid("9000")).unwrap();
+        HorizonGrid::open(&p, ZUnit::Metre).unwrap();
+        // In feet, 9000 ft is fine and 40000 ft is not.
+        HorizonGrid::open(&p, ZUnit::Foot).unwrap();
+        std::fs::write(&p, grid("-40000")).unwrap();
+        let e = HorizonGrid::open(&p, ZUnit::Foot).unwrap_err().to_string();
+        assert!(e.contains("-40000 ft"), "{e}");
     }
 }

@@ -1,6 +1,7 @@
 //! The errors of the borehole readers: each names the file, the line and the hole.
 
 use terramesh_core::desurvey::DesurveyError;
+use terramesh_core::limits::short;
 
 use crate::table::TableError;
 
@@ -67,7 +68,7 @@ pub enum BoreholeError {
         hole: String,
     },
     /// An interval whose `from` is not above its `to`.
-    #[error("{file}, line {line}, hole '{hole}': from {from} is not above to {to}: an interval runs from a smaller depth to a larger one")]
+    #[error("{file}, line {line}, hole '{hole}': from {} is not above to {}: an interval runs from a smaller depth to a larger one", short(*from), short(*to))]
     FromNotAboveTo {
         /// The intervals file.
         file: String,
@@ -81,7 +82,7 @@ pub enum BoreholeError {
         to: f64,
     },
     /// Two intervals of one hole overlap.
-    #[error("{file}, line {line}, hole '{hole}': the interval {from}-{to} overlaps the interval {other_from}-{other_to} of line {other_line}")]
+    #[error("{file}, line {line}, hole '{hole}': the interval {}-{} overlaps the interval {}-{} of line {other_line}", short(*from), short(*to), short(*other_from), short(*other_to))]
     Overlap {
         /// The intervals file.
         file: String,
@@ -146,6 +147,24 @@ pub enum BoreholeError {
         /// What is wrong.
         what: String,
     },
+    /// A coordinate, depth, elevation or angle beyond any a borehole on Earth has (a typo, a
+    /// unit mistake, `1e308`): refused rather than built into an absurd model. The bounds are
+    /// those of [`terramesh_core::limits`].
+    #[error("{file}, line {line}, hole '{hole}': {column} = {value} is {why}", value = terramesh_core::limits::short(*value))]
+    OutOfRange {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// The hole.
+        hole: String,
+        /// The column, as the file names it (`x`, `z`, `depth`, ...).
+        column: String,
+        /// The value as written (in the file's unit).
+        value: f64,
+        /// What the column accepts.
+        why: String,
+    },
     /// The survey of a hole cannot be desurveyed.
     #[error("{file}, line {line}, hole '{hole}': {source}")]
     Survey {
@@ -197,7 +216,7 @@ impl From<TableError> for BoreholeError {
 /// A top higher than the top of a unit above it in the column by more than
 /// [`BoreholeOptions::max_inversion`](super::BoreholeOptions::max_inversion).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}, line {line}, hole '{hole}': the top of '{unit}' is {amount} m above the top of '{above}' (line {above_line}), which the column puts above it; inversions up to {max} m are repaired (the lower top is lowered onto the upper one), this one is too large: check the picks, the column order or [geology] max_inversion")]
+#[error("{file}, line {line}, hole '{hole}': the top of '{unit}' is {} m above the top of '{above}' (line {above_line}), which the column puts above it; inversions up to {} m are repaired (the lower top is lowered onto the upper one), this one is too large: check the picks, the column order or [geology] max_inversion", short(*amount), short(*max))]
 pub struct Inversion {
     /// The tops file.
     pub file: String,

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use terramesh_core::coords::{parse_angle, Axis};
 use terramesh_core::desurvey::Station;
+use terramesh_core::limits::{coordinate_ok, short};
 
 use super::{BoreholeError, BoreholeOptions, ContactKind};
 use crate::table::{ReadOptions, Table};
@@ -59,6 +60,98 @@ fn num(t: &Table, row: usize, col: usize, hole: &str) -> Result<f64, BoreholeErr
     t.number(row, col).map_err(|source| BoreholeError::Value {
         hole: hole.to_string(),
         source: Box::new(source),
+    })
+}
+
+/// What a column of the borehole files accepts, for [`BoreholeError::OutOfRange`].
+#[derive(Clone, Copy)]
+enum Kind {
+    /// A projected `x` or `y`, metres.
+    Coordinate,
+    /// An elevation (collar `z`, a top's `elevation`), in `z_unit`.
+    Elevation,
+    /// A depth along the hole, in `z_unit`.
+    Depth,
+    /// A survey azimuth, degrees.
+    Azimuth,
+}
+
+/// The most an azimuth may be, in absolute value, degrees (one turn either way).
+const MAX_AZIMUTH: f64 = 360.0;
+
+/// `value` (as written, `metres` once converted) of column `col` of `row`, or
+/// [`BoreholeError::OutOfRange`] naming the file, line, hole and column when it lies outside
+/// the bounds of [`terramesh_core::limits`] for its kind.
+fn in_range(
+    t: &Table,
+    row: usize,
+    col: usize,
+    hole: &str,
+    value: f64,
+    kind: Kind,
+    opts: &BoreholeOptions,
+) -> Result<f64, BoreholeError> {
+    use terramesh_core::limits::{
+        depth_ok, elevation_ok, MAX_COORDINATE, MAX_DEPTH, MAX_ELEVATION, MIN_ELEVATION,
+    };
+    let f = opts.z_unit.metres();
+    let in_unit = |lo: f64, hi: f64| {
+        if f == 1.0 {
+            String::new()
+        } else {
+            format!(
+                " ({} to {} {}, [geology] z_unit)",
+                short((lo / f).round()),
+                short((hi / f).round()),
+                opts.z_unit
+            )
+        }
+    };
+    let (ok, why) = match kind {
+        Kind::Coordinate => (
+            coordinate_ok(value),
+            format!(
+                "not a projected coordinate: x and y are metres of the project's CRS, within \
+                 ±{MAX_COORDINATE:e} m; check the column and its unit"
+            ),
+        ),
+        Kind::Elevation => (
+            elevation_ok(value * f),
+            format!(
+                "not an elevation on Earth: elevations are between {MIN_ELEVATION} and \
+                 {MAX_ELEVATION} m{}; check the value and [geology] z_unit",
+                in_unit(MIN_ELEVATION, MAX_ELEVATION)
+            ),
+        ),
+        Kind::Depth => (
+            depth_ok(value * f),
+            format!(
+                "not a depth along a hole: depths are between 0 and {MAX_DEPTH} m{} from the \
+                 collar; check the value and [geology] z_unit",
+                in_unit(0.0, MAX_DEPTH)
+            ),
+        ),
+        Kind::Azimuth => (
+            (-MAX_AZIMUTH..=MAX_AZIMUTH).contains(&value),
+            format!(
+                "not an azimuth: give degrees clockwise from north, between -{MAX_AZIMUTH} and \
+                 {MAX_AZIMUTH}"
+            ),
+        ),
+    };
+    if ok {
+        return Ok(value);
+    }
+    Err(BoreholeError::OutOfRange {
+        file: t.name.clone(),
+        line: t.lines[row],
+        hole: hole.to_string(),
+        column: t
+            .headers
+            .get(col)
+            .map_or_else(String::new, |h| h.trim().to_string()),
+        value,
+        why,
     })
 }
 
@@ -128,7 +221,14 @@ pub(crate) fn collars(path: &Path, opts: &BoreholeOptions) -> Result<Vec<Collar>
         }
         first.insert(name.clone(), line);
         let (x, y) = match place {
-            Place::Xy(cx, cy) => (num(&t, row, cx, &name)?, num(&t, row, cy, &name)?),
+            Place::Xy(cx, cy) => {
+                let x = num(&t, row, cx, &name)?;
+                let y = num(&t, row, cy, &name)?;
+                (
+                    in_range(&t, row, cx, &name, x, Kind::Coordinate, opts)?,
+                    in_range(&t, row, cy, &name, y, Kind::Coordinate, opts)?,
+                )
+            }
             Place::LatLon(ca, co) => {
                 let angle = |col: usize, axis| {
                     parse_angle(&t.records[row][col], axis).map_err(|e| BoreholeError::Value {
@@ -146,10 +246,23 @@ pub(crate) fn collars(path: &Path, opts: &BoreholeOptions) -> Result<Vec<Collar>
                     hole: name.clone(),
                     why,
                 })?;
+                if !(coordinate_ok(p[0]) && coordinate_ok(p[1])) {
+                    return Err(BoreholeError::Projection {
+                        file: t.name.clone(),
+                        line,
+                        hole: name,
+                        why: format!(
+                            "({lat}, {lon}) projects to ({}, {}), beyond the project's CRS",
+                            short(p[0]),
+                            short(p[1])
+                        ),
+                    });
+                }
                 (p[0], p[1])
             }
         };
-        let zv = num(&t, row, z, &name)? * f;
+        let zv = num(&t, row, z, &name)?;
+        let zv = in_range(&t, row, z, &name, zv, Kind::Elevation, opts)? * f;
         out.push(Collar {
             name,
             line,
@@ -186,9 +299,11 @@ pub(crate) fn survey(
         if !known.contains_key(name.as_str()) {
             return Err(no_collar(&t, row, &name, collars_name));
         }
+        let depth = num(&t, row, d, &name)?;
+        let azimuth = num(&t, row, a, &name)?;
         let s = Station {
-            depth: num(&t, row, d, &name)? * f,
-            azimuth: num(&t, row, a, &name)?,
+            depth: in_range(&t, row, d, &name, depth, Kind::Depth, opts)? * f,
+            azimuth: in_range(&t, row, a, &name, azimuth, Kind::Azimuth, opts)?,
             dip: num(&t, row, p, &name)?,
         };
         let e = out
@@ -231,7 +346,8 @@ pub(crate) fn intervals(
         if !known.contains_key(name.as_str()) {
             return Err(no_collar(&t, row, &name, collars_name));
         }
-        let (from, to) = (num(&t, row, fc, &name)? * f, num(&t, row, tc, &name)? * f);
+        let (from_written, to_written) = (num(&t, row, fc, &name)?, num(&t, row, tc, &name)?);
+        let (from, to) = (from_written * f, to_written * f);
         let line = t.lines[row];
         if from < 0.0 {
             return Err(BoreholeError::OutsideHole {
@@ -239,10 +355,13 @@ pub(crate) fn intervals(
                 line,
                 hole: name,
                 what: format!(
-                    "from {from} is above the collar: depths are along the hole from the collar, 0 or more"
+                    "from {} is above the collar: depths are along the hole from the collar, 0 or more",
+                    short(from_written)
                 ),
             });
         }
+        in_range(&t, row, fc, &name, from_written, Kind::Depth, opts)?;
+        in_range(&t, row, tc, &name, to_written, Kind::Depth, opts)?;
         if from >= to {
             return Err(BoreholeError::FromNotAboveTo {
                 file: t.name.clone(),
@@ -339,7 +458,8 @@ pub(crate) fn tops(
             return Err(no_collar(&t, row, &name, collars_name));
         };
         let unit = unit_of(&t, row, uc, &name, opts)?;
-        let v = num(&t, row, col, &name)? * f;
+        let written = num(&t, row, col, &name)?;
+        let v = written * f;
         let line = t.lines[row];
         let outside = |what: String| BoreholeError::OutsideHole {
             file: t.name.clone(),
@@ -350,11 +470,14 @@ pub(crate) fn tops(
         let (top, at_collar) = if is_depth {
             if v < 0.0 {
                 return Err(outside(format!(
-                    "depth {v} is above the collar: depths are along the hole from the collar, 0 or more"
+                    "depth {} is above the collar: depths are along the hole from the collar, 0 or more",
+                    short(written)
                 )));
             }
+            in_range(&t, row, col, &name, written, Kind::Depth, opts)?;
             (At::Depth(v), v == 0.0)
         } else {
+            in_range(&t, row, col, &name, written, Kind::Elevation, opts)?;
             if v > collar.xyz[2] {
                 return Err(outside(format!(
                     "the top at elevation {v} m is above the collar ({} m, line {} of the collars)",

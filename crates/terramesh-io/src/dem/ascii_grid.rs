@@ -149,7 +149,8 @@ pub fn read_ascii_grid(path: &Path) -> Result<Raster, DemError> {
     })
 }
 
-/// The CRS from a `.prj` beside the file, or geographic when the extent fits in degrees.
+/// The CRS from a `.prj` beside the file, or geographic when the extent fits in degrees, or
+/// else an unnamed projected CRS ([`NO_PRJ`]).
 fn crs_of(path: &Path, t: &GeoTransform, rows: usize, cols: usize) -> Result<SourceCrs, DemError> {
     let prj = path.with_extension("prj");
     if let Ok(wkt) = std::fs::read_to_string(&prj) {
@@ -170,10 +171,16 @@ fn crs_of(path: &Path, t: &GeoTransform, rows: usize, cols: usize) -> Result<Sou
     if t.x0 >= -180.0 && x1 <= 180.0 && y1 >= -90.0 && t.y0 <= 90.0 {
         Ok(SourceCrs::Geographic)
     } else {
-        Err(DemError::crs(
-            path,
-            "unknown CRS: the coordinates are not degrees and there is no .prj beside the \
-             file; add a .prj (WGS 84 / UTM) or convert the grid to GeoTIFF with its CRS",
-        ))
+        // Not degrees and no .prj: an unnamed projected CRS, taken as is by a project in its
+        // own coordinates (`crs = "projected"`, or a named CRS: docs/crs.md); a geographic
+        // project cannot place it, and says so with this name.
+        Ok(SourceCrs::Projected {
+            name: NO_PRJ.into(),
+        })
     }
 }
+
+/// The CRS of an ESRI ASCII grid whose coordinates are not degrees and that has no `.prj`.
+pub const NO_PRJ: &str = "an unknown CRS (the coordinates are not degrees and there is no .prj \
+                          beside the file: add a .prj naming WGS 84 / UTM, or convert the grid \
+                          to GeoTIFF with its CRS)";

@@ -18,7 +18,7 @@ mod srtm;
 mod tiles;
 mod window;
 
-pub use ascii_grid::read_ascii_grid;
+pub use ascii_grid::{read_ascii_grid, NO_PRJ};
 pub use crs::SourceCrs;
 pub use error::DemError;
 pub use geotiff::{read_geotiff, read_geotiff_in};
@@ -52,6 +52,13 @@ pub trait ElevationSource: Send + Sync {
     fn sample(&self, x: f64, y: f64, method: Kernel) -> Result<f64, Missing>;
     /// A one-line description for messages: file, size, resolution.
     fn describe(&self) -> String;
+    /// For a source made of tiles (a directory of SRTM `.hgt` files), the name of the file
+    /// that would cover `(x, y)` (source CRS) when that tile was not read; `None` for a point
+    /// the source's tiles cover, and for every other kind of source.
+    fn lacking(&self, x: f64, y: f64) -> Option<String> {
+        let _ = (x, y);
+        None
+    }
 }
 
 /// Opens a raster source from a path: a directory of `.hgt` tiles, or a file by its

@@ -104,9 +104,23 @@ pub fn sample_nodes(
 ) -> Result<Vec<Result<f64, Missing>>, DemError> {
     let crs = source.crs().clone();
     let geographic_nodes = nodes.iter().all(|n| n.latlon.is_some());
+    // A project in its own coordinates (no zone: `crs = "projected"`) takes every projected
+    // source as is, in its CRS (docs/crs.md); only a source in degrees cannot be.
+    let as_is = zone.is_none() && !geographic_nodes;
     match (&crs, geographic_nodes) {
         (SourceCrs::Projected { name }, true) => return Err(not_convertible(source, name)),
         (SourceCrs::Projected { .. }, false) => {}
+        (SourceCrs::Geographic, false) => {
+            return Err(DemError::Crs {
+                file: source.describe(),
+                message: "the source is in latitude/longitude degrees and the region in \
+                          projected coordinates (crs = \"projected\"), which terramesh cannot \
+                          place in degrees; give the region in latitude/longitude, or a source \
+                          in the region's projected CRS"
+                    .into(),
+            })
+        }
+        (_, false) if as_is => {}
         (_, false) => {
             return Err(DemError::Crs {
                 file: source.describe(),
@@ -136,7 +150,7 @@ pub fn sample_nodes(
         .map(|n| {
             let (x, y) = match (&crs, n.latlon) {
                 (SourceCrs::Projected { .. } | SourceCrs::Epsg(_), _) => (n.xy[0], n.xy[1]),
-                _ if same_zone => (n.xy[0], n.xy[1]),
+                _ if same_zone || as_is => (n.xy[0], n.xy[1]),
                 (SourceCrs::Geographic, Some([lat, lon])) => (lon, lat),
                 (SourceCrs::Utm(z), Some([lat, lon])) => match to_utm(lat, lon, Some(*z)) {
                     Ok(p) => (p.easting, p.northing),

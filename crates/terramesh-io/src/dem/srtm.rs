@@ -92,6 +92,17 @@ fn parse_name(path: &Path) -> Option<(i32, i32)> {
     Some((lat, lon))
 }
 
+/// The file name of the tile whose south-west corner is `(lat, lon)`: `N48E007.hgt`.
+fn tile_name((lat, lon): (i32, i32)) -> String {
+    format!(
+        "{}{:02}{}{:03}.hgt",
+        if lat < 0 { 'S' } else { 'N' },
+        lat.unsigned_abs(),
+        if lon < 0 { 'W' } else { 'E' },
+        lon.unsigned_abs()
+    )
+}
+
 /// Whether a tile's south-west corner `(lat, lon)` (whole degrees) starts a 1° tile on
 /// Earth: latitude -90..=89, longitude -180..=179.
 fn corner_on_earth((lat, lon): (i32, i32)) -> bool {
@@ -344,6 +355,16 @@ impl ElevationSource for HgtMosaic {
         }
         interpolate(self, r, c, method)
     }
+    fn lacking(&self, lon: f64, lat: f64) -> Option<String> {
+        if !(lon.is_finite() && lat.is_finite()) {
+            return None;
+        }
+        let key = (lat.floor() as i32, lon.floor() as i32);
+        if !corner_on_earth(key) || self.tiles.contains_key(&key) {
+            return None;
+        }
+        Some(tile_name(key))
+    }
     fn describe(&self) -> String {
         let arc = if self.n == 1201 { 3 } else { 1 };
         let mut s = format!(
@@ -361,6 +382,21 @@ impl ElevationSource for HgtMosaic {
 
 #[cfg(test)]
 mod tests {
+    /// Issue 34: a point outside the tiles read names the tile that would cover it.
+    #[test]
+    fn a_point_off_the_tiles_names_the_missing_tile() {
+        use crate::dem::ElevationSource;
+        assert_eq!(tile_name((-1, -75)), "S01W075.hgt");
+        assert_eq!(tile_name((48, 7)), "N48E007.hgt");
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("N48E007.hgt"), vec![0u8; 1201 * 1201 * 2]).unwrap();
+        let m = HgtMosaic::open_dir(dir.path(), false).unwrap();
+        assert_eq!(m.lacking(7.5, 48.5), None);
+        assert_eq!(m.lacking(8.2, 48.5).as_deref(), Some("N48E008.hgt"));
+        assert_eq!(m.lacking(-0.5, -0.5).as_deref(), Some("S01W001.hgt"));
+        assert_eq!(m.lacking(f64::NAN, 48.5), None);
+    }
+
     use super::*;
 
     #[test]

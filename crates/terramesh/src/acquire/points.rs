@@ -90,6 +90,7 @@ pub fn sample_points(
                 }
             }
             Ok(SampleTable {
+                lacking: Vec::new(),
                 zone: None,
                 summary: format!(
                     "{}: {} points{class_note}, {} kept; x, y, z are in {name}, kept as in the file (not converted to UTM)",
@@ -163,6 +164,7 @@ pub fn sample_points(
                 }
             }
             Ok(SampleTable {
+                lacking: Vec::new(),
                 zone: Some(zone),
                 summary: format!(
                     "{}: {} points{class_note} in {crs}, {} kept",

@@ -41,11 +41,21 @@ fn sample(
         SourceCrs::Projected { .. } => None,
         _ => s.zone,
     };
+    // The tiles a tiled source lacks for the points it could not give (at most a few names).
+    let mut lacking = BTreeSet::new();
+    for (n, z) in nodes.iter().zip(&z) {
+        if let (Err(terramesh_core::sampling::Missing::Outside), Some([lat, lon])) = (z, n.latlon) {
+            if let Some(f) = dem.lacking(lon, lat) {
+                lacking.insert(f);
+            }
+        }
+    }
     let rows = super::table::node_rows(&nodes, z);
     Ok(SampleTable {
         zone,
         rows,
         summary: format!("{} ({} interpolation)", dem.describe(), s.options.kernel),
+        lacking: lacking.into_iter().collect(),
     })
 }
 

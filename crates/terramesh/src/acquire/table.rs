@@ -30,6 +30,9 @@ pub struct SampleTable {
     pub rows: Vec<Row>,
     /// What was read, for the summary line.
     pub summary: String,
+    /// The files a tiled source lacks for the points without elevation (SRTM tiles not in
+    /// its directory), for the message of `on_missing = "error"`; empty otherwise.
+    pub lacking: Vec<String>,
 }
 
 const CHUNK: usize = 8192;
@@ -82,6 +85,21 @@ fn extent(rows: &[Row]) -> String {
     }
 }
 
+/// `" The tile(s) N48E008.hgt that cover them are not in srtm: add them (or shrink the region)."`,
+/// or nothing when no tile is lacking.
+fn lacking(files: &[String], source: &impl std::fmt::Display) -> String {
+    match files {
+        [] => String::new(),
+        [one] => format!(
+            " The tile that covers them, {one}, is not in {source}: add it (or shrink the region)."
+        ),
+        _ => format!(
+            " The tiles that cover them, {}, are not in {source}: add them (or shrink the region).",
+            files.join(", ")
+        ),
+    }
+}
+
 /// Applies the on-missing policy and writes the table atomically to the plan's output
 /// (standard output without one); what was read and written goes to `progress` as notes.
 pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> Result<()> {
@@ -100,13 +118,14 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
                 "",
                 format!(
                     "{} of {} points have no elevation in {}{}; the first (point {}, {at}): \
-                     {}. Use {{on-missing}} nodata or skip to write the others{}",
+                     {}.{} Use {{on-missing}} nodata or skip to write the others{}",
                     missing.len(),
                     t.rows.len(),
                     s.options.source,
                     extent(&t.rows),
                     i + 1,
                     r.z.as_ref().err().map_or("", |e| e.as_str()),
+                    lacking(&t.lacking, &s.options.source),
                     if matches!(s.source, super::plan::Source::Web(_)) {
                         ", or rerun with {resume} to ask again for the failed points only"
                     } else {

@@ -57,6 +57,7 @@ pub fn sample_web(
     }
     let rows = super::table::node_rows(&nodes, z);
     Ok(SampleTable {
+        lacking: Vec::new(),
         zone: s.zone,
         rows,
         summary: format!(

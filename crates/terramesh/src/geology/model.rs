@@ -265,6 +265,32 @@ pub(crate) fn seal(
     seal_beside(planar, stack, layering, |_, _, _| ()).map(|(v, c, s, ())| (v, c, s))
 }
 
+/// Bytes of one cell of the volume mesh, all told: the cell's node indices and kind, its
+/// material and volume, and its share of the nodes (a vertex per level, half as many as the
+/// cells) and of the tagged faces. An upper estimate from the types' sizes, not measured.
+const BYTES_PER_CELL: f64 = 96.0;
+
+/// The volume mesh's size follows from the mesh and `[geology] layers` (up to 1,000 per unit):
+/// its cells (triangles x sub-layers, three tetrahedra per prism with `element = "tetra"`)
+/// estimated before anything is allocated, and refused beyond the memory ceiling naming the
+/// key (issue 34: every number that reaches an allocation).
+fn estimate_volume(planar: &Planar, layering: &Layering) -> Result<()> {
+    let sub_layers: f64 = layering.layers.iter().map(|&l| l as f64).sum();
+    let per_prism = if layering.element == terramesh_core::volume::Element::Tetra {
+        3.0
+    } else {
+        1.0
+    };
+    terramesh_core::limits::Estimate::new(
+        "cells of the volume mesh",
+        planar.triangles.len() as f64 * sub_layers * per_prism,
+        BYTES_PER_CELL,
+    )
+    .remedy(terramesh_core::limits::Remedy::lower("geology.layers"))
+    .check()?;
+    Ok(())
+}
+
 /// [`seal`], running `beside` at the same time as the checks (see [`assemble_beside`]).
 fn seal_beside<R: Send>(
     planar: &Planar,
@@ -272,6 +298,7 @@ fn seal_beside<R: Send>(
     layering: &Layering,
     beside: impl FnOnce(&VolumeMesh, &Stack, &[f64]) -> R + Send,
 ) -> Result<(VolumeMesh, CheckSummary, Vec<UnitStats>, R)> {
+    estimate_volume(planar, layering)?;
     let volume =
         terramesh_geology::volume_mesh(planar, stack, layering).context("the volume mesh")?;
     // computed once, for the checks here and the writers' own

@@ -176,13 +176,8 @@ pub fn run(
     }
     let epsg = crs.and_then(Crs::epsg);
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
-    let grid_crs = || match crs {
-        Some(c) => Ok(c),
-        None => Err(Error::invalid(
-            "horizon grids need the project's CRS to be placed in: name it with [region] \
-             crs = \"EPSG:...\"",
-        )),
-    };
+    // `crs = "projected"` (no CRS): every grid is taken as is, in the project's coordinates
+    // (docs/crs.md), like its other sources.
     let mut wanted = Vec::new();
     for (unit, path) in g.surfaces.iter().enumerate() {
         let Some(path) = path else { continue };
@@ -193,7 +188,7 @@ pub fn run(
                 g.units[0]
             );
         }
-        wanted.push((unit, path, grid_crs()?, opened.take(path)));
+        wanted.push((unit, path, crs, opened.take(path)));
     }
     // The grids are read and evaluated in parallel (each also in parallel over the vertices);
     // the first error in column order is reported.
@@ -214,7 +209,7 @@ pub fn run(
         BaseKey::Elevation(z) => Base::Elevation(*z),
         BaseKey::Raster(path) => {
             let ready = opened.take(path);
-            let v = horizon_at(path, &xy, g.z_unit, grid_crs()?, "the base", ready)?;
+            let v = horizon_at(path, &xy, g.z_unit, crs, "the base", ready)?;
             match v.iter().position(Option::is_none) {
                 Some(i) => bail!(
                     "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of the model's \
@@ -321,14 +316,15 @@ fn write_atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>)
     Ok(())
 }
 
-/// A horizon grid sampled at the planar vertices (project CRS `crs`), converted to metres;
+/// A horizon grid sampled at the planar vertices (project CRS `crs`; `None`: the grid is in
+/// the project's coordinates, `crs = "projected"`), converted to metres;
 /// `None` on a nodata pixel. A vertex outside the grid is an error naming it. `ready`: the
 /// grid opened already ([`OpenedGrids`]), else it is opened here.
 fn horizon_at(
     path: &Path,
     xy: &[[f64; 2]],
     z_unit: terramesh_core::volume::ZUnit,
-    crs: &Crs,
+    crs: Option<&Crs>,
     what: &str,
     ready: Option<std::result::Result<HorizonGrid, HorizonError>>,
 ) -> Result<Vec<Option<f64>>> {
@@ -336,6 +332,6 @@ fn horizon_at(
         Some(opened) => opened?,
         None => HorizonGrid::open(path, z_unit)?,
     };
-    grid.evaluate(xy, crs)
+    grid.evaluate_in(xy, crs)
         .with_context(|| format!("the grid of {what}"))
 }

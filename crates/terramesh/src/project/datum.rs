@@ -38,6 +38,10 @@ pub const KNOWN_VERTICAL_DATUMS: &[(&str, u16, &str)] = &[
 /// assert_eq!(e.name(), "egm96");
 /// assert_eq!("source".parse::<HeightDatum>()?.epsg(), None);
 /// assert!("msl".parse::<HeightDatum>().unwrap_err().contains("navd88"));
+/// // Only vertical CRSs of heights in metres (issue 34):
+/// assert!("EPSG:4326".parse::<HeightDatum>().unwrap_err().contains("horizontal"));
+/// assert!("EPSG:9999".parse::<HeightDatum>().unwrap_err().contains("not a vertical CRS"));
+/// assert!("EPSG:6360".parse::<HeightDatum>().unwrap_err().contains("EPSG:5703"));
 /// # Ok::<(), String>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -129,21 +133,71 @@ impl std::str::FromStr for HeightDatum {
         let code = t
             .strip_prefix("EPSG:")
             .or_else(|| t.strip_prefix("epsg:"))
-            .and_then(|c| c.parse::<u16>().ok())
-            .filter(|&c| (1024..=32766).contains(&c));
-        match code {
-            Some(c) => Ok(HeightDatum::Epsg(c)),
-            None => Err(format!(
-                "'{s}' is not a vertical datum: use one of {}, \"EPSG:<code>\" of a vertical \
-                 CRS (1024 to 32766), or \"source\" (not named)",
-                KNOWN_VERTICAL_DATUMS
-                    .iter()
-                    .map(|k| format!("\"{}\"", k.0))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
+            .and_then(|c| c.trim().parse::<u32>().ok());
+        if let Some(c) = code {
+            return vertical_code(c).map(HeightDatum::Epsg);
         }
+        Err(format!(
+            "'{s}' is not a vertical datum: use one of {}, \"EPSG:<code>\" of a vertical \
+             CRS of heights in metres, or \"source\" (not named)",
+            KNOWN_VERTICAL_DATUMS
+                .iter()
+                .map(|k| format!("\"{}\"", k.0))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
     }
+}
+
+/// The code of an EPSG vertical CRS whose heights are metres, up (what every output holds), or
+/// why `code` is not one: a horizontal CRS, no CRS at all, a depth CRS, heights in feet.
+fn vertical_code(code: u32) -> Result<u16, String> {
+    use terramesh_crs::vertical;
+    let accepted = "vertical_datum accepts the EPSG code of a vertical CRS of heights in \
+                    metres (\"EPSG:5703\", NAVD88 height), a known name (\"navd88\", \
+                    \"egm96\", ...) or \"source\"";
+    let Some(v) = vertical::lookup(code) else {
+        return Err(match terramesh_crs::Crs::from_epsg(code) {
+            Ok(c) => format!(
+                "EPSG:{code} is a horizontal CRS ({}), not a vertical one: it says where \
+                 points are, not what their heights refer to; {accepted}",
+                if c.is_geographic() {
+                    "geographic"
+                } else {
+                    "projected"
+                }
+            ),
+            Err(_) => format!("EPSG:{code} is not a vertical CRS of the EPSG registry; {accepted}"),
+        });
+    };
+    let twin = || {
+        v.metre_twin()
+            .map(|t| {
+                format!(
+                    " (its datum's heights in metres: \"EPSG:{}\", {})",
+                    t.code, t.name
+                )
+            })
+            .unwrap_or_default()
+    };
+    if !v.up {
+        return Err(format!(
+            "EPSG:{code} ({}) is a vertical CRS of depths (its axis points down), and \
+             terramesh's outputs hold heights: name a vertical CRS of heights{}",
+            v.name,
+            twin()
+        ));
+    }
+    if v.unit != "metre" {
+        return Err(format!(
+            "EPSG:{code} ({}) measures heights in {}, and terramesh's outputs hold metres (the \
+             inputs' z_unit converts them): name the vertical CRS in metres{}",
+            v.name,
+            v.unit,
+            twin()
+        ));
+    }
+    u16::try_from(code).map_err(|_| format!("EPSG:{code}: {accepted}"))
 }
 
 impl<'de> Deserialize<'de> for HeightDatum {

@@ -85,13 +85,41 @@ fn default_max_inversion() -> f64 {
 }
 
 /// `base` as written: a number or a string.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum BaseSpec {
     /// An elevation, metres.
     Elevation(f64),
     /// `"auto"` or a raster path.
     Text(String),
+}
+
+/// What `base` accepts, in words (serde's "expected ..." of a value of another type).
+const BASE_EXPECTED: &str =
+    "an elevation in metres (base = -250), a raster path (base = \"base.tif\") or \"auto\"";
+
+impl<'de> Deserialize<'de> for BaseSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<BaseSpec, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = BaseSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(BASE_EXPECTED)
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<BaseSpec, E> {
+                Ok(BaseSpec::Elevation(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<BaseSpec, E> {
+                Ok(BaseSpec::Elevation(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<BaseSpec, E> {
+                Ok(BaseSpec::Elevation(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<BaseSpec, E> {
+                Ok(BaseSpec::Text(v.to_string()))
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 impl Default for BaseSpec {
@@ -235,25 +263,34 @@ impl GeologySection {
                 );
             }
         }
-        if !nonneg(self.min_thickness) {
-            return bad(
-                "min_thickness",
-                "must be 0 or a positive number of metres".into(),
-            );
-        }
-        if !nonneg(self.max_inversion) {
-            return bad(
-                "max_inversion",
-                "must be 0 or a positive number of metres".into(),
-            );
+        // A thickness or an inversion is at most the whole range of elevations.
+        let most = MAX_BASE_ELEVATION - MIN_BASE_ELEVATION;
+        for (key, v) in [
+            ("min_thickness", self.min_thickness),
+            ("max_inversion", self.max_inversion),
+        ] {
+            if !nonneg(v) {
+                return bad(key, "must be 0 or a positive number of metres".into());
+            }
+            if v > most {
+                return bad(
+                    key,
+                    format!(
+                        "{} m is more than the whole range of elevations ({MIN_BASE_ELEVATION} \
+                         to {MAX_BASE_ELEVATION} m): give 0 to {most} metres",
+                        terramesh_core::limits::short(v)
+                    ),
+                );
+            }
         }
         match &self.base {
             BaseSpec::Elevation(b) if !(MIN_BASE_ELEVATION..=MAX_BASE_ELEVATION).contains(b) => {
                 bad(
                     "base",
                     format!(
-                    "{b} m is not an elevation on Earth: give metres between {MIN_BASE_ELEVATION} \
-                     and {MAX_BASE_ELEVATION}, a raster path, or \"auto\""
+                    "{} m is not an elevation on Earth: give metres between {MIN_BASE_ELEVATION} \
+                     and {MAX_BASE_ELEVATION}, a raster path, or \"auto\"",
+                    terramesh_core::limits::short(*b)
                 ),
                 )
             }
@@ -537,6 +574,37 @@ mod tests {
                 "max_inversion = -2",
                 "geology.max_inversion",
                 "positive",
+            ),
+            // Issue 34: finite absurd values, and a base of the wrong type.
+            (
+                "max_inversion = 10.0",
+                "max_inversion = 1e300",
+                "geology.max_inversion",
+                "1e300 m is more than the whole range",
+            ),
+            (
+                "min_thickness = 0.0",
+                "min_thickness = 1e300",
+                "geology.min_thickness",
+                "1e300 m is more than the whole range",
+            ),
+            (
+                "base = \"auto\"",
+                "base = 1e308",
+                "geology.base",
+                "1e308 m is not an elevation",
+            ),
+            (
+                "base = \"auto\"",
+                "base = true",
+                "geology.base",
+                "an elevation in metres (base = -250), a raster path",
+            ),
+            (
+                "base = \"auto\"",
+                "base = [1, 2]",
+                "geology.base",
+                "or \"auto\"",
             ),
         ] {
             let text = geo().replacen(from, to, 1);

@@ -466,13 +466,12 @@ pub const DEFAULT_IDW_NEIGHBORS: usize = 16;
 /// Smoothing iterations of a project's mesh, by default.
 pub const DEFAULT_SMOOTH: usize = 10;
 
-/// The lowest `export.base_elevation` accepted, metres: below the deepest point of the
-/// oceans, the Challenger Deep at about 10,935 m below sea level (Greenaway et al., 2021,
-/// Geoscience Letters 8:33).
-pub const MIN_BASE_ELEVATION: f64 = -11_000.0;
-/// The highest `export.base_elevation` accepted, metres: above Mount Everest, 8,848.86 m
-/// (the 2020 survey of China and Nepal).
-pub const MAX_BASE_ELEVATION: f64 = 9_000.0;
+/// The lowest `export.base_elevation` (and `[geology] base`) accepted, metres: the one bound
+/// of every elevation, [`terramesh_core::limits::MIN_ELEVATION`].
+pub const MIN_BASE_ELEVATION: f64 = terramesh_core::limits::MIN_ELEVATION;
+/// The highest `export.base_elevation` (and `[geology] base`) accepted, metres:
+/// [`terramesh_core::limits::MAX_ELEVATION`].
+pub const MAX_BASE_ELEVATION: f64 = terramesh_core::limits::MAX_ELEVATION;
 
 /// The commented project file written by `terramesh init`.
 pub const TEMPLATE: &str = include_str!("template.toml");
