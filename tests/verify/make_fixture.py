@@ -232,7 +232,7 @@ def write_dae(out, xy, z, tris, fmt=repr):
 
 
 def viewer_data(pts, tris, std, diff):
-    """The 3D viewer's scene as terramesh_io::viewer writes it: float32 offsets from an origin
+    """The 3D viewer's scene as terramesh_report::viewer writes it: float32 offsets from an origin
     (bbox centre in x, y; lowest z), Uint32 triangles, float32 fields, all base64."""
     origin = [float((pts[:, 0].min() + pts[:, 0].max()) / 2), float((pts[:, 1].min() + pts[:, 1].max()) / 2),
               float(pts[:, 2].min())]

@@ -10,6 +10,10 @@
 //! 3. [`check`] verifies the result independently of its construction, [`unit_stats`] gives
 //!    the per-unit figures of `model.json`.
 //!
+//! Before the model, [`boreholes`] turns the units present in each hole (as
+//! `terramesh_io::boreholes` reads them) into contacts and thicknesses by the rules of
+//! `docs/geology.md`.
+//!
 //! No files, no printing. See `docs/geology.md`, "The kernel".
 //!
 //! ```
@@ -37,6 +41,7 @@
 
 /// Sealed bodies: the closed outward surface of every unit.
 mod bodies;
+pub mod boreholes;
 /// Sorting by node (counting sort), for the checks.
 mod buckets;
 /// Cells of one planar triangle: wedges, pyramids, tetrahedra, and the diagonal rule.

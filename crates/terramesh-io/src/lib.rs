@@ -2,9 +2,10 @@
 //! ([`output`]), study regions from corner lists, GeoJSON, KML and WKT ([`region`]),
 //! elevation sources (SRTM `.hgt` tiles, GeoTIFF, ASCII grids, LAS/LAZ points, [`dem`]),
 //! rasters ([`grid_write`]), every surface export format ([`export`]), the geological
-//! model's volume mesh, boundary meshes and bodies ([`model`]), pictures
-//! ([`pictures`]), reports ([`report`]) and their 3D viewer ([`viewer`]). Numerical work
-//! lives in `terramesh-core` and `terramesh-mesh`.
+//! model's volume mesh, boundary meshes and bodies ([`model`]) and the colour maps they
+//! share with the pictures ([`colour`]). Numerical work lives in `terramesh-core` and
+//! `terramesh-mesh`, the rules that turn boreholes into contacts in `terramesh-geology`;
+//! pictures, the 3D viewer and `report.html` in `terramesh-report`.
 //!
 //! ```
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -23,6 +24,7 @@
 #![warn(missing_docs)]
 
 pub mod boreholes;
+pub mod colour;
 pub mod dem;
 pub mod export;
 pub mod folder;
@@ -31,12 +33,9 @@ pub mod model;
 pub mod number;
 mod numtext;
 pub mod output;
-pub mod pictures;
 pub mod quote;
 pub mod region;
-pub mod report;
 pub mod scratch;
 pub mod table;
 pub mod text;
 mod textsink;
-pub mod viewer;

@@ -84,10 +84,10 @@ pub enum Error {
     Terrain(#[from] terramesh_io::export::TerrainError),
     /// Drawing a picture.
     #[error(transparent)]
-    Picture(#[from] terramesh_io::pictures::PictureError),
+    Picture(#[from] terramesh_report::pictures::PictureError),
     /// The scene of the report's 3D viewer.
     #[error(transparent)]
-    Scene(#[from] terramesh_io::viewer::SceneError),
+    Scene(#[from] terramesh_report::viewer::SceneError),
     /// The geological model (rules, volume mesh, checks).
     #[error(transparent)]
     Geology(Box<terramesh_geology::GeologyError>),

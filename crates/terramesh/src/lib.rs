@@ -2,8 +2,10 @@
 //! model (DSM) and everything around it. This is the crate Rust users (and the Python
 //! bindings, and the `terramesh` binary) call: it owns the project file, the resolved plans,
 //! acquisition of elevations, the pipeline stages, exports, pictures and the report. The
-//! numerical kernels live below it (`terramesh-core`, `terramesh-geostat`, `terramesh-mesh`),
-//! file formats in `terramesh-io`, web services in `terramesh-web`.
+//! numerical kernels live below it (`terramesh-core`, `terramesh-geostat`, `terramesh-mesh`,
+//! `terramesh-geology`), file formats in `terramesh-io`, the drawing of pictures, the 3D
+//! viewer and `report.html` from plain data in `terramesh-report`, web services in
+//! `terramesh-web`.
 //!
 //! A whole build from a project file, here on spot heights written on the fly (a real project
 //! names a DEM, a lidar file or a web service):

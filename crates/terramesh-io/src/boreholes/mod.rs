@@ -57,13 +57,14 @@
 
 mod error;
 mod parse;
-mod rules;
 
 use std::path::PathBuf;
 
 pub use error::{BoreholeError, Inversion};
-use terramesh_core::desurvey::HolePath;
+use terramesh_core::desurvey::{DesurveyError, HolePath, Station};
 use terramesh_core::volume::ZUnit;
+pub use terramesh_geology::boreholes::{Contact, ContactKind, Repair, Thickness};
+use terramesh_geology::boreholes::{ContactError, HoleRules};
 
 /// The largest inversion of tops repaired by default, metres (`[geology] max_inversion`):
 /// about the precision of formation-top picks in well logs, and above the largest inversion
@@ -122,61 +123,6 @@ impl<'a> BoreholeOptions<'a> {
             project: None,
         }
     }
-}
-
-/// How a contact is known.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ContactKind {
-    /// The log shows the change into the unit there.
-    Logged,
-    /// The first logged unit starts at the collar: its top is at or above the ground.
-    Collar,
-    /// The unit is absent from the hole (zero thickness): the next present unit's top.
-    Absent,
-    /// An inverted top lowered onto the top above it (see [`Boreholes::repairs`]).
-    Repaired,
-}
-
-/// The top of one unit in one hole.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Contact {
-    /// The unit, an index into [`Boreholes::units`].
-    pub unit: usize,
-    /// Measured depth along the hole, metres.
-    pub md: f64,
-    /// `[x, y, z]`: where the hole meets the top (z the elevation, metres).
-    pub position: [f64; 3],
-    /// How it is known.
-    pub kind: ContactKind,
-    /// The line of the log row it comes from (for an absent unit, the next present unit's).
-    pub line: u64,
-}
-
-/// The vertical thickness of one unit in one hole.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Thickness {
-    /// Top minus base elevation, metres (0 where the unit is absent or pinched by a repair).
-    Known(f64),
-    /// The top is a contact but the base is not observed (the hole ends inside the unit, the
-    /// base lies in a gap of the log, or it is the lowest unit): a lower bound only.
-    Censored,
-    /// The hole does not show the unit's top.
-    Unknown,
-}
-
-/// One inverted top that was repaired.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Repair {
-    /// The hole.
-    pub hole: String,
-    /// The unit whose top was lowered.
-    pub unit: usize,
-    /// The unit above it onto whose top it was lowered.
-    pub above: usize,
-    /// The line of the inverted top.
-    pub line: u64,
-    /// By how much it was lowered, metres.
-    pub amount: f64,
 }
 
 /// One hole.
@@ -285,7 +231,7 @@ pub fn read(files: &BoreholeFiles, opts: &BoreholeOptions) -> Result<Boreholes, 
             Some((file, stations, lines)) => {
                 HolePath::new(c.xyz, stations).map_err(|source| BoreholeError::Survey {
                     file: file.clone(),
-                    line: rules::station_line(&source, stations, lines),
+                    line: station_line(&source, stations, lines),
                     hole: c.name.clone(),
                     source,
                 })?
@@ -293,13 +239,14 @@ pub fn read(files: &BoreholeFiles, opts: &BoreholeOptions) -> Result<Boreholes, 
             None => HolePath::vertical(c.xyz),
         };
         let present = logs.remove(&c.name).unwrap_or_default();
-        let ctx = rules::HoleContext {
-            file: &log_name,
+        let rules = HoleRules {
             hole: &c.name,
-            units: &opts.units,
+            units: opts.units.len(),
             max_inversion: opts.max_inversion,
         };
-        let (tops, thickness, mut r) = rules::contacts(&ctx, &path, &present)?;
+        let (tops, thickness, mut r) =
+            terramesh_geology::boreholes::contacts(&rules, &path, &present)
+                .map_err(|e| rule_error(e, &log_name, &c.name, &opts.units))?;
         repairs.append(&mut r);
         holes.push(Hole {
             name: c.name,
@@ -315,4 +262,55 @@ pub fn read(files: &BoreholeFiles, opts: &BoreholeOptions) -> Result<Boreholes, 
         holes,
         repairs,
     })
+}
+
+/// A refusal of the geology kernel's rules as the reader's error, with the file, the hole
+/// and the units' names.
+fn rule_error(e: ContactError, file: &str, hole: &str, units: &[String]) -> BoreholeError {
+    match e {
+        ContactError::Inversion {
+            line,
+            unit,
+            above,
+            above_line,
+            amount,
+            max,
+        } => BoreholeError::Inversion(Box::new(Inversion {
+            file: file.to_string(),
+            line,
+            hole: hole.to_string(),
+            unit: units[unit].clone(),
+            above: units[above].clone(),
+            above_line,
+            amount,
+            max,
+        })),
+        ContactError::Outside { line, what } => BoreholeError::OutsideHole {
+            file: file.to_string(),
+            line,
+            hole: hole.to_string(),
+            what,
+        },
+        other => BoreholeError::OutsideHole {
+            file: file.to_string(),
+            line: 0,
+            hole: hole.to_string(),
+            what: other.to_string(),
+        },
+    }
+}
+
+/// The line of the survey station a desurvey error is about.
+fn station_line(e: &DesurveyError, stations: &[Station], lines: &[u64]) -> u64 {
+    let depth = match e {
+        DesurveyError::BadStation { index, .. } => return lines[*index],
+        DesurveyError::NotIncreasing { depth, .. } => *depth,
+        DesurveyError::Reversal { to, .. } => *to,
+        _ => return lines.first().copied().unwrap_or(0),
+    };
+    // Stations are sorted by depth: the last one at that depth (a repeat is the second).
+    stations
+        .iter()
+        .rposition(|s| s.depth == depth)
+        .map_or(lines[0], |i| lines[i])
 }

@@ -1,5 +1,6 @@
 //! Reading the four borehole tables into collars, survey stations and, per hole, the units
-//! present with their tops (still as depths or elevations: [`super::rules`] places them).
+//! present with their tops (still as depths or elevations: `terramesh_geology::boreholes`
+//! places them).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -18,24 +19,7 @@ pub(crate) struct Collar {
     pub xyz: [f64; 3],
 }
 
-/// Where a top is given.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum At {
-    /// Measured depth along the hole, metres.
-    Depth(f64),
-    /// Elevation, metres.
-    Elevation(f64),
-}
-
-/// A unit present in a hole.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Present {
-    pub unit: usize,
-    /// Its top, when the log shows it.
-    pub top: Option<At>,
-    pub kind: ContactKind,
-    pub line: u64,
-}
+pub(crate) use terramesh_geology::boreholes::{At, Present};
 
 /// Survey stations per hole: the file, the stations by depth and their lines.
 pub(crate) type Surveys = HashMap<String, (String, Vec<Station>, Vec<u64>)>;

@@ -12,7 +12,7 @@ use std::io::{self, Write};
 
 use serde_json::{json, Value};
 
-use crate::pictures::ColourMap;
+use crate::colour::ColourMap;
 
 /// One named triangle mesh of a [`write_glb`] scene.
 #[derive(Debug, Clone)]

@@ -4,11 +4,12 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Context, Result};
 use terramesh_geostat::{InterpolationMethod, Named};
-use terramesh_io::pictures::{
-    draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d, render_both,
-    render_both_as, ColourMap, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
-};
 use terramesh_mesh::Mesh;
+pub use terramesh_report::labels::short_numbers;
+use terramesh_report::pictures::{
+    central_detail, draw_mesh, draw_samples, draw_surface, draw_variogram, draw_view3d,
+    render_both, render_both_as, ColourMap, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
+};
 
 use super::stages::{Interpolated, Meshed, Samples};
 
@@ -68,8 +69,8 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
         f,
     );
 
-    // Mesh pictures of large meshes show a central detail of about DETAIL triangles: the
-    // whole mesh would be a grey blot at this size.
+    // Mesh pictures of large meshes show a central detail of about DETAIL_TRIANGLES
+    // triangles (`central_detail`): the whole mesh would be a grey blot at this size.
     let adaptive = m.adaptive.is_some();
     for (k, (mesh, q, file)) in [
         (&m.unsmoothed, &m.before, "mesh-before-smoothing"),
@@ -280,126 +281,30 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     Ok(pics)
 }
 
-/// Triangles a mesh picture shows at most.
-const DETAIL: usize = 20_000;
-
-/// The absolute points and triangles to draw for `mesh`: all of them, or for a mesh of more
-/// than [`DETAIL`] triangles those whose centre lies in a central square holding about that
-/// many (with the square's side).
+/// The absolute points and triangles to draw for `mesh`: all of them, or for a large mesh a
+/// central detail ([`central_detail`]).
 fn mesh_detail(mesh: &Mesh, area: f64) -> (Vec<[f64; 2]>, Vec<[u32; 3]>, Option<f64>) {
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
-    let n = mesh.triangles.len();
-    if n <= DETAIL {
-        return (xy, mesh.triangles.clone(), None);
-    }
-    let side = (area * DETAIL as f64 / n as f64).sqrt();
-    let (lo, hi) = xy.iter().fold(
-        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-        |(lo, hi), p| {
-            (
-                [lo[0].min(p[0]), lo[1].min(p[1])],
-                [hi[0].max(p[0]), hi[1].max(p[1])],
-            )
-        },
-    );
-    let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-    let mut index = vec![u32::MAX; xy.len()];
-    let mut pts = Vec::new();
-    let mut tris = Vec::new();
-    for t in &mesh.triangles {
-        let g = t.iter().fold([0.0, 0.0], |a, &i| {
-            [
-                a[0] + xy[i as usize][0] / 3.0,
-                a[1] + xy[i as usize][1] / 3.0,
-            ]
-        });
-        if (g[0] - c[0]).abs() > 0.5 * side || (g[1] - c[1]).abs() > 0.5 * side {
-            continue;
-        }
-        tris.push(t.map(|i| {
-            if index[i as usize] == u32::MAX {
-                index[i as usize] = pts.len() as u32;
-                pts.push(xy[i as usize]);
-            }
-            index[i as usize]
-        }));
-    }
-    (pts, tris, Some(side))
-}
-
-/// Rewrites every decimal number in `s` with at most 4 significant decimals, for labels.
-pub fn short_numbers(s: &str) -> String {
-    let mut out = String::new();
-    let mut num = String::new();
-    let flush = |num: &mut String, out: &mut String| {
-        if let (true, Ok(v)) = (num.contains('.'), num.parse::<f64>()) {
-            let d = if v.abs() >= 100.0 { 1 } else { 4 };
-            out.push_str(&format!("{v:.d$}"));
-        } else {
-            out.push_str(num);
-        }
-        num.clear();
-    };
-    for c in s.chars() {
-        if c.is_ascii_digit() || c == '.' {
-            num.push(c);
-        } else {
-            flush(&mut num, &mut out);
-            out.push(c);
-        }
-    }
-    flush(&mut num, &mut out);
-    out
+    central_detail(xy, &mesh.triangles, area)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A `n` x `n` grid of unit squares, two triangles each, with its origin at (1000, 2000).
-    fn grid(n: u32) -> Mesh {
-        let mut points = Vec::new();
-        for r in 0..=n {
-            for c in 0..=n {
-                points.push([c as f64, r as f64]);
-            }
-        }
-        let mut triangles = Vec::new();
-        let id = |r: u32, c: u32| r * (n + 1) + c;
-        for r in 0..n {
-            for c in 0..n {
-                triangles.push([id(r, c), id(r, c + 1), id(r + 1, c + 1)]);
-                triangles.push([id(r, c), id(r + 1, c + 1), id(r + 1, c)]);
-            }
-        }
-        Mesh {
-            origin: [1000.0, 2000.0],
-            points,
-            triangles,
-            constraint_edges: vec![],
-        }
-    }
-
     #[test]
-    fn small_meshes_are_drawn_whole_and_large_ones_as_a_central_detail() {
-        let small = grid(10);
-        let (xy, tris, detail) = mesh_detail(&small, 100.0);
-        assert_eq!((xy.len(), tris.len(), detail), (121, 200, None));
-        assert_eq!(xy[0], [1000.0, 2000.0]);
-
-        let big = grid(200); // 80,000 triangles
-        let (xy, tris, detail) = mesh_detail(&big, 40_000.0);
-        let side = detail.expect("a detail");
-        assert!((side - 100.0).abs() < 1e-9, "{side}"); // a quarter of the triangles' area
-        assert!(tris.len() > DETAIL * 9 / 10 && tris.len() <= DETAIL * 11 / 10);
-        // Every drawn triangle is a triangle of the mesh, centred in the window.
-        for t in &tris {
-            let g = t.iter().fold([0.0, 0.0], |a, &i| {
-                let p = xy[i as usize];
-                [a[0] + p[0] / 3.0, a[1] + p[1] / 3.0]
-            });
-            assert!((g[0] - 1100.0).abs() <= 50.0 && (g[1] - 2100.0).abs() <= 50.0);
-        }
-        assert!(xy.len() < big.points.len());
+    fn mesh_pictures_draw_absolute_points() {
+        let mesh = Mesh {
+            origin: [1000.0, 2000.0],
+            points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            triangles: vec![[0, 1, 2]],
+            constraint_edges: vec![],
+        };
+        let (xy, tris, detail) = mesh_detail(&mesh, 0.5);
+        assert_eq!(
+            xy,
+            vec![[1000.0, 2000.0], [1001.0, 2000.0], [1000.0, 2001.0]]
+        );
+        assert_eq!((tris, detail), (vec![[0, 1, 2]], None));
     }
 }

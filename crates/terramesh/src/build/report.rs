@@ -6,8 +6,8 @@ use std::path::Path;
 use terramesh_core::coords::{format_dms, to_utm, Axis};
 use terramesh_geostat::InterpolationMethod;
 use terramesh_io::output::write_atomic;
-use terramesh_io::report::{Block, Report, Section};
 use terramesh_mesh::Quality;
+use terramesh_report::report::{Block, Report, Section};
 
 use super::exports::Written;
 use super::pictures::{short_numbers, Picture};
@@ -66,7 +66,7 @@ pub fn write_report(
     w: &Written,
     pics: &[Picture],
     timings: &Timings,
-    extra: Vec<terramesh_io::report::Section>,
+    extra: Vec<terramesh_report::report::Section>,
     geo: Option<&crate::geology::stage::ModelBuilt>,
 ) -> Result<()> {
     let title = p

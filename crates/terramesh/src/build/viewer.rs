@@ -1,4 +1,4 @@
-//! The scene of the 3D viewer in `report.html` (`terramesh_io::viewer`): the DSM surface
+//! The scene of the 3D viewer in `report.html` (`terramesh_report::viewer`): the DSM surface
 //! coloured by elevation, kriging standard deviation or UK minus IDW; the sealed solid's sides
 //! and base; the samples as points; with `[geology]`, the units (capped where the
 //! cross-section cuts them) and the boreholes (traces and collars) as further layers.
@@ -11,9 +11,9 @@
 
 use terramesh_core::geometry::Region;
 use terramesh_core::solid::extrude;
-use terramesh_io::pictures::ColourMap;
-use terramesh_io::viewer::{Field, Geometry, Layer, Scene};
 use terramesh_mesh::{adaptive_mesh, AdaptiveSettings, Fallible, MeshError};
+use terramesh_report::pictures::ColourMap;
+use terramesh_report::viewer::{compact, Field, Geometry, Layer, Scene};
 
 use super::stages::{Interpolated, Meshed, Samples};
 use crate::error::{Context, Result};
@@ -184,26 +184,6 @@ pub fn scene(
         note: (!notes.is_empty()).then(|| notes.join(" ")),
         layers: [vec![surface, solid, samples], model_layers].concat(),
     })
-}
-
-/// The vertices `tris` use, renumbered in order of first use.
-pub(crate) fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut map = vec![u32::MAX; vertices.len()];
-    let mut out = Vec::new();
-    let t = tris
-        .iter()
-        .map(|t| {
-            t.map(|i| {
-                let slot = &mut map[i as usize];
-                if *slot == u32::MAX {
-                    *slot = out.len() as u32;
-                    out.push(vertices[i as usize]);
-                }
-                *slot
-            })
-        })
-        .collect();
-    (out, t)
 }
 
 /// A decimated surface: positions (with z), triangles, the fields at its vertices.
@@ -482,13 +462,5 @@ mod tests {
         let corner = loc.interpolate(500_000.0, 5_400_000.0, &z).unwrap();
         let outside = loc.interpolate(499_995.0, 5_399_995.0, &z).unwrap();
         assert!((outside - corner).abs() < 1e-6, "{outside} vs {corner}");
-    }
-
-    #[test]
-    fn compact_keeps_only_used_vertices() {
-        let v = [[0.0; 3], [1.0; 3], [2.0; 3], [3.0; 3]];
-        let (cv, ct) = compact(&v, &[[3, 1, 3]]);
-        assert_eq!(cv, vec![[3.0; 3], [1.0; 3]]);
-        assert_eq!(ct, vec![[0, 1, 0]]);
     }
 }

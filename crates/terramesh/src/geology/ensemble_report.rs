@@ -23,11 +23,11 @@
 use std::path::Path;
 
 use terramesh_geostat::PointSummary;
-use terramesh_io::pictures::{
+use terramesh_mesh::Mesh;
+use terramesh_report::pictures::{
     draw_surface, render_both_as, ColourMap, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
 };
-use terramesh_io::report::{Block, Section};
-use terramesh_mesh::Mesh;
+use terramesh_report::report::{Block, Section};
 
 use super::ensemble::{EnsembleSummary, ModelEnsemble};
 use super::stage::ModelBuilt;

@@ -5,12 +5,12 @@
 
 use std::path::Path;
 
-use terramesh_io::pictures::{
+use terramesh_mesh::Mesh;
+use terramesh_report::pictures::{
     draw_bodies_view3d, draw_section, draw_surface, render_both_as, unit_colour, ColourMap,
     Section as Cut, SectionHole, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
 };
-use terramesh_io::report::{Block, Section};
-use terramesh_mesh::Mesh;
+use terramesh_report::report::{Block, Section};
 
 use super::section::{along_line, long_and_cross_axes, profile};
 use super::stage::ModelBuilt;

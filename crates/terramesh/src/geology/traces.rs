@@ -2,7 +2,7 @@
 //! path, in the colour of each logged unit ([`borehole_traces`]).
 
 use terramesh_io::boreholes::{ContactKind, Hole, Thickness};
-use terramesh_io::pictures::unit_colour;
+use terramesh_report::pictures::unit_colour;
 
 /// Half-width of a borehole trace, as a fraction of the scene's horizontal extent.
 pub(crate) const TRACE_RADIUS: f64 = 0.004;

@@ -10,11 +10,10 @@ use terramesh_core::volume::VolumeMesh;
 use terramesh_io::boreholes::Hole;
 use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
 use terramesh_io::output::Output;
-use terramesh_io::pictures::unit_colour;
-use terramesh_io::viewer::{Geometry, Layer};
+use terramesh_report::pictures::unit_colour;
+use terramesh_report::viewer::{compact, Geometry, Layer};
 
 use super::traces::{borehole_traces, STUB_FRACTION_PERCENT, TRACE_RADIUS, UNLOGGED};
-use crate::build::viewer::compact;
 use crate::error::{bail, Context, Result};
 
 /// Where `model.glb` is placed and what its heights mean, for its `extras`.
@@ -30,7 +29,7 @@ pub struct GlbFrame<'a> {
     pub title: &'a str,
 }
 
-/// The sRGB 8-bit colour of unit `k` (`terramesh_io::pictures::unit_colour`, the sections'
+/// The sRGB 8-bit colour of unit `k` (`terramesh_report::pictures::unit_colour`, the sections'
 /// colours) as the linear RGB that glTF's `COLOR_0` holds.
 ///
 /// ```

@@ -144,8 +144,14 @@ impl VariogramJob {
                 .collect();
             let label = fit.variogram.to_string();
             let v = &fit.variogram;
-            terramesh_io::pictures::render_file(p, (900, 600), |root| {
-                terramesh_io::pictures::draw_variogram(root, &pts, &|h| v.gamma(h), &title, &label)
+            terramesh_report::pictures::render_file(p, (900, 600), |root| {
+                terramesh_report::pictures::draw_variogram(
+                    root,
+                    &pts,
+                    &|h| v.gamma(h),
+                    &title,
+                    &label,
+                )
             })
             .map_err(|e| {
                 Error::setting(Setting::Plot, "", format!("{{plot}} {}: {e}", p.display()))

@@ -3,7 +3,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::colour::{hillshade, shade, ColourMap};
+use super::colour::{hillshade, rgb, shade, ColourMap};
 
 type Res = Result<(), Box<dyn std::error::Error>>;
 
@@ -127,8 +127,8 @@ where
 /// let dir = tempfile::tempdir()?;
 /// let pts = [[0.0, 0.0, 10.0], [10.0, 0.0, 12.0], [0.0, 10.0, 11.0]];
 /// let ring = vec![vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]];
-/// terramesh_io::pictures::render_both(&dir.path().join("s"), (400, 300), |root| {
-///     terramesh_io::pictures::draw_samples(root, &pts, &ring, "samples")
+/// terramesh_report::pictures::render_both(&dir.path().join("s"), (400, 300), |root| {
+///     terramesh_report::pictures::draw_samples(root, &pts, &ring, "samples")
 /// })?;
 /// # Ok(()) }
 /// ```
@@ -149,7 +149,7 @@ where
         .chain(outlines.iter().flatten().copied());
     let mut chart = plan_chart(root, title, all, 90)?;
     chart.draw_series(points.iter().map(|p| {
-        let c = ColourMap::Terrain.at((p[2] - lo) / (hi - lo));
+        let c = rgb(ColourMap::Terrain.at((p[2] - lo) / (hi - lo)));
         Circle::new((p[0], p[1]), 2, c.filled())
     }))?;
     draw_outlines(&mut chart, outlines)?;
@@ -192,7 +192,7 @@ where
     chart.draw_series(map.triangles.iter().map(|t| {
         let [a, b, c] = t.map(|i| i as usize);
         let v = (map.values[a] + map.values[b] + map.values[c]) / 3.0;
-        let mut col = map.colours.at((v - lo) / (hi - lo));
+        let mut col = rgb(map.colours.at((v - lo) / (hi - lo)));
         if let Some(z) = map.shade_z {
             let u = [xy[b][0] - xy[a][0], xy[b][1] - xy[a][1], z[b] - z[a]];
             let w = [xy[c][0] - xy[a][0], xy[c][1] - xy[a][1], z[c] - z[a]];
@@ -312,7 +312,7 @@ where
         let t = 1.0 - k as f64 / n as f64;
         root.draw(&Rectangle::new(
             [(x0, top + k), (x0 + 16, top + k + 1)],
-            colours.at(t).filled(),
+            rgb(colours.at(t)).filled(),
         ))?;
     }
     root.draw(&Rectangle::new(

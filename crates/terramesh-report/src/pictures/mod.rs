@@ -6,6 +6,7 @@
 
 mod chart;
 mod colour;
+mod detail;
 mod maps;
 mod section;
 mod view3d;
@@ -16,6 +17,7 @@ use plotters::prelude::*;
 
 pub use chart::draw_variogram;
 pub use colour::{hillshade, shade, ColourMap};
+pub use detail::{central_detail, DETAIL_TRIANGLES};
 pub use maps::{draw_mesh, draw_samples, draw_surface, SurfaceMap};
 pub use section::{draw_section, unit_colour, Section, SectionHole};
 pub use view3d::{draw_bodies_view3d, draw_view3d};
@@ -54,7 +56,7 @@ fn ensure_font() {
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use plotters::prelude::*;
 /// let dir = tempfile::tempdir()?;
-/// let files = terramesh_io::pictures::render_both(&dir.path().join("dot"), (100, 80), |root| {
+/// let files = terramesh_report::pictures::render_both(&dir.path().join("dot"), (100, 80), |root| {
 ///     root.fill(&WHITE)?;
 ///     root.draw(&Circle::new((50, 40), 10, RED.filled()))?;
 ///     Ok(())
@@ -124,17 +126,17 @@ where
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use plotters::prelude::*;
 /// let dir = tempfile::tempdir()?;
-/// let dot = |root: &DrawingArea<terramesh_io::pictures::DynBackend<'_>, plotters::coord::Shift>|
+/// let dot = |root: &DrawingArea<terramesh_report::pictures::DynBackend<'_>, plotters::coord::Shift>|
 ///     -> Result<(), Box<dyn std::error::Error>> {
 ///     root.fill(&WHITE)?;
 ///     root.draw(&Circle::new((50, 40), 10, RED.filled()))?;
 ///     Ok(())
 /// };
-/// terramesh_io::pictures::render_file(&dir.path().join("dot.svg"), (100, 80), dot)?;
+/// terramesh_report::pictures::render_file(&dir.path().join("dot.svg"), (100, 80), dot)?;
 /// assert!(std::fs::read_to_string(dir.path().join("dot.svg"))?.contains("<circle"));
-/// terramesh_io::pictures::render_file(&dir.path().join("dot.png"), (100, 80), dot)?;
+/// terramesh_report::pictures::render_file(&dir.path().join("dot.png"), (100, 80), dot)?;
 /// assert!(std::fs::read(dir.path().join("dot.png"))?.starts_with(b"\x89PNG"));
-/// assert!(terramesh_io::pictures::render_file(&dir.path().join("dot.gif"), (100, 80), dot).is_err());
+/// assert!(terramesh_report::pictures::render_file(&dir.path().join("dot.gif"), (100, 80), dot).is_err());
 /// # Ok(()) }
 /// ```
 pub fn render_file<F>(path: &Path, size: (u32, u32), draw: F) -> Result<(), PictureError>
@@ -156,7 +158,7 @@ where
         "svg" => svg_text(size, &draw).map_err(err)?.into_bytes(),
         _ => return Err(err("the file name must end in .png or .svg".into())),
     };
-    crate::output::write_atomic(path, &bytes).map_err(|e| err(e.to_string()))
+    terramesh_io::output::write_atomic(path, &bytes).map_err(|e| err(e.to_string()))
 }
 
 /// [`render_both`] with a choice of SVG content.
@@ -164,7 +166,7 @@ where
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use plotters::prelude::*;
-/// use terramesh_io::pictures::{render_both_as, SvgMode};
+/// use terramesh_report::pictures::{render_both_as, SvgMode};
 /// let dir = tempfile::tempdir()?;
 /// let files = render_both_as(&dir.path().join("dot"), (100, 80), SvgMode::Raster, |root| {
 ///     root.fill(&WHITE)?;
@@ -193,7 +195,7 @@ where
         message,
     };
     let encoded = png_bytes(size, &draw).map_err(|e| err(&png, e))?;
-    crate::output::write_atomic(&png, &encoded).map_err(|e| err(&png, e.to_string()))?;
+    terramesh_io::output::write_atomic(&png, &encoded).map_err(|e| err(&png, e.to_string()))?;
     let text = match mode {
         SvgMode::Raster => {
             let (w, h) = size;
@@ -206,7 +208,8 @@ where
         }
         SvgMode::Vector => svg_text(size, &draw).map_err(|e| err(&svg, e))?,
     };
-    crate::output::write_atomic(&svg, text.as_bytes()).map_err(|e| err(&svg, e.to_string()))?;
+    terramesh_io::output::write_atomic(&svg, text.as_bytes())
+        .map_err(|e| err(&svg, e.to_string()))?;
     Ok([png, svg])
 }
 

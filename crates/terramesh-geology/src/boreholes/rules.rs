@@ -2,45 +2,9 @@
 //! every top on the desurveyed path, repairing small inversions (onlap), giving absent units
 //! zero thickness, and censoring the bases the log does not show.
 
-use terramesh_core::desurvey::{DesurveyError, HolePath, Station};
+use terramesh_core::desurvey::HolePath;
 
-use super::error::Inversion;
-use super::parse::{At, Present};
-use super::{BoreholeError, Contact, ContactKind, Repair, Thickness};
-
-/// What messages about one hole need.
-pub(crate) struct HoleContext<'a> {
-    pub file: &'a str,
-    pub hole: &'a str,
-    pub units: &'a [String],
-    pub max_inversion: f64,
-}
-
-impl HoleContext<'_> {
-    fn outside(&self, line: u64, what: String) -> BoreholeError {
-        BoreholeError::OutsideHole {
-            file: self.file.to_string(),
-            line,
-            hole: self.hole.to_string(),
-            what,
-        }
-    }
-}
-
-/// The line of the survey station a desurvey error is about.
-pub(crate) fn station_line(e: &DesurveyError, stations: &[Station], lines: &[u64]) -> u64 {
-    let depth = match e {
-        DesurveyError::BadStation { index, .. } => return lines[*index],
-        DesurveyError::NotIncreasing { depth, .. } => *depth,
-        DesurveyError::Reversal { to, .. } => *to,
-        _ => return lines.first().copied().unwrap_or(0),
-    };
-    // Stations are sorted by depth: the last one at that depth (a repeat is the second).
-    stations
-        .iter()
-        .rposition(|s| s.depth == depth)
-        .map_or(lines[0], |i| lines[i])
-}
+use super::{At, Contact, ContactError, ContactKind, HoleRules, Present, Repair, Thickness};
 
 /// The measured depth at which `path` reaches elevation `z` (bisection: a hole never rises).
 fn md_at_elevation(path: &HolePath, z: f64) -> Option<f64> {
@@ -68,16 +32,21 @@ fn md_at_elevation(path: &HolePath, z: f64) -> Option<f64> {
 }
 
 /// The contacts (per unit of the column), the thicknesses and the repairs of one hole.
-pub(crate) type HoleResult = (Vec<Option<Contact>>, Vec<Thickness>, Vec<Repair>);
+pub type HoleResult = (Vec<Option<Contact>>, Vec<Thickness>, Vec<Repair>);
 
 /// Applies the rules of the module documentation to the units `present` in one hole (in
-/// column order, each unit once).
-pub(crate) fn contacts(
-    ctx: &HoleContext,
+/// column order, each unit once), desurveyed as `path`.
+///
+/// # Errors
+/// A top the path cannot place ([`ContactError::Outside`]); an inversion larger than
+/// [`HoleRules::max_inversion`] ([`ContactError::Inversion`]).
+pub fn contacts(
+    ctx: &HoleRules,
     path: &HolePath,
     present: &[Present],
-) -> Result<HoleResult, BoreholeError> {
-    let n = ctx.units.len();
+) -> Result<HoleResult, ContactError> {
+    let outside = |line: u64, what: String| ContactError::Outside { line, what };
+    let n = ctx.units;
     let mut tops: Vec<Option<Contact>> = vec![None; n];
     let mut repairs = Vec::new();
     // The lowest top placed so far (rule 2 compares against it).
@@ -86,21 +55,17 @@ pub(crate) fn contacts(
         let Some(at) = p.top else { continue };
         let (md, position) = match at {
             At::Depth(md) => {
-                let pos = path
-                    .at(md)
-                    .map_err(|e| ctx.outside(p.line, e.to_string()))?;
+                let pos = path.at(md).map_err(|e| outside(p.line, e.to_string()))?;
                 (md, pos)
             }
             At::Elevation(z) => {
                 let md = md_at_elevation(path, z).ok_or_else(|| {
-                    ctx.outside(
+                    outside(
                         p.line,
                         format!("the surveyed hole never reaches elevation {z} m"),
                     )
                 })?;
-                let pos = path
-                    .at(md)
-                    .map_err(|e| ctx.outside(p.line, e.to_string()))?;
+                let pos = path.at(md).map_err(|e| outside(p.line, e.to_string()))?;
                 // Keep the elevation as given, exactly.
                 (md, [pos[0], pos[1], z])
             }
@@ -116,16 +81,14 @@ pub(crate) fn contacts(
             Some(low) if c.position[2] > low.position[2] => {
                 let amount = c.position[2] - low.position[2];
                 if amount > ctx.max_inversion || amount.is_nan() {
-                    return Err(BoreholeError::Inversion(Box::new(Inversion {
-                        file: ctx.file.to_string(),
+                    return Err(ContactError::Inversion {
                         line: p.line,
-                        hole: ctx.hole.to_string(),
-                        unit: ctx.units[p.unit].clone(),
-                        above: ctx.units[low.unit].clone(),
+                        unit: p.unit,
+                        above: low.unit,
                         above_line: low.line,
                         amount,
                         max: ctx.max_inversion,
-                    })));
+                    });
                 }
                 repairs.push(Repair {
                     hole: ctx.hole.to_string(),

@@ -3,7 +3,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::colour::{shade, ColourMap};
+use super::colour::{rgb, shade, ColourMap};
 
 /// Draws a perspective-free (orthographic) 3D view of the surface seen from the south-west,
 /// 30 degrees above the horizon, with vertical exaggeration `exaggeration`; facets are
@@ -14,8 +14,8 @@ use super::colour::{shade, ColourMap};
 /// let dir = tempfile::tempdir()?;
 /// let v = [[0.0, 0.0, 1.0], [10.0, 0.0, 2.0], [10.0, 10.0, 4.0], [0.0, 10.0, 3.0]];
 /// let t = [[0, 1, 2], [0, 2, 3]];
-/// terramesh_io::pictures::render_both(&dir.path().join("v"), (300, 200), |root| {
-///     terramesh_io::pictures::draw_view3d(root, &v, &t, 2.0, "3D view")
+/// terramesh_report::pictures::render_both(&dir.path().join("v"), (300, 200), |root| {
+///     terramesh_report::pictures::draw_view3d(root, &v, &t, 2.0, "3D view")
 /// })?;
 /// # Ok(()) }
 /// ```
@@ -52,8 +52,8 @@ where
 /// let t = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
 /// let c = [RGBColor(200, 100, 50); 4];
 /// let dir = tempfile::tempdir()?;
-/// terramesh_io::pictures::render_both(&dir.path().join("b"), (300, 200), |root| {
-///     terramesh_io::pictures::draw_bodies_view3d(root, &v, &t, &c, 1.0, "bodies")
+/// terramesh_report::pictures::render_both(&dir.path().join("b"), (300, 200), |root| {
+///     terramesh_report::pictures::draw_bodies_view3d(root, &v, &t, &c, 1.0, "bodies")
 /// })?;
 /// # Ok(()) }
 /// ```
@@ -192,7 +192,7 @@ where
                     nrm = nrm.map(|x| -x);
                 }
                 let zt = ((a[2] + b[2] + cc[2]) / 3.0 - zlo) / zspan;
-                ColourMap::Terrain.at(zt)
+                rgb(ColourMap::Terrain.at(zt))
             }
             Facets::Bodies(colours) => {
                 // Towards the viewer (azimuth `az`, elevation `el`): facing away is hidden.

@@ -93,7 +93,7 @@ impl Report {
     /// Renders the page.
     ///
     /// ```
-    /// use terramesh_io::report::{Block, Report, Section};
+    /// use terramesh_report::report::{Block, Report, Section};
     /// let r = Report {
     ///     title: "Haut-Barr <DSM>".into(),
     ///     sections: vec![Section {
@@ -108,7 +108,7 @@ impl Report {
     /// let html = r.to_html()?;
     /// assert!(html.contains("<title>Haut-Barr &lt;DSM&gt;</title>"));
     /// assert!(html.contains("<td>1.23</td>"));
-    /// # Ok::<(), terramesh_io::viewer::SceneError>(())
+    /// # Ok::<(), terramesh_report::viewer::SceneError>(())
     /// ```
     ///
     /// # Errors

@@ -9,8 +9,8 @@ use plotters::prelude::*;
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// let dir = tempfile::tempdir()?;
 /// let pts = [(10.0, 1.0, 30), (20.0, 1.8, 50), (30.0, 2.1, 40)];
-/// terramesh_io::pictures::render_both(&dir.path().join("v"), (500, 350), |root| {
-///     terramesh_io::pictures::draw_variogram(root, &pts, &|h: f64| 2.0 * (1.0 - (-3.0 * h / 25.0).exp()), "variogram", "exponential")
+/// terramesh_report::pictures::render_both(&dir.path().join("v"), (500, 350), |root| {
+///     terramesh_report::pictures::draw_variogram(root, &pts, &|h: f64| 2.0 * (1.0 - (-3.0 * h / 25.0).exp()), "variogram", "exponential")
 /// })?;
 /// # Ok(()) }
 /// ```

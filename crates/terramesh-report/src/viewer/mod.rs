@@ -354,8 +354,8 @@ impl Scene {
     /// viewer per page (its elements have fixed ids).
     ///
     /// ```
-    /// use terramesh_io::pictures::ColourMap;
-    /// use terramesh_io::viewer::{Field, Geometry, Layer, Scene};
+    /// use terramesh_report::pictures::ColourMap;
+    /// use terramesh_report::viewer::{Field, Geometry, Layer, Scene};
     /// let positions = vec![[500_000.0, 5_400_000.0, 300.0], [500_010.0, 5_400_000.0, 301.0],
     ///                      [500_000.0, 5_400_010.0, 302.0]];
     /// let scene = Scene {
@@ -384,7 +384,7 @@ impl Scene {
     /// let html = scene.to_html()?;
     /// assert!(html.contains("id=\"tmv-data\"") && html.contains("getContext"));
     /// assert_eq!(scene.origin(), [500_005.0, 5_400_005.0, 300.0]);
-    /// # Ok::<(), terramesh_io::viewer::SceneError>(())
+    /// # Ok::<(), terramesh_report::viewer::SceneError>(())
     /// ```
     ///
     /// # Errors
@@ -405,9 +405,44 @@ impl Scene {
     }
 }
 
+/// The vertices `tris` use, renumbered in order of first use: a layer of a [`Scene`] holds only
+/// what it draws.
+///
+/// ```
+/// let v = [[0.0; 3], [1.0; 3], [2.0; 3], [3.0; 3]];
+/// let (cv, ct) = terramesh_report::viewer::compact(&v, &[[3, 1, 3]]);
+/// assert_eq!((cv, ct), (vec![[3.0; 3], [1.0; 3]], vec![[0, 1, 0]]));
+/// ```
+pub fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut map = vec![u32::MAX; vertices.len()];
+    let mut out = Vec::new();
+    let t = tris
+        .iter()
+        .map(|t| {
+            t.map(|i| {
+                let slot = &mut map[i as usize];
+                if *slot == u32::MAX {
+                    *slot = out.len() as u32;
+                    out.push(vertices[i as usize]);
+                }
+                *slot
+            })
+        })
+        .collect();
+    (out, t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn compact_keeps_only_used_vertices() {
+        let v = [[0.0; 3], [1.0; 3], [2.0; 3], [3.0; 3]];
+        let (cv, ct) = compact(&v, &[[3, 1, 3]]);
+        assert_eq!(cv, vec![[3.0; 3], [1.0; 3]]);
+        assert_eq!(ct, vec![[0, 1, 0]]);
+    }
 
     fn tri_layer() -> Layer {
         Layer {

@@ -1,6 +1,6 @@
-//! Colour maps and hillshade for the maps.
-
-use plotters::style::RGBColor;
+//! Colour maps shared by the pictures and viewer of `terramesh-report` and the per-vertex
+//! colours of the surface formats (`dsm.glb`): anchors as 8-bit sRGB, interpolated linearly.
+//! Plain data, no drawing library.
 
 /// A colour map: anchors from low to high, interpolated linearly in RGB.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,10 +42,10 @@ impl ColourMap {
     /// `report.html` interpolates the same ones).
     ///
     /// ```
-    /// use terramesh_io::pictures::ColourMap;
+    /// use terramesh_io::colour::ColourMap;
     /// let a = ColourMap::Terrain.anchors();
     /// let c = ColourMap::Terrain.at(0.0);
-    /// assert_eq!(a[0], (c.0, c.1, c.2));
+    /// assert_eq!(a[0], c);
     /// ```
     pub fn anchors(self) -> &'static [(u8, u8, u8)] {
         match self {
@@ -55,16 +55,16 @@ impl ColourMap {
         }
     }
 
-    /// The colour at `t` in `[0, 1]` (clamped; NaN maps to grey).
+    /// The sRGB colour at `t` in `[0, 1]` (clamped; NaN maps to grey).
     ///
     /// ```
-    /// use terramesh_io::pictures::ColourMap;
+    /// use terramesh_io::colour::ColourMap;
     /// let c = ColourMap::Diverging.at(0.5);
-    /// assert_eq!((c.0, c.1, c.2), (247, 247, 247));
+    /// assert_eq!(c, (247, 247, 247));
     /// ```
-    pub fn at(self, t: f64) -> RGBColor {
+    pub fn at(self, t: f64) -> (u8, u8, u8) {
         if t.is_nan() {
-            return RGBColor(128, 128, 128);
+            return (128, 128, 128);
         }
         let anchors = self.anchors();
         let t = t.clamp(0.0, 1.0) * (anchors.len() - 1) as f64;
@@ -72,34 +72,6 @@ impl ColourMap {
         let f = t - i as f64;
         let (a, b) = (anchors[i], anchors[i + 1]);
         let mix = |x: u8, y: u8| (x as f64 + (y as f64 - x as f64) * f).round() as u8;
-        RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+        (mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
     }
-}
-
-/// Lambertian hillshade of a facet with normal `n` (any length), sun from azimuth 315 degrees
-/// and altitude 45 degrees (the cartographic convention), scaled to `[0.35, 1]` so that shaded
-/// slopes keep their colour.
-///
-/// ```
-/// let flat = terramesh_io::pictures::hillshade([0.0, 0.0, 1.0]);
-/// let facing_sun = terramesh_io::pictures::hillshade([-1.0, 1.0, 1.0]);
-/// let away = terramesh_io::pictures::hillshade([1.0, -1.0, 1.0]);
-/// assert!(facing_sun > flat && flat > away);
-/// ```
-pub fn hillshade(n: [f64; 3]) -> f64 {
-    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    if len == 0.0 {
-        return 1.0;
-    }
-    let (az, alt) = (315f64.to_radians(), 45f64.to_radians());
-    // Direction towards the sun: x east, y north.
-    let sun = [az.sin() * alt.cos(), az.cos() * alt.cos(), alt.sin()];
-    let d = (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2]) / len;
-    0.35 + 0.65 * d.clamp(0.0, 1.0)
-}
-
-/// Multiplies a colour by a shade factor.
-pub fn shade(c: RGBColor, f: f64) -> RGBColor {
-    let s = |x: u8| (x as f64 * f).round().clamp(0.0, 255.0) as u8;
-    RGBColor(s(c.0), s(c.1), s(c.2))
 }

@@ -10,7 +10,7 @@ type Res = Result<(), Box<dyn std::error::Error>>;
 /// unit has the same colour in every picture of a build).
 ///
 /// ```
-/// use terramesh_io::pictures::unit_colour;
+/// use terramesh_report::pictures::unit_colour;
 /// assert_ne!(unit_colour(0), unit_colour(1));
 /// assert_eq!(unit_colour(3), unit_colour(3));
 /// ```
@@ -66,7 +66,7 @@ pub struct Section<'a> {
 ///
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
-/// use terramesh_io::pictures::{draw_section, render_both, Section, SectionHole};
+/// use terramesh_report::pictures::{draw_section, render_both, Section, SectionHole};
 /// let d: Vec<f64> = (0..=10).map(|i| i as f64 * 100.0).collect();
 /// let top: Vec<f64> = d.iter().map(|x| 200.0 + 0.02 * x).collect();
 /// let mid: Vec<f64> = d.iter().map(|x| 150.0 - 0.01 * x).collect();

@@ -1,6 +1,6 @@
 //! Pictures render deterministically and show what they should.
 
-use terramesh_io::pictures::{
+use terramesh_report::pictures::{
     draw_mesh, draw_samples, draw_surface, draw_view3d, render_both, ColourMap, SurfaceMap,
 };
 
