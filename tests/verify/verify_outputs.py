@@ -435,7 +435,7 @@ def check_tables(out):
 
 
 def check_identical(out, other):
-    """Every file byte-identical in a second build, except report.html."""
+    """Every file byte-identical in a second build, except report.html and build.json (timings)."""
     a = {p.relative_to(out.root) for p in out.root.rglob("*") if p.is_file()}
     b = {p.relative_to(other) for p in Path(other).rglob("*") if p.is_file()}
     require(a == b, f"file lists differ: only in first {sorted(map(str, a - b))}, only in second {sorted(map(str, b - a))}")
