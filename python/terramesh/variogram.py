@@ -370,7 +370,11 @@ class Variogram:
         ('reml', 1)
         >>> cands = [c for c in r.fit_info["candidates"] if c["fit"] is not None]
         >>> chosen = min(cands, key=lambda c: c["aic"])  # the least AIC is the model
-        >>> chosen["fit"]["variogram"]["nugget"] == r.nugget and len(cands) > 6
+        >>> chosen["model"] == r.model and len(cands) > 6
+        True
+        >>> # a Gaussian's nugget is then raised to at least 1e-6 of its sill, so that kriging
+        >>> # can solve it: never lowered
+        >>> chosen["fit"]["variogram"]["nugget"] <= r.nugget
         True
         """
         text = _core.variogram_fit(
