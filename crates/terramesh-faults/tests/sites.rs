@@ -56,9 +56,10 @@ fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
     );
 }
 
-#[test]
-fn one_dipping_fault() {
-    let site = Site::new(
+/// A 200 m site with one fault dipping 60 degrees east and three interfaces (the site of
+/// `one_dipping_fault`, also the first of `quality_pass`).
+fn one_fault_site() -> Site {
+    Site::new(
         200.0,
         10,
         0.2,
@@ -76,7 +77,12 @@ fn one_dipping_fault() {
             12.0,
         )],
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn one_dipping_fault() {
+    let site = one_fault_site();
     let (_, mesh, s, _) = build(&site, 10.0);
     let fraction = truth(&site, &mesh);
     report("one dipping fault", &mesh, &s, fraction);
@@ -346,25 +352,7 @@ fn thin_interbed() {
 /// reach it without refining the planar mesh.
 #[test]
 fn quality_pass() {
-    let one = Site::new(
-        200.0,
-        10,
-        0.2,
-        1,
-        [120.0, 0.02, -0.01],
-        0.0,
-        vec![90.0, 60.0, 30.0],
-        [0.01, 0.0],
-        vec![SynthFault::new(
-            "F1",
-            [80.0, -50.0],
-            [120.0, 250.0],
-            60.0,
-            90.0,
-            12.0,
-        )],
-    )
-    .unwrap();
+    let one = one_fault_site();
     let x = site(
         vec![
             SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
