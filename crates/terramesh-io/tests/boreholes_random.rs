@@ -28,6 +28,33 @@ impl Rng {
 
 const UNITS: [&str; 5] = ["a", "b", "c", "d", "e"];
 
+/// Writes one case's collars, log (tops or intervals) and optional survey into `dir`, each
+/// file named `<prefix>-<name>`.
+fn write_files(
+    dir: &std::path::Path,
+    prefix: &str,
+    tops: bool,
+    collars: &str,
+    log: &str,
+    survey: Option<&str>,
+) -> BoreholeFiles {
+    let write = |name: &str, text: &str| {
+        let p = dir.join(format!("{prefix}-{name}"));
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let log_path = write(if tops { "tops.csv" } else { "intervals.csv" }, log);
+    BoreholeFiles {
+        collars: write("collars.csv", collars),
+        log: if tops {
+            LogFile::Tops(log_path)
+        } else {
+            LogFile::Intervals(log_path)
+        },
+        survey: survey.map(|s| write("survey.csv", s)),
+    }
+}
+
 #[test]
 fn random_logs_give_errors_or_contacts_that_obey_the_rules() {
     let dir = tempfile::tempdir().unwrap();
@@ -94,21 +121,8 @@ fn random_logs_give_errors_or_contacts_that_obey_the_rules() {
                 }
             }
         }
-        let write = |name: &str, text: &str| {
-            let p = dir.path().join(format!("{case}-{name}"));
-            std::fs::write(&p, text).unwrap();
-            p
-        };
-        let log_path = write(if tops { "tops.csv" } else { "intervals.csv" }, &log);
-        let files = BoreholeFiles {
-            collars: write("collars.csv", &collars),
-            log: if tops {
-                LogFile::Tops(log_path)
-            } else {
-                LogFile::Intervals(log_path)
-            },
-            survey: (survey.lines().count() > 1).then(|| write("survey.csv", &survey)),
-        };
+        let survey = (survey.lines().count() > 1).then_some(survey.as_str());
+        let files = write_files(dir.path(), &case.to_string(), tops, &collars, &log, survey);
         let units: Vec<String> = UNITS.map(String::from).to_vec();
         match read(&files, &BoreholeOptions::new(units)) {
             Err(e) => {
@@ -206,21 +220,14 @@ fn random_extreme_values_are_refused_or_kept_within_the_bounds() {
             pick(5, "10"),
             pick(6, "45")
         );
-        let write = |name: &str, text: &str| {
-            let p = dir.path().join(format!("x{case}-{name}"));
-            std::fs::write(&p, text).unwrap();
-            p
-        };
-        let log_path = write(if tops { "tops.csv" } else { "intervals.csv" }, &log);
-        let files = BoreholeFiles {
-            collars: write("collars.csv", &collars),
-            log: if tops {
-                LogFile::Tops(log_path)
-            } else {
-                LogFile::Intervals(log_path)
-            },
-            survey: Some(write("survey.csv", &survey)),
-        };
+        let files = write_files(
+            dir.path(),
+            &format!("x{case}"),
+            tops,
+            &collars,
+            &log,
+            Some(&survey),
+        );
         let units: Vec<String> = UNITS.map(String::from).to_vec();
         match read(&files, &BoreholeOptions::new(units)) {
             Err(e) => {
