@@ -178,6 +178,29 @@ impl Stages<'_> {
         Ok(out)
     }
 
+    /// The variogram stage: the model fitted when `fit`, else the samples' data alone, with
+    /// `why` as the stage's line.
+    fn variogram(
+        &mut self,
+        fit: bool,
+        why: &str,
+        project: &Project,
+        samples: &stages::Samples,
+        base: &Path,
+    ) -> Result<stages::Fit> {
+        if fit {
+            let m = self.run(
+                "variogram",
+                || stages::model(project, samples, base),
+                |m| m.detail(),
+            )?;
+            Ok(stages::Fit::Model(Box::new(m)))
+        } else {
+            let d = self.run("variogram", || stages::sample_data(samples), |_| why.into())?;
+            Ok(stages::Fit::Data(d))
+        }
+    }
+
     /// Stops the build when the front end asks.
     fn check(&self) -> Result<()> {
         if self.progress.cancelled() {
@@ -505,26 +528,14 @@ fn build_into_with(
     }
     // What is computed: kriging only when something reported needs it; the neighbourhood
     // and the cross-validation by the number of samples (scale.rs).
-    let (model, data) = if scale::needs_kriging(project) {
-        let m = st.run(
-            "variogram",
-            || stages::model(project, &samples, base),
-            |m| m.detail(),
-        )?;
-        (Some(m), None)
-    } else {
-        let d = st.run(
-            "variogram",
-            || stages::sample_data(&samples),
-            |_| "not fitted: interpolation.methods is idw alone".to_string(),
-        )?;
-        (None, Some(d))
-    };
-    let data = match (&model, &data) {
-        (Some(m), _) => &m.data,
-        (None, Some(d)) => d,
-        (None, None) => return Err(Error::invalid("internal: no samples' data")),
-    };
+    let fit = st.variogram(
+        scale::needs_kriging(project),
+        "not fitted: interpolation.methods is idw alone",
+        project,
+        &samples,
+        base,
+    )?;
+    let (model, data) = (fit.model(), fit.data());
     let choice = scale::choose(project, data.len());
     progress.note(&choice.describe());
     let geology = project.geology();
@@ -533,7 +544,7 @@ fn build_into_with(
         crate::geology::stage::boreholes_and_collars(geology, samples.zone, samples.crs.as_ref())?;
     let mesh = st.run(
         "mesh",
-        || match &model {
+        || match model {
             Some(m) => stages::mesh(project, &samples, m, &collars),
             None => stages::mesh_refined(project, &samples, &collars),
         },
@@ -541,7 +552,7 @@ fn build_into_with(
     )?;
     let mut interp = st.run(
         "interpolation",
-        || stages::interpolate(project, &samples, &mesh, model.as_ref(), data, &choice),
+        || stages::interpolate(project, &samples, &mesh, model, data, &choice),
         |i| {
             let hood = match i.choice.neighbours {
                 scale::Neighbours::All => "all samples".to_string(),
@@ -575,7 +586,7 @@ fn build_into_with(
         }
         .write(out)?;
     }
-    if let (true, Some(model)) = (project.interpolation.realisations > 0, &model) {
+    if let (true, Some(model)) = (project.interpolation.realisations > 0, model) {
         let e = st.run(
             "simulation",
             || ensemble::simulate_vertices(project, model, &mesh, &interp),

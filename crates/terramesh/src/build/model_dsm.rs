@@ -34,32 +34,20 @@ pub(super) fn build_rest(
     let g = project
         .geology()
         .context("the project has no [geology] section")?;
-    let (model, data) = if needs_variogram(project) {
-        let m = st.run(
-            "variogram",
-            || stages::model(project, samples, base),
-            |m| m.detail(),
-        )?;
-        (Some(m), None)
-    } else {
-        let d = st.run(
-            "variogram",
-            || stages::sample_data(samples),
-            |_| "not fitted: the DSM is IDW (interpolation.methods) and needs none".to_string(),
-        )?;
-        (None, Some(d))
-    };
-    let data = match (&model, &data) {
-        (Some(m), _) => &m.data,
-        (None, Some(d)) => d,
-        (None, None) => bail!("internal: neither a variogram nor the samples' data"),
-    };
+    let fit = st.variogram(
+        needs_variogram(project),
+        "not fitted: the DSM is IDW (interpolation.methods) and needs none",
+        project,
+        samples,
+        base,
+    )?;
+    let (model, data) = (fit.model(), fit.data());
     let model_crs = crate::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
     let (boreholes, collars) =
         crate::geology::stage::boreholes_and_collars(Some(g), samples.zone, samples.crs.as_ref())?;
     let mesh = st.run(
         "mesh",
-        || match &model {
+        || match model {
             Some(m) => stages::mesh(project, samples, m, &collars),
             None => stages::mesh_refined(project, samples, &collars),
         },
@@ -67,7 +55,7 @@ pub(super) fn build_rest(
     )?;
     let heights = st.run(
         "interpolation",
-        || dsm_heights(project, samples, &mesh, data, model.as_ref()),
+        || dsm_heights(project, samples, &mesh, data, model),
         |h| {
             format!(
                 "{} at {} vertices (the DSM; the other methods, the DSM grid and \

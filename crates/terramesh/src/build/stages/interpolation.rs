@@ -86,6 +86,33 @@ impl Model {
     }
 }
 
+/// What the variogram stage gives: the fitted model (the samples' data inside it), or the
+/// samples' data alone where nothing the build reports needs kriging (`build/scale.rs`).
+pub(crate) enum Fit {
+    /// A variogram was fitted.
+    Model(Box<Model>),
+    /// Only the samples' data.
+    Data(Data),
+}
+
+impl Fit {
+    /// The samples' data.
+    pub(crate) fn data(&self) -> &Data {
+        match self {
+            Fit::Model(m) => &m.data,
+            Fit::Data(d) => d,
+        }
+    }
+
+    /// The fitted model, where one was fitted.
+    pub(crate) fn model(&self) -> Option<&Model> {
+        match self {
+            Fit::Model(m) => Some(m),
+            Fit::Data(_) => None,
+        }
+    }
+}
+
 /// The samples as kriging data (duplicates averaged).
 pub fn sample_data(s: &Samples) -> Result<Data> {
     Data::new(

@@ -3,7 +3,7 @@
 
 mod interpolation;
 
-pub(crate) use interpolation::{dsm_grid, interpolate, model, sample_data, Surface};
+pub(crate) use interpolation::{dsm_grid, interpolate, model, sample_data, Fit, Surface};
 pub use interpolation::{Interpolated, Model};
 
 use std::path::Path;
