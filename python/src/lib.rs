@@ -38,7 +38,7 @@ fn _terramesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
 fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
     use terramesh_core::vocab::Named;
     let d = pyo3::types::PyDict::new(py);
-    let mesh = terramesh::mesh::MeshSettings::default();
+    let mesh = terramesh::plan::MeshPlan::unsmoothed();
     d.set_item("min_angle", mesh.min_angle)?;
     d.set_item("max_min_angle", terramesh_mesh::MAX_MIN_ANGLE)?;
     d.set_item("smooth", mesh.smooth)?;

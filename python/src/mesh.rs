@@ -3,7 +3,7 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use terramesh::mesh::{mesh_region, MeshSettings};
+use terramesh::{mesh::mesh_region, plan::MeshPlan};
 use terramesh_core::geometry::{validate, Polygon, Region};
 use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
 use terramesh_mesh::{triangle_quality, Quality, Smoother};
@@ -131,7 +131,7 @@ fn mesh<'py>(
             points[i][0], points[i][1]
         )));
     }
-    let settings = MeshSettings {
+    let plan = MeshPlan {
         min_angle,
         max_area,
         max_edge,
@@ -139,12 +139,13 @@ fn mesh<'py>(
         strips,
         smooth,
         smoother,
-        points,
+        ..MeshPlan::unsmoothed()
     };
+    plan.check().map_err(to_py)?;
     let (region, planar, tq) = run(py, false, |cancel| {
         let region = region(polygons, path, corners, geographic, zone)?;
         cancel.check().map_err(to_py)?;
-        let planar = mesh_region(&region, &settings).map_err(to_py)?;
+        let planar = mesh_region(&region, &plan, &points).map_err(to_py)?;
         let m = &planar.mesh;
         let tq: Vec<_> = m
             .triangles

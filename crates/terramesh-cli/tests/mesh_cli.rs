@@ -239,7 +239,7 @@ fn errors_are_clear_and_leave_no_file() {
         ),
         (
             vec!["--corners", PAPER_CORNERS, "--max-area", "0"],
-            "--max-area 0",
+            "--max-area '0': must be a positive number",
         ),
         (
             vec![

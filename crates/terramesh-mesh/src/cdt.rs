@@ -424,7 +424,7 @@ impl CdtState {
         if !mids.is_empty() && self.cdt.num_vertices() == before {
             return Err(MeshError::Insertion {
                 at: mids[0],
-                why: "the midpoint of an edge longer than max_edge is already a vertex".into(),
+                why: "the midpoint of an edge longer than the maximum edge length is already a vertex".into(),
             });
         }
         Ok(mids.len())

@@ -179,6 +179,27 @@ fn setting_message(
 
 pub use terramesh_io::quote::cut;
 
+/// A mesh kernel's error with the settings it names (fields of the kernel's builder) worded
+/// as the front end words them.
+fn mesh_message(m: &terramesh_mesh::MeshError, word: &dyn Fn(Setting) -> String) -> String {
+    use terramesh_mesh::MeshError as M;
+    match m {
+        M::BadParameter { name, value, why } => match Setting::of_field(name) {
+            Some(s) => format!("{} {value}: {why}", word(s)),
+            None => m.to_string(),
+        },
+        M::Incomplete { cap, vertices } => format!(
+            "refinement reached its cap of {cap} added vertices ({vertices} vertices) before \
+             meeting the angle and size limits; raise {}, raise {} or {}, or lower {}",
+            word(Setting::MaxVertices),
+            word(Setting::MaxArea),
+            word(Setting::MaxEdge),
+            word(Setting::MinAngle)
+        ),
+        other => other.to_string(),
+    }
+}
+
 fn neutral(s: Setting) -> String {
     s.to_string()
 }
@@ -238,6 +259,7 @@ impl Error {
                     | Error::Mesh(terramesh_mesh::MeshError::TooLarge(t))
                     | Error::Geostat(terramesh_geostat::GeostatError::TooLarge(t)),
                 ) => t.describe(&|field| Setting::of_field(field).map_or(field.to_string(), name)),
+                Some(Error::Mesh(m)) => mesh_message(m, name),
                 _ => e.to_string(),
             };
             // Transparent wrappers, and messages such as "{file}: {source}", already show

@@ -57,6 +57,7 @@ pub mod gltf;
 pub mod horizon;
 pub mod interpolate;
 pub mod mesh;
+pub mod plan;
 pub mod project;
 pub mod simulate;
 pub mod tiles;

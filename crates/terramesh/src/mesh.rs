@@ -2,13 +2,13 @@
 //! smoothed, or a terrain-adaptive mesh against a DEM, with the summary the command prints.
 //!
 //! ```
-//! use terramesh::mesh::{mesh_region, MeshSettings};
+//! use terramesh::{mesh::mesh_region, plan::MeshPlan};
 //! use terramesh_io::region::{load, RegionCrs, RegionInput};
 //! let region = load(&RegionInput::Corners("0 0; 0 100; 100 100; 100 0".into()), RegionCrs::Projected, None)?;
-//! let mut settings = MeshSettings::default();
-//! settings.max_area = Some(50.0);
-//! settings.smooth = 5;
-//! let planar = mesh_region(&region, &settings)?;
+//! let mut plan = MeshPlan::unsmoothed();
+//! plan.max_area = Some(50.0);
+//! plan.smooth = 5;
+//! let planar = mesh_region(&region, &plan, &[])?;
 //! assert!(planar.after.min_angle >= 28.0);
 //! assert!(planar.summary(&region).contains("smoothing (Smart, 5 iterations)"));
 //! # Ok::<(), terramesh::Error>(())
@@ -17,59 +17,27 @@
 use std::path::Path;
 
 use terramesh_core::coords::{parse_angle, to_utm, to_wgs84, Axis, Zone};
+use terramesh_core::geometry::Region;
 use terramesh_core::sampling::Kernel;
 use terramesh_io::dem::{open_raster, ElevationSource};
 use terramesh_io::region::{LoadedRegion, RegionCrs};
 use terramesh_io::table::{ReadOptions, Table};
 use terramesh_mesh::{
-    adaptive_mesh, smooth, AdaptiveReport, AdaptiveSettings, BuildReport, Fallible, Mesh,
-    MeshBuilder, MeshError, Quality, SmoothReport, Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER,
+    adaptive_mesh, smooth_keeping, AdaptiveReport, AdaptiveSettings, BuildReport, Fallible, Mesh,
+    MeshError, Quality, SmoothReport, Smoother,
 };
 
 use crate::error::{Context, Error, Result};
+use crate::plan::MeshPlan;
 use crate::setting::Setting;
-
-/// What to mesh and how.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MeshSettings {
-    /// Minimum angle, degrees (0 turns angle refinement off).
-    pub min_angle: f64,
-    /// Maximum triangle area, m².
-    pub max_area: Option<f64>,
-    /// Maximum edge length, m.
-    pub max_edge: Option<f64>,
-    /// Cap on the vertices refinement may add.
-    pub max_vertices: Option<usize>,
-    /// Vertical strips meshed in parallel (default: from the expected size).
-    pub strips: Option<usize>,
-    /// Smoothing iterations (0: none).
-    pub smooth: usize,
-    /// The smoother.
-    pub smoother: Smoother,
-    /// Points to insert as mesh vertices, in the region's coordinates.
-    pub points: Vec<[f64; 2]>,
-}
-
-impl Default for MeshSettings {
-    fn default() -> Self {
-        MeshSettings {
-            min_angle: DEFAULT_MIN_ANGLE,
-            max_area: None,
-            max_edge: None,
-            max_vertices: None,
-            strips: None,
-            smooth: 0,
-            smoother: DEFAULT_SMOOTHER,
-            points: Vec::new(),
-        }
-    }
-}
 
 /// A planar mesh with its quality before and after smoothing.
 #[derive(Debug)]
 pub struct PlanarMesh {
     /// The mesh (smoothed when asked).
     pub mesh: Mesh,
+    /// The mesh before smoothing, when it was smoothed.
+    pub unsmoothed: Option<Mesh>,
     /// What the builder did.
     pub report: BuildReport,
     /// Quality before smoothing.
@@ -80,39 +48,74 @@ pub struct PlanarMesh {
     pub smoothing: Option<(Smoother, usize, SmoothReport)>,
 }
 
-/// Meshes `region`: constrained Delaunay refinement to the angle and size limits, then
-/// smoothing.
-pub fn mesh_region(region: &LoadedRegion, s: &MeshSettings) -> Result<PlanarMesh> {
-    let mut builder = MeshBuilder::new().min_angle(s.min_angle);
-    if let Some(a) = s.max_area {
-        builder = builder.max_area(a);
+/// Meshes `region`: constrained Delaunay refinement to the angle and size limits of `plan`,
+/// then smoothing. `points` are inserted as vertices (absolute coordinates); `keep`, among
+/// them, are vertices smoothing does not move (borehole collars: data positions).
+/// [`MeshPlan::check`] is the caller's: every front end checks its plan once, before any work.
+pub fn mesh_region(
+    region: &LoadedRegion,
+    plan: &MeshPlan,
+    points: &[[f64; 2]],
+) -> Result<PlanarMesh> {
+    planar(&region.projected, plan, None, points, &[])
+}
+
+/// The planar mesh stage of every driver (a build, `terramesh mesh`, Python's `mesh()`, a
+/// tile): `plan` lowered into the kernel ([`MeshPlan::builder`], `default_max_area` when the
+/// plan gives no size limit), `points` inserted, then smoothing that keeps the vertices at
+/// `keep` (a subset of `points`) where they are.
+pub fn planar(
+    region: &Region,
+    plan: &MeshPlan,
+    default_max_area: Option<f64>,
+    points: &[[f64; 2]],
+    keep: &[[f64; 2]],
+) -> Result<PlanarMesh> {
+    let mut builder = plan.builder(default_max_area);
+    if !points.is_empty() {
+        builder = builder.points(points.to_vec());
     }
-    if let Some(l) = s.max_edge {
-        builder = builder.max_edge(l);
-    }
-    if let Some(n) = s.max_vertices {
-        builder = builder.max_vertices(n);
-    }
-    if !s.points.is_empty() {
-        builder = builder.points(s.points.clone());
-    }
-    if let Some(k) = s.strips {
-        builder = builder.strips(k);
-    }
-    let (mut mesh, report) = builder.build(&region.projected)?;
+    let (mut mesh, report) = builder.build(region)?;
     let before = Quality::planar(&mesh);
-    let smoothing = (s.smooth > 0).then(|| {
-        let r = smooth(&mut mesh, s.smoother, s.smooth);
-        (s.smoother, s.smooth, r)
-    });
+    if plan.smooth == 0 {
+        return Ok(PlanarMesh {
+            mesh,
+            unsmoothed: None,
+            report,
+            after: before.clone(),
+            before,
+            smoothing: None,
+        });
+    }
+    let kept = vertices_at(&mesh, keep);
+    let unsmoothed = mesh.clone();
+    let r = smooth_keeping(&mut mesh, plan.smoother, plan.smooth, &kept);
     let after = Quality::planar(&mesh);
     Ok(PlanarMesh {
         mesh,
+        unsmoothed: Some(unsmoothed),
         report,
         before,
         after,
-        smoothing,
+        smoothing: Some((plan.smoother, plan.smooth, r)),
     })
+}
+
+/// The vertices of `mesh` at `points` (inserted there; points outside the region have none).
+fn vertices_at(mesh: &Mesh, points: &[[f64; 2]]) -> Vec<u32> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    let mut at: std::collections::HashMap<(i64, i64), u32> = std::collections::HashMap::new();
+    // Millimetre keys: an inserted point is a vertex to rounding of its local coordinates.
+    let key = |p: [f64; 2]| ((p[0] * 1e3).round() as i64, (p[1] * 1e3).round() as i64);
+    for i in 0..mesh.points.len() {
+        at.insert(key(mesh.absolute(i)), i as u32);
+    }
+    points
+        .iter()
+        .filter_map(|p| at.get(&key(*p)).copied())
+        .collect()
 }
 
 fn region_line(region: &LoadedRegion) -> String {

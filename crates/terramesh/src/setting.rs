@@ -116,6 +116,20 @@ pub enum Setting {
     Plot,
     /// The largest block of the REML likelihood (0: exact, one block).
     RemlBlock,
+    /// The smallest angle of a planar mesh.
+    MinAngle,
+    /// The largest vertical error of a terrain-adaptive mesh.
+    MaxError,
+    /// The cap on the vertices mesh refinement may add.
+    MaxVertices,
+    /// The vertical strips a mesh is cut into to be meshed in parallel.
+    Strips,
+    /// The smoothing iterations of a mesh.
+    Smooth,
+    /// The smoother of a mesh.
+    Smoother,
+    /// The thickness below which a unit pinches out.
+    MinThickness,
 }
 
 impl Setting {
@@ -131,6 +145,9 @@ impl Setting {
         Some(match field {
             "max_area" => Setting::MaxArea,
             "max_edge" => Setting::MaxEdge,
+            "min_angle" => Setting::MinAngle,
+            "max_vertices" => Setting::MaxVertices,
+            "max_error" => Setting::MaxError,
             "neighbors" => Setting::Neighbors,
             "lags" => Setting::Lags,
             "grid" => Setting::Grid,
@@ -199,4 +216,11 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Modes => "modes",
     Setting::Plot => "plot",
     Setting::RemlBlock => "reml-block",
+    Setting::MinAngle => "min-angle",
+    Setting::MaxError => "max-error",
+    Setting::MaxVertices => "max-vertices",
+    Setting::Strips => "strips",
+    Setting::Smooth => "smooth",
+    Setting::Smoother => "smoother",
+    Setting::MinThickness => "min-thickness",
 ]);

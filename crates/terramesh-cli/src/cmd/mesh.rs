@@ -3,11 +3,12 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use terramesh::mesh::{adaptive_dem, mesh_region, read_points, DemHeights, MeshSettings};
+use terramesh::mesh::{adaptive_dem, mesh_region, read_points, DemHeights};
+use terramesh::plan::MeshPlan;
 use terramesh_core::coords::Zone;
 use terramesh_io::export::{write_mesh, writer_for, MeshView};
 use terramesh_io::region::{load, RegionCrs, RegionInput};
-use terramesh_mesh::{AdaptiveSettings, Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
+use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
 /// Mesh the study region: constrained Delaunay triangulation refined to a minimum angle and a
 /// maximum triangle area or edge length, optionally smoothed; written in UTM metres (z = 0).
@@ -90,22 +91,7 @@ pub fn run(args: Args) -> Result<()> {
         (None, Some(r)) => RegionInput::File(r.clone()),
         _ => bail!("give the region with --corners or --region"),
     };
-    let region = load(&input, args.crs, args.zone)?;
-    if let (Some(max_error), Some(path)) = (args.max_error, &args.dem) {
-        let dem = DemHeights::open(path, region.zone).map_err(error)?;
-        let mut settings = AdaptiveSettings::new(max_error);
-        settings.min_angle = args.min_angle;
-        settings.max_area = args.max_area;
-        if let Some(n) = args.max_vertices {
-            settings.max_vertices = n;
-        }
-        let a = adaptive_dem(&region, &dem, &settings).map_err(error)?;
-        let mut view = MeshView::planar(a.mesh.origin, &a.mesh.points, &a.mesh.triangles);
-        view.z = Some(&a.z);
-        view.point_data.push(("elevation", &a.z));
-        return write_and_say(&args.output, &view, a.summary(&region, &dem, max_error));
-    }
-    let settings = MeshSettings {
+    let plan = MeshPlan {
         min_angle: args.min_angle,
         max_area: args.max_area,
         max_edge: args.max_edge,
@@ -113,13 +99,26 @@ pub fn run(args: Args) -> Result<()> {
         strips: args.strips.map(usize::from),
         smooth: args.smooth,
         smoother: args.smoother,
-        points: match &args.points {
-            Some(p) => read_points(p, args.crs, region.zone).map_err(error)?,
-            None => Vec::new(),
-        },
+        max_error: args.max_error,
+        ..MeshPlan::unsmoothed()
     };
-    let m = mesh_region(&region, &settings)
-        .map_err(error)
+    plan.check().map_err(crate::flag_error)?;
+    let region = load(&input, args.crs, args.zone)?;
+    if let (Some(max_error), Some(path)) = (args.max_error, &args.dem) {
+        let dem = DemHeights::open(path, region.zone).map_err(crate::flag_error)?;
+        let a =
+            adaptive_dem(&region, &dem, &plan.adaptive(max_error)).map_err(crate::flag_error)?;
+        let mut view = MeshView::planar(a.mesh.origin, &a.mesh.points, &a.mesh.triangles);
+        view.z = Some(&a.z);
+        view.point_data.push(("elevation", &a.z));
+        return write_and_say(&args.output, &view, a.summary(&region, &dem, max_error));
+    }
+    let points = match &args.points {
+        Some(p) => read_points(p, args.crs, region.zone).map_err(crate::flag_error)?,
+        None => Vec::new(),
+    };
+    let m = mesh_region(&region, &plan, &points)
+        .map_err(crate::flag_error)
         .with_context(|| region_context(&input, &region))?;
     let view = MeshView::planar(m.mesh.origin, &m.mesh.points, &m.mesh.triangles);
     write_and_say(&args.output, &view, m.summary(&region))
@@ -137,14 +136,6 @@ fn region_context(input: &RegionInput, region: &terramesh_io::region::LoadedRegi
         .map(|z| format!(" in UTM zone {z}"))
         .unwrap_or_default();
     format!("{what} ({:.4e} m2{zone})", region.projected.area())
-}
-
-/// A library error in this command's words: mesh settings and DEM paths as flags.
-fn error(e: terramesh::Error) -> anyhow::Error {
-    match e {
-        terramesh::Error::Mesh(m) => crate::wording::mesh_error(m),
-        e => crate::flag_error(e),
-    }
 }
 
 /// Writes the mesh, then prints `text` and what was written.

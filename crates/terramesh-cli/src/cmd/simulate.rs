@@ -81,7 +81,7 @@ pub fn run(args: Args) -> Result<()> {
             .map_err(|e| {
                 anyhow::anyhow!(
                     "--grid {g}: {}: give fewer nodes or --realisations",
-                    e.describe(&crate::wording::flag_of_field)
+                    e.describe(&crate::flag_of_field)
                 )
             })?;
             let mut t = Vec::with_capacity(nodes);

@@ -9,7 +9,7 @@
 
 use crate::error::{bail, Context, Result};
 use terramesh_core::sampling::{GridSurface, Kernel};
-use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, AdaptiveSettings, Mesh};
+use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, Mesh};
 
 use super::stages::{Model, Samples, Surface};
 use crate::project::Project;
@@ -107,9 +107,7 @@ pub fn adaptive(
         );
     }
     let tolerance = target - grid_error;
-    let mut settings = AdaptiveSettings::new(tolerance);
-    settings.min_angle = m.min_angle;
-    settings.max_area = m.max_area;
+    let settings = m.adaptive(tolerance);
     let f = |x: f64, y: f64| surface.height(x, y, Kernel::Bilinear);
     let (mesh, _, report) =
         adaptive_mesh(&s.region.projected, &settings, &f).context("[mesh] adaptive refinement")?;

@@ -20,11 +20,11 @@ pub use lower::key_of;
 
 use std::path::PathBuf;
 
+use crate::plan::MeshPlan;
 use serde::Deserialize;
 use terramesh_core::sampling::Kernel;
 use terramesh_geostat::{Drift, InterpolationMethod, DEFAULT_IDW_POWER};
 use terramesh_io::export::{Format, DEFAULT_FORMATS};
-use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
 /// A whole project.
 #[derive(Debug, Clone, Deserialize)]
@@ -42,7 +42,7 @@ pub struct Project {
     pub sampling: SamplingSection,
     /// The planar mesh.
     #[serde(default)]
-    pub mesh: MeshSection,
+    pub mesh: MeshPlan,
     /// Interpolation of vertex elevations.
     #[serde(default)]
     pub interpolation: InterpolationSection,
@@ -134,42 +134,6 @@ impl Default for SamplingSection {
             margin: DEFAULT_MARGIN,
             clip: false,
             method: Kernel::Bilinear,
-        }
-    }
-}
-
-/// `[mesh]`: the planar mesh of step 3.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct MeshSection {
-    /// Maximum triangle area, m².
-    pub max_area: Option<f64>,
-    /// Maximum edge length, m.
-    pub max_edge: Option<f64>,
-    /// Minimum angle, degrees (up to 33).
-    pub min_angle: f64,
-    /// Smoothing iterations.
-    pub smooth: usize,
-    /// `laplacian`, `smart` or `odt`.
-    pub smoother: Smoother,
-    /// Insert the sample locations as mesh vertices.
-    pub insert_samples: bool,
-    /// Terrain-adaptive refinement: refine until the mesh surface is within this many metres
-    /// of the first interpolation method's surface at triangle centres and edge midpoints,
-    /// then improve the 3D triangle shape (replaces planar smoothing).
-    pub max_error: Option<f64>,
-}
-
-impl Default for MeshSection {
-    fn default() -> Self {
-        MeshSection {
-            max_area: None,
-            max_edge: None,
-            min_angle: DEFAULT_MIN_ANGLE,
-            smooth: DEFAULT_SMOOTH,
-            smoother: DEFAULT_SMOOTHER,
-            insert_samples: false,
-            max_error: None,
         }
     }
 }
@@ -462,9 +426,6 @@ pub const DEFAULT_METHODS: [InterpolationMethod; 2] =
 
 /// IDW neighbours of a project, by default.
 pub const DEFAULT_IDW_NEIGHBORS: usize = 16;
-
-/// Smoothing iterations of a project's mesh, by default.
-pub const DEFAULT_SMOOTH: usize = 10;
 
 /// The lowest `export.base_elevation` (and `[geology] base`) accepted, metres: the one bound
 /// of every elevation, [`terramesh_core::limits::MIN_ELEVATION`].

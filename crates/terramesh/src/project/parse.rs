@@ -3,9 +3,7 @@
 
 use std::path::Path;
 
-use terramesh_mesh::MAX_MIN_ANGLE;
-
-use super::{Project, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
+use super::{key_of, Project, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 use crate::error::{Error, Result};
 
 fn positive(v: f64) -> bool {
@@ -84,7 +82,7 @@ impl Project {
     /// let p = Project::parse("t.toml", TEMPLATE, &["mesh.min_angle=32".into()])?;
     /// assert_eq!(p.mesh.min_angle, 32.0);
     /// let e = Project::parse("t.toml", "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nmin_angle = 40\n", &[]);
-    /// assert_eq!(e.unwrap_err().to_string(), "t.toml, line 6: mesh.min_angle: must be in [0, 33] degrees (0 turns angle refinement off)");
+    /// assert_eq!(e.unwrap_err().to_string(), "t.toml, line 6: mesh.min_angle '40': must be between 0 and 33 degrees (0 turns angle refinement off): Delaunay refinement cannot guarantee more");
     /// # Ok::<(), terramesh::Error>(())
     /// ```
     pub fn parse(name: &str, text: &str, sets: &[String]) -> Result<Project> {
@@ -129,7 +127,7 @@ impl Project {
         project.validate().map_err(|(key, why)| Error::Project {
             file: name.to_string(),
             line: key_line(text_for_lines, &key),
-            why: format!("{key}: {why}"),
+            why,
         })?;
         let folder = Path::new(name).parent().unwrap_or(Path::new(""));
         project.geology_settings = project.geology.as_ref().map(|g| g.lower(folder));
@@ -138,7 +136,7 @@ impl Project {
 
     /// Checks every value; the error is the key and what is wrong with it.
     fn validate(&self) -> std::result::Result<(), (String, String)> {
-        let bad = |key: &str, why: &str| Err((key.to_string(), why.to_string()));
+        let bad = |key: &str, why: &str| Err((key.to_string(), format!("{key}: {why}")));
         match (&self.region.corners, &self.region.file) {
             (None, None) => {
                 return bad(
@@ -167,24 +165,7 @@ impl Project {
                 "must be 0 or positive (a fraction below 1, or metres)",
             );
         }
-        let m = &self.mesh;
-        if !(0.0..=MAX_MIN_ANGLE).contains(&m.min_angle) {
-            return bad(
-                "mesh.min_angle",
-                &format!("must be in [0, {MAX_MIN_ANGLE}] degrees (0 turns angle refinement off)"),
-            );
-        }
-        for (k, v) in [
-            ("mesh.max_area", m.max_area),
-            ("mesh.max_edge", m.max_edge),
-            ("mesh.max_error", m.max_error),
-        ] {
-            if let Some(v) = v {
-                if !positive(v) {
-                    return bad(k, "must be positive");
-                }
-            }
-        }
+        self.mesh.check().map_err(|e| key_and_why(&e))?;
         if let Some(g) = self.export.grid_spacing {
             if !positive(g) {
                 return bad("export.grid_spacing", "must be a positive number of metres");
@@ -273,10 +254,21 @@ impl Project {
             }
         }
         if let Some(g) = &self.geology {
-            g.validate()?;
+            g.validate()
+                .map_err(|(key, why)| (key.clone(), format!("{key}: {why}")))?;
         }
         Ok(())
     }
+}
+
+/// A sub-plan's error as the project key it names (for its line) and the message, each
+/// [`Setting`](crate::Setting) worded as its key.
+fn key_and_why(e: &Error) -> (String, String) {
+    let key = match e {
+        Error::Setting { setting, .. } => key_of(*setting),
+        _ => "[project]".to_string(),
+    };
+    (key, e.render(&key_of))
 }
 
 /// Applies `section.key=value` to the TOML table; the value is read as TOML (number, boolean,
@@ -416,7 +408,10 @@ mod tests {
     fn bad_values_name_the_key_and_its_line() {
         let text = "[region]\ncorners = \"0 0; 0 1; 1 1\"\n[source]\npath = \"x\"\n[mesh]\nsmooth = 3\nmax_area = -1\n";
         let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
-        assert_eq!(e, "p.toml, line 7: mesh.max_area: must be positive");
+        assert_eq!(
+            e,
+            "p.toml, line 7: mesh.max_area '-1': must be a positive number"
+        );
         let text =
             "[region]\ncorners = \"0 0; 0 1; 1 1\"\nfile = \"a.kml\"\n[source]\npath = \"x\"\n";
         let e = Project::parse("p.toml", text, &[]).unwrap_err().to_string();
@@ -428,16 +423,14 @@ mod tests {
     /// The template shows every default: its values are the constants the library uses.
     #[test]
     fn the_template_writes_every_default() {
-        use crate::project::{ExportSection, InterpolationSection, MeshSection, SamplingSection};
+        use crate::plan::MeshPlan;
+        use crate::project::{ExportSection, InterpolationSection, SamplingSection};
         let p = Project::parse("t.toml", TEMPLATE, &[]).unwrap();
         assert_eq!(
             format!("{:?}", p.sampling),
             format!("{:?}", SamplingSection::default())
         );
-        assert_eq!(
-            format!("{:?}", p.mesh),
-            format!("{:?}", MeshSection::default())
-        );
+        assert_eq!(p.mesh, MeshPlan::default());
         assert_eq!(
             format!("{:?}", p.interpolation),
             format!("{:?}", InterpolationSection::default())

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use terramesh_core::coords::Zone;
 use terramesh_io::region::LoadedRegion;
-use terramesh_mesh::{smooth_keeping, Mesh, MeshBuilder, Quality, SmoothReport};
+use terramesh_mesh::{Mesh, Quality, SmoothReport};
 
 use crate::acquire::{acquire, write_table, SamplePlan};
 use crate::error::{bail, Context, Result};
@@ -169,65 +169,22 @@ pub fn mesh(p: &Project, s: &Samples, model: &Model, keep: &[[f64; 2]]) -> Resul
 /// variogram needed).
 pub fn mesh_refined(p: &Project, s: &Samples, keep: &[[f64; 2]]) -> Result<Meshed> {
     let m = &p.mesh;
-    let mut builder = MeshBuilder::new().min_angle(m.min_angle);
     // Default size: one triangle per sampling cell, so the mesh resolves what was sampled.
-    let max_area = match (m.max_area, m.max_edge) {
-        (Some(a), _) => Some(a),
-        (None, Some(_)) => None,
-        (None, None) => Some(s.cell[0] * s.cell[1]),
-    };
-    if let Some(a) = max_area {
-        builder = builder.max_area(a);
-    }
-    if let Some(e) = m.max_edge {
-        builder = builder.max_edge(e);
-    }
+    let cell_area = Some(s.cell[0] * s.cell[1]);
     let mut points: Vec<[f64; 2]> = Vec::new();
     if m.insert_samples {
         points.extend(s.xyz.iter().map(|q| [q[0], q[1]]));
     }
     points.extend_from_slice(keep);
-    if !points.is_empty() {
-        builder = builder.points(points);
-    }
-    let (mut mesh, _) = builder.build(&s.region.projected).context("[mesh]")?;
-    let kept = vertices_at(&mesh, keep);
-    let unsmoothed = mesh.clone();
-    let before = Quality::planar(&mesh);
-    let smoothing = if m.smooth > 0 {
-        Some(smooth_keeping(&mut mesh, m.smoother, m.smooth, &kept))
-    } else {
-        None
-    };
-    // Unsmoothed, the mesh is the one measured already.
-    let after = match smoothing {
-        Some(_) => Quality::planar(&mesh),
-        None => before.clone(),
-    };
+    let planar =
+        crate::mesh::planar(&s.region.projected, m, cell_area, &points, keep).context("[mesh]")?;
     Ok(Meshed {
-        mesh,
-        unsmoothed,
-        before,
-        after,
-        smoothing,
-        max_area,
+        unsmoothed: planar.unsmoothed.unwrap_or_else(|| planar.mesh.clone()),
+        mesh: planar.mesh,
+        before: planar.before,
+        after: planar.after,
+        smoothing: planar.smoothing.map(|(_, _, r)| r),
+        max_area: m.area(cell_area),
         adaptive: None,
     })
-}
-
-/// The vertices of `mesh` at `points` (inserted there; points outside the region have none).
-fn vertices_at(mesh: &Mesh, points: &[[f64; 2]]) -> Vec<u32> {
-    if points.is_empty() {
-        return Vec::new();
-    }
-    let mut at: std::collections::HashMap<(i64, i64), u32> = std::collections::HashMap::new();
-    // Millimetre keys: an inserted point is a vertex to rounding of its local coordinates.
-    let key = |p: [f64; 2]| ((p[0] * 1e3).round() as i64, (p[1] * 1e3).round() as i64);
-    for i in 0..mesh.points.len() {
-        at.insert(key(mesh.absolute(i)), i as u32);
-    }
-    points
-        .iter()
-        .filter_map(|&p| at.get(&key(p)).copied())
-        .collect()
 }

@@ -1,0 +1,16 @@
+//! The resolved plan of a build: one typed sub-plan per stage, each with its defaults beside
+//! its type and its ranges checked once.
+//!
+//! Every front end lowers into these types: the project file (`[mesh]` is a [`MeshPlan`]
+//! read as TOML, `--set mesh.min_angle=32` included), the command line's flags (`terramesh
+//! mesh --min-angle 32`) and Python's keywords (`terramesh.mesh(min_angle=32)`). A sub-plan's
+//! `check` is the one range check of its settings; its errors are
+//! [`Error::Setting`](crate::Error::Setting), naming the [`Setting`](crate::Setting), which each
+//! front end words as a key, a flag or a keyword. The stages are functions of a sub-plan and
+//! their inputs; the drivers (build, model, the single commands, a tile) only schedule them.
+//! `ARCHITECTURE.md` walks `mesh.min_angle` and `geology.min_thickness` from each front end to
+//! the kernel.
+
+mod mesh;
+
+pub use mesh::{MeshPlan, DEFAULT_SMOOTH, MAX_STRIPS};
