@@ -389,12 +389,12 @@ pub fn boreholes(data: &[u8]) {
 
 /// A `[geology]` section, appended to a minimal projected project (lines after a line `---`
 /// are `--set key=value` overrides, as in [`project_toml`]). When the project parses, every
-/// value of [`terramesh::project::GeologySettings`] that reaches a coordinate or an allocation
+/// value of [`terramesh::plan::GeologyPlan`] that reaches a coordinate or an allocation
 /// is within its documented bound: the base elevation within `terramesh_core::limits`'
 /// elevations, `min_thickness` and `max_inversion` finite, 0 or more and at most the range of
 /// elevations, every unit's sub-layers 1 to `MAX_LAYERS`, one entry per unit.
 pub fn geology_toml(data: &[u8]) {
-    use terramesh::project::{Base, MAX_LAYERS};
+    use terramesh::plan::{Base, MAX_LAYERS};
     use terramesh_core::limits::{elevation_ok, MAX_ELEVATION, MIN_ELEVATION};
     let Some(s) = text(data) else { return };
     let (section, sets) = s.split_once("\n---\n").unwrap_or((s, ""));

@@ -256,7 +256,7 @@ struct Dsm<'a> {
 fn geology_stage(
     st: &mut Stages,
     project: &Project,
-    g: &crate::project::GeologySettings,
+    g: &crate::plan::GeologyPlan,
     boreholes: Option<terramesh_io::boreholes::Boreholes>,
     dsm: Dsm,
     model_crs: Option<&terramesh_crs::Crs>,
@@ -307,7 +307,7 @@ fn geology_stage(
 /// DSM carried over into `out`. `None` when there is no such DSM (the caller builds one).
 fn model_on_kept_dsm(
     project: &Project,
-    g: &crate::project::GeologySettings,
+    g: &crate::plan::GeologyPlan,
     key: u64,
     out: &Path,
     previous: &Path,

@@ -53,14 +53,14 @@ use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 use terramesh_mesh::Mesh;
 
-use terramesh_geology::Layering;
 use terramesh_io::model::{write_model_vtu, ModelInfo};
 
 use super::fields::{FieldModel, Observation};
 use super::model::{field_observations, seal, stack_of, Base, GeologicalModel, ModelInputs};
 use super::stage::ModelBuilt;
 use crate::error::{bail, Context, Error, Result};
-use crate::project::{GeologySettings, Project};
+use crate::plan::GeologyPlan;
+use crate::project::Project;
 
 /// The seed of the fields' random streams given the project's `seed` (SplitMix64), so that
 /// the fields and the DSM do not share their streams.
@@ -530,24 +530,20 @@ fn write_csv(
 /// `model.json` (rewritten) and the files to `built.files`.
 pub fn run(
     p: &Project,
-    g: &GeologySettings,
+    g: &GeologyPlan,
     built: &mut ModelBuilt,
     mesh: &Mesh,
     terrains: &[Vec<f64>],
     out: &Path,
 ) -> Result<()> {
     let central = &built.model;
-    let inputs = ModelInputs {
-        boreholes: built.boreholes.as_ref(),
-        grids: central.grids.clone(),
-        base: Base::PerVertex(central.stack.surfaces[central.stack.surfaces.len() - 1].clone()),
-        min_thickness: g.min_thickness,
-        layering: Layering::new(g.units.clone())
-            .layers(g.layers.clone())
-            .element(g.element),
-        interpolate: g.interpolate,
-        method: Method::Universal(p.interpolation.drift),
-    };
+    let inputs = g.model_inputs(
+        built.boreholes.as_ref(),
+        central.grids.clone(),
+        Base::PerVertex(central.stack.surfaces[central.stack.surfaces.len() - 1].clone()),
+        g.interpolate,
+        Method::Universal(p.interpolation.drift),
+    );
     let dir = out.join("realisations");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
     // The model's other writer settings keep their defaults (none today but the CRS).

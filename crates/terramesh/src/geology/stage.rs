@@ -11,7 +11,6 @@ use rayon::prelude::*;
 use terramesh_core::coords::{to_utm, Zone};
 use terramesh_core::volume::VolumeMesh;
 use terramesh_crs::{Crs, Transformer};
-use terramesh_geology::Layering;
 use terramesh_geology::Stack;
 use terramesh_io::boreholes::Boreholes;
 use terramesh_io::grid_write::{write_geotiff_heights, Heights, RasterGrid};
@@ -19,12 +18,12 @@ use terramesh_io::model::{write_model_with, ModelInfo};
 use terramesh_io::output::Output;
 use terramesh_mesh::Mesh;
 
-use super::model::{assemble_beside, Base, GeologicalModel, ModelInputs};
+use super::model::{assemble_beside, Base, GeologicalModel};
 use super::summary::{interface_grid, ModelSummary};
 use crate::error::{bail, Context, Error, Result};
 use crate::horizon::{HorizonError, HorizonGrid};
+use crate::plan::{Base as BaseKey, GeologyPlan};
 use crate::project::Project;
-use crate::project::{Base as BaseKey, GeologySettings};
 
 /// What the geology stage made.
 #[derive(Debug)]
@@ -55,7 +54,7 @@ pub fn project_crs(zone: Option<Zone>, crs: Option<&Crs>) -> Result<Option<Crs>>
 /// Reads the boreholes of `g`, projecting geographic collars into the project's CRS (the UTM
 /// zone, or the named CRS; a `crs = "projected"` project takes `x,y` collars only).
 pub fn read_boreholes(
-    g: &GeologySettings,
+    g: &GeologyPlan,
     zone: Option<Zone>,
     crs: Option<&Crs>,
 ) -> Result<Option<Boreholes>> {
@@ -88,7 +87,7 @@ pub fn read_boreholes(
 /// The boreholes of `g` when there is a `[geology]` section ([`read_boreholes`]) and the points
 /// they insert into the planar mesh ([`collar_points`]; none without boreholes).
 pub fn boreholes_and_collars(
-    g: Option<&GeologySettings>,
+    g: Option<&GeologyPlan>,
     zone: Option<Zone>,
     crs: Option<&Crs>,
 ) -> Result<(Option<Boreholes>, Vec<[f64; 2]>)> {
@@ -132,7 +131,7 @@ pub struct OpenedGrids(Vec<(PathBuf, std::result::Result<HorizonGrid, HorizonErr
 
 impl OpenedGrids {
     /// Opens every grid of `g`, one after the other (beside other work: one core).
-    pub fn open(g: &GeologySettings) -> OpenedGrids {
+    pub fn open(g: &GeologyPlan) -> OpenedGrids {
         let base = match &g.base {
             BaseKey::Raster(p) => Some(p),
             _ => None,
@@ -160,7 +159,7 @@ impl OpenedGrids {
 #[allow(clippy::too_many_arguments)]
 pub fn run(
     p: &Project,
-    g: &GeologySettings,
+    g: &GeologyPlan,
     boreholes: Option<Boreholes>,
     mesh: &Mesh,
     dsm: &[f64],
@@ -222,17 +221,13 @@ pub fn run(
             }
         }
     };
-    let inputs = ModelInputs {
-        boreholes: boreholes.as_ref(),
+    let inputs = g.model_inputs(
+        boreholes.as_ref(),
         grids,
         base,
-        min_thickness: g.min_thickness,
-        layering: Layering::new(g.units.clone())
-            .layers(g.layers.clone())
-            .element(g.element),
-        interpolate: g.interpolate,
-        method: terramesh_geostat::Method::Universal(p.interpolation.drift),
-    };
+        g.interpolate,
+        terramesh_geostat::Method::Universal(p.interpolation.drift),
+    );
     let crs_name = match (epsg, crs) {
         (Some(e), _) => format!("EPSG:{e}"),
         (None, Some(c)) => c.definition().to_string(),

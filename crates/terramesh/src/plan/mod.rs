@@ -11,6 +11,8 @@
 //! `ARCHITECTURE.md` walks `mesh.min_angle` and `geology.min_thickness` from each front end to
 //! the kernel.
 
+mod geology;
 mod mesh;
 
+pub use geology::{Base, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS, MAX_LAYERS};
 pub use mesh::{MeshPlan, DEFAULT_SMOOTH, MAX_STRIPS};

@@ -1,5 +1,5 @@
 //! `[geology]`: the stratigraphic column and its inputs (boreholes, horizon grids, the base),
-//! parsed with the other keys, checked, and lowered to [`GeologySettings`] with paths resolved
+//! parsed with the other keys, checked, and lowered to [`GeologyPlan`] with paths resolved
 //! against the project file's folder. Without a `[geology]` section nothing changes.
 //!
 //! ```
@@ -27,17 +27,11 @@ use terramesh_io::boreholes::{
 
 use super::{MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 use crate::error::{Error, Result};
+use crate::plan::{Base, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS, MAX_LAYERS};
 
 /// The commented `[geology]` section that `terramesh init --geology` appends to
 /// [`TEMPLATE`](super::TEMPLATE).
 pub const GEOLOGY_TEMPLATE: &str = include_str!("template-geology.toml");
-
-/// The thickness below which a unit pinches out, by default: 0 m (only absent units do).
-pub const DEFAULT_MIN_THICKNESS: f64 = 0.0;
-/// Vertical sub-layers of a unit, by default.
-pub const DEFAULT_LAYERS: usize = 1;
-/// The most vertical sub-layers of one unit.
-pub const MAX_LAYERS: usize = 1000;
 
 /// `[geology]` as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -60,7 +54,7 @@ pub struct GeologySection {
     #[serde(default)]
     pub base: BaseSpec,
     /// Thinner than this (metres), a unit pinches out.
-    #[serde(default)]
+    #[serde(default = "default_min_thickness")]
     pub min_thickness: f64,
     /// Vertical sub-layers per unit: `{ unit = n }` (default 1).
     #[serde(default)]
@@ -78,6 +72,10 @@ pub struct GeologySection {
     /// The largest inversion of borehole tops repaired (metres); larger ones are errors.
     #[serde(default = "default_max_inversion")]
     pub max_inversion: f64,
+}
+
+fn default_min_thickness() -> f64 {
+    DEFAULT_MIN_THICKNESS
 }
 
 fn default_max_inversion() -> f64 {
@@ -126,42 +124,6 @@ impl Default for BaseSpec {
     fn default() -> Self {
         BaseSpec::Text("auto".into())
     }
-}
-
-/// The model bottom.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Base {
-    /// Chosen by the model builder below the lowest interface.
-    Auto,
-    /// A flat base at this elevation, metres.
-    Elevation(f64),
-    /// A raster of base elevations (in `z_unit`).
-    Raster(PathBuf),
-}
-
-/// `[geology]` lowered: every value typed, paths resolved, per-unit settings in column order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GeologySettings {
-    /// The borehole files, when the project gives boreholes.
-    pub boreholes: Option<BoreholeFiles>,
-    /// The stratigraphic column, top to bottom.
-    pub units: Vec<String>,
-    /// The horizon grid of each unit's top, where one is given (index as `units`).
-    pub surfaces: Vec<Option<PathBuf>>,
-    /// The model bottom.
-    pub base: Base,
-    /// Pinch-out thickness, metres.
-    pub min_thickness: f64,
-    /// Vertical sub-layers of each unit (index as `units`).
-    pub layers: Vec<usize>,
-    /// The cells of the volume mesh.
-    pub element: Element,
-    /// What is interpolated between boreholes.
-    pub interpolate: Interpolated,
-    /// The vertical unit of the borehole files and grids.
-    pub z_unit: ZUnit,
-    /// The largest inversion of borehole tops repaired, metres.
-    pub max_inversion: f64,
 }
 
 fn nonneg(v: f64) -> bool {
@@ -265,10 +227,7 @@ impl GeologySection {
         }
         // A thickness or an inversion is at most the whole range of elevations.
         let most = MAX_BASE_ELEVATION - MIN_BASE_ELEVATION;
-        for (key, v) in [
-            ("min_thickness", self.min_thickness),
-            ("max_inversion", self.max_inversion),
-        ] {
+        for (key, v) in [("max_inversion", self.max_inversion)] {
             if !nonneg(v) {
                 return bad(key, "must be 0 or a positive number of metres".into());
             }
@@ -303,7 +262,7 @@ impl GeologySection {
     }
 
     /// The settings, with paths relative to `base` (the project file's folder).
-    pub(crate) fn lower(&self, base: &Path) -> GeologySettings {
+    pub(crate) fn lower(&self, base: &Path) -> GeologyPlan {
         let boreholes = self.collars.as_ref().and_then(|c| {
             let log = match (&self.intervals, &self.tops) {
                 (Some(i), _) => LogFile::Intervals(base.join(i)),
@@ -316,7 +275,7 @@ impl GeologySection {
                 survey: self.survey.as_ref().map(|s| base.join(s)),
             })
         });
-        GeologySettings {
+        GeologyPlan {
             boreholes,
             surfaces: self
                 .units
@@ -359,7 +318,7 @@ fn readable(key: &str, path: &Path) -> Result<()> {
     })
 }
 
-impl GeologySettings {
+impl GeologyPlan {
     /// The options of the borehole reader: the column, `z_unit`, `max_inversion` and the
     /// projection of geographic collars (`None`: only `x,y` collars).
     pub fn borehole_options<'a>(&self, project: Option<Projection<'a>>) -> BoreholeOptions<'a> {

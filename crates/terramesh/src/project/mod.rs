@@ -12,15 +12,12 @@ mod parse;
 
 pub use crs::ProjectCrs;
 pub use datum::{HeightDatum, KNOWN_VERTICAL_DATUMS};
-pub use geology::{
-    Base, BaseSpec, GeologySection, GeologySettings, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS,
-    GEOLOGY_TEMPLATE, MAX_LAYERS,
-};
+pub use geology::{BaseSpec, GeologySection, GEOLOGY_TEMPLATE};
 pub use lower::key_of;
 
 use std::path::PathBuf;
 
-use crate::plan::MeshPlan;
+use crate::plan::{GeologyPlan, MeshPlan};
 use serde::Deserialize;
 use terramesh_core::sampling::Kernel;
 use terramesh_geostat::{Drift, InterpolationMethod, DEFAULT_IDW_POWER};
@@ -54,7 +51,7 @@ pub struct Project {
     pub geology: Option<GeologySection>,
     /// `[geology]` lowered by [`Project::parse`].
     #[serde(skip)]
-    geology_settings: Option<GeologySettings>,
+    geology_settings: Option<GeologyPlan>,
 }
 
 impl Project {
@@ -67,7 +64,7 @@ impl Project {
     /// assert!(Project::parse("t.toml", TEMPLATE, &[])?.geology().is_none());
     /// # Ok::<(), terramesh::Error>(())
     /// ```
-    pub fn geology(&self) -> Option<&GeologySettings> {
+    pub fn geology(&self) -> Option<&GeologyPlan> {
         self.geology_settings.as_ref()
     }
 }

@@ -131,6 +131,16 @@ impl Project {
         })?;
         let folder = Path::new(name).parent().unwrap_or(Path::new(""));
         project.geology_settings = project.geology.as_ref().map(|g| g.lower(folder));
+        if let Some(g) = &project.geology_settings {
+            g.check().map_err(|e| {
+                let (key, why) = key_and_why(&e);
+                Error::Project {
+                    file: name.to_string(),
+                    line: key_line(text_for_lines, &key),
+                    why,
+                }
+            })?;
+        }
         Ok(project)
     }
 

@@ -16,7 +16,8 @@ use crate::build::stages::Samples;
 use crate::error::{Context, Error, Result};
 use crate::geology::fields::MIN_KRIGED;
 use crate::geology::model::AUTO_BASE_MARGIN;
-use crate::project::{Base as BaseKey, GeologySettings, Project};
+use crate::plan::{Base as BaseKey, GeologyPlan as GeologySettings};
+use crate::project::Project;
 /// The plan of the geological model of `p` (None without `[geology]`), its files written
 /// into `out/geology/`, and each tile's geology halo for the extents `rects` (probe spacing
 /// `h`).

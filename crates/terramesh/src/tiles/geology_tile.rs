@@ -6,7 +6,6 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 use terramesh_core::volume::{Body, Cell, FaceTag, Interpolated, TaggedFace};
-use terramesh_geology::Layering;
 use terramesh_geostat::{Data, Duplicates, Idw, IdwSearch, KrigingFrame, Method, Predictor};
 use terramesh_mesh::Mesh;
 
@@ -15,7 +14,8 @@ use super::geology_plan::horizon_at;
 use crate::build::stages::Surface;
 use crate::error::{Context, Error, Result};
 use crate::geology::model::{assemble, Base, ModelInputs};
-use crate::project::{Base as BaseKey, Project};
+use crate::plan::Base as BaseKey;
+use crate::project::Project;
 
 /// One tile's geological model.
 pub(crate) struct TileModel {
@@ -184,17 +184,7 @@ pub(crate) fn build_model(
                 "the plan samples a base grid but the project's geology.base is none: plan again",
             )),
         };
-    let inputs = ModelInputs {
-        boreholes: None,
-        grids,
-        base,
-        min_thickness: g.min_thickness,
-        layering: Layering::new(g.units.clone())
-            .layers(g.layers.clone())
-            .element(g.element),
-        interpolate: Interpolated::Tops,
-        method: Method::Ordinary,
-    };
+    let inputs = g.model_inputs(None, grids, base, Interpolated::Tops, Method::Ordinary);
     let model = if gp.thickness {
         thickness_model(&mesh, terrain, &inputs)
     } else {
