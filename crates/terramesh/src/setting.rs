@@ -130,6 +130,8 @@ pub enum Setting {
     Smoother,
     /// The thickness below which a unit pinches out.
     MinThickness,
+    /// The largest inversion of borehole tops repaired.
+    MaxInversion,
 }
 
 impl Setting {
@@ -223,4 +225,5 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Smooth => "smooth",
     Setting::Smoother => "smoother",
     Setting::MinThickness => "min-thickness",
+    Setting::MaxInversion => "max-inversion",
 ]);

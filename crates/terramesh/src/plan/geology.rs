@@ -74,27 +74,31 @@ pub struct GeologyPlan {
 
 impl GeologyPlan {
     /// Checks the values a front end may set after lowering: the one range check of
-    /// `min_thickness` (0 up to the whole range of elevations).
+    /// `min_thickness` and `max_inversion` (0 up to the whole range of elevations).
     pub fn check(&self) -> Result<()> {
         let most = MAX_ELEVATION - MIN_ELEVATION;
-        let t = self.min_thickness;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Error::setting(
-                Setting::MinThickness,
-                t,
-                "must be 0 or a positive number of metres",
-            ));
-        }
-        if t > most {
-            return Err(Error::setting(
-                Setting::MinThickness,
-                "",
-                format!(
-                    "{} m is more than the whole range of elevations ({MIN_ELEVATION} to \
-                     {MAX_ELEVATION} m): give 0 to {most} metres",
-                    terramesh_core::limits::short(t)
-                ),
-            ));
+        for (setting, v) in [
+            (Setting::MinThickness, self.min_thickness),
+            (Setting::MaxInversion, self.max_inversion),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::setting(
+                    setting,
+                    v,
+                    "must be 0 or a positive number of metres",
+                ));
+            }
+            if v > most {
+                return Err(Error::setting(
+                    setting,
+                    "",
+                    format!(
+                        "{} m is more than the whole range of elevations ({MIN_ELEVATION} to \
+                         {MAX_ELEVATION} m): give 0 to {most} metres",
+                        terramesh_core::limits::short(v)
+                    ),
+                ));
+            }
         }
         Ok(())
     }

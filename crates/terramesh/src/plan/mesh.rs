@@ -179,7 +179,8 @@ mod tests {
     fn every_range_is_checked_and_named() {
         assert!(MeshPlan::default().check().is_ok());
         assert!(MeshPlan::unsmoothed().check().is_ok());
-        let cases: [(fn(&mut MeshPlan), Setting); 7] = [
+        type Spoil = fn(&mut MeshPlan);
+        let cases: [(Spoil, Setting); 7] = [
             (|p| p.min_angle = 33.5, Setting::MinAngle),
             (|p| p.min_angle = -1.0, Setting::MinAngle),
             (|p| p.max_area = Some(0.0), Setting::MaxArea),

@@ -126,10 +126,6 @@ impl Default for BaseSpec {
     }
 }
 
-fn nonneg(v: f64) -> bool {
-    v.is_finite() && v >= 0.0
-}
-
 impl GeologySection {
     /// Checks every value; the error is the key and what is wrong with it.
     pub(crate) fn validate(&self) -> std::result::Result<(), (String, String)> {
@@ -222,23 +218,6 @@ impl GeologySection {
                 return bad(
                     &format!("layers.{k}"),
                     format!("{n} sub-layers: give 1 to {MAX_LAYERS}"),
-                );
-            }
-        }
-        // A thickness or an inversion is at most the whole range of elevations.
-        let most = MAX_BASE_ELEVATION - MIN_BASE_ELEVATION;
-        for (key, v) in [("max_inversion", self.max_inversion)] {
-            if !nonneg(v) {
-                return bad(key, "must be 0 or a positive number of metres".into());
-            }
-            if v > most {
-                return bad(
-                    key,
-                    format!(
-                        "{} m is more than the whole range of elevations ({MIN_BASE_ELEVATION} \
-                         to {MAX_BASE_ELEVATION} m): give 0 to {most} metres",
-                        terramesh_core::limits::short(v)
-                    ),
                 );
             }
         }
