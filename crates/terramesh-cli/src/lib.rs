@@ -12,7 +12,6 @@ use clap::{Parser, Subcommand};
 mod cmd;
 mod interrupt;
 mod progress;
-mod wording;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
 ///
@@ -103,16 +102,6 @@ static PROGRAM: OnceLock<PathBuf> = OnceLock::new();
 /// Runs a parsed command and words its outcome as an exit code.
 fn execute(cli: Cli) -> u8 {
     interrupt::install();
-    // A project's settings are keys, worded by the library; a command's are flags.
-    let flags = !matches!(
-        cli.command,
-        Command::Build(_) | Command::Model(_) | Command::Init(_) | Command::Tiles(_)
-    );
-    let crs = if matches!(cli.command, Command::Mesh(_)) {
-        "--crs"
-    } else {
-        "--region-crs"
-    };
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
@@ -137,15 +126,9 @@ fn execute(cli: Cli) -> u8 {
         }
         Ok(()) => 0,
         Err(e) => {
-            // The context chain on one line: "file, line 3: what is wrong".
-            // Library phrases become the flags they stand for (`wording`).
-            let text = one_line(&e);
-            let text = if flags {
-                wording::flag_words(&text, crs)
-            } else {
-                text
-            };
-            eprintln!("terramesh: error: {text}");
+            // The context chain on one line: "file, line 3: what is wrong" (settings already
+            // worded as flags or keys where the library's error was caught).
+            eprintln!("terramesh: error: {}", one_line(&e));
             1
         }
     }

@@ -179,6 +179,50 @@ fn setting_message(
 
 pub use terramesh_io::quote::cut;
 
+/// The errors of the coordinate, table and region readers that name a setting in words
+/// ("force a zone", "name the columns", "the corner list"), with that setting worded by
+/// `word`; `None` for any other error.
+fn kernel_words(
+    e: &(dyn std::error::Error + 'static),
+    word: &dyn Fn(Setting) -> String,
+) -> Option<String> {
+    use terramesh_core::coords::CoordError;
+    use terramesh_io::table::TableError;
+    // This crate's transparent wrappers hide the kernel error from the chain: look inside.
+    let e: &(dyn std::error::Error + 'static) = match e.downcast_ref::<Error>() {
+        Some(Error::Coord(c)) => c,
+        Some(Error::Table(t)) => t,
+        Some(Error::Region(r)) => r,
+        _ => e,
+    };
+    if let Some(CoordError::OutsideUtm(lat)) = e.downcast_ref::<CoordError>() {
+        return Some(format!(
+            "latitude {lat} is outside the UTM domain (-80..84 degrees); force a zone with {} to \
+             project it anyway",
+            word(Setting::Zone)
+        ));
+    }
+    if let Some(TableError::MissingColumn {
+        file,
+        wanted,
+        found,
+    }) = e.downcast_ref::<TableError>()
+    {
+        return Some(format!(
+            "{file}: no column {wanted} (the header has: {found}); rename the column, or for a \
+             file without a header name the columns with {}",
+            word(Setting::Columns)
+        ));
+    }
+    if let Some(r) = e.downcast_ref::<terramesh_io::region::RegionError>() {
+        let text = r.to_string();
+        if let Some(rest) = text.strip_prefix(terramesh_io::region::CORNER_LIST) {
+            return Some(format!("{}{rest}", word(Setting::Corners)));
+        }
+    }
+    None
+}
+
 /// A mesh kernel's error with the settings it names (fields of the kernel's builder) worded
 /// as the front end words them.
 fn mesh_message(m: &terramesh_mesh::MeshError, word: &dyn Fn(Setting) -> String) -> String {
@@ -245,7 +289,7 @@ impl Error {
     /// assert_eq!(e.render(&|s| format!("--{}", s)), "--margin 'ten': give a fraction such as 0.1 or metres such as 50m");
     /// ```
     pub fn render(&self, name: &dyn Fn(Setting) -> String) -> String {
-        let mut parts = Vec::new();
+        let mut parts: Vec<String> = Vec::new();
         let mut cur: Option<&(dyn std::error::Error + 'static)> = Some(self);
         while let Some(e) = cur {
             let text = match e.downcast_ref::<Error>() {
@@ -261,6 +305,18 @@ impl Error {
                 ) => t.describe(&|field| Setting::of_field(field).map_or(field.to_string(), name)),
                 Some(Error::Mesh(m)) => mesh_message(m, name),
                 _ => e.to_string(),
+            };
+            // A kernel error that names a setting in words, worded from its fields; its
+            // wrappers ("{file}: {source}") show it worded too.
+            let text = match kernel_words(e, name) {
+                Some(worded) => {
+                    let plain = e.to_string();
+                    for p in parts.iter_mut() {
+                        *p = p.replace(&plain, &worded);
+                    }
+                    worded
+                }
+                None => text,
             };
             // Transparent wrappers, and messages such as "{file}: {source}", already show
             // their cause: write it once.
@@ -323,6 +379,51 @@ pub(crate) use bail;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Kernel errors that name a setting in words are worded by each front end, inside their
+    /// wrappers too, from the error's type and fields (no phrase list).
+    #[test]
+    fn kernel_errors_word_their_settings() {
+        let flag = |s: Setting| format!("--{s}");
+        let key = crate::project::key_of;
+        let utm: Result<()> = Err(terramesh_core::coords::CoordError::OutsideUtm(84.5).into());
+        let e = utm.context("polar.csv, line 3").unwrap_err();
+        assert!(e
+            .render(&flag)
+            .contains("force a zone with --zone to project it"));
+        assert!(e
+            .render(&key)
+            .contains("force a zone with region.zone to project it"));
+        let cols = terramesh_io::table::TableError::MissingColumn {
+            file: "p.csv".into(),
+            wanted: "'lat'".into(),
+            found: "a, b".into(),
+        };
+        let e = Error::within("reading points", cols);
+        assert!(
+            e.render(&flag).ends_with("name the columns with --columns"),
+            "{}",
+            e.render(&flag)
+        );
+        let corners = terramesh_io::region::load(
+            &terramesh_io::region::RegionInput::Corners("48 7; 48.1 7.1".into()),
+            terramesh_io::region::RegionCrs::Geographic,
+            None,
+        )
+        .unwrap_err();
+        let e = Error::from(corners);
+        assert!(
+            e.render(&flag).starts_with("--corners"),
+            "{}",
+            e.render(&flag)
+        );
+        assert!(
+            e.render(&key).starts_with("region.corners"),
+            "{}",
+            e.render(&key)
+        );
+        assert!(e.to_string().starts_with(terramesh_io::region::CORNER_LIST));
+    }
 
     #[test]
     fn render_walks_the_chain_and_words_settings() {

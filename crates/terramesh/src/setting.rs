@@ -132,6 +132,8 @@ pub enum Setting {
     MinThickness,
     /// The largest inversion of borehole tops repaired.
     MaxInversion,
+    /// The region's corners given inline.
+    Corners,
 }
 
 impl Setting {
@@ -226,4 +228,5 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Smoother => "smoother",
     Setting::MinThickness => "min-thickness",
     Setting::MaxInversion => "max-inversion",
+    Setting::Corners => "corners",
 ]);

@@ -5,7 +5,6 @@ use std::time::Instant;
 
 use anyhow::Result;
 use terramesh::project::Project;
-use terramesh_io::region::CORNER_LIST;
 
 use crate::progress::Terminal;
 
@@ -73,14 +72,9 @@ pub(crate) fn run_project(
 }
 
 /// A build's error, worded with project keys and said of the project file: a build error is
-/// about the file the user wrote, so it names it first (unless the message already does), and
-/// the inline corner list the library calls [`CORNER_LIST`] is the key `region.corners`.
+/// about the file the user wrote, so it names it first (unless the message already does).
 fn build_error(project: &Path, e: terramesh::Error) -> anyhow::Error {
     let msg = e.render(&terramesh::project::key_of);
-    let msg = match msg.strip_prefix(CORNER_LIST) {
-        Some(rest) => format!("region.corners{rest}"),
-        None => msg,
-    };
     let name = project.display().to_string();
     if msg.contains(&name) {
         anyhow::anyhow!(msg)

@@ -56,7 +56,7 @@ pub fn run(args: Args) -> Result<()> {
         columns: args.columns.clone(),
         delimiter,
     };
-    let table = Table::read(&args.input, &opts)?;
+    let table = Table::read(&args.input, &opts).map_err(|e| crate::flag_error(e.into()))?;
     let name = args
         .output
         .as_ref()

@@ -103,7 +103,7 @@ pub fn run(args: Args) -> Result<()> {
         ..MeshPlan::unsmoothed()
     };
     plan.check().map_err(crate::flag_error)?;
-    let region = load(&input, args.crs, args.zone)?;
+    let region = load(&input, args.crs, args.zone).map_err(|e| crate::flag_error(e.into()))?;
     if let (Some(max_error), Some(path)) = (args.max_error, &args.dem) {
         let dem = DemHeights::open(path, region.zone).map_err(crate::flag_error)?;
         let a =

@@ -38,6 +38,7 @@ pub fn key_of(s: Setting) -> String {
         Setting::Smoother => "mesh.smoother",
         Setting::MinThickness => "geology.min_thickness",
         Setting::MaxInversion => "geology.max_inversion",
+        Setting::Corners => "region.corners",
         Setting::Neighbors => "interpolation.neighbors",
         Setting::GridSpacing => "export.grid_spacing",
         Setting::Realisations => "interpolation.realisations",
