@@ -51,8 +51,8 @@ fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
     d.set_item("weighting", lags.weights.name())?;
     d.set_item("reml_block", lags.reml_block)?;
     d.set_item("idw_power", terramesh_geostat::DEFAULT_IDW_POWER)?;
-    d.set_item("rows", terramesh::project::DEFAULT_ROWS)?;
-    d.set_item("cols", terramesh::project::DEFAULT_COLS)?;
-    d.set_item("margin", terramesh::project::DEFAULT_MARGIN)?;
+    d.set_item("rows", terramesh::plan::DEFAULT_ROWS)?;
+    d.set_item("cols", terramesh::plan::DEFAULT_COLS)?;
+    d.set_item("margin", terramesh::plan::DEFAULT_MARGIN)?;
     Ok(d)
 }

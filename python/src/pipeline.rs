@@ -26,7 +26,7 @@ type SampleRow = (Option<[f64; 2]>, [f64; 2], Option<f64>);
 /// output), `x`, `y`, `z` (NaN where missing and `on_missing="skip"` did not drop it) and
 /// the zone.
 #[pyfunction]
-#[pyo3(signature = (source, region=None, region_file=None, geographic=true, zone=None, rows=Some(terramesh::project::DEFAULT_ROWS), cols=Some(terramesh::project::DEFAULT_COLS), spacing=None, margin=None, clip=false, on_missing="error", output=None, progress=false))]
+#[pyo3(signature = (source, region=None, region_file=None, geographic=true, zone=None, rows=Some(terramesh::plan::DEFAULT_ROWS), cols=Some(terramesh::plan::DEFAULT_COLS), spacing=None, margin=None, clip=false, on_missing="error", output=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 fn sample<'py>(
     py: Python<'py>,
@@ -64,7 +64,7 @@ fn sample<'py>(
         (None, _, _) => return Err(input("sample: give rows and cols, or spacing")),
     };
     o.margin = match margin {
-        None => MarginSpec::Fraction(terramesh::project::DEFAULT_MARGIN),
+        None => MarginSpec::Fraction(terramesh::plan::DEFAULT_MARGIN),
         Some(m) => m
             .parse::<MarginSpec>()
             .map_err(|e| input(format!("margin '{m}': {e}")))?,

@@ -134,6 +134,16 @@ pub enum Setting {
     MaxInversion,
     /// The region's corners given inline.
     Corners,
+    /// The rows of a sampling grid.
+    Rows,
+    /// The interpolation methods of a build.
+    Methods,
+    /// What an automatic variogram fit fits.
+    FitModel,
+    /// The base of the sealed solid.
+    BaseElevation,
+    /// The model name(s) of a given variogram.
+    ModelName,
 }
 
 impl Setting {
@@ -229,4 +239,9 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::MinThickness => "min-thickness",
     Setting::MaxInversion => "max-inversion",
     Setting::Corners => "corners",
+    Setting::Rows => "rows",
+    Setting::Methods => "methods",
+    Setting::FitModel => "fit-model",
+    Setting::BaseElevation => "base-elevation",
+    Setting::ModelName => "model-name",
 ]);

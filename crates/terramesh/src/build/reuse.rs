@@ -87,6 +87,23 @@ fn hash_path(h: &mut impl Hasher, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The mesh sub-plan as the key has always written it (`MeshSection { .. }`, its Debug form
+/// before the plan), with the keys added since (`max_vertices`, `strips`) only when set.
+fn mesh_key(m: &crate::plan::MeshPlan) -> String {
+    let mut text = format!(
+        "MeshSection {{ max_area: {:?}, max_edge: {:?}, min_angle: {:?}, smooth: {:?}, \
+         smoother: {:?}, insert_samples: {:?}, max_error: {:?} }}",
+        m.max_area, m.max_edge, m.min_angle, m.smooth, m.smoother, m.insert_samples, m.max_error
+    );
+    if m.max_vertices.is_some() || m.strips.is_some() {
+        text += &format!(
+            " max_vertices: {:?}, strips: {:?}",
+            m.max_vertices, m.strips
+        );
+    }
+    text
+}
+
 /// The key of what makes `p`'s DSM (paths relative to `base`): see the module documentation.
 pub fn key(p: &Project, base: &Path) -> Result<u64> {
     let mut h = hasher();
@@ -99,10 +116,14 @@ pub fn key(p: &Project, base: &Path) -> Result<u64> {
         p.region.crs,
         p.source,
         p.sampling,
-        p.mesh,
+        mesh_key(&p.mesh),
         p.interpolation,
         p.export.grid_spacing
     )
+    // The sub-plans' names as the key has always written them, so that a DSM kept by an
+    // earlier version stays valid.
+    .replace("SamplingPlan {", "SamplingSection {")
+    .replace("InterpolationPlan {", "InterpolationSection {")
     .hash(&mut h);
     // `interpolation.neighbors` and `cv_folds` print 0 whether set to 0 or unset (left to the
     // build, `scale.rs`), so that the keys of projects setting neither are what they were; an

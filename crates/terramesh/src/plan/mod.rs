@@ -11,8 +11,16 @@
 //! `ARCHITECTURE.md` walks `mesh.min_angle` and `geology.min_thickness` from each front end to
 //! the kernel.
 
+mod export;
 mod geology;
+mod interpolation;
 mod mesh;
+mod sample;
 
+pub use export::{ExportPlan, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 pub use geology::{Base, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS, MAX_LAYERS};
+pub use interpolation::{
+    Auto, InterpolationPlan, Numbers, VariogramSpec, DEFAULT_IDW_NEIGHBORS, DEFAULT_METHODS,
+};
 pub use mesh::{MeshPlan, DEFAULT_SMOOTH, MAX_STRIPS};
+pub use sample::{SamplingPlan, DEFAULT_COLS, DEFAULT_MARGIN, DEFAULT_ROWS};

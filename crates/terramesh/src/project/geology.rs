@@ -3,7 +3,8 @@
 //! against the project file's folder. Without a `[geology]` section nothing changes.
 //!
 //! ```
-//! use terramesh::project::{Base, Project, GEOLOGY_TEMPLATE, TEMPLATE};
+//! use terramesh::plan::Base;
+//! use terramesh::project::{Project, GEOLOGY_TEMPLATE, TEMPLATE};
 //! let text = format!("{TEMPLATE}{GEOLOGY_TEMPLATE}");
 //! let p = Project::parse("site/terramesh.toml", &text, &["geology.min_thickness=1".into()])?;
 //! let g = p.geology().expect("a [geology] section");
@@ -25,9 +26,11 @@ use terramesh_io::boreholes::{
     BoreholeFiles, BoreholeOptions, Boreholes, LogFile, Projection, DEFAULT_MAX_INVERSION,
 };
 
-use super::{MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 use crate::error::{Error, Result};
-use crate::plan::{Base, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS, MAX_LAYERS};
+use crate::plan::{
+    Base, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_LAYERS,
+    MIN_BASE_ELEVATION,
+};
 
 /// The commented `[geology]` section that `terramesh init --geology` appends to
 /// [`TEMPLATE`](super::TEMPLATE).

@@ -3,12 +3,8 @@
 
 use std::path::Path;
 
-use super::{key_of, Project, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
+use super::{key_of, Project};
 use crate::error::{Error, Result};
-
-fn positive(v: f64) -> bool {
-    v.is_finite() && v > 0.0
-}
 
 /// The 1-based line of byte `offset` in `text`.
 fn line_at(text: &str, offset: usize) -> usize {
@@ -157,112 +153,10 @@ impl Project {
             (Some(_), Some(_)) => return bad("[region]", "give either corners or file, not both"),
             _ => {}
         }
-        let s = &self.sampling;
-        if s.spacing.is_none() && (s.rows < 2 || s.cols < 2) {
-            return bad(
-                "sampling.rows",
-                "need at least 2 rows and 2 cols (or give sampling.spacing)",
-            );
-        }
-        if let Some(sp) = s.spacing {
-            if !positive(sp) {
-                return bad("sampling.spacing", "must be a positive number of metres");
-            }
-        }
-        if !(s.margin >= 0.0 && s.margin.is_finite()) {
-            return bad(
-                "sampling.margin",
-                "must be 0 or positive (a fraction below 1, or metres)",
-            );
-        }
+        self.sampling.check().map_err(|e| key_and_why(&e))?;
         self.mesh.check().map_err(|e| key_and_why(&e))?;
-        if let Some(g) = self.export.grid_spacing {
-            if !positive(g) {
-                return bad("export.grid_spacing", "must be a positive number of metres");
-            }
-        }
-        let i = &self.interpolation;
-        if i.methods.is_empty() {
-            return bad(
-                "interpolation.methods",
-                "name at least one of \"uk\", \"ok\", \"sk\", \"idw\" (the first gives the DSM)",
-            );
-        }
-        let neighbors = i.neighbors.or(0);
-        if neighbors != 0 && neighbors < i.drift.terms() {
-            return bad(
-                "interpolation.neighbors",
-                &format!(
-                    "{} is too few: universal kriging with a {} drift needs at least {} \
-                     neighbours (or 0 for all samples)",
-                    neighbors,
-                    i.drift,
-                    i.drift.terms()
-                ),
-            );
-        }
-        if i.cv_folds.get() == Some(1) {
-            return bad(
-                "interpolation.cv_folds",
-                "1 fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more folds",
-            );
-        }
-        if !positive(i.idw_power) {
-            return bad("interpolation.idw_power", "must be positive");
-        }
-        if let Some(v) = &i.model {
-            if let Err(e) = v.variogram() {
-                let (key, why) = e.split_once(": ").unwrap_or(("interpolation.model", &e));
-                return bad(key, why);
-            }
-        }
-        if !i.fit_model.eq_ignore_ascii_case("auto") {
-            if let Err(e) = crate::fitting::parse_models(&i.fit_model) {
-                return bad(
-                    "interpolation.fit_model",
-                    e.render(&|_| String::new()).trim_start(),
-                );
-            }
-        }
-        match i.anisotropy.to_ascii_lowercase().as_str() {
-            "none" | "auto" => {}
-            _ => {
-                return bad(
-                    "interpolation.anisotropy",
-                    &format!(
-                        "\"{}\": expected \"none\" or \"auto\" (a given model's anisotropy is model.anisotropy_angle and model.anisotropy_ratio)",
-                        i.anisotropy
-                    ),
-                )
-            }
-        }
-        if i.external_drift_grid.is_some()
-            && i.methods
-                .contains(&terramesh_geostat::InterpolationMethod::Simple)
-        {
-            return bad(
-                "interpolation.external_drift_grid",
-                "simple kriging (\"sk\" in interpolation.methods) has a known mean and no drift: krige with \"uk\" or \"ok\"",
-            );
-        }
-        let x = &self.export;
-        if let Some(b) = x.base_elevation {
-            if !(MIN_BASE_ELEVATION..=MAX_BASE_ELEVATION).contains(&b) {
-                return bad(
-                    "export.base_elevation",
-                    &format!(
-                        "{b} m is not an elevation on Earth: give metres between \
-                         {MIN_BASE_ELEVATION} and {MAX_BASE_ELEVATION}, below the lowest \
-                         point of the surface (or leave it out: 50 m below it)"
-                    ),
-                );
-            }
-        }
-        if let Some(g) = x.grid_spacing {
-            if !positive(g) {
-                return bad("export.grid_spacing", "must be a positive number of metres");
-            }
-        }
+        self.interpolation.check().map_err(|e| key_and_why(&e))?;
+        self.export.check().map_err(|e| key_and_why(&e))?;
         if let Some(g) = &self.geology {
             g.validate()
                 .map_err(|(key, why)| (key.clone(), format!("{key}: {why}")))?;
@@ -340,7 +234,7 @@ mod tests {
         assert_eq!(p.sampling.rows, 100);
         assert_eq!(p.sampling.cols, 50);
         assert_eq!(p.mesh.min_angle, 30.0);
-        assert_eq!(p.interpolation.methods, crate::project::DEFAULT_METHODS);
+        assert_eq!(p.interpolation.methods, crate::plan::DEFAULT_METHODS);
     }
 
     #[test]
@@ -434,26 +328,26 @@ mod tests {
     #[test]
     fn the_template_writes_every_default() {
         use crate::plan::MeshPlan;
-        use crate::project::{ExportSection, InterpolationSection, SamplingSection};
+        use crate::plan::{ExportPlan, InterpolationPlan, SamplingPlan};
         let p = Project::parse("t.toml", TEMPLATE, &[]).unwrap();
         assert_eq!(
             format!("{:?}", p.sampling),
-            format!("{:?}", SamplingSection::default())
+            format!("{:?}", SamplingPlan::default())
         );
         assert_eq!(p.mesh, MeshPlan::default());
         assert_eq!(
             format!("{:?}", p.interpolation),
-            format!("{:?}", InterpolationSection::default())
+            format!("{:?}", InterpolationPlan::default())
         );
         // Left to the build, as by default (their Debug prints 0 either way).
         assert_eq!(
             p.interpolation.neighbors,
-            InterpolationSection::default().neighbors
+            InterpolationPlan::default().neighbors
         );
         assert_eq!(p.interpolation.cv_folds.get(), None);
         assert_eq!(
             format!("{:?}", p.export),
-            format!("{:?}", ExportSection::default())
+            format!("{:?}", ExportPlan::default())
         );
         assert_eq!(p.region.crs, terramesh_io::region::RegionCrs::default());
         assert_eq!(p.mesh.min_angle, terramesh_mesh::DEFAULT_MIN_ANGLE);

@@ -1,0 +1,334 @@
+//! The interpolation sub-plan (`[interpolation]`): the variogram (fitted, read or given), the
+//! methods and their neighbourhoods, cross-validation and the conditional simulation of the
+//! vertex elevations; its defaults and its one range check.
+
+use std::path::PathBuf;
+
+use serde::Deserialize;
+use terramesh_geostat::{Drift, InterpolationMethod, DEFAULT_IDW_POWER};
+
+use crate::error::{Error, Result};
+use crate::setting::Setting;
+
+/// The interpolation methods of a project, by default: UK gives the DSM, IDW is compared.
+pub const DEFAULT_METHODS: [InterpolationMethod; 2] =
+    [InterpolationMethod::Universal, InterpolationMethod::Idw];
+
+/// IDW neighbours of a project, by default.
+pub const DEFAULT_IDW_NEIGHBORS: usize = 16;
+
+/// A variogram given in the project file: `model = { model = "spherical", psill = 1200.0,
+/// range = 600.0, nugget = 1.0 }`, or nested, `model = { model = "spherical+exponential",
+/// psill = [800.0, 400.0], range = [300.0, 900.0], nugget = 1.0 }`, with optional
+/// `shape` (one or a list), `anisotropy_angle` and `anisotropy_ratio`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariogramSpec {
+    /// Model name (`spherical`, `exponential`, `gaussian`, ...), or up to three joined by `+`.
+    pub model: String,
+    /// Partial sill, or one per structure.
+    pub psill: Numbers,
+    /// Practical range, metres, or one per structure.
+    pub range: Numbers,
+    /// Nugget.
+    #[serde(default)]
+    pub nugget: f64,
+    /// Power exponent or Matérn ν: one for every structure, or one per structure.
+    #[serde(default)]
+    pub shape: Option<Numbers>,
+    /// Geometric anisotropy: the major axis, degrees counter-clockwise from +x.
+    #[serde(default)]
+    pub anisotropy_angle: Option<f64>,
+    /// Geometric anisotropy: minor / major range, in (0, 1].
+    #[serde(default)]
+    pub anisotropy_ratio: Option<f64>,
+}
+
+/// A number, or a list of numbers (one per nested structure).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum Numbers {
+    /// One value.
+    One(f64),
+    /// One value per structure.
+    Many(Vec<f64>),
+}
+
+impl Numbers {
+    /// The values.
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            Numbers::One(v) => vec![*v],
+            Numbers::Many(v) => v.clone(),
+        }
+    }
+}
+
+impl VariogramSpec {
+    /// The variogram, or an error naming the key (`interpolation.model.psill`, ...).
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let set = |s: &str| vec![format!("interpolation.model={s}")];
+    /// let p = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = [8.0, 4.0], range = [300.0, 900.0], nugget = 1.0 }"))?;
+    /// let v = p.interpolation.model.unwrap().variogram()?;
+    /// assert_eq!((v.structures.len(), v.structures[1].range), (2, 900.0));
+    /// let e = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = 8.0, range = [300.0, 900.0] }")).unwrap_err();
+    /// assert!(e.to_string().contains("interpolation.model.psill"), "{e}");
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn variogram(&self) -> Result<terramesh_geostat::Variogram> {
+        use terramesh_geostat::{Anisotropy, Structure, Variogram};
+        let kinds = crate::fitting::parse_models(&self.model).map_err(|e| {
+            Error::setting(
+                Setting::ModelName,
+                "",
+                e.render(&|_| String::new()).trim_start(),
+            )
+        })?;
+        let n = kinds.len();
+        let list = |setting: Setting, v: &Numbers, one_for_all: bool| -> Result<Vec<f64>> {
+            let v = v.values();
+            match v.len() {
+                k if k == n => Ok(v),
+                1 if one_for_all => Ok(vec![v[0]; n]),
+                k => Err(Error::setting(
+                    setting,
+                    "",
+                    format!(
+                        "{k} values for the {n} structures of \"{}\": give a list of {n}",
+                        self.model
+                    ),
+                )),
+            }
+        };
+        let psill = list(Setting::Psill, &self.psill, false)?;
+        let range = list(Setting::Range, &self.range, false)?;
+        let shape = match &self.shape {
+            Some(s) => Some(list(Setting::Shape, s, true)?),
+            None => None,
+        };
+        for (setting, vals) in [(Setting::Psill, &psill), (Setting::Range, &range)] {
+            if let Some(v) = vals.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+                return Err(Error::setting(setting, "", format!("{v} must be positive")));
+            }
+        }
+        if !(self.nugget.is_finite() && self.nugget >= 0.0) {
+            return Err(Error::setting(
+                Setting::Nugget,
+                "",
+                format!("{} must be 0 or positive", self.nugget),
+            ));
+        }
+        let anisotropy = match (self.anisotropy_angle, self.anisotropy_ratio) {
+            (None, None) => None,
+            (a, r) => Some(Anisotropy {
+                angle: a.unwrap_or(0.0),
+                ratio: r.unwrap_or(1.0),
+            }),
+        };
+        let v = Variogram {
+            nugget: self.nugget,
+            structures: (0..n)
+                .map(|i| {
+                    let mut s = Structure::new(kinds[i], psill[i], range[i]);
+                    if let Some(sh) = &shape {
+                        s.shape = sh[i];
+                    }
+                    s
+                })
+                .collect(),
+            anisotropy,
+        };
+        v.validate()
+            .map_err(|e| Error::setting(Setting::Model, "", e))?;
+        Ok(v)
+    }
+}
+
+/// `[interpolation]`: step 4.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InterpolationPlan {
+    /// Methods to run (`uk`, `ok`, `sk`, `idw`); the first gives the DSM elevations, all are
+    /// cross-validated.
+    pub methods: Vec<InterpolationMethod>,
+    /// Drift of universal kriging: `constant`, `linear` (the paper's) or `quadratic`.
+    pub drift: Drift,
+    /// `auto` (fit from the samples) or a path to a `variogram.json`.
+    pub variogram: String,
+    /// An explicit variogram (overrides `variogram`).
+    pub model: Option<VariogramSpec>,
+    /// Kriging neighbours per target (0: all data, global kriging). Unset: chosen by the
+    /// number of samples ([`crate::build::scale`]): global up to
+    /// [`MAX_GLOBAL_SAMPLES`](crate::build::scale::MAX_GLOBAL_SAMPLES), else
+    /// [`DEFAULT_NEIGHBORS`](crate::build::scale::DEFAULT_NEIGHBORS).
+    pub neighbors: Auto,
+    /// IDW power.
+    pub idw_power: f64,
+    /// IDW neighbours.
+    pub idw_neighbors: usize,
+    /// Cross-validation folds (0: leave-one-out). Unset: chosen by the number of samples
+    /// ([`crate::build::scale`]): leave-one-out up to
+    /// [`MAX_GLOBAL_SAMPLES`](crate::build::scale::MAX_GLOBAL_SAMPLES), else
+    /// [`DEFAULT_CV_FOLDS`](crate::build::scale::DEFAULT_CV_FOLDS) folds.
+    pub cv_folds: Auto,
+    /// Conditional-simulation realisations of the vertex elevations (0: none).
+    pub realisations: usize,
+    /// Seed of the realisations' random streams.
+    pub seed: u64,
+    /// How `variogram = "auto"` fits: `wls` (least squares, least cross-validation RMSE; the
+    /// default), `reml` (restricted maximum likelihood with the UK drift over every model and
+    /// every nested pair, the model chosen by AIC) or `loo` (the parameters, then the model, of
+    /// least leave-one-out RMSE of kriging with the UK drift).
+    pub fit: terramesh_geostat::FitMethod,
+    /// What `variogram = "auto"` fits: `auto` (every model, the best kept), a model name, or a
+    /// nested sum of up to three joined by `+` (`spherical+exponential`, fitted jointly).
+    pub fit_model: String,
+    /// `none`, or `auto`: `variogram = "auto"` fits geometric anisotropy too, from directional
+    /// variograms along 8 azimuths.
+    pub anisotropy: String,
+    /// Kriging with an external drift: a raster (GeoTIFF or ESRI ASCII grid, in the project's
+    /// projected coordinates) sampled bilinearly at the samples and the mesh vertices, as a
+    /// drift of the kriging methods (uk: the polynomial and it; ok: the constant and it).
+    pub external_drift_grid: Option<PathBuf>,
+}
+
+impl Default for InterpolationPlan {
+    fn default() -> Self {
+        InterpolationPlan {
+            methods: DEFAULT_METHODS.to_vec(),
+            drift: Drift::Linear,
+            variogram: "auto".into(),
+            model: None,
+            neighbors: Auto::UNSET,
+            idw_power: DEFAULT_IDW_POWER,
+            idw_neighbors: DEFAULT_IDW_NEIGHBORS,
+            cv_folds: Auto::UNSET,
+            realisations: 0,
+            seed: 0,
+            fit: terramesh_geostat::FitMethod::default(),
+            fit_model: "auto".into(),
+            anisotropy: "none".into(),
+            external_drift_grid: None,
+        }
+    }
+}
+
+/// A count of `[interpolation]` that the build chooses when the project leaves it unset
+/// (`interpolation.neighbors`, `interpolation.cv_folds`; [`crate::build::scale`]).
+///
+/// Its `Debug` prints the number, and `0` when unset (what these keys meant before the
+/// choice), so that the key of a kept DSM (`build::reuse::key`) of a project that sets
+/// neither is what it was; `reuse::key` tells an explicit 0 apart.
+///
+/// ```
+/// use terramesh::plan::Auto;
+/// assert_eq!(Auto::UNSET.get(), None);
+/// assert_eq!(Auto::from(0).get(), Some(0)); // asked for: global kriging, leave-one-out
+/// assert_eq!(format!("{:?} {:?}", Auto::UNSET, Auto::from(64)), "0 64");
+/// ```
+#[derive(Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(transparent)]
+pub struct Auto(Option<usize>);
+
+impl Auto {
+    /// Left to the build.
+    pub const UNSET: Auto = Auto(None);
+
+    /// The value the project gives, `None` when unset.
+    pub fn get(self) -> Option<usize> {
+        self.0
+    }
+
+    /// The value given, or `unset` when none is.
+    pub fn or(self, unset: usize) -> usize {
+        self.0.unwrap_or(unset)
+    }
+}
+
+impl From<usize> for Auto {
+    fn from(v: usize) -> Auto {
+        Auto(Some(v))
+    }
+}
+
+impl std::fmt::Debug for Auto {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(&self.0.unwrap_or(0), f)
+    }
+}
+
+impl InterpolationPlan {
+    /// Checks every value: the one range check of `[interpolation]` (a given variogram
+    /// included, [`VariogramSpec::variogram`]).
+    pub fn check(&self) -> Result<()> {
+        if self.methods.is_empty() {
+            return Err(Error::setting(
+                Setting::Methods,
+                "",
+                "name at least one of \"uk\", \"ok\", \"sk\", \"idw\" (the first gives the DSM)",
+            ));
+        }
+        let neighbors = self.neighbors.or(0);
+        if neighbors != 0 && neighbors < self.drift.terms() {
+            return Err(Error::setting(
+                Setting::Neighbors,
+                "",
+                format!(
+                    "{} is too few: universal kriging with a {} drift needs at least {} \
+                     neighbours (or 0 for all samples)",
+                    neighbors,
+                    self.drift,
+                    self.drift.terms()
+                ),
+            ));
+        }
+        if self.cv_folds.get() == Some(1) {
+            return Err(Error::setting(
+                Setting::Folds,
+                "",
+                "1 fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more folds",
+            ));
+        }
+        if !(self.idw_power.is_finite() && self.idw_power > 0.0) {
+            return Err(Error::setting(Setting::Power, "", "must be positive"));
+        }
+        if let Some(v) = &self.model {
+            v.variogram()?;
+        }
+        if !self.fit_model.eq_ignore_ascii_case("auto") {
+            if let Err(e) = crate::fitting::parse_models(&self.fit_model) {
+                return Err(Error::setting(
+                    Setting::FitModel,
+                    "",
+                    e.render(&|_| String::new()).trim_start(),
+                ));
+            }
+        }
+        match self.anisotropy.to_ascii_lowercase().as_str() {
+            "none" | "auto" => {}
+            _ => {
+                return Err(Error::setting(
+                    Setting::Anisotropy,
+                    "",
+                    format!(
+                        "\"{}\": expected \"none\" or \"auto\" (a given model's anisotropy is \
+                         model.anisotropy_angle and model.anisotropy_ratio)",
+                        self.anisotropy
+                    ),
+                ))
+            }
+        }
+        if self.external_drift_grid.is_some() && self.methods.contains(&InterpolationMethod::Simple)
+        {
+            return Err(Error::setting(
+                Setting::ExternalDriftGrid,
+                "",
+                "simple kriging (\"sk\" in interpolation.methods) has a known mean and no \
+                 drift: krige with \"uk\" or \"ok\"",
+            ));
+        }
+        Ok(())
+    }
+}
