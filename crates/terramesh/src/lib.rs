@@ -59,5 +59,4 @@ pub mod interpolate;
 pub mod mesh;
 pub mod project;
 pub mod simulate;
-pub mod tiles;
 pub mod variogram_file;

@@ -12,10 +12,10 @@ use terramesh_mesh::Mesh;
 
 use super::geology::{Estimate, GeologyPlan};
 use super::geology_plan::horizon_at;
-use crate::build::stages::Surface;
-use crate::error::{Context, Error, Result};
-use crate::geology::model::{assemble, Base, ModelInputs};
-use crate::project::{Base as BaseKey, Project};
+use terramesh::build::Surface;
+use terramesh::geology::model::{assemble_estimated, Base, ModelInputs};
+use terramesh::project::{Base as BaseKey, Project};
+use terramesh::{Context, Error, Result};
 
 /// One tile's geological model.
 pub(crate) struct TileModel {
@@ -52,7 +52,7 @@ pub struct TileFigures {
 /// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
 ///
 /// ```
-/// use terramesh::tiles::tag_of_name;
+/// use terramesh_tiles::tag_of_name;
 /// use terramesh_core::volume::FaceTag;
 /// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
 /// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
@@ -133,7 +133,7 @@ pub(crate) fn build_model(
                         centre: frame.0,
                         scale: frame.1,
                     });
-                let v = crate::variogram_file::read_variogram_file(&plan.join(variogram))?;
+                let v = terramesh::variogram_file::read_variogram_file(&plan.join(variogram))?;
                 let method = if *universal {
                     Method::Universal(project.interpolation.drift)
                 } else {
@@ -184,6 +184,12 @@ pub(crate) fn build_model(
                 "the plan samples a base grid but the project's geology.base is none: plan again",
             )),
         };
+    // The plan estimated every field: unit tops (as horizon grids are given) or thicknesses.
+    let (grids, thick) = if gp.thickness {
+        (Vec::new(), grids.into_iter().map(|g| g.1).collect())
+    } else {
+        (grids, Vec::new())
+    };
     let inputs = ModelInputs {
         boreholes: None,
         grids,
@@ -192,15 +198,16 @@ pub(crate) fn build_model(
         layering: Layering::new(g.units.clone())
             .layers(g.layers.clone())
             .element(g.element),
-        interpolate: Interpolated::Tops,
+        interpolate: if gp.thickness {
+            Interpolated::Thickness
+        } else {
+            Interpolated::Tops
+        },
         method: Method::Ordinary,
     };
-    let model = if gp.thickness {
-        thickness_model(&mesh, terrain, &inputs)
-    } else {
-        assemble(&mesh, terrain, &inputs)
-    }
-    .with_context(|| format!("tile {}: [geology]", tile.id))?;
+    let values: Vec<&[f64]> = thick.iter().map(Vec::as_slice).collect();
+    let model = assemble_estimated(&mesh, terrain, &inputs, &values)
+        .with_context(|| format!("tile {}: [geology]", tile.id))?;
     let figures = TileFigures {
         volumes: model.check.unit_volumes.clone(),
         cells: (0..g.units.len())
@@ -229,33 +236,6 @@ pub(crate) fn build_model(
         faces: model.mesh.faces,
         bodies: model.mesh.bodies,
         figures,
-    })
-}
-
-/// The model from thickness fields (`inputs.grids`, units 0..n-1, in order) stacked down from
-/// the terrain, as a one-piece model stacks its kriged thicknesses (`stack_of`, `seal`).
-fn thickness_model(
-    mesh: &Mesh,
-    terrain: &[f64],
-    inputs: &ModelInputs,
-) -> Result<crate::geology::model::GeologicalModel> {
-    let planar =
-        terramesh_geology::Planar::new(&mesh.points, &mesh.triangles).context("the planar mesh")?;
-    let base = crate::geology::model::base_values(inputs, terrain, None, mesh.points.len())?;
-    let thick: Vec<Vec<f64>> = inputs.grids.iter().map(|g| g.1.clone()).collect();
-    let (stack, rules) =
-        terramesh_geology::stack_thicknesses(&planar, terrain, &thick, &base, inputs.min_thickness)
-            .context("the geological rules")?;
-    let (volume, check, stats) = crate::geology::model::seal(&planar, &stack, &inputs.layering)?;
-    Ok(crate::geology::model::GeologicalModel {
-        mesh: volume,
-        stack,
-        rules,
-        fields: Vec::new(),
-        stats,
-        check,
-        misfits: Vec::new(),
-        grids: Vec::new(),
     })
 }
 

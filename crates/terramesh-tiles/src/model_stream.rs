@@ -23,7 +23,7 @@ use super::geology::{tag_of_name, GeologyPlan, TileFigures, MODEL_BODIES, MODEL_
 use super::geology::{MODEL_JSON, MODEL_POINTS};
 use super::manifest::{Manifest, Tile};
 use super::model_merge::{cell_of, columns, key, node_map, Column};
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 type Key = (u64, u64);
 

@@ -28,8 +28,8 @@ use terramesh_mesh::{Mesh, SurfaceLocator};
 use super::build::tile_dir;
 use super::geology::GeologyPlan;
 use super::manifest::{Manifest, Tile};
-use crate::error::{Context, Error, Result};
-use crate::geology::model::Misfit;
+use terramesh::geology::model::Misfit;
+use terramesh::{Context, Error, Result};
 
 /// The contacts' list in the plan folder.
 pub const CONTACTS: &str = "geology/contacts.json";
@@ -39,7 +39,7 @@ pub const MISFITS: &str = "misfits.json";
 /// One observed contact, as the plan lists it.
 ///
 /// ```
-/// use terramesh::tiles::PlannedContact;
+/// use terramesh_tiles::PlannedContact;
 /// let c: PlannedContact = serde_json::from_str(
 ///     r#"{"hole": "B1", "unit": 0, "x": 10.0, "y": 20.0, "observed": 301.5}"#,
 /// )?;

@@ -11,10 +11,10 @@ use super::manifest::{
     DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM,
     VERSION,
 };
-use crate::build::stages;
-use crate::error::{Context, Error, Result};
-use crate::progress::Progress;
-use crate::project::Project;
+use terramesh::build as stages;
+use terramesh::progress::Progress;
+use terramesh::project::Project;
+use terramesh::{Context, Error, Result};
 
 /// The seams' vertex spacing in target edge lengths: the strips' cut spacing in
 /// `terramesh-mesh` (short enough that refinement never needs to split them).
@@ -38,7 +38,7 @@ pub struct Planned {
 /// Parses a tile size: metres (`2500`, `2500m`) or kilometres (`10km`, `2.5km`).
 ///
 /// ```
-/// use terramesh::tiles::parse_tile_size;
+/// use terramesh_tiles::parse_tile_size;
 /// assert_eq!(parse_tile_size("10km").unwrap(), 10_000.0);
 /// assert_eq!(parse_tile_size("750m").unwrap(), 750.0);
 /// assert_eq!(parse_tile_size("1200").unwrap(), 1200.0);
@@ -126,13 +126,13 @@ fn check_plan_folder(out: &Path) -> Result<()> {
         return Ok(());
     }
     Err(Error::setting(
-        crate::setting::Setting::Output,
+        terramesh::Setting::Output,
         out.display(),
         format!(
             "exists and is not a plan folder (no {}; it holds '{}' among {} entries): name a \
              new or empty folder",
             super::manifest::MANIFEST,
-            crate::error::cut(&names[0]),
+            terramesh::cut(&names[0]),
             names.len()
         ),
     ))
@@ -230,7 +230,7 @@ pub fn plan(
     let json = VariogramFile::new(model.variogram.clone()).to_json_pretty();
     terramesh_io::output::write_atomic(&vpath, json.as_bytes())
         .context(vpath.display().to_string())?;
-    let variogram = crate::variogram_file::read_variogram_file(&vpath)?;
+    let variogram = terramesh::variogram_file::read_variogram_file(&vpath)?;
     let data = &model.data;
     let frame = data.frame(&variogram);
     // The samples, as kriging sees them (duplicates merged), in order.

@@ -19,9 +19,9 @@ use super::files::{self, Vertex};
 use super::manifest::{update, Manifest, State, Tile, TileSummary, SAMPLES};
 use super::partition::in_window;
 use super::plan::owner;
-use crate::build::stages::Surface;
-use crate::error::{Context, Error, Result};
-use crate::project::Project;
+use terramesh::build::Surface;
+use terramesh::project::Project;
+use terramesh::{Context, Error, Result};
 
 /// Set to a comma-separated list of tile ids, makes those tiles fail on purpose (to test
 /// retries and the rerun of a failed tile).
@@ -132,7 +132,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
             centre: m.frame.0,
             scale: m.frame.1,
         });
-    let variogram = crate::variogram_file::read_variogram_file(&plan.join(&m.variogram))?;
+    let variogram = terramesh::variogram_file::read_variogram_file(&plan.join(&m.variogram))?;
     seconds.push(("data".to_string(), t0.elapsed().as_secs_f64()));
 
     // The mesh: the planned ring, no vertex added on it, boundary fixed while smoothing.

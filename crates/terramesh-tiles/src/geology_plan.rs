@@ -12,11 +12,11 @@ use terramesh_geostat::{
 
 use super::files::put_f64;
 use super::geology::{Estimate, GeologyPlan, InterfacePlan};
-use crate::build::stages::Samples;
-use crate::error::{Context, Error, Result};
-use crate::geology::fields::MIN_KRIGED;
-use crate::geology::model::AUTO_BASE_MARGIN;
-use crate::project::{Base as BaseKey, GeologySettings, Project};
+use terramesh::build::Samples;
+use terramesh::geology::fields::MIN_KRIGED;
+use terramesh::geology::model::AUTO_BASE_MARGIN;
+use terramesh::project::{Base as BaseKey, GeologySettings, Project};
+use terramesh::{Context, Error, Result};
 /// The plan of the geological model of `p` (None without `[geology]`), its files written
 /// into `out/geology/`, and each tile's geology halo for the extents `rects` (probe spacing
 /// `h`).
@@ -32,7 +32,7 @@ pub(crate) fn plan_geology(
         return Ok(None);
     };
     check_supported(g)?;
-    let holes = crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?;
+    let holes = terramesh::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?;
     let gridded = |unit: usize| g.surfaces.get(unit).and_then(Option::as_ref);
     match &holes {
         Some(_) => {}
@@ -128,7 +128,7 @@ pub(crate) fn plan_geology(
                     let json = VariogramFile::new(v).to_json_pretty();
                     terramesh_io::output::write_atomic(&vpath, json.as_bytes())
                         .context(vpath.display().to_string())?;
-                    let v = crate::variogram_file::read_variogram_file(&vpath)?;
+                    let v = terramesh::variogram_file::read_variogram_file(&vpath)?;
                     let f = data.frame(&v);
                     let k = k_project.min(data.len());
                     // Drift terms need more data than unknowns (as the one-piece model).
@@ -256,7 +256,7 @@ pub(super) fn horizon_at(
         )
     })?;
     let crs = terramesh_crs::Crs::from_epsg(code)?;
-    let grid = crate::horizon::HorizonGrid::open(path, g.z_unit)?;
+    let grid = terramesh::horizon::HorizonGrid::open(path, g.z_unit)?;
     grid.evaluate(xy, &crs)
         .with_context(|| format!("the grid of {what}"))
 }

@@ -9,7 +9,7 @@
 //! does): its observations file `geology/<k>.f64` (`[x, y, z]` little-endian `f64` triples),
 //! and how it is estimated, decided once as `fields` decides it for a one-piece model: a
 //! constant (every observation equal), inverse-distance weighting over every observation (fewer
-//! than [`MIN_KRIGED`](crate::geology::fields::MIN_KRIGED) locations, or no variogram fits), or
+//! than [`MIN_KRIGED`](terramesh::geology::fields::MIN_KRIGED) locations, or no variogram fits), or
 //! kriging with a variogram fitted once on all its observations (`geology/<k>-variogram.json`,
 //! fitted as the one-piece model fits it) in the frame of all its observations, with a moving
 //! neighbourhood of `interpolation.neighbors` observations (a tiled build needs one). The base
@@ -46,7 +46,7 @@ pub const MODEL_BODIES: &str = "model-bodies.u32";
 /// How an interface is estimated in every tile, as `tiles.json` records it.
 ///
 /// ```
-/// use terramesh::tiles::Estimate;
+/// use terramesh_tiles::Estimate;
 /// let e: Estimate = serde_json::from_str(
 ///     r#"{"kind": "kriged", "variogram": "geology/1-variogram.json",
 ///         "frame": [[303247.7, 3933730.3], 28062.7], "universal": true}"#,

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// The manifest's file name in the plan folder.
 pub const MANIFEST: &str = "tiles.json";
@@ -261,10 +261,10 @@ impl Manifest {
     }
 
     /// The vertical datum of the heights, as the project names it ([`Manifest::vertical_epsg`]).
-    pub fn height_datum(&self) -> crate::project::HeightDatum {
+    pub fn height_datum(&self) -> terramesh::project::HeightDatum {
         self.vertical_epsg.map_or(
-            crate::project::HeightDatum::Source,
-            crate::project::HeightDatum::Epsg,
+            terramesh::project::HeightDatum::Source,
+            terramesh::project::HeightDatum::Epsg,
         )
     }
 
@@ -424,7 +424,7 @@ impl Manifest {
             let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
             Error::invalid(format!(
                 "no tile '{id}' in the plan; its tiles are {}",
-                crate::cut(&ids.join(", "))
+                terramesh::cut(&ids.join(", "))
             ))
         })
     }
@@ -436,7 +436,7 @@ impl Manifest {
 /// ```
 /// # fn main() -> Result<(), terramesh::Error> {
 /// let dir = tempfile::tempdir()?;
-/// let e = terramesh::tiles::update(dir.path(), |_| Ok(())).unwrap_err();
+/// let e = terramesh_tiles::update(dir.path(), |_| Ok(())).unwrap_err();
 /// assert!(e.to_string().contains("terramesh tiles plan"));
 /// # Ok(()) }
 /// ```

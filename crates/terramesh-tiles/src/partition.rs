@@ -12,7 +12,7 @@ use std::path::Path;
 
 use super::manifest::Manifest;
 use super::plan::cell_of;
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// The folder of the per-tile sample files in the plan.
 pub const SAMPLES_DIR: &str = "samples";
@@ -26,7 +26,7 @@ pub fn samples_file(id: &str) -> String {
 /// extent grown by the halo on every side, edges included.
 ///
 /// ```
-/// use terramesh::tiles::in_window;
+/// use terramesh_tiles::in_window;
 /// assert!(in_window([0.0, 0.0, 10.0, 10.0], 2.0, [-2.0, 12.0]));
 /// assert!(!in_window([0.0, 0.0, 10.0, 10.0], 2.0, [-2.1, 5.0]));
 /// ```

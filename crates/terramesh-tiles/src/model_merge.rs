@@ -24,7 +24,7 @@ use super::build::tile_dir;
 use super::files::{read_f64s, read_u32s, read_vertices};
 use super::geology::{GeologyPlan, TileFigures, MODEL_CELLS, MODEL_JSON, MODEL_POINTS, SURFACES};
 use super::manifest::{Manifest, Tile};
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// One unit of the merged model.
 #[derive(Debug, Clone, Serialize)]
@@ -79,7 +79,7 @@ pub struct MergedModel {
     pub base: Option<f64>,
     /// One entry per observed contact, as a one-piece model lists them: the collars against
     /// the terrain, then the logged tops (`tiles/boreholes.rs`).
-    pub boreholes: Vec<crate::geology::model::Misfit>,
+    pub boreholes: Vec<terramesh::geology::model::Misfit>,
     /// The boundary meshes, `model.msh`, `model.f3grid` and the bodies
     /// (`tiles/model_export.rs`).
     pub exports: super::model_export::MergedExports,

@@ -1,5 +1,8 @@
-//! Tiled builds: a region split into square tiles that are built as independent jobs (on one
-//! machine, a Dask cluster or a Slurm array) and merged without seams.
+//! **terramesh-tiles**: tiled builds. A region split into square tiles that are built as
+//! independent jobs (on one machine, a Dask cluster or a Slurm array) and merged without seams.
+//! A tile runs the stages of the facade crate `terramesh` (its samples, variogram, predictors
+//! and geological model assembly) on its part of the region; this crate adds the partition,
+//! the manifest, the merge and the scripts.
 //!
 //! * [`plan()`]: samples the region once, fits one variogram, cuts the region into tiles with
 //!   their halos (from the kriging neighbourhood) and seams (vertices fixed in advance), and
@@ -21,7 +24,8 @@
 //! ```no_run
 //! # fn main() -> Result<(), terramesh::Error> {
 //! use std::path::Path;
-//! use terramesh::{project::Project, tiles};
+//! use terramesh::project::Project;
+//! use terramesh_tiles as tiles;
 //! let file = Path::new("examples/haut-barr/terramesh.toml");
 //! let p = Project::load(file, &[])?;
 //! let progress = terramesh::progress::Silent;
@@ -33,6 +37,8 @@
 //! tiles::merge(Path::new("plan"), Path::new("merged"))?;
 //! # Ok(()) }
 //! ```
+
+#![warn(missing_docs)]
 
 mod appended;
 mod boreholes;

@@ -22,7 +22,7 @@ use super::build::tile_dir;
 use super::files;
 use super::manifest::Manifest;
 use super::merge::NODATA;
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// What the grid merge held and wrote.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
