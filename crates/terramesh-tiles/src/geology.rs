@@ -22,11 +22,7 @@
 //! vertex's surfaces.
 
 use serde::{Deserialize, Serialize};
-
-pub(crate) use super::geology_plan::plan_geology;
-pub(crate) use super::geology_tile::{build_model, TileModel};
-pub use super::geology_tile::{tag_of_name, TileFigures};
-pub(crate) use super::model_files::write_model;
+use terramesh_core::volume::FaceTag;
 
 /// The model's files in a tile's folder.
 pub const SURFACES: &str = "surfaces.f64";
@@ -124,9 +120,44 @@ pub struct GeologyPlan {
     /// grids.
     #[serde(default)]
     pub crs_epsg: Option<u32>,
-    /// The boreholes' contacts file in the plan folder ([`super::boreholes::CONTACTS`]), each
+    /// The boreholes' contacts file in the plan folder ([`CONTACTS`](crate::CONTACTS)), each
     /// contact evaluated by the tile that owns its position for `model.json`'s `boreholes`;
     /// `None` without boreholes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contacts: Option<String>,
+}
+
+/// A tile's model figures (`PLAN/tiles/ID/model.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TileFigures {
+    /// Per unit, top to bottom: volume (m³).
+    pub volumes: Vec<f64>,
+    /// Per unit: cells.
+    pub cells: Vec<usize>,
+    /// Per unit: planar area where it has zero thickness, m².
+    pub pinched_area: Vec<f64>,
+    /// The volume between the terrain and the base over the tile, m³.
+    pub volume_between: f64,
+    /// The names of the tags of `model-faces.u32` (`top`, `bottom`, a side, `interface-<unit>`).
+    #[serde(default)]
+    pub tags: Vec<String>,
+}
+
+/// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
+///
+/// ```
+/// use terramesh_tiles::tag_of_name;
+/// use terramesh_core::volume::FaceTag;
+/// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
+/// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
+/// ```
+pub fn tag_of_name(name: &str) -> FaceTag {
+    match name {
+        "top" => FaceTag::Top,
+        "bottom" => FaceTag::Bottom,
+        _ => match name.strip_prefix("interface-") {
+            Some(u) => FaceTag::Interface(u.to_string()),
+            None => FaceTag::Side(name.to_string()),
+        },
+    }
 }

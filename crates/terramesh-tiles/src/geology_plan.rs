@@ -138,7 +138,7 @@ pub(crate) fn plan_geology(
                             Error::invalid(format!("search tree of {name}'s observations: {e:?}"))
                         })?;
                     for (halo, r) in halos.iter_mut().zip(rects) {
-                        *halo = halo.max(super::plan::reach(&tree, k, *r, h));
+                        *halo = halo.max(super::partition::reach(&tree, k, *r, h));
                     }
                     Estimate::Kriged {
                         variogram: vfile,

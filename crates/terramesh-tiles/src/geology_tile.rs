@@ -4,13 +4,12 @@
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
 use terramesh_core::volume::{Body, Cell, FaceTag, Interpolated, TaggedFace};
 use terramesh_geology::Layering;
 use terramesh_geostat::{Data, Duplicates, Idw, IdwSearch, KrigingFrame, Method, Predictor};
 use terramesh_mesh::Mesh;
 
-use super::geology::{Estimate, GeologyPlan};
+use super::geology::{Estimate, GeologyPlan, TileFigures};
 use super::geology_plan::horizon_at;
 use terramesh::build::Surface;
 use terramesh::geology::model::{assemble_estimated, Base, ModelInputs};
@@ -33,48 +32,13 @@ pub(crate) struct TileModel {
     pub figures: TileFigures,
 }
 
-/// A tile's model figures (`PLAN/tiles/ID/model.json`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TileFigures {
-    /// Per unit, top to bottom: volume (m³).
-    pub volumes: Vec<f64>,
-    /// Per unit: cells.
-    pub cells: Vec<usize>,
-    /// Per unit: planar area where it has zero thickness, m².
-    pub pinched_area: Vec<f64>,
-    /// The volume between the terrain and the base over the tile, m³.
-    pub volume_between: f64,
-    /// The names of the tags of `model-faces.u32` (`top`, `bottom`, a side, `interface-<unit>`).
-    #[serde(default)]
-    pub tags: Vec<String>,
-}
-
-/// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
-///
-/// ```
-/// use terramesh_tiles::tag_of_name;
-/// use terramesh_core::volume::FaceTag;
-/// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
-/// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
-/// ```
-pub fn tag_of_name(name: &str) -> FaceTag {
-    match name {
-        "top" => FaceTag::Top,
-        "bottom" => FaceTag::Bottom,
-        _ => match name.strip_prefix("interface-") {
-            Some(u) => FaceTag::Interface(u.to_string()),
-            None => FaceTag::Side(name.to_string()),
-        },
-    }
-}
-
 /// Builds the model of one tile on its planar mesh (`xy`, its absolute positions, the planned
 /// ones on the boundary; `triangles`) under `terrain`.
 pub(crate) fn build_model(
     plan: &Path,
     gp: &GeologyPlan,
     project: &Project,
-    tile: &super::Tile,
+    tile: &super::manifest::Tile,
     xy: &[[f64; 2]],
     triangles: &[[u32; 3]],
     terrain: &[f64],

@@ -51,6 +51,8 @@ mod geometry;
 mod grid_merge;
 mod manifest;
 mod merge;
+mod merged;
+mod model_columns;
 mod model_export;
 mod model_files;
 mod model_merge;
@@ -61,7 +63,7 @@ mod report;
 mod slurm;
 
 pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
-pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
+pub use build::{build_tile, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
     tag_of_name, Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_BODIES,
@@ -69,10 +71,11 @@ pub use geology::{
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
-    update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData,
-    TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
+    tile_dir, update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile,
+    TileData, TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
 };
-pub use merge::{merge, Merged};
+pub use merge::merge;
+pub use merged::Merged;
 pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};

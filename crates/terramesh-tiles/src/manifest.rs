@@ -470,3 +470,27 @@ impl Drop for Lock {
         let _ = self.0.unlock();
     }
 }
+
+/// The folder of tile `id` in `plan`.
+pub fn tile_dir(plan: &Path, id: &str) -> std::path::PathBuf {
+    plan.join("tiles").join(id)
+}
+
+/// The tile grid column or row of coordinate `v` (clamped to the grid).
+pub(crate) fn cell_of(v: f64, origin: f64, size: f64, n: usize) -> usize {
+    let k = ((v - origin) / size).floor();
+    if k < 0.0 {
+        0
+    } else {
+        (k as usize).min(n - 1)
+    }
+}
+
+/// The tile of the grid node or point `q`: exactly one, so that every DSM grid node is kriged
+/// by one tile.
+pub(crate) fn owner(m: &Manifest, q: [f64; 2]) -> [usize; 2] {
+    [
+        cell_of(q[0], m.origin[0], m.tile_size, m.shape[0]),
+        cell_of(q[1], m.origin[1], m.tile_size, m.shape[1]),
+    ]
+}

@@ -11,45 +11,16 @@
 
 use std::collections::HashMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-use serde::Serialize;
 use terramesh_io::output::Output;
 
 use super::appended::{self, put_f64, Array, Section, Values};
-use super::build::tile_dir;
 use super::files::{self, Vertex};
-use super::manifest::{Manifest, State, Tile};
+use super::manifest::{tile_dir, Manifest, State, Tile};
+use super::merged::Merged;
 use terramesh::{Context, Error, Result};
-
-/// What the merge made.
-#[derive(Debug, Clone, Serialize)]
-pub struct Merged {
-    /// Files written.
-    pub files: Vec<PathBuf>,
-    /// Vertices of the merged mesh.
-    pub vertices: usize,
-    /// Triangles.
-    pub triangles: usize,
-    /// Distinct seam vertices (each written once).
-    pub seam_vertices: usize,
-    /// The largest difference between two tiles' DSM elevations at one seam vertex (0: both
-    /// sides computed the same value).
-    pub seam_max_difference: f64,
-    /// The merged mesh's planar area, m².
-    pub area: f64,
-    /// What writing the grids held: one row at a time.
-    pub grid: super::grid_merge::GridFigures,
-    /// The geological model, when the plan has one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub model: Option<super::model_merge::MergedModel>,
-    /// Seconds the merge took.
-    pub seconds: f64,
-}
-
-/// The nodata value of the grids.
-pub(super) const NODATA: f64 = -9999.0;
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every

@@ -45,7 +45,7 @@ use terramesh_io::output::Output;
 
 use super::geology::GeologyPlan;
 use super::manifest::Manifest;
-use super::model_merge::Column;
+use super::model_columns::Column;
 use super::model_stream::TiledModel;
 use terramesh::{Context, Error, Result};
 

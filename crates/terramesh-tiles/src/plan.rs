@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use kiddo::ImmutableKdTree;
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
@@ -59,56 +59,6 @@ pub fn parse_tile_size(s: &str) -> std::result::Result<f64, String> {
             "'{s}' is not a tile size: give metres or kilometres, like 10km, 2500m or 2500"
         )),
     }
-}
-
-/// The tile grid column or row of coordinate `v` (clamped to the grid).
-pub(crate) fn cell_of(v: f64, origin: f64, size: f64, n: usize) -> usize {
-    let k = ((v - origin) / size).floor();
-    if k < 0.0 {
-        0
-    } else {
-        (k as usize).min(n - 1)
-    }
-}
-
-/// The tile of the grid node or point `q`: exactly one, so that every DSM grid node is kriged
-/// by one tile.
-pub(crate) fn owner(m: &Manifest, q: [f64; 2]) -> [usize; 2] {
-    [
-        cell_of(q[0], m.origin[0], m.tile_size, m.shape[0]),
-        cell_of(q[1], m.origin[1], m.tile_size, m.shape[1]),
-    ]
-}
-
-/// The halo of the extent `r`: the distance from any of its points to its `k`-th nearest point
-/// of `tree` is at most this. `R(q)` (the distance from `q` to its `k`-th nearest) is measured
-/// at probes on a lattice of spacing at most `h`; for any point `p` of the extent
-/// `R(p) <= R(q) + |p - q| <= max R + step/√2` (the triangle inequality), so every point any
-/// point of the extent uses lies within it, equal-distance ties included.
-pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f64) -> f64 {
-    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
-    let n = [
-        ((r[2] - r[0]) / h).ceil() as usize + 1,
-        ((r[3] - r[1]) / h).ceil() as usize + 1,
-    ];
-    let mut reach: f64 = 0.0;
-    for b in 0..n[1] {
-        for a in 0..n[0] {
-            let q = [
-                r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
-                r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
-            ];
-            let near = tree
-                .query(&q)
-                .nearest_n::<SquaredEuclidean<f64>>(kk)
-                .execute();
-            if let Some(last) = near.last() {
-                reach = reach.max(last.distance.sqrt());
-            }
-        }
-    }
-    let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
-    (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
 }
 
 /// A plan writes many files into its folder (`tiles.json`, `samples.csv`, `variogram.json`,
@@ -334,7 +284,7 @@ pub fn plan(
                 .collect();
             let neighbours = seams.iter().map(|s| s.neighbour.clone()).collect();
             // The halo: the farthest k-th neighbour over probes, plus the probes' reach.
-            let halo = reach(&tree, k, r, h);
+            let halo = super::partition::reach(&tree, k, r, h);
             max_halo = max_halo.max(halo);
             tiles.push(Tile {
                 id: id(i, j),
@@ -353,7 +303,7 @@ pub fn plan(
         }
     }
     let rects: Vec<[f64; 4]> = tiles.iter().map(|t| t.extent).collect();
-    let geology = super::geology::plan_geology(project, &samples, data.z(), out, &rects, h)?;
+    let geology = super::geology_plan::plan_geology(project, &samples, data.z(), out, &rects, h)?;
     let geology = geology.map(|(g, halos)| {
         for (t, halo) in tiles.iter_mut().zip(halos) {
             t.geology_halo = Some(halo);
