@@ -63,7 +63,7 @@ pub(crate) fn build_model(
                             it.unit
                         ))
                     })?;
-                let v = horizon_at(path, xy, g, gp.crs_epsg, &it.unit)
+                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), &it.unit)
                     .with_context(|| format!("tile {}", tile.id))?;
                 // Nodata: the unit is absent there (as in a one-piece model).
                 grids.push((
@@ -128,7 +128,7 @@ pub(crate) fn build_model(
         match (gp.base, &g.base) {
             (Some(z), _) => Base::Elevation(z),
             (None, BaseKey::Raster(path)) => {
-                let v = horizon_at(path, xy, g, gp.crs_epsg, "the base")
+                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), "the base")
                     .with_context(|| format!("tile {}", tile.id))?;
                 match v.iter().position(Option::is_none) {
                     Some(i) => {

@@ -66,8 +66,8 @@ pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
 pub use build::{build_tile, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
-    tag_of_name, Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_BODIES,
-    MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
+    tag_of_name, Estimate, GeologyPlan, InterfacePlan, PlanCrs, TileFigures, INTERFACES,
+    MODEL_BODIES, MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
