@@ -266,7 +266,7 @@ fn tiled_geological_model_is_conforming_and_equals_a_one_piece_model_on_the_same
     for t in tiles {
         let id = t["id"].as_str().unwrap();
         let dir = plan.join("tiles").join(id);
-        let v = terramesh::tiles::read_vertices(&dir).unwrap();
+        let v = terramesh_tiles::read_vertices(&dir).unwrap();
         let s = f64s(&dir.join("surfaces.f64"));
         assert_eq!(s.len(), v.len() * ns);
         let on: HashSet<[u64; 2]> = t["seams"]

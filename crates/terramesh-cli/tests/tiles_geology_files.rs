@@ -615,3 +615,120 @@ fn merged_outputs_carry_the_datum_and_the_misfits_of_one_piece() {
     let report = std::fs::read_to_string(merged.join("report.html")).unwrap();
     assert!(report.contains("model.glb is not merged: a GLB file is at most 4 GiB"));
 }
+
+/// An ESRI ASCII grid without a `.prj` (a `crs = "projected"` project's own coordinates):
+/// 15 x 15 cells of 50 m from (499900, 3999900), the plane `z0 + gx * x + gy * y` (x, y from
+/// the lower-left corner).
+fn plane_asc(z0: f64, gx: f64, gy: f64) -> String {
+    let mut s =
+        String::from("ncols 15\nnrows 15\nxllcorner 499900\nyllcorner 3999900\ncellsize 50\n");
+    for r in 0..15 {
+        let y = (14 - r) as f64 * 50.0 + 25.0;
+        let row: Vec<String> = (0..15)
+            .map(|c| format!("{:.4}", z0 + gx * (c as f64 * 50.0 + 25.0) + gy * y))
+            .collect();
+        s += &row.join(" ");
+        s.push('\n');
+    }
+    s
+}
+
+/// Issue 34 (item 15's tiled leftover): a `crs = "projected"` project takes its horizon and
+/// base grids as is, in its own coordinates, and so does a tiled build of it (the plan stores
+/// the project's CRS kind; tiles used to refuse grids without an EPSG code). Tilted planes, so
+/// that the interface is linear and its grid nodes equal on any mesh: the merged
+/// `interfaces/clay.tif` equals `terramesh model`'s at every node.
+#[test]
+fn tiled_horizon_grids_in_a_projected_project_match_terramesh_model() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("dem.asc"), plane_asc(300.0, 0.01, 0.006)).unwrap();
+    std::fs::write(dir.join("clay.asc"), plane_asc(290.0, -0.008, 0.004)).unwrap();
+    std::fs::write(dir.join("base.asc"), plane_asc(250.0, 0.002, -0.003)).unwrap();
+    let project = dir.join("project.toml");
+    std::fs::write(
+        &project,
+        r#"
+[region]
+crs = "projected"
+corners = "4000050 500050; 4000050 500400; 4000380 500400; 4000380 500050"
+[source]
+path = "dem.asc"
+[mesh]
+max_area = 2000.0
+[interpolation]
+methods = ["idw"]
+neighbors = 16
+idw_neighbors = 8
+[export]
+formats = ["vtu"]
+pictures = false
+report = false
+[geology]
+units = ["sand", "clay"]
+surfaces = { clay = "clay.asc" }
+base = "base.asc"
+interpolate = "tops"
+"#,
+    )
+    .unwrap();
+    let one = dir.join("one");
+    tiles_model::run(&[
+        "model",
+        project.to_str().unwrap(),
+        "-o",
+        one.to_str().unwrap(),
+        "-q",
+    ]);
+    let (plan, merged) = tiled(dir, &project, "200m", &[]);
+    let m = json(&plan.join("tiles.json"));
+    assert_eq!(m["tiles"].as_array().unwrap().len(), 4, "2 x 2 tiles");
+    assert_eq!(m["geology"]["crs"]["kind"], "projected", "{}", m["geology"]);
+    // Read with the tiff crate: terramesh's own reader refuses a GeoTIFF without a CRS code,
+    // which is what a project in its own coordinates writes.
+    let read = |p: &Path| {
+        let mut d = tiff::decoder::Decoder::new(std::fs::File::open(p).unwrap()).unwrap();
+        let size = d.dimensions().unwrap();
+        let values: Vec<f64> = match d.read_image().unwrap() {
+            tiff::decoder::DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
+            tiff::decoder::DecodingResult::F64(v) => v,
+            _ => panic!("{}: not a float grid", p.display()),
+        };
+        let nodata = |v: f64| v.is_nan() || v == -9999.0;
+        (
+            size,
+            values
+                .into_iter()
+                .map(|v| (!nodata(v)).then_some(v))
+                .collect::<Vec<_>>(),
+        )
+    };
+    let ((sa, a), (sb, b)) = (
+        read(&one.join("interfaces/clay.tif")),
+        read(&merged.join("interfaces/clay.tif")),
+    );
+    assert_eq!(sa, sb, "the same grid");
+    // Every node the tiles give, the one-piece model gives too, the same. (The one-piece
+    // model also fills the nodes on the region's outline, which no tile owns: one row here.)
+    let (mut worst, mut nodes, mut outline): (f64, usize, usize) = (0.0, 0, 0);
+    for (va, vb) in a.iter().zip(&b) {
+        match (va, vb) {
+            (Some(va), Some(vb)) => {
+                worst = worst.max((va - vb).abs());
+                nodes += 1;
+            }
+            (None, Some(vb)) => panic!("the tiles give {vb} where terramesh model has nodata"),
+            (Some(_), None) => outline += 1,
+            (None, None) => {}
+        }
+    }
+    assert!(nodes > 1000, "{nodes} nodes with a value");
+    assert!(
+        outline <= sa.0.max(sa.1) as usize,
+        "{outline} nodes of the one piece only"
+    );
+    assert!(
+        worst <= 1e-6,
+        "the tiled clay top differs from terramesh model's by {worst} m"
+    );
+}

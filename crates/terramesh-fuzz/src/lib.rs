@@ -172,8 +172,8 @@ pub fn variogram_json(data: &[u8]) {
 /// grid.
 pub fn tiles_plan(data: &[u8]) {
     use std::path::Component;
-    use terramesh::tiles::{tile_dir, Estimate, Manifest};
-    let path = files::write(terramesh::tiles::MANIFEST, data);
+    use terramesh_tiles::{tile_dir, Estimate, Manifest};
+    let path = files::write(terramesh_tiles::MANIFEST, data);
     let plan = path.parent().expect("a folder");
     let Ok(m) = Manifest::read(plan) else { return };
     let inside = |rel: &str| {

@@ -60,5 +60,4 @@ pub mod mesh;
 pub mod plan;
 pub mod project;
 pub mod simulate;
-pub mod tiles;
 pub mod variogram_file;

@@ -1,11 +1,11 @@
-//! `terramesh tiles plan|build|merge|slurm`: tiled builds ([`terramesh::tiles`]).
+//! `terramesh tiles plan|build|merge|slurm`: tiled builds ([`terramesh_tiles`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Result;
 use terramesh::project::Project;
-use terramesh::tiles;
+use terramesh_tiles as tiles;
 
 use crate::progress::Terminal;
 

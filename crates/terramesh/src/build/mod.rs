@@ -32,6 +32,9 @@ use crate::geology::stage::OpenedGrids;
 pub use adaptive::AdaptiveInfo;
 pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
+/// The stages a tile of a tiled build (`terramesh-tiles`) shares with a one-piece build: the
+/// samples, the variogram, the DSM grid's layout and the predictors.
+pub use stages::{dsm_grid, model, sample, Surface};
 pub use stages::{Interpolated, Meshed, Model, Samples};
 pub use viewer::{VIEWER_MODEL_VERTICES, VIEWER_SAMPLES, VIEWER_VERTICES};
 

@@ -169,6 +169,68 @@ pub(crate) fn assemble_beside<R: Send>(
     Ok((model, r))
 }
 
+/// Builds the model from fields estimated already at the planar vertices: `values` in the
+/// order of the fields [`assemble`] would interpolate (the tops of units 1.. that no horizon
+/// grid of `inputs` gives, or with [`Interpolated::Thickness`] the thicknesses of units
+/// 0..n-1; `inputs.boreholes` then only gives the misfits), followed by the same rules,
+/// volume mesh and checks. A tile of a tiled build (`terramesh-tiles`) takes this: the plan
+/// estimated its fields, the tile assembles its model as a one-piece build does.
+///
+/// ```
+/// use terramesh::geology::model::{assemble_estimated, Base, ModelInputs};
+/// use terramesh_core::volume::Interpolated;
+/// use terramesh_geology::Layering;
+/// use terramesh_geostat::Method;
+/// use terramesh_mesh::Mesh;
+/// let mesh = Mesh {
+///     origin: [0.0, 0.0],
+///     points: vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]],
+///     triangles: vec![[0, 1, 2], [0, 2, 3]],
+///     constraint_edges: vec![],
+/// };
+/// let inputs = ModelInputs {
+///     boreholes: None,
+///     grids: vec![],
+///     base: Base::Elevation(0.0),
+///     min_thickness: 0.0,
+///     layering: Layering::new(vec!["sand".into(), "clay".into()]),
+///     interpolate: Interpolated::Thickness,
+///     method: Method::Ordinary,
+/// };
+/// // 4 m of sand over clay down to the base at 0, under a flat terrain at 10 m.
+/// let model = assemble_estimated(&mesh, &[10.0; 4], &inputs, &[&[4.0; 4]])?;
+/// assert!((model.check.unit_volumes[0] - 400.0).abs() < 1e-9);
+/// assert!((model.check.unit_volumes[1] - 600.0).abs() < 1e-9);
+/// # Ok::<(), terramesh::Error>(())
+/// ```
+pub fn assemble_estimated(
+    mesh: &Mesh,
+    terrain: &[f64],
+    inputs: &ModelInputs,
+    values: &[&[f64]],
+) -> Result<GeologicalModel> {
+    if inputs.layering.units.is_empty() {
+        bail!("the geological column names no unit: list them in [geology] units");
+    }
+    let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
+    let planar = Planar::new(&xy, &mesh.triangles).context("the planar mesh")?;
+    let holes = inputs.boreholes;
+    let base = base_values(inputs, terrain, holes, xy.len())?;
+    let (stack, rules) = stack_of(&planar, terrain, &base, inputs, values)?;
+    let (volume, check, stats) = seal(&planar, &stack, &inputs.layering)?;
+    let misfits = holes.map(|b| misfits(b, mesh, &stack)).unwrap_or_default();
+    Ok(GeologicalModel {
+        mesh: volume,
+        stack,
+        rules,
+        fields: Vec::new(),
+        stats,
+        check,
+        misfits,
+        grids: inputs.grids.clone(),
+    })
+}
+
 /// The fields a model interpolates, in order, as `(unit, observations)`: the tops of units
 /// 1.. that no horizon grid gives, or the thicknesses of units 0..n-1.
 pub(crate) fn field_observations(inputs: &ModelInputs) -> Result<Vec<(usize, Vec<Observation>)>> {

@@ -350,7 +350,7 @@ pub fn interpolate(
 /// The DSM grid (`dsm.tif`) of a build: over the region's bounding box, at
 /// `export.grid_spacing` or the finer sampling cell size, north row first (the tiles of
 /// `terramesh tiles` share it).
-pub(crate) fn dsm_grid(p: &Project, s: &Samples) -> Result<terramesh_io::grid_write::RasterGrid> {
+pub fn dsm_grid(p: &Project, s: &Samples) -> Result<terramesh_io::grid_write::RasterGrid> {
     let (lo, hi) = s.region.projected.bbox().context("empty region")?;
     let step = p
         .export
@@ -386,13 +386,14 @@ fn idw_search(neighbors: usize) -> IdwSearch {
 }
 
 /// An interpolated surface: a predictor set up once (a kriging system factorised, a search
-/// tree built) and evaluated at many targets.
-pub(crate) struct Surface(Box<dyn Predictor>);
+/// tree built) and evaluated at many targets. Public for the tiles of a tiled build
+/// (`terramesh-tiles`), which predict with the same engines as a one-piece build.
+pub struct Surface(Box<dyn Predictor>);
 
 impl Surface {
     /// Kriging: global for `neighbors == 0` (the project's "all samples"), else a moving
     /// neighbourhood of that size.
-    pub(crate) fn kriging(
+    pub fn kriging(
         data: &Data,
         v: &Variogram,
         method: Method,
@@ -425,14 +426,14 @@ impl Surface {
     }
 
     /// IDW with `power` over `neighbors` neighbours (0: all).
-    pub(crate) fn idw(data: &Data, power: f64, neighbors: usize) -> Result<Surface> {
+    pub fn idw(data: &Data, power: f64, neighbors: usize) -> Result<Surface> {
         Ok(Surface(Box::new(
             Idw::new(data, power, idw_search(neighbors)).context("IDW")?,
         )))
     }
 
     /// The surface of the project's first interpolation method, which gives the DSM.
-    pub(crate) fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
+    pub fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
         Surface::primary_with(p, data, v, None)
     }
 
@@ -454,11 +455,7 @@ impl Surface {
     }
 
     /// Estimates (and variances on request, kriging only) at `targets`.
-    pub(crate) fn predict(
-        &self,
-        targets: &[[f64; 2]],
-        variance: bool,
-    ) -> Result<(Vec<f64>, Vec<f64>)> {
+    pub fn predict(&self, targets: &[[f64; 2]], variance: bool) -> Result<(Vec<f64>, Vec<f64>)> {
         let variance = variance && self.0.has_variance();
         let mut est = vec![0.0; targets.len()];
         let mut var = vec![0.0; if variance { targets.len() } else { 0 }];

@@ -3,8 +3,8 @@
 
 mod interpolation;
 
-pub(crate) use interpolation::{dsm_grid, interpolate, model, sample_data, Fit, Surface};
-pub use interpolation::{Interpolated, Model};
+pub use interpolation::{dsm_grid, model, Interpolated, Model, Surface};
+pub(crate) use interpolation::{interpolate, sample_data, Fit};
 
 use std::path::Path;
 

@@ -16,12 +16,11 @@ use terramesh_geostat::{Data, Duplicates, InterpolationMethod, KrigingFrame, Met
 use terramesh_mesh::{smooth_keeping, MeshBuilder};
 
 use super::files::{self, Vertex};
-use super::manifest::{update, Manifest, State, Tile, TileSummary, SAMPLES};
+use super::manifest::{owner, tile_dir, update, Manifest, State, Tile, TileSummary, SAMPLES};
 use super::partition::in_window;
-use super::plan::owner;
-use crate::build::stages::Surface;
-use crate::error::{Context, Error, Result};
-use crate::project::Project;
+use terramesh::build::Surface;
+use terramesh::project::Project;
+use terramesh::{Context, Error, Result};
 
 /// Set to a comma-separated list of tile ids, makes those tiles fail on purpose (to test
 /// retries and the rerun of a failed tile).
@@ -34,11 +33,6 @@ pub enum Outcome {
     AlreadyDone,
     /// The tile was built.
     Built(TileSummary),
-}
-
-/// The folder of tile `id` in `plan`.
-pub fn tile_dir(plan: &Path, id: &str) -> std::path::PathBuf {
-    plan.join("tiles").join(id)
 }
 
 /// Builds tile `id` of the plan in `plan`: marks it `running`, builds it into `plan/tiles/ID/`
@@ -132,7 +126,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
             centre: m.frame.0,
             scale: m.frame.1,
         });
-    let variogram = crate::variogram_file::read_variogram_file(&plan.join(&m.variogram))?;
+    let variogram = terramesh::variogram_file::read_variogram_file(&plan.join(&m.variogram))?;
     seconds.push(("data".to_string(), t0.elapsed().as_secs_f64()));
 
     // The mesh: the planned ring, no vertex added on it, boundary fixed while smoothing.
@@ -194,7 +188,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     // The geological model on the tile's planar mesh, under its DSM.
     let t = Instant::now();
     let model = match &m.geology {
-        Some(gp) => Some(super::geology::build_model(
+        Some(gp) => Some(super::geology_tile::build_model(
             plan, gp, &project, tile, &positions, &triangles, &dsm,
         )?),
         None => None,
@@ -222,7 +216,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     files::write_vertices(&folder.path().join(files::VERTICES), &vertices)?;
     files::write_triangles(&folder.path().join(files::TRIANGLES), &triangles)?;
     if let (Some(model), Some(gp)) = (&model, &m.geology) {
-        super::geology::write_model(folder.path(), model, &positions, &triangles, &nodes)?;
+        super::model_files::write_model(folder.path(), model, &positions, &triangles, &nodes)?;
         let misfits = super::boreholes::tile_misfits(
             plan,
             m,

@@ -7,7 +7,7 @@
 //! the edge's endpoints in one canonical order, and a side is split from its lower endpoint
 //! (by x, then y), whichever way the tile's ring runs along it.
 
-use crate::error::{Error, Result};
+use terramesh::{Error, Result};
 
 /// `(b - a) x (c - a)`.
 fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {

@@ -4,7 +4,7 @@
 use std::fmt::Write;
 
 use super::manifest::Manifest;
-use super::merge::Merged;
+use super::merged::Merged;
 
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")

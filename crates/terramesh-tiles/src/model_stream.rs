@@ -17,13 +17,12 @@ use std::path::Path;
 use terramesh_core::volume::{Body, Cell, FaceTag, TaggedFace, VolumeMesh};
 use terramesh_io::model::{boundary_mesh, BoundaryMesh, CellVisit, FaceVisit, ModelPasses};
 
-use super::build::tile_dir;
 use super::files::{read_f64s, read_u32s};
 use super::geology::{tag_of_name, GeologyPlan, TileFigures, MODEL_BODIES, MODEL_FACES};
 use super::geology::{MODEL_JSON, MODEL_POINTS};
-use super::manifest::{Manifest, Tile};
-use super::model_merge::{cell_of, columns, key, node_map, Column};
-use crate::error::{Context, Error, Result};
+use super::manifest::{tile_dir, Manifest, Tile};
+use super::model_columns::{cell_of, columns, key, node_map, read_cells, Column};
+use terramesh::{Context, Error, Result};
 
 type Key = (u64, u64);
 
@@ -309,7 +308,7 @@ impl<'a> TiledModel<'a> {
         let dir = tile_dir(self.plan, &t.id);
         let points = read_f64s(&dir.join(MODEL_POINTS), 3)?;
         let cells = if cells {
-            super::model_merge::read_cells(&dir, &t.id, points.len() / 3)?
+            read_cells(&dir, &t.id, points.len() / 3)?
         } else {
             Vec::new()
         };

@@ -17,7 +17,7 @@
 
 use std::io::Write;
 
-use crate::error::{Error, Result};
+use terramesh::{Error, Result};
 
 /// Where an array goes in the file, in document order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -72,7 +72,10 @@ pub(crate) fn text_field<'a>(name: &str, bytes: Vec<u8>) -> Array<'a> {
 
 /// The field data `crs`, `vertical_datum` and (when named) `vertical_crs` that a one-piece
 /// build writes into `dsm.vtu` and `model.vtu` (`terramesh_io::model::ModelInfo`).
-pub(crate) fn datum_fields<'a>(crs: &str, datum: &crate::project::HeightDatum) -> Vec<Array<'a>> {
+pub(crate) fn datum_fields<'a>(
+    crs: &str,
+    datum: &terramesh::project::HeightDatum,
+) -> Vec<Array<'a>> {
     let mut f = vec![
         text_field("crs", crs.as_bytes().to_vec()),
         text_field("vertical_datum", datum.name().into_bytes()),

@@ -9,7 +9,7 @@
 //! does): its observations file `geology/<k>.f64` (`[x, y, z]` little-endian `f64` triples),
 //! and how it is estimated, decided once as `fields` decides it for a one-piece model: a
 //! constant (every observation equal), inverse-distance weighting over every observation (fewer
-//! than [`MIN_KRIGED`](crate::geology::fields::MIN_KRIGED) locations, or no variogram fits), or
+//! than [`MIN_KRIGED`](terramesh::geology::fields::MIN_KRIGED) locations, or no variogram fits), or
 //! kriging with a variogram fitted once on all its observations (`geology/<k>-variogram.json`,
 //! fitted as the one-piece model fits it) in the frame of all its observations, with a moving
 //! neighbourhood of `interpolation.neighbors` observations (a tiled build needs one). The base
@@ -22,11 +22,8 @@
 //! vertex's surfaces.
 
 use serde::{Deserialize, Serialize};
-
-pub(crate) use super::geology_plan::plan_geology;
-pub(crate) use super::geology_tile::{build_model, TileModel};
-pub use super::geology_tile::{tag_of_name, TileFigures};
-pub(crate) use super::model_files::write_model;
+use terramesh::{Error, Result};
+use terramesh_core::volume::FaceTag;
 
 /// The model's files in a tile's folder.
 pub const SURFACES: &str = "surfaces.f64";
@@ -46,7 +43,7 @@ pub const MODEL_BODIES: &str = "model-bodies.u32";
 /// How an interface is estimated in every tile, as `tiles.json` records it.
 ///
 /// ```
-/// use terramesh::tiles::Estimate;
+/// use terramesh_tiles::Estimate;
 /// let e: Estimate = serde_json::from_str(
 ///     r#"{"kind": "kriged", "variogram": "geology/1-variogram.json",
 ///         "frame": [[303247.7, 3933730.3], 28062.7], "universal": true}"#,
@@ -124,9 +121,123 @@ pub struct GeologyPlan {
     /// grids.
     #[serde(default)]
     pub crs_epsg: Option<u32>,
-    /// The boreholes' contacts file in the plan folder ([`super::boreholes::CONTACTS`]), each
+    /// The project's CRS where it has no EPSG code (`crs_epsg` `None`): its own unnamed
+    /// coordinates (`crs = "projected"`) or a PROJ definition, so that the tiles sample the
+    /// grids as a one-piece model does ([`GeologyPlan::grid_crs`]). `None` with an EPSG code.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crs: Option<PlanCrs>,
+    /// The boreholes' contacts file in the plan folder ([`CONTACTS`](crate::CONTACTS)), each
     /// contact evaluated by the tile that owns its position for `model.json`'s `boreholes`;
     /// `None` without boreholes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contacts: Option<String>,
+}
+
+/// The project's CRS of a plan where it has no EPSG code ([`GeologyPlan::crs`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum PlanCrs {
+    /// `[region] crs = "projected"`: the project's own unnamed metric coordinates, in which
+    /// every grid is taken as is, whatever CRS its file declares (docs/crs.md).
+    Projected,
+    /// A CRS named by its PROJ definition.
+    Proj {
+        /// The definition, as `terramesh_crs::Crs::parse` reads it.
+        definition: String,
+    },
+}
+
+impl PlanCrs {
+    /// How a plan records the project's CRS `crs` (`None`: `crs = "projected"`) beside its
+    /// EPSG code `epsg`: `None` when the code names it.
+    pub fn of(crs: Option<&terramesh_crs::Crs>, epsg: Option<u32>) -> Option<PlanCrs> {
+        match (crs, epsg) {
+            (_, Some(_)) => None,
+            (None, None) => Some(PlanCrs::Projected),
+            (Some(c), None) => Some(PlanCrs::Proj {
+                definition: c.definition().to_string(),
+            }),
+        }
+    }
+}
+
+impl GeologyPlan {
+    /// The CRS the tiles sample the horizon and base grids in, as the one-piece model does:
+    /// `Some` for a named CRS, `None` for a project in its own coordinates (the grids taken as
+    /// is).
+    ///
+    /// ```
+    /// use terramesh_tiles::{GeologyPlan, PlanCrs};
+    /// let mut plan = GeologyPlan {
+    ///     units: vec!["sand".into(), "clay".into()],
+    ///     base: Some(0.0),
+    ///     base_rule: String::new(),
+    ///     neighbours: 8,
+    ///     interfaces: vec![],
+    ///     thickness: false,
+    ///     crs_epsg: None,
+    ///     crs: Some(PlanCrs::Projected),
+    ///     contacts: None,
+    /// };
+    /// assert!(plan.grid_crs()?.is_none());
+    /// plan.crs_epsg = Some(32632);
+    /// plan.crs = None;
+    /// assert_eq!(plan.grid_crs()?.and_then(|c| c.epsg()), Some(32632));
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// A code or definition that names no CRS terramesh knows (a damaged plan), or a plan that
+    /// records no CRS at all (made before [`GeologyPlan::crs`] for a project without an EPSG
+    /// code): plan again.
+    pub fn grid_crs(&self) -> Result<Option<terramesh_crs::Crs>> {
+        Ok(match (self.crs_epsg, &self.crs) {
+            (Some(code), _) => Some(terramesh_crs::Crs::from_epsg(code)?),
+            (None, Some(PlanCrs::Projected)) => None,
+            (None, Some(PlanCrs::Proj { definition })) => {
+                Some(terramesh_crs::Crs::parse(definition)?)
+            }
+            (None, None) => {
+                return Err(Error::invalid(
+                    "tiles.json: the geological plan records no CRS for the horizon grids \
+                     (a plan made by an older terramesh): plan again",
+                ))
+            }
+        })
+    }
+}
+
+/// A tile's model figures (`PLAN/tiles/ID/model.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TileFigures {
+    /// Per unit, top to bottom: volume (m³).
+    pub volumes: Vec<f64>,
+    /// Per unit: cells.
+    pub cells: Vec<usize>,
+    /// Per unit: planar area where it has zero thickness, m².
+    pub pinched_area: Vec<f64>,
+    /// The volume between the terrain and the base over the tile, m³.
+    pub volume_between: f64,
+    /// The names of the tags of `model-faces.u32` (`top`, `bottom`, a side, `interface-<unit>`).
+    #[serde(default)]
+    pub tags: Vec<String>,
+}
+
+/// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
+///
+/// ```
+/// use terramesh_tiles::tag_of_name;
+/// use terramesh_core::volume::FaceTag;
+/// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
+/// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
+/// ```
+pub fn tag_of_name(name: &str) -> FaceTag {
+    match name {
+        "top" => FaceTag::Top,
+        "bottom" => FaceTag::Bottom,
+        _ => match name.strip_prefix("interface-") {
+            Some(u) => FaceTag::Interface(u.to_string()),
+            None => FaceTag::Side(name.to_string()),
+        },
+    }
 }

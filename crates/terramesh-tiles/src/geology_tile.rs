@@ -4,18 +4,17 @@
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
 use terramesh_core::volume::{Body, Cell, FaceTag, Interpolated, TaggedFace};
 use terramesh_geostat::{Data, Duplicates, Idw, IdwSearch, KrigingFrame, Method, Predictor};
 use terramesh_mesh::Mesh;
 
-use super::geology::{Estimate, GeologyPlan};
+use super::geology::{Estimate, GeologyPlan, TileFigures};
 use super::geology_plan::horizon_at;
-use crate::build::stages::Surface;
-use crate::error::{Context, Error, Result};
-use crate::geology::model::{assemble, Base, ModelInputs};
-use crate::plan::Base as BaseKey;
-use crate::project::Project;
+use terramesh::build::Surface;
+use terramesh::geology::model::{assemble_estimated, Base};
+use terramesh::plan::Base as BaseKey;
+use terramesh::project::Project;
+use terramesh::{Context, Error, Result};
 
 /// One tile's geological model.
 pub(crate) struct TileModel {
@@ -33,48 +32,13 @@ pub(crate) struct TileModel {
     pub figures: TileFigures,
 }
 
-/// A tile's model figures (`PLAN/tiles/ID/model.json`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TileFigures {
-    /// Per unit, top to bottom: volume (m³).
-    pub volumes: Vec<f64>,
-    /// Per unit: cells.
-    pub cells: Vec<usize>,
-    /// Per unit: planar area where it has zero thickness, m².
-    pub pinched_area: Vec<f64>,
-    /// The volume between the terrain and the base over the tile, m³.
-    pub volume_between: f64,
-    /// The names of the tags of `model-faces.u32` (`top`, `bottom`, a side, `interface-<unit>`).
-    #[serde(default)]
-    pub tags: Vec<String>,
-}
-
-/// The tag a name of [`TileFigures::tags`] stands for (sides are compass sides in tiles).
-///
-/// ```
-/// use terramesh::tiles::tag_of_name;
-/// use terramesh_core::volume::FaceTag;
-/// assert_eq!(tag_of_name("interface-clay"), FaceTag::Interface("clay".into()));
-/// assert_eq!(tag_of_name("north"), FaceTag::Side("north".into()));
-/// ```
-pub fn tag_of_name(name: &str) -> FaceTag {
-    match name {
-        "top" => FaceTag::Top,
-        "bottom" => FaceTag::Bottom,
-        _ => match name.strip_prefix("interface-") {
-            Some(u) => FaceTag::Interface(u.to_string()),
-            None => FaceTag::Side(name.to_string()),
-        },
-    }
-}
-
 /// Builds the model of one tile on its planar mesh (`xy`, its absolute positions, the planned
 /// ones on the boundary; `triangles`) under `terrain`.
 pub(crate) fn build_model(
     plan: &Path,
     gp: &GeologyPlan,
     project: &Project,
-    tile: &super::Tile,
+    tile: &super::manifest::Tile,
     xy: &[[f64; 2]],
     triangles: &[[u32; 3]],
     terrain: &[f64],
@@ -99,7 +63,7 @@ pub(crate) fn build_model(
                             it.unit
                         ))
                     })?;
-                let v = horizon_at(path, xy, g, gp.crs_epsg, &it.unit)
+                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), &it.unit)
                     .with_context(|| format!("tile {}", tile.id))?;
                 // Nodata: the unit is absent there (as in a one-piece model).
                 grids.push((
@@ -133,7 +97,7 @@ pub(crate) fn build_model(
                         centre: frame.0,
                         scale: frame.1,
                     });
-                let v = crate::variogram_file::read_variogram_file(&plan.join(variogram))?;
+                let v = terramesh::variogram_file::read_variogram_file(&plan.join(variogram))?;
                 let method = if *universal {
                     Method::Universal(project.interpolation.drift)
                 } else {
@@ -164,7 +128,7 @@ pub(crate) fn build_model(
         match (gp.base, &g.base) {
             (Some(z), _) => Base::Elevation(z),
             (None, BaseKey::Raster(path)) => {
-                let v = horizon_at(path, xy, g, gp.crs_epsg, "the base")
+                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), "the base")
                     .with_context(|| format!("tile {}", tile.id))?;
                 match v.iter().position(Option::is_none) {
                     Some(i) => {
@@ -184,13 +148,21 @@ pub(crate) fn build_model(
                 "the plan samples a base grid but the project's geology.base is none: plan again",
             )),
         };
-    let inputs = g.model_inputs(None, grids, base, Interpolated::Tops, Method::Ordinary);
-    let model = if gp.thickness {
-        thickness_model(&mesh, terrain, &inputs)
+    // The plan estimated every field: unit tops (as horizon grids are given) or thicknesses.
+    let (grids, thick) = if gp.thickness {
+        (Vec::new(), grids.into_iter().map(|g| g.1).collect())
     } else {
-        assemble(&mesh, terrain, &inputs)
-    }
-    .with_context(|| format!("tile {}: [geology]", tile.id))?;
+        (grids, Vec::new())
+    };
+    let interpolate = if gp.thickness {
+        Interpolated::Thickness
+    } else {
+        Interpolated::Tops
+    };
+    let inputs = g.model_inputs(None, grids, base, interpolate, Method::Ordinary);
+    let values: Vec<&[f64]> = thick.iter().map(Vec::as_slice).collect();
+    let model = assemble_estimated(&mesh, terrain, &inputs, &values)
+        .with_context(|| format!("tile {}: [geology]", tile.id))?;
     let figures = TileFigures {
         volumes: model.check.unit_volumes.clone(),
         cells: (0..g.units.len())
@@ -219,33 +191,6 @@ pub(crate) fn build_model(
         faces: model.mesh.faces,
         bodies: model.mesh.bodies,
         figures,
-    })
-}
-
-/// The model from thickness fields (`inputs.grids`, units 0..n-1, in order) stacked down from
-/// the terrain, as a one-piece model stacks its kriged thicknesses (`stack_of`, `seal`).
-fn thickness_model(
-    mesh: &Mesh,
-    terrain: &[f64],
-    inputs: &ModelInputs,
-) -> Result<crate::geology::model::GeologicalModel> {
-    let planar =
-        terramesh_geology::Planar::new(&mesh.points, &mesh.triangles).context("the planar mesh")?;
-    let base = crate::geology::model::base_values(inputs, terrain, None, mesh.points.len())?;
-    let thick: Vec<Vec<f64>> = inputs.grids.iter().map(|g| g.1.clone()).collect();
-    let (stack, rules) =
-        terramesh_geology::stack_thicknesses(&planar, terrain, &thick, &base, inputs.min_thickness)
-            .context("the geological rules")?;
-    let (volume, check, stats) = crate::geology::model::seal(&planar, &stack, &inputs.layering)?;
-    Ok(crate::geology::model::GeologicalModel {
-        mesh: volume,
-        stack,
-        rules,
-        fields: Vec::new(),
-        stats,
-        check,
-        misfits: Vec::new(),
-        grids: Vec::new(),
     })
 }
 

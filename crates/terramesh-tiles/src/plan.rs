@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use kiddo::ImmutableKdTree;
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
@@ -11,10 +11,10 @@ use super::manifest::{
     DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM,
     VERSION,
 };
-use crate::build::stages;
-use crate::error::{Context, Error, Result};
-use crate::progress::Progress;
-use crate::project::Project;
+use terramesh::build as stages;
+use terramesh::progress::Progress;
+use terramesh::project::Project;
+use terramesh::{Context, Error, Result};
 
 /// The seams' vertex spacing in target edge lengths: the strips' cut spacing in
 /// `terramesh-mesh` (short enough that refinement never needs to split them).
@@ -38,7 +38,7 @@ pub struct Planned {
 /// Parses a tile size: metres (`2500`, `2500m`) or kilometres (`10km`, `2.5km`).
 ///
 /// ```
-/// use terramesh::tiles::parse_tile_size;
+/// use terramesh_tiles::parse_tile_size;
 /// assert_eq!(parse_tile_size("10km").unwrap(), 10_000.0);
 /// assert_eq!(parse_tile_size("750m").unwrap(), 750.0);
 /// assert_eq!(parse_tile_size("1200").unwrap(), 1200.0);
@@ -61,56 +61,6 @@ pub fn parse_tile_size(s: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// The tile grid column or row of coordinate `v` (clamped to the grid).
-pub(crate) fn cell_of(v: f64, origin: f64, size: f64, n: usize) -> usize {
-    let k = ((v - origin) / size).floor();
-    if k < 0.0 {
-        0
-    } else {
-        (k as usize).min(n - 1)
-    }
-}
-
-/// The tile of the grid node or point `q`: exactly one, so that every DSM grid node is kriged
-/// by one tile.
-pub(crate) fn owner(m: &Manifest, q: [f64; 2]) -> [usize; 2] {
-    [
-        cell_of(q[0], m.origin[0], m.tile_size, m.shape[0]),
-        cell_of(q[1], m.origin[1], m.tile_size, m.shape[1]),
-    ]
-}
-
-/// The halo of the extent `r`: the distance from any of its points to its `k`-th nearest point
-/// of `tree` is at most this. `R(q)` (the distance from `q` to its `k`-th nearest) is measured
-/// at probes on a lattice of spacing at most `h`; for any point `p` of the extent
-/// `R(p) <= R(q) + |p - q| <= max R + step/√2` (the triangle inequality), so every point any
-/// point of the extent uses lies within it, equal-distance ties included.
-pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f64) -> f64 {
-    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
-    let n = [
-        ((r[2] - r[0]) / h).ceil() as usize + 1,
-        ((r[3] - r[1]) / h).ceil() as usize + 1,
-    ];
-    let mut reach: f64 = 0.0;
-    for b in 0..n[1] {
-        for a in 0..n[0] {
-            let q = [
-                r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
-                r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
-            ];
-            let near = tree
-                .query(&q)
-                .nearest_n::<SquaredEuclidean<f64>>(kk)
-                .execute();
-            if let Some(last) = near.last() {
-                reach = reach.max(last.distance.sqrt());
-            }
-        }
-    }
-    let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
-    (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
-}
-
 /// A plan writes many files into its folder (`tiles.json`, `samples.csv`, `variogram.json`,
 /// `samples/`, ...): an existing folder is taken only when it is empty or holds a plan
 /// already (its `tiles.json`), never a folder of other files such as a home folder.
@@ -126,13 +76,13 @@ fn check_plan_folder(out: &Path) -> Result<()> {
         return Ok(());
     }
     Err(Error::setting(
-        crate::setting::Setting::Output,
+        terramesh::Setting::Output,
         out.display(),
         format!(
             "exists and is not a plan folder (no {}; it holds '{}' among {} entries): name a \
              new or empty folder",
             super::manifest::MANIFEST,
-            crate::error::cut(&names[0]),
+            terramesh::cut(&names[0]),
             names.len()
         ),
     ))
@@ -230,7 +180,7 @@ pub fn plan(
     let json = VariogramFile::new(model.variogram.clone()).to_json_pretty();
     terramesh_io::output::write_atomic(&vpath, json.as_bytes())
         .context(vpath.display().to_string())?;
-    let variogram = crate::variogram_file::read_variogram_file(&vpath)?;
+    let variogram = terramesh::variogram_file::read_variogram_file(&vpath)?;
     let data = &model.data;
     let frame = data.frame(&variogram);
     // The samples, as kriging sees them (duplicates merged), in order.
@@ -334,7 +284,7 @@ pub fn plan(
                 .collect();
             let neighbours = seams.iter().map(|s| s.neighbour.clone()).collect();
             // The halo: the farthest k-th neighbour over probes, plus the probes' reach.
-            let halo = reach(&tree, k, r, h);
+            let halo = super::partition::reach(&tree, k, r, h);
             max_halo = max_halo.max(halo);
             tiles.push(Tile {
                 id: id(i, j),
@@ -353,7 +303,7 @@ pub fn plan(
         }
     }
     let rects: Vec<[f64; 4]> = tiles.iter().map(|t| t.extent).collect();
-    let geology = super::geology::plan_geology(project, &samples, data.z(), out, &rects, h)?;
+    let geology = super::geology_plan::plan_geology(project, &samples, data.z(), out, &rects, h)?;
     let geology = geology.map(|(g, halos)| {
         for (t, halo) in tiles.iter_mut().zip(halos) {
             t.geology_halo = Some(halo);

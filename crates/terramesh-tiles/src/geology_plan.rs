@@ -11,13 +11,13 @@ use terramesh_geostat::{
 };
 
 use super::files::put_f64;
-use super::geology::{Estimate, GeologyPlan, InterfacePlan};
-use crate::build::stages::Samples;
-use crate::error::{Context, Error, Result};
-use crate::geology::fields::MIN_KRIGED;
-use crate::geology::model::AUTO_BASE_MARGIN;
-use crate::plan::{Base as BaseKey, GeologyPlan as GeologySettings};
-use crate::project::Project;
+use super::geology::{Estimate, GeologyPlan, InterfacePlan, PlanCrs};
+use terramesh::build::Samples;
+use terramesh::geology::fields::MIN_KRIGED;
+use terramesh::geology::model::AUTO_BASE_MARGIN;
+use terramesh::plan::{Base as BaseKey, GeologyPlan as GeologySettings};
+use terramesh::project::Project;
+use terramesh::{Context, Error, Result};
 /// The plan of the geological model of `p` (None without `[geology]`), its files written
 /// into `out/geology/`, and each tile's geology halo for the extents `rects` (probe spacing
 /// `h`).
@@ -33,7 +33,7 @@ pub(crate) fn plan_geology(
         return Ok(None);
     };
     check_supported(g)?;
-    let holes = crate::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?;
+    let holes = terramesh::geology::stage::read_boreholes(g, samples.zone, samples.crs.as_ref())?;
     let gridded = |unit: usize| g.surfaces.get(unit).and_then(Option::as_ref);
     match &holes {
         Some(_) => {}
@@ -48,6 +48,10 @@ pub(crate) fn plan_geology(
     }
     let contacts = || holes.iter().flat_map(|h| h.contacts());
     let crs_epsg = samples.epsg();
+    // The grids are sampled in the CRS the one-piece model samples them in: the project's,
+    // or as is in a project in its own coordinates (`crs = "projected"`, docs/crs.md).
+    let crs = terramesh::geology::stage::project_crs(samples.zone, samples.crs.as_ref())?;
+    let crs = crs.as_ref();
     // The horizon grids' lowest value at the samples (for an auto base).
     let mut grid_low = f64::INFINITY;
     let sample_xy: Vec<[f64; 2]> = samples.xyz.iter().map(|p| [p[0], p[1]]).collect();
@@ -65,7 +69,7 @@ pub(crate) fn plan_geology(
     for unit in fields {
         let name = &g.units[unit];
         if let Some(path) = gridded(unit).filter(|_| !thickness) {
-            let values = horizon_at(path, &sample_xy, g, crs_epsg, name)?;
+            let values = horizon_at(path, &sample_xy, g, crs, name)?;
             grid_low = values.into_iter().flatten().fold(grid_low, f64::min);
             interfaces.push(InterfacePlan {
                 unit: name.clone(),
@@ -129,7 +133,7 @@ pub(crate) fn plan_geology(
                     let json = VariogramFile::new(v).to_json_pretty();
                     terramesh_io::output::write_atomic(&vpath, json.as_bytes())
                         .context(vpath.display().to_string())?;
-                    let v = crate::variogram_file::read_variogram_file(&vpath)?;
+                    let v = terramesh::variogram_file::read_variogram_file(&vpath)?;
                     let f = data.frame(&v);
                     let k = k_project.min(data.len());
                     // Drift terms need more data than unknowns (as the one-piece model).
@@ -139,7 +143,7 @@ pub(crate) fn plan_geology(
                             Error::invalid(format!("search tree of {name}'s observations: {e:?}"))
                         })?;
                     for (halo, r) in halos.iter_mut().zip(rects) {
-                        *halo = halo.max(super::plan::reach(&tree, k, *r, h));
+                        *halo = halo.max(super::partition::reach(&tree, k, *r, h));
                     }
                     Estimate::Kriged {
                         variogram: vfile,
@@ -184,7 +188,7 @@ pub(crate) fn plan_geology(
                 path,
                 &sample_xy[..sample_xy.len().min(1)],
                 g,
-                crs_epsg,
+                crs,
                 "the base",
             )?;
             (
@@ -209,6 +213,7 @@ pub(crate) fn plan_geology(
             interfaces,
             thickness,
             crs_epsg,
+            crs: PlanCrs::of(crs, crs_epsg),
             contacts: contacts_file,
         },
         halos,
@@ -240,24 +245,18 @@ fn check_supported(g: &GeologySettings) -> Result<()> {
     Ok(())
 }
 
-/// A horizon grid (`[geology] surfaces` or the base) at `xy` in the project's CRS
-/// (`epsg`), in metres; `None` on a nodata pixel. Each point on its own (per vertex), as the
-/// one-piece model samples it.
+/// A horizon grid (`[geology] surfaces` or the base) at `xy` in the project's CRS `crs`
+/// (`None`: a project in its own coordinates, where the grid is taken as is), in metres;
+/// `None` on a nodata pixel. Each point on its own (per vertex), as the one-piece model
+/// samples it.
 pub(super) fn horizon_at(
     path: &Path,
     xy: &[[f64; 2]],
     g: &GeologySettings,
-    epsg: Option<u32>,
+    crs: Option<&terramesh_crs::Crs>,
     what: &str,
 ) -> Result<Vec<Option<f64>>> {
-    let code = epsg.ok_or_else(|| {
-        Error::invalid(
-            "horizon grids need the project's CRS to be placed in: name it with [region] crs = \
-             \"EPSG:...\"",
-        )
-    })?;
-    let crs = terramesh_crs::Crs::from_epsg(code)?;
-    let grid = crate::horizon::HorizonGrid::open(path, g.z_unit)?;
-    grid.evaluate(xy, &crs)
+    let grid = terramesh::horizon::HorizonGrid::open(path, g.z_unit)?;
+    grid.evaluate_in(xy, crs)
         .with_context(|| format!("the grid of {what}"))
 }

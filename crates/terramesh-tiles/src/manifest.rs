@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// The manifest's file name in the plan folder.
 pub const MANIFEST: &str = "tiles.json";
@@ -261,10 +261,10 @@ impl Manifest {
     }
 
     /// The vertical datum of the heights, as the project names it ([`Manifest::vertical_epsg`]).
-    pub fn height_datum(&self) -> crate::project::HeightDatum {
+    pub fn height_datum(&self) -> terramesh::project::HeightDatum {
         self.vertical_epsg.map_or(
-            crate::project::HeightDatum::Source,
-            crate::project::HeightDatum::Epsg,
+            terramesh::project::HeightDatum::Source,
+            terramesh::project::HeightDatum::Epsg,
         )
     }
 
@@ -424,7 +424,7 @@ impl Manifest {
             let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
             Error::invalid(format!(
                 "no tile '{id}' in the plan; its tiles are {}",
-                crate::cut(&ids.join(", "))
+                terramesh::cut(&ids.join(", "))
             ))
         })
     }
@@ -436,7 +436,7 @@ impl Manifest {
 /// ```
 /// # fn main() -> Result<(), terramesh::Error> {
 /// let dir = tempfile::tempdir()?;
-/// let e = terramesh::tiles::update(dir.path(), |_| Ok(())).unwrap_err();
+/// let e = terramesh_tiles::update(dir.path(), |_| Ok(())).unwrap_err();
 /// assert!(e.to_string().contains("terramesh tiles plan"));
 /// # Ok(()) }
 /// ```
@@ -469,4 +469,28 @@ impl Drop for Lock {
     fn drop(&mut self) {
         let _ = self.0.unlock();
     }
+}
+
+/// The folder of tile `id` in `plan`.
+pub fn tile_dir(plan: &Path, id: &str) -> std::path::PathBuf {
+    plan.join("tiles").join(id)
+}
+
+/// The tile grid column or row of coordinate `v` (clamped to the grid).
+pub(crate) fn cell_of(v: f64, origin: f64, size: f64, n: usize) -> usize {
+    let k = ((v - origin) / size).floor();
+    if k < 0.0 {
+        0
+    } else {
+        (k as usize).min(n - 1)
+    }
+}
+
+/// The tile of the grid node or point `q`: exactly one, so that every DSM grid node is kriged
+/// by one tile.
+pub(crate) fn owner(m: &Manifest, q: [f64; 2]) -> [usize; 2] {
+    [
+        cell_of(q[0], m.origin[0], m.tile_size, m.shape[0]),
+        cell_of(q[1], m.origin[1], m.tile_size, m.shape[1]),
+    ]
 }

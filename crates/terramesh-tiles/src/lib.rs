@@ -1,5 +1,8 @@
-//! Tiled builds: a region split into square tiles that are built as independent jobs (on one
-//! machine, a Dask cluster or a Slurm array) and merged without seams.
+//! **terramesh-tiles**: tiled builds. A region split into square tiles that are built as
+//! independent jobs (on one machine, a Dask cluster or a Slurm array) and merged without seams.
+//! A tile runs the stages of the facade crate `terramesh` (its samples, variogram, predictors
+//! and geological model assembly) on its part of the region; this crate adds the partition,
+//! the manifest, the merge and the scripts.
 //!
 //! * [`plan()`]: samples the region once, fits one variogram, cuts the region into tiles with
 //!   their halos (from the kriging neighbourhood) and seams (vertices fixed in advance), and
@@ -21,7 +24,8 @@
 //! ```no_run
 //! # fn main() -> Result<(), terramesh::Error> {
 //! use std::path::Path;
-//! use terramesh::{project::Project, tiles};
+//! use terramesh::project::Project;
+//! use terramesh_tiles as tiles;
 //! let file = Path::new("examples/haut-barr/terramesh.toml");
 //! let p = Project::load(file, &[])?;
 //! let progress = terramesh::progress::Silent;
@@ -34,6 +38,8 @@
 //! # Ok(()) }
 //! ```
 
+#![warn(missing_docs)]
+
 mod appended;
 mod boreholes;
 mod build;
@@ -45,6 +51,8 @@ mod geometry;
 mod grid_merge;
 mod manifest;
 mod merge;
+mod merged;
+mod model_columns;
 mod model_export;
 mod model_files;
 mod model_merge;
@@ -55,18 +63,19 @@ mod report;
 mod slurm;
 
 pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
-pub use build::{build_tile, tile_dir, Outcome, FAIL_ENV};
+pub use build::{build_tile, Outcome, FAIL_ENV};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
-    tag_of_name, Estimate, GeologyPlan, InterfacePlan, TileFigures, INTERFACES, MODEL_BODIES,
-    MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
+    tag_of_name, Estimate, GeologyPlan, InterfacePlan, PlanCrs, TileFigures, INTERFACES,
+    MODEL_BODIES, MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
-    update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData,
-    TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
+    tile_dir, update, CrsText, DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile,
+    TileData, TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
 };
-pub use merge::{merge, Merged};
+pub use merge::merge;
+pub use merged::Merged;
 pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};

@@ -9,7 +9,7 @@
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::Path;
 
-use crate::error::{Context, Result};
+use terramesh::{Context, Result};
 
 /// Vertex records' file.
 pub const VERTICES: &str = "vertices.f64";
@@ -102,7 +102,7 @@ fn read_all(path: &Path, record: usize) -> Result<Vec<u8>> {
         .read_to_end(&mut b)
         .context(path.display().to_string())?;
     if b.len() % record != 0 {
-        return Err(crate::Error::invalid(format!(
+        return Err(terramesh::Error::invalid(format!(
             "{}: {} bytes, not a whole number of {record}-byte records: build the tile again",
             path.display(),
             b.len()
@@ -171,7 +171,7 @@ pub(crate) fn check_indices(
         .enumerate()
         .find(|&(_, i)| i as usize >= n)
     {
-        return Err(crate::Error::invalid(format!(
+        return Err(terramesh::Error::invalid(format!(
             "{}: tile {id}: index {i} (record value {k}) refers past its {n} {what}: the tile \
              is damaged; build it again (terramesh tiles build PLAN --tile {id})",
             path.display()

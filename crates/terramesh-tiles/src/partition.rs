@@ -10,9 +10,10 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::manifest::Manifest;
-use super::plan::cell_of;
-use crate::error::{Context, Error, Result};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+
+use super::manifest::{cell_of, Manifest};
+use terramesh::{Context, Error, Result};
 
 /// The folder of the per-tile sample files in the plan.
 pub const SAMPLES_DIR: &str = "samples";
@@ -26,7 +27,7 @@ pub fn samples_file(id: &str) -> String {
 /// extent grown by the halo on every side, edges included.
 ///
 /// ```
-/// use terramesh::tiles::in_window;
+/// use terramesh_tiles::in_window;
 /// assert!(in_window([0.0, 0.0, 10.0, 10.0], 2.0, [-2.0, 12.0]));
 /// assert!(!in_window([0.0, 0.0, 10.0, 10.0], 2.0, [-2.1, 5.0]));
 /// ```
@@ -166,6 +167,37 @@ fn write_records(
         }
     }
     o.commit().with_context(at)
+}
+
+/// The halo of the extent `r`: the distance from any of its points to its `k`-th nearest point
+/// of `tree` is at most this. `R(q)` (the distance from `q` to its `k`-th nearest) is measured
+/// at probes on a lattice of spacing at most `h`; for any point `p` of the extent
+/// `R(p) <= R(q) + |p - q| <= max R + step/√2` (the triangle inequality), so every point any
+/// point of the extent uses lies within it, equal-distance ties included.
+pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f64) -> f64 {
+    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
+    let n = [
+        ((r[2] - r[0]) / h).ceil() as usize + 1,
+        ((r[3] - r[1]) / h).ceil() as usize + 1,
+    ];
+    let mut reach: f64 = 0.0;
+    for b in 0..n[1] {
+        for a in 0..n[0] {
+            let q = [
+                r[0] + (r[2] - r[0]) * a as f64 / (n[0] - 1) as f64,
+                r[1] + (r[3] - r[1]) * b as f64 / (n[1] - 1) as f64,
+            ];
+            let near = tree
+                .query(&q)
+                .nearest_n::<SquaredEuclidean<f64>>(kk)
+                .execute();
+            if let Some(last) = near.last() {
+                reach = reach.max(last.distance.sqrt());
+            }
+        }
+    }
+    let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
+    (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
 }
 
 #[cfg(test)]

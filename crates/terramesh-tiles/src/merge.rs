@@ -11,52 +11,23 @@
 
 use std::collections::HashMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-use serde::Serialize;
 use terramesh_io::output::Output;
 
 use super::appended::{self, put_f64, Array, Section, Values};
-use super::build::tile_dir;
 use super::files::{self, Vertex};
-use super::manifest::{Manifest, State, Tile};
-use crate::error::{Context, Error, Result};
-
-/// What the merge made.
-#[derive(Debug, Clone, Serialize)]
-pub struct Merged {
-    /// Files written.
-    pub files: Vec<PathBuf>,
-    /// Vertices of the merged mesh.
-    pub vertices: usize,
-    /// Triangles.
-    pub triangles: usize,
-    /// Distinct seam vertices (each written once).
-    pub seam_vertices: usize,
-    /// The largest difference between two tiles' DSM elevations at one seam vertex (0: both
-    /// sides computed the same value).
-    pub seam_max_difference: f64,
-    /// The merged mesh's planar area, m².
-    pub area: f64,
-    /// What writing the grids held: one row at a time.
-    pub grid: super::grid_merge::GridFigures,
-    /// The geological model, when the plan has one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub model: Option<super::model_merge::MergedModel>,
-    /// Seconds the merge took.
-    pub seconds: f64,
-}
-
-/// The nodata value of the grids.
-pub(super) const NODATA: f64 = -9999.0;
+use super::manifest::{tile_dir, Manifest, State, Tile};
+use super::merged::Merged;
+use terramesh::{Context, Error, Result};
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
 /// tile must be `done`; the error lists those that are not. The merge is atomic as a build
-/// is ([`crate::build::staging`]): written into a sibling of `out` and swapped in at the end,
+/// is ([`terramesh::build::staging`]): written into a sibling of `out` and swapped in at the end,
 /// so a failing merge leaves an existing `out` as it was; an existing `out` that is not a
-/// build folder (no [`MARKER`](crate::build::staging::MARKER), not empty) is refused.
+/// build folder (no [`MARKER`](terramesh::build::staging::MARKER), not empty) is refused.
 pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
     let t0 = Instant::now();
     let m = Manifest::read(plan)?;
@@ -65,7 +36,7 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         .iter()
         .filter(|t| t.state != State::Done)
         .map(|t| match &t.error {
-            Some(e) => format!("{} (failed: {})", t.id, crate::cut(e)),
+            Some(e) => format!("{} (failed: {})", t.id, terramesh::cut(e)),
             None => format!("{} ({:?})", t.id, t.state).to_lowercase(),
         })
         .collect();
@@ -74,14 +45,14 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
             "{} of {} tiles are not done: {}; build them with terramesh tiles build {} --tile ID",
             pending.len(),
             m.tiles.len(),
-            crate::cut(&pending.join(", ")),
+            terramesh::cut(&pending.join(", ")),
             plan.display()
         )));
     }
     // Staged like a build (`build/staging.rs`): written into a sibling folder, swapped in
     // at the end, so that a failing merge leaves `out` as it was; an existing `out` without
     // the build marker (and not empty) is refused.
-    let staging = crate::build::staging::Staging::begin(out, &crate::progress::Silent)?;
+    let staging = terramesh::build::staging::Staging::begin(out, &terramesh::progress::Silent)?;
     let merged = merge_into(plan, &m, staging.dir(), t0)?;
     let dir = staging.dir().to_path_buf();
     staging.commit()?;

@@ -7,10 +7,10 @@ use terramesh_mesh::{Mesh, SurfaceLocator};
 
 use super::files::put_f64;
 use super::geology::{
-    TileModel, INTERFACES, MODEL_BODIES, MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS,
-    SURFACES,
+    INTERFACES, MODEL_BODIES, MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
 };
-use crate::error::{Context, Result};
+use super::geology_tile::TileModel;
+use terramesh::{Context, Result};
 
 /// Writes a tile's model files into `dir`: `surfaces.f64` (per planar vertex, every surface),
 /// `model-points.f64` (`x, y, z`), `model-cells.u32` (per cell: kind 0 tetra, 1 pyramid, 2

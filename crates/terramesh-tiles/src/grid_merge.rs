@@ -18,11 +18,12 @@ use std::path::{Path, PathBuf};
 use terramesh_io::grid_write::{GridRows, Heights, RowFormat};
 use terramesh_io::output::Output;
 
-use super::build::tile_dir;
 use super::files;
-use super::manifest::Manifest;
-use super::merge::NODATA;
-use crate::error::{Context, Error, Result};
+use super::manifest::{tile_dir, Manifest};
+use terramesh::{Context, Error, Result};
+
+/// The nodata value of the grids.
+pub(super) const NODATA: f64 = -9999.0;
 
 /// What the grid merge held and wrote.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

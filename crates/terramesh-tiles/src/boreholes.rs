@@ -4,7 +4,7 @@
 //! The plan lists every contact once (`PLAN/geology/contacts.json`, [`PlannedContact`]) in the
 //! one-piece order: every collar against the terrain (the first unit's top), then the logged
 //! tops of the other units, hole by hole. A contact belongs to the tile that owns its position
-//! (the grid nodes' rule, [`super::plan::owner`]): for a vertical hole the tile of its collar,
+//! (the grid nodes' rule, [`super::manifest::owner`]): for a vertical hole the tile of its collar,
 //! for an inclined one the tile where the desurveyed hole meets the unit, which is where the
 //! model is evaluated. That tile evaluates the unit's top on its planar mesh (linear on its
 //! triangles, `terramesh_mesh::SurfaceLocator`, as the one-piece model does on its mesh) and
@@ -25,11 +25,10 @@ use serde::{Deserialize, Serialize};
 use terramesh_io::boreholes::Boreholes;
 use terramesh_mesh::{Mesh, SurfaceLocator};
 
-use super::build::tile_dir;
 use super::geology::GeologyPlan;
-use super::manifest::{Manifest, Tile};
-use crate::error::{Context, Error, Result};
-use crate::geology::model::Misfit;
+use super::manifest::{tile_dir, Manifest, Tile};
+use terramesh::geology::model::Misfit;
+use terramesh::{Context, Error, Result};
 
 /// The contacts' list in the plan folder.
 pub const CONTACTS: &str = "geology/contacts.json";
@@ -39,7 +38,7 @@ pub const MISFITS: &str = "misfits.json";
 /// One observed contact, as the plan lists it.
 ///
 /// ```
-/// use terramesh::tiles::PlannedContact;
+/// use terramesh_tiles::PlannedContact;
 /// let c: PlannedContact = serde_json::from_str(
 ///     r#"{"hole": "B1", "unit": 0, "x": 10.0, "y": 20.0, "observed": 301.5}"#,
 /// )?;
@@ -119,7 +118,7 @@ pub(crate) fn tile_misfits(
     let mut locators: Vec<Option<SurfaceLocator>> = (0..surfaces.len()).map(|_| None).collect();
     let mut out = Vec::new();
     for (i, c) in list.iter().enumerate() {
-        if super::plan::owner(m, [c.x, c.y]) != tile.index {
+        if super::manifest::owner(m, [c.x, c.y]) != tile.index {
             continue;
         }
         let s = surfaces.get(c.unit).ok_or_else(|| {

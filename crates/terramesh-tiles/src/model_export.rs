@@ -45,9 +45,9 @@ use terramesh_io::output::Output;
 
 use super::geology::GeologyPlan;
 use super::manifest::Manifest;
-use super::model_merge::Column;
+use super::model_columns::Column;
 use super::model_stream::TiledModel;
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// What the merge found making the merged model's other files (`exports` in `merge.json`'s
 /// `model`).

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::manifest::Manifest;
-use crate::error::{Context, Error, Result};
+use terramesh::{Context, Error, Result};
 
 /// The settings of the generated jobs.
 #[derive(Debug, Clone)]
@@ -82,7 +82,7 @@ fn sbatch_path(field: &str, p: &Path) -> Result<String> {
 /// nor be read as shell syntax. `Err` says what is wrong; the caller names the option.
 ///
 /// ```
-/// use terramesh::tiles::check_sbatch_value;
+/// use terramesh_tiles::check_sbatch_value;
 /// assert!(check_sbatch_value("compute,debug").is_ok());
 /// assert!(check_sbatch_value("1-00:00:00").is_ok());
 /// assert!(check_sbatch_value("4G").is_ok());

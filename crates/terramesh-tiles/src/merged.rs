@@ -1,0 +1,33 @@
+//! What a merge made ([`Merged`]): `merge.json` and the merge's report render it.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use super::grid_merge::GridFigures;
+use super::model_merge::MergedModel;
+
+/// What the merge made.
+#[derive(Debug, Clone, Serialize)]
+pub struct Merged {
+    /// Files written.
+    pub files: Vec<PathBuf>,
+    /// Vertices of the merged mesh.
+    pub vertices: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// Distinct seam vertices (each written once).
+    pub seam_vertices: usize,
+    /// The largest difference between two tiles' DSM elevations at one seam vertex (0: both
+    /// sides computed the same value).
+    pub seam_max_difference: f64,
+    /// The merged mesh's planar area, m².
+    pub area: f64,
+    /// What writing the grids held: one row at a time.
+    pub grid: GridFigures,
+    /// The geological model, when the plan has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<MergedModel>,
+    /// Seconds the merge took.
+    pub seconds: f64,
+}
