@@ -47,6 +47,9 @@ mod report;
 mod smooth;
 /// Meshing large regions in vertical strips, in parallel.
 mod strips;
+/// Small input angles: the ladders of triangles between two segments meeting at less than
+/// the angle limit.
+mod wedge;
 
 pub use adaptive::{
     adaptive_mesh, error_probes, surface_error, AdaptiveReport, AdaptiveSettings, Fallible,
