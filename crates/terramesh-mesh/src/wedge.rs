@@ -73,27 +73,21 @@ fn min_angle(p: [Point2<f64>; 3]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The vertices along the constraint edges from `apex` through `first`, as long as they
-/// continue straight on (a segment split by refinement): radius and position, outwards.
+/// The vertices along the constraint edges from `apex` in direction `dir` (unit), as long as
+/// they continue straight on (a segment split by refinement): radius and position, and
+/// handle, outwards.
 fn side(
     state: &CdtState,
     apex: FixedVertexHandle,
-    first: FixedVertexHandle,
+    dir: [f64; 2],
 ) -> (Vec<(f64, Point2<f64>)>, Vec<FixedVertexHandle>) {
     let o = state.cdt.vertex(apex).position();
-    let mut prev = apex;
-    let mut cur = first;
-    let d = sub(state.cdt.vertex(first).position(), o);
-    let len = d[0].hypot(d[1]);
-    let dir = [d[0] / len, d[1] / len];
+    let mut cur = apex;
     let (mut out, mut handles) = (Vec::new(), Vec::new());
     loop {
-        handles.push(cur);
         let p = state.cdt.vertex(cur).position();
-        let r = sub(p, o);
-        out.push((r[0] * dir[0] + r[1] * dir[1], p));
         let next = state.cdt.vertex(cur).out_edges().find(|e| {
-            if !e.is_constraint_edge() || e.to().fix() == prev {
+            if !e.is_constraint_edge() {
                 return false;
             }
             let q = sub(e.to().position(), p);
@@ -102,28 +96,48 @@ fn side(
                 && q[0] * dir[0] + q[1] * dir[1] > 0.0
                 && (q[0] * dir[1] - q[1] * dir[0]).abs() <= TOL * l
         });
-        match next {
-            Some(e) => {
-                prev = cur;
-                cur = e.to().fix();
-            }
-            None => return (out, handles),
-        }
+        let Some(e) = next else {
+            return (out, handles);
+        };
+        cur = e.to().fix();
+        let q = e.to().position();
+        let r = sub(q, o);
+        out.push((r[0] * dir[0] + r[1] * dir[1], q));
+        handles.push(cur);
     }
 }
 
-/// Every wedge: two consecutive constraint edges around a vertex that meet at less than
-/// `limit` (radians) with an inside triangle between them.
-fn wedges(state: &CdtState, inside: &[bool], limit: f64) -> Vec<Wedge> {
+/// Whether a face lies inside the region (its centroid does).
+fn inside(state: &CdtState, p: [Point2<f64>; 3]) -> bool {
+    state.contains([
+        (p[0].x + p[1].x + p[2].x) / 3.0,
+        (p[0].y + p[1].y + p[2].y) / 3.0,
+    ])
+}
+
+/// An input angle below the limit: its apex, the direction of its first side (radians) and
+/// its angle, and the unit directions of its two sides.
+struct Apex {
+    vertex: FixedVertexHandle,
+    start: f64,
+    angle: f64,
+    dirs: [[f64; 2]; 2],
+}
+
+/// Every input angle below `limit` (radians): two consecutive constraint edges around a
+/// vertex with an inside triangle between them. Refinement adds none (its vertices split a
+/// segment or lie off every segment), so they are found once.
+fn apexes(state: &CdtState, limit: f64) -> Vec<Apex> {
     let mut out = Vec::new();
     for v in state.cdt.vertices() {
-        let mut rays: Vec<(f64, FixedVertexHandle, Option<usize>)> = v
+        let mut rays: Vec<(f64, [f64; 2], Option<[Point2<f64>; 3]>)> = v
             .out_edges()
             .filter(|e| e.is_constraint_edge())
             .map(|e| {
                 let d = sub(e.to().position(), v.position());
-                let face = e.face().as_inner().map(|f| f.fix().index());
-                (d[1].atan2(d[0]), e.to().fix(), face)
+                let l = d[0].hypot(d[1]);
+                let face = e.face().as_inner().map(|f| f.positions());
+                (d[1].atan2(d[0]), [d[0] / l, d[1] / l], face)
             })
             .collect();
         if rays.len() < 2 {
@@ -131,24 +145,39 @@ fn wedges(state: &CdtState, inside: &[bool], limit: f64) -> Vec<Wedge> {
         }
         rays.sort_by(|a, b| a.0.total_cmp(&b.0));
         for i in 0..rays.len() {
-            let (a1, to1, face) = rays[i];
-            let (a2, to2, _) = rays[(i + 1) % rays.len()];
+            let (a1, d1, face) = rays[i];
+            let (a2, d2, _) = rays[(i + 1) % rays.len()];
             let angle = (a2 - a1).rem_euclid(std::f64::consts::TAU);
             // The face left of the first edge lies between the two (counter-clockwise).
-            if angle > 0.0 && angle < limit && face.is_some_and(|f| inside[f]) {
-                let (s1, handles) = side(state, v.fix(), to1);
-                let (s2, _) = side(state, v.fix(), to2);
-                out.push(Wedge {
-                    apex: v.position(),
+            if angle > 0.0 && angle < limit && face.is_some_and(|f| inside(state, f)) {
+                out.push(Apex {
+                    vertex: v.fix(),
                     start: a1,
                     angle,
-                    sides: [s1, s2],
-                    handles,
+                    dirs: [d1, d2],
                 });
             }
         }
     }
     out
+}
+
+/// The wedges of the apexes as the mesh is now.
+fn wedges(state: &CdtState, apexes: &[Apex]) -> Vec<Wedge> {
+    apexes
+        .iter()
+        .map(|a| {
+            let (s1, handles) = side(state, a.vertex, a.dirs[0]);
+            let (s2, _) = side(state, a.vertex, a.dirs[1]);
+            Wedge {
+                apex: state.cdt.vertex(a.vertex).position(),
+                start: a.start,
+                angle: a.angle,
+                sides: [s1, s2],
+                handles,
+            }
+        })
+        .collect()
 }
 
 /// Radii at which the wedge's segments are split: the geometric mean of the smallest and
@@ -216,11 +245,11 @@ fn circumcentre(p: [Point2<f64>; 3]) -> [f64; 2] {
 /// midpoint elsewhere. Returns how many vertices it inserted.
 fn refine_far(
     state: &mut CdtState,
-    inside: &[bool],
     ws: &[Wedge],
     limit: f64,
     max_vertices: usize,
-) -> Result<usize, MeshError> {
+    around: Option<&[FixedVertexHandle]>,
+) -> Result<Vec<FixedVertexHandle>, MeshError> {
     let key = |p: Point2<f64>| (p.x.to_bits(), p.y.to_bits());
     // Vertex on a wedge's segment -> (wedge, radius).
     let mut on = std::collections::HashMap::new();
@@ -233,21 +262,36 @@ fn refine_far(
         }
     }
     let target = limit * (1.0 - TOL);
-    let bad: Vec<[FixedVertexHandle; 3]> = state
-        .cdt
-        .inner_faces()
-        .filter(|f| inside[f.fix().index()])
+    let faces: Vec<_> = match around {
+        None => state.cdt.inner_faces().map(|f| f.fix()).collect(),
+        Some(vs) => {
+            // Faces around the new vertices and their neighbours: a vertex that splits a
+            // constraint edge re-inserts both halves, which may flip edges at its ends.
+            let mut fs: Vec<_> = vs
+                .iter()
+                .flat_map(|&v| state.cdt.vertex(v).out_edges())
+                .flat_map(|e| e.to().out_edges())
+                .filter_map(|e| e.face().as_inner().map(|f| f.fix()))
+                .collect();
+            fs.sort_unstable_by_key(|f| f.index());
+            fs.dedup();
+            fs
+        }
+    };
+    let bad: Vec<[FixedVertexHandle; 3]> = faces
+        .into_iter()
+        .map(|f| state.cdt.face(f))
         .filter(|f| {
             let p = f.positions();
             let g = [
                 (p[0].x + p[1].x + p[2].x) / 3.0,
                 (p[0].y + p[1].y + p[2].y) / 3.0,
             ];
-            min_angle(p) < target && !ws.iter().any(|w| w.holds(g))
+            min_angle(p) < target && inside(state, p) && !ws.iter().any(|w| w.holds(g))
         })
         .map(|f| f.vertices().map(|v| v.fix()))
         .collect();
-    let mut inserted = 0;
+    let mut inserted = Vec::new();
     for [v0, v1, v2] in bad {
         if state.cdt.num_vertices() >= max_vertices {
             break;
@@ -330,8 +374,7 @@ fn refine_far(
             None if holds_c => c,
             None => continue,
         };
-        state.insert_point(point)?;
-        inserted += 1;
+        inserted.push(state.insert_point(point)?);
     }
     Ok(inserted)
 }
@@ -345,9 +388,14 @@ pub(crate) fn repair(
     max_vertices: usize,
 ) -> Result<bool, MeshError> {
     let limit = min_angle_deg.to_radians();
+    // Vertices inserted since the last far pass (`None`: look at every triangle).
+    let mut touched: Option<Vec<FixedVertexHandle>> = None;
+    let apexes = apexes(state, limit);
+    if apexes.is_empty() {
+        return Ok(true);
+    }
     for _ in 0..ROUNDS {
-        let inside = state.inside_faces();
-        let ws = wedges(state, &inside, limit);
+        let ws = wedges(state, &apexes);
         let mut points = Vec::new();
         for w in &ws {
             let radii = splits(state, w);
@@ -370,9 +418,11 @@ pub(crate) fn repair(
             }
         }
         if points.is_empty() {
-            if refine_far(state, &inside, &ws, limit, max_vertices)? == 0 {
+            let fresh = refine_far(state, &ws, limit, max_vertices, touched.as_deref())?;
+            if fresh.is_empty() {
                 return Ok(true);
             }
+            touched = Some(fresh);
             if state.cdt.num_vertices() >= max_vertices {
                 return Ok(false);
             }
@@ -396,7 +446,10 @@ pub(crate) fn repair(
             return Ok(false);
         }
         for p in points {
-            state.insert_point(p)?;
+            let v = state.insert_point(p)?;
+            if let Some(t) = touched.as_mut() {
+                t.push(v);
+            }
         }
     }
     Ok(true)
