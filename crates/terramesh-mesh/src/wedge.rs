@@ -12,10 +12,15 @@
 //! Shells that do not match on the two segments make it worse.
 //!
 //! [`repair`] splits the two segments of every ladder triangle below its wedge's input angle
-//! at the geometric mean of its radii, on both segments, until none is below; the ladder's
-//! smallest angle is then the input angle. Each split also cuts a triangle on the far side of
-//! the segment, so the pass ends with a refinement that splits no constraint edge (the far
-//! side is refined by interior vertices). Meshes without such wedges are not touched.
+//! at the geometric mean of its radii, on both segments, until none is below: the shells are
+//! then concentric and less than `2 cos θ` apart, and the ladder's smallest angle is the
+//! input angle. Each split also cuts the triangle on the far side of the segment; the far
+//! sides are then refined as in Ruppert's algorithm, one vertex at a time (circumcentres, or
+//! splits of the constraint edges they encroach: at the geometric mean on a wedge's segment,
+//! at the midpoint elsewhere), looking only at the triangles around new vertices. spade's
+//! refinement cannot be run again for this: it only recognises the shells of its own run, so
+//! a second run splits every ladder afresh. Meshes without an input angle below the limit
+//! are not touched.
 
 use spade::handles::FixedVertexHandle;
 use spade::{Point2, Triangulation};
@@ -25,8 +30,9 @@ use crate::MeshError;
 
 /// Relative tolerance for a direction along a segment and for equal radii.
 const TOL: f64 = 1e-9;
-/// Rounds of splits and refinement at most (each round at least halves the ratios of the
-/// radii it splits; measured: two rounds on every case of the small-angle test).
+/// Rounds of ladder splits or far-side passes at most, a safety cap (a ladder split at least
+/// halves the logarithm of the ratio it splits); when it is reached the mesh is kept as it
+/// is, valid but with triangles that may miss the limit.
 const ROUNDS: usize = 1000;
 
 /// A wedge: the apex, its input angle (radians) and the vertices along its two segments
@@ -130,14 +136,17 @@ struct Apex {
 fn apexes(state: &CdtState, limit: f64) -> Vec<Apex> {
     let mut out = Vec::new();
     for v in state.cdt.vertices() {
-        let mut rays: Vec<(f64, [f64; 2], Option<[Point2<f64>; 3]>)> = v
+        let mut rays: Vec<(f64, [f64; 2], bool)> = v
             .out_edges()
             .filter(|e| e.is_constraint_edge())
             .map(|e| {
                 let d = sub(e.to().position(), v.position());
                 let l = d[0].hypot(d[1]);
-                let face = e.face().as_inner().map(|f| f.positions());
-                (d[1].atan2(d[0]), [d[0] / l, d[1] / l], face)
+                let face_in = e
+                    .face()
+                    .as_inner()
+                    .is_some_and(|f| inside(state, f.positions()));
+                (d[1].atan2(d[0]), [d[0] / l, d[1] / l], face_in)
             })
             .collect();
         if rays.len() < 2 {
@@ -145,11 +154,11 @@ fn apexes(state: &CdtState, limit: f64) -> Vec<Apex> {
         }
         rays.sort_by(|a, b| a.0.total_cmp(&b.0));
         for i in 0..rays.len() {
-            let (a1, d1, face) = rays[i];
+            let (a1, d1, face_in) = rays[i];
             let (a2, d2, _) = rays[(i + 1) % rays.len()];
             let angle = (a2 - a1).rem_euclid(std::f64::consts::TAU);
             // The face left of the first edge lies between the two (counter-clockwise).
-            if angle > 0.0 && angle < limit && face.is_some_and(|f| inside(state, f)) {
+            if angle > 0.0 && angle < limit && face_in {
                 out.push(Apex {
                     vertex: v.fix(),
                     start: a1,
@@ -379,9 +388,8 @@ fn refine_far(
     Ok(inserted)
 }
 
-/// Splits the wedges' ladders until no ladder triangle is below its input angle (see the
-/// module), refining the far sides of split segments without splitting constraint edges.
-/// Returns whether the last refinement finished within `max_vertices`.
+/// Splits the wedges' ladders until no ladder triangle is below its input angle and refines
+/// the far sides (see the module). Returns false if it stopped at `max_vertices` vertices.
 pub(crate) fn repair(
     state: &mut CdtState,
     min_angle_deg: f64,

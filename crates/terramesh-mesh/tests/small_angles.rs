@@ -18,6 +18,11 @@ fn fixture() -> Value {
     serde_json::from_str(&text).expect("valid JSON")
 }
 
+/// An input segment.
+type Segment = [[f64; 2]; 2];
+/// Rays around an input vertex: direction (radians) and segment index.
+type Rays = Vec<(f64, usize)>;
+
 fn point(v: &Value) -> [f64; 2] {
     [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()]
 }
@@ -31,7 +36,7 @@ fn polylines(v: &Value) -> Vec<Vec<[f64; 2]>> {
 }
 
 /// The shape as a region, its free points, and its input segments.
-fn shape(s: &Value) -> (Region, Vec<[f64; 2]>, Vec<[[f64; 2]; 2]>) {
+fn shape(s: &Value) -> (Region, Vec<[f64; 2]>, Vec<Segment>) {
     let rings = polylines(&s["rings"]);
     let lines = polylines(&s["lines"]);
     let points: Vec<[f64; 2]> = s["points"].as_array().unwrap().iter().map(point).collect();
@@ -56,8 +61,8 @@ fn shape(s: &Value) -> (Region, Vec<[f64; 2]>, Vec<[[f64; 2]; 2]>) {
 
 /// Pairs of segments that share an endpoint and meet there at less than `limit` degrees
 /// (consecutive around the endpoint), and the smallest input angle.
-fn small_pairs(segments: &[[[f64; 2]; 2]], limit: f64) -> (Vec<(usize, usize)>, f64) {
-    let mut around: Vec<([f64; 2], Vec<(f64, usize)>)> = Vec::new();
+fn small_pairs(segments: &[Segment], limit: f64) -> (Vec<(usize, usize)>, f64) {
+    let mut around: Vec<([f64; 2], Rays)> = Vec::new();
     for (k, s) in segments.iter().enumerate() {
         for (o, q) in [(s[0], s[1]), (s[1], s[0])] {
             let a = (q[1] - o[1]).atan2(q[0] - o[0]);
@@ -86,7 +91,7 @@ fn small_pairs(segments: &[[[f64; 2]; 2]], limit: f64) -> (Vec<(usize, usize)>, 
     (pairs, smallest)
 }
 
-fn on_segment(p: [f64; 2], s: [[f64; 2]; 2], tol: f64) -> bool {
+fn on_segment(p: [f64; 2], s: Segment, tol: f64) -> bool {
     let d = [s[1][0] - s[0][0], s[1][1] - s[0][1]];
     let t = ((p[0] - s[0][0]) * d[0] + (p[1] - s[0][1]) * d[1]) / (d[0] * d[0] + d[1] * d[1]);
     if !(-1e-12..=1.0 + 1e-12).contains(&t) {
@@ -98,7 +103,7 @@ fn on_segment(p: [f64; 2], s: [[f64; 2]; 2], tol: f64) -> bool {
 /// Smallest angle of the mesh, and smallest angle among the triangles that do not touch a
 /// small input angle: two of their vertices on two different segments of a small pair (the
 /// fixture script's definition).
-fn angles(m: &Mesh, segments: &[[[f64; 2]; 2]], pairs: &[(usize, usize)], tol: f64) -> (f64, f64) {
+fn angles(m: &Mesh, segments: &[Segment], pairs: &[(usize, usize)], tol: f64) -> (f64, f64) {
     let (mut all, mut away) = (f64::INFINITY, f64::INFINITY);
     for t in &m.triangles {
         let p = t.map(|i| m.absolute(i as usize));
