@@ -165,3 +165,71 @@ fn never_below_triangle_at_small_input_angles() {
     eprint!("{table}");
     assert!(failures.is_empty(), "{}", failures.join(""));
 }
+
+/// Random fans of segments from one corner (1 to 25 degrees apart, random lengths), with and
+/// without size limits: the build finishes, the mesh is sound, no triangle is below the
+/// smallest input angle, the edge limit holds.
+#[test]
+fn random_fans_keep_their_input_angles() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..40 {
+        let mut region =
+            Region::from_ring(vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]);
+        let mut a = 0.0;
+        loop {
+            a += 1.0 + 24.0 * next();
+            if a > 89.0 {
+                break;
+            }
+            let r = 3.0 + 6.0 * next();
+            let t = a.to_radians();
+            region
+                .lines
+                .push(vec![[0.0, 0.0], [r * t.cos(), r * t.sin()]]);
+        }
+        let segments: Vec<Segment> = shape_segments(&region);
+        let (_, smallest_input) = small_pairs(&segments, 360.0);
+        let limit = [20.0, 30.0, 33.0][case % 3];
+        let mut b = MeshBuilder::new().min_angle(limit);
+        let edge = 0.8 + next();
+        match case % 4 {
+            1 => b = b.max_area(0.5),
+            2 => b = b.max_edge(edge),
+            _ => {}
+        }
+        let (mesh, _) = b.build(&region).expect("meshes");
+        mesh.sanity_check(&region).unwrap();
+        let (ours, _) = angles(&mesh, &segments, &[], 0.0);
+        assert!(
+            ours >= smallest_input.min(limit) - 1e-9,
+            "case {case}: smallest {ours} below the input angle {smallest_input}"
+        );
+        if case % 4 == 2 {
+            for t in &mesh.triangles {
+                for i in 0..3 {
+                    let (p, q) = (
+                        mesh.points[t[i] as usize],
+                        mesh.points[t[(i + 1) % 3] as usize],
+                    );
+                    let l = (p[0] - q[0]).hypot(p[1] - q[1]);
+                    assert!(l <= edge * (1.0 + 1e-9), "case {case}: edge {l} > {edge}");
+                }
+            }
+        }
+    }
+}
+
+fn shape_segments(region: &Region) -> Vec<Segment> {
+    let r = &region.polygons[0].outer;
+    let mut s: Vec<Segment> = (0..r.len()).map(|i| [r[i], r[(i + 1) % r.len()]]).collect();
+    for l in &region.lines {
+        s.extend(l.windows(2).map(|w| [w[0], w[1]]));
+    }
+    s
+}
