@@ -3,7 +3,9 @@
 //! metrics in 2D and 3D, smoothing, and terrain-adaptive refinement against any height
 //! function. No files, no printing.
 //!
-//! Constrained triangulation and refinement are spade's; predicates are exact (`robust`).
+//! Constrained triangulation and refinement are spade's, finished at small input angles by a
+//! pass of terramesh's own (concentric shells, `docs/meshing.md`); predicates are exact
+//! (`robust`).
 //!
 //! ```
 //! use terramesh_core::geometry::{Polygon, Region};
