@@ -271,6 +271,12 @@ impl MeshBuilder {
         if self.min_angle > 0.0 || budget.is_some() {
             report.refinement_complete =
                 refine(&mut state, self.min_angle, budget, self.max_edge, n0 + cap)?;
+            // Small input angles: no ladder triangle below its input angle (`crate::wedge`).
+            // Not with a kept boundary, whose constraint edges are never split.
+            if report.refinement_complete && !state.keep && self.min_angle > 0.0 {
+                report.refinement_complete =
+                    crate::wedge::repair(&mut state, self.min_angle, n0 + cap)?;
+            }
         }
         report.steiner_points = state.cdt.num_vertices() - n0;
         if !report.refinement_complete {

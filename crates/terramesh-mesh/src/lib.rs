@@ -3,7 +3,9 @@
 //! metrics in 2D and 3D, smoothing, and terrain-adaptive refinement against any height
 //! function. No files, no printing.
 //!
-//! Constrained triangulation and refinement are spade's; predicates are exact (`robust`).
+//! Constrained triangulation and refinement are spade's, finished at small input angles by a
+//! pass of terramesh's own (concentric shells, `docs/meshing.md`); predicates are exact
+//! (`robust`).
 //!
 //! ```
 //! use terramesh_core::geometry::{Polygon, Region};
@@ -47,6 +49,9 @@ mod report;
 mod smooth;
 /// Meshing large regions in vertical strips, in parallel.
 mod strips;
+/// Small input angles: the ladders of triangles between two segments meeting at less than
+/// the angle limit.
+mod wedge;
 
 pub use adaptive::{
     adaptive_mesh, error_probes, surface_error, AdaptiveReport, AdaptiveSettings, Fallible,
