@@ -13,7 +13,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use support::faulted::{kernel_mesh, model, site};
+use support::faulted::{kernel_mesh, model, site, site_of};
 use terramesh_core::volume::VolumeMesh;
 use terramesh_io::export::parse_tsurf;
 use terramesh_io::model::{
@@ -379,4 +379,38 @@ fn faulted_models_pass_the_independent_checks() {
     }
     run_python("tests/verify/check_faulted.py", &[&dirs[0], &dirs[1]]);
     run_python("tests/verify/check_model.py", &[&dirs[0]]);
+}
+
+/// The small faulted model whose files are committed in `tests/verify/fixtures/faulted/` for
+/// the negative tests of `check_faulted.py` (`tests/verify/test_check_faulted.py`): they must
+/// be what the writers write (`TERRAMESH_BLESS=1` rewrites them). Split nodes, so that the
+/// `ExtractBoundary` comparison runs.
+#[test]
+fn committed_faulted_fixture_is_current() {
+    let fixture = root().join("tests/verify/fixtures/faulted");
+    let s = site_of(2, vec![60.0]);
+    let (m, f) = model(&s, &kernel_mesh(&s, 100.0), true);
+    let dir = tempfile::tempdir().unwrap();
+    let names = write_faulted_model(dir.path(), &m, &f, &info(), None).unwrap();
+    if std::env::var_os("TERRAMESH_BLESS").is_some() {
+        let _ = std::fs::remove_dir_all(&fixture);
+        std::fs::create_dir_all(&fixture).unwrap();
+        for n in &names {
+            std::fs::copy(dir.path().join(n), fixture.join(n)).unwrap();
+        }
+    }
+    for n in &names {
+        let got = std::fs::read(dir.path().join(n)).unwrap();
+        let want = std::fs::read(fixture.join(n)).unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}; run with TERRAMESH_BLESS=1",
+                fixture.join(n).display()
+            )
+        });
+        assert!(
+            got == want,
+            "{n} differs from the committed fixture; run with TERRAMESH_BLESS=1"
+        );
+    }
+    assert_eq!(std::fs::read_dir(&fixture).unwrap().count(), names.len());
 }

@@ -22,14 +22,19 @@ pub const UNITS: [&str; 4] = ["cover", "sand", "weak", "lime"];
 /// Two crossing faults (a normal one dipping 60 degrees east, a reverse one dipping 70 degrees
 /// north, negative throw) over a 200 m site, three interfaces.
 pub fn site() -> Site {
+    site_of(8, vec![90.0, 60.0, 45.0])
+}
+
+/// [`site`] over an `n` by `n` grid, with the interfaces `tops` (at most three).
+pub fn site_of(n: usize, tops: Vec<f64>) -> Site {
     Site::new(
         200.0,
-        8,
+        n,
         0.2,
         3,
         [120.0, 0.02, -0.01],
         0.0,
-        vec![90.0, 60.0, 45.0],
+        tops,
         [0.01, 0.0],
         vec![
             SynthFault::new("F1", [80.0, -50.0], [120.0, 250.0], 60.0, 90.0, 12.0),
@@ -140,7 +145,7 @@ pub fn model(site: &Site, mesh: &FaultedMesh, split: bool) -> (VolumeMesh, Fault
     for s in ["north", "east", "south", "west"] {
         tags.push(FaceTag::Side(s.into()));
     }
-    for u in &UNITS[1..] {
+    for u in &UNITS[1..mesh.units] {
         tags.push(FaceTag::Interface(u.to_string()));
     }
     let mut tagged = Vec::new();
@@ -208,7 +213,7 @@ pub fn model(site: &Site, mesh: &FaultedMesh, split: bool) -> (VolumeMesh, Fault
                 .push((c as u32, k as u8));
         }
     }
-    let mut bodies: Vec<Body> = (0..UNITS.len())
+    let mut bodies: Vec<Body> = (0..mesh.units)
         .map(|u| Body {
             unit: u,
             triangles: vec![],
@@ -237,7 +242,7 @@ pub fn model(site: &Site, mesh: &FaultedMesh, split: bool) -> (VolumeMesh, Fault
         points,
         cells,
         material: mesh.unit.iter().map(|&u| u as i32).collect(),
-        units: UNITS.iter().map(|s| s.to_string()).collect(),
+        units: UNITS[..mesh.units].iter().map(|s| s.to_string()).collect(),
         faces: tagged,
         tags,
         bodies,
