@@ -261,7 +261,8 @@ fn without_faults_the_files_are_todays() {
 fn broken_fault_data_is_refused_before_anything_is_written() {
     let (m, f) = faulted(false);
     let dir = tempfile::tempdir().unwrap();
-    let cases: Vec<(Box<dyn Fn(&mut FaultData)>, &str)> = vec![
+    type Change = Box<dyn Fn(&mut FaultData)>;
+    let cases: Vec<(Change, &str)> = vec![
         (
             Box::new(|f| f.block.pop().map(|_| ()).unwrap()),
             "block entries",

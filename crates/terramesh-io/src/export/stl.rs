@@ -160,7 +160,7 @@ pub fn parse_stl(
                     }
                     corners.push((n, p));
                 }
-                Some("endloop") if corners.len() % 3 != 0 => {
+                Some("endloop") if !corners.len().is_multiple_of(3) => {
                     return Err((n, "a facet's loop has not 3 vertices".into()));
                 }
                 Some("endsolid") => break,
@@ -173,7 +173,7 @@ pub fn parse_stl(
                 "the file is empty: an STL file is binary or begins with 'solid'".into(),
             ));
         }
-        if corners.len() % 3 != 0 {
+        if !corners.len().is_multiple_of(3) {
             return Err((0, "the last facet has not 3 vertices".into()));
         }
     }

@@ -44,6 +44,9 @@ pub fn parse_geojson(text: &str) -> Result<Region, String> {
     Ok(region)
 }
 
+/// A polyline read from GeoJSON: the JSON path of its coordinates and its positions.
+pub type GeoJsonLine = (String, Vec<[f64; 2]>);
+
 /// Parses GeoJSON text for polylines: every `LineString` and every part of a
 /// `MultiLineString` (in a FeatureCollection, a Feature, a GeometryCollection or bare), as
 /// written (`[x, y]` or `[lon, lat]`; a third value is ignored), each with the JSON path of its
@@ -55,14 +58,14 @@ pub fn parse_geojson(text: &str) -> Result<Region, String> {
 /// assert_eq!(l, vec![("$.geometry.coordinates".to_string(), vec![[0.0, 0.0], [10.0, 5.0]])]);
 /// # Ok::<(), String>(())
 /// ```
-pub fn parse_geojson_lines(text: &str) -> Result<Vec<(String, Vec<[f64; 2]>)>, String> {
+pub fn parse_geojson_lines(text: &str) -> Result<Vec<GeoJsonLine>, String> {
     let v: Value = serde_json::from_str(text).map_err(|e| json_error(&e))?;
     let mut lines = Vec::new();
     walk_lines(&v, "$", &mut lines)?;
     Ok(lines)
 }
 
-fn walk_lines(v: &Value, path: &str, out: &mut Vec<(String, Vec<[f64; 2]>)>) -> Result<(), String> {
+fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), String> {
     match kind(v, path)? {
         "FeatureCollection" => {
             let feats = v
