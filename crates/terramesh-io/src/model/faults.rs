@@ -22,6 +22,29 @@ pub struct FaceSide {
     pub face: u8,
 }
 
+impl FaceSide {
+    /// The side of cell `cell` whose face has the nodes `nodes` (any order): how a caller
+    /// holding a fault face as nodes and cells (the fault kernel's `FaultFace`, or a split
+    /// mesh's triangle of each side) finds the local face. `None` when the cell does not
+    /// exist or has no such face.
+    ///
+    /// ```
+    /// use terramesh_core::volume::{Cell, VolumeMesh};
+    /// use terramesh_io::model::FaceSide;
+    /// let m = VolumeMesh { points: vec![[0.0; 3]; 4], cells: vec![Cell::tetra([0, 1, 2, 3])], ..Default::default() };
+    /// assert_eq!(FaceSide::of(&m, 0, &[3, 2, 1]), Some(FaceSide { cell: 0, face: 2 }));
+    /// assert_eq!(FaceSide::of(&m, 0, &[0, 1, 4]), None);
+    /// ```
+    pub fn of(m: &VolumeMesh, cell: u32, nodes: &[u32]) -> Option<FaceSide> {
+        let c = m.cells.get(cell as usize)?;
+        let face = super::faces::find_face(c.kind, c.used(), nodes)?;
+        Some(FaceSide {
+            cell,
+            face: face as u8,
+        })
+    }
+}
+
 /// One fault of a faulted model: its name and its faces, each shared by one cell on each side.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct FaultFaces {

@@ -96,8 +96,17 @@ pub fn model(site: &Site, mesh: &FaultedMesh, split: bool) -> (VolumeMesh, Fault
     let faces = cell_faces(CellKind::Tetra);
     let nodes_of =
         |c: usize, k: usize| -> Vec<u32> { faces[k].iter().map(|&i| tets[c][i]).collect() };
-    // the local face of cell c whose original nodes are `want`
+    // the local face of cell c whose original nodes are `want` (unsplit: FaceSide::of)
     let local = |c: u32, want: [u32; 3]| -> u8 {
+        if !split {
+            let m = VolumeMesh {
+                cells: vec![cells[c as usize]],
+                ..Default::default()
+            };
+            return FaceSide::of(&m, 0, &want)
+                .expect("a fault face of its cell")
+                .face;
+        }
         (0..4)
             .find(|&k| {
                 let n = nodes_of(c as usize, k);
