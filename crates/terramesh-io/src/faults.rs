@@ -326,7 +326,8 @@ impl SurfaceFormat {
 }
 
 /// Reads a triangulated fault surface (GOCAD TSurf, OBJ or STL by the file's extension; STL
-/// coordinates are taken as absolute) and checks that it is a surface ([`check_surface`]).
+/// coordinates are taken as absolute, except in terramesh's own binary STL, whose header names
+/// the local origin added back, [`crate::export::stl_origin_of`]) and checks that it is a surface ([`check_surface`]).
 ///
 /// # Errors
 /// [`FaultFileError`] naming the file, the line where one is at fault, and `fault`: an unknown
@@ -363,7 +364,10 @@ pub fn parse_surface(
     let parsed = match format {
         SurfaceFormat::Tsurf => crate::export::parse_tsurf(text()?),
         SurfaceFormat::Obj => crate::export::parse_obj(text()?),
-        SurfaceFormat::Stl => crate::export::parse_stl(bytes, [0.0; 3]),
+        SurfaceFormat::Stl => {
+            let origin = crate::export::stl_origin_of(bytes).unwrap_or([0.0; 3]);
+            crate::export::parse_stl(bytes, origin)
+        }
     };
     let (vertices, triangles) =
         parsed.map_err(|(line, m)| invalid(path, (line > 0).then_some(line), None, f, m))?;

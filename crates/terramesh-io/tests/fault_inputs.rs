@@ -182,6 +182,15 @@ fn surfaces_round_trip_through_our_writers() {
     let s = read_surface(&write(&dir, "f1.stl", &stl), "F1").unwrap();
     assert_eq!(s.triangles, t);
     assert_eq!(s.vertices, v); // these coordinates are exact in float32
+                               // our own STL at UTM magnitudes: relative to the origin in its header, read back absolute
+    let far: Vec<[f64; 3]> = v
+        .iter()
+        .map(|p| [p[0] + 377_000.0, p[1] + 5_397_000.0, p[2]])
+        .collect();
+    let mut stl = Vec::new();
+    write_stl(&mut stl, &far, &t, [377_000.0, 5_397_000.0, 0.0]).unwrap();
+    let s = read_surface(&write(&dir, "far.stl", &stl), "F1").unwrap();
+    assert_eq!(s.vertices, far);
     let obj = "# F1\nv 0 0 10\nv 100 0 5\nv 100 50 -20\nv 0 50 -15\nf 1 2 3 4\n";
     let s = read_surface(&write(&dir, "f1.obj", obj.as_bytes()), "F1").unwrap();
     assert_eq!((s.vertices, s.triangles), (v, t));

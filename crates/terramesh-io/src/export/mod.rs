@@ -40,7 +40,7 @@ pub use kml::{write_kml, KmlStyle};
 pub use msh::Msh41;
 pub use obj::{parse_obj, Obj};
 pub use ply::Ply;
-pub use stl::{parse_stl, read_stl, write_stl};
+pub use stl::{parse_stl, read_stl, stl_origin_of, write_stl};
 pub use terrain::{
     build_pyramid, deepest_level, edge_indices, encode_tile, layer_json, level_spacing_m,
     oct_encode, tile_range, tile_size_deg, tiles_of, write_terrain, zigzag, GeoSurface, Lattice,

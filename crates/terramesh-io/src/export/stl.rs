@@ -200,3 +200,32 @@ pub fn parse_stl(
     }
     Ok((vertices, triangles))
 }
+
+/// The local origin named in the 80-byte header of a binary STL written by [`write_stl`]
+/// (`terramesh binary STL, metres, origin X Y Z ...`), to add to its coordinates; `None` for
+/// any other file.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_io::export::{stl_origin_of, write_stl};
+/// let mut buf = Vec::new();
+/// write_stl(&mut buf, &[[377_000.0, 5_397_000.0, 350.0]; 3], &[], [377_000.0, 5_397_000.0, 0.0])?;
+/// assert_eq!(stl_origin_of(&buf), Some([377_000.0, 5_397_000.0, 0.0]));
+/// assert_eq!(stl_origin_of(b"solid x\n"), None);
+/// # Ok(()) }
+/// ```
+pub fn stl_origin_of(bytes: &[u8]) -> Option<[f64; 3]> {
+    let header = std::str::from_utf8(bytes.get(..80)?).ok()?;
+    let rest = header
+        .strip_prefix("terramesh binary STL, metres, origin ")?
+        .split(" (")
+        .next()?;
+    let v: Vec<f64> = rest
+        .split_whitespace()
+        .map(|t| t.parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()?;
+    match v.as_slice() {
+        [x, y, z] => Some([*x, *y, *z]),
+        _ => None,
+    }
+}
