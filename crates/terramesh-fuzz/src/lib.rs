@@ -64,6 +64,10 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("geology_toml", geology_toml),
     ("crs", crs),
     ("tiles_plan", tiles_plan),
+    ("fault_trace", fault_trace),
+    ("fault_surface", fault_surface),
+    ("fault_points", fault_points),
+    ("fault_picks", fault_picks),
 ];
 
 /// Committed data crops (in `fixtures/data/`, paths from the repository root) that also seed a
@@ -449,6 +453,80 @@ pub fn crs(data: &[u8]) {
                     assert!(p.iter().all(|v| v.is_finite()), "{s}: ({x}, {y}) -> {p:?}");
                 }
             }
+        }
+    }
+}
+
+/// A fault's trace (`[[geology.faults]] trace`). The first byte is a flag (bit 0: the file is
+/// GeoJSON, else CSV; bit 1: geographic, `lat,lon`, else projected `x,y`; `'0'` to `'3'` make
+/// readable seeds). An accepted trace has at least 2 distinct points, none repeated next to
+/// itself, every coordinate finite and within the limits.
+pub fn fault_trace(data: &[u8]) {
+    use terramesh_io::region::RegionCrs;
+    let Some((&flags, rest)) = data.split_first() else {
+        return;
+    };
+    let name = if flags & 1 == 1 {
+        "f1.geojson"
+    } else {
+        "f1.csv"
+    };
+    let crs = if flags & 2 == 2 {
+        RegionCrs::Geographic
+    } else {
+        RegionCrs::Projected
+    };
+    if let Ok(t) = terramesh_io::faults::parse_trace(Path::new(name), rest, crs, "F1") {
+        assert!(t.len() >= 2, "a trace of {} points", t.len());
+        assert!(t.windows(2).all(|w| w[0] != w[1]), "a repeated point");
+        assert!(t
+            .iter()
+            .flatten()
+            .all(|v| terramesh_core::limits::coordinate_ok(*v)));
+    }
+}
+
+/// A triangulated fault surface (`[[geology.faults]] surface`); the first byte picks the format
+/// (`'t'` TSurf, `'o'` OBJ, anything else STL). An accepted surface passes its own check
+/// again, with finite vertices and at least one triangle.
+pub fn fault_surface(data: &[u8]) {
+    let Some((&flag, rest)) = data.split_first() else {
+        return;
+    };
+    let name = match flag {
+        b't' => "f1.ts",
+        b'o' => "f1.obj",
+        _ => "f1.stl",
+    };
+    if let Ok(s) = terramesh_io::faults::parse_surface(Path::new(name), rest, "F1") {
+        assert!(!s.triangles.is_empty());
+        assert!(s.vertices.iter().flatten().all(|v| v.is_finite()));
+        assert_eq!(terramesh_io::faults::check_surface(&s), Ok(()));
+    }
+}
+
+/// A fault's points (`[[geology.faults]] points`, `x,y,z`): accepted points are finite, at
+/// least 3.
+pub fn fault_points(data: &[u8]) {
+    if let Ok(p) = terramesh_io::faults::parse_points(Path::new("f1_points.csv"), data, "F1") {
+        assert!(p.len() >= 3);
+        assert!(p.iter().flatten().all(|v| v.is_finite()));
+    }
+}
+
+/// `fault_picks.csv` (`hole,depth,fault`), for the faults `F1` and `F2`: every accepted pick
+/// names a hole and one of them, at a finite depth of 0 or more.
+pub fn fault_picks(data: &[u8]) {
+    if let Ok(p) =
+        terramesh_io::faults::parse_picks(Path::new("fault_picks.csv"), data, &["F1", "F2"])
+    {
+        for k in &p {
+            assert!(!k.hole.is_empty() && (k.fault == "F1" || k.fault == "F2"));
+            assert!(
+                terramesh_core::limits::depth_ok(k.depth),
+                "depth {}",
+                k.depth
+            );
         }
     }
 }

@@ -1,8 +1,8 @@
 //! File formats of **terramesh**: delimited tables ([`table`]), atomic output files
 //! ([`output`]), study regions from corner lists, GeoJSON, KML and WKT ([`region`]),
 //! elevation sources (SRTM `.hgt` tiles, GeoTIFF, ASCII grids, LAS/LAZ points, [`dem`]),
-//! rasters ([`grid_write`]), every surface export format ([`export`]), the geological
-//! model's volume mesh, boundary meshes and bodies ([`model`]) and the colour maps they
+//! rasters ([`grid_write`]), every surface export format ([`export`]), the input files of faults ([`faults`]), the
+//! geological model's volume mesh, boundary meshes, bodies and faults ([`model`]) and the colour maps they
 //! share with the pictures ([`colour`]). Numerical work lives in `terramesh-core` and
 //! `terramesh-mesh`, the rules that turn boreholes into contacts in `terramesh-geology`;
 //! pictures, the 3D viewer and `report.html` in `terramesh-report`.
@@ -27,6 +27,7 @@ pub mod boreholes;
 pub mod colour;
 pub mod dem;
 pub mod export;
+pub mod faults;
 pub mod folder;
 pub mod grid_write;
 pub mod model;

@@ -38,16 +38,16 @@ pub use dxf::write_dxf;
 pub use glb::{elevation_colours, write_glb, GlbMesh, GlbOptions};
 pub use kml::{write_kml, KmlStyle};
 pub use msh::Msh41;
-pub use obj::Obj;
+pub use obj::{parse_obj, Obj};
 pub use ply::Ply;
-pub use stl::{read_stl, write_stl};
+pub use stl::{parse_stl, read_stl, stl_origin_of, write_stl};
 pub use terrain::{
     build_pyramid, deepest_level, edge_indices, encode_tile, layer_json, level_spacing_m,
     oct_encode, tile_range, tile_size_deg, tiles_of, write_terrain, zigzag, GeoSurface, Lattice,
     LayerInfo, PyramidOptions, QuantizedMesh, TerrainError, TerrainSummary, TileHeights, TileId,
     LATTICE, MAX_LEVEL, QUANT_MAX,
 };
-pub use tsurf::{write_tsurf, TsurfInfo};
+pub use tsurf::{parse_tsurf, write_tsurf, Surface, SurfaceParseError, TsurfInfo};
 pub use vtu::Vtu;
 
 /// A surface export format, named as its file extension: `vtu`, `obj`, `ply`, `stl`, `ts`,

@@ -72,6 +72,42 @@ pub enum MeshError {
         /// What is wrong.
         why: String,
     },
+    /// A faulted model's `block` does not have one entry per cell.
+    #[error("{cells} cells but {blocks} block entries; give every cell its fault block")]
+    BlockCount {
+        /// Cells.
+        cells: usize,
+        /// Block entries.
+        blocks: usize,
+    },
+    /// A cell's block is not an index into the blocks.
+    #[error("cell {cell} is in block {block}, but there are {blocks} blocks")]
+    Block {
+        /// The cell.
+        cell: usize,
+        /// Its block.
+        block: i32,
+        /// The number of blocks.
+        blocks: usize,
+    },
+    /// A fault's face is not one face of two cells.
+    #[error("fault '{fault}': {why}")]
+    Fault {
+        /// The fault.
+        fault: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// Two names would make one file or group name (equal ignoring case).
+    #[error("the {what} '{first}' and '{second}' would make one file or group name: rename one")]
+    Duplicate {
+        /// What they name (`blocks`, `face groups`).
+        what: String,
+        /// The first.
+        first: String,
+        /// The second.
+        second: String,
+    },
     /// A unit or side name cannot be a file name or a quoted group name.
     #[error("the name {name:?} cannot be used in file and group names: use 1 to 128 letters, digits, '-', '_' or '.', not beginning or ending with '.'")]
     Name {

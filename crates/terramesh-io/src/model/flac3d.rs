@@ -17,6 +17,7 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
+use super::faults::{used, Extra, FaultData};
 use super::passes::{Indexed, ModelPasses};
 use super::ModelInfo;
 use crate::textsink::{PointText, TextSink};
@@ -45,7 +46,57 @@ pub fn write_model_f3grid<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_f3grid(w, &Indexed::new(m), info, Some(&PointText::new(&m.points)))
+    write_f3grid(
+        w,
+        &Indexed::new(m),
+        info,
+        Some(&PointText::new(&m.points)),
+        &Extra::default(),
+    )
+}
+
+/// Writes a faulted model as a FLAC3D ASCII grid: [`write_model_f3grid`]'s file with each fault
+/// face (once, as seen from its negative side) after the tagged faces (`F T3`, ids going on),
+/// a zone group per block in slot `2` after the units' groups (slot `1`: a zone is in one
+/// group per slot), and a face group `fault-<name>` (slot `1`) per fault after the tags'
+/// groups: what FLAC3D's `zone interface create by-face` takes.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{write_faulted_f3grid, FaceSide, FaultData, FaultFaces, ModelInfo};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3]), Cell::tetra([1, 2, 3, 4])],
+///     material: vec![0, 0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// let f = FaultData {
+///     block: vec![0, 1],
+///     blocks: vec!["west".into(), "east".into()],
+///     faults: vec![FaultFaces { name: "F1".into(), faces: vec![[FaceSide { cell: 0, face: 2 }, FaceSide { cell: 1, face: 0 }]] }],
+/// };
+/// let mut buf = Vec::new();
+/// write_faulted_f3grid(&mut buf, &m, &f, &ModelInfo::default())?;
+/// let s = String::from_utf8(buf).unwrap();
+/// assert!(s.contains("F T3 1 2 3 4\n") && s.contains("FGROUP \"fault-F1\" SLOT 1\n 1\n"));
+/// assert!(s.contains("ZGROUP \"east\" SLOT 2\n 2\n"));
+/// # Ok(()) }
+/// ```
+pub fn write_faulted_f3grid<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    f: &FaultData,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    write_f3grid(
+        w,
+        &Indexed::new(m),
+        info,
+        Some(&PointText::new(&m.points)),
+        &Extra::new(m, f),
+    )
 }
 
 /// Writes a model read in passes ([`ModelPasses`]) as a FLAC3D ASCII grid, the bytes of
@@ -56,7 +107,7 @@ pub fn write_f3grid_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     m: &M,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_f3grid(w, m, info, None)
+    write_f3grid(w, m, info, None, &Extra::default())
 }
 
 /// [`write_f3grid_passes`], with the points' text made already where `pts` is given.
@@ -65,6 +116,7 @@ pub(super) fn write_f3grid<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     m: &M,
     info: &ModelInfo,
     pts: Option<&PointText>,
+    extra: &Extra,
 ) -> io::Result<()> {
     let mut sink = TextSink::new(w);
     let w = &mut sink;
@@ -116,20 +168,27 @@ pub(super) fn write_f3grid<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         w.byte(b'\n')
     })?;
     let mut per_tag = vec![0usize; m.tags().len()];
-    if m.face_count() > 0 {
+    let face = |w: &mut TextSink<W>, j: usize, nodes: &[u32]| -> io::Result<()> {
+        w.bytes(if nodes.len() == 3 { b"F T3" } else { b"F Q4" })?;
+        w.space_u64(j as u64)?;
+        for &k in nodes {
+            w.space_u64(u64::from(k) + 1)?;
+        }
+        w.byte(b'\n')
+    };
+    let nf = m.face_count() + extra.face_count();
+    if nf > 0 {
         writeln!(w, "* FACES")?;
         let mut j = 0usize;
         m.each_face(&mut |f, _| {
             j += 1;
             per_tag[f.tag as usize] += 1;
-            let nodes = f.used();
-            w.bytes(if nodes.len() == 3 { b"F T3" } else { b"F Q4" })?;
-            w.space_u64(j as u64)?;
-            for &k in nodes {
-                w.space_u64(u64::from(k) + 1)?;
-            }
-            w.byte(b'\n')
+            face(w, j, f.used())
         })?;
+        for f in extra.faults.iter().flat_map(|g| &g.faces) {
+            j += 1;
+            face(w, j, used(f))?;
+        }
     }
     writeln!(w, "* ZONE GROUPS")?;
     for (u, &count) in per_unit.iter().enumerate() {
@@ -139,13 +198,37 @@ pub(super) fn write_f3grid<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             m.each_cell_of(u as i32, None, &mut |i, _| ids.push(i as u64 + 1))?;
         }
     }
-    if m.face_count() > 0 {
+    if let Some((block, names)) = extra.blocks {
+        let mut per_block = vec![Vec::new(); names.len()];
+        for (i, &b) in block.iter().enumerate() {
+            per_block[b as usize].push(i as u64 + 1);
+        }
+        for (b, zones) in per_block.iter().enumerate() {
+            if !zones.is_empty() {
+                writeln!(w, "ZGROUP \"{}\" SLOT 2", names[b])?;
+                let mut ids = Ids::new(w, zones.len());
+                for &z in zones {
+                    ids.push(z)?;
+                }
+            }
+        }
+    }
+    if nf > 0 {
         writeln!(w, "* FACE GROUPS")?;
         for (t, &count) in per_tag.iter().enumerate() {
             if count > 0 {
                 writeln!(w, "FGROUP \"{}\" SLOT 1", m.tags()[t].name())?;
                 let mut ids = Ids::new(w, count);
                 m.each_face_of(t as u16, None, &mut |j, _| ids.push(j as u64 + 1))?;
+            }
+        }
+        let mut j = m.face_count() as u64;
+        for g in extra.faults.iter().filter(|g| !g.faces.is_empty()) {
+            writeln!(w, "FGROUP \"{}\" SLOT 1", g.name)?;
+            let mut ids = Ids::new(w, g.faces.len());
+            for _ in &g.faces {
+                j += 1;
+                ids.push(j)?;
             }
         }
     }

@@ -12,6 +12,7 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
+use super::faults::{used, Extra, FaultData};
 use super::passes::{Indexed, ModelPasses};
 use super::ModelInfo;
 use super::{vertical_note, write_shortest};
@@ -77,7 +78,56 @@ pub fn write_model_msh<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_msh(w, &Indexed::new(m), info, Some(&PointText::new(&m.points)))
+    write_msh(
+        w,
+        &Indexed::new(m),
+        info,
+        Some(&PointText::new(&m.points)),
+        &Extra::default(),
+    )
+}
+
+/// Writes a faulted model as Gmsh MSH 4.1 ASCII: [`write_model_msh`]'s file with, after the
+/// tags' surface groups, one surface entity and named physical surface `fault-<name>` per
+/// fault (tag = the number of face tags + the fault's index + 1), its elements (each face once,
+/// as seen from its negative side) numbered after the tagged faces.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{write_faulted_msh, FaceSide, FaultData, FaultFaces, ModelInfo};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3]), Cell::tetra([1, 2, 3, 4])],
+///     material: vec![0, 0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// let f = FaultData {
+///     block: vec![0, 1],
+///     blocks: vec!["a".into(), "b".into()],
+///     faults: vec![FaultFaces { name: "F1".into(), faces: vec![[FaceSide { cell: 0, face: 2 }, FaceSide { cell: 1, face: 0 }]] }],
+/// };
+/// let mut buf = Vec::new();
+/// write_faulted_msh(&mut buf, &m, &f, &ModelInfo::default())?;
+/// let s = String::from_utf8(buf).unwrap();
+/// assert!(s.contains("2 1 \"fault-F1\"\n"));
+/// assert!(s.contains("2 1 2 1\n3 2 3 4\n")); // surface 1, triangles, element 3
+/// # Ok(()) }
+/// ```
+pub fn write_faulted_msh<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    f: &FaultData,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    write_msh(
+        w,
+        &Indexed::new(m),
+        info,
+        Some(&PointText::new(&m.points)),
+        &Extra::new(m, f),
+    )
 }
 
 /// Writes a model read in passes ([`ModelPasses`]) as Gmsh MSH 4.1 ASCII, the bytes of
@@ -89,7 +139,7 @@ pub fn write_msh_passes<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     m: &M,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_msh(w, m, info, None)
+    write_msh(w, m, info, None, &Extra::default())
 }
 
 /// [`write_msh_passes`], with the points' text made already where `pts` is given.
@@ -98,6 +148,7 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     m: &M,
     info: &ModelInfo,
     pts: Option<&PointText>,
+    extra: &Extra,
 ) -> io::Result<()> {
     let mut sink = TextSink::new(w);
     let w = &mut sink;
@@ -139,19 +190,39 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         info.crs,
         vertical_note(info)
     )?;
-    writeln!(w, "$PhysicalNames\n{}", units.len() + tags.len())?;
+    let faults: Vec<usize> = (0..extra.faults.len())
+        .filter(|&g| !extra.faults[g].faces.is_empty())
+        .collect();
+    writeln!(
+        w,
+        "$PhysicalNames\n{}",
+        units.len() + tags.len() + faults.len()
+    )?;
     for &u in &units {
         writeln!(w, "3 {} \"{}\"", u + 1, quote(&m.units()[u]))?;
     }
     for &t in &tags {
         writeln!(w, "2 {} \"{}\"", t + 1, quote(&m.tags()[t].name()))?;
     }
+    for &g in &faults {
+        writeln!(w, "2 {} \"{}\"", nt + g + 1, quote(&extra.faults[g].name))?;
+    }
     writeln!(w, "$EndPhysicalNames")?;
-    writeln!(w, "$Entities\n0 0 {} {}", tags.len(), units.len())?;
+    writeln!(
+        w,
+        "$Entities\n0 0 {} {}",
+        tags.len() + faults.len(),
+        units.len()
+    )?;
     for &t in &tags {
         write!(w, "{}", t + 1)?;
         surf_box[t].write(w)?;
         writeln!(w, " 1 {} 0", t + 1)?;
+    }
+    for &g in &faults {
+        write!(w, "{}", nt + g + 1)?;
+        Bbox(extra.faults[g].lo, extra.faults[g].hi).write(w)?;
+        writeln!(w, " 1 {} 0", nt + g + 1)?;
     }
     for &u in &units {
         write!(w, "{}", u + 1)?;
@@ -184,10 +255,20 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         })?,
     }
     writeln!(w, "$EndNodes")?;
+    // a fault's triangles, then its quadrilaterals
+    let fault_blocks: Vec<[usize; 2]> = extra
+        .faults
+        .iter()
+        .map(|g| {
+            let tri = g.faces.iter().filter(|f| f[3] == u32::MAX).count();
+            [tri, g.faces.len() - tri]
+        })
+        .collect();
     let nblocks = vol_blocks.iter().flatten().filter(|&&b| b > 0).count()
-        + surf_blocks.iter().flatten().filter(|&&b| b > 0).count();
+        + surf_blocks.iter().flatten().filter(|&&b| b > 0).count()
+        + fault_blocks.iter().flatten().filter(|&&b| b > 0).count();
     let nc = m.cell_count();
-    let ne = nc + m.face_count();
+    let ne = nc + m.face_count() + extra.face_count();
     writeln!(w, "$Elements\n{nblocks} {ne} 1 {ne}")?;
     let line = |w: &mut TextSink<W>, tag: usize, nodes: &[u32]| -> io::Result<()> {
         w.u64(tag as u64)?;
@@ -216,6 +297,21 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             m.each_face_of(t as u16, Some(k + 3), &mut |j, f| {
                 line(w, nc + j + 1, f.used())
             })?;
+        }
+    }
+    let mut next = nc + m.face_count();
+    for &g in &faults {
+        for (k, &count) in fault_blocks[g].iter().enumerate() {
+            if count == 0 {
+                continue;
+            }
+            writeln!(w, "2 {} {} {}", nt + g + 1, 2 + k, count)?;
+            for f in &extra.faults[g].faces {
+                if used(f).len() == k + 3 {
+                    next += 1;
+                    line(w, next, used(f))?;
+                }
+            }
         }
     }
     writeln!(w, "$EndElements")?;

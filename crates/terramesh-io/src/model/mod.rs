@@ -5,6 +5,7 @@
 //! |---|---|---|
 //! | `model.vtu` | [`write_model_vtu`] | VTK XML unstructured grid, appended base64 binary: Float64 points, int32 `MaterialIDs`, field data `unit_names`, `crs`, `vertical_datum` (and `vertical_crs` when named); an OpenGeoSys bulk mesh |
 //! | `model-top.vtu`, `model-bottom.vtu`, `model-side-<name>.vtu` | [`write_boundary_vtu`] | OpenGeoSys boundary meshes (`bulk_node_ids`, `bulk_element_ids`, `bulk_face_ids`, as its `ExtractBoundary` writes them) |
+//! | `fault-<name>.vtu`, `fault-<name>.ts` | [`write_fault_vtu`], [`write_fault_tsurf`] | a faulted model's faults ([`FaultData`], [`write_faulted_model`]): an OpenGeoSys subdomain mesh with every face once per side, and the GOCAD TSurf of its faces |
 //! | `model.msh` | [`write_model_msh`] | Gmsh 4.1 ASCII: a volume entity and physical group per unit, a surface entity and group per tag |
 //! | `model.f3grid` | [`write_model_f3grid`] | FLAC3D ASCII grid: gridpoints, zones W6/P5/T4, zone groups per unit, face groups per tag |
 //! | `unit-<name>.ts`, `unit-<name>.stl` | [`write_body_tsurf`], [`write_body_stl`] | the sealed body of each unit (GOCAD TSurf in doubles; binary STL relative to [`stl_origin`]) |
@@ -48,6 +49,7 @@ mod bodies;
 mod boundary;
 mod check;
 mod faces;
+mod faults;
 mod flac3d;
 mod gmsh;
 mod passes;
@@ -66,10 +68,14 @@ pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
 pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
 pub use check::{check_mesh, check_mesh_with, MeshError};
 pub use faces::{cell_faces, ogs_face_index};
-pub use flac3d::{write_f3grid_passes, write_model_f3grid};
-pub use gmsh::{write_model_msh, write_msh_passes};
+pub use faults::{
+    check_faults, fault_mesh, side_nodes, write_fault_tsurf, FaceSide, FaultData, FaultFaces,
+    FaultMesh,
+};
+pub use flac3d::{write_f3grid_passes, write_faulted_f3grid, write_model_f3grid};
+pub use gmsh::{write_faulted_msh, write_model_msh, write_msh_passes};
 pub use passes::{CellVisit, FaceVisit, ModelPasses};
-pub use vtk::{write_boundary_vtu, write_model_vtu};
+pub use vtk::{write_boundary_vtu, write_fault_vtu, write_faulted_vtu, write_model_vtu};
 
 /// What the files record besides the mesh.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -147,17 +153,55 @@ pub fn write_model_with(
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
+    write_files(dir, mesh, None, info, volumes)
+}
+
+/// Writes every file of a faulted model into the existing folder `dir`: what [`write_model`]
+/// writes, with `model.vtu` carrying the blocks and the faults' names
+/// ([`write_faulted_vtu`]), `model.msh` and `model.f3grid` the faults' groups and the blocks
+/// ([`write_faulted_msh`], [`write_faulted_f3grid`]), and per fault `fault-<name>.vtu`
+/// ([`fault_mesh`], [`write_fault_vtu`]) and `fault-<name>.ts` ([`write_fault_tsurf`]),
+/// written after the boundary meshes. Both the mesh and the fault data are checked first
+/// ([`check_mesh_with`], [`check_faults`]): nothing is written when either is broken.
+/// `volumes` as in [`write_model_with`].
+pub fn write_faulted_model(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    faults: &FaultData,
+    info: &ModelInfo,
+    volumes: Option<&[f64]>,
+) -> Result<Vec<String>, ModelWriteError> {
+    write_files(dir, mesh, Some(faults), info, volumes)
+}
+
+fn write_files(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    faults: Option<&FaultData>,
+    info: &ModelInfo,
+    volumes: Option<&[f64]>,
+) -> Result<Vec<String>, ModelWriteError> {
     check_mesh_with(mesh, volumes)?;
+    if let Some(f) = faults {
+        check_faults(mesh, f)?;
+    }
     // the points' text, for model.msh, model.f3grid and the bodies' TSurf
     let pts = &crate::textsink::PointText::new(&mesh.points);
     let blocks = &passes::Indexed::new(mesh);
+    let extra = &match faults {
+        Some(f) => faults::Extra::new(mesh, f),
+        None => faults::Extra::default(),
+    };
     type Job<'a> = (
         String,
         Box<dyn Fn(&mut Output) -> io::Result<()> + Send + Sync + 'a>,
     );
     let mut jobs: Vec<Job> = vec![(
         "model.vtu".into(),
-        Box::new(|w: &mut Output| write_model_vtu(w, mesh, info)),
+        Box::new(move |w: &mut Output| match faults {
+            Some(f) => write_faulted_vtu(w, mesh, f, info),
+            None => write_model_vtu(w, mesh, info),
+        }),
     )];
     for t in boundary_tags(mesh) {
         let name = boundary_file_name(&mesh.tags[t as usize]).expect("a boundary tag");
@@ -166,13 +210,27 @@ pub fn write_model_with(
             Box::new(move |w: &mut Output| write_boundary_vtu(w, &boundary_mesh(mesh, t))),
         ));
     }
+    for (k, f) in faults
+        .iter()
+        .flat_map(|f| (0..f.faults.len()).map(move |k| (k, f)))
+    {
+        let stem = f.group_name(k);
+        jobs.push((
+            format!("{stem}.vtu"),
+            Box::new(move |w: &mut Output| write_fault_vtu(w, &fault_mesh(mesh, f, k))),
+        ));
+        jobs.push((
+            format!("{stem}.ts"),
+            Box::new(move |w: &mut Output| write_fault_tsurf(w, mesh, f, k, info)),
+        ));
+    }
     jobs.push((
         "model.msh".into(),
-        Box::new(move |w: &mut Output| gmsh::write_msh(w, blocks, info, Some(pts))),
+        Box::new(move |w: &mut Output| gmsh::write_msh(w, blocks, info, Some(pts), extra)),
     ));
     jobs.push((
         "model.f3grid".into(),
-        Box::new(move |w: &mut Output| flac3d::write_f3grid(w, blocks, info, Some(pts))),
+        Box::new(move |w: &mut Output| flac3d::write_f3grid(w, blocks, info, Some(pts), extra)),
     ));
     let origin = stl_origin(mesh);
     for body in &mesh.bodies {

@@ -15,6 +15,7 @@ use std::io::{self, Write};
 use terramesh_core::volume::{CellKind, VolumeMesh};
 
 use super::boundary::BoundaryMesh;
+use super::faults::{FaultData, FaultMesh};
 use super::ModelInfo;
 
 const VTK_TRIANGLE: u8 = 5;
@@ -255,11 +256,57 @@ pub fn write_model_vtu<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    let mut names = Vec::new();
-    for u in &m.units {
-        names.extend_from_slice(u.as_bytes());
-        names.push(0);
+    write_vtu(w, m, info, None)
+}
+
+/// Writes a faulted model as `model.vtu`: [`write_model_vtu`]'s arrays, then cell data `block`
+/// (Int32, [`FaultData::block`]) after `MaterialIDs`, and field data `fault_names` and
+/// `block_names` (each name followed by a zero byte, as `unit_names`) after the others.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{write_faulted_vtu, FaultData, FaultFaces, ModelInfo};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3])],
+///     material: vec![0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// let f = FaultData { block: vec![0], blocks: vec!["b0".into()], faults: vec![FaultFaces { name: "F1".into(), faces: vec![] }] };
+/// let mut buf = Vec::new();
+/// write_faulted_vtu(&mut buf, &m, &f, &ModelInfo::default())?;
+/// let text = String::from_utf8_lossy(&buf);
+/// assert!(text.contains("type=\"Int32\" Name=\"block\"") && text.contains("Name=\"fault_names\""));
+/// # Ok(()) }
+/// ```
+pub fn write_faulted_vtu<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    f: &FaultData,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    write_vtu(w, m, info, Some(f))
+}
+
+/// Zero-terminated names, one after the other.
+fn zero_terminated<'a>(names: impl Iterator<Item = &'a String>) -> Vec<u8> {
+    let mut out = Vec::new();
+    for n in names {
+        out.extend_from_slice(n.as_bytes());
+        out.push(0);
     }
+    out
+}
+
+fn write_vtu<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    info: &ModelInfo,
+    faults: Option<&FaultData>,
+) -> io::Result<()> {
+    let names = zero_terminated(m.units.iter());
     let vtk_nodes: Vec<([u32; 6], u8, usize)> = m
         .cells
         .iter()
@@ -272,17 +319,32 @@ pub fn write_model_vtu<W: Write + ?Sized>(
             }
         })
         .collect();
+    let mut field = model_fields(names, info);
+    let mut cell_data = vec![array(
+        "Int32",
+        "MaterialIDs",
+        1,
+        le(m.material.iter().copied(), i32::to_le_bytes),
+    )];
+    if let Some(f) = faults {
+        cell_data.push(array(
+            "Int32",
+            "block",
+            1,
+            le(f.block.iter().copied(), i32::to_le_bytes),
+        ));
+        field.push(text_field(
+            "fault_names",
+            zero_terminated(f.faults.iter().map(|x| &x.name)),
+        ));
+        field.push(text_field("block_names", zero_terminated(f.blocks.iter())));
+    }
     Grid {
         points: m.points.len(),
         cells: m.cells.len(),
-        field: model_fields(names, info),
+        field,
         point_data: vec![],
-        cell_data: vec![array(
-            "Int32",
-            "MaterialIDs",
-            1,
-            le(m.material.iter().copied(), i32::to_le_bytes),
-        )],
+        cell_data,
         pts: points(&m.points),
         cell_arrays: cell_arrays(vtk_nodes.iter().map(|(n, t, k)| (*t, &n[..*k]))),
     }
@@ -344,6 +406,53 @@ pub fn write_boundary_vtu<W: Write + ?Sized>(w: &mut W, b: &BoundaryMesh) -> io:
             ),
             array("UInt64", "bulk_element_ids", 1, u64s(&b.bulk_element_ids)),
             array("UInt64", "bulk_face_ids", 1, u64s(&b.bulk_face_ids)),
+        ],
+        pts: points(&b.points),
+        cell_arrays: cell_arrays(b.faces.iter().map(|f| {
+            let t = if f.len() == 3 { VTK_TRIANGLE } else { VTK_QUAD };
+            (t, f.as_slice())
+        })),
+    }
+    .write(w)
+}
+
+/// Writes a fault's subdomain mesh ([`super::fault_mesh`]) as `fault-<name>.vtu`: triangles
+/// (and quadrilaterals), point data `bulk_node_ids`, cell data `MaterialIDs` (Int32),
+/// `bulk_element_ids`, `bulk_face_ids` (UInt64, the names and types of
+/// [`write_boundary_vtu`]), `block` and `side` (Int32).
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_io::model::{write_fault_vtu, FaultMesh};
+/// let b = FaultMesh {
+///     points: vec![[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]],
+///     faces: vec![vec![0, 1, 2], vec![0, 2, 1]],
+///     bulk_node_ids: vec![3, 4, 5],
+///     bulk_element_ids: vec![0, 1],
+///     bulk_face_ids: vec![2, 0],
+///     material_ids: vec![0, 1],
+///     block: vec![0, 1],
+///     side: vec![0, 1],
+/// };
+/// let mut buf = Vec::new();
+/// write_fault_vtu(&mut buf, &b)?;
+/// assert!(String::from_utf8_lossy(&buf).contains("type=\"Int32\" Name=\"side\""));
+/// # Ok(()) }
+/// ```
+pub fn write_fault_vtu<W: Write + ?Sized>(w: &mut W, b: &FaultMesh) -> io::Result<()> {
+    let u64s = |v: &[u64]| le(v.iter().copied(), u64::to_le_bytes);
+    let i32s = |v: &[i32]| le(v.iter().copied(), i32::to_le_bytes);
+    Grid {
+        points: b.points.len(),
+        cells: b.faces.len(),
+        field: vec![],
+        point_data: vec![array("UInt64", "bulk_node_ids", 1, u64s(&b.bulk_node_ids))],
+        cell_data: vec![
+            array("Int32", "MaterialIDs", 1, i32s(&b.material_ids)),
+            array("UInt64", "bulk_element_ids", 1, u64s(&b.bulk_element_ids)),
+            array("UInt64", "bulk_face_ids", 1, u64s(&b.bulk_face_ids)),
+            array("Int32", "block", 1, i32s(&b.block)),
+            array("Int32", "side", 1, i32s(&b.side)),
         ],
         pts: points(&b.points),
         cell_arrays: cell_arrays(b.faces.iter().map(|f| {

@@ -44,6 +44,95 @@ pub fn parse_geojson(text: &str) -> Result<Region, String> {
     Ok(region)
 }
 
+/// A polyline read from GeoJSON: the JSON path of its coordinates and its positions.
+pub type GeoJsonLine = (String, Vec<[f64; 2]>);
+
+/// Parses GeoJSON text for polylines: every `LineString` and every part of a
+/// `MultiLineString` (in a FeatureCollection, a Feature, a GeometryCollection or bare), as
+/// written (`[x, y]` or `[lon, lat]`; a third value is ignored), each with the JSON path of its
+/// coordinates. Polygons are refused (a polyline was asked for); points are ignored.
+///
+/// ```
+/// let l = terramesh_io::region::parse_geojson_lines(r#"{"type": "Feature", "properties": {},
+///   "geometry": {"type": "LineString", "coordinates": [[0, 0], [10, 5, 120]]}}"#)?;
+/// assert_eq!(l, vec![("$.geometry.coordinates".to_string(), vec![[0.0, 0.0], [10.0, 5.0]])]);
+/// # Ok::<(), String>(())
+/// ```
+pub fn parse_geojson_lines(text: &str) -> Result<Vec<GeoJsonLine>, String> {
+    let v: Value = serde_json::from_str(text).map_err(|e| json_error(&e))?;
+    let mut lines = Vec::new();
+    walk_lines(&v, "$", &mut lines)?;
+    Ok(lines)
+}
+
+fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), String> {
+    match kind(v, path)? {
+        "FeatureCollection" => {
+            let feats = v
+                .get("features")
+                .and_then(Value::as_array)
+                .ok_or_else(|| format!("{path}: FeatureCollection without a \"features\" array"))?;
+            for (i, f) in feats.iter().enumerate() {
+                walk_lines(f, &format!("{path}.features[{i}]"), out)?;
+            }
+            Ok(())
+        }
+        "Feature" => match v.get("geometry") {
+            Some(Value::Null) | None => Ok(()),
+            Some(g) => walk_lines(g, &format!("{path}.geometry"), out),
+        },
+        "GeometryCollection" => {
+            let gs = v
+                .get("geometries")
+                .and_then(Value::as_array)
+                .ok_or_else(|| format!("{path}: GeometryCollection without \"geometries\""))?;
+            for (i, g) in gs.iter().enumerate() {
+                walk_lines(g, &format!("{path}.geometries[{i}]"), out)?;
+            }
+            Ok(())
+        }
+        "LineString" => {
+            let p = format!("{path}.coordinates");
+            let l = positions(coords(v, path)?, &p)?;
+            out.push((p, l));
+            Ok(())
+        }
+        "MultiLineString" => {
+            let c = coords(v, path)?;
+            for (i, l) in array(c, &format!("{path}.coordinates"))?.iter().enumerate() {
+                let p = format!("{path}.coordinates[{i}]");
+                let l = positions(l, &p)?;
+                out.push((p, l));
+            }
+            Ok(())
+        }
+        "Point" | "MultiPoint" => Ok(()),
+        "Polygon" | "MultiPolygon" => Err(format!(
+            "{path}: a polygon where a polyline (LineString or MultiLineString) is expected"
+        )),
+        other => Err(format!("{path}: unknown GeoJSON type \"{other}\"")),
+    }
+}
+
+/// serde_json's error worded with its line and column first.
+fn json_error(e: &serde_json::Error) -> String {
+    // serde_json ends its message with the position: say it once, first
+    let full = e.to_string();
+    let what = full
+        .strip_suffix(&format!(" at line {} column {}", e.line(), e.column()))
+        .unwrap_or(&full);
+    let what = if e.is_eof() {
+        "the text ends before the JSON does (a truncated file?)"
+    } else {
+        what
+    };
+    format!(
+        "not valid JSON at line {}, column {}: {what}",
+        e.line(),
+        e.column()
+    )
+}
+
 fn kind<'a>(v: &'a Value, path: &str) -> Result<&'a str, String> {
     v.get("type")
         .and_then(Value::as_str)

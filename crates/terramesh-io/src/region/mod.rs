@@ -12,7 +12,7 @@ use terramesh_core::coords::{to_utm, CoordError, Zone};
 use terramesh_core::geometry::{validate, Region, ValidationError};
 
 pub use corners::{parse_corner, parse_corners, parse_projected_corners};
-pub use geojson::parse_geojson;
+pub use geojson::{parse_geojson, parse_geojson_lines, GeoJsonLine};
 pub use kml::{parse_kml, MAX_KML_DEPTH};
 pub use wkt::{parse_wkt, MAX_WKT_DEPTH};
 

@@ -1,1 +1,2 @@
+pub mod faulted;
 pub mod layered;
