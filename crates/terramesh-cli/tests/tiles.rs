@@ -255,6 +255,14 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
     // The merged mesh: conforming, watertight, every seam vertex once, the region's area.
     let seam = watertight(&out, &p);
     let merged = manifest_of(&out.join("merge.json"));
+    // The files by their names in the merged folder (not the staging folder's paths).
+    let files: Vec<&str> = merged["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    assert_eq!(files, ["dsm.vtu", "dsm.tif", "dsm.asc"]);
     let g = &m["grid"];
     assert_eq!(
         merged["grid"]["row_bytes"].as_u64().unwrap(),

@@ -122,14 +122,25 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         seconds: t0.elapsed().as_secs_f64(),
     };
     let json = out.join("merge.json");
+    // The files by their names in the merged folder: `out` is the staging folder, swapped
+    // into place afterwards.
+    let mut merged = merged;
+    let absolute = std::mem::take(&mut merged.files);
+    merged.files = absolute
+        .iter()
+        .map(|f| {
+            f.strip_prefix(out)
+                .map_or_else(|_| f.clone(), Path::to_path_buf)
+        })
+        .collect();
     let text = serde_json::to_string_pretty(&merged)?;
+    merged.files = absolute;
     terramesh_io::output::write_atomic(&json, text.as_bytes())
         .context(json.display().to_string())?;
     let report = out.join("report.html");
     let html = super::report::html(m, &merged);
     terramesh_io::output::write_atomic(&report, html.as_bytes())
         .context(report.display().to_string())?;
-    let mut merged = merged;
     merged.files.push(json);
     merged.files.push(report);
     Ok(merged)

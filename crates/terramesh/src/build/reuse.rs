@@ -109,7 +109,7 @@ pub fn key(p: &Project, base: &Path) -> Result<u64> {
     let mut h = hasher();
     env!("CARGO_PKG_VERSION").hash(&mut h);
     format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{:?}|{:?}",
         p.region.corners,
         p.region.file,
         p.region.zone,
