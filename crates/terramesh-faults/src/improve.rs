@@ -13,6 +13,7 @@
 //! same region, so conformity, the volume and every label are kept.
 
 use rayon::prelude::*;
+use robust::{orient3d, Coord3D};
 
 use crate::mesh::{positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
 use crate::quality::min_dihedral;
@@ -23,6 +24,7 @@ use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
 pub(crate) struct Improved {
     pub collapsed: usize,
     pub moved: usize,
+    pub flipped: usize,
 }
 
 struct Pass<'a> {
@@ -30,14 +32,30 @@ struct Pass<'a> {
     alive: Vec<bool>,
     star: Vec<Vec<u32>>,
     angle: Vec<f64>,
+    /// Nodes of cells changed since the sweep began: a poor cell none of whose nodes was
+    /// touched failed every operation in the last sweep and would fail again.
+    touched: Vec<bool>,
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
     height: InterfaceFn<'a>,
     terrain: &'a Terrain,
     /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
     background: usize,
+    /// The quality floor of the pass, degrees: a move or flip may not add cells below it.
+    floor: f64,
     /// Half the tolerance of `check` for a boundary node on the terrain, a side or the base.
     tol: f64,
+}
+
+/// A node is moved only if the smallest angle of its cells gains at least this (degrees).
+const MIN_GAIN: f64 = 1e-6;
+
+fn c3(p: [f64; 3]) -> Coord3D<f64> {
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
 }
 
 fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -48,11 +66,159 @@ impl Pass<'_> {
     fn cells(&self, v: u32) -> Vec<u32> {
         // A cell enters a node's list once: when it is made, or when the node replaces one
         // of its nodes (it did not hold the node before).
-        self.star[v as usize]
+        let mut c: Vec<u32> = self.star[v as usize]
             .iter()
             .copied()
             .filter(|&c| self.alive[c as usize] && self.st.tets[c as usize].contains(&v))
-            .collect()
+            .collect();
+        c.sort_unstable();
+        c.dedup();
+        c
+    }
+
+    /// Whether the cells carry one label (side of every fault, unit, block): then no face or
+    /// edge between them lies on a fault or an interface, and a flip among them keeps every
+    /// surface.
+    fn one_label(&self, cells: &[u32]) -> bool {
+        let l = |c: u32| {
+            let c = c as usize;
+            (self.st.positive[c], self.st.below[c], self.st.block[c])
+        };
+        cells.iter().all(|&c| l(c) == l(cells[0]))
+    }
+
+    /// Puts tetrahedron `t` (smallest angle `q`) in cell `c`, or in a new cell (with the
+    /// labels of `like`) if `c` is `None`.
+    fn place(&mut self, c: Option<u32>, like: u32, t: [u32; 4], q: f64) {
+        let c = match c {
+            Some(c) => c,
+            None => {
+                let l = like as usize;
+                self.st.tets.push(t);
+                self.st.positive.push(self.st.positive[l]);
+                self.st.below.push(self.st.below[l]);
+                self.st.block.push(self.st.block[l]);
+                self.alive.push(true);
+                self.angle.push(q);
+                (self.st.tets.len() - 1) as u32
+            }
+        };
+        self.st.tets[c as usize] = t;
+        self.angle[c as usize] = q;
+        for v in t {
+            self.star[v as usize].push(c);
+            self.touched[v as usize] = true;
+        }
+    }
+
+    /// The 2-3 flip of face `k` of cell `c` (the face opposite its node `k`): the two cells
+    /// on the face become three around the edge between their apexes, if both carry one
+    /// label, every new cell is positive (exact) and the smallest angle improves.
+    fn flip23(&mut self, c: u32, k: usize) -> bool {
+        let t = self.st.tets[c as usize];
+        let face: Vec<u32> = (0..4).filter(|&i| i != k).map(|i| t[i]).collect();
+        let Some(d) = self
+            .cells(face[0])
+            .into_iter()
+            .find(|&d| d != c && face.iter().all(|v| self.st.tets[d as usize].contains(v)))
+        else {
+            return false;
+        };
+        if !self.one_label(&[c, d]) {
+            return false;
+        }
+        let u = self.st.tets[d as usize];
+        let Some(&b) = u.iter().find(|v| !face.contains(v)) else {
+            return false;
+        };
+        let old = self.angle[c as usize].min(self.angle[d as usize]);
+        // Node i of `t` (on the face) replaced by `b`: the orientation of `t` is kept, so
+        // each is positive exactly when the edge between the apexes crosses the face.
+        let mut new = Vec::with_capacity(3);
+        for i in (0..4).filter(|&i| i != k) {
+            let mut n = t;
+            n[i] = b;
+            if !positive(self.geo(n)) {
+                return false;
+            }
+            let q = min_dihedral(self.geo(n));
+            if q <= old {
+                return false;
+            }
+            new.push((n, q));
+        }
+        let poor = (self.angle[c as usize] < self.floor) as usize
+            + (self.angle[d as usize] < self.floor) as usize;
+        if new.iter().filter(|n| n.1 < self.floor).count() > poor {
+            return false;
+        }
+        self.place(Some(c), c, new[0].0, new[0].1);
+        self.place(Some(d), c, new[1].0, new[1].1);
+        self.place(None, c, new[2].0, new[2].1);
+        true
+    }
+
+    /// The 3-2 flip of edge (a, b): the three cells around it become two on the face of
+    /// their other nodes, if the ring is closed (an interior edge), the cells carry one
+    /// label, `a` and `b` lie strictly on either side of that face (exact) and the smallest
+    /// angle improves.
+    fn flip32(&mut self, a: u32, b: u32) -> bool {
+        let ring: Vec<u32> = self
+            .cells(a)
+            .into_iter()
+            .filter(|&c| self.st.tets[c as usize].contains(&b))
+            .collect();
+        if ring.len() != 3 || !self.one_label(&ring) {
+            return false;
+        }
+        let mut o: Vec<u32> = ring
+            .iter()
+            .flat_map(|&c| self.st.tets[c as usize])
+            .filter(|&v| v != a && v != b)
+            .collect();
+        o.sort_unstable();
+        o.dedup();
+        if o.len() != 3 {
+            return false;
+        }
+        let p = |v: u32| c3(self.st.points[v as usize]);
+        let (sa, sb) = (
+            orient3d(p(o[0]), p(o[1]), p(o[2]), p(a)),
+            orient3d(p(o[0]), p(o[1]), p(o[2]), p(b)),
+        );
+        if sa == 0.0 || sb == 0.0 || (sa > 0.0) == (sb > 0.0) {
+            return false;
+        }
+        let old = ring
+            .iter()
+            .map(|&c| self.angle[c as usize])
+            .fold(f64::MAX, f64::min);
+        let mut new = Vec::with_capacity(2);
+        for apex in [a, b] {
+            let mut n = [o[0], o[1], o[2], apex];
+            if !positive(self.geo(n)) {
+                n.swap(0, 1);
+            }
+            if !positive(self.geo(n)) {
+                return false;
+            }
+            let q = min_dihedral(self.geo(n));
+            if q <= old {
+                return false;
+            }
+            new.push((n, q));
+        }
+        let poor = ring
+            .iter()
+            .filter(|&&c| self.angle[c as usize] < self.floor)
+            .count();
+        if new.iter().filter(|n| n.1 < self.floor).count() > poor {
+            return false;
+        }
+        self.place(Some(ring[0]), ring[0], new[0].0, new[0].1);
+        self.place(Some(ring[1]), ring[0], new[1].0, new[1].1);
+        self.alive[ring[2] as usize] = false;
+        true
     }
 
     fn labels(&self, cells: &[u32]) -> Vec<(u64, u32, u32)> {
@@ -135,6 +301,9 @@ impl Pass<'_> {
             self.st.tets[c as usize] = t;
             self.angle[c as usize] = q;
             self.star[b as usize].push(c);
+            for w in t {
+                self.touched[w as usize] = true;
+            }
         }
         self.star[a as usize].clear();
         true
@@ -189,8 +358,16 @@ impl Pass<'_> {
     /// one fault; `None` if it may not move.
     fn slide(&self, v: u32, labels: &[(u64, u32, u32)], to: [f64; 3]) -> Option<[f64; 3]> {
         let f = self.st.flags[v as usize];
+        let p = self.st.points[v as usize];
         if f & (TOP | BASE | SIDE) != 0 {
-            return None;
+            // Off the interfaces and faults, a node on a side moves vertically (it stays on
+            // the same edges of the outline), a node on the base horizontally; on the base
+            // and a side, or on the terrain, it stays.
+            return match (labels, f & (TOP | BASE | SIDE)) {
+                ([_], SIDE) if f & ON_INTERFACE == 0 => Some([p[0], p[1], to[2]]),
+                ([_], BASE) if f & ON_INTERFACE == 0 => Some([to[0], to[1], p[2]]),
+                _ => None,
+            };
         }
         match labels {
             [_] if f & ON_INTERFACE == 0 => Some(to),
@@ -217,6 +394,106 @@ impl Pass<'_> {
             }
             _ => None,
         }
+    }
+
+    /// Moves node `v` (along its surface) up the gradient of the smallest angle of its
+    /// worst cell, a few steps, if the smallest angle of its cells improves.
+    fn optimise(&mut self, v: u32) -> bool {
+        let cells = self.cells(v);
+        if cells.is_empty() {
+            return false;
+        }
+        let labels = self.labels(&cells);
+        let p = self.st.points[v as usize];
+        if self.slide(v, &labels, p).is_none() {
+            return false;
+        }
+        let geo = |c: u32, q: [f64; 3]| {
+            self.st.tets[c as usize].map(|w| {
+                if w == v {
+                    q
+                } else {
+                    self.st.points[w as usize]
+                }
+            })
+        };
+        // The smallest angle over the cells with `v` at `q` (-1 if one is not positive),
+        // and the worst cell.
+        let eval = |q: [f64; 3]| {
+            let (mut worst, mut poor) = ((f64::MAX, 0u32), 0);
+            for &c in &cells {
+                let g = geo(c, q);
+                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                if a < worst.0 {
+                    worst = (a, c);
+                }
+                poor += (a < self.floor) as usize;
+            }
+            (worst, poor)
+        };
+        let mut len = f64::MAX;
+        for &c in &cells {
+            for w in self.st.tets[c as usize] {
+                if w != v {
+                    len = len.min(d2(p, self.st.points[w as usize]).sqrt());
+                }
+            }
+        }
+        let ((old, mut worst), poor) = eval(p);
+        let (mut best, mut q) = (old, p);
+        for _ in 0..4 {
+            let h = 1e-4 * len;
+            let a0 = min_dihedral(geo(worst, q));
+            let mut g = [0.0; 3];
+            for (k, gk) in g.iter_mut().enumerate() {
+                let mut r = q;
+                r[k] += h;
+                *gk = (min_dihedral(geo(worst, r)) - a0) / h;
+            }
+            let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+            if !(n > 0.0 && n.is_finite()) {
+                break;
+            }
+            let mut stepped = false;
+            for step in [0.3, 0.1, 0.03, 0.01] {
+                let to = [0, 1, 2].map(|k| q[k] + step * len * g[k] / n);
+                let Some(r) = self.slide(v, &labels, to) else {
+                    break;
+                };
+                let ((a, w), n) = eval(r);
+                if a > best && n <= poor {
+                    (best, worst, q) = (a, w, r);
+                    stepped = true;
+                    break;
+                }
+            }
+            if !stepped {
+                break;
+            }
+        }
+        if best < old + MIN_GAIN {
+            return false;
+        }
+        let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
+        self.st.points[v as usize] = q;
+        for (&c, a) in cells.iter().zip(angles) {
+            self.angle[c as usize] = a;
+            for w in self.st.tets[c as usize] {
+                self.touched[w as usize] = true;
+            }
+        }
+        true
+    }
+
+    /// Tries the 3-2 flip of every edge of cell `c`, then the 2-3 flip of every face.
+    fn try_flips(&mut self, c: u32) -> bool {
+        let t = self.st.tets[c as usize];
+        for &(i, j) in &EDGES {
+            if self.flip32(t[i], t[j]) {
+                return true;
+            }
+        }
+        (0..4).any(|k| self.flip23(c, k))
     }
 
     /// Moves node `v` towards the mean of its neighbours (along its surface) if better.
@@ -260,16 +537,24 @@ impl Pass<'_> {
                     }
                 });
                 let a = if positive(g) { min_dihedral(g) } else { -1.0 };
-                if a <= old {
+                if a < old + MIN_GAIN {
                     ok = false;
                     break;
                 }
                 new.push(a);
             }
-            if ok {
+            let poor = |a: &f64| *a < self.floor;
+            let before = cells
+                .iter()
+                .filter(|&&c| poor(&self.angle[c as usize]))
+                .count();
+            if ok && new.iter().filter(|a| poor(a)).count() <= before {
                 self.st.points[v as usize] = q;
                 for (&c, a) in cells.iter().zip(new) {
                     self.angle[c as usize] = a;
+                    for w in self.st.tets[c as usize] {
+                        self.touched[w as usize] = true;
+                    }
                 }
                 return true;
             }
@@ -308,6 +593,8 @@ pub(crate) fn improve(
     }
     let mut p = Pass {
         alive: vec![true; st.tets.len()],
+        touched: vec![true; st.points.len()],
+        floor: below,
         st,
         star,
         angle,
@@ -325,9 +612,15 @@ pub(crate) fn improve(
     };
     for _ in 0..passes {
         let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
-            .filter(|&c| p.alive[c as usize] && p.angle[c as usize] < below)
+            .filter(|&c| {
+                let c = c as usize;
+                p.alive[c]
+                    && p.angle[c] < below
+                    && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
+            })
             .collect();
         bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
+        p.touched.iter_mut().for_each(|t| *t = false);
         let before = done;
         for c in bad {
             let c = c as usize;
@@ -356,9 +649,22 @@ pub(crate) fn improve(
                     }
                 }
             }
+            if !fixed && p.try_flips(c as u32) {
+                done.flipped += 1;
+                fixed = true;
+            }
             if !fixed {
                 for v in t {
                     if p.smooth(v) {
+                        done.moved += 1;
+                        fixed = true;
+                        break;
+                    }
+                }
+            }
+            if !fixed {
+                for v in t {
+                    if p.optimise(v) {
                         done.moved += 1;
                         break;
                     }

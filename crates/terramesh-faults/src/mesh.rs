@@ -91,6 +91,8 @@ pub struct BuildReport {
     pub collapsed: usize,
     /// Nodes moved by the quality pass.
     pub moved: usize,
+    /// Flips (2-3 and 3-2) made by the quality pass.
+    pub flipped: usize,
 }
 
 /// A tetrahedral volume mesh cut by faults and interfaces.
@@ -831,6 +833,7 @@ pub fn faulted_mesh(
     );
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
+    st.report.flipped = done.flipped;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,
