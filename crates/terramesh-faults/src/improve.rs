@@ -41,7 +41,8 @@ struct Pass<'a> {
     terrain: &'a Terrain,
     /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
     background: usize,
-    /// The quality floor of the pass, degrees: a move or flip may not add cells below it.
+    /// The quality floor of the pass, degrees: a move may not add cells below it, nor a flip
+    /// unless every cell it replaces was below it.
     floor: f64,
     /// Half the tolerance of `check` for a boundary node on the terrain, a side or the base.
     tol: f64,
@@ -149,7 +150,7 @@ impl Pass<'_> {
         }
         let poor = (self.angle[c as usize] < self.floor) as usize
             + (self.angle[d as usize] < self.floor) as usize;
-        if new.iter().filter(|n| n.1 < self.floor).count() > poor {
+        if poor < 2 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
             return false;
         }
         self.place(Some(c), c, new[0].0, new[0].1);
@@ -212,7 +213,7 @@ impl Pass<'_> {
             .iter()
             .filter(|&&c| self.angle[c as usize] < self.floor)
             .count();
-        if new.iter().filter(|n| n.1 < self.floor).count() > poor {
+        if poor < 3 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
             return false;
         }
         self.place(Some(ring[0]), ring[0], new[0].0, new[0].1);
@@ -715,4 +716,151 @@ pub(crate) fn improve(
         *t = t.map(|v| used[v as usize]);
     }
     done
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::BuildReport;
+    use terramesh_core::volume::tetra_volume;
+
+    /// Runs the pass on cells whose nodes all lie on the terrain (none may move or be
+    /// collapsed: only a flip can mend them); returns the cells and their smallest angle.
+    fn pass(points: Vec<[f64; 3]>, tets: Vec<[u32; 4]>) -> (State, Improved) {
+        let n = points.len();
+        let m = tets.len();
+        let mut st = State {
+            points,
+            flags: vec![TOP; n],
+            on_fault: vec![0; n],
+            tets,
+            positive: vec![0; m],
+            below: vec![0; m],
+            block: vec![0; m],
+            report: BuildReport::default(),
+        };
+        for t in &mut st.tets {
+            if !positive(t.map(|v| st.points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        let terrain = Terrain::new(
+            vec![[-100.0, -100.0], [100.0, -100.0], [0.0, 100.0]],
+            vec![[0, 1, 2]],
+            vec![10.0; 3],
+        )
+        .unwrap();
+        let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
+        let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
+        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        (st, done)
+    }
+
+    fn orient(points: &[[f64; 3]], mut tets: Vec<[u32; 4]>) -> Vec<[u32; 4]> {
+        for t in &mut tets {
+            if !positive(t.map(|v| points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        tets
+    }
+
+    fn summary(points: &[[f64; 3]], tets: &[[u32; 4]]) -> (f64, f64) {
+        let mut worst = f64::MAX;
+        let mut volume = 0.0;
+        for t in tets {
+            let g = t.map(|v| points[v as usize]);
+            assert!(positive(g), "{t:?}");
+            worst = worst.min(min_dihedral(g));
+            volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
+        }
+        (worst, volume)
+    }
+
+    /// Two flat cells on a triangle, their apexes 0.2 m above and below its centre: the 2-3
+    /// flip makes three cells around the edge between the apexes, better, same volume.
+    #[test]
+    fn flip23_mends_a_flat_pair() {
+        let c = [5.0, 5.0 / 3f64.sqrt(), 0.0];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 75f64.sqrt(), 0.0],
+            [c[0], c[1], 0.2],
+            [c[0], c[1], -0.2],
+        ];
+        let tets = orient(&points, vec![[0, 1, 2, 3], [0, 1, 2, 4]]);
+        let (old, volume) = summary(&points, &tets);
+        assert!(old < 5.0, "{old}");
+        let (st, done) = pass(points, tets);
+        assert_eq!(done.flipped, 1);
+        assert_eq!(st.tets.len(), 3);
+        let (new, after) = summary(&st.points, &st.tets);
+        assert!(new > 5.0, "{old} -> {new}");
+        assert!((after - volume).abs() <= 1e-12 * volume);
+    }
+
+    /// Three cells around an edge that crosses a triangle 0.1 m from one of its sides (the
+    /// cell on that side is flat): the 3-2 flip makes two cells on the triangle.
+    #[test]
+    fn flip32_mends_a_flat_ring() {
+        let p = [5.0, 0.1];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 75f64.sqrt(), 0.0],
+            [p[0], p[1], 5.0],
+            [p[0], p[1], -5.0],
+        ];
+        let tets = orient(&points, vec![[3, 4, 0, 1], [3, 4, 1, 2], [3, 4, 2, 0]]);
+        let (old, volume) = summary(&points, &tets);
+        assert!(old < 5.0, "{old}");
+        let (st, done) = pass(points, tets);
+        assert_eq!(done.flipped, 1);
+        assert_eq!(st.tets.len(), 2);
+        let (new, after) = summary(&st.points, &st.tets);
+        assert!(new > old, "{old} -> {new}");
+        assert!((after - volume).abs() <= 1e-12 * volume);
+    }
+
+    /// A flip between cells of two labels (here two units) would remove a face of their
+    /// interface: refused.
+    #[test]
+    fn no_flip_across_a_label() {
+        let c = [5.0, 5.0 / 3f64.sqrt(), 0.0];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 75f64.sqrt(), 0.0],
+            [c[0], c[1], 0.2],
+            [c[0], c[1], -0.2],
+        ];
+        let n = points.len();
+        let mut st = State {
+            points,
+            flags: vec![TOP; n],
+            on_fault: vec![0; n],
+            tets: vec![[0, 1, 2, 3], [0, 1, 2, 4]],
+            positive: vec![0; 2],
+            below: vec![0, 1],
+            block: vec![0; 2],
+            report: BuildReport::default(),
+        };
+        for t in &mut st.tets {
+            if !positive(t.map(|v| st.points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        let terrain = Terrain::new(
+            vec![[-100.0, -100.0], [100.0, -100.0], [0.0, 100.0]],
+            vec![[0, 1, 2]],
+            vec![10.0; 3],
+        )
+        .unwrap();
+        let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
+        let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
+        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        assert_eq!(done.flipped, 0);
+        assert_eq!(st.tets.len(), 2);
+    }
 }
