@@ -1,7 +1,11 @@
-//! The quality pass after cutting: slivers removed by collapsing one of their edges, and nodes
-//! moved (free nodes anywhere inside their star, nodes on one interface along it, nodes on one
-//! fault along it), each operation kept only if every cell it makes has a positive volume
-//! (exact `orient3d`) and the smallest dihedral angle of the cells it touches improves.
+//! The quality pass after cutting: slivers removed by collapsing one of their edges, by 2-3
+//! and 3-2 flips among cells of one label, and by moving nodes (free nodes anywhere inside
+//! their star, nodes on a side vertically, on the base horizontally, nodes on one interface
+//! along it, nodes on one fault along it; towards the mean of their neighbours, else up the
+//! gradient of the worst cell's smallest angle), each operation kept only if every cell it
+//! makes has a positive volume (exact `orient3d`), the smallest dihedral angle of the cells
+//! it touches improves and (a move, or a flip among cells not all below the floor) no more
+//! of them fall below the floor.
 //!
 //! What an operation may change is decided from the cells' labels (their side of every fault
 //! and their unit): a node whose cells all carry one label lies on no fault and no interface;
@@ -586,7 +590,17 @@ pub(crate) fn improve(
         .par_iter()
         .map(|t| min_dihedral(t.map(|v| st.points[v as usize])))
         .collect();
-    let mut star: Vec<Vec<u32>> = vec![Vec::new(); st.points.len()];
+    // Every node's cells, each list sized once (room for a few cells made by the pass).
+    let mut degree = vec![0u32; st.points.len()];
+    for t in &st.tets {
+        for &v in t {
+            degree[v as usize] += 1;
+        }
+    }
+    let mut star: Vec<Vec<u32>> = degree
+        .iter()
+        .map(|&d| Vec::with_capacity(d as usize + 4))
+        .collect();
     for (c, t) in st.tets.iter().enumerate() {
         for &v in t {
             star[v as usize].push(c as u32);
