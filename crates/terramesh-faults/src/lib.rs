@@ -38,7 +38,8 @@
 //!    is moved onto the surface if it may move (never a terrain node or a node on an earlier
 //!    interface; onto a fault along its normal, vertically on a side, horizontally on the
 //!    base, not if on an earlier fault; onto an interface vertically, or along the dip line
-//!    of the one fault it lies on so that it stays on it) and if no cell of its star would
+//!    of the one fault it lies on so that it stays on it, or for a node on a side and one
+//!    fault along the line where they meet) and if no cell of its star would
 //!    invert or fall below the smaller of `guard_degrees` and its current smallest dihedral
 //!    angle; then every edge that still crosses is split at its crossing (found by
 //!    regula falsi on the field) and every cell is split at its split edges, the lowest edge

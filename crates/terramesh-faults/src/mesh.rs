@@ -198,9 +198,17 @@ impl Field<'_> {
 
     /// Where a vertex may move onto the surface, if it may: never on the terrain or an
     /// interface; onto a fault along its normal, vertically on a side, horizontally on the
-    /// base (not on a side then), and not if on another fault; onto an interface vertically, or along the dip line of the one trace
-    /// fault it lies on (so it stays on that fault), not on a side then.
-    fn target(&self, q: [f64; 3], flags: u8, on_fault: u64, faults: &FaultSet) -> Option<[f64; 3]> {
+    /// base (not on a side then), and not if on another fault; onto an interface vertically,
+    /// or along the dip line of the one trace fault it lies on (so it stays on that fault),
+    /// or, on a side, along the line where that fault meets the side (kept if still on it).
+    fn target(
+        &self,
+        q: [f64; 3],
+        flags: u8,
+        on_fault: u64,
+        faults: &FaultSet,
+        terrain: &Terrain,
+    ) -> Option<[f64; 3]> {
         if flags & (TOP | ON_INTERFACE) != 0 {
             return None;
         }
@@ -251,11 +259,38 @@ impl Field<'_> {
                 if on_fault == 0 {
                     return Some([q[0], q[1], h(*k, *key, [q[0], q[1]])]);
                 }
-                if flags & SIDE != 0 || on_fault.count_ones() != 1 {
+                if on_fault.count_ones() != 1 {
                     return None;
                 }
-                let f = on_fault.trailing_zeros() as usize;
-                faults.faults[f].dip_line().and_then(along)
+                let fault = &faults.faults[on_fault.trailing_zeros() as usize];
+                if flags & SIDE == 0 {
+                    return fault.dip_line().and_then(along);
+                }
+                // On a side and one fault: along their line of intersection (the fault's
+                // tangent plane there and the side's vertical plane), if the node lies on one
+                // edge of the outline only and the target is still on the fault.
+                let mut edges = terrain.outline.iter().filter_map(|&[i, j]| {
+                    let (a, b) = (terrain.points[i as usize], terrain.points[j as usize]);
+                    let e = [b[0] - a[0], b[1] - a[1]];
+                    let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+                    let d = ((q[0] - a[0]) * e[1] - (q[1] - a[1]) * e[0]) / l;
+                    let t = ((q[0] - a[0]) * e[0] + (q[1] - a[1]) * e[1]) / (l * l);
+                    (d.abs() <= 1e-9 * l.max(1.0) && t > 1e-9 && t < 1.0 - 1e-9).then_some([
+                        e[1] / l,
+                        -e[0] / l,
+                        0.0,
+                    ])
+                });
+                let (Some(side), None) = (edges.next(), edges.next()) else {
+                    return None;
+                };
+                let n = fault.side(q).normal;
+                let d = [
+                    n[1] * side[2] - n[2] * side[1],
+                    n[2] * side[0] - n[0] * side[2],
+                    n[0] * side[1] - n[1] * side[0],
+                ];
+                along(d).filter(|&r| fault.side(r).distance.abs() <= 0.1 * ON_SURFACE)
             }
         }
     }
@@ -481,6 +516,7 @@ fn cut(
     field: &Field,
     s: &MeshSettings,
     faults: &FaultSet,
+    terrain: &Terrain,
 ) -> (Vec<(f64, i8)>, usize) {
     let mut need = vec![cells.is_none(); st.points.len()];
     if let Some(cells) = cells {
@@ -553,9 +589,13 @@ fn cut(
             let hi = star.partition_point(|e| e.0 <= v);
             let cells: Vec<[u32; 4]> = star[lo..hi].iter().map(|e| st.tets[e.1 as usize]).collect();
             let q = st.points[v as usize];
-            let Some(target) =
-                field.target(q, st.flags[v as usize], st.on_fault[v as usize], faults)
-            else {
+            let Some(target) = field.target(
+                q,
+                st.flags[v as usize],
+                st.on_fault[v as usize],
+                faults,
+                terrain,
+            ) else {
                 continue;
             };
             if field.eval(target).1 != 0 {
@@ -723,7 +763,7 @@ pub fn faulted_mesh(
     let background_nodes = st.points.len();
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
-        let (values, _) = cut(&mut st, None, &field, settings, faults);
+        let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);
         let bits: Vec<u64> = (0..st.tets.len())
             .into_par_iter()
             .map(|c| {
@@ -783,7 +823,15 @@ pub fn faulted_mesh(
             for (b, &bk) in blocks.iter().enumerate() {
                 let field = Field::Interface(height, k, bk);
                 let before = st.tets.len();
-                splits += cut(&mut st, Some(&by_block[b]), &field, settings, faults).1;
+                splits += cut(
+                    &mut st,
+                    Some(&by_block[b]),
+                    &field,
+                    settings,
+                    faults,
+                    terrain,
+                )
+                .1;
                 for c in before..st.tets.len() {
                     by_block[st.block[c] as usize].push(c as u32);
                 }
