@@ -19,7 +19,9 @@
 use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
 
-use crate::mesh::{positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
+use crate::mesh::{
+    outline_edge, positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
+};
 use crate::quality::min_dihedral;
 use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
 
@@ -371,6 +373,7 @@ impl Pass<'_> {
             return match (labels, f & (TOP | BASE | SIDE)) {
                 ([_], SIDE) if f & ON_INTERFACE == 0 => Some([p[0], p[1], to[2]]),
                 ([_], BASE) if f & ON_INTERFACE == 0 => Some([to[0], to[1], p[2]]),
+                ([x, y], SIDE) => self.along_side(p, x, y, to),
                 _ => None,
             };
         }
@@ -499,6 +502,61 @@ impl Pass<'_> {
             }
         }
         (0..4).any(|k| self.flip23(c, k))
+    }
+
+    /// Where a node at `p` on a side and on one surface (between cells labelled `x` and `y`)
+    /// may go towards `to`: along the line where that interface or fault meets the side (its
+    /// one edge of the outline; not at a corner), if it lands on the surface.
+    fn along_side(
+        &self,
+        p: [f64; 3],
+        x: &(u64, u32, u32),
+        y: &(u64, u32, u32),
+        to: [f64; 3],
+    ) -> Option<[f64; 3]> {
+        let e = outline_edge(self.terrain, p)?;
+        if x.0 == y.0 && x.2 == y.2 && y.1 == x.1 + 1 {
+            // Interface x.1 of block x.2: along the edge, at the interface's height.
+            let t = (to[0] - p[0]) * e[0] + (to[1] - p[1]) * e[1];
+            let xy = [p[0] + t * e[0], p[1] + t * e[1]];
+            let z = (self.height)(x.1 as usize, self.blocks[x.2 as usize], xy);
+            return z.is_finite().then_some([xy[0], xy[1], z]);
+        }
+        if x.1 != y.1 || (x.0 ^ y.0).count_ones() != 1 {
+            return None;
+        }
+        let fault = &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize];
+        let side = [e[1], -e[0], 0.0];
+        let n = fault.side(p).normal;
+        let mut d = [
+            n[1] * side[2] - n[2] * side[1],
+            n[2] * side[0] - n[0] * side[2],
+            n[0] * side[1] - n[1] * side[0],
+        ];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if l.is_nan() || l <= 1e-9 {
+            return None;
+        }
+        d = d.map(|c| c / l);
+        let t = (0..3).map(|k| (to[k] - p[k]) * d[k]).sum::<f64>();
+        let mut q = [0, 1, 2].map(|k| p[k] + t * d[k]);
+        // Back onto the fault within the side's plane: along the fault's normal less its
+        // component across the side.
+        for _ in 0..4 {
+            let s = fault.side(q);
+            if s.distance.abs() <= 0.1 * ON_SURFACE {
+                return Some(q);
+            }
+            let m = s.normal;
+            let across = m[0] * side[0] + m[1] * side[1];
+            let w = [m[0] - across * side[0], m[1] - across * side[1], m[2]];
+            let dot = w[0] * m[0] + w[1] * m[1] + w[2] * m[2];
+            if dot.is_nan() || dot <= 1e-6 {
+                return None;
+            }
+            q = [0, 1, 2].map(|k| q[k] - s.distance * w[k] / dot);
+        }
+        (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
     }
 
     /// Moves node `v` towards the mean of its neighbours (along its surface) if better.

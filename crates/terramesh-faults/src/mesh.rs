@@ -269,21 +269,8 @@ impl Field<'_> {
                 // On a side and one fault: along their line of intersection (the fault's
                 // tangent plane there and the side's vertical plane), if the node lies on one
                 // edge of the outline only and the target is still on the fault.
-                let mut edges = terrain.outline.iter().filter_map(|&[i, j]| {
-                    let (a, b) = (terrain.points[i as usize], terrain.points[j as usize]);
-                    let e = [b[0] - a[0], b[1] - a[1]];
-                    let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
-                    let d = ((q[0] - a[0]) * e[1] - (q[1] - a[1]) * e[0]) / l;
-                    let t = ((q[0] - a[0]) * e[0] + (q[1] - a[1]) * e[1]) / (l * l);
-                    (d.abs() <= 1e-9 * l.max(1.0) && t > 1e-9 && t < 1.0 - 1e-9).then_some([
-                        e[1] / l,
-                        -e[0] / l,
-                        0.0,
-                    ])
-                });
-                let (Some(side), None) = (edges.next(), edges.next()) else {
-                    return None;
-                };
+                let e = outline_edge(terrain, q)?;
+                let side = [e[1], -e[0], 0.0];
                 let n = fault.side(q).normal;
                 let d = [
                     n[1] * side[2] - n[2] * side[1],
@@ -351,6 +338,23 @@ fn key(a: u32, b: u32) -> u64 {
 }
 
 pub(crate) const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// The unit direction of the one edge of the region's outline that `q` lies on (in plan,
+/// strictly between its ends); `None` off the outline or at a corner.
+pub(crate) fn outline_edge(terrain: &Terrain, q: [f64; 3]) -> Option<[f64; 2]> {
+    let mut edges = terrain.outline.iter().filter_map(|&[i, j]| {
+        let (a, b) = (terrain.points[i as usize], terrain.points[j as usize]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+        let d = ((q[0] - a[0]) * e[1] - (q[1] - a[1]) * e[0]) / l;
+        let t = ((q[0] - a[0]) * e[0] + (q[1] - a[1]) * e[1]) / (l * l);
+        (d.abs() <= 1e-9 * l.max(1.0) && t > 1e-9 && t < 1.0 - 1e-9).then_some([e[0] / l, e[1] / l])
+    });
+    match (edges.next(), edges.next()) {
+        (Some(e), None) => Some(e),
+        _ => None,
+    }
+}
 
 /// The three tetrahedra of a prism, upper triangle `t` above lower `b`, by the
 /// lowest-global-index rule: every quadrilateral is split by the diagonal through its lowest
