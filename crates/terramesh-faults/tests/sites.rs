@@ -143,7 +143,9 @@ fn quality_by_surface() {
         );
         assert!(s.quality.min > 0.0);
         assert!((bad.len() as f64) < 0.01 * mesh.tets.len() as f64);
-        if name == "background" || name == "interfaces only" {
+        // The 5-degree floor of issue 31: without faults, and (since the side moves of the
+        // quality pass: 4.03 degrees before) with one fault and no interface.
+        if name != "both" {
             assert!(s.quality.min >= 5.0, "{name}: {}", s.quality.min);
         }
     }
