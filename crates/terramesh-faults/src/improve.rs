@@ -57,6 +57,9 @@ struct Pass<'a> {
 /// A node is moved only if the smallest angle of its cells gains at least this (degrees).
 const MIN_GAIN: f64 = 1e-6;
 
+/// A cell's label: its side of every fault, its unit, its block.
+type Label = (u64, u32, u32);
+
 fn c3(p: [f64; 3]) -> Coord3D<f64> {
     Coord3D {
         x: p[0],
@@ -121,12 +124,12 @@ impl Pass<'_> {
     /// The 2-3 flip of face `k` of cell `c` (the face opposite its node `k`): the two cells
     /// on the face become three around the edge between their apexes, if both carry one
     /// label, every new cell is positive (exact) and the smallest angle improves.
-    fn flip23(&mut self, c: u32, k: usize) -> bool {
+    fn flip23(&mut self, c: u32, k: usize, around: &[u32]) -> bool {
         let t = self.st.tets[c as usize];
         let face: Vec<u32> = (0..4).filter(|&i| i != k).map(|i| t[i]).collect();
-        let Some(d) = self
-            .cells(face[0])
-            .into_iter()
+        let Some(d) = around
+            .iter()
+            .copied()
             .find(|&d| d != c && face.iter().all(|v| self.st.tets[d as usize].contains(v)))
         else {
             return false;
@@ -169,10 +172,10 @@ impl Pass<'_> {
     /// their other nodes, if the ring is closed (an interior edge), the cells carry one
     /// label, `a` and `b` lie strictly on either side of that face (exact) and the smallest
     /// angle improves.
-    fn flip32(&mut self, a: u32, b: u32) -> bool {
-        let ring: Vec<u32> = self
-            .cells(a)
-            .into_iter()
+    fn flip32(&mut self, a: u32, b: u32, around: &[u32]) -> bool {
+        let ring: Vec<u32> = around
+            .iter()
+            .copied()
             .filter(|&c| self.st.tets[c as usize].contains(&b))
             .collect();
         if ring.len() != 3 || !self.one_label(&ring) {
@@ -228,7 +231,7 @@ impl Pass<'_> {
         true
     }
 
-    fn labels(&self, cells: &[u32]) -> Vec<(u64, u32, u32)> {
+    fn labels(&self, cells: &[u32]) -> Vec<Label> {
         let mut l: Vec<(u64, u32, u32)> = cells
             .iter()
             .map(|&c| {
@@ -245,8 +248,9 @@ impl Pass<'_> {
         t.map(|w| self.st.points[w as usize])
     }
 
-    /// Collapses node `a` into its neighbour `b` if allowed and better.
-    fn collapse(&mut self, a: u32, b: u32) -> bool {
+    /// Collapses node `a` into its neighbour `b` if allowed and better; `around` holds the
+    /// cells and the labels of both (as `cells` and `labels` give them).
+    fn collapse(&mut self, a: u32, b: u32, around: [&(Vec<u32>, Vec<Label>); 2]) -> bool {
         let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
         let bound = fa & (TOP | BASE | SIDE);
         // A boundary node only into a node on the same boundaries; never a DSM vertex, never
@@ -254,9 +258,7 @@ impl Pass<'_> {
         if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) || fa & SIDE != 0 {
             return false;
         }
-        let ca = self.cells(a);
-        let cb = self.cells(b);
-        let (la, lb) = (self.labels(&ca), self.labels(&cb));
+        let [(ca, la), (cb, lb)] = around;
         if !la.iter().all(|l| lb.binary_search(l).is_ok()) {
             return false;
         }
@@ -266,7 +268,7 @@ impl Pass<'_> {
             .fold(f64::MAX, f64::min);
         // Positive volumes first (cheap, and most refusals), then the angles.
         let mut new = Vec::with_capacity(ca.len());
-        for &c in &ca {
+        for &c in ca {
             let t = self.st.tets[c as usize];
             if t.contains(&b) {
                 continue;
@@ -299,7 +301,7 @@ impl Pass<'_> {
         }) {
             return false;
         }
-        for &c in &ca {
+        for &c in ca {
             if self.st.tets[c as usize].contains(&b) {
                 self.alive[c as usize] = false;
             }
@@ -406,12 +408,10 @@ impl Pass<'_> {
 
     /// Moves node `v` (along its surface) up the gradient of the smallest angle of its
     /// worst cell, a few steps, if the smallest angle of its cells improves.
-    fn optimise(&mut self, v: u32) -> bool {
-        let cells = self.cells(v);
+    fn optimise(&mut self, v: u32, cells: &[u32], labels: &[Label]) -> bool {
         if cells.is_empty() {
             return false;
         }
-        let labels = self.labels(&cells);
         let p = self.st.points[v as usize];
         if self.slide(v, &labels, p).is_none() {
             return false;
@@ -429,7 +429,7 @@ impl Pass<'_> {
         // and the worst cell.
         let eval = |q: [f64; 3]| {
             let (mut worst, mut poor) = ((f64::MAX, 0u32), 0);
-            for &c in &cells {
+            for &c in cells {
                 let g = geo(c, q);
                 let a = if positive(g) { min_dihedral(g) } else { -1.0 };
                 if a < worst.0 {
@@ -440,7 +440,7 @@ impl Pass<'_> {
             (worst, poor)
         };
         let mut len = f64::MAX;
-        for &c in &cells {
+        for &c in cells {
             for w in self.st.tets[c as usize] {
                 if w != v {
                     len = len.min(d2(p, self.st.points[w as usize]).sqrt());
@@ -494,14 +494,16 @@ impl Pass<'_> {
     }
 
     /// Tries the 3-2 flip of every edge of cell `c`, then the 2-3 flip of every face.
-    fn try_flips(&mut self, c: u32) -> bool {
+    /// `around[i]`: the cells around node i of cell `c`.
+    fn try_flips(&mut self, c: u32, around: &[&[u32]; 4]) -> bool {
         let t = self.st.tets[c as usize];
         for &(i, j) in &EDGES {
-            if self.flip32(t[i], t[j]) {
+            if self.flip32(t[i], t[j], around[i]) {
                 return true;
             }
         }
-        (0..4).any(|k| self.flip23(c, k))
+        // The face opposite node k holds node 0, or node 1 when k is 0.
+        (0..4).any(|k| self.flip23(c, k, around[if k == 0 { 1 } else { 0 }]))
     }
 
     /// Where a node at `p` on a side and on one surface (between cells labelled `x` and `y`)
@@ -560,12 +562,10 @@ impl Pass<'_> {
     }
 
     /// Moves node `v` towards the mean of its neighbours (along its surface) if better.
-    fn smooth(&mut self, v: u32) -> bool {
-        let cells = self.cells(v);
+    fn smooth(&mut self, v: u32, cells: &[u32], labels: &[Label]) -> bool {
         if cells.is_empty() {
             return false;
         }
-        let labels = self.labels(&cells);
         let p = self.st.points[v as usize];
         let mut nb: Vec<u32> = cells
             .iter()
@@ -591,7 +591,7 @@ impl Pass<'_> {
             };
             let mut new = Vec::with_capacity(cells.len());
             let mut ok = true;
-            for &c in &cells {
+            for &c in cells {
                 let g = self.st.tets[c as usize].map(|w| {
                     if w == v {
                         q
@@ -713,22 +713,34 @@ pub(crate) fn improve(
                 .collect();
             edges.sort_by(|x, y| x.0.total_cmp(&y.0));
             let mut fixed = false;
+            // The cells and labels around the four nodes, once for the twelve tries.
+            let around: Vec<(Vec<u32>, Vec<Label>)> = t
+                .iter()
+                .map(|&v| {
+                    let cells = p.cells(v);
+                    let labels = p.labels(&cells);
+                    (cells, labels)
+                })
+                .collect();
+            let at = |v: u32| &around[t.iter().position(|&w| w == v).unwrap()];
             'edges: for &(_, u, v) in &edges {
                 for (a, b) in [(u, v), (v, u)] {
-                    if p.collapse(a, b) {
+                    if p.collapse(a, b, [at(a), at(b)]) {
                         done.collapsed += 1;
                         fixed = true;
                         break 'edges;
                     }
                 }
             }
-            if !fixed && p.try_flips(c as u32) {
+            let stars = [0, 1, 2, 3].map(|i| around[i].0.as_slice());
+            if !fixed && p.try_flips(c as u32, &stars) {
                 done.flipped += 1;
                 fixed = true;
             }
             if !fixed {
                 for v in t {
-                    if p.smooth(v) {
+                    let (cells, labels) = at(v);
+                    if p.smooth(v, cells, labels) {
                         done.moved += 1;
                         fixed = true;
                         break;
@@ -737,7 +749,8 @@ pub(crate) fn improve(
             }
             if !fixed {
                 for v in t {
-                    if p.optimise(v) {
+                    let (cells, labels) = at(v);
+                    if p.optimise(v, cells, labels) {
                         done.moved += 1;
                         break;
                     }
