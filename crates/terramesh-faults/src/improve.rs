@@ -413,7 +413,7 @@ impl Pass<'_> {
             return false;
         }
         let p = self.st.points[v as usize];
-        if self.slide(v, &labels, p).is_none() {
+        if self.slide(v, labels, p).is_none() {
             return false;
         }
         let geo = |c: u32, q: [f64; 3]| {
@@ -465,7 +465,7 @@ impl Pass<'_> {
             let mut stepped = false;
             for step in [0.3, 0.1, 0.03, 0.01] {
                 let to = [0, 1, 2].map(|k| q[k] + step * len * g[k] / n);
-                let Some(r) = self.slide(v, &labels, to) else {
+                let Some(r) = self.slide(v, labels, to) else {
                     break;
                 };
                 let ((a, w), n) = eval(r);
@@ -586,7 +586,7 @@ impl Pass<'_> {
             .fold(f64::MAX, f64::min);
         for s in [1.0, 0.5, 0.25] {
             let to = [0, 1, 2].map(|k| p[k] + s * (mean[k] - p[k]));
-            let Some(q) = self.slide(v, &labels, to) else {
+            let Some(q) = self.slide(v, labels, to) else {
                 return false;
             };
             let mut new = Vec::with_capacity(cells.len());
