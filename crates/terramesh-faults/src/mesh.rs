@@ -45,7 +45,7 @@ pub struct MeshSettings {
     /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
     /// by edge collapses and node moves that keep every label (default 5; 0 turns it off).
     pub improve_degrees: f64,
-    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 2).
+    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 3).
     pub improve_passes: usize,
 }
 
@@ -58,7 +58,7 @@ impl MeshSettings {
             snap: 0.35,
             guard_degrees: 10.0,
             improve_degrees: 5.0,
-            improve_passes: 2,
+            improve_passes: 3,
         }
     }
 }
