@@ -45,23 +45,46 @@ fn peak_rss_mib() -> f64 {
         .map_or(f64::NAN, |kib| kib / 1024.0)
 }
 
+/// The process's CPU time (user + system), seconds: less sensitive than the wall clock to
+/// other processes on a shared machine.
+fn cpu_s() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            let rest = s.rsplit_once(')')?.1;
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            Some((f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?) / 100.0)
+        })
+        .unwrap_or(f64::NAN)
+}
+
+/// The machine's load averages (1, 5, 15 minutes), as printed by `uptime`.
+fn load() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_default()
+}
+
 fn bench(c: &mut Criterion) {
     let site = site();
     let settings = MeshSettings::new(site.base, 20.0);
     let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
-    let t0 = Instant::now();
+    println!("load average before the build: {}", load());
+    let (t0, c0) = (Instant::now(), cpu_s());
     let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
     let mesh = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &settings).unwrap();
     let build = t0.elapsed().as_secs_f64();
+    let build_cpu = cpu_s() - c0;
     // The same without the quality pass, for its cost and its gain.
     let mut off = settings;
     off.improve_degrees = 0.0;
-    let t3 = Instant::now();
+    let (t3, c3) = (Instant::now(), cpu_s());
     let raw = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &off).unwrap();
     let raw_s = t3.elapsed().as_secs_f64();
+    let raw_cpu = cpu_s() - c3;
     let q0 = quality(&raw.points, &raw.tets);
     println!(
-        "without the quality pass: {} cells, build {raw_s:.2} s, min dihedral {:.2} deg, below 5 deg {} ({:.3} %), histogram {:?}",
+        "without the quality pass: {} cells, build {raw_s:.2} s ({raw_cpu:.2} CPU s), min dihedral {:.2} deg, below 5 deg {} ({:.3} %), histogram {:?}",
         raw.tets.len(),
         q0.min,
         q0.below_5,
@@ -70,8 +93,8 @@ fn bench(c: &mut Criterion) {
     );
     drop(raw);
     println!(
-        "the quality pass: {} collapses, {} moves",
-        mesh.report.collapsed, mesh.report.moved
+        "the quality pass ({} sweeps): {} collapses, {} flips, {} moves",
+        settings.improve_passes, mesh.report.collapsed, mesh.report.flipped, mesh.report.moved
     );
     let t1 = Instant::now();
     let s = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
@@ -130,7 +153,7 @@ fn bench(c: &mut Criterion) {
     );
     println!(
         "faulted site: {} cells ({} background), {} nodes, {} blocks, 5 faults ({:?} faces), 8 \
-         units; build {build:.2} s, check {checked:.2} s, split nodes + check {split_s:.2} s \
+         units; build {build:.2} s ({build_cpu:.2} CPU s), check {checked:.2} s, split nodes + check {split_s:.2} s \
          ({} opened, {} at a tip); peak RSS {:.0} MiB; volume in its true unit {:.5}; \
          snapped {}, split edges {}, unresolved {}; min dihedral \
          {:.2} deg, mean {:.1}, below 5 deg {} ({:.3} %), histogram {:?} over bins {:?}",
@@ -153,6 +176,7 @@ fn bench(c: &mut Criterion) {
         s.quality.histogram.iter().map(|b| b.2).collect::<Vec<_>>(),
         BINS
     );
+    println!("load average after: {}", load());
     let mut g = c.benchmark_group("faulted");
     g.sample_size(10);
     g.bench_function("faulted_mesh 1M cells, 5 faults, 8 units", |b| {

@@ -1,7 +1,11 @@
-//! The quality pass after cutting: slivers removed by collapsing one of their edges, and nodes
-//! moved (free nodes anywhere inside their star, nodes on one interface along it, nodes on one
-//! fault along it), each operation kept only if every cell it makes has a positive volume
-//! (exact `orient3d`) and the smallest dihedral angle of the cells it touches improves.
+//! The quality pass after cutting: slivers removed by collapsing one of their edges, by 2-3
+//! and 3-2 flips among cells of one label, and by moving nodes (free nodes anywhere inside
+//! their star, nodes on a side vertically, on the base horizontally, nodes on one interface
+//! along it, nodes on one fault along it; towards the mean of their neighbours, else up the
+//! gradient of the worst cell's smallest angle), each operation kept only if every cell it
+//! makes has a positive volume (exact `orient3d`), the smallest dihedral angle of the cells
+//! it touches improves and (a move, or a flip among cells not all below the floor) no more
+//! of them fall below the floor.
 //!
 //! What an operation may change is decided from the cells' labels (their side of every fault
 //! and their unit): a node whose cells all carry one label lies on no fault and no interface;
@@ -13,8 +17,11 @@
 //! same region, so conformity, the volume and every label are kept.
 
 use rayon::prelude::*;
+use robust::{orient3d, Coord3D};
 
-use crate::mesh::{positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
+use crate::mesh::{
+    outline_edge, positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
+};
 use crate::quality::min_dihedral;
 use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
 
@@ -23,6 +30,7 @@ use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
 pub(crate) struct Improved {
     pub collapsed: usize,
     pub moved: usize,
+    pub flipped: usize,
 }
 
 struct Pass<'a> {
@@ -30,14 +38,34 @@ struct Pass<'a> {
     alive: Vec<bool>,
     star: Vec<Vec<u32>>,
     angle: Vec<f64>,
+    /// Nodes of cells changed since the sweep began: a poor cell none of whose nodes was
+    /// touched failed every operation in the last sweep and would fail again.
+    touched: Vec<bool>,
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
     height: InterfaceFn<'a>,
     terrain: &'a Terrain,
     /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
     background: usize,
+    /// The quality floor of the pass, degrees: a move may not add cells below it, nor a flip
+    /// unless every cell it replaces was below it.
+    floor: f64,
     /// Half the tolerance of `check` for a boundary node on the terrain, a side or the base.
     tol: f64,
+}
+
+/// A node is moved only if the smallest angle of its cells gains at least this (degrees).
+const MIN_GAIN: f64 = 1e-6;
+
+/// A cell's label: its side of every fault, its unit, its block.
+type Label = (u64, u32, u32);
+
+fn c3(p: [f64; 3]) -> Coord3D<f64> {
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
 }
 
 fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -48,14 +76,162 @@ impl Pass<'_> {
     fn cells(&self, v: u32) -> Vec<u32> {
         // A cell enters a node's list once: when it is made, or when the node replaces one
         // of its nodes (it did not hold the node before).
-        self.star[v as usize]
+        let mut c: Vec<u32> = self.star[v as usize]
             .iter()
             .copied()
             .filter(|&c| self.alive[c as usize] && self.st.tets[c as usize].contains(&v))
-            .collect()
+            .collect();
+        c.sort_unstable();
+        c.dedup();
+        c
     }
 
-    fn labels(&self, cells: &[u32]) -> Vec<(u64, u32, u32)> {
+    /// Whether the cells carry one label (side of every fault, unit, block): then no face or
+    /// edge between them lies on a fault or an interface, and a flip among them keeps every
+    /// surface.
+    fn one_label(&self, cells: &[u32]) -> bool {
+        let l = |c: u32| {
+            let c = c as usize;
+            (self.st.positive[c], self.st.below[c], self.st.block[c])
+        };
+        cells.iter().all(|&c| l(c) == l(cells[0]))
+    }
+
+    /// Puts tetrahedron `t` (smallest angle `q`) in cell `c`, or in a new cell (with the
+    /// labels of `like`) if `c` is `None`.
+    fn place(&mut self, c: Option<u32>, like: u32, t: [u32; 4], q: f64) {
+        let c = match c {
+            Some(c) => c,
+            None => {
+                let l = like as usize;
+                self.st.tets.push(t);
+                self.st.positive.push(self.st.positive[l]);
+                self.st.below.push(self.st.below[l]);
+                self.st.block.push(self.st.block[l]);
+                self.alive.push(true);
+                self.angle.push(q);
+                (self.st.tets.len() - 1) as u32
+            }
+        };
+        self.st.tets[c as usize] = t;
+        self.angle[c as usize] = q;
+        for v in t {
+            self.star[v as usize].push(c);
+            self.touched[v as usize] = true;
+        }
+    }
+
+    /// The 2-3 flip of face `k` of cell `c` (the face opposite its node `k`): the two cells
+    /// on the face become three around the edge between their apexes, if both carry one
+    /// label, every new cell is positive (exact) and the smallest angle improves.
+    fn flip23(&mut self, c: u32, k: usize, around: &[u32]) -> bool {
+        let t = self.st.tets[c as usize];
+        let face: Vec<u32> = (0..4).filter(|&i| i != k).map(|i| t[i]).collect();
+        let Some(d) = around
+            .iter()
+            .copied()
+            .find(|&d| d != c && face.iter().all(|v| self.st.tets[d as usize].contains(v)))
+        else {
+            return false;
+        };
+        if !self.one_label(&[c, d]) {
+            return false;
+        }
+        let u = self.st.tets[d as usize];
+        let Some(&b) = u.iter().find(|v| !face.contains(v)) else {
+            return false;
+        };
+        let old = self.angle[c as usize].min(self.angle[d as usize]);
+        // Node i of `t` (on the face) replaced by `b`: the orientation of `t` is kept, so
+        // each is positive exactly when the edge between the apexes crosses the face.
+        let mut new = Vec::with_capacity(3);
+        for i in (0..4).filter(|&i| i != k) {
+            let mut n = t;
+            n[i] = b;
+            if !positive(self.geo(n)) {
+                return false;
+            }
+            let q = min_dihedral(self.geo(n));
+            if q <= old {
+                return false;
+            }
+            new.push((n, q));
+        }
+        let poor = (self.angle[c as usize] < self.floor) as usize
+            + (self.angle[d as usize] < self.floor) as usize;
+        if poor < 2 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
+            return false;
+        }
+        self.place(Some(c), c, new[0].0, new[0].1);
+        self.place(Some(d), c, new[1].0, new[1].1);
+        self.place(None, c, new[2].0, new[2].1);
+        true
+    }
+
+    /// The 3-2 flip of edge (a, b): the three cells around it become two on the face of
+    /// their other nodes, if the ring is closed (an interior edge), the cells carry one
+    /// label, `a` and `b` lie strictly on either side of that face (exact) and the smallest
+    /// angle improves.
+    fn flip32(&mut self, a: u32, b: u32, around: &[u32]) -> bool {
+        let ring: Vec<u32> = around
+            .iter()
+            .copied()
+            .filter(|&c| self.st.tets[c as usize].contains(&b))
+            .collect();
+        if ring.len() != 3 || !self.one_label(&ring) {
+            return false;
+        }
+        let mut o: Vec<u32> = ring
+            .iter()
+            .flat_map(|&c| self.st.tets[c as usize])
+            .filter(|&v| v != a && v != b)
+            .collect();
+        o.sort_unstable();
+        o.dedup();
+        if o.len() != 3 {
+            return false;
+        }
+        let p = |v: u32| c3(self.st.points[v as usize]);
+        let (sa, sb) = (
+            orient3d(p(o[0]), p(o[1]), p(o[2]), p(a)),
+            orient3d(p(o[0]), p(o[1]), p(o[2]), p(b)),
+        );
+        if sa == 0.0 || sb == 0.0 || (sa > 0.0) == (sb > 0.0) {
+            return false;
+        }
+        let old = ring
+            .iter()
+            .map(|&c| self.angle[c as usize])
+            .fold(f64::MAX, f64::min);
+        let mut new = Vec::with_capacity(2);
+        for apex in [a, b] {
+            let mut n = [o[0], o[1], o[2], apex];
+            if !positive(self.geo(n)) {
+                n.swap(0, 1);
+            }
+            if !positive(self.geo(n)) {
+                return false;
+            }
+            let q = min_dihedral(self.geo(n));
+            if q <= old {
+                return false;
+            }
+            new.push((n, q));
+        }
+        let poor = ring
+            .iter()
+            .filter(|&&c| self.angle[c as usize] < self.floor)
+            .count();
+        if poor < 3 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
+            return false;
+        }
+        self.place(Some(ring[0]), ring[0], new[0].0, new[0].1);
+        self.place(Some(ring[1]), ring[0], new[1].0, new[1].1);
+        self.alive[ring[2] as usize] = false;
+        true
+    }
+
+    fn labels(&self, cells: &[u32]) -> Vec<Label> {
         let mut l: Vec<(u64, u32, u32)> = cells
             .iter()
             .map(|&c| {
@@ -72,8 +248,9 @@ impl Pass<'_> {
         t.map(|w| self.st.points[w as usize])
     }
 
-    /// Collapses node `a` into its neighbour `b` if allowed and better.
-    fn collapse(&mut self, a: u32, b: u32) -> bool {
+    /// Collapses node `a` into its neighbour `b` if allowed and better; `around` holds the
+    /// cells and the labels of both (as `cells` and `labels` give them).
+    fn collapse(&mut self, a: u32, b: u32, around: [&(Vec<u32>, Vec<Label>); 2]) -> bool {
         let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
         let bound = fa & (TOP | BASE | SIDE);
         // A boundary node only into a node on the same boundaries; never a DSM vertex, never
@@ -81,9 +258,7 @@ impl Pass<'_> {
         if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) || fa & SIDE != 0 {
             return false;
         }
-        let ca = self.cells(a);
-        let cb = self.cells(b);
-        let (la, lb) = (self.labels(&ca), self.labels(&cb));
+        let [(ca, la), (cb, lb)] = around;
         if !la.iter().all(|l| lb.binary_search(l).is_ok()) {
             return false;
         }
@@ -93,7 +268,7 @@ impl Pass<'_> {
             .fold(f64::MAX, f64::min);
         // Positive volumes first (cheap, and most refusals), then the angles.
         let mut new = Vec::with_capacity(ca.len());
-        for &c in &ca {
+        for &c in ca {
             let t = self.st.tets[c as usize];
             if t.contains(&b) {
                 continue;
@@ -126,7 +301,7 @@ impl Pass<'_> {
         }) {
             return false;
         }
-        for &c in &ca {
+        for &c in ca {
             if self.st.tets[c as usize].contains(&b) {
                 self.alive[c as usize] = false;
             }
@@ -135,6 +310,9 @@ impl Pass<'_> {
             self.st.tets[c as usize] = t;
             self.angle[c as usize] = q;
             self.star[b as usize].push(c);
+            for w in t {
+                self.touched[w as usize] = true;
+            }
         }
         self.star[a as usize].clear();
         true
@@ -189,8 +367,17 @@ impl Pass<'_> {
     /// one fault; `None` if it may not move.
     fn slide(&self, v: u32, labels: &[(u64, u32, u32)], to: [f64; 3]) -> Option<[f64; 3]> {
         let f = self.st.flags[v as usize];
+        let p = self.st.points[v as usize];
         if f & (TOP | BASE | SIDE) != 0 {
-            return None;
+            // Off the interfaces and faults, a node on a side moves vertically (it stays on
+            // the same edges of the outline), a node on the base horizontally; on the base
+            // and a side, or on the terrain, it stays.
+            return match (labels, f & (TOP | BASE | SIDE)) {
+                ([_], SIDE) if f & ON_INTERFACE == 0 => Some([p[0], p[1], to[2]]),
+                ([_], BASE) if f & ON_INTERFACE == 0 => Some([to[0], to[1], p[2]]),
+                ([x, y], SIDE) => self.along_side(p, x, y, to),
+                _ => None,
+            };
         }
         match labels {
             [_] if f & ON_INTERFACE == 0 => Some(to),
@@ -219,13 +406,166 @@ impl Pass<'_> {
         }
     }
 
-    /// Moves node `v` towards the mean of its neighbours (along its surface) if better.
-    fn smooth(&mut self, v: u32) -> bool {
-        let cells = self.cells(v);
+    /// Moves node `v` (along its surface) up the gradient of the smallest angle of its
+    /// worst cell, a few steps, if the smallest angle of its cells improves.
+    fn optimise(&mut self, v: u32, cells: &[u32], labels: &[Label]) -> bool {
         if cells.is_empty() {
             return false;
         }
-        let labels = self.labels(&cells);
+        let p = self.st.points[v as usize];
+        if self.slide(v, labels, p).is_none() {
+            return false;
+        }
+        let geo = |c: u32, q: [f64; 3]| {
+            self.st.tets[c as usize].map(|w| {
+                if w == v {
+                    q
+                } else {
+                    self.st.points[w as usize]
+                }
+            })
+        };
+        // The smallest angle over the cells with `v` at `q` (-1 if one is not positive),
+        // and the worst cell.
+        let eval = |q: [f64; 3]| {
+            let (mut worst, mut poor) = ((f64::MAX, 0u32), 0);
+            for &c in cells {
+                let g = geo(c, q);
+                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                if a < worst.0 {
+                    worst = (a, c);
+                }
+                poor += (a < self.floor) as usize;
+            }
+            (worst, poor)
+        };
+        let mut len = f64::MAX;
+        for &c in cells {
+            for w in self.st.tets[c as usize] {
+                if w != v {
+                    len = len.min(d2(p, self.st.points[w as usize]).sqrt());
+                }
+            }
+        }
+        let ((old, mut worst), poor) = eval(p);
+        let (mut best, mut q) = (old, p);
+        for _ in 0..4 {
+            let h = 1e-4 * len;
+            let a0 = min_dihedral(geo(worst, q));
+            let mut g = [0.0; 3];
+            for (k, gk) in g.iter_mut().enumerate() {
+                let mut r = q;
+                r[k] += h;
+                *gk = (min_dihedral(geo(worst, r)) - a0) / h;
+            }
+            let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+            if !(n > 0.0 && n.is_finite()) {
+                break;
+            }
+            let mut stepped = false;
+            for step in [0.3, 0.1, 0.03, 0.01] {
+                let to = [0, 1, 2].map(|k| q[k] + step * len * g[k] / n);
+                let Some(r) = self.slide(v, labels, to) else {
+                    break;
+                };
+                let ((a, w), n) = eval(r);
+                if a > best && n <= poor {
+                    (best, worst, q) = (a, w, r);
+                    stepped = true;
+                    break;
+                }
+            }
+            if !stepped {
+                break;
+            }
+        }
+        if best < old + MIN_GAIN {
+            return false;
+        }
+        let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
+        self.st.points[v as usize] = q;
+        for (&c, a) in cells.iter().zip(angles) {
+            self.angle[c as usize] = a;
+            for w in self.st.tets[c as usize] {
+                self.touched[w as usize] = true;
+            }
+        }
+        true
+    }
+
+    /// Tries the 3-2 flip of every edge of cell `c`, then the 2-3 flip of every face.
+    /// `around[i]`: the cells around node i of cell `c`.
+    fn try_flips(&mut self, c: u32, around: &[&[u32]; 4]) -> bool {
+        let t = self.st.tets[c as usize];
+        for &(i, j) in &EDGES {
+            if self.flip32(t[i], t[j], around[i]) {
+                return true;
+            }
+        }
+        // The face opposite node k holds node 0, or node 1 when k is 0.
+        (0..4).any(|k| self.flip23(c, k, around[if k == 0 { 1 } else { 0 }]))
+    }
+
+    /// Where a node at `p` on a side and on one surface (between cells labelled `x` and `y`)
+    /// may go towards `to`: along the line where that interface or fault meets the side (its
+    /// one edge of the outline; not at a corner), if it lands on the surface.
+    fn along_side(
+        &self,
+        p: [f64; 3],
+        x: &(u64, u32, u32),
+        y: &(u64, u32, u32),
+        to: [f64; 3],
+    ) -> Option<[f64; 3]> {
+        let e = outline_edge(self.terrain, p)?;
+        if x.0 == y.0 && x.2 == y.2 && y.1 == x.1 + 1 {
+            // Interface x.1 of block x.2: along the edge, at the interface's height.
+            let t = (to[0] - p[0]) * e[0] + (to[1] - p[1]) * e[1];
+            let xy = [p[0] + t * e[0], p[1] + t * e[1]];
+            let z = (self.height)(x.1 as usize, self.blocks[x.2 as usize], xy);
+            return z.is_finite().then_some([xy[0], xy[1], z]);
+        }
+        if x.1 != y.1 || (x.0 ^ y.0).count_ones() != 1 {
+            return None;
+        }
+        let fault = &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize];
+        let side = [e[1], -e[0], 0.0];
+        let n = fault.side(p).normal;
+        let mut d = [
+            n[1] * side[2] - n[2] * side[1],
+            n[2] * side[0] - n[0] * side[2],
+            n[0] * side[1] - n[1] * side[0],
+        ];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if l.is_nan() || l <= 1e-9 {
+            return None;
+        }
+        d = d.map(|c| c / l);
+        let t = (0..3).map(|k| (to[k] - p[k]) * d[k]).sum::<f64>();
+        let mut q = [0, 1, 2].map(|k| p[k] + t * d[k]);
+        // Back onto the fault within the side's plane: along the fault's normal less its
+        // component across the side.
+        for _ in 0..4 {
+            let s = fault.side(q);
+            if s.distance.abs() <= 0.1 * ON_SURFACE {
+                return Some(q);
+            }
+            let m = s.normal;
+            let across = m[0] * side[0] + m[1] * side[1];
+            let w = [m[0] - across * side[0], m[1] - across * side[1], m[2]];
+            let dot = w[0] * m[0] + w[1] * m[1] + w[2] * m[2];
+            if dot.is_nan() || dot <= 1e-6 {
+                return None;
+            }
+            q = [0, 1, 2].map(|k| q[k] - s.distance * w[k] / dot);
+        }
+        (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
+    }
+
+    /// Moves node `v` towards the mean of its neighbours (along its surface) if better.
+    fn smooth(&mut self, v: u32, cells: &[u32], labels: &[Label]) -> bool {
+        if cells.is_empty() {
+            return false;
+        }
         let p = self.st.points[v as usize];
         let mut nb: Vec<u32> = cells
             .iter()
@@ -246,12 +586,12 @@ impl Pass<'_> {
             .fold(f64::MAX, f64::min);
         for s in [1.0, 0.5, 0.25] {
             let to = [0, 1, 2].map(|k| p[k] + s * (mean[k] - p[k]));
-            let Some(q) = self.slide(v, &labels, to) else {
+            let Some(q) = self.slide(v, labels, to) else {
                 return false;
             };
             let mut new = Vec::with_capacity(cells.len());
             let mut ok = true;
-            for &c in &cells {
+            for &c in cells {
                 let g = self.st.tets[c as usize].map(|w| {
                     if w == v {
                         q
@@ -260,16 +600,24 @@ impl Pass<'_> {
                     }
                 });
                 let a = if positive(g) { min_dihedral(g) } else { -1.0 };
-                if a <= old {
+                if a < old + MIN_GAIN {
                     ok = false;
                     break;
                 }
                 new.push(a);
             }
-            if ok {
+            let poor = |a: &f64| *a < self.floor;
+            let before = cells
+                .iter()
+                .filter(|&&c| poor(&self.angle[c as usize]))
+                .count();
+            if ok && new.iter().filter(|a| poor(a)).count() <= before {
                 self.st.points[v as usize] = q;
                 for (&c, a) in cells.iter().zip(new) {
                     self.angle[c as usize] = a;
+                    for w in self.st.tets[c as usize] {
+                        self.touched[w as usize] = true;
+                    }
                 }
                 return true;
             }
@@ -300,7 +648,17 @@ pub(crate) fn improve(
         .par_iter()
         .map(|t| min_dihedral(t.map(|v| st.points[v as usize])))
         .collect();
-    let mut star: Vec<Vec<u32>> = vec![Vec::new(); st.points.len()];
+    // Every node's cells, each list sized once (room for a few cells made by the pass).
+    let mut degree = vec![0u32; st.points.len()];
+    for t in &st.tets {
+        for &v in t {
+            degree[v as usize] += 1;
+        }
+    }
+    let mut star: Vec<Vec<u32>> = degree
+        .iter()
+        .map(|&d| Vec::with_capacity(d as usize + 4))
+        .collect();
     for (c, t) in st.tets.iter().enumerate() {
         for &v in t {
             star[v as usize].push(c as u32);
@@ -308,6 +666,8 @@ pub(crate) fn improve(
     }
     let mut p = Pass {
         alive: vec![true; st.tets.len()],
+        touched: vec![true; st.points.len()],
+        floor: below,
         st,
         star,
         angle,
@@ -325,9 +685,15 @@ pub(crate) fn improve(
     };
     for _ in 0..passes {
         let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
-            .filter(|&c| p.alive[c as usize] && p.angle[c as usize] < below)
+            .filter(|&c| {
+                let c = c as usize;
+                p.alive[c]
+                    && p.angle[c] < below
+                    && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
+            })
             .collect();
         bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
+        p.touched.iter_mut().for_each(|t| *t = false);
         let before = done;
         for c in bad {
             let c = c as usize;
@@ -347,18 +713,44 @@ pub(crate) fn improve(
                 .collect();
             edges.sort_by(|x, y| x.0.total_cmp(&y.0));
             let mut fixed = false;
+            // The cells and labels around the four nodes, once for the twelve tries.
+            let around: Vec<(Vec<u32>, Vec<Label>)> = t
+                .iter()
+                .map(|&v| {
+                    let cells = p.cells(v);
+                    let labels = p.labels(&cells);
+                    (cells, labels)
+                })
+                .collect();
+            let at = |v: u32| &around[t.iter().position(|&w| w == v).unwrap()];
             'edges: for &(_, u, v) in &edges {
                 for (a, b) in [(u, v), (v, u)] {
-                    if p.collapse(a, b) {
+                    if p.collapse(a, b, [at(a), at(b)]) {
                         done.collapsed += 1;
                         fixed = true;
                         break 'edges;
                     }
                 }
             }
+            let stars = [0, 1, 2, 3].map(|i| around[i].0.as_slice());
+            if !fixed && p.try_flips(c as u32, &stars) {
+                done.flipped += 1;
+                fixed = true;
+            }
             if !fixed {
                 for v in t {
-                    if p.smooth(v) {
+                    let (cells, labels) = at(v);
+                    if p.smooth(v, cells, labels) {
+                        done.moved += 1;
+                        fixed = true;
+                        break;
+                    }
+                }
+            }
+            if !fixed {
+                for v in t {
+                    let (cells, labels) = at(v);
+                    if p.optimise(v, cells, labels) {
                         done.moved += 1;
                         break;
                     }
@@ -409,4 +801,151 @@ pub(crate) fn improve(
         *t = t.map(|v| used[v as usize]);
     }
     done
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::BuildReport;
+    use terramesh_core::volume::tetra_volume;
+
+    /// Runs the pass on cells whose nodes all lie on the terrain (none may move or be
+    /// collapsed: only a flip can mend them); returns the cells and their smallest angle.
+    fn pass(points: Vec<[f64; 3]>, tets: Vec<[u32; 4]>) -> (State, Improved) {
+        let n = points.len();
+        let m = tets.len();
+        let mut st = State {
+            points,
+            flags: vec![TOP; n],
+            on_fault: vec![0; n],
+            tets,
+            positive: vec![0; m],
+            below: vec![0; m],
+            block: vec![0; m],
+            report: BuildReport::default(),
+        };
+        for t in &mut st.tets {
+            if !positive(t.map(|v| st.points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        let terrain = Terrain::new(
+            vec![[-100.0, -100.0], [100.0, -100.0], [0.0, 100.0]],
+            vec![[0, 1, 2]],
+            vec![10.0; 3],
+        )
+        .unwrap();
+        let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
+        let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
+        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        (st, done)
+    }
+
+    fn orient(points: &[[f64; 3]], mut tets: Vec<[u32; 4]>) -> Vec<[u32; 4]> {
+        for t in &mut tets {
+            if !positive(t.map(|v| points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        tets
+    }
+
+    fn summary(points: &[[f64; 3]], tets: &[[u32; 4]]) -> (f64, f64) {
+        let mut worst = f64::MAX;
+        let mut volume = 0.0;
+        for t in tets {
+            let g = t.map(|v| points[v as usize]);
+            assert!(positive(g), "{t:?}");
+            worst = worst.min(min_dihedral(g));
+            volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
+        }
+        (worst, volume)
+    }
+
+    /// Two flat cells on a triangle, their apexes 0.2 m above and below its centre: the 2-3
+    /// flip makes three cells around the edge between the apexes, better, same volume.
+    #[test]
+    fn flip23_mends_a_flat_pair() {
+        let c = [5.0, 5.0 / 3f64.sqrt(), 0.0];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 75f64.sqrt(), 0.0],
+            [c[0], c[1], 0.2],
+            [c[0], c[1], -0.2],
+        ];
+        let tets = orient(&points, vec![[0, 1, 2, 3], [0, 1, 2, 4]]);
+        let (old, volume) = summary(&points, &tets);
+        assert!(old < 5.0, "{old}");
+        let (st, done) = pass(points, tets);
+        assert_eq!(done.flipped, 1);
+        assert_eq!(st.tets.len(), 3);
+        let (new, after) = summary(&st.points, &st.tets);
+        assert!(new > 5.0, "{old} -> {new}");
+        assert!((after - volume).abs() <= 1e-12 * volume);
+    }
+
+    /// Three cells around an edge that crosses a triangle 0.1 m from one of its sides (the
+    /// cell on that side is flat): the 3-2 flip makes two cells on the triangle.
+    #[test]
+    fn flip32_mends_a_flat_ring() {
+        let p = [5.0, 0.1];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 75f64.sqrt(), 0.0],
+            [p[0], p[1], 5.0],
+            [p[0], p[1], -5.0],
+        ];
+        let tets = orient(&points, vec![[3, 4, 0, 1], [3, 4, 1, 2], [3, 4, 2, 0]]);
+        let (old, volume) = summary(&points, &tets);
+        assert!(old < 5.0, "{old}");
+        let (st, done) = pass(points, tets);
+        assert_eq!(done.flipped, 1);
+        assert_eq!(st.tets.len(), 2);
+        let (new, after) = summary(&st.points, &st.tets);
+        assert!(new > old, "{old} -> {new}");
+        assert!((after - volume).abs() <= 1e-12 * volume);
+    }
+
+    /// A flip between cells of two labels (here two units) would remove a face of their
+    /// interface: refused.
+    #[test]
+    fn no_flip_across_a_label() {
+        let c = [5.0, 5.0 / 3f64.sqrt(), 0.0];
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 75f64.sqrt(), 0.0],
+            [c[0], c[1], 0.2],
+            [c[0], c[1], -0.2],
+        ];
+        let n = points.len();
+        let mut st = State {
+            points,
+            flags: vec![TOP; n],
+            on_fault: vec![0; n],
+            tets: vec![[0, 1, 2, 3], [0, 1, 2, 4]],
+            positive: vec![0; 2],
+            below: vec![0, 1],
+            block: vec![0; 2],
+            report: BuildReport::default(),
+        };
+        for t in &mut st.tets {
+            if !positive(t.map(|v| st.points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        let terrain = Terrain::new(
+            vec![[-100.0, -100.0], [100.0, -100.0], [0.0, 100.0]],
+            vec![[0, 1, 2]],
+            vec![10.0; 3],
+        )
+        .unwrap();
+        let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
+        let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
+        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        assert_eq!(done.flipped, 0);
+        assert_eq!(st.tets.len(), 2);
+    }
 }

@@ -38,7 +38,8 @@
 //!    is moved onto the surface if it may move (never a terrain node or a node on an earlier
 //!    interface; onto a fault along its normal, vertically on a side, horizontally on the
 //!    base, not if on an earlier fault; onto an interface vertically, or along the dip line
-//!    of the one fault it lies on so that it stays on it) and if no cell of its star would
+//!    of the one fault it lies on so that it stays on it, or for a node on a side and one
+//!    fault along the line where they meet) and if no cell of its star would
 //!    invert or fall below the smaller of `guard_degrees` and its current smallest dihedral
 //!    angle; then every edge that still crosses is split at its crossing (found by
 //!    regula falsi on the field) and every cell is split at its split edges, the lowest edge
@@ -51,20 +52,23 @@
 //!    block, the number of interfaces above it its unit. A fault's faces are the faces
 //!    between cells on its two sides where it is active.
 //! 4. A quality pass (`MeshSettings::improve_degrees`, default 5; `improve_passes`, default
-//!    2): every cell whose smallest dihedral angle is below that, worst first, is mended by
-//!    collapsing one of its edges (shortest first) or else by moving one of its nodes towards
-//!    the mean of its neighbours. What may change is read from the cells' labels (side of every
-//!    fault, unit): a node whose cells carry one label lies on no surface and may move
-//!    anywhere; a node between two units of one block moves along that interface (its height
-//!    taken from `height`); a node between the two sides of one fault moves along the fault
-//!    (projected on it). A node is collapsed into a neighbour only if every label around it is
-//!    found around the neighbour (so the neighbour lies on every surface it lies on), a node on
-//!    the base only into one on the base, never a node on a side, a node on the terrain only
-//!    if the cutting made it (never a DSM vertex) and only into a terrain node, the new
-//!    terrain faces checked on the DSM. An
-//!    operation is kept only if every new cell has a positive volume (exact `orient3d`, so the
-//!    new cells tile the same star: conformity, the volume and the labels are kept) and the
-//!    smallest angle of the cells it touches improves.
+//!    3): every cell whose smallest dihedral angle is below that, worst first, is mended by
+//!    the first of: collapsing one of its edges (shortest first); a 3-2 flip of one of its
+//!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
+//!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
+//!    the smallest angle of its worst cell. What may change is read from the cells' labels
+//!    (side of every fault, unit): a node whose cells carry one label lies on no surface and
+//!    may move anywhere (on a side: vertically; on the base: horizontally); a node between two
+//!    units of one block moves along that interface (its height taken from `height`); a node
+//!    between the two sides of one fault moves along the fault (projected on it). A node is
+//!    collapsed into a neighbour only if every label around it is found around the neighbour
+//!    (so the neighbour lies on every surface it lies on), a node on the base only into one on
+//!    the base, never a node on a side, a node on the terrain only if the cutting made it
+//!    (never a DSM vertex) and only into a terrain node, the new terrain faces checked on the
+//!    DSM. An operation is kept only if every new cell has a positive volume (exact
+//!    `orient3d`, so the new cells tile the same star: conformity, the volume and the labels
+//!    are kept), the smallest angle of the cells it touches improves and (a move, or a flip
+//!    among cells not all below the floor) no more of them fall below the floor.
 //!
 //! # What is guaranteed and what is measured
 //! Guaranteed by construction and verified by [`check`]: conformity (every interior face in
@@ -73,9 +77,11 @@
 //! orientation test), no cell straddling a fault, fault faces within 1 cm of their fault.
 //! Measured, not guaranteed: the dihedral angles ([`quality`]: cells cut near nodes that may
 //! not move, at the crossing of two surfaces, or in a slab thinner than the planar cells are
-//! wide (a 0.5 m interbed, two faults 1 m apart) can stay slivers after the quality pass;
-//! the 5-degree floor of issue 31 is reached on the test sites without faults only; see
-//! `docs/geology.md`), and cells left straddling an interface where two
+//! wide (a 0.5 m interbed, two faults 1 m apart) can stay slivers after the quality pass: a
+//! cell of a slab t thick cut from columns of planar cells s wide has a dihedral angle near
+//! atan(t / s), so 5 degrees needs s <= about 11 t there; the 5-degree floor of issue 31 is
+//! reached on the test sites without faults only; see `docs/geology.md`), and cells left
+//! straddling an interface where two
 //! blocks' interface lines cross on a fault face after the last round
 //! ([`BuildReport::unresolved`]; [`check`] refuses a cell that straddles one).
 //!
@@ -90,7 +96,7 @@ mod check;
 mod error;
 /// Fault surfaces, their side tests, fault sets and block keys.
 mod fault;
-/// The quality pass: edge collapses and node moves.
+/// The quality pass: edge collapses, flips and node moves.
 mod improve;
 /// The conformal volume mesh.
 mod mesh;

@@ -45,7 +45,7 @@ pub struct MeshSettings {
     /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
     /// by edge collapses and node moves that keep every label (default 5; 0 turns it off).
     pub improve_degrees: f64,
-    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 2).
+    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 3).
     pub improve_passes: usize,
 }
 
@@ -58,7 +58,7 @@ impl MeshSettings {
             snap: 0.35,
             guard_degrees: 10.0,
             improve_degrees: 5.0,
-            improve_passes: 2,
+            improve_passes: 3,
         }
     }
 }
@@ -91,6 +91,8 @@ pub struct BuildReport {
     pub collapsed: usize,
     /// Nodes moved by the quality pass.
     pub moved: usize,
+    /// Flips (2-3 and 3-2) made by the quality pass.
+    pub flipped: usize,
 }
 
 /// A tetrahedral volume mesh cut by faults and interfaces.
@@ -196,9 +198,17 @@ impl Field<'_> {
 
     /// Where a vertex may move onto the surface, if it may: never on the terrain or an
     /// interface; onto a fault along its normal, vertically on a side, horizontally on the
-    /// base (not on a side then), and not if on another fault; onto an interface vertically, or along the dip line of the one trace
-    /// fault it lies on (so it stays on that fault), not on a side then.
-    fn target(&self, q: [f64; 3], flags: u8, on_fault: u64, faults: &FaultSet) -> Option<[f64; 3]> {
+    /// base (not on a side then), and not if on another fault; onto an interface vertically,
+    /// or along the dip line of the one trace fault it lies on (so it stays on that fault),
+    /// or, on a side, along the line where that fault meets the side (kept if still on it).
+    fn target(
+        &self,
+        q: [f64; 3],
+        flags: u8,
+        on_fault: u64,
+        faults: &FaultSet,
+        terrain: &Terrain,
+    ) -> Option<[f64; 3]> {
         if flags & (TOP | ON_INTERFACE) != 0 {
             return None;
         }
@@ -249,11 +259,25 @@ impl Field<'_> {
                 if on_fault == 0 {
                     return Some([q[0], q[1], h(*k, *key, [q[0], q[1]])]);
                 }
-                if flags & SIDE != 0 || on_fault.count_ones() != 1 {
+                if on_fault.count_ones() != 1 {
                     return None;
                 }
-                let f = on_fault.trailing_zeros() as usize;
-                faults.faults[f].dip_line().and_then(along)
+                let fault = &faults.faults[on_fault.trailing_zeros() as usize];
+                if flags & SIDE == 0 {
+                    return fault.dip_line().and_then(along);
+                }
+                // On a side and one fault: along their line of intersection (the fault's
+                // tangent plane there and the side's vertical plane), if the node lies on one
+                // edge of the outline only and the target is still on the fault.
+                let e = outline_edge(terrain, q)?;
+                let side = [e[1], -e[0], 0.0];
+                let n = fault.side(q).normal;
+                let d = [
+                    n[1] * side[2] - n[2] * side[1],
+                    n[2] * side[0] - n[0] * side[2],
+                    n[0] * side[1] - n[1] * side[0],
+                ];
+                along(d).filter(|&r| fault.side(r).distance.abs() <= 0.1 * ON_SURFACE)
             }
         }
     }
@@ -314,6 +338,23 @@ fn key(a: u32, b: u32) -> u64 {
 }
 
 pub(crate) const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// The unit direction of the one edge of the region's outline that `q` lies on (in plan,
+/// strictly between its ends); `None` off the outline or at a corner.
+pub(crate) fn outline_edge(terrain: &Terrain, q: [f64; 3]) -> Option<[f64; 2]> {
+    let mut edges = terrain.outline.iter().filter_map(|&[i, j]| {
+        let (a, b) = (terrain.points[i as usize], terrain.points[j as usize]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+        let d = ((q[0] - a[0]) * e[1] - (q[1] - a[1]) * e[0]) / l;
+        let t = ((q[0] - a[0]) * e[0] + (q[1] - a[1]) * e[1]) / (l * l);
+        (d.abs() <= 1e-9 * l.max(1.0) && t > 1e-9 && t < 1.0 - 1e-9).then_some([e[0] / l, e[1] / l])
+    });
+    match (edges.next(), edges.next()) {
+        (Some(e), None) => Some(e),
+        _ => None,
+    }
+}
 
 /// The three tetrahedra of a prism, upper triangle `t` above lower `b`, by the
 /// lowest-global-index rule: every quadrilateral is split by the diagonal through its lowest
@@ -479,6 +520,7 @@ fn cut(
     field: &Field,
     s: &MeshSettings,
     faults: &FaultSet,
+    terrain: &Terrain,
 ) -> (Vec<(f64, i8)>, usize) {
     let mut need = vec![cells.is_none(); st.points.len()];
     if let Some(cells) = cells {
@@ -551,9 +593,13 @@ fn cut(
             let hi = star.partition_point(|e| e.0 <= v);
             let cells: Vec<[u32; 4]> = star[lo..hi].iter().map(|e| st.tets[e.1 as usize]).collect();
             let q = st.points[v as usize];
-            let Some(target) =
-                field.target(q, st.flags[v as usize], st.on_fault[v as usize], faults)
-            else {
+            let Some(target) = field.target(
+                q,
+                st.flags[v as usize],
+                st.on_fault[v as usize],
+                faults,
+                terrain,
+            ) else {
                 continue;
             };
             if field.eval(target).1 != 0 {
@@ -721,7 +767,7 @@ pub fn faulted_mesh(
     let background_nodes = st.points.len();
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
-        let (values, _) = cut(&mut st, None, &field, settings, faults);
+        let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);
         let bits: Vec<u64> = (0..st.tets.len())
             .into_par_iter()
             .map(|c| {
@@ -781,7 +827,15 @@ pub fn faulted_mesh(
             for (b, &bk) in blocks.iter().enumerate() {
                 let field = Field::Interface(height, k, bk);
                 let before = st.tets.len();
-                splits += cut(&mut st, Some(&by_block[b]), &field, settings, faults).1;
+                splits += cut(
+                    &mut st,
+                    Some(&by_block[b]),
+                    &field,
+                    settings,
+                    faults,
+                    terrain,
+                )
+                .1;
                 for c in before..st.tets.len() {
                     by_block[st.block[c] as usize].push(c as u32);
                 }
@@ -831,6 +885,7 @@ pub fn faulted_mesh(
     );
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
+    st.report.flipped = done.flipped;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,

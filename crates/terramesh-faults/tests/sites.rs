@@ -143,7 +143,9 @@ fn quality_by_surface() {
         );
         assert!(s.quality.min > 0.0);
         assert!((bad.len() as f64) < 0.01 * mesh.tets.len() as f64);
-        if name == "background" || name == "interfaces only" {
+        // The 5-degree floor of issue 31: without faults, and with one fault and no
+        // interface (4.03 degrees before the flips, gradient moves and side moves).
+        if name != "both" {
             assert!(s.quality.min >= 5.0, "{name}: {}", s.quality.min);
         }
     }
@@ -383,10 +385,10 @@ fn quality_pass() {
     );
     // (name, site, cell height, most cells below 5 degrees after the pass (a fraction)).
     for (name, s, hcell, most) in [
-        ("one fault", &one, 10.0, 0.002),
-        ("X junction", &x, 8.0, 0.015),
-        ("two faults 1 m apart", &apart, 8.0, 0.04),
-        ("0.5 m interbed", &thin, 8.0, 0.12),
+        ("one fault", &one, 10.0, 0.0004),
+        ("X junction", &x, 8.0, 0.0045),
+        ("two faults 1 m apart", &apart, 8.0, 0.017),
+        ("0.5 m interbed", &thin, 8.0, 0.073),
     ] {
         let mut off = MeshSettings::new(s.base, hcell);
         off.improve_degrees = 0.0;
@@ -413,5 +415,80 @@ fn quality_pass() {
         assert!(q1.quality.below_5 < q0.quality.below_5, "{name}");
         assert!(q1.quality.min >= q0.quality.min, "{name}");
         assert!(share <= most, "{name}: {share}");
+    }
+}
+
+/// The smallest dihedral angle and the share of cells below 5 degrees after the quality pass,
+/// pinned on seeded sites (20 m planar cells, 8 m cell height) so that neither regresses:
+/// a vertical fault, a fault dipping 20 degrees, two faults 1 m apart, a 0.5 m interbed cut
+/// by a fault. Before the flips and the gradient moves of the pass, the snapping of side
+/// nodes on a fault onto an interface along the fault and the moves of side nodes along a
+/// fault or an interface (the figures below), every one of these failed. The 5-degree floor of issue 31 is not reached: a
+/// cell in a slab t thick whose face on one side of the slab is s wide has a dihedral angle
+/// near atan(t / s) (1.7 degrees for 0.5 m under 20 m cells), and cells cut next to the
+/// terrain (DSM vertices never move) or where a fault meets a side stay slivers; see
+/// docs/geology.md.
+#[test]
+fn dihedral_pinned() {
+    let one = |name: &str, dip: f64| {
+        vec![SynthFault::new(
+            name,
+            [95.0, -20.0],
+            [105.0, 220.0],
+            dip,
+            90.0,
+            7.0,
+        )]
+    };
+    let apart = vec![
+        SynthFault::new("A", [100.0, -20.0], [100.0, 220.0], 70.0, 90.0, 5.0),
+        SynthFault::new("B", [101.0, -20.0], [101.0, 220.0], 70.0, 90.0, 8.0),
+    ];
+    let thin = vec![SynthFault::new(
+        "F",
+        [60.0, -20.0],
+        [140.0, 220.0],
+        55.0,
+        100.0,
+        3.0,
+    )];
+    // (name, site, smallest angle at least, share below 5 degrees at most); measured (1.17,
+    // 0.03 %), (0.22, 0.29 %), (1.22, 1.5 %), (1.03, 7.1 %); before this work (0.61, 0.42 %),
+    // (0.05, 0.42 %), (0.44, 3.0 %), (0.50, 9.1 %).
+    for (name, s, min, share) in [
+        (
+            "dip 90",
+            site(one("V", 90.0), vec![90.0, 50.0], 0.2),
+            1.0,
+            0.0005,
+        ),
+        (
+            "dip 20",
+            site(one("L", 20.0), vec![90.0, 50.0], 0.2),
+            0.2,
+            0.0030,
+        ),
+        (
+            "two faults 1 m apart",
+            site(apart, vec![90.0, 50.0], 0.2),
+            1.1,
+            0.017,
+        ),
+        (
+            "0.5 m interbed by a fault",
+            site(thin, vec![90.0, 89.5, 45.0], 0.2),
+            1.0,
+            0.073,
+        ),
+    ] {
+        // `build` runs every check of the mesh.
+        let (_, mesh, q, _) = build(&s, 8.0);
+        let fraction = truth(&s, &mesh);
+        report(name, &mesh, &q, fraction);
+        assert!(fraction >= 0.99, "{name}: {fraction}");
+        let below = q.quality.below_5 as f64 / mesh.tets.len() as f64;
+        assert!(q.quality.min >= min, "{name}: {}", q.quality.min);
+        assert!(below <= share, "{name}: {below}");
+        assert!(mesh.report.flipped + mesh.report.moved > 0, "{name}");
     }
 }
