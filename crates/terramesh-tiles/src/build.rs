@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use terramesh_core::geometry::Region;
 use terramesh_geostat::{Data, Duplicates, InterpolationMethod, KrigingFrame, Method};
-use terramesh_mesh::{smooth_keeping, MeshBuilder};
+use terramesh_mesh::smooth_keeping;
 
 use super::files::{self, Vertex};
 use super::manifest::{owner, tile_dir, update, Manifest, State, Tile, TileSummary, SAMPLES};
@@ -131,20 +131,14 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
 
     // The mesh: the planned ring, no vertex added on it, boundary fixed while smoothing.
     let t = Instant::now();
-    let mut b = MeshBuilder::new()
-        .min_angle(m.mesh.min_angle)
-        .keep_boundary(true);
-    if let Some(a) = m.mesh.max_area {
-        b = b.max_area(a);
-    }
-    if let Some(l) = m.mesh.max_edge {
-        b = b.max_edge(l);
-    }
-    let (mut mesh, _) = b
+    let (mut mesh, _) = m
+        .mesh
+        .builder(None)
+        .keep_boundary(true)
         .build(&Region::from_ring(tile.ring.clone()))
         .with_context(|| format!("meshing tile {}", tile.id))?;
     if m.mesh.smooth > 0 {
-        smooth_keeping(&mut mesh, project.mesh.smoother, m.mesh.smooth, &[]);
+        smooth_keeping(&mut mesh, m.mesh.smoother, m.mesh.smooth, &[]);
     }
     let positions = planned_positions(&mesh, &tile.ring, &tile.id)?;
     let (positions, triangles) = sorted(positions, &mesh.triangles);

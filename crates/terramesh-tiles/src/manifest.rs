@@ -24,7 +24,7 @@ pub const SAMPLES: &str = "samples.f64";
 /// The variogram every tile uses.
 pub const VARIOGRAM: &str = "variogram.json";
 /// The manifest format's version.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// The most tiles a plan holds (`tiles plan` refuses a tile size that makes more).
 pub const MAX_TILES: usize = 100_000;
 
@@ -125,22 +125,6 @@ pub struct TileSummary {
     pub cells: usize,
 }
 
-/// The mesh settings every tile uses.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MeshSettings {
-    /// Minimum angle, degrees.
-    pub min_angle: f64,
-    /// Maximum triangle area, m².
-    pub max_area: Option<f64>,
-    /// Maximum edge length, m.
-    pub max_edge: Option<f64>,
-    /// Smoothing passes (boundary vertices never move).
-    pub smooth: usize,
-    /// The seams' and the outline's vertex spacing (0.7 target edge lengths, as the strips'
-    /// cuts of `terramesh-mesh`).
-    pub seam_spacing: f64,
-}
-
 /// The rule that picks each tile's data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DataRule {
@@ -208,8 +192,13 @@ pub struct Manifest {
     pub variogram: String,
     /// The kriging frame of all the data (centre and scale), which every tile kriges in.
     pub frame: ([f64; 2], f64),
-    /// The mesh settings.
-    pub mesh: MeshSettings,
+    /// The mesh sub-plan of every tile: the project's, with the size limit the one-piece build
+    /// would use (`max_area` from the sampling cell when the project gives none) and no strips
+    /// (the tiles are the parallelism).
+    pub mesh: terramesh::plan::MeshPlan,
+    /// The seams' and the outline's vertex spacing (0.7 target edge lengths, as the strips'
+    /// cuts of `terramesh-mesh`).
+    pub seam_spacing: f64,
     /// The data-selection rule.
     pub data: DataRule,
     /// The DSM grid.

@@ -8,8 +8,7 @@ use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
-    DataRule, GridSpec, Manifest, MeshSettings, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM,
-    VERSION,
+    DataRule, GridSpec, Manifest, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM, VERSION,
 };
 use terramesh::build as stages;
 use terramesh::progress::Progress;
@@ -194,11 +193,7 @@ pub fn plan(
     }
     .min(data.len());
     let m = &project.mesh;
-    let max_area = match (m.max_area, m.max_edge) {
-        (Some(a), _) => Some(a),
-        (None, Some(_)) => None,
-        (None, None) => Some(samples.cell[0] * samples.cell[1]),
-    };
+    let max_area = m.area(Some(samples.cell[0] * samples.cell[1]));
     let budget = match (max_area, m.max_edge) {
         (Some(a), Some(l)) => a.min(EQUILATERAL_AREA * l * l),
         (Some(a), None) => a,
@@ -320,13 +315,12 @@ pub fn plan(
         region: outline,
         variogram: VARIOGRAM.into(),
         frame: (frame.centre, frame.scale),
-        mesh: MeshSettings {
-            min_angle: m.min_angle,
+        mesh: terramesh::plan::MeshPlan {
             max_area,
-            max_edge: m.max_edge,
-            smooth: m.smooth,
-            seam_spacing: spacing,
+            strips: None,
+            ..m.clone()
         },
+        seam_spacing: spacing,
         data: DataRule {
             samples: SAMPLES.into(),
             count: data.len(),
