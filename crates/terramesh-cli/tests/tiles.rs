@@ -618,3 +618,50 @@ fn a_concave_region_is_tiled_without_seams_outside_it() {
         "no node outside the L"
     );
 }
+
+#[test]
+fn tiles_run_on_the_stored_plan_not_the_project_file() {
+    // The plan stores the resolved project (with its --set overrides); a tile built after
+    // the project file was edited or removed runs on the plan as it was planned.
+    let tmp = tempfile::tempdir().unwrap();
+    let site = tmp.path().join("site");
+    std::fs::create_dir(&site).unwrap();
+    let ex = example();
+    let ex_dir = ex.parent().unwrap();
+    for f in ["terramesh.toml", "corners.csv", "srtm-crop.asc"] {
+        std::fs::copy(ex_dir.join(f), site.join(f)).unwrap();
+    }
+    let project = site.join("terramesh.toml");
+    let p = tmp.path().join("plan");
+    let ps = p.to_str().unwrap();
+    ok(&terramesh(
+        &[
+            "tiles",
+            "plan",
+            project.to_str().unwrap(),
+            "--tile-size",
+            "250m",
+            "-o",
+            ps,
+            "--quiet",
+            "--set",
+            "mesh.min_angle=25",
+        ],
+        &[],
+    ));
+    let m = manifest(&p);
+    let stored = m["plan"].as_str().unwrap();
+    assert!(stored.contains("min_angle = 25"), "{stored}");
+    assert_eq!(m["mesh"]["min_angle"].as_f64(), Some(25.0));
+    // The project file is now something else entirely.
+    std::fs::write(&project, "this is not a project").unwrap();
+    for id in ids(&p) {
+        ok(&terramesh(&["tiles", "build", ps, "--tile", &id], &[]));
+    }
+    let out = tmp.path().join("merged");
+    ok(&terramesh(
+        &["tiles", "merge", ps, "-o", out.to_str().unwrap()],
+        &[],
+    ));
+    assert!(out.join("dsm.vtu").is_file());
+}

@@ -92,7 +92,9 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
             )));
         }
     }
-    let project = Project::load(&m.project, &m.set)?;
+    // The plan as it was planned (the project file is not read again).
+    let project = Project::parse(&m.project.display().to_string(), &m.plan, &[])
+        .context("the plan stored in tiles.json (plan again if it was edited)")?;
     let ip = &project.interpolation;
     // The data window: the extent grown by the halo. The tile reads its own samples file
     // (plans before it existed: the whole region's, keeping its window).

@@ -176,8 +176,13 @@ pub struct Manifest {
     pub version: u32,
     /// The project file (absolute).
     pub project: PathBuf,
-    /// Its `--set` overrides.
+    /// Its `--set` overrides (for the record: the tiles run on [`Manifest::plan`]).
     pub set: Vec<String>,
+    /// The resolved plan every tile runs on: the project's TOML with the overrides applied
+    /// ([`terramesh::project::Project::plan_text`]), parsed again by each tile under the
+    /// project's file name; the project file itself is not read again, so a tile runs on the
+    /// plan as it was planned.
+    pub plan: String,
     /// The tiles' side, metres.
     pub tile_size: f64,
     /// The south-west corner of the tile grid.

@@ -309,6 +309,7 @@ pub fn plan(
         version: VERSION,
         project: std::path::absolute(project_file).context(project_file.display().to_string())?,
         set: set.to_vec(),
+        plan: project.plan_text().to_string(),
         tile_size,
         origin: lo,
         shape,

@@ -49,6 +49,9 @@ pub struct Project {
     /// `[geology]` lowered by [`Project::parse`].
     #[serde(skip)]
     geology_settings: Option<GeologyPlan>,
+    /// The TOML text parsed, with the `--set` overrides applied ([`Project::plan_text`]).
+    #[serde(skip)]
+    text: String,
 }
 
 impl Project {
@@ -63,6 +66,23 @@ impl Project {
     /// ```
     pub fn geology(&self) -> Option<&GeologyPlan> {
         self.geology_settings.as_ref()
+    }
+
+    /// The resolved plan as TOML: the text parsed with every `--set` override applied.
+    /// [`Project::parse`] of it (under the same file name, so that paths resolve against the
+    /// same folder) gives this project again; a tiled build stores it in its manifest, so that
+    /// every tile runs on the plan as it was planned, whatever happens to the project file.
+    ///
+    /// ```
+    /// use terramesh::project::{Project, TEMPLATE};
+    /// let p = Project::parse("t.toml", TEMPLATE, &["mesh.min_angle=25".into()])?;
+    /// let again = Project::parse("t.toml", p.plan_text(), &[])?;
+    /// assert_eq!(again.mesh, p.mesh);
+    /// assert_eq!(again.mesh.min_angle, 25.0);
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn plan_text(&self) -> &str {
+        &self.text
     }
 }
 

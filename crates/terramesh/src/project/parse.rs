@@ -106,18 +106,22 @@ impl Project {
         }
         // Parse the original text when nothing was overridden, so errors carry line numbers.
         let mut project: Project = if sets.is_empty() {
-            toml::from_str(text).map_err(syntax)?
+            let mut p: Project = toml::from_str(text).map_err(syntax)?;
+            p.text = text.to_string();
+            p
         } else {
             let merged = toml::to_string(&doc).map_err(|e| Error::Project {
                 file: name.to_string(),
                 line: None,
                 why: format!("re-serialising the project: {e}"),
             })?;
-            toml::from_str(&merged).map_err(|e| Error::Project {
+            let mut p: Project = toml::from_str(&merged).map_err(|e| Error::Project {
                 file: format!("{name} with the overrides {}", sets.join(", ")),
                 line: None,
                 why: one_line(e.message()),
-            })?
+            })?;
+            p.text = merged;
+            p
         };
         let text_for_lines = if sets.is_empty() { text } else { "" };
         project.validate().map_err(|(key, why)| Error::Project {
