@@ -112,7 +112,7 @@ mod tests {
         for c in [5773, 3855, 5703, 5709, 5783, 7837, 5720, 5701] {
             assert!(lookup(c).is_some_and(|v| v.is_metre_height()), "{c}");
         }
-        // `ngvd29` names EPSG:5702, NGVD29 height in US survey feet (EPSG:7968 is the metre one).
+        // NGVD29 in US survey feet (5702) and in metres (7968, what the name `ngvd29` names).
         assert_eq!(lookup(5702).map(|v| v.unit), Some("US survey foot"));
         assert_eq!(
             lookup(5715).and_then(|v| v.metre_twin()).map(|v| v.code),

@@ -6,12 +6,14 @@ use std::fmt;
 
 use serde::Deserialize;
 
-/// Vertical datums known by name, with their EPSG vertical CRS codes.
+/// Vertical datums known by name, with the EPSG codes of their vertical CRSs of heights in
+/// metres (what every output holds; `ngvd29` is EPSG:7968, not 5702, NGVD29 in US survey
+/// feet).
 pub const KNOWN_VERTICAL_DATUMS: &[(&str, u16, &str)] = &[
     ("egm96", 5773, "EGM96 height"),
     ("egm2008", 3855, "EGM2008 height"),
     ("navd88", 5703, "NAVD88 height"),
-    ("ngvd29", 5702, "NGVD29 height"),
+    ("ngvd29", 7968, "NGVD29 height (m)"),
     ("nap", 5709, "NAP height"),
     ("dhhn92", 5783, "DHHN92 height"),
     ("dhhn2016", 7837, "DHHN2016 height"),
@@ -241,5 +243,21 @@ impl super::Project {
             .vertical_datum
             .as_ref()
             .map(|_| self.height_datum())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every name stands for a vertical CRS of heights in metres, up: the rule codes given as
+    /// `EPSG:<code>` are held to (a name once mapped NGVD29 to its US-survey-foot CRS).
+    #[test]
+    fn every_known_name_is_a_vertical_crs_of_heights_in_metres() {
+        for (name, code, _) in KNOWN_VERTICAL_DATUMS {
+            assert_eq!(vertical_code(u32::from(*code)), Ok(*code), "{name}");
+            let by_code: HeightDatum = format!("EPSG:{code}").parse().unwrap();
+            assert_eq!(by_code.name(), *name);
+        }
     }
 }
