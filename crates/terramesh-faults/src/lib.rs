@@ -102,6 +102,8 @@ mod improve;
 mod mesh;
 /// Dihedral angles.
 mod quality;
+/// Local refinement of the planar mesh where slabs are thin.
+mod refine;
 /// Split nodes.
 mod split;
 /// The synthetic site generator.

@@ -1,0 +1,371 @@
+//! Local refinement of the planar mesh where a slab is thin: a cell cut from a column of
+//! planar cells s wide across a slab t thick has a dihedral angle near atan(t / s), so planar
+//! triangles wider than `refine_ratio` times the thinnest slab at their vertices are bisected
+//! (conforming longest-edge bisection, Rivara's longest-edge propagation), round after round,
+//! within a budget of background cells. The terrain stays the same surface: a new vertex is
+//! an edge's midpoint with the mean of its ends' heights (the terrain is linear on every
+//! triangle).
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+use robust::{orient2d, Coord};
+
+use crate::mesh::InterfaceFn;
+use crate::{BlockKey, FaultError, FaultSet, MeshSettings, Terrain};
+
+/// Two surfaces bound a slab (rather than a wedge) where their normals are within this angle,
+/// degrees.
+const PARALLEL_DEGREES: f64 = 10.0;
+/// Surfaces closer than this (metres) coincide: a unit pinched out there, no slab.
+const COINCIDENT: f64 = 1e-3;
+/// At most this many rounds of bisection.
+const ROUNDS: usize = 12;
+
+/// A surface through a column: where it passes near the column and how to measure the
+/// distance to it.
+#[derive(Clone, Copy)]
+enum Kind {
+    Terrain,
+    Base,
+    Interface(usize, BlockKey),
+    Fault(usize),
+}
+
+struct Ctx<'a> {
+    terrain: &'a Terrain,
+    faults: &'a FaultSet,
+    interfaces: usize,
+    height: InterfaceFn<'a>,
+    base: f64,
+    levels: usize,
+}
+
+fn unit(n: [f64; 3]) -> [f64; 3] {
+    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if l > 0.0 && l.is_finite() {
+        [n[0] / l, n[1] / l, n[2] / l]
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+impl Ctx<'_> {
+    /// The unit normal of a height field at `p`, by central differences.
+    fn height_normal(&self, f: impl Fn([f64; 2]) -> f64, p: [f64; 2]) -> [f64; 3] {
+        let e = 0.5;
+        let fx = (f([p[0] + e, p[1]]) - f([p[0] - e, p[1]])) / (2.0 * e);
+        let fy = (f([p[0], p[1] + e]) - f([p[0], p[1] - e])) / (2.0 * e);
+        unit([-fx, -fy, 1.0])
+    }
+
+    /// The distance from `q` to a surface (a height field: vertically, times the normal's
+    /// vertical component `nz` there).
+    fn distance(&self, kind: Kind, q: [f64; 3], nz: f64) -> f64 {
+        match kind {
+            Kind::Terrain => (q[2] - self.terrain.height_or_nearest([q[0], q[1]])) * nz,
+            Kind::Base => q[2] - self.base,
+            Kind::Interface(k, b) => (q[2] - (self.height)(k, b, [q[0], q[1]])) * nz,
+            Kind::Fault(f) => self.faults.faults[f].side(q).distance,
+        }
+    }
+
+    /// The thinnest slab between two nearly parallel surfaces passing through (or, a fault,
+    /// within `reach` of) the column at `p`, terrain height `h`; infinity if none.
+    fn thinnest(&self, p: [f64; 2], h: f64, reach: f64) -> f64 {
+        let b = self.base;
+        let l = (self.levels - 1).max(1) as f64;
+        let zs: Vec<f64> = (0..self.levels).map(|k| h - (h - b) * k as f64 / l).collect();
+        // (kind, a point on it near the column, its unit normal).
+        let mut surf: Vec<(Kind, [f64; 3], [f64; 3])> = vec![
+            (
+                Kind::Terrain,
+                [p[0], p[1], h],
+                self.height_normal(|r| self.terrain.height_or_nearest(r), p),
+            ),
+            (Kind::Base, [p[0], p[1], b], [0.0, 0.0, 1.0]),
+        ];
+        let mut blocks: Vec<BlockKey> = Vec::new();
+        for (f, fault) in self.faults.faults.iter().enumerate() {
+            let d: Vec<f64> = zs
+                .iter()
+                .map(|&z| fault.side([p[0], p[1], z]).distance)
+                .collect();
+            // A crossing of the column, by regula falsi between two levels.
+            let mut on = None;
+            for k in 0..zs.len() - 1 {
+                if d[k] * d[k + 1] <= 0.0 && d[k] != d[k + 1] {
+                    let (mut z0, mut z1, mut d0, mut d1) = (zs[k], zs[k + 1], d[k], d[k + 1]);
+                    let mut z = z0;
+                    for _ in 0..8 {
+                        z = z0 - d0 * (z1 - z0) / (d1 - d0);
+                        let dz = fault.side([p[0], p[1], z]).distance;
+                        if dz.abs() < 1e-4 || !dz.is_finite() {
+                            break;
+                        }
+                        if (dz > 0.0) == (d0 > 0.0) {
+                            (z0, d0) = (z, dz);
+                        } else {
+                            (z1, d1) = (z, dz);
+                        }
+                    }
+                    on = Some([p[0], p[1], z]);
+                    break;
+                }
+            }
+            let on = on.or_else(|| {
+                let k = (0..zs.len()).min_by(|&i, &j| d[i].abs().total_cmp(&d[j].abs()))?;
+                (d[k].abs() <= reach).then(|| {
+                    let n = fault.side([p[0], p[1], zs[k]]).normal;
+                    [p[0] - d[k] * n[0], p[1] - d[k] * n[1], zs[k] - d[k] * n[2]]
+                })
+            });
+            if let Some(q) = on {
+                surf.push((Kind::Fault(f), q, fault.side(q).normal));
+            }
+        }
+        for &z in &zs {
+            let k = self.faults.block_key([p[0], p[1], z]);
+            if !blocks.contains(&k) {
+                blocks.push(k);
+            }
+        }
+        for &key in &blocks {
+            for k in 0..self.interfaces {
+                let z = (self.height)(k, key, p);
+                if !(z > b && z < h) || self.faults.block_key([p[0], p[1], z]) != key {
+                    continue;
+                }
+                let n = self.height_normal(|r| (self.height)(k, key, r), p);
+                surf.push((Kind::Interface(k, key), [p[0], p[1], z], n));
+            }
+        }
+        let cos = PARALLEL_DEGREES.to_radians().cos();
+        let mut thin = f64::INFINITY;
+        for (i, &(_, q, ni)) in surf.iter().enumerate() {
+            for (j, &(kj, _, nj)) in surf.iter().enumerate() {
+                if i == j || (ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2]).abs() < cos {
+                    continue;
+                }
+                let t = self.distance(kj, q, nj[2].abs()).abs();
+                if t >= COINCIDENT && t.is_finite() {
+                    thin = thin.min(t);
+                }
+            }
+        }
+        thin
+    }
+}
+
+fn co(p: [f64; 2]) -> Coord<f64> {
+    Coord { x: p[0], y: p[1] }
+}
+
+struct Planar {
+    points: Vec<[f64; 2]>,
+    heights: Vec<f64>,
+    tris: Vec<[u32; 3]>,
+    /// Directed edge (a, b) -> the triangle that has it.
+    edge: HashMap<(u32, u32), u32>,
+}
+
+impl Planar {
+    fn len2(&self, a: u32, b: u32) -> f64 {
+        let (p, q) = (self.points[a as usize], self.points[b as usize]);
+        (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)
+    }
+
+    /// The local index of the start of the longest edge (ties broken by the vertex indices,
+    /// the same way in both triangles of an edge).
+    fn longest(&self, t: u32) -> usize {
+        let tri = self.tris[t as usize];
+        (0..3)
+            .max_by(|&i, &j| {
+                let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                let (c, d) = (tri[j], tri[(j + 1) % 3]);
+                self.len2(a, b)
+                    .total_cmp(&self.len2(c, d))
+                    .then((a.min(b), a.max(b)).cmp(&(c.min(d), c.max(d))))
+            })
+            .unwrap()
+    }
+
+    fn longest_len(&self, t: u32) -> f64 {
+        let tri = self.tris[t as usize];
+        let i = self.longest(t);
+        self.len2(tri[i], tri[(i + 1) % 3]).sqrt()
+    }
+
+    /// Splits triangle `t` at its edge starting at local `i` through the new vertex `m`.
+    fn split(&mut self, t: u32, i: usize, m: u32) {
+        let tri = self.tris[t as usize];
+        let (a, b, c) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
+        let n = self.tris.len() as u32;
+        self.tris[t as usize] = [a, m, c];
+        self.tris.push([m, b, c]);
+        self.edge.remove(&(a, b));
+        self.edge.insert((a, m), t);
+        self.edge.insert((m, c), t);
+        self.edge.insert((m, b), n);
+        self.edge.insert((b, c), n);
+        self.edge.insert((c, m), n);
+    }
+
+    /// Bisects `t` at its longest edge, first bisecting the neighbour across it until that
+    /// edge is the neighbour's longest too (Rivara), so the mesh stays conforming. `false`
+    /// (nothing more changed) where the path ends at an outline edge whose midpoint is not
+    /// exactly on it.
+    fn bisect(&mut self, t: u32, depth: usize) -> bool {
+        if depth > 64 {
+            return false;
+        }
+        loop {
+            let i = self.longest(t);
+            let tri = self.tris[t as usize];
+            let (a, b) = (tri[i], tri[(i + 1) % 3]);
+            let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
+            let mid = [0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])];
+            match self.edge.get(&(b, a)).copied() {
+                None => {
+                    if orient2d(co(pa), co(pb), co(mid)) != 0.0 {
+                        return false;
+                    }
+                    let m = self.push(mid, a, b);
+                    self.split(t, i, m);
+                    return true;
+                }
+                Some(u) => {
+                    let j = self.longest(u);
+                    let ut = self.tris[u as usize];
+                    if ut[j] == b && ut[(j + 1) % 3] == a {
+                        let m = self.push(mid, a, b);
+                        self.split(t, i, m);
+                        self.split(u, j, m);
+                        return true;
+                    }
+                    if !self.bisect(u, depth + 1) {
+                        return false;
+                    }
+                }
+            }
+        }
+    }
+
+    fn push(&mut self, p: [f64; 2], a: u32, b: u32) -> u32 {
+        self.points.push(p);
+        self.heights
+            .push(0.5 * (self.heights[a as usize] + self.heights[b as usize]));
+        self.points.len() as u32 - 1
+    }
+}
+
+/// The refined terrain, or `None` where nothing needs refining (or refining is off).
+pub(crate) fn refine(
+    terrain: &Terrain,
+    faults: &FaultSet,
+    interfaces: usize,
+    height: InterfaceFn,
+    s: &MeshSettings,
+) -> Result<Option<Terrain>, FaultError> {
+    if !(s.refine_ratio >= 0.0 && s.refine_ratio.is_finite()) {
+        return Err(FaultError::Setting {
+            name: "refine_ratio".into(),
+            value: s.refine_ratio,
+            why: "must be a finite number >= 0 (0 turns refinement off)",
+        });
+    }
+    if !(s.refine_min_thickness > 0.0 && s.refine_min_thickness.is_finite()) {
+        return Err(FaultError::Setting {
+            name: "refine_min_thickness".into(),
+            value: s.refine_min_thickness,
+            why: "must be a positive number of metres",
+        });
+    }
+    if s.refine_ratio == 0.0 || !s.base.is_finite() || !(s.max_cell_height > 0.0) {
+        return Ok(None);
+    }
+    let thickest = terrain
+        .heights
+        .iter()
+        .fold(0.0f64, |m, &h| m.max(h - s.base));
+    if !(thickest > 0.0 && thickest.is_finite()) {
+        return Ok(None);
+    }
+    let levels = ((thickest / s.max_cell_height).ceil() as usize).max(1) + 1;
+    let per_triangle = 3 * (levels - 1);
+    let max_tris = s.refine_max_cells / per_triangle;
+    if terrain.triangles.len() >= max_tris {
+        return Ok(None);
+    }
+    let ctx = Ctx {
+        terrain,
+        faults,
+        interfaces,
+        height,
+        base: s.base,
+        levels,
+    };
+    let mut pl = Planar {
+        points: terrain.points.clone(),
+        heights: terrain.heights.clone(),
+        tris: terrain.triangles.clone(),
+        edge: HashMap::new(),
+    };
+    for (t, tri) in pl.tris.iter().enumerate() {
+        for k in 0..3 {
+            pl.edge.insert((tri[k], tri[(k + 1) % 3]), t as u32);
+        }
+    }
+    let mut thin: Vec<f64> = Vec::new();
+    let mut changed = false;
+    for _ in 0..ROUNDS {
+        // The thinnest slab at every vertex not measured yet, within reach of its triangles.
+        let mut reach = vec![0.0f64; pl.points.len()];
+        for t in 0..pl.tris.len() as u32 {
+            let l = pl.longest_len(t);
+            for &v in &pl.tris[t as usize] {
+                reach[v as usize] = reach[v as usize].max(l);
+            }
+        }
+        let from = thin.len();
+        let new: Vec<f64> = (from..pl.points.len())
+            .into_par_iter()
+            .map(|v| ctx.thinnest(pl.points[v], pl.heights[v], reach[v]))
+            .collect();
+        thin.extend(new);
+        let need = |pl: &Planar, t: u32| {
+            let m = pl.tris[t as usize]
+                .iter()
+                .map(|&v| thin.get(v as usize).copied().unwrap_or(f64::INFINITY))
+                .fold(f64::INFINITY, f64::min);
+            s.refine_ratio * m.max(s.refine_min_thickness)
+        };
+        let mut marked: Vec<(f64, u32)> = (0..pl.tris.len() as u32)
+            .filter_map(|t| {
+                let r = pl.longest_len(t) / need(&pl, t);
+                (r > 1.0).then_some((r, t))
+            })
+            .collect();
+        if marked.is_empty() {
+            break;
+        }
+        marked.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        let mut any = false;
+        for &(_, t) in &marked {
+            if pl.tris.len() + 8 > max_tris {
+                break;
+            }
+            if pl.longest_len(t) > need(&pl, t) && pl.bisect(t, 0) {
+                any = true;
+            }
+        }
+        changed |= any;
+        if !any || pl.tris.len() + 8 > max_tris {
+            break;
+        }
+    }
+    if !changed {
+        return Ok(None);
+    }
+    Terrain::new(pl.points, pl.tris, pl.heights).map(Some)
+}
