@@ -75,7 +75,9 @@ impl Ctx<'_> {
     fn thinnest(&self, p: [f64; 2], h: f64, reach: f64) -> f64 {
         let b = self.base;
         let l = (self.levels - 1).max(1) as f64;
-        let zs: Vec<f64> = (0..self.levels).map(|k| h - (h - b) * k as f64 / l).collect();
+        let zs: Vec<f64> = (0..self.levels)
+            .map(|k| h - (h - b) * k as f64 / l)
+            .collect();
         // (kind, a point on it near the column, its unit normal).
         let mut surf: Vec<(Kind, [f64; 3], [f64; 3])> = vec![
             (

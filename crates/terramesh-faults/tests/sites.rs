@@ -387,8 +387,8 @@ fn quality_pass() {
     for (name, s, hcell, most) in [
         ("one fault", &one, 10.0, 0.0004),
         ("X junction", &x, 8.0, 0.0045),
-        ("two faults 1 m apart", &apart, 8.0, 0.017),
-        ("0.5 m interbed", &thin, 8.0, 0.073),
+        ("two faults 1 m apart", &apart, 8.0, 0.001),
+        ("0.5 m interbed", &thin, 8.0, 0.0005),
     ] {
         let mut off = MeshSettings::new(s.base, hcell);
         off.improve_degrees = 0.0;
@@ -418,16 +418,14 @@ fn quality_pass() {
     }
 }
 
-/// The smallest dihedral angle and the share of cells below 5 degrees after the quality pass,
-/// pinned on seeded sites (20 m planar cells, 8 m cell height) so that neither regresses:
-/// a vertical fault, a fault dipping 20 degrees, two faults 1 m apart, a 0.5 m interbed cut
-/// by a fault. Before the flips and the gradient moves of the pass, the snapping of side
-/// nodes on a fault onto an interface along the fault and the moves of side nodes along a
-/// fault or an interface (the figures below), every one of these failed. The 5-degree floor of issue 31 is not reached: a
-/// cell in a slab t thick whose face on one side of the slab is s wide has a dihedral angle
-/// near atan(t / s) (1.7 degrees for 0.5 m under 20 m cells), and cells cut next to the
-/// terrain (DSM vertices never move) or where a fault meets a side stay slivers; see
-/// docs/geology.md.
+/// The smallest dihedral angle and the share of cells below 5 degrees after the local
+/// refinement and the quality pass, pinned on seeded sites (20 m planar cells, 8 m cell
+/// height) so that neither regresses: a vertical fault, a fault dipping 20 degrees, two faults
+/// 1 m apart, a 0.5 m interbed cut by a fault. The two thin-slab sites are refined (planar
+/// triangles about 10 times the slab wide); without refinement they had 1.5 % and 7.1 % of
+/// their cells below 5 degrees (the pins below fail there). The 5-degree floor of issue 31 is
+/// not reached: cells cut next to the terrain (DSM vertices never move), where a fault meets a
+/// side or an interface at a shallow angle stay slivers; see docs/geology.md.
 #[test]
 fn dihedral_pinned() {
     let one = |name: &str, dip: f64| {
@@ -452,33 +450,37 @@ fn dihedral_pinned() {
         100.0,
         3.0,
     )];
-    // (name, site, smallest angle at least, share below 5 degrees at most); measured (1.17,
-    // 0.03 %), (0.22, 0.29 %), (1.22, 1.5 %), (1.03, 7.1 %); before this work (0.61, 0.42 %),
-    // (0.05, 0.42 %), (0.44, 3.0 %), (0.50, 9.1 %).
-    for (name, s, min, share) in [
+    // (name, site, smallest angle at least, share below 5 degrees at most, refined);
+    // measured (1.17, 0.03 %), (0.22, 0.29 %), (0.29, 0.08 %), (0.25, 0.03 %); without the
+    // refinement (1.17, 0.03 %), (0.22, 0.29 %), (1.22, 1.5 %), (1.03, 7.1 %).
+    for (name, s, min, share, refined) in [
         (
             "dip 90",
             site(one("V", 90.0), vec![90.0, 50.0], 0.2),
             1.0,
             0.0005,
+            false,
         ),
         (
             "dip 20",
             site(one("L", 20.0), vec![90.0, 50.0], 0.2),
             0.2,
             0.0030,
+            false,
         ),
         (
             "two faults 1 m apart",
             site(apart, vec![90.0, 50.0], 0.2),
-            1.1,
-            0.017,
+            0.25,
+            0.001,
+            true,
         ),
         (
             "0.5 m interbed by a fault",
             site(thin, vec![90.0, 89.5, 45.0], 0.2),
-            1.0,
-            0.073,
+            0.2,
+            0.0005,
+            true,
         ),
     ] {
         // `build` runs every check of the mesh.
@@ -490,5 +492,137 @@ fn dihedral_pinned() {
         assert!(q.quality.min >= min, "{name}: {}", q.quality.min);
         assert!(below <= share, "{name}: {below}");
         assert!(mesh.report.flipped + mesh.report.moved > 0, "{name}");
+        assert_eq!(mesh.report.refined_triangles > 0, refined, "{name}");
     }
+}
+
+/// The local refinement: on the 0.5 m interbed cut by a fault, off (`refine_ratio = 0`) the
+/// mesh is the DSM's columns and 7.1 % of its cells are below 5 degrees; on, the planar
+/// triangles are bisected to about 5 m and that share falls below 0.1 %; a budget of
+/// background cells stops it (and every check still passes); where no slab is thin it adds
+/// nothing.
+#[test]
+fn local_refinement() {
+    let thin = site(
+        vec![SynthFault::new(
+            "F",
+            [60.0, -20.0],
+            [140.0, 220.0],
+            55.0,
+            100.0,
+            3.0,
+        )],
+        vec![90.0, 89.5, 45.0],
+        0.2,
+    );
+    let mut off = MeshSettings::new(thin.base, 8.0);
+    off.refine_ratio = 0.0;
+    let (_, plain, q0, _) = build_with(&thin, off);
+    let (_, fine, q1, s1) = build(&thin, 8.0);
+    let share = |q: &CheckSummary, m: &FaultedMesh| q.quality.below_5 as f64 / m.tets.len() as f64;
+    println!(
+        "0.5 m interbed: refinement off {} cells, {:.2} % below 5 degrees, min {:.2}; on {} \
+         cells ({} planar triangles added), {:.3} %, min {:.2}",
+        plain.tets.len(),
+        100.0 * share(&q0, &plain),
+        q0.quality.min,
+        fine.tets.len(),
+        fine.report.refined_triangles,
+        100.0 * share(&q1, &fine),
+        q1.quality.min
+    );
+    assert_eq!(plain.report.refined_triangles, 0);
+    assert!(share(&q0, &plain) > 0.05);
+    assert!(fine.report.refined_triangles > 0);
+    assert!(share(&q1, &fine) < 0.001);
+    assert!(fine.report.background_cells <= s1.refine_max_cells);
+    assert!(truth(&thin, &fine) >= 0.99);
+    // A budget: the background mesh stays within it, the checks pass, the share is between.
+    let mut capped = MeshSettings::new(thin.base, 8.0);
+    capped.refine_max_cells = 40_000;
+    let (_, mid, q2, _) = build_with(&thin, capped);
+    println!(
+        "  capped at 40,000 background cells: {} ({} triangles added), {:.2} % below 5 degrees",
+        mid.report.background_cells,
+        mid.report.refined_triangles,
+        100.0 * share(&q2, &mid)
+    );
+    assert!(mid.report.refined_triangles > 0);
+    assert!(mid.report.background_cells <= 40_000);
+    assert!(share(&q2, &mid) < share(&q0, &plain));
+    // Nothing thin: the mesh of the DSM's columns, unchanged.
+    let one = one_fault_site();
+    let (_, a, _, _) = build(&one, 10.0);
+    let mut off = MeshSettings::new(one.base, 10.0);
+    off.refine_ratio = 0.0;
+    let (_, b, _, _) = build_with(&one, off);
+    assert_eq!(a.report.refined_triangles, 0);
+    assert_eq!(a, b);
+}
+
+/// A unit that pinches out: a 0.5 m interbed thinning to nothing across the site (its two
+/// interfaces coincide east of x = 150), cut by a fault. Refinement near the pinch-out is
+/// bounded by `refine_min_thickness`; every check passes, the unit has no cell where it is
+/// absent (no interbed cell wholly east of the pinch-out line), and the quality is pinned.
+#[test]
+fn pinch_out() {
+    let s = site(
+        vec![SynthFault::new(
+            "F",
+            [60.0, -20.0],
+            [80.0, 220.0],
+            60.0,
+            90.0,
+            3.0,
+        )],
+        vec![90.0, 89.5, 45.0],
+        0.2,
+    );
+    let set = FaultSet::new(&s.specs(), &s.terrain, s.base).unwrap();
+    // Interface 1 rises to interface 0 eastwards: the interbed is 0.5 m thick at x <= 100,
+    // none at x >= 150.
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| {
+        let z = s.height(k, key, p);
+        if k == 1 {
+            let t = 0.5 * ((150.0 - p[0]) / 50.0).clamp(0.0, 1.0);
+            s.height(0, key, p) - t
+        } else {
+            z
+        }
+    };
+    // Not refined, this site fails `check` (a wedge cell next to the pinch-out line whose
+    // centroid is not in its recorded unit): see docs/geology.md. Its quality, for the record.
+    let mut off = MeshSettings::new(s.base, 8.0);
+    off.refine_ratio = 0.0;
+    let plain = faulted_mesh(&s.terrain, &set, s.tops.len(), &h, &off).unwrap();
+    let q0 = quality(&plain.points, &plain.tets);
+    println!(
+        "pinch-out, not refined: {} cells, min {:.2} deg, below 5 deg {} ({:.2} %)",
+        plain.tets.len(),
+        q0.min,
+        q0.below_5,
+        100.0 * q0.below_5 as f64 / plain.tets.len() as f64
+    );
+    let mut settings = MeshSettings::new(s.base, 8.0);
+    settings.refine_max_cells = 150_000;
+    let mesh = faulted_mesh(&s.terrain, &set, s.tops.len(), &h, &settings).unwrap();
+    let q = check(&mesh, &s.terrain, &set, &settings, &h).unwrap();
+    report("pinch-out, refined", &mesh, &q, 1.0);
+    assert!(mesh.report.background_cells <= 150_000);
+    assert!(mesh.report.refined_triangles > 0);
+    for (c, t) in mesh.tets.iter().enumerate() {
+        if mesh.unit[c] == 1 {
+            let x = t
+                .iter()
+                .map(|&v| mesh.points[v as usize][0])
+                .fold(f64::MAX, f64::min);
+            assert!(
+                x < 150.0,
+                "an interbed cell wholly east of the pinch-out, from x = {x}"
+            );
+        }
+    }
+    let below = q.quality.below_5 as f64 / mesh.tets.len() as f64;
+    assert!(q.quality.min > 0.0);
+    assert!(below < 0.015, "{below}");
 }
