@@ -283,7 +283,11 @@ pub(crate) fn refine(
             why: "must be a positive number of metres",
         });
     }
-    if s.refine_ratio == 0.0 || !s.base.is_finite() || !(s.max_cell_height > 0.0) {
+    if s.refine_ratio == 0.0
+        || !s.base.is_finite()
+        || s.max_cell_height.is_nan()
+        || s.max_cell_height <= 0.0
+    {
         return Ok(None);
     }
     let thickest = terrain
