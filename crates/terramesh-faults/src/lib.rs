@@ -40,7 +40,10 @@
 //!    first, until none is too wide or the background mesh would pass `refine_max_cells`
 //!    (default 600,000). A new vertex is its edge's midpoint with the mean of its ends'
 //!    heights, so the terrain is the same surface; an outline edge whose midpoint is not
-//!    exactly on it is not split.
+//!    exactly on it is not split. An edge that a fault meets on the terrain within 0.2 of
+//!    its length from its middle is split there instead (its height linear along the edge),
+//!    so that the new terrain node lies on the fault, not a few centimetres from it. The
+//!    quality pass may collapse these new terrain nodes (never the DSM's own vertices).
 //! 1. A background mesh: one column of nodes per planar vertex of the DSM, the same number of
 //!    levels in every column (enough for `max_cell_height` in the thickest column), every
 //!    prism split into three tetrahedra by the lowest-global-index diagonal rule, so that

@@ -779,6 +779,7 @@ pub fn faulted_mesh(
     height: InterfaceFn,
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
+    let dsm_vertices = terrain.points.len();
     let refined = crate::refine::refine(terrain, faults, interfaces, height, settings)?;
     let added = refined
         .as_ref()
@@ -786,7 +787,11 @@ pub fn faulted_mesh(
     let terrain = refined.as_ref().unwrap_or(terrain);
     let mut st = background(terrain, settings)?;
     st.report.refined_triangles = added;
-    let background_nodes = st.points.len();
+    // The DSM's own vertices' columns come first (node v * levels + k): the quality pass
+    // never moves or removes their terrain nodes; the refinement's new vertices (on the DSM's
+    // edges or inside its triangles) may be collapsed into another terrain node where the new
+    // terrain faces still lie on the DSM.
+    let background_nodes = dsm_vertices * (st.points.len() / terrain.points.len());
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
         let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);

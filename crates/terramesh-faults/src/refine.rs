@@ -163,7 +163,51 @@ fn co(p: [f64; 2]) -> Coord<f64> {
     Coord { x: p[0], y: p[1] }
 }
 
-struct Planar {
+/// Where to split the edge from `a` to `b` (terrain heights `ha`, `hb`): where a fault meets
+/// the terrain along it, if that is within [`TRACE_SPLIT`] of its middle (so that a terrain
+/// node lies on the fault instead of a few centimetres from it), else its middle.
+fn split_at(faults: &FaultSet, a: [f64; 2], b: [f64; 2], ha: f64, hb: f64) -> f64 {
+    let at = |t: f64| {
+        [
+            a[0] + t * (b[0] - a[0]),
+            a[1] + t * (b[1] - a[1]),
+            ha + t * (hb - ha),
+        ]
+    };
+    for fault in &faults.faults {
+        let g = |t: f64| fault.side(at(t)).distance;
+        let (mut t0, mut t1, mut g0, mut g1) = (0.0, 1.0, g(0.0), g(1.0));
+        if !(g0 * g1 < 0.0) {
+            continue;
+        }
+        let mut t = 0.5;
+        for _ in 0..60 {
+            t = (t0 - g0 * (t1 - t0) / (g1 - g0)).clamp(t0, t1);
+            let v = g(t);
+            if v.abs() <= 1e-8 || !v.is_finite() {
+                break;
+            }
+            if (v > 0.0) == (g0 > 0.0) {
+                (t0, g0) = (t, v);
+                g1 *= 0.5;
+            } else {
+                (t1, g1) = (t, v);
+                g0 *= 0.5;
+            }
+        }
+        if (t - 0.5).abs() <= TRACE_SPLIT {
+            return t;
+        }
+    }
+    0.5
+}
+
+/// An edge crossed by a fault's trace is split there if that is within this fraction of its
+/// length from its middle.
+const TRACE_SPLIT: f64 = 0.2;
+
+struct Planar<'a> {
+    faults: &'a FaultSet,
     points: Vec<[f64; 2]>,
     heights: Vec<f64>,
     tris: Vec<[u32; 3]>,
@@ -171,7 +215,7 @@ struct Planar {
     edge: HashMap<(u32, u32), u32>,
 }
 
-impl Planar {
+impl Planar<'_> {
     fn len2(&self, a: u32, b: u32) -> f64 {
         let (p, q) = (self.points[a as usize], self.points[b as usize]);
         (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)
@@ -226,13 +270,20 @@ impl Planar {
             let tri = self.tris[t as usize];
             let (a, b) = (tri[i], tri[(i + 1) % 3]);
             let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
-            let mid = [0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])];
+            let f = split_at(
+                self.faults,
+                pa,
+                pb,
+                self.heights[a as usize],
+                self.heights[b as usize],
+            );
+            let mid = [pa[0] + f * (pb[0] - pa[0]), pa[1] + f * (pb[1] - pa[1])];
             match self.edge.get(&(b, a)).copied() {
                 None => {
                     if orient2d(co(pa), co(pb), co(mid)) != 0.0 {
                         return false;
                     }
-                    let m = self.push(mid, a, b);
+                    let m = self.push(mid, a, b, f);
                     self.split(t, i, m);
                     return true;
                 }
@@ -240,7 +291,7 @@ impl Planar {
                     let j = self.longest(u);
                     let ut = self.tris[u as usize];
                     if ut[j] == b && ut[(j + 1) % 3] == a {
-                        let m = self.push(mid, a, b);
+                        let m = self.push(mid, a, b, f);
                         self.split(t, i, m);
                         self.split(u, j, m);
                         return true;
@@ -253,10 +304,12 @@ impl Planar {
         }
     }
 
-    fn push(&mut self, p: [f64; 2], a: u32, b: u32) -> u32 {
+    /// A new vertex at `p`, a fraction `f` of the way from `a` to `b`: the terrain's height
+    /// there, linear along the edge.
+    fn push(&mut self, p: [f64; 2], a: u32, b: u32, f: f64) -> u32 {
         self.points.push(p);
-        self.heights
-            .push(0.5 * (self.heights[a as usize] + self.heights[b as usize]));
+        let (ha, hb) = (self.heights[a as usize], self.heights[b as usize]);
+        self.heights.push(ha + f * (hb - ha));
         self.points.len() as u32 - 1
     }
 }
@@ -312,6 +365,7 @@ pub(crate) fn refine(
         levels,
     };
     let mut pl = Planar {
+        faults,
         points: terrain.points.clone(),
         heights: terrain.heights.clone(),
         tris: terrain.triangles.clone(),
