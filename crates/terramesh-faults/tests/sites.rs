@@ -560,12 +560,11 @@ fn local_refinement() {
     assert_eq!(a, b);
 }
 
-/// A unit that pinches out: a 0.5 m interbed thinning to nothing across the site (its two
-/// interfaces coincide east of x = 150), cut by a fault. Refinement near the pinch-out is
-/// bounded by `refine_min_thickness`; every check passes, the unit has no cell where it is
-/// absent (no interbed cell wholly east of the pinch-out line), and the quality is pinned.
-#[test]
-fn pinch_out() {
+/// A unit that pinches out: a 0.5 m interbed cut by a fault thinning to nothing between
+/// x = `from` and x = 150 (its two interfaces coincide east of x = 150). Returns the refined
+/// mesh's share of cells below 5 degrees and its smallest angle; every check passes and no
+/// interbed cell lies wholly east of the pinch-out line.
+fn pinch(from: f64, max_cells: usize) -> (f64, f64) {
     let s = site(
         vec![SynthFault::new(
             "F",
@@ -579,36 +578,47 @@ fn pinch_out() {
         0.2,
     );
     let set = FaultSet::new(&s.specs(), &s.terrain, s.base).unwrap();
-    // Interface 1 rises to interface 0 eastwards: the interbed is 0.5 m thick at x <= 100,
-    // none at x >= 150.
+    // The interbed's thickness at the DSM's vertices, linear on its triangles (as the facade
+    // gives interfaces interpolated on the DSM's planar mesh: no cell then straddles a bend).
+    let thickness = |x: f64| 0.5 * ((150.0 - x) / (150.0 - from)).clamp(0.0, 1.0);
     let h = |k: usize, key: BlockKey, p: [f64; 2]| {
         let z = s.height(k, key, p);
         if k == 1 {
-            let t = 0.5 * ((150.0 - p[0]) / 50.0).clamp(0.0, 1.0);
+            let q = [p[0].clamp(0.0, 200.0), p[1].clamp(0.0, 200.0)];
+            let (tri, w) = s.terrain.locate(q).unwrap();
+            let t: f64 = (0..3)
+                .map(|i| {
+                    w[i] * thickness(s.terrain.points[s.terrain.triangles[tri][i] as usize][0])
+                })
+                .sum();
             s.height(0, key, p) - t
         } else {
             z
         }
     };
-    // Not refined, this site fails `check` (a wedge cell next to the pinch-out line whose
-    // centroid is not in its recorded unit): see docs/geology.md. Its quality, for the record.
     let mut off = MeshSettings::new(s.base, 8.0);
     off.refine_ratio = 0.0;
     let plain = faulted_mesh(&s.terrain, &set, s.tops.len(), &h, &off).unwrap();
     let q0 = quality(&plain.points, &plain.tets);
+    let name = format!("pinch-out over {} m", 150.0 - from);
     println!(
-        "pinch-out, not refined: {} cells, min {:.2} deg, below 5 deg {} ({:.2} %)",
+        "{name}, not refined: {} cells, min {:.2} deg, below 5 deg {} ({:.2} %), check {}",
         plain.tets.len(),
         q0.min,
         q0.below_5,
-        100.0 * q0.below_5 as f64 / plain.tets.len() as f64
+        100.0 * q0.below_5 as f64 / plain.tets.len() as f64,
+        match check(&plain, &s.terrain, &set, &off, &h) {
+            Ok(_) => "passes".to_string(),
+            Err(e) => format!("fails: {e}"),
+        }
     );
     let mut settings = MeshSettings::new(s.base, 8.0);
-    settings.refine_max_cells = 150_000;
+    settings.refine_max_cells = max_cells;
     let mesh = faulted_mesh(&s.terrain, &set, s.tops.len(), &h, &settings).unwrap();
     let q = check(&mesh, &s.terrain, &set, &settings, &h).unwrap();
-    report("pinch-out, refined", &mesh, &q, 1.0);
-    assert!(mesh.report.background_cells <= 150_000);
+    report(&format!("{name}, refined"), &mesh, &q, 1.0);
+    println!("  {} planar triangles added", mesh.report.refined_triangles);
+    assert!(mesh.report.background_cells <= max_cells);
     assert!(mesh.report.refined_triangles > 0);
     for (c, t) in mesh.tets.iter().enumerate() {
         if mesh.unit[c] == 1 {
@@ -617,12 +627,32 @@ fn pinch_out() {
                 .map(|&v| mesh.points[v as usize][0])
                 .fold(f64::MAX, f64::min);
             assert!(
-                x < 150.0,
+                x < 150.0 + 20.0 * 1.5,
                 "an interbed cell wholly east of the pinch-out, from x = {x}"
             );
         }
     }
-    let below = q.quality.below_5 as f64 / mesh.tets.len() as f64;
-    assert!(q.quality.min > 0.0);
-    assert!(below < 0.015, "{below}");
+    (
+        q.quality.below_5 as f64 / mesh.tets.len() as f64,
+        q.quality.min,
+    )
+}
+
+/// Pinch-outs, with the interbed's thickness given at the DSM's vertices and linear on its
+/// triangles (as the facade will give interfaces). Thinning over 50 m (a wedge of 0.57
+/// degrees between the interfaces), no mesh that conforms to both can reach 5 degrees at the
+/// pinch-out line (a cell with an edge on the line and faces on both interfaces has a
+/// dihedral angle at most the wedge's); the refinement, bounded by `refine_min_thickness` and
+/// the budget, lowers the share (5.4 % unrefined). Ending where a vertex's thickness is below
+/// 0.5 m (what the geology rules' `min_thickness` makes: the unit ends across one DSM
+/// triangle, a wedge of about atan(0.5 / 20) = 1.4 degrees), likewise. Unrefined, the first
+/// site fails `check` after the quality pass (see docs/geology.md); the refined meshes pass.
+#[test]
+fn pinch_out() {
+    let (gradual, min) = pinch(100.0, 150_000);
+    assert!(gradual < 0.02, "{gradual}");
+    assert!(min > 0.0);
+    let (abrupt, min) = pinch(149.0, 150_000);
+    assert!(abrupt < 0.005, "{abrupt}");
+    assert!(min > 0.0);
 }
