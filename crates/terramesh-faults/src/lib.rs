@@ -38,7 +38,7 @@
 //!    first where that edge is not the neighbour's longest (Rivara's longest-edge
 //!    propagation: the planar mesh stays conforming and graded), round after round, worst
 //!    first, until none is too wide or the background mesh would pass `refine_max_cells`
-//!    (default 600,000). A new vertex is its edge's midpoint with the mean of its ends'
+//!    (default 600,000; skipped if that leaves room for less than 10 % more triangles). A new vertex is its edge's midpoint with the mean of its ends'
 //!    heights, so the terrain is the same surface; an outline edge whose midpoint is not
 //!    exactly on it is not split. An edge that a fault meets on the terrain within 0.2 of
 //!    its length from its middle is split there instead (its height linear along the edge),

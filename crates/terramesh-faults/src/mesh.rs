@@ -56,7 +56,8 @@ pub struct MeshSettings {
     /// pinching out does not ask for ever smaller triangles (default 0.25).
     pub refine_min_thickness: f64,
     /// Refinement stops before the background mesh would pass this many cells (default
-    /// 600,000; cutting then adds about half again).
+    /// 600,000; cutting then adds about half again); it is skipped when that leaves room for
+    /// less than 10 % more planar triangles than the DSM has.
     pub refine_max_cells: usize,
 }
 

@@ -19,6 +19,9 @@ use crate::{BlockKey, FaultError, FaultSet, MeshSettings, Terrain};
 const PARALLEL_DEGREES: f64 = 10.0;
 /// Surfaces closer than this (metres) coincide: a unit pinched out there, no slab.
 const COINCIDENT: f64 = 1e-3;
+/// Refinement is skipped when the budget leaves room for fewer than this fraction more
+/// triangles than the DSM has.
+const MIN_GROWTH: f64 = 0.1;
 /// At most this many rounds of bisection.
 const ROUNDS: usize = 12;
 
@@ -177,7 +180,7 @@ fn split_at(faults: &FaultSet, a: [f64; 2], b: [f64; 2], ha: f64, hb: f64) -> f6
     for fault in &faults.faults {
         let g = |t: f64| fault.side(at(t)).distance;
         let (mut t0, mut t1, mut g0, mut g1) = (0.0, 1.0, g(0.0), g(1.0));
-        if !(g0 * g1 < 0.0) {
+        if g0 * g1 >= 0.0 || (g0 * g1).is_nan() {
             continue;
         }
         let mut t = 0.5;
@@ -353,7 +356,8 @@ pub(crate) fn refine(
     let levels = ((thickest / s.max_cell_height).ceil() as usize).max(1) + 1;
     let per_triangle = 3 * (levels - 1);
     let max_tris = s.refine_max_cells / per_triangle;
-    if terrain.triangles.len() >= max_tris {
+    // A budget that leaves room for a patch only is not worth measuring every vertex.
+    if (terrain.triangles.len() as f64) * (1.0 + MIN_GROWTH) > max_tris as f64 {
         return Ok(None);
     }
     let ctx = Ctx {
