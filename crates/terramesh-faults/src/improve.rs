@@ -44,6 +44,8 @@ struct Pass<'a> {
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
     height: InterfaceFn<'a>,
+    /// The number of interfaces.
+    interfaces: usize,
     terrain: &'a Terrain,
     /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
     background: usize,
@@ -248,6 +250,41 @@ impl Pass<'_> {
         t.map(|w| self.st.points[w as usize])
     }
 
+    /// Whether cell `like`'s unit holds a cell at `g` as [`crate::check`] will see it, with
+    /// half its tolerance: the centroid in that unit of its block and no interface with
+    /// nodes on both sides. Only cells with a node on an interface are tested (the others
+    /// lie inside one unit's region by construction); a node moved along an interface or
+    /// collapsed can otherwise make faces that cut across a bend of another interface, which
+    /// a slab a few centimetres thick (near a pinch-out) cannot absorb.
+    fn in_unit(&self, t: [u32; 4], g: [[f64; 3]; 4], like: u32) -> bool {
+        if !t
+            .iter()
+            .any(|&v| self.st.flags[v as usize] & ON_INTERFACE != 0)
+        {
+            return true;
+        }
+        let tol = 0.5 * crate::FAULT_TOLERANCE;
+        let key = self.blocks[self.st.block[like as usize] as usize];
+        let unit = self.st.below[like as usize];
+        let c = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        let (mut lo, mut hi) = (0u32, 0u32);
+        for k in 0..self.interfaces {
+            let hz = (self.height)(k, key, [c[0], c[1]]);
+            lo += (hz - c[2] > tol) as u32;
+            hi += (hz - c[2] > -tol) as u32;
+            let (mut a, mut b) = (false, false);
+            for r in &g {
+                let d = r[2] - (self.height)(k, key, [r[0], r[1]]);
+                a |= d > tol;
+                b |= d < -tol;
+            }
+            if a && b {
+                return false;
+            }
+        }
+        lo <= unit && unit <= hi
+    }
+
     /// Collapses node `a` into its neighbour `b` if allowed and better; `around` holds the
     /// cells and the labels of both (as `cells` and `labels` give them).
     fn collapse(&mut self, a: u32, b: u32, around: [&(Vec<u32>, Vec<Label>); 2]) -> bool {
@@ -274,7 +311,7 @@ impl Pass<'_> {
                 continue;
             }
             let t = t.map(|w| if w == a { b } else { w });
-            if !positive(self.geo(t)) {
+            if !positive(self.geo(t)) || !self.in_unit(t, self.geo(t), c) {
                 return false;
             }
             new.push((c, t, 0.0));
@@ -479,7 +516,11 @@ impl Pass<'_> {
                 break;
             }
         }
-        if best < old + MIN_GAIN {
+        if best < old + MIN_GAIN
+            || !cells
+                .iter()
+                .all(|&c| self.in_unit(self.st.tets[c as usize], geo(c, q), c))
+        {
             return false;
         }
         let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
@@ -600,7 +641,7 @@ impl Pass<'_> {
                     }
                 });
                 let a = if positive(g) { min_dihedral(g) } else { -1.0 };
-                if a < old + MIN_GAIN {
+                if a < old + MIN_GAIN || !self.in_unit(self.st.tets[c as usize], g, c) {
                     ok = false;
                     break;
                 }
@@ -634,6 +675,7 @@ pub(crate) fn improve(
     faults: &FaultSet,
     blocks: &[BlockKey],
     height: InterfaceFn,
+    interfaces: usize,
     terrain: &Terrain,
     background: usize,
     below: f64,
@@ -674,6 +716,7 @@ pub(crate) fn improve(
         faults,
         blocks,
         height,
+        interfaces,
         terrain,
         background,
         tol: 0.5e-9
@@ -837,7 +880,7 @@ mod tests {
         .unwrap();
         let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
         let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
-        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        let done = improve(&mut st, &faults, &[], &h, 0, &terrain, n, 20.0, 2);
         (st, done)
     }
 
@@ -944,7 +987,7 @@ mod tests {
         .unwrap();
         let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
         let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
-        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        let done = improve(&mut st, &faults, &[], &h, 0, &terrain, n, 20.0, 2);
         assert_eq!(done.flipped, 0);
         assert_eq!(st.tets.len(), 2);
     }

@@ -83,8 +83,11 @@
 //!    (never a DSM vertex) and only into a terrain node, the new terrain faces checked on the
 //!    DSM. An operation is kept only if every new cell has a positive volume (exact
 //!    `orient3d`, so the new cells tile the same star: conformity, the volume and the labels
-//!    are kept), the smallest angle of the cells it touches improves and (a move, or a flip
-//!    among cells not all below the floor) no more of them fall below the floor.
+//!    are kept), the smallest angle of the cells it touches improves, (a move, or a flip
+//!    among cells not all below the floor) no more of them fall below the floor, and (a
+//!    collapse or a move) every cell it makes with a node on an interface lies in its unit
+//!    as [`check`] sees it (centroid and nodes, at half its tolerance): near a pinch-out a
+//!    slab a few centimetres thick cannot absorb faces across a bend of an interface.
 //!
 //! # What is guaranteed and what is measured
 //! Guaranteed by construction and verified by [`check`]: conformity (every interior face in

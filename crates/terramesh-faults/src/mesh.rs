@@ -906,6 +906,7 @@ pub fn faulted_mesh(
         faults,
         &blocks,
         height,
+        interfaces,
         terrain,
         background_nodes,
         settings.improve_degrees,
