@@ -267,11 +267,17 @@ impl Pass<'_> {
         let key = self.blocks[self.st.block[like as usize] as usize];
         let unit = self.st.below[like as usize];
         let c = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        // The cell's reach around its centroid, so that only interfaces within it (and the
+        // interfaces' slopes over it) are tested node by node.
+        let reach = g.iter().map(|p| d2(*p, c).sqrt()).fold(0.0, f64::max);
         let (mut lo, mut hi) = (0u32, 0u32);
         for k in 0..self.interfaces {
             let hz = (self.height)(k, key, [c[0], c[1]]);
             lo += (hz - c[2] > tol) as u32;
             hi += (hz - c[2] > -tol) as u32;
+            if (hz - c[2]).abs() > 2.0 * reach + tol {
+                continue;
+            }
             let (mut a, mut b) = (false, false);
             for r in &g {
                 let d = r[2] - (self.height)(k, key, [r[0], r[1]]);
@@ -311,7 +317,7 @@ impl Pass<'_> {
                 continue;
             }
             let t = t.map(|w| if w == a { b } else { w });
-            if !positive(self.geo(t)) || !self.in_unit(t, self.geo(t), c) {
+            if !positive(self.geo(t)) {
                 return false;
             }
             new.push((c, t, 0.0));
@@ -321,6 +327,9 @@ impl Pass<'_> {
             if e.2 <= old || (bound != 0 && !self.boundary_kept(e.1, b)) {
                 return false;
             }
+        }
+        if !new.iter().all(|e| self.in_unit(e.1, self.geo(e.1), e.0)) {
+            return false;
         }
         let mut keys: Vec<[u32; 4]> = cb
             .iter()
@@ -641,7 +650,7 @@ impl Pass<'_> {
                     }
                 });
                 let a = if positive(g) { min_dihedral(g) } else { -1.0 };
-                if a < old + MIN_GAIN || !self.in_unit(self.st.tets[c as usize], g, c) {
+                if a < old + MIN_GAIN {
                     ok = false;
                     break;
                 }
@@ -652,7 +661,21 @@ impl Pass<'_> {
                 .iter()
                 .filter(|&&c| poor(&self.angle[c as usize]))
                 .count();
-            if ok && new.iter().filter(|a| poor(a)).count() <= before {
+            let kept = |c: u32| {
+                let t = self.st.tets[c as usize];
+                let g = t.map(|w| {
+                    if w == v {
+                        q
+                    } else {
+                        self.st.points[w as usize]
+                    }
+                });
+                self.in_unit(t, g, c)
+            };
+            if ok
+                && new.iter().filter(|a| poor(a)).count() <= before
+                && cells.iter().all(|&c| kept(c))
+            {
                 self.st.points[v as usize] = q;
                 for (&c, a) in cells.iter().zip(new) {
                     self.angle[c as usize] = a;
