@@ -433,3 +433,108 @@ pub(crate) fn refine(
     }
     Terrain::new(pl.points, pl.tris, pl.heights).map(Some)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::FaultSpec;
+
+    fn h(p: [f64; 2]) -> f64 {
+        100.0 + 0.05 * p[0] - 0.02 * p[1]
+    }
+
+    /// Refines a region over a sloping terrain with a fault and a 0.4 m unit everywhere.
+    fn refined(pts: &[[f64; 2]], tris: Vec<[u32; 3]>) -> (Terrain, Option<Terrain>) {
+        let terrain =
+            Terrain::new(pts.to_vec(), tris, pts.iter().map(|&p| h(p)).collect()).unwrap();
+        let faults = FaultSet::new(
+            &[FaultSpec::trace(
+                "F",
+                vec![[40.0, -20.0], [60.0, 120.0]],
+                70.0,
+                90.0,
+            )],
+            &terrain,
+            0.0,
+        )
+        .unwrap();
+        let height = |k: usize, _b: BlockKey, p: [f64; 2]| 60.0 - 0.4 * k as f64 + 0.01 * p[0];
+        let mut s = MeshSettings::new(0.0, 20.0);
+        s.refine_max_cells = 200_000;
+        let r = refine(&terrain, &faults, 2, &height, &s).unwrap();
+        (terrain, r)
+    }
+
+    /// The refined planar mesh is conforming (every edge once each way, or once on the
+    /// outline), keeps the area, puts every vertex on the terrain and every vertex of its
+    /// outline exactly on the DSM's outline.
+    fn assert_valid(terrain: &Terrain, r: &Terrain) {
+        let mut edges: HashMap<(u32, u32), usize> = HashMap::new();
+        let area = |p: &[[f64; 2]], t: &[u32; 3]| {
+            let [a, b, c] = t.map(|v| p[v as usize]);
+            0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+        };
+        let whole: f64 = terrain
+            .triangles
+            .iter()
+            .map(|t| area(&terrain.points, t))
+            .sum();
+        let mut sum = 0.0;
+        for t in &r.triangles {
+            let [a, b, c] = t.map(|v| r.points[v as usize]);
+            assert!(orient2d(co(a), co(b), co(c)) > 0.0);
+            sum += area(&r.points, t);
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+            }
+        }
+        assert!((sum - whole).abs() < 1e-9 * whole, "{sum} {whole}");
+        for (&(a, b), &n) in &edges {
+            assert_eq!(n, 1);
+            if !edges.contains_key(&(b, a)) {
+                let on = |v: u32| {
+                    let p = r.points[v as usize];
+                    terrain.outline.iter().any(|&[i, j]| {
+                        let (pa, pb) = (terrain.points[i as usize], terrain.points[j as usize]);
+                        orient2d(co(pa), co(pb), co(p)) == 0.0
+                    })
+                };
+                assert!(on(a) && on(b));
+            }
+        }
+        for (v, &p) in r.points.iter().enumerate() {
+            assert!((r.heights[v] - h(p)).abs() < 1e-9, "{v}");
+        }
+    }
+
+    #[test]
+    fn refined_mesh_is_conforming_and_on_the_terrain() {
+        // A square with a jittered centre: refined down to 10 x 0.4 m = 4 m edges.
+        let pts = [
+            [0.0, 0.0],
+            [100.0, 0.0],
+            [100.0, 100.0],
+            [0.0, 100.0],
+            [47.3, 52.9],
+        ];
+        let (t, r) = refined(&pts, vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]);
+        let r = r.unwrap();
+        println!("square: {} triangles", r.triangles.len());
+        assert!(r.triangles.len() > 500, "{}", r.triangles.len());
+        assert_valid(&t, &r);
+        // A skewed outline: its edges' midpoints are mostly not exactly on them, and an
+        // outline edge is split only where the split point is: whatever is refined is valid.
+        let pts = [
+            [0.0, 0.0],
+            [103.7, 9.1],
+            [96.3, 101.9],
+            [-7.3, 88.1],
+            [47.3, 52.9],
+        ];
+        let (t, r) = refined(&pts, vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]);
+        if let Some(r) = r {
+            println!("skewed outline: {} triangles", r.triangles.len());
+            assert_valid(&t, &r);
+        }
+    }
+}
