@@ -2,7 +2,9 @@
 //! depth, one vertical) and 8 units (a 1 m interbed among them): the time to build the mesh,
 //! to check it and to split its nodes, printed once; then criterion times the build.
 //!
-//! `cargo bench -p terramesh-faults --bench faulted -- --test` builds it once.
+//! `cargo bench -p terramesh-faults --bench faulted -- --test` builds it once. It also
+//! prints what the 5-degree floor of issue 31 would cost on this site (the 1 m interbed spans
+//! it all, so the local refinement would have to cover it all).
 
 use std::time::Instant;
 
@@ -92,6 +94,26 @@ fn bench(c: &mut Criterion) {
         q0.histogram.iter().map(|b| b.2).collect::<Vec<_>>()
     );
     drop(raw);
+    // The local refinement and what 5 degrees would cost here: a cell of a slab t thick cut
+    // from planar cells whose altitude is d has a dihedral angle near atan(t / d), so the
+    // 1 m interbed, which spans the whole site, needs right-isosceles triangles with legs of
+    // at most 1 / tan(5 degrees) = 11.4 m everywhere.
+    let per_triangle = mesh.report.background_cells as f64
+        / (site.terrain.triangles.len() + mesh.report.refined_triangles) as f64;
+    let leg = 1.0 / 5f64.to_radians().tan();
+    let needed = 2.0 * (2000.0 / leg).powi(2);
+    let cut = mesh.tets.len() as f64 / mesh.report.background_cells as f64;
+    println!(
+        "refinement: {} planar triangles added to {} (budget {} background cells; none when it leaves room for less than 10 % more); 5 degrees in \
+         the 1 m interbed needs legs <= {leg:.1} m over the whole site: {needed:.0} triangles, \
+         {:.1} M background cells ({per_triangle:.0} per triangle), about {:.1} M cells after \
+         cutting (x {cut:.2}): not possible within 1,000,000 cells",
+        mesh.report.refined_triangles,
+        site.terrain.triangles.len(),
+        settings.refine_max_cells,
+        needed * per_triangle / 1e6,
+        needed * per_triangle * cut / 1e6
+    );
     println!(
         "the quality pass ({} sweeps): {} collapses, {} flips, {} moves",
         settings.improve_passes, mesh.report.collapsed, mesh.report.flipped, mesh.report.moved

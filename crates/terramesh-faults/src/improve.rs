@@ -44,6 +44,8 @@ struct Pass<'a> {
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
     height: InterfaceFn<'a>,
+    /// The number of interfaces.
+    interfaces: usize,
     terrain: &'a Terrain,
     /// Nodes below this index are the background's (on the terrain: the DSM's vertices).
     background: usize,
@@ -248,6 +250,47 @@ impl Pass<'_> {
         t.map(|w| self.st.points[w as usize])
     }
 
+    /// Whether cell `like`'s unit holds a cell at `g` as [`crate::check`] will see it, with
+    /// half its tolerance: the centroid in that unit of its block and no interface with
+    /// nodes on both sides. Only cells with a node on an interface are tested (the others
+    /// lie inside one unit's region by construction); a node moved along an interface or
+    /// collapsed can otherwise make faces that cut across a bend of another interface, which
+    /// a slab a few centimetres thick (near a pinch-out) cannot absorb.
+    fn in_unit(&self, t: [u32; 4], g: [[f64; 3]; 4], like: u32) -> bool {
+        if !t
+            .iter()
+            .any(|&v| self.st.flags[v as usize] & ON_INTERFACE != 0)
+        {
+            return true;
+        }
+        let tol = 0.5 * crate::FAULT_TOLERANCE;
+        let key = self.blocks[self.st.block[like as usize] as usize];
+        let unit = self.st.below[like as usize];
+        let c = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        // The cell's reach around its centroid, so that only interfaces within it (and the
+        // interfaces' slopes over it) are tested node by node.
+        let reach = g.iter().map(|p| d2(*p, c).sqrt()).fold(0.0, f64::max);
+        let (mut lo, mut hi) = (0u32, 0u32);
+        for k in 0..self.interfaces {
+            let hz = (self.height)(k, key, [c[0], c[1]]);
+            lo += (hz - c[2] > tol) as u32;
+            hi += (hz - c[2] > -tol) as u32;
+            if (hz - c[2]).abs() > 2.0 * reach + tol {
+                continue;
+            }
+            let (mut a, mut b) = (false, false);
+            for r in &g {
+                let d = r[2] - (self.height)(k, key, [r[0], r[1]]);
+                a |= d > tol;
+                b |= d < -tol;
+            }
+            if a && b {
+                return false;
+            }
+        }
+        lo <= unit && unit <= hi
+    }
+
     /// Collapses node `a` into its neighbour `b` if allowed and better; `around` holds the
     /// cells and the labels of both (as `cells` and `labels` give them).
     fn collapse(&mut self, a: u32, b: u32, around: [&(Vec<u32>, Vec<Label>); 2]) -> bool {
@@ -284,6 +327,9 @@ impl Pass<'_> {
             if e.2 <= old || (bound != 0 && !self.boundary_kept(e.1, b)) {
                 return false;
             }
+        }
+        if !new.iter().all(|e| self.in_unit(e.1, self.geo(e.1), e.0)) {
+            return false;
         }
         let mut keys: Vec<[u32; 4]> = cb
             .iter()
@@ -479,7 +525,11 @@ impl Pass<'_> {
                 break;
             }
         }
-        if best < old + MIN_GAIN {
+        if best < old + MIN_GAIN
+            || !cells
+                .iter()
+                .all(|&c| self.in_unit(self.st.tets[c as usize], geo(c, q), c))
+        {
             return false;
         }
         let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
@@ -611,7 +661,21 @@ impl Pass<'_> {
                 .iter()
                 .filter(|&&c| poor(&self.angle[c as usize]))
                 .count();
-            if ok && new.iter().filter(|a| poor(a)).count() <= before {
+            let kept = |c: u32| {
+                let t = self.st.tets[c as usize];
+                let g = t.map(|w| {
+                    if w == v {
+                        q
+                    } else {
+                        self.st.points[w as usize]
+                    }
+                });
+                self.in_unit(t, g, c)
+            };
+            if ok
+                && new.iter().filter(|a| poor(a)).count() <= before
+                && cells.iter().all(|&c| kept(c))
+            {
                 self.st.points[v as usize] = q;
                 for (&c, a) in cells.iter().zip(new) {
                     self.angle[c as usize] = a;
@@ -634,6 +698,7 @@ pub(crate) fn improve(
     faults: &FaultSet,
     blocks: &[BlockKey],
     height: InterfaceFn,
+    interfaces: usize,
     terrain: &Terrain,
     background: usize,
     below: f64,
@@ -674,6 +739,7 @@ pub(crate) fn improve(
         faults,
         blocks,
         height,
+        interfaces,
         terrain,
         background,
         tol: 0.5e-9
@@ -837,7 +903,7 @@ mod tests {
         .unwrap();
         let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
         let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
-        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        let done = improve(&mut st, &faults, &[], &h, 0, &terrain, n, 20.0, 2);
         (st, done)
     }
 
@@ -944,7 +1010,7 @@ mod tests {
         .unwrap();
         let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
         let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
-        let done = improve(&mut st, &faults, &[], &h, &terrain, n, 20.0, 2);
+        let done = improve(&mut st, &faults, &[], &h, 0, &terrain, n, 20.0, 2);
         assert_eq!(done.flipped, 0);
         assert_eq!(st.tets.len(), 2);
     }

@@ -28,6 +28,22 @@
 //! surface is meshed as plain faces between the two blocks.
 //!
 //! # The volume mesh ([`faulted_mesh`])
+//! 0. Local refinement (`MeshSettings::refine_ratio`, default 10; 0 turns it off): at every
+//!    planar vertex the thinnest slab between two nearly parallel surfaces (normals within
+//!    10 degrees: terrain, base, the interfaces of the blocks in its column, the faults that
+//!    cross the column or pass within its triangles' reach) is measured; a planar triangle
+//!    whose longest edge exceeds `refine_ratio` times the thinnest slab at its vertices (no
+//!    thinner than `refine_min_thickness`, default 0.25 m; surfaces within 1 mm coincide, a
+//!    pinched-out unit, no slab) is bisected at its longest edge, the neighbour across it
+//!    first where that edge is not the neighbour's longest (Rivara's longest-edge
+//!    propagation: the planar mesh stays conforming and graded), round after round, worst
+//!    first, until none is too wide or the background mesh would pass `refine_max_cells`
+//!    (default 600,000; skipped if that leaves room for less than 10 % more triangles). A new vertex is its edge's midpoint with the mean of its ends'
+//!    heights, so the terrain is the same surface; an outline edge whose midpoint is not
+//!    exactly on it is not split. An edge that a fault meets on the terrain within 0.2 of
+//!    its length from its middle is split there instead (its height linear along the edge),
+//!    so that the new terrain node lies on the fault, not a few centimetres from it. The
+//!    quality pass may collapse these new terrain nodes (never the DSM's own vertices).
 //! 1. A background mesh: one column of nodes per planar vertex of the DSM, the same number of
 //!    levels in every column (enough for `max_cell_height` in the thickest column), every
 //!    prism split into three tetrahedra by the lowest-global-index diagonal rule, so that
@@ -67,8 +83,11 @@
 //!    (never a DSM vertex) and only into a terrain node, the new terrain faces checked on the
 //!    DSM. An operation is kept only if every new cell has a positive volume (exact
 //!    `orient3d`, so the new cells tile the same star: conformity, the volume and the labels
-//!    are kept), the smallest angle of the cells it touches improves and (a move, or a flip
-//!    among cells not all below the floor) no more of them fall below the floor.
+//!    are kept), the smallest angle of the cells it touches improves, (a move, or a flip
+//!    among cells not all below the floor) no more of them fall below the floor, and (a
+//!    collapse or a move) every cell it makes with a node on an interface lies in its unit
+//!    as [`check`] sees it (centroid and nodes, at half its tolerance): near a pinch-out a
+//!    slab a few centimetres thick cannot absorb faces across a bend of an interface.
 //!
 //! # What is guaranteed and what is measured
 //! Guaranteed by construction and verified by [`check`]: conformity (every interior face in
@@ -77,10 +96,11 @@
 //! orientation test), no cell straddling a fault, fault faces within 1 cm of their fault.
 //! Measured, not guaranteed: the dihedral angles ([`quality`]: cells cut near nodes that may
 //! not move, at the crossing of two surfaces, or in a slab thinner than the planar cells are
-//! wide (a 0.5 m interbed, two faults 1 m apart) can stay slivers after the quality pass: a
-//! cell of a slab t thick cut from columns of planar cells s wide has a dihedral angle near
-//! atan(t / s), so 5 degrees needs s <= about 11 t there; the 5-degree floor of issue 31 is
-//! reached on the test sites without faults only; see `docs/geology.md`), and cells left
+//! wide can stay slivers after the quality pass: a cell of a slab t thick cut from columns
+//! of planar cells s wide has a dihedral angle near atan(t / s), so 5 degrees needs s <=
+//! about 11 t there, which the local refinement provides within its budget; the 5-degree
+//! floor of issue 31 is reached on the test sites without faults only; see
+//! `docs/geology.md`), and cells left
 //! straddling an interface where two
 //! blocks' interface lines cross on a fault face after the last round
 //! ([`BuildReport::unresolved`]; [`check`] refuses a cell that straddles one).
@@ -102,6 +122,8 @@ mod improve;
 mod mesh;
 /// Dihedral angles.
 mod quality;
+/// Local refinement of the planar mesh where slabs are thin.
+mod refine;
 /// Split nodes.
 mod split;
 /// The synthetic site generator.

@@ -47,6 +47,18 @@ pub struct MeshSettings {
     pub improve_degrees: f64,
     /// Sweeps of that quality pass over the cells below `improve_degrees` (default 3).
     pub improve_passes: usize,
+    /// Before meshing, planar triangles whose longest edge exceeds this many times the
+    /// thinnest slab at their vertices (between two nearly parallel surfaces: terrain, base,
+    /// interfaces, faults) are bisected, so that the cells cut from their columns are not
+    /// slivers (default 10; 0 turns refinement off).
+    pub refine_ratio: f64,
+    /// Slabs thinner than this (metres) count as this thick for refinement, so a unit
+    /// pinching out does not ask for ever smaller triangles (default 0.25).
+    pub refine_min_thickness: f64,
+    /// Refinement stops before the background mesh would pass this many cells (default
+    /// 600,000; cutting then adds about half again); it is skipped when that leaves room for
+    /// less than 10 % more planar triangles than the DSM has.
+    pub refine_max_cells: usize,
 }
 
 impl MeshSettings {
@@ -59,6 +71,9 @@ impl MeshSettings {
             guard_degrees: 10.0,
             improve_degrees: 5.0,
             improve_passes: 3,
+            refine_ratio: 10.0,
+            refine_min_thickness: 0.25,
+            refine_max_cells: 600_000,
         }
     }
 }
@@ -78,6 +93,8 @@ pub struct FaultFace {
 /// What the construction did.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct BuildReport {
+    /// Planar triangles added by refining where slabs are thin (0: the DSM's planar mesh).
+    pub refined_triangles: usize,
     /// Cells of the background mesh.
     pub background_cells: usize,
     /// Vertices moved onto a surface.
@@ -763,8 +780,19 @@ pub fn faulted_mesh(
     height: InterfaceFn,
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
+    let dsm_vertices = terrain.points.len();
+    let refined = crate::refine::refine(terrain, faults, interfaces, height, settings)?;
+    let added = refined
+        .as_ref()
+        .map_or(0, |r| r.triangles.len() - terrain.triangles.len());
+    let terrain = refined.as_ref().unwrap_or(terrain);
     let mut st = background(terrain, settings)?;
-    let background_nodes = st.points.len();
+    st.report.refined_triangles = added;
+    // The DSM's own vertices' columns come first (node v * levels + k): the quality pass
+    // never moves or removes their terrain nodes; the refinement's new vertices (on the DSM's
+    // edges or inside its triangles) may be collapsed into another terrain node where the new
+    // terrain faces still lie on the DSM.
+    let background_nodes = dsm_vertices * (st.points.len() / terrain.points.len());
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
         let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);
@@ -878,6 +906,7 @@ pub fn faulted_mesh(
         faults,
         &blocks,
         height,
+        interfaces,
         terrain,
         background_nodes,
         settings.improve_degrees,

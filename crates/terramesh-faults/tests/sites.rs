@@ -349,9 +349,9 @@ fn thin_interbed() {
 
 /// The quality pass (edge collapses and node moves after cutting) keeps every check and
 /// lowers the cells below 5 degrees on every faulted site; what it reaches is asserted.
-/// The 5-degree floor of issue 31 is reached only without faults (see `quality_by_surface`):
-/// thin slabs (a 0.5 m interbed, two faults 1 m apart) under 20 m wide planar cells cannot
-/// reach it without refining the planar mesh.
+/// The 5-degree floor of issue 31 is reached only without faults (see `quality_by_surface`);
+/// the thin slabs (a 0.5 m interbed, two faults 1 m apart) are refined locally first (both
+/// with and without the pass here), which is what brings their shares below 0.1 %.
 #[test]
 fn quality_pass() {
     let one = one_fault_site();
@@ -387,8 +387,8 @@ fn quality_pass() {
     for (name, s, hcell, most) in [
         ("one fault", &one, 10.0, 0.0004),
         ("X junction", &x, 8.0, 0.0045),
-        ("two faults 1 m apart", &apart, 8.0, 0.017),
-        ("0.5 m interbed", &thin, 8.0, 0.073),
+        ("two faults 1 m apart", &apart, 8.0, 0.0007),
+        ("0.5 m interbed", &thin, 8.0, 0.0003),
     ] {
         let mut off = MeshSettings::new(s.base, hcell);
         off.improve_degrees = 0.0;
@@ -418,16 +418,14 @@ fn quality_pass() {
     }
 }
 
-/// The smallest dihedral angle and the share of cells below 5 degrees after the quality pass,
-/// pinned on seeded sites (20 m planar cells, 8 m cell height) so that neither regresses:
-/// a vertical fault, a fault dipping 20 degrees, two faults 1 m apart, a 0.5 m interbed cut
-/// by a fault. Before the flips and the gradient moves of the pass, the snapping of side
-/// nodes on a fault onto an interface along the fault and the moves of side nodes along a
-/// fault or an interface (the figures below), every one of these failed. The 5-degree floor of issue 31 is not reached: a
-/// cell in a slab t thick whose face on one side of the slab is s wide has a dihedral angle
-/// near atan(t / s) (1.7 degrees for 0.5 m under 20 m cells), and cells cut next to the
-/// terrain (DSM vertices never move) or where a fault meets a side stay slivers; see
-/// docs/geology.md.
+/// The smallest dihedral angle and the share of cells below 5 degrees after the local
+/// refinement and the quality pass, pinned on seeded sites (20 m planar cells, 8 m cell
+/// height) so that neither regresses: a vertical fault, a fault dipping 20 degrees, two faults
+/// 1 m apart, a 0.5 m interbed cut by a fault. The two thin-slab sites are refined (planar
+/// triangles about 10 times the slab wide); without refinement they had 1.5 % and 7.1 % of
+/// their cells below 5 degrees (the pins below fail there). The 5-degree floor of issue 31 is
+/// not reached: cells cut next to the terrain (DSM vertices never move), where a fault meets a
+/// side or an interface at a shallow angle stay slivers; see docs/geology.md.
 #[test]
 fn dihedral_pinned() {
     let one = |name: &str, dip: f64| {
@@ -452,33 +450,37 @@ fn dihedral_pinned() {
         100.0,
         3.0,
     )];
-    // (name, site, smallest angle at least, share below 5 degrees at most); measured (1.17,
-    // 0.03 %), (0.22, 0.29 %), (1.22, 1.5 %), (1.03, 7.1 %); before this work (0.61, 0.42 %),
-    // (0.05, 0.42 %), (0.44, 3.0 %), (0.50, 9.1 %).
-    for (name, s, min, share) in [
+    // (name, site, smallest angle at least, share below 5 degrees at most, refined);
+    // measured (1.17, 0.03 %), (0.22, 0.29 %), (1.54, 0.05 %), (0.25, 0.02 %); without the
+    // refinement (1.17, 0.03 %), (0.22, 0.29 %), (1.22, 1.5 %), (1.03, 7.1 %).
+    for (name, s, min, share, refined) in [
         (
             "dip 90",
             site(one("V", 90.0), vec![90.0, 50.0], 0.2),
             1.0,
             0.0005,
+            false,
         ),
         (
             "dip 20",
             site(one("L", 20.0), vec![90.0, 50.0], 0.2),
             0.2,
             0.0030,
+            false,
         ),
         (
             "two faults 1 m apart",
             site(apart, vec![90.0, 50.0], 0.2),
-            1.1,
-            0.017,
+            1.5,
+            0.0007,
+            true,
         ),
         (
             "0.5 m interbed by a fault",
             site(thin, vec![90.0, 89.5, 45.0], 0.2),
-            1.0,
-            0.073,
+            0.2,
+            0.0003,
+            true,
         ),
     ] {
         // `build` runs every check of the mesh.
@@ -490,5 +492,169 @@ fn dihedral_pinned() {
         assert!(q.quality.min >= min, "{name}: {}", q.quality.min);
         assert!(below <= share, "{name}: {below}");
         assert!(mesh.report.flipped + mesh.report.moved > 0, "{name}");
+        assert_eq!(mesh.report.refined_triangles > 0, refined, "{name}");
     }
+}
+
+/// The local refinement: on the 0.5 m interbed cut by a fault, off (`refine_ratio = 0`) the
+/// mesh is the DSM's columns and 7.1 % of its cells are below 5 degrees; on, the planar
+/// triangles are bisected to about 5 m and that share falls below 0.1 %; a budget of
+/// background cells stops it (and every check still passes); where no slab is thin it adds
+/// nothing.
+#[test]
+fn local_refinement() {
+    let thin = site(
+        vec![SynthFault::new(
+            "F",
+            [60.0, -20.0],
+            [140.0, 220.0],
+            55.0,
+            100.0,
+            3.0,
+        )],
+        vec![90.0, 89.5, 45.0],
+        0.2,
+    );
+    let mut off = MeshSettings::new(thin.base, 8.0);
+    off.refine_ratio = 0.0;
+    let (_, plain, q0, _) = build_with(&thin, off);
+    let (_, fine, q1, s1) = build(&thin, 8.0);
+    let share = |q: &CheckSummary, m: &FaultedMesh| q.quality.below_5 as f64 / m.tets.len() as f64;
+    println!(
+        "0.5 m interbed: refinement off {} cells, {:.2} % below 5 degrees, min {:.2}; on {} \
+         cells ({} planar triangles added), {:.3} %, min {:.2}",
+        plain.tets.len(),
+        100.0 * share(&q0, &plain),
+        q0.quality.min,
+        fine.tets.len(),
+        fine.report.refined_triangles,
+        100.0 * share(&q1, &fine),
+        q1.quality.min
+    );
+    assert_eq!(plain.report.refined_triangles, 0);
+    assert!(share(&q0, &plain) > 0.05);
+    assert!(fine.report.refined_triangles > 0);
+    assert!(share(&q1, &fine) < 0.001);
+    assert!(fine.report.background_cells <= s1.refine_max_cells);
+    assert!(truth(&thin, &fine) >= 0.99);
+    // A budget: the background mesh stays within it, the checks pass, the share is between.
+    let mut capped = MeshSettings::new(thin.base, 8.0);
+    capped.refine_max_cells = 40_000;
+    let (_, mid, q2, _) = build_with(&thin, capped);
+    println!(
+        "  capped at 40,000 background cells: {} ({} triangles added), {:.2} % below 5 degrees",
+        mid.report.background_cells,
+        mid.report.refined_triangles,
+        100.0 * share(&q2, &mid)
+    );
+    assert!(mid.report.refined_triangles > 0);
+    assert!(mid.report.background_cells <= 40_000);
+    assert!(share(&q2, &mid) < share(&q0, &plain));
+    // Nothing thin: the mesh of the DSM's columns, unchanged.
+    let one = one_fault_site();
+    let (_, a, _, _) = build(&one, 10.0);
+    let mut off = MeshSettings::new(one.base, 10.0);
+    off.refine_ratio = 0.0;
+    let (_, b, _, _) = build_with(&one, off);
+    assert_eq!(a.report.refined_triangles, 0);
+    assert_eq!(a, b);
+}
+
+/// A unit that pinches out: a 0.5 m interbed cut by a fault thinning to nothing between
+/// x = `from` and x = 150 (its two interfaces coincide east of x = 150). Returns the refined
+/// mesh's share of cells below 5 degrees and its smallest angle; every check passes (refined
+/// and not) and no interbed cell lies wholly east of the pinch-out line.
+fn pinch(from: f64, max_cells: usize) -> (f64, f64) {
+    let s = site(
+        vec![SynthFault::new(
+            "F",
+            [60.0, -20.0],
+            [80.0, 220.0],
+            60.0,
+            90.0,
+            3.0,
+        )],
+        vec![90.0, 89.5, 45.0],
+        0.2,
+    );
+    let set = FaultSet::new(&s.specs(), &s.terrain, s.base).unwrap();
+    // The interbed's thickness at the DSM's vertices, linear on its triangles (as the facade
+    // gives interfaces interpolated on the DSM's planar mesh: no cell then straddles a bend).
+    let thickness = |x: f64| 0.5 * ((150.0 - x) / (150.0 - from)).clamp(0.0, 1.0);
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| {
+        let z = s.height(k, key, p);
+        if k == 1 {
+            let q = [p[0].clamp(0.0, 200.0), p[1].clamp(0.0, 200.0)];
+            let (tri, w) = s.terrain.locate(q).unwrap();
+            let t: f64 = (0..3)
+                .map(|i| {
+                    w[i] * thickness(s.terrain.points[s.terrain.triangles[tri][i] as usize][0])
+                })
+                .sum();
+            s.height(0, key, p) - t
+        } else {
+            z
+        }
+    };
+    let mut off = MeshSettings::new(s.base, 8.0);
+    off.refine_ratio = 0.0;
+    let plain = faulted_mesh(&s.terrain, &set, s.tops.len(), &h, &off).unwrap();
+    let q0 = quality(&plain.points, &plain.tets);
+    let name = format!("pinch-out over {} m", 150.0 - from);
+    println!(
+        "{name}, not refined: {} cells, min {:.2} deg, below 5 deg {} ({:.2} %)",
+        plain.tets.len(),
+        q0.min,
+        q0.below_5,
+        100.0 * q0.below_5 as f64 / plain.tets.len() as f64,
+    );
+    // Before the quality pass kept the cells it makes in their unit, the 50 m pinch-out
+    // failed here (a cell in a 3.5 cm slab, its centroid off its unit).
+    if let Err(e) = check(&plain, &s.terrain, &set, &off, &h) {
+        panic!("{name}, not refined: {e}");
+    }
+    let mut settings = MeshSettings::new(s.base, 8.0);
+    settings.refine_max_cells = max_cells;
+    let mesh = faulted_mesh(&s.terrain, &set, s.tops.len(), &h, &settings).unwrap();
+    let q = check(&mesh, &s.terrain, &set, &settings, &h).unwrap();
+    report(&format!("{name}, refined"), &mesh, &q, 1.0);
+    println!("  {} planar triangles added", mesh.report.refined_triangles);
+    assert!(mesh.report.background_cells <= max_cells);
+    assert!(mesh.report.refined_triangles > 0);
+    for (c, t) in mesh.tets.iter().enumerate() {
+        if mesh.unit[c] == 1 {
+            let x = t
+                .iter()
+                .map(|&v| mesh.points[v as usize][0])
+                .fold(f64::MAX, f64::min);
+            assert!(
+                x < 150.0 + 20.0 * 1.5,
+                "an interbed cell wholly east of the pinch-out, from x = {x}"
+            );
+        }
+    }
+    (
+        q.quality.below_5 as f64 / mesh.tets.len() as f64,
+        q.quality.min,
+    )
+}
+
+/// Pinch-outs, with the interbed's thickness given at the DSM's vertices and linear on its
+/// triangles (as the facade will give interfaces). Thinning over 50 m (a wedge of 0.57
+/// degrees between the interfaces), no mesh that conforms to both can reach 5 degrees at the
+/// pinch-out line (a cell with an edge on the line and faces on both interfaces has a
+/// dihedral angle at most the wedge's); the refinement, bounded by `refine_min_thickness` and
+/// the budget, lowers the share (5.4 % unrefined). Ending where a vertex's thickness is below
+/// 0.5 m (what the geology rules' `min_thickness` makes: the unit ends across one DSM
+/// triangle, a wedge of about atan(0.5 / 20) = 1.4 degrees), likewise. Every check passes,
+/// refined and not (the unrefined 50 m pinch-out failed it before the quality pass kept the
+/// cells it makes in their unit).
+#[test]
+fn pinch_out() {
+    let (gradual, min) = pinch(100.0, 150_000);
+    assert!(gradual < 0.02, "{gradual}");
+    assert!(min > 0.0);
+    let (abrupt, min) = pinch(149.0, 150_000);
+    assert!(abrupt < 0.005, "{abrupt}");
+    assert!(min > 0.0);
 }
