@@ -29,7 +29,13 @@ fn example() -> PathBuf {
 
 fn model(project: &Path, out: &Path, sets: &[&str]) -> std::process::Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_terramesh"));
-    c.args(["model", project.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    c.args([
+        "model",
+        project.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
     for s in sets {
         c.args(["--set", s]);
     }
@@ -65,7 +71,10 @@ fn truth() -> Site {
                 f["throw"].as_f64().unwrap(),
             );
             if let Some(e) = f["ends_at"].as_array() {
-                s.ends_at = Some((e[0].as_u64().unwrap() as usize, e[1].as_i64().unwrap() as i8));
+                s.ends_at = Some((
+                    e[0].as_u64().unwrap() as usize,
+                    e[1].as_i64().unwrap() as i8,
+                ));
             }
             s
         })
@@ -120,9 +129,15 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
     let checks = &json["checks"];
     assert_eq!(checks["closed"], true);
     assert_eq!(checks["conformal"], true);
-    assert!(checks["relative_difference"].as_f64().unwrap() < 1e-9, "{checks}");
+    assert!(
+        checks["relative_difference"].as_f64().unwrap() < 1e-9,
+        "{checks}"
+    );
     let faulted = &json["faulted"];
-    assert!(faulted["fault_distance"].as_f64().unwrap() < 0.01, "{faulted}");
+    assert!(
+        faulted["fault_distance"].as_f64().unwrap() < 0.01,
+        "{faulted}"
+    );
     // Every fault has faces, in model.json and in its own files; as meshed, each dips as given.
     let site = truth();
     for (k, f) in site.faults.iter().enumerate() {
@@ -134,7 +149,11 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
         assert!(fv.contains("bulk_element_ids"), "fault-{}.vtu", f.name);
         let cells = fv.split("NumberOfCells=\"").nth(1).unwrap();
         let cells: usize = cells[..cells.find('"').unwrap()].parse().unwrap();
-        assert_eq!(cells as u64, 2 * s["faces"].as_u64().unwrap(), "once per side");
+        assert_eq!(
+            cells as u64,
+            2 * s["faces"].as_u64().unwrap(),
+            "once per side"
+        );
         assert!(out.join(format!("fault-{}.ts", f.name)).is_file());
     }
     let msh = std::fs::read_to_string(out.join("model.msh")).unwrap();
@@ -231,11 +250,19 @@ fn bad_faults_are_refused_naming_the_key_and_nothing_is_written() {
             ),
             (
                 prism,
-                vec![format!("line {lp}"), "geology.element".into(), "tetra".into()],
+                vec![
+                    format!("line {lp}"),
+                    "geology.element".into(),
+                    "tetra".into(),
+                ],
             ),
             (
                 ends,
-                vec![format!("line {le}"), "geology.faults[F3].ends_at".into(), "F9".into()],
+                vec![
+                    format!("line {le}"),
+                    "geology.faults[F3].ends_at".into(),
+                    "F9".into(),
+                ],
             ),
         ]
     };
@@ -288,4 +315,39 @@ fn bad_faults_are_refused_naming_the_key_and_nothing_is_written() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("geology.faults[F1].dip_direction"), "{err}");
     assert!(!out.exists());
+}
+
+/// The faulted example's fault files through readers that share no code with terramesh
+/// (`tests/verify/check_faulted.py`: meshio, Gmsh, OpenGeoSys' ExtractBoundary and checkMesh).
+/// Needs `.venv-verify` (`.ci/verify-setup.sh`): without it the test fails when `CI` is set and
+/// otherwise says how to set it up and passes.
+#[test]
+fn the_faulted_example_passes_check_faulted_py() {
+    let python = root().join(".venv-verify/bin/python");
+    if !python.exists() {
+        let msg = format!(
+            "{} is missing: run .ci/verify-setup.sh to install the independent readers",
+            python.display()
+        );
+        assert!(std::env::var_os("CI").is_none(), "CI is set and {msg}");
+        eprintln!("the_faulted_example_passes_check_faulted_py: skipped: {msg}");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("model");
+    let o = model(&example().join("terramesh.toml"), &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let run = Command::new(&python)
+        .current_dir(root().join("tests/verify"))
+        .arg("check_faulted.py")
+        .arg(&out)
+        .output()
+        .expect("run tests/verify/check_faulted.py");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    println!("{stdout}");
+    assert!(
+        run.status.success(),
+        "check_faulted.py failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }

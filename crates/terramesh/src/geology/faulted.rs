@@ -486,11 +486,6 @@ impl BlockInterfaces {
                 }
             }
         }
-        if std::env::var_os("TM_DEBUG_FAULTS").is_some() {
-            for c in &contacts {
-                eprintln!("contact {} unit {} at {:?} block {:?}", c.0, c.1, c.2, c.3);
-            }
-        }
         let mut by_block: HashMap<BlockKey, Vec<Vec<([f64; 2], f64)>>> = HashMap::new();
         let mut all: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); interfaces];
         for (_, unit, p, key) in &contacts {
@@ -552,14 +547,6 @@ impl BlockInterfaces {
                     .map(|(q, z)| (*q, z - (plane[0] + plane[1] * q[0] + plane[2] * q[1])))
                     .collect();
                 row.push(Some(Fit { plane, residuals }));
-            }
-            if std::env::var_os("TM_DEBUG_FAULTS").is_some() {
-                for (k, f) in row.iter().enumerate() {
-                    if let Some(f) = f {
-                        let r = f.residuals.iter().map(|x| x.1.abs()).fold(0.0, f64::max);
-                        eprintln!("block {:?} interface {k}: {} contacts, plane {:?}, max residual {r:.4}", key, f.residuals.len(), f.plane);
-                    }
-                }
             }
             counts.insert(*key, pts.iter().map(Vec::len).collect());
             fits.insert(*key, row);
@@ -942,18 +929,6 @@ pub fn summarise(g: &GeologyPlan, f: &Faulted, ifs: &BlockInterfaces) -> Faulted
         fault_distance: f.check.fault_distance,
         split_nodes: f.split,
     }
-}
-
-/// Whether `path` is a file: a project's fault files are checked before the build.
-#[allow(dead_code)]
-pub(crate) fn readable(key: &str, path: &Path) -> Result<()> {
-    if !path.is_file() {
-        return Err(Error::invalid(format!(
-            "{key} {}: no such file: check the path (relative to the project file)",
-            path.display()
-        )));
-    }
-    Ok(())
 }
 
 /// The geology stage of a faulted model: see the module documentation. `mesh` and `dsm` are
