@@ -307,6 +307,28 @@ fn bad_faults_are_refused_naming_the_key_and_nothing_is_written() {
         assert!(!out.exists());
         std::fs::write(tmp.path().join(file), keep).unwrap();
     }
+    // A fault surface that is not a surface (three triangles on one edge).
+    let surface = text.replacen(
+        "trace = \"f2.csv\"\ndip = 70.0\ndip_direction = 180.0",
+        "surface = \"f2.obj\"",
+        1,
+    );
+    assert_ne!(surface, text);
+    std::fs::write(&project, surface).unwrap();
+    std::fs::write(
+        tmp.path().join("f2.obj"),
+        "v 0 0 0\nv 100 0 0\nv 0 100 0\nv 0 -100 0\nv 0 0 100\nf 1 2 3\nf 1 2 4\nf 1 2 5\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let o = model(&project, &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("geology.faults[F2].surface") && err.contains("f2.obj"),
+        "{err}"
+    );
+    assert!(!out.exists());
     let along = text.replacen("dip_direction = 90.0", "dip_direction = 4.5", 1);
     std::fs::write(&project, along).unwrap();
     let out = tmp.path().join("out");
@@ -350,4 +372,34 @@ fn the_faulted_example_passes_check_faulted_py() {
         "check_faulted.py failed:\n{stdout}\n{}",
         String::from_utf8_lossy(&run.stderr)
     );
+}
+
+/// `terramesh tiles plan` refuses a project with faults, naming `geology.faults`, and writes
+/// no manifest.
+#[test]
+fn tiles_plan_refuses_a_faulted_project_naming_geology_faults() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plan = tmp.path().join("plan");
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "tiles",
+            "plan",
+            example().join("terramesh.toml").to_str().unwrap(),
+            "--tile-size",
+            "200m",
+            "--set",
+            "interpolation.neighbors=32",
+            "-o",
+        ])
+        .arg(&plan)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("geology.faults") && err.contains("3 fault(s)"),
+        "{err}"
+    );
+    assert!(!plan.join("tiles.json").exists(), "a manifest was written");
 }
