@@ -117,11 +117,17 @@ pub(crate) fn fault_specs(
     Ok(specs)
 }
 
+/// Vertices and triangles of a surface.
+type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// Points `[x, y]` with a value.
+type Samples = Vec<([f64; 2], f64)>;
+
 /// The least-squares plane through `pts` (as `x = a + b y + c z`-free form: the plane through
 /// the centroid normal to the smallest principal axis) as a rectangle of two triangles
 /// covering the region's bounding box widened by its size, or `None` when it is degenerate or
 /// horizontal.
-fn plane_surface(pts: &[[f64; 3]], terrain: &Terrain) -> Option<(Vec<[f64; 3]>, Vec<[u32; 3]>)> {
+fn plane_surface(pts: &[[f64; 3]], terrain: &Terrain) -> Option<Triangles> {
     let n = pts.len() as f64;
     let c = pts.iter().fold([0.0; 3], |a, p| {
         [a[0] + p[0] / n, a[1] + p[1] / n, a[2] + p[2] / n]
@@ -342,7 +348,7 @@ fn plane_fit(pts: &[([f64; 2], f64)], o: [f64; 2]) -> Option<[f64; 3]> {
     let d = det(&m);
     let scale = m[0][0] * m[1][1] * m[2][2];
     // nearly on one line: the plane's gradient is not fixed
-    if !(d.abs() > 1e-3 * scale.abs()) {
+    if d.abs().partial_cmp(&(1e-3 * scale.abs())) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let mut x = [0.0; 3];
@@ -486,7 +492,7 @@ impl BlockInterfaces {
                 }
             }
         }
-        let mut by_block: HashMap<BlockKey, Vec<Vec<([f64; 2], f64)>>> = HashMap::new();
+        let mut by_block: HashMap<BlockKey, Vec<Samples>> = HashMap::new();
         let mut all: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); interfaces];
         for (_, unit, p, key) in &contacts {
             let k = unit - 1;

@@ -495,7 +495,7 @@ impl GeologySection {
                 }
             }
             if let Some(t) = f.throw {
-                if !(t.is_finite() && t >= 0.0 && t <= MAX_CELL_HEIGHT * 100.0) {
+                if !(t.is_finite() && (0.0..=MAX_CELL_HEIGHT * 100.0).contains(&t)) {
                     return bad(
                         "throw",
                         format!(
