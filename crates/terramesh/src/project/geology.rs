@@ -849,6 +849,96 @@ mod tests {
         assert!(e.contains("typo"), "{e}");
     }
 
+    /// `[[geology.faults]]`: every bad value names `geology.faults[<name>].<key>` and its line
+    /// in that fault's table; a good table lowers into a `FaultPlan` with paths resolved.
+    #[test]
+    fn fault_keys_name_the_fault_and_their_line() {
+        let faults = "\n[[geology.faults]]\nname = \"F1\"\ntrace = \"f1.csv\"\ndip = 60.0\n\
+                      dip_direction = 90.0\nthrow = 5.0\nkind = \"reverse\"\n\n\
+                      [[geology.faults]]\nname = \"F2\"\nsurface = \"f2.ts\"\nends_at = [\"F1\"]\n";
+        let base = geo().replace("element = \"prism\"", "element = \"tetra\"");
+        let ok = format!("{base}{faults}");
+        let p = Project::parse("d/p.toml", &ok, &[]).unwrap();
+        let g = p.geology().unwrap();
+        assert_eq!(g.faults.len(), 2);
+        assert_eq!(
+            g.faults[0].source,
+            FaultSource::Trace {
+                path: PathBuf::from("d/f1.csv"),
+                dip: 60.0,
+                dip_direction: 90.0
+            }
+        );
+        assert_eq!(g.faults[0].kind, FaultKind::Reverse);
+        assert_eq!(g.faults[0].throw, Some(5.0));
+        assert_eq!(g.faults[1].source, FaultSource::Surface("d/f2.ts".into()));
+        assert_eq!(g.faults[1].ends_at, ["F1"]);
+        assert_eq!(g.max_cell_height, DEFAULT_MAX_CELL_HEIGHT);
+        assert!(!g.split_faults);
+        let line_of = |text: &str, l: &str| 1 + text.lines().position(|x| x == l).unwrap();
+        for (from, to, want) in [
+            (
+                "dip = 60.0",
+                "dip = 0.0",
+                "geology.faults[F1].dip: 0 is outside (0, 90]",
+            ),
+            (
+                "dip = 60.0",
+                "dip = 95.0",
+                "geology.faults[F1].dip: 95 is outside (0, 90]",
+            ),
+            ("throw = 5.0", "throw = -5.0", "geology.faults[F1].throw"),
+            (
+                "ends_at = [\"F1\"]",
+                "ends_at = [\"F9\"]",
+                "geology.faults[F2].ends_at: 'F9' is not a fault",
+            ),
+            (
+                "ends_at = [\"F1\"]",
+                "ends_at = [\"F2\"]",
+                "geology.faults[F2].ends_at: 'F2' is this fault",
+            ),
+            (
+                "name = \"F2\"",
+                "name = \"F1\"",
+                "geology.faults[F1].name: 'F1' names two faults",
+            ),
+            (
+                "ends_at = [\"F1\"]",
+                "dip = 50.0",
+                "geology.faults[F2].dip: dip applies to a fault given by its trace",
+            ),
+            ("throw = 5.0", "zone = 2.0", "geology.faults[F1].zone"),
+            ("kind = \"reverse\"", "kind = \"sideways\"", "sideways"),
+        ] {
+            let text = ok.replacen(from, to, 1);
+            assert_ne!(text, ok, "{from}");
+            let e = Project::parse("p.toml", &text, &[])
+                .unwrap_err()
+                .to_string();
+            let line = line_of(&text, to);
+            assert!(
+                e.starts_with(&format!("p.toml, line {line}: ")) && e.contains(want),
+                "{e} (want line {line}: {want})"
+            );
+        }
+        let prism = format!("{}{faults}", geo());
+        let e = Project::parse("p.toml", &prism, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("geology.element") && e.contains("tetra"), "{e}");
+        let e = Project::parse("p.toml", &geo(), &["geology.fault_picks=p.csv".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("geology.fault_picks"), "{e}");
+        let e = Project::parse("p.toml", &ok, &["geology.max_cell_height=0".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("geology.max_cell_height"), "{e}");
+        let p = Project::parse("p.toml", &ok, &["geology.split_faults=true".into()]).unwrap();
+        assert!(p.geology().unwrap().split_faults);
+    }
+
     #[test]
     fn missing_and_bad_files_are_found_before_the_build() {
         let dir = tempfile::tempdir().unwrap();
