@@ -5,7 +5,7 @@
 //! ([`super::faulted_mesh::to_volume`]) and written by `terramesh_io::model::write_faulted_model`.
 //!
 //! The data walk: `GeologySection` (project/geology.rs) -> `GeologyPlan::faults`
-//! (`FaultPlan` per fault, paths resolved) -> [`fault_specs`] (the files read, traces at the
+//! (`FaultPlan` per fault, paths resolved) -> `fault_specs` (the files read, traces at the
 //! DSM's elevation) -> `FaultSet::new` -> [`BlockInterfaces::new`] (contacts to blocks by the
 //! kernel's side tests and `fault_picks.csv`) -> `faulted_mesh` -> `check` -> files.
 
