@@ -145,6 +145,14 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
         assert_eq!(s["name"], f.name.as_str());
         assert!(s["faces"].as_u64().unwrap() > 100, "{s}");
         assert!((s["mean_dip"].as_f64().unwrap() - f.dip).abs() < 1.0, "{s}");
+        // The throw as modelled: F2 (reverse, the hanging wall up 8 m) and F3 (normal, 6 m)
+        // offset every interface by their throw; F1's includes F3's where F3 ends at it.
+        if f.ends_at.is_some() || f.name == "F2" {
+            for t in s["throw_along"].as_array().unwrap() {
+                let mean = t["mean"].as_f64().unwrap();
+                assert!((mean - f.throw).abs() < 0.1, "{} {t}", f.name);
+            }
+        }
         let fv = std::fs::read_to_string(out.join(format!("fault-{}.vtu", f.name))).unwrap();
         assert!(fv.contains("bulk_element_ids"), "fault-{}.vtu", f.name);
         let cells = fv.split("NumberOfCells=\"").nth(1).unwrap();

@@ -796,6 +796,37 @@ pub struct FaultSummary {
     pub mean_dip: f64,
     /// Its mean dip direction as meshed, degrees clockwise from grid north.
     pub mean_dip_direction: f64,
+    /// Per interface, the throw along the fault as modelled: at every fault face's centroid,
+    /// the interface's height on the negative side (the footwall of a trace fault) minus on
+    /// the positive side (positive: the hanging wall is down), metres.
+    pub throw_along: Vec<ThrowRange>,
+    /// At every borehole that crosses it (`fault_picks.csv`): the mean over the interfaces of
+    /// the same difference at the hole.
+    pub throw_at_holes: Vec<HoleThrow>,
+}
+
+/// An interface's throw along a fault: min, mean and max over its faces.
+#[derive(Debug, Clone, Serialize)]
+pub struct ThrowRange {
+    /// The unit whose top it is.
+    pub unit: String,
+    /// Smallest, metres.
+    pub min: f64,
+    /// Mean, metres.
+    pub mean: f64,
+    /// Largest, metres.
+    pub max: f64,
+}
+
+/// A fault's throw at a borehole that crosses it.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoleThrow {
+    /// The hole.
+    pub hole: String,
+    /// The pick's depth along the hole, metres.
+    pub depth: f64,
+    /// The mean throw over the interfaces, metres (positive: the hanging wall is down).
+    pub throw: f64,
 }
 
 /// One fault block in `model.json`.
@@ -850,8 +881,66 @@ fn tet_volume(p: &[[f64; 3]], t: &[u32; 4]) -> f64 {
 }
 
 /// The faults' and blocks' figures.
-pub fn summarise(g: &GeologyPlan, f: &Faulted, ifs: &BlockInterfaces) -> FaultedSummary {
+pub fn summarise(
+    g: &GeologyPlan,
+    f: &Faulted,
+    ifs: &BlockInterfaces,
+    set: &FaultSet,
+    picks: &[FaultPick],
+) -> FaultedSummary {
     let m = &f.mesh;
+    let interfaces = g.units.len() - 1;
+    // The throw of interface k across fault i between the blocks of a face's two cells.
+    let throw_along = |i: usize| -> Vec<ThrowRange> {
+        (0..interfaces)
+            .map(|k| {
+                let (mut lo, mut hi, mut sum, mut n) = (f64::MAX, f64::MIN, 0.0, 0usize);
+                for face in m.fault_faces.iter().filter(|x| x.fault as usize == i) {
+                    let [a, b, c] = face.nodes.map(|v| m.points[v as usize]);
+                    let q = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+                    let key = |s: usize| m.blocks[m.block[face.cells[s] as usize] as usize];
+                    let d = ifs.height(k, key(0), q) - ifs.height(k, key(1), q);
+                    lo = lo.min(d);
+                    hi = hi.max(d);
+                    sum += d;
+                    n += 1;
+                }
+                ThrowRange {
+                    unit: g.units[k + 1].clone(),
+                    min: if n > 0 { lo } else { 0.0 },
+                    mean: if n > 0 { sum / n as f64 } else { 0.0 },
+                    max: if n > 0 { hi } else { 0.0 },
+                }
+            })
+            .collect()
+    };
+    let at_holes = |i: usize| -> Vec<HoleThrow> {
+        picks
+            .iter()
+            .filter(|p| p.fault == set.faults[i].name)
+            .filter_map(|p| {
+                let c = ifs.contacts.iter().find(|c| c.0 == p.hole)?;
+                let q = [c.2[0], c.2[1]];
+                // the block of the hole's first contact, with fault i's side set each way
+                let sides = |s: u64| {
+                    let mut pos = 0u64;
+                    for (j, fault) in set.faults.iter().enumerate() {
+                        pos |= ((fault.side(c.2).sign > 0) as u64) << j;
+                    }
+                    set.key_of_sides((pos & !(1 << i)) | (s << i))
+                };
+                let d: f64 = (0..interfaces)
+                    .map(|k| ifs.height(k, sides(0), q) - ifs.height(k, sides(1), q))
+                    .sum::<f64>()
+                    / interfaces.max(1) as f64;
+                Some(HoleThrow {
+                    hole: p.hole.clone(),
+                    depth: p.depth,
+                    throw: d,
+                })
+            })
+            .collect()
+    };
     let faults = g
         .faults
         .iter()
@@ -894,6 +983,8 @@ pub fn summarise(g: &GeologyPlan, f: &Faulted, ifs: &BlockInterfaces) -> Faulted
                 area: f.check.fault_areas.get(i).copied().unwrap_or(area),
                 mean_dip: dip,
                 mean_dip_direction: dir,
+                throw_along: throw_along(i),
+                throw_at_holes: at_holes(i),
             }
         })
         .collect();
@@ -1095,7 +1186,7 @@ pub(crate) fn run(
                 .into();
         }
     }
-    summary.faulted = Some(summarise(g, &faulted, &ifs));
+    summary.faulted = Some(summarise(g, &faulted, &ifs, &set, &picks));
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&summary)?;
     let mut o = terramesh_io::output::Output::create(Some(&path))?;
