@@ -411,3 +411,60 @@ fn tiles_plan_refuses_a_faulted_project_naming_geology_faults() {
     );
     assert!(!plan.join("tiles.json").exists(), "a manifest was written");
 }
+
+/// A fault given by `points` (x,y,z picks on it) is the least-squares plane of the points: F2
+/// given by 24 points of its true plane meshes with its true dip and dip direction.
+#[test]
+fn a_fault_given_by_points_is_their_plane() {
+    let tmp = tempfile::tempdir().unwrap();
+    for f in [
+        "heights.csv",
+        "collars.csv",
+        "intervals.csv",
+        "fault_picks.csv",
+        "f1.csv",
+        "f3.csv",
+    ] {
+        std::fs::copy(example().join(f), tmp.path().join(f)).unwrap();
+    }
+    let site = truth();
+    let f2 = &site.faults[1];
+    let [a, b] = f2.trace;
+    let z = |p: [f64; 2]| site.plane[0] + site.plane[1] * p[0] + site.plane[2] * p[1];
+    let d = f2.dip_direction.to_radians();
+    let cot = 1.0 / f2.dip.to_radians().tan();
+    let mut csv = String::from("x,y,z\n");
+    for i in 0..6 {
+        for j in 0..4 {
+            let t = 0.1 + 0.16 * i as f64;
+            let depth = 10.0 + 40.0 * j as f64;
+            let p = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            csv.push_str(&format!(
+                "{},{},{}\n",
+                p[0] + depth * cot * d.sin(),
+                p[1] + depth * cot * d.cos(),
+                z(p) - depth
+            ));
+        }
+    }
+    std::fs::write(tmp.path().join("f2_points.csv"), csv).unwrap();
+    let text = std::fs::read_to_string(example().join("terramesh.toml"))
+        .unwrap()
+        .replacen(
+            "trace = \"f2.csv\"\ndip = 70.0\ndip_direction = 180.0",
+            "points = \"f2_points.csv\"",
+            1,
+        );
+    let project = tmp.path().join("p.toml");
+    std::fs::write(&project, &text).unwrap();
+    let out = tmp.path().join("model");
+    let o = model(&project, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    let s = &json["faulted"]["faults"][1];
+    assert_eq!(s["name"], "F2");
+    assert!((s["mean_dip"].as_f64().unwrap() - 70.0).abs() < 0.5, "{s}");
+    let dir = s["mean_dip_direction"].as_f64().unwrap();
+    assert!((dir - 180.0).abs() < 5.0, "{s}");
+}

@@ -57,7 +57,8 @@ pub(crate) fn fault_error(e: terramesh_faults::FaultError) -> Error {
 
 /// The faults of `g` as the kernel takes them: traces read in the project's CRS (geographic
 /// traces projected into `crs`, the model's CRS), surfaces read and checked, point picks
-/// fitted by a plane (a rectangle of two triangles over the region's bounding box, widened).
+/// fitted by a plane (a rectangle of two triangles over the region's bounding box, widened,
+/// its normal upwards: its positive side, the hanging wall, above it).
 pub(crate) fn fault_specs(
     g: &GeologyPlan,
     geographic: bool,
@@ -176,6 +177,11 @@ fn plane_surface(pts: &[[f64; 3]], terrain: &Terrain) -> Option<Triangles> {
             return None;
         }
         v = [w[0] / l, w[1] / l, w[2] / l];
+    }
+    // The normal upwards: the positive side, the hanging wall, is above the fault (as for a
+    // trace fault), so that `throw` and `kind` mean the same.
+    if v[2] < 0.0 {
+        v = [-v[0], -v[1], -v[2]];
     }
     let h = (v[0] * v[0] + v[1] * v[1]).sqrt();
     if h < 1e-6 {
