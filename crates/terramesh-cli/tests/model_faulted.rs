@@ -468,3 +468,96 @@ fn a_fault_given_by_points_is_their_plane() {
     let dir = s["mean_dip_direction"].as_f64().unwrap();
     assert!((dir - 180.0).abs() < 5.0, "{s}");
 }
+
+/// A block without boreholes takes its neighbour's interfaces shifted by the throw: with every
+/// hole east of F1 and north of F2 left out, that block's interfaces come `from = "throw"` and
+/// the true unit still fills at least 99 % of the volume; without F1's throw it is an error
+/// naming `geology.faults[F1].throw`.
+#[test]
+fn a_block_without_boreholes_takes_its_neighbours_surface_shifted_by_the_throw() {
+    let tmp = tempfile::tempdir().unwrap();
+    for f in ["heights.csv", "f1.csv", "f2.csv", "f3.csv"] {
+        std::fs::copy(example().join(f), tmp.path().join(f)).unwrap();
+    }
+    let collars = std::fs::read_to_string(example().join("collars.csv")).unwrap();
+    let mut keep = std::collections::HashSet::new();
+    let mut kept = String::from("hole,x,y,z\n");
+    for l in collars.lines().skip(1) {
+        let v: Vec<&str> = l.split(',').collect();
+        let (x, y): (f64, f64) = (v[1].parse().unwrap(), v[2].parse().unwrap());
+        // east of F1's trace (x about 150 to 190 at the surface), north of F2's
+        if !(x > 200.0 && y > 250.0) {
+            keep.insert(v[0].to_string());
+            kept.push_str(l);
+            kept.push('\n');
+        }
+    }
+    assert!(keep.len() < 25 && keep.len() >= 18, "{}", keep.len());
+    std::fs::write(tmp.path().join("collars.csv"), kept).unwrap();
+    for f in ["intervals.csv", "fault_picks.csv"] {
+        let t = std::fs::read_to_string(example().join(f)).unwrap();
+        let mut lines = t.lines();
+        let mut s = format!("{}\n", lines.next().unwrap());
+        for l in lines.filter(|l| keep.contains(l.split(',').next().unwrap())) {
+            s.push_str(l);
+            s.push('\n');
+        }
+        std::fs::write(tmp.path().join(f), s).unwrap();
+    }
+    let text = std::fs::read_to_string(example().join("terramesh.toml")).unwrap();
+    let project = tmp.path().join("p.toml");
+    std::fs::write(&project, &text).unwrap();
+    let out = tmp.path().join("model");
+    let o = model(&project, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    let blocks = json["faulted"]["blocks"].as_array().unwrap();
+    let b = blocks
+        .iter()
+        .find(|b| b["name"] == "F1-hanging_F2-foot")
+        .expect("the block east of F1 and north of F2");
+    // (a hole west of x = 200 meets the deepest interfaces east of F1's trace, which dips
+    // east: those come from its contacts)
+    let from: Vec<&str> = b["interfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["from"].as_str().unwrap())
+        .collect();
+    assert!(
+        from.iter().filter(|f| **f == "throw").count() >= 3,
+        "{from:?}"
+    );
+    let site = truth();
+    let v = Vtu::read(&out.join("model.vtu"));
+    let pts = v.array("Name=\"Points\"");
+    let conn = v.array("Name=\"connectivity\"");
+    let unit = v.array("Name=\"MaterialIDs\"");
+    let (mut total, mut right) = (0.0, 0.0);
+    for (c, u) in unit.iter().enumerate() {
+        let t: [[f64; 3]; 4] = std::array::from_fn(|i| {
+            let n = conn[4 * c + i] as usize;
+            [pts[3 * n], pts[3 * n + 1], pts[3 * n + 2]]
+        });
+        let vol = tet_volume(t).abs();
+        let q = std::array::from_fn(|k| t.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        total += vol;
+        if site.true_unit(q) == *u as usize {
+            right += vol;
+        }
+    }
+    assert!(
+        right / total >= 0.99,
+        "the true unit in {:.4}",
+        right / total
+    );
+    // Without F1's throw: an error naming it.
+    std::fs::write(&project, text.replacen("throw = 12.0", "", 1)).unwrap();
+    let out = tmp.path().join("model2");
+    let o = model(&project, &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("geology.faults[F1].throw"), "{err}");
+    assert!(!out.exists());
+}
