@@ -29,6 +29,10 @@ use crate::plan::{FaultKind, FaultSource, GeologyPlan};
 /// gradient of all the interface's contacts (its own contacts fix the level).
 pub const PLANE_CONTACTS: usize = 3;
 
+/// A unit thinner than this (metres), or than `min_thickness`, pinches out in a faulted model:
+/// two interfaces closer than a millimetre would cut cells into slivers of no volume.
+pub const PINCH: f64 = 1e-3;
+
 /// A contact within this many metres (along the hole) of a fault pick is where the hole enters
 /// the next block (the fault surface), not a unit's top: it is left out of the interfaces.
 pub const PICK_TOLERANCE: f64 = 0.1;
@@ -643,7 +647,7 @@ impl BlockInterfaces {
         let mut z = f64::INFINITY;
         for j in 0..=k {
             z = self.raw(j, key, p).min(above);
-            if above.is_finite() && above - z < self.min_thickness {
+            if above.is_finite() && above - z < self.min_thickness.max(PINCH) {
                 z = above;
             }
             above = z;
@@ -1107,8 +1111,13 @@ pub(crate) fn run(
         vertical_datum: datum.name(),
         vertical_epsg: datum.epsg(),
     };
-    let written = write_faulted_model(out, &volume, &data, &info, None)
-        .map_err(|e| Error::invalid(e.to_string()))?;
+    let written = write_faulted_model(out, &volume, &data, &info, None).map_err(|e| match e {
+        terramesh_io::model::ModelWriteError::Mesh(m) => Error::invalid(format!(
+            "[[geology.faults]]: the faulted mesh cannot be written: {m}; please report it \
+             with the project"
+        )),
+        e => Error::invalid(e.to_string()),
+    })?;
     let mut files: Vec<std::path::PathBuf> = written.into_iter().map(|f| out.join(f)).collect();
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
