@@ -230,6 +230,14 @@ fn fitted(data: &Data) -> Result<terramesh_geostat::Variogram> {
 
 /// Refuses the geology a tiled build does not make yet, with the key to change.
 fn check_supported(g: &GeologySettings) -> Result<()> {
+    if let Some(f) = g.faults.first() {
+        return Err(Error::invalid(format!(
+            "geology.faults: the project has {} fault(s) ({} ...): tiled builds do not make \
+             faulted models yet; build it in one piece with terramesh build or terramesh model",
+            g.faults.len(),
+            f.name
+        )));
+    }
     if g.interpolate == Interpolated::Thickness && g.surfaces.iter().any(Option::is_some) {
         return Err(Error::invalid(
             "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" \

@@ -173,6 +173,9 @@ pub fn run(
     for u in &g.units {
         terramesh_core::names::check_name(u).context("geology.units")?;
     }
+    if !g.faults.is_empty() {
+        return super::faulted::run(p, g, boreholes, mesh, dsm, grid, crs, out);
+    }
     let epsg = crs.and_then(Crs::epsg);
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     // `crs = "projected"` (no CRS): every grid is taken as is, in the project's coordinates

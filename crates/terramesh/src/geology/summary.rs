@@ -106,6 +106,9 @@ pub struct ModelSummary {
     /// The ensemble of realisations (`interpolation.realisations`), when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub realisations: Option<super::ensemble::EnsembleSummary>,
+    /// The faults and fault blocks of a faulted model (`[[geology.faults]]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub faulted: Option<super::faulted::FaultedSummary>,
 }
 
 impl ModelSummary {
@@ -168,6 +171,7 @@ impl ModelSummary {
                 },
             },
             realisations: None,
+            faulted: None,
         }
     }
 }

@@ -35,6 +35,63 @@ pub const DEFAULT_LAYERS: usize = 1;
 /// The most vertical sub-layers of one unit.
 pub const MAX_LAYERS: usize = 1000;
 
+/// The largest vertical size of a cell of a faulted model, by default, metres
+/// (`geology.max_cell_height`): the background mesh under the DSM has as many levels as the
+/// thickest column needs for it.
+pub const DEFAULT_MAX_CELL_HEIGHT: f64 = 10.0;
+/// The largest `geology.max_cell_height` accepted, metres.
+pub const MAX_CELL_HEIGHT: f64 = 10_000.0;
+
+/// Which way a fault moved its hanging wall (`[[geology.faults]] kind`): the sign of `throw`
+/// where a block takes its neighbour's interface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FaultKind {
+    /// The hanging wall moved down.
+    #[default]
+    Normal,
+    /// The hanging wall moved up.
+    Reverse,
+}
+
+/// How a fault's surface is given, paths resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FaultSource {
+    /// A trace on the terrain, a dip (degrees below horizontal) and a dip direction (degrees
+    /// clockwise from grid north).
+    Trace {
+        /// The trace file (CSV or GeoJSON).
+        path: PathBuf,
+        /// Degrees below horizontal.
+        dip: f64,
+        /// Degrees clockwise from grid north.
+        dip_direction: f64,
+    },
+    /// A triangulated surface (GOCAD TSurf, OBJ or STL).
+    Surface(PathBuf),
+    /// `x,y,z` picks on the fault.
+    Points(PathBuf),
+}
+
+/// One fault of `[[geology.faults]]`, lowered.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaultPlan {
+    /// Its name.
+    pub name: String,
+    /// Its surface.
+    pub source: FaultSource,
+    /// The faults it ends at.
+    pub ends_at: Vec<String>,
+    /// Its down-dip extent below the trace, metres.
+    pub depth: Option<f64>,
+    /// Its vertical throw, metres, for blocks without contacts of an interface.
+    pub throw: Option<f64>,
+    /// Normal or reverse.
+    pub kind: FaultKind,
+    /// Fault-zone thickness (0: none; others are refused for now).
+    pub zone: f64,
+}
+
 /// The model bottom.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Base {
@@ -70,6 +127,14 @@ pub struct GeologyPlan {
     pub z_unit: ZUnit,
     /// The largest inversion of borehole tops repaired, metres.
     pub max_inversion: f64,
+    /// The faults (`[[geology.faults]]`); none for a layer-cake model.
+    pub faults: Vec<FaultPlan>,
+    /// `fault_picks.csv`: where holes cross faults.
+    pub fault_picks: Option<PathBuf>,
+    /// Duplicate the nodes on the faults (`geology.split_faults`).
+    pub split_faults: bool,
+    /// The largest vertical cell size of a faulted model, metres.
+    pub max_cell_height: f64,
 }
 
 impl GeologyPlan {

@@ -28,8 +28,8 @@ use terramesh_io::boreholes::{
 
 use crate::error::{Error, Result};
 use crate::plan::{
-    Base, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_LAYERS,
-    MIN_BASE_ELEVATION,
+    Base, FaultKind, FaultPlan, FaultSource, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MAX_CELL_HEIGHT,
+    DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_CELL_HEIGHT, MAX_LAYERS, MIN_BASE_ELEVATION,
 };
 
 /// The commented `[geology]` section that `terramesh init --geology` appends to
@@ -75,6 +75,52 @@ pub struct GeologySection {
     /// The largest inversion of borehole tops repaired (metres); larger ones are errors.
     #[serde(default = "default_max_inversion")]
     pub max_inversion: f64,
+    /// `[[geology.faults]]`: the faults cutting the model (issue 31).
+    #[serde(default)]
+    pub faults: Vec<FaultSection>,
+    /// `fault_picks.csv`: `hole,depth,fault` where a hole crosses a fault.
+    pub fault_picks: Option<PathBuf>,
+    /// Duplicate the nodes on the faults, one copy per side.
+    #[serde(default)]
+    pub split_faults: bool,
+    /// The largest vertical size of a cell of a faulted model, metres.
+    #[serde(default = "default_max_cell_height")]
+    pub max_cell_height: f64,
+}
+
+/// One `[[geology.faults]]` table as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultSection {
+    /// Its name (file and group names: `fault-<name>.vtu`).
+    pub name: String,
+    /// The trace on the terrain: CSV `x,y` (or `lat,lon`) or a GeoJSON LineString.
+    pub trace: Option<PathBuf>,
+    /// Degrees below horizontal, (0, 90] (with `trace`).
+    pub dip: Option<f64>,
+    /// Degrees clockwise from grid north, to one side of the trace (with `trace`).
+    pub dip_direction: Option<f64>,
+    /// A triangulated fault surface: GOCAD TSurf, OBJ or STL.
+    pub surface: Option<PathBuf>,
+    /// `x,y,z` picks on the fault, fitted by a surface.
+    pub points: Option<PathBuf>,
+    /// The faults this one stops at.
+    #[serde(default)]
+    pub ends_at: Vec<String>,
+    /// Down-dip extent below the trace, metres.
+    pub depth: Option<f64>,
+    /// Vertical throw, metres, for blocks whose boreholes do not fix an interface.
+    pub throw: Option<f64>,
+    /// `normal` (hanging wall down) or `reverse` (hanging wall up).
+    #[serde(default)]
+    pub kind: FaultKind,
+    /// The thickness of a fault zone, metres (0: none).
+    #[serde(default)]
+    pub zone: f64,
+}
+
+fn default_max_cell_height() -> f64 {
+    DEFAULT_MAX_CELL_HEIGHT
 }
 
 fn default_min_thickness() -> f64 {
@@ -224,6 +270,7 @@ impl GeologySection {
                 );
             }
         }
+        self.validate_faults()?;
         match &self.base {
             BaseSpec::Elevation(b) if !(MIN_BASE_ELEVATION..=MAX_BASE_ELEVATION).contains(b) => {
                 bad(
@@ -280,7 +327,214 @@ impl GeologySection {
             interpolate: self.interpolate,
             z_unit: self.z_unit,
             max_inversion: self.max_inversion,
+            faults: self
+                .faults
+                .iter()
+                .map(|f| FaultPlan {
+                    name: f.name.clone(),
+                    source: match (&f.trace, &f.surface, &f.points) {
+                        (Some(t), _, _) => FaultSource::Trace {
+                            path: base.join(t),
+                            dip: f.dip.unwrap_or(90.0),
+                            dip_direction: f.dip_direction.unwrap_or(0.0),
+                        },
+                        (None, Some(s), _) => FaultSource::Surface(base.join(s)),
+                        (None, None, Some(p)) => FaultSource::Points(base.join(p)),
+                        (None, None, None) => FaultSource::Surface(PathBuf::new()),
+                    },
+                    ends_at: f.ends_at.clone(),
+                    depth: f.depth,
+                    throw: f.throw,
+                    kind: f.kind,
+                    zone: f.zone,
+                })
+                .collect(),
+            fault_picks: self.fault_picks.as_ref().map(|p| base.join(p)),
+            split_faults: self.split_faults,
+            max_cell_height: self.max_cell_height,
         }
+    }
+
+    /// The checks of `[[geology.faults]]`, `fault_picks` and `max_cell_height` that need no
+    /// file: every error names `geology.faults[<name>].<key>`.
+    fn validate_faults(&self) -> std::result::Result<(), (String, String)> {
+        let h = self.max_cell_height;
+        if !(h.is_finite() && h > 0.0 && h <= MAX_CELL_HEIGHT) {
+            return Err((
+                "geology.max_cell_height".into(),
+                format!(
+                    "{} m: give a positive number of metres, at most {MAX_CELL_HEIGHT}",
+                    terramesh_core::limits::short(h)
+                ),
+            ));
+        }
+        if self.faults.is_empty() {
+            if self.fault_picks.is_some() {
+                return Err((
+                    "geology.fault_picks".into(),
+                    "picks name faults, and the project has none: add [[geology.faults]] or \
+                     remove fault_picks"
+                        .into(),
+                ));
+            }
+            return Ok(());
+        }
+        if let Some(u) = self.surfaces.keys().next() {
+            return Err((
+                format!("geology.surfaces.{u}"),
+                "horizon grids are not used by a faulted model yet (its interfaces come from \
+                 the boreholes, block by block): remove surfaces or the faults"
+                    .into(),
+            ));
+        }
+        if self.element == Element::Prism {
+            return Err((
+                "geology.element".into(),
+                "\"prism\": a faulted model (with [[geology.faults]]) is meshed with \
+                 tetrahedra: set element = \"tetra\""
+                    .into(),
+            ));
+        }
+        if self.faults.len() > 64 {
+            return Err((
+                "geology.faults".into(),
+                format!("{} faults: at most 64 are supported", self.faults.len()),
+            ));
+        }
+        let names: Vec<&str> = self.faults.iter().map(|f| f.name.as_str()).collect();
+        for (i, f) in self.faults.iter().enumerate() {
+            let key = |k: &str| format!("geology.faults[{}].{k}", f.name);
+            let bad = |k: &str, why: String| Err((key(k), why));
+            if let Err(e) = terramesh_core::names::check_name(&f.name) {
+                return Err((format!("geology.faults[{}].name", i + 1), e.to_string()));
+            }
+            if names[..i].contains(&f.name.as_str()) {
+                return bad(
+                    "name",
+                    format!(
+                        "'{}' names two faults: give every fault its own name",
+                        f.name
+                    ),
+                );
+            }
+            let given = [f.trace.is_some(), f.surface.is_some(), f.points.is_some()];
+            match given.iter().filter(|&&g| g).count() {
+                0 => {
+                    return bad(
+                        "trace",
+                        "the fault has no geometry: give trace = \"f.csv\" with dip and \
+                         dip_direction, or surface = \"f.ts\", or points = \"f.csv\""
+                            .into(),
+                    )
+                }
+                1 => {}
+                _ => {
+                    return bad(
+                        if f.trace.is_some() {
+                            "trace"
+                        } else {
+                            "surface"
+                        },
+                        "give one of trace, surface and points".into(),
+                    )
+                }
+            }
+            if f.trace.is_some() {
+                let Some(dip) = f.dip else {
+                    return bad("dip", "a fault given by its trace needs dip = <degrees below horizontal, 0 to 90>".into());
+                };
+                if !(dip > 0.0 && dip <= 90.0) {
+                    return bad(
+                        "dip",
+                        format!(
+                            "{} is outside (0, 90]: give degrees below horizontal, more than 0 \
+                             and at most 90",
+                            terramesh_core::limits::short(dip)
+                        ),
+                    );
+                }
+                let Some(dd) = f.dip_direction else {
+                    return bad("dip_direction", "a fault given by its trace needs dip_direction = <degrees clockwise from grid north>".into());
+                };
+                if !(dd.is_finite() && (-360.0..=360.0).contains(&dd)) {
+                    return bad(
+                        "dip_direction",
+                        format!(
+                            "{}: give degrees clockwise from grid north, 0 to 360",
+                            terramesh_core::limits::short(dd)
+                        ),
+                    );
+                }
+            } else {
+                for (k, v) in [("dip", f.dip), ("dip_direction", f.dip_direction)] {
+                    if v.is_some() {
+                        return bad(
+                            k,
+                            format!("{k} applies to a fault given by its trace; a surface or points give their own"),
+                        );
+                    }
+                }
+                if f.depth.is_some() {
+                    return bad(
+                        "depth",
+                        "depth applies to a fault given by its trace; a surface ends where it \
+                         ends"
+                            .into(),
+                    );
+                }
+            }
+            if let Some(d) = f.depth {
+                if !(d.is_finite() && d > 0.0) {
+                    return bad(
+                        "depth",
+                        format!(
+                            "{}: give a positive number of metres",
+                            terramesh_core::limits::short(d)
+                        ),
+                    );
+                }
+            }
+            if let Some(t) = f.throw {
+                if !(t.is_finite() && (0.0..=MAX_CELL_HEIGHT * 100.0).contains(&t)) {
+                    return bad(
+                        "throw",
+                        format!(
+                            "{}: give the vertical throw as 0 or a positive number of metres \
+                             (kind = \"normal\" or \"reverse\" says which way)",
+                            terramesh_core::limits::short(t)
+                        ),
+                    );
+                }
+            }
+            if f.zone != 0.0 {
+                return bad(
+                    "zone",
+                    format!(
+                        "{}: fault zones meshed as cells of their own are not supported yet; \
+                         give 0",
+                        terramesh_core::limits::short(f.zone)
+                    ),
+                );
+            }
+            for other in &f.ends_at {
+                if other == &f.name {
+                    return bad(
+                        "ends_at",
+                        format!("'{other}' is this fault: a fault cannot end at itself"),
+                    );
+                }
+                if !names.contains(&other.as_str()) {
+                    return bad(
+                        "ends_at",
+                        format!(
+                            "'{other}' is not a fault of [[geology.faults]] ({})",
+                            names.join(", ")
+                        ),
+                    );
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -360,7 +614,29 @@ impl GeologyPlan {
             readable("base", p)?;
         }
         let stand_in = |lat: f64, lon: f64| Ok([lon, lat]);
-        self.read_boreholes(Some(&stand_in))?;
+        let holes = self.read_boreholes(Some(&stand_in))?;
+        for f in &self.faults {
+            let io = |e: terramesh_io::faults::FaultFileError| Error::invalid(e.to_string());
+            match &f.source {
+                FaultSource::Trace { path, .. } => {
+                    readable(&format!("faults[{}].trace", f.name), path)?
+                }
+                FaultSource::Surface(path) => {
+                    readable(&format!("faults[{}].surface", f.name), path)?;
+                    terramesh_io::faults::read_surface(path, &f.name).map_err(|e| {
+                        Error::invalid(format!("geology.faults[{}].surface: {e}", f.name))
+                    })?;
+                }
+                FaultSource::Points(path) => {
+                    readable(&format!("faults[{}].points", f.name), path)?;
+                    terramesh_io::faults::read_points(path, &f.name).map_err(io)?;
+                }
+            }
+        }
+        if let Some(p) = &self.fault_picks {
+            readable("fault_picks", p)?;
+            crate::geology::faulted::read_fault_picks(self, holes.as_ref())?;
+        }
         Ok(())
     }
 }
@@ -571,6 +847,96 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("typo"), "{e}");
+    }
+
+    /// `[[geology.faults]]`: every bad value names `geology.faults[<name>].<key>` and its line
+    /// in that fault's table; a good table lowers into a `FaultPlan` with paths resolved.
+    #[test]
+    fn fault_keys_name_the_fault_and_their_line() {
+        let faults = "\n[[geology.faults]]\nname = \"F1\"\ntrace = \"f1.csv\"\ndip = 60.0\n\
+                      dip_direction = 90.0\nthrow = 5.0\nkind = \"reverse\"\n\n\
+                      [[geology.faults]]\nname = \"F2\"\nsurface = \"f2.ts\"\nends_at = [\"F1\"]\n";
+        let base = geo().replace("element = \"prism\"", "element = \"tetra\"");
+        let ok = format!("{base}{faults}");
+        let p = Project::parse("d/p.toml", &ok, &[]).unwrap();
+        let g = p.geology().unwrap();
+        assert_eq!(g.faults.len(), 2);
+        assert_eq!(
+            g.faults[0].source,
+            FaultSource::Trace {
+                path: PathBuf::from("d/f1.csv"),
+                dip: 60.0,
+                dip_direction: 90.0
+            }
+        );
+        assert_eq!(g.faults[0].kind, FaultKind::Reverse);
+        assert_eq!(g.faults[0].throw, Some(5.0));
+        assert_eq!(g.faults[1].source, FaultSource::Surface("d/f2.ts".into()));
+        assert_eq!(g.faults[1].ends_at, ["F1"]);
+        assert_eq!(g.max_cell_height, DEFAULT_MAX_CELL_HEIGHT);
+        assert!(!g.split_faults);
+        let line_of = |text: &str, l: &str| 1 + text.lines().position(|x| x == l).unwrap();
+        for (from, to, want) in [
+            (
+                "dip = 60.0",
+                "dip = 0.0",
+                "geology.faults[F1].dip: 0 is outside (0, 90]",
+            ),
+            (
+                "dip = 60.0",
+                "dip = 95.0",
+                "geology.faults[F1].dip: 95 is outside (0, 90]",
+            ),
+            ("throw = 5.0", "throw = -5.0", "geology.faults[F1].throw"),
+            (
+                "ends_at = [\"F1\"]",
+                "ends_at = [\"F9\"]",
+                "geology.faults[F2].ends_at: 'F9' is not a fault",
+            ),
+            (
+                "ends_at = [\"F1\"]",
+                "ends_at = [\"F2\"]",
+                "geology.faults[F2].ends_at: 'F2' is this fault",
+            ),
+            (
+                "name = \"F2\"",
+                "name = \"F1\"",
+                "geology.faults[F1].name: 'F1' names two faults",
+            ),
+            (
+                "ends_at = [\"F1\"]",
+                "dip = 50.0",
+                "geology.faults[F2].dip: dip applies to a fault given by its trace",
+            ),
+            ("throw = 5.0", "zone = 2.0", "geology.faults[F1].zone"),
+            ("kind = \"reverse\"", "kind = \"sideways\"", "sideways"),
+        ] {
+            let text = ok.replacen(from, to, 1);
+            assert_ne!(text, ok, "{from}");
+            let e = Project::parse("p.toml", &text, &[])
+                .unwrap_err()
+                .to_string();
+            let line = line_of(&text, to);
+            assert!(
+                e.starts_with(&format!("p.toml, line {line}: ")) && e.contains(want),
+                "{e} (want line {line}: {want})"
+            );
+        }
+        let prism = format!("{}{faults}", geo());
+        let e = Project::parse("p.toml", &prism, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("geology.element") && e.contains("tetra"), "{e}");
+        let e = Project::parse("p.toml", &geo(), &["geology.fault_picks=p.csv".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("geology.fault_picks"), "{e}");
+        let e = Project::parse("p.toml", &ok, &["geology.max_cell_height=0".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("geology.max_cell_height"), "{e}");
+        let p = Project::parse("p.toml", &ok, &["geology.split_faults=true".into()]).unwrap();
+        assert!(p.geology().unwrap().split_faults);
     }
 
     #[test]

@@ -14,6 +14,9 @@ fn line_at(text: &str, offset: usize) -> usize {
 /// The line that sets `key` (`section.name`, or `section.sub.name` for an inline table
 /// entry, or `[section]` for the section header) in `text`, if it is there.
 pub(crate) fn key_line(text: &str, key: &str) -> Option<usize> {
+    if let Some(rest) = key.strip_prefix("geology.faults[") {
+        return fault_key_line(text, rest);
+    }
     let key = key.trim_start_matches('[').trim_end_matches(']');
     let mut parts = key.split('.');
     let section = parts.next()?;
@@ -38,6 +41,63 @@ pub(crate) fn key_line(text: &str, key: &str) -> Option<usize> {
         }
     }
     None
+}
+
+/// The line of `NAME].key` (the rest of `geology.faults[NAME].key`) in `text`: the key's line
+/// in the `[[geology.faults]]` table whose `name` is NAME (or the NAME-th table, 1-based, when
+/// no table has that name), else that table's header.
+fn fault_key_line(text: &str, rest: &str) -> Option<usize> {
+    let (name, k) = rest.split_once(']')?;
+    let k = k.trim_start_matches('.');
+    // (header line, lines of the table)
+    let mut tables: Vec<(usize, Vec<(usize, &str)>)> = Vec::new();
+    let mut inside = false;
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if line.starts_with('[') {
+            inside = line.replace(' ', "") == "[[geology.faults]]";
+            if inside {
+                tables.push((i + 1, Vec::new()));
+            }
+            continue;
+        }
+        if inside {
+            if let Some(t) = tables.last_mut() {
+                t.1.push((i + 1, line));
+            }
+        }
+    }
+    let value = |l: &str, key: &str| {
+        l.split_once('=')
+            .filter(|(a, _)| a.trim() == key)
+            .map(|(_, v)| {
+                v.split('#')
+                    .next()
+                    .unwrap_or("")
+                    .trim()
+                    .trim_matches('"')
+                    .to_string()
+            })
+    };
+    let table = tables
+        .iter()
+        .find(|t| {
+            t.1.iter()
+                .any(|(_, l)| value(l, "name").as_deref() == Some(name))
+        })
+        .or_else(|| {
+            name.parse::<usize>()
+                .ok()
+                .and_then(|n| tables.get(n.checked_sub(1)?))
+        })?;
+    Some(
+        table
+            .1
+            .iter()
+            .find(|(_, l)| value(l, k).is_some())
+            .map(|(n, _)| *n)
+            .unwrap_or(table.0),
+    )
 }
 
 /// The `section.key` set on line `line` of `text`, if that line sets one.

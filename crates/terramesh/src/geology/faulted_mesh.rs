@@ -1,0 +1,244 @@
+//! The kernel's faulted mesh (`terramesh_faults::FaultedMesh`) as the writers take it: a
+//! `VolumeMesh` (tetrahedra, the units as materials, the faces on the terrain, the base and the
+//! region's sides tagged, the faces between two units of one block tagged
+//! `interface-<lower unit>`, one sealed body per unit) and its `FaultData` (blocks named after
+//! their side of each fault, each fault's faces with the local face of the cell on each side).
+//! With split nodes (`terramesh_faults::split_nodes`) each side's faces name its own copies.
+//!
+//! The sides are named from the region's outline as the layer-cake model names them
+//! (`SideTags::Compass`): by the outward normal of each side face, `north`, `east`, `south` or
+//! `west`, whichever is closest (east or west on an exact diagonal).
+
+use std::collections::HashMap;
+
+use terramesh_core::volume::{Body, Cell, CellKind, FaceTag, TaggedFace, VolumeMesh};
+use terramesh_faults::{split_nodes, FaultedMesh};
+use terramesh_io::model::{cell_faces, FaceSide, FaultData, FaultFaces};
+
+use super::faulted::block_name;
+
+fn key(nodes: &[u32]) -> [u32; 3] {
+    let mut k = [nodes[0], nodes[1], nodes[2]];
+    k.sort_unstable();
+    k
+}
+
+const SIDES: [&str; 4] = ["north", "east", "south", "west"];
+
+/// The compass side of a boundary face by its outward normal `n`.
+fn compass(n: [f64; 3]) -> usize {
+    if n[0].abs() >= n[1].abs() {
+        if n[0] > 0.0 {
+            1
+        } else {
+            3
+        }
+    } else if n[1] > 0.0 {
+        0
+    } else {
+        2
+    }
+}
+
+/// The writers' model of a kernel mesh (see the module documentation): `units` the column's
+/// names, `base` the flat base's elevation, `split` to split the faults' nodes.
+pub fn to_volume(
+    mesh: &FaultedMesh,
+    units: &[String],
+    base: f64,
+    split: bool,
+) -> (VolumeMesh, FaultData) {
+    let (points, tets, original) = if split {
+        let s = split_nodes(mesh);
+        (s.points, s.tets, s.original)
+    } else {
+        let n = mesh.points.len() as u32;
+        (mesh.points.clone(), mesh.tets.clone(), (0..n).collect())
+    };
+    let cells: Vec<Cell> = tets.iter().map(|&t| Cell::tetra(t)).collect();
+    let faces = cell_faces(CellKind::Tetra);
+    let nodes_of =
+        |c: usize, k: usize| -> Vec<u32> { faces[k].iter().map(|&i| tets[c][i]).collect() };
+    // the local face of cell c whose original nodes are `want`
+    let local = |c: u32, want: [u32; 3]| -> u8 {
+        (0..4)
+            .find(|&k| {
+                let n = nodes_of(c as usize, k);
+                key(&n.iter().map(|&v| original[v as usize]).collect::<Vec<_>>()) == key(&want)
+            })
+            .expect("a fault face of its cell") as u8
+    };
+    let mut fault_faces: Vec<FaultFaces> = mesh
+        .faults
+        .iter()
+        .map(|n| FaultFaces {
+            name: n.clone(),
+            faces: vec![],
+        })
+        .collect();
+    let mut fault_side: HashMap<(u32, u8), ()> = HashMap::new();
+    for f in &mesh.fault_faces {
+        let pair = [0, 1].map(|s| FaceSide {
+            cell: f.cells[s],
+            face: local(f.cells[s], f.nodes),
+        });
+        for s in pair {
+            fault_side.insert((s.cell, s.face), ());
+        }
+        fault_faces[f.fault as usize].faces.push(pair);
+    }
+    // every face by its nodes (of this mesh: split copies differ)
+    let mut by_key: HashMap<[u32; 3], Vec<(u32, u8)>> = HashMap::new();
+    for c in 0..tets.len() {
+        for k in 0..4 {
+            by_key
+                .entry(key(&nodes_of(c, k)))
+                .or_default()
+                .push((c as u32, k as u8));
+        }
+    }
+    // tags: top, bottom, the four sides, the interfaces; compacted to those in use below
+    let mut tags = vec![FaceTag::Top, FaceTag::Bottom];
+    for s in SIDES {
+        tags.push(FaceTag::Side(s.into()));
+    }
+    for u in &units[1..mesh.units] {
+        tags.push(FaceTag::Interface(u.to_string()));
+    }
+    let mut tagged = Vec::new();
+    let mut keys: Vec<_> = by_key.keys().copied().collect();
+    keys.sort_unstable();
+    for k in keys {
+        let sides = &by_key[&k];
+        let tag = match sides.as_slice() {
+            [(c, f)] if !fault_side.contains_key(&(*c, *f)) => {
+                let n = nodes_of(*c as usize, *f as usize);
+                let p: Vec<[f64; 3]> = n.iter().map(|&v| points[v as usize]).collect();
+                let u = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
+                let v = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
+                let mut nn = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                // outward: away from the cell's fourth node
+                let opp = tets[*c as usize]
+                    .iter()
+                    .map(|&v| points[v as usize])
+                    .find(|q| !p.contains(q))
+                    .unwrap_or(p[0]);
+                let d = [opp[0] - p[0][0], opp[1] - p[0][1], opp[2] - p[0][2]];
+                if nn[0] * d[0] + nn[1] * d[1] + nn[2] * d[2] > 0.0 {
+                    nn = [-nn[0], -nn[1], -nn[2]];
+                }
+                let l = (nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]).sqrt();
+                let t = if p.iter().all(|q| q[2] == base) && nn[2] < 0.0 {
+                    1
+                } else if nn[2].abs() <= 1e-6 * l {
+                    2 + compass(nn) as u16
+                } else {
+                    0
+                };
+                Some((t, *c, *f))
+            }
+            [(a, fa), (b, fb)] => {
+                let (a, b) = (*a as usize, *b as usize);
+                if mesh.block[a] == mesh.block[b] && mesh.unit[a] != mesh.unit[b] {
+                    let (c, f) = if mesh.unit[a] > mesh.unit[b] {
+                        (a, *fa)
+                    } else {
+                        (b, *fb)
+                    };
+                    Some((5 + mesh.unit[c] as u16, c as u32, f))
+                } else {
+                    None
+                }
+            }
+            _ => None,
+        };
+        if let Some((t, c, f)) = tag {
+            let n = nodes_of(c as usize, f as usize);
+            tagged.push(TaggedFace {
+                nodes: [n[0], n[1], n[2], u32::MAX],
+                cell: c,
+                tag: t,
+            });
+        }
+    }
+    // compact the tags to those in use, in their order
+    let mut used = vec![false; tags.len()];
+    for f in &tagged {
+        used[f.tag as usize] = true;
+    }
+    let mut remap = vec![0u16; tags.len()];
+    let mut kept = Vec::new();
+    for (i, t) in tags.into_iter().enumerate() {
+        if used[i] {
+            remap[i] = kept.len() as u16;
+            kept.push(t);
+        }
+    }
+    for f in &mut tagged {
+        f.tag = remap[f.tag as usize];
+    }
+    tagged.sort_by_key(|f| (f.tag, f.cell, f.nodes));
+    // sealed bodies over the original nodes: faces of a unit's cells whose other side is not
+    // of that unit (or none)
+    let mut by_orig: HashMap<[u32; 3], Vec<(u32, u8)>> = HashMap::new();
+    for c in 0..tets.len() {
+        for k in 0..4 {
+            let n: Vec<u32> = nodes_of(c, k)
+                .iter()
+                .map(|&v| original[v as usize])
+                .collect();
+            by_orig
+                .entry(key(&n))
+                .or_default()
+                .push((c as u32, k as u8));
+        }
+    }
+    let mut bodies: Vec<Body> = (0..mesh.units)
+        .map(|u| Body {
+            unit: u,
+            triangles: vec![],
+        })
+        .collect();
+    let mut okeys: Vec<_> = by_orig.keys().copied().collect();
+    okeys.sort_unstable();
+    for k in okeys {
+        let sides = &by_orig[&k];
+        for &(c, f) in sides {
+            let u = mesh.unit[c as usize];
+            if sides
+                .iter()
+                .all(|&(d, _)| d == c || mesh.unit[d as usize] != u)
+            {
+                let n: Vec<u32> = nodes_of(c as usize, f as usize)
+                    .iter()
+                    .map(|&v| original[v as usize])
+                    .collect();
+                bodies[u as usize].triangles.push([n[0], n[1], n[2]]);
+            }
+        }
+    }
+    bodies.retain(|b| !b.triangles.is_empty());
+    let vm = VolumeMesh {
+        points,
+        cells,
+        material: mesh.unit.iter().map(|&u| u as i32).collect(),
+        units: units[..mesh.units].to_vec(),
+        faces: tagged,
+        tags: kept,
+        bodies,
+    };
+    let fd = FaultData {
+        block: mesh.block.iter().map(|&b| b as i32).collect(),
+        blocks: mesh
+            .blocks
+            .iter()
+            .map(|b| block_name(&mesh.faults, b))
+            .collect(),
+        faults: fault_faces,
+    };
+    (vm, fd)
+}
