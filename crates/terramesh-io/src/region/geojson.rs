@@ -66,31 +66,7 @@ pub fn parse_geojson_lines(text: &str) -> Result<Vec<GeoJsonLine>, String> {
 }
 
 fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), String> {
-    match kind(v, path)? {
-        "FeatureCollection" => {
-            let feats = v
-                .get("features")
-                .and_then(Value::as_array)
-                .ok_or_else(|| format!("{path}: FeatureCollection without a \"features\" array"))?;
-            for (i, f) in feats.iter().enumerate() {
-                walk_lines(f, &format!("{path}.features[{i}]"), out)?;
-            }
-            Ok(())
-        }
-        "Feature" => match v.get("geometry") {
-            Some(Value::Null) | None => Ok(()),
-            Some(g) => walk_lines(g, &format!("{path}.geometry"), out),
-        },
-        "GeometryCollection" => {
-            let gs = v
-                .get("geometries")
-                .and_then(Value::as_array)
-                .ok_or_else(|| format!("{path}: GeometryCollection without \"geometries\""))?;
-            for (i, g) in gs.iter().enumerate() {
-                walk_lines(g, &format!("{path}.geometries[{i}]"), out)?;
-            }
-            Ok(())
-        }
+    each_geometry(v, path, &mut |v, kind, path| match kind {
         "LineString" => {
             let p = format!("{path}.coordinates");
             let l = positions(coords(v, path)?, &p)?;
@@ -111,7 +87,7 @@ fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), S
             "{path}: a polygon where a polyline (LineString or MultiLineString) is expected"
         )),
         other => Err(format!("{path}: unknown GeoJSON type \"{other}\"")),
-    }
+    })
 }
 
 /// serde_json's error worded with its line and column first.
@@ -139,7 +115,13 @@ fn kind<'a>(v: &'a Value, path: &str) -> Result<&'a str, String> {
         .ok_or_else(|| format!("{path}: missing \"type\""))
 }
 
-fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
+/// Calls `leaf` with every geometry of `v` (its kind and path), through FeatureCollections,
+/// Features (a null geometry is skipped) and GeometryCollections.
+fn each_geometry(
+    v: &Value,
+    path: &str,
+    leaf: &mut dyn FnMut(&Value, &str, &str) -> Result<(), String>,
+) -> Result<(), String> {
     match kind(v, path)? {
         "FeatureCollection" => {
             let feats = v
@@ -147,13 +129,13 @@ fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
                 .and_then(Value::as_array)
                 .ok_or_else(|| format!("{path}: FeatureCollection without a \"features\" array"))?;
             for (i, f) in feats.iter().enumerate() {
-                walk(f, &format!("{path}.features[{i}]"), region)?;
+                each_geometry(f, &format!("{path}.features[{i}]"), leaf)?;
             }
             Ok(())
         }
         "Feature" => match v.get("geometry") {
             Some(Value::Null) | None => Ok(()),
-            Some(g) => walk(g, &format!("{path}.geometry"), region),
+            Some(g) => each_geometry(g, &format!("{path}.geometry"), leaf),
         },
         "GeometryCollection" => {
             let gs = v
@@ -161,10 +143,16 @@ fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
                 .and_then(Value::as_array)
                 .ok_or_else(|| format!("{path}: GeometryCollection without \"geometries\""))?;
             for (i, g) in gs.iter().enumerate() {
-                walk(g, &format!("{path}.geometries[{i}]"), region)?;
+                each_geometry(g, &format!("{path}.geometries[{i}]"), leaf)?;
             }
             Ok(())
         }
+        other => leaf(v, other, path),
+    }
+}
+
+fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
+    each_geometry(v, path, &mut |v, kind, path| match kind {
         "Polygon" => {
             let c = coords(v, path)?;
             region
@@ -199,7 +187,7 @@ fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
         }
         "Point" | "MultiPoint" => Ok(()),
         other => Err(format!("{path}: unknown GeoJSON type \"{other}\"")),
-    }
+    })
 }
 
 fn coords<'a>(v: &'a Value, path: &str) -> Result<&'a Value, String> {
