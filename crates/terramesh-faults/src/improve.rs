@@ -878,6 +878,16 @@ mod tests {
     /// Runs the pass on cells whose nodes all lie on the terrain (none may move or be
     /// collapsed: only a flip can mend them); returns the cells and their smallest angle.
     fn pass(points: Vec<[f64; 3]>, tets: Vec<[u32; 4]>) -> (State, Improved) {
+        let below = vec![0; tets.len()];
+        pass_below(points, tets, below)
+    }
+
+    /// [`pass`], each cell in the unit `below` gives.
+    fn pass_below(
+        points: Vec<[f64; 3]>,
+        tets: Vec<[u32; 4]>,
+        below: Vec<u32>,
+    ) -> (State, Improved) {
         let n = points.len();
         let m = tets.len();
         let mut st = State {
@@ -886,7 +896,7 @@ mod tests {
             on_fault: vec![0; n],
             tets,
             positive: vec![0; m],
-            below: vec![0; m],
+            below,
             block: vec![0; m],
             report: BuildReport::default(),
         };
@@ -986,31 +996,7 @@ mod tests {
             [c[0], c[1], 0.2],
             [c[0], c[1], -0.2],
         ];
-        let n = points.len();
-        let mut st = State {
-            points,
-            flags: vec![TOP; n],
-            on_fault: vec![0; n],
-            tets: vec![[0, 1, 2, 3], [0, 1, 2, 4]],
-            positive: vec![0; 2],
-            below: vec![0, 1],
-            block: vec![0; 2],
-            report: BuildReport::default(),
-        };
-        for t in &mut st.tets {
-            if !positive(t.map(|v| st.points[v as usize])) {
-                t.swap(0, 1);
-            }
-        }
-        let terrain = Terrain::new(
-            vec![[-100.0, -100.0], [100.0, -100.0], [0.0, 100.0]],
-            vec![[0, 1, 2]],
-            vec![10.0; 3],
-        )
-        .unwrap();
-        let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
-        let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
-        let done = improve(&mut st, &faults, &[], &h, 0, &terrain, n, 20.0, 2);
+        let (st, done) = pass_below(points, vec![[0, 1, 2, 3], [0, 1, 2, 4]], vec![0, 1]);
         assert_eq!(done.flipped, 0);
         assert_eq!(st.tets.len(), 2);
     }
