@@ -113,6 +113,20 @@ pub enum Error {
     /// turned true): nothing it was writing was kept.
     #[error("stopped before it finished; its unfinished files were removed")]
     Cancelled,
+    /// Meshing a region failed: the region's file (`None`: its corners) and its size, so that
+    /// a region far larger than meant (a damaged coordinate) shows at once.
+    #[error("{}", mesh_region_message(file.as_deref(), *area, *zone, &neutral))]
+    MeshRegion {
+        /// The region file, or `None` for corners.
+        file: Option<std::path::PathBuf>,
+        /// The region's area, square metres.
+        area: f64,
+        /// Its UTM zone, if projected to one.
+        zone: Option<terramesh_core::coords::Zone>,
+        /// Why meshing failed.
+        #[source]
+        source: Box<Error>,
+    },
     /// What was being done when `source` happened.
     #[error("{context}")]
     Context {
@@ -244,6 +258,23 @@ fn mesh_message(m: &terramesh_mesh::MeshError, word: &dyn Fn(Setting) -> String)
     }
 }
 
+/// The context of [`Error::MeshRegion`]: `the region of FILE (AREA m2 in UTM zone Z)`.
+fn mesh_region_message(
+    file: Option<&std::path::Path>,
+    area: f64,
+    zone: Option<terramesh_core::coords::Zone>,
+    word: &dyn Fn(Setting) -> String,
+) -> String {
+    let what = match file {
+        Some(p) => p.display().to_string(),
+        None => word(Setting::Corners),
+    };
+    let zone = zone
+        .map(|z| format!(" in UTM zone {z}"))
+        .unwrap_or_default();
+    format!("the region of {what} ({area:.4e} m2{zone})")
+}
+
 fn neutral(s: Setting) -> String {
     s.to_string()
 }
@@ -304,6 +335,9 @@ impl Error {
                     | Error::Geostat(terramesh_geostat::GeostatError::TooLarge(t)),
                 ) => t.describe(&|field| Setting::of_field(field).map_or(field.to_string(), name)),
                 Some(Error::Mesh(m)) => mesh_message(m, name),
+                Some(Error::MeshRegion {
+                    file, area, zone, ..
+                }) => mesh_region_message(file.as_deref(), *area, *zone, name),
                 _ => e.to_string(),
             };
             // A kernel error that names a setting in words, worded from its fields; its
@@ -327,7 +361,9 @@ impl Error {
                 parts.push(text);
             }
             cur = match e.downcast_ref::<Error>() {
-                Some(Error::Context { source, .. }) => Some(source.as_ref()),
+                Some(Error::Context { source, .. } | Error::MeshRegion { source, .. }) => {
+                    Some(source.as_ref())
+                }
                 Some(Error::Setting { .. } | Error::Invalid(_) | Error::Project { .. }) => None,
                 _ => e.source(),
             };
