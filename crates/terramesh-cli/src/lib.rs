@@ -166,14 +166,6 @@ pub(crate) fn flag_error(e: terramesh::Error) -> anyhow::Error {
     anyhow::anyhow!(e.render(&cmd::sample::flag_of))
 }
 
-/// A library setting named as its field (`max_area`) as this tool's flag (`--max-area`).
-pub(crate) fn flag_of_field(field: &str) -> String {
-    terramesh::Setting::of_field(field).map_or_else(
-        || format!("--{}", field.replace('_', "-")),
-        cmd::sample::flag_of,
-    )
-}
-
 /// A library error worded for a project file: each setting as its key.
 pub(crate) fn project_error(e: terramesh::Error) -> anyhow::Error {
     anyhow::anyhow!(e.render(&terramesh::project::key_of))

@@ -79,5 +79,5 @@ pub use merged::Merged;
 pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};
-pub use plan::{parse_tile_size, plan, Planned};
-pub use slurm::{check_sbatch_value, write_slurm, SlurmOptions, SlurmScripts};
+pub use plan::{check_halo, parse_tile_size, plan, Planned};
+pub use slurm::{check_sbatch_value, write_slurm, SbatchValueError, SlurmOptions, SlurmScripts};

@@ -95,16 +95,14 @@ pub fn run(args: Args) -> Result<()> {
         max_error: args.max_error,
         ..MeshPlan::unsmoothed()
     };
-    let (crs, zone, points, dem, output) =
-        (args.crs, args.zone, args.points, args.dem, args.output);
     let job = MeshJob {
         region,
-        crs,
-        zone,
+        crs: args.crs,
+        zone: args.zone,
         plan,
-        points,
-        dem,
-        output,
+        points: args.points,
+        dem: args.dem,
+        output: args.output,
     };
     crate::say(&job.run().map_err(crate::flag_error)?)
 }

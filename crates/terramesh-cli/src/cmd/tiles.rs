@@ -103,15 +103,8 @@ pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
     match args.command {
         Sub::Plan(a) => {
-            if a.halo != "auto" {
-                anyhow::bail!(
-                    "--halo '{}': only auto is supported (the halo is computed from the \
-                     kriging neighbourhood so that every tile sees the samples it needs)",
-                    a.halo
-                );
-            }
-            let size = tiles::parse_tile_size(&a.tile_size)
-                .map_err(|e| anyhow::anyhow!("--tile-size {e}"))?;
+            tiles::check_halo(&a.halo).map_err(crate::flag_error)?;
+            let size = tiles::parse_tile_size(&a.tile_size).map_err(crate::flag_error)?;
             let p = Project::load(&a.project, &a.set).map_err(crate::project_error)?;
             let base = a.project.parent().unwrap_or(Path::new("."));
             let progress = Terminal::new(a.quiet, true);
@@ -164,27 +157,16 @@ pub fn run(args: Args) -> Result<()> {
             ))?;
         }
         Sub::Slurm(a) => {
-            // Each value becomes an #SBATCH line: refused before anything is written.
-            for (flag, value) in [
-                ("--partition", Some(&a.partition)),
-                ("--time", Some(&a.time)),
-                ("--mem", a.mem.as_ref()),
-            ] {
-                if let Some(v) = value {
-                    tiles::check_sbatch_value(v)
-                        .map_err(|why| anyhow::anyhow!("{flag} {v:?}: {why}"))?;
-                }
-            }
-            let binary = crate::program()?;
-            let output = a.output.unwrap_or_else(|| a.plan.join("merged"));
             let o = tiles::SlurmOptions {
+                binary: crate::program()?,
+                output: a.output.unwrap_or_else(|| a.plan.join("merged")),
                 partition: a.partition,
                 time: a.time,
                 cpus: a.cpus,
                 mem: a.mem,
-                binary,
-                output,
             };
+            // Each value becomes an #SBATCH line: refused before anything is written.
+            o.check().map_err(crate::flag_error)?;
             let s = tiles::write_slurm(&a.plan, &o).map_err(crate::project_error)?;
             crate::say(&format!(
                 "wrote {}, {} and {}: submit with bash {}\n",

@@ -28,11 +28,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod cv_job;
 mod job;
 mod method_options;
 mod model_options;
 mod variogram_job;
 
+pub use cv_job::CvJob;
 pub use job::{InterpolateJob, Targets};
 pub use method_options::{DriftOptions, ExternalDriftSetup, MethodOptions};
 pub use model_options::{LagOptions, ModelOptions};
