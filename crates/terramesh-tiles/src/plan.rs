@@ -34,6 +34,21 @@ pub struct Planned {
     pub max_halo: f64,
 }
 
+impl Planned {
+    /// What to tell the user of a plan written into `output`, `seconds` after the start.
+    pub fn summary(&self, output: &Path, seconds: f64) -> String {
+        format!(
+            "planned {} tiles ({} x {}) of {} samples into {} (widest halo {:.0} m) in {seconds:.2} s",
+            self.tiles,
+            self.shape[0],
+            self.shape[1],
+            self.samples,
+            output.display(),
+            self.max_halo
+        )
+    }
+}
+
 /// Parses a tile size: metres (`2500`, `2500m`) or kilometres (`10km`, `2.5km`); anything
 /// else is [`Setting::TileSize`](terramesh::Setting::TileSize).
 ///

@@ -34,6 +34,19 @@ pub struct SlurmScripts {
     pub submit: PathBuf,
 }
 
+impl SlurmScripts {
+    /// What to tell the user of the scripts written.
+    pub fn summary(&self) -> String {
+        format!(
+            "wrote {}, {} and {}: submit with bash {}\n",
+            self.tiles.display(),
+            self.merge.display(),
+            self.submit.display(),
+            self.submit.display()
+        )
+    }
+}
+
 /// `s` as one bash word in single quotes (a `'` written `'\''`).
 fn quote_str(s: &str) -> String {
     format!("'{}'", s.replace('\'', "'\\''"))

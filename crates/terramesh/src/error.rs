@@ -372,6 +372,32 @@ impl Error {
     }
 }
 
+impl Error {
+    /// [`Error::render`] said of `file` (a project file the user wrote): `FILE: message`,
+    /// unless the message names the file already.
+    ///
+    /// ```
+    /// use terramesh::{Error, Setting};
+    /// let e = Error::setting(Setting::Margin, "ten", "give a fraction");
+    /// assert_eq!(e.render_of_file("p.toml".as_ref(), &|s| s.to_string()), "p.toml: margin 'ten': give a fraction");
+    /// let e = Error::within("p.toml, line 3", e);
+    /// assert_eq!(e.render_of_file("p.toml".as_ref(), &|s| s.to_string()), "p.toml, line 3: margin 'ten': give a fraction");
+    /// ```
+    pub fn render_of_file(
+        &self,
+        file: &std::path::Path,
+        name: &dyn Fn(Setting) -> String,
+    ) -> String {
+        let msg = self.render(name);
+        let file = file.display().to_string();
+        if msg.contains(&file) {
+            msg
+        } else {
+            format!("{file}: {msg}")
+        }
+    }
+}
+
 /// Adds context to errors, like `anyhow::Context`, for this crate's [`Error`].
 pub trait Context<T> {
     /// Wraps the error with `context`.

@@ -154,6 +154,8 @@ pub enum Setting {
     Time,
     /// The Slurm memory of each task.
     Mem,
+    /// Replacing a file that exists.
+    Force,
 }
 
 impl Setting {
@@ -259,4 +261,5 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::Partition => "partition",
     Setting::Time => "time",
     Setting::Mem => "mem",
+    Setting::Force => "force",
 ]);

@@ -101,6 +101,7 @@ struct SlurmArgs {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
+    let secs = || t0.elapsed().as_secs_f64();
     match args.command {
         Sub::Plan(a) => {
             tiles::check_halo(&a.halo).map_err(crate::flag_error)?;
@@ -110,51 +111,15 @@ pub fn run(args: Args) -> Result<()> {
             let progress = Terminal::new(a.quiet, true);
             let planned = tiles::plan(&p, &a.project, &a.set, base, size, &a.output, &progress)
                 .map_err(crate::project_error)?;
-            progress.finish(&format!(
-                "planned {} tiles ({} x {}) of {} samples into {} (widest halo {:.0} m) in {:.2} s",
-                planned.tiles,
-                planned.shape[0],
-                planned.shape[1],
-                planned.samples,
-                a.output.display(),
-                planned.max_halo,
-                t0.elapsed().as_secs_f64()
-            ));
+            progress.finish(&planned.summary(&a.output, secs()));
         }
         Sub::Build(a) => {
-            match tiles::build_tile(&a.plan, &a.tile).map_err(crate::project_error)? {
-                tiles::Outcome::AlreadyDone => crate::say(&format!(
-                    "tile {} is done already: nothing changed\n",
-                    a.tile
-                ))?,
-                tiles::Outcome::Built(s) => crate::say(&format!(
-                    "built tile {}: {} vertices, {} triangles, {} grid nodes from {} samples in \
-                     {:.2} s\n",
-                    a.tile,
-                    s.vertices,
-                    s.triangles,
-                    s.grid_nodes,
-                    s.samples,
-                    t0.elapsed().as_secs_f64()
-                ))?,
-            }
+            let outcome = tiles::build_tile(&a.plan, &a.tile).map_err(crate::project_error)?;
+            crate::say(&outcome.summary(&a.tile, secs()))?;
         }
         Sub::Merge(a) => {
             let m = tiles::merge(&a.plan, &a.output).map_err(crate::project_error)?;
-            let model = m.model.as_ref().map_or(String::new(), |g| {
-                format!(
-                    ", a geological model of {} cells and {} nodes",
-                    g.cells, g.nodes
-                )
-            });
-            crate::say(&format!(
-                "merged into {}: {} vertices, {} triangles, {} seam vertices{model} in {:.2} s\n",
-                a.output.display(),
-                m.vertices,
-                m.triangles,
-                m.seam_vertices,
-                t0.elapsed().as_secs_f64()
-            ))?;
+            crate::say(&m.summary(&a.output, secs()))?;
         }
         Sub::Slurm(a) => {
             let o = tiles::SlurmOptions {
@@ -168,13 +133,7 @@ pub fn run(args: Args) -> Result<()> {
             // Each value becomes an #SBATCH line: refused before anything is written.
             o.check().map_err(crate::flag_error)?;
             let s = tiles::write_slurm(&a.plan, &o).map_err(crate::project_error)?;
-            crate::say(&format!(
-                "wrote {}, {} and {}: submit with bash {}\n",
-                s.tiles.display(),
-                s.merge.display(),
-                s.submit.display(),
-                s.submit.display()
-            ))?;
+            crate::say(&s.summary())?;
         }
     }
     Ok(())
