@@ -56,6 +56,7 @@ pub mod georef;
 pub mod gltf;
 pub mod horizon;
 pub mod interpolate;
+pub mod interrupt;
 pub mod mesh;
 pub mod plan;
 pub mod project;

@@ -371,15 +371,8 @@ impl MeshJob {
     /// The region of a front end's two ways to give it: corners, or a region file;
     /// [`Setting::Region`] when neither is given.
     pub fn region_input(corners: Option<String>, file: Option<PathBuf>) -> Result<RegionInput> {
-        match (corners, file) {
-            (Some(c), _) => Ok(RegionInput::Corners(c)),
-            (None, Some(f)) => Ok(RegionInput::File(f)),
-            (None, None) => Err(Error::setting(
-                Setting::Region,
-                "",
-                "give the region with {region}",
-            )),
-        }
+        RegionInput::given(corners, file)
+            .ok_or_else(|| Error::setting(Setting::Region, "", "give the region with {region}"))
     }
 
     /// Checks the settings (before any file is read), meshes the region, writes the mesh and
