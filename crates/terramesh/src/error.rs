@@ -106,7 +106,164 @@ pub enum Error {
     /// A size that follows from input would not fit in memory.
     #[error(transparent)]
     TooLarge(#[from] terramesh_core::limits::TooLarge),
-    /// Anything else, in words.
+    /// A targets CSV file without an `x` or a `y` column.
+    #[error("{file}: needs columns 'x' and 'y' (the header has: {header})")]
+    NoXyColumns {
+        /// The file.
+        file: String,
+        /// Its header, the names joined by `, `.
+        header: String,
+    },
+    /// A cell that must hold a finite number.
+    #[error("{file}, line {line}, column '{column}': '{text}' is not a finite number")]
+    NotANumber {
+        /// The file.
+        file: String,
+        /// The line (1-based).
+        line: u64,
+        /// The column's name.
+        column: String,
+        /// The cell as written.
+        text: String,
+    },
+    /// A targets file with a header and no rows.
+    #[error("{file}: no target rows after the header")]
+    NoTargets {
+        /// The file.
+        file: String,
+    },
+    /// Kriging failed at a target row of a file (`error`'s target index is the row's, 0-based).
+    #[error("{file}: {}", error.display_with_target(|i| format!("target row {}", i + 1)))]
+    AtTargetRow {
+        /// The targets file.
+        file: String,
+        /// The kernel's error.
+        error: terramesh_geostat::GeostatError,
+    },
+    /// A point of a points file that the source's CRS cannot place.
+    #[error("{file}: point {point} ({x}, {y}) is not a valid position in {crs}")]
+    BadPosition {
+        /// The points file.
+        file: String,
+        /// The point (1-based).
+        point: usize,
+        /// Its x.
+        x: f64,
+        /// Its y.
+        y: f64,
+        /// The CRS, as written.
+        crs: String,
+    },
+    /// A build's source is in a projected CRS without a project CRS to relate it to.
+    #[error(
+        "the source is in a projected CRS terramesh does not convert; use a geographic or UTM \
+         source for build, or give the project's CRS with [region] crs = \"EPSG:<code>\" (or \
+         \"projected\" when the region and the source share one metric CRS)"
+    )]
+    UnconvertedSource,
+    /// Too few samples with an elevation to build from.
+    #[error("only {samples} samples with an elevation: enlarge the grid or check the source")]
+    TooFewSamples {
+        /// The samples with an elevation.
+        samples: usize,
+    },
+    /// An interpolation gave NaN or an infinity at a mesh vertex.
+    #[error(
+        "{method} gave a non-finite value at mesh vertex {vertex}: the kriging system is \
+         ill-conditioned"
+    )]
+    NonFiniteAtVertex {
+        /// The method (`the DSM method`, ...).
+        method: String,
+        /// The vertex (0-based).
+        vertex: usize,
+    },
+    /// `[mesh] max_error` (an adaptive mesh) with `max_edge`.
+    #[error(
+        "[mesh]: max_edge cannot be combined with max_error (adaptive meshes vary in size); use \
+         max_area as the upper limit"
+    )]
+    MaxEdgeWithMaxError,
+    /// `[mesh] max_error` (an adaptive mesh) with `insert_samples`.
+    #[error("[mesh]: insert_samples cannot be combined with max_error")]
+    InsertSamplesWithMaxError,
+    /// `[mesh] max_error` closer than the kriged surface's own departure from a smooth one.
+    #[error(
+        "[mesh]: max_error = {target} m is too close to how far the kriged surface departs from a \
+         smooth surface through a grid of {nodes} nodes ({departure:.3} m; a moving neighbourhood \
+         makes kriging jump where the neighbour set changes): raise mesh.max_error above {:.3}, \
+         or krige with more neighbours (interpolation.neighbors, 0 for all)",
+        departure / 0.75
+    )]
+    MaxErrorTooSmall {
+        /// `mesh.max_error`, metres.
+        target: f64,
+        /// The nodes of the grid of the kriged surface.
+        nodes: usize,
+        /// How far the kriged surface departs from the smooth one, metres.
+        departure: f64,
+    },
+    /// The geological column names no unit.
+    #[error("the geological column names no unit: list them in [geology] units")]
+    NoUnits,
+    /// `interpolate = "thickness"` with horizon grids, which give tops.
+    #[error(
+        "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" to \
+         use them"
+    )]
+    GridsGiveTops,
+    /// `interpolate = "thickness"` without boreholes.
+    #[error("interpolate = \"thickness\" needs boreholes: set [geology] collars")]
+    ThicknessNeedsBoreholes,
+    /// A base of one value per vertex with another number of values.
+    #[error("the base has {values} values for the {vertices} vertices of the planar mesh")]
+    BaseValues {
+        /// The values given.
+        values: usize,
+        /// The vertices of the planar mesh.
+        vertices: usize,
+    },
+    /// A horizon grid given for the first unit, whose top is the terrain.
+    #[error(
+        "geology.surfaces.{unit}: the top of the first unit is the terrain (the DSM); give grids \
+         for the units below it"
+    )]
+    FirstUnitGrid {
+        /// The first unit.
+        unit: String,
+    },
+    /// A base grid without a value at a vertex of the model's mesh.
+    #[error(
+        "{}: the base grid has no value at ({x:.1}, {y:.1}), a vertex of the model's mesh: a \
+         base grid must cover the whole region",
+        file.display()
+    )]
+    BaseGridGap {
+        /// The base grid.
+        file: std::path::PathBuf,
+        /// The vertex's x.
+        x: f64,
+        /// The vertex's y.
+        y: f64,
+    },
+    /// A unit that no borehole meets and no grid gives.
+    #[error("no observation of {unit}: no borehole meets it and no grid gives it")]
+    NoObservation {
+        /// The unit.
+        unit: String,
+    },
+    /// A model ensemble asked for with no realisations.
+    #[error("interpolation.realisations = 0: no realisation of the model to simulate")]
+    NoRealisations,
+    /// A geological model without a body of any volume, for a file that draws them.
+    #[error("{}: the model has no unit with volume", file.display())]
+    NoVolume {
+        /// The file.
+        file: std::path::PathBuf,
+    },
+    /// Anything else, in words: only the faulted geology stage (`geology/faulted*.rs`) and
+    /// the exports (`build/exports.rs`) still word errors this way, and [`Context`] on an
+    /// `Option`.
     #[error("{0}")]
     Invalid(String),
     /// The work was stopped on request ([`Progress::cancelled`](crate::progress::Progress::cancelled)

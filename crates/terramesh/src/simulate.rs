@@ -53,10 +53,7 @@ pub fn read_targets(path: &Path) -> Result<Vec<[f64; 2]>> {
         out.push([t.number(r, xc)?, t.number(r, yc)?]);
     }
     if out.is_empty() {
-        return Err(Error::invalid(format!(
-            "{}: no target rows after the header",
-            t.name
-        )));
+        return Err(Error::NoTargets { file: t.name });
     }
     Ok(out)
 }

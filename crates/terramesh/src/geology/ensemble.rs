@@ -58,7 +58,7 @@ use terramesh_io::model::{write_model_vtu, ModelInfo};
 use super::fields::{FieldModel, Observation};
 use super::model::{field_observations, seal, stack_of, Base, GeologicalModel, ModelInputs};
 use super::stage::ModelBuilt;
-use crate::error::{bail, Context, Error, Result};
+use crate::error::{Context, Error, Result};
 use crate::plan::GeologyPlan;
 use crate::project::Project;
 
@@ -129,7 +129,7 @@ pub fn simulate_models(
 ) -> Result<ModelEnsemble> {
     let nr = terrains.len();
     if nr == 0 {
-        bail!("interpolation.realisations = 0: no realisation of the model to simulate");
+        return Err(Error::NoRealisations);
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let n = xy.len();
