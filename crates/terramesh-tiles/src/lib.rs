@@ -71,8 +71,8 @@ pub use geology::{
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
-    tile_dir, update, CrsText, DataRule, GridSpec, Manifest, Seam, State, Tile, TileData,
-    TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
+    tile_dir, update, CrsText, DataRule, GridSpec, Manifest, ManifestError, Seam, State, Tile,
+    TileData, TileProblem, TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::merge;
 pub use merged::Merged;

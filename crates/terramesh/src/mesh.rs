@@ -16,7 +16,7 @@
 
 use std::path::{Path, PathBuf};
 
-use terramesh_core::coords::{parse_angle, to_utm, to_wgs84, Axis, Zone};
+use terramesh_core::coords::{parse_angle, to_utm, to_wgs84, Axis, CoordError, Zone};
 use terramesh_core::geometry::Region;
 use terramesh_core::sampling::Kernel;
 use terramesh_io::dem::{open_raster, ElevationSource};
@@ -168,6 +168,20 @@ pub struct DemHeights {
     name: String,
 }
 
+/// Why a DEM has no height at a point ([`DemHeights::height`]).
+#[derive(Debug, thiserror::Error)]
+pub enum HeightError {
+    /// The point cannot be converted to the DEM's coordinates.
+    #[error(transparent)]
+    Coord(#[from] CoordError),
+    /// The point is outside the domain of the DEM's coordinate system.
+    #[error("outside the DEM's coordinate system")]
+    OutsideCrs,
+    /// The DEM has no value there (outside it, or a void).
+    #[error(transparent)]
+    Missing(terramesh_core::sampling::Missing),
+}
+
 impl DemHeights {
     /// Opens the DEM at `path` for a region in `zone` (`None`: the DEM's own coordinates).
     pub fn open(path: &Path, zone: Option<Zone>) -> Result<DemHeights> {
@@ -185,22 +199,21 @@ impl DemHeights {
     }
 
     /// The height at `(x, y)`, or why there is none.
-    pub fn height(&self, x: f64, y: f64) -> std::result::Result<f64, String> {
+    pub fn height(&self, x: f64, y: f64) -> std::result::Result<f64, HeightError> {
         let (sx, sy) = match self.zone {
             Some(z) => {
-                let (lat, lon) = to_wgs84(x, y, z).map_err(|e| e.to_string())?;
+                let (lat, lon) = to_wgs84(x, y, z)?;
                 self.dem
                     .crs()
-                    .from_wgs84(lat, lon)
-                    .map_err(|e| e.to_string())?
-                    .ok_or("outside the DEM's coordinate system")?
+                    .from_wgs84(lat, lon)?
+                    .ok_or(HeightError::OutsideCrs)?
             }
             None => (x, y),
         };
         self.dem
             .sample(sx, sy, Kernel::Bilinear)
             .or_else(|_| self.dem.sample(sx, sy, Kernel::Nearest))
-            .map_err(|e| e.to_string())
+            .map_err(HeightError::Missing)
     }
 
     /// Checks that the DEM covers `region`: its corners and a 101 x 101 grid inside it.
