@@ -79,6 +79,12 @@ pub enum Error {
     /// Writing a mesh file.
     #[error(transparent)]
     MeshWrite(#[from] terramesh_io::export::MeshWriteError),
+    /// Writing the geological model's files.
+    #[error(transparent)]
+    ModelWrite(#[from] terramesh_io::model::ModelWriteError),
+    /// A fault's file (a trace, a surface, picks).
+    #[error(transparent)]
+    FaultFile(Box<terramesh_io::faults::FaultFileError>),
     /// Writing the terrain tiles.
     #[error(transparent)]
     Terrain(#[from] terramesh_io::export::TerrainError),
@@ -261,6 +267,79 @@ pub enum Error {
         /// The file.
         file: std::path::PathBuf,
     },
+    /// `source`, about `what` (a file, a point, a stage): shown as `what: source` (the
+    /// source's whole chain).
+    #[error("{what}: {}", source.render(&neutral))]
+    About {
+        /// What it is about.
+        what: String,
+        /// The error.
+        #[source]
+        source: Box<Error>,
+    },
+    /// A path that a project key gives, and what is wrong with it.
+    #[error("{key} {}: {problem}", path.display())]
+    ProjectPath {
+        /// The key (`region.file`, `geology.collars`, ...).
+        key: String,
+        /// The path (joined to the project's folder).
+        path: std::path::PathBuf,
+        /// What is wrong.
+        problem: PathProblem,
+    },
+    /// Neither the source nor its fallback exists.
+    #[error(
+        "source.path {} and source.fallback {} do not exist",
+        path.display(),
+        fallback.display()
+    )]
+    NoSource {
+        /// `source.path`.
+        path: std::path::PathBuf,
+        /// `source.fallback`.
+        fallback: std::path::PathBuf,
+    },
+    /// `[region]` with both corners and a file, or neither.
+    #[error("[region]: give corners or file, not both or neither")]
+    CornersOrFile,
+    /// `terramesh model` of a project without `[geology]`.
+    #[error(
+        "the project has no [geology] section: add one (terramesh init --geology writes a \
+         template) or use terramesh build for the surface model"
+    )]
+    NoGeology,
+    /// An external drift that the other drift terms give at the data already.
+    #[error("the external drift is a combination of the other drift terms at the data")]
+    DriftCollinear,
+    /// A variogram file that cannot be used.
+    #[error(
+        "{}: {source}{}",
+        file.display(),
+        if matches!(source, terramesh_geostat::VariogramFileError::NoModel) {
+            " (write it with terramesh variogram)"
+        } else {
+            ""
+        }
+    )]
+    VariogramFile {
+        /// The file.
+        file: std::path::PathBuf,
+        /// What is wrong.
+        source: terramesh_geostat::VariogramFileError,
+    },
+    /// A project CRS that terramesh cannot transform to WGS 84, with exports that need it.
+    #[error(
+        "{key} = \"{crs}\": the geographic exports (kml, dae, glb, 3dtiles, terrain) need WGS-84 \
+         positions, and {source}; remove them from export.formats"
+    )]
+    NoWgs84 {
+        /// The key that gave the CRS.
+        key: String,
+        /// The CRS.
+        crs: String,
+        /// Why there is no transformation.
+        source: Box<terramesh_crs::CrsError>,
+    },
     /// Anything else, in words: only the faulted geology stage (`geology/faulted*.rs`) and
     /// the exports (`build/exports.rs`) still word errors this way, and [`Context`] on an
     /// `Option`.
@@ -295,6 +374,36 @@ pub enum Error {
     },
 }
 
+/// What is wrong with a path a project key gives ([`Error::ProjectPath`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PathProblem {
+    /// No file there (a path relative to the project file).
+    #[error("no such file: check the path (relative to the project file)")]
+    NoSuchFile,
+    /// Nothing there.
+    #[error("does not exist (no such file or directory)")]
+    DoesNotExist,
+    /// A file that cannot be opened.
+    #[error("cannot be read ({0}): check its permissions")]
+    Unreadable(std::io::Error),
+    /// A file or folder that cannot be opened or listed.
+    #[error("cannot be read ({0}): check the path and its permissions")]
+    UnreadablePath(std::io::Error),
+    /// No external drift raster there.
+    #[error(
+        "no such file: give a GeoTIFF (.tif) or ESRI ASCII grid (.asc) of the drift, in the \
+         project's coordinates"
+    )]
+    NoDriftGrid,
+    /// No variogram file there.
+    #[error(
+        "no such file: give \"auto\" to fit one, or the variogram.json of a previous build or \
+         of terramesh variogram"
+    )]
+    NoVariogramFile,
+}
+
 // Large kernel errors are boxed, so that `Result<T>` stays small.
 impl From<terramesh_crs::CrsError> for Error {
     fn from(e: terramesh_crs::CrsError) -> Self {
@@ -311,6 +420,12 @@ impl From<crate::horizon::HorizonError> for Error {
 impl From<terramesh_io::boreholes::BoreholeError> for Error {
     fn from(e: terramesh_io::boreholes::BoreholeError) -> Self {
         Error::Boreholes(Box::new(e))
+    }
+}
+
+impl From<terramesh_io::faults::FaultFileError> for Error {
+    fn from(e: terramesh_io::faults::FaultFileError) -> Self {
+        Error::FaultFile(Box::new(e))
     }
 }
 
@@ -454,6 +569,15 @@ impl Error {
         Error::Invalid(why.to_string())
     }
 
+    /// `source` about `what` (a file, a point, a stage): `what: source`, in its `Display` too
+    /// (unlike [`Error::within`], whose `Display` is the context alone).
+    pub fn about(what: impl Display, source: impl Into<Error>) -> Error {
+        Error::About {
+            what: what.to_string(),
+            source: Box::new(source.into()),
+        }
+    }
+
     /// `source` within `context` (a file name, a stage): rendered `context: source`.
     ///
     /// ```
@@ -495,6 +619,7 @@ impl Error {
                 Some(Error::MeshRegion {
                     file, area, zone, ..
                 }) => mesh_region_message(file.as_deref(), *area, *zone, name),
+                Some(Error::About { what, .. }) => what.clone(),
                 _ => e.to_string(),
             };
             // A kernel error that names a setting in words, worded from its fields; its
@@ -518,10 +643,19 @@ impl Error {
                 parts.push(text);
             }
             cur = match e.downcast_ref::<Error>() {
-                Some(Error::Context { source, .. } | Error::MeshRegion { source, .. }) => {
-                    Some(source.as_ref())
-                }
-                Some(Error::Setting { .. } | Error::Invalid(_) | Error::Project { .. }) => None,
+                Some(
+                    Error::Context { source, .. }
+                    | Error::MeshRegion { source, .. }
+                    | Error::About { source, .. },
+                ) => Some(source.as_ref()),
+                Some(
+                    Error::Setting { .. }
+                    | Error::Invalid(_)
+                    | Error::Project { .. }
+                    | Error::VariogramFile { .. }
+                    | Error::FaultFile(_)
+                    | Error::NoWgs84 { .. },
+                ) => None,
                 _ => e.source(),
             };
         }

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 use terramesh_core::limits::Estimate;
 use terramesh_geostat::{
-    simulate, Data, Ensemble, GeostatError, Method, Neighbourhood, SimulationSettings, Variogram,
+    simulate, Data, Ensemble, Method, Neighbourhood, SimulationSettings, Variogram,
 };
 use terramesh_io::grid_write::RasterGrid;
 use terramesh_io::number::write_shortest;
@@ -76,10 +76,7 @@ pub fn run_simulation(
             "give at least 1 realisation",
         ));
     }
-    simulate(data, v, method, hood, targets, settings).map_err(|e| match e {
-        GeostatError::TooLarge(_) => Error::Geostat(e),
-        other => Error::invalid(other),
-    })
+    Ok(simulate(data, v, method, hood, targets, settings)?)
 }
 
 /// Writes `x,y,z_1..z_N,mean,std,p10,p50,p90` to `output` (standard output without one),

@@ -545,7 +545,7 @@ pub fn run(
         Method::Universal(p.interpolation.drift),
     );
     let dir = out.join("realisations");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|e| Error::about(dir.display(), e))?;
     // The model's other writer settings keep their defaults (none today but the CRS).
     #[allow(clippy::needless_update)]
     let info = ModelInfo {

@@ -236,7 +236,7 @@ pub fn run(
     };
     let datum = p.height_datum();
     let dir = out.join("interfaces");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|e| Error::about(dir.display(), e))?;
     // The model's files and the interface grids are written side by side (rayon), and beside
     // the model's independent checks: `out` is the build's staging folder, thrown away when a
     // check fails. Errors in that order.
@@ -283,11 +283,7 @@ pub fn run(
     };
     let (model, (written, grids_written)) =
         assemble_beside(mesh, dsm, &inputs, write).context("[geology]")?;
-    let mut files: Vec<PathBuf> = written
-        .map_err(|e| Error::invalid(e.to_string()))?
-        .into_iter()
-        .map(|f| out.join(f))
-        .collect();
+    let mut files: Vec<PathBuf> = written?.into_iter().map(|f| out.join(f)).collect();
     for path in grids_written {
         files.push(path?);
     }

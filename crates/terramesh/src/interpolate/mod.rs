@@ -102,7 +102,7 @@ pub fn read_data(path: &Path, duplicates: Duplicates) -> Result<FileData> {
                 t.name, t.lines[first], t.lines[second]
             ),
         ),
-        other => Error::invalid(format!("{}: {other}", t.name)),
+        other => Error::about(&t.name, other),
     })?;
     Ok(FileData { data, name: t.name })
 }
