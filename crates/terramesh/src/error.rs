@@ -802,6 +802,31 @@ mod tests {
         assert_eq!(e.render(&|s| s.to_string()), "writing out/x: disk full");
     }
 
+    /// A typed error about a file keeps its source typed: the front end words the source's
+    /// settings, and `Display` shows the whole chain with neutral names.
+    #[test]
+    fn about_words_its_source_as_the_front_end_does() {
+        let inner = Error::within("d.csv", Error::setting(Setting::Zone, "99X", "not a zone"));
+        let e = Error::about("interpolation.variogram", inner);
+        assert_eq!(
+            e.render(&|s| format!("--{s}")),
+            "interpolation.variogram: d.csv: --zone '99X': not a zone"
+        );
+        assert_eq!(
+            e.to_string(),
+            "interpolation.variogram: d.csv: zone '99X': not a zone"
+        );
+        let p = Error::ProjectPath {
+            key: "region.file".into(),
+            path: "a/b.kml".into(),
+            problem: PathProblem::DoesNotExist,
+        };
+        assert_eq!(
+            p.render(&crate::project::key_of),
+            "region.file a/b.kml: does not exist (no such file or directory)"
+        );
+    }
+
     #[test]
     fn sizes_too_large_name_the_setting_as_the_front_end_words_it() {
         use terramesh_core::limits::{Estimate, Remedy};
