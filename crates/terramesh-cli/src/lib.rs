@@ -8,9 +8,9 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use clap::{Parser, Subcommand};
+use terramesh::interrupt;
 
 mod cmd;
-mod interrupt;
 mod progress;
 
 /// terramesh: terrain elevation samples to a triangulated discrete surface model (DSM).
@@ -58,7 +58,7 @@ enum Command {
 /// [`std::env::args_os`] gives them) and returns its exit code: 0 on success, 1 on an error
 /// (printed on standard error), 2 on a usage error, 130 when stopped by Ctrl-C or SIGTERM.
 /// Help and `--version` are printed on standard output. Installs the Ctrl-C handler
-/// (`interrupt`): call it once per process, as its `main` (the binary, the Python package's
+/// ([`terramesh::interrupt`]): call it once per process, as its `main` (the binary, the Python package's
 /// `terramesh` console script).
 ///
 /// ```no_run
@@ -99,9 +99,13 @@ pub(crate) fn program() -> std::io::Result<PathBuf> {
 
 static PROGRAM: OnceLock<PathBuf> = OnceLock::new();
 
+/// What a command stopped by Ctrl-C or SIGTERM says.
+const INTERRUPTED: &str =
+    "terramesh: interrupted: unfinished files removed, existing outputs untouched";
+
 /// Runs a parsed command and words its outcome as an exit code.
 fn execute(cli: Cli) -> u8 {
-    interrupt::install();
+    interrupt::install(INTERRUPTED);
     let result = match cli.command {
         Command::Convert(args) => cmd::convert::run(args),
         Command::Init(args) => cmd::init::run(args),
@@ -119,33 +123,18 @@ fn execute(cli: Cli) -> u8 {
     match result {
         // Stopped by Ctrl-C or SIGTERM (a command that finished anyway succeeded).
         Err(_) if interrupt::cancelled() => {
-            eprintln!(
-                "terramesh: interrupted: unfinished files removed, existing outputs untouched"
-            );
+            eprintln!("{INTERRUPTED}");
             interrupt::EXIT_INTERRUPTED
         }
         Ok(()) => 0,
         Err(e) => {
-            // The context chain on one line: "file, line 3: what is wrong" (settings already
-            // worded as flags or keys where the library's error was caught).
-            eprintln!("terramesh: error: {}", one_line(&e));
+            // One line, "file, line 3: what is wrong": a library error is rendered with its
+            // chain and each setting worded as a flag or a key where it was caught
+            // ([`terramesh::Error::render`]).
+            eprintln!("terramesh: error: {e}");
             1
         }
     }
-}
-
-/// The chain of `e` on one line, `context: cause: cause`, each cause once: a cause whose
-/// text its wrapper already shows (`"{file}: {source}"`, a transparent wrapper) is not
-/// repeated.
-fn one_line(e: &anyhow::Error) -> String {
-    let mut parts: Vec<String> = Vec::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if !parts.last().is_some_and(|last| last.contains(&text)) {
-            parts.push(text);
-        }
-    }
-    parts.join(": ")
 }
 
 /// A clap parser for a library enum with a fixed vocabulary ([`terramesh_core::vocab::Named`]):
@@ -166,14 +155,6 @@ pub(crate) fn flag_error(e: terramesh::Error) -> anyhow::Error {
     anyhow::anyhow!(e.render(&cmd::sample::flag_of))
 }
 
-/// A library setting named as its field (`max_area`) as this tool's flag (`--max-area`).
-pub(crate) fn flag_of_field(field: &str) -> String {
-    terramesh::Setting::of_field(field).map_or_else(
-        || format!("--{}", field.replace('_', "-")),
-        cmd::sample::flag_of,
-    )
-}
-
 /// A library error worded for a project file: each setting as its key.
 pub(crate) fn project_error(e: terramesh::Error) -> anyhow::Error {
     anyhow::anyhow!(e.render(&terramesh::project::key_of))
@@ -186,26 +167,5 @@ pub(crate) fn say(text: &str) -> anyhow::Result<()> {
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(()),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// An error that shows its source in its own text is written once, not twice.
-    #[test]
-    fn a_cause_its_wrapper_shows_is_written_once() {
-        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
-        let e = terramesh_io::region::RegionError::Io {
-            file: "area.geojson".into(),
-            source: io,
-        };
-        let e = anyhow::Error::new(e).context("reading the region");
-        assert_eq!(format!("{e:#}").matches("no such file").count(), 2);
-        assert_eq!(
-            one_line(&e),
-            "reading the region: area.geojson: no such file"
-        );
     }
 }

@@ -114,6 +114,6 @@ impl terramesh::progress::Progress for Terminal {
     }
 
     fn cancelled(&self) -> bool {
-        crate::interrupt::cancelled()
+        terramesh::interrupt::cancelled()
     }
 }

@@ -35,6 +35,20 @@ pub enum Outcome {
     Built(TileSummary),
 }
 
+impl Outcome {
+    /// What to tell the user of tile `id`, built or found done, `seconds` after the start.
+    pub fn summary(&self, id: &str, seconds: f64) -> String {
+        match self {
+            Outcome::AlreadyDone => format!("tile {id} is done already: nothing changed\n"),
+            Outcome::Built(s) => format!(
+                "built tile {id}: {} vertices, {} triangles, {} grid nodes from {} samples in \
+                 {seconds:.2} s\n",
+                s.vertices, s.triangles, s.grid_nodes, s.samples
+            ),
+        }
+    }
+}
+
 /// Builds tile `id` of the plan in `plan`: marks it `running`, builds it into `plan/tiles/ID/`
 /// (a temporary sibling renamed at the end) and marks it `done` with its summary, or `failed`
 /// with the error. A tile that is `done` with its folder in place is left as it is.

@@ -71,13 +71,13 @@ pub use geology::{
 };
 pub use grid_merge::GridFigures;
 pub use manifest::{
-    tile_dir, update, CrsText, DataRule, GridSpec, Manifest, Seam, State, Tile, TileData,
-    TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
+    tile_dir, update, CrsText, DataRule, GridSpec, Manifest, ManifestError, Seam, State, Tile,
+    TileData, TileProblem, TileSummary, LOCK, MANIFEST, MAX_TILES, SAMPLES, VARIOGRAM, VERSION,
 };
 pub use merge::merge;
 pub use merged::Merged;
 pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};
-pub use plan::{parse_tile_size, plan, Planned};
-pub use slurm::{check_sbatch_value, write_slurm, SlurmOptions, SlurmScripts};
+pub use plan::{check_halo, parse_tile_size, plan, Planned};
+pub use slurm::{check_sbatch_value, write_slurm, SbatchValueError, SlurmOptions, SlurmScripts};

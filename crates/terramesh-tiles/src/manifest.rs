@@ -236,6 +236,134 @@ pub struct CrsText {
     pub model: String,
 }
 
+/// What [`Manifest::check`] found wrong in a plan's manifest: the tile, the unit or the field,
+/// and the value.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    /// A file named by the manifest that is not a path inside the plan folder.
+    #[error("{field} {path:?} is not a file inside the plan folder: {source}")]
+    NotInPlan {
+        /// The field (`variogram`, `data.samples`, ...).
+        field: &'static str,
+        /// The path as written.
+        path: String,
+        /// Why it is not.
+        source: terramesh_core::names::NameError,
+    },
+    /// A tile grid of no tiles or of too many.
+    #[error("shape {} x {}: a plan has 1 to {MAX_TILES} tiles", shape[0], shape[1])]
+    Shape {
+        /// Tiles along x and y.
+        shape: [usize; 2],
+    },
+    /// More tiles than the grid has cells.
+    #[error("{tiles} tiles in a grid of {} x {}", shape[0], shape[1])]
+    TooManyTiles {
+        /// The tiles listed.
+        tiles: usize,
+        /// Tiles along x and y.
+        shape: [usize; 2],
+    },
+    /// A tile size that is not positive, or a corner that is not finite.
+    #[error(
+        "tile_size {tile_size} and origin {origin:?}: a positive size and a finite corner are \
+         needed"
+    )]
+    Origin {
+        /// The tiles' side.
+        tile_size: f64,
+        /// The grid's corner.
+        origin: [f64; 2],
+    },
+    /// A DSM grid of no nodes, or of more than can be counted.
+    #[error("grid of {nx} x {ny} nodes")]
+    GridNodes {
+        /// Nodes along x.
+        nx: usize,
+        /// Nodes along y.
+        ny: usize,
+    },
+    /// A DSM grid whose rows would not fit in memory.
+    #[error("grid: {}", .0.describe(&|s| s.to_string()))]
+    GridTooLarge(terramesh_core::limits::TooLarge),
+    /// A DSM grid extent that is not one.
+    #[error("grid [{}, {}] x [{}, {}]: not an extent", x[0], x[1], y[0], y[1])]
+    GridExtent {
+        /// `xmin`, `xmax`.
+        x: [f64; 2],
+        /// `ymin`, `ymax`.
+        y: [f64; 2],
+    },
+    /// A tile's entry.
+    #[error("tile {id:?}: {problem}")]
+    Tile {
+        /// The tile's id.
+        id: String,
+        /// What is wrong with it.
+        problem: TileProblem,
+    },
+    /// Two tiles whose folders would be one (ids differ only in case).
+    #[error(
+        "tiles {:?} and {:?} would share one folder (ids are unique, ignoring case)",
+        tiles[0], tiles[1]
+    )]
+    SharedFolder {
+        /// The two ids.
+        tiles: [String; 2],
+    },
+    /// A unit name that cannot be a file name.
+    #[error("geology.units: {0}")]
+    UnitName(terramesh_core::names::NameError),
+    /// Two units whose files would be one (names differ only in case).
+    #[error(
+        "geology.units {:?} and {:?} would be one file (names are unique, ignoring case)",
+        units[0], units[1]
+    )]
+    SharedUnitFile {
+        /// The two units.
+        units: [String; 2],
+    },
+    /// More interfaces than units.
+    #[error("geology: {interfaces} interfaces for {units} units")]
+    Interfaces {
+        /// The interfaces.
+        interfaces: usize,
+        /// The units.
+        units: usize,
+    },
+    /// An interface of a unit the plan does not have.
+    #[error("geology.interfaces: {unit:?} is not a unit")]
+    NotAUnit {
+        /// The unit named.
+        unit: String,
+    },
+}
+
+/// What is wrong with one tile of a manifest ([`ManifestError::Tile`]).
+#[derive(Debug, thiserror::Error)]
+pub enum TileProblem {
+    /// Its id cannot be a folder name.
+    #[error("its id cannot be a folder name: {0}")]
+    Id(terramesh_core::names::NameError),
+    /// Its index is outside the tile grid.
+    #[error("index {index:?} outside the grid of {} x {}", shape[0], shape[1])]
+    Index {
+        /// The tile's index.
+        index: [usize; 2],
+        /// Tiles along x and y.
+        shape: [usize; 2],
+    },
+    /// Its extent or halo is not finite (or the halo negative).
+    #[error("its extent and halo must be finite")]
+    NotFinite,
+    /// Its data file is not inside the plan folder.
+    #[error(transparent)]
+    Data(Box<ManifestError>),
+    /// It names a neighbour that is not a tile of the plan.
+    #[error("neighbour {0:?} is not a tile of the plan")]
+    Neighbour(String),
+}
+
 impl Manifest {
     /// `dsm.vtu`'s `crs`, as a one-piece build writes it.
     pub fn dsm_crs(&self) -> String {
@@ -291,104 +419,107 @@ impl Manifest {
     /// ([`terramesh_core::names::check_relative`]); the tile grid, the DSM grid and the tiles'
     /// indices are consistent and of a size the merge can hold. The error names the tile, the
     /// unit or the field.
-    pub fn check(&self) -> std::result::Result<(), String> {
+    pub fn check(&self) -> std::result::Result<(), ManifestError> {
         use terramesh_core::names::{check_name, check_relative, same_file_name};
-        let rel = |field: &str, p: &str| {
-            check_relative(p)
-                .map_err(|e| format!("{field} {p:?} is not a file inside the plan folder: {e}"))
+        use ManifestError as E;
+        let rel = |field: &'static str, p: &str| {
+            check_relative(p).map_err(|source| E::NotInPlan {
+                field,
+                path: p.to_string(),
+                source,
+            })
         };
         let [sx, sy] = self.shape;
         let cells = sx.checked_mul(sy).filter(|&c| c > 0 && c <= MAX_TILES);
         let Some(cells) = cells else {
-            return Err(format!(
-                "shape {sx} x {sy}: a plan has 1 to {MAX_TILES} tiles"
-            ));
+            return Err(E::Shape { shape: self.shape });
         };
         if self.tiles.len() > cells {
-            return Err(format!(
-                "{} tiles in a grid of {sx} x {sy}",
-                self.tiles.len()
-            ));
+            return Err(E::TooManyTiles {
+                tiles: self.tiles.len(),
+                shape: self.shape,
+            });
         }
         if !self.tile_size.is_finite()
             || self.tile_size <= 0.0
             || !self.origin.iter().all(|v| v.is_finite())
         {
-            return Err(format!(
-                "tile_size {} and origin {:?}: a positive size and a finite corner are needed",
-                self.tile_size, self.origin
-            ));
+            return Err(E::Origin {
+                tile_size: self.tile_size,
+                origin: self.origin,
+            });
         }
         rel("variogram", &self.variogram)?;
         rel("data.samples", &self.data.samples)?;
         let g = &self.grid;
         if g.nx == 0 || g.ny == 0 || g.nx.checked_mul(g.ny).is_none() {
-            return Err(format!("grid of {} x {} nodes", g.nx, g.ny));
+            return Err(E::GridNodes { nx: g.nx, ny: g.ny });
         }
         let width = 1 + self.geology.as_ref().map_or(0, |gp| gp.units.len());
         terramesh_core::limits::Estimate::new("grid columns", g.nx as f64, 8.0 * width as f64)
             .check()
-            .map_err(|e| format!("grid: {}", e.describe(&|s| s.to_string())))?;
+            .map_err(E::GridTooLarge)?;
         if ![g.xmin, g.ymin, g.xmax, g.ymax]
             .iter()
             .all(|v| v.is_finite())
             || g.xmin > g.xmax
             || g.ymin > g.ymax
         {
-            return Err(format!(
-                "grid [{}, {}] x [{}, {}]: not an extent",
-                g.xmin, g.xmax, g.ymin, g.ymax
-            ));
+            return Err(E::GridExtent {
+                x: [g.xmin, g.xmax],
+                y: [g.ymin, g.ymax],
+            });
         }
         let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
         for t in &self.tiles {
-            let tile = |why: String| format!("tile {:?}: {why}", t.id);
-            check_name(&t.id).map_err(|e| tile(format!("its id cannot be a folder name: {e}")))?;
+            let tile = |problem: TileProblem| E::Tile {
+                id: t.id.clone(),
+                problem,
+            };
+            check_name(&t.id).map_err(|e| tile(TileProblem::Id(e)))?;
             if t.index[0] >= sx || t.index[1] >= sy {
-                return Err(tile(format!(
-                    "index {:?} outside the grid of {sx} x {sy}",
-                    t.index
-                )));
+                return Err(tile(TileProblem::Index {
+                    index: t.index,
+                    shape: self.shape,
+                }));
             }
             if !t.extent.iter().all(|v| v.is_finite()) || !t.halo.is_finite() || t.halo < 0.0 {
-                return Err(tile("its extent and halo must be finite".into()));
+                return Err(tile(TileProblem::NotFinite));
             }
             if let Some(d) = &t.data {
-                rel("data.file", &d.file).map_err(tile)?;
+                rel("data.file", &d.file).map_err(|e| tile(TileProblem::Data(Box::new(e))))?;
             }
             for n in &t.neighbours {
                 if !ids.contains(&n.as_str()) {
-                    return Err(tile(format!("neighbour {n:?} is not a tile of the plan")));
+                    return Err(tile(TileProblem::Neighbour(n.clone())));
                 }
             }
         }
         if let Some((a, b)) = same_file_name(&ids) {
-            return Err(format!(
-                "tiles {:?} and {:?} would share one folder (ids are unique, ignoring case)",
-                ids[a], ids[b]
-            ));
+            return Err(E::SharedFolder {
+                tiles: [ids[a].to_string(), ids[b].to_string()],
+            });
         }
         if let Some(gp) = &self.geology {
             for u in &gp.units {
-                check_name(u).map_err(|e| format!("geology.units: {e}"))?;
+                check_name(u).map_err(E::UnitName)?;
             }
             if let Some((a, b)) = same_file_name(&gp.units) {
-                return Err(format!(
-                    "geology.units {:?} and {:?} would be one file (names are unique, ignoring \
-                     case)",
-                    gp.units[a], gp.units[b]
-                ));
+                return Err(E::SharedUnitFile {
+                    units: [gp.units[a].clone(), gp.units[b].clone()],
+                });
             }
             if gp.interfaces.len() > gp.units.len().max(1) {
-                return Err(format!(
-                    "geology: {} interfaces for {} units",
-                    gp.interfaces.len(),
-                    gp.units.len()
-                ));
+                return Err(E::Interfaces {
+                    interfaces: gp.interfaces.len(),
+                    units: gp.units.len(),
+                });
             }
             for it in &gp.interfaces {
                 if !gp.units.contains(&it.unit) {
-                    return Err(format!("geology.interfaces: {:?} is not a unit", it.unit));
+                    return Err(E::NotAUnit {
+                        unit: it.unit.clone(),
+                    });
                 }
                 let grid = matches!(it.estimate, super::geology::Estimate::Grid { .. });
                 if !(grid && it.observations.is_empty()) {

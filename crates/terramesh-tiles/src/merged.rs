@@ -1,6 +1,6 @@
 //! What a merge made ([`Merged`]): `merge.json` and the merge's report render it.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
@@ -30,4 +30,23 @@ pub struct Merged {
     pub model: Option<MergedModel>,
     /// Seconds the merge took.
     pub seconds: f64,
+}
+
+impl Merged {
+    /// What to tell the user of a merge into `output`, `seconds` after the start.
+    pub fn summary(&self, output: &Path, seconds: f64) -> String {
+        let model = self.model.as_ref().map_or(String::new(), |g| {
+            format!(
+                ", a geological model of {} cells and {} nodes",
+                g.cells, g.nodes
+            )
+        });
+        format!(
+            "merged into {}: {} vertices, {} triangles, {} seam vertices{model} in {seconds:.2} s\n",
+            output.display(),
+            self.vertices,
+            self.triangles,
+            self.seam_vertices
+        )
+    }
 }

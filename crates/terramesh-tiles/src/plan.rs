@@ -34,16 +34,33 @@ pub struct Planned {
     pub max_halo: f64,
 }
 
-/// Parses a tile size: metres (`2500`, `2500m`) or kilometres (`10km`, `2.5km`).
+impl Planned {
+    /// What to tell the user of a plan written into `output`, `seconds` after the start.
+    pub fn summary(&self, output: &Path, seconds: f64) -> String {
+        format!(
+            "planned {} tiles ({} x {}) of {} samples into {} (widest halo {:.0} m) in {seconds:.2} s",
+            self.tiles,
+            self.shape[0],
+            self.shape[1],
+            self.samples,
+            output.display(),
+            self.max_halo
+        )
+    }
+}
+
+/// Parses a tile size: metres (`2500`, `2500m`) or kilometres (`10km`, `2.5km`); anything
+/// else is [`Setting::TileSize`](terramesh::Setting::TileSize).
 ///
 /// ```
 /// use terramesh_tiles::parse_tile_size;
 /// assert_eq!(parse_tile_size("10km").unwrap(), 10_000.0);
 /// assert_eq!(parse_tile_size("750m").unwrap(), 750.0);
 /// assert_eq!(parse_tile_size("1200").unwrap(), 1200.0);
-/// assert!(parse_tile_size("ten").is_err());
+/// let e = parse_tile_size("ten").unwrap_err();
+/// assert!(e.render(&|s| format!("--{s}")).starts_with("--tile-size 'ten' is not a tile size"));
 /// ```
-pub fn parse_tile_size(s: &str) -> std::result::Result<f64, String> {
+pub fn parse_tile_size(s: &str) -> Result<f64> {
     let t = s.trim();
     let (num, scale) = if let Some(n) = t.strip_suffix("km") {
         (n, 1000.0)
@@ -54,10 +71,37 @@ pub fn parse_tile_size(s: &str) -> std::result::Result<f64, String> {
     };
     match num.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v * scale),
-        _ => Err(format!(
-            "'{s}' is not a tile size: give metres or kilometres, like 10km, 2500m or 2500"
+        _ => Err(Error::setting(
+            terramesh::Setting::TileSize,
+            "",
+            format!(
+                "{{tile-size}} '{s}' is not a tile size: give metres or kilometres, like 10km, \
+                 2500m or 2500"
+            ),
         )),
     }
+}
+
+/// Checks the halo around each tile's data: only `auto` ([`Setting::Halo`](terramesh::Setting::Halo)
+/// otherwise), the halo computed from the kriging neighbourhood, since a halo that is too
+/// narrow would change the estimates.
+///
+/// ```
+/// assert!(terramesh_tiles::check_halo("auto").is_ok());
+/// assert!(terramesh_tiles::check_halo("500m").is_err());
+/// ```
+pub fn check_halo(halo: &str) -> Result<()> {
+    if halo == "auto" {
+        return Ok(());
+    }
+    Err(Error::setting(
+        terramesh::Setting::Halo,
+        "",
+        format!(
+            "{{halo}} '{halo}': only auto is supported (the halo is computed from the kriging \
+             neighbourhood so that every tile sees the samples it needs)"
+        ),
+    ))
 }
 
 /// A plan writes many files into its folder (`tiles.json`, `samples.csv`, `variogram.json`,

@@ -34,6 +34,19 @@ pub struct SlurmScripts {
     pub submit: PathBuf,
 }
 
+impl SlurmScripts {
+    /// What to tell the user of the scripts written.
+    pub fn summary(&self) -> String {
+        format!(
+            "wrote {}, {} and {}: submit with bash {}\n",
+            self.tiles.display(),
+            self.merge.display(),
+            self.submit.display(),
+            self.submit.display()
+        )
+    }
+}
+
 /// `s` as one bash word in single quotes (a `'` written `'\''`).
 fn quote_str(s: &str) -> String {
     format!("'{}'", s.replace('\'', "'\\''"))
@@ -77,32 +90,66 @@ fn sbatch_path(field: &str, p: &Path) -> Result<String> {
     Ok(text.replace('%', "%%"))
 }
 
+/// Why a value cannot be written into an `#SBATCH` line ([`check_sbatch_value`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SbatchValueError {
+    /// Empty, or longer than 128 characters.
+    #[error("give 1 to 128 characters")]
+    Length,
+    /// A character other than letters, digits and `_ . , : + -`.
+    #[error(
+        "the character {0:?} cannot be written into an #SBATCH line: use letters, digits and \
+         _ . , : + -"
+    )]
+    Character(char),
+}
+
 /// Checks a value written into an `#SBATCH` line (`--partition`, `--time`, `--mem`): 1 to
 /// 128 characters among letters, digits and `_ . , : + -`, so that it can neither end the line
-/// nor be read as shell syntax. `Err` says what is wrong; the caller names the option.
+/// nor be read as shell syntax. The error says what is wrong; the caller names the option
+/// ([`SlurmOptions::check`]).
 ///
 /// ```
-/// use terramesh_tiles::check_sbatch_value;
+/// use terramesh_tiles::{check_sbatch_value, SbatchValueError};
 /// assert!(check_sbatch_value("compute,debug").is_ok());
 /// assert!(check_sbatch_value("1-00:00:00").is_ok());
 /// assert!(check_sbatch_value("4G").is_ok());
-/// assert!(check_sbatch_value("debug\nrm -rf ~").is_err());
+/// assert_eq!(check_sbatch_value("debug\nrm -rf ~"), Err(SbatchValueError::Character('\n')));
 /// assert!(check_sbatch_value("$(id)").is_err());
-/// assert!(check_sbatch_value("").is_err());
+/// assert_eq!(check_sbatch_value(""), Err(SbatchValueError::Length));
 /// ```
-pub fn check_sbatch_value(v: &str) -> std::result::Result<(), String> {
+pub fn check_sbatch_value(v: &str) -> std::result::Result<(), SbatchValueError> {
     if v.is_empty() || v.len() > 128 {
-        return Err("give 1 to 128 characters".into());
+        return Err(SbatchValueError::Length);
     }
     match v
         .chars()
         .find(|&c| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | ',' | ':' | '+' | '-')))
     {
-        Some(c) => Err(format!(
-            "the character {c:?} cannot be written into an #SBATCH line: use letters, digits \
-             and _ . , : + -"
-        )),
+        Some(c) => Err(SbatchValueError::Character(c)),
         None => Ok(()),
+    }
+}
+
+impl SlurmOptions {
+    /// Checks every value written into an `#SBATCH` line ([`check_sbatch_value`]) before
+    /// anything is written: an error names its [`Setting`](terramesh::Setting)
+    /// (`Partition`, `Time`, `Mem`).
+    pub fn check(&self) -> Result<()> {
+        use terramesh::Setting as S;
+        for (setting, value) in [
+            (S::Partition, Some(&self.partition)),
+            (S::Time, Some(&self.time)),
+            (S::Mem, self.mem.as_ref()),
+        ] {
+            if let Some(v) = value {
+                check_sbatch_value(v).map_err(|why| {
+                    let name = terramesh_core::vocab::Named::name(setting);
+                    Error::setting(setting, "", format!("{{{name}}} {v:?}: {why}"))
+                })?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -112,18 +159,9 @@ pub fn check_sbatch_value(v: &str) -> std::result::Result<(), String> {
 /// (`terramesh tiles build PLAN --tile ID`), so the script runs by hand too:
 /// `SLURM_ARRAY_TASK_ID=3 bash PLAN/slurm/tiles.sbatch`.
 pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
+    o.check()?;
     let m = Manifest::read(plan)?;
     // Every value written into a script line is checked (or quoted) first.
-    for (field, value) in [
-        ("partition", Some(&o.partition)),
-        ("time", Some(&o.time)),
-        ("mem", o.mem.as_ref()),
-    ] {
-        if let Some(v) = value {
-            check_sbatch_value(v)
-                .map_err(|why| Error::invalid(format!("the Slurm {field} {v:?}: {why}")))?;
-        }
-    }
     let plan_abs = std::path::absolute(plan).context(plan.display().to_string())?;
     let out_abs = std::path::absolute(&o.output).context(o.output.display().to_string())?;
     let plan_q = quote("the plan folder", &plan_abs)?;

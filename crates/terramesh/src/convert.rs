@@ -300,3 +300,49 @@ fn push_field(buf: &mut Vec<u8>, f: &str) {
         buf.extend_from_slice(f.as_bytes());
     }
 }
+
+/// The conversion of a table file as `terramesh convert` runs it: read (a header, or the
+/// given column names), converted by [`convert_table`], written atomically.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvertJob {
+    /// The input table (`-`: standard input).
+    pub input: std::path::PathBuf,
+    /// The output CSV (`None` or `-`: standard output).
+    pub output: Option<std::path::PathBuf>,
+    /// Column names of a headerless file.
+    pub columns: Option<Vec<String>>,
+    /// The field delimiter (default: detected); one ASCII character
+    /// ([`Setting::Delimiter`] otherwise).
+    pub delimiter: Option<char>,
+    /// The direction.
+    pub to: Target,
+    /// The UTM zone forced (utm) or of the input (wgs84).
+    pub zone: Option<Zone>,
+    /// Also the meridian convergence and the point scale factor.
+    pub extras: bool,
+}
+
+impl ConvertJob {
+    /// Runs it: nothing is written on error.
+    pub fn run(&self) -> Result<()> {
+        let delimiter = match self.delimiter {
+            Some(c) if c.is_ascii() => Some(c as u8),
+            Some(c) => {
+                let why = format!("{{delimiter}} '{c}' must be a single ASCII character");
+                return Err(Error::setting(Setting::Delimiter, "", why));
+            }
+            None => None,
+        };
+        let columns = self.columns.clone();
+        let opts = terramesh_io::table::ReadOptions { columns, delimiter };
+        let table = Table::read(&self.input, &opts)?;
+        let name = self
+            .output
+            .as_ref()
+            .map_or_else(|| "standard output".into(), |p| p.display().to_string());
+        let mut out = terramesh_io::output::Output::create(self.output.as_deref())
+            .with_context(|| format!("cannot write {name}"))?;
+        convert_table(&table, self.to, self.zone, self.extras, &mut out)?;
+        out.commit().with_context(|| format!("cannot write {name}"))
+    }
+}

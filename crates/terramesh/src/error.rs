@@ -79,6 +79,12 @@ pub enum Error {
     /// Writing a mesh file.
     #[error(transparent)]
     MeshWrite(#[from] terramesh_io::export::MeshWriteError),
+    /// Writing the geological model's files.
+    #[error(transparent)]
+    ModelWrite(#[from] terramesh_io::model::ModelWriteError),
+    /// A fault's file (a trace, a surface, picks).
+    #[error(transparent)]
+    FaultFile(Box<terramesh_io::faults::FaultFileError>),
     /// Writing the terrain tiles.
     #[error(transparent)]
     Terrain(#[from] terramesh_io::export::TerrainError),
@@ -106,13 +112,257 @@ pub enum Error {
     /// A size that follows from input would not fit in memory.
     #[error(transparent)]
     TooLarge(#[from] terramesh_core::limits::TooLarge),
-    /// Anything else, in words.
+    /// A targets CSV file without an `x` or a `y` column.
+    #[error("{file}: needs columns 'x' and 'y' (the header has: {header})")]
+    NoXyColumns {
+        /// The file.
+        file: String,
+        /// Its header, the names joined by `, `.
+        header: String,
+    },
+    /// A cell that must hold a finite number.
+    #[error("{file}, line {line}, column '{column}': '{text}' is not a finite number")]
+    NotANumber {
+        /// The file.
+        file: String,
+        /// The line (1-based).
+        line: u64,
+        /// The column's name.
+        column: String,
+        /// The cell as written.
+        text: String,
+    },
+    /// A targets file with a header and no rows.
+    #[error("{file}: no target rows after the header")]
+    NoTargets {
+        /// The file.
+        file: String,
+    },
+    /// Kriging failed at a target row of a file (`error`'s target index is the row's, 0-based).
+    #[error("{file}: {}", error.display_with_target(|i| format!("target row {}", i + 1)))]
+    AtTargetRow {
+        /// The targets file.
+        file: String,
+        /// The kernel's error.
+        error: terramesh_geostat::GeostatError,
+    },
+    /// A point of a points file that the source's CRS cannot place.
+    #[error("{file}: point {point} ({x}, {y}) is not a valid position in {crs}")]
+    BadPosition {
+        /// The points file.
+        file: String,
+        /// The point (1-based).
+        point: usize,
+        /// Its x.
+        x: f64,
+        /// Its y.
+        y: f64,
+        /// The CRS, as written.
+        crs: String,
+    },
+    /// A build's source is in a projected CRS without a project CRS to relate it to.
+    #[error(
+        "the source is in a projected CRS terramesh does not convert; use a geographic or UTM \
+         source for build, or give the project's CRS with [region] crs = \"EPSG:<code>\" (or \
+         \"projected\" when the region and the source share one metric CRS)"
+    )]
+    UnconvertedSource,
+    /// Too few samples with an elevation to build from.
+    #[error("only {samples} samples with an elevation: enlarge the grid or check the source")]
+    TooFewSamples {
+        /// The samples with an elevation.
+        samples: usize,
+    },
+    /// An interpolation gave NaN or an infinity at a mesh vertex.
+    #[error(
+        "{method} gave a non-finite value at mesh vertex {vertex}: the kriging system is \
+         ill-conditioned"
+    )]
+    NonFiniteAtVertex {
+        /// The method (`the DSM method`, ...).
+        method: String,
+        /// The vertex (0-based).
+        vertex: usize,
+    },
+    /// `[mesh] max_error` (an adaptive mesh) with `max_edge`.
+    #[error(
+        "[mesh]: max_edge cannot be combined with max_error (adaptive meshes vary in size); use \
+         max_area as the upper limit"
+    )]
+    MaxEdgeWithMaxError,
+    /// `[mesh] max_error` (an adaptive mesh) with `insert_samples`.
+    #[error("[mesh]: insert_samples cannot be combined with max_error")]
+    InsertSamplesWithMaxError,
+    /// `[mesh] max_error` closer than the kriged surface's own departure from a smooth one.
+    #[error(
+        "[mesh]: max_error = {target} m is too close to how far the kriged surface departs from a \
+         smooth surface through a grid of {nodes} nodes ({departure:.3} m; a moving neighbourhood \
+         makes kriging jump where the neighbour set changes): raise mesh.max_error above {:.3}, \
+         or krige with more neighbours (interpolation.neighbors, 0 for all)",
+        departure / 0.75
+    )]
+    MaxErrorTooSmall {
+        /// `mesh.max_error`, metres.
+        target: f64,
+        /// The nodes of the grid of the kriged surface.
+        nodes: usize,
+        /// How far the kriged surface departs from the smooth one, metres.
+        departure: f64,
+    },
+    /// The geological column names no unit.
+    #[error("the geological column names no unit: list them in [geology] units")]
+    NoUnits,
+    /// `interpolate = "thickness"` with horizon grids, which give tops.
+    #[error(
+        "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" to \
+         use them"
+    )]
+    GridsGiveTops,
+    /// `interpolate = "thickness"` without boreholes.
+    #[error("interpolate = \"thickness\" needs boreholes: set [geology] collars")]
+    ThicknessNeedsBoreholes,
+    /// A base of one value per vertex with another number of values.
+    #[error("the base has {values} values for the {vertices} vertices of the planar mesh")]
+    BaseValues {
+        /// The values given.
+        values: usize,
+        /// The vertices of the planar mesh.
+        vertices: usize,
+    },
+    /// A horizon grid given for the first unit, whose top is the terrain.
+    #[error(
+        "geology.surfaces.{unit}: the top of the first unit is the terrain (the DSM); give grids \
+         for the units below it"
+    )]
+    FirstUnitGrid {
+        /// The first unit.
+        unit: String,
+    },
+    /// A base grid without a value at a vertex of the model's mesh.
+    #[error(
+        "{}: the base grid has no value at ({x:.1}, {y:.1}), a vertex of the model's mesh: a \
+         base grid must cover the whole region",
+        file.display()
+    )]
+    BaseGridGap {
+        /// The base grid.
+        file: std::path::PathBuf,
+        /// The vertex's x.
+        x: f64,
+        /// The vertex's y.
+        y: f64,
+    },
+    /// A unit that no borehole meets and no grid gives.
+    #[error("no observation of {unit}: no borehole meets it and no grid gives it")]
+    NoObservation {
+        /// The unit.
+        unit: String,
+    },
+    /// A model ensemble asked for with no realisations.
+    #[error("interpolation.realisations = 0: no realisation of the model to simulate")]
+    NoRealisations,
+    /// A geological model without a body of any volume, for a file that draws them.
+    #[error("{}: the model has no unit with volume", file.display())]
+    NoVolume {
+        /// The file.
+        file: std::path::PathBuf,
+    },
+    /// `source`, about `what` (a file, a point, a stage): shown as `what: source` (the
+    /// source's whole chain).
+    #[error("{what}: {}", source.render(&neutral))]
+    About {
+        /// What it is about.
+        what: String,
+        /// The error.
+        #[source]
+        source: Box<Error>,
+    },
+    /// A path that a project key gives, and what is wrong with it.
+    #[error("{key} {}: {problem}", path.display())]
+    ProjectPath {
+        /// The key (`region.file`, `geology.collars`, ...).
+        key: String,
+        /// The path (joined to the project's folder).
+        path: std::path::PathBuf,
+        /// What is wrong.
+        problem: PathProblem,
+    },
+    /// Neither the source nor its fallback exists.
+    #[error(
+        "source.path {} and source.fallback {} do not exist",
+        path.display(),
+        fallback.display()
+    )]
+    NoSource {
+        /// `source.path`.
+        path: std::path::PathBuf,
+        /// `source.fallback`.
+        fallback: std::path::PathBuf,
+    },
+    /// `[region]` with both corners and a file, or neither.
+    #[error("[region]: give corners or file, not both or neither")]
+    CornersOrFile,
+    /// `terramesh model` of a project without `[geology]`.
+    #[error(
+        "the project has no [geology] section: add one (terramesh init --geology writes a \
+         template) or use terramesh build for the surface model"
+    )]
+    NoGeology,
+    /// An external drift that the other drift terms give at the data already.
+    #[error("the external drift is a combination of the other drift terms at the data")]
+    DriftCollinear,
+    /// A variogram file that cannot be used.
+    #[error(
+        "{}: {source}{}",
+        file.display(),
+        if matches!(source, terramesh_geostat::VariogramFileError::NoModel) {
+            " (write it with terramesh variogram)"
+        } else {
+            ""
+        }
+    )]
+    VariogramFile {
+        /// The file.
+        file: std::path::PathBuf,
+        /// What is wrong.
+        source: terramesh_geostat::VariogramFileError,
+    },
+    /// A project CRS that terramesh cannot transform to WGS 84, with exports that need it.
+    #[error(
+        "{key} = \"{crs}\": the geographic exports (kml, dae, glb, 3dtiles, terrain) need WGS-84 \
+         positions, and {source}; remove them from export.formats"
+    )]
+    NoWgs84 {
+        /// The key that gave the CRS.
+        key: String,
+        /// The CRS.
+        crs: String,
+        /// Why there is no transformation.
+        source: Box<terramesh_crs::CrsError>,
+    },
+    /// Anything else, in words: only the faulted geology stage (`geology/faulted*.rs`) and
+    /// the exports (`build/exports.rs`) still word errors this way, and [`Context`] on an
+    /// `Option`.
     #[error("{0}")]
     Invalid(String),
     /// The work was stopped on request ([`Progress::cancelled`](crate::progress::Progress::cancelled)
     /// turned true): nothing it was writing was kept.
     #[error("stopped before it finished; its unfinished files were removed")]
     Cancelled,
+    /// Meshing a region failed: the region's file (`None`: its corners) and its size, so that
+    /// a region far larger than meant (a damaged coordinate) shows at once.
+    #[error("{}", mesh_region_message(file.as_deref(), *area, *zone, &neutral))]
+    MeshRegion {
+        /// The region file, or `None` for corners.
+        file: Option<std::path::PathBuf>,
+        /// The region's area, square metres.
+        area: f64,
+        /// Its UTM zone, if projected to one.
+        zone: Option<terramesh_core::coords::Zone>,
+        /// Why meshing failed.
+        #[source]
+        source: Box<Error>,
+    },
     /// What was being done when `source` happened.
     #[error("{context}")]
     Context {
@@ -122,6 +372,36 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+}
+
+/// What is wrong with a path a project key gives ([`Error::ProjectPath`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PathProblem {
+    /// No file there (a path relative to the project file).
+    #[error("no such file: check the path (relative to the project file)")]
+    NoSuchFile,
+    /// Nothing there.
+    #[error("does not exist (no such file or directory)")]
+    DoesNotExist,
+    /// A file that cannot be opened.
+    #[error("cannot be read ({0}): check its permissions")]
+    Unreadable(std::io::Error),
+    /// A file or folder that cannot be opened or listed.
+    #[error("cannot be read ({0}): check the path and its permissions")]
+    UnreadablePath(std::io::Error),
+    /// No external drift raster there.
+    #[error(
+        "no such file: give a GeoTIFF (.tif) or ESRI ASCII grid (.asc) of the drift, in the \
+         project's coordinates"
+    )]
+    NoDriftGrid,
+    /// No variogram file there.
+    #[error(
+        "no such file: give \"auto\" to fit one, or the variogram.json of a previous build or \
+         of terramesh variogram"
+    )]
+    NoVariogramFile,
 }
 
 // Large kernel errors are boxed, so that `Result<T>` stays small.
@@ -140,6 +420,12 @@ impl From<crate::horizon::HorizonError> for Error {
 impl From<terramesh_io::boreholes::BoreholeError> for Error {
     fn from(e: terramesh_io::boreholes::BoreholeError) -> Self {
         Error::Boreholes(Box::new(e))
+    }
+}
+
+impl From<terramesh_io::faults::FaultFileError> for Error {
+    fn from(e: terramesh_io::faults::FaultFileError) -> Self {
+        Error::FaultFile(Box::new(e))
     }
 }
 
@@ -244,6 +530,23 @@ fn mesh_message(m: &terramesh_mesh::MeshError, word: &dyn Fn(Setting) -> String)
     }
 }
 
+/// The context of [`Error::MeshRegion`]: `the region of FILE (AREA m2 in UTM zone Z)`.
+fn mesh_region_message(
+    file: Option<&std::path::Path>,
+    area: f64,
+    zone: Option<terramesh_core::coords::Zone>,
+    word: &dyn Fn(Setting) -> String,
+) -> String {
+    let what = match file {
+        Some(p) => p.display().to_string(),
+        None => word(Setting::Corners),
+    };
+    let zone = zone
+        .map(|z| format!(" in UTM zone {z}"))
+        .unwrap_or_default();
+    format!("the region of {what} ({area:.4e} m2{zone})")
+}
+
 fn neutral(s: Setting) -> String {
     s.to_string()
 }
@@ -264,6 +567,15 @@ impl Error {
     /// An error in words.
     pub fn invalid(why: impl Display) -> Error {
         Error::Invalid(why.to_string())
+    }
+
+    /// `source` about `what` (a file, a point, a stage): `what: source`, in its `Display` too
+    /// (unlike [`Error::within`], whose `Display` is the context alone).
+    pub fn about(what: impl Display, source: impl Into<Error>) -> Error {
+        Error::About {
+            what: what.to_string(),
+            source: Box::new(source.into()),
+        }
     }
 
     /// `source` within `context` (a file name, a stage): rendered `context: source`.
@@ -304,6 +616,10 @@ impl Error {
                     | Error::Geostat(terramesh_geostat::GeostatError::TooLarge(t)),
                 ) => t.describe(&|field| Setting::of_field(field).map_or(field.to_string(), name)),
                 Some(Error::Mesh(m)) => mesh_message(m, name),
+                Some(Error::MeshRegion {
+                    file, area, zone, ..
+                }) => mesh_region_message(file.as_deref(), *area, *zone, name),
+                Some(Error::About { what, .. }) => what.clone(),
                 _ => e.to_string(),
             };
             // A kernel error that names a setting in words, worded from its fields; its
@@ -327,12 +643,49 @@ impl Error {
                 parts.push(text);
             }
             cur = match e.downcast_ref::<Error>() {
-                Some(Error::Context { source, .. }) => Some(source.as_ref()),
-                Some(Error::Setting { .. } | Error::Invalid(_) | Error::Project { .. }) => None,
+                Some(
+                    Error::Context { source, .. }
+                    | Error::MeshRegion { source, .. }
+                    | Error::About { source, .. },
+                ) => Some(source.as_ref()),
+                Some(
+                    Error::Setting { .. }
+                    | Error::Invalid(_)
+                    | Error::Project { .. }
+                    | Error::VariogramFile { .. }
+                    | Error::FaultFile(_)
+                    | Error::NoWgs84 { .. },
+                ) => None,
                 _ => e.source(),
             };
         }
         parts.join(": ")
+    }
+}
+
+impl Error {
+    /// [`Error::render`] said of `file` (a project file the user wrote): `FILE: message`,
+    /// unless the message names the file already.
+    ///
+    /// ```
+    /// use terramesh::{Error, Setting};
+    /// let e = Error::setting(Setting::Margin, "ten", "give a fraction");
+    /// assert_eq!(e.render_of_file("p.toml".as_ref(), &|s| s.to_string()), "p.toml: margin 'ten': give a fraction");
+    /// let e = Error::within("p.toml, line 3", e);
+    /// assert_eq!(e.render_of_file("p.toml".as_ref(), &|s| s.to_string()), "p.toml, line 3: margin 'ten': give a fraction");
+    /// ```
+    pub fn render_of_file(
+        &self,
+        file: &std::path::Path,
+        name: &dyn Fn(Setting) -> String,
+    ) -> String {
+        let msg = self.render(name);
+        let file = file.display().to_string();
+        if msg.contains(&file) {
+            msg
+        } else {
+            format!("{file}: {msg}")
+        }
     }
 }
 
@@ -447,6 +800,31 @@ mod tests {
         );
         assert_eq!(own.to_string(), "source x needs a region: give region");
         assert_eq!(e.render(&|s| s.to_string()), "writing out/x: disk full");
+    }
+
+    /// A typed error about a file keeps its source typed: the front end words the source's
+    /// settings, and `Display` shows the whole chain with neutral names.
+    #[test]
+    fn about_words_its_source_as_the_front_end_does() {
+        let inner = Error::within("d.csv", Error::setting(Setting::Zone, "99X", "not a zone"));
+        let e = Error::about("interpolation.variogram", inner);
+        assert_eq!(
+            e.render(&|s| format!("--{s}")),
+            "interpolation.variogram: d.csv: --zone '99X': not a zone"
+        );
+        assert_eq!(
+            e.to_string(),
+            "interpolation.variogram: d.csv: zone '99X': not a zone"
+        );
+        let p = Error::ProjectPath {
+            key: "region.file".into(),
+            path: "a/b.kml".into(),
+            problem: PathProblem::DoesNotExist,
+        };
+        assert_eq!(
+            p.render(&crate::project::key_of),
+            "region.file a/b.kml: does not exist (no such file or directory)"
+        );
     }
 
     #[test]

@@ -401,7 +401,7 @@ pub fn read_drift_column(path: &Path, column: &str, duplicates: Duplicates) -> R
         g.push(t.number(r, c)?);
     }
     // The same merge as the data's: equal locations, in the same order.
-    let d = Data::new(xy, g, duplicates).map_err(|e| Error::invalid(format!("{}: {e}", t.name)))?;
+    let d = Data::new(xy, g, duplicates).map_err(|e| Error::about(&t.name, e))?;
     Ok(d.z().to_vec())
 }
 
@@ -411,7 +411,7 @@ pub fn read_drift_column(path: &Path, column: &str, duplicates: Duplicates) -> R
 pub fn drift_residuals(data: &Data, g: &[f64], method: Method) -> Result<Data> {
     // The rule of kriging itself, so that a constant drift is refused alike from a column and
     // from a raster, with or without a fitted variogram.
-    terramesh_geostat::external_scale(g).map_err(|e| Error::invalid(e.to_string()))?;
+    terramesh_geostat::external_scale(g)?;
     let n = data.len();
     let (mut cx, mut cy) = (0.0, 0.0);
     for p in data.xy() {
@@ -447,13 +447,11 @@ pub fn drift_residuals(data: &Data, g: &[f64], method: Method) -> Result<Data> {
             }
         }
     }
-    let coef = solve(a, b, p).ok_or_else(|| {
-        Error::invalid("the external drift is a combination of the other drift terms at the data")
-    })?;
+    let coef = solve(a, b, p).ok_or(Error::DriftCollinear)?;
     let r: Vec<f64> = (0..n)
         .map(|i| data.z()[i] - cols(i).iter().zip(&coef).map(|(c, k)| c * k).sum::<f64>())
         .collect();
-    Data::new(data.xy().to_vec(), r, Duplicates::Reject).map_err(|e| Error::invalid(e.to_string()))
+    Ok(Data::new(data.xy().to_vec(), r, Duplicates::Reject)?)
 }
 
 /// Gaussian elimination with partial pivoting of a small system; `None` if singular.

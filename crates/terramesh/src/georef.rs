@@ -63,12 +63,12 @@ impl Georef {
     /// # Errors
     /// The CRS has no transformation to WGS 84 that terramesh can apply.
     pub fn crs(crs: &Crs, key: &str) -> Result<Georef> {
-        let to_wgs84 = Transformer::new(crs, &Crs::wgs84()).map_err(|e| {
-            crate::error::Error::invalid(format!(
-                "{key} = \"{crs}\": the geographic exports (kml, dae, glb, 3dtiles, terrain) need \
-                 WGS-84 positions, and {e}; remove them from export.formats"
-            ))
-        })?;
+        let to_wgs84 =
+            Transformer::new(crs, &Crs::wgs84()).map_err(|e| crate::error::Error::NoWgs84 {
+                key: key.to_string(),
+                crs: crs.to_string(),
+                source: Box::new(e),
+            })?;
         Ok(Georef {
             place: Place::Crs(Box::new(to_wgs84)),
             datum: None,

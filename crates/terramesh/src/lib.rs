@@ -45,7 +45,7 @@ mod error;
 pub mod progress;
 mod setting;
 
-pub use error::{cut, Context, Error, Result};
+pub use error::{cut, Context, Error, PathProblem, Result};
 pub use setting::Setting;
 pub mod build;
 pub mod convert;
@@ -56,6 +56,7 @@ pub mod georef;
 pub mod gltf;
 pub mod horizon;
 pub mod interpolate;
+pub mod interrupt;
 pub mod mesh;
 pub mod plan;
 pub mod project;

@@ -14,13 +14,14 @@
 //! # Ok::<(), terramesh::Error>(())
 //! ```
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use terramesh_core::coords::{parse_angle, to_utm, to_wgs84, Axis, Zone};
+use terramesh_core::coords::{parse_angle, to_utm, to_wgs84, Axis, CoordError, Zone};
 use terramesh_core::geometry::Region;
 use terramesh_core::sampling::Kernel;
 use terramesh_io::dem::{open_raster, ElevationSource};
-use terramesh_io::region::{LoadedRegion, RegionCrs};
+use terramesh_io::export::{write_mesh, writer_for, MeshView};
+use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
 use terramesh_io::table::{ReadOptions, Table};
 use terramesh_mesh::{
     adaptive_mesh, smooth_keeping, AdaptiveReport, AdaptiveSettings, BuildReport, Fallible, Mesh,
@@ -167,6 +168,20 @@ pub struct DemHeights {
     name: String,
 }
 
+/// Why a DEM has no height at a point ([`DemHeights::height`]).
+#[derive(Debug, thiserror::Error)]
+pub enum HeightError {
+    /// The point cannot be converted to the DEM's coordinates.
+    #[error(transparent)]
+    Coord(#[from] CoordError),
+    /// The point is outside the domain of the DEM's coordinate system.
+    #[error("outside the DEM's coordinate system")]
+    OutsideCrs,
+    /// The DEM has no value there (outside it, or a void).
+    #[error(transparent)]
+    Missing(terramesh_core::sampling::Missing),
+}
+
 impl DemHeights {
     /// Opens the DEM at `path` for a region in `zone` (`None`: the DEM's own coordinates).
     pub fn open(path: &Path, zone: Option<Zone>) -> Result<DemHeights> {
@@ -184,22 +199,21 @@ impl DemHeights {
     }
 
     /// The height at `(x, y)`, or why there is none.
-    pub fn height(&self, x: f64, y: f64) -> std::result::Result<f64, String> {
+    pub fn height(&self, x: f64, y: f64) -> std::result::Result<f64, HeightError> {
         let (sx, sy) = match self.zone {
             Some(z) => {
-                let (lat, lon) = to_wgs84(x, y, z).map_err(|e| e.to_string())?;
+                let (lat, lon) = to_wgs84(x, y, z)?;
                 self.dem
                     .crs()
-                    .from_wgs84(lat, lon)
-                    .map_err(|e| e.to_string())?
-                    .ok_or("outside the DEM's coordinate system")?
+                    .from_wgs84(lat, lon)?
+                    .ok_or(HeightError::OutsideCrs)?
             }
             None => (x, y),
         };
         self.dem
             .sample(sx, sy, Kernel::Bilinear)
             .or_else(|_| self.dem.sample(sx, sy, Kernel::Nearest))
-            .map_err(|e| e.to_string())
+            .map_err(HeightError::Missing)
     }
 
     /// Checks that the DEM covers `region`: its corners and a 101 x 101 grid inside it.
@@ -322,4 +336,98 @@ pub fn read_points(path: &Path, crs: RegionCrs, zone: Option<Zone>) -> Result<Ve
     (0..t.records.len())
         .map(|r| Ok([t.number(r, x)?, t.number(r, y)?]))
         .collect()
+}
+
+/// A standalone mesh of a study region (`terramesh mesh`, the facade of [`mesh_region`] and
+/// [`adaptive_dem`]): the region, the plan, the sample points to insert or the DEM of an
+/// adaptive mesh, and the mesh file to write.
+///
+/// ```
+/// use terramesh::{mesh::MeshJob, plan::MeshPlan};
+/// use terramesh_io::region::{RegionCrs, RegionInput};
+/// let dir = tempfile::tempdir()?;
+/// let mut plan = MeshPlan::unsmoothed();
+/// plan.max_area = Some(50.0);
+/// let job = MeshJob {
+///     region: RegionInput::Corners("0 0; 0 100; 100 100; 100 0".into()),
+///     crs: RegionCrs::Projected,
+///     zone: None,
+///     plan,
+///     points: None,
+///     dem: None,
+///     output: dir.path().join("mesh.vtu"),
+/// };
+/// let said = job.run()?;
+/// assert!(said.contains("mesh.vtu (") && dir.path().join("mesh.vtu").exists(), "{said}");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct MeshJob {
+    /// The region: corners or a region file.
+    pub region: RegionInput,
+    /// The coordinates of the region (and of `points`).
+    pub crs: RegionCrs,
+    /// The UTM zone (default: the zone of the region's centre).
+    pub zone: Option<Zone>,
+    /// The mesh's settings ([`MeshPlan::check`]ed by [`MeshJob::run`]); with
+    /// [`MeshPlan::max_error`], the mesh is adaptive against `dem`.
+    pub plan: MeshPlan,
+    /// Sample locations to insert as mesh vertices (a CSV file).
+    pub points: Option<PathBuf>,
+    /// The DEM of an adaptive mesh.
+    pub dem: Option<PathBuf>,
+    /// The mesh file (`.vtu`, `.obj`, `.ply` or `.msh`).
+    pub output: PathBuf,
+}
+
+impl MeshJob {
+    /// The region of a front end's two ways to give it: corners, or a region file;
+    /// [`Setting::Region`] when neither is given.
+    pub fn region_input(corners: Option<String>, file: Option<PathBuf>) -> Result<RegionInput> {
+        RegionInput::given(corners, file)
+            .ok_or_else(|| Error::setting(Setting::Region, "", "give the region with {region}"))
+    }
+
+    /// Checks the settings (before any file is read), meshes the region, writes the mesh and
+    /// returns what to tell the user: the quality summary and the file written.
+    pub fn run(&self) -> Result<String> {
+        writer_for(&self.output)?;
+        self.plan.check()?;
+        let region = load(&self.region, self.crs, self.zone)?;
+        if let (Some(max_error), Some(path)) = (self.plan.max_error, &self.dem) {
+            let dem = DemHeights::open(path, region.zone)?;
+            let a = adaptive_dem(&region, &dem, &self.plan.adaptive(max_error))?;
+            let mut view = MeshView::planar(a.mesh.origin, &a.mesh.points, &a.mesh.triangles);
+            view.z = Some(&a.z);
+            view.point_data.push(("elevation", &a.z));
+            return self.write(&view, a.summary(&region, &dem, max_error));
+        }
+        let points = match &self.points {
+            Some(p) => read_points(p, self.crs, region.zone)?,
+            None => Vec::new(),
+        };
+        let m = mesh_region(&region, &self.plan, &points).map_err(|e| Error::MeshRegion {
+            file: match &self.region {
+                RegionInput::File(p) => Some(p.clone()),
+                _ => None,
+            },
+            area: region.projected.area(),
+            zone: region.zone,
+            source: Box::new(e),
+        })?;
+        let view = MeshView::planar(m.mesh.origin, &m.mesh.points, &m.mesh.triangles);
+        self.write(&view, m.summary(&region))
+    }
+
+    /// Writes the mesh and adds what was written to `text`.
+    fn write(&self, view: &MeshView, mut text: String) -> Result<String> {
+        write_mesh(&self.output, view)?;
+        text += &format!(
+            "wrote {} ({} vertices, {} triangles)\n",
+            self.output.display(),
+            view.points.len(),
+            view.triangles.len()
+        );
+        Ok(text)
+    }
 }

@@ -144,6 +144,18 @@ pub enum Setting {
     BaseElevation,
     /// The model name(s) of a given variogram.
     ModelName,
+    /// The side of the tiles of a tiled build.
+    TileSize,
+    /// The halo around each tile's data.
+    Halo,
+    /// The Slurm partition of a tiled build's jobs.
+    Partition,
+    /// The Slurm time limit of each job.
+    Time,
+    /// The Slurm memory of each task.
+    Mem,
+    /// Replacing a file that exists.
+    Force,
 }
 
 impl Setting {
@@ -244,4 +256,10 @@ terramesh_core::named_enum!(Setting, "setting", [
     Setting::FitModel => "fit-model",
     Setting::BaseElevation => "base-elevation",
     Setting::ModelName => "model-name",
+    Setting::TileSize => "tile-size",
+    Setting::Halo => "halo",
+    Setting::Partition => "partition",
+    Setting::Time => "time",
+    Setting::Mem => "mem",
+    Setting::Force => "force",
 ]);

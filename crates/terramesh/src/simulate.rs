@@ -28,17 +28,19 @@
 //! ```
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use terramesh_core::limits::Estimate;
 use terramesh_geostat::{
-    simulate, Data, Ensemble, GeostatError, Method, Neighbourhood, SimulationSettings, Variogram,
+    simulate, Data, Ensemble, Method, Neighbourhood, SimulationSettings, Variogram,
 };
+use terramesh_io::grid_write::RasterGrid;
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 use terramesh_io::table::{ReadOptions, Table};
 
 use crate::error::{Context, Error, Result};
-use crate::interpolate::{X, Y};
+use crate::interpolate::{read_data, MethodOptions, Targets, X, Y};
 use crate::setting::Setting;
 
 /// The `x,y` targets of a CSV file (column names as [`crate::interpolate`] takes them);
@@ -51,10 +53,7 @@ pub fn read_targets(path: &Path) -> Result<Vec<[f64; 2]>> {
         out.push([t.number(r, xc)?, t.number(r, yc)?]);
     }
     if out.is_empty() {
-        return Err(Error::invalid(format!(
-            "{}: no target rows after the header",
-            t.name
-        )));
+        return Err(Error::NoTargets { file: t.name });
     }
     Ok(out)
 }
@@ -77,10 +76,7 @@ pub fn run_simulation(
             "give at least 1 realisation",
         ));
     }
-    simulate(data, v, method, hood, targets, settings).map_err(|e| match e {
-        GeostatError::TooLarge(_) => Error::Geostat(e),
-        other => Error::invalid(other),
-    })
+    Ok(simulate(data, v, method, hood, targets, settings)?)
 }
 
 /// Writes `x,y,z_1..z_N,mean,std,p10,p50,p90` to `output` (standard output without one),
@@ -114,4 +110,122 @@ pub fn write_ensemble(targets: &[[f64; 2]], e: &Ensemble, output: Option<&Path>)
     out.write_all(&buf)?;
     out.commit()?;
     Ok(())
+}
+
+/// One whole conditional simulation as `terramesh simulate` runs it: the settings checked
+/// before any file is read, the data read, the variogram given, read or fitted, the targets of
+/// a CSV file or the nodes of a grid, and the ensemble written as CSV.
+///
+/// ```
+/// use terramesh::interpolate::{MethodOptions, Targets};
+/// use terramesh::simulate::SimulateJob;
+/// use terramesh_geostat::InterpolationMethod;
+/// let dir = tempfile::tempdir()?;
+/// std::fs::write(dir.path().join("d.csv"), "x,y,z\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n")?;
+/// let mut m = MethodOptions::new(InterpolationMethod::Ordinary);
+/// (m.model.model, m.model.psill, m.model.range) = (Some("exponential".into()), vec![1.0], vec![20.0]);
+/// let mut job = SimulateJob::new(dir.path().join("d.csv"), Targets::Grid("0,0,10,10,3,3".into()), m, 2);
+/// job.output = Some(dir.path().join("sim.csv"));
+/// job.run(&|_| {})?;
+/// assert_eq!(std::fs::read_to_string(dir.path().join("sim.csv"))?.lines().count(), 10);
+///
+/// job.modes = 0;
+/// assert_eq!(job.run(&|_| {}).unwrap_err().render(&|s| format!("--{s}")), "--modes 0: give at least 1");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimulateJob {
+    /// The data file (`x,y,z`).
+    pub data: PathBuf,
+    /// Where to simulate (a grid's nodes are written as CSV rows).
+    pub targets: Targets,
+    /// The kriging method, its neighbourhood and variogram (IDW is refused).
+    pub method: MethodOptions,
+    /// The number of realisations (at least 1).
+    pub realisations: usize,
+    /// The seed of the random streams (one stream per realisation).
+    pub seed: u64,
+    /// Spectral modes per realisation (at least 1).
+    pub modes: usize,
+    /// The output CSV (standard output without one).
+    pub output: Option<PathBuf>,
+}
+
+impl SimulateJob {
+    /// `realisations` of `method` from `data` at `targets`, seed 0, the default number of
+    /// modes, to standard output.
+    pub fn new(
+        data: PathBuf,
+        targets: Targets,
+        method: MethodOptions,
+        realisations: usize,
+    ) -> SimulateJob {
+        SimulateJob {
+            data,
+            targets,
+            method,
+            realisations,
+            seed: 0,
+            modes: terramesh_geostat::DEFAULT_MODES,
+            output: None,
+        }
+    }
+
+    /// Runs it; a fitted variogram is told to `say`. The output is written atomically when
+    /// every realisation is done.
+    pub fn run(&self, say: &dyn Fn(&str)) -> Result<()> {
+        let m = &self.method;
+        m.check_simulation()?;
+        for (setting, n) in [
+            (Setting::Realisations, self.realisations),
+            (Setting::Modes, self.modes),
+        ] {
+            if n == 0 {
+                let name = terramesh_core::vocab::Named::name(setting);
+                return Err(Error::setting(
+                    setting,
+                    "",
+                    format!("{{{name}}} 0: give at least 1"),
+                ));
+            }
+        }
+        let fd = read_data(&self.data, m.duplicates)?;
+        let method = m.method(&fd.data)?;
+        let v = m.resolve_variogram(&fd, say)?;
+        let targets = match &self.targets {
+            Targets::Csv(t) => read_targets(t)?,
+            Targets::Grid(g) => self.grid_nodes(g)?,
+        };
+        let mut settings = SimulationSettings::new(self.realisations, self.seed);
+        settings.modes = self.modes;
+        let e = run_simulation(&fd.data, &v, method, m.neighbourhood(), &targets, &settings)
+            .map_err(|e| Error::within(&fd.name, e))?;
+        write_ensemble(&targets, &e, self.output.as_deref())
+    }
+
+    /// The nodes of the grid `g` (row by row from ymax), refused when the ensemble on them
+    /// would not fit in memory.
+    fn grid_nodes(&self, g: &str) -> Result<Vec<[f64; 2]>> {
+        let spec: RasterGrid = g
+            .parse()
+            .map_err(|e| Error::setting(Setting::Grid, "", format!("{{grid}} {e}")))?;
+        let nodes = Estimate::new(
+            "grid nodes",
+            spec.nx as f64 * spec.ny as f64,
+            16.0 * (self.realisations as f64 + 1.0),
+        )
+        .check()
+        .map_err(|e| {
+            let why = e.describe(&|field| field.to_string());
+            let why = format!("{{grid}} {g}: {why}: give fewer nodes or {{realisations}}");
+            Error::setting(Setting::Grid, "", why)
+        })?;
+        let mut t = Vec::with_capacity(nodes);
+        for j in 0..spec.ny {
+            for i in 0..spec.nx {
+                t.push(spec.node(i, j));
+            }
+        }
+        Ok(t)
+    }
 }

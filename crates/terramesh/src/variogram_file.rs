@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use terramesh_geostat::{Variogram, VariogramFile, VariogramFileError};
+use terramesh_geostat::{Variogram, VariogramFile};
 
 use crate::error::{Context, Error, Result};
 
@@ -24,10 +24,9 @@ pub fn read_variogram_file(path: &Path) -> Result<Variogram> {
     let text = terramesh_io::text::read_text(path).with_context(|| path.display().to_string())?;
     match VariogramFile::from_json(&text) {
         Ok(f) => Ok(f.model),
-        Err(e @ VariogramFileError::NoModel) => Err(Error::invalid(format!(
-            "{}: {e} (write it with terramesh variogram)",
-            path.display()
-        ))),
-        Err(e) => Err(Error::invalid(format!("{}: {e}", path.display()))),
+        Err(source) => Err(Error::VariogramFile {
+            file: path.to_path_buf(),
+            source,
+        }),
     }
 }

@@ -30,55 +30,40 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    run_project(
-        &args.project,
-        &args.output,
-        &args.set,
-        args.quiet,
-        terramesh::build::build,
-        "built",
-    )
+    run_project(&args.project, &args.output, &args.set, args.quiet, false)
 }
 
-/// A build function of the library (`build`, `build_model`).
-pub(crate) type Pipeline = fn(
-    &Project,
-    &Path,
-    &Path,
-    &dyn terramesh::progress::Progress,
-) -> terramesh::Result<terramesh::build::Built>;
-
-/// Loads `project` with its `--set`s and runs `pipeline` into `output` with a progress bar,
-/// then prints `done` and the time.
+/// Loads `project` with its `--set`s and builds it (only its geological model with `model`)
+/// into `output` with a progress bar, then prints what was built and the time.
 pub(crate) fn run_project(
     project: &Path,
     output: &Path,
     set: &[String],
     quiet: bool,
-    pipeline: Pipeline,
-    done: &str,
+    model: bool,
 ) -> Result<()> {
     let t0 = Instant::now();
     let p = Project::load(project, set).map_err(crate::project_error)?;
     let base = project.parent().unwrap_or(Path::new("."));
     let progress = Terminal::new(quiet, true);
-    pipeline(&p, base, output, &progress).map_err(|e| build_error(project, e))?;
-    progress.finish(&format!(
-        "{done} {} in {:.2} s",
-        output.display(),
-        t0.elapsed().as_secs_f64()
-    ));
+    let (pipeline, done) = match model {
+        false => (terramesh::build::build as Pipeline, "built"),
+        true => (
+            terramesh::build::build_model as Pipeline,
+            "built the model into",
+        ),
+    };
+    pipeline(&p, base, output, &progress)
+        .map_err(|e| anyhow::anyhow!(e.render_of_file(project, &terramesh::project::key_of)))?;
+    let secs = t0.elapsed().as_secs_f64();
+    progress.finish(&format!("{done} {} in {secs:.2} s", output.display()));
     Ok(())
 }
 
-/// A build's error, worded with project keys and said of the project file: a build error is
-/// about the file the user wrote, so it names it first (unless the message already does).
-fn build_error(project: &Path, e: terramesh::Error) -> anyhow::Error {
-    let msg = e.render(&terramesh::project::key_of);
-    let name = project.display().to_string();
-    if msg.contains(&name) {
-        anyhow::anyhow!(msg)
-    } else {
-        anyhow::anyhow!("{name}: {msg}")
-    }
-}
+/// A build function of the library (`build`, `build_model`).
+type Pipeline = fn(
+    &Project,
+    &Path,
+    &Path,
+    &dyn terramesh::progress::Progress,
+) -> terramesh::Result<terramesh::build::Built>;

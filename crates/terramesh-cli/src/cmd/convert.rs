@@ -2,11 +2,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
-use terramesh::convert::{convert_table, Target};
+use anyhow::Result;
+use terramesh::convert::{ConvertJob, Target};
 use terramesh_core::coords::Zone;
-use terramesh_io::output::Output;
-use terramesh_io::table::{ReadOptions, Table};
 
 /// Convert coordinates between WGS-84 and UTM.
 ///
@@ -47,24 +45,14 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let delimiter = match args.delimiter {
-        Some(c) if c.is_ascii() => Some(c as u8),
-        Some(c) => bail!("--delimiter '{c}' must be a single ASCII character"),
-        None => None,
+    let job = ConvertJob {
+        input: args.input,
+        output: args.output,
+        columns: args.columns,
+        delimiter: args.delimiter,
+        to: args.to,
+        zone: args.zone,
+        extras: args.extras,
     };
-    let opts = ReadOptions {
-        columns: args.columns.clone(),
-        delimiter,
-    };
-    let table = Table::read(&args.input, &opts).map_err(|e| crate::flag_error(e.into()))?;
-    let name = args
-        .output
-        .as_ref()
-        .map_or_else(|| "standard output".into(), |p| p.display().to_string());
-    let mut out =
-        Output::create(args.output.as_deref()).with_context(|| format!("cannot write {name}"))?;
-    convert_table(&table, args.to, args.zone, args.extras, &mut out).map_err(crate::flag_error)?;
-    out.commit()
-        .with_context(|| format!("cannot write {name}"))?;
-    Ok(())
+    job.run().map_err(crate::flag_error)
 }

@@ -2,9 +2,8 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
-use terramesh::interpolate::read_data;
-use terramesh_geostat::{cross_validate, cross_validate_external, Folds};
+use anyhow::Result;
+use terramesh::interpolate::CvJob;
 
 use super::interpolate::{say, DriftArgs, MethodArgs};
 
@@ -33,47 +32,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let fd = read_data(&args.data, args.m.duplicates).map_err(crate::flag_error)?;
-    let folds = match args.folds {
-        None => Folds::LeaveOneOut,
-        Some(k) if k < 2 => bail!("--folds {k}: must be at least 2"),
-        Some(k) => Folds::KFold(k),
-    };
-    let m = args.m.options();
-    let e = |e| crate::flag_error(terramesh::Error::within(&fd.name, e));
-    let r = match m
-        .external_drift(&args.drift.options(), &args.data, &fd, &say)
-        .map_err(crate::flag_error)?
-    {
-        Some(k) => cross_validate_external(
-            &fd.data,
-            &k.at_data,
-            &k.variogram,
-            k.method,
-            m.neighbourhood(),
-            folds,
-        ),
-        None => cross_validate(
-            &fd.data,
-            &m.interpolator(&fd, &say).map_err(crate::flag_error)?,
-            folds,
-        ),
-    }
-    .map_err(e)?;
-    let s = r.stats;
-    println!("key,value");
-    println!("n,{}", s.n);
-    println!(
-        "folds,{}",
-        args.folds
-            .map_or("leave-one-out".to_string(), |k| k.to_string())
-    );
-    println!("rmse,{}", s.rmse);
-    println!("mae,{}", s.mae);
-    println!("mean_error,{}", s.mean_error);
-    if let (Some(m), Some(v)) = (s.mean_standardized, s.var_standardized) {
-        println!("mean_standardized_error,{m}");
-        println!("var_standardized_error,{v}");
-    }
-    Ok(())
+    let mut job = CvJob::new(args.data, args.m.options());
+    (job.drift, job.folds) = (args.drift.options(), args.folds);
+    let stats = job.run(&say).map_err(crate::flag_error)?;
+    crate::say(&job.table(&stats))
 }

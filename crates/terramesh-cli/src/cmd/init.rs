@@ -2,10 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
-use terramesh_io::output::write_atomic;
-
-use terramesh::project::{Project, GEOLOGY_TEMPLATE, TEMPLATE};
+use anyhow::Result;
 
 /// Create a project directory with a commented terramesh.toml, ready to edit.
 #[derive(clap::Args, Debug)]
@@ -26,24 +23,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    std::fs::create_dir_all(&args.dir)
-        .with_context(|| format!("cannot create the directory {}", args.dir.display()))?;
-    let path = args.dir.join("terramesh.toml");
-    if path.exists() && !args.force {
-        bail!(
-            "{} exists already: edit it, or pass --force to replace it",
-            path.display()
-        );
-    }
-    let text = if args.geology {
-        format!("{TEMPLATE}{GEOLOGY_TEMPLATE}")
-    } else {
-        TEMPLATE.to_string()
-    };
-    // The template must always be a valid project.
-    Project::parse("the built-in template", &text, &[]).map_err(crate::project_error)?;
-    write_atomic(&path, text.as_bytes())
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    let path =
+        terramesh::project::init(&args.dir, args.force, args.geology).map_err(crate::flag_error)?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

@@ -146,11 +146,7 @@ pub fn say(text: &str) {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let targets = match (args.targets, args.grid) {
-        (Some(t), None) => Targets::Csv(t),
-        (None, Some(g)) => Targets::Grid(g),
-        _ => anyhow::bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
-    };
+    let targets = Targets::of(args.targets, args.grid).map_err(crate::flag_error)?;
     let job = InterpolateJob {
         data: args.data,
         targets,

@@ -2,12 +2,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
-use terramesh::mesh::{adaptive_dem, mesh_region, read_points, DemHeights};
+use anyhow::Result;
+use terramesh::mesh::MeshJob;
 use terramesh::plan::MeshPlan;
 use terramesh_core::coords::Zone;
-use terramesh_io::export::{write_mesh, writer_for, MeshView};
-use terramesh_io::region::{load, RegionCrs, RegionInput};
+use terramesh_io::region::RegionCrs;
 use terramesh_mesh::{Smoother, DEFAULT_MIN_ANGLE, DEFAULT_SMOOTHER};
 
 /// Mesh the study region: constrained Delaunay triangulation refined to a minimum angle and a
@@ -84,13 +83,7 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    // Resolve settings before any work, so that a bad flag fails fast.
-    writer_for(&args.output)?;
-    let input = match (&args.corners, &args.region) {
-        (Some(c), None) => RegionInput::Corners(c.clone()),
-        (None, Some(r)) => RegionInput::File(r.clone()),
-        _ => bail!("give the region with --corners or --region"),
-    };
+    let region = MeshJob::region_input(args.corners, args.region).map_err(crate::flag_error)?;
     let plan = MeshPlan {
         min_angle: args.min_angle,
         max_area: args.max_area,
@@ -102,50 +95,14 @@ pub fn run(args: Args) -> Result<()> {
         max_error: args.max_error,
         ..MeshPlan::unsmoothed()
     };
-    plan.check().map_err(crate::flag_error)?;
-    let region = load(&input, args.crs, args.zone).map_err(|e| crate::flag_error(e.into()))?;
-    if let (Some(max_error), Some(path)) = (args.max_error, &args.dem) {
-        let dem = DemHeights::open(path, region.zone).map_err(crate::flag_error)?;
-        let a =
-            adaptive_dem(&region, &dem, &plan.adaptive(max_error)).map_err(crate::flag_error)?;
-        let mut view = MeshView::planar(a.mesh.origin, &a.mesh.points, &a.mesh.triangles);
-        view.z = Some(&a.z);
-        view.point_data.push(("elevation", &a.z));
-        return write_and_say(&args.output, &view, a.summary(&region, &dem, max_error));
-    }
-    let points = match &args.points {
-        Some(p) => read_points(p, args.crs, region.zone).map_err(crate::flag_error)?,
-        None => Vec::new(),
+    let job = MeshJob {
+        region,
+        crs: args.crs,
+        zone: args.zone,
+        plan,
+        points: args.points,
+        dem: args.dem,
+        output: args.output,
     };
-    let m = mesh_region(&region, &plan, &points)
-        .map_err(crate::flag_error)
-        .with_context(|| region_context(&input, &region))?;
-    let view = MeshView::planar(m.mesh.origin, &m.mesh.points, &m.mesh.triangles);
-    write_and_say(&args.output, &view, m.summary(&region))
-}
-
-/// What a meshing error is about: the region's file (or corners) and its size, so that a
-/// region far larger than meant (a damaged coordinate) shows at once.
-fn region_context(input: &RegionInput, region: &terramesh_io::region::LoadedRegion) -> String {
-    let what = match input {
-        RegionInput::File(p) => format!("the region of {}", p.display()),
-        _ => "the region of --corners".to_string(),
-    };
-    let zone = region
-        .zone
-        .map(|z| format!(" in UTM zone {z}"))
-        .unwrap_or_default();
-    format!("{what} ({:.4e} m2{zone})", region.projected.area())
-}
-
-/// Writes the mesh, then prints `text` and what was written.
-fn write_and_say(output: &std::path::Path, view: &MeshView, mut text: String) -> Result<()> {
-    write_mesh(output, view)?;
-    text += &format!(
-        "wrote {} ({} vertices, {} triangles)\n",
-        output.display(),
-        view.points.len(),
-        view.triangles.len()
-    );
-    crate::say(&text)
+    crate::say(&job.run().map_err(crate::flag_error)?)
 }

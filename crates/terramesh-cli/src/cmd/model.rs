@@ -28,12 +28,5 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    super::build::run_project(
-        &args.project,
-        &args.output,
-        &args.set,
-        args.quiet,
-        terramesh::build::build_model,
-        "built the model into",
-    )
+    super::build::run_project(&args.project, &args.output, &args.set, args.quiet, true)
 }

@@ -147,11 +147,7 @@ impl Args {
         })?;
         Ok(SampleOptions {
             source: self.source.clone(),
-            region: match (&self.corners, &self.region) {
-                (Some(c), _) => Some(RegionInput::Corners(c.clone())),
-                (None, Some(r)) => Some(RegionInput::File(r.clone())),
-                (None, None) => None,
-            },
+            region: RegionInput::given(self.corners.clone(), self.region.clone()),
             region_crs: self.region_crs,
             zone: self.zone,
             project_crs: None,

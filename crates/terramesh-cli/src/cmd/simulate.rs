@@ -3,11 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
-use terramesh::interpolate::read_data;
-use terramesh::simulate::{read_targets, run_simulation, write_ensemble};
-use terramesh_geostat::{SimulationSettings, DEFAULT_MODES};
-use terramesh_io::grid_write::RasterGrid;
+use anyhow::Result;
+use terramesh::interpolate::Targets;
+use terramesh::simulate::SimulateJob;
+use terramesh_geostat::DEFAULT_MODES;
 
 use super::interpolate::{say, MethodArgs};
 
@@ -57,47 +56,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let m = args.m.options();
-    m.check_simulation().map_err(crate::flag_error)?;
-    if args.realisations == 0 {
-        bail!("--realisations 0: give at least 1");
-    }
-    if args.modes == 0 {
-        bail!("--modes 0: give at least 1");
-    }
-    let fd = read_data(&args.data, m.duplicates).map_err(crate::flag_error)?;
-    let method = m.method(&fd.data).map_err(crate::flag_error)?;
-    let v = m.resolve_variogram(&fd, &say).map_err(crate::flag_error)?;
-    let targets = match (&args.targets, &args.grid) {
-        (Some(t), None) => read_targets(t).map_err(crate::flag_error)?,
-        (None, Some(g)) => {
-            let spec: RasterGrid = g.parse().map_err(|e| anyhow::anyhow!("--grid {e}"))?;
-            let nodes = terramesh_core::limits::Estimate::new(
-                "grid nodes",
-                spec.nx as f64 * spec.ny as f64,
-                16.0 * (args.realisations as f64 + 1.0),
-            )
-            .check()
-            .map_err(|e| {
-                anyhow::anyhow!(
-                    "--grid {g}: {}: give fewer nodes or --realisations",
-                    e.describe(&crate::flag_of_field)
-                )
-            })?;
-            let mut t = Vec::with_capacity(nodes);
-            for j in 0..spec.ny {
-                for i in 0..spec.nx {
-                    t.push(spec.node(i, j));
-                }
-            }
-            t
-        }
-        _ => bail!("give --targets T.csv or --grid xmin,ymin,xmax,ymax,nx,ny"),
-    };
-    let hood = m.neighbourhood();
-    let mut settings = SimulationSettings::new(args.realisations, args.seed);
-    settings.modes = args.modes;
-    let e = run_simulation(&fd.data, &v, method, hood, &targets, &settings)
-        .map_err(|e| crate::flag_error(e).context(fd.name.clone()))?;
-    write_ensemble(&targets, &e, args.output.as_deref()).map_err(crate::flag_error)
+    let targets = Targets::of(args.targets, args.grid).map_err(crate::flag_error)?;
+    let mut job = SimulateJob::new(args.data, targets, args.m.options(), args.realisations);
+    (job.seed, job.modes, job.output) = (args.seed, args.modes, args.output);
+    job.run(&say).map_err(crate::flag_error)
 }

@@ -101,98 +101,39 @@ struct SlurmArgs {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
+    let secs = || t0.elapsed().as_secs_f64();
     match args.command {
         Sub::Plan(a) => {
-            if a.halo != "auto" {
-                anyhow::bail!(
-                    "--halo '{}': only auto is supported (the halo is computed from the \
-                     kriging neighbourhood so that every tile sees the samples it needs)",
-                    a.halo
-                );
-            }
-            let size = tiles::parse_tile_size(&a.tile_size)
-                .map_err(|e| anyhow::anyhow!("--tile-size {e}"))?;
+            tiles::check_halo(&a.halo).map_err(crate::flag_error)?;
+            let size = tiles::parse_tile_size(&a.tile_size).map_err(crate::flag_error)?;
             let p = Project::load(&a.project, &a.set).map_err(crate::project_error)?;
             let base = a.project.parent().unwrap_or(Path::new("."));
             let progress = Terminal::new(a.quiet, true);
             let planned = tiles::plan(&p, &a.project, &a.set, base, size, &a.output, &progress)
                 .map_err(crate::project_error)?;
-            progress.finish(&format!(
-                "planned {} tiles ({} x {}) of {} samples into {} (widest halo {:.0} m) in {:.2} s",
-                planned.tiles,
-                planned.shape[0],
-                planned.shape[1],
-                planned.samples,
-                a.output.display(),
-                planned.max_halo,
-                t0.elapsed().as_secs_f64()
-            ));
+            progress.finish(&planned.summary(&a.output, secs()));
         }
         Sub::Build(a) => {
-            match tiles::build_tile(&a.plan, &a.tile).map_err(crate::project_error)? {
-                tiles::Outcome::AlreadyDone => crate::say(&format!(
-                    "tile {} is done already: nothing changed\n",
-                    a.tile
-                ))?,
-                tiles::Outcome::Built(s) => crate::say(&format!(
-                    "built tile {}: {} vertices, {} triangles, {} grid nodes from {} samples in \
-                     {:.2} s\n",
-                    a.tile,
-                    s.vertices,
-                    s.triangles,
-                    s.grid_nodes,
-                    s.samples,
-                    t0.elapsed().as_secs_f64()
-                ))?,
-            }
+            let outcome = tiles::build_tile(&a.plan, &a.tile).map_err(crate::project_error)?;
+            crate::say(&outcome.summary(&a.tile, secs()))?;
         }
         Sub::Merge(a) => {
             let m = tiles::merge(&a.plan, &a.output).map_err(crate::project_error)?;
-            let model = m.model.as_ref().map_or(String::new(), |g| {
-                format!(
-                    ", a geological model of {} cells and {} nodes",
-                    g.cells, g.nodes
-                )
-            });
-            crate::say(&format!(
-                "merged into {}: {} vertices, {} triangles, {} seam vertices{model} in {:.2} s\n",
-                a.output.display(),
-                m.vertices,
-                m.triangles,
-                m.seam_vertices,
-                t0.elapsed().as_secs_f64()
-            ))?;
+            crate::say(&m.summary(&a.output, secs()))?;
         }
         Sub::Slurm(a) => {
-            // Each value becomes an #SBATCH line: refused before anything is written.
-            for (flag, value) in [
-                ("--partition", Some(&a.partition)),
-                ("--time", Some(&a.time)),
-                ("--mem", a.mem.as_ref()),
-            ] {
-                if let Some(v) = value {
-                    tiles::check_sbatch_value(v)
-                        .map_err(|why| anyhow::anyhow!("{flag} {v:?}: {why}"))?;
-                }
-            }
-            let binary = crate::program()?;
-            let output = a.output.unwrap_or_else(|| a.plan.join("merged"));
             let o = tiles::SlurmOptions {
+                binary: crate::program()?,
+                output: a.output.unwrap_or_else(|| a.plan.join("merged")),
                 partition: a.partition,
                 time: a.time,
                 cpus: a.cpus,
                 mem: a.mem,
-                binary,
-                output,
             };
+            // Each value becomes an #SBATCH line: refused before anything is written.
+            o.check().map_err(crate::flag_error)?;
             let s = tiles::write_slurm(&a.plan, &o).map_err(crate::project_error)?;
-            crate::say(&format!(
-                "wrote {}, {} and {}: submit with bash {}\n",
-                s.tiles.display(),
-                s.merge.display(),
-                s.submit.display(),
-                s.submit.display()
-            ))?;
+            crate::say(&s.summary())?;
         }
     }
     Ok(())

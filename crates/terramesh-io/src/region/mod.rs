@@ -79,6 +79,23 @@ pub enum RegionInput {
     File(PathBuf),
 }
 
+impl RegionInput {
+    /// The region of a front end's two ways to give it, corners first; `None` when neither is
+    /// given.
+    ///
+    /// ```
+    /// use terramesh_io::region::RegionInput;
+    /// assert_eq!(RegionInput::given(None, Some("a.kml".into())), Some(RegionInput::File("a.kml".into())));
+    /// assert_eq!(RegionInput::given(None, None), None);
+    /// ```
+    pub fn given(corners: Option<String>, file: Option<PathBuf>) -> Option<RegionInput> {
+        match (corners, file) {
+            (Some(c), _) => Some(RegionInput::Corners(c)),
+            (None, f) => f.map(RegionInput::File),
+        }
+    }
+}
+
 /// Whether region coordinates are geographic (projected to UTM) or already projected, named
 /// `geographic` and `projected` (see [`terramesh_core::vocab`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

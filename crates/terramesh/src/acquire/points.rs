@@ -125,13 +125,13 @@ pub fn sample_points(
                 })
                 .collect();
             if let Some(i) = latlon.iter().position(|p| p[0].is_nan()) {
-                crate::error::bail!(
-                    "{}: point {} ({}, {}) is not a valid position in {crs}",
-                    pc.name,
-                    i + 1,
-                    pc.xyz[i][0],
-                    pc.xyz[i][1]
-                );
+                return Err(Error::BadPosition {
+                    file: pc.name.clone(),
+                    point: i + 1,
+                    x: pc.xyz[i][0],
+                    y: pc.xyz[i][1],
+                    crs: crs.to_string(),
+                });
             }
             let zone = match s.zone {
                 Some(z) => z,

@@ -7,7 +7,7 @@
 //! below `max_error`. At the end, kriging itself is evaluated at every triangle centre and
 //! edge midpoint of the mesh, and that verified error is what the report shows.
 
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 use terramesh_core::sampling::{GridSurface, Kernel};
 use terramesh_mesh::{adaptive_mesh, error_probes, AdaptiveReport, Mesh};
 
@@ -50,10 +50,10 @@ pub fn adaptive(
 ) -> Result<(Mesh, AdaptiveInfo)> {
     let m = &p.mesh;
     if m.max_edge.is_some() {
-        bail!("[mesh]: max_edge cannot be combined with max_error (adaptive meshes vary in size); use max_area as the upper limit");
+        return Err(Error::MaxEdgeWithMaxError);
     }
     if m.insert_samples {
-        bail!("[mesh]: insert_samples cannot be combined with max_error");
+        return Err(Error::InsertSamplesWithMaxError);
     }
     // The surface of the first interpolation method, which gives the DSM heights.
     let engine = Surface::primary_with(p, &model.data, &model.variogram, model.drift.as_ref())?;
@@ -100,11 +100,11 @@ pub fn adaptive(
         step *= 0.5;
     };
     if grid_error >= 0.75 * target {
-        bail!(
-            "[mesh]: max_error = {target} m is too close to how far the kriged surface departs from a smooth surface through a grid of {} nodes ({grid_error:.3} m; a moving neighbourhood makes kriging jump where the neighbour set changes): raise mesh.max_error above {:.3}, or krige with more neighbours (interpolation.neighbors, 0 for all)",
-            surface.values.len(),
-            grid_error / 0.75
-        );
+        return Err(Error::MaxErrorTooSmall {
+            target,
+            nodes: surface.values.len(),
+            departure: grid_error,
+        });
     }
     let tolerance = target - grid_error;
     let settings = m.adaptive(tolerance);

@@ -126,7 +126,7 @@ fn write_build_json(
         peak_memory: how,
         interpolation,
     })
-    .map_err(|e| Error::invalid(format!("build.json: {e}")))?;
+    .map_err(|e| Error::about("build.json", e))?;
     let path = out.join(BUILD_JSON);
     terramesh_io::output::write_atomic(&path, format!("{json}\n").as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))?;
@@ -237,10 +237,7 @@ pub fn build_model(
     progress: &dyn Progress,
 ) -> Result<Built> {
     if project.geology().is_none() {
-        return Err(Error::invalid(
-            "the project has no [geology] section: add one (terramesh init --geology writes \
-             a template) or use terramesh build for the surface model",
-        ));
+        return Err(Error::NoGeology);
     }
     build_as(project, base, out, progress, What::ModelOnly)
 }

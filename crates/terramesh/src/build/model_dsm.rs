@@ -16,7 +16,7 @@ use terramesh_io::grid_write::RasterGrid;
 
 use super::stages::{self, dsm_grid, Meshed, Model, Samples, Surface};
 use super::{geology_stage, mesh_detail, reuse, Built, Dsm, Stages};
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 use crate::project::Project;
 
 /// The rest of `terramesh model` after the samples (`st` has run that stage): the variogram
@@ -178,9 +178,10 @@ pub fn dsm_heights(
 
 fn finite(name: &str, v: &[f64]) -> Result<()> {
     match v.iter().position(|x| !x.is_finite()) {
-        Some(i) => bail!(
-            "{name} gave a non-finite value at mesh vertex {i}: the kriging system is ill-conditioned"
-        ),
+        Some(vertex) => Err(Error::NonFiniteAtVertex {
+            method: name.to_string(),
+            vertex,
+        }),
         None => Ok(()),
     }
 }

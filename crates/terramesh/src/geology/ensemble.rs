@@ -58,7 +58,7 @@ use terramesh_io::model::{write_model_vtu, ModelInfo};
 use super::fields::{FieldModel, Observation};
 use super::model::{field_observations, seal, stack_of, Base, GeologicalModel, ModelInputs};
 use super::stage::ModelBuilt;
-use crate::error::{bail, Context, Error, Result};
+use crate::error::{Context, Error, Result};
 use crate::plan::GeologyPlan;
 use crate::project::Project;
 
@@ -129,7 +129,7 @@ pub fn simulate_models(
 ) -> Result<ModelEnsemble> {
     let nr = terrains.len();
     if nr == 0 {
-        bail!("interpolation.realisations = 0: no realisation of the model to simulate");
+        return Err(Error::NoRealisations);
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let n = xy.len();
@@ -545,7 +545,7 @@ pub fn run(
         Method::Universal(p.interpolation.drift),
     );
     let dir = out.join("realisations");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|e| Error::about(dir.display(), e))?;
     // The model's other writer settings keep their defaults (none today but the CRS).
     #[allow(clippy::needless_update)]
     let info = ModelInfo {

@@ -35,7 +35,7 @@ use terramesh_geostat::{
     ModelKind, Named, Neighbourhood, Variogram, Weighting,
 };
 
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 
 /// The fewest distinct observation locations a field is kriged from (an experimental
 /// variogram needs pairs at several distances).
@@ -99,7 +99,9 @@ pub fn interpolate_field(
     method: Method,
 ) -> Result<Field> {
     if obs.is_empty() {
-        bail!("no observation of {name}: no borehole meets it and no grid gives it");
+        return Err(Error::NoObservation {
+            unit: name.to_string(),
+        });
     }
     let data = Data::new(
         obs.iter().map(|o| [o.x, o.y]).collect(),

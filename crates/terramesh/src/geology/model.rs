@@ -39,7 +39,7 @@ use terramesh_io::boreholes::Boreholes;
 use terramesh_mesh::{Mesh, SurfaceLocator};
 
 use super::fields::{interpolate_field, Field, Observation};
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 
 /// The model's base.
 #[derive(Debug, Clone, PartialEq)]
@@ -142,7 +142,7 @@ pub(crate) fn assemble_beside<R: Send>(
 ) -> Result<(GeologicalModel, R)> {
     let units = &inputs.layering.units;
     if units.is_empty() {
-        bail!("the geological column names no unit: list them in [geology] units");
+        return Err(Error::NoUnits);
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let planar = Planar::new(&xy, &mesh.triangles).context("the planar mesh")?;
@@ -210,7 +210,7 @@ pub fn assemble_estimated(
     values: &[&[f64]],
 ) -> Result<GeologicalModel> {
     if inputs.layering.units.is_empty() {
-        bail!("the geological column names no unit: list them in [geology] units");
+        return Err(Error::NoUnits);
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     let planar = Planar::new(&xy, &mesh.triangles).context("the planar mesh")?;
@@ -243,12 +243,10 @@ pub(crate) fn field_observations(inputs: &ModelInputs) -> Result<Vec<(usize, Vec
             .collect(),
         Interpolated::Thickness => {
             if !inputs.grids.is_empty() {
-                bail!(
-                    "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" to use them"
-                );
+                return Err(Error::GridsGiveTops);
             }
             let Some(b) = holes else {
-                bail!("interpolate = \"thickness\" needs boreholes: set [geology] collars");
+                return Err(Error::ThicknessNeedsBoreholes);
             };
             (0..n - 1)
                 .map(|u| {
@@ -401,10 +399,12 @@ pub(crate) fn base_values(
     Ok(match &inputs.base {
         Base::Elevation(z) => vec![*z; n],
         Base::PerVertex(v) if v.len() == n => v.clone(),
-        Base::PerVertex(v) => bail!(
-            "the base has {} values for the {n} vertices of the planar mesh",
-            v.len()
-        ),
+        Base::PerVertex(v) => {
+            return Err(Error::BaseValues {
+                values: v.len(),
+                vertices: n,
+            })
+        }
         Base::Auto => {
             let hi = terrain.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             let mut lo = terrain.iter().copied().fold(f64::INFINITY, f64::min);

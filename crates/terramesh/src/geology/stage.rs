@@ -20,7 +20,7 @@ use terramesh_mesh::Mesh;
 
 use super::model::{assemble_beside, Base, GeologicalModel};
 use super::summary::{interface_grid, ModelSummary};
-use crate::error::{bail, Context, Error, Result};
+use crate::error::{Context, Error, Result};
 use crate::horizon::{HorizonError, HorizonGrid};
 use crate::plan::{Base as BaseKey, GeologyPlan};
 use crate::project::Project;
@@ -184,11 +184,9 @@ pub fn run(
     for (unit, path) in g.surfaces.iter().enumerate() {
         let Some(path) = path else { continue };
         if unit == 0 {
-            bail!(
-                "geology.surfaces.{}: the top of the first unit is the terrain (the DSM); \
-                 give grids for the units below it",
-                g.units[0]
-            );
+            return Err(Error::FirstUnitGrid {
+                unit: g.units[0].clone(),
+            });
         }
         wanted.push((unit, path, crs, opened.take(path)));
     }
@@ -213,13 +211,13 @@ pub fn run(
             let ready = opened.take(path);
             let v = horizon_at(path, &xy, g.z_unit, crs, "the base", ready)?;
             match v.iter().position(Option::is_none) {
-                Some(i) => bail!(
-                    "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of the model's \
-                     mesh: a base grid must cover the whole region",
-                    path.display(),
-                    xy[i][0],
-                    xy[i][1]
-                ),
+                Some(i) => {
+                    return Err(Error::BaseGridGap {
+                        file: path.clone(),
+                        x: xy[i][0],
+                        y: xy[i][1],
+                    })
+                }
                 None => Base::PerVertex(v.into_iter().flatten().collect()),
             }
         }
@@ -238,7 +236,7 @@ pub fn run(
     };
     let datum = p.height_datum();
     let dir = out.join("interfaces");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|e| Error::about(dir.display(), e))?;
     // The model's files and the interface grids are written side by side (rayon), and beside
     // the model's independent checks: `out` is the build's staging folder, thrown away when a
     // check fails. Errors in that order.
@@ -285,11 +283,7 @@ pub fn run(
     };
     let (model, (written, grids_written)) =
         assemble_beside(mesh, dsm, &inputs, write).context("[geology]")?;
-    let mut files: Vec<PathBuf> = written
-        .map_err(|e| Error::invalid(e.to_string()))?
-        .into_iter()
-        .map(|f| out.join(f))
-        .collect();
+    let mut files: Vec<PathBuf> = written?.into_iter().map(|f| out.join(f)).collect();
     for path in grids_written {
         files.push(path?);
     }

@@ -14,7 +14,7 @@ use terramesh_report::pictures::unit_colour;
 use terramesh_report::viewer::{compact, Geometry, Layer};
 
 use super::traces::{borehole_traces, STUB_FRACTION_PERCENT, TRACE_RADIUS, UNLOGGED};
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 
 /// Where `model.glb` is placed and what its heights mean, for its `extras`.
 #[derive(Debug, Clone, PartialEq)]
@@ -82,7 +82,9 @@ type BodyArrays = (usize, Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<[f32; 3]>);
 /// A model without bodies, or the file cannot be written.
 pub fn write_model_glb(path: &Path, model: &VolumeMesh, frame: &GlbFrame) -> Result<[f64; 3]> {
     if model.bodies.is_empty() {
-        bail!("{}: the model has no unit with volume", path.display());
+        return Err(Error::NoVolume {
+            file: path.to_path_buf(),
+        });
     }
     let parts: Vec<BodyArrays> = model
         .bodies

@@ -44,6 +44,21 @@ pub enum Targets {
     Grid(String),
 }
 
+impl Targets {
+    /// The targets of a front end's two ways to give them: a CSV file of `x,y` rows or a
+    /// grid; [`Setting::Targets`] unless exactly one is given.
+    pub fn of(csv: Option<PathBuf>, grid: Option<String>) -> Result<Targets> {
+        match (csv, grid) {
+            (Some(t), None) => Ok(Targets::Csv(t)),
+            (None, Some(g)) => Ok(Targets::Grid(g)),
+            _ => Err(own(
+                Setting::Targets,
+                "give {targets} T.csv or {grid} xmin,ymin,xmax,ymax,nx,ny",
+            )),
+        }
+    }
+}
+
 /// An interpolation of the `x,y,z` data of a file at targets.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InterpolateJob {

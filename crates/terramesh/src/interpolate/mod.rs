@@ -28,11 +28,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod cv_job;
 mod job;
 mod method_options;
 mod model_options;
 mod variogram_job;
 
+pub use cv_job::CvJob;
 pub use job::{InterpolateJob, Targets};
 pub use method_options::{DriftOptions, ExternalDriftSetup, MethodOptions};
 pub use model_options::{LagOptions, ModelOptions};
@@ -51,7 +53,7 @@ use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
 use terramesh_io::table::{ReadOptions, Table};
 
-use crate::error::{bail, Context, Error, Result};
+use crate::error::{Context, Error, Result};
 use crate::external_drift::{Engine, PredictError};
 use crate::fitting::FitPlan;
 use crate::setting::Setting;
@@ -100,7 +102,7 @@ pub fn read_data(path: &Path, duplicates: Duplicates) -> Result<FileData> {
                 t.name, t.lines[first], t.lines[second]
             ),
         ),
-        other => Error::invalid(format!("{}: {other}", t.name)),
+        other => Error::about(&t.name, other),
     })?;
     Ok(FileData { data, name: t.name })
 }
@@ -218,10 +220,10 @@ pub fn predict_csv(
             .position(|h| names.iter().any(|n| h.eq_ignore_ascii_case(n)))
     };
     let (Some(xc), Some(yc)) = (find(X), find(Y)) else {
-        bail!(
-            "{name}: needs columns 'x' and 'y' (the header has: {})",
-            headers.join(", ")
-        );
+        return Err(Error::NoXyColumns {
+            file: name,
+            header: headers.join(", "),
+        });
     };
     let gc = match eng.drift_column() {
         None => None,
@@ -258,10 +260,12 @@ pub fn predict_csv(
                 let s = rec.get(c).unwrap_or("").trim();
                 match s.parse::<f64>() {
                     Ok(v) if v.is_finite() => Ok(v),
-                    _ => bail!(
-                        "{name}, line {line}, column '{}': '{s}' is not a finite number",
-                        headers[c]
-                    ),
+                    _ => Err(Error::NotANumber {
+                        file: name.clone(),
+                        line,
+                        column: headers[c].clone(),
+                        text: s.to_string(),
+                    }),
                 }
             };
             pts.push([num(xc)?, num(yc)?]);
@@ -277,10 +281,10 @@ pub fn predict_csv(
                 .map_err(|e| match e {
                     PredictError::Kriging(e) => {
                         let e = e.offset_target(first_row);
-                        Error::invalid(format!(
-                            "{name}: {}",
-                            e.display_with_target(|i| format!("target row {}", i + 1))
-                        ))
+                        Error::AtTargetRow {
+                            file: name.clone(),
+                            error: e,
+                        }
                     }
                     PredictError::Drift(i, e) => Error::Context {
                         context: format!("{name}, target row {}", first_row + i + 1),
@@ -311,7 +315,7 @@ pub fn predict_csv(
         }
     }
     if total == 0 {
-        bail!("{name}: no target rows after the header");
+        return Err(Error::NoTargets { file: name });
     }
     out.commit()?;
     Ok(())

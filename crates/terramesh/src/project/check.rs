@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::Project;
 use crate::acquire::is_remote;
-use crate::error::{Error, Result};
+use crate::error::{Error, PathProblem, Result};
 
 /// `path` can be read: a file opened, a folder listed.
 fn readable(key: &str, path: &Path) -> Result<()> {
@@ -15,11 +15,10 @@ fn readable(key: &str, path: &Path) -> Result<()> {
     } else {
         std::fs::File::open(path).map(|_| ())
     };
-    read.map_err(|e| {
-        Error::invalid(format!(
-            "{key} {}: cannot be read ({e}): check the path and its permissions",
-            path.display()
-        ))
+    read.map_err(|e| Error::ProjectPath {
+        key: key.to_string(),
+        path: path.to_path_buf(),
+        problem: PathProblem::UnreadablePath(e),
     })
 }
 
@@ -54,10 +53,11 @@ impl Project {
         if let Some(f) = &self.region.file {
             let path = base.join(f);
             if !path.exists() {
-                return Err(Error::invalid(format!(
-                    "region.file {}: does not exist (no such file or directory)",
-                    path.display()
-                )));
+                return Err(Error::ProjectPath {
+                    key: "region.file".into(),
+                    path,
+                    problem: PathProblem::DoesNotExist,
+                });
             }
             readable("region.file", &path)?;
         }
@@ -65,29 +65,26 @@ impl Project {
         if let Some(g) = &ip.external_drift_grid {
             let path = base.join(g);
             if !path.is_file() {
-                return Err(Error::invalid(format!(
-                    "interpolation.external_drift_grid {}: no such file: give a GeoTIFF (.tif) or ESRI ASCII grid (.asc) of the drift, in the project's coordinates",
-                    path.display()
-                )));
+                return Err(Error::ProjectPath {
+                    key: "interpolation.external_drift_grid".into(),
+                    path,
+                    problem: PathProblem::NoDriftGrid,
+                });
             }
             readable("interpolation.external_drift_grid", &path)?;
         }
         if ip.model.is_none() && ip.variogram != "auto" {
             let path = base.join(&ip.variogram);
             if !path.is_file() {
-                return Err(Error::invalid(format!(
-                    "interpolation.variogram {}: no such file: give \"auto\" to fit one, or \
-                     the variogram.json of a previous build or of terramesh variogram",
-                    path.display()
-                )));
+                return Err(Error::ProjectPath {
+                    key: "interpolation.variogram".into(),
+                    path,
+                    problem: PathProblem::NoVariogramFile,
+                });
             }
             readable("interpolation.variogram", &path)?;
-            crate::variogram_file::read_variogram_file(&path).map_err(|e| {
-                Error::invalid(format!(
-                    "interpolation.variogram: {}",
-                    e.render(&|s| s.to_string())
-                ))
-            })?;
+            crate::variogram_file::read_variogram_file(&path)
+                .map_err(|e| Error::about("interpolation.variogram", e))?;
         }
         // Against `base` like every other path here (the same folder as `geology()`'s when
         // `base` is the project file's folder, as for `terramesh build`).

@@ -26,7 +26,7 @@ use terramesh_io::boreholes::{
     BoreholeFiles, BoreholeOptions, Boreholes, LogFile, Projection, DEFAULT_MAX_INVERSION,
 };
 
-use crate::error::{Error, Result};
+use crate::error::{Error, PathProblem, Result};
 use crate::plan::{
     Base, FaultKind, FaultPlan, FaultSource, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MAX_CELL_HEIGHT,
     DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_CELL_HEIGHT, MAX_LAYERS, MIN_BASE_ELEVATION,
@@ -541,17 +541,19 @@ impl GeologySection {
 /// `path` exists and can be opened, or an error naming the key.
 fn readable(key: &str, path: &Path) -> Result<()> {
     if !path.is_file() {
-        return Err(Error::invalid(format!(
-            "geology.{key} {}: no such file: check the path (relative to the project file)",
-            path.display()
-        )));
+        return Err(Error::ProjectPath {
+            key: format!("geology.{key}"),
+            path: path.to_path_buf(),
+            problem: PathProblem::NoSuchFile,
+        });
     }
-    std::fs::File::open(path).map(|_| ()).map_err(|e| {
-        Error::invalid(format!(
-            "geology.{key} {}: cannot be read ({e}): check its permissions",
-            path.display()
-        ))
-    })
+    std::fs::File::open(path)
+        .map(|_| ())
+        .map_err(|e| Error::ProjectPath {
+            key: format!("geology.{key}"),
+            path: path.to_path_buf(),
+            problem: PathProblem::Unreadable(e),
+        })
 }
 
 impl GeologyPlan {
@@ -616,7 +618,7 @@ impl GeologyPlan {
         let stand_in = |lat: f64, lon: f64| Ok([lon, lat]);
         let holes = self.read_boreholes(Some(&stand_in))?;
         for f in &self.faults {
-            let io = |e: terramesh_io::faults::FaultFileError| Error::invalid(e.to_string());
+            let io = Error::from;
             match &f.source {
                 FaultSource::Trace { path, .. } => {
                     readable(&format!("faults[{}].trace", f.name), path)?

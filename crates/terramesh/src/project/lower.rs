@@ -8,7 +8,7 @@ use terramesh_io::region::RegionInput;
 
 use super::Project;
 use crate::acquire::{is_remote, MarginSpec, SampleOptions};
-use crate::error::{Error, Result};
+use crate::error::{Error, PathProblem, Result};
 use crate::setting::Setting;
 
 /// The project key that sets `s`, as a message should name it; settings a project cannot set
@@ -77,11 +77,7 @@ impl Project {
                 }
             }
             (None, Some(f)) => RegionInput::File(base.join(f)),
-            _ => {
-                return Err(Error::invalid(
-                    "[region]: give corners or file, not both or neither",
-                ))
-            }
+            _ => return Err(Error::CornersOrFile),
         });
         o.zone = match &self.region.zone {
             Some(z) => Some(
@@ -125,15 +121,12 @@ impl Project {
             if fb.exists() {
                 return Ok(fb.display().to_string());
             }
-            return Err(Error::invalid(format!(
-                "source.path {} and source.fallback {} do not exist",
-                path.display(),
-                fb.display()
-            )));
+            return Err(Error::NoSource { path, fallback: fb });
         }
-        Err(Error::invalid(format!(
-            "source.path {}: does not exist (no such file or directory)",
-            path.display()
-        )))
+        Err(Error::ProjectPath {
+            key: "source.path".into(),
+            path,
+            problem: PathProblem::DoesNotExist,
+        })
     }
 }

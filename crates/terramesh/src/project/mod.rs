@@ -123,3 +123,43 @@ pub struct SourceSection {
 
 /// The commented project file written by `terramesh init`.
 pub const TEMPLATE: &str = include_str!("template.toml");
+
+/// Writes a new project, `dir/terramesh.toml` (`terramesh init`): [`TEMPLATE`], followed by
+/// [`GEOLOGY_TEMPLATE`] with `geology`, creating `dir` if needed. An existing file is kept
+/// ([`Setting::Force`](crate::Setting::Force)) unless `force`. Returns the file written.
+///
+/// ```
+/// let dir = tempfile::tempdir()?;
+/// let path = terramesh::project::init(dir.path(), false, true)?;
+/// let text = std::fs::read_to_string(&path)?;
+/// assert!(text.contains("[geology]"));
+/// let e = terramesh::project::init(dir.path(), false, false).unwrap_err();
+/// assert!(e.render(&|s| format!("--{s}")).ends_with("exists already: edit it, or pass --force to replace it"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn init(dir: &std::path::Path, force: bool, geology: bool) -> crate::Result<PathBuf> {
+    use crate::error::Context;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the directory {}", dir.display()))?;
+    let path = dir.join("terramesh.toml");
+    if path.exists() && !force {
+        return Err(crate::Error::setting(
+            crate::Setting::Force,
+            "",
+            format!(
+                "{} exists already: edit it, or pass {{force}} to replace it",
+                path.display()
+            ),
+        ));
+    }
+    let text = if geology {
+        format!("{TEMPLATE}{GEOLOGY_TEMPLATE}")
+    } else {
+        TEMPLATE.to_string()
+    };
+    // The template must always be a valid project.
+    Project::parse("the built-in template", &text, &[])?;
+    terramesh_io::output::write_atomic(&path, text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path)
+}

@@ -12,7 +12,7 @@ use terramesh_geostat::{
 };
 
 use crate::build::scale::Choice;
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 use crate::project::Project;
 
 /// Step 4: vertex elevations by UK and IDW, a DSM grid, and cross-validation.
@@ -326,7 +326,10 @@ pub fn interpolate(
         ("the DSM method", &dsm),
     ] {
         if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-            bail!("{name} gave a non-finite value at mesh vertex {i}: the kriging system is ill-conditioned");
+            return Err(Error::NonFiniteAtVertex {
+                method: name.to_string(),
+                vertex: i,
+            });
         }
     }
     Ok(Interpolated {

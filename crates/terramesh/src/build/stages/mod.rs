@@ -13,7 +13,7 @@ use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{Mesh, Quality, SmoothReport};
 
 use crate::acquire::{acquire, write_table, SamplePlan};
-use crate::error::{bail, Context, Result};
+use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
 
@@ -51,11 +51,7 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
     let zone = match table.zone {
         Some(z) if !own_crs => Some(z),
         _ if own_crs => None,
-        _ => bail!(
-            "the source is in a projected CRS terramesh does not convert; use a geographic or \
-             UTM source for build, or give the project's CRS with [region] crs = \"EPSG:<code>\" \
-             (or \"projected\" when the region and the source share one metric CRS)"
-        ),
+        _ => return Err(Error::UnconvertedSource),
     };
     let region = plan
         .region
@@ -68,10 +64,7 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
         }
     }
     if xyz.len() < 10 {
-        bail!(
-            "only {} samples with an elevation: enlarge the grid or check the source",
-            xyz.len()
-        );
+        return Err(Error::TooFewSamples { samples: xyz.len() });
     }
     let s = &p.sampling;
     let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
