@@ -78,7 +78,7 @@ pub const WLS_LOO_POINTS: usize = 1000;
 /// options as equally good and keeps the one of least relative nugget: leave-one-out
 /// predicts at about one data spacing and cannot tell a small nugget from none, while the
 /// surface between the data (nearer a datum than that) is better without one.
-pub const WLS_LOO_TIE: f64 = 0.01;
+pub const WLS_LOO_TIE: f64 = 0.03;
 
 /// Number of models that [`FitMethod::WlsLoo`] refines (those of least leave-one-out RMSE
 /// from their WLS fits).
