@@ -187,7 +187,7 @@ fn experimental<'py>(
     Ok(out)
 }
 
-/// Fits `model` (`auto`, a name or a nested sum `a+b[+c]`) to the data by `fit` (`wls`,
+/// Fits `model` (`auto`, a name or a nested sum `a+b[+c]`) to the data by `fit` (`wls-loo`, `wls`,
 /// `reml` with `drift`, `loo`; the library's [`FitMethod`] names), through the facade's
 /// [`terramesh::fitting::fit`] as `terramesh variogram` does; returns the variogram file's
 /// JSON (model, lags, fit, candidates, selection, experimental).

@@ -88,7 +88,8 @@ pub use aniso::{
     fit_anisotropy, fit_anisotropy_lags, AnisotropyFit, DirectionalLags, DEFAULT_DIRECTIONS,
 };
 pub use auto::{
-    fit_auto_loo, fit_auto_reml, lag_rmse, AutoSettings, FitMethod, Selection, DEFAULT_LOO_POINTS,
+    fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, lag_rmse, AutoSettings, FitMethod, Selection,
+    DEFAULT_LOO_POINTS, WLS_LOO_POINTS, WLS_LOO_REFINED, WLS_LOO_TIE,
 };
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
@@ -106,7 +107,7 @@ pub use global::{DenseRoute, GlobalKriging, BLOCK, TRUNCATION_TOLERANCE};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
 pub use ked::{external_scale, ExternalDriftKriging, CONSTANT_DRIFT_RTOL};
 pub use ked_cv::cross_validate_external;
-pub use loo_fit::{fit_loo, LooFit};
+pub use loo_fit::{fit_loo, fit_wls_loo, LooFit};
 pub use model::{Anisotropy, ModelKind, Structure, Variogram};
 pub use neighbourhood::LocalKriging;
 pub use nested::{fit_nested, MAX_STRUCTURES};

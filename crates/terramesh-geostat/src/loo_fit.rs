@@ -63,11 +63,53 @@ pub fn fit_loo(data: &Data, start: &Variogram, s: &AutoSettings) -> Result<LooFi
         _ => data.clone(),
     };
     let (hmin, hmax) = spacing(&sub);
-    fit_loo_within(&sub, s.drift, start, hmin, hmax)
+    fit_loo_within(&sub, s.drift, start, hmin, hmax, Effort::Full)
+}
+
+/// [`fit_loo`] as [`FitMethod::WlsLoo`](crate::FitMethod::WlsLoo) refines a model: one
+/// short minimisation, on at most [`WLS_LOO_POINTS`](crate::WLS_LOO_POINTS) data. Where
+/// `start` (the WLS fit) has the smaller leave-one-out RMSE it is kept, rescaled as the
+/// minimisation's optimum is.
+///
+/// ```
+/// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+/// use terramesh_geostat::{fit_loo, fit_wls_loo, AutoSettings, Data, Duplicates, ModelKind, Variogram};
+/// let xy: Vec<[f64; 2]> = (0..144).map(|i| [(i % 12) as f64 * 10.0, (i / 12) as f64 * 10.0]).collect();
+/// let z: Vec<f64> = xy.iter().map(|p| (p[0] / 30.0).sin() + 0.01 * p[1]).collect();
+/// let data = Data::new(xy, z, Duplicates::Reject)?;
+/// let start = Variogram::single(ModelKind::Gaussian, 0.1, 1.0, 20.0)?;
+/// let quick = fit_wls_loo(&data, &start, &AutoSettings::default())?;
+/// let full = fit_loo(&data, &start, &AutoSettings::default())?;
+/// assert!(full.cv_rmse <= quick.cv_rmse && quick.points == 144);
+/// # Ok(()) }
+/// ```
+pub fn fit_wls_loo(data: &Data, start: &Variogram, s: &AutoSettings) -> Result<LooFit> {
+    start.validate()?;
+    let m = s
+        .loo_points
+        .map_or(data.len(), |m| m.min(crate::WLS_LOO_POINTS));
+    let sub = if data.len() > m {
+        data.subset(&draw_subset(data.len(), m))
+    } else {
+        data.clone()
+    };
+    let (hmin, hmax) = spacing(&sub);
+    fit_loo_within(&sub, s.drift, start, hmin, hmax, Effort::Quick)
+}
+
+/// How many evaluations a leave-one-out fit may spend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Effort {
+    /// Two Nelder–Mead runs (`30 d + 10`, then a restart of `15 d + 5` evaluations):
+    /// `--fit loo`.
+    Full,
+    /// One run of `12 d + 8` evaluations (`--fit wls-loo`): the optimum of the leave-one-out
+    /// RMSE is flat, and most of its gain is in the first evaluations.
+    Quick,
 }
 
 /// The smallest and largest distance between two data (the smallest by a grid of cells).
-fn spacing(data: &Data) -> (f64, f64) {
+pub(crate) fn spacing(data: &Data) -> (f64, f64) {
     let xy = data.xy();
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in xy {
@@ -96,7 +138,7 @@ fn spacing(data: &Data) -> (f64, f64) {
 }
 
 /// The leave-one-out errors and variances of `v` (unit scale) with `drift`.
-fn loo(sub: &Data, v: &Variogram, drift: Drift) -> Option<(f64, f64)> {
+pub(crate) fn loo(sub: &Data, v: &Variogram, drift: Drift) -> Option<(f64, f64)> {
     let method = match drift {
         Drift::Constant => Method::Ordinary,
         d => Method::Universal(d),
@@ -134,6 +176,7 @@ pub(crate) fn fit_loo_within(
     start: &Variogram,
     hmin: f64,
     hmax: f64,
+    effort: Effort,
 ) -> Result<LooFit> {
     let unusable = || {
         GeostatError::Fit(
@@ -168,8 +211,13 @@ pub(crate) fn fit_loo_within(
     let mut best = cost(&th);
     // RMSE to 1e-4 of itself: far finer than its sampling error (about 1/sqrt(2n)).
     let tol = if best.is_finite() { 1e-4 * best } else { 0.0 };
-    for run in 0..2 {
-        let evals = if run == 0 { 30 * d + 10 } else { 15 * d + 5 };
+    let runs = if effort == Effort::Full { 2 } else { 1 };
+    for run in 0..runs {
+        let evals = match (effort, run) {
+            (Effort::Quick, _) => 12 * d + 8,
+            (_, 0) => 30 * d + 10,
+            _ => 15 * d + 5,
+        };
         let (t, v) = nelder_mead(&mut cost, &th, &layout.steps(d), tol, evals);
         let moved = best - v;
         if v <= best {

@@ -1,7 +1,8 @@
-//! Fitting a variogram by plan: a named model or `auto`, by weighted least squares (the
-//! default), REML (with the drift of the kriging that will use it) or the least leave-one-out
-//! RMSE of that kriging (`loo`). One function for `terramesh variogram`, `interpolate
-//! --variogram auto`, `cv` and `build`.
+//! Fitting a variogram by plan: a named model or `auto`, by weighted least squares chosen and
+//! refined by the leave-one-out RMSE of the kriging that will use it (`wls-loo`, the
+//! default), weighted least squares alone (`wls`), REML (with the drift of that kriging) or
+//! the least leave-one-out RMSE minimised in full (`loo`). One function for `terramesh
+//! variogram`, `interpolate --variogram auto`, `cv` and `build`.
 //!
 //! ```
 //! use terramesh::fitting::{fit, FitPlan};
@@ -13,10 +14,14 @@
 //! let reml = FitPlan { method: Some(FitMethod::Reml), ..FitPlan::default() }; // auto, linear drift
 //! let auto = fit(&data, &lags, &reml)?;
 //! assert!(auto.selection.is_some() && auto.candidates.iter().all(|c| c.aic.is_some() || c.error.is_some()));
-//! let default = fit(&data, &lags, &FitPlan::default())?; // auto by WLS, the default
-//! assert!(default.selection.is_none() && !default.candidates.is_empty());
-//! let wls = fit(&data, &lags, &FitPlan { model: "spherical".into(), ..FitPlan::default() })?;
-//! assert!(wls.selection.is_none() && wls.candidates.is_empty()); // a named model: WLS by default
+//! let default = fit(&data, &lags, &FitPlan::default())?; // auto by wls-loo, the default
+//! assert_eq!(default.selection.unwrap().method, FitMethod::WlsLoo);
+//! assert!(!default.candidates.is_empty());
+//! let wls = FitPlan { method: Some(FitMethod::Wls), ..FitPlan::default() };
+//! assert!(fit(&data, &lags, &wls)?.selection.is_none()); // auto by WLS alone
+//! let named = FitPlan { model: "spherical".into(), method: Some(FitMethod::Wls), ..FitPlan::default() };
+//! let wls = fit(&data, &lags, &named)?;
+//! assert!(wls.selection.is_none() && wls.candidates.is_empty());
 //! let plan = FitPlan { model: "spherical".into(), method: Some(FitMethod::Reml), ..FitPlan::default() };
 //! assert_eq!(fit(&data, &lags, &plan)?.selection.unwrap().points, 144);
 //! let loo = FitPlan { model: "spherical".into(), method: Some(FitMethod::Loo), ..FitPlan::default() };
@@ -27,9 +32,10 @@
 //! ```
 
 use terramesh_geostat::{
-    fit_anisotropy, fit_auto, fit_auto_loo, fit_auto_reml, fit_loo, fit_model, fit_nested,
-    fit_reml, AutoSettings, Candidate, Data, DirectionalLags, Fit, FitMethod, Lag, LagSettings,
-    ModelKind, Named, Selection, Variogram, DEFAULT_DIRECTIONS, MAX_STRUCTURES,
+    fit_anisotropy, fit_auto, fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, fit_loo, fit_model,
+    fit_nested, fit_reml, fit_wls_loo, AutoSettings, Candidate, Data, DirectionalLags, Fit,
+    FitMethod, Lag, LagSettings, ModelKind, Named, Selection, Variogram, DEFAULT_DIRECTIONS,
+    MAX_STRUCTURES,
 };
 
 use crate::error::{Error, Result};
@@ -41,7 +47,7 @@ pub struct FitPlan {
     /// `auto`, a model name ([`ModelKind`]) or a nested sum of up to three names joined by
     /// `+` (`spherical+exponential`), fitted jointly.
     pub model: String,
-    /// REML, loo or WLS; `None`: [`FitMethod`]'s default (WLS).
+    /// wls-loo, REML, loo or WLS; `None`: [`FitMethod`]'s default (wls-loo).
     pub method: Option<FitMethod>,
     /// The drift, the weights of the WLS fits and the REML subset.
     pub auto: AutoSettings,
@@ -252,10 +258,11 @@ fn fit_anisotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> 
     .map_err(|e| Error::setting(Setting::Anisotropy, "auto", e.to_string()))?;
     fitted.directions = af.directions;
     fitted.fit = af.fit;
-    if plan.method == Some(FitMethod::Loo) {
-        let (f, _) = loo(data, lags, plan, &fitted.fit.variogram)?;
+    let method = plan.method.unwrap_or_default();
+    if matches!(method, FitMethod::Loo | FitMethod::WlsLoo) {
+        let (f, _) = loo(data, lags, plan, method, &fitted.fit.variogram)?;
         fitted.fit = f;
-    } else if plan.method == Some(FitMethod::Reml) {
+    } else if method == FitMethod::Reml {
         let r = fit_reml(
             data,
             plan.auto.drift,
@@ -273,10 +280,34 @@ fn fit_anisotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> 
 
 fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     let auto = plan.model.eq_ignore_ascii_case("auto");
-    // WLS unless REML is asked for (FitMethod's default)
+    // wls-loo unless another is asked for (FitMethod's default)
     let method = plan.method.unwrap_or_default();
     if auto {
         return Ok(match method {
+            FitMethod::WlsLoo => match fit_auto_wls_loo(data, lags, ModelKind::ALL, &plan.auto) {
+                Ok((fit, candidates, s)) => Fitted {
+                    fit,
+                    candidates,
+                    selection: Some(s),
+                    directions: Vec::new(),
+                    notes: Vec::new(),
+                },
+                // Too few data for kriging with the drift to leave one out: WLS alone.
+                Err(e) => {
+                    let (fit, candidates) =
+                        fit_auto(data, lags, plan.auto.weighting, ModelKind::ALL)?;
+                    Fitted {
+                        fit,
+                        candidates,
+                        selection: None,
+                        directions: Vec::new(),
+                        notes: vec![format!(
+                            "the automatic fit chose by ordinary kriging's cross-validation \
+                             (wls): {e}"
+                        )],
+                    }
+                }
+            },
             FitMethod::Reml => {
                 let (fit, candidates, s) = fit_auto_reml(data, lags, ModelKind::ALL, &plan.auto)?;
                 Fitted {
@@ -324,8 +355,24 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
             notes: Vec::new(),
         });
     }
-    if method == FitMethod::Loo {
-        let (fit, selection) = loo(data, lags, plan, &wls.variogram)?;
+    if matches!(method, FitMethod::Loo | FitMethod::WlsLoo) {
+        let (fit, selection) = match loo(data, lags, plan, method, &wls.variogram) {
+            Ok(r) => r,
+            // The default on data too few for kriging with the drift to leave one out: the
+            // WLS fit as it is.
+            Err(e) if method == FitMethod::WlsLoo && plan.method.is_none() => {
+                return Ok(Fitted {
+                    fit: wls,
+                    candidates: Vec::new(),
+                    selection: None,
+                    directions: Vec::new(),
+                    notes: vec![format!(
+                        "the fit is weighted least squares alone (wls): {e}"
+                    )],
+                });
+            }
+            Err(e) => return Err(e),
+        };
         return Ok(Fitted {
             fit,
             candidates: Vec::new(),
@@ -355,11 +402,22 @@ fn fit_isotropic(data: &Data, lags: &[Lag], plan: &FitPlan) -> Result<Fitted> {
     })
 }
 
-/// `start`'s model fitted by leave-one-out (its `objective` is the leave-one-out RMSE).
-fn loo(data: &Data, lags: &[Lag], plan: &FitPlan, start: &Variogram) -> Result<(Fit, Selection)> {
-    let f = fit_loo(data, start, &plan.auto)?;
+/// `start`'s model fitted by leave-one-out, in full (`loo`) or shortly (`wls-loo`); its
+/// `objective` is the leave-one-out RMSE.
+fn loo(
+    data: &Data,
+    lags: &[Lag],
+    plan: &FitPlan,
+    method: FitMethod,
+    start: &Variogram,
+) -> Result<(Fit, Selection)> {
+    let f = if method == FitMethod::Loo {
+        fit_loo(data, start, &plan.auto)?
+    } else {
+        fit_wls_loo(data, start, &plan.auto)?
+    };
     let selection = Selection {
-        method: FitMethod::Loo,
+        method,
         drift: Some(plan.auto.drift),
         points: f.points,
         blocks: 1,

@@ -83,13 +83,16 @@ pub struct LagArgs {
     /// (the same draw every run); 0 uses all (the pair count grows with the square).
     #[arg(long, default_value_t = terramesh_geostat::DEFAULT_MAX_POINTS)]
     pub max_points: usize,
-    /// How the model's parameters are fitted: reml (restricted maximum likelihood with the
-    /// kriging's drift, from the WLS fit), loo (the parameters of least leave-one-out RMSE of
-    /// kriging with the drift, from the WLS fit; the scale from the standardised errors) or
-    /// wls (weighted least squares on the lag classes). With auto, reml tries every model
-    /// and every pair nested and keeps the least AIC; loo and wls keep the model of least
-    /// leave-one-out RMSE (loo: of kriging with the drift; wls: of ordinary kriging in 32
-    /// neighbours). Default: wls.
+    /// How the model's parameters are fitted: wls-loo (the WLS fit refined by a short
+    /// minimisation of the leave-one-out RMSE of kriging with the drift, on at most 1,000
+    /// data), reml (restricted maximum likelihood with the kriging's drift, from the WLS
+    /// fit), loo (the parameters of least leave-one-out RMSE of kriging with the drift, from
+    /// the WLS fit, minimised in full on at most 3,000 data; the scale from the standardised
+    /// errors) or wls (weighted least squares on the lag classes). With auto, reml tries every
+    /// model and every pair nested and keeps the least AIC; wls-loo scores every model's WLS
+    /// fit by the leave-one-out RMSE of kriging with the drift, refines the best two and keeps
+    /// the least; loo and wls keep the model of least leave-one-out RMSE (loo: of kriging
+    /// with the drift; wls: of ordinary kriging in 32 neighbours). Default: wls-loo.
     #[arg(long, value_parser = crate::named::<FitMethod>())]
     pub fit: Option<FitMethod>,
     /// REML in spatial blocks of at most this many data (a composite likelihood; each

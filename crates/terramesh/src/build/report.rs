@@ -293,7 +293,9 @@ pub fn write_report(
         ))),
     }
     if !it.candidates.is_empty() {
-        let reml = it.selection.is_some();
+        let reml = it
+            .selection
+            .is_some_and(|s| s.method != terramesh_geostat::FitMethod::WlsLoo);
         let mut header = vec!["model", "cross-validation RMSE (m)", "fit RMSE (m²)"];
         if reml {
             header.extend(["restricted log-likelihood", "AIC"]);
@@ -309,6 +311,12 @@ pub fn write_report(
                     } else {
                         "one block".into()
                     }
+                ),
+                Some(s) if s.method == terramesh_geostat::FitMethod::WlsLoo => format!(
+                    "Models tried by the automatic fit: each model's weighted least-squares fit scored by the leave-one-out RMSE of kriging with a {} drift on {} samples, the {} best refined by that RMSE, the least kept",
+                    s.drift.map_or("constant", terramesh_geostat::Named::name),
+                    s.cv_points.unwrap_or(s.points),
+                    terramesh_geostat::WLS_LOO_REFINED,
                 ),
                 Some(s) => format!(
                     "Models tried by the automatic fit: REML with a {} drift on {} samples ({}), every model alone and every pair nested, chosen by the least AIC",
