@@ -89,21 +89,9 @@ pub fn block_contacts(
     contacts
 }
 
-/// A block's name: its side of every fault that counts there, `F1-hanging_F2-foot`
-/// (`all` without faults).
-pub fn block_name(names: &[String], b: &BlockKey) -> String {
-    let parts: Vec<String> = (0..names.len())
-        .filter_map(|f| {
-            b.side(f)
-                .map(|s| format!("{}-{}", names[f], if s > 0 { "hanging" } else { "foot" }))
-        })
-        .collect();
-    if parts.is_empty() {
-        "all".into()
-    } else {
-        parts.join("_")
-    }
-}
+/// A block's name: its side of every fault that counts there (one naming with the files'
+/// blocks).
+pub use terramesh_io::model::block_name;
 
 /// The blocks met at the planar vertices at 33 levels between the terrain and the base, and
 /// at the contacts: the blocks whose interfaces are checked before meshing.

@@ -2,7 +2,7 @@
 //! (`terramesh_faults`), every interface interpolated per fault block from the contacts in that
 //! block ([`BlockInterfaces`]), the kernel's conformal tetrahedral mesh checked
 //! (`terramesh_faults::check`), its nodes split on request, turned into the writers' model
-//! ([`super::faulted_mesh::to_volume`]) and written by `terramesh_io::model::write_faulted_model`.
+//! (`terramesh_io::model::faulted_volume`) and written by `terramesh_io::model::write_faulted_model`.
 //!
 //! The data walk: `GeologySection` (project/geology.rs) -> `GeologyPlan::faults`
 //! (`FaultPlan` per fault, paths resolved) -> `fault_specs` (the files read, traces at the
@@ -66,7 +66,7 @@ pub(crate) fn run(
     )?;
     let faulted = build_mesh(g, &terrain, &set, &ifs, base)?;
     let (volume, data) =
-        crate::geology::faulted_mesh::to_volume(&faulted.mesh, &g.units, base, g.split_faults);
+        terramesh_io::model::faulted_volume(&faulted.mesh, &g.units, base, g.split_faults);
     // The surfaces at the planar vertices, for the pictures, the statistics and the grids: at
     // each vertex an interface in the block where it lies there.
     let n = g.units.len();
