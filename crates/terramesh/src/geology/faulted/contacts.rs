@@ -6,6 +6,8 @@ use terramesh_faults::{BlockKey, FaultSet, Terrain};
 use terramesh_io::boreholes::{Boreholes, ContactKind};
 use terramesh_io::faults::FaultPick;
 
+use crate::error::{Error, Result};
+
 /// A contact within this many metres (along the hole) of a fault pick is where the hole enters
 /// the next block (the fault surface), not a unit's top: it is left out of the interfaces.
 pub const PICK_TOLERANCE: f64 = 0.1;
@@ -15,12 +17,16 @@ pub type Contact = (String, usize, [f64; 3], BlockKey);
 
 /// Assigns every contact of a unit below the first to the block it lies in (the kernel's
 /// side tests at the contact; where `fault_picks.csv` says where the hole crosses a fault,
-/// the side of that fault is the collar's above the pick and the other below it).
+/// the side of that fault is the collar's above the pick and the other below it). A hole's
+/// repeated units (past a reverse fault, `Hole::repeated`) give contacts too, each to the
+/// block it lies in; a unit whose two contacts in one hole lie in one block is an error
+/// naming the hole, the unit and the lines (a repeat needs a fault between).
 pub fn block_contacts(
     set: &FaultSet,
     boreholes: Option<&Boreholes>,
     picks: &[FaultPick],
-) -> Vec<Contact> {
+    units: &[String],
+) -> Result<Vec<Contact>> {
     let mut contacts = Vec::new();
     if let Some(b) = boreholes {
         for h in &b.holes {
@@ -38,10 +44,43 @@ pub fn block_contacts(
                 .tops
                 .iter()
                 .flatten()
+                .chain(&h.repeated)
                 .filter(|c| c.kind != ContactKind::Absent)
                 .map(|c| c.md)
                 .collect();
-            for c in h.tops.iter().flatten() {
+            // Every restart of the column (a unit logged again) needs a fault crossed between
+            // the contact above it and just below it: a pick there, or a side changed.
+            for r in &h.restarts {
+                let above = h
+                    .tops
+                    .iter()
+                    .flatten()
+                    .chain(&h.repeated)
+                    .filter(|c| c.kind != ContactKind::Absent && c.md < r.md)
+                    .max_by(|a, b| a.md.total_cmp(&b.md));
+                let (md_above, at_above) = above.map_or((0.0, h.collar), |c| (c.md, c.position));
+                let below = h.path.at(r.md + PICK_TOLERANCE).unwrap_or(r.position);
+                let picked = my_picks
+                    .iter()
+                    .any(|&(_, d)| d > md_above && d <= r.md + PICK_TOLERANCE);
+                if !picked && set.block_key(at_above) == set.block_key(below) {
+                    let l =
+                        above.map_or(String::from("the collar"), |c| format!("line {}", c.line));
+                    return Err(Error::invalid(format!(
+                        "hole '{}': unit '{}' is logged again at depth {} m (line {}) below \
+                         a deeper unit ({l}), with no fault between: a unit repeats in a hole \
+                         only past a fault (a reverse fault): give where the hole crosses it in \
+                         geology.fault_picks, or correct the log",
+                        h.name,
+                        units[r.unit],
+                        terramesh_core::limits::short(r.md),
+                        r.line
+                    )));
+                }
+            }
+            let first = contacts.len();
+            let mut lines: Vec<u64> = Vec::new();
+            for c in h.tops.iter().flatten().chain(&h.repeated) {
                 if c.unit == 0 {
                     continue;
                 }
@@ -77,16 +116,30 @@ pub fn block_contacts(
                     let bit = if c.md < depth { collar } else { 1 - collar };
                     positive = (positive & !(1 << f)) | (bit << f);
                 }
-                contacts.push((
-                    h.name.clone(),
-                    c.unit,
-                    c.position,
-                    set.key_of_sides(positive),
-                ));
+                let key = set.key_of_sides(positive);
+                if let Some(j) = contacts[first..]
+                    .iter()
+                    .position(|d: &Contact| d.1 == c.unit && d.3 == key)
+                {
+                    let names: Vec<String> = set.faults.iter().map(|f| f.name.clone()).collect();
+                    return Err(Error::invalid(format!(
+                        "hole '{}': the top of unit '{}' is logged twice (lines {} and {}) in \
+                         one fault block ({}): a unit repeats in a hole only past a fault (a \
+                         reverse fault): give where the hole crosses it in geology.fault_picks, \
+                         or correct the log",
+                        h.name,
+                        units[c.unit],
+                        lines[j],
+                        c.line,
+                        block_name(&names, &key)
+                    )));
+                }
+                contacts.push((h.name.clone(), c.unit, c.position, key));
+                lines.push(c.line);
             }
         }
     }
-    contacts
+    Ok(contacts)
 }
 
 /// A block's name: its side of every fault that counts there (one naming with the files'
