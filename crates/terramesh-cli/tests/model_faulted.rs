@@ -644,8 +644,80 @@ fn a_reverse_fault_repeats_units_in_a_hole_and_each_contact_counts_in_its_block(
     let o = model(&project, &out, &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    for want in ["B01", "'limestone'", &format!("{line}"), "fault_picks"] {
+    for want in [
+        "intervals.csv",
+        &format!("line {line}"),
+        "'B01'",
+        "'limestone'",
+        "fault_picks",
+    ] {
         assert!(err.contains(want), "{want}: {err}");
     }
     assert!(!out.exists());
+}
+
+/// Issue 31, "faults in the report": `terramesh build` of the faulted example writes a report
+/// with a table of faults (one row per fault: kind, area, mean dip and dip direction as meshed,
+/// throw) and of fault blocks (one row per block of model.json: volume, units), and the
+/// cross-sections draw the faults they cross.
+#[test]
+fn the_report_of_the_faulted_example_shows_its_faults_and_blocks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "build",
+            example().join("terramesh.toml").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    assert!(
+        html.contains("<caption>Faults as meshed (3 faults"),
+        "no fault table"
+    );
+    for f in json["faulted"]["faults"].as_array().unwrap() {
+        let row = format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td>",
+            f["name"].as_str().unwrap(),
+            f["kind"].as_str().unwrap(),
+            f["throw"].as_f64().unwrap(),
+            f["faces"].as_u64().unwrap(),
+            f["area"].as_f64().unwrap(),
+            f["mean_dip"].as_f64().unwrap(),
+            f["mean_dip_direction"].as_f64().unwrap(),
+        );
+        assert!(html.contains(&row), "{row}");
+    }
+    let blocks = json["faulted"]["blocks"].as_array().unwrap();
+    assert!(blocks.len() >= 4, "{}", blocks.len());
+    assert!(html.contains(&format!("<caption>Fault blocks ({})", blocks.len())));
+    for b in blocks {
+        let units: Vec<&str> = b["units"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|u| u.as_str().unwrap())
+            .collect();
+        let row = format!(
+            "<tr><td>{}</td><td>{}</td><td>{:.6e}</td><td>{}</td><td>{}</td>",
+            b["block"].as_u64().unwrap(),
+            b["name"].as_str().unwrap(),
+            b["volume"].as_f64().unwrap(),
+            b["cells"].as_u64().unwrap(),
+            units.join(", ")
+        );
+        assert!(html.contains(&row), "{row}");
+    }
+    // Both sections cross F1 (north-south) or F2/F3 (east-west): at least one names a fault.
+    assert!(
+        html.contains("and the faults it crosses (F"),
+        "no section draws a fault"
+    );
 }

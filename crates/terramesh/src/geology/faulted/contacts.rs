@@ -3,10 +3,11 @@
 //! met under the terrain.
 
 use terramesh_faults::{BlockKey, FaultSet, Terrain};
-use terramesh_io::boreholes::{Boreholes, ContactKind};
+use terramesh_io::boreholes::{Boreholes, ContactKind, LogFile};
 use terramesh_io::faults::FaultPick;
 
 use crate::error::{Error, Result};
+use crate::plan::GeologyPlan;
 
 /// A contact within this many metres (along the hole) of a fault pick is where the hole enters
 /// the next block (the fault surface), not a unit's top: it is left out of the interfaces.
@@ -25,8 +26,13 @@ pub fn block_contacts(
     set: &FaultSet,
     boreholes: Option<&Boreholes>,
     picks: &[FaultPick],
-    units: &[String],
+    g: &GeologyPlan,
 ) -> Result<Vec<Contact>> {
+    let units = &g.units;
+    let log = match g.boreholes.as_ref().map(|b| &b.log) {
+        Some(LogFile::Intervals(p)) | Some(LogFile::Tops(p)) => p.display().to_string(),
+        None => "the borehole log".into(),
+    };
     let mut contacts = Vec::new();
     if let Some(b) = boreholes {
         for h in &b.holes {
@@ -67,14 +73,14 @@ pub fn block_contacts(
                     let l =
                         above.map_or(String::from("the collar"), |c| format!("line {}", c.line));
                     return Err(Error::invalid(format!(
-                        "hole '{}': unit '{}' is logged again at depth {} m (line {}) below \
-                         a deeper unit ({l}), with no fault between: a unit repeats in a hole \
-                         only past a fault (a reverse fault): give where the hole crosses it in \
-                         geology.fault_picks, or correct the log",
+                        "{log}, line {}, hole '{}': unit '{}' is logged again at depth {} m \
+                         below a deeper unit ({l}), with no fault between: a unit repeats in a \
+                         hole only past a fault (a reverse fault): give where the hole crosses \
+                         it in geology.fault_picks, or correct the log",
+                        r.line,
                         h.name,
                         units[r.unit],
                         terramesh_core::limits::short(r.md),
-                        r.line
                     )));
                 }
             }
@@ -123,14 +129,14 @@ pub fn block_contacts(
                 {
                     let names: Vec<String> = set.faults.iter().map(|f| f.name.clone()).collect();
                     return Err(Error::invalid(format!(
-                        "hole '{}': the top of unit '{}' is logged twice (lines {} and {}) in \
+                        "{log}, line {}, hole '{}': the top of unit '{}' is logged twice (first on line {}) in \
                          one fault block ({}): a unit repeats in a hole only past a fault (a \
                          reverse fault): give where the hole crosses it in geology.fault_picks, \
                          or correct the log",
+                        c.line,
                         h.name,
                         units[c.unit],
                         lines[j],
-                        c.line,
                         block_name(&names, &key)
                     )));
                 }

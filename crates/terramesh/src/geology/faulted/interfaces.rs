@@ -137,7 +137,7 @@ impl BlockInterfaces {
         picks: &[FaultPick],
     ) -> Result<BlockInterfaces> {
         let interfaces = g.units.len() - 1;
-        let contacts = block_contacts(set, boreholes, picks, &g.units)?;
+        let contacts = block_contacts(set, boreholes, picks, g)?;
         let mut by_block: HashMap<BlockKey, Vec<Samples>> = HashMap::new();
         let mut all: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); interfaces];
         for (_, unit, p, key) in &contacts {

@@ -31,6 +31,60 @@ pub use interfaces::{BlockInterfaces, InterfaceSource, PINCH, PLANE_CONTACTS};
 pub use mesh::{build_mesh, Faulted};
 pub use summary::{summarise, BlockSummary, FaultSummary, FaultedSummary, HoleThrow, ThrowRange};
 
+/// A fault as meshed: its faces' corners, for the report.
+#[derive(Debug, Clone)]
+pub struct FaultSheet {
+    /// Its name.
+    pub name: String,
+    /// Its triangles.
+    pub triangles: Vec<[[f64; 3]; 3]>,
+}
+
+impl FaultSheet {
+    /// Where it cuts the vertical plane through the line `a`-`b`: segments of
+    /// `(distance from a along the line, elevation)`, clipped to the line's length.
+    pub fn cut(&self, a: [f64; 2], b: [f64; 2]) -> Vec<[(f64, f64); 2]> {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = (dx * dx + dy * dy).sqrt();
+        if len <= 0.0 {
+            return Vec::new();
+        }
+        let (ux, uy) = (dx / len, dy / len);
+        // signed distance from the plane, and distance along the line
+        let off = |p: &[f64; 3]| (p[0] - a[0]) * uy - (p[1] - a[1]) * ux;
+        let along = |p: [f64; 3]| (p[0] - a[0]) * ux + (p[1] - a[1]) * uy;
+        let mut out = Vec::new();
+        for t in &self.triangles {
+            let s = t.map(|p| off(&p));
+            let mut pts = Vec::with_capacity(2);
+            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                if (s[i] < 0.0) != (s[j] < 0.0) {
+                    let w = s[i] / (s[i] - s[j]);
+                    let p = std::array::from_fn(|k| t[i][k] + w * (t[j][k] - t[i][k]));
+                    pts.push((along(p), p[2]));
+                }
+            }
+            if let [p, q] = pts[..] {
+                // clipped to the line: both ends within it
+                let (lo, hi) = if p.0 <= q.0 { (p, q) } else { (q, p) };
+                if hi.0 < 0.0 || lo.0 > len || hi.0 - lo.0 <= 0.0 && (lo.0 < 0.0 || lo.0 > len) {
+                    continue;
+                }
+                let clip = |x: f64| {
+                    if hi.0 - lo.0 <= 0.0 {
+                        lo.1
+                    } else {
+                        lo.1 + (x - lo.0) / (hi.0 - lo.0) * (hi.1 - lo.1)
+                    }
+                };
+                let (x0, x1) = (lo.0.max(0.0), hi.0.min(len));
+                out.push([(x0, clip(x0)), (x1, clip(x1))]);
+            }
+        }
+        out
+    }
+}
+
 /// The geology stage of a faulted model: see the module documentation. `mesh` and `dsm` are
 /// the DSM's planar mesh and heights, `out` the build's staging folder.
 #[allow(clippy::too_many_arguments)]
@@ -205,11 +259,28 @@ pub(crate) fn run(
     o.commit()
         .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
     files.push(path);
+    let faults = faulted
+        .mesh
+        .faults
+        .iter()
+        .enumerate()
+        .map(|(i, name)| FaultSheet {
+            name: name.clone(),
+            triangles: faulted
+                .mesh
+                .fault_faces
+                .iter()
+                .filter(|f| f.fault as usize == i)
+                .map(|f| f.nodes.map(|v| faulted.mesh.points[v as usize]))
+                .collect(),
+        })
+        .collect();
     Ok(crate::geology::stage::ModelBuilt {
         model,
         summary,
         boreholes,
         files,
         ensemble: None,
+        faults,
     })
 }
