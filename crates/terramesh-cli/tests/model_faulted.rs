@@ -628,11 +628,7 @@ fn a_reverse_fault_repeats_units_in_a_hole_and_each_contact_counts_in_its_block(
     }
     // A unit logged twice in one block: B01 (west of F1, south of F3: one block down to the
     // base) with limestone again below its marl.
-    let last = intervals
-        .lines()
-        .filter(|l| l.starts_with("B01,"))
-        .last()
-        .unwrap();
+    let last = intervals.lines().rfind(|l| l.starts_with("B01,")).unwrap();
     let to: f64 = last.split(',').nth(2).unwrap().parse().unwrap();
     let line = intervals.lines().count() + 1;
     std::fs::write(

@@ -67,7 +67,7 @@ impl FaultSheet {
             if let [p, q] = pts[..] {
                 // clipped to the line: both ends within it
                 let (lo, hi) = if p.0 <= q.0 { (p, q) } else { (q, p) };
-                if hi.0 < 0.0 || lo.0 > len || hi.0 - lo.0 <= 0.0 && (lo.0 < 0.0 || lo.0 > len) {
+                if hi.0 < 0.0 || lo.0 > len {
                     continue;
                 }
                 let clip = |x: f64| {
