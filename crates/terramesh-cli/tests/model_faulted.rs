@@ -711,6 +711,32 @@ fn the_report_of_the_faulted_example_shows_its_faults_and_blocks() {
         );
         assert!(html.contains(&row), "{row}");
     }
+    // Per-block interfaces: universal kriging where a block has 7 or more distinct contacts
+    // of the interface, else the plane; model.json says which, and every contact is honoured
+    // within 1 mm in its own block either way.
+    let methods: Vec<(&str, u64)> = blocks
+        .iter()
+        .flat_map(|b| b["interfaces"].as_array().unwrap())
+        .filter(|i| i["from"] == "contacts")
+        .map(|i| {
+            (
+                i["method"].as_str().unwrap(),
+                i["contacts"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert!(methods.iter().any(|m| m.0 == "kriging"), "{methods:?}");
+    assert!(methods.iter().any(|m| m.0 == "plane"), "{methods:?}");
+    for m in &methods {
+        assert!(
+            m.0 == "plane" || m.0 == "kriging" && m.1 >= 7,
+            "{methods:?}"
+        );
+        assert!(m.0 == "kriging" || m.1 < 7, "{methods:?}");
+    }
+    for m in json["boreholes"].as_array().unwrap() {
+        assert!(m["misfit"].as_f64().unwrap().abs() <= 1e-3, "{m}");
+    }
     // Both sections cross F1 (north-south) or F2/F3 (east-west): at least one names a fault.
     assert!(
         html.contains("and the faults it crosses (F"),

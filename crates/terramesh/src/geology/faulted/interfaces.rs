@@ -2,14 +2,20 @@
 //! contacts, or taken from a neighbouring block shifted by the faults' throws.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use serde::Serialize;
 use terramesh_faults::{BlockKey, FaultSet};
+use terramesh_geostat::{
+    experimental, fit_auto, kriging, Data, Drift, Duplicates, LagSettings, Method, ModelKind,
+    Named, Neighbourhood, Predictor, Weighting,
+};
 use terramesh_io::boreholes::Boreholes;
 use terramesh_io::faults::FaultPick;
 
 use super::contacts::{block_contacts, block_name, Contact};
 use crate::error::{Error, Result};
+use crate::geology::fields::MIN_KRIGED;
 use crate::plan::{FaultKind, GeologyPlan};
 
 /// Fewer contacts of an interface than this in a block, and the block's plane takes the
@@ -23,17 +29,87 @@ pub const PINCH: f64 = 1e-3;
 /// Points `[x, y]` with a value.
 type Samples = Vec<([f64; 2], f64)>;
 
-/// A fitted interface in one block: a plane and the residuals of its contacts, spread by
-/// inverse distance (squared), so that the surface passes through every contact.
-#[derive(Debug, Clone)]
+/// A fitted interface in one block: universal kriging with a linear drift of the block's
+/// contacts where they are enough ([`kriged`]), else a plane; plus the residuals of its
+/// contacts spread by inverse distance (squared), so that the surface passes through every
+/// contact.
+#[derive(Clone)]
 struct Fit {
     plane: [f64; 3],
+    kriged: Option<Arc<dyn Predictor>>,
     residuals: Vec<([f64; 2], f64)>,
 }
 
+/// Fewer distinct contact locations of an interface than this in a block, and it is a plane
+/// plus residuals instead of kriged: a variogram is fitted from [`MIN_KRIGED`] locations, and
+/// universal kriging with a linear drift (3 terms) needs more than twice its terms, as the
+/// unfaulted model's fields (`geology::fields`).
+pub const KRIGED_CONTACTS: usize = 7;
+
+/// The block's contacts `p` kriged as the unfaulted model's interfaces are
+/// (`geology::fields`: the variogram fitted automatically, universal kriging with a linear
+/// drift over all the contacts), or `None` when they are too few (fewer than
+/// [`KRIGED_CONTACTS`] distinct locations), all equal, or no variogram fits.
+fn kriged(p: &[([f64; 2], f64)]) -> Option<Arc<dyn Predictor>> {
+    let data = Data::new(
+        p.iter().map(|(q, _)| *q).collect(),
+        p.iter().map(|(_, z)| *z).collect(),
+        Duplicates::Mean,
+    )
+    .ok()?;
+    let drift = Drift::Linear;
+    if data.len() < KRIGED_CONTACTS.max(MIN_KRIGED) || data.len() <= 2 * drift.terms() {
+        return None;
+    }
+    let (lo, hi) = data
+        .z()
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if hi - lo <= 1e-12 * hi.abs().max(1.0) {
+        return None;
+    }
+    let lags = experimental(&data, &LagSettings::default()).ok()?;
+    let (fit, _) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL).ok()?;
+    let k = kriging(
+        &data,
+        &fit.variogram,
+        Method::Universal(drift),
+        Neighbourhood::All,
+        false,
+    )
+    .ok()?;
+    Some(Arc::from(k))
+}
+
 impl Fit {
+    /// How it is interpolated, for `model.json`.
+    fn method(&self) -> &'static str {
+        if self.kriged.is_some() {
+            "kriging"
+        } else {
+            "plane"
+        }
+    }
+
+    /// The surface before the residuals.
+    fn base(&self, p: [f64; 2]) -> f64 {
+        let plane = self.plane[0] + self.plane[1] * p[0] + self.plane[2] * p[1];
+        match &self.kriged {
+            Some(k) => {
+                let mut e = [0.0];
+                match k.predict(&[p], &mut e, None) {
+                    Ok(()) if e[0].is_finite() => e[0],
+                    _ => plane,
+                }
+            }
+            None => plane,
+        }
+    }
+
     fn at(&self, p: [f64; 2]) -> f64 {
-        let z = self.plane[0] + self.plane[1] * p[0] + self.plane[2] * p[1];
+        let z = self.base(p);
         let (mut num, mut den) = (0.0, 0.0);
         for (q, r) in &self.residuals {
             let d2 = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
@@ -99,6 +175,12 @@ pub struct InterfaceSource {
     /// `contacts` (fitted to the block's own contacts) or `throw` (the neighbouring block's
     /// surface shifted by the faults' throws).
     pub from: &'static str,
+    /// How the surface it takes is interpolated: `kriging` (universal kriging with a linear
+    /// drift of the block's contacts, at least [`KRIGED_CONTACTS`] distinct locations) or
+    /// `plane` (their least-squares plane, or the interface's gradient through them, with
+    /// fewer), each plus the residuals at the contacts by inverse distance; `gradient`
+    /// without any block's surface.
+    pub method: &'static str,
     /// The block's contacts of this interface.
     pub contacts: usize,
     /// For `throw`: the block whose surface it takes.
@@ -194,11 +276,13 @@ impl BlockInterfaces {
                         / p.len() as f64;
                     [a, gx, gy]
                 });
-                let residuals = p
-                    .iter()
-                    .map(|(q, z)| (*q, z - (plane[0] + plane[1] * q[0] + plane[2] * q[1])))
-                    .collect();
-                row.push(Some(Fit { plane, residuals }));
+                let mut fit = Fit {
+                    plane,
+                    kriged: kriged(p),
+                    residuals: Vec::new(),
+                };
+                fit.residuals = p.iter().map(|(q, z)| (*q, z - fit.base(*q))).collect();
+                row.push(Some(fit));
             }
             counts.insert(*key, pts.iter().map(Vec::len).collect());
             fits.insert(*key, row);
@@ -312,6 +396,14 @@ impl BlockInterfaces {
         Ok(())
     }
 
+    /// How interface `k` of block `j` (one with a fit) is interpolated.
+    fn method(&self, k: usize, j: BlockKey) -> &'static str {
+        self.fits
+            .get(&j)
+            .and_then(|r| r[k].as_ref())
+            .map_or("gradient", Fit::method)
+    }
+
     /// Where every interface of `key` comes from.
     pub fn sources(&self, key: BlockKey, units: &[String]) -> Vec<InterfaceSource> {
         (0..self.gradient.len())
@@ -321,6 +413,7 @@ impl BlockInterfaces {
                     Ok((j, _)) if j == key => InterfaceSource {
                         unit: units[k + 1].clone(),
                         from: "contacts",
+                        method: self.method(k, j),
                         contacts,
                         block: None,
                         shift: None,
@@ -328,6 +421,7 @@ impl BlockInterfaces {
                     Ok((j, s)) => InterfaceSource {
                         unit: units[k + 1].clone(),
                         from: "throw",
+                        method: self.method(k, j),
                         contacts,
                         block: Some(block_name(&self.names, &j)),
                         shift: Some(s),
@@ -335,6 +429,7 @@ impl BlockInterfaces {
                     Err(_) => InterfaceSource {
                         unit: units[k + 1].clone(),
                         from: "gradient",
+                        method: "gradient",
                         contacts,
                         block: None,
                         shift: None,

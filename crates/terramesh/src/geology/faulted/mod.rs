@@ -27,7 +27,7 @@ use crate::plan::GeologyPlan;
 pub use contacts::{block_contacts, block_name, sampled_blocks, Contact, PICK_TOLERANCE};
 pub use inputs::flat_base;
 pub(crate) use inputs::{fault_error, fault_specs, read_fault_picks};
-pub use interfaces::{BlockInterfaces, InterfaceSource, PINCH, PLANE_CONTACTS};
+pub use interfaces::{BlockInterfaces, InterfaceSource, KRIGED_CONTACTS, PINCH, PLANE_CONTACTS};
 pub use mesh::{build_mesh, Faulted};
 pub use summary::{summarise, BlockSummary, FaultSummary, FaultedSummary, HoleThrow, ThrowRange};
 
@@ -243,10 +243,11 @@ pub(crate) fn run(
         crate::geology::summary::ModelSummary::of(&model, &crs_name).with_datum(&datum);
     for (k, u) in summary.units.iter_mut().enumerate() {
         if k > 0 {
-            u.interpolated = "per fault block: the least-squares plane of the block's contacts \
-                (the gradient of all contacts with fewer than 3) plus their residuals by inverse \
-                distance; a block without contacts takes its neighbour's surface shifted by the \
-                throw (model.json faulted.blocks)"
+            u.interpolated = "per fault block: universal kriging with a linear drift of the \
+                block's contacts where it has at least 7 distinct ones, else their least-squares \
+                plane (the gradient of all contacts with fewer than 3), each plus the residuals \
+                by inverse distance; a block without contacts takes its neighbour's surface \
+                shifted by the throw (model.json faulted.blocks[].interfaces[].method)"
                 .into();
         }
     }
