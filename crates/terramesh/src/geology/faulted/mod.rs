@@ -70,13 +70,12 @@ impl FaultSheet {
                 if hi.0 < 0.0 || lo.0 > len {
                     continue;
                 }
-                let clip = |x: f64| {
-                    if hi.0 - lo.0 <= 0.0 {
-                        lo.1
-                    } else {
-                        lo.1 + (x - lo.0) / (hi.0 - lo.0) * (hi.1 - lo.1)
-                    }
-                };
+                if hi.0 - lo.0 <= 0.0 {
+                    // vertical in the section: kept whole
+                    out.push([lo, hi]);
+                    continue;
+                }
+                let clip = |x: f64| lo.1 + (x - lo.0) / (hi.0 - lo.0) * (hi.1 - lo.1);
                 let (x0, x1) = (lo.0.max(0.0), hi.0.min(len));
                 out.push([(x0, clip(x0)), (x1, clip(x1))]);
             }
@@ -284,4 +283,54 @@ pub(crate) fn run(
         ensemble: None,
         faults,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FaultSheet;
+
+    /// A vertical fault along x = 50 (two triangles, z 0 to 100) cut by an east-west line
+    /// from x = 0 to 100: one vertical trace at 50 m along the line; a line that misses it
+    /// (x 60 to 100) gives nothing, and a line across its tilted copy gives the tilt.
+    #[test]
+    fn a_fault_cuts_a_section_where_its_faces_cross_the_plane() {
+        let sheet = |top_x: f64| FaultSheet {
+            name: "F".into(),
+            triangles: vec![
+                [[50.0, -10.0, 0.0], [50.0, 10.0, 0.0], [top_x, 10.0, 100.0]],
+                [
+                    [50.0, -10.0, 0.0],
+                    [top_x, 10.0, 100.0],
+                    [top_x, -10.0, 100.0],
+                ],
+            ],
+        };
+        let f = sheet(50.0);
+        let segs = f.cut([0.0, 0.0], [100.0, 0.0]);
+        assert!(!segs.is_empty());
+        let (lo, hi) = segs
+            .iter()
+            .flatten()
+            .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+        assert!(
+            (lo - 0.0).abs() < 1e-9 && (hi - 100.0).abs() < 1e-9,
+            "{segs:?}"
+        );
+        for p in segs.iter().flatten() {
+            assert!((p.0 - 50.0).abs() < 1e-9, "{segs:?}");
+        }
+        assert!(f.cut([60.0, 0.0], [100.0, 0.0]).is_empty());
+        // leaning east by 20 m over its height: at z = 100 it is 70 m along the line
+        let g = sheet(70.0);
+        let top = g
+            .cut([0.0, 0.0], [100.0, 0.0])
+            .into_iter()
+            .flatten()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap();
+        assert!(
+            (top.0 - 70.0).abs() < 1e-9 && (top.1 - 100.0).abs() < 1e-9,
+            "{top:?}"
+        );
+    }
 }
