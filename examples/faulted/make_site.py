@@ -2,7 +2,7 @@
 """Writes the synthetic faulted site of examples/faulted/ (issue 31): a planar terrain, eight
 planar strata (three thin weak interbeds), three planar faults (F1 normal, F2 reverse, F3 normal
 ending at F1) offsetting them by constant throws, and 25 vertical boreholes logged from the
-known truth. Standard library only; deterministic (seeded).
+known truth (past the reverse fault F2 a hole logs the units it repeats). Standard library only; deterministic (seeded).
 
     python3 examples/faulted/make_site.py      # rewrites the files beside it
 
@@ -103,8 +103,8 @@ def main():
             name = f"B{5 * j + i + 1:02d}"
             zc = terrain(x, y)
             collars.append(f"{name},{x:.3f},{y:.3f},{zc:.6f}")
-            # The log from the truth every 1 cm, down to 25 m above the base; a hole stops
-            # above the point where a unit it has passed would come again (a reverse fault).
+            # The log from the truth every 1 cm, down to 25 m above the base; past a reverse
+            # fault a unit the hole has passed comes again, and is logged again.
             runs = []
             md = 0.0
             bottom = BASE + 25.0
@@ -112,8 +112,6 @@ def main():
                 u = true_unit([x, y, zc - md - step / 2])
                 if runs and runs[-1][2] == u:
                     runs[-1][1] = md + step
-                elif any(r[2] == u for r in runs) or (runs and u < runs[-1][2]):
-                    break
                 else:
                     runs.append([md, md + step, u])
                 md += step

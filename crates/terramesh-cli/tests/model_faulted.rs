@@ -561,3 +561,185 @@ fn a_block_without_boreholes_takes_its_neighbours_surface_shifted_by_the_throw()
     assert!(err.contains("geology.faults[F1].throw"), "{err}");
     assert!(!out.exists());
 }
+
+/// Issue 31: "Reverse faults repeat units in a hole". The example's hole B14 crosses the
+/// reverse fault F2 and logs limestone, weak_3 and marl again below it: accepted, each
+/// contact going to the block it lies in, here found by the fault surface itself (the hole's
+/// F2 pick left out), and honoured there within 1 mm. A unit logged twice with no fault
+/// between is refused, naming the hole, the unit and the lines, and nothing is written.
+#[test]
+fn a_reverse_fault_repeats_units_in_a_hole_and_each_contact_counts_in_its_block() {
+    let tmp = tempfile::tempdir().unwrap();
+    for f in [
+        "heights.csv",
+        "f1.csv",
+        "f2.csv",
+        "f3.csv",
+        "collars.csv",
+        "terramesh.toml",
+    ] {
+        std::fs::copy(example().join(f), tmp.path().join(f)).unwrap();
+    }
+    let intervals = std::fs::read_to_string(example().join("intervals.csv")).unwrap();
+    let b14: Vec<&str> = intervals
+        .lines()
+        .filter(|l| l.starts_with("B14,"))
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
+    let repeated: Vec<&str> = b14
+        .iter()
+        .enumerate()
+        .filter(|(i, u)| b14[..*i].contains(u))
+        .map(|(_, u)| *u)
+        .collect();
+    assert_eq!(repeated, ["limestone", "weak_3", "marl"], "{b14:?}");
+    std::fs::write(tmp.path().join("intervals.csv"), &intervals).unwrap();
+    let picks = std::fs::read_to_string(example().join("fault_picks.csv")).unwrap();
+    assert!(picks.contains("B14,") && picks.contains(",F2"), "{picks}");
+    let kept: String = picks
+        .lines()
+        .filter(|l| !(l.starts_with("B14,") && l.ends_with(",F2")))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_eq!(kept.lines().count() + 1, picks.lines().count());
+    std::fs::write(tmp.path().join("fault_picks.csv"), kept).unwrap();
+    let project = tmp.path().join("terramesh.toml");
+    let out = tmp.path().join("model");
+    let o = model(&project, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    let misfits: Vec<&serde_json::Value> = json["boreholes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["hole"] == "B14")
+        .collect();
+    for unit in ["weak_3", "marl"] {
+        let at: Vec<&&serde_json::Value> = misfits.iter().filter(|m| m["unit"] == unit).collect();
+        assert_eq!(at.len(), 2, "{unit}: {at:?}");
+        // the two tops of the unit, one in each wall of F2: the lower one about F2's 8 m throw
+        // lower, both honoured
+        let dz = at[0]["observed"].as_f64().unwrap() - at[1]["observed"].as_f64().unwrap();
+        assert!((dz.abs() - 8.0).abs() < 0.2, "{unit}: {dz}");
+        for m in at {
+            assert!(m["misfit"].as_f64().unwrap().abs() <= 1e-3, "{m}");
+        }
+    }
+    // A unit logged twice in one block: B01 (west of F1, south of F3: one block down to the
+    // base) with limestone again below its marl.
+    let last = intervals.lines().rfind(|l| l.starts_with("B01,")).unwrap();
+    let to: f64 = last.split(',').nth(2).unwrap().parse().unwrap();
+    let line = intervals.lines().count() + 1;
+    std::fs::write(
+        tmp.path().join("intervals.csv"),
+        format!("{intervals}B01,{to},{},limestone\n", to + 1.0),
+    )
+    .unwrap();
+    let out = tmp.path().join("model2");
+    let o = model(&project, &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    for want in [
+        "intervals.csv",
+        &format!("line {line}"),
+        "'B01'",
+        "'limestone'",
+        "fault_picks",
+    ] {
+        assert!(err.contains(want), "{want}: {err}");
+    }
+    assert!(!out.exists());
+}
+
+/// Issue 31, "faults in the report": `terramesh build` of the faulted example writes a report
+/// with a table of faults (one row per fault: kind, area, mean dip and dip direction as meshed,
+/// throw) and of fault blocks (one row per block of model.json: volume, units), and the
+/// cross-sections draw the faults they cross.
+#[test]
+fn the_report_of_the_faulted_example_shows_its_faults_and_blocks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "build",
+            example().join("terramesh.toml").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    assert!(
+        html.contains("<caption>Faults as meshed (3 faults"),
+        "no fault table"
+    );
+    for f in json["faulted"]["faults"].as_array().unwrap() {
+        let row = format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td>",
+            f["name"].as_str().unwrap(),
+            f["kind"].as_str().unwrap(),
+            f["throw"].as_f64().unwrap(),
+            f["faces"].as_u64().unwrap(),
+            f["area"].as_f64().unwrap(),
+            f["mean_dip"].as_f64().unwrap(),
+            f["mean_dip_direction"].as_f64().unwrap(),
+        );
+        assert!(html.contains(&row), "{row}");
+    }
+    let blocks = json["faulted"]["blocks"].as_array().unwrap();
+    assert!(blocks.len() >= 4, "{}", blocks.len());
+    assert!(html.contains(&format!("<caption>Fault blocks ({})", blocks.len())));
+    for b in blocks {
+        let units: Vec<&str> = b["units"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|u| u.as_str().unwrap())
+            .collect();
+        let row = format!(
+            "<tr><td>{}</td><td>{}</td><td>{:.6e}</td><td>{}</td><td>{}</td>",
+            b["block"].as_u64().unwrap(),
+            b["name"].as_str().unwrap(),
+            b["volume"].as_f64().unwrap(),
+            b["cells"].as_u64().unwrap(),
+            units.join(", ")
+        );
+        assert!(html.contains(&row), "{row}");
+    }
+    // Per-block interfaces: universal kriging where a block has 7 or more distinct contacts
+    // of the interface, else the plane; model.json says which, and every contact is honoured
+    // within 1 mm in its own block either way.
+    let methods: Vec<(&str, u64)> = blocks
+        .iter()
+        .flat_map(|b| b["interfaces"].as_array().unwrap())
+        .filter(|i| i["from"] == "contacts")
+        .map(|i| {
+            (
+                i["method"].as_str().unwrap(),
+                i["contacts"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert!(methods.iter().any(|m| m.0 == "kriging"), "{methods:?}");
+    assert!(methods.iter().any(|m| m.0 == "plane"), "{methods:?}");
+    for m in &methods {
+        assert!(
+            m.0 == "plane" || m.0 == "kriging" && m.1 >= 7,
+            "{methods:?}"
+        );
+        assert!(m.0 == "kriging" || m.1 < 7, "{methods:?}");
+    }
+    for m in json["boreholes"].as_array().unwrap() {
+        assert!(m["misfit"].as_f64().unwrap().abs() <= 1e-3, "{m}");
+    }
+    // Both sections cross F1 (north-south) or F2/F3 (east-west): at least one names a fault.
+    assert!(
+        html.contains("and the faults it crosses (F"),
+        "no section draws a fault"
+    );
+}

@@ -172,6 +172,47 @@ fn tops_inverted_beyond_repair_say_which() {
     assert!(m.contains("'sand'") && m.contains("'clay'"), "{m}");
 }
 
+/// With `repeats` (a faulted model: a reverse fault repeats units) a unit logged again below
+/// a deeper one starts a new run of the column: its later contacts are `Hole::repeated`,
+/// without the run's first top (the fault crossing) or the units above it; without
+/// `repeats` the same log is refused as out of order.
+#[test]
+fn repeated_units_are_a_new_run_only_when_repeats_are_allowed() {
+    let s = Set::new(COLLARS);
+    // fill, sand, clay; past a fault at 9 m sand again, then clay and gravel
+    let log = "hole,from,to,unit\nB1,0,3,fill\nB1,3,6,sand\nB1,6,9,clay\nB1,9,12,sand\n\
+               B1,12,15,clay\nB1,15,20,gravel\n";
+    let e = s.intervals(log).unwrap_err();
+    assert!(matches!(e, BoreholeError::OutOfOrder { .. }), "{e}");
+    let files = BoreholeFiles {
+        collars: s.collars(),
+        log: LogFile::Intervals(s.file("intervals.csv", log)),
+        survey: None,
+    };
+    let b = read(
+        &files,
+        &BoreholeOptions {
+            repeats: true,
+            ..BoreholeOptions::new(units())
+        },
+    )
+    .unwrap();
+    let h = &b.holes[0];
+    let tops: Vec<_> = h.tops.iter().map(|t| t.map(|c| c.position[2])).collect();
+    // the first run: fill at the collar, sand at 47, clay at 44, gravel not reached
+    assert_eq!(tops, [Some(50.0), Some(47.0), Some(44.0), None]);
+    // the second run: sand's top at 9 m is the fault crossing; clay at 38, gravel at 35
+    let rep: Vec<_> = h
+        .repeated
+        .iter()
+        .map(|c| (c.unit, c.position[2], c.line))
+        .collect();
+    assert_eq!(rep, [(2, 38.0, 6), (3, 35.0, 7)]);
+    let restarts: Vec<_> = h.restarts.iter().map(|c| (c.unit, c.md, c.line)).collect();
+    assert_eq!(restarts, [(1, 9.0, 5)]);
+    assert!(b.holes[1].repeated.is_empty() && b.holes[1].restarts.is_empty());
+}
+
 #[test]
 fn small_inversions_are_repaired_by_onlap() {
     let s = Set::new(COLLARS);

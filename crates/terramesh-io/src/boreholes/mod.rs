@@ -24,7 +24,11 @@
 //!    [`BoreholeOptions::max_inversion`]: the lower top is lowered onto the upper one (same
 //!    point, [`ContactKind::Repaired`], listed in [`Boreholes::repairs`]); a larger one is
 //!    [`BoreholeError::Inversion`]. In intervals, a unit logged below a unit that the column
-//!    puts under it is [`BoreholeError::OutOfOrder`].
+//!    puts under it is [`BoreholeError::OutOfOrder`], unless [`BoreholeOptions::repeats`]
+//!    (a faulted model: a reverse fault repeats units): the hole then starts a new run of the
+//!    column there, and the contacts of every later run are [`Hole::repeated`] (its first
+//!    unit's top is the fault crossing, and the units above it were cut out by the fault:
+//!    neither is a contact).
 //! 3. A unit of the column absent from a hole that reaches a unit below it has zero thickness
 //!    there: its top is the next present unit's top ([`ContactKind::Absent`]).
 //! 4. A unit's vertical thickness is known where its top and the top of the next unit of the
@@ -106,6 +110,10 @@ pub struct BoreholeOptions<'a> {
     pub max_inversion: f64,
     /// Projects geographic collars; `None`: only `x,y` collars are accepted.
     pub project: Option<Projection<'a>>,
+    /// A unit may be logged again below a deeper unit (intervals only): the hole has crossed
+    /// a fault (a reverse fault repeats units), see rule 2 and [`Hole::repeated`]. Only a
+    /// faulted model sets it; otherwise a repeat is [`BoreholeError::OutOfOrder`].
+    pub repeats: bool,
 }
 
 impl<'a> BoreholeOptions<'a> {
@@ -121,6 +129,7 @@ impl<'a> BoreholeOptions<'a> {
             z_unit: ZUnit::Metre,
             max_inversion: DEFAULT_MAX_INVERSION,
             project: None,
+            repeats: false,
         }
     }
 }
@@ -140,6 +149,14 @@ pub struct Hole {
     pub tops: Vec<Option<Contact>>,
     /// The vertical thickness of every unit of the column.
     pub thickness: Vec<Thickness>,
+    /// With [`BoreholeOptions::repeats`]: the contacts below the first place where a unit is
+    /// logged again (each later run of the column, past a fault), in depth order, without each
+    /// run's first top (the fault crossing) and the units above it; empty otherwise.
+    pub repeated: Vec<Contact>,
+    /// With [`BoreholeOptions::repeats`]: where each later run of the column starts, the top
+    /// of the unit logged again there (a fault crossing, not a top of that unit), where the
+    /// log places it; empty otherwise.
+    pub restarts: Vec<Contact>,
 }
 
 /// A borehole data set, read and checked.
@@ -244,10 +261,29 @@ pub fn read(files: &BoreholeFiles, opts: &BoreholeOptions) -> Result<Boreholes, 
             units: opts.units.len(),
             max_inversion: opts.max_inversion,
         };
+        // Runs of the column: a new one where a unit is not below the one above it (only
+        // with `repeats`: the reader refuses it otherwise).
+        let mut runs: Vec<&[terramesh_geology::boreholes::Present]> = Vec::new();
+        let mut start = 0;
+        for i in 1..present.len() {
+            if present[i].unit <= present[i - 1].unit {
+                runs.push(&present[start..i]);
+                start = i;
+            }
+        }
+        runs.push(&present[start..]);
         let (tops, thickness, mut r) =
-            terramesh_geology::boreholes::contacts(&rules, &path, &present)
+            terramesh_geology::boreholes::contacts(&rules, &path, runs[0])
                 .map_err(|e| rule_error(e, &log_name, &c.name, &opts.units))?;
         repairs.append(&mut r);
+        let (mut repeated, mut restarts) = (Vec::new(), Vec::new());
+        for run in &runs[1..] {
+            let (t, _, mut r) = terramesh_geology::boreholes::contacts(&rules, &path, run)
+                .map_err(|e| rule_error(e, &log_name, &c.name, &opts.units))?;
+            repairs.append(&mut r);
+            restarts.extend(t[run[0].unit]);
+            repeated.extend(t.into_iter().flatten().filter(|t| t.unit > run[0].unit));
+        }
         holes.push(Hole {
             name: c.name,
             line: c.line,
@@ -255,6 +291,8 @@ pub fn read(files: &BoreholeFiles, opts: &BoreholeOptions) -> Result<Boreholes, 
             path,
             tops,
             thickness,
+            repeated,
+            restarts,
         });
     }
     Ok(Boreholes {

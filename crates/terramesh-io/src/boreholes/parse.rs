@@ -384,7 +384,7 @@ pub(crate) fn intervals(
             };
             match present.last() {
                 Some(last) if last.unit == unit => {}
-                Some(last) if last.unit > unit => {
+                Some(last) if last.unit > unit && !opts.repeats => {
                     return Err(BoreholeError::OutOfOrder {
                         file: t.name.clone(),
                         line,

@@ -49,6 +49,7 @@ mod bodies;
 mod boundary;
 mod check;
 mod faces;
+mod faulted_volume;
 mod faults;
 mod flac3d;
 mod gmsh;
@@ -68,6 +69,7 @@ pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
 pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
 pub use check::{check_mesh, check_mesh_with, MeshError};
 pub use faces::{cell_faces, ogs_face_index};
+pub use faulted_volume::{block_name, faulted_volume};
 pub use faults::{
     check_faults, fault_mesh, side_nodes, write_fault_tsurf, FaceSide, FaultData, FaultFaces,
     FaultMesh,

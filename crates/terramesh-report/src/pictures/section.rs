@@ -45,6 +45,16 @@ pub struct SectionHole {
     pub intervals: Vec<(f64, f64, usize)>,
 }
 
+/// A fault's trace on a section: the segments where its surface cuts the section's vertical
+/// plane, `((distance, elevation), (distance, elevation))` in metres.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionFault {
+    /// Its name, written at its highest point.
+    pub name: String,
+    /// The segments.
+    pub segments: Vec<[(f64, f64); 2]>,
+}
+
 /// A vertical section through a layered model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Section<'a> {
@@ -59,6 +69,8 @@ pub struct Section<'a> {
     pub units: &'a [String],
     /// Boreholes to draw.
     pub holes: &'a [SectionHole],
+    /// Faults to draw (a faulted model), as thick dark red lines named at their top.
+    pub faults: &'a [SectionFault],
 }
 
 /// Draws `s`: each unit filled between its top and bottom surface where both are defined,
@@ -76,7 +88,7 @@ pub struct Section<'a> {
 /// let holes = vec![SectionHole { name: "B1".into(), distance: 400.0,
 ///     intervals: vec![(208.0, 146.0, 0), (146.0, 120.0, 1)] }];
 /// let dir = tempfile::tempdir()?;
-/// let s = Section { title: "A-A'", distance: &d, surfaces: &surfaces, units: &units, holes: &holes };
+/// let s = Section { title: "A-A'", distance: &d, surfaces: &surfaces, units: &units, holes: &holes, faults: &[] };
 /// render_both(&dir.path().join("section"), (800, 400), |root| draw_section(root, &s))?;
 /// assert!(dir.path().join("section.png").is_file());
 /// # Ok(()) }
@@ -146,6 +158,28 @@ where
                 run.iter().map(|&i| (s.distance[i], surf[i])),
                 BLACK.stroke_width(1),
             ))?;
+        }
+    }
+    let fault_colour = RGBColor(150, 20, 20);
+    for f in s.faults {
+        chart.draw_series(
+            f.segments
+                .iter()
+                .map(|seg| PathElement::new(vec![seg[0], seg[1]], fault_colour.stroke_width(3))),
+        )?;
+        let top = f
+            .segments
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|p| p.0 >= d0 && p.0 <= d1)
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((d, z)) = top {
+            chart.draw_series(std::iter::once(Text::new(
+                f.name.clone(),
+                (d, z + pad * 0.4),
+                ("sans-serif", 12).into_font().color(&fault_colour),
+            )))?;
         }
     }
     let w = (d1 - d0) * 0.006;
@@ -218,6 +252,7 @@ mod tests {
             surfaces: &surfaces,
             units: &units,
             holes: &[],
+            faults: &[],
         };
         let dir = tempfile::tempdir().unwrap();
         let e = crate::pictures::render_file(&dir.path().join("s.png"), (200, 100), |r| {

@@ -6,7 +6,6 @@
 pub mod ensemble;
 pub mod ensemble_report;
 pub mod faulted;
-pub mod faulted_mesh;
 pub mod fields;
 pub mod model;
 pub mod report;

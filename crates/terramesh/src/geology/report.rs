@@ -8,7 +8,7 @@ use std::path::Path;
 use terramesh_mesh::Mesh;
 use terramesh_report::pictures::{
     draw_bodies_view3d, draw_section, draw_surface, render_both_as, unit_colour, ColourMap,
-    Section as Cut, SectionHole, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
+    Section as Cut, SectionFault, SectionHole, SurfaceMap, SvgMode, VECTOR_TRIANGLE_LIMIT,
 };
 use terramesh_report::report::{Block, Section};
 
@@ -56,12 +56,31 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
                 })
             })
             .collect();
+        let faults: Vec<SectionFault> = m
+            .faults
+            .iter()
+            .map(|f| SectionFault {
+                name: f.name.clone(),
+                segments: f.cut(a, b),
+            })
+            .filter(|f| !f.segments.is_empty())
+            .collect();
         let cut = Cut {
             title,
             distance: &d,
             surfaces: &z,
             units,
             holes: &holes,
+            faults: &faults,
+        };
+        let crossed = if faults.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<&str> = faults.iter().map(|f| f.name.as_str()).collect();
+            format!(
+                ", and the faults it crosses ({}) in dark red",
+                names.join(", ")
+            )
         };
         let files = render_both_as(&dir.join(name), (1100, 550), SvgMode::Vector, |r| {
             draw_section(r, &cut)
@@ -70,7 +89,7 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
             &files[0],
             format!(
                 "{title}: from ({:.0}, {:.0}) to ({:.0}, {:.0}), {:.0} m, with the {} holes within \
-                 {:.0} m of the line and their logged units",
+                 {:.0} m of the line and their logged units{crossed}",
                 a[0],
                 a[1],
                 b[0],
@@ -147,6 +166,9 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
             })
             .collect(),
     });
+    if let Some(f) = &s.faulted {
+        blocks.extend(fault_tables(f));
+    }
     if !s.boreholes.is_empty() {
         let worst = s
             .boreholes
@@ -164,6 +186,83 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
         heading: "Geological model".into(),
         blocks,
     })
+}
+
+/// The tables of a faulted model: its faults (kind, throw given, area, mean dip and dip
+/// direction as meshed, the throw along it) and its fault blocks (volume, cells, units, where
+/// the interfaces come from), from `model.json`'s `faulted`.
+pub fn fault_tables(f: &super::faulted::FaultedSummary) -> [Block; 2] {
+    let faults = Block::Table {
+        caption: format!(
+            "Faults as meshed ({} faults; the smallest dihedral angle of any cell {:.1} degrees, \
+             the largest distance of a fault face from its fault {:.1e} m)",
+            f.faults.len(),
+            f.min_dihedral_degrees,
+            f.fault_distance
+        ),
+        header: [
+            "fault",
+            "kind",
+            "throw given (m)",
+            "faces",
+            "area (m²)",
+            "mean dip (°)",
+            "mean dip direction (°)",
+            "throw along it, mean over the interfaces (m)",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: f
+            .faults
+            .iter()
+            .map(|x| {
+                let n = x.throw_along.len().max(1) as f64;
+                let mean = x.throw_along.iter().map(|t| t.mean).sum::<f64>() / n;
+                vec![
+                    x.name.clone(),
+                    format!("{:?}", x.kind).to_lowercase(),
+                    x.throw.map_or("-".into(), |t| format!("{t}")),
+                    x.faces.to_string(),
+                    format!("{:.1}", x.area),
+                    format!("{:.1}", x.mean_dip),
+                    format!("{:.1}", x.mean_dip_direction),
+                    format!("{mean:.2}"),
+                ]
+            })
+            .collect(),
+    };
+    let blocks = Block::Table {
+        caption: format!(
+            "Fault blocks ({}): each named by its side of every fault that counts there",
+            f.blocks.len()
+        ),
+        header: [
+            "block",
+            "name",
+            "volume (m³)",
+            "cells",
+            "units",
+            "interfaces from contacts / throw",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: f
+            .blocks
+            .iter()
+            .map(|b| {
+                let from = |w: &str| b.interfaces.iter().filter(|i| i.from == w).count();
+                vec![
+                    b.block.to_string(),
+                    b.name.clone(),
+                    format!("{:.6e}", b.volume),
+                    b.cells.to_string(),
+                    b.units.join(", "),
+                    format!("{} / {}", from("contacts"), from("throw")),
+                ]
+            })
+            .collect(),
+    };
+    [faults, blocks]
 }
 
 /// The still 3D view of the stacked unit bodies (`pictures/model-view3d.png`): each unit's

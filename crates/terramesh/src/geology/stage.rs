@@ -39,6 +39,8 @@ pub struct ModelBuilt {
     /// The spread of every interface over the realisations (`interpolation.realisations`),
     /// for the report; `None` without realisations.
     pub ensemble: Option<Vec<super::ensemble_report::InterfaceSpread>>,
+    /// A faulted model's faults as meshed, for the report's sections; empty otherwise.
+    pub faults: Vec<super::faulted::FaultSheet>,
 }
 
 /// The project's CRS for the model: the UTM zone of a geographic project, or the named CRS
@@ -298,6 +300,7 @@ pub fn run(
         boreholes,
         files,
         ensemble: None,
+        faults: Vec::new(),
     })
 }
 

@@ -173,6 +173,8 @@ mod tests {
                 Thickness::Known(20.0),
                 Thickness::Censored,
             ],
+            repeated: Vec::new(),
+            restarts: Vec::new(),
         };
         let r = 0.5;
         let t = borehole_traces(&[&hole], r);
@@ -245,6 +247,8 @@ mod tests {
             path: path.clone(),
             tops: vec![contact(0, 0.0), contact(1, 100.0)],
             thickness: vec![Thickness::Known(60.0), Thickness::Known(10.0)],
+            repeated: Vec::new(),
+            restarts: Vec::new(),
         };
         let t = borehole_traces(&[&hole], 0.5);
         // Rings of four vertices: each piece has one at either end.

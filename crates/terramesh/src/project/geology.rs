@@ -557,14 +557,17 @@ fn readable(key: &str, path: &Path) -> Result<()> {
 }
 
 impl GeologyPlan {
-    /// The options of the borehole reader: the column, `z_unit`, `max_inversion` and the
-    /// projection of geographic collars (`None`: only `x,y` collars).
+    /// The options of the borehole reader: the column, `z_unit`, `max_inversion`, the
+    /// projection of geographic collars (`None`: only `x,y` collars) and, with faults, units
+    /// repeated in a hole (past a reverse fault).
     pub fn borehole_options<'a>(&self, project: Option<Projection<'a>>) -> BoreholeOptions<'a> {
         BoreholeOptions {
             units: self.units.clone(),
             z_unit: self.z_unit,
             max_inversion: self.max_inversion,
             project,
+            // a reverse fault repeats units in a hole
+            repeats: !self.faults.is_empty(),
         }
     }
 

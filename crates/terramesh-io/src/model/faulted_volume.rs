@@ -1,4 +1,5 @@
-//! The kernel's faulted mesh (`terramesh_faults::FaultedMesh`) as the writers take it: a
+//! The fault kernel's mesh (`terramesh_faults::FaultedMesh`) as the writers take it
+//! ([`faulted_volume`]), one conversion for the facade's geology stage and the writers' tests: a
 //! `VolumeMesh` (tetrahedra, the units as materials, the faces on the terrain, the base and the
 //! region's sides tagged, the faces between two units of one block tagged
 //! `interface-<lower unit>`, one sealed body per unit) and its `FaultData` (blocks named after
@@ -12,10 +13,27 @@
 use std::collections::HashMap;
 
 use terramesh_core::volume::{Body, Cell, CellKind, FaceTag, TaggedFace, VolumeMesh};
+use terramesh_faults::BlockKey;
 use terramesh_faults::{split_nodes, FaultedMesh};
-use terramesh_io::model::{cell_faces, FaceSide, FaultData, FaultFaces};
 
-use super::faulted::block_name;
+use super::faces::cell_faces;
+use super::faults::{FaceSide, FaultData, FaultFaces};
+
+/// A fault block's name: its side of every fault that counts there, `F1-hanging_F2-foot`
+/// (`all` without faults); `names` are the faults' names in the kernel's order.
+pub fn block_name(names: &[String], b: &BlockKey) -> String {
+    let parts: Vec<String> = (0..names.len())
+        .filter_map(|f| {
+            b.side(f)
+                .map(|s| format!("{}-{}", names[f], if s > 0 { "hanging" } else { "foot" }))
+        })
+        .collect();
+    if parts.is_empty() {
+        "all".into()
+    } else {
+        parts.join("_")
+    }
+}
 
 fn key(nodes: &[u32]) -> [u32; 3] {
     let mut k = [nodes[0], nodes[1], nodes[2]];
@@ -42,7 +60,7 @@ fn compass(n: [f64; 3]) -> usize {
 
 /// The writers' model of a kernel mesh (see the module documentation): `units` the column's
 /// names, `base` the flat base's elevation, `split` to split the faults' nodes.
-pub fn to_volume(
+pub fn faulted_volume(
     mesh: &FaultedMesh,
     units: &[String],
     base: f64,

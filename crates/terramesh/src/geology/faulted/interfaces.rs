@@ -1,0 +1,441 @@
+//! Per-block interface surfaces: every interface fitted in every block from that block's
+//! contacts, or taken from a neighbouring block shifted by the faults' throws.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use serde::Serialize;
+use terramesh_faults::{BlockKey, FaultSet};
+use terramesh_geostat::{
+    experimental, fit_auto, kriging, Data, Drift, Duplicates, LagSettings, Method, ModelKind,
+    Named, Neighbourhood, Predictor, Weighting,
+};
+use terramesh_io::boreholes::Boreholes;
+use terramesh_io::faults::FaultPick;
+
+use super::contacts::{block_contacts, block_name, Contact};
+use crate::error::{Error, Result};
+use crate::geology::fields::MIN_KRIGED;
+use crate::plan::{FaultKind, GeologyPlan};
+
+/// Fewer contacts of an interface than this in a block, and the block's plane takes the
+/// gradient of all the interface's contacts (its own contacts fix the level).
+pub const PLANE_CONTACTS: usize = 3;
+
+/// A unit thinner than this (metres), or than `min_thickness`, pinches out in a faulted model:
+/// two interfaces closer than a millimetre would cut cells into slivers of no volume.
+pub const PINCH: f64 = 1e-3;
+
+/// Points `[x, y]` with a value.
+type Samples = Vec<([f64; 2], f64)>;
+
+/// A fitted interface in one block: universal kriging with a linear drift of the block's
+/// contacts where they are enough ([`kriged`]), else a plane; plus the residuals of its
+/// contacts spread by inverse distance (squared), so that the surface passes through every
+/// contact.
+#[derive(Clone)]
+struct Fit {
+    plane: [f64; 3],
+    kriged: Option<Arc<dyn Predictor>>,
+    residuals: Vec<([f64; 2], f64)>,
+}
+
+/// Fewer distinct contact locations of an interface than this in a block, and it is a plane
+/// plus residuals instead of kriged: a variogram is fitted from [`MIN_KRIGED`] locations, and
+/// universal kriging with a linear drift (3 terms) needs more than twice its terms, as the
+/// unfaulted model's fields (`geology::fields`).
+pub const KRIGED_CONTACTS: usize = 7;
+
+/// The block's contacts `p` kriged as the unfaulted model's interfaces are
+/// (`geology::fields`: the variogram fitted automatically, universal kriging with a linear
+/// drift over all the contacts), or `None` when they are too few (fewer than
+/// [`KRIGED_CONTACTS`] distinct locations), all equal, or no variogram fits.
+fn kriged(p: &[([f64; 2], f64)]) -> Option<Arc<dyn Predictor>> {
+    let data = Data::new(
+        p.iter().map(|(q, _)| *q).collect(),
+        p.iter().map(|(_, z)| *z).collect(),
+        Duplicates::Mean,
+    )
+    .ok()?;
+    let drift = Drift::Linear;
+    if data.len() < KRIGED_CONTACTS.max(MIN_KRIGED) || data.len() <= 2 * drift.terms() {
+        return None;
+    }
+    let (lo, hi) = data
+        .z()
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if hi - lo <= 1e-12 * hi.abs().max(1.0) {
+        return None;
+    }
+    let lags = experimental(&data, &LagSettings::default()).ok()?;
+    let (fit, _) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL).ok()?;
+    let k = kriging(
+        &data,
+        &fit.variogram,
+        Method::Universal(drift),
+        Neighbourhood::All,
+        false,
+    )
+    .ok()?;
+    Some(Arc::from(k))
+}
+
+impl Fit {
+    /// How it is interpolated, for `model.json`.
+    fn method(&self) -> &'static str {
+        if self.kriged.is_some() {
+            "kriging"
+        } else {
+            "plane"
+        }
+    }
+
+    /// The surface before the residuals.
+    fn base(&self, p: [f64; 2]) -> f64 {
+        let plane = self.plane[0] + self.plane[1] * p[0] + self.plane[2] * p[1];
+        match &self.kriged {
+            Some(k) => {
+                let mut e = [0.0];
+                match k.predict(&[p], &mut e, None) {
+                    Ok(()) if e[0].is_finite() => e[0],
+                    _ => plane,
+                }
+            }
+            None => plane,
+        }
+    }
+
+    fn at(&self, p: [f64; 2]) -> f64 {
+        let z = self.base(p);
+        let (mut num, mut den) = (0.0, 0.0);
+        for (q, r) in &self.residuals {
+            let d2 = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+            if d2 < 1e-18 {
+                return z + r;
+            }
+            num += r / d2;
+            den += 1.0 / d2;
+        }
+        if den > 0.0 {
+            z + num / den
+        } else {
+            z
+        }
+    }
+}
+
+/// Least squares plane `z = a + b x + c y` through `pts` (x, y relative to `o`), `None` when
+/// they are fewer than 3 or on one line.
+fn plane_fit(pts: &[([f64; 2], f64)], o: [f64; 2]) -> Option<[f64; 3]> {
+    if pts.len() < PLANE_CONTACTS {
+        return None;
+    }
+    let mut m = [[0.0; 3]; 3];
+    let mut r = [0.0; 3];
+    for (p, z) in pts {
+        let v = [1.0, p[0] - o[0], p[1] - o[1]];
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] += v[i] * v[j];
+            }
+            r[i] += v[i] * z;
+        }
+    }
+    let det = |a: &[[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let d = det(&m);
+    let scale = m[0][0] * m[1][1] * m[2][2];
+    // nearly on one line: the plane's gradient is not fixed
+    if d.abs().partial_cmp(&(1e-3 * scale.abs())) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let mut x = [0.0; 3];
+    for (k, xk) in x.iter_mut().enumerate() {
+        let mut a = m;
+        for row in 0..3 {
+            a[row][k] = r[row];
+        }
+        *xk = det(&a) / d;
+    }
+    // back to absolute x, y
+    Some([x[0] - x[1] * o[0] - x[2] * o[1], x[1], x[2]])
+}
+
+/// Where an interface of a block comes from, for `model.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct InterfaceSource {
+    /// The unit whose top it is.
+    pub unit: String,
+    /// `contacts` (fitted to the block's own contacts) or `throw` (the neighbouring block's
+    /// surface shifted by the faults' throws).
+    pub from: &'static str,
+    /// How the surface it takes is interpolated: `kriging` (universal kriging with a linear
+    /// drift of the block's contacts, at least [`KRIGED_CONTACTS`] distinct locations) or
+    /// `plane` (their least-squares plane, or the interface's gradient through them, with
+    /// fewer), each plus the residuals at the contacts by inverse distance; `gradient`
+    /// without any block's surface.
+    pub method: &'static str,
+    /// The block's contacts of this interface.
+    pub contacts: usize,
+    /// For `throw`: the block whose surface it takes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block: Option<String>,
+    /// For `throw`: the vertical shift added, metres (negative: down).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shift: Option<f64>,
+}
+
+/// Every interface per fault block.
+pub struct BlockInterfaces {
+    /// Per block with contacts, per interface: its fit.
+    fits: HashMap<BlockKey, Vec<Option<Fit>>>,
+    /// Per interface, the gradient of all its contacts.
+    gradient: Vec<[f64; 2]>,
+    /// Per fault: the signed shift of the hanging wall (negative: down), where given.
+    throws: Vec<Option<f64>>,
+    /// Per block with contacts, per interface, the contacts.
+    counts: HashMap<BlockKey, Vec<usize>>,
+    /// Pinch-out thickness.
+    min_thickness: f64,
+    /// Fault names, for block names.
+    names: Vec<String>,
+    /// Every contact as `(hole, unit, xyz, block)`.
+    pub contacts: Vec<Contact>,
+}
+
+impl BlockInterfaces {
+    /// Assigns every contact of a unit below the first to the block it lies in
+    /// ([`block_contacts`]) and fits every interface in every block that has contacts of it.
+    pub fn new(
+        g: &GeologyPlan,
+        set: &FaultSet,
+        boreholes: Option<&Boreholes>,
+        picks: &[FaultPick],
+    ) -> Result<BlockInterfaces> {
+        let interfaces = g.units.len() - 1;
+        let contacts = block_contacts(set, boreholes, picks, g)?;
+        let mut by_block: HashMap<BlockKey, Vec<Samples>> = HashMap::new();
+        let mut all: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); interfaces];
+        for (_, unit, p, key) in &contacts {
+            let k = unit - 1;
+            by_block
+                .entry(*key)
+                .or_insert_with(|| vec![Vec::new(); interfaces])[k]
+                .push(([p[0], p[1]], p[2]));
+            all[k].push(([p[0], p[1]], p[2]));
+        }
+        for (k, a) in all.iter().enumerate() {
+            if a.is_empty() {
+                return Err(Error::invalid(format!(
+                    "[geology]: no borehole meets the top of '{}': a faulted model interpolates \
+                     every interface from the boreholes' contacts",
+                    g.units[k + 1]
+                )));
+            }
+        }
+        let origin = all
+            .iter()
+            .flatten()
+            .next()
+            .map(|(p, _)| *p)
+            .unwrap_or([0.0; 2]);
+        // The gradient of each interface from all its contacts, each block's offset removed:
+        // the plane of the block with the most contacts when it has a plane, else flat.
+        let gradient: Vec<[f64; 2]> = (0..interfaces)
+            .map(|k| {
+                by_block
+                    .values()
+                    .filter(|v| v[k].len() >= PLANE_CONTACTS)
+                    .max_by_key(|v| v[k].len())
+                    .and_then(|v| plane_fit(&v[k], origin))
+                    .map(|p| [p[1], p[2]])
+                    .unwrap_or([0.0, 0.0])
+            })
+            .collect();
+        let mut fits = HashMap::new();
+        let mut counts = HashMap::new();
+        for (key, pts) in &by_block {
+            let mut row = Vec::with_capacity(interfaces);
+            for (k, p) in pts.iter().enumerate() {
+                if p.is_empty() {
+                    row.push(None);
+                    continue;
+                }
+                let plane = plane_fit(p, origin).unwrap_or_else(|| {
+                    let [gx, gy] = gradient[k];
+                    let a = p
+                        .iter()
+                        .map(|(q, z)| z - gx * q[0] - gy * q[1])
+                        .sum::<f64>()
+                        / p.len() as f64;
+                    [a, gx, gy]
+                });
+                let mut fit = Fit {
+                    plane,
+                    kriged: kriged(p),
+                    residuals: Vec::new(),
+                };
+                fit.residuals = p.iter().map(|(q, z)| (*q, z - fit.base(*q))).collect();
+                row.push(Some(fit));
+            }
+            counts.insert(*key, pts.iter().map(Vec::len).collect());
+            fits.insert(*key, row);
+        }
+        Ok(BlockInterfaces {
+            fits,
+            gradient,
+            throws: g
+                .faults
+                .iter()
+                .map(|f| {
+                    f.throw.map(|t| match f.kind {
+                        FaultKind::Normal => -t,
+                        FaultKind::Reverse => t,
+                    })
+                })
+                .collect(),
+            counts,
+            min_thickness: g.min_thickness,
+            names: set.faults.iter().map(|f| f.name.clone()).collect(),
+            contacts,
+        })
+    }
+
+    /// Where interface `k` of block `key` comes from: its own fit, or the block with a fit
+    /// across the fewest faults and the shift by their throws (`Err` naming the first of those
+    /// faults without a throw).
+    fn source(&self, k: usize, key: BlockKey) -> std::result::Result<(BlockKey, f64), usize> {
+        if self.fits.get(&key).is_some_and(|r| r[k].is_some()) {
+            return Ok((key, 0.0));
+        }
+        let differ = |a: &BlockKey, b: &BlockKey| -> Vec<(usize, i8)> {
+            (0..self.names.len())
+                .filter_map(|f| match (a.side(f), b.side(f)) {
+                    (Some(x), Some(y)) if x != y => Some((f, x)),
+                    _ => None,
+                })
+                .collect()
+        };
+        let mut best: Option<(usize, BlockKey)> = None;
+        let mut keys: Vec<&BlockKey> = self.fits.keys().collect();
+        keys.sort();
+        for j in keys {
+            if self.fits[j][k].is_none() {
+                continue;
+            }
+            let n = differ(&key, j).len();
+            if best.is_none_or(|(m, _)| n < m) {
+                best = Some((n, *j));
+            }
+        }
+        let (_, j) = best.expect("every interface has a contact");
+        let mut shift = 0.0;
+        for (f, side) in differ(&key, &j) {
+            let Some(t) = self.throws[f] else {
+                return Err(f);
+            };
+            // this block on the hanging wall: moved by t relative to the footwall
+            shift += if side > 0 { t } else { -t };
+        }
+        Ok((j, shift))
+    }
+
+    /// The raw height of interface `k` in block `key` at `p`, before the column's order.
+    fn raw(&self, k: usize, key: BlockKey, p: [f64; 2]) -> f64 {
+        match self.source(k, key) {
+            Ok((j, shift)) => self.fits[&j][k].as_ref().expect("a fit").at(p) + shift,
+            // Checked before meshing for the blocks found; a block met only by the mesher
+            // takes the gradient through the mean of all contacts.
+            Err(_) => {
+                let [gx, gy] = self.gradient[k];
+                gx * p[0] + gy * p[1]
+            }
+        }
+    }
+
+    /// The height of interface `k` (the top of unit `k + 1`) in block `key` at `p`: never
+    /// above the interface above it, and onto it where the unit between is thinner than
+    /// `min_thickness` (pinched out).
+    pub fn height(&self, k: usize, key: BlockKey, p: [f64; 2]) -> f64 {
+        let mut above = f64::INFINITY;
+        let mut z = f64::INFINITY;
+        for j in 0..=k {
+            z = self.raw(j, key, p).min(above);
+            if above.is_finite() && above - z < self.min_thickness.max(PINCH) {
+                z = above;
+            }
+            above = z;
+        }
+        z
+    }
+
+    /// Checks that every block in `keys` gets every interface: a block without contacts of one
+    /// needs the throw of every fault between it and the block it takes it from.
+    pub fn check_blocks(&self, keys: &[BlockKey], units: &[String]) -> Result<()> {
+        for key in keys {
+            for k in 0..self.gradient.len() {
+                if let Err(f) = self.source(k, *key) {
+                    return Err(Error::invalid(format!(
+                        "geology.faults[{}].throw: block {} has no contact of the top of '{}', \
+                         which it takes from the other side of {} shifted by the throw: give \
+                         throw (metres) and kind (\"normal\" or \"reverse\")",
+                        self.names[f],
+                        block_name(&self.names, key),
+                        units[k + 1],
+                        self.names[f]
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// How interface `k` of block `j` (one with a fit) is interpolated.
+    fn method(&self, k: usize, j: BlockKey) -> &'static str {
+        self.fits
+            .get(&j)
+            .and_then(|r| r[k].as_ref())
+            .map_or("gradient", Fit::method)
+    }
+
+    /// Where every interface of `key` comes from.
+    pub fn sources(&self, key: BlockKey, units: &[String]) -> Vec<InterfaceSource> {
+        (0..self.gradient.len())
+            .map(|k| {
+                let contacts = self.counts.get(&key).map(|c| c[k]).unwrap_or(0);
+                match self.source(k, key) {
+                    Ok((j, _)) if j == key => InterfaceSource {
+                        unit: units[k + 1].clone(),
+                        from: "contacts",
+                        method: self.method(k, j),
+                        contacts,
+                        block: None,
+                        shift: None,
+                    },
+                    Ok((j, s)) => InterfaceSource {
+                        unit: units[k + 1].clone(),
+                        from: "throw",
+                        method: self.method(k, j),
+                        contacts,
+                        block: Some(block_name(&self.names, &j)),
+                        shift: Some(s),
+                    },
+                    Err(_) => InterfaceSource {
+                        unit: units[k + 1].clone(),
+                        from: "gradient",
+                        method: "gradient",
+                        contacts,
+                        block: None,
+                        shift: None,
+                    },
+                }
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,50 @@
+//! The kernel's conformal mesh of a faulted model, built and checked, its nodes split on
+//! request.
+
+use terramesh_faults::{
+    check as check_mesh, faulted_mesh, split_nodes, BlockKey, FaultSet, MeshSettings, Terrain,
+};
+
+use super::inputs::fault_error;
+use super::interfaces::BlockInterfaces;
+use crate::error::{Error, Result};
+use crate::plan::GeologyPlan;
+
+/// Everything the faulted stage makes besides the files.
+pub struct Faulted {
+    /// The kernel's mesh.
+    pub mesh: terramesh_faults::FaultedMesh,
+    /// The kernel's checks.
+    pub check: terramesh_faults::CheckSummary,
+    /// The mesh settings.
+    pub settings: MeshSettings,
+    /// The split mesh's node count, when split.
+    pub split: Option<usize>,
+}
+
+/// Builds and checks the faulted mesh.
+pub fn build_mesh(
+    g: &GeologyPlan,
+    terrain: &Terrain,
+    set: &FaultSet,
+    ifs: &BlockInterfaces,
+    base: f64,
+) -> Result<Faulted> {
+    let settings = MeshSettings::new(base, g.max_cell_height);
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
+    let mesh = faulted_mesh(terrain, set, g.units.len() - 1, &h, &settings).map_err(fault_error)?;
+    let check = check_mesh(&mesh, terrain, set, &settings, &h).map_err(|e| {
+        Error::invalid(format!(
+            "[[geology.faults]]: the faulted mesh failed its checks ({e}; {} cells left \
+             straddling an interface); please report it with the project",
+            mesh.report.unresolved
+        ))
+    })?;
+    let split = g.split_faults.then(|| split_nodes(&mesh).points.len());
+    Ok(Faulted {
+        mesh,
+        check,
+        settings,
+        split,
+    })
+}
