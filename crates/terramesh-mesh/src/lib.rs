@@ -130,4 +130,7 @@ pub enum MeshError {
         /// The function's reason.
         why: String,
     },
+    /// A level-of-detail copy could not be made ([`simplify`]).
+    #[error(transparent)]
+    Simplify(#[from] SimplifyError),
 }
