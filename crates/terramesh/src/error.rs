@@ -79,6 +79,9 @@ pub enum Error {
     /// Writing a mesh file.
     #[error(transparent)]
     MeshWrite(#[from] terramesh_io::export::MeshWriteError),
+    /// Writing a surface through the format registry (`terramesh_io::export::writer`).
+    #[error(transparent)]
+    Export(#[from] terramesh_io::export::ExportError),
     /// Writing the terrain tiles.
     #[error(transparent)]
     Terrain(#[from] terramesh_io::export::TerrainError),

@@ -10,10 +10,8 @@ use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_core::vocab::Named;
 use terramesh_geostat::{CandidateEntry, VariogramFile};
 use terramesh_io::export::{
-    write_collada, write_dxf, write_kml, write_model_kml, write_stl, write_tsurf, ColladaOptions,
-    KmlStyle, TsurfInfo,
+    all_formats, write_mesh, write_stl, writer, GlbParts, MeshView, SurfaceWriter, Target, ToWrite,
 };
-use terramesh_io::export::{write_mesh, MeshView};
 use terramesh_io::grid_write::{write_asc, write_geotiff_heights, Heights};
 use terramesh_io::number::write_shortest;
 use terramesh_io::output::Output;
@@ -88,17 +86,15 @@ fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Re
     Ok(path.to_path_buf())
 }
 
-/// `dsm.dae` (COLLADA, vertices in east-north-up metres around the model origin) and
-/// `dsm-model.kml`, whose `<Model>` places it at that origin with absolute altitude. The origin
-/// is the centre of the mesh's UTM bounding box at the lowest elevation.
-fn write_dae(
-    out: &Path,
+/// `dsm.dae`'s frame: its vertices in east-north-up metres around the model origin, and that
+/// origin (longitude, latitude, altitude) where `dsm-model.kml`'s `<Model>` places it with
+/// absolute altitude. The origin is the centre of the mesh's UTM bounding box at the lowest
+/// elevation.
+fn dae_frame(
     abs: &[[f64; 3]],
     geo: &[[f64; 3]],
-    tris: &[[u32; 3]],
     georef: &Georef,
-    title: &str,
-) -> Result<Vec<PathBuf>> {
+) -> Result<(Vec<[f64; 3]>, [f64; 3])> {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for q in abs {
         for k in 0..3 {
@@ -108,22 +104,34 @@ fn write_dae(
     }
     let (lat0, lon0) = georef.to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))?;
     let frame = LocalEnu::new(lat0, lon0, lo[2]);
-    let enu: Vec<[f64; 3]> = geo.iter().map(|g| frame.to_enu(g[1], g[0], g[2])).collect();
-    let dae = atomic(&out.join("dsm.dae"), |w| {
-        write_collada(
-            w,
-            &enu,
-            tris,
-            &ColladaOptions {
-                name: title,
-                ..ColladaOptions::default()
-            },
-        )
-    })?;
-    let kml = atomic(&out.join("dsm-model.kml"), |w| {
-        write_model_kml(w, "dsm.dae", [lon0, lat0, lo[2]], title)
-    })?;
-    Ok(vec![dae, kml])
+    let enu: Vec<[f64; 3]> = geo
+        .par_iter()
+        .map(|g| frame.to_enu(g[1], g[0], g[2]))
+        .collect();
+    Ok((enu, [lon0, lat0, lo[2]]))
+}
+
+/// Writes `dsm.<ext>` (and its companion, `dsm-model.kml` for COLLADA) atomically through
+/// the registry's writer `w`.
+fn write_format(
+    out: &Path,
+    w: &dyn SurfaceWriter,
+    surface: &ToWrite,
+    ext: &str,
+) -> Result<Vec<PathBuf>> {
+    let name = format!("dsm.{ext}");
+    let path = out.join(&name);
+    let mut o =
+        Output::create(Some(&path)).with_context(|| format!("cannot write {}", path.display()))?;
+    w.write(surface, &mut o)
+        .with_context(|| format!("writing {}", path.display()))?;
+    o.commit()
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    let mut files = vec![path];
+    if let Some((companion, bytes)) = w.companion(surface, &name)? {
+        files.push(atomic(&out.join(companion), |o| o.write_all(&bytes))?);
+    }
+    Ok(files)
 }
 
 /// Writes every output of step 5.
@@ -158,7 +166,7 @@ pub fn write_all(
     // Every file is a job of its own, written through its own buffered, atomic output; the
     // jobs run at once on the thread pool and their files are listed in this order.
     // (What the jobs borrow is declared before them, so that it outlives them.)
-    let (view, title, georef, geo, solid);
+    let (view, title, crs_name, georef, geo, frame, glb, surface, solid);
     let mut jobs: Vec<Job> = Vec::new();
 
     // Per-vertex values as the library computed them (IDW alone when nothing was kriged).
@@ -209,51 +217,10 @@ pub fn write_all(
         jobs.push(Box::new(move || Ok(vec![e.write_csv(out)?])));
     }
     view = v;
-    let view = &view;
-    for ext in ["vtu", "obj", "ply", "msh"] {
-        if want(ext) {
-            jobs.push(Box::new(move || {
-                let path = out.join(format!("dsm.{ext}"));
-                write_mesh(&path, view)?;
-                Ok(vec![path])
-            }));
-        }
-    }
     let origin = [mesh.origin[0], mesh.origin[1], 0.0];
-    if want("stl") {
-        jobs.push(Box::new(move || {
-            one(atomic(&out.join("dsm.stl"), |w| {
-                write_stl(w, abs, tris, origin)
-            }))
-        }));
-    }
     let zone = s.zone;
-    let crs_name = s.crs_name();
-    if want("ts") {
-        let crs_name = crs_name.clone();
-        jobs.push(Box::new(move || {
-            one(atomic(&out.join("dsm.ts"), |w| {
-                write_tsurf(
-                    w,
-                    abs,
-                    tris,
-                    &TsurfInfo {
-                        name: "terramesh_dsm",
-                        crs_name: &crs_name,
-                    },
-                )
-            }))
-        }));
-    }
-    if want("dxf") {
-        jobs.push(Box::new(move || {
-            one(atomic(&out.join("dsm.dxf"), |w| {
-                write_dxf(w, abs, tris, "DSM")
-            }))
-        }));
-    }
+    crs_name = s.crs_name();
     title = p.title.clone().unwrap_or_else(|| "terramesh DSM".into());
-    let title = &title;
     // Geographic exports need WGS-84 positions: a UTM project's, converted exactly; a project
     // in a named CRS's, through terramesh_crs; a project in an unnamed CRS gets none of them
     // (refused, not approximated).
@@ -289,40 +256,48 @@ pub fn write_all(
         _ => Vec::<[f64; 3]>::new(),
     };
     let geo = &geo;
-    if let Some(georef) = &georef {
-        if want("kml") {
-            jobs.push(Box::new(move || {
-                one(atomic(&out.join("dsm.kml"), |w| {
-                    write_kml(
-                        w,
-                        geo,
-                        tris,
-                        &KmlStyle {
-                            name: title,
-                            ..KmlStyle::default()
-                        },
-                    )
-                }))
-            }));
+    frame = match &georef {
+        Some(georef) if want("dae") => Some(dae_frame(abs, geo, georef)?),
+        _ => None,
+    };
+    let dsm = georef.as_ref().map(|georef| crate::gltf::Dsm {
+        mesh,
+        z: &it.dsm,
+        georef,
+        title: &title,
+    });
+    glb = match &dsm {
+        Some(dsm) if want("glb") => Some(crate::gltf::glb_parts(dsm, abs)),
+        _ => None,
+    };
+    // Every surface format through its writer in terramesh_io's registry.
+    surface = ToWrite {
+        view: &view,
+        vertices: abs,
+        stl_origin: origin,
+        title: &title,
+        tsurf_name: "terramesh_dsm",
+        crs_name: &crs_name,
+        dxf_layer: "DSM",
+        lon_lat_alt: georef.is_some().then_some(&geo[..]),
+        enu: frame.as_ref().map(|(enu, at)| (&enu[..], *at)),
+        glb: glb.as_ref().map(|(origin, colours, extras)| GlbParts {
+            origin: *origin,
+            colours: Some(colours),
+            extras: extras.clone(),
+        }),
+    };
+    let surface = &surface;
+    for f in all_formats() {
+        let w = writer(f);
+        match w.target() {
+            Target::File(ext) if want(f.name()) => {
+                jobs.push(Box::new(move || write_format(out, w, surface, ext)));
+            }
+            _ => {}
         }
-        if want("dae") {
-            jobs.push(Box::new(move || {
-                write_dae(out, abs, geo, tris, georef, title)
-            }));
-        }
-        let dsm = crate::gltf::Dsm {
-            mesh,
-            z: &it.dsm,
-            georef,
-            title,
-        };
-        if want("glb") {
-            jobs.push(Box::new(move || {
-                let path = out.join("dsm.glb");
-                crate::gltf::write_dsm_glb(&path, &dsm)?;
-                Ok(vec![path])
-            }));
-        }
+    }
+    if let Some(dsm) = dsm {
         if want("3dtiles") {
             let region = &s.region.projected;
             jobs.push(Box::new(move || {
@@ -333,6 +308,7 @@ pub fn write_all(
         }
         if want("terrain") {
             let res = m.after.edge.mean;
+            let title = &title;
             jobs.push(Box::new(move || {
                 Ok(vec![super::terrain::write(out, geo, tris, res, title)?])
             }));
