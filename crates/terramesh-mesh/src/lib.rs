@@ -66,7 +66,7 @@ pub use lod::{lod_tree, LodLevel, LodSettings, LodTile};
 pub use mesh::Mesh;
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;
-pub use simplify::{simplify, Simplified, SimplifyError, MIN_LOD_TRIANGLES};
+pub use simplify::{simplify, simplify_to, Simplified, SimplifyError, MIN_LOD_TRIANGLES};
 pub use smooth::{smooth, smooth_keeping, SmoothReport, Smoother, DEFAULT_SMOOTHER};
 
 use terramesh_core::geometry::ValidationError;

@@ -122,6 +122,17 @@ pub enum SimplifyError {
 /// # Ok::<(), terramesh_mesh::SimplifyError>(())
 /// ```
 pub fn simplify(mesh: &Mesh, z: &[f64], max_triangles: usize) -> Result<Simplified, SimplifyError> {
+    simplify_to(mesh, z, max_triangles, usize::MAX)
+}
+
+/// [`simplify`] with at most `max_vertices` vertices as well (the copy has at most both).
+pub fn simplify_to(
+    mesh: &Mesh,
+    z: &[f64],
+    max_triangles: usize,
+    max_vertices: usize,
+) -> Result<Simplified, SimplifyError> {
+    let vertex_cap = max_vertices;
     let n = mesh.points.len();
     if z.len() != n {
         return Err(SimplifyError::Heights {
@@ -141,7 +152,7 @@ pub fn simplify(mesh: &Mesh, z: &[f64], max_triangles: usize) -> Result<Simplifi
             height: z[k],
         });
     }
-    if mesh.triangles.len() <= max_triangles {
+    if mesh.triangles.len() <= max_triangles && n <= vertex_cap {
         return Ok(Simplified {
             vertices: (0..n as u32).collect(),
             triangles: mesh.triangles.clone(),
@@ -159,7 +170,7 @@ pub fn simplify(mesh: &Mesh, z: &[f64], max_triangles: usize) -> Result<Simplifi
     let loops = boundary_loops(&boundary, n);
     // Euler: a triangulated region of c >= 1 pieces with h holes has T = 2V - B - 2c + 2h
     // triangles, and h <= loops - 1.
-    let max_vertices = (max_triangles + b + 4).saturating_sub(2 * loops) / 2;
+    let max_vertices = ((max_triangles + b + 4).saturating_sub(2 * loops) / 2).min(vertex_cap);
     if max_vertices < b + 1 {
         return Err(SimplifyError::Boundary {
             boundary: b,
@@ -549,6 +560,17 @@ mod tests {
         let coarse = simplify(&mesh, &z, 1500).unwrap();
         let fine = simplify(&mesh, &z, 6000).unwrap();
         assert!(fine.max_error < coarse.max_error / 2.0);
+    }
+
+    #[test]
+    fn a_vertex_cap_holds_as_well() {
+        let (mesh, z) = terrain();
+        let s = simplify_to(&mesh, &z, 6000, 2000).unwrap();
+        assert!(s.vertices.len() <= 2000, "{}", s.vertices.len());
+        assert!(s.triangles.len() <= 6000);
+        // Within both budgets already: kept whole only when both hold.
+        let whole = simplify_to(&mesh, &z, mesh.triangles.len(), mesh.points.len() - 1).unwrap();
+        assert!(whole.vertices.len() < mesh.points.len());
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! shows and the largest vertical difference from the DSM at the DSM's vertices.
 
 use terramesh_core::solid::extrude;
-use terramesh_mesh::{simplify, Mesh};
+use terramesh_mesh::{simplify_to, Mesh};
 use terramesh_report::pictures::ColourMap;
 use terramesh_report::viewer::{compact, Field, Geometry, Layer, Scene};
 
@@ -57,17 +57,20 @@ pub fn scene(
     // The unit tops below the first and the base ride along as fields of the planar mesh.
     let surfaces = geo.map_or(&[][..], |g| &g.model.stack.surfaces[..]);
     fields.extend(surfaces.iter().skip(1).map(|v| &v[..]));
-    // Triangles: about twice the vertices, which a model's shells copy twice per unit.
-    let budget = match surfaces.len() {
-        0 => VIEWER_TRIANGLES,
-        n => VIEWER_TRIANGLES.min(2 * VIEWER_MODEL_VERTICES / (2 * n - 1)),
+    // Vertices (which a model's shells copy twice per unit) and triangles.
+    let vertices = match surfaces.len() {
+        0 => VIEWER_VERTICES,
+        n => VIEWER_VERTICES.min(VIEWER_MODEL_VERTICES / (2 * n - 1)),
     };
+    let budget = VIEWER_TRIANGLES.min(2 * vertices);
     let mut notes = Vec::new();
-    let (positions, triangles, mut values) = if mesh.triangles.len() > budget {
-        let d = level_of_detail(mesh, &it.dsm, &fields, budget)?;
+    let (positions, triangles, mut values) = if mesh.triangles.len() > budget
+        || abs.len() > vertices
+    {
+        let d = level_of_detail(mesh, &it.dsm, &fields, budget, vertices)?;
         notes.push(format!(
-            "The DSM has {} vertices and {} triangles; this view shows a level-of-detail copy \
-             of {} of its vertices and {} triangles (at most {budget}), within {:.3} m of the \
+            "The DSM has {} vertices and {} triangles; this view shows a decimated, level-of-detail \
+             copy of {} of its vertices and {} triangles (at most {budget}), within {:.3} m of the \
              DSM in elevation at every DSM vertex{}. The exports and the pictures use the \
              full mesh.",
             abs.len(),
@@ -201,7 +204,8 @@ pub(super) struct Decimated {
     pub max_error: f64,
 }
 
-/// A copy of `mesh` (elevations `z`) with at most `max_triangles` triangles
+/// A copy of `mesh` (elevations `z`) with at most `max_triangles` triangles and `max_vertices`
+/// vertices
 /// (`terramesh_mesh::simplify`), with `fields` (one value per vertex of `mesh`) read at its
 /// vertices, which are vertices of `mesh`.
 pub(super) fn level_of_detail(
@@ -209,8 +213,9 @@ pub(super) fn level_of_detail(
     z: &[f64],
     fields: &[&[f64]],
     max_triangles: usize,
+    max_vertices: usize,
 ) -> Result<Decimated> {
-    let lod = simplify(mesh, z, max_triangles)
+    let lod = simplify_to(mesh, z, max_triangles, max_vertices)
         .map_err(terramesh_mesh::MeshError::from)
         .context("the level-of-detail copy of the DSM for the 3D view")?;
     let positions = lod
@@ -266,7 +271,7 @@ mod tests {
         let east: Vec<f64> = (0..mesh.points.len())
             .map(|i| mesh.absolute(i)[0] - 500_000.0)
             .collect();
-        let d = level_of_detail(&mesh, &z, &[&east], 2000).unwrap();
+        let d = level_of_detail(&mesh, &z, &[&east], 2000, 1000).unwrap();
         assert!(
             d.triangles.len() <= 2000 && d.triangles.len() > 1000,
             "{}",
