@@ -165,7 +165,7 @@ mod tests {
     #[test]
     fn fixed_exact_is_format_byte_for_byte() {
         let mut state: u64 = 7;
-        let mut check = |v: f64| {
+        let check = |v: f64| {
             for d in [0usize, 1, 3, 6, 10, 15] {
                 let mut a = Vec::new();
                 push_fixed_exact(&mut a, v, d);

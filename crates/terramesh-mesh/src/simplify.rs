@@ -99,7 +99,9 @@ pub enum SimplifyError {
 
 /// A copy of `mesh` (heights `z`, one per vertex) with at most `max_triangles` triangles and its
 /// largest vertical error at the mesh's vertices; the mesh itself (every vertex) when it already
-/// fits. See the [module documentation](self).
+/// fits. The copy keeps every boundary vertex and edge; its interior vertices are vertices of
+/// the mesh chosen in rounds, the furthest in height from the copy in each of its triangles
+/// first.
 ///
 /// ```
 /// use terramesh_mesh::{simplify, Mesh};

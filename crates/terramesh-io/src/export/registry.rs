@@ -156,7 +156,7 @@ impl<W: MeshWriter + Send + Sync> SurfaceWriter for ViewWriter<W> {
 /// The formats written from plain vertices and options.
 struct Plain(Format);
 
-fn need<'a, T>(v: Option<T>, format: Format, part: &'static str) -> Result<T, ExportError> {
+fn need<T>(v: Option<T>, format: Format, part: &'static str) -> Result<T, ExportError> {
     v.ok_or(ExportError::Missing {
         format: format.name(),
         part,
