@@ -6,8 +6,6 @@
 //! bottom share exactly the surface's boundary vertices and the result is watertight by
 //! construction; [`check_closed`] verifies it.
 
-use std::collections::HashMap;
-
 /// Errors building or checking a solid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -80,24 +78,19 @@ pub fn extrude(
     if base.is_nan() || base >= min_z {
         return Err(SolidError::BaseTooHigh { base, min_z });
     }
-    // Directed edge use counts; boundary edges are used once and never in reverse.
-    let mut uses: HashMap<(u32, u32), usize> = HashMap::with_capacity(triangles.len() * 3);
-    for t in triangles {
-        for k in 0..3 {
-            *uses.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
-        }
-    }
-    if let Some((&(a, b), &c)) = uses.iter().find(|(_, &c)| c > 1) {
+    // Directed edges, sorted (a run per edge: its uses); boundary edges are used once and
+    // never in reverse. A sorted vector rather than a hash map: an eighth of the memory.
+    let edges = sorted_edges(triangles);
+    if let Some((a, b, c)) = runs(&edges).find(|r| r.2 > 1) {
         return Err(SolidError::NotManifold(format!(
             "edge {a}-{b} is used {c} times in the same direction (inconsistent orientation or a fold)"
         )));
     }
-    let mut boundary: Vec<(u32, u32)> = uses
-        .keys()
-        .filter(|&&(a, b)| !uses.contains_key(&(b, a)))
-        .copied()
+    let boundary: Vec<(u32, u32)> = runs(&edges)
+        .filter(|&(a, b, _)| uses(&edges, b, a) == 0)
+        .map(|(a, b, _)| (a, b))
         .collect();
-    boundary.sort_unstable(); // deterministic output
+    drop(edges);
 
     let mut out_v = Vec::with_capacity(vertices.len() * 2);
     out_v.extend_from_slice(vertices);
@@ -121,6 +114,29 @@ pub fn extrude(
     })
 }
 
+/// Every directed edge of `triangles` as `a << 32 | b`, sorted.
+fn sorted_edges(triangles: &[[u32; 3]]) -> Vec<u64> {
+    let mut e: Vec<u64> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (u64::from(t[k]) << 32) | u64::from(t[(k + 1) % 3])))
+        .collect();
+    e.sort_unstable();
+    e
+}
+
+/// The runs of equal edges of sorted `edges`: `(a, b, uses)`, in `(a, b)` order.
+fn runs(edges: &[u64]) -> impl Iterator<Item = (u32, u32, usize)> + '_ {
+    edges
+        .chunk_by(|x, y| x == y)
+        .map(|r| ((r[0] >> 32) as u32, r[0] as u32, r.len()))
+}
+
+/// How many times sorted `edges` hold the directed edge `a -> b`.
+fn uses(edges: &[u64], a: u32, b: u32) -> usize {
+    let k = (u64::from(a) << 32) | u64::from(b);
+    edges.partition_point(|&e| e <= k) - edges.partition_point(|&e| e < k)
+}
+
 /// Checks that every edge is shared by exactly two faces, once in each direction (a closed,
 /// consistently oriented 2-manifold).
 ///
@@ -132,23 +148,14 @@ pub fn extrude(
 /// assert!(check_closed(&t[..3]).is_err());
 /// ```
 pub fn check_closed(triangles: &[[u32; 3]]) -> Result<(), SolidError> {
-    let mut uses: HashMap<(u32, u32), usize> = HashMap::with_capacity(triangles.len() * 3);
-    for t in triangles {
-        for k in 0..3 {
-            *uses.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
-        }
-    }
-    let mut bad: Vec<(u32, u32, usize, usize)> = uses
-        .iter()
-        .filter_map(|(&(a, b), &c)| {
-            let r = uses.get(&(b, a)).copied().unwrap_or(0);
-            (c != 1 || r != 1).then_some((a, b, c, r))
-        })
-        .collect();
-    bad.sort_unstable();
-    match bad.first() {
+    let edges = sorted_edges(triangles);
+    // The first bad edge in (a, b) order.
+    let bad = runs(&edges)
+        .map(|(a, b, c)| (a, b, c, uses(&edges, b, a)))
+        .find(|&(_, _, c, r)| c != 1 || r != 1);
+    match bad {
         None => Ok(()),
-        Some(&(a, b, count, reverse)) => Err(SolidError::Open {
+        Some((a, b, count, reverse)) => Err(SolidError::Open {
             a,
             b,
             count,

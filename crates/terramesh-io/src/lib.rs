@@ -23,6 +23,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod blocks;
 pub mod boreholes;
 pub mod colour;
 pub mod dem;

@@ -46,6 +46,50 @@ pub fn push_fixed(out: &mut Vec<u8>, v: f64, decimals: usize) {
     }
 }
 
+/// Appends `v` with exactly `decimals` digits after the point, byte for byte as
+/// `format!("{v:.decimals$}")` (sign of negative zero and of values rounding to zero kept): an
+/// integer path where the scaled value is not within two ulps of a rounding tie (then the
+/// rounding of the exact value is that of the scaled one), `format!` otherwise.
+///
+/// ```
+/// let mut s = Vec::new();
+/// terramesh_io::number::push_fixed_exact(&mut s, -97.48, 10);
+/// assert_eq!(s, format!("{:.10}", -97.48).as_bytes());
+/// ```
+#[inline]
+pub fn push_fixed_exact(out: &mut Vec<u8>, v: f64, decimals: usize) {
+    if decimals < POW10.len() && v.is_finite() {
+        let scaled = v.abs() * POW10[decimals] as f64;
+        if scaled < 4.0e15 {
+            let whole = scaled.floor();
+            let frac = scaled - whole; // exact below 2^52
+            let ulp = f64::from_bits(scaled.to_bits() + 1) - scaled;
+            if (frac - 0.5).abs() > 2.0 * ulp {
+                let x = whole as u64 + u64::from(frac > 0.5);
+                let scale = POW10[decimals];
+                let (int, fr) = (x / scale, x % scale);
+                if v.is_sign_negative() {
+                    out.push(b'-');
+                }
+                let mut tmp = itoa::Buffer::new();
+                out.extend_from_slice(tmp.format(int).as_bytes());
+                if decimals > 0 {
+                    out.push(b'.');
+                    let at = out.len();
+                    out.resize(at + decimals, b'0');
+                    let mut f = fr;
+                    for k in (0..decimals).rev() {
+                        out[at + k] = b'0' + (f % 10) as u8;
+                        f /= 10;
+                    }
+                }
+                return;
+            }
+        }
+    }
+    out.extend_from_slice(format!("{v:.decimals$}").as_bytes());
+}
+
 const POW10: [u64; 16] = [
     1,
     10,
@@ -117,6 +161,57 @@ pub fn write_shortest<W: Write>(w: &mut W, v: f64) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixed_exact_is_format_byte_for_byte() {
+        let mut state: u64 = 7;
+        let check = |v: f64| {
+            for d in [0usize, 1, 3, 6, 10, 15] {
+                let mut a = Vec::new();
+                push_fixed_exact(&mut a, v, d);
+                assert_eq!(
+                    std::str::from_utf8(&a).unwrap(),
+                    format!("{v:.d$}"),
+                    "{v:e} {d}"
+                );
+            }
+        };
+        for _ in 0..300_000 {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1442695040888963407);
+            let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+            // Longitudes, latitudes, elevations, UTM coordinates, and tiny values.
+            for scale in [180.0, 90.0, 4000.0, 7.0e6, 1e-6] {
+                check((u - 0.5) * 2.0 * scale);
+            }
+        }
+        // Ties, zeros, signs, and what takes format!.
+        for v in [
+            0.5,
+            1.5,
+            2.5,
+            -0.5,
+            0.125,
+            0.375,
+            -0.0,
+            0.0,
+            1e-12,
+            -1e-12,
+            5e-11,
+            1e300,
+            -1e17,
+            f64::NAN,
+            f64::INFINITY,
+            0.05,
+            0.15,
+            0.25,
+            2.675,
+            1.0000000000005,
+        ] {
+            check(v);
+        }
+    }
 
     #[test]
     fn fixed_matches_format_away_from_ties() {

@@ -45,6 +45,8 @@ mod quality;
 mod refine;
 /// What a build did.
 mod report;
+/// A level-of-detail copy of a surface mesh with a bounded number of triangles.
+mod simplify;
 /// Laplacian, smart Laplacian and ODT smoothing.
 mod smooth;
 /// Meshing large regions in vertical strips, in parallel.
@@ -64,6 +66,7 @@ pub use lod::{lod_tree, LodLevel, LodSettings, LodTile};
 pub use mesh::Mesh;
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;
+pub use simplify::{simplify, simplify_to, Simplified, SimplifyError, MIN_LOD_TRIANGLES};
 pub use smooth::{smooth, smooth_keeping, SmoothReport, Smoother, DEFAULT_SMOOTHER};
 
 use terramesh_core::geometry::ValidationError;
@@ -127,4 +130,7 @@ pub enum MeshError {
         /// The function's reason.
         why: String,
     },
+    /// A level-of-detail copy could not be made ([`simplify`]).
+    #[error(transparent)]
+    Simplify(#[from] SimplifyError),
 }

@@ -85,6 +85,9 @@ pub enum Error {
     /// A fault's file (a trace, a surface, picks).
     #[error(transparent)]
     FaultFile(Box<terramesh_io::faults::FaultFileError>),
+    /// Writing a surface through the format registry (`terramesh_io::export::writer`).
+    #[error(transparent)]
+    Export(#[from] terramesh_io::export::ExportError),
     /// Writing the terrain tiles.
     #[error(transparent)]
     Terrain(#[from] terramesh_io::export::TerrainError),

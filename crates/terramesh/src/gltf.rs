@@ -91,9 +91,7 @@ fn centre_low(v: &[[f64; 3]]) -> [f64; 3] {
 /// ```
 pub fn write_dsm_glb(path: &Path, dsm: &Dsm) -> Result<[f64; 3]> {
     let abs = dsm.absolute();
-    let origin = centre_low(&abs);
-    let (lo, hi) = dsm.range();
-    let colours = elevation_colours(dsm.z, lo, hi);
+    let (origin, colours, extras) = glb_parts(dsm, &abs);
     let mesh = GlbMesh {
         name: dsm.title,
         vertices: &abs,
@@ -103,14 +101,7 @@ pub fn write_dsm_glb(path: &Path, dsm: &Dsm) -> Result<[f64; 3]> {
     let opts = GlbOptions {
         name: dsm.title,
         origin,
-        extras: json!({
-            "crs": dsm.georef.crs_code(),
-            "crs_name": dsm.georef.crs_name(),
-            "units": "metre",
-            "vertical_datum": dsm.georef.vertical_datum(),
-            "heights": dsm.georef.heights(),
-            "colours": "COLOR_0: the report's elevation colour map (terrain), linear RGB",
-        }),
+        extras,
     };
     let mut out =
         Output::create(Some(path)).with_context(|| format!("cannot write {}", path.display()))?;
@@ -118,6 +109,27 @@ pub fn write_dsm_glb(path: &Path, dsm: &Dsm) -> Result<[f64; 3]> {
     out.commit()
         .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(origin)
+}
+
+/// `dsm.glb`'s origin (the centre of the bounding box of `abs`, the DSM's absolute vertices,
+/// at the lowest elevation), vertex colours and `extras` ([`write_dsm_glb`]; the export stage
+/// writes them through `terramesh_io::export::writer`).
+pub(crate) fn glb_parts(
+    dsm: &Dsm,
+    abs: &[[f64; 3]],
+) -> ([f64; 3], Vec<[f32; 3]>, serde_json::Value) {
+    let origin = centre_low(abs);
+    let (lo, hi) = dsm.range();
+    let colours = elevation_colours(dsm.z, lo, hi);
+    let extras = json!({
+        "crs": dsm.georef.crs_code(),
+        "crs_name": dsm.georef.crs_name(),
+        "units": "metre",
+        "vertical_datum": dsm.georef.vertical_datum(),
+        "heights": dsm.georef.heights(),
+        "colours": "COLOR_0: the report's elevation colour map (terrain), linear RGB",
+    });
+    (origin, colours, extras)
 }
 
 /// What [`write_dsm_tileset`] wrote.

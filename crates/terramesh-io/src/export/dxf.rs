@@ -24,13 +24,16 @@ pub fn write_dxf<W: Write>(
 ) -> io::Result<()> {
     w.write_all(b"0\nSECTION\n2\nHEADER\n9\n$ACADVER\n1\nAC1009\n0\nENDSEC\n")?;
     w.write_all(b"0\nSECTION\n2\nENTITIES\n")?;
-    for t in triangles {
-        writeln!(w, "0\n3DFACE\n8\n{layer}")?;
-        let corners = [t[0], t[1], t[2], t[2]];
-        for (k, &i) in corners.iter().enumerate() {
-            let v = vertices[i as usize];
-            writeln!(w, "1{k}\n{}\n2{k}\n{}\n3{k}\n{}", v[0], v[1], v[2])?;
+    crate::blocks::write_in_blocks(w, triangles.len(), crate::blocks::BLOCK, |r, w| {
+        for t in &triangles[r] {
+            writeln!(w, "0\n3DFACE\n8\n{layer}")?;
+            let corners = [t[0], t[1], t[2], t[2]];
+            for (k, &i) in corners.iter().enumerate() {
+                let v = vertices[i as usize];
+                writeln!(w, "1{k}\n{}\n2{k}\n{}\n3{k}\n{}", v[0], v[1], v[2])?;
+            }
         }
-    }
+        Ok(())
+    })?;
     w.write_all(b"0\nENDSEC\n0\nEOF\n")
 }

@@ -2,6 +2,8 @@
 
 use std::io::{self, Write};
 
+use crate::number::push_fixed_exact;
+
 /// Appearance of the KML surface.
 #[derive(Debug, Clone)]
 pub struct KmlStyle<'a> {
@@ -57,16 +59,25 @@ pub fn write_kml<W: Write>(
         w,
         "<Placemark>\n<name>{name}</name>\n<styleUrl>#dsm</styleUrl>\n<MultiGeometry>"
     )?;
-    for t in triangles {
-        w.write_all(
-            b"<Polygon><altitudeMode>absolute</altitudeMode><outerBoundaryIs><LinearRing><coordinates>",
-        )?;
-        for &i in [t[0], t[1], t[2], t[0]].iter() {
-            let p = lon_lat_alt[i as usize];
-            write!(w, "{:.10},{:.10},{:.3} ", p[0], p[1], p[2])?;
+    crate::blocks::write_in_blocks(w, triangles.len(), crate::blocks::BLOCK, |r, w| {
+        for t in &triangles[r] {
+            w.write_all(
+                b"<Polygon><altitudeMode>absolute</altitudeMode><outerBoundaryIs><LinearRing><coordinates>",
+            )?;
+            for &i in [t[0], t[1], t[2], t[0]].iter() {
+                // The bytes of `{:.10},{:.10},{:.3} `.
+                let p = lon_lat_alt[i as usize];
+                push_fixed_exact(w, p[0], 10);
+                w.push(b',');
+                push_fixed_exact(w, p[1], 10);
+                w.push(b',');
+                push_fixed_exact(w, p[2], 3);
+                w.push(b' ');
+            }
+            w.write_all(b"</coordinates></LinearRing></outerBoundaryIs></Polygon>\n")?;
         }
-        w.write_all(b"</coordinates></LinearRing></outerBoundaryIs></Polygon>\n")?;
-    }
+        Ok(())
+    })?;
     writeln!(w, "</MultiGeometry>\n</Placemark>\n</Document>\n</kml>")
 }
 

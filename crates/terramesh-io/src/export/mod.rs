@@ -10,8 +10,13 @@
 //! [`writer_for`] and written atomically by [`write_mesh`]. The others take plain slices
 //! (`vertices` in metres, `triangles` as 0-based indices, counter-clockwise seen from above or
 //! from outside) and format options, and write to any `std::io::Write`; use
-//! [`crate::output::Output`] to write a file atomically. To add a format, give it a module
-//! here, a [`Format`] variant, and for a [`MeshView`] format list it in [`writers`].
+//! [`crate::output::Output`] to write a file atomically.
+//!
+//! Every format, surface or model, has one [`SurfaceWriter`] in the registry: [`writer`] of a
+//! [`Format`], [`writer_named`] of a name or extension (an unknown one is
+//! [`ExportError::UnknownFormat`]); `terramesh build`'s export stage writes through it. To add
+//! a format, give it a module here, a [`Format`] variant, its arm in [`writer`], and for a
+//! [`MeshView`] format list it in [`writers`].
 
 mod collada;
 mod dxf;
@@ -20,6 +25,7 @@ mod kml;
 mod msh;
 mod obj;
 mod ply;
+mod registry;
 mod stl;
 mod terrain;
 pub mod tiles3d;
@@ -40,6 +46,9 @@ pub use kml::{write_kml, KmlStyle};
 pub use msh::Msh41;
 pub use obj::{parse_obj, Obj};
 pub use ply::Ply;
+pub use registry::{
+    all_formats, writer, writer_named, ExportError, GlbParts, Needs, SurfaceWriter, Target, ToWrite,
+};
 pub use stl::{parse_stl, read_stl, stl_origin_of, write_stl};
 pub use terrain::{
     build_pyramid, deepest_level, edge_indices, encode_tile, layer_json, level_spacing_m,

@@ -3,6 +3,7 @@
 use std::io::{self, Write};
 
 use super::{MeshView, MeshWriter};
+use crate::blocks::{write_in_blocks, BLOCK};
 
 /// The Gmsh MSH 4.1 writer.
 pub struct Msh41;
@@ -40,15 +41,22 @@ impl MeshWriter for Msh41 {
         for i in 1..=np {
             writeln!(out, "{i}")?;
         }
-        for i in 0..np {
-            let p = m.point(i);
-            writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
-        }
+        write_in_blocks(out, np, BLOCK, |r, out| {
+            for i in r {
+                let p = m.point(i);
+                writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+            }
+            Ok(())
+        })?;
         writeln!(out, "$EndNodes")?;
         writeln!(out, "$Elements\n1 {nt} 1 {nt}\n2 1 2 {nt}")?;
-        for (k, t) in m.triangles.iter().enumerate() {
-            writeln!(out, "{} {} {} {}", k + 1, t[0] + 1, t[1] + 1, t[2] + 1)?;
-        }
+        write_in_blocks(out, nt, BLOCK, |r, out| {
+            for k in r {
+                let t = m.triangles[k];
+                writeln!(out, "{} {} {} {}", k + 1, t[0] + 1, t[1] + 1, t[2] + 1)?;
+            }
+            Ok(())
+        })?;
         writeln!(out, "$EndElements")
     }
 }

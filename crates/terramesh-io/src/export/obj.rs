@@ -3,6 +3,7 @@
 use std::io::{self, Write};
 
 use super::{MeshView, MeshWriter};
+use crate::blocks::{write_in_blocks, BLOCK};
 
 /// The OBJ writer.
 pub struct Obj;
@@ -21,14 +22,19 @@ impl MeshWriter for Obj {
             m.points.len(),
             m.triangles.len()
         )?;
-        for i in 0..m.points.len() {
-            let p = m.point(i);
-            writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
-        }
-        for t in m.triangles {
-            writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-        }
-        Ok(())
+        write_in_blocks(out, m.points.len(), BLOCK, |r, out| {
+            for i in r {
+                let p = m.point(i);
+                writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+            }
+            Ok(())
+        })?;
+        write_in_blocks(out, m.triangles.len(), BLOCK, |r, out| {
+            for t in &m.triangles[r] {
+                writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+            }
+            Ok(())
+        })
     }
 }
 

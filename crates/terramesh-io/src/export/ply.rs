@@ -30,7 +30,9 @@ impl MeshWriter for Ply {
         }
         writeln!(out, "element face {}", m.triangles.len())?;
         writeln!(out, "property list uchar int vertex_indices\nend_header")?;
-        let mut buf = Vec::with_capacity(m.points.len() * 8 * (3 + m.point_data.len()));
+        // Streamed in blocks of about CHUNK bytes, never the whole body in memory.
+        const CHUNK: usize = 1 << 16;
+        let mut buf = Vec::with_capacity(CHUNK + 256);
         for i in 0..m.points.len() {
             let p = m.point(i);
             for c in p {
@@ -39,9 +41,11 @@ impl MeshWriter for Ply {
             for (_, v) in &m.point_data {
                 buf.extend_from_slice(&v[i].to_le_bytes());
             }
+            if buf.len() >= CHUNK {
+                out.write_all(&buf)?;
+                buf.clear();
+            }
         }
-        out.write_all(&buf)?;
-        buf.clear();
         for t in m.triangles {
             buf.push(3u8);
             for &k in t {
@@ -49,6 +53,10 @@ impl MeshWriter for Ply {
                     io::Error::new(io::ErrorKind::InvalidInput, "vertex index beyond PLY's int")
                 })?;
                 buf.extend_from_slice(&k.to_le_bytes());
+            }
+            if buf.len() >= CHUNK {
+                out.write_all(&buf)?;
+                buf.clear();
             }
         }
         out.write_all(&buf)

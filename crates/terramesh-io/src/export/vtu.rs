@@ -5,6 +5,7 @@
 use std::io::{self, Write};
 
 use super::{MeshView, MeshWriter};
+use crate::blocks::{write_in_blocks, BLOCK};
 
 /// The VTU writer.
 pub struct Vtu;
@@ -48,18 +49,24 @@ impl MeshWriter for Vtu {
             out,
             "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
         )?;
-        for i in 0..np {
-            let p = m.point(i);
-            writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
-        }
+        write_in_blocks(out, np, BLOCK, |r, out| {
+            for i in r {
+                let p = m.point(i);
+                writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+            }
+            Ok(())
+        })?;
         writeln!(out, "</DataArray>\n</Points>\n<Cells>")?;
         writeln!(
             out,
             "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
         )?;
-        for t in m.triangles {
-            writeln!(out, "{} {} {}", t[0], t[1], t[2])?;
-        }
+        write_in_blocks(out, nt, BLOCK, |r, out| {
+            for t in &m.triangles[r] {
+                writeln!(out, "{} {} {}", t[0], t[1], t[2])?;
+            }
+            Ok(())
+        })?;
         writeln!(out, "</DataArray>")?;
         writeln!(
             out,
@@ -94,9 +101,12 @@ fn data_section(out: &mut dyn Write, tag: &str, arrays: &[(&str, &[f64])]) -> io
             out,
             "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
         )?;
-        for v in values.iter() {
-            writeln!(out, "{v:?}")?;
-        }
+        write_in_blocks(out, values.len(), BLOCK, |r, out| {
+            for v in &values[r] {
+                writeln!(out, "{v:?}")?;
+            }
+            Ok(())
+        })?;
         writeln!(out, "</DataArray>")?;
     }
     writeln!(out, "</{tag}>")

@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Context, Result};
+use rayon::prelude::*;
 use terramesh_geostat::{InterpolationMethod, Named};
 use terramesh_mesh::Mesh;
 pub use terramesh_report::labels::short_numbers;
@@ -38,36 +39,41 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     let dir = out.join("pictures");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let rings = outlines(s);
-    let mut pics = Vec::new();
-    let mut add = |name: &str, caption: String, files: [PathBuf; 2]| {
-        let _ = name;
-        pics.push(Picture {
-            caption,
-            png: files[0].clone(),
-        });
+    let rings = &rings;
+    let dir = &dir;
+    // Every picture is a job of its own; the jobs run at once on the thread pool and the
+    // pictures are listed in this order (the report's).
+    type Job<'a> = Box<dyn FnOnce() -> Result<Picture> + Send + 'a>;
+    // (What the jobs borrow is declared before them, so that it outlives them.)
+    let (xy, diff, v3): (Vec<[f64; 2]>, Vec<f64>, Vec<[f64; 3]>);
+    let mut jobs: Vec<Job> = Vec::new();
+    let pic = |caption: String, files: [PathBuf; 2]| Picture {
+        caption,
+        png: files[0].clone(),
     };
     let sample_mode = if s.xyz.len() > VECTOR_TRIANGLE_LIMIT {
         SvgMode::Raster
     } else {
         SvgMode::Vector
     };
-    let f = render_both_as(&dir.join("samples"), SIZE, sample_mode, |r| {
-        draw_samples(
-            r,
-            &s.xyz,
-            &rings,
-            &format!("{} samples over the study region", s.xyz.len()),
-        )
-    })?;
-    add(
-        "samples",
-        format!(
-            "Sample points coloured by elevation ({} from {})",
-            s.xyz.len(),
-            s.source
-        ),
-        f,
-    );
+    jobs.push(Box::new(move || {
+        let f = render_both_as(&dir.join("samples"), SIZE, sample_mode, |r| {
+            draw_samples(
+                r,
+                &s.xyz,
+                rings,
+                &format!("{} samples over the study region", s.xyz.len()),
+            )
+        })?;
+        Ok(pic(
+            format!(
+                "Sample points coloured by elevation ({} from {})",
+                s.xyz.len(),
+                s.source
+            ),
+            f,
+        ))
+    }));
 
     // Mesh pictures of large meshes show a central detail of about DETAIL_TRIANGLES
     // triangles (`central_detail`): the whole mesh would be a grey blot at this size.
@@ -79,40 +85,46 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
     .into_iter()
     .enumerate()
     {
-        let (xy, tris, detail) = mesh_detail(mesh, s.region.projected.area());
-        let mut title = match (adaptive, k) {
-            (true, _) => format!("Terrain-adaptive mesh: min angle {:.1}°", q.min_angle),
-            (false, 0) => format!(
-                "Planar mesh before smoothing: min angle {:.1}°",
-                q.min_angle
-            ),
-            _ => format!("Planar mesh after smoothing: min angle {:.1}°", q.min_angle),
-        };
-        let mut caption = match (adaptive, k) {
-            (true, 0) => "Terrain-adaptive mesh after refinement and 3D improvement".to_string(),
-            (true, _) => "Terrain-adaptive mesh (no planar smoothing: 3D flips and moves)".into(),
-            (false, 0) => "Planar mesh after Delaunay refinement, before smoothing".into(),
-            _ => "Planar mesh after smoothing and Delaunay flips".into(),
-        };
-        if let Some(side) = detail {
-            title += &format!(" (central {side:.0} m square)");
-            caption += &format!(
-                "; detail: the {} triangles in the central {side:.0} m square of {}",
-                tris.len(),
-                mesh.triangles.len()
-            );
-        }
-        let rings_here = if detail.is_some() {
-            Vec::new()
-        } else {
-            rings.clone()
-        };
-        let f = render_both(&dir.join(file), SIZE, |r| {
-            draw_mesh(r, &xy, &tris, &rings_here, &title)
-        })?;
-        add(file, caption, f);
+        jobs.push(Box::new(move || {
+            let (xy, tris, detail) = mesh_detail(mesh, s.region.projected.area());
+            let mut title = match (adaptive, k) {
+                (true, _) => format!("Terrain-adaptive mesh: min angle {:.1}°", q.min_angle),
+                (false, 0) => format!(
+                    "Planar mesh before smoothing: min angle {:.1}°",
+                    q.min_angle
+                ),
+                _ => format!("Planar mesh after smoothing: min angle {:.1}°", q.min_angle),
+            };
+            let mut caption = match (adaptive, k) {
+                (true, 0) => {
+                    "Terrain-adaptive mesh after refinement and 3D improvement".to_string()
+                }
+                (true, _) => {
+                    "Terrain-adaptive mesh (no planar smoothing: 3D flips and moves)".into()
+                }
+                (false, 0) => "Planar mesh after Delaunay refinement, before smoothing".into(),
+                _ => "Planar mesh after smoothing and Delaunay flips".into(),
+            };
+            if let Some(side) = detail {
+                title += &format!(" (central {side:.0} m square)");
+                caption += &format!(
+                    "; detail: the {} triangles in the central {side:.0} m square of {}",
+                    tris.len(),
+                    mesh.triangles.len()
+                );
+            }
+            let rings_here = if detail.is_some() {
+                Vec::new()
+            } else {
+                rings.clone()
+            };
+            let f = render_both(&dir.join(file), SIZE, |r| {
+                draw_mesh(r, &xy, &tris, &rings_here, &title)
+            })?;
+            Ok(pic(caption, f))
+        }));
     }
-    let xy: Vec<[f64; 2]> = (0..m.mesh.points.len())
+    xy = (0..m.mesh.points.len())
         .map(|i| m.mesh.absolute(i))
         .collect();
     let svg_mode = if m.mesh.triangles.len() > VECTOR_TRIANGLE_LIMIT {
@@ -123,29 +135,30 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
 
     // The variogram, when one was fitted or read (none for IDW alone).
     if let Some(variogram) = &it.variogram {
-        let pts: Vec<(f64, f64, u64)> = it
-            .lags
-            .iter()
-            .map(|l| (l.distance, l.gamma, l.pairs))
-            .collect();
-        let label = short_numbers(&variogram.to_string());
-        let f = render_both(&dir.join("variogram"), (900, 600), |r| {
-            draw_variogram(
-                r,
-                &pts,
-                &|h| variogram.gamma(h),
-                "Experimental variogram and fitted model",
-                &label,
-            )
-        })?;
-        add(
-            "variogram",
-            format!("Variogram of the samples and the fitted model: {label}"),
-            f,
-        );
+        jobs.push(Box::new(move || {
+            let pts: Vec<(f64, f64, u64)> = it
+                .lags
+                .iter()
+                .map(|l| (l.distance, l.gamma, l.pairs))
+                .collect();
+            let label = short_numbers(&variogram.to_string());
+            let f = render_both(&dir.join("variogram"), (900, 600), |r| {
+                draw_variogram(
+                    r,
+                    &pts,
+                    &|h| variogram.gamma(h),
+                    "Experimental variogram and fitted model",
+                    &label,
+                )
+            })?;
+            Ok(pic(
+                format!("Variogram of the samples and the fitted model: {label}"),
+                f,
+            ))
+        }));
     }
 
-    let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
+    diff = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
     type Map<'a> = (&'a str, &'a str, &'a [f64], bool, ColourMap, bool, &'a str);
     let mut maps: Vec<Map> = vec![
         (
@@ -221,33 +234,35 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
             ),
         ] as [Map; 3]);
     }
+    let xy = &xy;
     for (name, title, values, shaded, colours, symmetric, unit) in maps {
-        let map = SurfaceMap {
-            xy: &xy,
-            values,
-            shade_z: shaded.then_some(if it.kriged() { &it.uk[..] } else { &it.idw[..] }),
-            triangles: &m.mesh.triangles,
-            title,
-            unit,
-            colours,
-            symmetric,
-            outlines: &rings,
-        };
-        let f = render_both_as(&dir.join(name), SIZE, svg_mode, |r| draw_surface(r, &map))?;
-        add(
-            name,
-            format!(
-                "{title}{}",
-                if shaded {
-                    ", hill-shaded, with contours"
-                } else {
-                    ", with contours"
-                }
-            ),
-            f,
-        );
+        jobs.push(Box::new(move || {
+            let map = SurfaceMap {
+                xy,
+                values,
+                shade_z: shaded.then_some(if it.kriged() { &it.uk[..] } else { &it.idw[..] }),
+                triangles: &m.mesh.triangles,
+                title,
+                unit,
+                colours,
+                symmetric,
+                outlines: rings,
+            };
+            let f = render_both_as(&dir.join(name), SIZE, svg_mode, |r| draw_surface(r, &map))?;
+            Ok(pic(
+                format!(
+                    "{title}{}",
+                    if shaded {
+                        ", hill-shaded, with contours"
+                    } else {
+                        ", with contours"
+                    }
+                ),
+                f,
+            ))
+        }));
     }
-    let v3: Vec<[f64; 3]> = xy
+    v3 = xy
         .iter()
         .zip(&it.dsm)
         .map(|(p, z)| [p[0], p[1], *z])
@@ -266,19 +281,26 @@ pub fn draw_all(out: &Path, s: &Samples, m: &Meshed, it: &Interpolated) -> Resul
         1.0
     };
     let ex = (ex * 2.0).round() / 2.0;
-    let f = render_both_as(&dir.join("dsm-3d"), SIZE, svg_mode, |r| {
-        draw_view3d(r, &v3, &m.mesh.triangles, ex, "The DSM in 3D")
-    })?;
-    let by = match it.dsm_method {
-        InterpolationMethod::Universal => "UK".to_string(),
-        other => other.name().to_uppercase(),
-    };
-    add(
-        "3d",
-        format!("Shaded 3D view of the DSM ({by} elevations)"),
-        f,
-    );
-    Ok(pics)
+    let v3 = &v3;
+    jobs.push(Box::new(move || {
+        let f = render_both_as(&dir.join("dsm-3d"), SIZE, svg_mode, |r| {
+            draw_view3d(r, v3, &m.mesh.triangles, ex, "The DSM in 3D")
+        })?;
+        let by = match it.dsm_method {
+            InterpolationMethod::Universal => "UK".to_string(),
+            other => other.name().to_uppercase(),
+        };
+        Ok(pic(
+            format!("Shaded 3D view of the DSM ({by} elevations)"),
+            f,
+        ))
+    }));
+    jobs.into_par_iter()
+        .with_max_len(1)
+        .map(|job| job())
+        .collect::<Vec<Result<Picture>>>()
+        .into_iter()
+        .collect()
 }
 
 /// The absolute points and triangles to draw for `mesh`: all of them, or for a large mesh a

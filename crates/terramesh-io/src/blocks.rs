@@ -1,0 +1,78 @@
+//! Text formats written in parallel and streamed: items formatted in blocks on the thread
+//! pool, a bounded window of blocks at a time, written in order as each window is done. The
+//! bytes are those of formatting the items one after another; the memory is the window's.
+
+use std::io::{self, Write};
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+/// Items per block of [`write_in_blocks`] for a format's lines (a triangle or vertex each).
+pub const BLOCK: usize = 8192;
+
+/// Writes items `0..n` to `w` in order, `format` appending the items of a range to a buffer:
+/// blocks of `block` items formatted in parallel, two blocks per thread of the pool at a time.
+///
+/// ```
+/// use std::io::Write;
+/// let mut out = Vec::new();
+/// terramesh_io::blocks::write_in_blocks(&mut out, 5, 2, |r, b| {
+///     for i in r {
+///         writeln!(b, "{i}")?;
+///     }
+///     Ok(())
+/// })?;
+/// assert_eq!(out, b"0\n1\n2\n3\n4\n");
+/// # Ok::<(), std::io::Error>(())
+/// ```
+pub fn write_in_blocks<W, F>(w: &mut W, n: usize, block: usize, format: F) -> io::Result<()>
+where
+    W: Write + ?Sized,
+    F: Fn(Range<usize>, &mut Vec<u8>) -> io::Result<()> + Sync,
+{
+    let block = block.max(1);
+    let window = block * 2 * rayon::current_num_threads().max(1);
+    let mut start = 0;
+    while start < n {
+        let end = (start + window).min(n);
+        let starts: Vec<usize> = (start..end).step_by(block).collect();
+        let bufs: Vec<io::Result<Vec<u8>>> = starts
+            .into_par_iter()
+            .map(|a| {
+                let mut b = Vec::with_capacity(64 * block);
+                format(a..(a + block).min(end), &mut b)?;
+                Ok(b)
+            })
+            .collect();
+        for b in bufs {
+            w.write_all(&b?)?;
+        }
+        start = end;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_bytes_are_those_of_one_pass_at_any_block_size() {
+        let one = |r: Range<usize>, b: &mut Vec<u8>| -> io::Result<()> {
+            for i in r {
+                write!(b, "{:?} ", (i as f64).sqrt())?;
+            }
+            Ok(())
+        };
+        let mut want = Vec::new();
+        one(0..10_007, &mut want).unwrap();
+        for block in [1, 7, 1000, 20_000] {
+            let mut got = Vec::new();
+            write_in_blocks(&mut got, 10_007, block, one).unwrap();
+            assert_eq!(got, want, "block {block}");
+        }
+        let mut none = Vec::new();
+        write_in_blocks(&mut none, 0, 5, one).unwrap();
+        assert!(none.is_empty());
+    }
+}
