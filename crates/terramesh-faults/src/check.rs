@@ -63,7 +63,8 @@ fn rotated(f: [u32; 3]) -> [u32; 3] {
 }
 
 /// Checks a faulted mesh:
-/// 1. every index in range, every cell of positive volume (exact orientation test);
+/// 1. every index in range, every cell of positive volume (exact orientation test, and the
+///    floating-point volume the writers compute positive too);
 /// 2. every face in one cell (boundary) or two with opposite orientations (interior);
 /// 3. the boundary closed (every edge in two boundary faces, once each way) and only on the
 ///    terrain (nodes and centroid on the DSM, facing up), the base (facing down) or the sides
@@ -112,7 +113,8 @@ pub fn check(
         }
     }
     let p = &mesh.points;
-    // 1. Positive volumes.
+    // 1. Positive volumes: exactly, and as the writers compute them (a cell so flat that its
+    // floating-point volume is zero or negative is refused by every writer).
     if let Some(c) = (0..m).into_par_iter().find_any(|&c| {
         let t = mesh.tets[c].map(|v| c3(p[v as usize]));
         orient3d(t[0], t[1], t[2], t[3]) >= 0.0
@@ -120,6 +122,19 @@ pub fn check(
         return Err(fail(
             centroid(p, &mesh.tets[c]),
             format!("cell {c} has no positive volume"),
+        ));
+    }
+    if let Some(c) = (0..m).into_par_iter().find_any(|&c| {
+        let q = mesh.tets[c].map(|v| p[v as usize]);
+        tetra_volume(q[0], q[1], q[2], q[3]) <= 0.0
+    }) {
+        let q = mesh.tets[c].map(|v| p[v as usize]);
+        return Err(fail(
+            centroid(p, &mesh.tets[c]),
+            format!(
+                "cell {c} is flat: its volume computes as {:e} m³",
+                tetra_volume(q[0], q[1], q[2], q[3])
+            ),
         ));
     }
     // 2. Faces.

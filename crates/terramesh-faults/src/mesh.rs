@@ -345,9 +345,12 @@ fn c3(p: [f64; 3]) -> Coord3D<f64> {
     }
 }
 
-/// Positive volume in our node order (`terramesh_core::volume`): orient3d is negative.
+/// Positive volume in our node order (`terramesh_core::volume`): orient3d is negative, and
+/// the floating-point volume that the writers compute is positive too (a cell whose volume is
+/// below rounding is flat for every reader, whatever its exact sign).
 pub(crate) fn positive(p: [[f64; 3]; 4]) -> bool {
     orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3])) < 0.0
+        && terramesh_core::volume::tetra_volume(p[0], p[1], p[2], p[3]) > 0.0
 }
 
 fn key(a: u32, b: u32) -> u64 {
