@@ -504,7 +504,10 @@ impl BlockInterfaces {
                 }
             }
         }
-        let mut by_block: HashMap<BlockKey, Vec<Samples>> = HashMap::new();
+        // A sorted map: the gradient below takes the block with the most contacts, and a tie
+        // must not be broken by a hash map's per-process order (it was: the same project
+        // gave a different mesh from run to run).
+        let mut by_block: BTreeMap<BlockKey, Vec<Samples>> = BTreeMap::new();
         let mut all: Vec<Vec<([f64; 2], f64)>> = vec![Vec::new(); interfaces];
         for (_, unit, p, key) in &contacts {
             let k = unit - 1;
