@@ -63,7 +63,8 @@ fn rotated(f: [u32; 3]) -> [u32; 3] {
 }
 
 /// Checks a faulted mesh:
-/// 1. every index in range, every cell of positive volume (exact orientation test);
+/// 1. every index in range, every cell of positive volume (exact orientation test, and the
+///    floating-point volume the writers compute positive too);
 /// 2. every face in one cell (boundary) or two with opposite orientations (interior);
 /// 3. the boundary closed (every edge in two boundary faces, once each way) and only on the
 ///    terrain (nodes and centroid on the DSM, facing up), the base (facing down) or the sides
@@ -112,7 +113,8 @@ pub fn check(
         }
     }
     let p = &mesh.points;
-    // 1. Positive volumes.
+    // 1. Positive volumes: exactly, and as the writers compute them (a cell so flat that its
+    // floating-point volume is zero or negative is refused by every writer).
     if let Some(c) = (0..m).into_par_iter().find_any(|&c| {
         let t = mesh.tets[c].map(|v| c3(p[v as usize]));
         orient3d(t[0], t[1], t[2], t[3]) >= 0.0
@@ -120,6 +122,19 @@ pub fn check(
         return Err(fail(
             centroid(p, &mesh.tets[c]),
             format!("cell {c} has no positive volume"),
+        ));
+    }
+    if let Some(c) = (0..m).into_par_iter().find_any(|&c| {
+        let q = mesh.tets[c].map(|v| p[v as usize]);
+        tetra_volume(q[0], q[1], q[2], q[3]) <= 0.0
+    }) {
+        let q = mesh.tets[c].map(|v| p[v as usize]);
+        return Err(fail(
+            centroid(p, &mesh.tets[c]),
+            format!(
+                "cell {c} is flat: its volume computes as {:e} m³",
+                tetra_volume(q[0], q[1], q[2], q[3])
+            ),
         ));
     }
     // 2. Faces.
@@ -285,6 +300,31 @@ pub fn check(
             })
         })
         .collect();
+    // Every interface's height at every node, once per block the node's cells are recorded
+    // in (a node is in 20 cells or so: once per cell cost most of the check).
+    let ni = mesh.units - 1;
+    let mut pairs: Vec<u64> = mesh
+        .tets
+        .par_iter()
+        .zip(&mesh.block)
+        .flat_map_iter(|(t, &b)| t.iter().map(move |&v| (v as u64) << 32 | b as u64))
+        .collect();
+    pairs.par_sort_unstable();
+    pairs.dedup();
+    let node_heights: Vec<f64> = pairs
+        .par_iter()
+        .flat_map_iter(|&e| {
+            let r = p[(e >> 32) as usize];
+            let key = mesh.blocks[e as u32 as usize];
+            (0..ni).map(move |k| height(k, key, [r[0], r[1]]))
+        })
+        .collect();
+    let node_height = |v: u32, b: u32, k: usize| {
+        let i = pairs
+            .binary_search(&((v as u64) << 32 | b as u64))
+            .expect("every node of every cell");
+        node_heights[i * ni + k]
+    };
     let per_cell: Vec<Result<(bool, bool), FaultError>> = (0..m)
         .into_par_iter()
         .map(|c| {
@@ -323,8 +363,8 @@ pub fn check(
                 }
                 let (mut a, mut b) = (false, false);
                 for &v in &t {
-                    let r = p[v as usize];
-                    let d = r[2] - height(k, key, [r[0], r[1]]);
+                    // The recorded block is the centroid's (checked above).
+                    let d = p[v as usize][2] - node_height(v, mesh.block[c], k);
                     a |= d > FAULT_TOLERANCE;
                     b |= d < -FAULT_TOLERANCE;
                 }

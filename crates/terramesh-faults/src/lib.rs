@@ -93,7 +93,9 @@
 //! Guaranteed by construction and verified by [`check`]: conformity (every interior face in
 //! two cells, oppositely oriented), a closed boundary on the terrain, base and sides only, the
 //! volume (to 1e-9 relative: the terrain and base are never moved), positive volumes (exact
-//! orientation test), no cell straddling a fault, fault faces within 1 cm of their fault.
+//! orientation test, and the floating-point volume the writers compute positive too: a cell
+//! flat to rounding reads 0 degrees in [`min_dihedral`], so the quality pass never keeps one),
+//! no cell straddling a fault, fault faces within 1 cm of their fault.
 //! Measured, not guaranteed: the dihedral angles ([`quality`]: cells cut near nodes that may
 //! not move, at the crossing of two surfaces, or in a slab thinner than the planar cells are
 //! wide can stay slivers after the quality pass: a cell of a slab t thick cut from columns

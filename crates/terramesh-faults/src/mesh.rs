@@ -345,9 +345,12 @@ fn c3(p: [f64; 3]) -> Coord3D<f64> {
     }
 }
 
-/// Positive volume in our node order (`terramesh_core::volume`): orient3d is negative.
+/// Positive volume in our node order (`terramesh_core::volume`): orient3d is negative, and
+/// the floating-point volume that the writers compute is positive too (a cell whose volume is
+/// below rounding is flat for every reader, whatever its exact sign).
 pub(crate) fn positive(p: [[f64; 3]; 4]) -> bool {
     orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3])) < 0.0
+        && terramesh_core::volume::tetra_volume(p[0], p[1], p[2], p[3]) > 0.0
 }
 
 fn key(a: u32, b: u32) -> u64 {
@@ -830,12 +833,19 @@ pub fn faulted_mesh(
     for k in 0..interfaces {
         // A height that is not a number would read as "on the interface": refuse it.
         for (b, &bk) in blocks.iter().enumerate() {
-            let bad = by_block[b].par_iter().find_map_any(|&c| {
-                st.tets[c as usize].iter().find_map(|&v| {
-                    let p = st.points[v as usize];
-                    let z = height(k, bk, [p[0], p[1]]);
-                    (!z.is_finite()).then_some((p, z))
-                })
+            // Each node of the block's cells once (not once per cell).
+            let mut need = vec![false; st.points.len()];
+            for &c in &by_block[b] {
+                for &v in &st.tets[c as usize] {
+                    need[v as usize] = true;
+                }
+            }
+            let bad = st.points.par_iter().zip(&need).find_map_any(|(&p, &n)| {
+                if !n {
+                    return None;
+                }
+                let z = height(k, bk, [p[0], p[1]]);
+                (!z.is_finite()).then_some((p, z))
             });
             if let Some((p, z)) = bad {
                 return Err(FaultError::Setting {

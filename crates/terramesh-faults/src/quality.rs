@@ -1,6 +1,8 @@
 //! Cell quality: the dihedral angles of a tetrahedron and their distribution over a mesh.
 
 use rayon::prelude::*;
+use robust::{orient3d, Coord3D};
+use terramesh_core::volume::tetra_volume;
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -18,30 +20,45 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// The smallest of the six dihedral angles of a tetrahedron, degrees (0 for a flat one).
 ///
+/// The faces' normals are oriented by one exact orientation test (`orient3d`) of the whole
+/// cell, not face by face: for a cell so flat that the floating-point volume's sign is noise,
+/// a test per face could flip some normals and read a flat cell as a good one (180 degrees).
+/// A cell whose exact orientation is zero, or whose floating-point volume (what the writers
+/// compute, `terramesh_core::volume::tetra_volume`) is zero or of the other sign, is flat: 0.
+///
 /// ```
 /// let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let a = terramesh_faults::min_dihedral(p);
 /// assert!((a - (1.0f64 / 3.0f64.sqrt()).acos().to_degrees()).abs() < 1e-9); // 54.7 degrees
 /// ```
 pub fn min_dihedral(p: [[f64; 3]; 4]) -> f64 {
-    // The normal of the face opposite vertex i, pointing out of the tetrahedron.
+    let c = |q: [f64; 3]| Coord3D {
+        x: q[0],
+        y: q[1],
+        z: q[2],
+    };
+    let o = orient3d(c(p[0]), c(p[1]), c(p[2]), c(p[3]));
+    let v = tetra_volume(p[0], p[1], p[2], p[3]);
+    // Ours is positive when orient3d is negative (terramesh_core::volume's node order).
+    let sign = if o < 0.0 && v > 0.0 {
+        1.0
+    } else if o > 0.0 && v < 0.0 {
+        -1.0
+    } else {
+        return 0.0;
+    };
+    // The faces wound counter-clockwise seen from outside a positive cell, opposite vertex
+    // 3, 2, 0 and 1 (`mesh::outward_faces`): their normals point out of it.
+    let faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
     let mut n = [[0.0; 3]; 4];
-    for (i, ni) in n.iter_mut().enumerate() {
-        let (a, b, c) = match i {
-            0 => (p[1], p[2], p[3]),
-            1 => (p[0], p[2], p[3]),
-            2 => (p[0], p[1], p[3]),
-            _ => (p[0], p[1], p[2]),
-        };
-        let mut m = cross(sub(b, a), sub(c, a));
-        if dot(m, sub(p[i], a)) > 0.0 {
-            m = [-m[0], -m[1], -m[2]];
-        }
+    for (ni, f) in n.iter_mut().zip(faces) {
+        let a = p[f[0]];
+        let m = cross(sub(p[f[1]], a), sub(p[f[2]], a));
         let l = dot(m, m).sqrt();
         if l == 0.0 {
             return 0.0;
         }
-        *ni = [m[0] / l, m[1] / l, m[2] / l];
+        *ni = [sign * m[0] / l, sign * m[1] / l, sign * m[2] / l];
     }
     // The largest cosine is the smallest angle: one arc cosine.
     let mut most = -1.0f64;
@@ -95,5 +112,39 @@ pub fn quality(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Quality {
         mean: angles.iter().sum::<f64>() / angles.len().max(1) as f64,
         below_5: angles.iter().filter(|&&a| a < 5.0).count(),
         histogram,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::min_dihedral;
+
+    /// A cell the quality pass made on a thinned set of the faulted example's holes: its four
+    /// nodes lie in one plane to rounding (floating-point volume -1.3e-16 m³, exactly
+    /// positive). Oriented face by face, its normals came out inconsistent and it read as a
+    /// 180-degree cell, so a flip kept it and the writers refused the model.
+    #[test]
+    fn a_flat_cell_reads_as_flat() {
+        let p = [
+            [154.20894393416393, 264.53129677619586, 85.36825644348251],
+            [154.50796778807072, 262.35871044430706, 85.3604930742795],
+            [164.17878221395068, 257.01515671538164, 75.35671203863703],
+            [163.08913887329737, 265.47446911464175, 75.3035190432341],
+        ];
+        assert_eq!(min_dihedral(p), 0.0);
+        // Every node order: one flat reading, never a good one.
+        for r in [[1, 0, 2, 3], [0, 2, 1, 3], [3, 1, 2, 0], [2, 3, 0, 1]] {
+            assert_eq!(min_dihedral(r.map(|i| p[i])), 0.0);
+        }
+        // A good cell keeps its angle in both orientations.
+        let q = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let a = min_dihedral(q);
+        assert!(a > 54.0 && a < 55.0);
+        assert_eq!(min_dihedral([q[1], q[0], q[2], q[3]]), a);
     }
 }

@@ -658,3 +658,42 @@ fn pinch_out() {
     assert!(abrupt < 0.005, "{abrupt}");
     assert!(min > 0.0);
 }
+
+/// Two vertical faults 1 m apart and a third across them, five interfaces (a 1 m interbed
+/// among them), refinement within 40,000 background cells: before the quality pass oriented dihedral angles by one exact
+/// test, it kept a cell flat to rounding (its floating-point volume 0 m³, read as 180
+/// degrees), which every writer refuses. The same defect failed `terramesh model` on thinned
+/// hole sets of examples/faulted.
+#[test]
+fn no_cell_flat_to_rounding() {
+    let site = Site::new(
+        200.0,
+        10,
+        0.3,
+        7,
+        [100.0, 0.03, -0.02],
+        0.0,
+        vec![80.0, 60.0, 59.0, 45.7, 30.0],
+        [0.02, 0.01],
+        vec![
+            SynthFault::new("F1", [71.1, -10.0], [101.1, 210.0], 90.0, 90.0, 7.0),
+            SynthFault::new("F2", [72.1, -10.0], [102.1, 210.0], 90.0, 90.0, 4.0),
+            SynthFault::new("F3", [-10.0, 127.0], [210.0, 90.0], 70.0, 0.0, 5.0),
+        ],
+    )
+    .unwrap();
+    let mut settings = MeshSettings::new(site.base, 5.0);
+    settings.refine_max_cells = 40_000;
+    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    let mesh = faulted_mesh(&site.terrain, &set, site.tops.len(), &h, &settings).unwrap();
+    // The volume as every writer computes it (terramesh_io's check_mesh refuses <= 0).
+    for (c, t) in mesh.tets.iter().enumerate() {
+        let q = t.map(|v| mesh.points[v as usize]);
+        let v = terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3]);
+        assert!(v > 0.0, "cell {c} {q:?} has volume {v:e} m³");
+    }
+    let s = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
+    assert!(truth(&site, &mesh) > 0.99);
+    report("no_cell_flat_to_rounding", &mesh, &s, truth(&site, &mesh));
+}

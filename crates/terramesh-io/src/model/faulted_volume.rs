@@ -12,6 +12,8 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use terramesh_core::volume::{Body, Cell, CellKind, FaceTag, TaggedFace, VolumeMesh};
 use terramesh_faults::BlockKey;
 use terramesh_faults::{split_nodes, FaultedMesh};
@@ -105,16 +107,22 @@ pub fn faulted_volume(
         }
         fault_faces[f.fault as usize].faces.push(pair);
     }
-    // every face by its nodes (of this mesh: split copies differ)
-    let mut by_key: HashMap<[u32; 3], Vec<(u32, u8)>> = HashMap::new();
-    for c in 0..tets.len() {
-        for k in 0..4 {
-            by_key
-                .entry(key(&nodes_of(c, k)))
-                .or_default()
-                .push((c as u32, k as u8));
-        }
-    }
+    // every face by its nodes (of this mesh: split copies differ), sorted: each group of
+    // equal nodes in the order of its key, its sides by cell then face (a sorted vector, not
+    // a map: no hashing and no allocation per face)
+    let nodes3 = |c: usize, k: usize| -> [u32; 3] {
+        let f = faces[k];
+        [tets[c][f[0]], tets[c][f[1]], tets[c][f[2]]]
+    };
+    let grouped = |key_of: &(dyn Fn(usize, usize) -> [u32; 3] + Sync)| {
+        let mut v: Vec<([u32; 3], u32, u8)> = (0..tets.len())
+            .into_par_iter()
+            .flat_map_iter(|c| (0..4).map(move |k| (key_of(c, k), c as u32, k as u8)))
+            .collect();
+        v.par_sort_unstable();
+        v
+    };
+    let by_key = grouped(&|c, k| key(&nodes3(c, k)));
     // tags: top, bottom, the four sides, the interfaces; compacted to those in use below
     let mut tags = vec![FaceTag::Top, FaceTag::Bottom];
     for s in SIDES {
@@ -124,12 +132,9 @@ pub fn faulted_volume(
         tags.push(FaceTag::Interface(u.to_string()));
     }
     let mut tagged = Vec::new();
-    let mut keys: Vec<_> = by_key.keys().copied().collect();
-    keys.sort_unstable();
-    for k in keys {
-        let sides = &by_key[&k];
-        let tag = match sides.as_slice() {
-            [(c, f)] if !fault_side.contains_key(&(*c, *f)) => {
+    for sides in by_key.chunk_by(|a, b| a.0 == b.0) {
+        let tag = match sides {
+            [(_, c, f)] if !fault_side.contains_key(&(*c, *f)) => {
                 let n = nodes_of(*c as usize, *f as usize);
                 let p: Vec<[f64; 3]> = n.iter().map(|&v| points[v as usize]).collect();
                 let u = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
@@ -159,7 +164,7 @@ pub fn faulted_volume(
                 };
                 Some((t, *c, *f))
             }
-            [(a, fa), (b, fb)] => {
+            [(_, a, fa), (_, b, fb)] => {
                 let (a, b) = (*a as usize, *b as usize);
                 if mesh.block[a] == mesh.block[b] && mesh.unit[a] != mesh.unit[b] {
                     let (c, f) = if mesh.unit[a] > mesh.unit[b] {
@@ -202,34 +207,20 @@ pub fn faulted_volume(
     tagged.sort_by_key(|f| (f.tag, f.cell, f.nodes));
     // sealed bodies over the original nodes: faces of a unit's cells whose other side is not
     // of that unit (or none)
-    let mut by_orig: HashMap<[u32; 3], Vec<(u32, u8)>> = HashMap::new();
-    for c in 0..tets.len() {
-        for k in 0..4 {
-            let n: Vec<u32> = nodes_of(c, k)
-                .iter()
-                .map(|&v| original[v as usize])
-                .collect();
-            by_orig
-                .entry(key(&n))
-                .or_default()
-                .push((c as u32, k as u8));
-        }
-    }
+    let by_orig = grouped(&|c, k| key(&nodes3(c, k).map(|v| original[v as usize])));
+    drop(by_key);
     let mut bodies: Vec<Body> = (0..mesh.units)
         .map(|u| Body {
             unit: u,
             triangles: vec![],
         })
         .collect();
-    let mut okeys: Vec<_> = by_orig.keys().copied().collect();
-    okeys.sort_unstable();
-    for k in okeys {
-        let sides = &by_orig[&k];
-        for &(c, f) in sides {
+    for sides in by_orig.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, c, f) in sides {
             let u = mesh.unit[c as usize];
             if sides
                 .iter()
-                .all(|&(d, _)| d == c || mesh.unit[d as usize] != u)
+                .all(|&(_, d, _)| d == c || mesh.unit[d as usize] != u)
             {
                 let n: Vec<u32> = nodes_of(c as usize, f as usize)
                     .iter()
