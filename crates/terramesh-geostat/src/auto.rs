@@ -80,6 +80,11 @@ pub const WLS_LOO_POINTS: usize = 1000;
 /// surface between the data (nearer a datum than that) is better without one.
 pub const WLS_LOO_TIE: f64 = 0.03;
 
+/// The least leave-one-out RMSE, relative to the data's range, below which
+/// [`fit_auto_wls_loo`] refuses to choose (the data lie on the drift to rounding) and the
+/// caller falls back to the WLS fit.
+pub const WLS_LOO_ROUNDING: f64 = 1e-9;
+
 /// Number of models that [`FitMethod::WlsLoo`] refines (those of least leave-one-out RMSE
 /// from their WLS fits).
 pub const WLS_LOO_REFINED: usize = 2;
@@ -406,6 +411,17 @@ pub fn fit_auto_wls_loo(
         .flatten()
         .map(|o| o.1)
         .fold(f64::INFINITY, f64::min);
+    // Data on the drift to rounding (a plane with a linear drift): every model predicts them
+    // to within rounding, the scale from the standardised errors is rounding noise (a sill of
+    // 1e-26 that no kriging system can be solved with), and leave-one-out cannot choose.
+    let z = sub.z();
+    let spread = z.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+        - z.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    if min <= WLS_LOO_ROUNDING * spread {
+        return Err(GeostatError::Fit(format!(
+            "the data lie on the drift to rounding (leave-one-out RMSE {min:.3e} against a range of {spread:.3e}): leave-one-out cannot choose a model"
+        )));
+    }
     let mut chosen: Option<(usize, usize, f64, f64)> = None; // kind, option, nugget ratio, rmse
     for (i, all) in options.iter().enumerate() {
         for (j, (v, rmse)) in all.iter().enumerate() {
@@ -664,4 +680,34 @@ fn loo_rmse(sub: &Data, v: &Variogram, drift: Drift) -> Option<f64> {
     cross_validate(sub, &how, Folds::LeaveOneOut)
         .ok()
         .map(|r| r.stats.rmse)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{experimental, Duplicates, LagSettings};
+
+    /// Heights exactly on a plane with a linear drift (the faulted example's DSM): every
+    /// leave-one-out error is rounding, and wls-loo must refuse to choose (its caller falls
+    /// back to WLS) instead of scaling a model to a sill of 1e-26 that no kriging system
+    /// can be solved with.
+    #[test]
+    fn data_on_the_drift_are_refused_not_scaled_to_rounding() {
+        let xy: Vec<[f64; 2]> = (0..400)
+            .map(|i| [(i % 20) as f64 * 20.0, (i / 20) as f64 * 20.0])
+            .collect();
+        let z: Vec<f64> = xy
+            .iter()
+            .map(|p| 150.0 + 0.02 * p[0] - 0.01 * p[1])
+            .collect();
+        let data = Data::new(xy, z, Duplicates::Reject).unwrap();
+        let lags = experimental(&data, &LagSettings::default()).unwrap();
+        let kinds = [
+            ModelKind::Spherical,
+            ModelKind::Exponential,
+            ModelKind::Linear,
+        ];
+        let e = fit_auto_wls_loo(&data, &lags, &kinds, &AutoSettings::default()).unwrap_err();
+        assert!(e.to_string().contains("on the drift to rounding"), "{e}");
+    }
 }

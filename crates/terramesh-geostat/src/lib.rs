@@ -89,7 +89,7 @@ pub use aniso::{
 };
 pub use auto::{
     fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, lag_rmse, AutoSettings, FitMethod, Selection,
-    DEFAULT_LOO_POINTS, WLS_LOO_POINTS, WLS_LOO_REFINED, WLS_LOO_TIE,
+    DEFAULT_LOO_POINTS, WLS_LOO_POINTS, WLS_LOO_REFINED, WLS_LOO_ROUNDING, WLS_LOO_TIE,
 };
 pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
