@@ -120,6 +120,8 @@ mod fault;
 mod improve;
 /// The conformal volume mesh.
 mod mesh;
+/// Engineering objects: tunnels, excavations and structures cut into the mesh.
+mod objects;
 /// Dihedral angles.
 mod quality;
 /// Local refinement of the planar mesh where slabs are thin.
@@ -135,7 +137,12 @@ pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
 pub use error::FaultError;
 pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG_TRACE_DEGREES};
 pub use mesh::{
-    faulted_mesh, BuildReport, FaultFace, FaultedMesh, InterfaceFn, MeshSettings, ON_SURFACE,
+    faulted_mesh, faulted_mesh_with_objects, BuildReport, FaultFace, FaultedMesh, InterfaceFn,
+    MeshSettings, ON_SURFACE,
+};
+pub use objects::{
+    check_objects, Object, ObjectCells, ObjectCheck, ObjectGeometry, ObjectSet, ObjectSpec,
+    Profile, Wall, OBJECT_MAX_CELLS, OBJECT_TOLERANCE, STRUCTURE_RESOLUTION,
 };
 pub use quality::{min_dihedral, quality, Quality, BINS};
 pub use split::{check_split, split_nodes, SplitMesh, SplitSummary};

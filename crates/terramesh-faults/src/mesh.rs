@@ -136,6 +136,8 @@ pub struct FaultedMesh {
     pub units: usize,
     /// What the construction did.
     pub report: BuildReport,
+    /// The engineering objects' labels of every cell (empty objects: all 0).
+    pub objects: crate::ObjectCells,
 }
 
 pub(crate) struct State {
@@ -350,7 +352,7 @@ pub(crate) fn positive(p: [[f64; 3]; 4]) -> bool {
     orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3])) < 0.0
 }
 
-fn key(a: u32, b: u32) -> u64 {
+pub(crate) fn key(a: u32, b: u32) -> u64 {
     (a.min(b) as u64) << 32 | a.max(b) as u64
 }
 
@@ -506,7 +508,7 @@ fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> 
 
 /// Splits `t` at every edge in `keys` (sorted), the lowest key first, as splitting those
 /// edges one after another through the whole mesh would: neighbours agree.
-fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
+pub(crate) fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
     let mut best: Option<(usize, usize, usize)> = None;
     for &(i, j) in &EDGES {
         if let Ok(pos) = keys.binary_search(&key(t[i], t[j])) {
@@ -780,6 +782,30 @@ pub fn faulted_mesh(
     height: InterfaceFn,
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
+    faulted_mesh_with_objects(
+        terrain,
+        faults,
+        interfaces,
+        height,
+        settings,
+        &crate::ObjectSet::default(),
+    )
+}
+
+/// [`faulted_mesh`] with engineering objects (tunnels, excavations, structures) cut in after
+/// the faults, the interfaces and the quality pass (see [`crate::ObjectSet`]).
+///
+/// # Errors
+/// As [`faulted_mesh`], and [`FaultError::Object`] for an object no part of which lies in the
+/// model.
+pub fn faulted_mesh_with_objects(
+    terrain: &Terrain,
+    faults: &FaultSet,
+    interfaces: usize,
+    height: InterfaceFn,
+    settings: &MeshSettings,
+    objects: &crate::ObjectSet,
+) -> Result<FaultedMesh, FaultError> {
     let dsm_vertices = terrain.points.len();
     let refined = crate::refine::refine(terrain, faults, interfaces, height, settings)?;
     let added = refined
@@ -915,6 +941,7 @@ pub fn faulted_mesh(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
+    let object_cells = crate::objects::cut_objects(&mut st, objects)?;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,
@@ -927,6 +954,7 @@ pub fn faulted_mesh(
         faults: faults.faults.iter().map(|f| f.name.clone()).collect(),
         units: interfaces + 1,
         report: st.report,
+        objects: object_cells,
     })
 }
 
