@@ -819,6 +819,7 @@ pub fn faulted_mesh_with_objects(
     // edges or inside its triangles) may be collapsed into another terrain node where the new
     // terrain faces still lie on the DSM.
     let background_nodes = dsm_vertices * (st.points.len() / terrain.points.len());
+    let object_cells = crate::objects::refine_near_objects(&mut st, objects)?;
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
         let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);
@@ -941,7 +942,7 @@ pub fn faulted_mesh_with_objects(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
-    let object_cells = crate::objects::cut_objects(&mut st, objects)?;
+    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells)?;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,

@@ -1315,21 +1315,29 @@ fn split_edges(st: &mut State, labels: &mut ObjectCells, keys: &[u64], points: V
             st.positive.push(st.positive[c]);
             st.below.push(st.below[c]);
             st.block.push(st.block[c]);
-            labels.object.push(labels.object[c]);
-            labels.lining.push(labels.lining[c]);
+            if !labels.object.is_empty() {
+                labels.object.push(labels.object[c]);
+                labels.lining.push(labels.lining[c]);
+            }
         }
     }
 }
 
-/// Refines near the objects, cuts every object's walls into the mesh and labels the cells
-/// (a cell in several objects takes the first in project order).
-pub(crate) fn cut_objects(st: &mut State, set: &ObjectSet) -> Result<ObjectCells, FaultError> {
-    let m = st.tets.len();
-    let mut labels = ObjectCells {
-        object: vec![0; m],
-        lining: vec![false; m],
-        ..ObjectCells::default()
-    };
+fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
+    set.objects
+        .iter()
+        .enumerate()
+        .flat_map(|(i, o)| o.walls().iter().map(move |&w| (i, w)))
+        .collect()
+}
+
+/// Refines the background mesh near the objects (before the faults and the interfaces are
+/// cut, so that their cuts land on the refined edges and every node they make lies on them).
+pub(crate) fn refine_near_objects(
+    st: &mut State,
+    set: &ObjectSet,
+) -> Result<ObjectCells, FaultError> {
+    let mut labels = ObjectCells::default();
     if set.objects.is_empty() {
         return Ok(labels);
     }
@@ -1340,13 +1348,8 @@ pub(crate) fn cut_objects(st: &mut State, set: &ObjectSet) -> Result<ObjectCells
             why: "must be a positive fraction of each object's size",
         });
     }
-    let walls: Vec<(usize, Wall)> = set
-        .objects
-        .iter()
-        .enumerate()
-        .flat_map(|(i, o)| o.walls().iter().map(move |&w| (i, w)))
-        .collect();
-    // 1. Refinement near the walls: bisect the longest edge of every cell near a wall whose
+    let walls = walls(set);
+    // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
         let values: Vec<Vec<f64>> = walls
@@ -1433,7 +1436,20 @@ pub(crate) fn cut_objects(st: &mut State, set: &ObjectSet) -> Result<ObjectCells
         labels.refined_edges += keys.len();
         split_edges(st, &mut labels, &keys, mids);
     }
-    // 2. Cut every wall, then label the cells inside it.
+    Ok(labels)
+}
+
+/// Cuts every object's walls into the mesh (after the faults, the interfaces and the quality
+/// pass) and labels the cells (a cell in several objects takes the first in project order);
+/// `labels` carries what [`refine_near_objects`] did.
+pub(crate) fn cut_objects(
+    st: &mut State,
+    set: &ObjectSet,
+    mut labels: ObjectCells,
+) -> Result<ObjectCells, FaultError> {
+    labels.object = vec![0; st.tets.len()];
+    labels.lining = vec![false; st.tets.len()];
+    let walls = walls(set);
     for &(i, w) in &walls {
         let o = &set.objects[i];
         let f = |q: [f64; 3]| o.field(w, q);
