@@ -105,6 +105,16 @@
 //! blocks' interface lines cross on a fault face after the last round
 //! ([`BuildReport::unresolved`]; [`check`] refuses a cell that straddles one).
 //!
+//! # Engineering objects ([`ObjectSet`], [`faulted_mesh_with_objects`], [`check_objects`])
+//! Tunnels (a profile swept along a mitred polyline axis, with an optional lining),
+//! excavations (faces descending from an outline on the terrain at a face angle to a floor)
+//! and closed triangulated structures, each read through an implicit field negative inside:
+//! the mesh is refined near them right after the background mesh (edges whose midpoint's field
+//! strays from the mean of its ends' by more than [`ObjectSet::resolution`] x the object's
+//! size are bisected), and after the quality pass every wall cuts the mesh as a fault does;
+//! cells are labelled by object and lining ([`ObjectCells`]). See `docs/geology.md`,
+//! "Engineering structures".
+//!
 //! [`split_nodes`] duplicates the nodes on the faults (one copy per side) and
 //! [`check_split`] verifies that every fault face then appears twice. [`Site`] builds a
 //! synthetic site with a known truth.

@@ -942,7 +942,13 @@ pub fn faulted_mesh_with_objects(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
-    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells)?;
+    let surfaces = crate::objects::Surfaces {
+        faults,
+        blocks: &blocks,
+        height,
+        interfaces,
+    };
+    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,

@@ -18,8 +18,8 @@
 use rayon::prelude::*;
 use robust::{orient2d, orient3d, Coord, Coord3D};
 
-use crate::mesh::{centroid, key, split_tet, State, BASE, EDGES, SIDE, TOP};
-use crate::{FaultError, Terrain, ON_SURFACE};
+use crate::mesh::{centroid, key, split_tet, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
+use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
 
 /// The default of [`ObjectSet::resolution`] (`geology.structure_resolution`): how far the
 /// facets may stray from an object's exact boundary, as a fraction of the object's size (a
@@ -1323,6 +1323,48 @@ fn split_edges(st: &mut State, labels: &mut ObjectCells, keys: &[u64], points: V
     }
 }
 
+/// The faults and interfaces already cut: a node that an object's wall puts on an edge of a
+/// fault's or an interface's face is moved from the face's chord onto the curved surface.
+pub(crate) struct Surfaces<'a> {
+    pub(crate) faults: &'a FaultSet,
+    pub(crate) blocks: &'a [BlockKey],
+    pub(crate) height: InterfaceFn<'a>,
+    pub(crate) interfaces: usize,
+}
+
+impl Surfaces<'_> {
+    /// `p` on edge ab (cell block `block`) moved onto the fault or interface that both a and
+    /// b lie on, if any (a fault: along its normal, not on the region's boundary; an
+    /// interface: vertically, not on the terrain or the base).
+    fn onto(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3]) -> [f64; 3] {
+        let (qa, qb) = (st.points[a], st.points[b]);
+        let both = st.flags[a] & st.flags[b];
+        let common = st.on_fault[a] & st.on_fault[b];
+        if common != 0 && both & (TOP | BASE | SIDE) == 0 {
+            for (f, fault) in self.faults.faults.iter().enumerate() {
+                if common >> f & 1 == 1
+                    && fault.side(qa).distance.abs() <= ON_SURFACE
+                    && fault.side(qb).distance.abs() <= ON_SURFACE
+                {
+                    let s = fault.side(p);
+                    return [0, 1, 2].map(|k| p[k] - s.distance * s.normal[k]);
+                }
+            }
+        }
+        if both & ON_INTERFACE != 0 && both & (TOP | BASE) == 0 {
+            let key = self.blocks[block as usize];
+            for k in 0..self.interfaces {
+                let h = |q: [f64; 3]| (self.height)(k, key, [q[0], q[1]]);
+                if (qa[2] - h(qa)).abs() <= ON_SURFACE && (qb[2] - h(qb)).abs() <= ON_SURFACE {
+                    let z = h(p);
+                    return if z.is_finite() { [p[0], p[1], z] } else { p };
+                }
+            }
+        }
+        p
+    }
+}
+
 fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
     set.objects
         .iter()
@@ -1446,6 +1488,7 @@ pub(crate) fn cut_objects(
     st: &mut State,
     set: &ObjectSet,
     mut labels: ObjectCells,
+    surfaces: &Surfaces,
 ) -> Result<ObjectCells, FaultError> {
     labels.object = vec![0; st.tets.len()];
     labels.lining = vec![false; st.tets.len()];
@@ -1479,17 +1522,62 @@ pub(crate) fn cut_objects(
             .collect();
         keys.par_sort_unstable();
         keys.dedup();
-        let pts: Vec<[f64; 3]> = keys
+        // The block of a cell around each edge (for the interfaces' heights).
+        let mut edge_block: Vec<(u64, u32)> = st
+            .tets
+            .par_iter()
+            .zip(&st.block)
+            .flat_map_iter(|(t, &b)| {
+                let values = &values;
+                EDGES
+                    .iter()
+                    .filter(move |&&(i, j)| values[t[i] as usize].1 * values[t[j] as usize].1 < 0)
+                    .map(move |&(i, j)| (key(t[i], t[j]), b))
+            })
+            .collect();
+        edge_block.par_sort_unstable();
+        edge_block.dedup_by_key(|e| e.0);
+        let chords: Vec<[f64; 3]> = keys
             .par_iter()
             .map(|&k| {
                 let (a, b) = ((k >> 32) as usize, k as u32 as usize);
                 crossing(&f, st.points[a], st.points[b], values[a].0, values[b].0)
             })
             .collect();
+        let pts: Vec<[f64; 3]> = keys
+            .par_iter()
+            .zip(&chords)
+            .zip(&edge_block)
+            .map(|((&k, &p), &(_, block))| {
+                surfaces.onto(st, (k >> 32) as usize, k as u32 as usize, block, p)
+            })
+            .collect();
         labels.split_edges += keys.len();
         let mut values = values;
         values.resize(st.points.len() + keys.len(), (0.0, 0));
+        let first = st.points.len();
         split_edges(st, &mut labels, &keys, pts);
+        // Where a node moved onto a curved interface or fault inverts a cell, it goes back
+        // to the chord.
+        for _ in 0..8 {
+            let bad: Vec<u32> = st
+                .tets
+                .par_iter()
+                .filter(|t| !crate::mesh::positive(t.map(|v| st.points[v as usize])))
+                .flat_map_iter(|t| t.iter().copied().filter(|&v| v as usize >= first))
+                .collect();
+            let mut reverted = 0;
+            for v in bad {
+                let c = chords[v as usize - first];
+                if st.points[v as usize] != c {
+                    st.points[v as usize] = c;
+                    reverted += 1;
+                }
+            }
+            if reverted == 0 {
+                break;
+            }
+        }
         let inside: Vec<bool> = st
             .tets
             .par_iter()
