@@ -33,6 +33,7 @@ pub mod grid_write;
 pub mod model;
 pub mod number;
 mod numtext;
+pub mod objects;
 pub mod output;
 pub mod quote;
 pub mod region;

@@ -15,8 +15,7 @@ use std::path::Path;
 use serde::Serialize;
 use terramesh_crs::{Crs, Transformer};
 use terramesh_faults::{
-    check as check_mesh, faulted_mesh, split_nodes, BlockKey, FaultSet, FaultSpec, MeshSettings,
-    Terrain,
+    check as check_mesh, split_nodes, BlockKey, FaultSet, FaultSpec, MeshSettings, Terrain,
 };
 use terramesh_io::boreholes::{Boreholes, ContactKind, LogFile};
 use terramesh_io::faults::{read_picks, read_points, read_surface, read_trace, FaultPick};
@@ -772,7 +771,7 @@ pub fn build_mesh(
 ) -> Result<Faulted> {
     let settings = MeshSettings::new(base, g.max_cell_height);
     let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
-    let mesh = faulted_mesh(terrain, set, g.units.len() - 1, &h, &settings).map_err(fault_error)?;
+    let mesh = super::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
     let check = check_mesh(&mesh, terrain, set, &settings, &h).map_err(|e| {
         Error::invalid(format!(
             "[[geology.faults]]: the faulted mesh failed its checks ({e}; {} cells left \
@@ -1202,6 +1201,27 @@ pub(crate) fn run(
         }
     }
     summary.faulted = Some(summarise(g, &faulted, &ifs, &set, &picks));
+    summary.objects = super::objects::finish(
+        g,
+        &faulted.mesh,
+        &terrain,
+        base,
+        &|q| {
+            super::objects::unit_at(
+                q,
+                &terrain,
+                &set,
+                n - 1,
+                &|k, key, p| ifs.height(k, key, p),
+                base,
+            )
+        },
+        &summary
+            .faulted
+            .as_ref()
+            .map(|f| f.blocks.iter().map(|b| b.name.clone()).collect::<Vec<_>>())
+            .unwrap_or_default(),
+    )?;
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&summary)?;
     let mut o = terramesh_io::output::Output::create(Some(&path))?;

@@ -9,6 +9,7 @@ pub mod faulted;
 pub mod faulted_mesh;
 pub mod fields;
 pub mod model;
+pub mod objects;
 pub mod report;
 pub mod section;
 pub mod stage;
