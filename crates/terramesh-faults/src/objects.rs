@@ -18,7 +18,9 @@
 use rayon::prelude::*;
 use robust::{orient2d, orient3d, Coord, Coord3D};
 
-use crate::mesh::{centroid, key, split_tet, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
+use crate::mesh::{
+    centroid, key, split_tet, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
+};
 use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
 
 /// The default of [`ObjectSet::resolution`] (`geology.structure_resolution`): how far the
@@ -32,6 +34,8 @@ use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
 pub const STRUCTURE_RESOLUTION: f64 = 0.008;
 /// The default of [`ObjectSet::max_cells`].
 pub const OBJECT_MAX_CELLS: usize = 4_000_000;
+/// A node within this distance of an object's wall (metres, by its field) lies on it.
+pub const ON_WALL: f64 = 1e-3;
 /// The checks of [`check_objects`] allow the larger of this distance (metres) and 4 times an
 /// object's facet tolerance (`resolution` times its size, the refinement's shortest edge).
 pub const OBJECT_TOLERANCE: f64 = 0.01;
@@ -1334,9 +1338,19 @@ pub(crate) struct Surfaces<'a> {
 
 impl Surfaces<'_> {
     /// `p` on edge ab (cell block `block`) moved onto the fault or interface that both a and
-    /// b lie on, if any (a fault: along its normal, not on the region's boundary; an
-    /// interface: vertically, not on the terrain or the base).
-    fn onto(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3]) -> [f64; 3] {
+    /// b lie on, if any and if that moves it at most `most` (a fault: along its normal, not on
+    /// the region's boundary; an interface: vertically, not on the terrain or the base).
+    fn onto(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3], most: f64) -> [f64; 3] {
+        let q = self.project(st, a, b, block, p);
+        let d = norm(sub(q, p));
+        if d <= most {
+            q
+        } else {
+            p
+        }
+    }
+
+    fn project(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3]) -> [f64; 3] {
         let (qa, qb) = (st.points[a], st.points[b]);
         let both = st.flags[a] & st.flags[b];
         let common = st.on_fault[a] & st.on_fault[b];
@@ -1505,7 +1519,15 @@ pub(crate) fn cut_objects(
                 if (0..3).any(|k| q[k] < lo[k] - margin || q[k] > hi[k] + margin) {
                     (1.0, 1)
                 } else {
-                    eval(f(q))
+                    // A node within a millimetre of the wall lies on it: a split that close
+                    // to an edge's end would leave a cell too thin for its volume to be
+                    // computed in floating point.
+                    let v = f(q);
+                    if v.abs() <= ON_WALL {
+                        (0.0, 0)
+                    } else {
+                        eval(v)
+                    }
                 }
             })
             .collect();
@@ -1537,6 +1559,10 @@ pub(crate) fn cut_objects(
             .collect();
         edge_block.par_sort_unstable();
         edge_block.dedup_by_key(|e| e.0);
+        // A move onto a fault or an interface may take the node this far off the wall (half
+        // the tolerance of check_objects); a farther one (an edge between two nodes of the
+        // surface that is not on its faces) keeps the chord.
+        let most = 0.5 * OBJECT_TOLERANCE.max(4.0 * set.resolution * o.size);
         let chords: Vec<[f64; 3]> = keys
             .par_iter()
             .map(|&k| {
@@ -1549,7 +1575,7 @@ pub(crate) fn cut_objects(
             .zip(&chords)
             .zip(&edge_block)
             .map(|((&k, &p), &(_, block))| {
-                surfaces.onto(st, (k >> 32) as usize, k as u32 as usize, block, p)
+                surfaces.onto(st, (k >> 32) as usize, k as u32 as usize, block, p, most)
             })
             .collect();
         labels.split_edges += keys.len();
@@ -1563,7 +1589,13 @@ pub(crate) fn cut_objects(
             let bad: Vec<u32> = st
                 .tets
                 .par_iter()
-                .filter(|t| !crate::mesh::positive(t.map(|v| st.points[v as usize])))
+                .filter(|t| {
+                    let q = t.map(|v| st.points[v as usize]);
+                    // Exactly positive, and positive in floating point too (the writers
+                    // compute volumes in floating point).
+                    !crate::mesh::positive(q)
+                        || terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3]) <= 0.0
+                })
                 .flat_map_iter(|t| t.iter().copied().filter(|&v| v as usize >= first))
                 .collect();
             let mut reverted = 0;
@@ -1713,11 +1745,12 @@ pub fn check_objects(
                 let cen = centroid(points, t);
                 let fc = f(cen);
                 if straddles {
-                    Some((c, cen, "has nodes on both sides of"))
+                    let (lo, hi) = v.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+                    Some((c, cen, format!("has nodes on both sides (field {lo:.3} to {hi:.3} m, tolerance {tol:.3}) of")))
                 } else if label_in && fc > tol {
-                    Some((c, cen, "is labelled inside but lies outside"))
+                    Some((c, cen, "is labelled inside but lies outside".to_string()))
                 } else if !label_in && cells.object[c] == 0 && fc < -tol {
-                    Some((c, cen, "is labelled outside but lies inside"))
+                    Some((c, cen, "is labelled outside but lies inside".to_string()))
                 } else {
                     None
                 }
