@@ -15,6 +15,8 @@
 //! Splitting an edge at a point of the edge changes no face's geometry, so the terrain, the
 //! faults and the interfaces keep every face they had.
 
+#![allow(clippy::needless_range_loop)] // coordinates indexed by axis across several arrays
+
 use rayon::prelude::*;
 use robust::{orient2d, orient3d, Coord, Coord3D};
 
@@ -208,8 +210,9 @@ pub struct Object {
     pub stage: u32,
     /// Whether it has a lining (a tunnel with `lining > 0`).
     pub has_lining: bool,
-    /// Its exact volume inside the model (see [`Object::exact_volumes`]), m³, and its
-    /// lining's (0 without one).
+    /// Its exact volume inside the model, m³, and its lining's (0 without one): a tunnel's
+    /// profile area times its axis length, a structure's enclosed volume, or (an excavation,
+    /// or an object that crosses the terrain) a column quadrature ([`Object::exact_method`]).
     pub exact: [f64; 2],
     /// How the exact volume was found.
     pub exact_method: &'static str,
