@@ -136,6 +136,19 @@ pub enum FaultError {
         /// The fault it should end at.
         other: String,
     },
+    /// An engineering object (a tunnel, an excavation or a structure) is invalid: `key` is
+    /// the input that is wrong (`axis`, `diameter`, `outline`, `solid`, ...).
+    #[error("{kind} {name}: {key}: {why}")]
+    Object {
+        /// `tunnel`, `excavation` or `structure`.
+        kind: &'static str,
+        /// The object's name.
+        name: String,
+        /// The key whose value is wrong.
+        key: &'static str,
+        /// What is wrong and what to do.
+        why: String,
+    },
     /// A check of the volume mesh failed.
     #[error("check failed: {what} near ({x}, {y}, {z})")]
     Check {

@@ -107,6 +107,16 @@
 //! blocks' interface lines cross on a fault face after the last round
 //! ([`BuildReport::unresolved`]; [`check`] refuses a cell that straddles one).
 //!
+//! # Engineering objects ([`ObjectSet`], [`faulted_mesh_with_objects`], [`check_objects`])
+//! Tunnels (a profile swept along a mitred polyline axis, with an optional lining),
+//! excavations (faces descending from an outline on the terrain at a face angle to a floor)
+//! and closed triangulated structures, each read through an implicit field negative inside:
+//! the mesh is refined near them right after the background mesh (edges whose midpoint's field
+//! strays from the mean of its ends' by more than [`ObjectSet::resolution`] x the object's
+//! size are bisected), and after the quality pass every wall cuts the mesh as a fault does;
+//! cells are labelled by object and lining ([`ObjectCells`]). See `docs/geology.md`,
+//! "Engineering structures".
+//!
 //! [`split_nodes`] duplicates the nodes on the faults (one copy per side) and
 //! [`check_split`] verifies that every fault face then appears twice. [`Site`] builds a
 //! synthetic site with a known truth.
@@ -122,6 +132,8 @@ mod fault;
 mod improve;
 /// The conformal volume mesh.
 mod mesh;
+/// Engineering objects: tunnels, excavations and structures cut into the mesh.
+mod objects;
 /// Dihedral angles.
 mod quality;
 /// Local refinement of the planar mesh where slabs are thin.
@@ -137,7 +149,12 @@ pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
 pub use error::FaultError;
 pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG_TRACE_DEGREES};
 pub use mesh::{
-    faulted_mesh, BuildReport, FaultFace, FaultedMesh, InterfaceFn, MeshSettings, ON_SURFACE,
+    faulted_mesh, faulted_mesh_with_objects, BuildReport, FaultFace, FaultedMesh, InterfaceFn,
+    MeshSettings, ON_SURFACE,
+};
+pub use objects::{
+    check_objects, Object, ObjectCells, ObjectCheck, ObjectGeometry, ObjectSet, ObjectSpec,
+    Profile, Wall, OBJECT_MAX_CELLS, OBJECT_TOLERANCE, STRUCTURE_RESOLUTION,
 };
 pub use quality::{min_dihedral, quality, Quality, BINS};
 pub use split::{check_split, split_nodes, SplitMesh, SplitSummary};

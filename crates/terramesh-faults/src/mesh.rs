@@ -136,6 +136,8 @@ pub struct FaultedMesh {
     pub units: usize,
     /// What the construction did.
     pub report: BuildReport,
+    /// The engineering objects' labels of every cell (empty objects: all 0).
+    pub objects: crate::ObjectCells,
 }
 
 pub(crate) struct State {
@@ -353,7 +355,7 @@ pub(crate) fn positive(p: [[f64; 3]; 4]) -> bool {
         && terramesh_core::volume::tetra_volume(p[0], p[1], p[2], p[3]) > 0.0
 }
 
-fn key(a: u32, b: u32) -> u64 {
+pub(crate) fn key(a: u32, b: u32) -> u64 {
     (a.min(b) as u64) << 32 | a.max(b) as u64
 }
 
@@ -509,7 +511,7 @@ fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> 
 
 /// Splits `t` at every edge in `keys` (sorted), the lowest key first, as splitting those
 /// edges one after another through the whole mesh would: neighbours agree.
-fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
+pub(crate) fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
     let mut best: Option<(usize, usize, usize)> = None;
     for &(i, j) in &EDGES {
         if let Ok(pos) = keys.binary_search(&key(t[i], t[j])) {
@@ -783,6 +785,30 @@ pub fn faulted_mesh(
     height: InterfaceFn,
     settings: &MeshSettings,
 ) -> Result<FaultedMesh, FaultError> {
+    faulted_mesh_with_objects(
+        terrain,
+        faults,
+        interfaces,
+        height,
+        settings,
+        &crate::ObjectSet::default(),
+    )
+}
+
+/// [`faulted_mesh`] with engineering objects (tunnels, excavations, structures) cut in after
+/// the faults, the interfaces and the quality pass (see [`crate::ObjectSet`]).
+///
+/// # Errors
+/// As [`faulted_mesh`], and [`FaultError::Object`] for an object no part of which lies in the
+/// model.
+pub fn faulted_mesh_with_objects(
+    terrain: &Terrain,
+    faults: &FaultSet,
+    interfaces: usize,
+    height: InterfaceFn,
+    settings: &MeshSettings,
+    objects: &crate::ObjectSet,
+) -> Result<FaultedMesh, FaultError> {
     let dsm_vertices = terrain.points.len();
     let refined = crate::refine::refine(terrain, faults, interfaces, height, settings)?;
     let added = refined
@@ -796,6 +822,7 @@ pub fn faulted_mesh(
     // edges or inside its triangles) may be collapsed into another terrain node where the new
     // terrain faces still lie on the DSM.
     let background_nodes = dsm_vertices * (st.points.len() / terrain.points.len());
+    let object_cells = crate::objects::refine_near_objects(&mut st, objects)?;
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
         let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);
@@ -925,6 +952,13 @@ pub fn faulted_mesh(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
+    let surfaces = crate::objects::Surfaces {
+        faults,
+        blocks: &blocks,
+        height,
+        interfaces,
+    };
+    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,
@@ -937,6 +971,7 @@ pub fn faulted_mesh(
         faults: faults.faults.iter().map(|f| f.name.clone()).collect(),
         units: interfaces + 1,
         report: st.report,
+        objects: object_cells,
     })
 }
 

@@ -34,6 +34,7 @@ pub mod grid_write;
 pub mod model;
 pub mod number;
 mod numtext;
+pub mod objects;
 pub mod output;
 pub mod quote;
 pub mod region;

@@ -8,6 +8,7 @@ pub mod ensemble_report;
 pub mod faulted;
 pub mod fields;
 pub mod model;
+pub mod objects;
 pub mod report;
 pub mod section;
 pub mod stage;

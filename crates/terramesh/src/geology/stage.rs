@@ -175,7 +175,7 @@ pub fn run(
     for u in &g.units {
         terramesh_core::names::check_name(u).context("geology.units")?;
     }
-    if !g.faults.is_empty() {
+    if !g.faults.is_empty() || !g.objects.is_empty() {
         return super::faulted::run(p, g, boreholes, mesh, dsm, grid, crs, out);
     }
     let epsg = crs.and_then(Crs::epsg);

@@ -109,6 +109,10 @@ pub struct ModelSummary {
     /// The faults and fault blocks of a faulted model (`[[geology.faults]]`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub faulted: Option<super::faulted::FaultedSummary>,
+    /// The engineering objects (`[[geology.tunnels]]`, `[[geology.excavations]]`,
+    /// `[[geology.structures]]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub objects: Option<super::objects::ObjectsSummary>,
 }
 
 impl ModelSummary {
@@ -172,6 +176,7 @@ impl ModelSummary {
             },
             realisations: None,
             faulted: None,
+            objects: None,
         }
     }
 }

@@ -135,6 +135,11 @@ pub struct GeologyPlan {
     pub split_faults: bool,
     /// The largest vertical cell size of a faulted model, metres.
     pub max_cell_height: f64,
+    /// The engineering objects (tunnels, excavations, structures) in project order.
+    pub objects: Vec<super::ObjectPlan>,
+    /// How far an object's facets may stray from its boundary, as a fraction of its size
+    /// (`geology.structure_resolution`).
+    pub structure_resolution: f64,
 }
 
 impl GeologyPlan {

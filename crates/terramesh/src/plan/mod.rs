@@ -15,6 +15,7 @@ mod export;
 mod geology;
 mod interpolation;
 mod mesh;
+mod objects;
 mod sample;
 
 pub use export::{ExportPlan, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
@@ -26,4 +27,5 @@ pub use interpolation::{
     Auto, InterpolationPlan, Numbers, VariogramSpec, DEFAULT_IDW_NEIGHBORS, DEFAULT_METHODS,
 };
 pub use mesh::{MeshPlan, DEFAULT_SMOOTH, MAX_STRIPS};
+pub use objects::{ObjectPlan, ObjectSource, Profile, DEFAULT_STRUCTURE_RESOLUTION};
 pub use sample::{SamplingPlan, DEFAULT_COLS, DEFAULT_MARGIN, DEFAULT_ROWS};

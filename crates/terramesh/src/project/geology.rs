@@ -86,6 +86,22 @@ pub struct GeologySection {
     /// The largest vertical size of a cell of a faulted model, metres.
     #[serde(default = "default_max_cell_height")]
     pub max_cell_height: f64,
+    /// `[[geology.tunnels]]` (issue 32).
+    #[serde(default)]
+    pub tunnels: Vec<super::TunnelSection>,
+    /// `[[geology.excavations]]` (issue 32).
+    #[serde(default)]
+    pub excavations: Vec<super::ExcavationSection>,
+    /// `[[geology.structures]]` (issue 32).
+    #[serde(default)]
+    pub structures: Vec<super::StructureSection>,
+    /// How far an object's facets may stray from its boundary, a fraction of its size.
+    #[serde(default = "default_structure_resolution")]
+    pub structure_resolution: f64,
+}
+
+fn default_structure_resolution() -> f64 {
+    crate::plan::DEFAULT_STRUCTURE_RESOLUTION
 }
 
 /// One `[[geology.faults]]` table as written.
@@ -271,6 +287,13 @@ impl GeologySection {
             }
         }
         self.validate_faults()?;
+        super::objects::validate(
+            &self.tunnels,
+            &self.excavations,
+            &self.structures,
+            self.structure_resolution,
+            self.element == Element::Tetra,
+        )?;
         match &self.base {
             BaseSpec::Elevation(b) if !(MIN_BASE_ELEVATION..=MAX_BASE_ELEVATION).contains(b) => {
                 bad(
@@ -352,6 +375,13 @@ impl GeologySection {
             fault_picks: self.fault_picks.as_ref().map(|p| base.join(p)),
             split_faults: self.split_faults,
             max_cell_height: self.max_cell_height,
+            objects: super::objects::lower(
+                &self.tunnels,
+                &self.excavations,
+                &self.structures,
+                base,
+            ),
+            structure_resolution: self.structure_resolution,
         }
     }
 
@@ -638,6 +668,7 @@ impl GeologyPlan {
                 }
             }
         }
+        crate::geology::objects::check_inputs(self)?;
         if let Some(p) = &self.fault_picks {
             readable("fault_picks", p)?;
             crate::geology::faulted::read_fault_picks(self, holes.as_ref())?;

@@ -8,12 +8,14 @@ mod crs;
 mod datum;
 mod geology;
 mod lower;
+mod objects;
 mod parse;
 
 pub use crs::ProjectCrs;
 pub use datum::{HeightDatum, KNOWN_VERTICAL_DATUMS};
 pub use geology::{BaseSpec, GeologySection, GEOLOGY_TEMPLATE};
 pub use lower::key_of;
+pub use objects::{ExcavationSection, StructureSection, TunnelSection};
 
 use std::path::PathBuf;
 

@@ -2,10 +2,9 @@
 //! request.
 
 use terramesh_faults::{
-    check as check_mesh, faulted_mesh, split_nodes, BlockKey, FaultSet, MeshSettings, Terrain,
+    check as check_mesh, split_nodes, BlockKey, FaultSet, MeshSettings, Terrain,
 };
 
-use super::inputs::fault_error;
 use super::interfaces::BlockInterfaces;
 use crate::error::{Error, Result};
 use crate::plan::GeologyPlan;
@@ -32,7 +31,7 @@ pub fn build_mesh(
 ) -> Result<Faulted> {
     let settings = MeshSettings::new(base, g.max_cell_height);
     let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
-    let mesh = faulted_mesh(terrain, set, g.units.len() - 1, &h, &settings).map_err(fault_error)?;
+    let mesh = crate::geology::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
     let check = check_mesh(&mesh, terrain, set, &settings, &h).map_err(|e| {
         Error::invalid(format!(
             "[[geology.faults]]: the faulted mesh failed its checks ({e}; {} cells left \

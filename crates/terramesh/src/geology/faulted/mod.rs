@@ -251,6 +251,27 @@ pub(crate) fn run(
         }
     }
     summary.faulted = Some(summarise(g, &faulted, &ifs, &set, &picks));
+    summary.objects = crate::geology::objects::finish(
+        g,
+        &faulted.mesh,
+        &terrain,
+        base,
+        &|q| {
+            crate::geology::objects::unit_at(
+                q,
+                &terrain,
+                &set,
+                n - 1,
+                &|k, key, p| ifs.height(k, key, p),
+                base,
+            )
+        },
+        &summary
+            .faulted
+            .as_ref()
+            .map(|f| f.blocks.iter().map(|b| b.name.clone()).collect::<Vec<_>>())
+            .unwrap_or_default(),
+    )?;
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&summary)?;
     let mut o = terramesh_io::output::Output::create(Some(&path))?;

@@ -1,0 +1,1850 @@
+//! Engineering objects cut into the faulted mesh: tunnels, excavations and structures
+//! (issue 32). Each object is a closed region given by exact geometry and read through an
+//! implicit field, negative inside: a tunnel's swept profile (circle, horseshoe or rectangle
+//! along a polyline axis, mitred at bends, capped flat at its ends) and, with a lining, a second
+//! field for the lining's outer wall; an excavation's faces descending from its outline on the
+//! terrain at `face_angle` down to its floor; a structure's closed triangulated surface (inside
+//! by exact ray parity, `robust::orient2d`/`orient3d` with a symbolic perturbation).
+//!
+//! After the faults, the interfaces and the quality pass, the mesh is refined near every
+//! object (the longest edge of every cell near a boundary is bisected, conformally, round
+//! after round, until no such edge is longer than `resolution` times the object's size), then
+//! every object's field cuts the mesh as a fault's does: every edge that crosses the boundary
+//! is split at its crossing (regula falsi on the field) and every cell at its split edges,
+//! the lowest edge first, so that the mesh stays conformal and no cell crosses the boundary.
+//! Splitting an edge at a point of the edge changes no face's geometry, so the terrain, the
+//! faults and the interfaces keep every face they had.
+
+#![allow(clippy::needless_range_loop)] // coordinates indexed by axis across several arrays
+
+use rayon::prelude::*;
+use robust::{orient2d, orient3d, Coord, Coord3D};
+
+use crate::mesh::{
+    centroid, key, split_tet, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
+};
+use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
+
+/// The default of [`ObjectSet::resolution`] (`geology.structure_resolution`): how far the
+/// facets may stray from an object's exact boundary, as a fraction of the object's size (a
+/// tunnel's radius, half its smaller profile dimension; an excavation's depth; a structure's
+/// smallest extent). The mesh is refined near the boundary until the field at the midpoint of
+/// every edge there (and at every cell's centroid) is within that of the mean of its ends', or
+/// the edge is shorter than 4 times it. A circle's facets then sag at most 0.008 r, so its
+/// area is short by at most about 4/3 of that, 1 % (0.2 to 0.3 % measured: most facets are
+/// shorter than the longest allowed).
+pub const STRUCTURE_RESOLUTION: f64 = 0.008;
+/// The default of [`ObjectSet::max_cells`].
+pub const OBJECT_MAX_CELLS: usize = 4_000_000;
+/// A node within this distance of an object's wall (metres, by its field) lies on it.
+pub const ON_WALL: f64 = 1e-3;
+/// The checks of [`check_objects`] allow the larger of this distance (metres) and 4 times an
+/// object's facet tolerance (`resolution` times its size, the refinement's shortest edge).
+pub const OBJECT_TOLERANCE: f64 = 0.01;
+
+/// A tunnel's cross-section, centred on its axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Profile {
+    /// A circle of this diameter.
+    Circle {
+        /// Metres.
+        diameter: f64,
+    },
+    /// A horseshoe: vertical walls and a flat invert, `width` wide, under a semicircular crown
+    /// of diameter `width`; `height` from invert to crown (at least `width / 2`).
+    Horseshoe {
+        /// Metres.
+        width: f64,
+        /// Metres.
+        height: f64,
+    },
+    /// A rectangle.
+    Rectangle {
+        /// Metres.
+        width: f64,
+        /// Metres.
+        height: f64,
+    },
+}
+
+impl Profile {
+    /// The profile's area, m².
+    pub fn area(&self) -> f64 {
+        match *self {
+            Profile::Circle { diameter } => std::f64::consts::PI * diameter * diameter / 4.0,
+            Profile::Horseshoe { width, height } => {
+                width * (height - width / 2.0) + std::f64::consts::PI * width * width / 8.0
+            }
+            Profile::Rectangle { width, height } => width * height,
+        }
+    }
+
+    /// The profile grown by `t` on every side.
+    fn grown(&self, t: f64) -> Profile {
+        match *self {
+            Profile::Circle { diameter } => Profile::Circle {
+                diameter: diameter + 2.0 * t,
+            },
+            Profile::Horseshoe { width, height } => Profile::Horseshoe {
+                width: width + 2.0 * t,
+                height: height + 2.0 * t,
+            },
+            Profile::Rectangle { width, height } => Profile::Rectangle {
+                width: width + 2.0 * t,
+                height: height + 2.0 * t,
+            },
+        }
+    }
+
+    /// Half the smaller dimension.
+    fn radius(&self) -> f64 {
+        match *self {
+            Profile::Circle { diameter } => diameter / 2.0,
+            Profile::Horseshoe { width, height } | Profile::Rectangle { width, height } => {
+                width.min(height) / 2.0
+            }
+        }
+    }
+
+    /// Half the larger dimension (a bound of the profile).
+    fn reach(&self) -> f64 {
+        match *self {
+            Profile::Circle { diameter } => diameter / 2.0,
+            Profile::Horseshoe { width, height } | Profile::Rectangle { width, height } => {
+                0.5 * (width * width + height * height).sqrt()
+            }
+        }
+    }
+
+    /// The signed distance (or a bound of it with the right sign) of the point `(a, b)` of the
+    /// profile's plane, `a` across, `b` up, from the profile.
+    fn sdf(&self, a: f64, b: f64) -> f64 {
+        fn rect(a: f64, b: f64, hw: f64, hh: f64) -> f64 {
+            let (dx, dy) = (a.abs() - hw, b.abs() - hh);
+            let (ox, oy) = (dx.max(0.0), dy.max(0.0));
+            (ox * ox + oy * oy).sqrt() + dx.max(dy).min(0.0)
+        }
+        match *self {
+            Profile::Circle { diameter } => (a * a + b * b).sqrt() - diameter / 2.0,
+            Profile::Rectangle { width, height } => rect(a, b, width / 2.0, height / 2.0),
+            Profile::Horseshoe { width, height } => {
+                // The bounding rectangle intersected with the vertical strip of the width
+                // capped by the crown's half circle (centred at c): an intersection of two
+                // fields, so the field has no false zero inside.
+                let c = height / 2.0 - width / 2.0;
+                let strip = if b > c {
+                    (a * a + (b - c) * (b - c)).sqrt() - width / 2.0
+                } else {
+                    a.abs() - width / 2.0
+                };
+                rect(a, b, width / 2.0, height / 2.0).max(strip)
+            }
+        }
+    }
+}
+
+/// The geometry of an object, in the model's coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ObjectGeometry {
+    /// A tunnel: its axis (the centre of the profile, a polyline of at least two points), its
+    /// profile and an optional lining thickness (0: none).
+    Tunnel {
+        /// The axis, x, y, z.
+        axis: Vec<[f64; 3]>,
+        /// The cross-section.
+        profile: Profile,
+        /// The lining's thickness, metres (0: no lining).
+        lining: f64,
+    },
+    /// An excavation: its outline at the surface (a simple polygon, either orientation, not
+    /// closed by a repeated point or closed, either way), its floor's elevation and its faces'
+    /// angle from horizontal (90: vertical walls).
+    Excavation {
+        /// The outline, x, y.
+        outline: Vec<[f64; 2]>,
+        /// The floor's elevation.
+        floor: f64,
+        /// Degrees from horizontal, in (0, 90].
+        face_angle: f64,
+    },
+    /// A structure: a closed triangulated surface (every edge in exactly two triangles, once
+    /// each way).
+    Structure {
+        /// The vertices.
+        vertices: Vec<[f64; 3]>,
+        /// The triangles (either orientation, consistently).
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// One object as given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjectSpec {
+    /// Its name.
+    pub name: String,
+    /// Its geometry.
+    pub geometry: ObjectGeometry,
+    /// Its excavation stage (1 = first; structures are never excavated and ignore it).
+    pub stage: u32,
+}
+
+impl ObjectSpec {
+    /// `tunnel`, `excavation` or `structure`.
+    pub fn kind(&self) -> &'static str {
+        match self.geometry {
+            ObjectGeometry::Tunnel { .. } => "tunnel",
+            ObjectGeometry::Excavation { .. } => "excavation",
+            ObjectGeometry::Structure { .. } => "structure",
+        }
+    }
+}
+
+/// A validated object with what its field needs.
+#[derive(Debug, Clone)]
+pub struct Object {
+    /// Its name.
+    pub name: String,
+    /// `tunnel`, `excavation` or `structure`.
+    pub kind: &'static str,
+    /// Its excavation stage: 0 for a structure.
+    pub stage: u32,
+    /// Whether it has a lining (a tunnel with `lining > 0`).
+    pub has_lining: bool,
+    /// Its exact volume inside the model, m³, and its lining's (0 without one): a tunnel's
+    /// profile area times its axis length, a structure's enclosed volume, or (an excavation,
+    /// or an object that crosses the terrain) a column quadrature ([`Object::exact_method`]).
+    pub exact: [f64; 2],
+    /// How the exact volume was found.
+    pub exact_method: &'static str,
+    size: f64,
+    bbox: [[f64; 3]; 2],
+    shape: Shape,
+}
+
+#[derive(Debug, Clone)]
+enum Shape {
+    Tunnel {
+        pieces: Vec<Piece>,
+        profile: Profile,
+        outer: Option<Profile>,
+        length: f64,
+    },
+    Excavation {
+        outline: Vec<[f64; 2]>,
+        /// The terrain at the outline's vertices.
+        tops: Vec<f64>,
+        floor: f64,
+        sin: f64,
+        cos: f64,
+    },
+    Structure {
+        vertices: Vec<[f64; 3]>,
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// One straight piece of a tunnel: from `a` along `t` for `len`, its frame across (`n`,
+/// horizontal) and up (`u`), and the normals of the planes that end it (mitres at bends).
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    a: [f64; 3],
+    b: [f64; 3],
+    n: [f64; 3],
+    u: [f64; 3],
+    start: [f64; 3],
+    end: [f64; 3],
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let l = norm(a);
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+/// Which wall of an object: the object's own boundary, or its lining's outer wall.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wall {
+    /// The object's boundary (a tunnel's excavated profile).
+    Inner,
+    /// The lining's outer wall.
+    Outer,
+}
+
+impl Object {
+    /// The field of a wall at `q`: negative inside, zero on the boundary, about the distance
+    /// to it (a lower or an upper bound near edges and corners, with the right sign).
+    pub fn field(&self, wall: Wall, q: [f64; 3]) -> f64 {
+        match &self.shape {
+            Shape::Tunnel {
+                pieces,
+                profile,
+                outer,
+                ..
+            } => {
+                let prof = match (wall, outer) {
+                    (Wall::Outer, Some(o)) => o,
+                    _ => profile,
+                };
+                // The piece whose mitre planes enclose q (the first, else the piece of the
+                // nearest axis segment): a union of pieces by the min of their fields would
+                // read near zero on every mitre plane inside the tunnel.
+                let last = pieces.len() - 1;
+                let k = pieces
+                    .iter()
+                    .enumerate()
+                    .position(|(k, p)| {
+                        (k == 0 || dot(sub(q, p.a), p.start) >= 0.0)
+                            && (k == last || dot(sub(q, p.b), p.end) < 0.0)
+                    })
+                    .unwrap_or_else(|| {
+                        let d = |p: &Piece| {
+                            let e = sub(p.b, p.a);
+                            let t = (dot(sub(q, p.a), e) / dot(e, e)).clamp(0.0, 1.0);
+                            norm(sub(
+                                q,
+                                [p.a[0] + t * e[0], p.a[1] + t * e[1], p.a[2] + t * e[2]],
+                            ))
+                        };
+                        (0..pieces.len())
+                            .min_by(|&x, &y| d(&pieces[x]).total_cmp(&d(&pieces[y])))
+                            .unwrap()
+                    });
+                let p = &pieces[k];
+                let d = sub(q, p.a);
+                let mut f = prof.sdf(dot(d, p.n), dot(d, p.u));
+                if k == 0 {
+                    f = f.max(-dot(d, p.start));
+                }
+                if k == last {
+                    f = f.max(dot(sub(q, p.b), p.end));
+                }
+                f
+            }
+            Shape::Excavation {
+                outline,
+                tops,
+                floor,
+                sin,
+                cos,
+            } => {
+                let p = [q[0], q[1]];
+                let n = outline.len();
+                let mut inside = false;
+                let mut f = floor - q[2];
+                let mut nearest = (f64::INFINITY, 0.0);
+                for i in 0..n {
+                    let (a, b) = (outline[i], outline[(i + 1) % n]);
+                    if (a[1] > p[1]) != (b[1] > p[1])
+                        && p[0] < a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+                    {
+                        inside = !inside;
+                    }
+                    let e = [b[0] - a[0], b[1] - a[1]];
+                    let t = (((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1])
+                        / (e[0] * e[0] + e[1] * e[1]))
+                        .clamp(0.0, 1.0);
+                    let c = [a[0] + t * e[0] - p[0], a[1] + t * e[1] - p[1]];
+                    let d = (c[0] * c[0] + c[1] * c[1]).sqrt();
+                    let h = tops[i] + t * (tops[(i + 1) % n] - tops[i]);
+                    f = f.max((h - q[2]) * cos - d * sin);
+                    if d < nearest.0 {
+                        nearest = (d, h);
+                    }
+                }
+                if inside {
+                    f
+                } else {
+                    nearest.0 * sin + (nearest.1 - q[2]).max(0.0) * cos + nearest.0.min(1e-3)
+                }
+            }
+            Shape::Structure {
+                vertices,
+                triangles,
+            } => {
+                let [lo, hi] = self.bbox;
+                // Far from the bounding box its distance stands in for the distance (a
+                // lower bound, cheap).
+                let margin = 2.0 * self.size + 50.0;
+                let out = [0, 1, 2].map(|k| (lo[k] - q[k]).max(q[k] - hi[k]).max(0.0));
+                if norm(out) > margin {
+                    return norm(out);
+                }
+                let mut d2 = f64::INFINITY;
+                for t in triangles {
+                    let tri = t.map(|v| vertices[v as usize]);
+                    d2 = d2.min(point_triangle_d2(q, tri));
+                }
+                match parity(q, vertices, triangles) {
+                    Some(true) => -d2.sqrt(),
+                    Some(false) => d2.sqrt(),
+                    None => 0.0,
+                }
+            }
+        }
+    }
+
+    /// The size that `resolution` multiplies: a tunnel's radius (half its smaller profile
+    /// dimension), an excavation's depth, a structure's smallest extent.
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// A tunnel's axis length, metres (`None` for other objects).
+    pub fn axis_length(&self) -> Option<f64> {
+        match self.shape {
+            Shape::Tunnel { length, .. } => Some(length),
+            _ => None,
+        }
+    }
+
+    /// The walls this object has.
+    pub fn walls(&self) -> &'static [Wall] {
+        if self.has_lining {
+            &[Wall::Inner, Wall::Outer]
+        } else {
+            &[Wall::Inner]
+        }
+    }
+}
+
+/// The squared distance from `p` to a triangle (Ericson, *Real-Time Collision Detection*, 5.1.5).
+fn point_triangle_d2(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let at = |v: f64, w: f64| {
+        let q = [
+            a[0] + v * ab[0] + w * ac[0],
+            a[1] + v * ab[1] + w * ac[1],
+            a[2] + v * ab[2] + w * ac[2],
+        ];
+        let d = sub(p, q);
+        dot(d, d)
+    };
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return dot(ap, ap);
+    }
+    let bp = sub(p, b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return dot(bp, bp);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return at(d1 / (d1 - d3), 0.0);
+    }
+    let cp = sub(p, c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return dot(cp, cp);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return at(0.0, d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return at(1.0 - w, w);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    at(vb * denom, vc * denom)
+}
+
+fn c2(p: [f64; 3]) -> Coord<f64> {
+    Coord { x: p[0], y: p[1] }
+}
+fn c3(p: [f64; 3]) -> Coord3D<f64> {
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
+}
+
+/// The side of `q` of the directed plan edge u -> v, exact, with `q` perturbed by
+/// (ε, ε²) so that it is never 0 (simulation of simplicity): positive to the left.
+fn side_sos(u: [f64; 3], v: [f64; 3], q: [f64; 3]) -> f64 {
+    let o = orient2d(c2(u), c2(v), c2(q));
+    if o != 0.0 {
+        return o;
+    }
+    if v[1] != u[1] {
+        -(v[1] - u[1])
+    } else {
+        v[0] - u[0]
+    }
+}
+
+/// Whether the vertical ray up from `q` crosses the triangle (exact): `None` if `q` lies on it.
+fn ray_crosses(q: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> Option<bool> {
+    let o = orient2d(c2(a), c2(b), c2(c));
+    if o == 0.0 {
+        // A vertical triangle: the perturbed ray misses it; q may still lie on it.
+        return Some(false);
+    }
+    let (b, c) = if o > 0.0 { (b, c) } else { (c, b) };
+    if side_sos(a, b, q) < 0.0 || side_sos(b, c, q) < 0.0 || side_sos(c, a, q) < 0.0 {
+        return Some(false);
+    }
+    let s = orient3d(c3(a), c3(b), c3(c), c3(q));
+    if s == 0.0 {
+        None
+    } else {
+        Some(s > 0.0)
+    }
+}
+
+/// Inside a closed surface by the parity of the vertical ray's crossings (exact); `None` on it.
+fn parity(q: [f64; 3], vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Option<bool> {
+    let mut inside = false;
+    for t in triangles {
+        let tri = t.map(|v| vertices[v as usize]);
+        if tri.iter().all(|p| p[2] < q[2]) {
+            continue;
+        }
+        if ray_crosses(q, tri)? {
+            inside = !inside;
+        }
+    }
+    Some(inside)
+}
+
+/// The objects of a model, validated, in project order (object `i` is numbered `i + 1`).
+#[derive(Debug, Clone, Default)]
+pub struct ObjectSet {
+    /// The objects.
+    pub objects: Vec<Object>,
+    /// How far the facets may stray from an object's boundary, as a fraction of its size
+    /// ([`Object::size`]); default [`STRUCTURE_RESOLUTION`] (`geology.structure_resolution`).
+    pub resolution: f64,
+    /// Refinement near objects stops before the mesh would pass this many cells (default
+    /// [`OBJECT_MAX_CELLS`]).
+    pub max_cells: usize,
+}
+
+fn err(spec: &ObjectSpec, key: &'static str, why: impl Into<String>) -> FaultError {
+    FaultError::Object {
+        kind: spec.kind(),
+        name: spec.name.clone(),
+        key,
+        why: why.into(),
+    }
+}
+
+fn finite3(p: &[[f64; 3]]) -> Option<usize> {
+    p.iter().position(|q| q.iter().any(|v| !v.is_finite()))
+}
+
+/// Whether plan segments ab and cd intersect (touching included), exact.
+fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let o = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        orient2d(
+            Coord { x: p[0], y: p[1] },
+            Coord { x: q[0], y: q[1] },
+            Coord { x: r[0], y: r[1] },
+        )
+    };
+    let on = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    let (d1, d2, d3, d4) = (o(c, d, a), o(c, d, b), o(a, b, c), o(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on(c, d, a))
+        || (d2 == 0.0 && on(c, d, b))
+        || (d3 == 0.0 && on(a, b, c))
+        || (d4 == 0.0 && on(a, b, d))
+}
+
+impl ObjectSet {
+    /// Validates the objects against the region (the terrain's plan and the base) and computes
+    /// their exact volumes inside the model.
+    ///
+    /// ```
+    /// use terramesh_faults::{ObjectGeometry, ObjectSet, ObjectSpec, Profile, Terrain};
+    /// let t = Terrain::new(vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]],
+    ///     vec![[0, 1, 2], [0, 2, 3]], vec![100.0; 4])?;
+    /// let tunnel = ObjectSpec { name: "T".into(), stage: 1, geometry: ObjectGeometry::Tunnel {
+    ///     axis: vec![[10.0, 50.0, 50.0], [90.0, 50.0, 50.0]],
+    ///     profile: Profile::Circle { diameter: 10.0 }, lining: 0.0 } };
+    /// let set = ObjectSet::new(&[tunnel], &t, 0.0)?;
+    /// let exact = std::f64::consts::PI * 25.0 * 80.0;
+    /// assert!((set.objects[0].exact[0] - exact).abs() < 1e-9 * exact);
+    /// # Ok::<(), terramesh_faults::FaultError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`FaultError::Object`] naming the object and the key: an axis with fewer than two
+    /// distinct points or a vertical segment, a profile dimension or lining that is not a
+    /// positive number, an outline with fewer than three points or that intersects itself, a
+    /// floor above the terrain everywhere in the outline, a face angle outside (0, 90], a
+    /// solid that is not closed, an object wholly outside the region, two objects of one name.
+    pub fn new(
+        specs: &[ObjectSpec],
+        terrain: &Terrain,
+        base: f64,
+    ) -> Result<ObjectSet, FaultError> {
+        let mut objects = Vec::with_capacity(specs.len());
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for (p, h) in terrain.points.iter().zip(&terrain.heights) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+            hi[2] = hi[2].max(*h);
+        }
+        lo[2] = base;
+        for (i, spec) in specs.iter().enumerate() {
+            if specs[..i].iter().any(|s| s.name == spec.name) {
+                return Err(err(
+                    spec,
+                    "name",
+                    "another object has this name; give each object its own",
+                ));
+            }
+            let o = Object::new(spec, terrain, base)?;
+            let [a, b] = o.bbox;
+            if (0..3).any(|k| a[k] >= hi[k] || b[k] <= lo[k]) {
+                let key = match spec.geometry {
+                    ObjectGeometry::Tunnel { .. } => "axis",
+                    ObjectGeometry::Excavation { .. } => "outline",
+                    ObjectGeometry::Structure { .. } => "solid",
+                };
+                return Err(err(
+                    spec,
+                    key,
+                    format!(
+                        "the object lies wholly outside the region ({:.1}..{:.1}, {:.1}..{:.1}, z {:.1}..{:.1}); check its coordinates and CRS",
+                        lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+                    ),
+                ));
+            }
+            objects.push(o);
+        }
+        Ok(ObjectSet {
+            objects,
+            resolution: STRUCTURE_RESOLUTION,
+            max_cells: OBJECT_MAX_CELLS,
+        })
+    }
+
+    /// The excavation stage of a cell from its labels: 0 for no object, a lining or a
+    /// structure.
+    pub fn stage(&self, object: u32, lining: bool) -> u32 {
+        if object == 0 || lining {
+            0
+        } else {
+            self.objects[object as usize - 1].stage
+        }
+    }
+}
+
+impl Object {
+    fn new(spec: &ObjectSpec, terrain: &Terrain, base: f64) -> Result<Object, FaultError> {
+        let positive = |key: &'static str, v: f64| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(err(
+                    spec,
+                    key,
+                    format!("{v} must be a positive number of metres"),
+                ))
+            }
+        };
+        if spec.stage == 0 && spec.kind() != "structure" {
+            return Err(err(
+                spec,
+                "stage",
+                "0: stages count from 1 (the first excavated)",
+            ));
+        }
+        let (shape, size, bbox, exact, method) = match &spec.geometry {
+            ObjectGeometry::Tunnel {
+                axis,
+                profile,
+                lining,
+            } => {
+                if let Some(i) = finite3(axis) {
+                    return Err(err(
+                        spec,
+                        "axis",
+                        format!(
+                            "point {} has a coordinate that is not a finite number",
+                            i + 1
+                        ),
+                    ));
+                }
+                let mut pts: Vec<[f64; 3]> = Vec::with_capacity(axis.len());
+                for &p in axis {
+                    if pts.last().is_none_or(|&l| norm(sub(p, l)) > 1e-9) {
+                        pts.push(p);
+                    }
+                }
+                if pts.len() < 2 {
+                    return Err(err(
+                        spec,
+                        "axis",
+                        format!(
+                            "{} distinct point(s): a tunnel's axis needs at least two",
+                            pts.len()
+                        ),
+                    ));
+                }
+                match *profile {
+                    Profile::Circle { diameter } => positive("diameter", diameter)?,
+                    Profile::Horseshoe { width, height } | Profile::Rectangle { width, height } => {
+                        positive("width", width)?;
+                        positive("height", height)?;
+                        if matches!(profile, Profile::Horseshoe { .. }) && height < width / 2.0 {
+                            return Err(err(spec, "height", format!("{height} is less than half the width {width}: a horseshoe's crown is a half circle of the width")));
+                        }
+                    }
+                }
+                if !(lining.is_finite() && *lining >= 0.0) {
+                    return Err(err(
+                        spec,
+                        "lining",
+                        format!("{lining} must be a thickness in metres, 0 or more"),
+                    ));
+                }
+                let tangents: Vec<[f64; 3]> =
+                    pts.windows(2).map(|w| unit(sub(w[1], w[0]))).collect();
+                let mut pieces: Vec<Piece> = Vec::new();
+                let mut length = 0.0;
+                for (i, w) in pts.windows(2).enumerate() {
+                    let t = tangents[i];
+                    if t[0].hypot(t[1]) < 1e-6 {
+                        return Err(err(spec, "axis", format!("segment {} (points {} to {}) is vertical: shafts are not supported", i + 1, i + 1, i + 2)));
+                    }
+                    if i > 0 && dot(t, tangents[i - 1]) < -0.5 {
+                        return Err(err(
+                            spec,
+                            "axis",
+                            format!(
+                                "the axis turns back by more than 120 degrees at point {}",
+                                i + 1
+                            ),
+                        ));
+                    }
+                    // The first piece's profile stands upright (n horizontal); each next
+                    // piece's frame is its predecessor's reflected in the mitre plane, so
+                    // that both pieces cut the same section out of that plane (the field is
+                    // continuous there).
+                    let (n, u) = match pieces.last() {
+                        None => {
+                            let n = unit(cross(t, [0.0, 0.0, 1.0]));
+                            let u = cross(n, t);
+                            (n, if u[2] < 0.0 { [-u[0], -u[1], -u[2]] } else { u })
+                        }
+                        Some(prev) => {
+                            let m = prev.end;
+                            let r = |v: [f64; 3]| {
+                                let d = 2.0 * dot(v, m);
+                                [v[0] - d * m[0], v[1] - d * m[1], v[2] - d * m[2]]
+                            };
+                            (r(prev.n), r(prev.u))
+                        }
+                    };
+                    let start = if i == 0 {
+                        t
+                    } else {
+                        unit([
+                            t[0] + tangents[i - 1][0],
+                            t[1] + tangents[i - 1][1],
+                            t[2] + tangents[i - 1][2],
+                        ])
+                    };
+                    let end = if i + 2 == pts.len() {
+                        t
+                    } else {
+                        unit([
+                            t[0] + tangents[i + 1][0],
+                            t[1] + tangents[i + 1][1],
+                            t[2] + tangents[i + 1][2],
+                        ])
+                    };
+                    length += norm(sub(w[1], w[0]));
+                    pieces.push(Piece {
+                        a: w[0],
+                        b: w[1],
+                        n,
+                        u,
+                        start,
+                        end,
+                    });
+                }
+                let outer = (*lining > 0.0).then(|| profile.grown(*lining));
+                let reach = outer.unwrap_or(*profile).reach();
+                let mut bbox = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
+                for p in &pts {
+                    for k in 0..3 {
+                        bbox[0][k] = bbox[0][k].min(p[k] - reach);
+                        bbox[1][k] = bbox[1][k].max(p[k] + reach);
+                    }
+                }
+                let a = profile.area();
+                let exact = [a * length, outer.map_or(0.0, |o| (o.area() - a) * length)];
+                (
+                    Shape::Tunnel {
+                        pieces,
+                        profile: *profile,
+                        outer,
+                        length,
+                    },
+                    profile.radius(),
+                    bbox,
+                    exact,
+                    "profile area times axis length",
+                )
+            }
+            ObjectGeometry::Excavation {
+                outline,
+                floor,
+                face_angle,
+            } => {
+                let mut ring: Vec<[f64; 2]> = Vec::with_capacity(outline.len());
+                for (i, &p) in outline.iter().enumerate() {
+                    if !(p[0].is_finite() && p[1].is_finite()) {
+                        return Err(err(
+                            spec,
+                            "outline",
+                            format!(
+                                "point {} has a coordinate that is not a finite number",
+                                i + 1
+                            ),
+                        ));
+                    }
+                    if ring.last() != Some(&p) {
+                        ring.push(p);
+                    }
+                }
+                if ring.len() > 1 && ring[0] == ring[ring.len() - 1] {
+                    ring.pop();
+                }
+                if ring.len() < 3 {
+                    return Err(err(
+                        spec,
+                        "outline",
+                        format!(
+                            "{} distinct point(s): an outline needs at least three",
+                            ring.len()
+                        ),
+                    ));
+                }
+                let n = ring.len();
+                for i in 0..n {
+                    for j in i + 1..n {
+                        let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+                        let (a, b, c, d) = (ring[i], ring[(i + 1) % n], ring[j], ring[(j + 1) % n]);
+                        let meets = if adjacent {
+                            // Adjacent edges share one point; they must not overlap.
+                            let shared = if j == i + 1 { b } else { a };
+                            let (p, q) = if j == i + 1 { (a, d) } else { (b, c) };
+                            let o = orient2d(
+                                Coord { x: p[0], y: p[1] },
+                                Coord {
+                                    x: shared[0],
+                                    y: shared[1],
+                                },
+                                Coord { x: q[0], y: q[1] },
+                            );
+                            o == 0.0
+                                && ((p[0] - shared[0]) * (q[0] - shared[0])
+                                    + (p[1] - shared[1]) * (q[1] - shared[1]))
+                                    > 0.0
+                        } else {
+                            segments_meet(a, b, c, d)
+                        };
+                        if meets {
+                            return Err(err(spec, "outline", format!("edge {} (points {} to {}) meets edge {} (points {} to {}): the outline intersects itself", i + 1, i + 1, (i + 1) % n + 1, j + 1, j + 1, (j + 1) % n + 1)));
+                        }
+                    }
+                }
+                let area2: f64 = (0..n)
+                    .map(|i| {
+                        let (a, b) = (ring[i], ring[(i + 1) % n]);
+                        a[0] * b[1] - a[1] * b[0]
+                    })
+                    .sum();
+                if area2 == 0.0 {
+                    return Err(err(spec, "outline", "the outline encloses no area"));
+                }
+                if !floor.is_finite() {
+                    return Err(err(
+                        spec,
+                        "floor",
+                        format!("{floor} is not a finite elevation"),
+                    ));
+                }
+                if !(face_angle.is_finite() && *face_angle > 0.0 && *face_angle <= 90.0) {
+                    return Err(err(
+                        spec,
+                        "face_angle",
+                        format!("{face_angle} must be in (0, 90] degrees from horizontal"),
+                    ));
+                }
+                let tops: Vec<f64> = ring.iter().map(|&p| terrain.height_or_nearest(p)).collect();
+                let mut highest = tops.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                for (p, h) in terrain.points.iter().zip(&terrain.heights) {
+                    if point_in_ring(*p, &ring) {
+                        highest = highest.max(*h);
+                    }
+                }
+                if *floor >= highest {
+                    return Err(err(spec, "floor", format!("{floor} is at or above the terrain everywhere in the outline (highest {highest:.3}): lower it")));
+                }
+                let lowest_top = tops.iter().copied().fold(f64::INFINITY, f64::min);
+                let a = face_angle.to_radians();
+                let mut bbox = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
+                for p in &ring {
+                    for k in 0..2 {
+                        bbox[0][k] = bbox[0][k].min(p[k]);
+                        bbox[1][k] = bbox[1][k].max(p[k]);
+                    }
+                }
+                bbox[0][2] = *floor;
+                bbox[1][2] = highest;
+                let shape = Shape::Excavation {
+                    outline: ring,
+                    tops,
+                    floor: *floor,
+                    sin: a.sin(),
+                    cos: a.cos(),
+                };
+                let depth = (lowest_top - floor).max(highest - floor).max(1e-3);
+                (
+                    shape,
+                    depth,
+                    bbox,
+                    [0.0, 0.0],
+                    "column quadrature on a 512 x 512 grid",
+                )
+            }
+            ObjectGeometry::Structure {
+                vertices,
+                triangles,
+            } => {
+                if let Some(i) = finite3(vertices) {
+                    return Err(err(
+                        spec,
+                        "solid",
+                        format!(
+                            "vertex {} has a coordinate that is not a finite number",
+                            i + 1
+                        ),
+                    ));
+                }
+                if let Some(t) = triangles
+                    .iter()
+                    .position(|t| t.iter().any(|&v| v as usize >= vertices.len()))
+                {
+                    return Err(err(
+                        spec,
+                        "solid",
+                        format!("triangle {} names a vertex that does not exist", t + 1),
+                    ));
+                }
+                if triangles.len() < 4 {
+                    return Err(err(
+                        spec,
+                        "solid",
+                        format!(
+                            "{} triangle(s): a closed solid needs at least four",
+                            triangles.len()
+                        ),
+                    ));
+                }
+                let mut edges: Vec<(u32, u32, bool)> = triangles
+                    .iter()
+                    .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+                    .map(|(a, b)| (a.min(b), a.max(b), a < b))
+                    .collect();
+                edges.sort_unstable();
+                let mut i = 0;
+                while i < edges.len() {
+                    let mut j = i;
+                    let mut fwd = 0;
+                    while j < edges.len() && edges[j].0 == edges[i].0 && edges[j].1 == edges[i].1 {
+                        fwd += edges[j].2 as usize;
+                        j += 1;
+                    }
+                    if j - i != 2 || fwd != 1 {
+                        let p = vertices[edges[i].0 as usize];
+                        return Err(err(spec, "solid", format!(
+                            "the surface is not closed: the edge from vertex {} ({}, {}, {}) to vertex {} is in {} triangle(s){}; give a closed, consistently oriented surface",
+                            edges[i].0 + 1, p[0], p[1], p[2], edges[i].1 + 1, j - i,
+                            if j - i == 2 { " with the same orientation" } else { "" }
+                        )));
+                    }
+                    i = j;
+                }
+                let vol: f64 = triangles
+                    .iter()
+                    .map(|t| {
+                        let [a, b, c] = t.map(|v| vertices[v as usize]);
+                        dot(a, cross(b, c)) / 6.0
+                    })
+                    .sum();
+                if vol.abs() == 0.0 {
+                    return Err(err(spec, "solid", "the surface encloses no volume"));
+                }
+                let mut bbox = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
+                for p in vertices {
+                    for k in 0..3 {
+                        bbox[0][k] = bbox[0][k].min(p[k]);
+                        bbox[1][k] = bbox[1][k].max(p[k]);
+                    }
+                }
+                let size = (0..3)
+                    .map(|k| bbox[1][k] - bbox[0][k])
+                    .fold(f64::INFINITY, f64::min);
+                let _ = base;
+                (
+                    Shape::Structure {
+                        vertices: vertices.clone(),
+                        triangles: triangles.clone(),
+                    },
+                    size,
+                    bbox,
+                    [vol.abs(), 0.0],
+                    "enclosed volume (divergence theorem)",
+                )
+            }
+        };
+        let mut o = Object {
+            name: spec.name.clone(),
+            kind: spec.kind(),
+            stage: if spec.kind() == "structure" {
+                0
+            } else {
+                spec.stage
+            },
+            has_lining: exact[1] > 0.0,
+            exact,
+            exact_method: method,
+            size,
+            bbox,
+            shape,
+        };
+        o.exact_volumes(terrain, base);
+        Ok(o)
+    }
+
+    /// The exact volume of the part of the object inside the model (under the terrain, above
+    /// the base). A tunnel wholly under the terrain: its profile's area times its axis
+    /// length (exact for circles and rectangles; for a horseshoe where the axis bends
+    /// vertically, up to the mitre's first moment). A structure wholly between base and
+    /// terrain: its enclosed volume. Otherwise (an excavation; a structure or a tunnel that
+    /// crosses the terrain): the integral over the plan of the length of each vertical line's
+    /// part inside the object and under the terrain, by the midpoint rule on a 512 x 512
+    /// grid over its bounding box.
+    fn exact_volumes(&mut self, terrain: &Terrain, base: f64) {
+        let [lo, hi] = self.bbox;
+        let inside_model =
+            |p: [f64; 3]| terrain.height([p[0], p[1]]).is_some_and(|h| p[2] < h) && p[2] > base;
+        let corners_inside = (0..8).all(|k| {
+            inside_model([
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            ])
+        });
+        // Is the terrain above the bounding box everywhere over it? Check the terrain's
+        // vertices inside its plan too (the terrain is linear between them).
+        let under = corners_inside
+            && terrain.points.iter().zip(&terrain.heights).all(|(p, &h)| {
+                !(p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1]) || h > hi[2]
+            });
+        if under && !matches!(self.shape, Shape::Excavation { .. }) {
+            return;
+        }
+        const N: usize = 512;
+        let (dx, dy) = ((hi[0] - lo[0]) / N as f64, (hi[1] - lo[1]) / N as f64);
+        let walls: Vec<Wall> = self.walls().to_vec();
+        let sums: Vec<[f64; 2]> = (0..N)
+            .into_par_iter()
+            .map(|j| {
+                let mut s = [0.0; 2];
+                for i in 0..N {
+                    let (x, y) = (lo[0] + (i as f64 + 0.5) * dx, lo[1] + (j as f64 + 0.5) * dy);
+                    let Some(top) = terrain.height([x, y]) else {
+                        continue;
+                    };
+                    let (z0, z1) = (lo[2].max(base), hi[2].min(top));
+                    if z1 <= z0 {
+                        continue;
+                    }
+                    let inner = self.vertical_length(Wall::Inner, x, y, z0, z1);
+                    s[0] += inner;
+                    if walls.len() == 2 {
+                        s[1] += self.vertical_length(Wall::Outer, x, y, z0, z1) - inner;
+                    }
+                }
+                s
+            })
+            .collect();
+        let v = sums
+            .iter()
+            .fold([0.0; 2], |a, s| [a[0] + s[0], a[1] + s[1]]);
+        self.exact = [v[0] * dx * dy, v[1] * dx * dy];
+        self.exact_method = if matches!(self.shape, Shape::Excavation { .. }) {
+            "column quadrature on a 512 x 512 grid"
+        } else {
+            "column quadrature on a 512 x 512 grid (the object crosses the model's boundary)"
+        };
+    }
+
+    /// The length of the vertical segment x, y, z0..z1 inside a wall.
+    fn vertical_length(&self, wall: Wall, x: f64, y: f64, z0: f64, z1: f64) -> f64 {
+        match &self.shape {
+            Shape::Structure {
+                vertices,
+                triangles,
+            } => {
+                // The crossings of the vertical line, exactly located triangles, z by the plane.
+                let q = [x, y, 0.0];
+                let mut zs: Vec<f64> = triangles
+                    .iter()
+                    .filter_map(|t| {
+                        let [a, b, c] = t.map(|v| vertices[v as usize]);
+                        let o = orient2d(c2(a), c2(b), c2(c));
+                        if o == 0.0 {
+                            return None;
+                        }
+                        let (b, c) = if o > 0.0 { (b, c) } else { (c, b) };
+                        if side_sos(a, b, q) < 0.0
+                            || side_sos(b, c, q) < 0.0
+                            || side_sos(c, a, q) < 0.0
+                        {
+                            return None;
+                        }
+                        let n = cross(sub(b, a), sub(c, a));
+                        Some(a[2] - (n[0] * (x - a[0]) + n[1] * (y - a[1])) / n[2])
+                    })
+                    .collect();
+                zs.sort_by(f64::total_cmp);
+                zs.chunks(2)
+                    .filter(|c| c.len() == 2)
+                    .map(|c| (c[1].min(z1) - c[0].max(z0)).max(0.0))
+                    .sum()
+            }
+            Shape::Excavation { .. } => {
+                // Inside from the lowest point where the field is negative up: the field is
+                // monotone in z (faces descend inwards), so bisect for the bottom.
+                if self.field(wall, [x, y, z1 - 1e-9]) >= 0.0 {
+                    return 0.0;
+                }
+                if self.field(wall, [x, y, z0]) < 0.0 {
+                    return z1 - z0;
+                }
+                let (mut a, mut b) = (z0, z1 - 1e-9);
+                for _ in 0..60 {
+                    let m = 0.5 * (a + b);
+                    if self.field(wall, [x, y, m]) < 0.0 {
+                        b = m;
+                    } else {
+                        a = m;
+                    }
+                }
+                z1 - 0.5 * (a + b)
+            }
+            Shape::Tunnel { .. } => {
+                // Sample the segment finely, then bisect each sign change.
+                let n = 256;
+                let f = |z: f64| self.field(wall, [x, y, z]);
+                let mut len = 0.0;
+                let mut prev = (z0, f(z0));
+                for k in 1..=n {
+                    let z = z0 + (z1 - z0) * k as f64 / n as f64;
+                    let cur = (z, f(z));
+                    let inside = |v: f64| v < 0.0;
+                    if inside(prev.1) == inside(cur.1) {
+                        if inside(cur.1) {
+                            len += cur.0 - prev.0;
+                        }
+                    } else {
+                        let (mut a, mut b) = (prev.0, cur.0);
+                        for _ in 0..60 {
+                            let m = 0.5 * (a + b);
+                            if inside(f(m)) == inside(prev.1) {
+                                a = m;
+                            } else {
+                                b = m;
+                            }
+                        }
+                        let m = 0.5 * (a + b);
+                        len += if inside(prev.1) {
+                            m - prev.0
+                        } else {
+                            cur.0 - m
+                        };
+                    }
+                    prev = cur;
+                }
+                len
+            }
+        }
+    }
+}
+
+fn point_in_ring(p: [f64; 2], ring: &[[f64; 2]]) -> bool {
+    let n = ring.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        if (a[1] > p[1]) != (b[1] > p[1])
+            && p[0] < a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+        {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// The objects' labels of every cell and what cutting them did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ObjectCells {
+    /// Per cell: 0 for none, else the object's number (1-based, in project order).
+    pub object: Vec<u32>,
+    /// Per cell: whether it is in the object's lining (then `object` names the tunnel).
+    pub lining: Vec<bool>,
+    /// Edges bisected by the refinement near objects.
+    pub refined_edges: usize,
+    /// Edges split at an object's boundary.
+    pub split_edges: usize,
+    /// Whether the refinement stopped at [`ObjectSet::max_cells`].
+    pub capped: bool,
+}
+
+fn eval(v: f64) -> (f64, i8) {
+    if !v.is_finite() || v.abs() <= ON_SURFACE {
+        (0.0, 0)
+    } else if v > 0.0 {
+        (v, 1)
+    } else {
+        (v, -1)
+    }
+}
+
+/// The crossing of segment ab by a field (values of opposite signs), Illinois regula falsi.
+fn crossing(f: &dyn Fn([f64; 3]) -> f64, a: [f64; 3], b: [f64; 3], va: f64, vb: f64) -> [f64; 3] {
+    let at = |t: f64| {
+        [
+            a[0] + t * (b[0] - a[0]),
+            a[1] + t * (b[1] - a[1]),
+            a[2] + t * (b[2] - a[2]),
+        ]
+    };
+    let (mut t0, mut t1, mut f0, mut f1) = (0.0, 1.0, va, vb);
+    let mut t = f0 / (f0 - f1);
+    let mut last = 0i8;
+    for _ in 0..80 {
+        t = (t0 - f0 * (t1 - t0) / (f1 - f0)).clamp(t0, t1);
+        let (v, s) = eval(f(at(t)));
+        if s == 0 || v.abs() < 1e-10 {
+            break;
+        }
+        if (v > 0.0) == (f0 > 0.0) {
+            (t0, f0) = (t, v);
+            if last == 1 {
+                f1 *= 0.5;
+            }
+            last = 1;
+        } else {
+            (t1, f1) = (t, v);
+            if last == -1 {
+                f0 *= 0.5;
+            }
+            last = -1;
+        }
+    }
+    at(t.clamp(1e-12, 1.0 - 1e-12))
+}
+
+/// Splits the given edges (sorted keys) at the given points, conformally, the children of a
+/// cell keeping its labels.
+fn split_edges(st: &mut State, labels: &mut ObjectCells, keys: &[u64], points: Vec<[f64; 3]>) {
+    let first = st.points.len() as u32;
+    for (&k, p) in keys.iter().zip(points) {
+        let (a, b) = ((k >> 32) as usize, k as u32 as usize);
+        st.points.push(p);
+        st.flags
+            .push(st.flags[a] & st.flags[b] & (TOP | BASE | SIDE));
+        st.on_fault.push(st.on_fault[a] & st.on_fault[b]);
+    }
+    let mut end = vec![false; first as usize];
+    for &k in keys {
+        end[(k >> 32) as usize] = true;
+        end[k as u32 as usize] = true;
+    }
+    let children: Vec<(usize, Vec<[u32; 4]>)> = st
+        .tets
+        .par_iter()
+        .enumerate()
+        .filter(|(_, t)| {
+            t.iter().filter(|&&v| end[v as usize]).count() >= 2
+                && EDGES
+                    .iter()
+                    .any(|&(i, j)| keys.binary_search(&key(t[i], t[j])).is_ok())
+        })
+        .map(|(c, &t)| {
+            let mut out = Vec::with_capacity(8);
+            split_tet(t, keys, first, &mut out);
+            (c, out)
+        })
+        .collect();
+    for (c, kids) in children {
+        st.tets[c] = kids[0];
+        for &k in &kids[1..] {
+            st.tets.push(k);
+            st.positive.push(st.positive[c]);
+            st.below.push(st.below[c]);
+            st.block.push(st.block[c]);
+            if !labels.object.is_empty() {
+                labels.object.push(labels.object[c]);
+                labels.lining.push(labels.lining[c]);
+            }
+        }
+    }
+}
+
+/// The faults and interfaces already cut: a node that an object's wall puts on an edge of a
+/// fault's or an interface's face is moved from the face's chord onto the curved surface.
+pub(crate) struct Surfaces<'a> {
+    pub(crate) faults: &'a FaultSet,
+    pub(crate) blocks: &'a [BlockKey],
+    pub(crate) height: InterfaceFn<'a>,
+    pub(crate) interfaces: usize,
+}
+
+impl Surfaces<'_> {
+    /// `p` on edge ab (cell block `block`) moved onto the fault or interface that both a and
+    /// b lie on, if any and if that moves it at most `most` (a fault: along its normal, not on
+    /// the region's boundary; an interface: vertically, not on the terrain or the base).
+    fn onto(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3], most: f64) -> [f64; 3] {
+        let q = self.project(st, a, b, block, p);
+        let d = norm(sub(q, p));
+        if d <= most {
+            q
+        } else {
+            p
+        }
+    }
+
+    fn project(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3]) -> [f64; 3] {
+        let (qa, qb) = (st.points[a], st.points[b]);
+        let both = st.flags[a] & st.flags[b];
+        let common = st.on_fault[a] & st.on_fault[b];
+        if common != 0 && both & (TOP | BASE | SIDE) == 0 {
+            for (f, fault) in self.faults.faults.iter().enumerate() {
+                if common >> f & 1 == 1
+                    && fault.side(qa).distance.abs() <= ON_SURFACE
+                    && fault.side(qb).distance.abs() <= ON_SURFACE
+                {
+                    let s = fault.side(p);
+                    return [0, 1, 2].map(|k| p[k] - s.distance * s.normal[k]);
+                }
+            }
+        }
+        if both & ON_INTERFACE != 0 && both & (TOP | BASE) == 0 {
+            let key = self.blocks[block as usize];
+            for k in 0..self.interfaces {
+                let h = |q: [f64; 3]| (self.height)(k, key, [q[0], q[1]]);
+                if (qa[2] - h(qa)).abs() <= ON_SURFACE && (qb[2] - h(qb)).abs() <= ON_SURFACE {
+                    let z = h(p);
+                    return if z.is_finite() { [p[0], p[1], z] } else { p };
+                }
+            }
+        }
+        p
+    }
+}
+
+fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
+    set.objects
+        .iter()
+        .enumerate()
+        .flat_map(|(i, o)| o.walls().iter().map(move |&w| (i, w)))
+        .collect()
+}
+
+/// Refines the background mesh near the objects (before the faults and the interfaces are
+/// cut, so that their cuts land on the refined edges and every node they make lies on them).
+pub(crate) fn refine_near_objects(
+    st: &mut State,
+    set: &ObjectSet,
+) -> Result<ObjectCells, FaultError> {
+    let mut labels = ObjectCells::default();
+    if set.objects.is_empty() {
+        return Ok(labels);
+    }
+    if !(set.resolution > 0.0 && set.resolution.is_finite()) {
+        return Err(FaultError::Setting {
+            name: "structure_resolution".into(),
+            value: set.resolution,
+            why: "must be a positive fraction of each object's size",
+        });
+    }
+    let walls = walls(set);
+    // Refinement near the walls: bisect the longest edge of every cell near a wall whose
+    // longest edge is longer than the object's target.
+    for _round in 0..40 {
+        let values: Vec<Vec<f64>> = walls
+            .iter()
+            .map(|&(i, w)| {
+                let o = &set.objects[i];
+                st.points.par_iter().map(|&q| o.field(w, q)).collect()
+            })
+            .collect();
+        let mut keys: Vec<u64> = st
+            .tets
+            .par_iter()
+            .filter_map(|t| {
+                let q = t.map(|n| st.points[n as usize]);
+                let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
+                let longest = EDGES
+                    .iter()
+                    .copied()
+                    .max_by(|&a, &b| len(a).total_cmp(&len(b)))
+                    .unwrap();
+                let l = len(longest);
+                // The edge to split for a wall: the longest of the edges whose midpoint's
+                // field deviates from the mean of its ends' by more than the tolerance (the
+                // facets there would stray from the wall), or the longest edge if only the
+                // centroid's does; nothing where the edges are already short.
+                let mut pick: Option<(usize, usize)> = None;
+                for (w, &(i, wall)) in walls.iter().enumerate() {
+                    let o = &set.objects[i];
+                    let tol = set.resolution * o.size;
+                    if l <= 4.0 * tol {
+                        continue;
+                    }
+                    let v = t.map(|n| values[w][n as usize]);
+                    if v.iter().all(|x| x.abs() >= l) {
+                        continue;
+                    }
+                    let mut best: Option<(usize, usize)> = None;
+                    for &(a, b) in &EDGES {
+                        if len((a, b)) <= 4.0 * tol {
+                            continue;
+                        }
+                        let m = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
+                        if (o.field(wall, m) - 0.5 * (v[a] + v[b])).abs() > tol
+                            && best.is_none_or(|e| len((a, b)) > len(e))
+                        {
+                            best = Some((a, b));
+                        }
+                    }
+                    if best.is_none() {
+                        let c = centroid(&st.points, t);
+                        if (o.field(wall, c) - 0.25 * v.iter().sum::<f64>()).abs() > tol {
+                            best = Some(longest);
+                        }
+                    }
+                    if let Some(e) = best {
+                        if pick.is_none_or(|p| len(e) > len(p)) {
+                            pick = Some(e);
+                        }
+                    }
+                }
+                pick.map(|(a, b)| key(t[a], t[b]))
+            })
+            .collect();
+        keys.par_sort_unstable();
+        keys.dedup();
+        if keys.is_empty() {
+            break;
+        }
+        if st.tets.len() + 6 * keys.len() > set.max_cells {
+            labels.capped = true;
+            break;
+        }
+        let mids: Vec<[f64; 3]> = keys
+            .iter()
+            .map(|&k| {
+                let (a, b) = (st.points[(k >> 32) as usize], st.points[k as u32 as usize]);
+                [
+                    0.5 * (a[0] + b[0]),
+                    0.5 * (a[1] + b[1]),
+                    0.5 * (a[2] + b[2]),
+                ]
+            })
+            .collect();
+        labels.refined_edges += keys.len();
+        split_edges(st, &mut labels, &keys, mids);
+    }
+    Ok(labels)
+}
+
+/// Cuts every object's walls into the mesh (after the faults, the interfaces and the quality
+/// pass) and labels the cells (a cell in several objects takes the first in project order);
+/// `labels` carries what [`refine_near_objects`] did.
+pub(crate) fn cut_objects(
+    st: &mut State,
+    set: &ObjectSet,
+    mut labels: ObjectCells,
+    surfaces: &Surfaces,
+) -> Result<ObjectCells, FaultError> {
+    labels.object = vec![0; st.tets.len()];
+    labels.lining = vec![false; st.tets.len()];
+    let walls = walls(set);
+    for &(i, w) in &walls {
+        let o = &set.objects[i];
+        let f = |q: [f64; 3]| o.field(w, q);
+        let [lo, hi] = o.bbox;
+        let margin = 1e-3 + o.size * 1e-6;
+        let values: Vec<(f64, i8)> = st
+            .points
+            .par_iter()
+            .map(|&q| {
+                if (0..3).any(|k| q[k] < lo[k] - margin || q[k] > hi[k] + margin) {
+                    (1.0, 1)
+                } else {
+                    // A node within a millimetre of the wall lies on it: a split that close
+                    // to an edge's end would leave a cell too thin for its volume to be
+                    // computed in floating point.
+                    let v = f(q);
+                    if v.abs() <= ON_WALL {
+                        (0.0, 0)
+                    } else {
+                        eval(v)
+                    }
+                }
+            })
+            .collect();
+        let mut keys: Vec<u64> = st
+            .tets
+            .par_iter()
+            .flat_map_iter(|t| {
+                let values = &values;
+                EDGES
+                    .iter()
+                    .filter(move |&&(a, b)| values[t[a] as usize].1 * values[t[b] as usize].1 < 0)
+                    .map(move |&(a, b)| key(t[a], t[b]))
+            })
+            .collect();
+        keys.par_sort_unstable();
+        keys.dedup();
+        // The block of a cell around each edge (for the interfaces' heights).
+        let mut edge_block: Vec<(u64, u32)> = st
+            .tets
+            .par_iter()
+            .zip(&st.block)
+            .flat_map_iter(|(t, &b)| {
+                let values = &values;
+                EDGES
+                    .iter()
+                    .filter(move |&&(i, j)| values[t[i] as usize].1 * values[t[j] as usize].1 < 0)
+                    .map(move |&(i, j)| (key(t[i], t[j]), b))
+            })
+            .collect();
+        edge_block.par_sort_unstable();
+        edge_block.dedup_by_key(|e| e.0);
+        // A move onto a fault or an interface may take the node this far off the wall (half
+        // the tolerance of check_objects); a farther one (an edge between two nodes of the
+        // surface that is not on its faces) keeps the chord.
+        let most = 0.5 * OBJECT_TOLERANCE.max(4.0 * set.resolution * o.size);
+        let chords: Vec<[f64; 3]> = keys
+            .par_iter()
+            .map(|&k| {
+                let (a, b) = ((k >> 32) as usize, k as u32 as usize);
+                crossing(&f, st.points[a], st.points[b], values[a].0, values[b].0)
+            })
+            .collect();
+        let pts: Vec<[f64; 3]> = keys
+            .par_iter()
+            .zip(&chords)
+            .zip(&edge_block)
+            .map(|((&k, &p), &(_, block))| {
+                surfaces.onto(st, (k >> 32) as usize, k as u32 as usize, block, p, most)
+            })
+            .collect();
+        labels.split_edges += keys.len();
+        let mut values = values;
+        values.resize(st.points.len() + keys.len(), (0.0, 0));
+        let first = st.points.len();
+        split_edges(st, &mut labels, &keys, pts);
+        // Where a node moved onto a curved interface or fault inverts a cell, it goes back
+        // to the chord.
+        for _ in 0..8 {
+            let bad: Vec<u32> = st
+                .tets
+                .par_iter()
+                .filter(|t| {
+                    let q = t.map(|v| st.points[v as usize]);
+                    // Exactly positive, and positive in floating point too (the writers
+                    // compute volumes in floating point).
+                    !crate::mesh::positive(q)
+                        || terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3]) <= 0.0
+                })
+                .flat_map_iter(|t| t.iter().copied().filter(|&v| v as usize >= first))
+                .collect();
+            let mut reverted = 0;
+            for v in bad {
+                let c = chords[v as usize - first];
+                if st.points[v as usize] != c {
+                    st.points[v as usize] = c;
+                    reverted += 1;
+                }
+            }
+            if reverted == 0 {
+                break;
+            }
+        }
+        let inside: Vec<bool> = st
+            .tets
+            .par_iter()
+            .map(|t| {
+                let (mut p, mut n) = (false, false);
+                for &v in t {
+                    match values[v as usize].1 {
+                        1 => p = true,
+                        -1 => n = true,
+                        _ => {}
+                    }
+                }
+                match (p, n) {
+                    (false, true) => true,
+                    (true, _) => false,
+                    (false, false) => f(centroid(&st.points, t)) < 0.0,
+                }
+            })
+            .collect();
+        let mut count = 0usize;
+        for (c, inside) in inside.into_iter().enumerate() {
+            if !inside {
+                continue;
+            }
+            count += 1;
+            let (obj, lin) = (&mut labels.object[c], &mut labels.lining[c]);
+            match w {
+                Wall::Inner => {
+                    if *obj == 0 {
+                        *obj = i as u32 + 1;
+                    }
+                }
+                Wall::Outer => {
+                    if *obj == 0 {
+                        *obj = i as u32 + 1;
+                        *lin = true;
+                    }
+                }
+            }
+        }
+        if count == 0 && w == Wall::Inner {
+            return Err(FaultError::Object {
+                kind: o.kind,
+                name: o.name.clone(),
+                key: match o.kind {
+                    "tunnel" => "axis",
+                    "excavation" => "outline",
+                    _ => "solid",
+                },
+                why: "no part of the object lies inside the model (under the terrain, above the base, inside the region); check its coordinates and CRS".into(),
+            });
+        }
+    }
+    Ok(labels)
+}
+
+/// What [`check_objects`] measured for one object.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ObjectCheck {
+    /// The meshed volume of the object (without its lining), m³.
+    pub volume: f64,
+    /// Its exact volume inside the model, m³ ([`Object::exact`]).
+    pub exact: f64,
+    /// The meshed volume of its lining, m³.
+    pub lining_volume: f64,
+    /// The exact volume of its lining, m³.
+    pub lining_exact: f64,
+    /// Its cells (lining included).
+    pub cells: usize,
+    /// The faces of its boundary (and its lining's outer wall), inside the model.
+    pub boundary_faces: usize,
+    /// The largest distance of a boundary face's node from its wall's exact boundary, measured
+    /// by the field, metres.
+    pub boundary_distance: f64,
+    /// The tolerance the checks used for it, metres.
+    pub tolerance: f64,
+}
+
+impl ObjectCheck {
+    /// The relative error of the meshed volume: |meshed - exact| / exact.
+    pub fn volume_error(&self) -> f64 {
+        (self.volume - self.exact).abs() / self.exact.max(f64::MIN_POSITIVE)
+    }
+}
+
+/// Checks the objects cut into a mesh (within a tolerance, see [`OBJECT_TOLERANCE`]): no
+/// cell with nodes on both sides of an object's wall, every cell labelled inside an object (or a lining) with its
+/// centroid inside that wall (within the tolerance), every face between cells of different
+/// labels (an object's boundary) with its nodes on the wall within the tolerance; and measures
+/// every object's meshed volume against its exact volume.
+///
+/// # Errors
+/// [`FaultError::Check`] naming the first failure and where.
+pub fn check_objects(
+    points: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    cells: &ObjectCells,
+    set: &ObjectSet,
+) -> Result<Vec<ObjectCheck>, FaultError> {
+    let fail = |p: [f64; 3], what: String| FaultError::Check {
+        what,
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    };
+    if cells.object.len() != tets.len() || cells.lining.len() != tets.len() {
+        return Err(fail(
+            [0.0; 3],
+            "the objects' per-cell arrays have the wrong length".into(),
+        ));
+    }
+    let mut out = vec![ObjectCheck::default(); set.objects.len()];
+    for (i, o) in set.objects.iter().enumerate() {
+        out[i].exact = o.exact[0];
+        out[i].lining_exact = o.exact[1];
+        let tol = OBJECT_TOLERANCE.max(4.0 * set.resolution * o.size);
+        out[i].tolerance = tol;
+        for &w in o.walls() {
+            let f = |q: [f64; 3]| o.field(w, q);
+            let [lo, hi] = o.bbox;
+            let bad = tets.par_iter().enumerate().find_map_any(|(c, t)| {
+                let q = t.map(|v| points[v as usize]);
+                if q.iter()
+                    .all(|p| (0..3).any(|k| p[k] < lo[k] - 1.0 || p[k] > hi[k] + 1.0))
+                {
+                    return None;
+                }
+                let v = q.map(f);
+                let straddles = v.iter().any(|&x| x < -OBJECT_TOLERANCE)
+                    && v.iter().any(|&x| x > OBJECT_TOLERANCE);
+                let label_in =
+                    cells.object[c] == i as u32 + 1 && (w == Wall::Outer || !cells.lining[c]);
+                let cen = centroid(points, t);
+                let fc = f(cen);
+                if straddles {
+                    let (lo, hi) = v.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+                    Some((c, cen, format!("has nodes on both sides (field {lo:.3} to {hi:.3} m, tolerance {tol:.3}) of")))
+                } else if label_in && fc > tol {
+                    Some((c, cen, "is labelled inside but lies outside".to_string()))
+                } else if !label_in && cells.object[c] == 0 && fc < -tol {
+                    Some((c, cen, "is labelled outside but lies inside".to_string()))
+                } else {
+                    None
+                }
+            });
+            if let Some((c, p, what)) = bad {
+                return Err(fail(
+                    p,
+                    format!(
+                        "cell {c} {what} the {}wall of {} {}",
+                        if w == Wall::Outer {
+                            "lining's outer "
+                        } else {
+                            ""
+                        },
+                        o.kind,
+                        o.name
+                    ),
+                ));
+            }
+        }
+    }
+    let faces = crate::mesh::all_faces(tets);
+    let mut i = 0;
+    while i < faces.len() {
+        if i + 1 < faces.len() && faces[i].0 == faces[i + 1].0 {
+            let (a, b) = (faces[i].1 as usize, faces[i + 1].1 as usize);
+            let la = (cells.object[a], cells.lining[a]);
+            let lb = (cells.object[b], cells.lining[b]);
+            if la != lb {
+                // The wall between them: of the object of the inner label.
+                let (inner, outer) = if la.0 != 0 && (lb.0 == 0 || (la.0 == lb.0 && !la.1)) {
+                    (la, lb)
+                } else {
+                    (lb, la)
+                };
+                let nodes = crate::mesh::outward_faces(&tets[a])[faces[i].2 as usize];
+                let dist = |o: &Object, w: Wall| {
+                    nodes
+                        .iter()
+                        .map(|&v| o.field(w, points[v as usize]).abs())
+                        .fold(0.0, f64::max)
+                };
+                let o = &set.objects[inner.0 as usize - 1];
+                let w = if inner.1 || (outer.0 == 0 && o.has_lining) {
+                    Wall::Outer
+                } else {
+                    Wall::Inner
+                };
+                let mut d = dist(o, w);
+                if outer.0 != 0 && outer.0 != inner.0 {
+                    // Two objects touch: the face lies on either's wall.
+                    let p = &set.objects[outer.0 as usize - 1];
+                    for &w in p.walls() {
+                        d = d.min(dist(p, w));
+                    }
+                }
+                let k = inner.0 as usize - 1;
+                out[k].boundary_faces += 1;
+                out[k].boundary_distance = out[k].boundary_distance.max(d);
+            }
+            i += 2;
+        } else {
+            i += 1;
+        }
+    }
+    for (c, t) in tets.iter().enumerate() {
+        let o = cells.object[c];
+        if o == 0 {
+            continue;
+        }
+        let q = t.map(|v| points[v as usize]);
+        let v = terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3]);
+        let r = &mut out[o as usize - 1];
+        r.cells += 1;
+        if cells.lining[c] {
+            r.lining_volume += v;
+        } else {
+            r.volume += v;
+        }
+    }
+    for (i, r) in out.iter().enumerate() {
+        if r.boundary_distance > r.tolerance {
+            let o = &set.objects[i];
+            return Err(fail(
+                [0.0; 3],
+                format!(
+                    "a boundary face of {} {} lies {:.3e} m from its wall",
+                    o.kind, o.name, r.boundary_distance
+                ),
+            ));
+        }
+    }
+    Ok(out)
+}

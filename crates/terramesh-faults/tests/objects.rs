@@ -1,0 +1,342 @@
+//! Engineering objects cut into a faulted mesh (issue 32): every check of the faulted mesh
+//! still passes, no cell straddles an object's wall, and each object's meshed volume is
+//! within 1 % of its exact volume; bad objects are refused naming the object and the key.
+
+use terramesh_faults::*;
+
+/// The 200 m synthetic site with one fault dipping 60 degrees east and three interfaces.
+fn faulted_site(plane: [f64; 3]) -> Site {
+    Site::new(
+        200.0,
+        10,
+        0.2,
+        1,
+        plane,
+        0.0,
+        vec![90.0, 60.0, 30.0],
+        [0.01, 0.0],
+        vec![SynthFault::new(
+            "F1",
+            [80.0, -50.0],
+            [120.0, 250.0],
+            60.0,
+            90.0,
+            12.0,
+        )],
+    )
+    .unwrap()
+}
+
+fn tunnel(name: &str, axis: Vec<[f64; 3]>, profile: Profile, lining: f64) -> ObjectSpec {
+    ObjectSpec {
+        name: name.into(),
+        stage: 2,
+        geometry: ObjectGeometry::Tunnel {
+            axis,
+            profile,
+            lining,
+        },
+    }
+}
+
+/// A closed box, outward oriented.
+fn box_solid(lo: [f64; 3], hi: [f64; 3]) -> ObjectGeometry {
+    let v = (0..8)
+        .map(|k| {
+            [
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            ]
+        })
+        .collect();
+    let quads = [
+        [0, 2, 3, 1], // bottom, facing down
+        [4, 5, 7, 6], // top
+        [0, 1, 5, 4], // y = lo
+        [2, 6, 7, 3], // y = hi
+        [0, 4, 6, 2], // x = lo
+        [1, 3, 7, 5], // x = hi
+    ];
+    let triangles = quads
+        .iter()
+        .flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    ObjectGeometry::Structure {
+        vertices: v,
+        triangles,
+    }
+}
+
+/// Builds, runs every check, and returns the mesh and the objects' checks.
+fn build(site: &Site, specs: &[ObjectSpec]) -> (FaultedMesh, Vec<ObjectCheck>, CheckSummary) {
+    let settings = MeshSettings::new(site.base, 10.0);
+    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
+    let objects = ObjectSet::new(specs, &site.terrain, site.base).unwrap();
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    let mesh = faulted_mesh_with_objects(
+        &site.terrain,
+        &set,
+        site.tops.len(),
+        &h,
+        &settings,
+        &objects,
+    )
+    .unwrap();
+    let summary = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
+    let checks = check_objects(&mesh.points, &mesh.tets, &mesh.objects, &objects).unwrap();
+    for (o, c) in objects.objects.iter().zip(&checks) {
+        println!(
+            "{} {}: {} cells, meshed {:.3} m3, exact {:.3} m3 ({}), error {:.4} %, lining {:.3} / {:.3}, \
+             {} boundary faces within {:.2e} m",
+            o.kind,
+            o.name,
+            c.cells,
+            c.volume,
+            c.exact,
+            o.exact_method,
+            100.0 * c.volume_error(),
+            c.lining_volume,
+            c.lining_exact,
+            c.boundary_faces,
+            c.boundary_distance
+        );
+    }
+    println!(
+        "{} cells, refined edges {}, split edges {}, capped {}, min dihedral {:.2}",
+        mesh.tets.len(),
+        mesh.objects.refined_edges,
+        mesh.objects.split_edges,
+        mesh.objects.capped,
+        summary.quality.min
+    );
+    (mesh, checks, summary)
+}
+
+#[test]
+fn circular_tunnel_through_a_fault_has_its_exact_volume() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    // A straight tunnel 160 m long at z = 45 crossing F1 (its trace near x = 100) and two
+    // interfaces, with a 0.5 m lining.
+    let r = 5.0;
+    let spec = tunnel(
+        "diversion",
+        vec![[20.0, 90.0, 45.0], [180.0, 110.0, 45.0]],
+        Profile::Circle { diameter: 2.0 * r },
+        0.5,
+    );
+    let (mesh, checks, summary) = build(&site, &[spec]);
+    let length = (160.0f64 * 160.0 + 20.0 * 20.0).sqrt();
+    let exact = std::f64::consts::PI * r * r * length;
+    assert!((checks[0].exact - exact).abs() < 1e-9 * exact);
+    assert!(checks[0].volume_error() < 0.01, "{:?}", checks[0]);
+    let lining_exact = std::f64::consts::PI * (5.5f64.powi(2) - 25.0) * length;
+    assert!((checks[0].lining_volume - lining_exact).abs() < 0.01 * lining_exact);
+    // The tunnel crosses the fault: cells of both blocks inside it.
+    let mut blocks: Vec<u32> = (0..mesh.tets.len())
+        .filter(|&c| mesh.objects.object[c] == 1 && !mesh.objects.lining[c])
+        .map(|c| mesh.block[c])
+        .collect();
+    blocks.sort_unstable();
+    blocks.dedup();
+    assert!(
+        blocks.len() >= 2,
+        "the tunnel should cross F1: blocks {blocks:?}"
+    );
+    assert!(summary.fault_faces[0] > 0);
+}
+
+#[test]
+fn pit_with_planar_faces_has_its_exact_volume() {
+    // A flat terrain at 120 m: a 60 x 40 m pit, floor at 100 m, faces at 60 degrees.
+    let site = faulted_site([120.0, 0.0, 0.0]);
+    let outline = vec![
+        [40.0, 60.0],
+        [100.0, 60.0],
+        [100.0, 100.0],
+        [40.0, 100.0],
+        [40.0, 60.0],
+    ];
+    let spec = ObjectSpec {
+        name: "pit".into(),
+        stage: 1,
+        geometry: ObjectGeometry::Excavation {
+            outline,
+            floor: 100.0,
+            face_angle: 60.0,
+        },
+    };
+    // The frustum's volume: the inset rectangle at depth t has sides a - 2ct, b - 2ct.
+    let (a, b, d, c) = (60.0, 40.0, 20.0, 1.0 / 60f64.to_radians().tan());
+    let analytic = a * b * d - (a + b) * c * d * d + 4.0 * c * c * d * d * d / 3.0;
+    let set = ObjectSet::new(std::slice::from_ref(&spec), &site.terrain, 0.0).unwrap();
+    let quadrature = set.objects[0].exact[0];
+    assert!(
+        (quadrature - analytic).abs() < 1e-4 * analytic,
+        "quadrature {quadrature} against {analytic}"
+    );
+    let (_, checks, _) = build(&site, &[spec]);
+    assert!(checks[0].volume_error() < 0.01, "{:?}", checks[0]);
+    assert!((checks[0].volume - analytic).abs() < 0.01 * analytic);
+}
+
+#[test]
+fn box_structure_and_horseshoe_tunnel_have_their_exact_volumes() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    let dam = ObjectSpec {
+        name: "block".into(),
+        stage: 1,
+        geometry: box_solid([120.0, 40.0, 70.0], [160.0, 70.0, 90.0]),
+    };
+    let gallery = tunnel(
+        "gallery",
+        vec![
+            [30.0, 150.0, 40.0],
+            [90.0, 150.0, 45.0],
+            [150.0, 170.0, 45.0],
+        ],
+        Profile::Horseshoe {
+            width: 6.0,
+            height: 7.0,
+        },
+        0.0,
+    );
+    let (mesh, checks, _) = build(&site, &[dam, gallery]);
+    assert!((checks[0].exact - 40.0 * 30.0 * 20.0).abs() < 1e-9);
+    for c in &checks {
+        assert!(c.volume_error() < 0.01, "{c:?}");
+    }
+    // Object numbers in project order; a structure is never excavated.
+    assert!(mesh.objects.object.contains(&1) && mesh.objects.object.contains(&2));
+}
+
+fn refused(spec: ObjectSpec, key: &str) -> String {
+    let site = faulted_site([120.0, 0.0, 0.0]);
+    let name = spec.name.clone();
+    let kind = spec.kind();
+    match ObjectSet::new(&[spec], &site.terrain, 0.0) {
+        Err(e @ FaultError::Object { .. }) => {
+            let FaultError::Object {
+                kind: k,
+                name: n,
+                key: y,
+                ..
+            } = &e
+            else {
+                unreachable!()
+            };
+            assert_eq!((*k, n.as_str(), *y), (kind, name.as_str(), key), "{e}");
+            e.to_string()
+        }
+        other => panic!("expected an object error for {name}, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_objects_are_refused_naming_the_object_and_the_key() {
+    let circle = Profile::Circle { diameter: 10.0 };
+    let m = refused(tunnel("t1", vec![[10.0, 10.0, 50.0]], circle, 0.0), "axis");
+    assert!(m.contains("at least two"), "{m}");
+    refused(
+        tunnel(
+            "t2",
+            vec![[10.0, 10.0, 50.0], [10.0, 10.0, 50.0]],
+            circle,
+            0.0,
+        ),
+        "axis",
+    );
+    refused(
+        tunnel(
+            "t3",
+            vec![[10.0, 10.0, 50.0], [90.0, 10.0, 50.0]],
+            Profile::Circle { diameter: 0.0 },
+            0.0,
+        ),
+        "diameter",
+    );
+    refused(
+        tunnel(
+            "t4",
+            vec![[10.0, 10.0, 50.0], [90.0, 10.0, 50.0]],
+            Profile::Rectangle {
+                width: 4.0,
+                height: f64::NAN,
+            },
+            0.0,
+        ),
+        "height",
+    );
+    let m = refused(
+        tunnel(
+            "far",
+            vec![[5000.0, 10.0, 50.0], [5100.0, 10.0, 50.0]],
+            circle,
+            0.0,
+        ),
+        "axis",
+    );
+    assert!(m.contains("outside the region"), "{m}");
+    let pit = |name: &str, outline: Vec<[f64; 2]>, floor: f64| ObjectSpec {
+        name: name.into(),
+        stage: 1,
+        geometry: ObjectGeometry::Excavation {
+            outline,
+            floor,
+            face_angle: 60.0,
+        },
+    };
+    // A bow tie.
+    let m = refused(
+        pit(
+            "bowtie",
+            vec![[40.0, 40.0], [100.0, 100.0], [100.0, 40.0], [40.0, 100.0]],
+            100.0,
+        ),
+        "outline",
+    );
+    assert!(m.contains("intersects itself"), "{m}");
+    let square = vec![[40.0, 40.0], [100.0, 40.0], [100.0, 100.0], [40.0, 100.0]];
+    let m = refused(pit("high", square.clone(), 130.0), "floor");
+    assert!(m.contains("above the terrain"), "{m}");
+    refused(
+        pit("two", vec![[40.0, 40.0], [100.0, 40.0]], 100.0),
+        "outline",
+    );
+    // An open solid: a box with one triangle missing.
+    let ObjectGeometry::Structure {
+        vertices,
+        mut triangles,
+    } = box_solid([50.0, 50.0, 50.0], [60.0, 60.0, 60.0])
+    else {
+        unreachable!()
+    };
+    triangles.pop();
+    let m = refused(
+        ObjectSpec {
+            name: "dam".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Structure {
+                vertices,
+                triangles,
+            },
+        },
+        "solid",
+    );
+    assert!(m.contains("not closed"), "{m}");
+    // An object inside the region's box but under the base: refused when meshing.
+    let site = faulted_site([120.0, 0.0, 0.0]);
+    let deep = ObjectSet::new(
+        &[ObjectSpec {
+            name: "deep".into(),
+            stage: 1,
+            geometry: box_solid([50.0, 50.0, -30.0], [60.0, 60.0, 0.0]),
+        }],
+        &site.terrain,
+        0.0,
+    );
+    assert!(
+        matches!(deep, Err(FaultError::Object { key: "solid", .. })),
+        "{deep:?}"
+    );
+}
