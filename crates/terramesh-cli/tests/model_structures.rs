@@ -296,3 +296,34 @@ fn bad_objects_are_refused_naming_the_object_and_the_key_and_nothing_is_written(
         assert!(!out.exists(), "case {i}: {} was written", out.display());
     }
 }
+
+/// `terramesh tiles plan` refuses a project with engineering objects (and no faults), naming
+/// the objects' table, and writes no manifest: a tiled build would silently leave them out.
+#[test]
+fn tiles_plan_refuses_a_project_with_objects_naming_the_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = site(tmp.path(), false);
+    let project = tmp.path().join("terramesh.toml");
+    std::fs::write(&project, text).unwrap();
+    let plan = tmp.path().join("plan");
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "tiles",
+            "plan",
+            project.to_str().unwrap(),
+            "--tile-size",
+            "200m",
+        ])
+        .args(["--set", "interpolation.neighbors=32", "-o"])
+        .arg(&plan)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("geology.tunnels") && err.contains("engineering object(s)"),
+        "{err}"
+    );
+    assert!(!plan.join("tiles.json").exists(), "a manifest was written");
+}

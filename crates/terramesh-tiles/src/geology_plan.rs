@@ -238,6 +238,16 @@ fn check_supported(g: &GeologySettings) -> Result<()> {
             f.name
         )));
     }
+    if let Some(o) = g.objects.first() {
+        return Err(Error::invalid(format!(
+            "geology.{}: the project has {} engineering object(s) ({} ...): tiled builds do not \
+             cut tunnels, excavations or structures into the model yet; build it in one piece \
+             with terramesh build or terramesh model",
+            o.table(),
+            g.objects.len(),
+            o.name
+        )));
+    }
     if g.interpolate == Interpolated::Thickness && g.surfaces.iter().any(Option::is_some) {
         return Err(Error::invalid(
             "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" \

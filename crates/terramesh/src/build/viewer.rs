@@ -18,7 +18,7 @@ use super::stages::{Interpolated, Meshed, Samples};
 use crate::error::{Context, Result};
 use crate::geology::stage::ModelBuilt;
 
-/// Most DSM vertices the viewer shows (at most [`VIEWER_TRIANGLES`] triangles have about half
+/// Most DSM vertices the viewer shows (at most `VIEWER_TRIANGLES` triangles have about half
 /// as many vertices).
 pub const VIEWER_VERTICES: usize = 200_000;
 /// Most DSM triangles the viewer shows; larger surfaces are shown as a level-of-detail copy.

@@ -2,7 +2,7 @@
 //! structures of `[[geology.tunnels]]`, `[[geology.excavations]]` and `[[geology.structures]]`
 //! read (`terramesh_io::objects`), validated against the region (`terramesh_faults::ObjectSet`)
 //! and cut into the faulted model's tetrahedral mesh by the kernel after the faults and the
-//! interfaces ([`mesh`], called by the faulted stage's `build_mesh`), checked
+//! interfaces (`mesh`, called by the faulted stage's `build_mesh`), checked
 //! (`terramesh_faults::check_objects`), and summarised for `model.json` ([`finish`]).
 //!
 //! A model with objects but no faults goes through the same tetrahedral kernel (one fault
