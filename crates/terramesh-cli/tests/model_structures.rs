@@ -111,6 +111,28 @@ fn site(dir: &Path, faults: bool) -> String {
         let cut = text.find("[[geology.faults]]").unwrap();
         text.truncate(cut);
         text = text.replace("fault_picks = \"fault_picks.csv\"\n", "");
+        // Without faults a unit logged twice in a hole (B14's repeat below the reverse fault
+        // F2) is out of order: keep each hole's log up to its first repeat.
+        let log = std::fs::read_to_string(dir.join("intervals.csv")).unwrap();
+        let mut seen = std::collections::HashSet::new();
+        let mut cut_holes = std::collections::HashSet::new();
+        let kept: Vec<&str> = log
+            .lines()
+            .enumerate()
+            .filter(|(i, l)| {
+                let f: Vec<&str> = l.split(',').collect();
+                if *i == 0 || f.len() < 4 {
+                    return true;
+                }
+                if cut_holes.contains(f[0]) || !seen.insert((f[0], f[3])) {
+                    cut_holes.insert(f[0]);
+                    return false;
+                }
+                true
+            })
+            .map(|(_, l)| l)
+            .collect();
+        std::fs::write(dir.join("intervals.csv"), kept.join("\n") + "\n").unwrap();
     }
     text.push_str(OBJECTS);
     text
