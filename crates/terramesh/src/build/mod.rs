@@ -51,7 +51,15 @@ pub struct Timings(pub Vec<(String, f64)>, pub Vec<Option<u64>>);
 impl Timings {
     /// Records a stage: its seconds and the peak memory now.
     pub fn push(&mut self, name: &str, seconds: f64) -> Option<u64> {
-        let peak = peak_memory();
+        // Linux's VmHWM is the larger of a high-water mark updated only on some events (an
+        // unmap, an exit) and the current resident size, so it can read lower than it did
+        // after an earlier stage once memory is given back (seen after the concurrent
+        // exports): the peak so far is at least every earlier reading.
+        let earlier = self.1.iter().flatten().copied().max();
+        let peak = match (peak_memory(), earlier) {
+            (Some(now), Some(e)) => Some(now.max(e)),
+            (now, _) => now,
+        };
         self.0.push((name.to_string(), seconds));
         self.1.push(peak);
         peak
