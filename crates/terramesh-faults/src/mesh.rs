@@ -511,7 +511,7 @@ fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> 
 
 /// Splits `t` at every edge in `keys` (sorted), the lowest key first, as splitting those
 /// edges one after another through the whole mesh would: neighbours agree.
-pub(crate) fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
+fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
     let mut best: Option<(usize, usize, usize)> = None;
     for &(i, j) in &EDGES {
         if let Ok(pos) = keys.binary_search(&key(t[i], t[j])) {
@@ -683,9 +683,19 @@ fn cut(
         st.on_fault.push(b);
         values.push((0.0, 0));
     }
+    split_cells(st, &keys, first, |_| {});
+    st.report.split_edges += keys.len();
+    (values, keys.len())
+}
+
+/// Splits every cell at its edges among `keys` (sorted edge keys whose new nodes are already
+/// pushed, numbered from `first` in key order), conformally: the first child replaces the
+/// cell, the others are pushed with its `positive`, `below` and `block`, and `child(c)` is
+/// called once per pushed child of cell `c` (for labels the caller keeps beside the mesh).
+pub(crate) fn split_cells(st: &mut State, keys: &[u64], first: u32, mut child: impl FnMut(usize)) {
     // Only cells with two ends of split edges can hold one.
     let mut end = vec![false; first as usize];
-    for &k in &keys {
+    for &k in keys {
         end[(k >> 32) as usize] = true;
         end[k as u32 as usize] = true;
     }
@@ -701,7 +711,7 @@ fn cut(
         })
         .map(|(c, &t)| {
             let mut out = Vec::with_capacity(8);
-            split_tet(t, &keys, first, &mut out);
+            split_tet(t, keys, first, &mut out);
             (c, out)
         })
         .collect();
@@ -712,10 +722,9 @@ fn cut(
             st.positive.push(st.positive[c]);
             st.below.push(st.below[c]);
             st.block.push(st.block[c]);
+            child(c);
         }
     }
-    st.report.split_edges += keys.len();
-    (values, keys.len())
 }
 
 /// The side of every selected cell from its nodes' values: +1, -1, or 0 for a cell with

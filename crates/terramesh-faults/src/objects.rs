@@ -20,9 +20,7 @@
 use rayon::prelude::*;
 use robust::{orient2d, orient3d, Coord, Coord3D};
 
-use crate::mesh::{
-    centroid, key, split_tet, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
-};
+use crate::mesh::{centroid, key, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
 use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
 
 /// The default of [`ObjectSet::resolution`] (`geology.structure_resolution`): how far the
@@ -1294,40 +1292,12 @@ fn split_edges(st: &mut State, labels: &mut ObjectCells, keys: &[u64], points: V
             .push(st.flags[a] & st.flags[b] & (TOP | BASE | SIDE));
         st.on_fault.push(st.on_fault[a] & st.on_fault[b]);
     }
-    let mut end = vec![false; first as usize];
-    for &k in keys {
-        end[(k >> 32) as usize] = true;
-        end[k as u32 as usize] = true;
-    }
-    let children: Vec<(usize, Vec<[u32; 4]>)> = st
-        .tets
-        .par_iter()
-        .enumerate()
-        .filter(|(_, t)| {
-            t.iter().filter(|&&v| end[v as usize]).count() >= 2
-                && EDGES
-                    .iter()
-                    .any(|&(i, j)| keys.binary_search(&key(t[i], t[j])).is_ok())
-        })
-        .map(|(c, &t)| {
-            let mut out = Vec::with_capacity(8);
-            split_tet(t, keys, first, &mut out);
-            (c, out)
-        })
-        .collect();
-    for (c, kids) in children {
-        st.tets[c] = kids[0];
-        for &k in &kids[1..] {
-            st.tets.push(k);
-            st.positive.push(st.positive[c]);
-            st.below.push(st.below[c]);
-            st.block.push(st.block[c]);
-            if !labels.object.is_empty() {
-                labels.object.push(labels.object[c]);
-                labels.lining.push(labels.lining[c]);
-            }
+    crate::mesh::split_cells(st, keys, first, |c| {
+        if !labels.object.is_empty() {
+            labels.object.push(labels.object[c]);
+            labels.lining.push(labels.lining[c]);
         }
-    }
+    });
 }
 
 /// The faults and interfaces already cut: a node that an object's wall puts on an edge of a
