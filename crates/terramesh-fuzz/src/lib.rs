@@ -68,6 +68,7 @@ pub const TARGETS: &[(&str, Harness)] = &[
     ("fault_surface", fault_surface),
     ("fault_points", fault_points),
     ("fault_picks", fault_picks),
+    ("objects", objects),
 ];
 
 /// Committed data crops (in `fixtures/data/`, paths from the repository root) that also seed a
@@ -527,6 +528,112 @@ pub fn fault_picks(data: &[u8]) {
                 "depth {}",
                 k.depth
             );
+        }
+    }
+}
+
+/// An engineering object (`[[geology.tunnels]]`, `[[geology.excavations]]`,
+/// `[[geology.structures]]`) read from its file and validated against a fixed terrain (a 1 km
+/// square, 100 to 110 m, base 0). The first byte picks the object and its file: `'c'`, `'h'`,
+/// `'r'` a circular, horseshoe or rectangular tunnel (an axis CSV `x,y,z`, with a lining for
+/// `'c'`); `'e'`, `'g'`, `'w'` an excavation (outline as a CSV ring, GeoJSON or WKT; floor 50 m,
+/// faces at 60°); `'s'`, `'o'`, `'t'` a structure (STL, OBJ or TSurf). An accepted object has
+/// positive, finite exact volumes and a finite field at its corners and centre.
+pub fn objects(data: &[u8]) {
+    use terramesh_faults::{ObjectGeometry, ObjectSet, ObjectSpec, Profile, Terrain};
+    let Some((&flag, rest)) = data.split_first() else {
+        return;
+    };
+    let geometry = match flag {
+        b'c' | b'h' | b'r' => {
+            let path = files::write("axis.csv", rest);
+            let Ok(axis) = terramesh_io::objects::read_axis(&path, "t") else {
+                return;
+            };
+            let profile = match flag {
+                b'c' => Profile::Circle { diameter: 10.0 },
+                b'h' => Profile::Horseshoe {
+                    width: 8.0,
+                    height: 9.0,
+                },
+                _ => Profile::Rectangle {
+                    width: 6.0,
+                    height: 4.0,
+                },
+            };
+            let lining = if flag == b'c' { 0.5 } else { 0.0 };
+            ObjectGeometry::Tunnel {
+                axis,
+                profile,
+                lining,
+            }
+        }
+        b'e' | b'g' | b'w' => {
+            let name = match flag {
+                b'e' => "pit.csv",
+                b'g' => "pit.geojson",
+                _ => "pit.wkt",
+            };
+            let path = files::write(name, rest);
+            let Ok(outline) = terramesh_io::objects::read_outline(&path, "pit") else {
+                return;
+            };
+            ObjectGeometry::Excavation {
+                outline,
+                floor: 50.0,
+                face_angle: 60.0,
+            }
+        }
+        _ => {
+            let name = match flag {
+                b'o' => "dam.obj",
+                b't' => "dam.ts",
+                _ => "dam.stl",
+            };
+            let path = files::write(name, rest);
+            let Ok((vertices, triangles)) = terramesh_io::objects::read_solid(&path, "dam") else {
+                return;
+            };
+            ObjectGeometry::Structure {
+                vertices,
+                triangles,
+            }
+        }
+    };
+    let terrain = Terrain::new(
+        vec![[0.0, 0.0], [1000.0, 0.0], [1000.0, 1000.0], [0.0, 1000.0]],
+        vec![[0, 1, 2], [0, 2, 3]],
+        vec![100.0, 104.0, 110.0, 102.0],
+    )
+    .expect("a valid terrain");
+    let spec = ObjectSpec {
+        name: "object".into(),
+        geometry,
+        stage: 1,
+    };
+    let Ok(set) = ObjectSet::new(std::slice::from_ref(&spec), &terrain, 0.0) else {
+        return;
+    };
+    let o = &set.objects[0];
+    assert!(
+        o.exact[0].is_finite() && o.exact[0] > 0.0,
+        "exact volume {}",
+        o.exact[0]
+    );
+    assert!(
+        o.exact[1].is_finite() && o.exact[1] >= 0.0,
+        "lining volume {}",
+        o.exact[1]
+    );
+    assert!(o.size().is_finite() && o.size() > 0.0, "size {}", o.size());
+    for x in [0.0, 500.0, 1000.0] {
+        for y in [0.0, 500.0, 1000.0] {
+            for z in [0.0, 50.0, 105.0] {
+                for &w in o.walls() {
+                    let f = o.field(w, [x, y, z]);
+                    assert!(!f.is_nan(), "the field at ({x}, {y}, {z}) is NaN");
+                }
+            }
         }
     }
 }
