@@ -453,10 +453,10 @@ impl SamplePlan {
     /// The grid nodes over the region.
     pub fn nodes(&self) -> Result<Vec<Node>> {
         let r = self.region()?;
-        let (lo, hi) = r.projected.bbox().context("the region has no vertices")?;
+        let (lo, hi) = r.projected.bbox().ok_or(Error::EmptyRegion)?;
         let metres = (hi[0] - lo[0], hi[1] - lo[1]);
         let (geo_lo, geo_hi) = match &r.geographic {
-            Some(g) => g.bbox().context("the region has no vertices")?,
+            Some(g) => g.bbox().ok_or(Error::EmptyRegion)?,
             None => (lo, hi),
         };
         let degrees = (geo_hi[0] - geo_lo[0], geo_hi[1] - geo_lo[1]);
