@@ -58,18 +58,37 @@ pub enum MarginSpec {
 /// The message of a margin that is not one.
 pub const MARGIN_HELP: &str = "give a fraction such as 0.1 or metres such as 50m";
 
+/// A margin that is not one: not a number, negative or not finite ([`MarginSpec`]'s
+/// `FromStr`). Its message is [`MARGIN_HELP`]; the front end names the setting and the value.
+///
+/// ```
+/// use terramesh::acquire::{BadMargin, MarginSpec};
+/// let e = "-1m".parse::<MarginSpec>().unwrap_err();
+/// assert_eq!(e, BadMargin { value: "-1m".into() });
+/// assert_eq!(e.to_string(), terramesh::acquire::MARGIN_HELP);
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{MARGIN_HELP}")]
+pub struct BadMargin {
+    /// The margin as written.
+    pub value: String,
+}
+
 impl FromStr for MarginSpec {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
+    type Err = BadMargin;
+    fn from_str(s: &str) -> std::result::Result<Self, BadMargin> {
+        let bad = || BadMargin {
+            value: s.to_string(),
+        };
         let t = s.trim();
         let m = match t.strip_suffix('m') {
             Some(m) => m.trim().parse::<f64>().map(MarginSpec::Metres),
             None => t.parse::<f64>().map(MarginSpec::Fraction),
         }
-        .map_err(|_| MARGIN_HELP.to_string())?;
+        .map_err(|_| bad())?;
         let (MarginSpec::Fraction(v) | MarginSpec::Metres(v)) = m;
         if !(v.is_finite() && v >= 0.0) {
-            return Err(MARGIN_HELP.to_string());
+            return Err(bad());
         }
         Ok(m)
     }
