@@ -343,6 +343,18 @@ pub enum Error {
         /// Why there is no transformation.
         source: Box<terramesh_crs::CrsError>,
     },
+    // ---- project: the project file and its overrides -------------------------------------
+    /// A `--set KEY=VALUE` override (Python's `sets`) that cannot be applied.
+    #[error("{file}: override '{set}': {problem}")]
+    Override {
+        /// The project file.
+        file: String,
+        /// The override as given.
+        set: String,
+        /// What is wrong with it.
+        problem: OverrideProblem,
+    },
+
     // ---- acquire: sampling the elevation source -------------------------------------------
     /// A web map tile that does not decode as a Terrarium tile.
     #[error("tile {z}/{x}/{y} from {template}: {why}")]
@@ -682,6 +694,21 @@ pub enum PathProblem {
     NoVariogramFile,
 }
 
+/// What is wrong with a `KEY=VALUE` override ([`Error::Override`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OverrideProblem {
+    /// No `=`.
+    #[error("write KEY=VALUE, e.g. mesh.min_angle=32")]
+    NoEquals,
+    /// An empty part of the key (`mesh..min_angle`, `.x`).
+    #[error("bad key '{0}'")]
+    BadKey(String),
+    /// A part of the key that is a value, not a section.
+    #[error("'{0}' is not a section")]
+    NotASection(String),
+}
+
 // Large kernel errors are boxed, so that `Result<T>` stays small.
 impl From<terramesh_crs::CrsError> for Error {
     fn from(e: terramesh_crs::CrsError) -> Self {
@@ -956,6 +983,7 @@ impl Error {
                     | Error::FaultedMeshWrite { .. }
                     | Error::WriteFile { .. }
                     | Error::Project { .. }
+                    | Error::Override { .. }
                     | Error::VariogramFile { .. }
                     | Error::FaultFile(_)
                     | Error::NoWgs84 { .. },
@@ -1072,6 +1100,53 @@ mod tests {
             e.render(&key)
         );
         assert!(e.to_string().starts_with(terramesh_io::region::CORNER_LIST));
+    }
+
+    /// The faulted stage's typed errors say what the strings they replaced said: the kernel's
+    /// error after the key it is about, a pick with its file, line, hole and fault.
+    #[test]
+    fn faulted_errors_name_the_key_file_line_hole_and_fault() {
+        use terramesh_faults::FaultError;
+        let dip = Error::Fault {
+            source: Box::new(FaultError::Dip {
+                fault: "F1".into(),
+                dip: 95.0,
+            }),
+        };
+        assert_eq!(
+            dip.render(&crate::project::key_of),
+            "geology.faults[F1].dip: fault F1: dip 95 is outside (0, 90] degrees below horizontal"
+        );
+        let planar = Error::Fault {
+            source: Box::new(FaultError::Setting {
+                name: "base".into(),
+                value: f64::NAN,
+                why: "must be finite",
+            }),
+        };
+        assert!(planar
+            .to_string()
+            .starts_with("[[geology.faults]]: base = NaN"));
+        let pick = Error::PickBeyondHole {
+            file: "picks.csv".into(),
+            line: 3,
+            hole: "BH1".into(),
+            fault: "F1".into(),
+            depth: 120.5,
+            deepest: 80.0,
+        };
+        assert_eq!(
+            pick.to_string(),
+            "picks.csv, line 3: hole 'BH1' crosses fault 'F1' at depth 120.5 m, beyond the hole \
+             (logged to 80 m): correct the depth"
+        );
+        let web = Error::NoGeoreference {
+            formats: vec!["kml".into(), "glb".into()],
+            crs: "a projected CRS".into(),
+        };
+        assert!(web
+            .to_string()
+            .starts_with("export.formats: kml, glb need geographic (WGS-84) positions"));
     }
 
     #[test]
