@@ -357,7 +357,7 @@ pub enum Error {
 
     // ---- acquire: sampling the elevation source -------------------------------------------
     /// A web map tile that does not decode as a Terrarium tile.
-    #[error("tile {z}/{x}/{y} from {template}: {why}")]
+    #[error("tile {z}/{x}/{y} from {template}: {source}")]
     TileDecode {
         /// The zoom level.
         z: u8,
@@ -368,7 +368,8 @@ pub enum Error {
         /// The URL template it came from.
         template: String,
         /// What the decoder says is wrong.
-        why: String,
+        #[source]
+        source: terramesh_io::dem::TileError,
     },
     /// A point of a points source that cannot be projected to the region's UTM zone.
     #[error("{file}: point {point}: {source}")]
@@ -974,6 +975,7 @@ impl Error {
                     Error::Setting { .. }
                     | Error::Invalid(_)
                     | Error::PointProjection { .. }
+                    | Error::TileDecode { .. }
                     | Error::Fault { .. }
                     | Error::FaultSurface { .. }
                     | Error::PickDepths { .. }

@@ -94,12 +94,12 @@ pub fn sample_tiles(s: &SamplePlan, template: &str) -> Result<SampleTable> {
     };
     let tiles = fetch_tiles_tolerant(template, z, &need, &opts)?;
     for ((x, y), bytes) in tiles {
-        m.insert(x, y, &bytes).map_err(|why| Error::TileDecode {
+        m.insert(x, y, &bytes).map_err(|source| Error::TileDecode {
             z,
             x,
             y,
             template: template.to_string(),
-            why,
+            source,
         })?;
     }
     sample(s, &m, nodes)
