@@ -343,9 +343,297 @@ pub enum Error {
         /// Why there is no transformation.
         source: Box<terramesh_crs::CrsError>,
     },
-    /// Anything else, in words: only the faulted geology stage (`geology/faulted*.rs`) and
-    /// the exports (`build/exports.rs`) still word errors this way, and [`Context`] on an
-    /// `Option`.
+    // ---- project: the project file and its overrides -------------------------------------
+    /// A `--set KEY=VALUE` override (Python's `sets`) that cannot be applied.
+    #[error("{file}: override '{set}': {problem}")]
+    Override {
+        /// The project file.
+        file: String,
+        /// The override as given.
+        set: String,
+        /// What is wrong with it.
+        problem: OverrideProblem,
+    },
+
+    // ---- acquire: sampling the elevation source -------------------------------------------
+    /// A web map tile that does not decode as a Terrarium tile.
+    #[error("tile {z}/{x}/{y} from {template}: {source}")]
+    TileDecode {
+        /// The zoom level.
+        z: u8,
+        /// The tile's column.
+        x: u32,
+        /// The tile's row.
+        y: u32,
+        /// The URL template it came from.
+        template: String,
+        /// What the decoder says is wrong.
+        #[source]
+        source: terramesh_io::dem::TileError,
+    },
+    /// A point of a points source that cannot be projected to the region's UTM zone.
+    #[error("{file}: point {point}: {source}")]
+    PointProjection {
+        /// The points source's name.
+        file: String,
+        /// The point (1-based).
+        point: usize,
+        /// Why it cannot be projected.
+        #[source]
+        source: terramesh_core::coords::CoordError,
+    },
+    /// A region whose outline has no vertex.
+    #[error("the region has no vertices")]
+    EmptyRegion,
+    /// An elevation web service asked for over a region without latitudes and longitudes.
+    #[error("elevation services need a region in latitude/longitude")]
+    ServiceNeedsLatLon,
+    /// A build without a region.
+    #[error("a region is needed for build")]
+    BuildNeedsRegion,
+    /// Points in latitude/longitude without the UTM zone to project them to.
+    #[error("geographic points need the region's UTM zone")]
+    GeographicPointsNeedZone,
+
+    // ---- build: the interpolation stage and the exports -----------------------------------
+    /// Kriging asked of a stage that fitted no variogram (a bug: the plan asks for one
+    /// whenever a method kriges).
+    #[error("internal: kriging without a variogram (none fitted)")]
+    NoVariogramFitted,
+    /// IDW asked for its kriging method (a bug: IDW is not kriging).
+    #[error("IDW has no kriging method")]
+    IdwNotKriging,
+    /// Geographic exports of a project in an unnamed projected CRS.
+    #[error(
+        "export.formats: {} need geographic (WGS-84) positions, and this project is in {crs} \
+         (region.crs = \"projected\"), which terramesh cannot place on the Earth: name the \
+         CRS with region.crs = \"EPSG:<code>\", or remove them from export.formats, e.g. \
+         formats = [\"vtu\", \"obj\", \"ply\", \"stl\", \"ts\", \"msh\", \"dxf\"]",
+        formats.join(", ")
+    )]
+    NoGeoreference {
+        /// The geographic formats asked for.
+        formats: Vec<String>,
+        /// The project's CRS, in words.
+        crs: String,
+    },
+
+    // ---- geology::faulted: the faulted geological model -----------------------------------
+    /// The fault kernel's error, said of the `[[geology.faults]]` key it is about
+    /// (`geology.faults[F1].dip`).
+    #[error("{}: {source}", fault_key(source))]
+    Fault {
+        /// The kernel's error.
+        #[source]
+        source: Box<terramesh_faults::FaultError>,
+    },
+    /// A fault's surface file that cannot be used.
+    #[error("geology.faults[{fault}].surface: {source}")]
+    FaultSurface {
+        /// The fault.
+        fault: String,
+        /// What is wrong with the file.
+        #[source]
+        source: Box<terramesh_io::faults::FaultFileError>,
+    },
+    /// A trace in latitude/longitude without the model's CRS to project it to.
+    #[error("geology.faults[{fault}].trace: a geographic trace needs the model's CRS")]
+    TraceNeedsCrs {
+        /// The fault.
+        fault: String,
+    },
+    /// Fault points that fix no plane, or a horizontal one.
+    #[error(
+        "geology.faults[{fault}].points {}: the points do not fix a plane that is not \
+         horizontal: give points spread over the fault",
+        file.display()
+    )]
+    FaultPointsNoPlane {
+        /// The fault.
+        fault: String,
+        /// The points file.
+        file: std::path::PathBuf,
+    },
+    /// The intervals file, read for the holes' depths to check the fault picks against.
+    #[error("{source}")]
+    PickDepths {
+        /// What is wrong with the file.
+        #[source]
+        source: terramesh_io::table::TableError,
+    },
+    /// Fault picks without boreholes.
+    #[error(
+        "geology.fault_picks {}: picks are where boreholes cross faults, and the project \
+         gives no boreholes: give collars and intervals",
+        file.display()
+    )]
+    PicksWithoutBoreholes {
+        /// The picks file.
+        file: std::path::PathBuf,
+    },
+    /// A fault pick of a hole that the collars file does not have.
+    #[error(
+        "{}, line {line}: hole '{hole}' (fault '{fault}') is not in the collars file",
+        file.display()
+    )]
+    PickUnknownHole {
+        /// The picks file.
+        file: std::path::PathBuf,
+        /// The pick's line.
+        line: u64,
+        /// The hole.
+        hole: String,
+        /// The fault.
+        fault: String,
+    },
+    /// A fault pick deeper than its hole.
+    #[error(
+        "{}, line {line}: hole '{hole}' crosses fault '{fault}' at depth {} m, beyond the hole \
+         (logged to {} m): correct the depth",
+        file.display(),
+        terramesh_core::limits::short(*depth),
+        terramesh_core::limits::short(*deepest)
+    )]
+    PickBeyondHole {
+        /// The picks file.
+        file: std::path::PathBuf,
+        /// The pick's line.
+        line: u64,
+        /// The hole.
+        hole: String,
+        /// The fault.
+        fault: String,
+        /// The pick's measured depth, metres.
+        depth: f64,
+        /// The hole's deepest logged depth, metres.
+        deepest: f64,
+    },
+    /// A base grid for a faulted model, whose base is flat.
+    #[error(
+        "geology.base {}: a faulted model has a flat base for now: give an elevation \
+         (base = -250) or \"auto\"",
+        file.display()
+    )]
+    FaultedRasterBase {
+        /// The base grid.
+        file: std::path::PathBuf,
+    },
+    /// A unit logged again below a deeper one in a hole that crosses no fault there.
+    #[error(
+        "{log}, line {line}, hole '{hole}': unit '{unit}' is logged again at depth {} m below a \
+         deeper unit ({above}), with no fault between: a unit repeats in a hole only past a \
+         fault (a reverse fault): give where the hole crosses it in geology.fault_picks, or \
+         correct the log",
+        terramesh_core::limits::short(*depth)
+    )]
+    RepeatWithoutFault {
+        /// The log file.
+        log: String,
+        /// The line of the repeated unit.
+        line: u64,
+        /// The hole.
+        hole: String,
+        /// The unit.
+        unit: String,
+        /// Its measured depth, metres.
+        depth: f64,
+        /// The contact above it (`line N`, or `the collar`).
+        above: String,
+    },
+    /// The top of a unit logged twice in one fault block of a hole.
+    #[error(
+        "{log}, line {line}, hole '{hole}': the top of unit '{unit}' is logged twice (first on \
+         line {first}) in one fault block ({block}): a unit repeats in a hole only past a fault \
+         (a reverse fault): give where the hole crosses it in geology.fault_picks, or correct \
+         the log"
+    )]
+    TopTwiceInBlock {
+        /// The log file.
+        log: String,
+        /// The line of the second top.
+        line: u64,
+        /// The hole.
+        hole: String,
+        /// The unit.
+        unit: String,
+        /// The line of the first top.
+        first: u64,
+        /// The fault block, in words.
+        block: String,
+    },
+    /// An interface of a faulted model that no borehole meets.
+    #[error(
+        "[geology]: no borehole meets the top of '{unit}': a faulted model interpolates every \
+         interface from the boreholes' contacts"
+    )]
+    NoContactOfTop {
+        /// The unit whose top no borehole meets.
+        unit: String,
+    },
+    /// A fault block without contacts of an interface, and no throw to take it across.
+    #[error(
+        "geology.faults[{fault}].throw: block {block} has no contact of the top of '{unit}', \
+         which it takes from the other side of {fault} shifted by the throw: give throw \
+         (metres) and kind (\"normal\" or \"reverse\")"
+    )]
+    NoThrow {
+        /// The fault.
+        fault: String,
+        /// The block, in words.
+        block: String,
+        /// The unit.
+        unit: String,
+    },
+    /// The terrain (the DSM over the planar mesh) that the fault kernel refuses.
+    #[error("[[geology.faults]]: the DSM: {source}")]
+    FaultedTerrain {
+        /// The kernel's error.
+        #[source]
+        source: Box<terramesh_faults::FaultError>,
+    },
+    /// The planar mesh under the faulted model.
+    #[error("the planar mesh: {source}")]
+    PlanarMesh {
+        /// The kernel's error.
+        #[source]
+        source: Box<terramesh_geology::GeologyError>,
+    },
+    /// The faulted mesh failed its checks (a bug).
+    #[error(
+        "[[geology.faults]]: the faulted mesh failed its checks ({source}; {unresolved} cells \
+         left straddling an interface); please report it with the project"
+    )]
+    FaultedMeshCheck {
+        /// The failed check.
+        #[source]
+        source: Box<terramesh_faults::FaultError>,
+        /// The cells left straddling an interface.
+        unresolved: usize,
+    },
+    /// The faulted mesh that the writer refuses (a bug).
+    #[error(
+        "[[geology.faults]]: the faulted mesh cannot be written: {source}; please report it \
+         with the project"
+    )]
+    FaultedMeshWrite {
+        /// The writer's error.
+        #[source]
+        source: terramesh_io::model::MeshError,
+    },
+    /// Writing a file of the faulted model.
+    #[error("{}: {source}", file.display())]
+    WriteFile {
+        /// The file or folder.
+        file: std::path::PathBuf,
+        /// The error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// Anything else, in words. This crate words none of its own errors this way any more
+    /// (objects aside, typed by their own work); it stays for the crates built on it that
+    /// still do (terramesh-tiles, the Python binding) and for [`Context`] on an `Option`
+    /// (used by terramesh-tiles).
     #[error("{0}")]
     Invalid(String),
     /// The work was stopped on request ([`Progress::cancelled`](crate::progress::Progress::cancelled)
@@ -407,6 +695,21 @@ pub enum PathProblem {
     NoVariogramFile,
 }
 
+/// What is wrong with a `KEY=VALUE` override ([`Error::Override`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OverrideProblem {
+    /// No `=`.
+    #[error("write KEY=VALUE, e.g. mesh.min_angle=32")]
+    NoEquals,
+    /// An empty part of the key (`mesh..min_angle`, `.x`).
+    #[error("bad key '{0}'")]
+    BadKey(String),
+    /// A part of the key that is a value, not a section.
+    #[error("'{0}' is not a section")]
+    NotASection(String),
+}
+
 // Large kernel errors are boxed, so that `Result<T>` stays small.
 impl From<terramesh_crs::CrsError> for Error {
     fn from(e: terramesh_crs::CrsError) -> Self {
@@ -436,6 +739,23 @@ impl From<terramesh_geology::GeologyError> for Error {
     fn from(e: terramesh_geology::GeologyError) -> Self {
         Error::Geology(Box::new(e))
     }
+}
+
+/// The `[[geology.faults]]` key a fault kernel's error is about: `geology.faults[F1].dip`,
+/// or `[[geology.faults]]` for an error about no one key.
+fn fault_key(e: &terramesh_faults::FaultError) -> String {
+    use terramesh_faults::FaultError as F;
+    let (fault, key) = match e {
+        F::Dip { fault, .. } => (fault, "dip"),
+        F::DipAlongTrace { fault, .. } => (fault, "dip_direction"),
+        F::TraceOutside { fault } | F::Trace { fault, .. } => (fault, "trace"),
+        F::Surface { fault, .. } => (fault, "surface"),
+        F::Depth { fault, .. } => (fault, "depth"),
+        F::UnknownEndsAt { fault, .. } | F::NeverMeets { fault, .. } => (fault, "ends_at"),
+        F::Faults { fault, .. } => (fault, "name"),
+        _ => return "[[geology.faults]]".to_string(),
+    };
+    format!("geology.faults[{fault}].{key}")
 }
 
 /// The message of a bad setting: `NAME 'VALUE': WHY`, or `NAME: WHY` without a value. `WHY`
@@ -654,7 +974,18 @@ impl Error {
                 Some(
                     Error::Setting { .. }
                     | Error::Invalid(_)
+                    | Error::PointProjection { .. }
+                    | Error::TileDecode { .. }
+                    | Error::Fault { .. }
+                    | Error::FaultSurface { .. }
+                    | Error::PickDepths { .. }
+                    | Error::FaultedTerrain { .. }
+                    | Error::PlanarMesh { .. }
+                    | Error::FaultedMeshCheck { .. }
+                    | Error::FaultedMeshWrite { .. }
+                    | Error::WriteFile { .. }
                     | Error::Project { .. }
+                    | Error::Override { .. }
                     | Error::VariogramFile { .. }
                     | Error::FaultFile(_)
                     | Error::NoWgs84 { .. },
@@ -724,14 +1055,6 @@ impl<T> Context<T> for Option<T> {
     }
 }
 
-/// `bail!(...)`: return an [`Error::Invalid`] with a formatted message.
-macro_rules! bail {
-    ($($t:tt)*) => {
-        return Err($crate::error::Error::Invalid(format!($($t)*)))
-    };
-}
-pub(crate) use bail;
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -779,6 +1102,53 @@ mod tests {
             e.render(&key)
         );
         assert!(e.to_string().starts_with(terramesh_io::region::CORNER_LIST));
+    }
+
+    /// The faulted stage's typed errors say what the strings they replaced said: the kernel's
+    /// error after the key it is about, a pick with its file, line, hole and fault.
+    #[test]
+    fn faulted_errors_name_the_key_file_line_hole_and_fault() {
+        use terramesh_faults::FaultError;
+        let dip = Error::Fault {
+            source: Box::new(FaultError::Dip {
+                fault: "F1".into(),
+                dip: 95.0,
+            }),
+        };
+        assert_eq!(
+            dip.render(&crate::project::key_of),
+            "geology.faults[F1].dip: fault F1: dip 95 is outside (0, 90] degrees below horizontal"
+        );
+        let planar = Error::Fault {
+            source: Box::new(FaultError::Setting {
+                name: "base".into(),
+                value: f64::NAN,
+                why: "must be finite",
+            }),
+        };
+        assert!(planar
+            .to_string()
+            .starts_with("[[geology.faults]]: base = NaN"));
+        let pick = Error::PickBeyondHole {
+            file: "picks.csv".into(),
+            line: 3,
+            hole: "BH1".into(),
+            fault: "F1".into(),
+            depth: 120.5,
+            deepest: 80.0,
+        };
+        assert_eq!(
+            pick.to_string(),
+            "picks.csv, line 3: hole 'BH1' crosses fault 'F1' at depth 120.5 m, beyond the hole \
+             (logged to 80 m): correct the depth"
+        );
+        let web = Error::NoGeoreference {
+            formats: vec!["kml".into(), "glb".into()],
+            crs: "a projected CRS".into(),
+        };
+        assert!(web
+            .to_string()
+            .starts_with("export.formats: kml, glb need geographic (WGS-84) positions"));
     }
 
     #[test]

@@ -218,7 +218,7 @@ impl DemHeights {
 
     /// Checks that the DEM covers `region`: its corners and a 101 x 101 grid inside it.
     pub fn check_covers(&self, region: &LoadedRegion) -> Result<()> {
-        let (lo, hi) = region.projected.bbox().context("empty region")?;
+        let (lo, hi) = region.projected.bbox().ok_or(Error::EmptyRegion)?;
         let mut probes: Vec<[f64; 2]> = region
             .projected
             .polygons
@@ -318,7 +318,7 @@ pub fn read_points(path: &Path, crs: RegionCrs, zone: Option<Zone>) -> Result<Ve
         t.find(&["lon", "longitude", "lng"]),
     );
     if let (RegionCrs::Geographic, (Some(la), Some(lo))) = (crs, lat_lon) {
-        let zone = zone.context("geographic points need the region's UTM zone")?;
+        let zone = zone.ok_or(Error::GeographicPointsNeedZone)?;
         let mut out = Vec::with_capacity(t.records.len());
         for r in 0..t.records.len() {
             let ang = |c: usize, axis| {

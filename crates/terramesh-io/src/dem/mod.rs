@@ -27,7 +27,7 @@ pub use points::{read_points, PointCloud};
 pub use raster::{GeoTransform, Raster};
 pub use sample::{sample_in, sample_latlon, sample_nodes, sample_utm};
 pub use srtm::{HgtMosaic, HGT_VOID};
-pub use tiles::{terrarium_decode, TileMosaic};
+pub use tiles::{terrarium_decode, TileError, TileMosaic};
 pub use window::LatLonBox;
 
 use std::path::Path;

@@ -13,17 +13,66 @@ use super::{DemError, ElevationSource, SourceCrs};
 
 const SIDE: usize = 256;
 
+/// A Terrarium tile that does not decode ([`terrarium_decode`]).
+///
+/// ```
+/// use terramesh_io::dem::{terrarium_decode, TileError};
+/// let e = terrarium_decode(b"not a png").unwrap_err();
+/// assert!(matches!(e, TileError::Png { what: "not a PNG", .. }), "{e}");
+/// assert!(e.to_string().starts_with("not a PNG: "));
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TileError {
+    /// A chunk whose checksum does not match its data.
+    #[error(
+        "{what}: the checksum (CRC) of its {chunk} chunk does not match its data: the file is \
+         damaged; fetch the tile again"
+    )]
+    Checksum {
+        /// What was being read (`not a PNG`: the header, `bad PNG data`: the image).
+        what: &'static str,
+        /// The chunk's type (`IDAT`, ...).
+        chunk: String,
+    },
+    /// The bytes end before the image does.
+    #[error("{}", super::error::TRUNCATED)]
+    Truncated,
+    /// Any other error of the PNG decoder.
+    #[error("{what}: {detail}")]
+    Png {
+        /// What was being read (`not a PNG`: the header, `bad PNG data`: the image).
+        what: &'static str,
+        /// The decoder's message.
+        detail: String,
+    },
+    /// An image that is not 256 x 256 pixels.
+    #[error("{width} x {height} pixels: a terrain tile is 256 x 256")]
+    Size {
+        /// Its width, pixels.
+        width: u32,
+        /// Its height, pixels.
+        height: u32,
+    },
+    /// An image that is not RGB or RGBA.
+    #[error("{color} PNG: Terrarium tiles are RGB")]
+    Color {
+        /// Its colour type, as the decoder names it.
+        color: String,
+    },
+}
+
 /// Decodes a Terrarium PNG (RGB or RGBA, 8-bit) into 256 x 256 elevations, row by row from
 /// the north. A fully transparent pixel is a void (NaN).
 ///
 /// ```
-/// # fn main() -> Result<(), String> {
+/// # fn main() -> Result<(), terramesh_io::dem::TileError> {
 /// let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/tiles/crop_11_385_803.png");
 /// let z = terramesh_io::dem::terrarium_decode(&std::fs::read(p).unwrap())?;
 /// assert_eq!(z.len(), 256 * 256);
 /// # Ok(()) }
 /// ```
-pub fn terrarium_decode(png_bytes: &[u8]) -> Result<Vec<f32>, String> {
+pub fn terrarium_decode(png_bytes: &[u8]) -> Result<Vec<f32>, TileError> {
     let mut dec = png::Decoder::new(png_bytes);
     dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
     let mut reader = dec.read_info().map_err(|e| png_error("not a PNG", e))?;
@@ -31,7 +80,10 @@ pub fn terrarium_decode(png_bytes: &[u8]) -> Result<Vec<f32>, String> {
     // 2^20 x 2^20 pixels asked for terabytes).
     let (w, h) = (reader.info().width, reader.info().height);
     if (w as usize, h as usize) != (SIDE, SIDE) {
-        return Err(format!("{w} x {h} pixels: a terrain tile is 256 x 256"));
+        return Err(TileError::Size {
+            width: w,
+            height: h,
+        });
     }
     let mut buf = vec![0; reader.output_buffer_size()];
     let info = reader
@@ -40,7 +92,11 @@ pub fn terrarium_decode(png_bytes: &[u8]) -> Result<Vec<f32>, String> {
     let ch = match info.color_type {
         png::ColorType::Rgb => 3,
         png::ColorType::Rgba => 4,
-        other => return Err(format!("{other:?} PNG: Terrarium tiles are RGB")),
+        other => {
+            return Err(TileError::Color {
+                color: format!("{other:?}"),
+            })
+        }
     };
     Ok(buf[..SIDE * SIDE * ch]
         .chunks_exact(ch)
@@ -87,7 +143,7 @@ impl TileMosaic {
     /// m.insert(385, 803, &std::fs::read(p).unwrap()).unwrap();
     /// assert!(m.insert(385, 804, b"not a png").is_err());
     /// ```
-    pub fn insert(&mut self, x: u32, y: u32, png_bytes: &[u8]) -> Result<(), String> {
+    pub fn insert(&mut self, x: u32, y: u32, png_bytes: &[u8]) -> Result<(), TileError> {
         self.tiles.insert((x, y), terrarium_decode(png_bytes)?);
         Ok(())
     }
@@ -164,7 +220,7 @@ pub(crate) fn read_tile_file(path: &Path) -> Result<TileMosaic, DemError> {
     }
     let mut m = TileMosaic::new(z as u8, &path.display().to_string());
     m.insert(x, y, &bytes)
-        .map_err(|e| DemError::format(path, e))?;
+        .map_err(|e| DemError::format(path, e.to_string()))?;
     Ok(m)
 }
 
@@ -212,20 +268,65 @@ impl ElevationSource for TileMosaic {
 
 /// A PNG decoder's error in words: its checksum errors end in a debug dump of the chunk type
 /// (`while decoding ChunkType { type: IDAT, critical: true, ... } chunk.`), cut to the name.
-fn png_error(what: &str, e: png::DecodingError) -> String {
+fn png_error(what: &'static str, e: png::DecodingError) -> TileError {
     let text = e.to_string();
     if text.contains("CRC error") {
         let chunk = text
             .split_once("type: ")
             .and_then(|(_, rest)| rest.split([',', ' ', '}']).next())
             .unwrap_or("a");
-        return format!(
-            "{what}: the checksum (CRC) of its {chunk} chunk does not match its data: the file \
-             is damaged; fetch the tile again"
-        );
+        return TileError::Checksum {
+            what,
+            chunk: chunk.to_string(),
+        };
     }
     if super::error::is_truncation(&text) {
-        return super::error::TRUNCATED.to_string();
+        return TileError::Truncated;
     }
-    format!("{what}: {text}")
+    TileError::Png { what, detail: text }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tile() -> Vec<u8> {
+        let p = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/data/tiles/crop_11_385_803.png"
+        );
+        std::fs::read(p).unwrap()
+    }
+
+    /// A damaged or cut tile is a typed error, with the words it had as a string.
+    #[test]
+    fn damaged_tiles_say_how() {
+        let good = tile();
+        assert_eq!(terrarium_decode(&good).unwrap().len(), SIDE * SIDE);
+        let cut = terrarium_decode(&good[..good.len() / 2]).unwrap_err();
+        assert!(
+            matches!(
+                &cut,
+                TileError::Png {
+                    what: "bad PNG data",
+                    ..
+                }
+            ),
+            "{cut:?}"
+        );
+        assert!(cut.to_string().starts_with("bad PNG data: "), "{cut}");
+        // A byte of the first IDAT chunk's checksum flipped: it no longer matches the data.
+        let idat = good.windows(4).position(|w| w == b"IDAT").unwrap();
+        let len = u32::from_be_bytes(good[idat - 4..idat].try_into().unwrap()) as usize;
+        let mut bad = good.clone();
+        bad[idat + 4 + len] ^= 0xff;
+        let e = terrarium_decode(&bad).unwrap_err();
+        assert!(
+            matches!(&e, TileError::Checksum { chunk, .. } if chunk == "IDAT"),
+            "{e:?}"
+        );
+        assert!(e
+            .to_string()
+            .ends_with("chunk does not match its data: the file is damaged; fetch the tile again"));
+    }
 }

@@ -38,9 +38,9 @@ mod table;
 mod web;
 
 pub use plan::{
-    default_cache_dir, is_remote, journal_path, MarginSpec, OnMissing, SampleOptions, SamplePlan,
-    Source, WebOptions, DEFAULT_BACKOFF, DEFAULT_CONCURRENCY, DEFAULT_NODATA, DEFAULT_RETRIES,
-    DEFAULT_TIMEOUT, DEFAULT_ZOOM, MARGIN_HELP,
+    default_cache_dir, is_remote, journal_path, BadMargin, MarginSpec, OnMissing, SampleOptions,
+    SamplePlan, Source, WebOptions, DEFAULT_BACKOFF, DEFAULT_CONCURRENCY, DEFAULT_NODATA,
+    DEFAULT_RETRIES, DEFAULT_TIMEOUT, DEFAULT_ZOOM, MARGIN_HELP,
 };
 pub use table::{write_table, Row, SampleTable};
 

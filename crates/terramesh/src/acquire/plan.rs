@@ -58,18 +58,37 @@ pub enum MarginSpec {
 /// The message of a margin that is not one.
 pub const MARGIN_HELP: &str = "give a fraction such as 0.1 or metres such as 50m";
 
+/// A margin that is not one: not a number, negative or not finite ([`MarginSpec`]'s
+/// `FromStr`). Its message is [`MARGIN_HELP`]; the front end names the setting and the value.
+///
+/// ```
+/// use terramesh::acquire::{BadMargin, MarginSpec};
+/// let e = "-1m".parse::<MarginSpec>().unwrap_err();
+/// assert_eq!(e, BadMargin { value: "-1m".into() });
+/// assert_eq!(e.to_string(), terramesh::acquire::MARGIN_HELP);
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{MARGIN_HELP}")]
+pub struct BadMargin {
+    /// The margin as written.
+    pub value: String,
+}
+
 impl FromStr for MarginSpec {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
+    type Err = BadMargin;
+    fn from_str(s: &str) -> std::result::Result<Self, BadMargin> {
+        let bad = || BadMargin {
+            value: s.to_string(),
+        };
         let t = s.trim();
         let m = match t.strip_suffix('m') {
             Some(m) => m.trim().parse::<f64>().map(MarginSpec::Metres),
             None => t.parse::<f64>().map(MarginSpec::Fraction),
         }
-        .map_err(|_| MARGIN_HELP.to_string())?;
+        .map_err(|_| bad())?;
         let (MarginSpec::Fraction(v) | MarginSpec::Metres(v)) = m;
         if !(v.is_finite() && v >= 0.0) {
-            return Err(MARGIN_HELP.to_string());
+            return Err(bad());
         }
         Ok(m)
     }
@@ -453,10 +472,10 @@ impl SamplePlan {
     /// The grid nodes over the region.
     pub fn nodes(&self) -> Result<Vec<Node>> {
         let r = self.region()?;
-        let (lo, hi) = r.projected.bbox().context("the region has no vertices")?;
+        let (lo, hi) = r.projected.bbox().ok_or(Error::EmptyRegion)?;
         let metres = (hi[0] - lo[0], hi[1] - lo[1]);
         let (geo_lo, geo_hi) = match &r.geographic {
-            Some(g) => g.bbox().context("the region has no vertices")?,
+            Some(g) => g.bbox().ok_or(Error::EmptyRegion)?,
             None => (lo, hi),
         };
         let degrees = (geo_hi[0] - geo_lo[0], geo_hi[1] - geo_lo[1]);

@@ -55,7 +55,7 @@ pub fn sample_points(
     let region = s.region.as_ref();
     let keep = |xy: [f64; 2]| -> Result<bool> {
         let Some(r) = region else { return Ok(true) };
-        let (lo, hi) = r.projected.bbox().context("the region has no vertices")?;
+        let (lo, hi) = r.projected.bbox().ok_or(Error::EmptyRegion)?;
         let (lo, hi) = s.options.margin.projected().enlarge(lo, hi)?;
         let inside_box = xy[0] >= lo[0] && xy[0] <= hi[0] && xy[1] >= lo[1] && xy[1] <= hi[1];
         Ok(inside_box && (!s.options.clip || r.projected.contains(xy)))
@@ -143,18 +143,17 @@ pub fn sample_points(
                     Zone::for_point(la / n, lo / n).context("choosing a UTM zone for the points")?
                 }
             };
-            let xy: Vec<Result<[f64; 2], String>> = latlon
+            let xy: Vec<Result<[f64; 2], _>> = latlon
                 .par_iter()
-                .map(|&[lat, lon]| {
-                    to_utm(lat, lon, Some(zone))
-                        .map(|u| [u.easting, u.northing])
-                        .map_err(|e| e.to_string())
-                })
+                .map(|&[lat, lon]| to_utm(lat, lon, Some(zone)).map(|u| [u.easting, u.northing]))
                 .collect();
             let mut rows = Vec::new();
             for (i, p) in xy.into_iter().enumerate() {
-                let p =
-                    p.map_err(|e| Error::invalid(format!("{}: point {}: {e}", pc.name, i + 1)))?;
+                let p = p.map_err(|source| Error::PointProjection {
+                    file: pc.name.clone(),
+                    point: i + 1,
+                    source,
+                })?;
                 if keep(p)? {
                     rows.push(Row {
                         latlon: Some(latlon[i]),

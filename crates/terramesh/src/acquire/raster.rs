@@ -94,8 +94,13 @@ pub fn sample_tiles(s: &SamplePlan, template: &str) -> Result<SampleTable> {
     };
     let tiles = fetch_tiles_tolerant(template, z, &need, &opts)?;
     for ((x, y), bytes) in tiles {
-        m.insert(x, y, &bytes)
-            .map_err(|e| Error::invalid(format!("tile {z}/{x}/{y} from {template}: {e}")))?;
+        m.insert(x, y, &bytes).map_err(|source| Error::TileDecode {
+            z,
+            x,
+            y,
+            template: template.to_string(),
+            source,
+        })?;
     }
     sample(s, &m, nodes)
 }

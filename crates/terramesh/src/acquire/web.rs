@@ -6,7 +6,7 @@ use terramesh_web::{fetch, Endpoint, FetchOptions, PointStore};
 
 use super::plan::SamplePlan;
 use super::table::SampleTable;
-use crate::error::{Context, Result};
+use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 
 fn fnv(s: &str) -> u64 {
@@ -26,7 +26,7 @@ pub fn sample_web(
         .iter()
         .map(|n| n.latlon)
         .collect::<Option<_>>()
-        .context("elevation services need a region in latitude/longitude")?;
+        .ok_or(Error::ServiceNeedsLatLon)?;
     let opts = FetchOptions {
         cache: s
             .cache_dir

@@ -57,7 +57,7 @@ pub fn adaptive(
     }
     // The surface of the first interpolation method, which gives the DSM heights.
     let engine = Surface::primary_with(p, &model.data, &model.variogram, model.drift.as_ref())?;
-    let (lo, hi) = s.region.projected.bbox().context("empty region")?;
+    let (lo, hi) = s.region.projected.bbox().ok_or(Error::EmptyRegion)?;
     let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
     // Half the sampling cell resolves what was sampled; the node cap bounds the work.
     let mut step = (0.5 * s.cell[0].min(s.cell[1]))

@@ -236,14 +236,12 @@ pub fn write_all(
         _ if web.is_empty() => None,
         (Some(z), _) => Some(named(Georef::utm(z))),
         (None, Some(c)) => Some(named(Georef::crs(c, "region.crs")?)),
-        (None, None) => crate::error::bail!(
-            "export.formats: {} need geographic (WGS-84) positions, and this project is in {} \
-             (region.crs = \"projected\"), which terramesh cannot place on the Earth: name the \
-             CRS with region.crs = \"EPSG:<code>\", or remove them from export.formats, e.g. \
-             formats = [\"vtu\", \"obj\", \"ply\", \"stl\", \"ts\", \"msh\", \"dxf\"]",
-            web.join(", "),
-            s.crs_name()
-        ),
+        (None, None) => {
+            return Err(crate::Error::NoGeoreference {
+                formats: web.iter().map(|f| f.to_string()).collect(),
+                crs: s.crs_name(),
+            })
+        }
     };
     geo = match &georef {
         Some(georef) if want("kml") || want("dae") || want("terrain") => abs

@@ -31,9 +31,7 @@ pub(super) fn build_rest(
     dsm_key: Option<u64>,
     grids: &mut super::GridsAhead,
 ) -> Result<Built> {
-    let g = project
-        .geology()
-        .context("the project has no [geology] section")?;
+    let g = project.geology().ok_or(Error::NoGeology)?;
     let fit = st.variogram(
         needs_variogram(project),
         "not fitted: the DSM is IDW (interpolation.methods) and needs none",
@@ -135,10 +133,7 @@ pub fn dsm_heights(
         .map(|i| m.mesh.absolute(i))
         .collect();
     let primary = ip.methods[0];
-    let variogram = || {
-        model
-            .context("the DSM's kriging needs the variogram of the samples (internal: none fitted)")
-    };
+    let variogram = || model.ok_or(Error::NoVariogramFitted);
     let dsm = match primary {
         InterpolationMethod::Idw => {
             let engine = Surface::idw(data, ip.idw_power, ip.idw_neighbors)?;

@@ -226,7 +226,7 @@ pub fn bounded_variogram(data: &Data, lags: &[Lag]) -> Result<Variogram> {
         .copied()
         .filter(|k| k.bounded())
         .collect();
-    let (fit, _) = fit_auto(data, lags, Weighting::Cressie, &kinds).map_err(Error::invalid)?;
+    let (fit, _) = fit_auto(data, lags, Weighting::Cressie, &kinds)?;
     Ok(fit.variogram)
 }
 
@@ -270,8 +270,7 @@ fn simulate_field(
         obs.iter().map(|o| [o.x, o.y]).collect(),
         obs.iter().map(|o| o.value).collect(),
         Duplicates::Mean,
-    )
-    .map_err(Error::invalid)?;
+    )?;
     // A variogram without a sill (power, linear) has no covariance to simulate with: the
     // field is simulated with the best bounded model fitted to the same experimental
     // variogram, as the model's fit would have chosen among those.
@@ -280,7 +279,7 @@ fn simulate_field(
         (variogram, format!("its own variogram, {variogram}"))
     } else {
         let fitted = experimental(&data, &LagSettings::default())
-            .map_err(Error::invalid)
+            .map_err(Error::from)
             .and_then(|lags| bounded_variogram(&data, &lags));
         match fitted {
             Ok(v) => {
@@ -309,8 +308,7 @@ fn simulate_field(
     };
     let s = field_seed(seed);
     let settings = SimulationSettings::new(nr, s);
-    let e = simulate(&data, variogram, method, Neighbourhood::All, xy, &settings)
-        .map_err(Error::invalid)?;
+    let e = simulate(&data, variogram, method, Neighbourhood::All, xy, &settings)?;
     let values: Vec<f64> = (0..e.len()).flat_map(|t| e.at(t).to_vec()).collect();
     Ok((
         FieldSimulation {

@@ -38,7 +38,7 @@ use terramesh_geostat::{
 };
 
 use super::{FileData, LagOptions, ModelOptions, VariogramSource};
-use crate::error::{Context, Error, Result};
+use crate::error::{Error, Result};
 use crate::external_drift::{drift_variogram, DriftSource, Engine};
 use crate::setting::Setting;
 
@@ -136,7 +136,7 @@ impl MethodOptions {
         }
         self.method
             .method(self.drift.unwrap_or(Drift::Linear), self.mean, data)
-            .context("IDW has no kriging method")
+            .ok_or(Error::IdwNotKriging)
     }
 
     /// The moving neighbourhood (or all data).

@@ -23,9 +23,11 @@ use terramesh_io::region::RegionCrs;
 /// assert_eq!(c.region_crs(), RegionCrs::Projected);
 /// assert_eq!(c.crs().and_then(|c| c.epsg()), Some(28992));
 /// assert_eq!("geographic".parse::<ProjectCrs>()?, RegionCrs::Geographic);
-/// assert!("EPSG:4269".parse::<ProjectCrs>().unwrap_err().contains("geographic"));
-/// assert!("EPSG:2277".parse::<ProjectCrs>().unwrap_err().contains("feet"));
-/// # Ok::<(), String>(())
+/// assert!("EPSG:4269".parse::<ProjectCrs>().unwrap_err().to_string().contains("geographic"));
+/// let feet = "EPSG:2277".parse::<ProjectCrs>().unwrap_err();
+/// assert!(matches!(feet, terramesh::project::ProjectCrsError::Feet { .. }));
+/// assert!(feet.to_string().contains("feet"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum ProjectCrs {
@@ -76,33 +78,66 @@ impl fmt::Display for ProjectCrs {
     }
 }
 
+/// A `[region] crs` that terramesh cannot work in ([`ProjectCrs`]'s `FromStr`).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ProjectCrsError {
+    /// Not a word terramesh knows, nor a CRS.
+    #[error(
+        "'{text}' is not \"geographic\", \"projected\" or a projected CRS \"EPSG:<code>\": \
+         {source}"
+    )]
+    NotACrs {
+        /// The value as written.
+        text: String,
+        /// Why it is not a CRS.
+        #[source]
+        source: Box<terramesh_crs::CrsError>,
+    },
+    /// A geographic CRS (degrees).
+    #[error(
+        "{crs} is geographic: a project CRS must be projected (metres); use crs = \
+         \"geographic\" for latitude/longitude regions (worked in UTM), or a projected EPSG \
+         code"
+    )]
+    Geographic {
+        /// The CRS, in words.
+        crs: String,
+    },
+    /// A projected CRS whose unit is not the metre.
+    #[error(
+        "{crs} is in feet ({metres_per_unit} m per unit): a project CRS must be in metres; use \
+         the metre variant of the CRS (inputs in feet are reprojected from their own CRS)"
+    )]
+    Feet {
+        /// The CRS, in words.
+        crs: String,
+        /// Metres per unit of the CRS.
+        metres_per_unit: f64,
+    },
+}
+
 impl std::str::FromStr for ProjectCrs {
-    type Err = String;
-    fn from_str(s: &str) -> Result<ProjectCrs, String> {
+    type Err = ProjectCrsError;
+    fn from_str(s: &str) -> Result<ProjectCrs, ProjectCrsError> {
         if let Ok(r) = s.parse::<RegionCrs>() {
             return Ok(match r {
                 RegionCrs::Geographic => ProjectCrs::Geographic,
                 RegionCrs::Projected => ProjectCrs::Projected,
             });
         }
-        let c = Crs::parse(s).map_err(|e| {
-            format!(
-                "'{s}' is not \"geographic\", \"projected\" or a projected CRS \"EPSG:<code>\": {e}"
-            )
+        let c = Crs::parse(s).map_err(|e| ProjectCrsError::NotACrs {
+            text: s.to_string(),
+            source: Box::new(e),
         })?;
         if c.is_geographic() {
-            return Err(format!(
-                "{c} is geographic: a project CRS must be projected (metres); use \
-                 crs = \"geographic\" for latitude/longitude regions (worked in UTM), or a \
-                 projected EPSG code"
-            ));
+            return Err(ProjectCrsError::Geographic { crs: c.to_string() });
         }
         if c.unit_metres() != 1.0 {
-            return Err(format!(
-                "{c} is in feet ({} m per unit): a project CRS must be in metres; use the \
-                 metre variant of the CRS (inputs in feet are reprojected from their own CRS)",
-                c.unit_metres()
-            ));
+            return Err(ProjectCrsError::Feet {
+                crs: c.to_string(),
+                metres_per_unit: c.unit_metres(),
+            });
         }
         Ok(ProjectCrs::Crs(c))
     }

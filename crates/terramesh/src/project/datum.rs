@@ -39,12 +39,17 @@ pub const KNOWN_VERTICAL_DATUMS: &[(&str, u16, &str)] = &[
 /// let e: HeightDatum = "EPSG:5773".parse()?;
 /// assert_eq!(e.name(), "egm96");
 /// assert_eq!("source".parse::<HeightDatum>()?.epsg(), None);
-/// assert!("msl".parse::<HeightDatum>().unwrap_err().contains("navd88"));
+/// let words = |s: &str| s.parse::<HeightDatum>().unwrap_err().to_string();
+/// assert!(words("msl").contains("navd88"));
 /// // Only vertical CRSs of heights in metres (issue 34):
-/// assert!("EPSG:4326".parse::<HeightDatum>().unwrap_err().contains("horizontal"));
-/// assert!("EPSG:9999".parse::<HeightDatum>().unwrap_err().contains("not a vertical CRS"));
-/// assert!("EPSG:6360".parse::<HeightDatum>().unwrap_err().contains("EPSG:5703"));
-/// # Ok::<(), String>(())
+/// assert!(words("EPSG:4326").contains("horizontal"));
+/// assert!(words("EPSG:9999").contains("not a vertical CRS"));
+/// assert!(words("EPSG:6360").contains("EPSG:5703"));
+/// assert!(matches!(
+///     "EPSG:6360".parse::<HeightDatum>(),
+///     Err(terramesh::project::HeightDatumError::NotMetres { code: 6360, .. })
+/// ));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum HeightDatum {
@@ -119,9 +124,94 @@ impl fmt::Display for HeightDatum {
     }
 }
 
+/// What `vertical_datum` accepts, said after each refusal of an EPSG code.
+const ACCEPTED: &str = "vertical_datum accepts the EPSG code of a vertical CRS of heights in \
+                        metres (\"EPSG:5703\", NAVD88 height), a known name (\"navd88\", \
+                        \"egm96\", ...) or \"source\"";
+
+/// A `vertical_datum` that terramesh cannot record ([`HeightDatum`]'s `FromStr`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum HeightDatumError {
+    /// Neither a known name, nor `EPSG:<code>`, nor `source`.
+    #[error(
+        "'{text}' is not a vertical datum: use one of {}, \"EPSG:<code>\" of a vertical CRS of \
+         heights in metres, or \"source\" (not named)",
+        KNOWN_VERTICAL_DATUMS
+            .iter()
+            .map(|k| format!("\"{}\"", k.0))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )]
+    Unknown {
+        /// The value as written.
+        text: String,
+    },
+    /// The code of a horizontal CRS.
+    #[error(
+        "EPSG:{code} is a horizontal CRS ({}), not a vertical one: it says where points are, \
+         not what their heights refer to; {ACCEPTED}",
+        if *geographic { "geographic" } else { "projected" }
+    )]
+    Horizontal {
+        /// The EPSG code.
+        code: u32,
+        /// Whether the CRS is geographic (else projected).
+        geographic: bool,
+    },
+    /// A code of no CRS of the registry.
+    #[error("EPSG:{code} is not a vertical CRS of the EPSG registry; {ACCEPTED}")]
+    NotInRegistry {
+        /// The EPSG code.
+        code: u32,
+    },
+    /// A vertical CRS of depths.
+    #[error(
+        "EPSG:{code} ({name}) is a vertical CRS of depths (its axis points down), and \
+         terramesh's outputs hold heights: name a vertical CRS of heights{}",
+        twin_words(*twin)
+    )]
+    Depths {
+        /// The EPSG code.
+        code: u32,
+        /// The CRS's name.
+        name: &'static str,
+        /// The vertical CRS of its datum's heights in metres, if any: code and name.
+        twin: Option<(u32, &'static str)>,
+    },
+    /// A vertical CRS of heights in another unit than the metre.
+    #[error(
+        "EPSG:{code} ({name}) measures heights in {unit}, and terramesh's outputs hold metres \
+         (the inputs' z_unit converts them): name the vertical CRS in metres{}",
+        twin_words(*twin)
+    )]
+    NotMetres {
+        /// The EPSG code.
+        code: u32,
+        /// The CRS's name.
+        name: &'static str,
+        /// Its unit.
+        unit: &'static str,
+        /// The vertical CRS of its datum's heights in metres, if any: code and name.
+        twin: Option<(u32, &'static str)>,
+    },
+    /// A code too large for a GeoTIFF key.
+    #[error("EPSG:{code}: {ACCEPTED}")]
+    TooLarge {
+        /// The EPSG code.
+        code: u32,
+    },
+}
+
+/// ` (its datum's heights in metres: "EPSG:5703", NAVD88 height)`, or nothing.
+fn twin_words(twin: Option<(u32, &'static str)>) -> String {
+    twin.map(|(code, name)| format!(" (its datum's heights in metres: \"EPSG:{code}\", {name})"))
+        .unwrap_or_default()
+}
+
 impl std::str::FromStr for HeightDatum {
-    type Err = String;
-    fn from_str(s: &str) -> Result<HeightDatum, String> {
+    type Err = HeightDatumError;
+    fn from_str(s: &str) -> Result<HeightDatum, HeightDatumError> {
         let t = s.trim();
         if t.eq_ignore_ascii_case("source") {
             return Ok(HeightDatum::Source);
@@ -139,67 +229,42 @@ impl std::str::FromStr for HeightDatum {
         if let Some(c) = code {
             return vertical_code(c).map(HeightDatum::Epsg);
         }
-        Err(format!(
-            "'{s}' is not a vertical datum: use one of {}, \"EPSG:<code>\" of a vertical \
-             CRS of heights in metres, or \"source\" (not named)",
-            KNOWN_VERTICAL_DATUMS
-                .iter()
-                .map(|k| format!("\"{}\"", k.0))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))
+        Err(HeightDatumError::Unknown {
+            text: s.to_string(),
+        })
     }
 }
 
 /// The code of an EPSG vertical CRS whose heights are metres, up (what every output holds), or
 /// why `code` is not one: a horizontal CRS, no CRS at all, a depth CRS, heights in feet.
-fn vertical_code(code: u32) -> Result<u16, String> {
+fn vertical_code(code: u32) -> Result<u16, HeightDatumError> {
     use terramesh_crs::vertical;
-    let accepted = "vertical_datum accepts the EPSG code of a vertical CRS of heights in \
-                    metres (\"EPSG:5703\", NAVD88 height), a known name (\"navd88\", \
-                    \"egm96\", ...) or \"source\"";
     let Some(v) = vertical::lookup(code) else {
         return Err(match terramesh_crs::Crs::from_epsg(code) {
-            Ok(c) => format!(
-                "EPSG:{code} is a horizontal CRS ({}), not a vertical one: it says where \
-                 points are, not what their heights refer to; {accepted}",
-                if c.is_geographic() {
-                    "geographic"
-                } else {
-                    "projected"
-                }
-            ),
-            Err(_) => format!("EPSG:{code} is not a vertical CRS of the EPSG registry; {accepted}"),
+            Ok(c) => HeightDatumError::Horizontal {
+                code,
+                geographic: c.is_geographic(),
+            },
+            Err(_) => HeightDatumError::NotInRegistry { code },
         });
     };
-    let twin = || {
-        v.metre_twin()
-            .map(|t| {
-                format!(
-                    " (its datum's heights in metres: \"EPSG:{}\", {})",
-                    t.code, t.name
-                )
-            })
-            .unwrap_or_default()
-    };
+    let twin = v.metre_twin().map(|t| (t.code, t.name));
     if !v.up {
-        return Err(format!(
-            "EPSG:{code} ({}) is a vertical CRS of depths (its axis points down), and \
-             terramesh's outputs hold heights: name a vertical CRS of heights{}",
-            v.name,
-            twin()
-        ));
+        return Err(HeightDatumError::Depths {
+            code,
+            name: v.name,
+            twin,
+        });
     }
     if v.unit != "metre" {
-        return Err(format!(
-            "EPSG:{code} ({}) measures heights in {}, and terramesh's outputs hold metres (the \
-             inputs' z_unit converts them): name the vertical CRS in metres{}",
-            v.name,
-            v.unit,
-            twin()
-        ));
+        return Err(HeightDatumError::NotMetres {
+            code,
+            name: v.name,
+            unit: v.unit,
+            twin,
+        });
     }
-    u16::try_from(code).map_err(|_| format!("EPSG:{code}: {accepted}"))
+    u16::try_from(code).map_err(|_| HeightDatumError::TooLarge { code })
 }
 
 impl<'de> Deserialize<'de> for HeightDatum {

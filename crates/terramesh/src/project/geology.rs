@@ -659,7 +659,10 @@ impl GeologyPlan {
                 FaultSource::Surface(path) => {
                     readable(&format!("faults[{}].surface", f.name), path)?;
                     terramesh_io::faults::read_surface(path, &f.name).map_err(|e| {
-                        Error::invalid(format!("geology.faults[{}].surface: {e}", f.name))
+                        Error::FaultSurface {
+                            fault: f.name.clone(),
+                            source: Box::new(e),
+                        }
                     })?;
                 }
                 FaultSource::Points(path) => {

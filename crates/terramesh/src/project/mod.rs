@@ -11,8 +11,8 @@ mod lower;
 mod objects;
 mod parse;
 
-pub use crs::ProjectCrs;
-pub use datum::{HeightDatum, KNOWN_VERTICAL_DATUMS};
+pub use crs::{ProjectCrs, ProjectCrsError};
+pub use datum::{HeightDatum, HeightDatumError, KNOWN_VERTICAL_DATUMS};
 pub use geology::{BaseSpec, GeologySection, GEOLOGY_TEMPLATE};
 pub use lower::key_of;
 pub use objects::{ExcavationSection, StructureSection, TunnelSection};

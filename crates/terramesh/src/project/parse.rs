@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::{key_of, Project};
-use crate::error::{Error, Result};
+use crate::error::{Error, OverrideProblem, Result};
 
 /// The 1-based line of byte `offset` in `text`.
 fn line_at(text: &str, offset: usize) -> usize {
@@ -158,10 +158,10 @@ impl Project {
         };
         let mut doc: toml::Table = toml::from_str(text).map_err(syntax)?;
         for s in sets {
-            apply_set(&mut doc, s).map_err(|why| Error::Project {
+            apply_set(&mut doc, s).map_err(|problem| Error::Override {
                 file: name.to_string(),
-                line: None,
-                why,
+                set: s.to_string(),
+                problem,
             })?;
         }
         // Parse the original text when nothing was overridden, so errors carry line numbers.
@@ -241,14 +241,12 @@ fn key_and_why(e: &Error) -> (String, String) {
 
 /// Applies `section.key=value` to the TOML table; the value is read as TOML (number, boolean,
 /// array, quoted string) and otherwise taken as a bare string.
-fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), String> {
-    let (key, value) = set
-        .split_once('=')
-        .ok_or_else(|| format!("override '{set}': write KEY=VALUE, e.g. mesh.min_angle=32"))?;
+fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), OverrideProblem> {
+    let (key, value) = set.split_once('=').ok_or(OverrideProblem::NoEquals)?;
     let key = key.trim();
     let parts: Vec<&str> = key.split('.').collect();
     if parts.iter().any(|p| p.is_empty()) {
-        return Err(format!("override '{set}': bad key '{key}'"));
+        return Err(OverrideProblem::BadKey(key.to_string()));
     }
     let value = match toml::from_str::<toml::Table>(&format!("v = {}", value.trim())) {
         Ok(mut t) => t.remove("v"),
@@ -262,7 +260,7 @@ fn apply_set(doc: &mut toml::Table, set: &str) -> std::result::Result<(), String
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
         table = entry
             .as_table_mut()
-            .ok_or_else(|| format!("override '{set}': '{p}' is not a section"))?;
+            .ok_or_else(|| OverrideProblem::NotASection(p.to_string()))?;
     }
     table.insert(parts[parts.len() - 1].to_string(), value);
     Ok(())
@@ -291,6 +289,32 @@ mod tests {
     use super::*;
     use crate::project::TEMPLATE;
     use terramesh_core::vocab::Named;
+
+    /// A `--set` that cannot be applied is a typed error naming the file and the override.
+    #[test]
+    fn overrides_that_cannot_apply_say_why() {
+        let e = |set: &str| Project::parse("t.toml", TEMPLATE, &[set.to_string()]).unwrap_err();
+        let no_eq = e("mesh.min_angle");
+        assert!(matches!(
+            no_eq,
+            Error::Override {
+                problem: OverrideProblem::NoEquals,
+                ..
+            }
+        ));
+        assert_eq!(
+            no_eq.to_string(),
+            "t.toml: override 'mesh.min_angle': write KEY=VALUE, e.g. mesh.min_angle=32"
+        );
+        assert_eq!(
+            e("mesh..min_angle=3").to_string(),
+            "t.toml: override 'mesh..min_angle=3': bad key 'mesh..min_angle'"
+        );
+        assert_eq!(
+            e("mesh.min_angle.x=3").to_string(),
+            "t.toml: override 'mesh.min_angle.x=3': 'min_angle' is not a section"
+        );
+    }
 
     #[test]
     fn template_parses_with_documented_defaults() {

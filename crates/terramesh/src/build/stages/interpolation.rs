@@ -157,7 +157,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     let mut selection = None;
     let mut notes = Vec::new();
     let variogram = if let Some(v) = &ip.model {
-        v.variogram().map_err(crate::Error::invalid)?
+        v.variogram()?
     } else if ip.variogram == "auto" {
         // REML filters out, and loo kriges with, the drift of the UK that uses the model
         // (constant without UK).
@@ -235,11 +235,7 @@ pub fn interpolate(
     let (idw, _) = idw_engine
         .predict(&vertices, false)
         .context("IDW at the mesh vertices")?;
-    let variogram = || {
-        model
-            .map(|m| &m.variogram)
-            .context("internal: kriging without a variogram")
-    };
+    let variogram = || model.map(|m| &m.variogram).ok_or(Error::NoVariogramFitted);
     // The first method gives the DSM (its heights and its grid).
     let primary = ip.methods[0];
     let other;
@@ -354,7 +350,7 @@ pub fn interpolate(
 /// `export.grid_spacing` or the finer sampling cell size, north row first (the tiles of
 /// `terramesh tiles` share it).
 pub fn dsm_grid(p: &Project, s: &Samples) -> Result<terramesh_io::grid_write::RasterGrid> {
-    let (lo, hi) = s.region.projected.bbox().context("empty region")?;
+    let (lo, hi) = s.region.projected.bbox().ok_or(Error::EmptyRegion)?;
     let step = p
         .export
         .grid_spacing

@@ -53,10 +53,7 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
         _ if own_crs => None,
         _ => return Err(Error::UnconvertedSource),
     };
-    let region = plan
-        .region
-        .clone()
-        .context("a region is needed for build")?;
+    let region = plan.region.clone().ok_or(Error::BuildNeedsRegion)?;
     let mut xyz = Vec::with_capacity(table.rows.len());
     for r in &table.rows {
         if let Ok(z) = r.z {

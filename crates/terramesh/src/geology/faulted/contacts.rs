@@ -72,16 +72,14 @@ pub fn block_contacts(
                 if !picked && set.block_key(at_above) == set.block_key(below) {
                     let l =
                         above.map_or(String::from("the collar"), |c| format!("line {}", c.line));
-                    return Err(Error::invalid(format!(
-                        "{log}, line {}, hole '{}': unit '{}' is logged again at depth {} m \
-                         below a deeper unit ({l}), with no fault between: a unit repeats in a \
-                         hole only past a fault (a reverse fault): give where the hole crosses \
-                         it in geology.fault_picks, or correct the log",
-                        r.line,
-                        h.name,
-                        units[r.unit],
-                        terramesh_core::limits::short(r.md),
-                    )));
+                    return Err(Error::RepeatWithoutFault {
+                        log: log.to_string(),
+                        line: r.line,
+                        hole: h.name.clone(),
+                        unit: units[r.unit].to_string(),
+                        depth: r.md,
+                        above: l,
+                    });
                 }
             }
             let first = contacts.len();
@@ -128,17 +126,14 @@ pub fn block_contacts(
                     .position(|d: &Contact| d.1 == c.unit && d.3 == key)
                 {
                     let names: Vec<String> = set.faults.iter().map(|f| f.name.clone()).collect();
-                    return Err(Error::invalid(format!(
-                        "{log}, line {}, hole '{}': the top of unit '{}' is logged twice (first on line {}) in \
-                         one fault block ({}): a unit repeats in a hole only past a fault (a \
-                         reverse fault): give where the hole crosses it in geology.fault_picks, \
-                         or correct the log",
-                        c.line,
-                        h.name,
-                        units[c.unit],
-                        lines[j],
-                        block_name(&names, &key)
-                    )));
+                    return Err(Error::TopTwiceInBlock {
+                        log: log.to_string(),
+                        line: c.line,
+                        hole: h.name.clone(),
+                        unit: units[c.unit].to_string(),
+                        first: lines[j],
+                        block: block_name(&names, &key),
+                    });
                 }
                 contacts.push((h.name.clone(), c.unit, c.position, key));
                 lines.push(c.line);

@@ -12,25 +12,10 @@ use terramesh_io::region::RegionCrs;
 use crate::error::{Error, Result};
 use crate::plan::{FaultSource, GeologyPlan};
 
-/// Wraps a kernel error naming the fault key where it names a fault.
+/// A kernel error, said of the fault key it names ([`Error::Fault`]).
 pub(crate) fn fault_error(e: terramesh_faults::FaultError) -> Error {
-    use terramesh_faults::FaultError as F;
-    let key = |f: &str, k: &str| format!("geology.faults[{f}].{k}");
-    match &e {
-        F::Dip { fault, .. } => Error::invalid(format!("{}: {e}", key(fault, "dip"))),
-        F::DipAlongTrace { fault, .. } => {
-            Error::invalid(format!("{}: {e}", key(fault, "dip_direction")))
-        }
-        F::TraceOutside { fault } | F::Trace { fault, .. } => {
-            Error::invalid(format!("{}: {e}", key(fault, "trace")))
-        }
-        F::Surface { fault, .. } => Error::invalid(format!("{}: {e}", key(fault, "surface"))),
-        F::Depth { fault, .. } => Error::invalid(format!("{}: {e}", key(fault, "depth"))),
-        F::UnknownEndsAt { fault, .. } | F::NeverMeets { fault, .. } => {
-            Error::invalid(format!("{}: {e}", key(fault, "ends_at")))
-        }
-        F::Faults { fault, .. } => Error::invalid(format!("{}: {e}", key(fault, "name"))),
-        _ => Error::invalid(format!("[[geology.faults]]: {e}")),
+    Error::Fault {
+        source: Box::new(e),
     }
 }
 
@@ -44,7 +29,7 @@ pub(crate) fn fault_specs(
     crs: Option<&Crs>,
     terrain: &Terrain,
 ) -> Result<Vec<FaultSpec>> {
-    let io = |e: terramesh_io::faults::FaultFileError| Error::invalid(e.to_string());
+    let io = Error::from;
     let mut specs = Vec::with_capacity(g.faults.len());
     for f in &g.faults {
         let mut spec = match &f.source {
@@ -61,10 +46,9 @@ pub(crate) fn fault_specs(
                 let mut trace = read_trace(path, rc, &f.name).map_err(io)?;
                 if geographic {
                     let Some(c) = crs else {
-                        return Err(Error::invalid(format!(
-                            "geology.faults[{}].trace: a geographic trace needs the model's CRS",
-                            f.name
-                        )));
+                        return Err(Error::TraceNeedsCrs {
+                            fault: f.name.clone(),
+                        });
                     };
                     let t = Transformer::new(&Crs::wgs84(), c)?;
                     for p in &mut trace {
@@ -79,14 +63,11 @@ pub(crate) fn fault_specs(
             }
             FaultSource::Points(path) => {
                 let pts = read_points(path, &f.name).map_err(io)?;
-                let (v, t) = plane_surface(&pts, terrain).ok_or_else(|| {
-                    Error::invalid(format!(
-                        "geology.faults[{}].points {}: the points do not fix a plane that is \
-                         not horizontal: give points spread over the fault",
-                        f.name,
-                        path.display()
-                    ))
-                })?;
+                let (v, t) =
+                    plane_surface(&pts, terrain).ok_or_else(|| Error::FaultPointsNoPlane {
+                        fault: f.name.clone(),
+                        file: path.clone(),
+                    })?;
                 FaultSpec::surface(&f.name, v, t)
             }
         };
@@ -210,14 +191,12 @@ fn hole_depths(g: &GeologyPlan) -> Result<HashMap<String, f64>> {
     let LogFile::Intervals(path) = &files.log else {
         return Ok(out);
     };
-    let t = terramesh_io::table::Table::read(path, &Default::default())
-        .map_err(|e| Error::invalid(e.to_string()))?;
+    let depths = |source| Error::PickDepths { source };
+    let t = terramesh_io::table::Table::read(path, &Default::default()).map_err(depths)?;
     let h = t
         .require(&["hole", "hole_id", "holeid", "bhid"])
-        .map_err(|e| Error::invalid(e.to_string()))?;
-    let to = t
-        .require(&["to", "depth_to", "bottom"])
-        .map_err(|e| Error::invalid(e.to_string()))?;
+        .map_err(depths)?;
+    let to = t.require(&["to", "depth_to", "bottom"]).map_err(depths)?;
     for r in 0..t.records.len() {
         if let Ok(d) = t.number(r, to) {
             let d = d * g.z_unit.metres();
@@ -238,40 +217,33 @@ pub(crate) fn read_fault_picks(
         return Ok(Vec::new());
     };
     let names: Vec<&str> = g.faults.iter().map(|f| f.name.as_str()).collect();
-    let picks = read_picks(path, &names).map_err(|e| Error::invalid(e.to_string()))?;
+    let picks = read_picks(path, &names)?;
     let Some(b) = boreholes else {
-        return Err(Error::invalid(format!(
-            "geology.fault_picks {}: picks are where boreholes cross faults, and the project \
-             gives no boreholes: give collars and intervals",
-            path.display()
-        )));
+        return Err(Error::PicksWithoutBoreholes { file: path.clone() });
     };
     let depths = hole_depths(g)?;
     for p in &picks {
         let Some(hole) = b.holes.iter().find(|h| h.name == p.hole) else {
-            return Err(Error::invalid(format!(
-                "{}, line {}: hole '{}' (fault '{}') is not in the collars file",
-                path.display(),
-                p.line,
-                p.hole,
-                p.fault
-            )));
+            return Err(Error::PickUnknownHole {
+                file: path.clone(),
+                line: p.line,
+                hole: p.hole.clone(),
+                fault: p.fault.clone(),
+            });
         };
         let deepest = depths
             .get(&p.hole)
             .copied()
             .unwrap_or_else(|| hole.tops.iter().flatten().map(|c| c.md).fold(0.0, f64::max));
         if p.depth > deepest {
-            return Err(Error::invalid(format!(
-                "{}, line {}: hole '{}' crosses fault '{}' at depth {} m, beyond the hole \
-                 (logged to {} m): correct the depth",
-                path.display(),
-                p.line,
-                p.hole,
-                p.fault,
-                terramesh_core::limits::short(p.depth),
-                terramesh_core::limits::short(deepest)
-            )));
+            return Err(Error::PickBeyondHole {
+                file: path.clone(),
+                line: p.line,
+                hole: p.hole.clone(),
+                fault: p.fault.clone(),
+                depth: p.depth,
+                deepest,
+            });
         }
     }
     Ok(picks)
@@ -281,11 +253,7 @@ pub(crate) fn read_fault_picks(
 pub fn flat_base(g: &GeologyPlan, terrain: &Terrain, boreholes: Option<&Boreholes>) -> Result<f64> {
     match &g.base {
         crate::plan::Base::Elevation(z) => Ok(*z),
-        crate::plan::Base::Raster(p) => Err(Error::invalid(format!(
-            "geology.base {}: a faulted model has a flat base for now: give an elevation \
-             (base = -250) or \"auto\"",
-            p.display()
-        ))),
+        crate::plan::Base::Raster(p) => Err(Error::FaultedRasterBase { file: p.clone() }),
         crate::plan::Base::Auto => {
             let hi = terrain.heights.iter().copied().fold(f64::MIN, f64::max);
             let mut lo = terrain.heights.iter().copied().fold(f64::MAX, f64::min);

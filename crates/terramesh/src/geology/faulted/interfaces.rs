@@ -370,11 +370,9 @@ impl BlockInterfaces {
         }
         for (k, a) in all.iter().enumerate() {
             if a.is_empty() {
-                return Err(Error::invalid(format!(
-                    "[geology]: no borehole meets the top of '{}': a faulted model interpolates \
-                     every interface from the boreholes' contacts",
-                    g.units[k + 1]
-                )));
+                return Err(Error::NoContactOfTop {
+                    unit: g.units[k + 1].clone(),
+                });
             }
         }
         let origin = all
@@ -526,15 +524,11 @@ impl BlockInterfaces {
         for key in keys {
             for k in 0..self.gradient.len() {
                 if let Err(f) = self.source(k, *key) {
-                    return Err(Error::invalid(format!(
-                        "geology.faults[{}].throw: block {} has no contact of the top of '{}', \
-                         which it takes from the other side of {} shifted by the throw: give \
-                         throw (metres) and kind (\"normal\" or \"reverse\")",
-                        self.names[f],
-                        block_name(&self.names, key),
-                        units[k + 1],
-                        self.names[f]
-                    )));
+                    return Err(Error::NoThrow {
+                        fault: self.names[f].clone(),
+                        block: block_name(&self.names, key),
+                        unit: units[k + 1].clone(),
+                    });
                 }
             }
         }

@@ -32,13 +32,11 @@ pub fn build_mesh(
     let settings = MeshSettings::new(base, g.max_cell_height);
     let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
     let mesh = crate::geology::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
-    let check = check_mesh(&mesh, terrain, set, &settings, &h).map_err(|e| {
-        Error::invalid(format!(
-            "[[geology.faults]]: the faulted mesh failed its checks ({e}; {} cells left \
-             straddling an interface); please report it with the project",
-            mesh.report.unresolved
-        ))
-    })?;
+    let check =
+        check_mesh(&mesh, terrain, set, &settings, &h).map_err(|e| Error::FaultedMeshCheck {
+            source: Box::new(e),
+            unresolved: mesh.report.unresolved,
+        })?;
     let split = g.split_faults.then(|| split_nodes(&mesh).points.len());
     Ok(Faulted {
         mesh,

@@ -103,8 +103,11 @@ pub(crate) fn run(
     use terramesh_io::model::{write_faulted_model, ModelInfo};
 
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
-    let terrain = Terrain::new(xy.clone(), mesh.triangles.clone(), dsm.to_vec())
-        .map_err(|e| Error::invalid(format!("[[geology.faults]]: the DSM: {e}")))?;
+    let terrain = Terrain::new(xy.clone(), mesh.triangles.clone(), dsm.to_vec()).map_err(|e| {
+        Error::FaultedTerrain {
+            source: Box::new(e),
+        }
+    })?;
     let geographic = matches!(p.region.crs, crate::project::ProjectCrs::Geographic);
     let specs = fault_specs(g, geographic, crs, &terrain)?;
     let holes = boreholes.as_ref();
@@ -143,8 +146,9 @@ pub(crate) fn run(
     }
     surfaces.push(vec![base; xy.len()]);
     let stack = Stack { surfaces };
-    let planar = Planar::new(&xy, &mesh.triangles)
-        .map_err(|e| Error::invalid(format!("the planar mesh: {e}")))?;
+    let planar = Planar::new(&xy, &mesh.triangles).map_err(|e| Error::PlanarMesh {
+        source: Box::new(e),
+    })?;
     let stats = terramesh_geology::unit_stats(&planar, &stack, &volume);
     let crs_name = match (crs.and_then(Crs::epsg), crs) {
         (Some(e), _) => format!("EPSG:{e}"),
@@ -158,15 +162,12 @@ pub(crate) fn run(
         vertical_epsg: datum.epsg(),
     };
     let written = write_faulted_model(out, &volume, &data, &info, None).map_err(|e| match e {
-        terramesh_io::model::ModelWriteError::Mesh(m) => Error::invalid(format!(
-            "[[geology.faults]]: the faulted mesh cannot be written: {m}; please report it \
-             with the project"
-        )),
-        e => Error::invalid(e.to_string()),
+        terramesh_io::model::ModelWriteError::Mesh(source) => Error::FaultedMeshWrite { source },
+        e => Error::ModelWrite(e),
     })?;
     let mut files: Vec<std::path::PathBuf> = written.into_iter().map(|f| out.join(f)).collect();
     let dir = out.join("interfaces");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::invalid(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(write_error(&dir))?;
     let epsg = crs.and_then(Crs::epsg).and_then(|e| u16::try_from(e).ok());
     for (k, unit) in g.units.iter().enumerate() {
         let values =
@@ -183,9 +184,8 @@ pub(crate) fn run(
             }),
             Some(-9999.0),
         )
-        .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
-        o.commit()
-            .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
+        .map_err(write_error(&path))?;
+        o.commit().map_err(write_error(&path))?;
         files.push(path);
     }
     // Every contact against its own block's interface; the collars against the terrain.
@@ -275,10 +275,8 @@ pub(crate) fn run(
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&summary)?;
     let mut o = terramesh_io::output::Output::create(Some(&path))?;
-    std::io::Write::write_all(&mut o, text.as_bytes())
-        .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
-    o.commit()
-        .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
+    std::io::Write::write_all(&mut o, text.as_bytes()).map_err(write_error(&path))?;
+    o.commit().map_err(write_error(&path))?;
     files.push(path);
     let faults = faulted
         .mesh
@@ -304,6 +302,14 @@ pub(crate) fn run(
         ensemble: None,
         faults,
     })
+}
+
+/// Said of `file` when writing it fails ([`Error::WriteFile`]).
+fn write_error(file: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |source| Error::WriteFile {
+        file: file.to_path_buf(),
+        source,
+    }
 }
 
 #[cfg(test)]
