@@ -11,7 +11,9 @@
 // cursor readout shows coordinates and an elevation inside the ranges of dsm-vertices.csv
 // (read here, beside report.html) and says what the elevation is above. With geological
 // units: hiding each removes its colour; the borehole traces show the logged units' colours;
-// the cross-section fills each cut unit with its colour (and not with the filling off).
+// the cross-section fills each cut unit with its colour (and not with the filling off). With
+// faults and engineering objects: hiding each removes its colour, the cross-section cuts the
+// faults and fills each object's cut.
 // Exit status 1 with the failed check on stderr.
 import { chromium } from "playwright-core";
 import { existsSync, mkdirSync, readFileSync } from "node:fs";
@@ -286,6 +288,97 @@ try {
     const holes = scene.layers.find((l) => l.name.startsWith("boreholes"));
     if (!holes || holes.vertices < 2) fail("the scene has no borehole collars");
     ok(`${holes.name}: ${holes.vertices} points`);
+
+    // Faults and engineering objects (a faulted model, objects cut in): with everything else
+    // hidden, hiding each removes its colour; the cross-section cuts the faults (fewer of
+    // their pixels) and fills each object's cut in its colour (not with the filling off).
+    const sheetRe = /^(fault|tunnel|excavation|structure) /;
+    const setClip = (v) => page.evaluate((v) => {
+      const e = document.getElementById("tmv-clip-pos");
+      e.value = String(v);
+      e.dispatchEvent(new Event("input"));
+    }, v);
+    const sheets = scene.layers.filter((l) => sheetRe.test(l.name));
+    if (sheets.length) {
+      const others = scene.layers.filter((l) => !sheetRe.test(l.name) && l.visible);
+      for (const l of others) await page.locator(`input[data-layer="${l.name}"]`).uncheck();
+      const alone = await snapshot("sheetsAlone");
+      const seen = [];
+      for (const l of sheets) {
+        const before = await countShade(alone, l.colour);
+        const input = page.locator(`input[data-layer="${l.name}"]`);
+        await input.uncheck();
+        const hidden = await snapshot(`hidden-${l.name}`);
+        const after = await countShade(hidden, l.colour);
+        if (before < 100 || after > 0.1 * before) fail(`hiding "${l.name}" took its pixels ${before} -> ${after}`);
+        seen.push(`${l.name} ${before} -> ${after}`);
+        await input.check();
+      }
+      ok(`hiding each fault or object removes its colour (pixels shown -> hidden): ${seen.join(", ")}`);
+      const faults = sheets.filter((l) => l.name.startsWith("fault "));
+      const objects = sheets.filter((l) => !l.name.startsWith("fault "));
+      const count = async (snap, ls) => {
+        let n = 0;
+        for (const l of ls) n += await countShade(snap, l.colour);
+        return n;
+      };
+      if (faults.length) {
+        for (const l of objects) await page.locator(`input[data-layer="${l.name}"]`).uncheck();
+        const whole = await snapshot("faultsWhole");
+        await page.check("#tmv-clip");
+        const cutFaults = await snapshot("faultsCut");
+        const [n, m] = [await count(whole, faults), await count(cutFaults, faults)];
+        if (m > 0.9 * n || m < 0.05 * n) fail(`the cross-section left ${m} of the faults' ${n} pixels`);
+        ok(`the cross-section cuts the faults: their pixels ${n} -> ${m}`);
+        await page.uncheck("#tmv-clip");
+        for (const l of objects) await page.locator(`input[data-layer="${l.name}"]`).check();
+      }
+      if (objects.length) {
+        // The section through the middle of the largest object (the viewer's plane spans the
+        // box of every layer's positions).
+        const box = (l) => {
+          const b = Buffer.from(l.positions, "base64");
+          const p = new Float32Array(b.buffer, b.byteOffset, b.length / 4);
+          let lo = Infinity, hi = -Infinity;
+          for (let i = 0; i < p.length; i += 3) { lo = Math.min(lo, p[i]); hi = Math.max(hi, p[i]); }
+          return [lo, hi];
+        };
+        const all = scene.layers.map(box);
+        const [xlo, xhi] = [Math.min(...all.map((b) => b[0])), Math.max(...all.map((b) => b[1]))];
+        const big = objects.reduce((a, b) => (b.triangles > a.triangles ? b : a));
+        const [blo, bhi] = box(big);
+        for (const l of faults) await page.locator(`input[data-layer="${l.name}"]`).uncheck();
+        await page.check("#tmv-clip");
+        await page.selectOption("#tmv-clip-axis", "0");
+        await setClip(Math.round(1000 * (0.5 * (blo + bhi) - xlo) / (xhi - xlo)));
+        const capped = await snapshot("objectsCapped");
+        await page.uncheck("#tmv-cap");
+        const open = await snapshot("objectsOpen");
+        const exact = (snap, rgb) => page.evaluate(([name, rgb]) => {
+          const d = window.__snaps[name];
+          let n = 0;
+          for (let i = 0; i < d.length; i += 4) {
+            if (Math.abs(d[i] - rgb[0]) <= 3 && Math.abs(d[i + 1] - rgb[1]) <= 3 && Math.abs(d[i + 2] - rgb[2]) <= 3) n++;
+          }
+          return n;
+        }, [snap.name, rgb]);
+        const [n, m] = [await exact(capped, big.colour), await exact(open, big.colour)];
+        if (n < 100 || m > 0.2 * n) fail(`the cross-section through "${big.name}" fills ${n} pixels in its colour, ${m} without the filling`);
+        ok(`the cross-section through "${big.name}" fills its cut: exact-colour pixels ${n} -> ${m} without the filling`);
+        if (shotDir) {
+          await page.check("#tmv-cap");
+          await snapshot("objectsSection");
+          await shot("viewer-objects-section.png");
+        }
+        await page.check("#tmv-cap");
+        await setClip(500);
+        await page.uncheck("#tmv-clip");
+        for (const l of faults) await page.locator(`input[data-layer="${l.name}"]`).check();
+      }
+      for (const l of others) await page.locator(`input[data-layer="${l.name}"]`).check();
+      const sheetsBack = await snapshot("sheetsBack");
+      if (await changed(exaggerated, sheetsBack) > 0.001) fail("showing the layers again did not restore the picture");
+    }
     if (shotDir) {
       await page.click("#tmv-reset");
       await snapshot("unitsReset");
