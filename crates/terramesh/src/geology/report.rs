@@ -387,8 +387,13 @@ pub const STILL_SHEET_TRIANGLES: usize = 60_000;
 /// [`STILL_SHEET_TRIANGLES`] in all as the viewer thins them.
 fn sheets_view(dir: &Path, m: &ModelBuilt) -> Result<Block> {
     use super::web::{fault_colour, object_colour, sheet_mesh};
-    let n = m.faults.len() + m.objects.len();
-    let each = STILL_SHEET_TRIANGLES / n.max(1);
+    let sizes: Vec<usize> = m
+        .faults
+        .iter()
+        .map(|f| 2 * f.triangles.len())
+        .chain(m.objects.iter().map(|o| o.triangles.len()))
+        .collect();
+    let shares = super::web::shares(&sizes, STILL_SHEET_TRIANGLES, STILL_SHEET_TRIANGLES);
     let (mut v, mut t, mut c) = (Vec::new(), Vec::new(), Vec::new());
     let mut thinned = false;
     let sheets = m
@@ -402,7 +407,7 @@ fn sheets_view(dir: &Path, m: &ModelBuilt) -> Result<Block> {
                 .enumerate()
                 .map(|(k, o)| (o, object_colour(k), false)),
         );
-    for (sheet, colour, both_sides) in sheets {
+    for ((sheet, colour, both_sides), &each) in sheets.zip(&shares) {
         let s = sheet_mesh(&sheet.triangles, if both_sides { each / 2 } else { each });
         thinned |= s.cell > 0.0;
         let off = v.len() as u32;

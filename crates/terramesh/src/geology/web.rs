@@ -411,6 +411,29 @@ pub fn object_colour(k: usize) -> [u8; 3] {
     PALETTE[k % PALETTE.len()]
 }
 
+/// How many triangles each of sheets of `sizes` triangles may keep: at most `each` and
+/// `total` together, shared out so that sheets within an equal share keep all theirs and
+/// what they leave goes to the larger ones (water-filling).
+///
+/// ```
+/// use terramesh::geology::web::shares;
+/// assert_eq!(shares(&[10, 500, 40], 300, 1000), vec![10, 250, 40]);
+/// assert_eq!(shares(&[10, 500, 40], 3000, 200), vec![10, 200, 40]);
+/// assert_eq!(shares(&[400, 500], 600, 1000), vec![300, 300]);
+/// ```
+pub fn shares(sizes: &[usize], total: usize, each: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..sizes.len()).collect();
+    order.sort_by_key(|&i| sizes[i]);
+    let mut out = vec![0; sizes.len()];
+    let mut left = total;
+    for (k, &i) in order.iter().enumerate() {
+        let fair = left / (sizes.len() - k);
+        out[i] = sizes[i].min(fair).min(each);
+        left -= out[i];
+    }
+    out
+}
+
 /// A sheet's triangles as shared vertices and indices (corners with the same coordinates
 /// merged), thinned to at most `max` triangles.
 pub(crate) fn sheet_mesh(triangles: &[[[f64; 3]; 3]], max: usize) -> Clustered {
@@ -438,7 +461,13 @@ fn sheet_layers(g: &super::stage::ModelBuilt) -> (Vec<Layer>, String) {
     if n == 0 {
         return (Vec::new(), String::new());
     }
-    let each = VIEWER_SHEET_TRIANGLES_EACH.min(VIEWER_SHEET_TRIANGLES / n);
+    let sizes: Vec<usize> = g
+        .faults
+        .iter()
+        .chain(&g.objects)
+        .map(|s| s.triangles.len())
+        .collect();
+    let shares = shares(&sizes, VIEWER_SHEET_TRIANGLES, VIEWER_SHEET_TRIANGLES_EACH);
     let kinds: Vec<&str> = g
         .summary
         .objects
@@ -456,11 +485,12 @@ fn sheet_layers(g: &super::stage::ModelBuilt) -> (Vec<Layer>, String) {
             let kind = kinds.get(k).copied().unwrap_or("object");
             (format!("{kind} {}", o.name), o, object_colour(k), true)
         }));
-    for (name, sheet, colour, closed) in sheets {
+    for ((name, sheet, colour, closed), &each) in sheets.zip(&shares) {
         let c = sheet_mesh(&sheet.triangles, each);
         if c.cell > 0.0 {
             thinned.push(format!(
-                "{name}: {} of its {} faces, corners merged on a {:.2} m grid (moved at most                  {:.2} m)",
+                "{name}: {} of its {} faces, corners merged on a {:.2} m grid (moved at most \
+                 {:.2} m)",
                 c.triangles.len(),
                 sheet.triangles.len(),
                 c.cell,
@@ -483,22 +513,29 @@ fn sheet_layers(g: &super::stage::ModelBuilt) -> (Vec<Layer>, String) {
     let mut note = String::new();
     if !g.faults.is_empty() {
         note.push_str(&format!(
-            " The {} faults are drawn as meshed (the model's fault faces), each toggled on its              own, in reds; the cross-section cuts them.",
+            " The {} faults are drawn as meshed (the model's fault faces), each toggled on its \
+             own, in reds; the cross-section cuts them.",
             g.faults.len()
         ));
     }
     if !g.objects.is_empty() {
         note.push_str(&format!(
-            " The {} engineering objects are drawn by their boundaries as meshed (the faces of              their cells, lining included, that face other cells or the model's boundary), each              toggled on its own, in blues; the cross-section cuts them and fills each cut.",
+            " The {} engineering objects are drawn by their boundaries as meshed (the faces of \
+             their cells, lining included, that face other cells or the model's boundary), each \
+             toggled on its own, in blues; the cross-section cuts them and fills each cut.",
             g.objects.len()
         ));
     }
     note.push_str(&format!(
-        " At most {each} triangles a fault or object are shown{}",
+        " They are shown with at most {VIEWER_SHEET_TRIANGLES} triangles together and \
+         {VIEWER_SHEET_TRIANGLES_EACH} each{}",
         if thinned.is_empty() {
-            "; all are.".to_string()
+            ": all of their faces are.".to_string()
         } else {
-            format!(", thinned by vertex clustering: {}.", thinned.join("; "))
+            format!(
+                "; thinned by vertex clustering: {}.",
+                thinned.join("; ")
+            )
         }
     ));
     (layers, note)
