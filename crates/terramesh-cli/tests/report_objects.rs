@@ -35,8 +35,8 @@ fn build(project: &Path, out: &Path) -> (String, Value) {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    let json = serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap())
-        .unwrap();
+    let json =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
     (html, json)
 }
 
@@ -213,10 +213,7 @@ fn the_report_of_the_structures_example_shows_its_objects_and_faults() {
         assert!(html.contains(&row), "{row}");
     }
     let stages = json["objects"]["stages"].as_array().unwrap();
-    assert!(html.contains(&format!(
-        "<caption>Excavation stages ({})",
-        stages.len()
-    )));
+    assert!(html.contains(&format!("<caption>Excavation stages ({})", stages.len())));
     for s in stages {
         let n = s["stage"].as_u64().unwrap();
         let names: Vec<&str> = objects

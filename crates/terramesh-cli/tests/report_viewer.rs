@@ -163,7 +163,13 @@ fn report_viewer_shows_the_faults_and_objects() {
         String::from_utf8_lossy(&run.stderr)
     );
     let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
-    for layer in ["fault F1", "fault F2", "fault F3", "tunnel diversion", "excavation pit"] {
+    for layer in [
+        "fault F1",
+        "fault F2",
+        "fault F3",
+        "tunnel diversion",
+        "excavation pit",
+    ] {
         assert!(
             html.contains(&format!("\"name\":\"{layer}\"")),
             "the viewer has no layer {layer}"

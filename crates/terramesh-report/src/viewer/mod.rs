@@ -566,8 +566,7 @@ mod tests {
                 let m = [(0, 1), (1, 2), (2, 0)].map(|(a, b)| {
                     let key = (tri[a].min(tri[b]), tri[a].max(tri[b]));
                     *mid.entry(key).or_insert_with(|| {
-                        let (p, q): ([f64; 3], [f64; 3]) =
-                            (v[tri[a] as usize], v[tri[b] as usize]);
+                        let (p, q): ([f64; 3], [f64; 3]) = (v[tri[a] as usize], v[tri[b] as usize]);
                         let c = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
                         let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
                         v.push(c.map(|x| x / l));

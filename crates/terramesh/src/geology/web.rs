@@ -532,10 +532,7 @@ fn sheet_layers(g: &super::stage::ModelBuilt) -> (Vec<Layer>, String) {
         if thinned.is_empty() {
             ": all of their faces are.".to_string()
         } else {
-            format!(
-                "; thinned by vertex clustering: {}.",
-                thinned.join("; ")
-            )
+            format!("; thinned by vertex clustering: {}.", thinned.join("; "))
         }
     ));
     (layers, note)
