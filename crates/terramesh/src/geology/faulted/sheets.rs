@@ -20,7 +20,8 @@ pub(crate) fn object_sheets(
     // Per object, each face by its sorted corners' coordinates: how many of its cells have
     // it, and the face as the first one saw it, oriented away from that cell.
     type Key = [[u64; 3]; 3];
-    let mut faces: HashMap<u32, HashMap<Key, (u32, [[f64; 3]; 3])>> = HashMap::new();
+    type Faces = HashMap<Key, (u32, [[f64; 3]; 3])>;
+    let mut faces: HashMap<u32, Faces> = HashMap::new();
     for (c, t) in tets.iter().enumerate() {
         let o = object.get(c).copied().unwrap_or(0);
         if o == 0 {
@@ -60,7 +61,7 @@ pub(crate) fn object_sheets(
                 })
                 .unwrap_or_default();
             // The hash map's order is not the same from run to run: sorted, the report is.
-            tris.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+            tris.sort_unstable_by_key(|t| t.0);
             FaultSheet {
                 name: name.clone(),
                 triangles: tris.into_iter().map(|t| t.1).collect(),
