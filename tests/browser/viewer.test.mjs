@@ -1,7 +1,8 @@
 // Drives the 3D viewer of a built report.html in Debian's chromium through playwright-core and
 // checks what a person would see:
 //
-//   node tests/browser/viewer.test.mjs OUT/report.html [--screenshots DIR]
+//   node tests/browser/viewer.test.mjs OUT/report.html [--screenshots DIR] [--prefix P]
+//        [--no-field-checks]
 //
 // Asserted: no console error or warning and no page error; the canvas is not blank; its
 // centre pixel is a shade of the elevation colour map (not the background); a mouse drag,
@@ -10,8 +11,10 @@
 // picture; after switching fields the centre pixel is a shade of that field's colour map; the
 // cursor readout shows coordinates and an elevation inside the ranges of dsm-vertices.csv
 // (read here, beside report.html) and says what the elevation is above. With geological
-// units: hiding each removes its colour; the borehole traces show the logged units' colours;
-// the cross-section fills each cut unit with its colour (and not with the filling off).
+// units: hiding each removes its colour (the DSM and the borehole traces hidden meanwhile); the borehole traces show the logged units' colours;
+// the cross-section fills each cut unit with its colour (and not with the filling off). With
+// faults and engineering objects: hiding each removes its colour, the cross-section cuts the
+// faults and fills each object's cut.
 // Exit status 1 with the failed check on stderr.
 import { chromium } from "playwright-core";
 import { existsSync, mkdirSync, readFileSync } from "node:fs";
@@ -120,18 +123,23 @@ try {
       return n / (x.length / 4);
     }, [a.name, b.name]);
   }
-  // Pixels of a snapshot that are a shade s * rgb of one colour (within 3 per channel).
-  async function countShade(snap, rgb) {
-    return page.evaluate(([name, rgb]) => {
-      const d = window.__snaps[name], r2 = rgb[0] ** 2 + rgb[1] ** 2 + rgb[2] ** 2;
+  // Pixels of a snapshot that are a shade s * rgb of one colour (within 3 per channel) and,
+  // when `others` are given, not also a shade of one of them (dark shades of two colours can
+  // coincide: the faulted example's colluvium and marl).
+  async function countShade(snap, rgb, others = []) {
+    return page.evaluate(([name, rgb, others]) => {
+      const d = window.__snaps[name];
+      const shade = (i, c) => {
+        const s = (d[i] * c[0] + d[i + 1] * c[1] + d[i + 2] * c[2]) / (c[0] ** 2 + c[1] ** 2 + c[2] ** 2);
+        return s > 0.1 && Math.abs(d[i] - s * c[0]) <= 3 && Math.abs(d[i + 1] - s * c[1]) <= 3
+          && Math.abs(d[i + 2] - s * c[2]) <= 3;
+      };
       let n = 0;
       for (let i = 0; i < d.length; i += 4) {
-        const s = (d[i] * rgb[0] + d[i + 1] * rgb[1] + d[i + 2] * rgb[2]) / r2;
-        if (s > 0.1 && Math.abs(d[i] - s * rgb[0]) <= 3 && Math.abs(d[i + 1] - s * rgb[1]) <= 3
-          && Math.abs(d[i + 2] - s * rgb[2]) <= 3) n++;
+        if (shade(i, rgb) && !others.some((c) => shade(i, c))) n++;
       }
       return n;
-    }, [snap.name, rgb]);
+    }, [snap.name, rgb, others]);
   }
   // How far a pixel is from the nearest shade s * map(t) of a colour map (max channel error).
   function offMap(px, anchors) {
@@ -208,6 +216,9 @@ try {
   if (units.length) {
     const dsmInput = page.locator(`input[data-layer="${scene.layers[0].name}"]`);
     await dsmInput.uncheck();
+    // The borehole traces are drawn in the units' colours: hidden too meanwhile.
+    const traceLayer = scene.layers.find((l) => l.name.startsWith("borehole traces"));
+    if (traceLayer) await page.locator(`input[data-layer="${traceLayer.name}"]`).uncheck();
     const noDsm = await snapshot("noDsm");
     let best = null;
     for (const u of units) {
@@ -215,12 +226,13 @@ try {
       if (!best || n > best.n) best = { u, n };
     }
     for (const u of [best.u, ...units.filter((x) => x !== best.u)]) {
-      const before = await countShade(noDsm, u.colour);
+      const others = units.filter((x) => x.colour.join() !== u.colour.join()).map((x) => x.colour);
+      const before = await countShade(noDsm, u.colour, others);
       const input = page.locator(`input[data-layer="${u.name}"]`);
       await input.uncheck();
       const hidden = await snapshot(`hidden-${u.name}`);
       const d = await changed(noDsm, hidden);
-      const after = await countShade(hidden, u.colour);
+      const after = await countShade(hidden, u.colour, others);
       if (u === best.u && (d < 0.005 || before < 500 || after > 0.1 * before)) {
         fail(`hiding "${u.name}" changed ${(100 * d).toFixed(2)} % of the pixels; its pixels ${before} -> ${after}`);
       }
@@ -231,6 +243,7 @@ try {
       await input.check();
     }
     ok(`hiding any of the ${units.length} units removes its colour from the picture`);
+    if (traceLayer) await page.locator(`input[data-layer="${traceLayer.name}"]`).check();
 
     // The boreholes as traces coloured by logged unit: with the units hidden, at least two
     // units' colours show along the holes, and go when the traces are hidden.
@@ -286,6 +299,7 @@ try {
     const holes = scene.layers.find((l) => l.name.startsWith("boreholes"));
     if (!holes || holes.vertices < 2) fail("the scene has no borehole collars");
     ok(`${holes.name}: ${holes.vertices} points`);
+
     if (shotDir) {
       await page.click("#tmv-reset");
       await snapshot("unitsReset");
@@ -336,9 +350,12 @@ try {
     solidBack = await snapshot("solidBack2");
   }
 
-  // Colour by the other fields.
+  // Colour by the other fields (not with --no-field-checks: a DSM whose samples lie on a
+  // plane, the faulted examples', has a kriging standard deviation of zero everywhere and
+  // nothing for these checks to see).
   let prev = solidBack;
-  for (const key of ["kriging_std", "uk_minus_idw"]) {
+  const fieldChecks = args.includes("--no-field-checks") ? [] : ["kriging_std", "uk_minus_idw"];
+  for (const key of fieldChecks) {
     if (!scene.fields[key]) fail(`the colour-by selector has no ${key}`);
     await page.selectOption("#tmv-field", key);
     const s = await snapshot(key);
@@ -367,6 +384,109 @@ try {
   await page.click("#tmv-reset");
   await snapshot("reset");
   await shot("viewer-cross-section.png");
+
+  // Faults and engineering objects (a faulted model, objects cut in): with everything else
+  // hidden, hiding each removes its colour; the cross-section cuts the faults (fewer of
+  // their pixels) and fills each object's cut in its colour (not with the filling off).
+  const sheetRe = /^(fault|tunnel|excavation|structure) /;
+  const setClip = (v) => page.evaluate((v) => {
+    const e = document.getElementById("tmv-clip-pos");
+    e.value = String(v);
+    e.dispatchEvent(new Event("input"));
+  }, v);
+  const sheets = scene.layers.filter((l) => sheetRe.test(l.name));
+  if (sheets.length) {
+      // From the first view (the drag turned a fault edge-on), the cross-section off, each
+    // sheet alone (the others would hide it: the tunnel lies behind F1).
+    await page.uncheck("#tmv-clip");
+    await page.click("#tmv-reset");
+    const viewBase = await snapshot("sheetsBase");
+    const others = scene.layers.filter((l) => !sheetRe.test(l.name) && l.visible);
+    for (const l of [...others, ...sheets]) await page.locator(`input[data-layer="${l.name}"]`).uncheck();
+    const seen = [];
+    for (const l of sheets) {
+      const input = page.locator(`input[data-layer="${l.name}"]`);
+      await input.check();
+      const shown = await snapshot(`shown-${l.name}`);
+      const before = await countShade(shown, l.colour);
+      await input.uncheck();
+      const hidden = await snapshot(`hidden-${l.name}`);
+      const after = await countShade(hidden, l.colour);
+      if (before < 100 || after > 0.1 * before) fail(`hiding "${l.name}" took its pixels ${before} -> ${after}`);
+      seen.push(`${l.name} ${before} -> ${after}`);
+    }
+    for (const l of sheets) await page.locator(`input[data-layer="${l.name}"]`).check();
+    ok(`hiding each fault or object (shown alone) removes its colour (pixels shown -> hidden): ${seen.join(", ")}`);
+    const faults = sheets.filter((l) => l.name.startsWith("fault "));
+    const objects = sheets.filter((l) => !l.name.startsWith("fault "));
+    const count = async (snap, ls) => {
+      let n = 0;
+      for (const l of ls) n += await countShade(snap, l.colour);
+      return n;
+    };
+    if (faults.length) {
+      for (const l of objects) await page.locator(`input[data-layer="${l.name}"]`).uncheck();
+      const whole = await snapshot("faultsWhole");
+      await page.check("#tmv-clip");
+      const cutFaults = await snapshot("faultsCut");
+      const [n, m] = [await count(whole, faults), await count(cutFaults, faults)];
+      if (m > 0.9 * n || m < 0.05 * n) fail(`the cross-section left ${m} of the faults' ${n} pixels`);
+      ok(`the cross-section cuts the faults: their pixels ${n} -> ${m}`);
+      await page.uncheck("#tmv-clip");
+      for (const l of objects) await page.locator(`input[data-layer="${l.name}"]`).check();
+    }
+    if (objects.length) {
+      // The section through the middle of the largest object (the viewer's plane spans the
+      // box of every layer's positions, as the slider does).
+      // (Each layer's bounding box: [lo, hi] per axis.)
+      const box = (l) => {
+        const b = Buffer.from(l.positions, "base64");
+        const p = new Float32Array(b.buffer.slice(b.byteOffset, b.byteOffset + b.length));
+        const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+        for (let i = 0; i < p.length; i += 3) {
+          for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p[i + k]); hi[k] = Math.max(hi[k], p[i + k]); }
+        }
+        return [lo, hi];
+      };
+      const all = scene.layers.filter((l) => l.vertices > 0).map(box);
+      const [xlo, xhi] = [Math.min(...all.map((b) => b[0][0])), Math.max(...all.map((b) => b[1][0]))];
+      // The object of the largest box, cut across x (the north-south plane).
+      const size = (l) => { const [lo, hi] = box(l); return (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]); };
+      const big = objects.reduce((a, b) => (size(b) > size(a) ? b : a));
+      const [blo, bhi] = box(big).map((c) => c[0]);
+      for (const l of faults) await page.locator(`input[data-layer="${l.name}"]`).uncheck();
+      await page.check("#tmv-clip");
+      await page.selectOption("#tmv-clip-axis", "0");
+      await setClip(Math.round(1000 * (0.5 * (blo + bhi) - xlo) / (xhi - xlo)));
+      const capped = await snapshot("objectsCapped");
+      await page.uncheck("#tmv-cap");
+      const open = await snapshot("objectsOpen");
+      const exact = (snap, rgb) => page.evaluate(([name, rgb]) => {
+        const d = window.__snaps[name];
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          if (Math.abs(d[i] - rgb[0]) <= 3 && Math.abs(d[i + 1] - rgb[1]) <= 3 && Math.abs(d[i + 2] - rgb[2]) <= 3) n++;
+        }
+        return n;
+      }, [snap.name, rgb]);
+      const [n, m] = [await exact(capped, big.colour), await exact(open, big.colour)];
+      if (n < 100 || m > 0.2 * n) fail(`the cross-section through "${big.name}" fills ${n} pixels in its colour, ${m} without the filling`);
+      ok(`the cross-section through "${big.name}" fills its cut: exact-colour pixels ${n} -> ${m} without the filling`);
+      if (shotDir) {
+        await page.check("#tmv-cap");
+        await snapshot("objectsSection");
+        await shot("viewer-objects-section.png");
+      }
+      await page.check("#tmv-cap");
+      await setClip(500);
+      await page.uncheck("#tmv-clip");
+      for (const l of faults) await page.locator(`input[data-layer="${l.name}"]`).check();
+    }
+    for (const l of others) await page.locator(`input[data-layer="${l.name}"]`).check();
+    const sheetsBack = await snapshot("sheetsBack");
+    if (await changed(viewBase, sheetsBack) > 0.001) fail("showing the layers again did not restore the picture");
+    ok("showing every layer again restores the picture");
+  }
 
   if (problems.length) fail(`console or page problems: ${problems.join(" | ")}`);
   ok("no console error or warning, no page error, no failed request");

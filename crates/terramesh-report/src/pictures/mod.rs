@@ -19,6 +19,8 @@ pub use chart::draw_variogram;
 pub use colour::{hillshade, shade, ColourMap};
 pub use detail::{central_detail, DETAIL_TRIANGLES};
 pub use maps::{draw_mesh, draw_samples, draw_surface, SurfaceMap};
+/// The colour type of [`draw_bodies_view3d`]'s facets and [`unit_colour`] (plotters').
+pub use plotters::style::RGBColor;
 pub use section::{draw_section, unit_colour, Section, SectionFault, SectionHole};
 pub use view3d::{draw_bodies_view3d, draw_view3d};
 

@@ -46,7 +46,8 @@ pub struct SectionHole {
 }
 
 /// A fault's trace on a section: the segments where its surface cuts the section's vertical
-/// plane, `((distance, elevation), (distance, elevation))` in metres.
+/// plane, `((distance, elevation), (distance, elevation))` in metres. An engineering object's
+/// outline on a section (where its boundary cuts the plane) takes the same form.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SectionFault {
     /// Its name, written at its highest point.
@@ -71,6 +72,9 @@ pub struct Section<'a> {
     pub holes: &'a [SectionHole],
     /// Faults to draw (a faulted model), as thick dark red lines named at their top.
     pub faults: &'a [SectionFault],
+    /// Engineering objects (tunnels, excavations, structures) to draw: their outlines where
+    /// their boundaries cross the section, as dark blue lines named at their top.
+    pub objects: &'a [SectionFault],
 }
 
 /// Draws `s`: each unit filled between its top and bottom surface where both are defined,
@@ -88,7 +92,7 @@ pub struct Section<'a> {
 /// let holes = vec![SectionHole { name: "B1".into(), distance: 400.0,
 ///     intervals: vec![(208.0, 146.0, 0), (146.0, 120.0, 1)] }];
 /// let dir = tempfile::tempdir()?;
-/// let s = Section { title: "A-A'", distance: &d, surfaces: &surfaces, units: &units, holes: &holes, faults: &[] };
+/// let s = Section { title: "A-A'", distance: &d, surfaces: &surfaces, units: &units, holes: &holes, faults: &[], objects: &[] };
 /// render_both(&dir.path().join("section"), (800, 400), |root| draw_section(root, &s))?;
 /// assert!(dir.path().join("section.png").is_file());
 /// # Ok(()) }
@@ -161,11 +165,17 @@ where
         }
     }
     let fault_colour = RGBColor(150, 20, 20);
-    for f in s.faults {
+    let object_colour = RGBColor(20, 50, 140);
+    let lines = s
+        .faults
+        .iter()
+        .map(|f| (f, fault_colour, 3))
+        .chain(s.objects.iter().map(|o| (o, object_colour, 2)));
+    for (f, colour, width) in lines {
         chart.draw_series(
             f.segments
                 .iter()
-                .map(|seg| PathElement::new(vec![seg[0], seg[1]], fault_colour.stroke_width(3))),
+                .map(|seg| PathElement::new(vec![seg[0], seg[1]], colour.stroke_width(width))),
         )?;
         let top = f
             .segments
@@ -178,7 +188,7 @@ where
             chart.draw_series(std::iter::once(Text::new(
                 f.name.clone(),
                 (d, z + pad * 0.4),
-                ("sans-serif", 12).into_font().color(&fault_colour),
+                ("sans-serif", 12).into_font().color(&colour),
             )))?;
         }
     }
@@ -253,6 +263,7 @@ mod tests {
             units: &units,
             holes: &[],
             faults: &[],
+            objects: &[],
         };
         let dir = tempfile::tempdir().unwrap();
         let e = crate::pictures::render_file(&dir.path().join("s.png"), (200, 100), |r| {

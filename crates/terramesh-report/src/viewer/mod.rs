@@ -432,9 +432,184 @@ pub fn compact(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<[f64; 3]>, Vec<
     (out, t)
 }
 
+/// A triangulated surface in 3D thinned for the viewer by [`cluster`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clustered {
+    /// The vertices kept (each one of the input's).
+    pub vertices: Vec<[f64; 3]>,
+    /// The triangles left, indices into [`Clustered::vertices`].
+    pub triangles: Vec<[u32; 3]>,
+    /// The size of the grid's cubes, metres (0 when the surface was small enough as it is).
+    pub cell: f64,
+    /// The largest distance of an input vertex from the vertex that stands for it, metres.
+    pub moved: f64,
+}
+
+/// A copy of a surface in 3D (a fault's faces, an object's boundary) with at most
+/// `max_triangles` triangles, for the viewer: vertex clustering on a grid of cubes, the
+/// first vertex in each cube (in input order) standing for the others, triangles that
+/// collapse dropped. The cube size starts where the surface's area spread over
+/// `max_triangles` triangles would put it and grows by a quarter until the copy fits. The
+/// copy keeps the surface's shape to within [`Clustered::moved`], and a closed surface stays
+/// closed (each cut edge is shared by the same triangles after the merge). A surface that
+/// already fits is returned compacted and unchanged.
+///
+/// ```
+/// use terramesh_report::viewer::cluster;
+/// // A 10 x 10 m square of 2 * 20 * 20 triangles, thinned to at most 100.
+/// let n = 20;
+/// let v: Vec<[f64; 3]> = (0..=n).flat_map(|j| (0..=n).map(move |i| [i as f64 * 0.5, j as f64 * 0.5, 0.0])).collect();
+/// let mut t = Vec::new();
+/// for j in 0..n { for i in 0..n {
+///     let a = (j * (n + 1) + i) as u32; let w = n as u32 + 1;
+///     t.push([a, a + 1, a + w + 1]); t.push([a, a + w + 1, a + w]);
+/// } }
+/// let c = cluster(&v, &t, 100);
+/// assert!(c.triangles.len() <= 100 && c.triangles.len() > 10);
+/// assert!(c.moved <= c.cell * 3f64.sqrt());
+/// // within its budget: every triangle kept (its vertices renumbered in order of use)
+/// let same = cluster(&v, &t, 800);
+/// assert_eq!((same.triangles.len(), same.cell, same.moved), (t.len(), 0.0, 0.0));
+/// ```
+pub fn cluster(vertices: &[[f64; 3]], triangles: &[[u32; 3]], max_triangles: usize) -> Clustered {
+    if triangles.len() <= max_triangles {
+        let (vertices, triangles) = compact(vertices, triangles);
+        return Clustered {
+            vertices,
+            triangles,
+            cell: 0.0,
+            moved: 0.0,
+        };
+    }
+    let (mut lo, mut area) = ([f64::INFINITY; 3], 0.0);
+    for t in triangles {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        for p in [a, b, c] {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+            }
+        }
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        area += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    }
+    let mut cell = (area / max_triangles.max(1) as f64).sqrt().max(1e-6);
+    loop {
+        let mut rep: std::collections::HashMap<[i64; 3], u32> = std::collections::HashMap::new();
+        let mut to = vec![u32::MAX; vertices.len()];
+        let mut moved = 0.0_f64;
+        let mut kept = Vec::new();
+        for t in triangles {
+            let m = t.map(|i| {
+                let slot = &mut to[i as usize];
+                if *slot == u32::MAX {
+                    let p = vertices[i as usize];
+                    let key = [0, 1, 2].map(|k| ((p[k] - lo[k]) / cell).floor() as i64);
+                    let r = *rep.entry(key).or_insert(i);
+                    let q = vertices[r as usize];
+                    moved = moved.max(
+                        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2))
+                            .sqrt(),
+                    );
+                    *slot = r;
+                }
+                *slot
+            });
+            if m[0] != m[1] && m[1] != m[2] && m[2] != m[0] {
+                kept.push(m);
+            }
+        }
+        if kept.len() <= max_triangles {
+            let (vertices, triangles) = compact(vertices, &kept);
+            return Clustered {
+                vertices,
+                triangles,
+                cell,
+                moved,
+            };
+        }
+        cell *= 1.25;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A closed octahedron refined `n` times (each triangle into four), outward.
+    fn sphere(n: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut v = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let mut t = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        for _ in 0..n {
+            let mut mid = std::collections::HashMap::new();
+            let mut next = Vec::new();
+            for tri in &t {
+                let m = [(0, 1), (1, 2), (2, 0)].map(|(a, b)| {
+                    let key = (tri[a].min(tri[b]), tri[a].max(tri[b]));
+                    *mid.entry(key).or_insert_with(|| {
+                        let (p, q): ([f64; 3], [f64; 3]) = (v[tri[a] as usize], v[tri[b] as usize]);
+                        let c = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+                        let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                        v.push(c.map(|x| x / l));
+                        v.len() as u32 - 1
+                    })
+                });
+                next.push([tri[0], m[0], m[2]]);
+                next.push([tri[1], m[1], m[0]]);
+                next.push([tri[2], m[2], m[1]]);
+                next.push(m);
+            }
+            t = next;
+        }
+        (v, t)
+    }
+
+    /// Every directed edge of a closed, consistently oriented surface is matched by its
+    /// reverse as often: the clustered copy of a closed sphere keeps that, fits its budget,
+    /// and each vertex is one of the input's.
+    #[test]
+    fn a_clustered_closed_surface_stays_closed_and_fits() {
+        let (v, t) = sphere(5);
+        assert_eq!(t.len(), 8192);
+        let c = cluster(&v, &t, 1000);
+        assert!(
+            c.triangles.len() <= 1000 && c.triangles.len() >= 200,
+            "{}",
+            c.triangles.len()
+        );
+        assert!(c.cell > 0.0 && c.moved > 0.0 && c.moved <= c.cell * 3f64.sqrt() + 1e-12);
+        let mut edges = std::collections::HashMap::<(u32, u32), i64>::new();
+        for t in &c.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                *edges.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+            }
+        }
+        assert!(edges.values().all(|&n| n == 0), "an unmatched edge");
+        for p in &c.vertices {
+            assert!(v.contains(p));
+        }
+    }
 
     #[test]
     fn compact_keeps_only_used_vertices() {

@@ -65,6 +65,15 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
             })
             .filter(|f| !f.segments.is_empty())
             .collect();
+        let objects: Vec<SectionFault> = m
+            .objects
+            .iter()
+            .map(|o| SectionFault {
+                name: o.name.clone(),
+                segments: o.cut(a, b),
+            })
+            .filter(|o| !o.segments.is_empty())
+            .collect();
         let cut = Cut {
             title,
             distance: &d,
@@ -72,6 +81,7 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
             units,
             holes: &holes,
             faults: &faults,
+            objects: &objects,
         };
         let crossed = if faults.is_empty() {
             String::new()
@@ -79,6 +89,16 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
             let names: Vec<&str> = faults.iter().map(|f| f.name.as_str()).collect();
             format!(
                 ", and the faults it crosses ({}) in dark red",
+                names.join(", ")
+            )
+        };
+        let crossed = if objects.is_empty() {
+            crossed
+        } else {
+            let names: Vec<&str> = objects.iter().map(|o| o.name.as_str()).collect();
+            format!(
+                "{crossed}, and the outlines of the engineering objects it crosses ({}) in dark \
+                 blue",
                 names.join(", ")
             )
         };
@@ -102,6 +122,9 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
     }
     let xy: Vec<[f64; 2]> = (0..mesh.points.len()).map(|i| mesh.absolute(i)).collect();
     blocks.push(stacked_view(&dir, &xy, mesh, surfaces, units)?);
+    if !m.faults.is_empty() || !m.objects.is_empty() {
+        blocks.push(sheets_view(&dir, m)?);
+    }
     for (k, unit) in units.iter().enumerate() {
         let thickness: Vec<f64> = (0..xy.len())
             .map(|v| surfaces[k][v] - surfaces[k + 1][v])
@@ -168,6 +191,9 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
     });
     if let Some(f) = &s.faulted {
         blocks.extend(fault_tables(f));
+    }
+    if let Some(o) = &s.objects {
+        blocks.extend(object_tables(o));
     }
     if !s.boreholes.is_empty() {
         let worst = s
@@ -263,6 +289,173 @@ pub fn fault_tables(f: &super::faulted::FaultedSummary) -> [Block; 2] {
             .collect(),
     };
     [faults, blocks]
+}
+
+/// The tables of a model's engineering objects, from `model.json`'s `objects`: per object its
+/// kind, stage, cells, meshed against exact volume, the units it crosses (its volume in each
+/// and a tunnel's axis length) and its fault blocks; per excavation stage the excavated volume,
+/// its cells and the objects dug in it.
+pub fn object_tables(o: &super::objects::ObjectsSummary) -> [Block; 2] {
+    let objects = Block::Table {
+        caption: format!(
+            "Engineering objects as meshed ({} objects; the volume error is |meshed − exact| / \
+             exact; the units each crosses with its volume in each, and a tunnel's axis length)",
+            o.objects.len()
+        ),
+        header: [
+            "object",
+            "kind",
+            "stage",
+            "material",
+            "cells",
+            "meshed volume (m³)",
+            "exact volume (m³)",
+            "volume error (%)",
+            "units crossed: volume (m³) [axis length (m)]",
+            "fault blocks",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: o
+            .objects
+            .iter()
+            .map(|x| {
+                let units: Vec<String> = x
+                    .units
+                    .iter()
+                    .map(|u| match u.length {
+                        Some(l) => format!("{}: {:.1} [{l:.1}]", u.unit, u.volume),
+                        None => format!("{}: {:.1}", u.unit, u.volume),
+                    })
+                    .collect();
+                vec![
+                    x.name.clone(),
+                    x.kind.to_string(),
+                    if x.stage == 0 {
+                        "-".into()
+                    } else {
+                        x.stage.to_string()
+                    },
+                    x.material.clone().unwrap_or_else(|| "-".into()),
+                    x.cells.to_string(),
+                    format!("{:.1}", x.meshed_volume),
+                    format!("{:.1}", x.exact_volume),
+                    format!("{:.3}", 100.0 * x.volume_error),
+                    units.join("; "),
+                    x.blocks.join(", "),
+                ]
+            })
+            .collect(),
+    };
+    let stages = Block::Table {
+        caption: format!(
+            "Excavation stages ({}): the cells each removes (FLAC3D's zone group stage-<n>, \
+             model.vtu's excavation_stage), a tunnel's lining never",
+            o.stages.len()
+        ),
+        header: ["stage", "excavated volume (m³)", "cells", "objects"]
+            .map(String::from)
+            .to_vec(),
+        rows: o
+            .stages
+            .iter()
+            .map(|st| {
+                let names: Vec<&str> = o
+                    .objects
+                    .iter()
+                    .filter(|x| x.stage == st.stage)
+                    .map(|x| x.name.as_str())
+                    .collect();
+                vec![
+                    st.stage.to_string(),
+                    format!("{:.1}", st.excavated_volume),
+                    st.cells.to_string(),
+                    names.join(", "),
+                ]
+            })
+            .collect(),
+    };
+    [objects, stages]
+}
+
+/// Most triangles of the still picture of the faults and objects (all sheets together).
+pub const STILL_SHEET_TRIANGLES: usize = 60_000;
+
+/// The still 3D view of a faulted model's faults and its engineering objects
+/// (`pictures/model-faults-view3d.png`): each fault's faces (both sides) and each object's
+/// boundary in the viewer's colours, seen as the stacked bodies are, at true scale, thinned to
+/// [`STILL_SHEET_TRIANGLES`] in all as the viewer thins them.
+fn sheets_view(dir: &Path, m: &ModelBuilt) -> Result<Block> {
+    use super::web::{fault_colour, object_colour, sheet_mesh};
+    let sizes: Vec<usize> = m
+        .faults
+        .iter()
+        .map(|f| 2 * f.triangles.len())
+        .chain(m.objects.iter().map(|o| o.triangles.len()))
+        .collect();
+    let shares = super::web::shares(&sizes, STILL_SHEET_TRIANGLES, STILL_SHEET_TRIANGLES);
+    let (mut v, mut t, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    let mut thinned = false;
+    let sheets = m
+        .faults
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (f, fault_colour(k), true))
+        .chain(
+            m.objects
+                .iter()
+                .enumerate()
+                .map(|(k, o)| (o, object_colour(k), false)),
+        );
+    for ((sheet, colour, both_sides), &each) in sheets.zip(&shares) {
+        let s = sheet_mesh(&sheet.triangles, if both_sides { each / 2 } else { each });
+        thinned |= s.cell > 0.0;
+        let off = v.len() as u32;
+        v.extend_from_slice(&s.vertices);
+        let rgb = terramesh_report::pictures::RGBColor(colour[0], colour[1], colour[2]);
+        for tr in &s.triangles {
+            t.push(tr.map(|i| i + off));
+            c.push(rgb);
+            if both_sides {
+                // a fault is an open sheet: seen from either side
+                t.push([tr[0], tr[2], tr[1]].map(|i| i + off));
+                c.push(rgb);
+            }
+        }
+    }
+    let mode = if t.len() > VECTOR_TRIANGLE_LIMIT {
+        SvgMode::Raster
+    } else {
+        SvgMode::Vector
+    };
+    let title = "Faults and engineering objects";
+    let files = render_both_as(&dir.join("model-faults-view3d"), (1000, 700), mode, |r| {
+        draw_bodies_view3d(r, &v, &t, &c, 1.0, title)
+    })?;
+    let mut parts = Vec::new();
+    if !m.faults.is_empty() {
+        let names: Vec<&str> = m.faults.iter().map(|f| f.name.as_str()).collect();
+        parts.push(format!("the faults ({}) in reds", names.join(", ")));
+    }
+    if !m.objects.is_empty() {
+        let names: Vec<&str> = m.objects.iter().map(|o| o.name.as_str()).collect();
+        parts.push(format!(
+            "the engineering objects' boundaries ({}) in blues",
+            names.join(", ")
+        ));
+    }
+    png(
+        &files[0],
+        format!(
+            "{title} as meshed, seen as the stacked bodies are, true scale: {}{}",
+            parts.join(" and "),
+            if thinned {
+                format!(" (thinned by vertex clustering to at most {STILL_SHEET_TRIANGLES} triangles in all)")
+            } else {
+                String::new()
+            }
+        ),
+    )
 }
 
 /// The still 3D view of the stacked unit bodies (`pictures/model-view3d.png`): each unit's

@@ -41,6 +41,9 @@ pub struct ModelBuilt {
     pub ensemble: Option<Vec<super::ensemble_report::InterfaceSpread>>,
     /// A faulted model's faults as meshed, for the report's sections; empty otherwise.
     pub faults: Vec<super::faulted::FaultSheet>,
+    /// The engineering objects' boundaries as meshed (outward, one sheet per object of
+    /// `summary.objects`, in its order), for the report; empty without objects.
+    pub objects: Vec<super::faulted::FaultSheet>,
 }
 
 /// The project's CRS for the model: the UTM zone of a geographic project, or the named CRS
@@ -301,6 +304,7 @@ pub fn run(
         files,
         ensemble: None,
         faults: Vec::new(),
+        objects: Vec::new(),
     })
 }
 

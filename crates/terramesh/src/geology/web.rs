@@ -11,7 +11,7 @@ use terramesh_io::boreholes::Hole;
 use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
 use terramesh_io::output::Output;
 use terramesh_report::pictures::unit_colour;
-use terramesh_report::viewer::{compact, Geometry, Layer};
+use terramesh_report::viewer::{cluster, compact, Clustered, Geometry, Layer};
 
 use super::traces::{borehole_traces, STUB_FRACTION_PERCENT, TRACE_RADIUS, UNLOGGED};
 use crate::error::{Context, Error, Result};
@@ -353,6 +353,8 @@ pub(crate) fn viewer_layers(
             vertex_colours: None,
         });
     }
+    let (sheet_layers, sheet_note) = sheet_layers(g);
+    layers.extend(sheet_layers);
     let note = format!(
         "The geological model: {shown} of its {} units have thickness, each drawn as its top, \
          bottom and sides (on the full planar mesh: its sealed body's boundary) and toggled on \
@@ -370,6 +372,169 @@ pub(crate) fn viewer_layers(
             )
         }
     );
+    (layers, format!("{note}{sheet_note}"))
+}
+
+/// Most triangles of the faults' and the engineering objects' layers together in the viewer;
+/// each sheet gets an equal share (at most [`VIEWER_SHEET_TRIANGLES_EACH`]) and a larger one
+/// is thinned by vertex clustering (`terramesh_report::viewer::cluster`).
+pub const VIEWER_SHEET_TRIANGLES: usize = 200_000;
+/// Most triangles of one fault's or object's layer in the viewer.
+pub const VIEWER_SHEET_TRIANGLES_EACH: usize = 100_000;
+
+/// The colour of fault `k` in the viewer and the still picture: reds and oranges, apart from
+/// the units' palette.
+pub fn fault_colour(k: usize) -> [u8; 3] {
+    const PALETTE: [[u8; 3]; 6] = [
+        [180, 20, 20],
+        [235, 95, 20],
+        [200, 30, 130],
+        [130, 50, 10],
+        [240, 175, 0],
+        [110, 0, 50],
+    ];
+    PALETTE[k % PALETTE.len()]
+}
+
+/// The colour of engineering object `k` (in `model.json`'s order) in the viewer, the still
+/// picture and nowhere else: saturated blues, teals and violets, apart from the units'
+/// palette and the faults'.
+pub fn object_colour(k: usize) -> [u8; 3] {
+    const PALETTE: [[u8; 3]; 6] = [
+        [30, 60, 210],
+        [0, 150, 170],
+        [130, 40, 190],
+        [40, 40, 40],
+        [0, 120, 60],
+        [80, 0, 140],
+    ];
+    PALETTE[k % PALETTE.len()]
+}
+
+/// How many triangles each of sheets of `sizes` triangles may keep: at most `each` and
+/// `total` together, shared out so that sheets within an equal share keep all theirs and
+/// what they leave goes to the larger ones (water-filling).
+///
+/// ```
+/// use terramesh::geology::web::shares;
+/// assert_eq!(shares(&[10, 500, 40], 300, 1000), vec![10, 250, 40]);
+/// assert_eq!(shares(&[10, 500, 40], 3000, 200), vec![10, 200, 40]);
+/// assert_eq!(shares(&[400, 500], 600, 1000), vec![300, 300]);
+/// ```
+pub fn shares(sizes: &[usize], total: usize, each: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..sizes.len()).collect();
+    order.sort_by_key(|&i| sizes[i]);
+    let mut out = vec![0; sizes.len()];
+    let mut left = total;
+    for (k, &i) in order.iter().enumerate() {
+        let fair = left / (sizes.len() - k);
+        out[i] = sizes[i].min(fair).min(each);
+        left -= out[i];
+    }
+    out
+}
+
+/// A sheet's triangles as shared vertices and indices (corners with the same coordinates
+/// merged), thinned to at most `max` triangles.
+pub(crate) fn sheet_mesh(triangles: &[[[f64; 3]; 3]], max: usize) -> Clustered {
+    let mut index: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
+    let mut v = Vec::new();
+    let t: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|tri| {
+            tri.map(|p| {
+                *index.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                    v.push(p);
+                    v.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    cluster(&v, &t, max)
+}
+
+/// The viewer's layers of a faulted model's faults (one toggle each, open sheets, cut by the
+/// cross-section) and of its engineering objects (one toggle each, closed: the cross-section
+/// fills their cut), with a sentence for the viewer's note ("" without either).
+fn sheet_layers(g: &super::stage::ModelBuilt) -> (Vec<Layer>, String) {
+    let n = g.faults.len() + g.objects.len();
+    if n == 0 {
+        return (Vec::new(), String::new());
+    }
+    let sizes: Vec<usize> = g
+        .faults
+        .iter()
+        .chain(&g.objects)
+        .map(|s| s.triangles.len())
+        .collect();
+    let shares = shares(&sizes, VIEWER_SHEET_TRIANGLES, VIEWER_SHEET_TRIANGLES_EACH);
+    let kinds: Vec<&str> = g
+        .summary
+        .objects
+        .iter()
+        .flat_map(|o| o.objects.iter().map(|x| x.kind))
+        .collect();
+    let mut layers = Vec::new();
+    let mut thinned = Vec::new();
+    let sheets = g
+        .faults
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (format!("fault {}", f.name), f, fault_colour(k), false))
+        .chain(g.objects.iter().enumerate().map(|(k, o)| {
+            let kind = kinds.get(k).copied().unwrap_or("object");
+            (format!("{kind} {}", o.name), o, object_colour(k), true)
+        }));
+    for ((name, sheet, colour, closed), &each) in sheets.zip(&shares) {
+        let c = sheet_mesh(&sheet.triangles, each);
+        if c.cell > 0.0 {
+            thinned.push(format!(
+                "{name}: {} of its {} faces, corners merged on a {:.2} m grid (moved at most \
+                 {:.2} m)",
+                c.triangles.len(),
+                sheet.triangles.len(),
+                c.cell,
+                c.moved
+            ));
+        }
+        layers.push(Layer {
+            name,
+            positions: c.vertices,
+            geometry: Geometry::Triangles(c.triangles),
+            fields: Vec::new(),
+            colour,
+            visible: true,
+            pickable: true,
+            clipped: true,
+            closed,
+            vertex_colours: None,
+        });
+    }
+    let mut note = String::new();
+    if !g.faults.is_empty() {
+        note.push_str(&format!(
+            " The {} faults are drawn as meshed (the model's fault faces), each toggled on its \
+             own, in reds; the cross-section cuts them.",
+            g.faults.len()
+        ));
+    }
+    if !g.objects.is_empty() {
+        note.push_str(&format!(
+            " The {} engineering objects are drawn by their boundaries as meshed (the faces of \
+             their cells, lining included, that face other cells or the model's boundary), each \
+             toggled on its own, in blues; the cross-section cuts them and fills each cut.",
+            g.objects.len()
+        ));
+    }
+    note.push_str(&format!(
+        " They are shown with at most {VIEWER_SHEET_TRIANGLES} triangles together and \
+         {VIEWER_SHEET_TRIANGLES_EACH} each{}",
+        if thinned.is_empty() {
+            ": all of their faces are.".to_string()
+        } else {
+            format!("; thinned by vertex clustering: {}.", thinned.join("; "))
+        }
+    ));
     (layers, note)
 }
 

@@ -13,6 +13,7 @@ mod contacts;
 mod inputs;
 mod interfaces;
 mod mesh;
+mod sheets;
 mod summary;
 
 use std::path::Path;
@@ -294,6 +295,18 @@ pub(crate) fn run(
                 .collect(),
         })
         .collect();
+    let named: Vec<(u32, String)> = summary
+        .objects
+        .iter()
+        .flat_map(|o| &o.objects)
+        .map(|o| (o.object, o.name.clone()))
+        .collect();
+    let objects = sheets::object_sheets(
+        &faulted.mesh.points,
+        &faulted.mesh.tets,
+        &faulted.mesh.objects.object,
+        &named,
+    );
     Ok(crate::geology::stage::ModelBuilt {
         model,
         summary,
@@ -301,6 +314,7 @@ pub(crate) fn run(
         files,
         ensemble: None,
         faults,
+        objects,
     })
 }
 
