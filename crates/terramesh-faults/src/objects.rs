@@ -1375,6 +1375,7 @@ impl Surfaces<'_> {
     /// on the region's boundary; an interface: vertically, not on the terrain or the base).
     /// Otherwise `p` (the chord): a node moved off the wall would leave the cells around it
     /// with nodes on both sides of the wall.
+    #[allow(clippy::too_many_arguments)]
     fn onto(
         &self,
         st: &State,
@@ -1410,7 +1411,7 @@ impl Surfaces<'_> {
             let gn = dot(g, n);
             let t = [0, 1, 2].map(|k| g[k] - gn * n[k]);
             let tt = dot(t, t);
-            if !(tt > 1e-12) {
+            if tt.is_nan() || tt <= 1e-12 {
                 return p;
             }
             let r = [0, 1, 2].map(|k| q[k] - f * t[k] / tt);
