@@ -200,9 +200,6 @@ fn without_pit(text: &str) -> String {
 }
 
 #[test]
-#[ignore = "known failure (issue 32): without faults (the tunnel and the dam on the faulted \
-            example's site) the writer refuses cell 1311510, of volume -3e-16 m3 in floating \
-            point (exactly positive in the kernel); not diagnosed"]
 fn objects_without_faults_go_through_the_tetrahedral_kernel() {
     let tmp = tempfile::tempdir().unwrap();
     let project = tmp.path().join("terramesh.toml");
@@ -228,8 +225,6 @@ fn objects_without_faults_go_through_the_tetrahedral_kernel() {
 }
 
 #[test]
-#[ignore = "known failure (issue 32): without faults the pit's cut fails check_objects near the \
-            terrain at (114, 41, 150): a cell with nodes on both sides of its wall; not diagnosed"]
 fn a_pit_without_faults_passes_its_checks() {
     let tmp = tempfile::tempdir().unwrap();
     let project = tmp.path().join("terramesh.toml");

@@ -111,9 +111,12 @@
 //! Tunnels (a profile swept along a mitred polyline axis, with an optional lining),
 //! excavations (faces descending from an outline on the terrain at a face angle to a floor)
 //! and closed triangulated structures, each read through an implicit field negative inside:
-//! the mesh is refined near them right after the background mesh (edges whose midpoint's field
-//! strays from the mean of its ends' by more than [`ObjectSet::resolution`] x the object's
-//! size are bisected), and after the quality pass every wall cuts the mesh as a fault does;
+//! the mesh is refined near them right after the background mesh (a cell with an edge whose
+//! midpoint's field strays from the mean of its ends' by more than [`ObjectSet::resolution`]
+//! x the object's size is bisected there if that edge is near its longest, else at its
+//! longest edge, so that the cells keep their shape), and after the quality pass every wall
+//! cuts the mesh as a fault does (a crossing moved onto a fault or an interface stays on the
+//! wall);
 //! cells are labelled by object and lining ([`ObjectCells`]). See `docs/geology.md`,
 //! "Engineering structures".
 //!

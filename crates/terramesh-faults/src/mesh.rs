@@ -410,7 +410,7 @@ pub(crate) fn split_prism(t: [u32; 3], b: [u32; 3], points: &[[f64; 3]]) -> [[u3
 }
 
 #[allow(clippy::needless_range_loop)] // vertex v indexes points, heights and sides
-fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> {
+pub(crate) fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> {
     if !s.base.is_finite() {
         return Err(FaultError::Setting {
             name: "base".into(),
@@ -509,13 +509,15 @@ fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, FaultError> 
     })
 }
 
-/// Splits `t` at every edge in `keys` (sorted), the lowest key first, as splitting those
-/// edges one after another through the whole mesh would: neighbours agree.
-fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
+/// Splits `t` at every edge in `keys` (sorted), the edge of the lowest rank first (`rank[pos]`
+/// for the edge at `keys[pos]`, the lowest key first without ranks), as splitting those edges
+/// one after another through the whole mesh would: neighbours agree.
+fn split_tet(t: [u32; 4], keys: &[u64], rank: Option<&[u32]>, first: u32, out: &mut Vec<[u32; 4]>) {
+    let order = |pos: usize| rank.map_or(pos as u64, |r| (r[pos] as u64) << 32 | pos as u64);
     let mut best: Option<(usize, usize, usize)> = None;
     for &(i, j) in &EDGES {
         if let Ok(pos) = keys.binary_search(&key(t[i], t[j])) {
-            if !matches!(best, Some(b) if pos >= b.2) {
+            if !matches!(best, Some(b) if order(pos) >= order(b.2)) {
                 best = Some((i, j, pos));
             }
         }
@@ -527,8 +529,8 @@ fn split_tet(t: [u32; 4], keys: &[u64], first: u32, out: &mut Vec<[u32; 4]>) {
             let (mut a, mut b) = (t, t);
             a[j] = m;
             b[i] = m;
-            split_tet(a, keys, first, out);
-            split_tet(b, keys, first, out);
+            split_tet(a, keys, rank, first, out);
+            split_tet(b, keys, rank, first, out);
         }
     }
 }
@@ -692,7 +694,19 @@ fn cut(
 /// pushed, numbered from `first` in key order), conformally: the first child replaces the
 /// cell, the others are pushed with its `positive`, `below` and `block`, and `child(c)` is
 /// called once per pushed child of cell `c` (for labels the caller keeps beside the mesh).
-pub(crate) fn split_cells(st: &mut State, keys: &[u64], first: u32, mut child: impl FnMut(usize)) {
+pub(crate) fn split_cells(st: &mut State, keys: &[u64], first: u32, child: impl FnMut(usize)) {
+    split_cells_ranked(st, keys, None, first, child)
+}
+
+/// [`split_cells`], the edges of each cell split in the order of `rank` (one per key; ties:
+/// the lower key first) instead of the keys' order.
+pub(crate) fn split_cells_ranked(
+    st: &mut State,
+    keys: &[u64],
+    rank: Option<&[u32]>,
+    first: u32,
+    mut child: impl FnMut(usize),
+) {
     // Only cells with two ends of split edges can hold one.
     let mut end = vec![false; first as usize];
     for &k in keys {
@@ -711,7 +725,7 @@ pub(crate) fn split_cells(st: &mut State, keys: &[u64], first: u32, mut child: i
         })
         .map(|(c, &t)| {
             let mut out = Vec::with_capacity(8);
-            split_tet(t, keys, first, &mut out);
+            split_tet(t, keys, rank, first, &mut out);
             (c, out)
         })
         .collect();

@@ -923,7 +923,22 @@ impl Object {
                     }
                 }
                 bbox[0][2] = *floor;
-                bbox[1][2] = highest;
+                // The top: the terrain over the outline, which may rise above every DSM vertex
+                // inside it and the outline's own heights (a triangle across the outline with
+                // a high vertex outside it): the highest vertex of every DSM triangle that
+                // meets the outline's box (the cut takes nodes outside the box as outside).
+                let mut top = highest;
+                for t in &terrain.triangles {
+                    let q = t.map(|v| terrain.points[v as usize]);
+                    if (0..2).all(|k| {
+                        q.iter().any(|p| p[k] >= bbox[0][k]) && q.iter().any(|p| p[k] <= bbox[1][k])
+                    }) {
+                        for &v in t {
+                            top = top.max(terrain.heights[v as usize]);
+                        }
+                    }
+                }
+                bbox[1][2] = top;
                 let shape = Shape::Excavation {
                     outline: ring,
                     tops,
@@ -1281,9 +1296,51 @@ fn crossing(f: &dyn Fn([f64; 3]) -> f64, a: [f64; 3], b: [f64; 3], va: f64, vb: 
     at(t.clamp(1e-12, 1.0 - 1e-12))
 }
 
+/// The refinement near objects bisects a cell at an edge that strays from a wall only if
+/// that edge is at least this fraction of the cell's longest edge, else at its longest edge.
+const NEAR_LONGEST: f64 = 0.75;
+
+/// The squared length of an edge (by key).
+fn edge_d2(points: &[[f64; 3]], k: u64) -> f64 {
+    let d = sub(points[(k >> 32) as usize], points[k as u32 as usize]);
+    dot(d, d)
+}
+
+/// The key of a cell's longest edge (ties: the lowest key, so that every cell agrees).
+fn longest_edge(points: &[[f64; 3]], t: &[u32; 4]) -> u64 {
+    EDGES
+        .iter()
+        .map(|&(i, j)| key(t[i], t[j]))
+        .max_by(|&a, &b| {
+            edge_d2(points, a)
+                .total_cmp(&edge_d2(points, b))
+                .then(b.cmp(&a))
+        })
+        .unwrap()
+}
+
 /// Splits the given edges (sorted keys) at the given points, conformally, the children of a
-/// cell keeping its labels.
-fn split_edges(st: &mut State, labels: &mut ObjectCells, keys: &[u64], points: Vec<[f64; 3]>) {
+/// cell keeping its labels; with `longest_first`, each cell's edges are split longest first.
+fn split_edges(
+    st: &mut State,
+    labels: &mut ObjectCells,
+    keys: &[u64],
+    points: Vec<[f64; 3]>,
+    longest_first: bool,
+) {
+    let rank: Option<Vec<u32>> = longest_first.then(|| {
+        let mut order: Vec<u32> = (0..keys.len() as u32).collect();
+        order.sort_by(|&a, &b| {
+            edge_d2(&st.points, keys[b as usize])
+                .total_cmp(&edge_d2(&st.points, keys[a as usize]))
+                .then(a.cmp(&b))
+        });
+        let mut rank = vec![0u32; keys.len()];
+        for (r, &pos) in order.iter().enumerate() {
+            rank[pos as usize] = r as u32;
+        }
+        rank
+    });
     let first = st.points.len() as u32;
     for (&k, p) in keys.iter().zip(points) {
         let (a, b) = ((k >> 32) as usize, k as u32 as usize);
@@ -1292,7 +1349,7 @@ fn split_edges(st: &mut State, labels: &mut ObjectCells, keys: &[u64], points: V
             .push(st.flags[a] & st.flags[b] & (TOP | BASE | SIDE));
         st.on_fault.push(st.on_fault[a] & st.on_fault[b]);
     }
-    crate::mesh::split_cells(st, keys, first, |c| {
+    crate::mesh::split_cells_ranked(st, keys, rank.as_deref(), first, |c| {
         if !labels.object.is_empty() {
             labels.object.push(labels.object[c]);
             labels.lining.push(labels.lining[c]);
@@ -1310,20 +1367,73 @@ pub(crate) struct Surfaces<'a> {
 }
 
 impl Surfaces<'_> {
-    /// `p` on edge ab (cell block `block`) moved onto the fault or interface that both a and
-    /// b lie on, if any and if that moves it at most `most` (a fault: along its normal, not on
-    /// the region's boundary; an interface: vertically, not on the terrain or the base).
-    fn onto(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3], most: f64) -> [f64; 3] {
-        let q = self.project(st, a, b, block, p);
-        let d = norm(sub(q, p));
-        if d <= most {
+    /// `p` on edge ab (cell block `block`), the crossing of the wall `wall` (a field), moved
+    /// onto the fault or interface that both a and b lie on, if any, and kept on the wall: to
+    /// the point of their intersection near `p`, found by projecting onto the surface and
+    /// stepping along it down the wall's field (Newton), if that lands within [`ON_WALL`] of
+    /// the wall, on the surface, and at most `most` from `p` (a fault: along its normal, not
+    /// on the region's boundary; an interface: vertically, not on the terrain or the base).
+    /// Otherwise `p` (the chord): a node moved off the wall would leave the cells around it
+    /// with nodes on both sides of the wall.
+    #[allow(clippy::too_many_arguments)]
+    fn onto(
+        &self,
+        st: &State,
+        a: usize,
+        b: usize,
+        block: u32,
+        p: [f64; 3],
+        most: f64,
+        wall: &dyn Fn([f64; 3]) -> f64,
+    ) -> [f64; 3] {
+        let Some(on) = self.surface(st, a, b, block) else {
+            return p;
+        };
+        let Some(mut q) = self.project(on, block, p) else {
+            return p;
+        };
+        let e = 1e-4;
+        for _ in 0..12 {
+            let f = wall(q);
+            if !f.is_finite() {
+                return p;
+            }
+            if f.abs() <= 0.01 * ON_WALL {
+                break;
+            }
+            let g = [0, 1, 2].map(|k| {
+                let (mut x, mut y) = (q, q);
+                x[k] += e;
+                y[k] -= e;
+                (wall(x) - wall(y)) / (2.0 * e)
+            });
+            let n = self.normal(on, block, q);
+            let gn = dot(g, n);
+            let t = [0, 1, 2].map(|k| g[k] - gn * n[k]);
+            let tt = dot(t, t);
+            if tt.is_nan() || tt <= 1e-12 {
+                return p;
+            }
+            let r = [0, 1, 2].map(|k| q[k] - f * t[k] / tt);
+            match self.project(on, block, r) {
+                Some(r) => q = r,
+                None => return p,
+            }
+        }
+        let ok = wall(q).abs() <= 0.5 * ON_WALL
+            && norm(sub(q, p)) <= most
+            && self
+                .project(on, block, q)
+                .is_some_and(|r| norm(sub(r, q)) <= 0.1 * ON_SURFACE);
+        if ok {
             q
         } else {
             p
         }
     }
 
-    fn project(&self, st: &State, a: usize, b: usize, block: u32, p: [f64; 3]) -> [f64; 3] {
+    /// The fault or interface that both a and b lie on, if any.
+    fn surface(&self, st: &State, a: usize, b: usize, block: u32) -> Option<On> {
         let (qa, qb) = (st.points[a], st.points[b]);
         let both = st.flags[a] & st.flags[b];
         let common = st.on_fault[a] & st.on_fault[b];
@@ -1333,8 +1443,7 @@ impl Surfaces<'_> {
                     && fault.side(qa).distance.abs() <= ON_SURFACE
                     && fault.side(qb).distance.abs() <= ON_SURFACE
                 {
-                    let s = fault.side(p);
-                    return [0, 1, 2].map(|k| p[k] - s.distance * s.normal[k]);
+                    return Some(On::Fault(f));
                 }
             }
         }
@@ -1343,13 +1452,49 @@ impl Surfaces<'_> {
             for k in 0..self.interfaces {
                 let h = |q: [f64; 3]| (self.height)(k, key, [q[0], q[1]]);
                 if (qa[2] - h(qa)).abs() <= ON_SURFACE && (qb[2] - h(qb)).abs() <= ON_SURFACE {
-                    let z = h(p);
-                    return if z.is_finite() { [p[0], p[1], z] } else { p };
+                    return Some(On::Interface(k));
                 }
             }
         }
-        p
+        None
     }
+
+    /// `p` projected onto the surface: along the fault's normal, or vertically.
+    fn project(&self, on: On, block: u32, p: [f64; 3]) -> Option<[f64; 3]> {
+        let q = match on {
+            On::Fault(f) => {
+                let s = self.faults.faults[f].side(p);
+                [0, 1, 2].map(|k| p[k] - s.distance * s.normal[k])
+            }
+            On::Interface(k) => {
+                let z = (self.height)(k, self.blocks[block as usize], [p[0], p[1]]);
+                [p[0], p[1], z]
+            }
+        };
+        q.iter().all(|x| x.is_finite()).then_some(q)
+    }
+
+    /// The surface's unit normal at `q`.
+    fn normal(&self, on: On, block: u32, q: [f64; 3]) -> [f64; 3] {
+        match on {
+            On::Fault(f) => self.faults.faults[f].side(q).normal,
+            On::Interface(k) => {
+                let key = self.blocks[block as usize];
+                let h = |x: f64, y: f64| (self.height)(k, key, [x, y]);
+                let e = 1e-3;
+                let hx = (h(q[0] + e, q[1]) - h(q[0] - e, q[1])) / (2.0 * e);
+                let hy = (h(q[0], q[1] + e) - h(q[0], q[1] - e)) / (2.0 * e);
+                unit([-hx, -hy, 1.0])
+            }
+        }
+    }
+}
+
+/// A surface already cut: a fault or interface `k`.
+#[derive(Debug, Clone, Copy)]
+enum On {
+    Fault(usize),
+    Interface(usize),
 }
 
 fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
@@ -1394,16 +1539,13 @@ pub(crate) fn refine_near_objects(
             .filter_map(|t| {
                 let q = t.map(|n| st.points[n as usize]);
                 let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
-                let longest = EDGES
-                    .iter()
-                    .copied()
-                    .max_by(|&a, &b| len(a).total_cmp(&len(b)))
-                    .unwrap();
-                let l = len(longest);
-                // The edge to split for a wall: the longest of the edges whose midpoint's
-                // field deviates from the mean of its ends' by more than the tolerance (the
-                // facets there would stray from the wall), or the longest edge if only the
-                // centroid's does; nothing where the edges are already short.
+                let l = EDGES.iter().map(|&e| len(e)).fold(0.0, f64::max);
+                // A cell is refined where the facets would stray from a wall: an edge whose
+                // midpoint's field deviates from the mean of its ends' by more than the
+                // tolerance, or the centroid's; nothing where the edges are already short.
+                // It is bisected at its longest edge (not at the edge that deviates:
+                // bisecting other edges again and again makes needles, then cells flat to
+                // rounding).
                 let mut pick: Option<(usize, usize)> = None;
                 for (w, &(i, wall)) in walls.iter().enumerate() {
                     let o = &set.objects[i];
@@ -1430,7 +1572,7 @@ pub(crate) fn refine_near_objects(
                     if best.is_none() {
                         let c = centroid(&st.points, t);
                         if (o.field(wall, c) - 0.25 * v.iter().sum::<f64>()).abs() > tol {
-                            best = Some(longest);
+                            best = Some((0, 0));
                         }
                     }
                     if let Some(e) = best {
@@ -1439,13 +1581,46 @@ pub(crate) fn refine_near_objects(
                         }
                     }
                 }
-                pick.map(|(a, b)| key(t[a], t[b]))
+                pick.map(|(a, b)| {
+                    if a != b && len((a, b)) >= NEAR_LONGEST * l {
+                        key(t[a], t[b])
+                    } else {
+                        longest_edge(&st.points, t)
+                    }
+                })
             })
             .collect();
         keys.par_sort_unstable();
         keys.dedup();
         if keys.is_empty() {
             break;
+        }
+        // Rivara's closure, relaxed: a cell with edges to split none of which is near its
+        // longest (within NEAR_LONGEST) has its longest edge split too, and every cell is
+        // split at its longest edges first, so that no cell is split at a short edge only.
+        loop {
+            let mut add: Vec<u64> = st
+                .tets
+                .par_iter()
+                .filter_map(|t| {
+                    let marked = EDGES
+                        .iter()
+                        .map(|&(i, j)| key(t[i], t[j]))
+                        .filter(|k| keys.binary_search(k).is_ok())
+                        .map(|k| edge_d2(&st.points, k))
+                        .fold(-1.0, f64::max);
+                    let l = longest_edge(&st.points, t);
+                    (marked >= 0.0 && marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, l))
+                        .then_some(l)
+                })
+                .collect();
+            if add.is_empty() {
+                break;
+            }
+            add.par_sort_unstable();
+            add.dedup();
+            keys.extend(add);
+            keys.par_sort_unstable();
         }
         if st.tets.len() + 6 * keys.len() > set.max_cells {
             labels.capped = true;
@@ -1463,7 +1638,7 @@ pub(crate) fn refine_near_objects(
             })
             .collect();
         labels.refined_edges += keys.len();
-        split_edges(st, &mut labels, &keys, mids);
+        split_edges(st, &mut labels, &keys, mids, true);
     }
     Ok(labels)
 }
@@ -1532,9 +1707,9 @@ pub(crate) fn cut_objects(
             .collect();
         edge_block.par_sort_unstable();
         edge_block.dedup_by_key(|e| e.0);
-        // A move onto a fault or an interface may take the node this far off the wall (half
-        // the tolerance of check_objects); a farther one (an edge between two nodes of the
-        // surface that is not on its faces) keeps the chord.
+        // A move onto a fault or an interface (along it, staying on the wall) may take the
+        // node this far from the chord (half the tolerance of check_objects); a farther one
+        // (an edge between two nodes of the surface that is not on its faces) keeps the chord.
         let most = 0.5 * OBJECT_TOLERANCE.max(4.0 * set.resolution * o.size);
         let chords: Vec<[f64; 3]> = keys
             .par_iter()
@@ -1548,14 +1723,22 @@ pub(crate) fn cut_objects(
             .zip(&chords)
             .zip(&edge_block)
             .map(|((&k, &p), &(_, block))| {
-                surfaces.onto(st, (k >> 32) as usize, k as u32 as usize, block, p, most)
+                surfaces.onto(
+                    st,
+                    (k >> 32) as usize,
+                    k as u32 as usize,
+                    block,
+                    p,
+                    most,
+                    &f,
+                )
             })
             .collect();
         labels.split_edges += keys.len();
         let mut values = values;
         values.resize(st.points.len() + keys.len(), (0.0, 0));
         let first = st.points.len();
-        split_edges(st, &mut labels, &keys, pts);
+        split_edges(st, &mut labels, &keys, pts, false);
         // Where a node moved onto a curved interface or fault inverts a cell, it goes back
         // to the chord.
         for _ in 0..8 {
@@ -1817,4 +2000,61 @@ pub fn check_objects(
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{min_dihedral, MeshSettings, Site};
+
+    /// The refinement near a horseshoe tunnel (its corners keep the facets straying from the
+    /// wall down to the smallest edges) keeps every cell positive in floating point and of a
+    /// bounded shape: bisecting the edge that strays, whatever its length, made needles and
+    /// then cells flat to rounding (859 of them here, and the box structure's test failed).
+    #[test]
+    fn refinement_near_a_tunnel_keeps_cells_shaped() {
+        let site = Site::new(
+            200.0,
+            10,
+            0.2,
+            1,
+            [120.0, 0.02, -0.01],
+            0.0,
+            vec![90.0, 60.0, 30.0],
+            [0.01, 0.0],
+            vec![],
+        )
+        .unwrap();
+        let spec = ObjectSpec {
+            name: "gallery".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![
+                    [30.0, 150.0, 40.0],
+                    [90.0, 150.0, 45.0],
+                    [150.0, 170.0, 45.0],
+                ],
+                profile: Profile::Horseshoe {
+                    width: 6.0,
+                    height: 7.0,
+                },
+                lining: 0.0,
+            },
+        };
+        let set = ObjectSet::new(&[spec], &site.terrain, site.base).unwrap();
+        let mut st =
+            crate::mesh::background(&site.terrain, &MeshSettings::new(site.base, 10.0)).unwrap();
+        let before = st.tets.len();
+        let labels = refine_near_objects(&mut st, &set).unwrap();
+        assert!(st.tets.len() > 10 * before && labels.refined_edges > 0);
+        let worst = st
+            .tets
+            .iter()
+            .map(|t| min_dihedral(t.map(|v| st.points[v as usize])))
+            .fold(f64::MAX, f64::min);
+        assert!(
+            worst > 1.0,
+            "a cell of {worst} degrees after the refinement"
+        );
+    }
 }

@@ -181,10 +181,6 @@ fn pit_with_planar_faces_has_its_exact_volume() {
 }
 
 #[test]
-#[ignore = "known failure (issue 32): since check() also requires every cell's floating-point \
-            volume to be positive (the zero-volume fix of issue 31), the box structure's cut \
-            leaves one cell that is positive exactly and flat in floating point (cell 433200 \
-            near (89.8, 153.1, 45.7)); the walls are cut without snapping nodes"]
 fn box_structure_and_horseshoe_tunnel_have_their_exact_volumes() {
     let site = faulted_site([120.0, 0.02, -0.01]);
     let dam = ObjectSpec {
