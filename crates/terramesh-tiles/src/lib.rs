@@ -22,7 +22,7 @@
 //! reach.
 //!
 //! ```no_run
-//! # fn main() -> Result<(), terramesh::Error> {
+//! # fn main() -> Result<(), terramesh_tiles::TilesError> {
 //! use std::path::Path;
 //! use terramesh::project::Project;
 //! use terramesh_tiles as tiles;
@@ -43,6 +43,7 @@
 mod appended;
 mod boreholes;
 mod build;
+mod error;
 mod files;
 mod geology;
 mod geology_plan;
@@ -64,6 +65,10 @@ mod slurm;
 
 pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
 pub use build::{build_tile, Outcome, FAIL_ENV};
+pub use error::{
+    BoundaryProblem, ContactProblem, Doing, GridProblem, PlanMismatch, Result, ScriptPath,
+    TilesError, Untileable, UntileableGeology,
+};
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
     tag_of_name, Estimate, GeologyPlan, InterfacePlan, PlanCrs, TileFigures, INTERFACES,

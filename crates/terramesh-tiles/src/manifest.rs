@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// The manifest's file name in the plan folder.
 pub const MANIFEST: &str = "tiles.json";
@@ -393,22 +393,21 @@ impl Manifest {
     /// Reads `PLAN/tiles.json`.
     pub fn read(plan: &Path) -> Result<Manifest> {
         let path = plan.join(MANIFEST);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            Error::invalid(format!(
-                "{}: {e}; make a plan first with terramesh tiles plan",
-                path.display()
-            ))
-        })?;
-        let m: Manifest = serde_json::from_str(&text).context(path.display().to_string())?;
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(source) => return Err(Error::NoManifest { path, source }),
+        };
+        let m: Manifest = serde_json::from_str(&text).at(&path)?;
         if m.version != VERSION {
-            return Err(Error::invalid(format!(
-                "{}: manifest version {} (this terramesh reads {VERSION}): plan again",
-                path.display(),
-                m.version
-            )));
+            return Err(Error::ManifestVersion {
+                path,
+                version: m.version,
+                reads: VERSION,
+            });
         }
-        m.check()
-            .map_err(|why| Error::invalid(format!("{}: {why}: plan again", path.display())))?;
+        if let Err(source) = m.check() {
+            return Err(Error::Manifest { path, source });
+        }
         Ok(m)
     }
 
@@ -540,17 +539,17 @@ impl Manifest {
     pub fn write(&self, plan: &Path) -> Result<()> {
         let text = serde_json::to_string_pretty(self)?;
         terramesh_io::output::write_atomic(&plan.join(MANIFEST), text.as_bytes())
-            .context(plan.join(MANIFEST).display().to_string())
+            .at(&plan.join(MANIFEST))
     }
 
     /// The tile with `id`, or an error listing the ids.
     pub fn tile(&self, id: &str) -> Result<&Tile> {
         self.tiles.iter().find(|t| t.id == id).ok_or_else(|| {
             let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
-            Error::invalid(format!(
-                "no tile '{id}' in the plan; its tiles are {}",
-                terramesh::cut(&ids.join(", "))
-            ))
+            Error::NoSuchTile {
+                id: id.to_string(),
+                tiles: ids.join(", "),
+            }
         })
     }
 }
@@ -559,7 +558,7 @@ impl Manifest {
 /// returned. The lock is held from the read to the write.
 ///
 /// ```
-/// # fn main() -> Result<(), terramesh::Error> {
+/// # fn main() -> Result<(), terramesh_tiles::TilesError> {
 /// let dir = tempfile::tempdir()?;
 /// let e = terramesh_tiles::update(dir.path(), |_| Ok(())).unwrap_err();
 /// assert!(e.to_string().contains("terramesh tiles plan"));
@@ -584,8 +583,8 @@ impl Lock {
             .truncate(false)
             .write(true)
             .open(&path)
-            .context(path.display().to_string())?;
-        file.lock().context(path.display().to_string())?;
+            .at(&path)?;
+        file.lock().at(&path)?;
         Ok(Lock(file))
     }
 }

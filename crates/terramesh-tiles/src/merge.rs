@@ -20,7 +20,7 @@ use super::appended::{self, put_f64, Array, Section, Values};
 use super::files::{self, Vertex};
 use super::manifest::{tile_dir, Manifest, State, Tile};
 use super::merged::Merged;
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
@@ -41,13 +41,12 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         })
         .collect();
     if !pending.is_empty() {
-        return Err(Error::invalid(format!(
-            "{} of {} tiles are not done: {}; build them with terramesh tiles build {} --tile ID",
-            pending.len(),
-            m.tiles.len(),
-            terramesh::cut(&pending.join(", ")),
-            plan.display()
-        )));
+        return Err(Error::NotDone {
+            pending: pending.len(),
+            tiles: m.tiles.len(),
+            ids: pending.join(", "),
+            plan: plan.to_path_buf(),
+        });
     }
     // Staged like a build (`build/staging.rs`): written into a sibling folder, swapped in
     // at the end, so that a failing merge leaves `out` as it was; an existing `out` without
@@ -135,12 +134,10 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         .collect();
     let text = serde_json::to_string_pretty(&merged)?;
     merged.files = absolute;
-    terramesh_io::output::write_atomic(&json, text.as_bytes())
-        .context(json.display().to_string())?;
+    terramesh_io::output::write_atomic(&json, text.as_bytes()).at(&json)?;
     let report = out.join("report.html");
     let html = super::report::html(m, &merged);
-    terramesh_io::output::write_atomic(&report, html.as_bytes())
-        .context(report.display().to_string())?;
+    terramesh_io::output::write_atomic(&report, html.as_bytes()).at(&report)?;
     merged.files.push(json);
     merged.files.push(report);
     Ok(merged)
@@ -170,12 +167,9 @@ fn mapped(
         .map(|p| {
             let key = bits(p.xy);
             if on.contains(&key) {
-                let &(g, owner, _) = seams.get(&key).ok_or_else(|| {
-                    Error::invalid(format!(
-                        "tile {}: a seam vertex at ({}, {}) changed between two reads of its \
-                         files: do not build tiles during a merge",
-                        t.id, p.xy[0], p.xy[1]
-                    ))
+                let &(g, owner, _) = seams.get(&key).ok_or_else(|| Error::SeamChanged {
+                    tile: t.id.clone(),
+                    at: p.xy,
                 })?;
                 if owner == k {
                     *next += 1;
@@ -277,13 +271,11 @@ fn write_vtu(
                     let path = dir.join(super::geology::SURFACES);
                     let surf = super::files::read_f64s(&path, ns)?;
                     if surf.len() != map.len() * ns {
-                        return Err(Error::invalid(format!(
-                            "{}: {} surfaces for {} vertices: the tile is damaged; build it \
-                             again",
-                            path.display(),
-                            surf.len() / ns,
-                            map.len()
-                        )));
+                        return Err(Error::SurfacesCount {
+                            file: path,
+                            surfaces: surf.len() / ns,
+                            vertices: map.len(),
+                        });
                     }
                     for (k, &(_, mine)) in map.iter().enumerate() {
                         if mine {
@@ -383,7 +375,7 @@ fn write_vtu(
         nt as u64,
         values,
     ));
-    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
-    appended::write(&mut o, n, nt, arrays).context(path.display().to_string())?;
-    o.commit().context(path.display().to_string())
+    let mut o = Output::create(Some(path)).at(&path)?;
+    appended::write(&mut o, n, nt, arrays).at(&path)?;
+    o.commit().at(&path)
 }
