@@ -65,7 +65,7 @@ pub(crate) fn read_u32s(path: &Path, record: usize) -> Result<Vec<u32>> {
 
 /// Writes the vertex file.
 pub(crate) fn write_vertices(path: &Path, v: &[Vertex]) -> Result<()> {
-    let mut w = BufWriter::new(std::fs::File::create(path).at(&path)?);
+    let mut w = BufWriter::new(std::fs::File::create(path).at(path)?);
     for p in v {
         put(&mut w, &[p.xy[0], p.xy[1], p.dsm, p.uk, p.std, p.idw])?;
     }
@@ -75,7 +75,7 @@ pub(crate) fn write_vertices(path: &Path, v: &[Vertex]) -> Result<()> {
 
 /// Writes the triangle file.
 pub(crate) fn write_triangles(path: &Path, t: &[[u32; 3]]) -> Result<()> {
-    let mut w = BufWriter::new(std::fs::File::create(path).at(&path)?);
+    let mut w = BufWriter::new(std::fs::File::create(path).at(path)?);
     for tri in t {
         for v in tri {
             w.write_all(&v.to_le_bytes())?;
@@ -87,7 +87,7 @@ pub(crate) fn write_triangles(path: &Path, t: &[[u32; 3]]) -> Result<()> {
 
 /// Writes the grid file.
 pub(crate) fn write_grid(path: &Path, nodes: &[(u64, f64)]) -> Result<()> {
-    let mut w = BufWriter::new(std::fs::File::create(path).at(&path)?);
+    let mut w = BufWriter::new(std::fs::File::create(path).at(path)?);
     for (i, v) in nodes {
         w.write_all(&i.to_le_bytes())?;
         w.write_all(&v.to_le_bytes())?;
@@ -98,9 +98,9 @@ pub(crate) fn write_grid(path: &Path, nodes: &[(u64, f64)]) -> Result<()> {
 
 fn read_all(path: &Path, record: usize) -> Result<Vec<u8>> {
     let mut b = Vec::new();
-    BufReader::new(std::fs::File::open(path).at(&path)?)
+    BufReader::new(std::fs::File::open(path).at(path)?)
         .read_to_end(&mut b)
-        .at(&path)?;
+        .at(path)?;
     if b.len() % record != 0 {
         return Err(TilesError::PartialRecord {
             file: path.to_path_buf(),
@@ -196,13 +196,13 @@ pub fn read_grid(dir: &Path) -> Result<Vec<(u64, f64)>> {
 
 /// Streams the samples file, calling `keep` with each `[x, y, z]` in order.
 pub(crate) fn stream_samples(path: &Path, mut keep: impl FnMut([f64; 3])) -> Result<()> {
-    let mut r = BufReader::with_capacity(1 << 20, std::fs::File::open(path).at(&path)?);
+    let mut r = BufReader::with_capacity(1 << 20, std::fs::File::open(path).at(path)?);
     let mut rec = [0u8; 24];
     loop {
         match r.read_exact(&mut rec) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(()),
-            Err(e) => return Err(e).at(&path),
+            Err(e) => return Err(e).at(path),
         }
         let f = |i: usize| f64::from_le_bytes(rec[8 * i..8 * i + 8].try_into().expect("8"));
         keep([f(0), f(1), f(2)]);

@@ -71,7 +71,7 @@ fn index_at(f: &mut File, at: u64, path: &Path) -> Result<u64> {
     let mut b = [0u8; 8];
     f.seek(SeekFrom::Start(at))
         .and_then(|_| f.read_exact(&mut b))
-        .at(&path)?;
+        .at(path)?;
     Ok(u64::from_le_bytes(b))
 }
 
@@ -187,8 +187,8 @@ fn merge_rows(
     let spec = g.raster();
     let mut writers = Vec::new();
     for (path, format, _) in outputs {
-        let o = Output::create(Some(path)).at(&path)?;
-        writers.push(GridRows::new(o, &spec, *format).at(&path)?);
+        let o = Output::create(Some(path)).at(path)?;
+        writers.push(GridRows::new(o, &spec, *format).at(path)?);
     }
     let mut rows = vec![vec![NODATA; g.nx]; width];
     let mut seen = vec![false; g.nx];
@@ -229,11 +229,11 @@ fn merge_rows(
         }
         active.retain(|s| s.pending.is_some() || s.left > 0);
         for (w, (path, _, k)) in writers.iter_mut().zip(outputs) {
-            w.row(&rows[*k]).at(&path)?;
+            w.row(&rows[*k]).at(path)?;
         }
     }
     for (w, (path, _, _)) in writers.into_iter().zip(outputs) {
-        w.finish().and_then(|o| o.commit()).at(&path)?;
+        w.finish().and_then(|o| o.commit()).at(path)?;
     }
     Ok(GridFigures {
         nodes,

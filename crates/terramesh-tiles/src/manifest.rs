@@ -234,6 +234,10 @@ pub struct CrsText {
     /// `model.vtu`'s field data `crs` and `model.json`'s: `EPSG:<code>`, else the CRS's
     /// definition, else `projected`.
     pub model: String,
+    /// The CRS's name as the one-piece build's `dsm.ts` gives it (`WGS 84 / UTM zone 32N`);
+    /// plans made before it have none, and the merge writes [`CrsText::dsm`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
 }
 
 /// What [`Manifest::check`] found wrong in a plan's manifest: the tile, the unit or the field,

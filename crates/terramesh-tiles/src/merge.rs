@@ -5,9 +5,13 @@
 //! vertex belongs to one tile. `dsm.vtu` (raw appended binary VTK, the arrays of `terramesh
 //! build`'s) is written array by array, each a pass over the tiles, so that the merge holds one tile's mesh
 //! and the seam vertices' index, never the region's mesh. `dsm.tif` and `dsm.asc` are written
-//! row by row, one row in memory (`grid_merge.rs`). The formats that need the whole mesh
-//! at once (the sealed solid, glTF and 3D Tiles, Cesium terrain, the report's 3D view, the
-//! pictures) are not made by the merge: build them from `dsm.vtu` or in one piece.
+//! row by row, one row in memory (`grid_merge.rs`). The other surface formats of the
+//! project's `export.formats` that are written from the mesh alone (OBJ, PLY, STL, TSurf, MSH,
+//! DXF) go through the one-piece build's writers, reading the merged mesh from mapped scratch
+//! files (`exports.rs`). The formats that need WGS-84 positions or the whole mesh at once
+//! (KML, COLLADA, glTF, 3D Tiles, Cesium terrain, the sealed solid, the report's 3D view, the
+//! pictures) are not made by the merge (`merge.json`'s `not_merged`): build them from
+//! `dsm.vtu` or in one piece.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -20,7 +24,7 @@ use super::appended::{self, put_f64, Array, Section, Values};
 use super::files::{self, Vertex};
 use super::manifest::{tile_dir, Manifest, State, Tile};
 use super::merged::Merged;
-use crate::error::{Context, Result, TilesError as Error};
+use crate::error::{Context, Doing, Result, TilesError as Error};
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
@@ -97,6 +101,29 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
     write_vtu(&vtu, plan, m, &seams, n as usize, nt)?;
     written.push(vtu);
 
+    // The other surface formats of the project's `export.formats`, streamed.
+    let project =
+        terramesh::project::Project::parse(&m.project.display().to_string(), &m.plan, &[])
+            .doing(|| Doing::PlanStored)?;
+    let title = project
+        .title
+        .clone()
+        .unwrap_or_else(|| "terramesh DSM".into());
+    let crs_name = m
+        .crs_text
+        .as_ref()
+        .and_then(|c| c.name.clone())
+        .unwrap_or_else(|| m.dsm_crs());
+    let labels = super::exports::Labels {
+        formats: &project.export.formats,
+        title: &title,
+        crs_name: &crs_name,
+        field_data: Vec::new(),
+        stl_origin: [m.origin[0], m.origin[1], 0.0],
+    };
+    let surfaces = super::exports::write_surfaces(plan, m, &seams, out, &labels)?;
+    written.extend(surfaces.files);
+
     // The grids, row by row.
     let (grid_files, grid) = super::grid_merge::write_grids(plan, m, out)?;
     written.extend(grid_files);
@@ -118,6 +145,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         area,
         grid,
         model,
+        not_merged: surfaces.skipped,
         seconds: t0.elapsed().as_secs_f64(),
     };
     let json = out.join("merge.json");
@@ -155,7 +183,7 @@ fn seam_keys(t: &Tile) -> std::collections::HashSet<(u64, u64)> {
 }
 
 /// One tile's vertices with their global indices and whether this tile writes them.
-fn mapped(
+pub(crate) fn mapped(
     k: usize,
     t: &Tile,
     v: &[Vertex],
@@ -375,7 +403,7 @@ fn write_vtu(
         nt as u64,
         values,
     ));
-    let mut o = Output::create(Some(path)).at(&path)?;
-    appended::write(&mut o, n, nt, arrays).at(&path)?;
-    o.commit().at(&path)
+    let mut o = Output::create(Some(path)).at(path)?;
+    appended::write(&mut o, n, nt, arrays).at(path)?;
+    o.commit().at(path)
 }

@@ -67,9 +67,9 @@ pub struct MergedExports {
 
 /// Writes `path` atomically with `f`.
 fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Result<PathBuf> {
-    let mut o = Output::create(Some(path)).at(&path)?;
-    f(&mut o).at(&path)?;
-    o.commit().at(&path)?;
+    let mut o = Output::create(Some(path)).at(path)?;
+    f(&mut o).at(path)?;
+    o.commit().at(path)?;
     Ok(path.to_path_buf())
 }
 

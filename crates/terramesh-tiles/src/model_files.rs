@@ -91,5 +91,5 @@ pub(crate) fn write_model(
 }
 
 fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).at(&path)
+    std::fs::write(path, bytes).at(path)
 }

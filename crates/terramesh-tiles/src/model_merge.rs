@@ -393,7 +393,7 @@ fn write_vtu(
         4 * nc as u64,
         values,
     ));
-    let mut o = Output::create(Some(path)).at(&path)?;
-    super::appended::write(&mut o, n, nc, arrays).at(&path)?;
-    o.commit().at(&path)
+    let mut o = Output::create(Some(path)).at(path)?;
+    super::appended::write(&mut o, n, nc, arrays).at(path)?;
+    o.commit().at(path)
 }

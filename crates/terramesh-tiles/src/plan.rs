@@ -180,7 +180,7 @@ pub fn plan(
     }
     project.check_inputs(base)?;
     check_plan_folder(out)?;
-    std::fs::create_dir_all(out).at(&out)?;
+    std::fs::create_dir_all(out).at(out)?;
     let samples = stages::sample(project, base, out, progress)?;
     let polys = &samples.region.projected.polygons;
     let holes: usize = polys.iter().map(|p| p.holes.len()).sum();
@@ -327,7 +327,7 @@ pub fn plan(
     });
     let mut manifest = Manifest {
         version: VERSION,
-        project: std::path::absolute(project_file).at(&project_file)?,
+        project: std::path::absolute(project_file).at(project_file)?,
         set: set.to_vec(),
         plan: project.plan_text().to_string(),
         tile_size,
@@ -370,6 +370,7 @@ pub fn plan(
                 (None, Some(c)) => c.definition().to_string(),
                 (None, None) => "projected".to_string(),
             },
+            name: Some(samples.crs_name()),
         }),
         geology,
         tiles,

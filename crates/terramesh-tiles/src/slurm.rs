@@ -163,7 +163,7 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
     o.check()?;
     let m = Manifest::read(plan)?;
     // Every value written into a script line is checked (or quoted) first.
-    let plan_abs = std::path::absolute(plan).at(&plan)?;
+    let plan_abs = std::path::absolute(plan).at(plan)?;
     let out_abs = std::path::absolute(&o.output).at(&o.output)?;
     let plan_q = quote("the plan folder", &plan_abs)?;
     let out_q = quote("the merge's output folder", &out_abs)?;
@@ -224,11 +224,11 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
         (&out.merge, merge),
         (&out.submit, submit),
     ] {
-        terramesh_io::output::write_atomic(p, text.as_bytes()).at(&p)?;
+        terramesh_io::output::write_atomic(p, text.as_bytes()).at(p)?;
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;
-            std::fs::set_permissions(p, std::fs::Permissions::from_mode(0o755)).at(&p)?;
+            std::fs::set_permissions(p, std::fs::Permissions::from_mode(0o755)).at(p)?;
         }
     }
     Ok(out)

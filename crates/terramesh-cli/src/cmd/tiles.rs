@@ -31,7 +31,9 @@ enum Sub {
     /// Build one tile into PLAN/tiles/ID/ (atomically) and mark it done; a done tile is left
     /// as it is, a failed one records why and can be built again.
     Build(BuildArgs),
-    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, merge.json, report.html.
+    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, the project's other surface
+    /// formats written from the mesh alone (obj, ply, stl, ts, msh, dxf), merge.json,
+    /// report.html.
     Merge(MergeArgs),
     /// Write Slurm scripts: an sbatch array (one tile per task) and a merge job after it.
     Slurm(SlurmArgs),
