@@ -21,6 +21,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use memmap2::Mmap;
+use rayon::prelude::*;
 use terramesh_core::vocab::Named;
 use terramesh_io::export::{writer, Format, MeshView, Target, ToWrite};
 use terramesh_io::output::Output;
@@ -155,12 +156,16 @@ pub(crate) fn write_surfaces(
     std::fs::create_dir_all(&dir).at(&dir)?;
     let scratch = Scratch(dir);
     write_scratch(plan, m, seams, &scratch.0)?;
-    let mut written = Vec::new();
-    for (f, ext) in wanted {
-        let path = out.join(format!("dsm.{ext}"));
-        write_one(f, &path, &scratch.0, labels)?;
-        written.push(path);
-    }
+    // The formats at once on the thread pool, as a one-piece build writes its exports; each
+    // maps the scratch files on its own (the same pages of the page cache).
+    let written: Vec<PathBuf> = wanted
+        .par_iter()
+        .with_max_len(1)
+        .map(|(f, ext)| {
+            let path = out.join(format!("dsm.{ext}"));
+            write_one(*f, &path, &scratch.0, labels).map(|()| path)
+        })
+        .collect::<Result<_>>()?;
     drop(scratch);
     Ok(Surfaces {
         files: written,
