@@ -265,7 +265,17 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
     assert_eq!(
         files,
         [
-            "dsm.vtu", "dsm.obj", "dsm.ply", "dsm.stl", "dsm.ts", "dsm.msh", "dsm.dxf", "dsm.tif",
+            "dsm.vtu",
+            "dsm.obj",
+            "dsm.ply",
+            "dsm.stl",
+            "dsm.ts",
+            "dsm.msh",
+            "dsm.dxf",
+            "dsm.kml",
+            "dsm.dae",
+            "dsm-model.kml",
+            "dsm.tif",
             "dsm.asc"
         ]
     );

@@ -69,7 +69,7 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         .iter()
         .map(|f| f.as_str().unwrap())
         .collect();
-    let surfaces = ["obj", "ply", "stl", "ts", "msh", "dxf"];
+    let surfaces = ["obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae"];
     for ext in surfaces {
         assert!(files.contains(&format!("dsm.{ext}").as_str()), "{files:?}");
     }
@@ -79,11 +79,14 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         .iter()
         .map(|s| s["format"].as_str().unwrap())
         .collect();
-    assert_eq!(skipped, ["kml", "dae", "glb", "3dtiles", "terrain"]);
+    assert_eq!(skipped, ["glb", "3dtiles", "terrain"]);
     assert!(
-        said.contains("not merged") && said.contains("kml"),
+        said.contains("not merged") && said.contains("glb"),
         "{said}"
     );
+    for name in ["dsm.kml", "dsm.dae", "dsm-model.kml"] {
+        assert!(files.contains(&name), "{files:?}");
+    }
     assert!(
         !out.join(".merge-scratch").exists(),
         "the scratch folder is removed"
@@ -151,6 +154,40 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         .unwrap()
         .to_string();
 
+    // KML's and COLLADA's positions as a one-piece build computes them (`build/exports.rs`):
+    // WGS-84 point by point in the project's UTM zone (the one TSurf names); COLLADA's frame
+    // at the centre of the mesh's bounding box, at its lowest elevation.
+    let zone = crs_name
+        .strip_prefix("WGS 84 / UTM zone ")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let georef = terramesh::georef::Georef::utm(zone);
+    let geo: Vec<[f64; 3]> = points
+        .iter()
+        .map(|q| {
+            let (lat, lon) = georef.to_wgs84(q[0], q[1]).unwrap();
+            [lon, lat, q[2]]
+        })
+        .collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in &points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    let (lat0, lon0) = georef
+        .to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))
+        .unwrap();
+    let frame = terramesh_core::coords::LocalEnu::new(lat0, lon0, lo[2]);
+    let enu: Vec<[f64; 3]> = geo.iter().map(|g| frame.to_enu(g[1], g[0], g[2])).collect();
+    let title = std::fs::read_to_string(&ex)
+        .unwrap()
+        .lines()
+        .find_map(|l| Some(l.strip_prefix("title = \"")?.strip_suffix('"')?.to_string()))
+        .unwrap();
+
     let origin = [
         m["origin"][0].as_f64().unwrap(),
         m["origin"][1].as_f64().unwrap(),
@@ -160,12 +197,12 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         view: &view,
         vertices: &points,
         stl_origin: origin,
-        title: "",
+        title: &title,
         tsurf_name: "terramesh_dsm",
         crs_name: &crs_name,
         dxf_layer: "DSM",
-        lon_lat_alt: None,
-        enu: None,
+        lon_lat_alt: Some(&geo),
+        enu: Some((&enu, [lon0, lat0, lo[2]])),
         glb: None,
     };
     let mut compared = Vec::new();
@@ -187,8 +224,17 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
             want.len()
         );
         compared.push(ext);
+        let main = format!("dsm.{ext}");
+        if let Some((companion, bytes)) = w.companion(&surface, &main).unwrap() {
+            assert_eq!(
+                std::fs::read(out.join(&companion)).unwrap(),
+                bytes,
+                "{companion}"
+            );
+            compared.push("dsm-model.kml");
+        }
     }
-    assert_eq!(compared.len(), surfaces.len(), "{compared:?}");
+    assert_eq!(compared.len(), surfaces.len() + 1, "{compared:?}");
 
     // And the geometry read back: the OBJ's vertices and triangles are the VTU's.
     let (v, t) = parse_obj(&std::fs::read_to_string(out.join("dsm.obj")).unwrap()).unwrap();

@@ -11,9 +11,11 @@
 //! process's heap holds one tile and the seam index, as for `dsm.vtu`. The scratch folder is
 //! removed before the merge's folder is swapped in.
 //!
-//! The geographic formats (KML, COLLADA, glTF) and the folders (3D Tiles, terrain tiles) need
-//! WGS-84 positions or a level-of-detail tree of the whole mesh: they are not merged yet
-//! ([`Skipped`]).
+//! KML and COLLADA are written the same way from two more scratch files, the WGS-84 positions
+//! (computed point by point as a one-piece build computes them) and COLLADA's east-north-up
+//! vertices around the centre of the mesh's bounding box. glTF (its colours and bounds) and
+//! the folders (3D Tiles, terrain tiles: a level-of-detail tree of the whole mesh) are not
+//! merged yet ([`Skipped`]).
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -59,6 +61,9 @@ pub(crate) struct Labels<'a> {
     pub field_data: Vec<(&'static str, String)>,
     /// Subtracted from STL's 32-bit coordinates.
     pub stl_origin: [f64; 3],
+    /// Where the project lies on the Earth (KML, COLLADA), as the one-piece build places it;
+    /// `None`: the geographic formats are not merged.
+    pub georef: Option<terramesh::georef::Georef>,
 }
 
 /// The scratch files of the merged mesh, removed on drop.
@@ -75,6 +80,10 @@ const XY: &str = "xy.f64";
 const Z: &str = "z.f64";
 const XYZ: &str = "xyz.f64";
 const TRIS: &str = "triangles.u32";
+/// WGS-84 longitude, latitude and the elevation per vertex (KML, COLLADA's frame).
+const GEO: &str = "lon-lat-alt.f64";
+/// East-north-up metres around COLLADA's origin per vertex.
+const ENU: &str = "enu.f64";
 const FIELDS: [&str; 4] = [
     "elevation_uk",
     "kriging_std",
@@ -128,14 +137,22 @@ pub(crate) fn write_surfaces(
         }
         let w = writer(f);
         let needs = w.needs();
+        let placed = labels.georef.is_some();
         match w.target() {
-            Target::File(ext) if !(needs.geographic || needs.enu || needs.glb) => {
+            Target::File(ext) if !needs.glb && (placed || !(needs.geographic || needs.enu)) => {
                 wanted.push((f, ext));
             }
+            Target::File(_) if !needs.glb => skipped.push(Skipped {
+                format: f.name().into(),
+                why: "the plan records no CRS that places the region on the Earth (a plan made \
+                      by an older terramesh, or a CRS without an EPSG code): plan again, or \
+                      build it in one piece"
+                    .into(),
+            }),
             Target::File(_) => skipped.push(Skipped {
                 format: f.name().into(),
-                why: "needs WGS-84 positions of the whole mesh: not merged yet; build it in one \
-                      piece, or convert the merged dsm.vtu"
+                why: "needs glTF's colours and bounds of the whole mesh: not merged yet; build \
+                      it in one piece, or convert the merged dsm.vtu"
                     .into(),
             }),
             Target::Folder(_) => skipped.push(Skipped {
@@ -155,7 +172,18 @@ pub(crate) fn write_surfaces(
     let dir = out.join(".merge-scratch");
     std::fs::create_dir_all(&dir).at(&dir)?;
     let scratch = Scratch(dir);
-    write_scratch(plan, m, seams, &scratch.0)?;
+    let needs = |f: fn(&terramesh_io::export::Needs) -> bool| {
+        wanted.iter().any(|(w, _)| f(&writer(*w).needs()))
+    };
+    let geo = match &labels.georef {
+        Some(g) if needs(|n| n.geographic || n.enu) => Some(g),
+        _ => None,
+    };
+    let lo = write_scratch(plan, m, seams, &scratch.0, geo)?;
+    let at = match geo {
+        Some(g) if needs(|n| n.enu) => Some(write_enu(&scratch.0, g, lo)?),
+        _ => None,
+    };
     // The formats at once on the thread pool, as a one-piece build writes its exports; each
     // maps the scratch files on its own (the same pages of the page cache).
     let written: Vec<PathBuf> = wanted
@@ -163,9 +191,12 @@ pub(crate) fn write_surfaces(
         .with_max_len(1)
         .map(|(f, ext)| {
             let path = out.join(format!("dsm.{ext}"));
-            write_one(*f, &path, &scratch.0, labels).map(|()| path)
+            write_one(*f, &path, &scratch.0, labels, at)
         })
-        .collect::<Result<_>>()?;
+        .collect::<Result<Vec<Vec<PathBuf>>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     drop(scratch);
     Ok(Surfaces {
         files: written,
@@ -175,12 +206,27 @@ pub(crate) fn write_surfaces(
 
 /// Writes `path` in format `f` from the scratch files in `dir`, mapped for this file alone
 /// (the pages it read are released with the mappings when it is written).
-fn write_one(f: Format, path: &Path, dir: &Path, labels: &Labels) -> Result<()> {
+fn write_one(
+    f: Format,
+    path: &Path,
+    dir: &Path,
+    labels: &Labels,
+    at: Option<[f64; 3]>,
+) -> Result<Vec<PathBuf>> {
     let maps: Vec<Option<Mmap>> = [XY, Z, XYZ, TRIS]
         .iter()
         .chain(FIELDS.iter())
         .map(|name| map(&dir.join(name)))
         .collect::<Result<_>>()?;
+    let needs = writer(f).needs();
+    let geo = match needs.geographic {
+        true => map(&dir.join(GEO))?,
+        false => None,
+    };
+    let enu = match needs.enu {
+        true => map(&dir.join(ENU))?,
+        false => None,
+    };
     let fields: Vec<(&str, &[f64])> = FIELDS
         .iter()
         .zip(&maps[4..])
@@ -203,14 +249,53 @@ fn write_one(f: Format, path: &Path, dir: &Path, labels: &Labels) -> Result<()> 
         tsurf_name: "terramesh_dsm",
         crs_name: labels.crs_name,
         dxf_layer: "DSM",
-        lon_lat_alt: None,
-        enu: None,
+        lon_lat_alt: needs.geographic.then(|| slice::<[f64; 3]>(&geo)),
+        enu: match (needs.enu, at) {
+            (true, Some(at)) => Some((slice::<[f64; 3]>(&enu), at)),
+            _ => None,
+        },
         glb: None,
     };
+    let w = writer(f);
     let mut o = Output::create(Some(path)).at(path)?;
-    writer(f).write(&surface, &mut o).at(path)?;
+    w.write(&surface, &mut o).at(path)?;
     o.commit().at(path)?;
-    Ok(())
+    let mut files = vec![path.to_path_buf()];
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+    if let Some((companion, bytes)) = w.companion(&surface, name.as_deref().unwrap_or(""))? {
+        let p = path.with_file_name(companion);
+        terramesh_io::output::write_atomic(&p, &bytes).at(&p)?;
+        files.push(p);
+    }
+    Ok(files)
+}
+
+/// COLLADA's frame, as a one-piece build's `dsm.dae` has it: the centre of the mesh's
+/// bounding box (`lo`, `hi`) at its lowest elevation; its east-north-up vertices into the
+/// scratch folder `dir` (from the WGS-84 positions there); returns the origin as longitude,
+/// latitude and altitude.
+fn write_enu(
+    dir: &Path,
+    g: &terramesh::georef::Georef,
+    (lo, hi): ([f64; 3], [f64; 3]),
+) -> Result<[f64; 3]> {
+    let (lat0, lon0) = g.to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))?;
+    let frame = terramesh_core::coords::LocalEnu::new(lat0, lon0, lo[2]);
+    let geo = map(&dir.join(GEO))?;
+    let path = dir.join(ENU);
+    let mut w = File::create(&path)
+        .map(|f| BufWriter::with_capacity(1 << 20, f))
+        .at(&path)?;
+    let io = |w: &mut BufWriter<File>| -> std::io::Result<()> {
+        for q in slice::<[f64; 3]>(&geo) {
+            for x in frame.to_enu(q[1], q[0], q[2]) {
+                w.write_all(&x.to_ne_bytes())?;
+            }
+        }
+        w.flush()
+    };
+    io(&mut w).at(&path)?;
+    Ok([lon0, lat0, lo[2]])
 }
 
 /// One pass over the tiles: the merged mesh's vertices (each once, in the merge's order) and
@@ -220,8 +305,13 @@ fn write_scratch(
     m: &Manifest,
     seams: &HashMap<(u64, u64), (u32, usize, f64)>,
     dir: &Path,
-) -> Result<()> {
-    let names: Vec<&str> = [XY, Z, XYZ, TRIS].into_iter().chain(FIELDS).collect();
+    geo: Option<&terramesh::georef::Georef>,
+) -> Result<([f64; 3], [f64; 3])> {
+    let mut names: Vec<&str> = [XY, Z, XYZ, TRIS].into_iter().chain(FIELDS).collect();
+    if geo.is_some() {
+        names.push(GEO);
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     let mut w: Vec<BufWriter<File>> = names
         .iter()
         .map(|name| {
@@ -237,6 +327,19 @@ fn write_scratch(
         let tdir = tile_dir(plan, &t.id);
         let (v, tris) = files::read_mesh(&tdir, &t.id)?;
         let map = super::merge::mapped(k, t, &v, seams, &mut next)?;
+        // The WGS-84 positions as a one-piece build computes them, point by point.
+        let lla: Vec<[f64; 3]> = match geo {
+            Some(g) => v
+                .iter()
+                .zip(&map)
+                .filter(|(_, &(_, mine))| mine)
+                .map(|(p, _)| {
+                    let (lat, lon) = g.to_wgs84(p.xy[0], p.xy[1])?;
+                    Ok([lon, lat, p.dsm])
+                })
+                .collect::<terramesh::Result<_>>()?,
+            None => Vec::new(),
+        };
         let mut io = || -> std::io::Result<()> {
             for (p, &(_, mine)) in v.iter().zip(&map) {
                 if !mine {
@@ -245,8 +348,10 @@ fn write_scratch(
                 put(&mut w[0], p.xy[0])?;
                 put(&mut w[0], p.xy[1])?;
                 put(&mut w[1], p.dsm)?;
-                for x in [p.xy[0], p.xy[1], p.dsm] {
+                for (k, x) in [p.xy[0], p.xy[1], p.dsm].into_iter().enumerate() {
                     put(&mut w[2], x)?;
+                    lo[k] = lo[k].min(x);
+                    hi[k] = hi[k].max(x);
                 }
                 for (k, x) in [p.uk, p.std, p.idw, p.uk - p.idw].into_iter().enumerate() {
                     put(&mut w[4 + k], x)?;
@@ -257,6 +362,11 @@ fn write_scratch(
                     w[3].write_all(&map[*i as usize].0.to_ne_bytes())?;
                 }
             }
+            for q in &lla {
+                for x in q {
+                    put(&mut w[8], *x)?;
+                }
+            }
             Ok(())
         };
         io().at(dir)?;
@@ -264,5 +374,5 @@ fn write_scratch(
     for (file, name) in w.iter_mut().zip(&names) {
         file.flush().at(&dir.join(name))?;
     }
-    Ok(())
+    Ok((lo, hi))
 }

@@ -238,6 +238,10 @@ pub struct CrsText {
     /// plans made before it have none, and the merge writes [`CrsText::dsm`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
+    /// The UTM zone of a project in UTM coordinates (`32N`): where the merge's KML and COLLADA
+    /// place the region, as a one-piece build does; plans made before it have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zone: Option<String>,
 }
 
 /// What [`Manifest::check`] found wrong in a plan's manifest: the tile, the unit or the field,

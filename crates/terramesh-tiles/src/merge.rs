@@ -120,6 +120,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         crs_name: &crs_name,
         field_data: Vec::new(),
         stl_origin: [m.origin[0], m.origin[1], 0.0],
+        georef: georef_of(m, &project.export.formats)?,
     };
     let surfaces = super::exports::write_surfaces(plan, m, &seams, out, &labels)?;
     written.extend(surfaces.files);
@@ -169,6 +170,36 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
     merged.files.push(json);
     merged.files.push(report);
     Ok(merged)
+}
+
+/// Where the plan's region lies on the Earth, as the one-piece build places it (a UTM zone, or
+/// the project's CRS by its EPSG code), when KML or COLLADA are asked for; `None` for a plan
+/// that does not record it (made before `crs_text.zone`) or a CRS without an EPSG code.
+fn georef_of(
+    m: &Manifest,
+    formats: &[terramesh_io::export::Format],
+) -> Result<Option<terramesh::georef::Georef>> {
+    use terramesh_io::export::Format;
+    if !formats
+        .iter()
+        .any(|f| matches!(f, Format::Kml | Format::Collada))
+    {
+        return Ok(None);
+    }
+    let Some(text) = &m.crs_text else {
+        return Ok(None);
+    };
+    Ok(match (&text.zone, text.name.is_some(), m.epsg) {
+        (Some(z), _, _) => z
+            .parse::<terramesh_core::coords::Zone>()
+            .ok()
+            .map(terramesh::georef::Georef::utm),
+        (None, true, Some(code)) => {
+            let crs = terramesh_crs::Crs::from_epsg(code)?;
+            Some(terramesh::georef::Georef::crs(&crs, "region.crs")?)
+        }
+        _ => None,
+    })
 }
 
 fn bits(p: [f64; 2]) -> (u64, u64) {

@@ -371,6 +371,7 @@ pub fn plan(
                 (None, None) => "projected".to_string(),
             },
             name: Some(samples.crs_name()),
+            zone: samples.zone.map(|z| z.to_string()),
         }),
         geology,
         tiles,
