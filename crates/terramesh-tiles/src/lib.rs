@@ -10,8 +10,8 @@
 //! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
 //!   its state under a lock, so many processes may build at once.
 //! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc`, the other surface
-//!   formats of `export.formats` written from the mesh alone (`dsm.obj`, `.ply`, `.stl`,
-//!   `.ts`, `.msh`, `.dxf`, through the one-piece build's writers) and a report, and,
+//!   single-file formats of `export.formats` but glTF (`dsm.obj`, `.ply`, `.stl`, `.ts`,
+//!   `.msh`, `.dxf`, `.kml`, `.dae`, through the one-piece build's writers) and a report, and,
 //!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`, and from the
 //!   merged volume mesh the boundary meshes, `model.msh`, `model.f3grid` and the bodies.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.

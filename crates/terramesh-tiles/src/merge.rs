@@ -6,12 +6,11 @@
 //! build`'s) is written array by array, each a pass over the tiles, so that the merge holds one tile's mesh
 //! and the seam vertices' index, never the region's mesh. `dsm.tif` and `dsm.asc` are written
 //! row by row, one row in memory (`grid_merge.rs`). The other surface formats of the
-//! project's `export.formats` that are written from the mesh alone (OBJ, PLY, STL, TSurf, MSH,
-//! DXF) go through the one-piece build's writers, reading the merged mesh from mapped scratch
-//! files (`exports.rs`). The formats that need WGS-84 positions or the whole mesh at once
-//! (KML, COLLADA, glTF, 3D Tiles, Cesium terrain, the sealed solid, the report's 3D view, the
-//! pictures) are not made by the merge (`merge.json`'s `not_merged`): build them from
-//! `dsm.vtu` or in one piece.
+//! project's `export.formats` (OBJ, PLY, STL, TSurf, MSH, DXF, KML, COLLADA) go through the
+//! one-piece build's writers, reading the merged mesh from mapped scratch files
+//! (`exports.rs`). glTF and the formats that need the whole mesh at once (3D Tiles, Cesium
+//! terrain, the sealed solid, the report's 3D view, the pictures) are not made by the merge
+//! (`merge.json`'s `not_merged`): build them from `dsm.vtu` or in one piece.
 
 use std::collections::HashMap;
 use std::io::Write;

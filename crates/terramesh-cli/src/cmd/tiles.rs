@@ -32,7 +32,7 @@ enum Sub {
     /// as it is, a failed one records why and can be built again.
     Build(BuildArgs),
     /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, the project's other surface
-    /// formats written from the mesh alone (obj, ply, stl, ts, msh, dxf), merge.json,
+    /// single-file formats but glb (obj, ply, stl, ts, msh, dxf, kml, dae), merge.json,
     /// report.html.
     Merge(MergeArgs),
     /// Write Slurm scripts: an sbatch array (one tile per task) and a merge job after it.
