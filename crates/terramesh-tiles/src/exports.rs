@@ -151,8 +151,10 @@ pub(crate) fn write_surfaces(
             }),
             Target::File(_) => skipped.push(Skipped {
                 format: f.name().into(),
-                why: "needs glTF's colours and bounds of the whole mesh: not merged yet; build \
-                      it in one piece, or convert the merged dsm.vtu"
+                why: "a GLB file is at most 4 GiB (its chunk lengths are 32-bit), which a region \
+                      too large for one process exceeds, and its colours and bounds are made \
+                      from the whole mesh: not merged; build a part of the region in one piece, \
+                      or view the merged dsm.vtu"
                     .into(),
             }),
             Target::Folder(_) => skipped.push(Skipped {
