@@ -262,7 +262,23 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
         .iter()
         .map(|f| f.as_str().unwrap())
         .collect();
-    assert_eq!(files, ["dsm.vtu", "dsm.tif", "dsm.asc"]);
+    assert_eq!(
+        files,
+        [
+            "dsm.vtu",
+            "dsm.obj",
+            "dsm.ply",
+            "dsm.stl",
+            "dsm.ts",
+            "dsm.msh",
+            "dsm.dxf",
+            "dsm.kml",
+            "dsm.dae",
+            "dsm-model.kml",
+            "dsm.tif",
+            "dsm.asc"
+        ]
+    );
     let g = &m["grid"];
     assert_eq!(
         merged["grid"]["row_bytes"].as_u64().unwrap(),

@@ -17,7 +17,7 @@
 
 use std::io::Write;
 
-use terramesh::{Error, Result};
+use crate::error::{Result, TilesError as Error};
 
 /// Where an array goes in the file, in document order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -168,11 +168,11 @@ pub(crate) fn write(
         let mut c = Counting { w, n: 0 };
         (a.values)(&mut c)?;
         if c.n != a.bytes {
-            return Err(Error::invalid(format!(
-                "the merged VTU's array {} has {} bytes where its header says {}: a tile's \
-                 files changed during the merge; merge again",
-                a.name, c.n, a.bytes
-            )));
+            return Err(Error::ArrayChanged {
+                array: a.name.clone(),
+                bytes: c.n,
+                header: a.bytes,
+            });
         }
     }
     writeln!(w, "\n</AppendedData>\n</VTKFile>")?;

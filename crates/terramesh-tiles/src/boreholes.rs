@@ -27,8 +27,8 @@ use terramesh_mesh::{Mesh, SurfaceLocator};
 
 use super::geology::GeologyPlan;
 use super::manifest::{tile_dir, Manifest, Tile};
+use crate::error::{ContactProblem, Context, Result, TilesError as Error};
 use terramesh::geology::model::Misfit;
-use terramesh::{Context, Error, Result};
 
 /// The contacts' list in the plan folder.
 pub const CONTACTS: &str = "geology/contacts.json";
@@ -82,15 +82,14 @@ pub(crate) fn plan_contacts(b: &Boreholes, out: &Path) -> Result<String> {
     let list: Vec<PlannedContact> = collars.chain(tops).collect();
     let path = out.join(CONTACTS);
     let text = serde_json::to_string_pretty(&list)?;
-    terramesh_io::output::write_atomic(&path, text.as_bytes())
-        .context(path.display().to_string())?;
+    terramesh_io::output::write_atomic(&path, text.as_bytes()).at(&path)?;
     Ok(CONTACTS.to_string())
 }
 
 fn read_contacts(plan: &Path, file: &str) -> Result<Vec<PlannedContact>> {
     let path = plan.join(file);
-    let text = std::fs::read_to_string(&path).context(path.display().to_string())?;
-    serde_json::from_str(&text).context(path.display().to_string())
+    let text = std::fs::read_to_string(&path).at(&path)?;
+    serde_json::from_str(&text).at(&path)
 }
 
 /// The model's value at every contact tile `tile` owns, on its planar mesh (`xy`, absolute;
@@ -121,15 +120,12 @@ pub(crate) fn tile_misfits(
         if super::manifest::owner(m, [c.x, c.y]) != tile.index {
             continue;
         }
-        let s = surfaces.get(c.unit).ok_or_else(|| {
-            Error::invalid(format!(
-                "{}: contact {i} (hole {}) names unit {}, and the model has {} surfaces: \
-                 plan again",
-                plan.join(file).display(),
-                c.hole,
-                c.unit,
-                surfaces.len()
-            ))
+        let s = surfaces.get(c.unit).ok_or_else(|| Error::ContactUnit {
+            file: plan.join(file),
+            contact: i,
+            hole: c.hole.clone(),
+            unit: c.unit,
+            surfaces: surfaces.len(),
         })?;
         let loc = locators[c.unit].get_or_insert_with(|| SurfaceLocator::new(&mesh, s));
         if let Some(z) = loc.height(c.x, c.y) {
@@ -143,7 +139,7 @@ pub(crate) fn tile_misfits(
 pub(crate) fn write_tile_misfits(dir: &Path, values: &[(usize, f64)]) -> Result<()> {
     let path = dir.join(MISFITS);
     let text = serde_json::to_string(values)?;
-    std::fs::write(&path, text).context(path.display().to_string())
+    std::fs::write(&path, text).at(&path)
 }
 
 /// The merged `boreholes` list: every contact some tile evaluated, in the plan's order.
@@ -155,33 +151,31 @@ pub(crate) fn merged_misfits(plan: &Path, m: &Manifest, gp: &GeologyPlan) -> Res
     let mut model: Vec<Option<f64>> = vec![None; list.len()];
     for t in &m.tiles {
         let path = tile_dir(plan, &t.id).join(MISFITS);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            Error::invalid(format!(
-                "{}: {e}: build tile {} again (tiles built before the merge listed the \
-                 boreholes lack it)",
-                path.display(),
-                t.id
-            ))
-        })?;
-        let values: Vec<(usize, f64)> =
-            serde_json::from_str(&text).context(path.display().to_string())?;
+        let contacts = |why| Error::TileContacts {
+            file: path.clone(),
+            why,
+            tile: t.id.clone(),
+        };
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| contacts(ContactProblem::Unreadable(e)))?;
+        let values: Vec<(usize, f64)> = serde_json::from_str(&text).at(&path)?;
         for (i, z) in values {
             let slot = model.get_mut(i).ok_or_else(|| {
-                Error::invalid(format!(
-                    "{}: contact {i} of {}: build tile {} again",
-                    path.display(),
-                    list.len(),
-                    t.id
-                ))
+                contacts(ContactProblem::Missing {
+                    contact: i,
+                    of: list.len(),
+                })
             })?;
             if slot.replace(z).is_some() {
-                return Err(Error::invalid(format!(
-                    "{}: contact {i} ({} in {}) evaluated by two tiles: build tile {} again",
-                    path.display(),
-                    gp.units.get(list[i].unit).map_or("?", String::as_str),
-                    list[i].hole,
-                    t.id
-                )));
+                return Err(contacts(ContactProblem::Twice {
+                    contact: i,
+                    unit: gp
+                        .units
+                        .get(list[i].unit)
+                        .map_or("?", String::as_str)
+                        .to_string(),
+                    hole: list[i].hole.clone(),
+                }));
             }
         }
     }

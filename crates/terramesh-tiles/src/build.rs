@@ -18,9 +18,9 @@ use terramesh_mesh::smooth_keeping;
 use super::files::{self, Vertex};
 use super::manifest::{owner, tile_dir, update, Manifest, State, Tile, TileSummary, SAMPLES};
 use super::partition::in_window;
+use crate::error::{Context, Doing, Result, TilesError as Error};
 use terramesh::build::Surface;
 use terramesh::project::Project;
-use terramesh::{Context, Error, Result};
 
 /// Set to a comma-separated list of tile ids, makes those tiles fail on purpose (to test
 /// retries and the rerun of a failed tile).
@@ -100,15 +100,14 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     let mut seconds = Vec::new();
     if let Ok(list) = std::env::var(FAIL_ENV) {
         if list.split(',').any(|s| s.trim() == tile.id) {
-            return Err(Error::invalid(format!(
-                "tile {} failed on purpose ({FAIL_ENV} names it)",
-                tile.id
-            )));
+            return Err(Error::FailedOnPurpose {
+                tile: tile.id.clone(),
+            });
         }
     }
     // The plan as it was planned (the project file is not read again).
     let project = Project::parse(&m.project.display().to_string(), &m.plan, &[])
-        .context("the plan stored in tiles.json (plan again if it was edited)")?;
+        .doing(|| Doing::PlanStored)?;
     let ip = &project.interpolation;
     // The data window: the extent grown by the halo. The tile reads its own samples file
     // (plans before it existed: the whole region's, keeping its window).
@@ -127,17 +126,17 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     let samples = xy.len();
     if let Some(d) = &tile.data {
         if read != d.count || samples != d.count {
-            return Err(Error::invalid(format!(
-                "{}: {read} samples, {samples} of them in tile {}'s window, where the plan \
-                 wrote {}: the plan folder is damaged; plan again",
-                file.display(),
-                tile.id,
-                d.count
-            )));
+            return Err(Error::TileSamples {
+                file,
+                tile: tile.id.clone(),
+                read,
+                inside: samples,
+                planned: d.count,
+            });
         }
     }
     let data = Data::new(xy, z, Duplicates::Reject)
-        .context("the tile's samples")?
+        .doing(|| Doing::TileSamples)?
         .with_frame(KrigingFrame {
             centre: m.frame.0,
             scale: m.frame.1,
@@ -152,7 +151,9 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         .builder(None)
         .keep_boundary(true)
         .build(&Region::from_ring(tile.ring.clone()))
-        .with_context(|| format!("meshing tile {}", tile.id))?;
+        .doing(|| Doing::Meshing {
+            tile: tile.id.clone(),
+        })?;
     if m.mesh.smooth > 0 {
         smooth_keeping(&mut mesh, m.mesh.smoother, m.mesh.smooth, &[]);
     }
@@ -188,10 +189,10 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         engine.predict(&targets, false)?.0
     };
     if let Some(i) = dsm.iter().chain(&values).position(|v| !v.is_finite()) {
-        return Err(Error::invalid(format!(
-            "tile {}: a non-finite elevation (value {i}): the kriging system is ill-conditioned",
-            tile.id
-        )));
+        return Err(Error::NonFiniteElevation {
+            tile: tile.id.clone(),
+            value: i,
+        });
     }
     seconds.push(("interpolation".to_string(), t.elapsed().as_secs_f64()));
 
@@ -210,10 +211,8 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     // The tile's folder, atomically.
     let t = Instant::now();
     let dir = tile_dir(plan, &tile.id);
-    std::fs::create_dir_all(plan.join("tiles"))
-        .context(plan.join("tiles").display().to_string())?;
-    let folder =
-        terramesh_io::folder::OutputFolder::create(&dir).context(dir.display().to_string())?;
+    std::fs::create_dir_all(plan.join("tiles")).at(&plan.join("tiles"))?;
+    let folder = terramesh_io::folder::OutputFolder::create(&dir).at(&dir)?;
     let vertices: Vec<Vertex> = (0..positions.len())
         .map(|i| Vertex {
             xy: positions[i],
@@ -256,7 +255,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     };
     let json = serde_json::to_string_pretty(&summary)?;
     std::fs::write(folder.path().join(files::SUMMARY), json)?;
-    folder.commit().context(dir.display().to_string())?;
+    folder.commit().at(&dir)?;
     Ok(summary)
 }
 
@@ -302,12 +301,12 @@ fn planned_positions(
     let boundary = count.values().filter(|&&c| c == 1).count();
     let missing = seen.iter().filter(|s| !**s).count();
     if missing > 0 || boundary != ring.len() {
-        return Err(Error::invalid(format!(
-            "tile {id}: the mesh does not keep its planned boundary ({missing} of {} ring \
-             vertices missing, {boundary} boundary edges): plan again with larger tiles or a \
-             smaller mesh.max_area",
-            ring.len()
-        )));
+        return Err(Error::LostBoundary {
+            tile: id.to_string(),
+            missing,
+            ring: ring.len(),
+            boundary,
+        });
     }
     Ok(out)
 }

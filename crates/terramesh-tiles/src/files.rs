@@ -9,7 +9,7 @@
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::Path;
 
-use terramesh::{Context, Result};
+use crate::error::{Context, Result, TilesError};
 
 /// Vertex records' file.
 pub const VERTICES: &str = "vertices.f64";
@@ -65,7 +65,7 @@ pub(crate) fn read_u32s(path: &Path, record: usize) -> Result<Vec<u32>> {
 
 /// Writes the vertex file.
 pub(crate) fn write_vertices(path: &Path, v: &[Vertex]) -> Result<()> {
-    let mut w = BufWriter::new(std::fs::File::create(path).context(path.display().to_string())?);
+    let mut w = BufWriter::new(std::fs::File::create(path).at(path)?);
     for p in v {
         put(&mut w, &[p.xy[0], p.xy[1], p.dsm, p.uk, p.std, p.idw])?;
     }
@@ -75,7 +75,7 @@ pub(crate) fn write_vertices(path: &Path, v: &[Vertex]) -> Result<()> {
 
 /// Writes the triangle file.
 pub(crate) fn write_triangles(path: &Path, t: &[[u32; 3]]) -> Result<()> {
-    let mut w = BufWriter::new(std::fs::File::create(path).context(path.display().to_string())?);
+    let mut w = BufWriter::new(std::fs::File::create(path).at(path)?);
     for tri in t {
         for v in tri {
             w.write_all(&v.to_le_bytes())?;
@@ -87,7 +87,7 @@ pub(crate) fn write_triangles(path: &Path, t: &[[u32; 3]]) -> Result<()> {
 
 /// Writes the grid file.
 pub(crate) fn write_grid(path: &Path, nodes: &[(u64, f64)]) -> Result<()> {
-    let mut w = BufWriter::new(std::fs::File::create(path).context(path.display().to_string())?);
+    let mut w = BufWriter::new(std::fs::File::create(path).at(path)?);
     for (i, v) in nodes {
         w.write_all(&i.to_le_bytes())?;
         w.write_all(&v.to_le_bytes())?;
@@ -98,15 +98,15 @@ pub(crate) fn write_grid(path: &Path, nodes: &[(u64, f64)]) -> Result<()> {
 
 fn read_all(path: &Path, record: usize) -> Result<Vec<u8>> {
     let mut b = Vec::new();
-    BufReader::new(std::fs::File::open(path).context(path.display().to_string())?)
+    BufReader::new(std::fs::File::open(path).at(path)?)
         .read_to_end(&mut b)
-        .context(path.display().to_string())?;
+        .at(path)?;
     if b.len() % record != 0 {
-        return Err(terramesh::Error::invalid(format!(
-            "{}: {} bytes, not a whole number of {record}-byte records: build the tile again",
-            path.display(),
-            b.len()
-        )));
+        return Err(TilesError::PartialRecord {
+            file: path.to_path_buf(),
+            bytes: b.len(),
+            record,
+        });
     }
     Ok(b)
 }
@@ -171,11 +171,14 @@ pub(crate) fn check_indices(
         .enumerate()
         .find(|&(_, i)| i as usize >= n)
     {
-        return Err(terramesh::Error::invalid(format!(
-            "{}: tile {id}: index {i} (record value {k}) refers past its {n} {what}: the tile \
-             is damaged; build it again (terramesh tiles build PLAN --tile {id})",
-            path.display()
-        )));
+        return Err(TilesError::IndexPast {
+            file: path.to_path_buf(),
+            tile: id.to_string(),
+            index: i as u64,
+            value: k,
+            count: n,
+            what: what.to_string(),
+        });
     }
     Ok(())
 }
@@ -193,16 +196,13 @@ pub fn read_grid(dir: &Path) -> Result<Vec<(u64, f64)>> {
 
 /// Streams the samples file, calling `keep` with each `[x, y, z]` in order.
 pub(crate) fn stream_samples(path: &Path, mut keep: impl FnMut([f64; 3])) -> Result<()> {
-    let mut r = BufReader::with_capacity(
-        1 << 20,
-        std::fs::File::open(path).context(path.display().to_string())?,
-    );
+    let mut r = BufReader::with_capacity(1 << 20, std::fs::File::open(path).at(path)?);
     let mut rec = [0u8; 24];
     loop {
         match r.read_exact(&mut rec) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(()),
-            Err(e) => return Err(e).context(path.display().to_string()),
+            Err(e) => return Err(e).at(path),
         }
         let f = |i: usize| f64::from_le_bytes(rec[8 * i..8 * i + 8].try_into().expect("8"));
         keep([f(0), f(1), f(2)]);

@@ -21,8 +21,8 @@
 //! frame, same system; the rules act per vertex, and a node column depends only on its
 //! vertex's surfaces.
 
+use crate::error::{Result, TilesError as Error};
 use serde::{Deserialize, Serialize};
-use terramesh::{Error, Result};
 use terramesh_core::volume::FaceTag;
 
 /// The model's files in a tile's folder.
@@ -183,7 +183,7 @@ impl GeologyPlan {
     /// plan.crs_epsg = Some(32632);
     /// plan.crs = None;
     /// assert_eq!(plan.grid_crs()?.and_then(|c| c.epsg()), Some(32632));
-    /// # Ok::<(), terramesh::Error>(())
+    /// # Ok::<(), terramesh_tiles::TilesError>(())
     /// ```
     ///
     /// # Errors
@@ -197,12 +197,7 @@ impl GeologyPlan {
             (None, Some(PlanCrs::Proj { definition })) => {
                 Some(terramesh_crs::Crs::parse(definition)?)
             }
-            (None, None) => {
-                return Err(Error::invalid(
-                    "tiles.json: the geological plan records no CRS for the horizon grids \
-                     (a plan made by an older terramesh): plan again",
-                ))
-            }
+            (None, None) => return Err(Error::NoGridCrs),
         })
     }
 }

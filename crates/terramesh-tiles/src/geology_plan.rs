@@ -12,12 +12,12 @@ use terramesh_geostat::{
 
 use super::files::put_f64;
 use super::geology::{Estimate, GeologyPlan, InterfacePlan, PlanCrs};
+use crate::error::{Context, Doing, Result, TilesError as Error, UntileableGeology};
 use terramesh::build::Samples;
 use terramesh::geology::fields::MIN_KRIGED;
 use terramesh::geology::model::AUTO_BASE_MARGIN;
 use terramesh::plan::{Base as BaseKey, GeologyPlan as GeologySettings};
 use terramesh::project::Project;
-use terramesh::{Context, Error, Result};
 /// The plan of the geological model of `p` (None without `[geology]`), its files written
 /// into `out/geology/`, and each tile's geology halo for the extents `rects` (probe spacing
 /// `h`).
@@ -38,13 +38,7 @@ pub(crate) fn plan_geology(
     match &holes {
         Some(_) => {}
         None if (1..g.units.len()).all(|u| gridded(u).is_some()) => {}
-        None => {
-            return Err(Error::invalid(
-                "a tiled geological model is kriged from boreholes where no horizon grid gives a \
-                 unit's top: set [geology] collars and tops, or surfaces for every unit below \
-                 the first",
-            ))
-        }
+        None => return Err(Error::Geology(UntileableGeology::NoBoreholes)),
     }
     let contacts = || holes.iter().flat_map(|h| h.contacts());
     let crs_epsg = samples.epsg();
@@ -56,7 +50,7 @@ pub(crate) fn plan_geology(
     let mut grid_low = f64::INFINITY;
     let sample_xy: Vec<[f64; 2]> = samples.xyz.iter().map(|p| [p[0], p[1]]).collect();
     let dir = out.join("geology");
-    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
+    std::fs::create_dir_all(&dir).at(&dir)?;
     let k_project = p.interpolation.neighbors.or(0);
     let mut interfaces = Vec::new();
     let mut halos = vec![0.0f64; rects.len()];
@@ -92,24 +86,26 @@ pub(crate) fn plan_geology(
                 .collect(),
         };
         if obs.is_empty() {
-            return Err(Error::invalid(format!(
-                "no observation of {name}: no borehole meets it and [geology] surfaces gives \
-                 no grid for it (a tiled model takes unit tops from boreholes or horizon grids)"
-            )));
+            return Err(Error::Geology(UntileableGeology::NoObservation {
+                unit: name.to_string(),
+            }));
         }
         let data = Data::new(
             obs.iter().map(|o| [o[0], o[1]]).collect(),
             obs.iter().map(|o| o[2]).collect(),
             Duplicates::Mean,
         )
-        .with_context(|| format!("the observations of {name}"))?;
+        .doing(|| Doing::Observations {
+            unit: name.to_string(),
+            tile: None,
+        })?;
         let file = format!("geology/{unit}.f64");
         let mut bytes = Vec::with_capacity(24 * data.len());
         for (q, z) in data.xy().iter().zip(data.z()) {
             put_f64(&mut bytes, &[q[0], q[1], *z]);
         }
         let path = out.join(&file);
-        terramesh_io::output::write_atomic(&path, &bytes).context(path.display().to_string())?;
+        terramesh_io::output::write_atomic(&path, &bytes).at(&path)?;
         let (lo, hi) = data
             .z()
             .iter()
@@ -131,16 +127,16 @@ pub(crate) fn plan_geology(
                     let vfile = format!("geology/{unit}-variogram.json");
                     let vpath = out.join(&vfile);
                     let json = VariogramFile::new(v).to_json_pretty();
-                    terramesh_io::output::write_atomic(&vpath, json.as_bytes())
-                        .context(vpath.display().to_string())?;
+                    terramesh_io::output::write_atomic(&vpath, json.as_bytes()).at(&vpath)?;
                     let v = terramesh::variogram_file::read_variogram_file(&vpath)?;
                     let f = data.frame(&v);
                     let k = k_project.min(data.len());
                     // Drift terms need more data than unknowns (as the one-piece model).
                     let universal = k > 2 * p.interpolation.drift.terms();
                     let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(data.xy())
-                        .map_err(|e| {
-                            Error::invalid(format!("search tree of {name}'s observations: {e:?}"))
+                        .map_err(|e| Error::SearchTree {
+                            points: format!("{name}'s observations"),
+                            why: format!("{e:?}"),
                         })?;
                     for (halo, r) in halos.iter_mut().zip(rects) {
                         *halo = halo.max(super::partition::reach(&tree, k, *r, h));
@@ -222,43 +218,35 @@ pub(crate) fn plan_geology(
 
 /// The variogram of one interface, fitted as a one-piece model fits it.
 fn fitted(data: &Data) -> Result<terramesh_geostat::Variogram> {
-    let lags = experimental(data, &LagSettings::default()).context("experimental variogram")?;
+    let lags =
+        experimental(data, &LagSettings::default()).doing(|| Doing::ExperimentalVariogram)?;
     let (fit, _) = fit_auto(data, &lags, Weighting::Cressie, ModelKind::ALL)
-        .context("fitting the variogram")?;
+        .doing(|| Doing::FittingVariogram)?;
     Ok(fit.variogram)
 }
 
 /// Refuses the geology a tiled build does not make yet, with the key to change.
 fn check_supported(g: &GeologySettings) -> Result<()> {
     if let Some(f) = g.faults.first() {
-        return Err(Error::invalid(format!(
-            "geology.faults: the project has {} fault(s) ({} ...): tiled builds do not make \
-             faulted models yet; build it in one piece with terramesh build or terramesh model",
-            g.faults.len(),
-            f.name
-        )));
+        return Err(Error::Geology(UntileableGeology::Faults {
+            count: g.faults.len(),
+            first: f.name.to_string(),
+        }));
     }
     if let Some(o) = g.objects.first() {
-        return Err(Error::invalid(format!(
-            "geology.{}: the project has {} engineering object(s) ({} ...): tiled builds do not \
-             cut tunnels, excavations or structures into the model yet; build it in one piece \
-             with terramesh build or terramesh model",
-            o.table(),
-            g.objects.len(),
-            o.name
-        )));
+        return Err(Error::Geology(UntileableGeology::Objects {
+            table: o.table(),
+            count: g.objects.len(),
+            first: o.name.to_string(),
+        }));
     }
     if g.interpolate == Interpolated::Thickness && g.surfaces.iter().any(Option::is_some) {
-        return Err(Error::invalid(
-            "horizon grids give unit tops, not thicknesses: set [geology] interpolate = \"tops\" \
-             to use them",
-        ));
+        return Err(Error::Geology(UntileableGeology::GridsGiveTops));
     }
     if let (Some(Some(_)), Some(first)) = (g.surfaces.first(), g.units.first()) {
-        return Err(Error::invalid(format!(
-            "geology.surfaces.{first}: the top of the first unit is the terrain (the DSM); give \
-             grids for the units below it"
-        )));
+        return Err(Error::Geology(UntileableGeology::FirstUnitGrid {
+            unit: first.to_string(),
+        }));
     }
     Ok(())
 }
@@ -275,6 +263,7 @@ pub(super) fn horizon_at(
     what: &str,
 ) -> Result<Vec<Option<f64>>> {
     let grid = terramesh::horizon::HorizonGrid::open(path, g.z_unit)?;
-    grid.evaluate_in(xy, crs)
-        .with_context(|| format!("the grid of {what}"))
+    grid.evaluate_in(xy, crs).doing(|| Doing::GridOf {
+        what: what.to_string(),
+    })
 }

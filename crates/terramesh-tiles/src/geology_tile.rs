@@ -10,11 +10,11 @@ use terramesh_mesh::Mesh;
 
 use super::geology::{Estimate, GeologyPlan, TileFigures};
 use super::geology_plan::horizon_at;
+use crate::error::{Context, Doing, PlanMismatch, Result, TilesError as Error};
 use terramesh::build::Surface;
 use terramesh::geology::model::{assemble_estimated, Base};
 use terramesh::plan::Base as BaseKey;
 use terramesh::project::Project;
-use terramesh::{Context, Error, Result};
 
 /// One tile's geological model.
 pub(crate) struct TileModel {
@@ -43,9 +43,9 @@ pub(crate) fn build_model(
     triangles: &[[u32; 3]],
     terrain: &[f64],
 ) -> Result<TileModel> {
-    let g = project.geology().ok_or_else(|| {
-        Error::invalid("the plan has a geological model but the project no [geology]: plan again")
-    })?;
+    let g = project
+        .geology()
+        .ok_or(Error::PlanProject(PlanMismatch::NoGeology))?;
     let [x0, y0, x1, y1] = tile.extent;
     let hh = tile.geology_halo.unwrap_or(0.0);
     let mut grids = Vec::new();
@@ -57,14 +57,15 @@ pub(crate) fn build_model(
                     .get(k + 1)
                     .and_then(Option::as_ref)
                     .ok_or_else(|| {
-                        Error::invalid(format!(
-                            "the plan samples a grid for the top of {} but the project's \
-                         [geology] surfaces names none: plan again",
-                            it.unit
-                        ))
+                        Error::PlanProject(PlanMismatch::NoSurface {
+                            unit: it.unit.clone(),
+                        })
                     })?;
-                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), &it.unit)
-                    .with_context(|| format!("tile {}", tile.id))?;
+                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), &it.unit).doing(|| {
+                    Doing::Tile {
+                        tile: tile.id.clone(),
+                    }
+                })?;
                 // Nodata: the unit is absent there (as in a one-piece model).
                 grids.push((
                     k + 1,
@@ -75,12 +76,17 @@ pub(crate) fn build_model(
             Estimate::Constant { value } => vec![*value; xy.len()],
             Estimate::Idw { .. } => {
                 let (oxy, oz) = observations(&plan.join(&it.observations), |_| true)?;
-                let data = Data::new(oxy, oz, Duplicates::Reject)
-                    .with_context(|| format!("the observations of {}", it.unit))?;
-                let idw = Idw::new(&data, 2.0, IdwSearch::All).context("IDW")?;
+                let data =
+                    Data::new(oxy, oz, Duplicates::Reject).doing(|| Doing::Observations {
+                        unit: it.unit.clone(),
+                        tile: None,
+                    })?;
+                let idw =
+                    Idw::new(&data, 2.0, IdwSearch::All).doing(|| Doing::Idw { unit: None })?;
                 let mut v = vec![0.0; xy.len()];
-                Predictor::predict(&idw, xy, &mut v, None)
-                    .with_context(|| format!("inverse-distance weighting of {}", it.unit))?;
+                Predictor::predict(&idw, xy, &mut v, None).doing(|| Doing::Idw {
+                    unit: Some(it.unit.clone()),
+                })?;
                 v
             }
             Estimate::Kriged {
@@ -92,7 +98,10 @@ pub(crate) fn build_model(
                     q[0] >= x0 - hh && q[0] <= x1 + hh && q[1] >= y0 - hh && q[1] <= y1 + hh
                 })?;
                 let data = Data::new(oxy, oz, Duplicates::Reject)
-                    .with_context(|| format!("tile {}: the observations of {}", tile.id, it.unit))?
+                    .doing(|| Doing::Observations {
+                        unit: it.unit.clone(),
+                        tile: Some(tile.id.clone()),
+                    })?
                     .with_frame(KrigingFrame {
                         centre: frame.0,
                         scale: frame.1,
@@ -110,10 +119,11 @@ pub(crate) fn build_model(
             }
         };
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::invalid(format!(
-                "tile {}: the top of {} is not finite at ({:.1}, {:.1})",
-                tile.id, it.unit, xy[i][0], xy[i][1]
-            )));
+            return Err(Error::NonFiniteTop {
+                tile: tile.id.clone(),
+                unit: it.unit.clone(),
+                at: xy[i],
+            });
         }
         grids.push((if gp.thickness { k } else { k + 1 }, values));
     }
@@ -124,30 +134,27 @@ pub(crate) fn build_model(
         triangles: triangles.to_vec(),
         constraint_edges: vec![],
     };
-    let base =
-        match (gp.base, &g.base) {
-            (Some(z), _) => Base::Elevation(z),
-            (None, BaseKey::Raster(path)) => {
-                let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), "the base")
-                    .with_context(|| format!("tile {}", tile.id))?;
-                match v.iter().position(Option::is_none) {
-                    Some(i) => {
-                        return Err(Error::invalid(format!(
-                        "{}: the base grid has no value at ({:.1}, {:.1}), a vertex of tile {}: \
-                         a base grid must cover the whole region",
-                        path.display(),
-                        xy[i][0],
-                        xy[i][1],
-                        tile.id
-                    )))
-                    }
-                    None => Base::PerVertex(v.into_iter().flatten().collect()),
+    let base = match (gp.base, &g.base) {
+        (Some(z), _) => Base::Elevation(z),
+        (None, BaseKey::Raster(path)) => {
+            let v = horizon_at(path, xy, g, gp.grid_crs()?.as_ref(), "the base").doing(|| {
+                Doing::Tile {
+                    tile: tile.id.clone(),
                 }
+            })?;
+            match v.iter().position(Option::is_none) {
+                Some(i) => {
+                    return Err(Error::BaseGridGap {
+                        file: path.clone(),
+                        at: xy[i],
+                        tile: tile.id.clone(),
+                    })
+                }
+                None => Base::PerVertex(v.into_iter().flatten().collect()),
             }
-            (None, _) => return Err(Error::invalid(
-                "the plan samples a base grid but the project's geology.base is none: plan again",
-            )),
-        };
+        }
+        (None, _) => return Err(Error::PlanProject(PlanMismatch::NoBase)),
+    };
     // The plan estimated every field: unit tops (as horizon grids are given) or thicknesses.
     let (grids, thick) = if gp.thickness {
         (Vec::new(), grids.into_iter().map(|g| g.1).collect())
@@ -161,8 +168,10 @@ pub(crate) fn build_model(
     };
     let inputs = g.model_inputs(None, grids, base, interpolate, Method::Ordinary);
     let values: Vec<&[f64]> = thick.iter().map(Vec::as_slice).collect();
-    let model = assemble_estimated(&mesh, terrain, &inputs, &values)
-        .with_context(|| format!("tile {}: [geology]", tile.id))?;
+    let model =
+        assemble_estimated(&mesh, terrain, &inputs, &values).doing(|| Doing::TileGeology {
+            tile: tile.id.clone(),
+        })?;
     let figures = TileFigures {
         volumes: model.check.unit_volumes.clone(),
         cells: (0..g.units.len())

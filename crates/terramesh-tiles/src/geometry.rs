@@ -7,7 +7,7 @@
 //! the edge's endpoints in one canonical order, and a side is split from its lower endpoint
 //! (by x, then y), whichever way the tile's ring runs along it.
 
-use terramesh::{Error, Result};
+use crate::error::{Result, TilesError as Error};
 
 /// `(b - a) x (c - a)`.
 fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
@@ -41,9 +41,7 @@ pub(crate) fn ccw_ring(ring: &[[f64; 2]]) -> Result<(Vec<[f64; 2]>, bool)> {
     }
     let n = r.len();
     if n < 3 || area == 0.0 {
-        return Err(Error::invalid(
-            "tiled builds need a region with an area (three corners or more)",
-        ));
+        return Err(Error::NoArea);
     }
     let convex = (0..n).all(|i| orient(r[i], r[(i + 1) % n], r[(i + 2) % n]) >= 0.0);
     Ok((r, convex))

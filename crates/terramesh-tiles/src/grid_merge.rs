@@ -20,7 +20,7 @@ use terramesh_io::output::Output;
 
 use super::files;
 use super::manifest::{tile_dir, Manifest};
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, GridProblem, Result, TilesError as Error};
 
 /// The nodata value of the grids.
 pub(super) const NODATA: f64 = -9999.0;
@@ -51,8 +51,7 @@ impl Stream {
     fn peek(&mut self) -> Result<Option<u64>> {
         if self.pending.is_none() && self.left > 0 {
             let r = self.r.as_mut().expect("opened");
-            r.read_exact(&mut self.rec)
-                .context(self.path.display().to_string())?;
+            r.read_exact(&mut self.rec).at(&self.path)?;
             self.left -= 1;
             self.pending = Some(u64::from_le_bytes(
                 self.rec[..8].try_into().expect("8 bytes"),
@@ -72,7 +71,7 @@ fn index_at(f: &mut File, at: u64, path: &Path) -> Result<u64> {
     let mut b = [0u8; 8];
     f.seek(SeekFrom::Start(at))
         .and_then(|_| f.read_exact(&mut b))
-        .context(path.display().to_string())?;
+        .at(path)?;
     Ok(u64::from_le_bytes(b))
 }
 
@@ -111,7 +110,7 @@ pub(crate) fn write_interfaces(
     out: &Path,
 ) -> Result<Vec<PathBuf>> {
     let dir = out.join("interfaces");
-    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
+    std::fs::create_dir_all(&dir).at(&dir)?;
     let outputs: Vec<(PathBuf, RowFormat, usize)> = units
         .iter()
         .enumerate()
@@ -135,23 +134,24 @@ fn merge_rows(
     let g = &m.grid;
     let nx = g.nx as u64;
     let total = nx * g.ny as u64;
-    let damaged = |path: &Path, why: String| {
-        Error::invalid(format!(
-            "{}: {why}: build the tile again (terramesh tiles build {} --tile ID)",
-            path.display(),
-            plan.display()
-        ))
+    let damaged = |path: &Path, why: GridProblem| Error::TileGrid {
+        file: path.to_path_buf(),
+        why,
+        plan: plan.to_path_buf(),
     };
     // Every tile's file: its records and its first node's row.
     let mut streams = Vec::new();
     for t in &m.tiles {
         let path = tile_dir(plan, &t.id).join(file);
-        let mut f = File::open(&path).context(path.display().to_string())?;
-        let len = f.metadata().context(path.display().to_string())?.len();
+        let mut f = File::open(&path).at(&path)?;
+        let len = f.metadata().at(&path)?.len();
         if len % size != 0 {
             return Err(damaged(
                 &path,
-                format!("{len} bytes, not whole {size}-byte records"),
+                GridProblem::PartialRecord {
+                    bytes: len,
+                    record: size,
+                },
             ));
         }
         if len == 0 {
@@ -164,7 +164,11 @@ fn merge_rows(
         if last >= total || first > last {
             return Err(damaged(
                 &path,
-                format!("nodes {first}..{last} do not lie in order in the grid of {total}"),
+                GridProblem::Order {
+                    first,
+                    last,
+                    nodes: total,
+                },
             ));
         }
         drop(f);
@@ -183,8 +187,8 @@ fn merge_rows(
     let spec = g.raster();
     let mut writers = Vec::new();
     for (path, format, _) in outputs {
-        let o = Output::create(Some(path)).context(path.display().to_string())?;
-        writers.push(GridRows::new(o, &spec, *format).context(path.display().to_string())?);
+        let o = Output::create(Some(path)).at(path)?;
+        writers.push(GridRows::new(o, &spec, *format).at(path)?);
     }
     let mut rows = vec![vec![NODATA; g.nx]; width];
     let mut seen = vec![false; g.nx];
@@ -192,7 +196,7 @@ fn merge_rows(
     for r in 0..g.ny {
         while streams.last().is_some_and(|s| s.first_row == r) {
             let mut s = streams.pop().expect("a stream");
-            let f = File::open(&s.path).context(s.path.display().to_string())?;
+            let f = File::open(&s.path).at(&s.path)?;
             s.r = Some(BufReader::with_capacity(1 << 16, f));
             active.push(s);
         }
@@ -208,17 +212,11 @@ fn merge_rows(
                     break;
                 }
                 if i < lo {
-                    return Err(damaged(
-                        &s.path,
-                        format!("node {i} after the nodes of row {r}: not in order"),
-                    ));
+                    return Err(damaged(&s.path, GridProblem::AfterRow { node: i, row: r }));
                 }
                 let c = (i - lo) as usize;
                 if seen[c] {
-                    return Err(damaged(
-                        &s.path,
-                        format!("node {i} is another tile's too (each node has one owner)"),
-                    ));
+                    return Err(damaged(&s.path, GridProblem::Shared { node: i }));
                 }
                 seen[c] = true;
                 for (k, row) in rows.iter_mut().enumerate() {
@@ -231,13 +229,11 @@ fn merge_rows(
         }
         active.retain(|s| s.pending.is_some() || s.left > 0);
         for (w, (path, _, k)) in writers.iter_mut().zip(outputs) {
-            w.row(&rows[*k]).context(path.display().to_string())?;
+            w.row(&rows[*k]).at(path)?;
         }
     }
     for (w, (path, _, _)) in writers.into_iter().zip(outputs) {
-        w.finish()
-            .and_then(|o| o.commit())
-            .context(path.display().to_string())?;
+        w.finish().and_then(|o| o.commit()).at(path)?;
     }
     Ok(GridFigures {
         nodes,

@@ -9,7 +9,9 @@
 //!   writes the manifest `PLAN/tiles.json` ([`Manifest`]).
 //! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
 //!   its state under a lock, so many processes may build at once.
-//! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc` and a report, and,
+//! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc`, the other surface
+//!   single-file formats of `export.formats` but glTF (`dsm.obj`, `.ply`, `.stl`, `.ts`,
+//!   `.msh`, `.dxf`, `.kml`, `.dae`, through the one-piece build's writers) and a report, and,
 //!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`, and from the
 //!   merged volume mesh the boundary meshes, `model.msh`, `model.f3grid` and the bodies.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.
@@ -22,7 +24,7 @@
 //! reach.
 //!
 //! ```no_run
-//! # fn main() -> Result<(), terramesh::Error> {
+//! # fn main() -> Result<(), terramesh_tiles::TilesError> {
 //! use std::path::Path;
 //! use terramesh::project::Project;
 //! use terramesh_tiles as tiles;
@@ -43,6 +45,8 @@
 mod appended;
 mod boreholes;
 mod build;
+mod error;
+mod exports;
 mod files;
 mod geology;
 mod geology_plan;
@@ -64,6 +68,11 @@ mod slurm;
 
 pub use boreholes::{PlannedContact, CONTACTS, MISFITS};
 pub use build::{build_tile, Outcome, FAIL_ENV};
+pub use error::{
+    BoundaryProblem, ContactProblem, Doing, GridProblem, PlanMismatch, Result, ScriptPath,
+    TilesError, Untileable, UntileableGeology,
+};
+pub use exports::Skipped;
 pub use files::{peak_rss, read_grid, read_triangles, read_vertices, Vertex};
 pub use geology::{
     tag_of_name, Estimate, GeologyPlan, InterfacePlan, PlanCrs, TileFigures, INTERFACES,

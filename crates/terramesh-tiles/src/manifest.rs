@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// The manifest's file name in the plan folder.
 pub const MANIFEST: &str = "tiles.json";
@@ -234,6 +234,14 @@ pub struct CrsText {
     /// `model.vtu`'s field data `crs` and `model.json`'s: `EPSG:<code>`, else the CRS's
     /// definition, else `projected`.
     pub model: String,
+    /// The CRS's name as the one-piece build's `dsm.ts` gives it (`WGS 84 / UTM zone 32N`);
+    /// plans made before it have none, and the merge writes [`CrsText::dsm`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The UTM zone of a project in UTM coordinates (`32N`): where the merge's KML and COLLADA
+    /// place the region, as a one-piece build does; plans made before it have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zone: Option<String>,
 }
 
 /// What [`Manifest::check`] found wrong in a plan's manifest: the tile, the unit or the field,
@@ -393,22 +401,21 @@ impl Manifest {
     /// Reads `PLAN/tiles.json`.
     pub fn read(plan: &Path) -> Result<Manifest> {
         let path = plan.join(MANIFEST);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            Error::invalid(format!(
-                "{}: {e}; make a plan first with terramesh tiles plan",
-                path.display()
-            ))
-        })?;
-        let m: Manifest = serde_json::from_str(&text).context(path.display().to_string())?;
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(source) => return Err(Error::NoManifest { path, source }),
+        };
+        let m: Manifest = serde_json::from_str(&text).at(&path)?;
         if m.version != VERSION {
-            return Err(Error::invalid(format!(
-                "{}: manifest version {} (this terramesh reads {VERSION}): plan again",
-                path.display(),
-                m.version
-            )));
+            return Err(Error::ManifestVersion {
+                path,
+                version: m.version,
+                reads: VERSION,
+            });
         }
-        m.check()
-            .map_err(|why| Error::invalid(format!("{}: {why}: plan again", path.display())))?;
+        if let Err(source) = m.check() {
+            return Err(Error::Manifest { path, source });
+        }
         Ok(m)
     }
 
@@ -540,17 +547,17 @@ impl Manifest {
     pub fn write(&self, plan: &Path) -> Result<()> {
         let text = serde_json::to_string_pretty(self)?;
         terramesh_io::output::write_atomic(&plan.join(MANIFEST), text.as_bytes())
-            .context(plan.join(MANIFEST).display().to_string())
+            .at(&plan.join(MANIFEST))
     }
 
     /// The tile with `id`, or an error listing the ids.
     pub fn tile(&self, id: &str) -> Result<&Tile> {
         self.tiles.iter().find(|t| t.id == id).ok_or_else(|| {
             let ids: Vec<&str> = self.tiles.iter().map(|t| t.id.as_str()).collect();
-            Error::invalid(format!(
-                "no tile '{id}' in the plan; its tiles are {}",
-                terramesh::cut(&ids.join(", "))
-            ))
+            Error::NoSuchTile {
+                id: id.to_string(),
+                tiles: ids.join(", "),
+            }
         })
     }
 }
@@ -559,7 +566,7 @@ impl Manifest {
 /// returned. The lock is held from the read to the write.
 ///
 /// ```
-/// # fn main() -> Result<(), terramesh::Error> {
+/// # fn main() -> Result<(), terramesh_tiles::TilesError> {
 /// let dir = tempfile::tempdir()?;
 /// let e = terramesh_tiles::update(dir.path(), |_| Ok(())).unwrap_err();
 /// assert!(e.to_string().contains("terramesh tiles plan"));
@@ -584,8 +591,8 @@ impl Lock {
             .truncate(false)
             .write(true)
             .open(&path)
-            .context(path.display().to_string())?;
-        file.lock().context(path.display().to_string())?;
+            .at(&path)?;
+        file.lock().at(&path)?;
         Ok(Lock(file))
     }
 }

@@ -5,9 +5,12 @@
 //! vertex belongs to one tile. `dsm.vtu` (raw appended binary VTK, the arrays of `terramesh
 //! build`'s) is written array by array, each a pass over the tiles, so that the merge holds one tile's mesh
 //! and the seam vertices' index, never the region's mesh. `dsm.tif` and `dsm.asc` are written
-//! row by row, one row in memory (`grid_merge.rs`). The formats that need the whole mesh
-//! at once (the sealed solid, glTF and 3D Tiles, Cesium terrain, the report's 3D view, the
-//! pictures) are not made by the merge: build them from `dsm.vtu` or in one piece.
+//! row by row, one row in memory (`grid_merge.rs`). The other surface formats of the
+//! project's `export.formats` (OBJ, PLY, STL, TSurf, MSH, DXF, KML, COLLADA) go through the
+//! one-piece build's writers, reading the merged mesh from mapped scratch files
+//! (`exports.rs`). glTF and the formats that need the whole mesh at once (3D Tiles, Cesium
+//! terrain, the sealed solid, the report's 3D view, the pictures) are not made by the merge
+//! (`merge.json`'s `not_merged`): build them from `dsm.vtu` or in one piece.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -20,7 +23,7 @@ use super::appended::{self, put_f64, Array, Section, Values};
 use super::files::{self, Vertex};
 use super::manifest::{tile_dir, Manifest, State, Tile};
 use super::merged::Merged;
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Doing, Result, TilesError as Error};
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
@@ -41,13 +44,12 @@ pub fn merge(plan: &Path, out: &Path) -> Result<Merged> {
         })
         .collect();
     if !pending.is_empty() {
-        return Err(Error::invalid(format!(
-            "{} of {} tiles are not done: {}; build them with terramesh tiles build {} --tile ID",
-            pending.len(),
-            m.tiles.len(),
-            terramesh::cut(&pending.join(", ")),
-            plan.display()
-        )));
+        return Err(Error::NotDone {
+            pending: pending.len(),
+            tiles: m.tiles.len(),
+            ids: pending.join(", "),
+            plan: plan.to_path_buf(),
+        });
     }
     // Staged like a build (`build/staging.rs`): written into a sibling folder, swapped in
     // at the end, so that a failing merge leaves `out` as it was; an existing `out` without
@@ -98,6 +100,30 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
     write_vtu(&vtu, plan, m, &seams, n as usize, nt)?;
     written.push(vtu);
 
+    // The other surface formats of the project's `export.formats`, streamed.
+    let project =
+        terramesh::project::Project::parse(&m.project.display().to_string(), &m.plan, &[])
+            .doing(|| Doing::PlanStored)?;
+    let title = project
+        .title
+        .clone()
+        .unwrap_or_else(|| "terramesh DSM".into());
+    let crs_name = m
+        .crs_text
+        .as_ref()
+        .and_then(|c| c.name.clone())
+        .unwrap_or_else(|| m.dsm_crs());
+    let labels = super::exports::Labels {
+        formats: &project.export.formats,
+        title: &title,
+        crs_name: &crs_name,
+        field_data: Vec::new(),
+        stl_origin: [m.origin[0], m.origin[1], 0.0],
+        georef: georef_of(m, &project.export.formats)?,
+    };
+    let surfaces = super::exports::write_surfaces(plan, m, &seams, out, &labels)?;
+    written.extend(surfaces.files);
+
     // The grids, row by row.
     let (grid_files, grid) = super::grid_merge::write_grids(plan, m, out)?;
     written.extend(grid_files);
@@ -119,6 +145,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         area,
         grid,
         model,
+        not_merged: surfaces.skipped,
         seconds: t0.elapsed().as_secs_f64(),
     };
     let json = out.join("merge.json");
@@ -135,15 +162,43 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         .collect();
     let text = serde_json::to_string_pretty(&merged)?;
     merged.files = absolute;
-    terramesh_io::output::write_atomic(&json, text.as_bytes())
-        .context(json.display().to_string())?;
+    terramesh_io::output::write_atomic(&json, text.as_bytes()).at(&json)?;
     let report = out.join("report.html");
     let html = super::report::html(m, &merged);
-    terramesh_io::output::write_atomic(&report, html.as_bytes())
-        .context(report.display().to_string())?;
+    terramesh_io::output::write_atomic(&report, html.as_bytes()).at(&report)?;
     merged.files.push(json);
     merged.files.push(report);
     Ok(merged)
+}
+
+/// Where the plan's region lies on the Earth, as the one-piece build places it (a UTM zone, or
+/// the project's CRS by its EPSG code), when KML or COLLADA are asked for; `None` for a plan
+/// that does not record it (made before `crs_text.zone`) or a CRS without an EPSG code.
+fn georef_of(
+    m: &Manifest,
+    formats: &[terramesh_io::export::Format],
+) -> Result<Option<terramesh::georef::Georef>> {
+    use terramesh_io::export::Format;
+    if !formats
+        .iter()
+        .any(|f| matches!(f, Format::Kml | Format::Collada))
+    {
+        return Ok(None);
+    }
+    let Some(text) = &m.crs_text else {
+        return Ok(None);
+    };
+    Ok(match (&text.zone, text.name.is_some(), m.epsg) {
+        (Some(z), _, _) => z
+            .parse::<terramesh_core::coords::Zone>()
+            .ok()
+            .map(terramesh::georef::Georef::utm),
+        (None, true, Some(code)) => {
+            let crs = terramesh_crs::Crs::from_epsg(code)?;
+            Some(terramesh::georef::Georef::crs(&crs, "region.crs")?)
+        }
+        _ => None,
+    })
 }
 
 fn bits(p: [f64; 2]) -> (u64, u64) {
@@ -158,7 +213,7 @@ fn seam_keys(t: &Tile) -> std::collections::HashSet<(u64, u64)> {
 }
 
 /// One tile's vertices with their global indices and whether this tile writes them.
-fn mapped(
+pub(crate) fn mapped(
     k: usize,
     t: &Tile,
     v: &[Vertex],
@@ -170,12 +225,9 @@ fn mapped(
         .map(|p| {
             let key = bits(p.xy);
             if on.contains(&key) {
-                let &(g, owner, _) = seams.get(&key).ok_or_else(|| {
-                    Error::invalid(format!(
-                        "tile {}: a seam vertex at ({}, {}) changed between two reads of its \
-                         files: do not build tiles during a merge",
-                        t.id, p.xy[0], p.xy[1]
-                    ))
+                let &(g, owner, _) = seams.get(&key).ok_or_else(|| Error::SeamChanged {
+                    tile: t.id.clone(),
+                    at: p.xy,
                 })?;
                 if owner == k {
                     *next += 1;
@@ -277,13 +329,11 @@ fn write_vtu(
                     let path = dir.join(super::geology::SURFACES);
                     let surf = super::files::read_f64s(&path, ns)?;
                     if surf.len() != map.len() * ns {
-                        return Err(Error::invalid(format!(
-                            "{}: {} surfaces for {} vertices: the tile is damaged; build it \
-                             again",
-                            path.display(),
-                            surf.len() / ns,
-                            map.len()
-                        )));
+                        return Err(Error::SurfacesCount {
+                            file: path,
+                            surfaces: surf.len() / ns,
+                            vertices: map.len(),
+                        });
                     }
                     for (k, &(_, mine)) in map.iter().enumerate() {
                         if mine {
@@ -383,7 +433,7 @@ fn write_vtu(
         nt as u64,
         values,
     ));
-    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
-    appended::write(&mut o, n, nt, arrays).context(path.display().to_string())?;
-    o.commit().context(path.display().to_string())
+    let mut o = Output::create(Some(path)).at(path)?;
+    appended::write(&mut o, n, nt, arrays).at(path)?;
+    o.commit().at(path)
 }

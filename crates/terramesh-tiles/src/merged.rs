@@ -28,6 +28,9 @@ pub struct Merged {
     /// The geological model, when the plan has one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<MergedModel>,
+    /// The formats of the project's `export.formats` the merge did not write, with why.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_merged: Vec<super::exports::Skipped>,
     /// Seconds the merge took.
     pub seconds: f64,
 }
@@ -41,8 +44,17 @@ impl Merged {
                 g.cells, g.nodes
             )
         });
+        let skipped: Vec<&str> = self.not_merged.iter().map(|s| s.format.as_str()).collect();
+        let skipped = match skipped.is_empty() {
+            true => String::new(),
+            false => format!(
+                "not merged (see merge.json; build them in one piece): {}\n",
+                skipped.join(", ")
+            ),
+        };
         format!(
-            "merged into {}: {} vertices, {} triangles, {} seam vertices{model} in {seconds:.2} s\n",
+            "merged into {}: {} vertices, {} triangles, {} seam vertices{model} in {seconds:.2} s\n\
+             {skipped}",
             output.display(),
             self.vertices,
             self.triangles,

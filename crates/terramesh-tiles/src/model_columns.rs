@@ -10,7 +10,7 @@ use terramesh_core::volume::{Cell, CellKind};
 use super::files::{check_indices, read_f64s, read_u32s};
 use super::geology::{MODEL_CELLS, MODEL_POINTS};
 use super::manifest::{tile_dir, Tile};
-use terramesh::Result;
+use crate::error::Result;
 
 /// A seam vertex's column: its first global node, how many nodes, the tile that writes it,
 /// and its surfaces.

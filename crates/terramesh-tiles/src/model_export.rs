@@ -47,7 +47,7 @@ use super::geology::GeologyPlan;
 use super::manifest::Manifest;
 use super::model_columns::Column;
 use super::model_stream::TiledModel;
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// What the merge found making the merged model's other files (`exports` in `merge.json`'s
 /// `model`).
@@ -67,9 +67,9 @@ pub struct MergedExports {
 
 /// Writes `path` atomically with `f`.
 fn atomic(path: &Path, f: impl FnOnce(&mut Output) -> std::io::Result<()>) -> Result<PathBuf> {
-    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
-    f(&mut o).context(path.display().to_string())?;
-    o.commit().context(path.display().to_string())?;
+    let mut o = Output::create(Some(path)).at(path)?;
+    f(&mut o).at(path)?;
+    o.commit().at(path)?;
     Ok(path.to_path_buf())
 }
 
@@ -91,10 +91,13 @@ fn enclosed(points: &[[f64; 3]], triangles: &[[u32; 3]], what: &str) -> Result<(
         }
     }
     if let Some((&(a, b), &(f, r))) = edges.iter().find(|(_, &(f, r))| f != r || f == 0 || f > 2) {
-        return Err(Error::invalid(format!(
-            "the merged {what}: its edge {:?}-{:?} is met {f} and {r} times each way: it is not              closed there",
-            points[a as usize], points[b as usize]
-        )));
+        return Err(Error::NotClosed {
+            what: what.to_string(),
+            a: points[a as usize],
+            b: points[b as usize],
+            forward: f,
+            backward: r,
+        });
     }
     let r = points.first().copied().unwrap_or_default();
     let (mut sum, mut magnitude) = (0.0, 0.0);
@@ -161,9 +164,11 @@ pub(crate) fn merge_exports(
         let (volume, magnitude) = enclosed(&mesh.points, &body.triangles, &what)?;
         let cells = unit_volumes.get(u).copied().unwrap_or(0.0);
         if (volume - cells).abs() > 1e-9 * volume.abs().max(cells.abs()).max(magnitude) {
-            return Err(Error::invalid(format!(
-                "the merged {what} encloses {volume} m³ but its cells hold {cells} m³"
-            )));
+            return Err(Error::BodyVolume {
+                what: what.to_string(),
+                volume,
+                cells,
+            });
         }
         bodies.push((unit.clone(), volume));
         let (mr, br, ir) = (&mesh, &body, &info);

@@ -10,7 +10,7 @@ use super::geology::{
     INTERFACES, MODEL_BODIES, MODEL_CELLS, MODEL_FACES, MODEL_JSON, MODEL_POINTS, SURFACES,
 };
 use super::geology_tile::TileModel;
-use terramesh::{Context, Result};
+use crate::error::{Context, Result};
 
 /// Writes a tile's model files into `dir`: `surfaces.f64` (per planar vertex, every surface),
 /// `model-points.f64` (`x, y, z`), `model-cells.u32` (per cell: kind 0 tetra, 1 pyramid, 2
@@ -91,5 +91,5 @@ pub(crate) fn write_model(
 }
 
 fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).context(path.display().to_string())
+    std::fs::write(path, bytes).at(path)
 }

@@ -24,7 +24,7 @@ use super::files::{read_f64s, read_u32s, read_vertices};
 use super::geology::{GeologyPlan, TileFigures, MODEL_CELLS, MODEL_JSON, SURFACES};
 use super::manifest::{tile_dir, Manifest};
 use super::model_columns::{cell_of, columns, key, node_map, read_model, Column, TileModel};
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// One unit of the merged model.
 #[derive(Debug, Clone, Serialize)]
@@ -124,13 +124,12 @@ pub(crate) fn merge_model(
         let surf = read_f64s(&dir.join(SURFACES), ns)?;
         let tm = read_model(plan, t)?;
         if surf.len() != v.len() * ns {
-            return Err(Error::invalid(format!(
-                "{}: {} surfaces for {} vertices: build tile {} again",
-                dir.join(SURFACES).display(),
-                surf.len() / ns,
-                v.len(),
-                t.id
-            )));
+            return Err(Error::ModelSurfaces {
+                file: dir.join(SURFACES),
+                surfaces: surf.len() / ns,
+                vertices: v.len(),
+                tile: t.id.clone(),
+            });
         }
         let mut at: HashMap<(u64, u64), usize> = HashMap::new();
         for (i, p) in v.iter().enumerate() {
@@ -141,12 +140,9 @@ pub(crate) fn merge_model(
             let z: Vec<u64> = (first..first + count)
                 .map(|i| tm.points[3 * i + 2].to_bits())
                 .collect();
-            let vi = *at.get(&ck).ok_or_else(|| {
-                Error::invalid(format!(
-                    "tile {}: a model node column at no planar vertex: build it again",
-                    t.id
-                ))
-            })?;
+            let vi = *at
+                .get(&ck)
+                .ok_or_else(|| Error::StrayColumn { tile: t.id.clone() })?;
             let s = surf[vi * ns..(vi + 1) * ns].to_vec();
             if !on.contains(&ck) {
                 n += count as u32;
@@ -159,16 +155,12 @@ pub(crate) fn merge_model(
                         diff = diff.max((a - b).abs());
                     }
                     if c.z != z {
-                        return Err(Error::invalid(format!(
-                            "tiles {} and {}: the node columns at ({}, {}) differ ({} and {} \
-                             nodes): the seam would not be conforming; build both again",
-                            m.tiles[c.owner].id,
-                            t.id,
-                            f64::from_bits(ck.0),
-                            f64::from_bits(ck.1),
-                            c.count,
-                            count
-                        )));
+                        return Err(Error::SeamColumns {
+                            first: m.tiles[c.owner].id.clone(),
+                            second: t.id.clone(),
+                            at: [f64::from_bits(ck.0), f64::from_bits(ck.1)],
+                            nodes: [c.count as usize, count],
+                        });
                     }
                 }
                 None => {
@@ -203,14 +195,17 @@ pub(crate) fn merge_model(
             let u = usize::try_from(mat)
                 .ok()
                 .filter(|&u| u < units)
-                .ok_or_else(|| Error::invalid(format!("tile {}: a cell of unit {mat}", t.id)))?;
+                .ok_or_else(|| Error::CellUnit {
+                    tile: t.id.clone(),
+                    unit: mat.into(),
+                })?;
             volume[u] += cell_volume(&pts, &c);
             cells[u] += 1;
             nc += 1;
         }
         let path = dir.join(MODEL_JSON);
-        let text = std::fs::read_to_string(&path).context(path.display().to_string())?;
-        let f: TileFigures = serde_json::from_str(&text).context(path.display().to_string())?;
+        let text = std::fs::read_to_string(&path).at(&path)?;
+        let f: TileFigures = serde_json::from_str(&text).at(&path)?;
         for u in 0..units.min(f.volumes.len()) {
             sum_tiles[u] += f.volumes[u];
             pinched[u] += f.pinched_area.get(u).copied().unwrap_or(0.0);
@@ -256,8 +251,7 @@ pub(crate) fn merge_model(
     };
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&merged)?;
-    terramesh_io::output::write_atomic(&path, text.as_bytes())
-        .context(path.display().to_string())?;
+    terramesh_io::output::write_atomic(&path, text.as_bytes()).at(&path)?;
     written.push(path);
     Ok((merged, written))
 }
@@ -399,7 +393,7 @@ fn write_vtu(
         4 * nc as u64,
         values,
     ));
-    let mut o = Output::create(Some(path)).context(path.display().to_string())?;
-    super::appended::write(&mut o, n, nc, arrays).context(path.display().to_string())?;
-    o.commit().context(path.display().to_string())
+    let mut o = Output::create(Some(path)).at(path)?;
+    super::appended::write(&mut o, n, nc, arrays).at(path)?;
+    o.commit().at(path)
 }

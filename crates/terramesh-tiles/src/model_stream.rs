@@ -22,7 +22,7 @@ use super::geology::{tag_of_name, GeologyPlan, TileFigures, MODEL_BODIES, MODEL_
 use super::geology::{MODEL_JSON, MODEL_POINTS};
 use super::manifest::{tile_dir, Manifest, Tile};
 use super::model_columns::{cell_of, columns, key, node_map, read_cells, Column};
-use terramesh::{Context, Error, Result};
+use crate::error::{BoundaryProblem, Context, Result, TilesError as Error};
 
 type Key = (u64, u64);
 
@@ -123,7 +123,7 @@ fn over_edge(l: &Loaded, nodes: &[u32]) -> Option<[Key; 2]> {
 }
 
 fn io_err(e: Error) -> io::Error {
-    io::Error::other(e.to_string())
+    io::Error::other(e)
 }
 
 impl<'a> TiledModel<'a> {
@@ -137,8 +137,8 @@ impl<'a> TiledModel<'a> {
         let mut names = Vec::with_capacity(m.tiles.len());
         for t in &m.tiles {
             let path = tile_dir(plan, &t.id).join(MODEL_JSON);
-            let text = std::fs::read_to_string(&path).context(path.display().to_string())?;
-            let f: TileFigures = serde_json::from_str(&text).context(path.display().to_string())?;
+            let text = std::fs::read_to_string(&path).at(&path)?;
+            let f: TileFigures = serde_json::from_str(&text).at(&path)?;
             names.push(f.tags);
         }
         let tags = merged_tags(&names, &gp.units);
@@ -197,29 +197,29 @@ impl<'a> TiledModel<'a> {
             for (ck, _, count) in columns(&l.points) {
                 seam.extend(std::iter::repeat_n(seams.contains_key(&ck), count));
             }
-            let bad = |what: &str| {
-                Error::invalid(format!(
-                    "{}: {what}: build tile {} again (tiles built before the merge wrote the \
-                     boundary meshes lack it)",
-                    dir.display(),
-                    t.id
-                ))
+            let bad = |why: BoundaryProblem| Error::BoundaryMeshes {
+                dir: dir.clone(),
+                why,
+                tile: t.id.clone(),
             };
             let path = dir.join(MODEL_FACES);
             if !path.is_file() {
-                return Err(bad(&format!("no {MODEL_FACES}")));
+                return Err(bad(BoundaryProblem::Missing(MODEL_FACES)));
             }
             let map = &tm.tag_map[k];
             for (j, rec) in read_u32s(&path, 6)?.chunks_exact(6).enumerate() {
-                let tag = *map
-                    .get(rec[5] as usize)
-                    .ok_or_else(|| bad(&format!("a face of tag {} of {}", rec[5], map.len())))?;
+                let tag = *map.get(rec[5] as usize).ok_or_else(|| {
+                    bad(BoundaryProblem::FaceTag {
+                        tag: rec[5],
+                        tags: map.len(),
+                    })
+                })?;
                 if rec[4] as usize >= local_cells
                     || rec[..4]
                         .iter()
                         .any(|&n| n != u32::MAX && n as usize >= l.map.len())
                 {
-                    return Err(bad("a face out of range"));
+                    return Err(bad(BoundaryProblem::FaceRange));
                 }
                 tm.faces += 1;
                 let used: Vec<u32> = rec[..4]
@@ -248,12 +248,12 @@ impl<'a> TiledModel<'a> {
             }
             let path = dir.join(MODEL_BODIES);
             if !path.is_file() {
-                return Err(bad(&format!("no {MODEL_BODIES}")));
+                return Err(bad(BoundaryProblem::Missing(MODEL_BODIES)));
             }
             for (j, rec) in read_u32s(&path, 4)?.chunks_exact(4).enumerate() {
                 let u = rec[0] as usize;
                 if u >= tm.units.len() || rec[1..].iter().any(|&n| n as usize >= l.map.len()) {
-                    return Err(bad("a body triangle out of range"));
+                    return Err(bad(BoundaryProblem::TriangleRange));
                 }
                 tm.body_triangles[u] += 1;
                 if !rec[1..].iter().all(|&n| seam[n as usize]) {
@@ -279,14 +279,13 @@ impl<'a> TiledModel<'a> {
             match edge {
                 Some(e) if edges[*k].contains(e) && !dead[*k].contains(i) => {
                     let p = |c: Key| (f64::from_bits(c.0), f64::from_bits(c.1));
-                    Err(Error::invalid(format!(
-                        "tile {}: {what} {i} over its seam edge {:?}-{:?} has no twin in the \
-                         neighbouring tile: the merged model would be open there; build both \
-                         tiles again",
-                        m.tiles[*k].id,
-                        p(e[0]),
-                        p(e[1])
-                    )))
+                    Err(Error::NoTwin {
+                        tile: m.tiles[*k].id.clone(),
+                        what: what.to_string(),
+                        index: *i,
+                        a: p(e[0]),
+                        b: p(e[1]),
+                    })
                 }
                 _ => Ok(()),
             }

@@ -13,7 +13,7 @@ use std::path::Path;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use super::manifest::{cell_of, Manifest};
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// The folder of the per-tile sample files in the plan.
 pub const SAMPLES_DIR: &str = "samples";
@@ -82,12 +82,10 @@ fn write_windows(
     z: &[f64],
 ) -> Result<Vec<usize>> {
     if xy.len() > u32::MAX as usize {
-        return Err(Error::invalid(format!(
-            "{} samples: more than the plan partitions ({}): make a coarser sample \
-             (sampling.cell) or split the region",
-            xy.len(),
-            u32::MAX
-        )));
+        return Err(Error::TooManySamples {
+            samples: xy.len(),
+            max: u32::MAX.into(),
+        });
     }
     let [nx, ny] = shape;
     let cell = |p: [f64; 2]| {
@@ -112,7 +110,7 @@ fn write_windows(
     }
     drop(fill);
     let dir = plan.join(SAMPLES_DIR);
-    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
+    std::fs::create_dir_all(&dir).at(&dir)?;
     let mut counts = Vec::with_capacity(windows.len());
     let mut keep: Vec<u32> = Vec::new();
     for t in windows {
@@ -159,14 +157,13 @@ fn write_records(
     xy: &[[f64; 2]],
     z: &[f64],
 ) -> Result<()> {
-    let at = || path.display().to_string();
-    let mut o = terramesh_io::output::Output::create(Some(path)).with_context(at)?;
+    let mut o = terramesh_io::output::Output::create(Some(path)).at(path)?;
     for k in which {
         for v in [xy[k][0], xy[k][1], z[k]] {
-            o.write_all(&v.to_le_bytes()).with_context(at)?;
+            o.write_all(&v.to_le_bytes()).at(path)?;
         }
     }
-    o.commit().with_context(at)
+    o.commit().at(path)
 }
 
 /// The halo of the extent `r`: the distance from any of its points to its `k`-th nearest point

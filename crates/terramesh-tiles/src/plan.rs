@@ -10,10 +10,10 @@ use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
     DataRule, GridSpec, Manifest, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM, VERSION,
 };
+use crate::error::{Context, Result, TilesError as Error, Untileable};
 use terramesh::build as stages;
 use terramesh::progress::Progress;
 use terramesh::project::Project;
-use terramesh::{Context, Error, Result};
 
 /// The seams' vertex spacing in target edge lengths: the strips' cut spacing in
 /// `terramesh-mesh` (short enough that refinement never needs to split them).
@@ -71,14 +71,14 @@ pub fn parse_tile_size(s: &str) -> Result<f64> {
     };
     match num.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v * scale),
-        _ => Err(Error::setting(
+        _ => Err(Error::from(terramesh::Error::setting(
             terramesh::Setting::TileSize,
             "",
             format!(
                 "{{tile-size}} '{s}' is not a tile size: give metres or kilometres, like 10km, \
                  2500m or 2500"
             ),
-        )),
+        ))),
     }
 }
 
@@ -94,14 +94,14 @@ pub fn check_halo(halo: &str) -> Result<()> {
     if halo == "auto" {
         return Ok(());
     }
-    Err(Error::setting(
+    Err(Error::from(terramesh::Error::setting(
         terramesh::Setting::Halo,
         "",
         format!(
             "{{halo}} '{halo}': only auto is supported (the halo is computed from the kriging \
              neighbourhood so that every tile sees the samples it needs)"
         ),
-    ))
+    )))
 }
 
 /// A plan writes many files into its folder (`tiles.json`, `samples.csv`, `variogram.json`,
@@ -118,7 +118,7 @@ fn check_plan_folder(out: &Path) -> Result<()> {
     if names.is_empty() || names.iter().any(|n| n == super::manifest::MANIFEST) {
         return Ok(());
     }
-    Err(Error::setting(
+    Err(Error::from(terramesh::Error::setting(
         terramesh::Setting::Output,
         out.display(),
         format!(
@@ -128,43 +128,27 @@ fn check_plan_folder(out: &Path) -> Result<()> {
             terramesh::cut(&names[0]),
             names.len()
         ),
-    ))
+    )))
 }
 
 /// Refuses what tiles cannot reproduce, with the key to change.
 fn check_tileable(p: &Project) -> Result<()> {
     let ip = &p.interpolation;
-    let refuse = |why: &str| Err(Error::invalid(why.to_string()));
+    let refuse = |why: Untileable| Err(Error::Untileable(why));
     if ip.neighbors.or(0) == 0 {
-        return refuse(
-            "interpolation.neighbors = 0 is global kriging (every sample in every system), \
-             which tiles cannot reproduce: a tiled build needs a moving neighbourhood; set \
-             interpolation.neighbors (e.g. --set interpolation.neighbors=32)",
-        );
+        return refuse(Untileable::GlobalKriging);
     }
     if ip.methods.contains(&InterpolationMethod::Idw) && ip.idw_neighbors == 0 {
-        return refuse(
-            "interpolation.idw_neighbors = 0 weighs every sample into IDW, which tiles cannot \
-             reproduce: set interpolation.idw_neighbors (e.g. 16)",
-        );
+        return refuse(Untileable::GlobalIdw);
     }
     if ip.external_drift_grid.is_some() {
-        return refuse(
-            "interpolation.external_drift_grid: tiles do not krige with an external drift yet; \
-             build the project in one piece",
-        );
+        return refuse(Untileable::ExternalDrift);
     }
     if p.mesh.max_error.is_some() {
-        return refuse(
-            "mesh.max_error (terrain-adaptive meshes) is not supported by tiled builds yet: \
-             remove it or build in one piece",
-        );
+        return refuse(Untileable::MaxError);
     }
     if p.mesh.insert_samples {
-        return refuse(
-            "mesh.insert_samples is not supported by tiled builds (a sample on a seam would \
-             be a vertex the neighbour lacks): set it to false or build in one piece",
-        );
+        return refuse(Untileable::InsertSamples);
     }
     Ok(())
 }
@@ -192,27 +176,22 @@ pub fn plan(
 ) -> Result<Planned> {
     check_tileable(project)?;
     if !(tile_size.is_finite() && tile_size > 0.0) {
-        return Err(Error::invalid(format!(
-            "tile size {tile_size} m: must be a positive number of metres"
-        )));
+        return Err(Error::TileSize { tile_size });
     }
     project.check_inputs(base)?;
     check_plan_folder(out)?;
-    std::fs::create_dir_all(out).context(out.display().to_string())?;
+    std::fs::create_dir_all(out).at(out)?;
     let samples = stages::sample(project, base, out, progress)?;
     let polys = &samples.region.projected.polygons;
     let holes: usize = polys.iter().map(|p| p.holes.len()).sum();
     let lines = samples.region.projected.lines.len();
     if polys.len() != 1 || holes > 0 || lines > 0 {
-        return Err(Error::invalid(format!(
-            "{}: [region] has {} polygon(s), {holes} hole(s) and {lines} constraint line(s); \
-             tiled builds take one polygon (convex or not) without holes or constraint lines \
-             (a tile's ring would have to follow a hole's edge, and a line's vertices would \
-             have to be planned on every seam it crosses; not done): build this region in \
-             one piece with terramesh build, or tile its outer ring alone",
-            project_file.display(),
-            polys.len()
-        )));
+        return Err(Error::RegionShape {
+            file: project_file.to_path_buf(),
+            polygons: polys.len(),
+            holes,
+            lines,
+        });
     }
     let outline = polys[0].outer.clone();
     let (region, convex) = ccw_ring(&outline)?;
@@ -221,8 +200,7 @@ pub fn plan(
     // The variogram file every tile (and a one-piece build given it) reads.
     let vpath = out.join(VARIOGRAM);
     let json = VariogramFile::new(model.variogram.clone()).to_json_pretty();
-    terramesh_io::output::write_atomic(&vpath, json.as_bytes())
-        .context(vpath.display().to_string())?;
+    terramesh_io::output::write_atomic(&vpath, json.as_bytes()).at(&vpath)?;
     let variogram = terramesh::variogram_file::read_variogram_file(&vpath)?;
     let data = &model.data;
     let frame = data.frame(&variogram);
@@ -248,16 +226,13 @@ pub fn plan(
     let spec = stages::dsm_grid(project, &samples)?;
 
     // The tile grid over the region's bounding box.
-    let (lo, hi) = samples.region.projected.bbox().context("empty region")?;
+    let (lo, hi) = samples.region.projected.bbox().ok_or(Error::EmptyRegion)?;
     let shape = [
         (((hi[0] - lo[0]) / tile_size).ceil() as usize).max(1),
         (((hi[1] - lo[1]) / tile_size).ceil() as usize).max(1),
     ];
     if shape[0] * shape[1] > super::manifest::MAX_TILES {
-        return Err(Error::invalid(format!(
-            "tile size {tile_size} m makes {} x {} tiles: use larger tiles",
-            shape[0], shape[1]
-        )));
+        return Err(Error::TooManyTiles { tile_size, shape });
     }
     let rect = |i: usize, j: usize| {
         [
@@ -277,12 +252,10 @@ pub fn plan(
             } else {
                 let mut parts = clip_concave(&region, rect(i, j), tol);
                 if parts.len() > 1 {
-                    return Err(Error::invalid(format!(
-                        "tile {} holds {} separate parts of the region, which tiles do not \
-                         build yet: choose another --tile-size",
-                        id(i, j),
-                        parts.len()
-                    )));
+                    return Err(Error::TileParts {
+                        tile: id(i, j),
+                        parts: parts.len(),
+                    });
                 }
                 parts.pop().unwrap_or_default()
             };
@@ -295,8 +268,11 @@ pub fn plan(
             && (j as usize) < shape[1]
             && !polys[j as usize * shape[0] + i as usize].is_empty()
     };
-    let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(data.xy())
-        .map_err(|e| Error::invalid(format!("search tree of the samples: {e:?}")))?;
+    let tree: ImmutableKdTree<f64, 2> =
+        ImmutableKdTree::new_from_slice(data.xy()).map_err(|e| Error::SearchTree {
+            points: "the samples".into(),
+            why: format!("{e:?}"),
+        })?;
     let h = samples.cell[0].min(samples.cell[1]).min(tile_size / 4.0);
     let mut tiles = Vec::new();
     let mut max_halo: f64 = 0.0;
@@ -351,7 +327,7 @@ pub fn plan(
     });
     let mut manifest = Manifest {
         version: VERSION,
-        project: std::path::absolute(project_file).context(project_file.display().to_string())?,
+        project: std::path::absolute(project_file).at(project_file)?,
         set: set.to_vec(),
         plan: project.plan_text().to_string(),
         tile_size,
@@ -394,6 +370,8 @@ pub fn plan(
                 (None, Some(c)) => c.definition().to_string(),
                 (None, None) => "projected".to_string(),
             },
+            name: Some(samples.crs_name()),
+            zone: samples.zone.map(|z| z.to_string()),
         }),
         geology,
         tiles,

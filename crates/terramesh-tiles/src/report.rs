@@ -85,6 +85,15 @@ pub(crate) fn html(m: &Manifest, merged: &Merged) -> String {
         ),
         None => String::new(),
     };
+    let mut model = model;
+    for s in &merged.not_merged {
+        let _ = write!(
+            model,
+            "<p>Not merged: {} ({}).</p>",
+            esc(&s.format),
+            esc(&s.why)
+        );
+    }
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Tiled DSM</title>\
          <style>body{{font-family:sans-serif;margin:2em}}td,th{{padding:2px 8px;border-bottom:1px solid #ddd}}</style></head><body>\

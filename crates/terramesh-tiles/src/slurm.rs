@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::manifest::Manifest;
-use terramesh::{Context, Error, Result};
+use crate::error::{Context, Result, ScriptPath, TilesError as Error};
 
 /// The settings of the generated jobs.
 #[derive(Debug, Clone)]
@@ -62,17 +62,17 @@ fn quote(field: &str, p: &Path) -> Result<String> {
 /// The path as text fit for a script line.
 fn script_path<'a>(field: &str, p: &'a Path) -> Result<&'a str> {
     let text = p.to_str().ok_or_else(|| {
-        Error::invalid(format!(
-            "{field} {}: not UTF-8, so it cannot be written into a script unchanged: move or \
-             rename it",
-            p.display()
-        ))
+        Error::ScriptPath(ScriptPath::NotUtf8 {
+            field: field.to_string(),
+            path: p.to_path_buf(),
+        })
     })?;
     if let Some(c) = text.chars().find(|c| c.is_control()) {
-        return Err(Error::invalid(format!(
-            "{field} {text:?}: holds the control character {c:?}, which would break the \
-             script's line: move or rename it"
-        )));
+        return Err(Error::ScriptPath(ScriptPath::Control {
+            field: field.to_string(),
+            text: text.to_string(),
+            c,
+        }));
     }
     Ok(text)
 }
@@ -83,9 +83,10 @@ fn script_path<'a>(field: &str, p: &'a Path) -> Result<&'a str> {
 fn sbatch_path(field: &str, p: &Path) -> Result<String> {
     let text = script_path(field, p)?;
     if text.contains('"') {
-        return Err(Error::invalid(format!(
-            "{field} {text:?}: holds '\"', which an #SBATCH line cannot quote: move or rename it"
-        )));
+        return Err(Error::ScriptPath(ScriptPath::Quote {
+            field: field.to_string(),
+            text: text.to_string(),
+        }));
     }
     Ok(text.replace('%', "%%"))
 }
@@ -145,7 +146,7 @@ impl SlurmOptions {
             if let Some(v) = value {
                 check_sbatch_value(v).map_err(|why| {
                     let name = terramesh_core::vocab::Named::name(setting);
-                    Error::setting(setting, "", format!("{{{name}}} {v:?}: {why}"))
+                    terramesh::Error::setting(setting, "", format!("{{{name}}} {v:?}: {why}"))
                 })?;
             }
         }
@@ -162,8 +163,8 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
     o.check()?;
     let m = Manifest::read(plan)?;
     // Every value written into a script line is checked (or quoted) first.
-    let plan_abs = std::path::absolute(plan).context(plan.display().to_string())?;
-    let out_abs = std::path::absolute(&o.output).context(o.output.display().to_string())?;
+    let plan_abs = std::path::absolute(plan).at(plan)?;
+    let out_abs = std::path::absolute(&o.output).at(&o.output)?;
     let plan_q = quote("the plan folder", &plan_abs)?;
     let out_q = quote("the merge's output folder", &out_abs)?;
     let bin_q = quote("the terramesh binary", &o.binary)?;
@@ -172,7 +173,7 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
     let tile_log = format!("\"{logs}{sep}tile-%a.log\"");
     let merge_log = format!("\"{logs}{sep}merge.log\"");
     let dir = plan.join("slurm");
-    std::fs::create_dir_all(&dir).context(dir.display().to_string())?;
+    std::fs::create_dir_all(&dir).at(&dir)?;
     let ids: Vec<String> = m.tiles.iter().map(|t| quote_str(&t.id)).collect();
     let last = m.tiles.len().saturating_sub(1);
     let mem = o
@@ -223,12 +224,11 @@ pub fn write_slurm(plan: &Path, o: &SlurmOptions) -> Result<SlurmScripts> {
         (&out.merge, merge),
         (&out.submit, submit),
     ] {
-        terramesh_io::output::write_atomic(p, text.as_bytes()).context(p.display().to_string())?;
+        terramesh_io::output::write_atomic(p, text.as_bytes()).at(p)?;
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;
-            std::fs::set_permissions(p, std::fs::Permissions::from_mode(0o755))
-                .context(p.display().to_string())?;
+            std::fs::set_permissions(p, std::fs::Permissions::from_mode(0o755)).at(p)?;
         }
     }
     Ok(out)

@@ -1,0 +1,243 @@
+//! `terramesh tiles merge` writes the surface formats a one-piece build writes (issue 33, goal
+//! 4): each merged file, streamed by the merge, is byte for byte what the one writer
+//! interface of a one-piece build (`terramesh_io::export::writer`) writes for the merged
+//! mesh, and its labels (TSurf's CRS) are the one-piece build's.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use terramesh_io::export::{all_formats, parse_obj, writer, Format, MeshView, Target, ToWrite};
+
+#[allow(dead_code)] // (the field-data readers are for tiles_geology_files.rs)
+#[path = "support/vtu_read.rs"]
+mod vtu_read;
+
+fn example() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/haut-barr/terramesh.toml")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o: Output = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args(args)
+        .env_remove("TERRAMESH_TILES_FAIL")
+        .output()
+        .expect("run terramesh");
+    assert!(
+        o.status.success(),
+        "terramesh {args:?} failed: {}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+#[test]
+fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plan = tmp.path().join("plan");
+    let ps = plan.to_str().unwrap();
+    let ex = example();
+    ok(&[
+        "tiles",
+        "plan",
+        ex.to_str().unwrap(),
+        "--tile-size",
+        "150m",
+        "-o",
+        ps,
+        "--quiet",
+    ]);
+    let m = json(&plan.join("tiles.json"));
+    let tiles = m["tiles"].as_array().unwrap();
+    assert!(tiles.len() >= 2, "{} tiles", tiles.len());
+    for t in tiles {
+        ok(&["tiles", "build", ps, "--tile", t["id"].as_str().unwrap()]);
+    }
+    let out = tmp.path().join("merged");
+    let said = ok(&["tiles", "merge", ps, "-o", out.to_str().unwrap()]);
+
+    // Every single-file format of the example's export.formats that needs no WGS-84
+    // positions; the others are named as not merged.
+    let merged = json(&out.join("merge.json"));
+    let files: Vec<&str> = merged["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    let surfaces = ["obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae"];
+    for ext in surfaces {
+        assert!(files.contains(&format!("dsm.{ext}").as_str()), "{files:?}");
+    }
+    let skipped: Vec<&str> = merged["not_merged"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["format"].as_str().unwrap())
+        .collect();
+    assert_eq!(skipped, ["glb", "3dtiles", "terrain"]);
+    assert!(
+        said.contains("not merged") && said.contains("glb"),
+        "{said}"
+    );
+    for name in ["dsm.kml", "dsm.dae", "dsm-model.kml"] {
+        assert!(files.contains(&name), "{files:?}");
+    }
+    assert!(
+        !out.join(".merge-scratch").exists(),
+        "the scratch folder is removed"
+    );
+
+    // The merged mesh as dsm.vtu has it (tested seamless and watertight in tiles.rs).
+    let vtu = vtu_read::Vtu::read(&out.join("dsm.vtu"));
+    let (points, tris) = vtu.triangles();
+    assert_eq!(points.len() as u64, merged["vertices"].as_u64().unwrap());
+    let xy: Vec<[f64; 2]> = points.iter().map(|p| [p[0], p[1]]).collect();
+    let z: Vec<f64> = points.iter().map(|p| p[2]).collect();
+    let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|i| i as u32)).collect();
+    let names = [
+        "elevation_uk",
+        "kriging_std",
+        "elevation_idw",
+        "uk_minus_idw",
+    ];
+    let fields: Vec<Vec<f64>> = names
+        .iter()
+        .map(|n| vtu.array(&format!("Name=\"{n}\"")))
+        .collect();
+    let view = MeshView {
+        origin: [0.0, 0.0],
+        points: &xy,
+        z: Some(&z),
+        triangles: &triangles,
+        point_data: names
+            .iter()
+            .copied()
+            .zip(fields.iter().map(|f| &f[..]))
+            .collect(),
+        cell_data: Vec::new(),
+        field_data: Vec::new(),
+    };
+
+    // The labels of a one-piece build of the same project: TSurf's CRS name.
+    let one = tmp.path().join("one");
+    ok(&[
+        "build",
+        ex.to_str().unwrap(),
+        "-o",
+        one.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "export.formats=[\"ts\"]",
+        "--set",
+        "export.pictures=false",
+        "--set",
+        "export.report=false",
+    ]);
+    let header = |p: &Path| -> Vec<String> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .take_while(|l| *l != "TFACE")
+            .map(str::to_string)
+            .collect()
+    };
+    let one_header = header(&one.join("dsm.ts"));
+    assert_eq!(header(&out.join("dsm.ts")), one_header);
+    let crs_name = one_header
+        .iter()
+        .find_map(|l| l.strip_prefix("NAME \"")?.strip_suffix('"'))
+        .unwrap()
+        .to_string();
+
+    // KML's and COLLADA's positions as a one-piece build computes them (`build/exports.rs`):
+    // WGS-84 point by point in the project's UTM zone (the one TSurf names); COLLADA's frame
+    // at the centre of the mesh's bounding box, at its lowest elevation.
+    let zone = crs_name
+        .strip_prefix("WGS 84 / UTM zone ")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let georef = terramesh::georef::Georef::utm(zone);
+    let geo: Vec<[f64; 3]> = points
+        .iter()
+        .map(|q| {
+            let (lat, lon) = georef.to_wgs84(q[0], q[1]).unwrap();
+            [lon, lat, q[2]]
+        })
+        .collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in &points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    let (lat0, lon0) = georef
+        .to_wgs84(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))
+        .unwrap();
+    let frame = terramesh_core::coords::LocalEnu::new(lat0, lon0, lo[2]);
+    let enu: Vec<[f64; 3]> = geo.iter().map(|g| frame.to_enu(g[1], g[0], g[2])).collect();
+    let title = std::fs::read_to_string(&ex)
+        .unwrap()
+        .lines()
+        .find_map(|l| Some(l.strip_prefix("title = \"")?.strip_suffix('"')?.to_string()))
+        .unwrap();
+
+    let origin = [
+        m["origin"][0].as_f64().unwrap(),
+        m["origin"][1].as_f64().unwrap(),
+        0.0,
+    ];
+    let surface = ToWrite {
+        view: &view,
+        vertices: &points,
+        stl_origin: origin,
+        title: &title,
+        tsurf_name: "terramesh_dsm",
+        crs_name: &crs_name,
+        dxf_layer: "DSM",
+        lon_lat_alt: Some(&geo),
+        enu: Some((&enu, [lon0, lat0, lo[2]])),
+        glb: None,
+    };
+    let mut compared = Vec::new();
+    for f in all_formats() {
+        let w = writer(f);
+        let Target::File(ext) = w.target() else {
+            continue;
+        };
+        if f == Format::Vtu || !surfaces.contains(&ext) {
+            continue;
+        }
+        let mut want = Vec::new();
+        w.write(&surface, &mut want).unwrap();
+        let got = std::fs::read(out.join(format!("dsm.{ext}"))).unwrap();
+        assert!(
+            got == want,
+            "dsm.{ext}: the merge's file ({} bytes) differs from the writer's ({} bytes)",
+            got.len(),
+            want.len()
+        );
+        compared.push(ext);
+        let main = format!("dsm.{ext}");
+        if let Some((companion, bytes)) = w.companion(&surface, &main).unwrap() {
+            assert_eq!(
+                std::fs::read(out.join(&companion)).unwrap(),
+                bytes,
+                "{companion}"
+            );
+            compared.push("dsm-model.kml");
+        }
+    }
+    assert_eq!(compared.len(), surfaces.len() + 1, "{compared:?}");
+
+    // And the geometry read back: the OBJ's vertices and triangles are the VTU's.
+    let (v, t) = parse_obj(&std::fs::read_to_string(out.join("dsm.obj")).unwrap()).unwrap();
+    assert_eq!(v, points);
+    assert_eq!(t, triangles);
+}
