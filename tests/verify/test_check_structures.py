@@ -27,6 +27,16 @@ from test_check_model import edit, rewrite_vtu  # noqa: E402
 FIXTURE = HERE / "fixtures" / "structures"
 
 
+def rewrite_model(path, change):
+    """rewrite_vtu for model.vtu, whose empty field data fault_names (no faults) meshio cannot
+    read back once written as ascii: dropped first."""
+    edit(path, '<DataArray type="UInt8" Name="fault_names" NumberOfTuples="0"', '<DataArray type="UInt8" Name="x"')
+    s = path.read_text()
+    s = re.sub(r'<DataArray type="UInt8" Name="x"[^\n]*\n', "", s, count=1)
+    path.write_text(s)
+    rewrite_vtu(path, change)
+
+
 @pytest.fixture
 def out(tmp_path):
     d = tmp_path / "structures"
@@ -61,7 +71,7 @@ def test_excavated_lining_fails(out, capsys):
     def dig(m):
         o = cs.Objects(FIXTURE)
         m.cell_data["excavation_stage"][0][np.nonzero(o.lining(0))[0][0]] = 2
-    rewrite_vtu(out / "model.vtu", dig)
+    rewrite_model(out / "model.vtu", dig)
     f = failures(out, "model.vtu: object, excavation_stage, materials", capsys)
     assert f and "lining-adit is excavated" in f[0], f
 
@@ -104,19 +114,22 @@ def test_renamed_boundary_face_group_fails(out, capsys):
     assert f and "no face group 'tunnel-adit-boundary'" in f[0], f
 
 
-def test_renamed_physical_volume_fails(out, capsys):
+def test_entity_out_of_its_object_group_fails(out, capsys):
+    # the first volume entity in two physical groups (its material's and an object group's)
+    # loses the object group: the group misses those cells
     p = out / "model.msh"
     s = p.read_text()
-    m = re.search(r'\n3 (\d+) "structure-dam"\n', s)
+    a, b = s.index("$Entities\n"), s.index("$EndEntities")
+    m = re.search(r" 2 (\d+) (\d+) 0\n", s[a:b])
     assert m
-    p.write_text(s.replace(m.group(0), f'\n3 {m.group(1)} "excavation-dam"\n'))
+    p.write_text(s[:a] + s[a:b].replace(m.group(0), f" 1 {m.group(1)} 0\n", 1) + s[b:])
     f = failures(out, "model.msh: object volumes and boundaries (gmsh)", capsys)
-    assert f and "physical volume 'excavation-dam' is not its cells" in f[0], f
+    assert f and ("is not its cells" in f[0] or "finds no physical volume" in f[0]), f
 
 
 def test_nothing_excavated_fails_the_diffusion(out, capsys):
     def keep(m):
         m.cell_data["excavation_stage"][0][:] = 0
-    rewrite_vtu(out / "model.vtu", keep)
+    rewrite_model(out / "model.vtu", keep)
     f = failures(out, "ogs: steady diffusion u = z without the excavated cells", capsys)
     assert f and "no excavated cell" in f[0], f
