@@ -104,6 +104,17 @@ pub enum Error {
         /// The kernel's error.
         source: Box<terramesh_faults::FaultError>,
     },
+    /// A structure's material that cannot name a `MaterialIDs` value of its own: the name of
+    /// a unit or of a lining's material, or not usable as a group name.
+    #[error("{key} = \"{material}\": {why}")]
+    ObjectMaterial {
+        /// The key (`geology.structures[dam].material`).
+        key: String,
+        /// The material as given.
+        material: String,
+        /// What is wrong, and what to do.
+        why: String,
+    },
     /// The objects cut into the mesh failed their checks before the files were written: a
     /// bug to report.
     #[error(

@@ -85,10 +85,46 @@ fn spec(o: &ObjectPlan) -> Result<ObjectSpec> {
 /// A file that cannot be read or parsed, or an object the kernel refuses, naming
 /// `geology.<table>[<name>].<key>`.
 pub fn object_set(g: &GeologyPlan, terrain: &Terrain, base: f64) -> Result<ObjectSet> {
+    check_materials(g)?;
     let specs = g.objects.iter().map(spec).collect::<Result<Vec<_>>>()?;
     let mut set = ObjectSet::new(&specs, terrain, base).map_err(|e| object_error(g, e))?;
     set.resolution = g.structure_resolution;
     Ok(set)
+}
+
+/// Checks that every structure's material can name a `MaterialIDs` value of its own (after
+/// the units, see `terramesh_io::model::extra_materials`): a usable group name, not a unit's
+/// name nor a lining's material (`lining-<tunnel>`), ignoring case.
+fn check_materials(g: &GeologyPlan) -> Result<()> {
+    let taken: Vec<String> = g
+        .units
+        .iter()
+        .cloned()
+        .chain(g.objects.iter().filter_map(|o| match o.source {
+            ObjectSource::Tunnel { lining, .. } if lining > 0.0 => Some(format!("lining-{}", o.name)),
+            _ => None,
+        }))
+        .collect();
+    for o in &g.objects {
+        let ObjectSource::Structure { material, .. } = &o.source else {
+            continue;
+        };
+        let bad = |why: String| Error::ObjectMaterial {
+            key: o.key("material"),
+            material: material.clone(),
+            why,
+        };
+        if let Err(e) = terramesh_core::names::check_name(material) {
+            return Err(bad(e.to_string()));
+        }
+        if let Some(t) = taken.iter().find(|t| t.eq_ignore_ascii_case(material)) {
+            return Err(bad(format!(
+                "'{t}' already names a unit or a lining's material, and a structure's cells get \
+                 a MaterialIDs value of their own: name its material differently"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Checks that every object's file can be read (`terramesh check`).
@@ -96,6 +132,7 @@ pub fn object_set(g: &GeologyPlan, terrain: &Terrain, base: f64) -> Result<Objec
 /// # Errors
 /// As [`object_set`]'s reading.
 pub fn check_inputs(g: &GeologyPlan) -> Result<()> {
+    check_materials(g)?;
     for o in &g.objects {
         spec(o)?;
     }
