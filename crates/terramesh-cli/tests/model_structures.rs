@@ -451,7 +451,10 @@ fn bad_objects_are_refused_naming_the_object_and_the_key_and_nothing_is_written(
         (
             text.replacen("material = \"concrete\"", "material = \"Marl\"", 1),
             None,
-            vec!["geology.structures[dam].material", "'marl' already names a unit"],
+            vec![
+                "geology.structures[dam].material",
+                "'marl' already names a unit",
+            ],
         ),
         (
             text.replacen("shape = \"circle\"", "shape = \"oval\"", 1),

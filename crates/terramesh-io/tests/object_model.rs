@@ -403,6 +403,47 @@ fn every_object_file_is_written_and_reads_back() {
             "{name}: boundary encloses {flux}, cells {volume}"
         );
     }
+    // unit-<name>.ts: the body of every material, the objects' cells taken out of the units
+    let cell_volume = |c: usize| {
+        let q: Vec<[f64; 3]> = m.cells[c]
+            .used()
+            .iter()
+            .map(|&v| m.points[v as usize])
+            .collect();
+        terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3])
+    };
+    let all: Vec<String> = m
+        .units
+        .iter()
+        .cloned()
+        .chain(["concrete".into(), "lining-adit".into()])
+        .collect();
+    for (u, name) in all.iter().enumerate() {
+        let want: f64 = (0..mats.len())
+            .filter(|&c| mats[c] == u as i32)
+            .map(cell_volume)
+            .sum();
+        let path = dir.path().join(format!("unit-{name}.ts"));
+        assert_eq!(path.is_file(), want > 0.0, "{}", path.display());
+        if want == 0.0 {
+            continue;
+        }
+        let (v, t) = parse_tsurf(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let got: f64 = t
+            .iter()
+            .map(|tri| {
+                let [a, b, c] = tri.map(|i| v[i as usize]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum();
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "unit-{name}.ts encloses {got}, its cells {want}"
+        );
+    }
+
     // object-<name>.vtu and .ts: the boundary of the object without its lining
     for (name, g) in [("adit", 0), ("pit", 2), ("dam", 3)] {
         let text = std::fs::read_to_string(dir.path().join(format!("object-{name}.vtu"))).unwrap();
@@ -736,7 +777,7 @@ fn a_portal_is_part_of_the_tunnel_boundary() {
 
 /// The independent readers on a model with objects: meshio, Gmsh and OpenGeoSys
 /// (`check_structures.py`: the groups, checkMesh, the diffusion with the excavated cells
-/// removed), unsplit and split.
+/// removed; `check_model.py`: everything a model's files must pass).
 #[test]
 fn object_models_pass_the_independent_checks() {
     let tmp = tempfile::tempdir().unwrap();
@@ -745,4 +786,7 @@ fn object_models_pass_the_independent_checks() {
     let (_, m, f, o) = objected(false);
     write_object_model(&d, &m, Some(&f), &o, &info(), None).unwrap();
     run_python("tests/verify/check_structures.py", &[&d]);
+    // and every check of a model's files (cells, boundary meshes, the bodies of every
+    // material, Gmsh, FLAC3D, OpenGeoSys) on the same files
+    run_python("tests/verify/check_model.py", &[&d]);
 }

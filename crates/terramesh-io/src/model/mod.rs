@@ -195,7 +195,9 @@ pub fn write_faulted_model(
 /// `<group>-boundary` per group; `model.f3grid` with zone groups of the objects (slot 3) and the
 /// stages (`stage-<n>`, slot 4) and face groups `<group>-boundary` (slots 2, 3, ...); and per
 /// object `object-<name>.vtu` ([`object_mesh`]) and `object-<name>.ts`
-/// ([`write_object_tsurf`]), its boundary without its lining, after the faults' files. The
+/// ([`write_object_tsurf`]), its boundary without its lining, after the faults' files; the
+/// bodies `unit-<name>.ts` and `.stl` are those of every material, the structures' and
+/// linings' (`unit-concrete.ts`, `unit-lining-<name>.ts`) taken out of the units'. The
 /// mesh, the fault data and the object data are checked first ([`check_objects`]).
 pub fn write_object_model(
     dir: &Path,
@@ -222,7 +224,7 @@ fn write_files(
     }
     // With objects, the structures' and linings' cells take materials of their own after the
     // units: every writer takes that copy of the mesh.
-    let relabelled;
+    let mut relabelled;
     let mesh = match objects {
         Some(d) => {
             check_objects(mesh, faults, d)?;
@@ -233,6 +235,9 @@ fn write_files(
                 units,
                 ..mesh.clone()
             };
+            if d.object.iter().any(|&o| o > 0) {
+                relabelled.bodies = objects::material_bodies(&relabelled);
+            }
             &relabelled
         }
         None => mesh,

@@ -13,7 +13,8 @@
 use std::collections::HashMap;
 use std::io::{self, Write};
 
-use terramesh_core::volume::{FaceTag, VolumeMesh};
+use rayon::prelude::*;
+use terramesh_core::volume::{Body, FaceTag, VolumeMesh};
 
 use super::boundary::BoundaryMesh;
 use super::faces::cell_faces;
@@ -518,4 +519,67 @@ pub(super) fn boundary_groups(
             }
         })
         .collect()
+}
+
+/// The sealed body of every material of `m` (its units and the objects' materials after
+/// them): the faces of a material's cells whose other side (matched by the points'
+/// coordinates, so split fault nodes make one face) is of another material or none, each
+/// counter-clockwise seen from outside its cell (quadrilaterals split in two); bodies without
+/// faces left out. What `unit-<name>.ts` and `.stl` hold for a model with objects, whose
+/// structures and linings take their cells out of the units.
+pub(super) fn material_bodies(m: &VolumeMesh) -> Vec<Body> {
+    // one id per distinct point
+    let mut order: Vec<u32> = (0..m.points.len() as u32).collect();
+    let bits = |i: u32| m.points[i as usize].map(|v| (v + 0.0).to_bits());
+    order.par_sort_unstable_by_key(|&i| bits(i));
+    let mut canon = vec![0u32; m.points.len()];
+    for w in 0..order.len() {
+        canon[order[w] as usize] = if w > 0 && bits(order[w]) == bits(order[w - 1]) {
+            canon[order[w - 1] as usize]
+        } else {
+            order[w]
+        };
+    }
+    let key = |c: usize, f: usize| -> [u32; 4] {
+        let cell = &m.cells[c];
+        let mut k = [u32::MAX; 4];
+        for (j, &i) in cell_faces(cell.kind)[f].iter().enumerate() {
+            k[j] = canon[cell.used()[i] as usize];
+        }
+        k.sort_unstable();
+        k
+    };
+    let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            (0..cell_faces(m.cells[c].kind).len()).map(move |f| (key(c, f), c as u32, f as u8))
+        })
+        .collect();
+    sides.par_sort_unstable();
+    let mut bodies: Vec<Body> = (0..m.units.len())
+        .map(|unit| Body {
+            unit,
+            triangles: vec![],
+        })
+        .collect();
+    for group in sides.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, c, f) in group {
+            let mat = m.material[c as usize];
+            if group
+                .iter()
+                .all(|&(_, d, _)| d == c || m.material[d as usize] != mat)
+            {
+                let cell = &m.cells[c as usize];
+                let n: Vec<u32> = cell_faces(cell.kind)[f as usize]
+                    .iter()
+                    .map(|&i| cell.used()[i])
+                    .collect();
+                for k in 1..n.len() - 1 {
+                    bodies[mat as usize].triangles.push([n[0], n[k], n[k + 1]]);
+                }
+            }
+        }
+    }
+    bodies.retain(|b| !b.triangles.is_empty());
+    bodies
 }

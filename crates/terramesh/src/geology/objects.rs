@@ -101,7 +101,9 @@ fn check_materials(g: &GeologyPlan) -> Result<()> {
         .iter()
         .cloned()
         .chain(g.objects.iter().filter_map(|o| match o.source {
-            ObjectSource::Tunnel { lining, .. } if lining > 0.0 => Some(format!("lining-{}", o.name)),
+            ObjectSource::Tunnel { lining, .. } if lining > 0.0 => {
+                Some(format!("lining-{}", o.name))
+            }
             _ => None,
         }))
         .collect();
