@@ -10,7 +10,6 @@
 //! Faces are matched by their points' coordinates, so that split fault nodes (two copies at
 //! one place) still make one face of two cells.
 
-use std::collections::HashMap;
 use std::io::{self, Write};
 
 use rayon::prelude::*;
@@ -321,49 +320,41 @@ pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
         return out;
     }
     let inside = |p: [f64; 3]| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]);
-    let key = |c: usize, f: usize| -> Vec<[u64; 3]> {
-        let cell = &m.cells[c];
-        let mut k: Vec<[u64; 3]> = cell_faces(cell.kind)[f]
-            .iter()
-            .map(|&i| m.points[cell.used()[i] as usize].map(|v| (v + 0.0).to_bits()))
-            .collect();
-        k.sort_unstable();
-        k
-    };
-    // every face of the cells near the objects, by its points
-    let mut sides: HashMap<Vec<[u64; 3]>, Vec<(u32, u8)>> = HashMap::new();
-    for (c, cell) in m.cells.iter().enumerate() {
-        let near = cell
-            .used()
-            .iter()
-            .filter(|&&n| inside(m.points[n as usize]))
-            .count();
-        if near < 3 {
-            continue;
-        }
-        for f in 0..cell_faces(cell.kind).len() {
-            sides
-                .entry(key(c, f))
-                .or_default()
-                .push((c as u32, f as u8));
-        }
-    }
-    for (c, &g) in cell_group.iter().enumerate() {
-        if g == u32::MAX {
-            continue;
-        }
-        for f in 0..cell_faces(m.cells[c].kind).len() {
-            let others = &sides[&key(c, f)];
-            let shared = others
+    let canon = &canonical_points(m);
+    // every face of the cells near the objects (a neighbour has three points in their box),
+    // by its points, sorted
+    let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
+        .into_par_iter()
+        .filter(|&c| {
+            let near = m.cells[c]
+                .used()
                 .iter()
-                .any(|&(d, _)| d as usize != c && cell_group[d as usize] == g);
-            if !shared {
-                out[g as usize].push(FaceSide {
-                    cell: c as u32,
-                    face: f as u8,
-                });
+                .filter(|&&n| inside(m.points[n as usize]))
+                .count();
+            near >= 3
+        })
+        .flat_map_iter(|c| {
+            (0..cell_faces(m.cells[c].kind).len())
+                .map(move |f| (face_key(m, canon, c, f), c as u32, f as u8))
+        })
+        .collect();
+    sides.par_sort_unstable();
+    for group in sides.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, c, f) in group {
+            let g = cell_group[c as usize];
+            if g == u32::MAX {
+                continue;
+            }
+            if !group
+                .iter()
+                .any(|&(_, d, _)| d != c && cell_group[d as usize] == g)
+            {
+                out[g as usize].push(FaceSide { cell: c, face: f });
             }
         }
+    }
+    for faces in &mut out {
+        faces.sort_unstable_by_key(|s| (s.cell, s.face));
     }
     out
 }
@@ -528,27 +519,8 @@ pub(super) fn boundary_groups(
 /// faces left out. What `unit-<name>.ts` and `.stl` hold for a model with objects, whose
 /// structures and linings take their cells out of the units.
 pub(super) fn material_bodies(m: &VolumeMesh) -> Vec<Body> {
-    // one id per distinct point
-    let mut order: Vec<u32> = (0..m.points.len() as u32).collect();
-    let bits = |i: u32| m.points[i as usize].map(|v| (v + 0.0).to_bits());
-    order.par_sort_unstable_by_key(|&i| bits(i));
-    let mut canon = vec![0u32; m.points.len()];
-    for w in 0..order.len() {
-        canon[order[w] as usize] = if w > 0 && bits(order[w]) == bits(order[w - 1]) {
-            canon[order[w - 1] as usize]
-        } else {
-            order[w]
-        };
-    }
-    let key = |c: usize, f: usize| -> [u32; 4] {
-        let cell = &m.cells[c];
-        let mut k = [u32::MAX; 4];
-        for (j, &i) in cell_faces(cell.kind)[f].iter().enumerate() {
-            k[j] = canon[cell.used()[i] as usize];
-        }
-        k.sort_unstable();
-        k
-    };
+    let canon = &canonical_points(m);
+    let key = |c: usize, f: usize| face_key(m, canon, c, f);
     let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
         .into_par_iter()
         .flat_map_iter(|c| {
@@ -582,4 +554,32 @@ pub(super) fn material_bodies(m: &VolumeMesh) -> Vec<Body> {
     }
     bodies.retain(|b| !b.triangles.is_empty());
     bodies
+}
+
+/// Per point: the smallest index of a point at the same coordinates (split fault nodes share
+/// one).
+fn canonical_points(m: &VolumeMesh) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..m.points.len() as u32).collect();
+    let bits = |i: u32| m.points[i as usize].map(|v| (v + 0.0).to_bits());
+    order.par_sort_unstable_by_key(|&i| (bits(i), i));
+    let mut canon = vec![0u32; m.points.len()];
+    for w in 0..order.len() {
+        canon[order[w] as usize] = if w > 0 && bits(order[w]) == bits(order[w - 1]) {
+            canon[order[w - 1] as usize]
+        } else {
+            order[w]
+        };
+    }
+    canon
+}
+
+/// Face `f` of cell `c` by its points' canonical ids, sorted (`u32::MAX` after a triangle's).
+fn face_key(m: &VolumeMesh, canon: &[u32], c: usize, f: usize) -> [u32; 4] {
+    let cell = &m.cells[c];
+    let mut k = [u32::MAX; 4];
+    for (j, &i) in cell_faces(cell.kind)[f].iter().enumerate() {
+        k[j] = canon[cell.used()[i] as usize];
+    }
+    k.sort_unstable();
+    k
 }
