@@ -190,6 +190,161 @@ fn a_tunnel_through_a_fault_a_pit_and_a_dam_are_cut_into_the_faulted_model() {
     let pit = objects[1]["meshed_volume"].as_f64().unwrap();
     assert!((stages[0]["excavated_volume"].as_f64().unwrap() - pit).abs() < 1e-6 * pit);
     assert_eq!(objects[2]["stage"], 0);
+    object_files_agree_with_model_json(&out, &json);
+}
+
+/// Decodes the appended base64 array `name` of a `.vtu` written by terramesh.
+fn vtu_array(text: &str, name: &str) -> Vec<u8> {
+    let val = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        _ => 63,
+    } as u32;
+    let attr = |l: &str, a: &str| -> String {
+        let rest = l.split(&format!("{a}=\"")).nth(1).unwrap();
+        rest.split('"').next().unwrap().to_string()
+    };
+    let offsets: Vec<(String, usize)> = text
+        .lines()
+        .filter(|l| l.contains("format=\"appended\""))
+        .map(|l| (attr(l, "Name"), attr(l, "offset").parse().unwrap()))
+        .collect();
+    let data =
+        &text.as_bytes()[text.find("\n_").unwrap() + 2..text.rfind("\n</AppendedData>").unwrap()];
+    let start = offsets.iter().find(|o| o.0 == name).expect(name).1;
+    let end = offsets
+        .iter()
+        .map(|o| o.1)
+        .filter(|&o| o > start)
+        .min()
+        .unwrap_or(data.len());
+    let mut bytes = Vec::new();
+    for q in data[start..end].chunks(4) {
+        let n = q.iter().take_while(|&&c| c != b'=').count();
+        let mut v = 0u32;
+        for (i, &c) in q.iter().enumerate().take(n) {
+            v |= val(c) << (18 - 6 * i);
+        }
+        bytes.extend_from_slice(&v.to_be_bytes()[1..n]);
+    }
+    let count = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    bytes[8..8 + count].to_vec()
+}
+
+/// `model.vtu`'s `object`, `excavation_stage` and `MaterialIDs` against `model.json`: the
+/// volume of each stage's cells is its excavated volume, each object's cells (its lining's
+/// material left out) its meshed volume, the lining's its lining volume; the dam's cells and
+/// the lining's carry the materials `model.json` names after the units, as `unit_names` does;
+/// the object groups and files are there.
+fn object_files_agree_with_model_json(out: &Path, json: &serde_json::Value) {
+    let vtu = std::fs::read_to_string(out.join("model.vtu")).unwrap();
+    let i32s = |name: &str| -> Vec<i32> {
+        vtu_array(&vtu, name)
+            .chunks(4)
+            .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
+            .collect()
+    };
+    let (object, stage, mats) = (
+        i32s("object"),
+        i32s("excavation_stage"),
+        i32s("MaterialIDs"),
+    );
+    let points: Vec<f64> = vtu_array(&vtu, "Points")
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let conn: Vec<usize> = vtu_array(&vtu, "connectivity")
+        .chunks(8)
+        .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as usize)
+        .collect();
+    assert_eq!(conn.len(), 4 * object.len(), "all tetrahedra");
+    let p = |i: usize| [points[3 * i], points[3 * i + 1], points[3 * i + 2]];
+    let volume: Vec<f64> = conn
+        .chunks(4)
+        .map(|t| {
+            let [a, b, c, d] = [p(t[0]), p(t[1]), p(t[2]), p(t[3])];
+            let u = [0, 1, 2].map(|k| b[k] - a[k]);
+            let v = [0, 1, 2].map(|k| c[k] - a[k]);
+            let w = [0, 1, 2].map(|k| d[k] - a[k]);
+            (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+                + u[2] * (v[0] * w[1] - v[1] * w[0]))
+                / 6.0
+        })
+        .collect();
+    let names: Vec<String> = String::from_utf8(vtu_array(&vtu, "unit_names"))
+        .unwrap()
+        .split_terminator('\0')
+        .map(String::from)
+        .collect();
+    let materials = json["objects"]["materials"].as_array().unwrap();
+    assert_eq!(materials.len(), 2, "{materials:?}");
+    for m in materials {
+        let id = m["material_id"].as_i64().unwrap() as usize;
+        assert_eq!(names[id], m["name"].as_str().unwrap());
+    }
+    let id_of = |n: &str| names.iter().position(|x| x == n).unwrap() as i32;
+    let (concrete, lining) = (id_of("concrete"), id_of("lining-diversion"));
+    let close = |a: f64, b: f64, what: &str| {
+        assert!(
+            (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+            "{what}: {a} vs {b}"
+        );
+    };
+    for s in json["objects"]["stages"].as_array().unwrap() {
+        let n = s["stage"].as_i64().unwrap() as i32;
+        let v: f64 = (0..stage.len())
+            .filter(|&c| stage[c] == n)
+            .map(|c| volume[c])
+            .sum();
+        close(v, s["excavated_volume"].as_f64().unwrap(), "stage volume");
+    }
+    for o in json["objects"]["objects"].as_array().unwrap() {
+        let k = o["object"].as_i64().unwrap() as i32;
+        let mine = |c: usize| object[c] == k && mats[c] != lining;
+        let v: f64 = (0..object.len())
+            .filter(|&c| mine(c))
+            .map(|c| volume[c])
+            .sum();
+        close(v, o["meshed_volume"].as_f64().unwrap(), "object volume");
+        if let Some(l) = o["lining"].as_array() {
+            let v: f64 = (0..object.len())
+                .filter(|&c| object[c] == k && mats[c] == lining)
+                .map(|c| volume[c])
+                .sum();
+            close(v, l[0].as_f64().unwrap(), "lining volume");
+            assert!((0..object.len()).all(|c| mats[c] != lining || stage[c] == 0));
+        }
+        let name = o["name"].as_str().unwrap();
+        let structure = o["kind"] == "structure";
+        assert!((0..object.len()).all(|c| !mine(c) || (mats[c] == concrete) == structure));
+        assert!(out.join(format!("object-{name}.vtu")).is_file());
+        assert!(out.join(format!("object-{name}.ts")).is_file());
+    }
+    let msh = std::fs::read_to_string(out.join("model.msh")).unwrap();
+    for g in [
+        "tunnel-diversion",
+        "lining-diversion",
+        "excavation-pit",
+        "structure-dam",
+    ] {
+        assert!(msh.contains(&format!(" \"{g}\"\n")), "model.msh: {g}");
+        assert!(
+            msh.contains(&format!(" \"{g}-boundary\"\n")),
+            "model.msh: {g}-boundary"
+        );
+    }
+    let f3 = std::fs::read_to_string(out.join("model.f3grid")).unwrap();
+    for g in [
+        "ZGROUP \"stage-1\" SLOT 4",
+        "ZGROUP \"stage-2\" SLOT 4",
+        "ZGROUP \"tunnel-diversion\" SLOT 3",
+        "ZGROUP \"lining-diversion\" SLOT 1",
+        "FGROUP \"structure-dam-boundary\"",
+    ] {
+        assert!(f3.contains(g), "model.f3grid: {g}");
+    }
 }
 
 /// The objects' tables without the pit.
@@ -287,6 +442,14 @@ fn bad_objects_are_refused_naming_the_object_and_the_key_and_nothing_is_written(
             text.replacen("floor = 135.0", "floor = 400.0", 1),
             None,
             vec!["geology.excavations[pit].floor", "above the terrain"],
+        ),
+        (
+            text.replacen("material = \"concrete\"", "material = \"Marl\"", 1),
+            None,
+            vec![
+                "geology.structures[dam].material",
+                "'marl' already names a unit",
+            ],
         ),
         (
             text.replacen("shape = \"circle\"", "shape = \"oval\"", 1),

@@ -85,6 +85,52 @@ pub enum Error {
     /// A fault's file (a trace, a surface, picks).
     #[error(transparent)]
     FaultFile(Box<terramesh_io::faults::FaultFileError>),
+    /// An engineering object's file (an axis, an outline, a solid) that cannot be read or
+    /// parsed (issue 32).
+    #[error("{key}: {source}")]
+    ObjectFile {
+        /// The key that names the file (`geology.tunnels[diversion].axis`).
+        key: String,
+        /// What is wrong with it.
+        source: Box<terramesh_io::objects::ObjectFileError>,
+    },
+    /// An engineering object the kernel refuses, named by the key at fault
+    /// (`geology.tunnels[diversion].diameter`; `geology` when the kernel names no object of
+    /// the project).
+    #[error("{key}: {source}")]
+    ObjectRefused {
+        /// The key.
+        key: String,
+        /// The kernel's error.
+        source: Box<terramesh_faults::FaultError>,
+    },
+    /// A structure's material that cannot name a `MaterialIDs` value of its own: the name of
+    /// a unit or of a lining's material, or not usable as a group name.
+    #[error("{key} = \"{material}\": {why}")]
+    ObjectMaterial {
+        /// The key (`geology.structures[dam].material`).
+        key: String,
+        /// The material as given.
+        material: String,
+        /// What is wrong, and what to do.
+        why: String,
+    },
+    /// The objects cut into the mesh failed their checks before the files were written: a
+    /// bug to report.
+    #[error(
+        "geology: the objects cut into the mesh failed their checks ({source}); please report \
+         it with the project"
+    )]
+    ObjectCheck {
+        /// The failed check.
+        source: Box<terramesh_faults::FaultError>,
+    },
+    /// The objects' checks failed when their figures for `model.json` were computed.
+    #[error("geology: the objects' checks: {source}")]
+    ObjectFigures {
+        /// The failed check.
+        source: Box<terramesh_faults::FaultError>,
+    },
     /// Writing a surface through the format registry (`terramesh_io::export::writer`).
     #[error(transparent)]
     Export(#[from] terramesh_io::export::ExportError),

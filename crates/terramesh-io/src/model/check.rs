@@ -108,6 +108,27 @@ pub enum MeshError {
         /// The second.
         second: String,
     },
+    /// A model's engineering objects do not label every cell.
+    #[error("{cells} cells but {labels} object labels; give every cell its object")]
+    ObjectCount {
+        /// Cells.
+        cells: usize,
+        /// Object labels.
+        labels: usize,
+    },
+    /// A cell's object label is not one of the objects, or it is in a lining of an object
+    /// without one.
+    #[error("cell {cell} is labelled object {object} (lining: {lining}), but there are {objects} objects and only a tunnel with a lining has lining cells")]
+    ObjectLabel {
+        /// The cell.
+        cell: usize,
+        /// Its object number (0: none).
+        object: u32,
+        /// Whether it is labelled a lining cell.
+        lining: bool,
+        /// The number of objects.
+        objects: usize,
+    },
     /// A unit or side name cannot be a file name or a quoted group name.
     #[error("the name {name:?} cannot be used in file and group names: use 1 to 128 letters, digits, '-', '_' or '.', not beginning or ending with '.'")]
     Name {

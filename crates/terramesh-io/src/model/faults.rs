@@ -357,6 +357,8 @@ pub(super) struct FaultGroup {
     pub(super) faces: Vec<[u32; 4]>,
     pub(super) lo: [f64; 3],
     pub(super) hi: [f64; 3],
+    /// Its FLAC3D face group slot (1 for a fault).
+    pub(super) slot: u32,
 }
 
 /// What the Gmsh and FLAC3D writers add for a faulted model: the fault groups and the blocks.
@@ -365,6 +367,8 @@ pub(super) struct Extra<'a> {
     pub(super) faults: Vec<FaultGroup>,
     /// The block of every cell and the blocks' names.
     pub(super) blocks: Option<(&'a [i32], &'a [String])>,
+    /// The engineering objects' groups and stages (their boundaries are in `faults`).
+    pub(super) objects: Option<super::objects::ObjectExtra>,
 }
 
 impl<'a> Extra<'a> {
@@ -397,12 +401,14 @@ impl<'a> Extra<'a> {
                     faces,
                     lo,
                     hi,
+                    slot: 1,
                 }
             })
             .collect();
         Extra {
             faults,
             blocks: Some((&f.block, &f.blocks)),
+            objects: None,
         }
     }
 

@@ -213,6 +213,34 @@ pub(super) fn write_f3grid<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             }
         }
     }
+    if let Some(o) = &extra.objects {
+        // the objects' groups in slot 3 (a lining's cells are its material's group, slot 1),
+        // the excavation stages in slot 4
+        let mut per_group = vec![Vec::new(); o.groups.len()];
+        let mut per_stage = vec![Vec::new(); o.stages.len()];
+        for (i, (&g, &s)) in o.cell_group.iter().zip(&o.stage).enumerate() {
+            if g != u32::MAX {
+                per_group[g as usize].push(i as u64 + 1);
+            }
+            if s > 0 {
+                let k = o.stages.binary_search(&(s as u32)).expect("a stage");
+                per_stage[k].push(i as u64 + 1);
+            }
+        }
+        let groups = o.groups.iter().map(|(n, l)| (n.clone(), *l, 3));
+        let stages = o.stages.iter().map(|s| (format!("stage-{s}"), false, 4));
+        for ((name, lining, slot), zones) in
+            groups.chain(stages).zip(per_group.iter().chain(&per_stage))
+        {
+            if !lining && !zones.is_empty() {
+                writeln!(w, "ZGROUP \"{name}\" SLOT {slot}")?;
+                let mut ids = Ids::new(w, zones.len());
+                for &z in zones {
+                    ids.push(z)?;
+                }
+            }
+        }
+    }
     if nf > 0 {
         writeln!(w, "* FACE GROUPS")?;
         for (t, &count) in per_tag.iter().enumerate() {
@@ -224,7 +252,7 @@ pub(super) fn write_f3grid<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         }
         let mut j = m.face_count() as u64;
         for g in extra.faults.iter().filter(|g| !g.faces.is_empty()) {
-            writeln!(w, "FGROUP \"{}\" SLOT 1", g.name)?;
+            writeln!(w, "FGROUP \"{}\" SLOT {}", g.name, g.slot)?;
             let mut ids = Ids::new(w, g.faces.len());
             for _ in &g.faces {
                 j += 1;

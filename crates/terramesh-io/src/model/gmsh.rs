@@ -47,6 +47,18 @@ impl Bbox {
     }
 }
 
+/// A volume entity of `model.msh`: its tag, the cells of material `mat` in object group
+/// `group` (`u32::MAX`: none), per kind (wedge, pyramid, tetrahedron), its box and its physical
+/// groups.
+struct VolEnt {
+    tag: usize,
+    mat: i32,
+    group: u32,
+    blocks: [usize; 3],
+    bbox: Bbox,
+    phys: Vec<usize>,
+}
+
 fn quote(s: &str) -> String {
     s.replace('"', "'")
 }
@@ -179,6 +191,60 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     let units: Vec<usize> = (0..nu)
         .filter(|&u| vol_blocks[u].iter().any(|&b| b > 0))
         .collect();
+    // The volume entities: one per unit; with objects, one per unit and object group, each
+    // in its unit's physical volume and its group's (a lining's group is its material's).
+    let mut ents: Vec<VolEnt> = Vec::new();
+    let mut group_tags: Vec<Option<usize>> = Vec::new();
+    match &extra.objects {
+        None => {
+            for &u in &units {
+                ents.push(VolEnt {
+                    tag: u + 1,
+                    mat: u as i32,
+                    group: u32::MAX,
+                    blocks: vol_blocks[u],
+                    bbox: Bbox(vol_box[u].0, vol_box[u].1),
+                    phys: vec![u + 1],
+                });
+            }
+        }
+        Some(o) => {
+            let mut next = nu;
+            for (_, lining) in &o.groups {
+                group_tags.push((!lining).then(|| {
+                    next += 1;
+                    next
+                }));
+            }
+            let mut map: std::collections::BTreeMap<(i32, u32), ([usize; 3], Bbox)> =
+                std::collections::BTreeMap::new();
+            let mut i = 0usize;
+            m.each_cell(&mut |c, mat, pts| {
+                let g = o.cell_group[i];
+                i += 1;
+                let e = map.entry((mat, g)).or_insert_with(|| ([0; 3], Bbox::new()));
+                e.0[kinds.iter().position(|&k| k == c.kind).expect("a kind")] += 1;
+                for p in pts {
+                    e.1.add(*p);
+                }
+                Ok(())
+            })?;
+            for (k, ((mat, g), (blocks, bbox))) in map.into_iter().enumerate() {
+                let mut phys = vec![mat as usize + 1];
+                if let Some(Some(t)) = group_tags.get(g as usize) {
+                    phys.push(*t);
+                }
+                ents.push(VolEnt {
+                    tag: k + 1,
+                    mat,
+                    group: g,
+                    blocks,
+                    bbox,
+                    phys,
+                });
+            }
+        }
+    }
     let tags: Vec<usize> = (0..nt)
         .filter(|&t| surf_blocks[t].iter().any(|&b| b > 0))
         .collect();
@@ -193,13 +259,28 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
     let faults: Vec<usize> = (0..extra.faults.len())
         .filter(|&g| !extra.faults[g].faces.is_empty())
         .collect();
+    let object_groups: Vec<(usize, &str)> = match &extra.objects {
+        Some(o) => group_tags
+            .iter()
+            .zip(&o.groups)
+            .enumerate()
+            .filter_map(|(g, (t, (name, _)))| {
+                let has = ents.iter().any(|e| e.group == g as u32);
+                t.filter(|_| has).map(|t| (t, name.as_str()))
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     writeln!(
         w,
         "$PhysicalNames\n{}",
-        units.len() + tags.len() + faults.len()
+        units.len() + object_groups.len() + tags.len() + faults.len()
     )?;
     for &u in &units {
         writeln!(w, "3 {} \"{}\"", u + 1, quote(&m.units()[u]))?;
+    }
+    for &(t, name) in &object_groups {
+        writeln!(w, "3 {t} \"{}\"", quote(name))?;
     }
     for &t in &tags {
         writeln!(w, "2 {} \"{}\"", t + 1, quote(&m.tags()[t].name()))?;
@@ -212,7 +293,7 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         w,
         "$Entities\n0 0 {} {}",
         tags.len() + faults.len(),
-        units.len()
+        ents.len()
     )?;
     for &t in &tags {
         write!(w, "{}", t + 1)?;
@@ -224,14 +305,18 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         Bbox(extra.faults[g].lo, extra.faults[g].hi).write(w)?;
         writeln!(w, " 1 {} 0", nt + g + 1)?;
     }
-    for &u in &units {
-        write!(w, "{}", u + 1)?;
-        vol_box[u].write(w)?;
-        writeln!(w, " 1 {} 0", u + 1)?;
+    for e in &ents {
+        write!(w, "{}", e.tag)?;
+        e.bbox.write(w)?;
+        write!(w, " {}", e.phys.len())?;
+        for t in &e.phys {
+            write!(w, " {t}")?;
+        }
+        writeln!(w, " 0")?;
     }
     writeln!(w, "$EndEntities")?;
     let np = m.point_count();
-    let node_entity = units.first().map_or(1, |u| u + 1);
+    let node_entity = ents.first().map_or(1, |e| e.tag);
     writeln!(w, "$Nodes\n1 {np} 1 {np}\n3 {node_entity} 0 {np}")?;
     for i in 1..=np {
         w.u64(i as u64)?;
@@ -264,7 +349,11 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
             [tri, g.faces.len() - tri]
         })
         .collect();
-    let nblocks = vol_blocks.iter().flatten().filter(|&&b| b > 0).count()
+    let nblocks = ents
+        .iter()
+        .flat_map(|e| e.blocks)
+        .filter(|&b| b > 0)
+        .count()
         + surf_blocks.iter().flatten().filter(|&&b| b > 0).count()
         + fault_blocks.iter().flatten().filter(|&&b| b > 0).count();
     let nc = m.cell_count();
@@ -277,14 +366,19 @@ pub(super) fn write_msh<W: Write + ?Sized, M: ModelPasses + ?Sized>(
         }
         w.byte(b'\n')
     };
-    for &u in &units {
-        for (k, &count) in vol_blocks[u].iter().enumerate() {
+    for e in &ents {
+        for (k, &count) in e.blocks.iter().enumerate() {
             if count == 0 {
                 continue;
             }
-            writeln!(w, "3 {} {} {}", u + 1, gmsh_type(kinds[k]), count)?;
-            m.each_cell_of(u as i32, Some(kinds[k]), &mut |i, c| {
-                line(w, i + 1, c.used())
+            writeln!(w, "3 {} {} {}", e.tag, gmsh_type(kinds[k]), count)?;
+            let group = extra.objects.as_ref().map(|o| &o.cell_group);
+            m.each_cell_of(e.mat, Some(kinds[k]), &mut |i, c| {
+                if group.is_none_or(|g| g[i] == e.group) {
+                    line(w, i + 1, c.used())
+                } else {
+                    Ok(())
+                }
             })?;
         }
     }

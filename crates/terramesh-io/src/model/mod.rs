@@ -6,6 +6,7 @@
 //! | `model.vtu` | [`write_model_vtu`] | VTK XML unstructured grid, appended base64 binary: Float64 points, int32 `MaterialIDs`, field data `unit_names`, `crs`, `vertical_datum` (and `vertical_crs` when named); an OpenGeoSys bulk mesh |
 //! | `model-top.vtu`, `model-bottom.vtu`, `model-side-<name>.vtu` | [`write_boundary_vtu`] | OpenGeoSys boundary meshes (`bulk_node_ids`, `bulk_element_ids`, `bulk_face_ids`, as its `ExtractBoundary` writes them) |
 //! | `fault-<name>.vtu`, `fault-<name>.ts` | [`write_fault_vtu`], [`write_fault_tsurf`] | a faulted model's faults ([`FaultData`], [`write_faulted_model`]): an OpenGeoSys subdomain mesh with every face once per side, and the GOCAD TSurf of its faces |
+//! | `object-<name>.vtu`, `object-<name>.ts` | [`object_mesh`], [`write_object_tsurf`] | a model with engineering objects ([`ObjectData`], [`write_object_model`]): each object's boundary as an OpenGeoSys boundary mesh and as GOCAD TSurf; `model.vtu` then carries `excavation_stage` and `object` ([`write_object_vtu`]), `model.msh` and `model.f3grid` the objects' groups |
 //! | `model.msh` | [`write_model_msh`] | Gmsh 4.1 ASCII: a volume entity and physical group per unit, a surface entity and group per tag |
 //! | `model.f3grid` | [`write_model_f3grid`] | FLAC3D ASCII grid: gridpoints, zones W6/P5/T4, zone groups per unit, face groups per tag |
 //! | `unit-<name>.ts`, `unit-<name>.stl` | [`write_body_tsurf`], [`write_body_stl`] | the sealed body of each unit (GOCAD TSurf in doubles; binary STL relative to [`stl_origin`]) |
@@ -53,6 +54,7 @@ mod faulted_volume;
 mod faults;
 mod flac3d;
 mod gmsh;
+mod objects;
 mod passes;
 mod vtk;
 
@@ -76,8 +78,14 @@ pub use faults::{
 };
 pub use flac3d::{write_f3grid_passes, write_faulted_f3grid, write_model_f3grid};
 pub use gmsh::{write_faulted_msh, write_model_msh, write_msh_passes};
+pub use objects::{
+    check_objects, extra_materials, object_boundaries, object_mesh, write_object_tsurf,
+    ModelObject, ObjectData, ObjectGroup, ObjectKind,
+};
 pub use passes::{CellVisit, FaceVisit, ModelPasses};
-pub use vtk::{write_boundary_vtu, write_fault_vtu, write_faulted_vtu, write_model_vtu};
+pub use vtk::{
+    write_boundary_vtu, write_fault_vtu, write_faulted_vtu, write_model_vtu, write_object_vtu,
+};
 
 /// What the files record besides the mesh.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -155,7 +163,7 @@ pub fn write_model_with(
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
-    write_files(dir, mesh, None, info, volumes)
+    write_files(dir, mesh, None, None, info, volumes)
 }
 
 /// Writes every file of a faulted model into the existing folder `dir`: what [`write_model`]
@@ -173,13 +181,40 @@ pub fn write_faulted_model(
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
-    write_files(dir, mesh, Some(faults), info, volumes)
+    write_files(dir, mesh, Some(faults), None, info, volumes)
+}
+
+/// Writes every file of a model with engineering objects (issue 32) into the existing folder
+/// `dir`: what [`write_faulted_model`] writes (or [`write_model`] without `faults`), with the
+/// materials of a structure's and a lining's cells after the units
+/// ([`ObjectData::material_ids`], named by [`extra_materials`] in `unit_names` and in every
+/// file's `MaterialIDs` and material groups); `model.vtu` with the cell data
+/// `excavation_stage` and `object` and the field data `object_names` ([`write_object_vtu`]);
+/// `model.msh` with a physical volume per object group (`tunnel-<name>`, `excavation-<name>`,
+/// `structure-<name>`; `lining-<name>` is the lining's material group) and a physical surface
+/// `<group>-boundary` per group; `model.f3grid` with zone groups of the objects (slot 3) and the
+/// stages (`stage-<n>`, slot 4) and face groups `<group>-boundary` (slots 2, 3, ...); and per
+/// object `object-<name>.vtu` ([`object_mesh`]) and `object-<name>.ts`
+/// ([`write_object_tsurf`]), its boundary without its lining, after the faults' files; the
+/// bodies `unit-<name>.ts` and `.stl` are those of every material, the structures' and
+/// linings' (`unit-concrete.ts`, `unit-lining-<name>.ts`) taken out of the units'. The
+/// mesh, the fault data and the object data are checked first ([`check_objects`]).
+pub fn write_object_model(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    faults: Option<&FaultData>,
+    objects: &ObjectData,
+    info: &ModelInfo,
+    volumes: Option<&[f64]>,
+) -> Result<Vec<String>, ModelWriteError> {
+    write_files(dir, mesh, faults, Some(objects), info, volumes)
 }
 
 fn write_files(
     dir: &Path,
     mesh: &VolumeMesh,
     faults: Option<&FaultData>,
+    objects: Option<&ObjectData>,
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
@@ -187,22 +222,49 @@ fn write_files(
     if let Some(f) = faults {
         check_faults(mesh, f)?;
     }
+    // With objects, the structures' and linings' cells take materials of their own after the
+    // units: every writer takes that copy of the mesh.
+    let mut relabelled;
+    let mesh = match objects {
+        Some(d) => {
+            check_objects(mesh, faults, d)?;
+            let mut units = mesh.units.clone();
+            units.extend(extra_materials(&d.objects));
+            relabelled = VolumeMesh {
+                material: d.material_ids(&mesh.material, mesh.units.len()),
+                units,
+                ..mesh.clone()
+            };
+            if d.object.iter().any(|&o| o > 0) {
+                relabelled.bodies = objects::material_bodies(&relabelled);
+            }
+            &relabelled
+        }
+        None => mesh,
+    };
+    let boundaries = &objects.map(|d| object_boundaries(mesh, d));
     // the points' text, for model.msh, model.f3grid and the bodies' TSurf
     let pts = &crate::textsink::PointText::new(&mesh.points);
     let blocks = &passes::Indexed::new(mesh);
-    let extra = &match faults {
+    let mut extra = match faults {
         Some(f) => faults::Extra::new(mesh, f),
         None => faults::Extra::default(),
     };
+    if let (Some(d), Some(b)) = (objects, boundaries) {
+        extra.faults.extend(objects::boundary_groups(mesh, d, b));
+        extra.objects = Some(objects::ObjectExtra::new(d));
+    }
+    let extra = &extra;
     type Job<'a> = (
         String,
         Box<dyn Fn(&mut Output) -> io::Result<()> + Send + Sync + 'a>,
     );
     let mut jobs: Vec<Job> = vec![(
         "model.vtu".into(),
-        Box::new(move |w: &mut Output| match faults {
-            Some(f) => write_faulted_vtu(w, mesh, f, info),
-            None => write_model_vtu(w, mesh, info),
+        Box::new(move |w: &mut Output| match (faults, objects) {
+            (_, Some(d)) => write_object_vtu(w, mesh, faults, d, info),
+            (Some(f), None) => write_faulted_vtu(w, mesh, f, info),
+            (None, None) => write_model_vtu(w, mesh, info),
         }),
     )];
     for t in boundary_tags(mesh) {
@@ -225,6 +287,27 @@ fn write_files(
             format!("{stem}.ts"),
             Box::new(move |w: &mut Output| write_fault_tsurf(w, mesh, f, k, info)),
         ));
+    }
+    if let (Some(d), Some(b)) = (objects, boundaries) {
+        let groups = d.groups();
+        for (k, o) in d.objects.iter().enumerate() {
+            let g = groups
+                .iter()
+                .position(|g| g.object == k && !g.lining)
+                .expect("a group per object");
+            let faces = &b[g];
+            let name = &o.name;
+            jobs.push((
+                format!("object-{name}.vtu"),
+                Box::new(move |w: &mut Output| {
+                    write_boundary_vtu(w, &object_mesh(mesh, &mesh.material, faces))
+                }),
+            ));
+            jobs.push((
+                format!("object-{name}.ts"),
+                Box::new(move |w: &mut Output| write_object_tsurf(w, mesh, faces, name, info)),
+            ));
+        }
     }
     jobs.push((
         "model.msh".into(),

@@ -16,6 +16,7 @@ use terramesh_core::volume::{CellKind, VolumeMesh};
 
 use super::boundary::BoundaryMesh;
 use super::faults::{FaultData, FaultMesh};
+use super::objects::ObjectData;
 use super::ModelInfo;
 
 const VTK_TRIANGLE: u8 = 5;
@@ -256,7 +257,7 @@ pub fn write_model_vtu<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_vtu(w, m, info, None)
+    write_vtu(w, m, info, None, None)
 }
 
 /// Writes a faulted model as `model.vtu`: [`write_model_vtu`]'s arrays, then cell data `block`
@@ -287,7 +288,43 @@ pub fn write_faulted_vtu<W: Write + ?Sized>(
     f: &FaultData,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    write_vtu(w, m, info, Some(f))
+    write_vtu(w, m, info, Some(f), None)
+}
+
+/// Writes a model with engineering objects as `model.vtu`: [`write_model_vtu`]'s arrays (and
+/// [`write_faulted_vtu`]'s with `faults`), then cell data `excavation_stage` and `object`
+/// (Int32, [`ObjectData::excavation_stage`] and [`ObjectData::object`]) and field data
+/// `object_names` (each name followed by a zero byte: name `k - 1` is object `k`). `m` carries
+/// the materials of [`ObjectData::material_ids`] and the units followed by
+/// [`super::extra_materials`], so that `unit_names` names every `MaterialIDs` value.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{write_object_vtu, ModelInfo, ModelObject, ObjectData, ObjectKind};
+/// let m = VolumeMesh {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     cells: vec![Cell::tetra([0, 1, 2, 3])],
+///     material: vec![0],
+///     units: vec!["sand".into()],
+///     ..Default::default()
+/// };
+/// let d = ObjectData { objects: vec![ModelObject { name: "pit".into(), kind: ObjectKind::Excavation,
+///     stage: 1, material: None, lining: false }], object: vec![1], lining: vec![false] };
+/// let mut buf = Vec::new();
+/// write_object_vtu(&mut buf, &m, None, &d, &ModelInfo::default())?;
+/// let text = String::from_utf8_lossy(&buf);
+/// assert!(text.contains("type=\"Int32\" Name=\"excavation_stage\"") && text.contains("Name=\"object_names\""));
+/// # Ok(()) }
+/// ```
+pub fn write_object_vtu<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    faults: Option<&FaultData>,
+    objects: &ObjectData,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    write_vtu(w, m, info, faults, Some(objects))
 }
 
 /// Zero-terminated names, one after the other.
@@ -305,6 +342,7 @@ fn write_vtu<W: Write + ?Sized>(
     m: &VolumeMesh,
     info: &ModelInfo,
     faults: Option<&FaultData>,
+    objects: Option<&ObjectData>,
 ) -> io::Result<()> {
     let names = zero_terminated(m.units.iter());
     let vtk_nodes: Vec<([u32; 6], u8, usize)> = m
@@ -338,6 +376,24 @@ fn write_vtu<W: Write + ?Sized>(
             zero_terminated(f.faults.iter().map(|x| &x.name)),
         ));
         field.push(text_field("block_names", zero_terminated(f.blocks.iter())));
+    }
+    if let Some(o) = objects {
+        cell_data.push(array(
+            "Int32",
+            "excavation_stage",
+            1,
+            le(o.excavation_stage().into_iter(), i32::to_le_bytes),
+        ));
+        cell_data.push(array(
+            "Int32",
+            "object",
+            1,
+            le(o.object.iter().map(|&k| k as i32), i32::to_le_bytes),
+        ));
+        field.push(text_field(
+            "object_names",
+            zero_terminated(o.objects.iter().map(|x| &x.name)),
+        ));
     }
     Grid {
         points: m.points.len(),

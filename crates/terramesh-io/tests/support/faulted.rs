@@ -42,6 +42,23 @@ pub fn site_of(n: usize, tops: Vec<f64>) -> Site {
     .unwrap()
 }
 
+/// [`site_of`] over a 2 by 2 grid with one interface at 60 m and no fault: the smallest site
+/// for the committed fixture of a model with objects.
+pub fn site_without_faults() -> Site {
+    Site::new(
+        200.0,
+        2,
+        0.2,
+        3,
+        [120.0, 0.02, -0.01],
+        0.0,
+        vec![60.0],
+        [0.01, 0.0],
+        vec![],
+    )
+    .unwrap()
+}
+
 /// The kernel's mesh of [`site`].
 pub fn kernel_mesh(site: &Site, max_cell_height: f64) -> FaultedMesh {
     let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
@@ -61,4 +78,113 @@ pub fn kernel_mesh(site: &Site, max_cell_height: f64) -> FaultedMesh {
 pub fn model(site: &Site, mesh: &FaultedMesh, split: bool) -> (VolumeMesh, FaultData) {
     let units: Vec<String> = UNITS.iter().map(|s| s.to_string()).collect();
     faulted_volume(mesh, &units, site.base, split)
+}
+
+/// A closed box, outward oriented, as the kernel's structure geometry.
+pub fn box_solid(lo: [f64; 3], hi: [f64; 3]) -> terramesh_faults::ObjectGeometry {
+    let vertices = (0..8)
+        .map(|k| {
+            [
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            ]
+        })
+        .collect();
+    let quads: [[u32; 4]; 6] = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let triangles = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    terramesh_faults::ObjectGeometry::Structure {
+        vertices,
+        triangles,
+    }
+}
+
+/// The engineering objects of the writers' tests on [`site`] (or [`site_of`]): a lined
+/// rectangular tunnel (stage 2) crossing F1 east-west at z = 40 through the western side (a
+/// portal), a pit with 60 degree faces (stage 1) and a box-shaped structure of material
+/// `concrete` reaching down into the rock; `scale` shrinks the tunnel's and the pit's sizes.
+pub fn object_specs(scale: f64) -> Vec<terramesh_faults::ObjectSpec> {
+    use terramesh_faults::{ObjectGeometry, ObjectSpec, Profile};
+    vec![
+        ObjectSpec {
+            name: "adit".into(),
+            stage: 2,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[-10.0, 40.0, 40.0], [150.0, 40.0, 40.0]],
+                profile: Profile::Rectangle {
+                    width: 8.0 * scale,
+                    height: 6.0 * scale,
+                },
+                lining: 1.0,
+            },
+        },
+        ObjectSpec {
+            name: "pit".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Excavation {
+                outline: vec![[30.0, 120.0], [80.0, 120.0], [80.0, 170.0], [30.0, 170.0]],
+                floor: 100.0,
+                face_angle: 60.0,
+            },
+        },
+        ObjectSpec {
+            name: "dam".into(),
+            stage: 0,
+            geometry: box_solid([140.0, 130.0, 90.0], [170.0, 160.0, 125.0]),
+        },
+    ]
+}
+
+/// The writers' objects of [`object_specs`] (their names, kinds, stages, the dam's material
+/// `concrete`, the adit's lining).
+pub fn model_objects() -> Vec<terramesh_io::model::ModelObject> {
+    use terramesh_io::model::{ModelObject, ObjectKind};
+    let o = |name: &str, kind, stage, material: Option<&str>, lining| ModelObject {
+        name: name.into(),
+        kind,
+        stage,
+        material: material.map(String::from),
+        lining,
+    };
+    vec![
+        o("adit", ObjectKind::Tunnel, 2, None, true),
+        o("pit", ObjectKind::Excavation, 1, None, false),
+        o("dam", ObjectKind::Structure, 0, Some("concrete"), false),
+    ]
+}
+
+/// The kernel's mesh of `site` with the objects of [`object_specs`] cut in, their refinement
+/// at `resolution` (`geology.structure_resolution`) and stopped before `max_cells` cells.
+pub fn kernel_mesh_with_objects(
+    site: &Site,
+    max_cell_height: f64,
+    scale: f64,
+    resolution: f64,
+    max_cells: usize,
+) -> FaultedMesh {
+    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
+    let mut objects =
+        terramesh_faults::ObjectSet::new(&object_specs(scale), &site.terrain, site.base).unwrap();
+    objects.resolution = resolution;
+    objects.max_cells = max_cells;
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    terramesh_faults::faulted_mesh_with_objects(
+        &site.terrain,
+        &set,
+        site.tops.len(),
+        &h,
+        &MeshSettings::new(site.base, max_cell_height),
+        &objects,
+    )
+    .unwrap()
 }

@@ -21,19 +21,29 @@ use crate::plan::{GeologyPlan, ObjectPlan, ObjectSource};
 /// Words a kernel error about an object with the key the project file writes
 /// (`geology.tunnels[diversion].diameter`); other errors as the faulted stage words them.
 pub(crate) fn object_error(g: &GeologyPlan, e: FaultError) -> Error {
-    match &e {
-        FaultError::Object { name, key, .. } => match g.objects.iter().find(|o| &o.name == name) {
-            Some(o) => Error::invalid(format!("{}: {e}", o.key(key))),
-            None => Error::invalid(format!("geology: {e}")),
+    let key = match &e {
+        FaultError::Object { name, key, .. } => Some(
+            g.objects
+                .iter()
+                .find(|o| &o.name == name)
+                .map_or_else(|| "geology".to_string(), |o| o.key(key)),
+        ),
+        _ => None,
+    };
+    match key {
+        Some(key) => Error::ObjectRefused {
+            key,
+            source: Box::new(e),
         },
-        _ => super::faulted::fault_error(e),
+        None => super::faulted::fault_error(e),
     }
 }
 
 /// Reads one object's file into the kernel's spec.
 fn spec(o: &ObjectPlan) -> Result<ObjectSpec> {
-    let io = |key: &str, e: terramesh_io::objects::ObjectFileError| {
-        Error::invalid(format!("{}: {e}", o.key(key)))
+    let io = |key: &str, e: terramesh_io::objects::ObjectFileError| Error::ObjectFile {
+        key: o.key(key),
+        source: Box::new(e),
     };
     let geometry = match &o.source {
         ObjectSource::Tunnel {
@@ -75,10 +85,48 @@ fn spec(o: &ObjectPlan) -> Result<ObjectSpec> {
 /// A file that cannot be read or parsed, or an object the kernel refuses, naming
 /// `geology.<table>[<name>].<key>`.
 pub fn object_set(g: &GeologyPlan, terrain: &Terrain, base: f64) -> Result<ObjectSet> {
+    check_materials(g)?;
     let specs = g.objects.iter().map(spec).collect::<Result<Vec<_>>>()?;
     let mut set = ObjectSet::new(&specs, terrain, base).map_err(|e| object_error(g, e))?;
     set.resolution = g.structure_resolution;
     Ok(set)
+}
+
+/// Checks that every structure's material can name a `MaterialIDs` value of its own (after
+/// the units, see `terramesh_io::model::extra_materials`): a usable group name, not a unit's
+/// name nor a lining's material (`lining-<tunnel>`), ignoring case.
+fn check_materials(g: &GeologyPlan) -> Result<()> {
+    let taken: Vec<String> = g
+        .units
+        .iter()
+        .cloned()
+        .chain(g.objects.iter().filter_map(|o| match o.source {
+            ObjectSource::Tunnel { lining, .. } if lining > 0.0 => {
+                Some(format!("lining-{}", o.name))
+            }
+            _ => None,
+        }))
+        .collect();
+    for o in &g.objects {
+        let ObjectSource::Structure { material, .. } = &o.source else {
+            continue;
+        };
+        let bad = |why: String| Error::ObjectMaterial {
+            key: o.key("material"),
+            material: material.clone(),
+            why,
+        };
+        if let Err(e) = terramesh_core::names::check_name(material) {
+            return Err(bad(e.to_string()));
+        }
+        if let Some(t) = taken.iter().find(|t| t.eq_ignore_ascii_case(material)) {
+            return Err(bad(format!(
+                "'{t}' already names a unit or a lining's material, and a structure's cells get \
+                 a MaterialIDs value of their own: name its material differently"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Checks that every object's file can be read (`terramesh check`).
@@ -86,6 +134,7 @@ pub fn object_set(g: &GeologyPlan, terrain: &Terrain, base: f64) -> Result<Objec
 /// # Errors
 /// As [`object_set`]'s reading.
 pub fn check_inputs(g: &GeologyPlan) -> Result<()> {
+    check_materials(g)?;
     for o in &g.objects {
         spec(o)?;
     }
@@ -110,13 +159,63 @@ pub(crate) fn mesh(
         .map_err(|e| object_error(g, e))?;
     if !objects.objects.is_empty() {
         check_objects(&mesh.points, &mesh.tets, &mesh.objects, &objects).map_err(|e| {
-            Error::invalid(format!(
-                "geology: the objects cut into the mesh failed their checks ({e}); please \
-                 report it with the project"
-            ))
+            Error::ObjectCheck {
+                source: Box::new(e),
+            }
         })?;
     }
     Ok(mesh)
+}
+
+/// The writers' labels of the objects (`None` without objects): their names, kinds, stages
+/// and materials in project order, and the kernel's object and lining flag of every cell
+/// (the cells' order is kept by `terramesh_io::model::faulted_volume`, split or not).
+pub fn object_data(g: &GeologyPlan, mesh: &FaultedMesh) -> Option<terramesh_io::model::ObjectData> {
+    if g.objects.is_empty() {
+        return None;
+    }
+    Some(terramesh_io::model::ObjectData {
+        objects: model_objects(g),
+        object: mesh.objects.object.clone(),
+        lining: mesh.objects.lining.clone(),
+    })
+}
+
+/// The objects as the writers name them, in project order.
+fn model_objects(g: &GeologyPlan) -> Vec<terramesh_io::model::ModelObject> {
+    use terramesh_io::model::{ModelObject, ObjectKind};
+    g.objects
+        .iter()
+        .map(|o| {
+            let (kind, material, lining) = match &o.source {
+                ObjectSource::Tunnel { lining, .. } => (ObjectKind::Tunnel, None, *lining > 0.0),
+                ObjectSource::Excavation { .. } => (ObjectKind::Excavation, None, false),
+                ObjectSource::Structure { material, .. } => {
+                    (ObjectKind::Structure, Some(material.clone()), false)
+                }
+            };
+            ModelObject {
+                name: o.name.clone(),
+                kind,
+                stage: match kind {
+                    ObjectKind::Structure => 0,
+                    _ => o.stage,
+                },
+                material,
+                lining,
+            }
+        })
+        .collect()
+}
+
+/// A material after the units in `model.json`: its `MaterialIDs` value and name.
+#[derive(Debug, Clone, Serialize)]
+pub struct MaterialName {
+    /// Its `MaterialIDs` value (after the units').
+    pub material_id: i32,
+    /// Its name (a structure's `material`, or `lining-<tunnel>`), as in `model.vtu`'s
+    /// `unit_names`.
+    pub name: String,
 }
 
 /// One unit's share of an object.
@@ -188,6 +287,9 @@ pub struct ObjectsSummary {
     pub objects: Vec<ObjectSummary>,
     /// Per excavation stage.
     pub stages: Vec<StageSummary>,
+    /// The materials after the units: the structures' (one per distinct `material`), then
+    /// one per lining (`lining-<tunnel>`).
+    pub materials: Vec<MaterialName>,
     /// Edges bisected near the objects.
     pub refined_edges: usize,
     /// Edges split at the objects' boundaries.
@@ -220,7 +322,9 @@ pub fn finish(
     }
     let set = object_set(g, terrain, base)?;
     let checks: Vec<ObjectCheck> = check_objects(&mesh.points, &mesh.tets, &mesh.objects, &set)
-        .map_err(|e| Error::invalid(format!("geology: the objects' checks: {e}")))?;
+        .map_err(|e| Error::ObjectFigures {
+            source: Box::new(e),
+        })?;
     let cells = &mesh.objects;
     let mut per_unit = vec![vec![0.0; g.units.len()]; set.objects.len()];
     let mut blocks = vec![Vec::new(); set.objects.len()];
@@ -257,8 +361,10 @@ pub fn finish(
         let plan = &g.objects[k];
         let lengths = match &plan.source {
             ObjectSource::Tunnel { axis, .. } => {
-                let pts = read_axis(axis, &plan.name)
-                    .map_err(|e| Error::invalid(format!("{}: {e}", plan.key("axis"))))?;
+                let pts = read_axis(axis, &plan.name).map_err(|e| Error::ObjectFile {
+                    key: plan.key("axis"),
+                    source: Box::new(e),
+                })?;
                 let mut len = vec![0.0; g.units.len()];
                 for w in pts.windows(2) {
                     let d = [0, 1, 2].map(|i| w[1][i] - w[0][i]);
@@ -320,10 +426,19 @@ pub fn finish(
                 .collect(),
         });
     }
+    let materials = terramesh_io::model::extra_materials(&model_objects(g))
+        .into_iter()
+        .enumerate()
+        .map(|(k, name)| MaterialName {
+            material_id: (g.units.len() + k) as i32,
+            name,
+        })
+        .collect();
     Ok(Some(ObjectsSummary {
         structure_resolution: set.resolution,
         objects: out,
         stages,
+        materials,
         refined_edges: cells.refined_edges,
         split_edges: cells.split_edges,
         refinement_capped: cells.capped,

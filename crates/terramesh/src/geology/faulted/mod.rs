@@ -162,7 +162,14 @@ pub(crate) fn run(
         vertical_datum: datum.name(),
         vertical_epsg: datum.epsg(),
     };
-    let written = write_faulted_model(out, &volume, &data, &info, None).map_err(|e| match e {
+    let objects = crate::geology::objects::object_data(g, &faulted.mesh);
+    let written = match &objects {
+        Some(d) => {
+            terramesh_io::model::write_object_model(out, &volume, Some(&data), d, &info, None)
+        }
+        None => write_faulted_model(out, &volume, &data, &info, None),
+    }
+    .map_err(|e| match e {
         terramesh_io::model::ModelWriteError::Mesh(source) => Error::FaultedMeshWrite { source },
         e => Error::ModelWrite(e),
     })?;

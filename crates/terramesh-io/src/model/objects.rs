@@ -1,0 +1,585 @@
+//! What a model with engineering objects (issue 32: tunnels, excavations, structures) adds to
+//! its [`VolumeMesh`] ([`ObjectData`]): the object and the lining flag of every cell, from
+//! which the writers derive the int32 cell arrays `object` and `excavation_stage` of
+//! `model.vtu`, the `MaterialIDs` of a structure's and a lining's cells (after the units),
+//! the objects' volume groups (`tunnel-<name>`, `excavation-<name>`, `structure-<name>`,
+//! `lining-<name>`), their boundaries (faces between a cell of the group and a cell not of
+//! it, and the group's faces on the model's outer boundary) and the files
+//! `object-<name>.vtu` ([`object_mesh`]) and `object-<name>.ts` ([`write_object_tsurf`]).
+//!
+//! Faces are matched by their points' coordinates, so that split fault nodes (two copies at
+//! one place) still make one face of two cells.
+
+use std::io::{self, Write};
+
+use rayon::prelude::*;
+use terramesh_core::volume::{Body, FaceTag, VolumeMesh};
+
+use super::boundary::BoundaryMesh;
+use super::faces::cell_faces;
+use super::faults::{side_nodes, FaceSide, FaultData, FaultGroup};
+use super::{ogs_face_index, MeshError, ModelInfo};
+use crate::export::tsurf::write_tsurf_with;
+use crate::export::TsurfInfo;
+
+/// What an engineering object is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ObjectKind {
+    /// A tunnel (`[[geology.tunnels]]`).
+    Tunnel,
+    /// An excavation (`[[geology.excavations]]`).
+    Excavation,
+    /// A structure (`[[geology.structures]]`): its cells get a material of their own.
+    Structure,
+}
+
+impl ObjectKind {
+    /// `tunnel`, `excavation` or `structure`: the prefix of the object's group names.
+    pub fn word(self) -> &'static str {
+        match self {
+            ObjectKind::Tunnel => "tunnel",
+            ObjectKind::Excavation => "excavation",
+            ObjectKind::Structure => "structure",
+        }
+    }
+}
+
+/// One engineering object as the writers name it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModelObject {
+    /// Its name (files `object-<name>.vtu`, `.ts`; groups `<kind>-<name>`).
+    pub name: String,
+    /// What it is.
+    pub kind: ObjectKind,
+    /// Its excavation stage (1 = first; 0: never excavated, a structure).
+    pub stage: u32,
+    /// A structure's material (its `MaterialIDs` name).
+    pub material: Option<String>,
+    /// Whether it is a tunnel with a lining (then the material and group `lining-<name>`).
+    pub lining: bool,
+}
+
+impl ModelObject {
+    /// The group of its cells (lining excluded): `<kind>-<name>`.
+    pub fn group_name(&self) -> String {
+        format!("{}-{}", self.kind.word(), self.name)
+    }
+}
+
+/// The materials after the units, in this order: each distinct structure material (in the
+/// order of the structures), then `lining-<name>` per tunnel with a lining. `MaterialIDs`
+/// `units + k` is material `k`.
+///
+/// ```
+/// use terramesh_io::model::{extra_materials, ModelObject, ObjectKind};
+/// let o = |name: &str, kind, material: Option<&str>, lining| ModelObject {
+///     name: name.into(), kind, stage: 0, material: material.map(String::from), lining };
+/// let objects = [o("t", ObjectKind::Tunnel, None, true), o("dam", ObjectKind::Structure, Some("concrete"), false),
+///     o("wall", ObjectKind::Structure, Some("concrete"), false)];
+/// assert_eq!(extra_materials(&objects), ["concrete", "lining-t"]);
+/// ```
+pub fn extra_materials(objects: &[ModelObject]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for o in objects {
+        if let (ObjectKind::Structure, Some(m)) = (o.kind, &o.material) {
+            if !out.contains(m) {
+                out.push(m.clone());
+            }
+        }
+    }
+    for o in objects.iter().filter(|o| o.lining) {
+        out.push(format!("lining-{}", o.name));
+    }
+    out
+}
+
+/// The engineering objects of a model and the labels of its cells (see the module
+/// documentation).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ObjectData {
+    /// The objects in project order: object `k` is number `k + 1` in `object`.
+    pub objects: Vec<ModelObject>,
+    /// Per cell: 0 for none, else its object's number.
+    pub object: Vec<u32>,
+    /// Per cell: whether it is in its tunnel's lining.
+    pub lining: Vec<bool>,
+}
+
+/// One volume group of the objects: its name and which cells it holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ObjectGroup {
+    /// `tunnel-<name>`, `excavation-<name>`, `structure-<name>` or `lining-<name>`.
+    pub name: String,
+    /// The object's index (0-based).
+    pub object: usize,
+    /// Whether it is the object's lining.
+    pub lining: bool,
+}
+
+impl ObjectData {
+    /// The volume groups: per object its cells (`<kind>-<name>`), then its lining's
+    /// (`lining-<name>`) where it has one.
+    pub fn groups(&self) -> Vec<ObjectGroup> {
+        let mut out = Vec::new();
+        for (k, o) in self.objects.iter().enumerate() {
+            out.push(ObjectGroup {
+                name: o.group_name(),
+                object: k,
+                lining: false,
+            });
+            if o.lining {
+                out.push(ObjectGroup {
+                    name: format!("lining-{}", o.name),
+                    object: k,
+                    lining: true,
+                });
+            }
+        }
+        out
+    }
+
+    /// The group of every cell (an index into [`ObjectData::groups`]), `u32::MAX` for none.
+    pub fn cell_groups(&self) -> Vec<u32> {
+        let groups = self.groups();
+        let first: Vec<u32> = (0..self.objects.len())
+            .map(|k| groups.iter().position(|g| g.object == k).unwrap_or(0) as u32)
+            .collect();
+        self.object
+            .iter()
+            .zip(&self.lining)
+            .map(|(&o, &l)| {
+                if o == 0 {
+                    u32::MAX
+                } else {
+                    first[o as usize - 1] + u32::from(l)
+                }
+            })
+            .collect()
+    }
+
+    /// Per cell: its excavation stage (0: never excavated: no object, a structure, a lining).
+    pub fn excavation_stage(&self) -> Vec<i32> {
+        self.object
+            .iter()
+            .zip(&self.lining)
+            .map(|(&o, &l)| {
+                if o == 0 || l {
+                    0
+                } else {
+                    self.objects[o as usize - 1].stage as i32
+                }
+            })
+            .collect()
+    }
+
+    /// Per cell: its `MaterialIDs`: `material` (its unit) but for a structure's cells and a
+    /// lining's, which take `units + k` for their material `k` of [`extra_materials`].
+    pub fn material_ids(&self, material: &[i32], units: usize) -> Vec<i32> {
+        let extra = extra_materials(&self.objects);
+        let id = |name: &str| (units + extra.iter().position(|m| m == name).unwrap_or(0)) as i32;
+        let of_object: Vec<Option<i32>> = self
+            .objects
+            .iter()
+            .map(|o| match (o.kind, &o.material) {
+                (ObjectKind::Structure, Some(m)) => Some(id(m)),
+                _ => None,
+            })
+            .collect();
+        let of_lining: Vec<i32> = self
+            .objects
+            .iter()
+            .map(|o| id(&format!("lining-{}", o.name)))
+            .collect();
+        material
+            .iter()
+            .zip(self.object.iter().zip(&self.lining))
+            .map(|(&m, (&o, &l))| match (o, l) {
+                (0, _) => m,
+                (o, true) => of_lining[o as usize - 1],
+                (o, false) => of_object[o as usize - 1].unwrap_or(m),
+            })
+            .collect()
+    }
+}
+
+/// Checks what the writers rely on in [`ObjectData`] (after [`super::check_mesh`] and
+/// [`super::check_faults`]): one label per cell, object numbers within the objects, linings
+/// only in tunnels with one, names usable in file and group names and distinct (the groups
+/// from each other, from the units' and blocks' names and the face groups).
+///
+/// ```
+/// use terramesh_core::volume::{Cell, VolumeMesh};
+/// use terramesh_io::model::{check_objects, MeshError, ModelObject, ObjectData, ObjectKind};
+/// let m = VolumeMesh { points: vec![[0.0; 3]; 4], cells: vec![Cell::tetra([0, 1, 2, 3])],
+///     material: vec![0], units: vec!["sand".into()], ..Default::default() };
+/// let mut d = ObjectData { objects: vec![ModelObject { name: "pit".into(), kind: ObjectKind::Excavation,
+///     stage: 1, material: None, lining: false }], object: vec![1], lining: vec![false] };
+/// assert!(check_objects(&m, None, &d).is_ok());
+/// d.object[0] = 2;
+/// assert!(matches!(check_objects(&m, None, &d), Err(MeshError::ObjectLabel { cell: 0, .. })));
+/// ```
+pub fn check_objects(
+    m: &VolumeMesh,
+    faults: Option<&FaultData>,
+    d: &ObjectData,
+) -> Result<(), MeshError> {
+    if d.object.len() != m.cells.len() || d.lining.len() != m.cells.len() {
+        return Err(MeshError::ObjectCount {
+            cells: m.cells.len(),
+            labels: d.object.len().min(d.lining.len()),
+        });
+    }
+    for (cell, (&o, &l)) in d.object.iter().zip(&d.lining).enumerate() {
+        let bad =
+            o as usize > d.objects.len() || (l && (o == 0 || !d.objects[o as usize - 1].lining));
+        if bad {
+            return Err(MeshError::ObjectLabel {
+                cell,
+                object: o,
+                lining: l,
+                objects: d.objects.len(),
+            });
+        }
+    }
+    let groups = d.groups();
+    let mut names: Vec<String> = m.units.clone();
+    names.extend(extra_materials(&d.objects));
+    for o in &d.objects {
+        if terramesh_core::names::check_name(&o.name).is_err() {
+            return Err(MeshError::Name {
+                name: o.name.clone(),
+            });
+        }
+    }
+    let dup = |names: &[String], what: &str| -> Result<(), MeshError> {
+        match terramesh_core::names::same_file_name(names) {
+            Some((i, j)) => Err(MeshError::Duplicate {
+                what: what.to_string(),
+                first: names[i].clone(),
+                second: names[j].clone(),
+            }),
+            None => Ok(()),
+        }
+    };
+    dup(&names, "materials")?;
+    // the zone groups: materials (slot 1), blocks, the objects' groups, the stages
+    if let Some(f) = faults {
+        names.extend(f.blocks.iter().cloned());
+    }
+    names.extend(groups.iter().filter(|g| !g.lining).map(|g| g.name.clone()));
+    names.extend(stages(d).iter().map(|s| format!("stage-{s}")));
+    dup(&names, "zone groups")?;
+    let mut faces: Vec<String> = m.tags.iter().map(FaceTag::name).collect();
+    if let Some(f) = faults {
+        faces.extend((0..f.faults.len()).map(|i| f.group_name(i)));
+    }
+    faces.extend(groups.iter().map(|g| format!("{}-boundary", g.name)));
+    dup(&faces, "face groups")?;
+    let objects: Vec<String> = d.objects.iter().map(|o| o.name.clone()).collect();
+    dup(&objects, "objects")
+}
+
+/// The excavation stages that have cells, increasing.
+pub(super) fn stages(d: &ObjectData) -> Vec<u32> {
+    let mut s: Vec<u32> = d
+        .excavation_stage()
+        .into_iter()
+        .filter(|&s| s > 0)
+        .map(|s| s as u32)
+        .collect();
+    s.sort_unstable();
+    s.dedup();
+    s
+}
+
+/// The boundary faces of every group of [`ObjectData::groups`], each as the side of its
+/// group's cell (counter-clockwise seen from outside the group): the faces between a cell of
+/// the group and a cell not of it, and the group's faces on the model's outer boundary (a
+/// portal), in increasing cell and face.
+///
+/// # Panics
+/// On what [`check_objects`] rejects.
+pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
+    let groups = d.groups();
+    let cell_group = d.cell_groups();
+    let mut out = vec![Vec::new(); groups.len()];
+    // the objects' bounding box: a neighbour has at least three points in it
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for (c, &g) in cell_group.iter().enumerate() {
+        if g != u32::MAX {
+            for &n in m.cells[c].used() {
+                let p = m.points[n as usize];
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+        }
+    }
+    if lo[0] > hi[0] {
+        return out;
+    }
+    let inside = |p: [f64; 3]| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]);
+    let canon = &canonical_points(m);
+    // every face of the cells near the objects (a neighbour has three points in their box),
+    // by its points, sorted
+    let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
+        .into_par_iter()
+        .filter(|&c| {
+            let near = m.cells[c]
+                .used()
+                .iter()
+                .filter(|&&n| inside(m.points[n as usize]))
+                .count();
+            near >= 3
+        })
+        .flat_map_iter(|c| {
+            (0..cell_faces(m.cells[c].kind).len())
+                .map(move |f| (face_key(m, canon, c, f), c as u32, f as u8))
+        })
+        .collect();
+    sides.par_sort_unstable();
+    for group in sides.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, c, f) in group {
+            let g = cell_group[c as usize];
+            if g == u32::MAX {
+                continue;
+            }
+            if !group
+                .iter()
+                .any(|&(_, d, _)| d != c && cell_group[d as usize] == g)
+            {
+                out[g as usize].push(FaceSide { cell: c, face: f });
+            }
+        }
+    }
+    for faces in &mut out {
+        faces.sort_unstable_by_key(|s| (s.cell, s.face));
+    }
+    out
+}
+
+/// The boundary of object `object` (its cells, lining excluded) as an OpenGeoSys boundary mesh
+/// (`object-<name>.vtu`): its faces counter-clockwise seen from outside the object, as
+/// `ExtractBoundary` writes them (`bulk_node_ids`, `bulk_element_ids`: the object's cell,
+/// `bulk_face_ids`, `MaterialIDs`: `materials[cell]`); `boundary` is its group's faces of
+/// [`object_boundaries`].
+pub fn object_mesh(m: &VolumeMesh, materials: &[i32], boundary: &[FaceSide]) -> BoundaryMesh {
+    let mut local = vec![u32::MAX; m.points.len()];
+    for s in boundary {
+        for n in side_nodes(m, *s) {
+            local[n as usize] = 0;
+        }
+    }
+    let mut nodes = Vec::new();
+    for (n, l) in local.iter_mut().enumerate() {
+        if *l == 0 {
+            *l = nodes.len() as u32;
+            nodes.push(n);
+        }
+    }
+    let mut out = BoundaryMesh {
+        points: nodes.iter().map(|&n| m.points[n]).collect(),
+        bulk_node_ids: nodes.iter().map(|&n| n as u64).collect(),
+        ..Default::default()
+    };
+    for s in boundary {
+        let c = &m.cells[s.cell as usize];
+        out.faces.push(
+            side_nodes(m, *s)
+                .iter()
+                .map(|&n| local[n as usize])
+                .collect(),
+        );
+        out.bulk_element_ids.push(u64::from(s.cell));
+        out.bulk_face_ids
+            .push(ogs_face_index(c.kind, s.face as usize));
+        out.material_ids.push(materials[s.cell as usize]);
+    }
+    out
+}
+
+/// Writes an object's boundary faces (those of [`object_mesh`]) as GOCAD TSurf
+/// (`object-<name>.ts`): triangles facing out of the object (quadrilaterals split in two) over
+/// their own vertices in increasing index of [`VolumeMesh::points`]; the object name is
+/// `name`.
+pub fn write_object_tsurf<W: Write + ?Sized>(
+    w: &mut W,
+    m: &VolumeMesh,
+    boundary: &[FaceSide],
+    name: &str,
+    info: &ModelInfo,
+) -> io::Result<()> {
+    let mut tris = Vec::with_capacity(boundary.len());
+    for s in boundary {
+        let n = side_nodes(m, *s);
+        for k in 1..n.len() - 1 {
+            tris.push([n[0], n[k], n[k + 1]]);
+        }
+    }
+    let mut local = vec![u32::MAX; m.points.len()];
+    for &n in tris.iter().flatten() {
+        local[n as usize] = 0;
+    }
+    let mut nodes = Vec::new();
+    for (n, l) in local.iter_mut().enumerate() {
+        if *l == 0 {
+            *l = nodes.len() as u32;
+            nodes.push(n as u32);
+        }
+    }
+    let tris: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|n| local[n as usize])).collect();
+    write_tsurf_with(
+        w,
+        nodes.len(),
+        |s, i| {
+            for c in m.points[nodes[i] as usize] {
+                s.byte(b' ')?;
+                s.f64(if c == 0.0 { 0.0 } else { c })?;
+            }
+            Ok(())
+        },
+        &tris,
+        &TsurfInfo {
+            name,
+            crs_name: &info.crs,
+        },
+    )
+}
+
+/// What the Gmsh and FLAC3D writers add for the objects: the group of every cell, the groups'
+/// names (lining groups are the lining materials' groups already), the stages, and the
+/// boundaries as face groups (after the faults').
+pub(super) struct ObjectExtra {
+    /// Per cell: its group, `u32::MAX` for none.
+    pub(super) cell_group: Vec<u32>,
+    /// The groups' names and whether each is a lining.
+    pub(super) groups: Vec<(String, bool)>,
+    /// Per cell: its excavation stage.
+    pub(super) stage: Vec<i32>,
+    /// The stages with cells, increasing.
+    pub(super) stages: Vec<u32>,
+}
+
+impl ObjectExtra {
+    pub(super) fn new(d: &ObjectData) -> ObjectExtra {
+        ObjectExtra {
+            cell_group: d.cell_groups(),
+            groups: d.groups().into_iter().map(|g| (g.name, g.lining)).collect(),
+            stage: d.excavation_stage(),
+            stages: stages(d),
+        }
+    }
+}
+
+/// The boundaries of the groups as face groups `<group>-boundary` for `model.msh` and
+/// `model.f3grid`, in FLAC3D slots 2, 3, ... (one per boundary: boundaries share faces with
+/// each other and with the model's faces, and a face is in one group per slot).
+pub(super) fn boundary_groups(
+    m: &VolumeMesh,
+    d: &ObjectData,
+    boundaries: &[Vec<FaceSide>],
+) -> Vec<FaultGroup> {
+    d.groups()
+        .iter()
+        .zip(boundaries)
+        .enumerate()
+        .map(|(g, (group, faces))| {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            let faces = faces
+                .iter()
+                .map(|s| {
+                    let mut a = [u32::MAX; 4];
+                    for (k, &v) in side_nodes(m, *s).iter().enumerate() {
+                        a[k] = v;
+                        let p = m.points[v as usize];
+                        for d in 0..3 {
+                            lo[d] = lo[d].min(p[d]);
+                            hi[d] = hi[d].max(p[d]);
+                        }
+                    }
+                    a
+                })
+                .collect();
+            FaultGroup {
+                name: format!("{}-boundary", group.name),
+                faces,
+                lo,
+                hi,
+                slot: 2 + g as u32,
+            }
+        })
+        .collect()
+}
+
+/// The sealed body of every material of `m` (its units and the objects' materials after
+/// them): the faces of a material's cells whose other side (matched by the points'
+/// coordinates, so split fault nodes make one face) is of another material or none, each
+/// counter-clockwise seen from outside its cell (quadrilaterals split in two); bodies without
+/// faces left out. What `unit-<name>.ts` and `.stl` hold for a model with objects, whose
+/// structures and linings take their cells out of the units.
+pub(super) fn material_bodies(m: &VolumeMesh) -> Vec<Body> {
+    let canon = &canonical_points(m);
+    let key = |c: usize, f: usize| face_key(m, canon, c, f);
+    let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            (0..cell_faces(m.cells[c].kind).len()).map(move |f| (key(c, f), c as u32, f as u8))
+        })
+        .collect();
+    sides.par_sort_unstable();
+    let mut bodies: Vec<Body> = (0..m.units.len())
+        .map(|unit| Body {
+            unit,
+            triangles: vec![],
+        })
+        .collect();
+    for group in sides.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, c, f) in group {
+            let mat = m.material[c as usize];
+            if group
+                .iter()
+                .all(|&(_, d, _)| d == c || m.material[d as usize] != mat)
+            {
+                let cell = &m.cells[c as usize];
+                let n: Vec<u32> = cell_faces(cell.kind)[f as usize]
+                    .iter()
+                    .map(|&i| cell.used()[i])
+                    .collect();
+                for k in 1..n.len() - 1 {
+                    bodies[mat as usize].triangles.push([n[0], n[k], n[k + 1]]);
+                }
+            }
+        }
+    }
+    bodies.retain(|b| !b.triangles.is_empty());
+    bodies
+}
+
+/// Per point: the smallest index of a point at the same coordinates (split fault nodes share
+/// one).
+fn canonical_points(m: &VolumeMesh) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..m.points.len() as u32).collect();
+    let bits = |i: u32| m.points[i as usize].map(|v| (v + 0.0).to_bits());
+    order.par_sort_unstable_by_key(|&i| (bits(i), i));
+    let mut canon = vec![0u32; m.points.len()];
+    for w in 0..order.len() {
+        canon[order[w] as usize] = if w > 0 && bits(order[w]) == bits(order[w - 1]) {
+            canon[order[w - 1] as usize]
+        } else {
+            order[w]
+        };
+    }
+    canon
+}
+
+/// Face `f` of cell `c` by its points' canonical ids, sorted (`u32::MAX` after a triangle's).
+fn face_key(m: &VolumeMesh, canon: &[u32], c: usize, f: usize) -> [u32; 4] {
+    let cell = &m.cells[c];
+    let mut k = [u32::MAX; 4];
+    for (j, &i) in cell_faces(cell.kind)[f].iter().enumerate() {
+        k[j] = canon[cell.used()[i] as usize];
+    }
+    k.sort_unstable();
+    k
+}
