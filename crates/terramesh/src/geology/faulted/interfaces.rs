@@ -2,12 +2,13 @@
 //! contacts, or taken from a neighbouring block shifted by the faults' throws.
 
 use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 use serde::Serialize;
 use terramesh_faults::{BlockKey, FaultSet};
 use terramesh_geostat::{
-    experimental, fit_auto, Data, Drift, Duplicates, LagSettings, ModelKind, Named, Variogram,
-    Weighting,
+    experimental, fit_auto, kriging, Data, Drift, Duplicates, LagSettings, Method, ModelKind,
+    Named, Neighbourhood, Predictor, Weighting,
 };
 use terramesh_io::boreholes::Boreholes;
 use terramesh_io::faults::FaultPick;
@@ -35,7 +36,7 @@ type Samples = Vec<([f64; 2], f64)>;
 #[derive(Clone)]
 struct Fit {
     plane: [f64; 3],
-    kriged: Option<Dual>,
+    kriged: Option<Arc<dyn Predictor>>,
     residuals: Vec<([f64; 2], f64)>,
 }
 
@@ -49,7 +50,7 @@ pub const KRIGED_CONTACTS: usize = 7;
 /// (`geology::fields`: the variogram fitted automatically, universal kriging with a linear
 /// drift over all the contacts), or `None` when they are too few (fewer than
 /// [`KRIGED_CONTACTS`] distinct locations), all equal, or no variogram fits.
-fn kriged(p: &[([f64; 2], f64)]) -> Option<Dual> {
+fn kriged(p: &[([f64; 2], f64)]) -> Option<Arc<dyn Predictor>> {
     let data = Data::new(
         p.iter().map(|(q, _)| *q).collect(),
         p.iter().map(|(_, z)| *z).collect(),
@@ -71,123 +72,15 @@ fn kriged(p: &[([f64; 2], f64)]) -> Option<Dual> {
     }
     let lags = experimental(&data, &LagSettings::default()).ok()?;
     let (fit, _) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL).ok()?;
-    Dual::new(data.xy(), data.z(), fit.variogram)
-}
-
-/// Universal kriging with a linear drift over every contact of one interface in one block, in
-/// its dual form: the system `[Γ F; Fᵀ 0] [b; a] = [z; 0]` (Γ the semivariances between the
-/// data, F their drift terms `1, x, y`) is solved once, and the estimate at `p` is then
-/// `Σ b_i γ(p − x_i) + a · (1, x, y)`, the same as the ordinary (primal) universal kriging
-/// estimate, with no system per point. The mesher asks for an interface's height at every
-/// node it places and at every step of every edge's crossing search: solving the kriging
-/// system there was half of `terramesh model`'s time on a 1,000,000-cell site.
-#[derive(Clone)]
-struct Dual {
-    /// The data's centre: the drift's coordinates are taken from it (UTM northings are ~5e6).
-    origin: [f64; 2],
-    /// The data, centred and mapped to the variogram's isotropic space.
-    xy: Vec<[f64; 2]>,
-    /// The weights of the semivariances.
-    b: Vec<f64>,
-    /// The drift's coefficients, on centred coordinates.
-    a: [f64; 3],
-    variogram: Variogram,
-}
-
-impl Dual {
-    fn new(xy: &[[f64; 2]], z: &[f64], variogram: Variogram) -> Option<Dual> {
-        let n = xy.len();
-        let origin = [
-            xy.iter().map(|p| p[0]).sum::<f64>() / n as f64,
-            xy.iter().map(|p| p[1]).sum::<f64>() / n as f64,
-        ];
-        let centred: Vec<[f64; 2]> = xy
-            .iter()
-            .map(|p| [p[0] - origin[0], p[1] - origin[1]])
-            .collect();
-        let iso: Vec<[f64; 2]> = centred.iter().map(|&p| variogram.transform(p)).collect();
-        let m = n + 3;
-        let mut a = vec![0.0; m * m];
-        let mut r = vec![0.0; m];
-        for i in 0..n {
-            for j in 0..n {
-                a[i * m + j] = if i == j {
-                    0.0
-                } else {
-                    variogram.gamma(dist(iso[i], iso[j]))
-                };
-            }
-            let f = [1.0, centred[i][0], centred[i][1]];
-            for t in 0..3 {
-                a[i * m + n + t] = f[t];
-                a[(n + t) * m + i] = f[t];
-            }
-            r[i] = z[i];
-        }
-        let x = solve(a, r, m)?;
-        Some(Dual {
-            origin,
-            xy: iso,
-            b: x[..n].to_vec(),
-            a: [x[n], x[n + 1], x[n + 2]],
-            variogram,
-        })
-    }
-
-    fn at(&self, p: [f64; 2]) -> f64 {
-        let c = [p[0] - self.origin[0], p[1] - self.origin[1]];
-        let q = self.variogram.transform(c);
-        let mut s = self.a[0] + self.a[1] * c[0] + self.a[2] * c[1];
-        for (x, b) in self.xy.iter().zip(&self.b) {
-            let h = dist(q, *x);
-            // γ(0) = 0: at a datum the estimate is the datum (kriging is exact there).
-            if h > 0.0 {
-                s += b * self.variogram.gamma(h);
-            }
-        }
-        s
-    }
-}
-
-fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
-    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
-}
-
-/// Solves the dense `m` x `m` system `a x = r` (row-major) by Gaussian elimination with partial
-/// pivoting; `None` if it is singular to rounding or the solution is not finite.
-fn solve(mut a: Vec<f64>, mut r: Vec<f64>, m: usize) -> Option<Vec<f64>> {
-    let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-    if !(scale > 0.0 && scale.is_finite()) {
-        return None;
-    }
-    for c in 0..m {
-        let p = (c..m).max_by(|&i, &j| a[i * m + c].abs().total_cmp(&a[j * m + c].abs()))?;
-        if a[p * m + c].abs() <= 1e-13 * scale {
-            return None;
-        }
-        if p != c {
-            for k in 0..m {
-                a.swap(p * m + k, c * m + k);
-            }
-            r.swap(p, c);
-        }
-        let d = a[c * m + c];
-        for i in c + 1..m {
-            let f = a[i * m + c] / d;
-            if f != 0.0 {
-                for k in c..m {
-                    a[i * m + k] -= f * a[c * m + k];
-                }
-                r[i] -= f * r[c];
-            }
-        }
-    }
-    let mut x = vec![0.0; m];
-    for c in (0..m).rev() {
-        let s: f64 = (c + 1..m).map(|k| a[c * m + k] * x[k]).sum();
-        x[c] = (r[c] - s) / a[c * m + c];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    let k = kriging(
+        &data,
+        &fit.variogram,
+        Method::Universal(drift),
+        Neighbourhood::All,
+        false,
+    )
+    .ok()?;
+    Some(Arc::from(k))
 }
 
 impl Fit {
@@ -205,11 +98,10 @@ impl Fit {
         let plane = self.plane[0] + self.plane[1] * p[0] + self.plane[2] * p[1];
         match &self.kriged {
             Some(k) => {
-                let e = k.at(p);
-                if e.is_finite() {
-                    e
-                } else {
-                    plane
+                let mut e = [0.0];
+                match k.predict(&[p], &mut e, None) {
+                    Ok(()) if e[0].is_finite() => e[0],
+                    _ => plane,
                 }
             }
             None => plane,
@@ -576,88 +468,5 @@ impl BlockInterfaces {
                 }
             })
             .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use terramesh_geostat::{kriging, Method, Neighbourhood, Structure};
-
-    /// The dual form gives universal kriging's estimate: against terramesh-geostat's global
-    /// kriging (the primal system solved per point) on scattered contacts of a bent interface
-    /// in UTM coordinates, for a bounded, an unbounded and an anisotropic model.
-    #[test]
-    fn the_dual_form_is_universal_kriging() {
-        let mut s = 7u64;
-        let mut r = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let xy: Vec<[f64; 2]> = (0..40)
-            .map(|_| [500_000.0 + 900.0 * r(), 5_400_000.0 + 700.0 * r()])
-            .collect();
-        let z: Vec<f64> = xy
-            .iter()
-            .map(|p| {
-                let (u, v) = (p[0] - 500_000.0, p[1] - 5_400_000.0);
-                100.0 + 0.02 * u - 0.01 * v + 3.0 * (u / 150.0).sin() * (v / 200.0).cos()
-            })
-            .collect();
-        let data = Data::new(xy.clone(), z.clone(), Duplicates::Reject).unwrap();
-        let mut aniso = Variogram::single(ModelKind::Gaussian, 0.1, 5.0, 400.0).unwrap();
-        aniso.anisotropy = Some(terramesh_geostat::Anisotropy {
-            angle: 30.0,
-            ratio: 0.5,
-        });
-        let models = [
-            Variogram::single(ModelKind::Spherical, 0.05, 6.0, 350.0).unwrap(),
-            Variogram {
-                nugget: 0.0,
-                structures: vec![Structure::new(ModelKind::Linear, 0.01, 1.0)],
-                anisotropy: None,
-            },
-            aniso,
-        ];
-        for v in models {
-            let primal = kriging(
-                &data,
-                &v,
-                Method::Universal(Drift::Linear),
-                Neighbourhood::All,
-                false,
-            )
-            .unwrap();
-            let dual = Dual::new(&xy, &z, v.clone()).unwrap();
-            let mut worst: f64 = 0.0;
-            for _ in 0..200 {
-                let p = [
-                    500_000.0 + 1000.0 * r() - 50.0,
-                    5_400_000.0 + 800.0 * r() - 50.0,
-                ];
-                let mut e = [0.0];
-                primal.predict(&[p], &mut e, None).unwrap();
-                worst = worst.max((dual.at(p) - e[0]).abs());
-            }
-            assert!(worst < 1e-7, "{v}: the dual estimate differs by {worst:e}");
-            // And it honours the data.
-            for (p, z) in xy.iter().zip(&z) {
-                assert!(
-                    (dual.at(*p) - z).abs() < 1e-7,
-                    "{v}: {} against {z}",
-                    dual.at(*p)
-                );
-            }
-        }
-    }
-
-    /// Coincident data make the system singular: no dual, the caller takes the plane.
-    #[test]
-    fn a_singular_system_gives_no_dual() {
-        let xy = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 1.0]];
-        let v = Variogram::single(ModelKind::Spherical, 0.0, 1.0, 10.0).unwrap();
-        assert!(Dual::new(&xy, &[1.0, 2.0, 3.0, 3.0], v).is_none());
     }
 }
