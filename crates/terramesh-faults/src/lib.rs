@@ -114,9 +114,7 @@
 //! the mesh is refined near them right after the background mesh (a cell with an edge whose
 //! midpoint's field strays from the mean of its ends' by more than [`ObjectSet::resolution`]
 //! x the object's size is bisected there if that edge is near its longest, else at its
-//! longest edge, so that the cells keep their shape), and after the quality pass the cells
-//! each wall crosses are refined where its facets would still stray (crossings that the
-//! nodes' signs miss, a tunnel's ends, what the refinement's cap left), then every wall
+//! longest edge, so that the cells keep their shape), and after the quality pass every wall
 //! cuts the mesh as a fault does (a crossing moved onto a fault or an interface stays on the
 //! wall);
 //! cells are labelled by object and lining ([`ObjectCells`]). See `docs/geology.md`,
