@@ -70,9 +70,19 @@ fn box_solid(lo: [f64; 3], hi: [f64; 3]) -> ObjectGeometry {
 
 /// Builds, runs every check, and returns the mesh and the objects' checks.
 fn build(site: &Site, specs: &[ObjectSpec]) -> (FaultedMesh, Vec<ObjectCheck>, CheckSummary) {
+    build_capped(site, specs, OBJECT_MAX_CELLS)
+}
+
+/// [`build`] with the refinement near the objects capped at `max_cells`.
+fn build_capped(
+    site: &Site,
+    specs: &[ObjectSpec],
+    max_cells: usize,
+) -> (FaultedMesh, Vec<ObjectCheck>, CheckSummary) {
     let settings = MeshSettings::new(site.base, 10.0);
     let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
-    let objects = ObjectSet::new(specs, &site.terrain, site.base).unwrap();
+    let mut objects = ObjectSet::new(specs, &site.terrain, site.base).unwrap();
+    objects.max_cells = max_cells;
     let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
     let mesh = faulted_mesh_with_objects(
         &site.terrain,
@@ -144,6 +154,34 @@ fn circular_tunnel_through_a_fault_has_its_exact_volume() {
         "the tunnel should cross F1: blocks {blocks:?}"
     );
     assert!(summary.fault_faces[0] > 0);
+}
+
+/// The faulted benchmark's 2 km tunnel passed the cap of the refinement near objects, which
+/// then left cells several metres wide across the tunnel's crown: every node outside the wall,
+/// nothing cut, the cell labelled outside with its centroid 0.1 to 0.5 m inside ("labelled
+/// outside but lies inside the wall of tunnel diversion"), and cells across a tunnel's end
+/// cut with their corner chopped. The same here with the cap at 150,000 cells ("cell ... is
+/// labelled outside but lies inside the wall of tunnel diversion" at the tunnel's west end).
+/// A fix that bisected, before the cut, the cells a wall crosses (missed crossings; facets
+/// straying by more than 2 x the tolerance) passed this and built the benchmark (7,150,005
+/// cells, 245 s, 3.0 GB) but broke two tests of `model_structures.rs` (a cell recorded in
+/// unit 4, not the unit at its centroid), so it is not in: see docs/geology.md.
+#[test]
+#[ignore = "known failure (issue 32): the refinement near objects is capped and the cut then misses crossings"]
+fn capped_refinement_still_cuts_a_lined_tunnel_cleanly() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    let spec = tunnel(
+        "diversion",
+        vec![[20.0, 90.0, 45.0], [180.0, 110.0, 45.0]],
+        Profile::Circle { diameter: 8.0 },
+        0.4,
+    );
+    let (mesh, checks, _) = build_capped(&site, &[spec], 150_000);
+    assert!(
+        mesh.objects.capped,
+        "the refinement should have been capped"
+    );
+    assert!(checks[0].volume_error() < 0.02, "{:?}", checks[0]);
 }
 
 #[test]
