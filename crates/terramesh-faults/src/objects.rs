@@ -1249,6 +1249,9 @@ pub struct ObjectCells {
     pub split_edges: usize,
     /// Whether the refinement stopped at [`ObjectSet::max_cells`].
     pub capped: bool,
+    /// Edges bisected, before a wall's cut, in the cells it crosses where its facets would
+    /// stray from it (what the refinement left, capped or not).
+    pub repaired_edges: usize,
 }
 
 fn eval(v: f64) -> (f64, i8) {
@@ -1355,6 +1358,91 @@ fn split_edges(
             labels.lining.push(labels.lining[c]);
         }
     });
+}
+
+/// Rivara's closure, relaxed: a cell with edges to split (`keys`, sorted) none of which is
+/// near its longest (within [`NEAR_LONGEST`]) has its longest edge split too, so that no cell
+/// is split at a short edge only.
+fn close(st: &State, keys: &mut Vec<u64>) {
+    loop {
+        let mut add: Vec<u64> = st
+            .tets
+            .par_iter()
+            .filter_map(|t| {
+                let marked = EDGES
+                    .iter()
+                    .map(|&(i, j)| key(t[i], t[j]))
+                    .filter(|k| keys.binary_search(k).is_ok())
+                    .map(|k| edge_d2(&st.points, k))
+                    .fold(-1.0, f64::max);
+                let l = longest_edge(&st.points, t);
+                (marked >= 0.0 && marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, l))
+                    .then_some(l)
+            })
+            .collect();
+        if add.is_empty() {
+            break;
+        }
+        add.par_sort_unstable();
+        add.dedup();
+        keys.extend(add);
+        keys.par_sort_unstable();
+        keys.dedup();
+    }
+}
+
+/// Bisects the given edges (sorted keys) at their midpoints, every cell at its longest first.
+fn bisect(st: &mut State, labels: &mut ObjectCells, keys: &[u64]) {
+    let mids: Vec<[f64; 3]> = keys
+        .iter()
+        .map(|&k| {
+            let (a, b) = (st.points[(k >> 32) as usize], st.points[k as u32 as usize]);
+            [
+                0.5 * (a[0] + b[0]),
+                0.5 * (a[1] + b[1]),
+                0.5 * (a[2] + b[2]),
+            ]
+        })
+        .collect();
+    split_edges(st, labels, keys, mids, true);
+}
+
+/// The edge of cell `t` to bisect where a wall's facets would stray from it (field `f`, node
+/// values `v`, tolerance `tol`): an edge longer than 4 `tol` whose midpoint's field strays
+/// from the mean of its ends' by more than `tol` (the longest such; it if within
+/// [`NEAR_LONGEST`] of the cell's longest edge, else the longest edge), or the longest edge if
+/// only the centroid's does.
+fn straying_edge(
+    points: &[[f64; 3]],
+    t: &[u32; 4],
+    v: [f64; 4],
+    f: &(dyn Fn([f64; 3]) -> f64 + Sync),
+    tol: f64,
+) -> Option<u64> {
+    let q = t.map(|n| points[n as usize]);
+    let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
+    let l = EDGES.iter().map(|&e| len(e)).fold(0.0, f64::max);
+    if l <= 4.0 * tol {
+        return None;
+    }
+    let mut best: Option<(usize, usize)> = None;
+    for &(a, b) in &EDGES {
+        if len((a, b)) <= 4.0 * tol {
+            continue;
+        }
+        let m = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
+        if (f(m) - 0.5 * (v[a] + v[b])).abs() > tol && best.is_none_or(|e| len((a, b)) > len(e)) {
+            best = Some((a, b));
+        }
+    }
+    match best {
+        Some((a, b)) if len((a, b)) >= NEAR_LONGEST * l => Some(key(t[a], t[b])),
+        Some(_) => Some(longest_edge(points, t)),
+        None => {
+            let c = centroid(points, t);
+            ((f(c) - 0.25 * v.iter().sum::<f64>()).abs() > tol).then(|| longest_edge(points, t))
+        }
+    }
 }
 
 /// The faults and interfaces already cut: a node that an object's wall puts on an edge of a
@@ -1595,52 +1683,98 @@ pub(crate) fn refine_near_objects(
         if keys.is_empty() {
             break;
         }
-        // Rivara's closure, relaxed: a cell with edges to split none of which is near its
-        // longest (within NEAR_LONGEST) has its longest edge split too, and every cell is
-        // split at its longest edges first, so that no cell is split at a short edge only.
-        loop {
-            let mut add: Vec<u64> = st
-                .tets
-                .par_iter()
-                .filter_map(|t| {
-                    let marked = EDGES
-                        .iter()
-                        .map(|&(i, j)| key(t[i], t[j]))
-                        .filter(|k| keys.binary_search(k).is_ok())
-                        .map(|k| edge_d2(&st.points, k))
-                        .fold(-1.0, f64::max);
-                    let l = longest_edge(&st.points, t);
-                    (marked >= 0.0 && marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, l))
-                        .then_some(l)
-                })
-                .collect();
-            if add.is_empty() {
-                break;
-            }
-            add.par_sort_unstable();
-            add.dedup();
-            keys.extend(add);
-            keys.par_sort_unstable();
-        }
+        close(st, &mut keys);
         if st.tets.len() + 6 * keys.len() > set.max_cells {
             labels.capped = true;
             break;
         }
-        let mids: Vec<[f64; 3]> = keys
-            .iter()
-            .map(|&k| {
-                let (a, b) = (st.points[(k >> 32) as usize], st.points[k as u32 as usize]);
-                [
-                    0.5 * (a[0] + b[0]),
-                    0.5 * (a[1] + b[1]),
-                    0.5 * (a[2] + b[2]),
-                ]
-            })
-            .collect();
         labels.refined_edges += keys.len();
-        split_edges(st, &mut labels, &keys, mids, true);
+        bisect(st, &mut labels, &keys);
     }
     Ok(labels)
+}
+
+/// The cells a wall crosses (nodes on both sides) are refined before the cut where their
+/// facets would stray from it by more than this times the refinement's tolerance (half the
+/// checks' tolerance).
+const CROSSED_STRAY: f64 = 2.0;
+
+/// Refines, round after round, the cells that a wall crosses where its facets would stray from
+/// it (see [`straying_edge`]), whatever [`ObjectSet::max_cells`] left: the refinement near
+/// the objects stops at that cap, and the wall then crossed cells many times its tolerance
+/// wide, some with every node outside it (an edge across a tunnel's crown: no sign change,
+/// nothing cut, a cell labelled outside with most of its volume inside). A cell is crossed
+/// where its nodes, its edges' midpoints and its centroid have fields of both signs (beyond
+/// [`ON_WALL`]). Only these cells are bisected (with the relaxed Rivara closure), so the cost
+/// is that of the wall's surface, not of the band the refinement covers. Returns the edges
+/// bisected.
+fn refine_missed(
+    st: &mut State,
+    labels: &mut ObjectCells,
+    f: &(dyn Fn([f64; 3]) -> f64 + Sync),
+    [lo, hi]: [[f64; 3]; 2],
+    tol: f64,
+) -> usize {
+    let mut total = 0;
+    for _ in 0..40 {
+        let margin = 1.0 + 1e-6 * tol;
+        let values: Vec<f64> = st
+            .points
+            .par_iter()
+            .map(|&q| {
+                if (0..3).any(|k| q[k] < lo[k] - margin || q[k] > hi[k] + margin) {
+                    f64::INFINITY
+                } else {
+                    f(q)
+                }
+            })
+            .collect();
+        let mut keys: Vec<u64> = st
+            .tets
+            .par_iter()
+            .filter_map(|t| {
+                let v = t.map(|n| values[n as usize]);
+                if v.iter().any(|x| !x.is_finite()) {
+                    return None;
+                }
+                let q = t.map(|n| st.points[n as usize]);
+                let l = EDGES
+                    .iter()
+                    .map(|&(i, j)| norm(sub(q[i], q[j])))
+                    .fold(0.0, f64::max);
+                if l <= 4.0 * tol || v.iter().all(|x| x.abs() >= l) {
+                    return None;
+                }
+                let neg = |x: &f64| *x < -ON_WALL;
+                let pos = |x: &f64| *x > ON_WALL;
+                if v.iter().any(neg) && v.iter().any(pos) {
+                    // The cut splits it: refined only where its facets would stray from the
+                    // wall by more than half the checks' tolerance (a sharp edge of the wall,
+                    // a tunnel's end, across the cell; facets left coarse by the cap).
+                    return straying_edge(&st.points, t, v, f, CROSSED_STRAY * tol);
+                }
+                let mut samples: Vec<f64> = EDGES
+                    .iter()
+                    .map(|&(a, b)| f([0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]))))
+                    .collect();
+                samples.push(f(centroid(&st.points, t)));
+                samples.extend(v);
+                if !(samples.iter().any(neg) && samples.iter().any(pos)) {
+                    return None;
+                }
+                straying_edge(&st.points, t, v, f, tol)
+            })
+            .collect();
+        keys.par_sort_unstable();
+        keys.dedup();
+        if keys.is_empty() {
+            break;
+        }
+        close(st, &mut keys);
+        total += keys.len();
+        bisect(st, labels, &keys);
+    }
+    total
 }
 
 /// Cuts every object's walls into the mesh (after the faults, the interfaces and the quality
@@ -1655,6 +1789,20 @@ pub(crate) fn cut_objects(
     labels.object = vec![0; st.tets.len()];
     labels.lining = vec![false; st.tets.len()];
     let walls = walls(set);
+    // Every wall's crossings missed by its nodes' signs are refined away before any wall is
+    // cut (a midpoint of an edge on a wall already cut would lie off that wall).
+    for _pass in 0..4 {
+        let mut bisected = 0;
+        for &(i, w) in &walls {
+            let o = &set.objects[i];
+            let f = |q: [f64; 3]| o.field(w, q);
+            bisected += refine_missed(st, &mut labels, &f, o.bbox, set.resolution * o.size);
+        }
+        labels.repaired_edges += bisected;
+        if bisected == 0 {
+            break;
+        }
+    }
     for &(i, w) in &walls {
         let o = &set.objects[i];
         let f = |q: [f64; 3]| o.field(w, q);

@@ -167,7 +167,6 @@ fn circular_tunnel_through_a_fault_has_its_exact_volume() {
 /// cells, 245 s, 3.0 GB) but broke two tests of `model_structures.rs` (a cell recorded in
 /// unit 4, not the unit at its centroid), so it is not in: see docs/geology.md.
 #[test]
-#[ignore = "known failure (issue 32): the refinement near objects is capped and the cut then misses crossings"]
 fn capped_refinement_still_cuts_a_lined_tunnel_cleanly() {
     let site = faulted_site([120.0, 0.02, -0.01]);
     let spec = tunnel(
