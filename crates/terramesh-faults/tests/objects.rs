@@ -161,11 +161,8 @@ fn circular_tunnel_through_a_fault_has_its_exact_volume() {
 /// nothing cut, the cell labelled outside with its centroid 0.1 to 0.5 m inside ("labelled
 /// outside but lies inside the wall of tunnel diversion"), and cells across a tunnel's end
 /// cut with their corner chopped. The same here with the cap at 150,000 cells ("cell ... is
-/// labelled outside but lies inside the wall of tunnel diversion" at the tunnel's west end).
-/// A fix that bisected, before the cut, the cells a wall crosses (missed crossings; facets
-/// straying by more than 2 x the tolerance) passed this and built the benchmark (7,150,005
-/// cells, 245 s, 3.0 GB) but broke two tests of `model_structures.rs` (a cell recorded in
-/// unit 4, not the unit at its centroid), so it is not in: see docs/geology.md.
+/// labelled outside but lies inside the wall of tunnel diversion" at the tunnel's west end)
+/// before the cells a wall crosses were refined before the cut.
 #[test]
 fn capped_refinement_still_cuts_a_lined_tunnel_cleanly() {
     let site = faulted_site([120.0, 0.02, -0.01]);
