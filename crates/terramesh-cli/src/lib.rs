@@ -151,12 +151,12 @@ where
 }
 
 /// A library error worded for the command line: each setting as its flag.
-pub(crate) fn flag_error(e: terramesh::Error) -> anyhow::Error {
+pub(crate) fn flag_error(e: impl terramesh::Render) -> anyhow::Error {
     anyhow::anyhow!(e.render(&cmd::sample::flag_of))
 }
 
 /// A library error worded for a project file: each setting as its key.
-pub(crate) fn project_error(e: terramesh::Error) -> anyhow::Error {
+pub(crate) fn project_error(e: impl terramesh::Render) -> anyhow::Error {
     anyhow::anyhow!(e.render(&terramesh::project::key_of))
 }
 

@@ -921,6 +921,12 @@ through_facade!(
     terramesh::horizon::HorizonError,
 );
 
+impl terramesh::Render for TilesError {
+    fn render(&self, name: &dyn Fn(terramesh::Setting) -> String) -> String {
+        TilesError::render(self, name)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1101,6 +1101,20 @@ impl<T> Context<T> for Option<T> {
     }
 }
 
+/// An error that a front end words itself, naming each [`Setting`] its own way (a project key,
+/// a flag, a keyword): the facade's [`Error`] and the errors of the crates over it (the tiles'),
+/// so that a front end has one way to print any of them.
+pub trait Render {
+    /// The message, each setting named by `name`.
+    fn render(&self, name: &dyn Fn(Setting) -> String) -> String;
+}
+
+impl Render for Error {
+    fn render(&self, name: &dyn Fn(Setting) -> String) -> String {
+        Error::render(self, name)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

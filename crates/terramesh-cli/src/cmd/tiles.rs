@@ -31,9 +31,8 @@ enum Sub {
     /// Build one tile into PLAN/tiles/ID/ (atomically) and mark it done; a done tile is left
     /// as it is, a failed one records why and can be built again.
     Build(BuildArgs),
-    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, the project's other surface
-    /// single-file formats but glb (obj, ply, stl, ts, msh, dxf, kml, dae), merge.json,
-    /// report.html.
+    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, the project's single-file
+    /// exports but glb (obj, ply, stl, ts, msh, dxf, kml, dae), merge.json, report.html.
     Merge(MergeArgs),
     /// Write Slurm scripts: an sbatch array (one tile per task) and a merge job after it.
     Slurm(SlurmArgs),
@@ -100,37 +99,27 @@ struct SlurmArgs {
     output: Option<PathBuf>,
 }
 
-/// A tiles error worded for the command line: each setting as its flag.
-fn flag_error(e: tiles::TilesError) -> anyhow::Error {
-    anyhow::anyhow!(e.render(&crate::cmd::sample::flag_of))
-}
-
-/// A tiles error worded for a project file: each setting as its key.
-fn project_error(e: tiles::TilesError) -> anyhow::Error {
-    anyhow::anyhow!(e.render(&terramesh::project::key_of))
-}
-
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
     let secs = || t0.elapsed().as_secs_f64();
     match args.command {
         Sub::Plan(a) => {
-            tiles::check_halo(&a.halo).map_err(flag_error)?;
-            let size = tiles::parse_tile_size(&a.tile_size).map_err(flag_error)?;
+            tiles::check_halo(&a.halo).map_err(crate::flag_error)?;
+            let size = tiles::parse_tile_size(&a.tile_size).map_err(crate::flag_error)?;
             let p = Project::load(&a.project, &a.set).map_err(crate::project_error)?;
             let base = a.project.parent().unwrap_or(Path::new("."));
             let progress = Terminal::new(a.quiet, true);
             let planned = tiles::plan(&p, &a.project, &a.set, base, size, &a.output, &progress)
-                .map_err(project_error)?;
+                .map_err(crate::project_error)?;
             progress.finish(&planned.summary(&a.output, secs()));
         }
         Sub::Build(a) => {
-            let outcome = tiles::build_tile(&a.plan, &a.tile).map_err(project_error)?;
+            let outcome = tiles::build_tile(&a.plan, &a.tile).map_err(crate::project_error)?;
             crate::say(&outcome.summary(&a.tile, secs()))?;
         }
         Sub::Merge(a) => {
-            let m = tiles::merge(&a.plan, &a.output).map_err(project_error)?;
+            let m = tiles::merge(&a.plan, &a.output).map_err(crate::project_error)?;
             crate::say(&m.summary(&a.output, secs()))?;
         }
         Sub::Slurm(a) => {
@@ -143,8 +132,8 @@ pub fn run(args: Args) -> Result<()> {
                 mem: a.mem,
             };
             // Each value becomes an #SBATCH line: refused before anything is written.
-            o.check().map_err(flag_error)?;
-            let s = tiles::write_slurm(&a.plan, &o).map_err(project_error)?;
+            o.check().map_err(crate::flag_error)?;
+            let s = tiles::write_slurm(&a.plan, &o).map_err(crate::project_error)?;
             crate::say(&s.summary())?;
         }
     }
