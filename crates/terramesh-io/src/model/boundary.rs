@@ -8,7 +8,7 @@
 
 use terramesh_core::volume::{FaceTag, VolumeMesh};
 
-use super::faces::find_face;
+use super::faces::{compact_nodes, find_face};
 use super::ogs_face_index;
 
 /// One boundary mesh (see the module documentation).
@@ -76,21 +76,12 @@ pub fn boundary_tags(m: &VolumeMesh) -> Vec<u16> {
 pub fn boundary_mesh(m: &VolumeMesh, tag: u16) -> BoundaryMesh {
     let faces: Vec<_> = m.faces.iter().filter(|f| f.tag == tag).collect();
     // a dense map from mesh nodes to the boundary mesh's points, in increasing node order
-    let mut local = vec![u32::MAX; m.points.len()];
-    for f in &faces {
-        for &n in f.used() {
-            local[n as usize] = 0;
-        }
-    }
-    let mut nodes = Vec::new();
-    for (n, l) in local.iter_mut().enumerate() {
-        if *l == 0 {
-            *l = nodes.len() as u32;
-            nodes.push(n);
-        }
-    }
+    let (nodes, local) = compact_nodes(
+        m.points.len(),
+        faces.iter().flat_map(|f| f.used().iter().copied()),
+    );
     let mut b = BoundaryMesh {
-        points: nodes.iter().map(|&n| m.points[n]).collect(),
+        points: nodes.iter().map(|&n| m.points[n as usize]).collect(),
         bulk_node_ids: nodes.iter().map(|&n| n as u64).collect(),
         faces: Vec::with_capacity(faces.len()),
         bulk_element_ids: Vec::with_capacity(faces.len()),

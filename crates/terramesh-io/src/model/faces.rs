@@ -79,3 +79,24 @@ pub(crate) fn find_face(kind: CellKind, cell: &[u32], face: &[u32]) -> Option<us
         .iter()
         .position(|f| f.len() == want.1 && sorted(f.iter().map(|&k| cell[k])) == want)
 }
+
+/// The mesh nodes that `used` names, in increasing order, and the dense map from every one of
+/// the `points` mesh nodes to its index among them (`u32::MAX` for a node not used): how a
+/// boundary, fault or object mesh numbers its own points.
+pub(super) fn compact_nodes(
+    points: usize,
+    used: impl IntoIterator<Item = u32>,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut local = vec![u32::MAX; points];
+    for n in used {
+        local[n as usize] = 0;
+    }
+    let mut nodes = Vec::new();
+    for (n, l) in local.iter_mut().enumerate() {
+        if *l == 0 {
+            *l = nodes.len() as u32;
+            nodes.push(n as u32);
+        }
+    }
+    (nodes, local)
+}

@@ -8,7 +8,7 @@ use std::io::{self, Write};
 
 use terramesh_core::volume::{FaceTag, VolumeMesh};
 
-use super::faces::cell_faces;
+use super::faces::{cell_faces, compact_nodes};
 use super::{ogs_face_index, MeshError, ModelInfo};
 use crate::export::tsurf::write_tsurf_with;
 use crate::export::TsurfInfo;
@@ -252,21 +252,12 @@ pub struct FaultMesh {
 /// On what [`check_faults`] rejects.
 pub fn fault_mesh(m: &VolumeMesh, f: &FaultData, fault: usize) -> FaultMesh {
     let faces = &f.faults[fault].faces;
-    let mut local = vec![u32::MAX; m.points.len()];
-    for s in faces.iter().flatten() {
-        for n in side_nodes(m, *s) {
-            local[n as usize] = 0;
-        }
-    }
-    let mut nodes = Vec::new();
-    for (n, l) in local.iter_mut().enumerate() {
-        if *l == 0 {
-            *l = nodes.len() as u32;
-            nodes.push(n);
-        }
-    }
+    let (nodes, local) = compact_nodes(
+        m.points.len(),
+        faces.iter().flatten().flat_map(|s| side_nodes(m, *s)),
+    );
     let mut out = FaultMesh {
-        points: nodes.iter().map(|&n| m.points[n]).collect(),
+        points: nodes.iter().map(|&n| m.points[n as usize]).collect(),
         bulk_node_ids: nodes.iter().map(|&n| n as u64).collect(),
         ..Default::default()
     };
@@ -327,24 +318,23 @@ pub fn write_fault_tsurf<W: Write + ?Sized>(
 /// A fault's faces as seen from the negative side: its nodes (increasing) and its triangles
 /// renumbered into them.
 pub(super) fn fault_triangles(m: &VolumeMesh, fault: &FaultFaces) -> (Vec<u32>, Vec<[u32; 3]>) {
-    let mut tris = Vec::with_capacity(fault.faces.len());
-    for pair in &fault.faces {
-        let n = side_nodes(m, pair[0]);
+    side_triangles(m, fault.faces.iter().map(|pair| pair[0]))
+}
+
+/// Faces of cells as triangles (a quadrilateral split in two from its first node) over their
+/// own nodes: the nodes (increasing) and the triangles renumbered into them.
+pub(super) fn side_triangles(
+    m: &VolumeMesh,
+    sides: impl IntoIterator<Item = FaceSide>,
+) -> (Vec<u32>, Vec<[u32; 3]>) {
+    let mut tris = Vec::new();
+    for s in sides {
+        let n = side_nodes(m, s);
         for k in 1..n.len() - 1 {
             tris.push([n[0], n[k], n[k + 1]]);
         }
     }
-    let mut local = vec![u32::MAX; m.points.len()];
-    for &n in tris.iter().flatten() {
-        local[n as usize] = 0;
-    }
-    let mut nodes = Vec::new();
-    for (n, l) in local.iter_mut().enumerate() {
-        if *l == 0 {
-            *l = nodes.len() as u32;
-            nodes.push(n as u32);
-        }
-    }
+    let (nodes, local) = compact_nodes(m.points.len(), tris.iter().flatten().copied());
     let tris = tris.iter().map(|t| t.map(|n| local[n as usize])).collect();
     (nodes, tris)
 }

@@ -16,8 +16,8 @@ use rayon::prelude::*;
 use terramesh_core::volume::{Body, FaceTag, VolumeMesh};
 
 use super::boundary::BoundaryMesh;
-use super::faces::cell_faces;
-use super::faults::{side_nodes, FaceSide, FaultData, FaultGroup};
+use super::faces::{cell_faces, compact_nodes};
+use super::faults::{side_nodes, side_triangles, FaceSide, FaultData, FaultGroup};
 use super::{ogs_face_index, MeshError, ModelInfo};
 use crate::export::tsurf::write_tsurf_with;
 use crate::export::TsurfInfo;
@@ -365,21 +365,12 @@ pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
 /// `bulk_face_ids`, `MaterialIDs`: `materials[cell]`); `boundary` is its group's faces of
 /// [`object_boundaries`].
 pub fn object_mesh(m: &VolumeMesh, materials: &[i32], boundary: &[FaceSide]) -> BoundaryMesh {
-    let mut local = vec![u32::MAX; m.points.len()];
-    for s in boundary {
-        for n in side_nodes(m, *s) {
-            local[n as usize] = 0;
-        }
-    }
-    let mut nodes = Vec::new();
-    for (n, l) in local.iter_mut().enumerate() {
-        if *l == 0 {
-            *l = nodes.len() as u32;
-            nodes.push(n);
-        }
-    }
+    let (nodes, local) = compact_nodes(
+        m.points.len(),
+        boundary.iter().flat_map(|s| side_nodes(m, *s)),
+    );
     let mut out = BoundaryMesh {
-        points: nodes.iter().map(|&n| m.points[n]).collect(),
+        points: nodes.iter().map(|&n| m.points[n as usize]).collect(),
         bulk_node_ids: nodes.iter().map(|&n| n as u64).collect(),
         ..Default::default()
     };
@@ -410,25 +401,7 @@ pub fn write_object_tsurf<W: Write + ?Sized>(
     name: &str,
     info: &ModelInfo,
 ) -> io::Result<()> {
-    let mut tris = Vec::with_capacity(boundary.len());
-    for s in boundary {
-        let n = side_nodes(m, *s);
-        for k in 1..n.len() - 1 {
-            tris.push([n[0], n[k], n[k + 1]]);
-        }
-    }
-    let mut local = vec![u32::MAX; m.points.len()];
-    for &n in tris.iter().flatten() {
-        local[n as usize] = 0;
-    }
-    let mut nodes = Vec::new();
-    for (n, l) in local.iter_mut().enumerate() {
-        if *l == 0 {
-            *l = nodes.len() as u32;
-            nodes.push(n as u32);
-        }
-    }
-    let tris: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|n| local[n as usize])).collect();
+    let (nodes, tris) = side_triangles(m, boundary.iter().copied());
     write_tsurf_with(
         w,
         nodes.len(),
