@@ -13,18 +13,14 @@ Prints `PASS name` or `FAIL name: why` per check, then `N passed, M failed`; exi
 failed. See docs/geology.md, "Faulted model files".
 """
 
-import argparse
-import contextlib
-import io
 import sys
 import tempfile
-from pathlib import Path
 
 import numpy as np
 
 from check_model import (VTK_FACES, Model, cell_volumes, check_vtu_ogs, extract_boundary, faces_of,
                          read_tsurf)
-from vcommon import CheckFailed, close, meshio_read, require
+from vcommon import CheckFailed, close, meshio_read, model_dir_main, require, run_checks
 
 
 def names(fd, key):
@@ -235,41 +231,16 @@ CHECKS = [
 
 def run(model_dir, only=None):
     """Runs the checks, prints a line each, returns (passed, failed)."""
-    passed = failed = 0
     try:
         f = Faulted(model_dir)
     except CheckFailed as e:
         print(f"FAIL model.vtu: {e}\n0 passed, 1 failed")
         return 0, 1
-    for name, fn in CHECKS:
-        if only and not any(name.startswith(s) for s in only):
-            continue
-        try:
-            with contextlib.redirect_stdout(io.StringIO()):
-                fn(f)
-        except CheckFailed as e:
-            print(f"FAIL {name}: {e}", flush=True)
-            failed += 1
-        except (Exception, SystemExit) as e:
-            print(f"FAIL {name}: {type(e).__name__}: {e}", flush=True)
-            failed += 1
-        else:
-            print(f"PASS {name}", flush=True)
-            passed += 1
-    print(f"{passed} passed, {failed} failed")
-    return passed, failed
+    return run_checks(CHECKS, f, only)
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("model_dir")
-    ap.add_argument("--only", action="append", help="run only the checks whose name starts with this")
-    a = ap.parse_args(argv)
-    if not Path(a.model_dir).is_dir():
-        print(f"error: {a.model_dir} is not a directory", file=sys.stderr)
-        return 2
-    _, failed = run(a.model_dir, a.only)
-    return 1 if failed else 0
+    return model_dir_main(__doc__, run, argv)
 
 
 if __name__ == "__main__":

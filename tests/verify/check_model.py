@@ -10,9 +10,6 @@ checked against model.vtu's. Prints `PASS name` or
 model.vtu as meshio reads it; every other file is compared with it. See docs/geology.md.
 """
 
-import argparse
-import contextlib
-import io
 import os
 import re
 import shutil
@@ -24,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from check_datum import check_vertical_datum
-from vcommon import REL_DOUBLE, CheckFailed, close, meshio_read, require
+from vcommon import REL_DOUBLE, CheckFailed, close, meshio_read, model_dir_main, require, run_checks
 
 HERE = Path(__file__).resolve().parent
 TOL_OGS = 1e-9  # OpenGeoSys solutions: of the z range, and inflow + outflow of the inflow
@@ -628,37 +625,13 @@ CHECKS = [
 def run(model_dir, only=None):
     """Runs the checks, prints a line each, returns (passed, failed)."""
     model = Model(model_dir)
-    passed = failed = 0
     import check_model_glb  # model.glb's checks, when the build wrote one
-    for name, fn in CHECKS + (check_model_glb.CHECKS if check_model_glb.glb_present(model) else []):
-        if only and not any(name.startswith(s) for s in only):
-            continue
-        try:
-            with contextlib.redirect_stdout(io.StringIO()):
-                fn(model)
-        except CheckFailed as e:
-            print(f"FAIL {name}: {e}", flush=True)
-            failed += 1
-        except (Exception, SystemExit) as e:
-            print(f"FAIL {name}: {type(e).__name__}: {e}", flush=True)
-            failed += 1
-        else:
-            print(f"PASS {name}", flush=True)
-            passed += 1
-    print(f"{passed} passed, {failed} failed")
-    return passed, failed
+    glb = check_model_glb.CHECKS if check_model_glb.glb_present(model) else []
+    return run_checks(CHECKS + glb, model, only)
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("model_dir")
-    ap.add_argument("--only", action="append", help="run only the checks whose name starts with this")
-    a = ap.parse_args(argv)
-    if not Path(a.model_dir).is_dir():
-        print(f"error: {a.model_dir} is not a directory", file=sys.stderr)
-        return 2
-    _, failed = run(a.model_dir, a.only)
-    return 1 if failed else 0
+    return model_dir_main(__doc__, run, argv)
 
 
 if __name__ == "__main__":

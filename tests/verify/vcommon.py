@@ -30,6 +30,50 @@ class CheckFailed(Exception):
     """A check's failure, with the reason shown to the user."""
 
 
+def run_checks(checks, subject, only=None):
+    """Runs each `(name, fn)` of `checks` on `subject` (those whose name starts with one of
+    `only`, if given), its own output hidden; prints `PASS name` or `FAIL name: why` per check
+    and the totals; returns (passed, failed)."""
+    import contextlib
+    import io
+
+    passed = failed = 0
+    for name, fn in checks:
+        if only and not any(name.startswith(s) for s in only):
+            continue
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                fn(subject)
+        except CheckFailed as e:
+            print(f"FAIL {name}: {e}", flush=True)
+            failed += 1
+        except (Exception, SystemExit) as e:
+            print(f"FAIL {name}: {type(e).__name__}: {e}", flush=True)
+            failed += 1
+        else:
+            print(f"PASS {name}", flush=True)
+            passed += 1
+    print(f"{passed} passed, {failed} failed")
+    return passed, failed
+
+
+def model_dir_main(doc, run, argv=None):
+    """The command line of a model checker: MODEL_DIR and --only; `run(model_dir, only)`
+    returns (passed, failed). Exit status 2 for a missing folder, 1 if a check failed."""
+    import argparse
+    import sys
+
+    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
+    ap.add_argument("model_dir")
+    ap.add_argument("--only", action="append", help="run only the checks whose name starts with this")
+    a = ap.parse_args(argv)
+    if not Path(a.model_dir).is_dir():
+        print(f"error: {a.model_dir} is not a directory", file=sys.stderr)
+        return 2
+    _, failed = run(a.model_dir, a.only)
+    return 1 if failed else 0
+
+
 def require(cond, msg):
     if not cond:
         raise CheckFailed(msg)
