@@ -7,7 +7,7 @@
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use terramesh::interpolate::LagOptions;
+use terramesh::plan::LagPlan;
 use terramesh_geostat::{
     cross_validate as cv, experimental as lags_of, kriging, Data, Direction, Drift, Duplicates,
     Estimator, FitMethod, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood,
@@ -220,11 +220,11 @@ fn variogram_fit(
         .map(|f| f.parse().map_err(|e| input(format!("fit: {e}"))))
         .transpose()?;
     let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
-    let plan = LagOptions {
+    let plan = LagPlan {
         weights: w,
         fit: method,
         reml_block,
-        ..LagOptions::default()
+        ..LagPlan::default()
     }
     .plan(model, drift);
     run(py, false, |_| {

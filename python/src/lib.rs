@@ -43,7 +43,7 @@ fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
     d.set_item("max_min_angle", terramesh_mesh::MAX_MIN_ANGLE)?;
     d.set_item("smooth", mesh.smooth)?;
     d.set_item("smoother", mesh.smoother.name())?;
-    let lags = terramesh::interpolate::LagOptions::default();
+    let lags = terramesh::plan::LagPlan::default();
     d.set_item("lags", lags.lags)?;
     d.set_item("max_points", lags.max_points)?;
     d.set_item("tolerance", lags.tolerance)?;

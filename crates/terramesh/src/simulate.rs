@@ -40,7 +40,8 @@ use terramesh_io::output::Output;
 use terramesh_io::table::{ReadOptions, Table};
 
 use crate::error::{Context, Error, Result};
-use crate::interpolate::{read_data, MethodOptions, Targets, X, Y};
+use crate::interpolate::{read_data, Targets, X, Y};
+use crate::plan::InterpolationPlan;
 use crate::setting::Setting;
 
 /// The `x,y` targets of a CSV file (column names as [`crate::interpolate`] takes them);
@@ -117,19 +118,21 @@ pub fn write_ensemble(targets: &[[f64; 2]], e: &Ensemble, output: Option<&Path>)
 /// a CSV file or the nodes of a grid, and the ensemble written as CSV.
 ///
 /// ```
-/// use terramesh::interpolate::{MethodOptions, Targets};
+/// use terramesh::interpolate::Targets;
+/// use terramesh::plan::InterpolationPlan;
 /// use terramesh::simulate::SimulateJob;
 /// use terramesh_geostat::InterpolationMethod;
 /// let dir = tempfile::tempdir()?;
 /// std::fs::write(dir.path().join("d.csv"), "x,y,z\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n")?;
-/// let mut m = MethodOptions::new(InterpolationMethod::Ordinary);
-/// (m.model.model, m.model.psill, m.model.range) = (Some("exponential".into()), vec![1.0], vec![20.0]);
-/// let mut job = SimulateJob::new(dir.path().join("d.csv"), Targets::Grid("0,0,10,10,3,3".into()), m, 2);
+/// let mut m = InterpolationPlan::single(InterpolationMethod::Ordinary);
+/// (m.parts.model, m.parts.psill, m.parts.range) = (Some("exponential".into()), vec![1.0], vec![20.0]);
+/// m.realisations = 2;
+/// let mut job = SimulateJob::new(dir.path().join("d.csv"), Targets::Grid("0,0,10,10,3,3".into()), m);
 /// job.output = Some(dir.path().join("sim.csv"));
 /// job.run(&|_| {})?;
 /// assert_eq!(std::fs::read_to_string(dir.path().join("sim.csv"))?.lines().count(), 10);
 ///
-/// job.modes = 0;
+/// job.plan.modes = 0;
 /// assert_eq!(job.run(&|_| {}).unwrap_err().render(&|s| format!("--{s}")), "--modes 0: give at least 1");
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -139,34 +142,22 @@ pub struct SimulateJob {
     pub data: PathBuf,
     /// Where to simulate (a grid's nodes are written as CSV rows).
     pub targets: Targets,
-    /// The kriging method, its neighbourhood and variogram (IDW is refused).
-    pub method: MethodOptions,
-    /// The number of realisations (at least 1).
-    pub realisations: usize,
-    /// The seed of the random streams (one stream per realisation).
-    pub seed: u64,
-    /// Spectral modes per realisation (at least 1).
-    pub modes: usize,
+    /// The kriging method, its neighbourhood and variogram (IDW is refused), the number of
+    /// realisations (at least 1), the seed of their random streams (one stream per
+    /// realisation) and the spectral modes per realisation (at least 1): a single command's
+    /// plan ([`InterpolationPlan::single`]).
+    pub plan: InterpolationPlan,
     /// The output CSV (standard output without one).
     pub output: Option<PathBuf>,
 }
 
 impl SimulateJob {
-    /// `realisations` of `method` from `data` at `targets`, seed 0, the default number of
-    /// modes, to standard output.
-    pub fn new(
-        data: PathBuf,
-        targets: Targets,
-        method: MethodOptions,
-        realisations: usize,
-    ) -> SimulateJob {
+    /// The simulation of `plan` from `data` at `targets`, to standard output.
+    pub fn new(data: PathBuf, targets: Targets, plan: InterpolationPlan) -> SimulateJob {
         SimulateJob {
             data,
             targets,
-            method,
-            realisations,
-            seed: 0,
-            modes: terramesh_geostat::DEFAULT_MODES,
+            plan,
             output: None,
         }
     }
@@ -174,21 +165,8 @@ impl SimulateJob {
     /// Runs it; a fitted variogram is told to `say`. The output is written atomically when
     /// every realisation is done.
     pub fn run(&self, say: &dyn Fn(&str)) -> Result<()> {
-        let m = &self.method;
+        let m = &self.plan;
         m.check_simulation()?;
-        for (setting, n) in [
-            (Setting::Realisations, self.realisations),
-            (Setting::Modes, self.modes),
-        ] {
-            if n == 0 {
-                let name = terramesh_core::vocab::Named::name(setting);
-                return Err(Error::setting(
-                    setting,
-                    "",
-                    format!("{{{name}}} 0: give at least 1"),
-                ));
-            }
-        }
         let fd = read_data(&self.data, m.duplicates)?;
         let method = m.method(&fd.data)?;
         let v = m.resolve_variogram(&fd, say)?;
@@ -196,8 +174,8 @@ impl SimulateJob {
             Targets::Csv(t) => read_targets(t)?,
             Targets::Grid(g) => self.grid_nodes(g)?,
         };
-        let mut settings = SimulationSettings::new(self.realisations, self.seed);
-        settings.modes = self.modes;
+        let mut settings = SimulationSettings::new(m.realisations, m.seed);
+        settings.modes = m.modes;
         let e = run_simulation(&fd.data, &v, method, m.neighbourhood(), &targets, &settings)
             .map_err(|e| Error::within(&fd.name, e))?;
         write_ensemble(&targets, &e, self.output.as_deref())
@@ -212,7 +190,7 @@ impl SimulateJob {
         let nodes = Estimate::new(
             "grid nodes",
             spec.nx as f64 * spec.ny as f64,
-            16.0 * (self.realisations as f64 + 1.0),
+            16.0 * (self.plan.realisations as f64 + 1.0),
         )
         .check()
         .map_err(|e| {

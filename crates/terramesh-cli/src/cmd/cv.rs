@@ -32,8 +32,9 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let mut job = CvJob::new(args.data, args.m.options());
-    (job.drift, job.folds) = (args.drift.options(), args.folds);
+    let mut job = CvJob::new(args.data, args.m.plan()?);
+    job.plan.cv_folds = args.folds.into();
+    args.drift.lower(&mut job.plan);
     let stats = job.run(&say).map_err(crate::flag_error)?;
     crate::say(&job.table(&stats))
 }

@@ -1,8 +1,8 @@
 //! The flags of the variogram model and of the lag classes, shared by `variogram`,
-//! `interpolate`, `cv` and `simulate`, lowered to the library's settings
-//! ([`ModelOptions`], [`LagOptions`]), which check them.
+//! `interpolate`, `cv` and `simulate`, lowered into the plan's variogram settings
+//! ([`ModelParts`], [`LagPlan`]), which check them.
 
-use terramesh::interpolate::{LagOptions, ModelOptions};
+use terramesh::plan::{LagPlan, ModelParts};
 use terramesh_geostat::{Estimator, FitMethod, Weighting};
 
 /// Variogram flags shared by the commands.
@@ -44,8 +44,8 @@ pub struct ModelArgs {
 
 impl ModelArgs {
     /// The library's settings of these flags.
-    pub fn options(&self) -> ModelOptions {
-        ModelOptions {
+    pub fn options(&self) -> ModelParts {
+        ModelParts {
             model: self.model.clone(),
             psill: self.psill.clone(),
             range: self.range.clone(),
@@ -104,8 +104,8 @@ pub struct LagArgs {
 
 impl LagArgs {
     /// The library's settings of these flags.
-    pub fn options(&self) -> LagOptions {
-        LagOptions {
+    pub fn options(&self) -> LagPlan {
+        LagPlan {
             lags: self.lags,
             max_dist: self.max_dist,
             azimuth: self.azimuth,

@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use terramesh::interpolate::{DriftOptions, InterpolateJob, MethodOptions, Targets};
+use terramesh::interpolate::{InterpolateJob, Targets};
+use terramesh::plan::InterpolationPlan;
 use terramesh_geostat::{Drift, Duplicates, InterpolationMethod};
 
 use super::geodata::{LagArgs, ModelArgs};
@@ -112,30 +113,23 @@ pub struct DriftArgs {
 }
 
 impl MethodArgs {
-    /// The library's settings of these flags (checked there).
-    pub fn options(&self) -> MethodOptions {
-        MethodOptions {
-            method: self.method,
-            drift: self.drift,
-            mean: self.mean,
-            model: self.model.options(),
-            variogram: self.variogram.clone(),
-            lag: self.lag.options(),
-            neighbors: self.neighbors,
-            radius: self.radius,
-            power: self.power,
-            duplicates: self.duplicates,
-        }
+    /// These flags lowered into a single command's plan (checked there).
+    pub fn plan(&self) -> Result<InterpolationPlan> {
+        let mut p = InterpolationPlan::single(self.method);
+        p.set_drift(self.drift).map_err(crate::flag_error)?;
+        p.set_neighbors(self.neighbors);
+        (p.mean, p.radius, p.idw_power) = (self.mean, self.radius, self.power);
+        (p.parts, p.variogram) = (self.model.options(), self.variogram.clone());
+        (p.lag, p.duplicates) = (self.lag.options(), self.duplicates);
+        Ok(p)
     }
 }
 
 impl DriftArgs {
-    /// The library's settings of these flags.
-    pub fn options(&self) -> DriftOptions {
-        DriftOptions {
-            column: self.external_drift.clone(),
-            grid: self.external_drift_grid.clone(),
-        }
+    /// These flags lowered into the plan `p`.
+    pub fn lower(&self, p: &mut InterpolationPlan) {
+        p.external_drift = self.external_drift.clone();
+        p.external_drift_grid = self.external_drift_grid.clone();
     }
 }
 
@@ -147,11 +141,12 @@ pub fn say(text: &str) {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let targets = Targets::of(args.targets, args.grid).map_err(crate::flag_error)?;
+    let mut plan = args.m.plan()?;
+    args.drift.lower(&mut plan);
     let job = InterpolateJob {
         data: args.data,
         targets,
-        method: args.m.options(),
-        drift: args.drift.options(),
+        plan,
         no_variance: args.no_variance,
         epsg: args.epsg,
         variance_grid: args.variance_grid,

@@ -57,7 +57,9 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let targets = Targets::of(args.targets, args.grid).map_err(crate::flag_error)?;
-    let mut job = SimulateJob::new(args.data, targets, args.m.options(), args.realisations);
-    (job.seed, job.modes, job.output) = (args.seed, args.modes, args.output);
+    let mut plan = args.m.plan()?;
+    (plan.realisations, plan.seed, plan.modes) = (args.realisations, args.seed, args.modes);
+    let mut job = SimulateJob::new(args.data, targets, plan);
+    job.output = args.output;
     job.run(&say).map_err(crate::flag_error)
 }

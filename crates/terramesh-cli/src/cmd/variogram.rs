@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use terramesh::interpolate::VariogramJob;
+use terramesh::plan::InterpolationPlan;
 use terramesh_geostat::{Drift, Duplicates};
 
 use super::geodata::LagArgs;
@@ -61,13 +62,13 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
+    let mut plan = InterpolationPlan::single(terramesh_geostat::InterpolationMethod::Universal);
+    (plan.fit_model, plan.lag, plan.drift) = (args.model, args.lag.options(), args.drift);
+    plan.anisotropy = args.anisotropy.unwrap_or(plan.anisotropy);
+    plan.duplicates = args.duplicates;
     let job = VariogramJob {
         data: args.data,
-        model: args.model,
-        anisotropy: args.anisotropy,
-        lag: args.lag.options(),
-        drift: args.drift,
-        duplicates: args.duplicates,
+        plan,
         output: args.output,
         plot: args.plot,
     };

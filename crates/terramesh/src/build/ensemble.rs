@@ -69,7 +69,7 @@ pub fn simulate_vertices(
     // An automatic fit without a sill (power, linear) has no covariance to simulate with:
     // the best bounded model fitted to the same experimental variogram instead. A model the
     // project names is used as it is (and an unbounded one is refused).
-    let auto = ip.model.is_none() && ip.variogram == "auto";
+    let auto = ip.model.is_none() && ip.variogram_or_auto() == "auto";
     let fitted = &model.variogram;
     let variogram = match fitted.sill() {
         None if auto => {

@@ -104,12 +104,40 @@ fn mesh_key(m: &crate::plan::MeshPlan) -> String {
     text
 }
 
+/// The interpolation sub-plan as the key has always written it (`InterpolationSection { .. }`,
+/// its Debug form before the single commands' settings joined the plan): the settings a build
+/// reads, in their order, an unset `variogram` as `"auto"`. The fields that only the single
+/// commands set (`mean`, `parts`, `lag`, `radius`, `modes`, `external_drift`, `duplicates`;
+/// no project key reaches them) are not in it, so that adding one keeps every kept DSM.
+fn interpolation_key(ip: &crate::plan::InterpolationPlan) -> String {
+    format!(
+        "InterpolationSection {{ methods: {:?}, drift: {:?}, variogram: {:?}, model: {:?}, \
+         neighbors: {:?}, idw_power: {:?}, idw_neighbors: {:?}, cv_folds: {:?}, \
+         realisations: {:?}, seed: {:?}, fit: {:?}, fit_model: {:?}, anisotropy: {:?}, \
+         external_drift_grid: {:?} }}",
+        ip.methods,
+        ip.drift,
+        ip.variogram_or_auto(),
+        ip.model,
+        ip.neighbors,
+        ip.idw_power,
+        ip.idw_neighbors,
+        ip.cv_folds,
+        ip.realisations,
+        ip.seed,
+        ip.fit,
+        ip.fit_model,
+        ip.anisotropy,
+        ip.external_drift_grid
+    )
+}
+
 /// The key of what makes `p`'s DSM (paths relative to `base`): see the module documentation.
 pub fn key(p: &Project, base: &Path) -> Result<u64> {
     let mut h = hasher();
     env!("CARGO_PKG_VERSION").hash(&mut h);
     format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{:?}|{:?}",
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{}|{:?}",
         p.region.corners,
         p.region.file,
         p.region.zone,
@@ -117,13 +145,12 @@ pub fn key(p: &Project, base: &Path) -> Result<u64> {
         p.source,
         p.sampling,
         mesh_key(&p.mesh),
-        p.interpolation,
+        interpolation_key(&p.interpolation),
         p.export.grid_spacing
     )
-    // The sub-plans' names as the key has always written them, so that a DSM kept by an
-    // earlier version stays valid.
+    // The sub-plan's name as the key has always written it, so that a DSM kept by an earlier
+    // version stays valid.
     .replace("SamplingPlan {", "SamplingSection {")
-    .replace("InterpolationPlan {", "InterpolationSection {")
     .hash(&mut h);
     // `interpolation.neighbors` and `cv_folds` print 0 whether set to 0 or unset (left to the
     // build, `scale.rs`), so that the keys of projects setting neither are what they were; an
@@ -142,8 +169,8 @@ pub fn key(p: &Project, base: &Path) -> Result<u64> {
     if let Some(f) = &p.region.file {
         files.push(base.join(f));
     }
-    if p.interpolation.variogram != "auto" {
-        files.push(base.join(&p.interpolation.variogram));
+    if p.interpolation.variogram_or_auto() != "auto" {
+        files.push(base.join(p.interpolation.variogram_or_auto()));
     }
     for f in files {
         hash_path(&mut h, &f)?;
@@ -356,6 +383,68 @@ mod tests {
             },
             samples: 400,
             source: "dem.tif".into(),
+        }
+    }
+
+    /// The `[interpolation]` part of the key, as the derived `Debug` of the plan wrote it
+    /// before the single commands' settings joined the plan (captured from that build), so
+    /// that every DSM kept before stays reused.
+    #[test]
+    fn the_interpolation_key_is_what_it_was() {
+        use crate::project::{Project, TEMPLATE};
+        let cases: [(&[&str], &str); 3] = [
+            (&[], "InterpolationSection { methods: [Universal, Idw], drift: Linear, variogram: \"auto\", model: None, neighbors: 0, idw_power: 2.0, idw_neighbors: 16, cv_folds: 0, realisations: 0, seed: 0, fit: WlsLoo, fit_model: \"auto\", anisotropy: \"none\", external_drift_grid: None }"),
+            (
+                &[
+                    "interpolation.methods=[\"ok\", \"idw\"]",
+                    "interpolation.drift=\"quadratic\"",
+                    "interpolation.neighbors=32",
+                    "interpolation.cv_folds=5",
+                    "interpolation.model={ model = \"spherical+exponential\", psill = [8.0, 4.0], range = [300.0, 900.0], nugget = 1.0, shape = 1.5, anisotropy_angle = 30.0, anisotropy_ratio = 0.5 }",
+                    "interpolation.idw_power=3.0",
+                    "interpolation.idw_neighbors=8",
+                    "interpolation.realisations=4",
+                    "interpolation.seed=9",
+                    "interpolation.fit=\"reml\"",
+                    "interpolation.fit_model=\"spherical\"",
+                    "interpolation.anisotropy=\"auto\"",
+                    "interpolation.external_drift_grid=\"coarse.tif\"",
+                ],
+                "InterpolationSection { methods: [Ordinary, Idw], drift: Quadratic, variogram: \"auto\", model: Some(VariogramSpec { model: \"spherical+exponential\", psill: Many([8.0, 4.0]), range: Many([300.0, 900.0]), nugget: 1.0, shape: Some(One(1.5)), anisotropy_angle: Some(30.0), anisotropy_ratio: Some(0.5) }), neighbors: 32, idw_power: 3.0, idw_neighbors: 8, cv_folds: 5, realisations: 4, seed: 9, fit: Reml, fit_model: \"spherical\", anisotropy: \"auto\", external_drift_grid: Some(\"coarse.tif\") }",
+            ),
+            (
+                &[
+                    "interpolation.variogram=\"v.json\"",
+                    "interpolation.model={ model = \"gaussian\", psill = 2.0, range = 50.0 }",
+                ],
+                "InterpolationSection { methods: [Universal, Idw], drift: Linear, variogram: \"v.json\", model: Some(VariogramSpec { model: \"gaussian\", psill: One(2.0), range: One(50.0), nugget: 0.0, shape: None, anisotropy_angle: None, anisotropy_ratio: None }), neighbors: 0, idw_power: 2.0, idw_neighbors: 16, cv_folds: 0, realisations: 0, seed: 0, fit: WlsLoo, fit_model: \"auto\", anisotropy: \"none\", external_drift_grid: None }",
+            ),
+        ];
+        for (sets, want) in cases {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            let p = Project::parse("t.toml", TEMPLATE, &sets).unwrap();
+            assert_eq!(interpolation_key(&p.interpolation), want);
+            // The single commands' own settings (no project key sets them) leave it alone.
+            let mut q = p.interpolation.clone();
+            (q.mean, q.radius, q.modes) = (Some(1.0), Some(5.0), 7);
+            (q.lag.lags, q.parts.nugget) = (3, Some(1.0));
+            q.external_drift = Some("dem".into());
+            q.duplicates = terramesh_geostat::Duplicates::Mean;
+            assert_eq!(interpolation_key(&q), want);
+        }
+    }
+
+    /// A project cannot set the single commands' own settings, and they take their defaults.
+    #[test]
+    fn a_project_leaves_the_single_commands_settings_at_their_defaults() {
+        use crate::project::{Project, TEMPLATE};
+        let p = Project::parse("t.toml", TEMPLATE, &[]).unwrap();
+        assert_eq!(p.interpolation.modes, terramesh_geostat::DEFAULT_MODES);
+        assert_eq!(p.interpolation.lag, crate::plan::LagPlan::default());
+        assert_eq!(p.interpolation.variogram_or_auto(), "auto");
+        for key in ["mean=1.0", "radius=5.0", "modes=3", "duplicates=\"mean\""] {
+            let set = vec![format!("interpolation.{key}")];
+            assert!(Project::parse("t.toml", TEMPLATE, &set).is_err(), "{key}");
         }
     }
 

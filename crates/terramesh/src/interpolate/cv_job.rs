@@ -3,68 +3,52 @@
 //! and its statistics as a `key,value` table.
 //!
 //! ```
-//! use terramesh::interpolate::{CvJob, MethodOptions};
+//! use terramesh::interpolate::CvJob;
+//! use terramesh::plan::InterpolationPlan;
 //! use terramesh_geostat::InterpolationMethod;
 //! let dir = tempfile::tempdir()?;
 //! std::fs::write(dir.path().join("d.csv"), "x,y,z\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n5,5,2\n")?;
-//! let mut job = CvJob::new(dir.path().join("d.csv"), MethodOptions::new(InterpolationMethod::Idw));
+//! let mut job = CvJob::new(dir.path().join("d.csv"), InterpolationPlan::single(InterpolationMethod::Idw));
 //! let stats = job.run(&|_| {})?;
 //! assert!(job.table(&stats).starts_with("key,value\nn,5\nfolds,leave-one-out\nrmse,"));
 //!
-//! job.folds = Some(1);
+//! job.plan.cv_folds = 1.into();
 //! assert_eq!(job.run(&|_| {}).unwrap_err().render(&|s| format!("--{s}")), "--folds 1: must be at least 2");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 use std::path::PathBuf;
 
-use terramesh_geostat::{cross_validate, cross_validate_external, CvStats, Folds};
+use terramesh_geostat::{cross_validate, cross_validate_external, CvStats};
 
-use super::{read_data, DriftOptions, MethodOptions};
+use super::read_data;
 use crate::error::{Error, Result};
-use crate::setting::Setting;
+use crate::plan::InterpolationPlan;
 
 /// A cross-validation of an interpolation method on the `x,y,z` data of a file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CvJob {
     /// The data file.
     pub data: PathBuf,
-    /// The method and its settings.
-    pub method: MethodOptions,
-    /// Kriging with an external drift.
-    pub drift: DriftOptions,
-    /// k-fold with this many folds (at least 2); `None`: leave-one-out.
-    pub folds: Option<usize>,
+    /// The method, its settings, its external drift and the folds (`cv_folds`: k-fold with
+    /// at least 2, unset: leave-one-out): a single command's plan
+    /// ([`InterpolationPlan::single`]).
+    pub plan: InterpolationPlan,
 }
 
 impl CvJob {
-    /// Leave-one-out cross-validation of `method` on `data`.
-    pub fn new(data: PathBuf, method: MethodOptions) -> CvJob {
-        CvJob {
-            data,
-            method,
-            drift: DriftOptions::default(),
-            folds: None,
-        }
+    /// The cross-validation of `plan` on `data`.
+    pub fn new(data: PathBuf, plan: InterpolationPlan) -> CvJob {
+        CvJob { data, plan }
     }
 
     /// Runs it and returns the statistics; what a front end should tell the user (a fitted
     /// variogram, an external drift's coefficient) goes to `say`.
     pub fn run(&self, say: &dyn Fn(&str)) -> Result<CvStats> {
-        let m = &self.method;
+        let m = &self.plan;
         let fd = read_data(&self.data, m.duplicates)?;
-        let folds = match self.folds {
-            None => Folds::LeaveOneOut,
-            Some(k) if k < 2 => {
-                return Err(Error::setting(
-                    Setting::Folds,
-                    "",
-                    format!("{{folds}} {k}: must be at least 2"),
-                ))
-            }
-            Some(k) => Folds::KFold(k),
-        };
-        let r = match m.external_drift(&self.drift, &self.data, &fd, say)? {
+        let folds = m.folds()?;
+        let r = match m.external_drift(&self.data, &fd, say)? {
             Some(k) => cross_validate_external(
                 &fd.data,
                 &k.at_data,
@@ -84,7 +68,9 @@ impl CvJob {
     /// mean and variance of the standardised errors.
     pub fn table(&self, s: &CvStats) -> String {
         let folds = self
-            .folds
+            .plan
+            .cv_folds
+            .get()
             .map_or("leave-one-out".to_string(), |k| k.to_string());
         let mut t = format!("key,value\nn,{}\nfolds,{folds}\n", s.n);
         t += &format!(

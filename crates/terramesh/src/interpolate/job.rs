@@ -3,14 +3,15 @@
 //! of a CSV file or on a grid.
 //!
 //! ```
-//! use terramesh::interpolate::{InterpolateJob, MethodOptions, Targets};
+//! use terramesh::interpolate::{InterpolateJob, Targets};
+//! use terramesh::plan::InterpolationPlan;
 //! use terramesh_geostat::InterpolationMethod;
 //! let dir = tempfile::tempdir()?;
 //! std::fs::write(dir.path().join("d.csv"), "x,y,z\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n")?;
 //! let mut job = InterpolateJob::new(
 //!     dir.path().join("d.csv"),
 //!     Targets::Grid("0,0,10,10,3,3".into()),
-//!     MethodOptions::new(InterpolationMethod::Idw),
+//!     InterpolationPlan::single(InterpolationMethod::Idw),
 //! );
 //! job.output = Some(dir.path().join("g.asc"));
 //! job.run(&|_| {})?;
@@ -31,8 +32,9 @@ use std::path::PathBuf;
 use terramesh_geostat::InterpolationMethod;
 use terramesh_io::grid_write::RasterGrid;
 
-use super::{predict_csv, predict_grid, read_data, DriftOptions, MethodOptions};
+use super::{predict_csv, predict_grid, read_data};
 use crate::error::{Error, Result};
+use crate::plan::InterpolationPlan;
 use crate::setting::Setting;
 
 /// Where an interpolation predicts.
@@ -66,10 +68,9 @@ pub struct InterpolateJob {
     pub data: PathBuf,
     /// Where to predict.
     pub targets: Targets,
-    /// The method and its settings.
-    pub method: MethodOptions,
-    /// Kriging with an external drift.
-    pub drift: DriftOptions,
+    /// The method, its settings and its external drift: a single command's plan
+    /// ([`InterpolationPlan::single`]).
+    pub plan: InterpolationPlan,
     /// Estimates only (dual kriging; much faster for global kriging).
     pub no_variance: bool,
     /// The EPSG code written into a GeoTIFF grid.
@@ -85,13 +86,12 @@ fn own(setting: Setting, message: &str) -> Error {
 }
 
 impl InterpolateJob {
-    /// The job of `method` from `data` at `targets`, with variances, to standard output.
-    pub fn new(data: PathBuf, targets: Targets, method: MethodOptions) -> InterpolateJob {
+    /// The job of `plan` from `data` at `targets`, with variances, to standard output.
+    pub fn new(data: PathBuf, targets: Targets, plan: InterpolationPlan) -> InterpolateJob {
         InterpolateJob {
             data,
             targets,
-            method,
-            drift: DriftOptions::default(),
+            plan,
             no_variance: false,
             epsg: None,
             variance_grid: None,
@@ -103,14 +103,14 @@ impl InterpolateJob {
     /// drift's coefficient) goes to `say`. The outputs are written atomically, each only
     /// when every target is done.
     pub fn run(&self, say: &dyn Fn(&str)) -> Result<()> {
-        let m = &self.method;
+        let m = &self.plan;
         let fd = read_data(&self.data, m.duplicates)?;
-        let want_var = m.method != InterpolationMethod::Idw && !self.no_variance;
+        let want_var = m.primary() != InterpolationMethod::Idw && !self.no_variance;
         if self.variance_grid.is_some() {
             if !matches!(self.targets, Targets::Grid(_)) {
                 return Err(own(Setting::VarianceGrid, "{variance-grid} writes the variances beside {grid}'s estimates: give {grid} (with {targets} the variances are a column of {output})"));
             }
-            if m.method == InterpolationMethod::Idw {
+            if m.primary() == InterpolationMethod::Idw {
                 return Err(own(
                     Setting::VarianceGrid,
                     "{variance-grid}: IDW has no variance; give {method} sk, ok or uk",
@@ -123,7 +123,7 @@ impl InterpolateJob {
                 ));
             }
         }
-        let eng = m.engine_with_drift(&self.drift, &self.data, &fd, want_var, say)?;
+        let eng = m.engine_with_drift(&self.data, &fd, want_var, say)?;
         match &self.targets {
             Targets::Csv(t) => predict_csv(&eng, t, want_var, self.output.as_deref()),
             Targets::Grid(g) => {
@@ -136,7 +136,7 @@ impl InterpolateJob {
                         "{grid} needs {output} FILE.asc or {output} FILE.tif",
                     ));
                 };
-                if self.drift.column.is_some() {
+                if m.external_drift.is_some() {
                     return Err(own(Setting::ExternalDrift, "{grid} with {external-drift}: grid nodes have no column; sample the drift from a raster with {external-drift-grid}"));
                 }
                 predict_grid(&eng, &spec, out, self.variance_grid.as_deref(), self.epsg)

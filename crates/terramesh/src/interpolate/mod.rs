@@ -1,6 +1,7 @@
 //! Interpolation of scattered x, y, z data on its own (`terramesh variogram`, `interpolate`,
-//! `cv`): the settings of each command checked and lowered ([`MethodOptions`],
-//! [`ModelOptions`], [`LagOptions`]; whole runs: [`InterpolateJob`], [`VariogramJob`]),
+//! `cv`): each command's [`InterpolationPlan`](crate::plan::InterpolationPlan) checked and
+//! lowered to the kernels (`single.rs`; whole runs: [`InterpolateJob`], [`CvJob`],
+//! [`VariogramJob`]),
 //! reading the data with line numbers, fitting a variogram by name, and predicting at
 //! the targets of a CSV file or on a grid through an [`Engine`]: any
 //! [`Predictor`](terramesh_geostat::Predictor), or kriging with an external drift.
@@ -30,14 +31,12 @@
 
 mod cv_job;
 mod job;
-mod method_options;
-mod model_options;
+mod single;
 mod variogram_job;
 
 pub use cv_job::CvJob;
 pub use job::{InterpolateJob, Targets};
-pub use method_options::{DriftOptions, ExternalDriftSetup, MethodOptions};
-pub use model_options::{LagOptions, ModelOptions};
+pub use single::ExternalDriftSetup;
 pub use variogram_job::VariogramJob;
 
 use std::fs::File;

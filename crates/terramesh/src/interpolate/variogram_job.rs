@@ -13,7 +13,7 @@
 //! }
 //! std::fs::write(dir.path().join("d.csv"), text)?;
 //! let mut job = VariogramJob::new(dir.path().join("d.csv"));
-//! job.model = "spherical".into();
+//! job.plan.fit_model = "spherical".into();
 //! job.output = Some(dir.path().join("v.json"));
 //! let file = job.run()?;
 //! assert_eq!(file.points, 144);
@@ -28,13 +28,12 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use terramesh_geostat::{
-    experimental, CandidateEntry, Drift, Duplicates, FitSummary, LagSummary, VariogramFile,
-};
+use terramesh_geostat::{experimental, CandidateEntry, FitSummary, LagSummary, VariogramFile};
 use terramesh_io::output::Output;
 
-use super::{read_data, LagOptions};
+use super::read_data;
 use crate::error::{Context, Error, Result};
+use crate::plan::InterpolationPlan;
 use crate::setting::Setting;
 
 /// An experimental variogram of the `x,y,z` data of a file and a model fitted to it.
@@ -42,16 +41,11 @@ use crate::setting::Setting;
 pub struct VariogramJob {
     /// The data file.
     pub data: PathBuf,
-    /// The model to fit: `auto`, a name, or a nested sum `a+b[+c]`.
-    pub model: String,
-    /// `auto`: fit geometric anisotropy too.
-    pub anisotropy: Option<String>,
-    /// The lag classes and the fit.
-    pub lag: LagOptions,
-    /// The drift a REML fit filters out (and a leave-one-out fit kriges with).
-    pub drift: Drift,
-    /// What to do with data at one location.
-    pub duplicates: Duplicates,
+    /// The fit, as the plan's variogram settings: `fit_model` (`auto`, a name, or a nested
+    /// sum `a+b[+c]`), `anisotropy` (`auto`: fit geometric anisotropy too), `lag` (the lag
+    /// classes and the fit), `drift` (the drift a REML fit filters out and a leave-one-out
+    /// fit kriges with) and `duplicates`.
+    pub plan: InterpolationPlan,
     /// The JSON file (standard output without one).
     pub output: Option<PathBuf>,
     /// A chart of the lags and the model: SVG or PNG by the extension.
@@ -63,11 +57,7 @@ impl VariogramJob {
     pub fn new(data: PathBuf) -> VariogramJob {
         VariogramJob {
             data,
-            model: "auto".into(),
-            anisotropy: None,
-            lag: LagOptions::default(),
-            drift: Drift::Linear,
-            duplicates: Duplicates::Reject,
+            plan: InterpolationPlan::single(terramesh_geostat::InterpolationMethod::Universal),
             output: None,
             plot: None,
         }
@@ -90,18 +80,19 @@ impl VariogramJob {
                 ));
             }
         }
-        let fd = read_data(&self.data, self.duplicates)?;
-        let s = self.lag.settings();
+        let ip = &self.plan;
+        let fd = read_data(&self.data, ip.duplicates)?;
+        let s = ip.lag.settings();
         let lags = experimental(&fd.data, &s)
             .map_err(Error::from)
             .context(&fd.name)?;
-        let mut plan = self.lag.plan(&self.model, self.drift);
-        match self.anisotropy.as_deref() {
-            None => {}
-            Some(a) if a.eq_ignore_ascii_case("auto") => {
-                plan.anisotropy = Some(self.lag.anisotropy_plan()?)
+        let mut plan = ip.lag.plan(&ip.fit_model, ip.drift);
+        match ip.anisotropy.as_str() {
+            a if a.eq_ignore_ascii_case("none") => {}
+            a if a.eq_ignore_ascii_case("auto") => {
+                plan.anisotropy = Some(ip.lag.anisotropy_plan()?)
             }
-            Some(a) => {
+            a => {
                 return Err(Error::setting(
                     Setting::Anisotropy,
                     "",
@@ -117,14 +108,14 @@ impl VariogramJob {
             lags: Some(LagSummary {
                 classes: s.lags,
                 max_dist: lags.last().map(|l| l.hi),
-                azimuth: self.lag.azimuth,
-                tolerance: self.lag.azimuth.map(|_| self.lag.tolerance),
+                azimuth: ip.lag.azimuth,
+                tolerance: ip.lag.azimuth.map(|_| ip.lag.tolerance),
                 estimator: s.estimator,
             }),
             experimental: lags.clone(),
             model: fit.variogram.clone(),
             fit: Some(FitSummary {
-                weights: self.lag.weights,
+                weights: ip.lag.weights,
                 objective: fit.objective,
                 rmse: fit.rmse,
             }),

@@ -1,12 +1,21 @@
 //! The interpolation sub-plan (`[interpolation]`): the variogram (fitted, read or given), the
 //! methods and their neighbourhoods, cross-validation and the conditional simulation of the
 //! vertex elevations; its defaults and its one range check.
+//!
+//! The single commands (`terramesh interpolate`, `cv`, `simulate`, `variogram`) lower their
+//! flags into the same plan ([`InterpolationPlan::single`]): their one method is the first of
+//! `methods`, `--neighbors` is `neighbors` for kriging and `idw_neighbors` for IDW, and the
+//! settings no project key reaches (yet) are fields that a project cannot set (`mean`,
+//! `radius`, `duplicates`, `external_drift`, `parts`, `lag`, `modes`), each with its default
+//! here and its check in [`InterpolationPlan::check_single`] and the methods of
+//! `terramesh::interpolate` that lower the plan to the kernels.
 
 use std::path::PathBuf;
 
 use serde::Deserialize;
-use terramesh_geostat::{Drift, InterpolationMethod, DEFAULT_IDW_POWER};
+use terramesh_geostat::{Drift, Duplicates, InterpolationMethod, DEFAULT_IDW_POWER, DEFAULT_MODES};
 
+use super::variogram::{LagPlan, ModelParts};
 use crate::error::{Error, Result};
 use crate::setting::Setting;
 
@@ -21,7 +30,7 @@ pub const DEFAULT_IDW_NEIGHBORS: usize = 16;
 /// range = 600.0, nugget = 1.0 }`, or nested, `model = { model = "spherical+exponential",
 /// psill = [800.0, 400.0], range = [300.0, 900.0], nugget = 1.0 }`, with optional
 /// `shape` (one or a list), `anisotropy_angle` and `anisotropy_ratio`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VariogramSpec {
     /// Model name (`spherical`, `exponential`, `gaussian`, ...), or up to three joined by `+`.
@@ -147,7 +156,7 @@ impl VariogramSpec {
 }
 
 /// `[interpolation]`: step 4.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InterpolationPlan {
     /// Methods to run (`uk`, `ok`, `sk`, `idw`); the first gives the DSM elevations, all are
@@ -155,18 +164,36 @@ pub struct InterpolationPlan {
     pub methods: Vec<InterpolationMethod>,
     /// Drift of universal kriging: `constant`, `linear` (the paper's) or `quadratic`.
     pub drift: Drift,
-    /// `auto` (fit from the samples) or a path to a `variogram.json`.
-    pub variogram: String,
-    /// An explicit variogram (overrides `variogram`).
+    /// The known mean of simple kriging (unset: the data mean). `--mean`; not a project key.
+    #[serde(skip)]
+    pub mean: Option<f64>,
+    /// `auto` (fit from the samples) or a path to a `variogram.json`. Unset: a project fits
+    /// (`auto`, [`InterpolationPlan::variogram_or_auto`]); a single command kriges only with
+    /// it or with a model in `parts`.
+    pub variogram: Option<String>,
+    /// An explicit variogram (overrides `variogram`), as a project's table.
     pub model: Option<VariogramSpec>,
+    /// A variogram model as the single commands' flags give it (`--model`, `--psill`,
+    /// `--range`, ...): given in full, named for a fit, or `auto`. Not a project key.
+    #[serde(skip)]
+    pub parts: ModelParts,
+    /// The lag classes and the fit's settings of a single command's automatic variogram
+    /// (`--lags`, `--max-dist`, `--fit`, ...). Not a project key: a build fits with the
+    /// defaults of [`LagPlan`] and `fit`.
+    #[serde(skip)]
+    pub lag: LagPlan,
     /// Kriging neighbours per target (0: all data, global kriging). Unset: chosen by the
     /// number of samples ([`crate::build::scale`]): global up to
     /// [`MAX_GLOBAL_SAMPLES`](crate::build::scale::MAX_GLOBAL_SAMPLES), else
     /// [`DEFAULT_NEIGHBORS`](crate::build::scale::DEFAULT_NEIGHBORS).
     pub neighbors: Auto,
+    /// IDW: the data within this radius (`--radius`; an error for a target with none). Not a
+    /// project key.
+    #[serde(skip)]
+    pub radius: Option<f64>,
     /// IDW power.
     pub idw_power: f64,
-    /// IDW neighbours.
+    /// IDW neighbours (0: all data; a single command's default).
     pub idw_neighbors: usize,
     /// Cross-validation folds (0: leave-one-out). Unset: chosen by the number of samples
     /// ([`crate::build::scale`]): leave-one-out up to
@@ -177,6 +204,9 @@ pub struct InterpolationPlan {
     pub realisations: usize,
     /// Seed of the realisations' random streams.
     pub seed: u64,
+    /// Spectral modes per realisation of `terramesh simulate` (`--modes`). Not a project key.
+    #[serde(skip)]
+    pub modes: usize,
     /// How `variogram = "auto"` fits: `wls` (least squares, least cross-validation RMSE; the
     /// default), `reml` (restricted maximum likelihood with the UK drift over every model and
     /// every nested pair, the model chosen by AIC) or `loo` (the parameters, then the model, of
@@ -192,6 +222,14 @@ pub struct InterpolationPlan {
     /// projected coordinates) sampled bilinearly at the samples and the mesh vertices, as a
     /// drift of the kriging methods (uk: the polynomial and it; ok: the constant and it).
     pub external_drift_grid: Option<PathBuf>,
+    /// Kriging with an external drift, a single command's other source of it: this column of
+    /// the data CSV and of the targets CSV (`--external-drift`). Not a project key.
+    #[serde(skip)]
+    pub external_drift: Option<String>,
+    /// What a single command does with data at one location (`--duplicates`; default:
+    /// refused). Not a project key: a build averages its samples at one location.
+    #[serde(skip)]
+    pub duplicates: Duplicates,
 }
 
 impl Default for InterpolationPlan {
@@ -199,18 +237,25 @@ impl Default for InterpolationPlan {
         InterpolationPlan {
             methods: DEFAULT_METHODS.to_vec(),
             drift: Drift::Linear,
-            variogram: "auto".into(),
+            mean: None,
+            variogram: None,
             model: None,
+            parts: ModelParts::default(),
+            lag: LagPlan::default(),
             neighbors: Auto::UNSET,
+            radius: None,
             idw_power: DEFAULT_IDW_POWER,
             idw_neighbors: DEFAULT_IDW_NEIGHBORS,
             cv_folds: Auto::UNSET,
             realisations: 0,
             seed: 0,
+            modes: DEFAULT_MODES,
             fit: terramesh_geostat::FitMethod::default(),
             fit_model: "auto".into(),
             anisotropy: "none".into(),
             external_drift_grid: None,
+            external_drift: None,
+            duplicates: Duplicates::Reject,
         }
     }
 }
@@ -244,6 +289,12 @@ impl Auto {
     /// The value given, or `unset` when none is.
     pub fn or(self, unset: usize) -> usize {
         self.0.unwrap_or(unset)
+    }
+}
+
+impl From<Option<usize>> for Auto {
+    fn from(v: Option<usize>) -> Auto {
+        Auto(v)
     }
 }
 
@@ -330,5 +381,93 @@ impl InterpolationPlan {
             ));
         }
         Ok(())
+    }
+}
+
+impl InterpolationPlan {
+    /// The plan of a single command (`terramesh interpolate`, `cv`, `simulate`) with its one
+    /// `method` and every other setting at a single command's default: all data in the
+    /// neighbourhood of kriging and of IDW, no variogram (kriging needs `variogram` or a
+    /// model in `parts`), leave-one-out cross-validation, no realisations.
+    ///
+    /// ```
+    /// use terramesh::plan::InterpolationPlan;
+    /// use terramesh_geostat::{Drift, InterpolationMethod};
+    /// let mut p = InterpolationPlan::single(InterpolationMethod::Idw);
+    /// p.set_neighbors(Some(8));
+    /// assert_eq!((p.primary(), p.idw_neighbors, p.variogram.is_none()), (InterpolationMethod::Idw, 8, true));
+    /// let mut ok = InterpolationPlan::single(InterpolationMethod::Ordinary);
+    /// let e = ok.set_drift(Some(Drift::Quadratic)).unwrap_err();
+    /// assert_eq!(e.render(&|s| format!("--{s}")), "--drift applies to --method uk only");
+    /// ```
+    pub fn single(method: InterpolationMethod) -> InterpolationPlan {
+        InterpolationPlan {
+            methods: vec![method],
+            idw_neighbors: 0,
+            ..InterpolationPlan::default()
+        }
+    }
+
+    /// The method that gives the estimates (a single command's one method).
+    pub fn primary(&self) -> InterpolationMethod {
+        self.methods.first().copied().unwrap_or(DEFAULT_METHODS[0])
+    }
+
+    /// A single command's drift of universal kriging (`--drift`): refused for ordinary and
+    /// simple kriging, which would ignore it (IDW ignores it).
+    pub fn set_drift(&mut self, drift: Option<Drift>) -> Result<()> {
+        let Some(d) = drift else { return Ok(()) };
+        if matches!(
+            self.primary(),
+            InterpolationMethod::Ordinary | InterpolationMethod::Simple
+        ) {
+            return Err(Error::setting(
+                Setting::Drift,
+                "",
+                "{drift} applies to {method} uk only",
+            ));
+        }
+        self.drift = d;
+        Ok(())
+    }
+
+    /// A single command's neighbourhood (`--neighbors K`; unset: all data): `neighbors` of
+    /// kriging, and `idw_neighbors` of IDW (0 there meaning all data). `Some(0)` is kept in
+    /// `neighbors`, where the single commands refuse it (at least 1).
+    pub fn set_neighbors(&mut self, k: Option<usize>) {
+        self.neighbors = k.into();
+        if self.primary() == InterpolationMethod::Idw {
+            self.idw_neighbors = k.unwrap_or(0);
+        }
+    }
+
+    /// `variogram`, or `auto` (a project's default: fit from the samples) when unset.
+    pub fn variogram_or_auto(&self) -> &str {
+        self.variogram.as_deref().unwrap_or("auto")
+    }
+
+    /// The setting that asked for an external drift: `external_drift` (a column) or
+    /// `external_drift_grid`.
+    pub fn external_drift_setting(&self) -> Setting {
+        if self.external_drift.is_some() {
+            Setting::ExternalDrift
+        } else {
+            Setting::ExternalDriftGrid
+        }
+    }
+
+    /// The folds of a single command's cross-validation (`terramesh cv --folds K`): unset,
+    /// leave-one-out; else at least 2.
+    pub fn folds(&self) -> Result<terramesh_geostat::Folds> {
+        use terramesh_geostat::Folds;
+        match self.cv_folds.get() {
+            None => Ok(Folds::LeaveOneOut),
+            Some(k) if k < 2 => Err(Error::setting(
+                Setting::Folds,
+                "",
+                format!("{{folds}} {k}: must be at least 2"),
+            )),
+            Some(k) => Ok(Folds::KFold(k)),
+        }
     }
 }

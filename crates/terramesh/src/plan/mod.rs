@@ -17,6 +17,7 @@ mod interpolation;
 mod mesh;
 mod objects;
 mod sample;
+mod variogram;
 
 pub use export::{ExportPlan, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 pub use geology::{
@@ -29,3 +30,4 @@ pub use interpolation::{
 pub use mesh::{MeshPlan, DEFAULT_SMOOTH, MAX_STRIPS};
 pub use objects::{ObjectPlan, ObjectSource, Profile, DEFAULT_STRUCTURE_RESOLUTION};
 pub use sample::{SamplingPlan, DEFAULT_COLS, DEFAULT_MARGIN, DEFAULT_ROWS};
+pub use variogram::{LagPlan, ModelParts};

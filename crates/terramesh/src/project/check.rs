@@ -73,8 +73,8 @@ impl Project {
             }
             readable("interpolation.external_drift_grid", &path)?;
         }
-        if ip.model.is_none() && ip.variogram != "auto" {
-            let path = base.join(&ip.variogram);
+        if ip.model.is_none() && ip.variogram_or_auto() != "auto" {
+            let path = base.join(ip.variogram_or_auto());
             if !path.is_file() {
                 return Err(Error::ProjectPath {
                     key: "interpolation.variogram".into(),

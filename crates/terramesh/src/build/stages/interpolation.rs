@@ -158,7 +158,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
     let mut notes = Vec::new();
     let variogram = if let Some(v) = &ip.model {
         v.variogram()?
-    } else if ip.variogram == "auto" {
+    } else if ip.variogram_or_auto() == "auto" {
         // REML filters out, and loo kriges with, the drift of the UK that uses the model
         // (constant without UK).
         let drift = if ip.methods.contains(&InterpolationMethod::Universal) {
@@ -188,7 +188,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         notes = fitted.notes;
         fitted.fit.variogram
     } else {
-        crate::variogram_file::read_variogram_file(&base.join(&ip.variogram))
+        crate::variogram_file::read_variogram_file(&base.join(ip.variogram_or_auto()))
             .context("interpolation.variogram")?
     };
     Ok(Model {

@@ -1,25 +1,29 @@
-//! The variogram settings of a standalone interpolation as a front end gives them (the
-//! command line's `--model`, `--psill`, `--range`, ...; Python's keywords), checked and
-//! lowered to the kernel's [`Variogram`] or to a fit's [`FitPlan`].
+//! The variogram sub-plan: the lag classes of an experimental variogram and the settings of its
+//! fit ([`LagPlan`]), and a variogram model as the command line (`--model`, `--psill`,
+//! `--range`, ...) gives it in parts ([`ModelParts`]), checked and lowered to the kernel's
+//! [`Variogram`] or to a fit's [`FitPlan`]. Both are fields of the
+//! [`InterpolationPlan`](super::InterpolationPlan) that `terramesh variogram`, `interpolate`,
+//! `cv` and `simulate` lower into; a project file gives its model as a table instead
+//! ([`VariogramSpec`](super::VariogramSpec)), worded as keys.
 //!
 //! Every error is an [`Error::Setting`] that names the settings involved, so that each front
 //! end words them its own way ([`Error::render`]).
 //!
 //! ```
-//! use terramesh::interpolate::ModelOptions;
-//! let m = ModelOptions {
+//! use terramesh::plan::ModelParts;
+//! let m = ModelParts {
 //!     model: Some("spherical+exponential".into()),
 //!     psill: vec![8000.0, 4000.0],
 //!     range: vec![3000.0, 9000.0],
 //!     nugget: Some(50.0),
-//!     ..ModelOptions::default()
+//!     ..ModelParts::default()
 //! };
 //! let v = m.explicit_or_fit(false)?.expect("a model given in full");
 //! assert_eq!(v.structures.len(), 2);
 //! assert_eq!(v.nugget, 50.0);
 //!
 //! // One partial sill for two structures is refused, naming both settings.
-//! let bad = ModelOptions { psill: vec![8000.0], ..m };
+//! let bad = ModelParts { psill: vec![8000.0], ..m };
 //! let e = bad.explicit_or_fit(false).unwrap_err();
 //! assert_eq!(
 //!     e.render(&|s| format!("--{s}")),
@@ -40,7 +44,7 @@ use crate::setting::Setting;
 /// The settings of a variogram model: given in full (`model`, `psill`, `range`, ...), named
 /// for a fit, or `auto`.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct ModelOptions {
+pub struct ModelParts {
     /// A model name, a nested sum `a+b[+c]`, or `auto`.
     pub model: Option<String>,
     /// Partial sill per structure.
@@ -91,7 +95,7 @@ fn per_structure(
     }
 }
 
-impl ModelOptions {
+impl ModelParts {
     /// Whether `anisotropy` is `auto` (any other value is an error, and so is a given angle
     /// or ratio beside it).
     pub fn anisotropy_auto(&self) -> Result<bool> {
@@ -233,7 +237,7 @@ impl ModelOptions {
 
 /// The lag classes and fitting settings of an experimental variogram and its fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LagOptions {
+pub struct LagPlan {
     /// Number of lag classes.
     pub lags: usize,
     /// Largest lag distance (default: half the data diameter).
@@ -254,9 +258,9 @@ pub struct LagOptions {
     pub reml_block: usize,
 }
 
-impl Default for LagOptions {
+impl Default for LagPlan {
     fn default() -> Self {
-        LagOptions {
+        LagPlan {
             lags: terramesh_geostat::DEFAULT_LAGS,
             max_dist: None,
             azimuth: None,
@@ -270,7 +274,7 @@ impl Default for LagOptions {
     }
 }
 
-impl LagOptions {
+impl LagPlan {
     /// The experimental variogram's settings.
     pub fn settings(&self) -> LagSettings {
         LagSettings {
@@ -347,12 +351,12 @@ mod tests {
         e.render(&|s| format!("--{s}"))
     }
 
-    fn nested() -> ModelOptions {
-        ModelOptions {
+    fn nested() -> ModelParts {
+        ModelParts {
             model: Some("matern+spherical".into()),
             psill: vec![1.0, 2.0],
             range: vec![10.0, 30.0],
-            ..ModelOptions::default()
+            ..ModelParts::default()
         }
     }
 
@@ -385,7 +389,7 @@ mod tests {
             ),
         ];
         for (psill, range, nugget, want) in cases {
-            let m = ModelOptions {
+            let m = ModelParts {
                 psill,
                 range,
                 nugget,
@@ -394,7 +398,7 @@ mod tests {
             assert_eq!(flags(m.explicit_or_fit(false).unwrap_err()), want);
         }
         // zero is a valid partial sill and nugget (not a valid range)
-        let m = ModelOptions {
+        let m = ModelParts {
             psill: vec![0.0, 2.0],
             nugget: Some(0.0),
             ..nested()
@@ -415,7 +419,7 @@ mod tests {
         m.shape = vec![2.5, 1.0, 3.0];
         assert!(flags(m.explicit_or_fit(false).unwrap_err())
             .starts_with("--shape 2.5,1,3: --model matern+spherical has 2 structures"));
-        let m = ModelOptions {
+        let m = ModelParts {
             psill: vec![],
             ..nested()
         };
@@ -424,25 +428,25 @@ mod tests {
             "--model matern+spherical needs --psill (the partial sills, one per structure: --psill C1,C2)"
         );
         // Fitted when the parameters are left out and the variogram is fitted.
-        let m = ModelOptions {
+        let m = ModelParts {
             psill: vec![],
             range: vec![],
             ..nested()
         };
         assert_eq!(m.explicit_or_fit(true).unwrap(), None);
-        let m = ModelOptions {
+        let m = ModelParts {
             psill: vec![0.0, 0.0],
             ..nested()
         };
         assert!(flags(m.explicit_or_fit(false).unwrap_err()).contains("the sill is zero"));
-        let m = ModelOptions {
+        let m = ModelParts {
             anisotropy_ratio: Some(1.5),
             ..nested()
         };
         assert!(
             flags(m.explicit_or_fit(false).unwrap_err()).starts_with("--anisotropy-ratio 1.5: ")
         );
-        let m = ModelOptions {
+        let m = ModelParts {
             model: None,
             ..nested()
         };
@@ -463,22 +467,22 @@ mod tests {
         m.anisotropy = Some("yes".into());
         assert!(flags(m.anisotropy_auto().unwrap_err())
             .starts_with("--anisotropy 'yes': expected auto"));
-        let l = LagOptions {
+        let l = LagPlan {
             azimuth: Some(30.0),
-            ..LagOptions::default()
+            ..LagPlan::default()
         };
         assert!(flags(l.anisotropy_plan().unwrap_err())
             .starts_with("--azimuth 30 and --anisotropy auto"));
-        let l = LagOptions {
+        let l = LagPlan {
             tolerance: 100.0,
-            ..LagOptions::default()
+            ..LagPlan::default()
         };
         assert_eq!(
             flags(l.anisotropy_plan().unwrap_err()),
             "--tolerance 100: must be in (0, 90] degrees"
         );
         assert_eq!(
-            LagOptions::default().anisotropy_plan().unwrap().tolerance,
+            LagPlan::default().anisotropy_plan().unwrap().tolerance,
             terramesh_geostat::DEFAULT_TOLERANCE
         );
     }

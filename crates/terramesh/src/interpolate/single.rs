@@ -1,18 +1,18 @@
-//! The method settings of a standalone interpolation (`terramesh interpolate`, `cv`,
-//! `simulate`): kriging or IDW, its drift, neighbourhood and variogram, checked together and
-//! lowered to the kernels' types: a [`Predictor`], an [`Interpolator`] for cross-validation,
-//! or kriging with an external drift.
+//! The single commands' interpolation (`terramesh interpolate`, `cv`, `simulate`) lowered from
+//! their [`InterpolationPlan`] to the kernels' types: a [`Predictor`], an [`Interpolator`] for
+//! cross-validation, or kriging with an external drift; the checks of what the plan's one
+//! method takes.
 //!
-//! A front end fills a [`MethodOptions`] from its own words (flags, keywords) and renders the
-//! [`Error::Setting`]s these checks return in them ([`Error::render`]).
+//! A front end lowers its flags or keywords into the plan ([`InterpolationPlan::single`]) and
+//! renders the [`Error::Setting`]s these checks return in its words ([`Error::render`]).
 //!
 //! ```
-//! use terramesh::interpolate::MethodOptions;
+//! use terramesh::plan::InterpolationPlan;
 //! use terramesh_geostat::{Data, Duplicates, InterpolationMethod};
-//! let mut m = MethodOptions::new(InterpolationMethod::Ordinary);
-//! m.model.model = Some("spherical".into());
-//! m.model.psill = vec![1.0];
-//! m.model.range = vec![30.0];
+//! let mut m = InterpolationPlan::single(InterpolationMethod::Ordinary);
+//! m.parts.model = Some("spherical".into());
+//! m.parts.psill = vec![1.0];
+//! m.parts.range = vec![30.0];
 //! let xy: Vec<[f64; 2]> = (0..25).map(|i| [(i % 5) as f64 * 10.0, (i / 5) as f64 * 10.0]).collect();
 //! let z: Vec<f64> = xy.iter().map(|p| p[0] / 10.0 + p[1] / 20.0).collect();
 //! let fd = terramesh::interpolate::FileData { data: Data::new(xy, z, Duplicates::Reject)?, name: "d.csv".into() };
@@ -22,70 +22,26 @@
 //! assert!(est[0].is_finite() && var[0] > 0.0);
 //!
 //! // IDW takes a number of neighbours or a radius, not both.
-//! m.method = InterpolationMethod::Idw;
-//! m.neighbors = Some(4);
+//! let mut m = InterpolationPlan::single(InterpolationMethod::Idw);
+//! m.set_neighbors(Some(4));
 //! m.radius = Some(20.0);
 //! let e = m.engine(&fd, false, &|_| {}).map(|_| ()).unwrap_err();
 //! assert_eq!(e.render(&|s| format!("--{s}")), "IDW takes --neighbors or --radius, not both");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use terramesh_geostat::{
-    kriging, Data, Drift, Duplicates, ExternalDriftKriging, GeostatError, Idw, IdwSearch,
-    InterpolationMethod, Interpolator, Method, Neighbourhood, Predictor, Variogram,
+    kriging, Data, Drift, ExternalDriftKriging, GeostatError, Idw, IdwSearch, InterpolationMethod,
+    Interpolator, Method, Neighbourhood, Predictor, Variogram,
 };
 
-use super::{FileData, LagOptions, ModelOptions, VariogramSource};
+use super::{FileData, VariogramSource};
 use crate::error::{Error, Result};
 use crate::external_drift::{drift_variogram, DriftSource, Engine};
+use crate::plan::InterpolationPlan;
 use crate::setting::Setting;
-
-/// The settings of one kriging or IDW, as a front end gives them.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MethodOptions {
-    /// sk, ok, uk or idw.
-    pub method: InterpolationMethod,
-    /// The drift of universal kriging (default linear).
-    pub drift: Option<Drift>,
-    /// The known mean of simple kriging (default: the data mean).
-    pub mean: Option<f64>,
-    /// The variogram model's settings.
-    pub model: ModelOptions,
-    /// `auto` (fit the model) or a JSON file written by `terramesh variogram`.
-    pub variogram: Option<String>,
-    /// The lag classes and the fit of an automatic variogram.
-    pub lag: LagOptions,
-    /// A moving neighbourhood of this many nearest data (default: all data).
-    pub neighbors: Option<usize>,
-    /// IDW: the data within this radius.
-    pub radius: Option<f64>,
-    /// IDW power.
-    pub power: f64,
-    /// What to do with data at one location.
-    pub duplicates: Duplicates,
-}
-
-/// The external drift's secondary variable: a column of the data and targets, or a raster.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct DriftOptions {
-    /// The column of the data CSV and of the targets CSV.
-    pub column: Option<String>,
-    /// The raster sampled at the data, the targets and the grid nodes.
-    pub grid: Option<PathBuf>,
-}
-
-impl DriftOptions {
-    /// The setting that asked for the external drift.
-    pub fn setting(&self) -> Setting {
-        if self.column.is_some() {
-            Setting::ExternalDrift
-        } else {
-            Setting::ExternalDriftGrid
-        }
-    }
-}
 
 /// Kriging with an external drift, set up: the method, the drift at the data, the variogram
 /// and where the targets' drift comes from.
@@ -109,45 +65,27 @@ fn in_file(name: &str, e: GeostatError) -> Error {
     Error::within(name, e)
 }
 
-impl MethodOptions {
-    /// The settings of `method` with every other setting at its default.
-    pub fn new(method: InterpolationMethod) -> MethodOptions {
-        MethodOptions {
-            method,
-            drift: None,
-            mean: None,
-            model: ModelOptions::default(),
-            variogram: None,
-            lag: LagOptions::default(),
-            neighbors: None,
-            radius: None,
-            power: terramesh_geostat::DEFAULT_IDW_POWER,
-            duplicates: Duplicates::Reject,
-        }
-    }
-
-    /// The kriging method; the drift and the mean only where they apply.
+impl InterpolationPlan {
+    /// The kriging method; the mean only where it applies.
     pub fn method(&self, data: &Data) -> Result<Method> {
-        if self.drift.is_some() && self.method != InterpolationMethod::Universal {
-            return Err(own(Setting::Drift, "{drift} applies to {method} uk only"));
-        }
-        if self.mean.is_some() && self.method != InterpolationMethod::Simple {
+        if self.mean.is_some() && self.primary() != InterpolationMethod::Simple {
             return Err(own(Setting::Mean, "{mean} applies to {method} sk only"));
         }
-        self.method
-            .method(self.drift.unwrap_or(Drift::Linear), self.mean, data)
+        self.primary()
+            .method(self.drift, self.mean, data)
             .ok_or(Error::IdwNotKriging)
     }
 
-    /// The moving neighbourhood (or all data).
+    /// The moving neighbourhood of kriging (or all data).
     pub fn neighbourhood(&self) -> Neighbourhood {
         self.neighbors
+            .get()
             .map_or(Neighbourhood::All, Neighbourhood::Nearest)
     }
 
     /// A moving neighbourhood of at least one datum.
     fn check_neighbors(&self) -> Result<()> {
-        if let Some(0) = self.neighbors {
+        if let Some(0) = self.neighbors.get() {
             return Err(own(Setting::Neighbors, "{neighbors} 0: must be at least 1"));
         }
         Ok(())
@@ -167,30 +105,30 @@ impl MethodOptions {
     /// IDW's power and search.
     pub fn idw(&self) -> Result<(f64, IdwSearch)> {
         self.check_neighbors()?;
-        if !(self.power.is_finite() && self.power > 0.0) {
+        if !(self.idw_power.is_finite() && self.idw_power > 0.0) {
             return Err(own(
                 Setting::Power,
-                format!("{{power}} {}: must be a finite number > 0", self.power),
+                format!("{{power}} {}: must be a finite number > 0", self.idw_power),
             ));
         }
-        let search = match (self.neighbors, self.radius) {
-            (Some(_), Some(_)) => {
+        let search = match (self.idw_neighbors, self.radius) {
+            (k, Some(_)) if k > 0 => {
                 return Err(own(
                     Setting::Radius,
                     "IDW takes {neighbors} or {radius}, not both",
                 ))
             }
-            (Some(k), None) => IdwSearch::Nearest(k),
-            (None, Some(r)) if !(r.is_finite() && r > 0.0) => {
+            (0, None) => IdwSearch::All,
+            (k, None) => IdwSearch::Nearest(k),
+            (_, Some(r)) if !(r.is_finite() && r > 0.0) => {
                 return Err(own(
                     Setting::Radius,
                     format!("{{radius}} {r}: must be a finite number > 0"),
                 ))
             }
-            (None, Some(r)) => IdwSearch::Radius(r),
-            (None, None) => IdwSearch::All,
+            (_, Some(r)) => IdwSearch::Radius(r),
         };
-        Ok((self.power, search))
+        Ok((self.idw_power, search))
     }
 
     /// Where the variogram comes from: given in full, a file, or fitted.
@@ -199,11 +137,11 @@ impl MethodOptions {
             .variogram
             .as_deref()
             .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
-        let auto_model = self.model.is_auto();
-        if self.model.anisotropy_auto()? && !fitting && !auto_model {
+        let auto_model = self.parts.is_auto();
+        if self.parts.anisotropy_auto()? && !fitting && !auto_model {
             return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the anisotropy with the variogram: give {variogram} auto (the model's angle and ratio are otherwise {anisotropy-angle} and {anisotropy-ratio})"));
         }
-        if let Some(v) = self.model.explicit_or_fit(fitting)? {
+        if let Some(v) = self.parts.explicit_or_fit(fitting)? {
             if self.variogram.is_some() {
                 return Err(own(
                     Setting::Variogram,
@@ -214,7 +152,7 @@ impl MethodOptions {
         }
         match self.variogram.as_deref() {
             _ if fitting => self.fit_plan(),
-            Some(file) => Ok(VariogramSource::File(PathBuf::from(file))),
+            Some(file) => Ok(VariogramSource::File(file.into())),
             None if auto_model => self.fit_plan(),
             None => Err(own(Setting::Variogram, "kriging needs a variogram: {variogram} auto, {variogram} FILE.json, or {model} NAME {psill} C {range} A [{nugget} C0]")),
         }
@@ -223,13 +161,13 @@ impl MethodOptions {
     /// The fit of an automatic variogram: lag classes, models, REML's drift (that of the
     /// kriging that will use the model) and the anisotropy fit.
     fn fit_plan(&self) -> Result<VariogramSource> {
-        let drift = match self.method {
-            InterpolationMethod::Universal => self.drift.unwrap_or(Drift::Linear),
+        let drift = match self.primary() {
+            InterpolationMethod::Universal => self.drift,
             _ => Drift::Constant,
         };
-        let model = self.model.model.as_deref().unwrap_or("auto");
+        let model = self.parts.model.as_deref().unwrap_or("auto");
         let mut plan = self.lag.plan(model, drift);
-        if self.model.anisotropy_auto()? {
+        if self.parts.anisotropy_auto()? {
             plan.anisotropy = Some(self.lag.anisotropy_plan()?);
         }
         Ok(VariogramSource::Fit {
@@ -248,8 +186,8 @@ impl MethodOptions {
         Ok(v)
     }
 
-    /// The interpolator of these settings on the data of `fd` (with kriging variances when
-    /// `variance`).
+    /// The interpolator of the plan's one method on the data of `fd` (with kriging variances
+    /// when `variance`).
     pub fn engine(
         &self,
         fd: &FileData,
@@ -257,7 +195,7 @@ impl MethodOptions {
         say: &dyn Fn(&str),
     ) -> Result<Box<dyn Predictor>> {
         self.check_neighbors()?;
-        if self.method == InterpolationMethod::Idw {
+        if self.primary() == InterpolationMethod::Idw {
             let (power, search) = self.idw()?;
             return Idw::new(&fd.data, power, search)
                 .map(|i| Box::new(i) as Box<dyn Predictor>)
@@ -272,7 +210,7 @@ impl MethodOptions {
 
     /// The interpolator of a cross-validation ([`terramesh_geostat::cross_validate`]).
     pub fn interpolator(&self, fd: &FileData, say: &dyn Fn(&str)) -> Result<Interpolator> {
-        if self.method == InterpolationMethod::Idw {
+        if self.primary() == InterpolationMethod::Idw {
             let (power, search) = self.idw()?;
             return Ok(Interpolator::Idw { power, search });
         }
@@ -285,38 +223,50 @@ impl MethodOptions {
         })
     }
 
-    /// The checks of a conditional simulation's method, before any file is read.
+    /// The checks of a conditional simulation's method and counts, before any file is read.
     pub fn check_simulation(&self) -> Result<()> {
-        if self.method == InterpolationMethod::Idw {
+        if self.primary() == InterpolationMethod::Idw {
             return Err(own(
                 Setting::Method,
                 "{method} idw: simulation conditions by kriging; give sk, ok or uk",
             ));
         }
         self.check_no_radius("simulation")?;
-        self.check_neighbors()
+        self.check_neighbors()?;
+        for (setting, n) in [
+            (Setting::Realisations, self.realisations),
+            (Setting::Modes, self.modes),
+        ] {
+            if n == 0 {
+                let name = terramesh_core::vocab::Named::name(setting);
+                return Err(own(setting, format!("{{{name}}} 0: give at least 1")));
+            }
+        }
+        Ok(())
     }
 
-    /// Kriging with an external drift set up from `drift` (the drift chosen and read at the
-    /// data of `fd`, from the file `data`, and an automatic variogram fitted to its
-    /// residuals); `None` without a drift.
+    /// Kriging with the plan's external drift set up (the drift chosen and read at the data
+    /// of `fd`, from the file `data`, and an automatic variogram fitted to its residuals);
+    /// `None` without a drift.
     pub fn external_drift(
         &self,
-        drift: &DriftOptions,
         data: &Path,
         fd: &FileData,
         say: &dyn Fn(&str),
     ) -> Result<Option<ExternalDriftSetup>> {
-        let Some(source) = DriftSource::choose(drift.column.as_deref(), drift.grid.as_deref())?
+        let Some(source) = DriftSource::choose(
+            self.external_drift.as_deref(),
+            self.external_drift_grid.as_deref(),
+        )?
         else {
             return Ok(None);
         };
-        let method = match self.method {
+        let method = match self.primary() {
             InterpolationMethod::Ordinary | InterpolationMethod::Universal => {
                 self.method(&fd.data)?
             }
             other => {
-                let s = drift.setting();
+                let s = self.external_drift_setting();
                 return Err(own(s, format!("{{{s}}}: kriging with an external drift is {{method}} ok (the constant and the drift) or uk (the polynomial and the drift), not {other}")));
             }
         };
@@ -336,20 +286,19 @@ impl MethodOptions {
         }))
     }
 
-    /// The engine of an interpolation: [`MethodOptions::engine`], or kriging with the
-    /// external drift of `drift` (its coefficient told to `say`).
+    /// The engine of an interpolation: [`InterpolationPlan::engine`], or kriging with the
+    /// plan's external drift (its coefficient told to `say`).
     pub fn engine_with_drift(
         &self,
-        drift: &DriftOptions,
         data: &Path,
         fd: &FileData,
         variance: bool,
         say: &dyn Fn(&str),
     ) -> Result<Engine> {
-        let Some(k) = self.external_drift(drift, data, fd, say)? else {
+        let Some(k) = self.external_drift(data, fd, say)? else {
             return Ok(Engine::Plain(self.engine(fd, variance, say)?));
         };
-        let s = drift.setting();
+        let s = self.external_drift_setting();
         let kriging = ExternalDriftKriging::new(
             &fd.data,
             &k.at_data,
@@ -383,6 +332,8 @@ impl MethodOptions {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::plan::ModelParts;
+    use terramesh_geostat::Duplicates;
 
     fn flags(e: Error) -> String {
         e.render(&|s| format!("--{s}"))
@@ -399,13 +350,13 @@ mod tests {
         }
     }
 
-    fn spherical(method: InterpolationMethod) -> MethodOptions {
-        let mut m = MethodOptions::new(method);
-        m.model = ModelOptions {
+    fn spherical(method: InterpolationMethod) -> InterpolationPlan {
+        let mut m = InterpolationPlan::single(method);
+        m.parts = ModelParts {
             model: Some("spherical".into()),
             psill: vec![1.0],
             range: vec![25.0],
-            ..ModelOptions::default()
+            ..ModelParts::default()
         };
         m
     }
@@ -414,10 +365,15 @@ mod tests {
     fn settings_that_would_be_ignored_are_refused_naming_them() {
         let fd = data();
         let mut m = spherical(InterpolationMethod::Ordinary);
-        m.drift = Some(Drift::Quadratic);
         assert_eq!(
-            flags(m.method(&fd.data).unwrap_err()),
+            flags(m.set_drift(Some(Drift::Quadratic)).unwrap_err()),
             "--drift applies to --method uk only"
+        );
+        let mut m = spherical(InterpolationMethod::Universal);
+        m.set_drift(Some(Drift::Quadratic)).unwrap();
+        assert_eq!(
+            m.method(&fd.data).unwrap(),
+            Method::Universal(Drift::Quadratic)
         );
         let mut m = spherical(InterpolationMethod::Universal);
         m.mean = Some(3.0);
@@ -438,20 +394,20 @@ mod tests {
             flags(m.check_simulation().unwrap_err()),
             "--radius applies to --method idw; simulation takes --neighbors"
         );
-        let m = MethodOptions::new(InterpolationMethod::Idw);
+        let m = InterpolationPlan::single(InterpolationMethod::Idw);
         assert!(flags(m.check_simulation().unwrap_err()).starts_with("--method idw: "));
     }
 
     #[test]
     fn the_variogram_comes_from_exactly_one_place() {
         let fd = data();
-        let mut m = MethodOptions::new(InterpolationMethod::Ordinary);
+        let mut m = InterpolationPlan::single(InterpolationMethod::Ordinary);
         assert!(flags(m.variogram_source().unwrap_err())
             .starts_with("kriging needs a variogram: --variogram auto, --variogram FILE.json"));
         m.variogram = Some("auto".into());
         assert!(m.variogram_source().unwrap().fits());
         // A named model with --variogram auto is fitted; with its parameters it is given.
-        m.model.model = Some("exponential".into());
+        m.parts.model = Some("exponential".into());
         match m.variogram_source().unwrap() {
             VariogramSource::Fit { plan, .. } => assert_eq!(plan.model, "exponential"),
             other => panic!("{other:?}"),
@@ -478,20 +434,22 @@ mod tests {
 
     #[test]
     fn idw_search_settings_are_checked() {
-        let mut m = MethodOptions::new(InterpolationMethod::Idw);
+        let mut m = InterpolationPlan::single(InterpolationMethod::Idw);
         assert!(matches!(m.idw().unwrap(), (_, IdwSearch::All)));
-        m.power = -1.0;
+        m.set_neighbors(Some(5));
+        assert!(matches!(m.idw().unwrap(), (_, IdwSearch::Nearest(5))));
+        m.idw_power = -1.0;
         assert_eq!(
             flags(m.idw().unwrap_err()),
             "--power -1: must be a finite number > 0"
         );
-        m.power = 2.0;
-        m.neighbors = Some(0);
+        m.idw_power = 2.0;
+        m.set_neighbors(Some(0));
         assert_eq!(
             flags(m.idw().unwrap_err()),
             "--neighbors 0: must be at least 1"
         );
-        m.neighbors = None;
+        m.set_neighbors(None);
         m.radius = Some(f64::NAN);
         assert_eq!(
             flags(m.idw().unwrap_err()),
