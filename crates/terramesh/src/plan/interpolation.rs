@@ -167,9 +167,9 @@ pub struct InterpolationPlan {
     /// The known mean of simple kriging (unset: the data mean). `--mean`; not a project key.
     #[serde(skip)]
     pub mean: Option<f64>,
-    /// `auto` (fit from the samples) or a path to a `variogram.json`. Unset: a project fits
-    /// (`auto`, [`InterpolationPlan::variogram_or_auto`]); a single command kriges only with
-    /// it or with a model in `parts`.
+    /// `auto` (fit from the samples; a project's default) or a path to a `variogram.json`.
+    /// Unset in a single command's plan ([`InterpolationPlan::single`]), which kriges only
+    /// with it or with a model in `parts`.
     pub variogram: Option<String>,
     /// An explicit variogram (overrides `variogram`), as a project's table.
     pub model: Option<VariogramSpec>,
@@ -238,7 +238,7 @@ impl Default for InterpolationPlan {
             methods: DEFAULT_METHODS.to_vec(),
             drift: Drift::Linear,
             mean: None,
-            variogram: None,
+            variogram: Some("auto".into()),
             model: None,
             parts: ModelParts::default(),
             lag: LagPlan::default(),
@@ -403,6 +403,7 @@ impl InterpolationPlan {
     pub fn single(method: InterpolationMethod) -> InterpolationPlan {
         InterpolationPlan {
             methods: vec![method],
+            variogram: None,
             idw_neighbors: 0,
             ..InterpolationPlan::default()
         }

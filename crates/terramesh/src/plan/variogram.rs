@@ -456,6 +456,24 @@ mod tests {
         );
     }
 
+    /// A build fits the DSM's variogram with the plan's `LagPlan`, which a project cannot set:
+    /// its defaults are the kernels' (what the build used before), so the DSM is unchanged.
+    #[test]
+    fn the_lag_defaults_are_the_kernels() {
+        let l = LagPlan::default();
+        let (s, k) = (l.settings(), LagSettings::default());
+        assert_eq!(
+            (s.lags, s.max_dist, s.estimator, s.max_points),
+            (k.lags, k.max_dist, k.estimator, k.max_points)
+        );
+        assert!(s.direction.is_none() && k.direction.is_none());
+        let (a, d) = (l.plan("auto", Drift::Linear).auto, AutoSettings::default());
+        assert_eq!(
+            (a.drift, a.weighting, a.block, a.loo_points),
+            (d.drift, d.weighting, d.block, d.loo_points)
+        );
+    }
+
     #[test]
     fn the_anisotropy_fit_is_asked_for_by_auto_only() {
         let mut m = nested();

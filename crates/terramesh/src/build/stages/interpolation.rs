@@ -7,8 +7,8 @@ use std::path::Path;
 
 use terramesh_geostat::{
     cross_validate, experimental, kriging, CandidateSummary, CvStats, Data, Drift, Duplicates, Idw,
-    IdwSearch, InterpolationMethod, Interpolator, Lag, LagSettings, Method, Named, Neighbourhood,
-    Predictor, Selection, Variogram,
+    IdwSearch, InterpolationMethod, Interpolator, Lag, Method, Named, Neighbourhood, Predictor,
+    Selection, Variogram,
 };
 
 use crate::build::scale::Choice;
@@ -151,7 +151,9 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
                 .context("interpolation.external_drift_grid")?
         }
     };
-    let lags = experimental(&fit_to, &LagSettings::default())
+    // The lag classes and the fit's weights of the plan's variogram settings (`LagPlan`; a
+    // project keeps their defaults).
+    let lags = experimental(&fit_to, &ip.lag.settings())
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let mut selection = None;
@@ -166,18 +168,12 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         } else {
             Drift::Constant
         };
-        let plan = crate::fitting::FitPlan {
-            model: ip.fit_model.clone(),
-            method: Some(ip.fit),
-            auto: terramesh_geostat::AutoSettings {
-                drift,
-                ..Default::default()
-            },
-            anisotropy: ip
-                .anisotropy
-                .eq_ignore_ascii_case("auto")
-                .then(crate::fitting::AnisotropyPlan::default),
-        };
+        let mut plan = ip.lag.plan(&ip.fit_model, drift);
+        plan.method = Some(ip.fit);
+        plan.anisotropy = ip
+            .anisotropy
+            .eq_ignore_ascii_case("auto")
+            .then(crate::fitting::AnisotropyPlan::default);
         let fitted = crate::fitting::fit(&fit_to, &lags, &plan).context("fitting the variogram")?;
         candidates = fitted
             .candidates
