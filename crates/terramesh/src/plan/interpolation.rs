@@ -7,8 +7,9 @@
 //! `methods`, `--neighbors` is `neighbors` for kriging and `idw_neighbors` for IDW, and the
 //! settings no project key reaches (yet) are fields that a project cannot set (`mean`,
 //! `radius`, `duplicates`, `external_drift`, `parts`, `lag`, `modes`), each with its default
-//! here and its check in [`InterpolationPlan::check_single`] and the methods of
-//! `terramesh::interpolate` that lower the plan to the kernels.
+//! here; a single command checks them where it lowers the plan to the kernels
+//! ([`InterpolationPlan::engine`], [`InterpolationPlan::interpolator`],
+//! [`InterpolationPlan::check_simulation`], [`InterpolationPlan::folds`]).
 
 use std::path::PathBuf;
 
