@@ -163,7 +163,9 @@ fn check_tileable(p: &Project) -> Result<()> {
 /// `k`-th nearest sample (k the larger of kriging's and IDW's neighbourhoods) is measured at
 /// probes on a square lattice of spacing `h` over the tile; for any point `p` of the tile
 /// `R(p) <= R(q) + |p - q| <= max R + h/√2` (the triangle inequality), so every sample any
-/// point of the tile uses lies within that of the tile, equal-distance ties included.
+/// point of the tile uses lies within that of the tile, equal-distance ties included. `R(q)` is
+/// found among the samples of a window around the tile, grown until it provably holds every
+/// probe's `k` nearest (no search tree over the region's samples).
 pub fn plan(
     project: &Project,
     project_file: &Path,
