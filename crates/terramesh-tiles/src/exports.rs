@@ -413,5 +413,6 @@ fn write_glb(
         title,
         georef,
     };
-    super::glb_merge::write_merged_glb(path, &dir.join(NORMALS), &input)
+    let limit = super::glb_merge::GLB_MAX;
+    super::glb_merge::write_merged_glb(path, &dir.join(NORMALS), &input, limit)
 }

@@ -44,16 +44,17 @@ fn pad4(n: usize) -> usize {
 }
 
 /// The largest GLB file (its lengths are 32-bit).
-const GLB_MAX: usize = u32::MAX as usize;
+pub(crate) const GLB_MAX: usize = u32::MAX as usize;
 
 /// Writes `path` as `write_glb` writes the mesh of `g` (one mesh, colours, the one-piece
 /// build's origin and `extras`); the normals' accumulator is the scratch file `acc_path`.
-/// `Ok(Err(bytes))`: the file would be `bytes` long, past GLB's 4 GiB, and nothing was
-/// written.
+/// `Ok(Err(bytes))`: the file would be `bytes` long, past `limit` ([`GLB_MAX`], GLB's 4 GiB),
+/// and nothing was written.
 pub(crate) fn write_merged_glb(
     path: &Path,
     acc_path: &Path,
     g: &GlbInput,
+    limit: usize,
 ) -> Result<std::result::Result<(), usize>> {
     let n = g.vertices.len();
     let (lo, hi) = g.bounds;
@@ -176,7 +177,7 @@ pub(crate) fn write_merged_glb(
     let mut text = serde_json::to_vec(&doc)?;
     text.resize(pad4(text.len()), b' ');
     let total = 12 + 8 + text.len() + 8 + offset;
-    if total > GLB_MAX {
+    if total > limit.min(GLB_MAX) {
         return Ok(Err(total));
     }
 
@@ -286,4 +287,112 @@ fn normals(
         }
     }
     Ok(Some(m))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
+
+    /// `write_glb`'s bytes for the mesh with a one-piece build's parts (`gltf::glb_parts`).
+    fn one_piece(g: &GlbInput) -> Vec<u8> {
+        let (lo, hi) = g.bounds;
+        let origin = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]];
+        let colours = elevation_colours(g.z, lo[2], hi[2]);
+        let extras = json!({
+            "crs": g.georef.crs_code(),
+            "crs_name": g.georef.crs_name(),
+            "units": "metre",
+            "vertical_datum": g.georef.vertical_datum(),
+            "heights": g.georef.heights(),
+            "colours": "COLOR_0: the report's elevation colour map (terrain), linear RGB",
+        });
+        let mesh = GlbMesh {
+            name: g.title,
+            vertices: g.vertices,
+            triangles: g.triangles,
+            colours: Some(&colours),
+        };
+        let opts = GlbOptions {
+            name: g.title,
+            origin,
+            extras,
+        };
+        let mut buf = Vec::new();
+        write_glb(&mut buf, &[mesh], &opts).unwrap();
+        buf
+    }
+
+    /// A `cols` x `rows` lattice at UTM magnitudes, a wavy surface, two triangles a square,
+    /// one degenerate triangle (a zero normal) and one vertex in no triangle.
+    fn lattice(cols: u32, rows: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut v = Vec::new();
+        for j in 0..rows {
+            for i in 0..cols {
+                let (x, y) = (f64::from(i) * 7.3, f64::from(j) * 6.1);
+                v.push([
+                    656_000.0 + x,
+                    3_615_000.0 + y,
+                    150.0 + 20.0 * (x / 90.0).sin() * (y / 70.0).cos(),
+                ]);
+            }
+        }
+        let mut t = Vec::new();
+        for j in 0..rows - 1 {
+            for i in 0..cols - 1 {
+                let a = j * cols + i;
+                t.push([a, a + 1, a + cols + 1]);
+                t.push([a, a + cols + 1, a + cols]);
+            }
+        }
+        t.push([0, 0, 1]);
+        v.push([656_000.0, 3_614_990.0, 149.0]);
+        (v, t)
+    }
+
+    /// The streamed file is `write_glb`'s, with 16-bit indices (a small mesh) and 32-bit ones
+    /// (more than 65,534 vertices); past the limit nothing is written.
+    #[test]
+    fn the_streamed_glb_is_the_writers() {
+        let dir = tempfile::tempdir().unwrap();
+        let georef = terramesh::georef::Georef::utm("14N".parse().unwrap())
+            .with_datum("navd88", "metres, NAVD88 height (EPSG:5703)");
+        for (cols, rows) in [(12, 9), (300, 230)] {
+            let (v, t) = lattice(cols, rows);
+            let z: Vec<f64> = v.iter().map(|p| p[2]).collect();
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for p in &v {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            let g = GlbInput {
+                vertices: &v,
+                z: &z,
+                triangles: &t,
+                bounds: (lo, hi),
+                title: "Fort Worth",
+                georef: &georef,
+            };
+            let path = dir.path().join(format!("dsm-{cols}.glb"));
+            let acc = dir.path().join("acc.f64");
+            let want = one_piece(&g);
+            assert_eq!(want[..4], *b"glTF");
+            assert_eq!(v.len() >= 65_535, cols == 300);
+            assert_eq!(write_merged_glb(&path, &acc, &g, GLB_MAX).unwrap(), Ok(()));
+            let got = std::fs::read(&path).unwrap();
+            assert!(
+                got == want,
+                "{} bytes against the writer's {}",
+                got.len(),
+                want.len()
+            );
+
+            let small = dir.path().join(format!("small-{cols}.glb"));
+            let said = write_merged_glb(&small, &acc, &g, 1000).unwrap();
+            assert_eq!(said, Err(want.len()));
+            assert!(!small.exists());
+        }
+    }
 }
