@@ -275,6 +275,7 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
             "dsm.kml",
             "dsm.dae",
             "dsm-model.kml",
+            "dsm.glb",
             "dsm.tif",
             "dsm.asc"
         ]

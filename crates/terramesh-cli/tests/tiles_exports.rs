@@ -6,7 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use terramesh_io::export::{all_formats, parse_obj, writer, Format, MeshView, Target, ToWrite};
+use terramesh_io::export::{
+    all_formats, elevation_colours, parse_obj, writer, Format, GlbParts, MeshView, Target, ToWrite,
+};
 
 #[allow(dead_code)] // (the field-data readers are for tiles_geology_files.rs)
 #[path = "support/vtu_read.rs"]
@@ -69,7 +71,7 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         .iter()
         .map(|f| f.as_str().unwrap())
         .collect();
-    let surfaces = ["obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae"];
+    let surfaces = ["obj", "ply", "stl", "ts", "msh", "dxf", "kml", "dae", "glb"];
     for ext in surfaces {
         assert!(files.contains(&format!("dsm.{ext}").as_str()), "{files:?}");
     }
@@ -79,9 +81,9 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         .iter()
         .map(|s| s["format"].as_str().unwrap())
         .collect();
-    assert_eq!(skipped, ["glb", "3dtiles", "terrain"]);
+    assert_eq!(skipped, ["3dtiles", "terrain"]);
     assert!(
-        said.contains("not merged") && said.contains("glb"),
+        said.contains("not merged") && said.contains("3dtiles"),
         "{said}"
     );
     for name in ["dsm.kml", "dsm.dae", "dsm-model.kml"] {
@@ -132,7 +134,7 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         one.to_str().unwrap(),
         "--quiet",
         "--set",
-        "export.formats=[\"ts\"]",
+        "export.formats=[\"ts\", \"glb\"]",
         "--set",
         "export.pictures=false",
         "--set",
@@ -182,6 +184,18 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         .unwrap();
     let frame = terramesh_core::coords::LocalEnu::new(lat0, lon0, lo[2]);
     let enu: Vec<[f64; 3]> = geo.iter().map(|g| frame.to_enu(g[1], g[0], g[2])).collect();
+    // glTF's parts as a one-piece build makes them (`terramesh::gltf::glb_parts`): the origin
+    // above, the elevation colours over the elevations' range, and the `extras` of the
+    // one-piece build's own dsm.glb (its CRS and vertical datum; `origin` and `axes` are the
+    // writer's).
+    let colours = elevation_colours(&z, lo[2], hi[2]);
+    let one_glb = std::fs::read(one.join("dsm.glb")).unwrap();
+    let jl = u32::from_le_bytes(one_glb[12..16].try_into().unwrap()) as usize;
+    let doc: serde_json::Value = serde_json::from_slice(&one_glb[20..20 + jl]).unwrap();
+    let mut one_extras = doc["nodes"][0]["extras"].clone();
+    let extras = one_extras.as_object_mut().unwrap();
+    assert!(extras.remove("origin").is_some() && extras.remove("axes").is_some());
+    assert!(extras.contains_key("crs") && extras.contains_key("vertical_datum"));
     let title = std::fs::read_to_string(&ex)
         .unwrap()
         .lines()
@@ -203,7 +217,11 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         dxf_layer: "DSM",
         lon_lat_alt: Some(&geo),
         enu: Some((&enu, [lon0, lat0, lo[2]])),
-        glb: None,
+        glb: Some(GlbParts {
+            origin: [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), lo[2]],
+            colours: Some(&colours),
+            extras: one_extras,
+        }),
     };
     let mut compared = Vec::new();
     for f in all_formats() {

@@ -13,9 +13,10 @@
 //!
 //! KML and COLLADA are written the same way from two more scratch files, the WGS-84 positions
 //! (computed point by point as a one-piece build computes them) and COLLADA's east-north-up
-//! vertices around the centre of the mesh's bounding box. glTF (its colours and bounds) and
-//! the folders (3D Tiles, terrain tiles: a level-of-detail tree of the whole mesh) are not
-//! merged yet ([`Skipped`]).
+//! vertices around the centre of the mesh's bounding box. `dsm.glb` is streamed from the same
+//! scratch files by [`super::glb_merge`] (the writer's bytes, without its in-memory arrays);
+//! a mesh whose GLB would pass 4 GiB is skipped. The folders (3D Tiles, terrain tiles: a
+//! level-of-detail tree of the whole mesh) are not merged yet ([`Skipped`]).
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -84,6 +85,8 @@ const TRIS: &str = "triangles.u32";
 const GEO: &str = "lon-lat-alt.f64";
 /// East-north-up metres around COLLADA's origin per vertex.
 const ENU: &str = "enu.f64";
+/// The glTF normals' per-vertex sums (`dsm.glb`).
+const NORMALS: &str = "normal-sums.f64";
 const FIELDS: [&str; 4] = [
     "elevation_uk",
     "kriging_std",
@@ -131,6 +134,7 @@ pub(crate) fn write_surfaces(
 ) -> Result<Surfaces> {
     let mut skipped = Vec::new();
     let mut wanted = Vec::new();
+    let mut glb = false;
     for &f in terramesh_io::export::all_formats().iter() {
         if !labels.formats.contains(&f) || f == Format::Vtu {
             continue;
@@ -139,22 +143,15 @@ pub(crate) fn write_surfaces(
         let needs = w.needs();
         let placed = labels.georef.is_some();
         match w.target() {
+            Target::File(_) if needs.glb && placed => glb = true,
             Target::File(ext) if !needs.glb && (placed || !(needs.geographic || needs.enu)) => {
                 wanted.push((f, ext));
             }
-            Target::File(_) if !needs.glb => skipped.push(Skipped {
+            Target::File(_) => skipped.push(Skipped {
                 format: f.name().into(),
                 why: "the plan records no CRS that places the region on the Earth (a plan made \
                       by an older terramesh, or a CRS without an EPSG code): plan again, or \
                       build it in one piece"
-                    .into(),
-            }),
-            Target::File(_) => skipped.push(Skipped {
-                format: f.name().into(),
-                why: "a GLB file is at most 4 GiB (its chunk lengths are 32-bit), which a region \
-                      too large for one process exceeds, and its colours and bounds are made \
-                      from the whole mesh: not merged; build a part of the region in one piece, \
-                      or view the merged dsm.vtu"
                     .into(),
             }),
             Target::Folder(_) => skipped.push(Skipped {
@@ -165,7 +162,7 @@ pub(crate) fn write_surfaces(
             }),
         }
     }
-    if wanted.is_empty() {
+    if wanted.is_empty() && !glb {
         return Ok(Surfaces {
             files: Vec::new(),
             skipped,
@@ -199,6 +196,21 @@ pub(crate) fn write_surfaces(
         .into_iter()
         .flatten()
         .collect();
+    let mut written = written;
+    if let (true, Some(georef)) = (glb, &labels.georef) {
+        let path = out.join("dsm.glb");
+        match write_glb(&path, &scratch.0, labels.title, georef, lo)? {
+            Ok(()) => written.push(path),
+            Err(bytes) => skipped.push(Skipped {
+                format: Format::Glb.name().into(),
+                why: format!(
+                    "the merged mesh's GLB file would be {bytes} bytes, past the format's 4 GiB \
+                     (its chunk lengths are 32-bit): not merged; view the merged dsm.vtu, or \
+                     build a part of the region in one piece"
+                ),
+            }),
+        }
+    }
     drop(scratch);
     Ok(Surfaces {
         files: written,
@@ -377,4 +389,30 @@ fn write_scratch(
         file.flush().at(&dir.join(name))?;
     }
     Ok((lo, hi))
+}
+
+/// Writes `path` (`dsm.glb`) from the scratch files in `dir` ([`super::glb_merge`]);
+/// `Ok(Err(bytes))` when it would be past GLB's 4 GiB.
+fn write_glb(
+    path: &Path,
+    dir: &Path,
+    title: &str,
+    georef: &terramesh::georef::Georef,
+    bounds: ([f64; 3], [f64; 3]),
+) -> Result<std::result::Result<(), usize>> {
+    let (xyz, z, tris) = (
+        map(&dir.join(XYZ))?,
+        map(&dir.join(Z))?,
+        map(&dir.join(TRIS))?,
+    );
+    let input = super::glb_merge::GlbInput {
+        vertices: slice::<[f64; 3]>(&xyz),
+        z: slice::<f64>(&z),
+        triangles: slice::<[u32; 3]>(&tris),
+        bounds,
+        title,
+        georef,
+    };
+    let limit = super::glb_merge::GLB_MAX;
+    super::glb_merge::write_merged_glb(path, &dir.join(NORMALS), &input, limit)
 }

@@ -10,8 +10,9 @@
 //! * [`build_tile`]: builds one tile into `PLAN/tiles/ID/`, atomically; the manifest records
 //!   its state under a lock, so many processes may build at once.
 //! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc`, the other surface
-//!   single-file formats of `export.formats` but glTF (`dsm.obj`, `.ply`, `.stl`, `.ts`,
-//!   `.msh`, `.dxf`, `.kml`, `.dae`, through the one-piece build's writers) and a report, and,
+//!   single-file formats of `export.formats` (`dsm.obj`, `.ply`, `.stl`, `.ts`, `.msh`,
+//!   `.dxf`, `.kml`, `.dae`, through the one-piece build's writers; `dsm.glb`, the glTF
+//!   writer's bytes streamed) and a report, and,
 //!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`, and from the
 //!   merged volume mesh the boundary meshes, `model.msh`, `model.f3grid` and the bodies.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.
@@ -52,6 +53,7 @@ mod geology;
 mod geology_plan;
 mod geology_tile;
 mod geometry;
+mod glb_merge;
 mod grid_merge;
 mod manifest;
 mod merge;

@@ -8,9 +8,10 @@
 //! row by row, one row in memory (`grid_merge.rs`). The other surface formats of the
 //! project's `export.formats` (OBJ, PLY, STL, TSurf, MSH, DXF, KML, COLLADA) go through the
 //! one-piece build's writers, reading the merged mesh from mapped scratch files
-//! (`exports.rs`). glTF and the formats that need the whole mesh at once (3D Tiles, Cesium
-//! terrain, the sealed solid, the report's 3D view, the pictures) are not made by the merge
-//! (`merge.json`'s `not_merged`): build them from `dsm.vtu` or in one piece.
+//! (`exports.rs`); glTF is the glTF writer's bytes streamed from them (`glb_merge.rs`). The
+//! formats that need the whole mesh at once (3D Tiles, Cesium terrain, the sealed solid, the
+//! report's 3D view, the pictures) are not made by the merge (`merge.json`'s `not_merged`):
+//! build them from `dsm.vtu` or in one piece.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -119,7 +120,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         crs_name: &crs_name,
         field_data: Vec::new(),
         stl_origin: [m.origin[0], m.origin[1], 0.0],
-        georef: georef_of(m, &project.export.formats)?,
+        georef: georef_of(m, &project)?,
     };
     let surfaces = super::exports::write_surfaces(plan, m, &seams, out, &labels)?;
     written.extend(surfaces.files);
@@ -172,23 +173,26 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
 }
 
 /// Where the plan's region lies on the Earth, as the one-piece build places it (a UTM zone, or
-/// the project's CRS by its EPSG code), when KML or COLLADA are asked for; `None` for a plan
-/// that does not record it (made before `crs_text.zone`) or a CRS without an EPSG code.
+/// the project's CRS by its EPSG code, with the vertical datum the project names), when KML,
+/// COLLADA or glTF are asked for; `None` for a plan that does not record it (made before
+/// `crs_text.zone`) or a CRS without an EPSG code.
 fn georef_of(
     m: &Manifest,
-    formats: &[terramesh_io::export::Format],
+    project: &terramesh::project::Project,
 ) -> Result<Option<terramesh::georef::Georef>> {
     use terramesh_io::export::Format;
-    if !formats
+    if !project
+        .export
+        .formats
         .iter()
-        .any(|f| matches!(f, Format::Kml | Format::Collada))
+        .any(|f| matches!(f, Format::Kml | Format::Collada | Format::Glb))
     {
         return Ok(None);
     }
     let Some(text) = &m.crs_text else {
         return Ok(None);
     };
-    Ok(match (&text.zone, text.name.is_some(), m.epsg) {
+    let georef = match (&text.zone, text.name.is_some(), m.epsg) {
         (Some(z), _, _) => z
             .parse::<terramesh_core::coords::Zone>()
             .ok()
@@ -198,7 +202,12 @@ fn georef_of(
             Some(terramesh::georef::Georef::crs(&crs, "region.crs")?)
         }
         _ => None,
-    })
+    };
+    // glTF's `extras` name the datum as a one-piece build's do (`build/exports.rs`).
+    Ok(georef.map(|g| match project.named_height_datum() {
+        Some(d) => g.with_datum(d.name(), d.describe()),
+        None => g,
+    }))
 }
 
 fn bits(p: [f64; 2]) -> (u64, u64) {

@@ -41,14 +41,13 @@ pub fn in_window(extent: [f64; 4], halo: f64, p: [f64; 2]) -> bool {
 /// triples) from the samples `xy`, `z` (in the order of `PLAN/samples.f64`), and returns each
 /// tile's count in the order of `m.tiles`.
 ///
-/// The samples are bucketed once by the tile grid's cells of `m` (counting sort, 4 bytes a
-/// sample); a tile gathers the buckets of the cells its window overlaps, keeps the samples
-/// [`in_window`] accepts and writes them in their original order. The cell of a coordinate is
-/// monotone in it (clamped at the grid's edges), so every sample of a window lies in one of
-/// the cells between the cells of the window's corners.
+/// The samples are bucketed once by the tile grid's cells of `m` ([`Buckets`]); a tile
+/// gathers the buckets of the cells its window overlaps, keeps the samples [`in_window`]
+/// accepts and writes them in their original order.
 pub(crate) fn write_tile_samples(
     plan: &Path,
     m: &Manifest,
+    buckets: &Buckets,
     xy: &[[f64; 2]],
     z: &[f64],
 ) -> Result<Vec<usize>> {
@@ -61,7 +60,11 @@ pub(crate) fn write_tile_samples(
             halo: t.halo,
         })
         .collect();
-    write_windows(plan, m.origin, m.tile_size, m.shape, &windows, xy, z)
+    debug_assert_eq!(
+        (buckets.origin, buckets.size, buckets.shape),
+        (m.origin, m.tile_size, m.shape)
+    );
+    write_windows(plan, buckets, &windows, xy, z)
 }
 
 /// A tile's data window.
@@ -71,77 +74,156 @@ struct Window<'a> {
     halo: f64,
 }
 
-/// [`write_tile_samples`] for the tile grid of `origin`, `size` and `shape`.
+/// [`write_tile_samples`] for the `windows`, the samples bucketed by `buckets`.
 fn write_windows(
     plan: &Path,
-    origin: [f64; 2],
-    size: f64,
-    shape: [usize; 2],
+    buckets: &Buckets,
     windows: &[Window],
     xy: &[[f64; 2]],
     z: &[f64],
 ) -> Result<Vec<usize>> {
-    if xy.len() > u32::MAX as usize {
-        return Err(Error::TooManySamples {
-            samples: xy.len(),
-            max: u32::MAX.into(),
-        });
-    }
-    let [nx, ny] = shape;
-    let cell = |p: [f64; 2]| {
-        let i = cell_of(p[0], origin[0], size, nx);
-        let j = cell_of(p[1], origin[1], size, ny);
-        j * nx + i
-    };
-    // Counting sort of the sample indices by cell: `start[c]..start[c + 1]` in `order`.
-    let mut start = vec![0usize; nx * ny + 1];
-    for &p in xy {
-        start[cell(p) + 1] += 1;
-    }
-    for c in 0..nx * ny {
-        start[c + 1] += start[c];
-    }
-    let mut fill = start.clone();
-    let mut order = vec![0u32; xy.len()];
-    for (k, &p) in xy.iter().enumerate() {
-        let c = cell(p);
-        order[fill[c]] = k as u32;
-        fill[c] += 1;
-    }
-    drop(fill);
     let dir = plan.join(SAMPLES_DIR);
     std::fs::create_dir_all(&dir).at(&dir)?;
     let mut counts = Vec::with_capacity(windows.len());
     let mut keep: Vec<u32> = Vec::new();
     for t in windows {
-        let [x0, y0, x1, y1] = t.extent;
-        let h = t.halo;
+        buckets.window(xy, t.extent, t.halo, &mut keep);
+        let path = plan.join(samples_file(t.id));
+        write_records(&path, keep.iter().map(|&k| k as usize), xy, z)?;
+        counts.push(keep.len());
+    }
+    Ok(counts)
+}
+
+/// The samples bucketed by the cells of the tile grid (a counting sort of their indices, 4
+/// bytes a sample), to gather a window's samples without a search tree over the region.
+pub(crate) struct Buckets {
+    origin: [f64; 2],
+    size: f64,
+    shape: [usize; 2],
+    /// Cell `c`'s samples are `order[start[c]..start[c + 1]]`, in increasing order.
+    start: Vec<usize>,
+    order: Vec<u32>,
+}
+
+impl Buckets {
+    /// The samples `xy` bucketed by the tile grid of `origin`, `size` and `shape`.
+    pub(crate) fn new(
+        origin: [f64; 2],
+        size: f64,
+        shape: [usize; 2],
+        xy: &[[f64; 2]],
+    ) -> Result<Buckets> {
+        if xy.len() > u32::MAX as usize {
+            return Err(Error::TooManySamples {
+                samples: xy.len(),
+                max: u32::MAX.into(),
+            });
+        }
+        let mut b = Buckets {
+            origin,
+            size,
+            shape,
+            start: vec![0usize; shape[0] * shape[1] + 1],
+            order: vec![0u32; xy.len()],
+        };
+        for &p in xy {
+            let c = b.cell(p);
+            b.start[c + 1] += 1;
+        }
+        for c in 0..shape[0] * shape[1] {
+            b.start[c + 1] += b.start[c];
+        }
+        let mut fill = b.start.clone();
+        for (k, &p) in xy.iter().enumerate() {
+            let c = b.cell(p);
+            b.order[fill[c]] = k as u32;
+            fill[c] += 1;
+        }
+        Ok(b)
+    }
+
+    fn cell(&self, p: [f64; 2]) -> usize {
+        let i = cell_of(p[0], self.origin[0], self.size, self.shape[0]);
+        let j = cell_of(p[1], self.origin[1], self.size, self.shape[1]);
+        j * self.shape[0] + i
+    }
+
+    /// Into `keep`, in increasing order: the indices of the samples [`in_window`] of `extent`
+    /// and `halo`. The cell of a coordinate is monotone in it (clamped at the grid's edges),
+    /// so every sample of the window lies in one of the cells between the cells of the
+    /// window's corners.
+    pub(crate) fn window(&self, xy: &[[f64; 2]], extent: [f64; 4], halo: f64, keep: &mut Vec<u32>) {
+        let [x0, y0, x1, y1] = extent;
+        let (o, s, [nx, ny]) = (self.origin, self.size, self.shape);
         let (i0, i1) = (
-            cell_of(x0 - h, origin[0], size, nx),
-            cell_of(x1 + h, origin[0], size, nx),
+            cell_of(x0 - halo, o[0], s, nx),
+            cell_of(x1 + halo, o[0], s, nx),
         );
         let (j0, j1) = (
-            cell_of(y0 - h, origin[1], size, ny),
-            cell_of(y1 + h, origin[1], size, ny),
+            cell_of(y0 - halo, o[1], s, ny),
+            cell_of(y1 + halo, o[1], s, ny),
         );
         keep.clear();
         for j in j0..=j1 {
             for i in i0..=i1 {
                 let c = j * nx + i;
                 keep.extend(
-                    order[start[c]..start[c + 1]]
+                    self.order[self.start[c]..self.start[c + 1]]
                         .iter()
                         .copied()
-                        .filter(|&k| in_window(t.extent, h, xy[k as usize])),
+                        .filter(|&k| in_window(extent, halo, xy[k as usize])),
                 );
             }
         }
         keep.sort_unstable();
-        let path = plan.join(samples_file(t.id));
-        write_records(&path, keep.iter().map(|&k| k as usize), xy, z)?;
-        counts.push(keep.len());
     }
-    Ok(counts)
+}
+
+/// [`reach`] of the extent `r` over every sample of `xy`, computed from the samples near the
+/// extent only (no search tree over the region), bit for bit the same value.
+///
+/// The samples in the window of a trial halo `g` (starting at `guess`, doubled until it holds)
+/// are searched: where the `k`-th nearest window sample of every probe `q` is at most `g`
+/// away, no sample outside the window is as near (every point outside it lies farther than
+/// `g` from the extent), so the window's `k`-th distances are the region's, and so is their
+/// maximum. Returns the halo and the trial halos tried.
+pub(crate) fn reach_near(
+    buckets: &Buckets,
+    xy: &[[f64; 2]],
+    k: usize,
+    r: [f64; 4],
+    h: f64,
+    guess: f64,
+) -> Result<(f64, usize)> {
+    let k = k.max(1).min(xy.len());
+    let mut g = if guess > 0.0 && guess.is_finite() {
+        guess
+    } else {
+        (r[2] - r[0]).max(r[3] - r[1])
+    };
+    let mut keep = Vec::new();
+    let mut near: Vec<[f64; 2]> = Vec::new();
+    for tried in 1.. {
+        buckets.window(xy, r, g, &mut keep);
+        let all = keep.len() == xy.len();
+        if keep.len() >= k {
+            near.clear();
+            near.extend(keep.iter().map(|&i| xy[i as usize]));
+            let tree: ImmutableKdTree<f64, 2> =
+                ImmutableKdTree::new_from_slice(&near).map_err(|e| Error::SearchTree {
+                    points: "the samples".into(),
+                    why: format!("{e:?}"),
+                })?;
+            // A probe whose k-th window sample lies past `g` ends the trial.
+            let limit = if all { f64::INFINITY } else { g };
+            if let Some((farthest, step)) = farthest(&tree, k, r, h, limit) {
+                return Ok((pad(farthest, step), tried));
+            }
+        }
+        g *= 2.0;
+    }
+    unreachable!("the window grows until it holds every sample")
 }
 
 /// Writes the samples `xy`, `z` to `path` as `[x, y, z]` little-endian `f64` triples,
@@ -172,6 +254,20 @@ fn write_records(
 /// `R(p) <= R(q) + |p - q| <= max R + step/√2` (the triangle inequality), so every point any
 /// point of the extent uses lies within it, equal-distance ties included.
 pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f64) -> f64 {
+    let (farthest, step) = farthest(tree, k, r, h, f64::INFINITY).expect("no limit");
+    pad(farthest, step)
+}
+
+/// The largest distance from a probe of the extent `r` (a lattice of spacing at most `h`) to
+/// its `k`-th nearest point of `tree`, and the lattice's step; `None` as soon as a distance is
+/// past `limit`.
+fn farthest(
+    tree: &ImmutableKdTree<f64, 2>,
+    k: usize,
+    r: [f64; 4],
+    h: f64,
+    limit: f64,
+) -> Option<(f64, f64)> {
     let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
     let n = [
         ((r[2] - r[0]) / h).ceil() as usize + 1,
@@ -190,16 +286,70 @@ pub(crate) fn reach(tree: &ImmutableKdTree<f64, 2>, k: usize, r: [f64; 4], h: f6
                 .execute();
             if let Some(last) = near.last() {
                 reach = reach.max(last.distance.sqrt());
+                if reach > limit {
+                    return None;
+                }
             }
         }
     }
     let step = ((r[2] - r[0]) / (n[0] - 1) as f64).max((r[3] - r[1]) / (n[1] - 1) as f64);
-    (reach + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
+    Some((reach, step))
+}
+
+/// The halo from the farthest `k`-th neighbour and the probes' step (see [`reach`]).
+fn pad(farthest: f64, step: f64) -> f64 {
+    (farthest + step * std::f64::consts::FRAC_1_SQRT_2) * (1.0 + 1e-9) + 1e-6
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The halo from the samples near a tile is the halo from a search tree over all of them,
+    /// bit for bit: clustered samples, an empty corner (whose halo reaches far), ties on a
+    /// lattice, and a first guess far too small (the window grows).
+    #[test]
+    fn the_halo_from_nearby_samples_is_the_halo_from_all_of_them() {
+        let (origin, size, shape) = ([0.0, 0.0], 100.0, [4, 3]);
+        let mut xy = Vec::new();
+        for a in 0..60 {
+            for b in 0..45 {
+                let p = [a as f64 * 5.0 + 2.5, b as f64 * 5.0 + 2.5];
+                // leave the tile x3y2 and most of x2y2 empty
+                if p[0] > 240.0 && p[1] > 200.0 {
+                    continue;
+                }
+                xy.push(p);
+            }
+        }
+        for k in 0..500u32 {
+            // a cluster of irregular points around (120, 80)
+            let f = |m: u32| ((k.wrapping_mul(m) % 997) as f64 / 997.0 - 0.5) * 30.0;
+            xy.push([120.0 + f(7919), 80.0 + f(104_729)]);
+        }
+        let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(&xy).unwrap();
+        let buckets = Buckets::new(origin, size, shape, &xy).unwrap();
+        let mut grew = 0;
+        for k in [1, 16, 32] {
+            for j in 0..3 {
+                for i in 0..4 {
+                    let r = [
+                        i as f64 * size,
+                        j as f64 * size,
+                        (i + 1) as f64 * size,
+                        (j + 1) as f64 * size,
+                    ];
+                    let want = reach(&tree, k, r, 5.0);
+                    let (got, tried) = reach_near(&buckets, &xy, k, r, 5.0, 1.0).unwrap();
+                    assert_eq!(got.to_bits(), want.to_bits(), "k {k}, tile {i},{j}");
+                    assert!(tried > 1, "a guess of 1 m holds nowhere");
+                    grew = grew.max(tried);
+                }
+            }
+        }
+        // The empty corner's window grew past its neighbours' samples.
+        assert!(grew >= 8, "{grew}");
+    }
 
     /// Every window's file holds exactly the samples a scan of all of them keeps, in order:
     /// samples on the windows' edges, outside the tile grid, and repeated coordinates.
@@ -233,7 +383,8 @@ mod tests {
                 });
             }
         }
-        let counts = write_windows(dir.path(), origin, size, shape, &windows, &xy, &z).unwrap();
+        let buckets = Buckets::new(origin, size, shape, &xy).unwrap();
+        let counts = write_windows(dir.path(), &buckets, &windows, &xy, &z).unwrap();
         for (w, count) in windows.iter().zip(counts) {
             let want: Vec<[f64; 3]> = (0..xy.len())
                 .filter(|&k| in_window(w.extent, w.halo, xy[k]))

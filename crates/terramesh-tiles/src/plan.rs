@@ -3,7 +3,6 @@
 
 use std::path::Path;
 
-use kiddo::ImmutableKdTree;
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
@@ -164,7 +163,9 @@ fn check_tileable(p: &Project) -> Result<()> {
 /// `k`-th nearest sample (k the larger of kriging's and IDW's neighbourhoods) is measured at
 /// probes on a square lattice of spacing `h` over the tile; for any point `p` of the tile
 /// `R(p) <= R(q) + |p - q| <= max R + h/√2` (the triangle inequality), so every sample any
-/// point of the tile uses lies within that of the tile, equal-distance ties included.
+/// point of the tile uses lies within that of the tile, equal-distance ties included. `R(q)` is
+/// found among the samples of a window around the tile, grown until it provably holds every
+/// probe's `k` nearest (no search tree over the region's samples).
 pub fn plan(
     project: &Project,
     project_file: &Path,
@@ -268,11 +269,9 @@ pub fn plan(
             && (j as usize) < shape[1]
             && !polys[j as usize * shape[0] + i as usize].is_empty()
     };
-    let tree: ImmutableKdTree<f64, 2> =
-        ImmutableKdTree::new_from_slice(data.xy()).map_err(|e| Error::SearchTree {
-            points: "the samples".into(),
-            why: format!("{e:?}"),
-        })?;
+    // The samples by tile cell: each tile's halo from the samples near it (no search tree
+    // over the region), then each tile's samples file.
+    let buckets = super::partition::Buckets::new(lo, tile_size, shape, data.xy())?;
     let h = samples.cell[0].min(samples.cell[1]).min(tile_size / 4.0);
     let mut tiles = Vec::new();
     let mut max_halo: f64 = 0.0;
@@ -299,7 +298,7 @@ pub fn plan(
                 .collect();
             let neighbours = seams.iter().map(|s| s.neighbour.clone()).collect();
             // The halo: the farthest k-th neighbour over probes, plus the probes' reach.
-            let halo = super::partition::reach(&tree, k, r, h);
+            let (halo, _) = super::partition::reach_near(&buckets, data.xy(), k, r, h, 4.0 * h)?;
             max_halo = max_halo.max(halo);
             tiles.push(Tile {
                 id: id(i, j),
@@ -377,7 +376,8 @@ pub fn plan(
         tiles,
     };
     // Every tile's own samples, so that a tile reads only its window.
-    let counts = super::partition::write_tile_samples(out, &manifest, data.xy(), data.z())?;
+    let counts =
+        super::partition::write_tile_samples(out, &manifest, &buckets, data.xy(), data.z())?;
     for (t, count) in manifest.tiles.iter_mut().zip(counts) {
         t.data = Some(TileData {
             file: super::partition::samples_file(&t.id),
