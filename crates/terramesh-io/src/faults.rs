@@ -806,7 +806,12 @@ mod tests {
     #[test]
     fn surface_errors_are_typed_and_count_from_one() {
         let mut s = FaultSurface {
-            vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]],
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, -1.0, 0.0],
+            ],
             triangles: vec![[0, 1, 2], [0, 1, 3]],
         };
         let e = check_surface(&s).unwrap_err();
@@ -824,7 +829,13 @@ mod tests {
         );
         s.triangles[1] = [2, 0, 1];
         let e = check_surface(&s).unwrap_err();
-        assert_eq!(e, SurfaceError::RepeatedTriangle { triangle: 1, first: 0 });
+        assert_eq!(
+            e,
+            SurfaceError::RepeatedTriangle {
+                triangle: 1,
+                first: 0
+            }
+        );
         assert_eq!(e.to_string(), "triangle 2 repeats triangle 1");
         s.triangles[1] = [0, 1, 9];
         let e = check_surface(&s).unwrap_err();
@@ -836,15 +847,25 @@ mod tests {
                 vertices: 4
             }
         );
-        assert_eq!(e.to_string(), "triangle 2 refers to vertex 10, but there are 4");
+        assert_eq!(
+            e.to_string(),
+            "triangle 2 refers to vertex 10, but there are 4"
+        );
         // A file's surface error names the file and the fault around the typed error.
-        let e = parse_surface(Path::new("a.obj"), b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "F1")
-            .unwrap_err();
+        let e = parse_surface(
+            Path::new("a.obj"),
+            b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+            "F1",
+        )
+        .unwrap_err();
         assert!(
             matches!(
                 &e,
                 FaultFileError::Surface {
-                    source: SurfaceError::Collinear { triangle: 0, corners: [0, 1, 2] },
+                    source: SurfaceError::Collinear {
+                        triangle: 0,
+                        corners: [0, 1, 2]
+                    },
                     ..
                 }
             ),

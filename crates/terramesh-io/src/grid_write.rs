@@ -445,17 +445,34 @@ mod tests {
     fn grid_spec_errors_are_typed_and_worded() {
         let e = |t: &str| t.parse::<RasterGrid>().unwrap_err();
         let c = e("0,0,1");
-        assert_eq!(c, GridSpecError::Count { spec: "0,0,1".into() });
-        assert_eq!(c.to_string(), "'0,0,1': expected xmin,ymin,xmax,ymax,nx,ny (6 values)");
+        assert_eq!(
+            c,
+            GridSpecError::Count {
+                spec: "0,0,1".into()
+            }
+        );
+        assert_eq!(
+            c.to_string(),
+            "'0,0,1': expected xmin,ymin,xmax,ymax,nx,ny (6 values)"
+        );
         let f = e("0,nan,1,1,2,2");
-        assert!(matches!(f, GridSpecError::NotFinite { name: "ymin", .. }), "{f:?}");
+        assert!(
+            matches!(f, GridSpecError::NotFinite { name: "ymin", .. }),
+            "{f:?}"
+        );
         assert_eq!(f.to_string(), "ymin 'nan' is not a finite number");
         let n = e("0,0,1,1,2, 1");
-        assert!(matches!(n, GridSpecError::TooFewNodes { name: "ny", .. }), "{n:?}");
+        assert!(
+            matches!(n, GridSpecError::TooFewNodes { name: "ny", .. }),
+            "{n:?}"
+        );
         assert_eq!(n.to_string(), "ny '1' must be an integer >= 2");
         let z = e("0,0,0,1,2,2");
         assert!(matches!(z, GridSpecError::Empty { .. }), "{z:?}");
-        assert_eq!(z.to_string(), "'0,0,0,1,2,2': needs xmax > xmin and ymax > ymin");
+        assert_eq!(
+            z.to_string(),
+            "'0,0,0,1,2,2': needs xmax > xmin and ymax > ymin"
+        );
     }
 
     #[test]

@@ -315,7 +315,10 @@ mod tests {
         );
         assert_eq!(
             e.to_string(),
-            format!("{} (object 'pit'): no POLYGON or MULTIPOLYGON found", wkt.display())
+            format!(
+                "{} (object 'pit'): no POLYGON or MULTIPOLYGON found",
+                wkt.display()
+            )
         );
         let obj = dir.path().join("dam.obj");
         std::fs::write(&obj, "# nothing\n").unwrap();

@@ -310,7 +310,10 @@ mod tests {
         bad.constraint_edges.pop();
         let e = bad.sanity_check(&r).unwrap_err();
         assert_eq!(e, SanityError::UnconstrainedBoundary { edge: [0, 3] });
-        assert_eq!(e.to_string(), "boundary edge (0, 3) is not a constraint edge");
+        assert_eq!(
+            e.to_string(),
+            "boundary edge (0, 3) is not a constraint edge"
+        );
         let mut bad = m.clone();
         bad.triangles.pop();
         bad.constraint_edges = vec![[0, 1], [1, 2], [2, 0]];
@@ -334,6 +337,9 @@ mod tests {
             matches!(e, SanityError::Uncovered { segment: 4, .. }),
             "{e:?}"
         );
-        assert!(e.to_string().starts_with("input segment 4 of length "), "{e}");
+        assert!(
+            e.to_string().starts_with("input segment 4 of length "),
+            "{e}"
+        );
     }
 }

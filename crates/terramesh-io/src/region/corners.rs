@@ -223,14 +223,28 @@ mod tests {
     #[test]
     fn corner_errors_are_typed_and_worded() {
         let e = parse_corner("48.5").unwrap_err();
-        assert_eq!(e, CornerError::OneValue { corner: "48.5".into() });
+        assert_eq!(
+            e,
+            CornerError::OneValue {
+                corner: "48.5".into()
+            }
+        );
         assert_eq!(
             e.to_string(),
             "corner '48.5' needs a latitude and a longitude, e.g. \"48.7224 7.3368\""
         );
         let e = parse_corner(" x y ").unwrap_err();
-        assert_eq!(e, CornerError::Unreadable { corner: "x y".into() });
-        assert!(e.to_string().starts_with("cannot read corner 'x y' as LATITUDE LONGITUDE"), "{e}");
+        assert_eq!(
+            e,
+            CornerError::Unreadable {
+                corner: "x y".into()
+            }
+        );
+        assert!(
+            e.to_string()
+                .starts_with("cannot read corner 'x y' as LATITUDE LONGITUDE"),
+            "{e}"
+        );
         let e = parse_corner("48 43 7 20").unwrap_err();
         assert!(matches!(e, CornerError::Ambiguous { .. }), "{e:?}");
         assert!(e.to_string().contains("in more than one way"), "{e}");
@@ -239,7 +253,15 @@ mod tests {
         // In a list, the corner's number and the list are named around the typed error.
         match parse_corners("0 0; 0 1; x y").unwrap_err() {
             RegionError::Corner { corner, source, .. } => {
-                assert_eq!((corner, source), (3, CornerError::Unreadable { corner: "x y".into() }));
+                assert_eq!(
+                    (corner, source),
+                    (
+                        3,
+                        CornerError::Unreadable {
+                            corner: "x y".into()
+                        }
+                    )
+                );
             }
             other => panic!("{other:?}"),
         }

@@ -339,13 +339,16 @@ mod tests {
         let e = parse_geojson(r#"{"type":"LineString","coordinates":[[0,0],[1,1]]}"#).unwrap_err();
         assert!(matches!(e, GeoJsonError::NoPolygon), "{e:?}");
         assert!(e.to_string().starts_with("no Polygon"), "{e}");
-        let e = parse_geojson_lines(r#"{"type":"Feature","geometry":{"type":"Circle"}}"#)
-            .unwrap_err();
+        let e =
+            parse_geojson_lines(r#"{"type":"Feature","geometry":{"type":"Circle"}}"#).unwrap_err();
         assert!(
             matches!(&e, GeoJsonError::UnknownType { path, kind }
                 if path == "$.geometry" && kind == "Circle"),
             "{e:?}"
         );
-        assert_eq!(e.to_string(), r#"$.geometry: unknown GeoJSON type "Circle""#);
+        assert_eq!(
+            e.to_string(),
+            r#"$.geometry: unknown GeoJSON type "Circle""#
+        );
     }
 }

@@ -273,6 +273,10 @@ mod tests {
         assert!(e.to_string().starts_with("not valid XML: "), "{e}");
         let e = parse_kml("<kml></kml>").unwrap_err();
         assert!(matches!(e, KmlError::NoPolygon), "{e:?}");
-        assert!(e.to_string().starts_with("no <Polygon> found; in Google Earth"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("no <Polygon> found; in Google Earth"),
+            "{e}"
+        );
     }
 }

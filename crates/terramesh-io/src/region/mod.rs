@@ -373,7 +373,10 @@ mod tests {
             "{e:?}"
         );
         let e = e.to_string();
-        assert!(e.contains("x.kml: line 1: <Polygon> without <outerBoundaryIs>"), "{e}");
+        assert!(
+            e.contains("x.kml: line 1: <Polygon> without <outerBoundaryIs>"),
+            "{e}"
+        );
         let e = load(
             &RegionInput::File(dir.path().join("missing.geojson")),
             RegionCrs::Projected,

@@ -76,17 +76,13 @@ pub enum WktProblem {
     #[error("expected a number")]
     Number,
     /// A geometry keyword was expected.
-    #[error(
-        "expected POLYGON, MULTIPOLYGON, LINESTRING, MULTILINESTRING or GEOMETRYCOLLECTION"
-    )]
+    #[error("expected POLYGON, MULTIPOLYGON, LINESTRING, MULTILINESTRING or GEOMETRYCOLLECTION")]
     Geometry,
     /// A `POINT`'s parentheses do not close.
     #[error("unbalanced parentheses")]
     Unbalanced,
     /// `GEOMETRYCOLLECTION`s nested deeper than [`MAX_WKT_DEPTH`].
-    #[error(
-        "GEOMETRYCOLLECTIONs nest more than {MAX_WKT_DEPTH} deep; flatten the collection"
-    )]
+    #[error("GEOMETRYCOLLECTIONs nest more than {MAX_WKT_DEPTH} deep; flatten the collection")]
     TooDeep,
 }
 
@@ -313,7 +309,10 @@ mod tests {
                 found: "x, 0 0))".into()
             }
         );
-        assert_eq!(e.to_string(), "line 2, column 4: expected a number, found 'x, 0 0))'");
+        assert_eq!(
+            e.to_string(),
+            "line 2, column 4: expected a number, found 'x, 0 0))'"
+        );
         let e = parse_wkt("CIRCLE (0 0, 1)").unwrap_err().to_string();
         assert!(e.contains("expected POLYGON"), "{e}");
         assert!(parse_wkt("POLYGON ((0 0, 1 0, 1 1, 0 0)").is_err());
