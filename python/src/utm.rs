@@ -2,6 +2,7 @@
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
+use terramesh::ArrayPoint;
 use terramesh_core::coords::{parse_angle, to_utm_many, to_wgs84_many, Axis, Parallelism, Zone};
 
 use crate::errors::{input, kernel};
@@ -80,10 +81,14 @@ fn point_error(
 ) -> terramesh::Error {
     let bad =
         (lo..lat.len()).find(|&i| terramesh_core::coords::to_utm(lat[i], lon[i], zone).is_err());
-    let at = bad.map_or(String::new(), |i| {
-        format!("point {i} (lat {}, lon {}): ", lat[i], lon[i])
-    });
-    terramesh::Error::invalid(format!("{at}{err}"))
+    terramesh::Error::ArrayPoint {
+        at: bad.map(|i| ArrayPoint::Geographic {
+            index: i,
+            lat: lat[i],
+            lon: lon[i],
+        }),
+        source: err,
+    }
 }
 
 type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
@@ -110,10 +115,14 @@ fn utm_inverse<'py>(
                         .clone()
                         .find(|&i| terramesh_core::coords::to_wgs84(e[i], n[i], z).is_err())
                         .unwrap_or(lo);
-                    terramesh::Error::invalid(format!(
-                        "point {i} (easting {}, northing {}): {err}",
-                        e[i], n[i]
-                    ))
+                    terramesh::Error::ArrayPoint {
+                        at: Some(ArrayPoint::Utm {
+                            index: i,
+                            easting: e[i],
+                            northing: n[i],
+                        }),
+                        source: err,
+                    }
                 })?;
             for (a, o) in out {
                 lat.push(a);

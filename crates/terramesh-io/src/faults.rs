@@ -27,7 +27,7 @@ use std::path::Path;
 use terramesh_core::coords::{parse_angle, Axis};
 use terramesh_core::limits::{coordinate_ok, depth_ok, elevation_ok, short};
 
-use crate::region::{parse_geojson_lines, RegionCrs};
+use crate::region::{parse_geojson_lines, GeoJsonError, RegionCrs};
 use crate::table::{ReadOptions, Table, TableError};
 
 /// Errors reading a fault's input files.
@@ -53,6 +53,28 @@ pub enum FaultFileError {
         /// The table error.
         #[source]
         source: Box<TableError>,
+    },
+    /// A GeoJSON trace that does not read.
+    #[error("{file}{}: {source}", fault_note(fault))]
+    GeoJson {
+        /// The file.
+        file: String,
+        /// The fault.
+        fault: Option<String>,
+        /// What is wrong, with the JSON path.
+        #[source]
+        source: GeoJsonError,
+    },
+    /// A triangulated surface that is not a surface ([`check_surface`]).
+    #[error("{file}{}: {source}", fault_note(fault))]
+    Surface {
+        /// The file.
+        file: String,
+        /// The fault.
+        fault: Option<String>,
+        /// What is wrong with the triangles.
+        #[source]
+        source: SurfaceError,
     },
     /// The file's content is not what is needed.
     #[error("{file}{}{}: {message}", place(*line, column), fault_note(fault))]
@@ -98,6 +120,8 @@ impl FaultFileError {
         match self {
             FaultFileError::Io { fault, .. }
             | FaultFileError::Table { fault, .. }
+            | FaultFileError::GeoJson { fault, .. }
+            | FaultFileError::Surface { fault, .. }
             | FaultFileError::Invalid { fault, .. } => fault.as_deref(),
         }
     }
@@ -172,7 +196,11 @@ pub fn parse_trace(
     let (mut trace, lines): (Vec<[f64; 2]>, Vec<Option<u64>>) = if is_geojson(path, &head) {
         let text = std::str::from_utf8(bytes)
             .map_err(|e| invalid(path, None, None, f, format!("not UTF-8 text ({e})")))?;
-        let parts = parse_geojson_lines(text).map_err(|m| invalid(path, None, None, f, m))?;
+        let parts = parse_geojson_lines(text).map_err(|source| FaultFileError::GeoJson {
+            file: path.display().to_string(),
+            fault: f.map(str::to_string),
+            source,
+        })?;
         if parts.is_empty() {
             return Err(invalid(
                 path,
@@ -375,7 +403,11 @@ pub fn parse_surface(
         vertices,
         triangles,
     };
-    check_surface(&s).map_err(|m| invalid(path, None, None, f, m))?;
+    check_surface(&s).map_err(|source| FaultFileError::Surface {
+        file: path.display().to_string(),
+        fault: f.map(str::to_string),
+        source,
+    })?;
     Ok(s)
 }
 
@@ -393,41 +425,37 @@ pub fn parse_surface(
 /// };
 /// assert!(check_surface(&s).is_ok());
 /// s.triangles.push([0, 1, 3]); // collinear
-/// assert!(check_surface(&s).unwrap_err().contains("triangle 2"));
+/// let e = check_surface(&s).unwrap_err();
+/// assert!(e.to_string().starts_with("triangle 2 (vertices 1 2 4) is degenerate"), "{e}");
 /// ```
-pub fn check_surface(s: &FaultSurface) -> Result<(), String> {
+pub fn check_surface(s: &FaultSurface) -> Result<(), SurfaceError> {
     if s.triangles.is_empty() {
-        return Err("no triangles: a fault surface is a triangulated surface".into());
+        return Err(SurfaceError::NoTriangles);
     }
     for (i, p) in s.vertices.iter().enumerate() {
         if !(coordinate_ok(p[0]) && coordinate_ok(p[1]) && elevation_ok(p[2])) {
-            return Err(format!(
-                "vertex {} ({}, {}, {}) is not finite or beyond the coordinates and elevations terramesh accepts",
-                i + 1,
-                short(p[0]),
-                short(p[1]),
-                short(p[2])
-            ));
+            return Err(SurfaceError::Vertex {
+                vertex: i,
+                position: *p,
+            });
         }
     }
     let nv = s.vertices.len();
     let mut edges: HashMap<(u32, u32), (usize, usize)> = HashMap::new();
     let mut seen: HashMap<[u32; 3], usize> = HashMap::new();
     for (i, t) in s.triangles.iter().enumerate() {
-        let n = i + 1;
         if let Some(&v) = t.iter().find(|&&v| v as usize >= nv) {
-            return Err(format!(
-                "triangle {n} refers to vertex {}, but there are {nv}",
-                v as u64 + 1
-            ));
+            return Err(SurfaceError::NoSuchVertex {
+                triangle: i,
+                vertex: v,
+                vertices: nv,
+            });
         }
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-            return Err(format!(
-                "triangle {n} repeats a vertex ({} {} {}): degenerate",
-                t[0] + 1,
-                t[1] + 1,
-                t[2] + 1
-            ));
+            return Err(SurfaceError::RepeatedVertex {
+                triangle: i,
+                corners: *t,
+            });
         }
         let [a, b, c] = t.map(|v| s.vertices[v as usize]);
         let flat = |i: usize, j: usize| {
@@ -438,17 +466,15 @@ pub fn check_surface(s: &FaultSurface) -> Result<(), String> {
             ) == 0.0
         };
         if flat(0, 1) && flat(1, 2) && flat(2, 0) {
-            return Err(format!(
-                "triangle {n} (vertices {} {} {}) is degenerate: its corners lie on one line",
-                t[0] + 1,
-                t[1] + 1,
-                t[2] + 1
-            ));
+            return Err(SurfaceError::Collinear {
+                triangle: i,
+                corners: *t,
+            });
         }
         let mut key = *t;
         key.sort_unstable();
-        if let Some(first) = seen.insert(key, n) {
-            return Err(format!("triangle {n} repeats triangle {first}"));
+        if let Some(first) = seen.insert(key, i) {
+            return Err(SurfaceError::RepeatedTriangle { triangle: i, first });
         }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
@@ -459,22 +485,124 @@ pub fn check_surface(s: &FaultSurface) -> Result<(), String> {
                 e.1 += 1;
             }
             if e.0 + e.1 > 2 {
-                return Err(format!(
-                    "the edge between vertices {} and {} is in more than two triangles (the third is triangle {n}): not a manifold surface",
-                    u.min(v) + 1,
-                    u.max(v) + 1
-                ));
+                return Err(SurfaceError::NonManifoldEdge {
+                    edge: [u.min(v), u.max(v)],
+                    triangle: i,
+                });
             }
             if e.0 > 1 || e.1 > 1 {
-                return Err(format!(
-                    "triangle {n} runs along the edge {}-{} in the same direction as its neighbour: orient the triangles consistently",
-                    u + 1,
-                    v + 1
-                ));
+                return Err(SurfaceError::Orientation {
+                    triangle: i,
+                    edge: [u, v],
+                });
             }
         }
     }
     Ok(())
+}
+
+/// Why a triangulated surface is not one ([`check_surface`]). Fields hold 0-based indices into
+/// [`FaultSurface::vertices`] and [`FaultSurface::triangles`]; the messages count from 1, as
+/// the files do.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceError {
+    /// No triangle.
+    #[error("no triangles: a fault surface is a triangulated surface")]
+    NoTriangles,
+    /// A vertex that is not finite or beyond [`terramesh_core::limits`].
+    #[error(
+        "vertex {} ({}, {}, {}) is not finite or beyond the coordinates and elevations terramesh \
+         accepts",
+        vertex + 1,
+        short(position[0]),
+        short(position[1]),
+        short(position[2])
+    )]
+    Vertex {
+        /// The vertex.
+        vertex: usize,
+        /// Its coordinates.
+        position: [f64; 3],
+    },
+    /// A triangle naming a vertex that does not exist.
+    #[error(
+        "triangle {} refers to vertex {}, but there are {vertices}",
+        triangle + 1,
+        u64::from(*vertex) + 1
+    )]
+    NoSuchVertex {
+        /// The triangle.
+        triangle: usize,
+        /// The vertex it names.
+        vertex: u32,
+        /// How many vertices there are.
+        vertices: usize,
+    },
+    /// A triangle with a vertex twice.
+    #[error(
+        "triangle {} repeats a vertex ({} {} {}): degenerate",
+        triangle + 1,
+        corners[0] + 1,
+        corners[1] + 1,
+        corners[2] + 1
+    )]
+    RepeatedVertex {
+        /// The triangle.
+        triangle: usize,
+        /// Its three vertices.
+        corners: [u32; 3],
+    },
+    /// A triangle whose corners lie on one line (exact).
+    #[error(
+        "triangle {} (vertices {} {} {}) is degenerate: its corners lie on one line",
+        triangle + 1,
+        corners[0] + 1,
+        corners[1] + 1,
+        corners[2] + 1
+    )]
+    Collinear {
+        /// The triangle.
+        triangle: usize,
+        /// Its three vertices.
+        corners: [u32; 3],
+    },
+    /// A triangle given twice.
+    #[error("triangle {} repeats triangle {}", triangle + 1, first + 1)]
+    RepeatedTriangle {
+        /// The second one.
+        triangle: usize,
+        /// The first one.
+        first: usize,
+    },
+    /// An edge in more than two triangles.
+    #[error(
+        "the edge between vertices {} and {} is in more than two triangles (the third is \
+         triangle {}): not a manifold surface",
+        edge[0] + 1,
+        edge[1] + 1,
+        triangle + 1
+    )]
+    NonManifoldEdge {
+        /// The edge's vertices, the lower first.
+        edge: [u32; 2],
+        /// The third triangle on it.
+        triangle: usize,
+    },
+    /// Two triangles running along their shared edge the same way (inconsistent orientation).
+    #[error(
+        "triangle {} runs along the edge {}-{} in the same direction as its neighbour: orient \
+         the triangles consistently",
+        triangle + 1,
+        edge[0] + 1,
+        edge[1] + 1
+    )]
+    Orientation {
+        /// The triangle.
+        triangle: usize,
+        /// The edge, in the triangle's direction.
+        edge: [u32; 2],
+    },
 }
 
 /// Reads a fault's points, a CSV with columns `x,y,z` (also `easting,northing,elevation`),
@@ -669,4 +797,84 @@ fn picks_of(path: &Path, t: &Table, faults: &[&str]) -> Result<Vec<FaultPick>, F
         });
     }
     Ok(picks)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn surface_errors_are_typed_and_count_from_one() {
+        let mut s = FaultSurface {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, -1.0, 0.0],
+            ],
+            triangles: vec![[0, 1, 2], [0, 1, 3]],
+        };
+        let e = check_surface(&s).unwrap_err();
+        assert_eq!(
+            e,
+            SurfaceError::Orientation {
+                triangle: 1,
+                edge: [0, 1]
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "triangle 2 runs along the edge 1-2 in the same direction as its neighbour: orient \
+             the triangles consistently"
+        );
+        s.triangles[1] = [2, 0, 1];
+        let e = check_surface(&s).unwrap_err();
+        assert_eq!(
+            e,
+            SurfaceError::RepeatedTriangle {
+                triangle: 1,
+                first: 0
+            }
+        );
+        assert_eq!(e.to_string(), "triangle 2 repeats triangle 1");
+        s.triangles[1] = [0, 1, 9];
+        let e = check_surface(&s).unwrap_err();
+        assert_eq!(
+            e,
+            SurfaceError::NoSuchVertex {
+                triangle: 1,
+                vertex: 9,
+                vertices: 4
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "triangle 2 refers to vertex 10, but there are 4"
+        );
+        // A file's surface error names the file and the fault around the typed error.
+        let e = parse_surface(
+            Path::new("a.obj"),
+            b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+            "F1",
+        )
+        .unwrap_err();
+        assert!(
+            matches!(
+                &e,
+                FaultFileError::Surface {
+                    source: SurfaceError::Collinear {
+                        triangle: 0,
+                        corners: [0, 1, 2]
+                    },
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "a.obj (fault 'F1'): triangle 1 (vertices 1 2 3) is degenerate: its corners lie on one \
+             line"
+        );
+    }
 }

@@ -7,6 +7,40 @@
 
 use std::io::{self, Write};
 
+/// What is wrong with a grid written `xmin,ymin,xmax,ymax,nx,ny` ([`RasterGrid::parse_str`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GridSpecError {
+    /// Not six comma-separated values.
+    #[error("'{spec}': expected xmin,ymin,xmax,ymax,nx,ny (6 values)")]
+    Count {
+        /// The text as given.
+        spec: String,
+    },
+    /// An edge (`xmin`, `ymin`, `xmax`, `ymax`) that is not a finite number.
+    #[error("{name} '{value}' is not a finite number")]
+    NotFinite {
+        /// Which edge.
+        name: &'static str,
+        /// Its text.
+        value: String,
+    },
+    /// A node count (`nx`, `ny`) that is not an integer of at least 2.
+    #[error("{name} '{value}' must be an integer >= 2")]
+    TooFewNodes {
+        /// Which count.
+        name: &'static str,
+        /// Its text.
+        value: String,
+    },
+    /// Edges that span no area (`xmax <= xmin` or `ymax <= ymin`).
+    #[error("'{spec}': needs xmax > xmin and ymax > ymin")]
+    Empty {
+        /// The text as given.
+        spec: String,
+    },
+}
+
 /// A regular grid of `nx x ny` nodes spanning `[xmin, xmax] x [ymin, ymax]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RasterGrid {
@@ -34,23 +68,27 @@ impl RasterGrid {
     /// assert_eq!(g.node(1, 0), [10.0, 50.0]);
     /// assert!("0,0,100,50,1,6".parse::<RasterGrid>().is_err());
     /// ```
-    pub fn parse_str(s: &str) -> Result<RasterGrid, String> {
+    pub fn parse_str(s: &str) -> Result<RasterGrid, GridSpecError> {
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         if parts.len() != 6 {
-            return Err(format!(
-                "'{s}': expected xmin,ymin,xmax,ymax,nx,ny (6 values)"
-            ));
+            return Err(GridSpecError::Count { spec: s.into() });
         }
-        let f = |i: usize, name: &str| -> Result<f64, String> {
+        let f = |i: usize, name: &'static str| -> Result<f64, GridSpecError> {
             match parts[i].parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(format!("{name} '{}' is not a finite number", parts[i])),
+                _ => Err(GridSpecError::NotFinite {
+                    name,
+                    value: parts[i].into(),
+                }),
             }
         };
-        let n = |i: usize, name: &str| -> Result<usize, String> {
+        let n = |i: usize, name: &'static str| -> Result<usize, GridSpecError> {
             match parts[i].parse::<usize>() {
                 Ok(v) if v >= 2 => Ok(v),
-                _ => Err(format!("{name} '{}' must be an integer >= 2", parts[i])),
+                _ => Err(GridSpecError::TooFewNodes {
+                    name,
+                    value: parts[i].into(),
+                }),
             }
         };
         let g = RasterGrid {
@@ -62,7 +100,7 @@ impl RasterGrid {
             ny: n(5, "ny")?,
         };
         if !(g.xmax > g.xmin && g.ymax > g.ymin) {
-            return Err(format!("'{s}': needs xmax > xmin and ymax > ymin"));
+            return Err(GridSpecError::Empty { spec: s.into() });
         }
         Ok(g)
     }
@@ -87,8 +125,8 @@ impl RasterGrid {
 }
 
 impl std::str::FromStr for RasterGrid {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = GridSpecError;
+    fn from_str(s: &str) -> Result<Self, GridSpecError> {
         RasterGrid::parse_str(s)
     }
 }
@@ -401,6 +439,40 @@ mod tests {
     }
     fn u32_at(b: &[u8], o: usize) -> u32 {
         u32::from_le_bytes(b[o..o + 4].try_into().unwrap())
+    }
+
+    #[test]
+    fn grid_spec_errors_are_typed_and_worded() {
+        let e = |t: &str| t.parse::<RasterGrid>().unwrap_err();
+        let c = e("0,0,1");
+        assert_eq!(
+            c,
+            GridSpecError::Count {
+                spec: "0,0,1".into()
+            }
+        );
+        assert_eq!(
+            c.to_string(),
+            "'0,0,1': expected xmin,ymin,xmax,ymax,nx,ny (6 values)"
+        );
+        let f = e("0,nan,1,1,2,2");
+        assert!(
+            matches!(f, GridSpecError::NotFinite { name: "ymin", .. }),
+            "{f:?}"
+        );
+        assert_eq!(f.to_string(), "ymin 'nan' is not a finite number");
+        let n = e("0,0,1,1,2, 1");
+        assert!(
+            matches!(n, GridSpecError::TooFewNodes { name: "ny", .. }),
+            "{n:?}"
+        );
+        assert_eq!(n.to_string(), "ny '1' must be an integer >= 2");
+        let z = e("0,0,0,1,2,2");
+        assert!(matches!(z, GridSpecError::Empty { .. }), "{z:?}");
+        assert_eq!(
+            z.to_string(),
+            "'0,0,0,1,2,2': needs xmax > xmin and ymax > ymin"
+        );
     }
 
     #[test]

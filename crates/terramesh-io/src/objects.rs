@@ -26,6 +26,7 @@ use std::path::Path;
 
 use terramesh_core::limits::{coordinate_ok, elevation_ok};
 
+use crate::region::RegionFormatError;
 use crate::table::{ReadOptions, Table, TableError};
 
 /// What went wrong reading an object's file.
@@ -52,6 +53,28 @@ pub enum ObjectFileError {
         #[source]
         source: Box<TableError>,
     },
+    /// An outline file (GeoJSON, WKT) that does not read.
+    #[error("{file} (object '{object}'): {source}")]
+    Format {
+        /// The file.
+        file: String,
+        /// The object.
+        object: String,
+        /// What is wrong, with its place in the file.
+        #[source]
+        source: RegionFormatError,
+    },
+    /// A solid's triangles that are not a surface (worded for a solid: not the source, so
+    /// that a chain of errors does not say it twice).
+    #[error("{file} (object '{object}'): {}", solid_message(surface))]
+    Solid {
+        /// The file.
+        file: String,
+        /// The object.
+        object: String,
+        /// What is wrong with the triangles.
+        surface: crate::faults::SurfaceError,
+    },
     /// The file's content is not what the key takes.
     #[error("{file}{} (object '{object}'): {message}", line.map(|l| format!(", line {l}")).unwrap_or_default())]
     Invalid {
@@ -72,8 +95,20 @@ impl ObjectFileError {
         match self {
             ObjectFileError::Io { object, .. }
             | ObjectFileError::Table { object, .. }
+            | ObjectFileError::Format { object, .. }
+            | ObjectFileError::Solid { object, .. }
             | ObjectFileError::Invalid { object, .. } => object,
         }
+    }
+}
+
+/// A surface's error said of a structure's solid.
+fn solid_message(e: &crate::faults::SurfaceError) -> String {
+    match e {
+        crate::faults::SurfaceError::NoTriangles => {
+            "no triangles: a structure's solid is a triangulated surface".into()
+        }
+        other => other.to_string(),
     }
 }
 
@@ -176,12 +211,16 @@ pub fn read_outline(path: &Path, object: &str) -> Result<Vec<[f64; 2]>, ObjectFi
     })?;
     let first = text.trim_start().chars().next().unwrap_or(' ');
     let parsed = match ext.as_str() {
-        "geojson" | "json" => crate::region::parse_geojson(&text),
-        "wkt" => crate::region::parse_wkt(&text),
-        _ if first == '{' => crate::region::parse_geojson(&text),
-        _ => crate::region::parse_wkt(&text),
+        "geojson" | "json" => crate::region::parse_geojson(&text).map_err(RegionFormatError::from),
+        "wkt" => crate::region::parse_wkt(&text).map_err(RegionFormatError::from),
+        _ if first == '{' => crate::region::parse_geojson(&text).map_err(RegionFormatError::from),
+        _ => crate::region::parse_wkt(&text).map_err(RegionFormatError::from),
     }
-    .map_err(|m| invalid(path, None, object, m))?;
+    .map_err(|source| ObjectFileError::Format {
+        file: path.display().to_string(),
+        object: object.into(),
+        source,
+    })?;
     match parsed.polygons.as_slice() {
         [p] if p.holes.is_empty() => Ok(p.outer.clone()),
         [_] => Err(invalid(
@@ -237,5 +276,70 @@ pub fn read_solid(
             object: object.into(),
             source,
         }),
+        Err(crate::faults::FaultFileError::Surface { source, .. }) => Err(ObjectFileError::Solid {
+            file: path.display().to_string(),
+            object: object.into(),
+            surface: source,
+        }),
+        Err(crate::faults::FaultFileError::GeoJson { source, .. }) => {
+            Err(ObjectFileError::Format {
+                file: path.display().to_string(),
+                object: object.into(),
+                source: source.into(),
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::faults::SurfaceError;
+    use crate::region::WktError;
+
+    #[test]
+    fn outline_and_solid_errors_carry_the_parsers_typed_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let wkt = dir.path().join("pit.wkt");
+        std::fs::write(&wkt, "LINESTRING (0 0, 1 1)").unwrap();
+        let e = read_outline(&wkt, "pit").unwrap_err();
+        assert!(
+            matches!(
+                &e,
+                ObjectFileError::Format {
+                    source: RegionFormatError::Wkt(WktError::NoPolygon),
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{} (object 'pit'): no POLYGON or MULTIPOLYGON found",
+                wkt.display()
+            )
+        );
+        let obj = dir.path().join("dam.obj");
+        std::fs::write(&obj, "# nothing\n").unwrap();
+        let e = read_solid(&obj, "dam").unwrap_err();
+        assert!(
+            matches!(
+                &e,
+                ObjectFileError::Solid {
+                    surface: SurfaceError::NoTriangles,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{} (object 'dam'): no triangles: a structure's solid is a triangulated surface",
+                obj.display()
+            )
+        );
+        assert_eq!(e.object(), "dam");
     }
 }

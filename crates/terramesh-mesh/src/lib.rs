@@ -63,7 +63,7 @@ pub use build::{MeshBuilder, DEFAULT_MIN_ANGLE, MAX_MIN_ANGLE};
 pub use flip::delaunay_flips;
 pub use locate::SurfaceLocator;
 pub use lod::{lod_tree, LodLevel, LodSettings, LodTile};
-pub use mesh::Mesh;
+pub use mesh::{Mesh, SanityError};
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;
 pub use simplify::{simplify, simplify_to, Simplified, SimplifyError, MIN_LOD_TRIANGLES};

@@ -120,7 +120,7 @@ impl Mesh {
     /// the region area to `1e-9` relative, and every boundary segment and constraint line
     /// covered exactly by constraint edges lying on it.
     ///
-    /// Returns a description of the first violation.
+    /// Returns the first violation, a [`SanityError`].
     ///
     /// ```
     /// use terramesh_core::geometry::Region;
@@ -130,46 +130,48 @@ impl Mesh {
     /// mesh.sanity_check(&r).unwrap();
     /// # Ok::<(), terramesh_mesh::MeshError>(())
     /// ```
-    pub fn sanity_check(&self, region: &Region) -> Result<(), String> {
+    pub fn sanity_check(&self, region: &Region) -> Result<(), SanityError> {
         let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
         for (ti, t) in self.triangles.iter().enumerate() {
             let [a, b, c] = t.map(|i| self.points[i as usize]);
             if orient(a, b, c) <= 0.0 {
-                return Err(format!("triangle {ti} is not counter-clockwise"));
+                return Err(SanityError::Clockwise { triangle: ti });
             }
             let centre = [
                 self.origin[0] + (a[0] + b[0] + c[0]) / 3.0,
                 self.origin[1] + (a[1] + b[1] + c[1]) / 3.0,
             ];
             if !region.contains(centre) {
-                return Err(format!(
-                    "triangle {ti} lies outside the region or in a hole"
-                ));
+                return Err(SanityError::Outside { triangle: ti });
             }
             for k in 0..3 {
                 *uses.entry(key(t[k], t[(k + 1) % 3])).or_default() += 1;
             }
         }
-        if let Some((e, n)) = uses.iter().find(|(_, &n)| n > 2) {
-            return Err(format!("edge {e:?} is shared by {n} triangles"));
+        if let Some((&(a, b), &triangles)) = uses.iter().find(|(_, &n)| n > 2) {
+            return Err(SanityError::SharedEdge {
+                edge: [a, b],
+                triangles,
+            });
         }
         let (area, expect) = (self.area(), region.area());
         if (area - expect).abs() > 1e-9 * expect {
-            return Err(format!(
-                "mesh area {area} differs from region area {expect}"
-            ));
+            return Err(SanityError::Area {
+                mesh: area,
+                region: expect,
+            });
         }
         // Edges used once form the boundary; each must be a constraint edge.
         let cons = self.constraint_set();
-        if let Some(e) = uses.iter().find(|(e, &n)| n == 1 && !cons.contains(e)) {
-            return Err(format!("boundary edge {:?} is not a constraint edge", e.0));
+        if let Some((&(a, b), _)) = uses.iter().find(|(e, &n)| n == 1 && !cons.contains(e)) {
+            return Err(SanityError::UnconstrainedBoundary { edge: [a, b] });
         }
         self.check_segments_covered(region)
     }
 
     /// Every input segment (ring edges and line segments) must be the union of constraint
     /// edges lying on it.
-    fn check_segments_covered(&self, region: &Region) -> Result<(), String> {
+    fn check_segments_covered(&self, region: &Region) -> Result<(), SanityError> {
         let rel = |p: [f64; 2]| [p[0] - self.origin[0], p[1] - self.origin[1]];
         let mut segs = Vec::new();
         for poly in &region.polygons {
@@ -202,15 +204,70 @@ impl Mesh {
         for (si, &(a, b)) in segs.iter().enumerate() {
             let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
             if (covered[si] - len).abs() > 1e-9 * len.max(1.0) {
-                return Err(format!(
-                    "input segment {si} of length {len} is covered by constraint edges of \
-                     total length {}",
-                    covered[si]
-                ));
+                return Err(SanityError::Uncovered {
+                    segment: si,
+                    length: len,
+                    covered: covered[si],
+                });
             }
         }
         Ok(())
     }
+}
+
+/// The first invariant a mesh breaks ([`Mesh::sanity_check`]): a bug in the mesher. Indices
+/// are 0-based (into [`Mesh::triangles`], [`Mesh::points`], and the region's segments: each
+/// ring's edges, polygon by polygon, outer ring first, then each line's segments).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SanityError {
+    /// A triangle with zero or negative area.
+    #[error("triangle {triangle} is not counter-clockwise")]
+    Clockwise {
+        /// The triangle.
+        triangle: usize,
+    },
+    /// A triangle whose centre is outside the region.
+    #[error("triangle {triangle} lies outside the region or in a hole")]
+    Outside {
+        /// The triangle.
+        triangle: usize,
+    },
+    /// An edge in more than two triangles.
+    #[error("edge ({}, {}) is shared by {triangles} triangles", edge[0], edge[1])]
+    SharedEdge {
+        /// The edge's points, the lower first.
+        edge: [u32; 2],
+        /// How many triangles share it.
+        triangles: u32,
+    },
+    /// The mesh's area is not the region's.
+    #[error("mesh area {mesh} differs from region area {region}")]
+    Area {
+        /// The mesh's area.
+        mesh: f64,
+        /// The region's area.
+        region: f64,
+    },
+    /// An edge on the mesh's boundary that is not a constraint edge.
+    #[error("boundary edge ({}, {}) is not a constraint edge", edge[0], edge[1])]
+    UnconstrainedBoundary {
+        /// The edge's points, the lower first.
+        edge: [u32; 2],
+    },
+    /// A boundary segment or constraint line segment not covered by constraint edges.
+    #[error(
+        "input segment {segment} of length {length} is covered by constraint edges of total \
+         length {covered}"
+    )]
+    Uncovered {
+        /// The segment.
+        segment: usize,
+        /// Its length.
+        length: f64,
+        /// The length of the constraint edges on it.
+        covered: f64,
+    },
 }
 
 /// True if `p` lies on segment `a b` within `tol`.
@@ -223,4 +280,66 @@ fn on_segment(a: [f64; 2], b: [f64; 2], p: [f64; 2], tol: f64) -> bool {
     }
     let proj = [a[0] + t * d[0], a[1] + t * d[1]];
     (proj[0] - p[0]).abs() <= tol && (proj[1] - p[1]).abs() <= tol
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> (Mesh, Region) {
+        let r = Region::from_ring(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+        let m = Mesh {
+            origin: [0.5, 0.5],
+            points: vec![[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            constraint_edges: vec![[0, 1], [1, 2], [2, 3], [3, 0]],
+        };
+        (m, r)
+    }
+
+    #[test]
+    fn sanity_errors_are_typed_and_worded() {
+        let (m, r) = square();
+        assert_eq!(m.sanity_check(&r), Ok(()));
+        let mut bad = m.clone();
+        bad.triangles[1] = [0, 3, 2];
+        let e = bad.sanity_check(&r).unwrap_err();
+        assert_eq!(e, SanityError::Clockwise { triangle: 1 });
+        assert_eq!(e.to_string(), "triangle 1 is not counter-clockwise");
+        let mut bad = m.clone();
+        bad.constraint_edges.pop();
+        let e = bad.sanity_check(&r).unwrap_err();
+        assert_eq!(e, SanityError::UnconstrainedBoundary { edge: [0, 3] });
+        assert_eq!(
+            e.to_string(),
+            "boundary edge (0, 3) is not a constraint edge"
+        );
+        let mut bad = m.clone();
+        bad.triangles.pop();
+        bad.constraint_edges = vec![[0, 1], [1, 2], [2, 0]];
+        let e = bad.sanity_check(&r).unwrap_err();
+        assert_eq!(
+            e,
+            SanityError::Area {
+                mesh: 0.5,
+                region: 1.0
+            }
+        );
+        assert_eq!(e.to_string(), "mesh area 0.5 differs from region area 1");
+        let mut bad = m.clone();
+        bad.constraint_edges = vec![[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]];
+        let lined = Region {
+            lines: vec![vec![[0.0, 0.0], [1.0, 0.5]]],
+            ..r.clone()
+        };
+        let e = bad.sanity_check(&lined).unwrap_err();
+        assert!(
+            matches!(e, SanityError::Uncovered { segment: 4, .. }),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string().starts_with("input segment 4 of length "),
+            "{e}"
+        );
+    }
 }

@@ -428,6 +428,16 @@ pub enum Error {
         #[source]
         source: terramesh_core::coords::CoordError,
     },
+    /// A point of an array (the Python binding's `utm_forward` and `utm_inverse`) that cannot
+    /// be converted between latitude/longitude and UTM: `point 3 (lat 91, lon 7): why`.
+    #[error("{}{source}", at.map_or(String::new(), |p| format!("{p}: ")))]
+    ArrayPoint {
+        /// The first point of the array that fails, where found.
+        at: Option<ArrayPoint>,
+        /// Why it cannot be converted.
+        #[source]
+        source: terramesh_core::coords::CoordError,
+    },
     /// A region whose outline has no vertex.
     #[error("the region has no vertices")]
     EmptyRegion,
@@ -676,12 +686,6 @@ pub enum Error {
         source: std::io::Error,
     },
 
-    /// Anything else, in words. This crate words none of its own errors this way any more
-    /// (objects aside, typed by their own work); it stays for the crates built on it that
-    /// still do (terramesh-tiles, the Python binding) and for [`Context`] on an `Option`
-    /// (used by terramesh-tiles).
-    #[error("{0}")]
-    Invalid(String),
     /// The work was stopped on request ([`Progress::cancelled`](crate::progress::Progress::cancelled)
     /// turned true): nothing it was writing was kept.
     #[error("stopped before it finished; its unfinished files were removed")]
@@ -709,6 +713,45 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+}
+
+/// A point of an array, by its 0-based index and its coordinates ([`Error::ArrayPoint`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum ArrayPoint {
+    /// A point given in degrees: `point 3 (lat 91, lon 7)`.
+    Geographic {
+        /// The index.
+        index: usize,
+        /// Latitude, degrees.
+        lat: f64,
+        /// Longitude, degrees.
+        lon: f64,
+    },
+    /// A point given in UTM metres: `point 3 (easting 500000, northing -1)`.
+    Utm {
+        /// The index.
+        index: usize,
+        /// Easting, metres.
+        easting: f64,
+        /// Northing, metres.
+        northing: f64,
+    },
+}
+
+impl Display for ArrayPoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ArrayPoint::Geographic { index, lat, lon } => {
+                write!(f, "point {index} (lat {lat}, lon {lon})")
+            }
+            ArrayPoint::Utm {
+                index,
+                easting,
+                northing,
+            } => write!(f, "point {index} (easting {easting}, northing {northing})"),
+        }
+    }
 }
 
 /// What is wrong with a path a project key gives ([`Error::ProjectPath`]).
@@ -933,11 +976,6 @@ impl Error {
         }
     }
 
-    /// An error in words.
-    pub fn invalid(why: impl Display) -> Error {
-        Error::Invalid(why.to_string())
-    }
-
     /// `source` about `what` (a file, a point, a stage): `what: source`, in its `Display` too
     /// (unlike [`Error::within`], whose `Display` is the context alone).
     pub fn about(what: impl Display, source: impl Into<Error>) -> Error {
@@ -951,8 +989,8 @@ impl Error {
     ///
     /// ```
     /// use terramesh::Error;
-    /// let e = Error::within("d.csv", Error::invalid("no data"));
-    /// assert_eq!(e.render(&|s| s.to_string()), "d.csv: no data");
+    /// let e = Error::within("d.csv", Error::EmptyRegion);
+    /// assert_eq!(e.render(&|s| s.to_string()), "d.csv: the region has no vertices");
     /// ```
     pub fn within(context: impl Display, source: impl Into<Error>) -> Error {
         Error::Context {
@@ -1019,7 +1057,7 @@ impl Error {
                 ) => Some(source.as_ref()),
                 Some(
                     Error::Setting { .. }
-                    | Error::Invalid(_)
+                    | Error::ArrayPoint { .. }
                     | Error::PointProjection { .. }
                     | Error::TileDecode { .. }
                     | Error::Fault { .. }
@@ -1089,15 +1127,6 @@ impl<T, E: Into<Error>> Context<T> for std::result::Result<T, E> {
             context: f().to_string(),
             source: Box::new(e.into()),
         })
-    }
-}
-
-impl<T> Context<T> for Option<T> {
-    fn context(self, context: impl Display) -> Result<T> {
-        self.ok_or_else(|| Error::Invalid(context.to_string()))
-    }
-    fn with_context<C: Display>(self, f: impl FnOnce() -> C) -> Result<T> {
-        self.ok_or_else(|| Error::Invalid(f().to_string()))
     }
 }
 
@@ -1258,6 +1287,44 @@ mod tests {
             p.render(&crate::project::key_of),
             "region.file a/b.kml: does not exist (no such file or directory)"
         );
+    }
+
+    #[test]
+    fn array_points_name_the_point_and_keep_the_kernels_words() {
+        use terramesh_core::coords::CoordError;
+        let e = Error::ArrayPoint {
+            at: Some(ArrayPoint::Geographic {
+                index: 1,
+                lat: 85.0,
+                lon: 7.5,
+            }),
+            source: CoordError::OutsideUtm(85.0),
+        };
+        let words = "point 1 (lat 85, lon 7.5): latitude 85 is outside the UTM domain \
+                     (-80..84 degrees); force a zone to project it anyway";
+        assert_eq!(e.to_string(), words);
+        // Rendered as it displays: the kernel's error is not worded a second time.
+        assert_eq!(e.render(&|s| s.to_string()), words);
+        let e = Error::ArrayPoint {
+            at: Some(ArrayPoint::Utm {
+                index: 0,
+                easting: 5e5,
+                northing: f64::NAN,
+            }),
+            source: CoordError::BadProjected {
+                what: "northing",
+                value: f64::NAN,
+            },
+        };
+        assert_eq!(
+            e.render(&|s| s.to_string()),
+            "point 0 (easting 500000, northing NaN): northing NaN is not a usable UTM coordinate"
+        );
+        let e = Error::ArrayPoint {
+            at: None,
+            source: CoordError::OutsideUtm(-81.0),
+        };
+        assert!(e.to_string().starts_with("latitude -81 is outside"), "{e}");
     }
 
     #[test]

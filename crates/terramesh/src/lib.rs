@@ -45,7 +45,7 @@ mod error;
 pub mod progress;
 mod setting;
 
-pub use error::{cut, Context, Error, OverrideProblem, PathProblem, Render, Result};
+pub use error::{cut, ArrayPoint, Context, Error, OverrideProblem, PathProblem, Render, Result};
 pub use setting::Setting;
 pub mod build;
 pub mod convert;

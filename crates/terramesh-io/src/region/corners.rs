@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use terramesh_core::coords::{parse_angle, Axis};
+use terramesh_core::coords::{parse_angle, Axis, CoordError};
 
 use super::RegionError;
 use crate::table::{ReadOptions, Table};
@@ -22,18 +22,16 @@ use crate::table::{ReadOptions, Table};
 /// assert_eq!(parse_corner("48.5, -7.25").unwrap(), [-7.25, 48.5]);
 /// assert!(parse_corner("48 43 7 20").is_err()); // ambiguous
 /// ```
-pub fn parse_corner(text: &str) -> Result<[f64; 2], String> {
+pub fn parse_corner(text: &str) -> Result<[f64; 2], CornerError> {
     let t = text.trim();
     if let Some((a, b)) = t.split_once(',') {
-        let lat = parse_angle(a, Axis::Lat).map_err(|e| e.to_string())?;
-        let lon = parse_angle(b, Axis::Lon).map_err(|e| e.to_string())?;
+        let lat = parse_angle(a, Axis::Lat)?;
+        let lon = parse_angle(b, Axis::Lon)?;
         return Ok([lon, lat]);
     }
     let tokens: Vec<&str> = t.split_whitespace().collect();
     if tokens.len() < 2 {
-        return Err(format!(
-            "corner '{t}' needs a latitude and a longitude, e.g. \"48.7224 7.3368\""
-        ));
+        return Err(CornerError::OneValue { corner: t.into() });
     }
     let mut found = Vec::new();
     for k in 1..tokens.len() {
@@ -45,16 +43,44 @@ pub fn parse_corner(text: &str) -> Result<[f64; 2], String> {
     }
     match found.len() {
         1 => Ok(found[0]),
-        0 => Err(format!(
-            "cannot read corner '{}' as LATITUDE LONGITUDE (decimal degrees or DMS such as N48°43'20.64\" E7°20'12.48\")",
-            crate::quote::cut(t)
-        )),
-        _ => Err(format!(
-            "corner '{}' can be split into latitude and longitude in more than one way; \
-             separate them with a comma or add hemisphere letters",
-            crate::quote::cut(t)
-        )),
+        0 => Err(CornerError::Unreadable { corner: t.into() }),
+        _ => Err(CornerError::Ambiguous { corner: t.into() }),
     }
+}
+
+/// What is wrong with one corner `"LAT LON"` ([`parse_corner`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CornerError {
+    /// A latitude or longitude (separated by a comma) that is not an angle.
+    #[error(transparent)]
+    Angle(#[from] CoordError),
+    /// Fewer than two values.
+    #[error("corner '{corner}' needs a latitude and a longitude, e.g. \"48.7224 7.3368\"")]
+    OneValue {
+        /// The corner as given (trimmed).
+        corner: String,
+    },
+    /// No split of the values reads as a latitude and a longitude.
+    #[error(
+        "cannot read corner '{}' as LATITUDE LONGITUDE (decimal degrees or DMS such as \
+         N48°43'20.64\" E7°20'12.48\")",
+        crate::quote::cut(corner)
+    )]
+    Unreadable {
+        /// The corner as given (trimmed).
+        corner: String,
+    },
+    /// The values split into a latitude and a longitude in more than one way.
+    #[error(
+        "corner '{}' can be split into latitude and longitude in more than one way; separate \
+         them with a comma or add hemisphere letters",
+        crate::quote::cut(corner)
+    )]
+    Ambiguous {
+        /// The corner as given (trimmed).
+        corner: String,
+    },
 }
 
 /// Parses `"LAT LON; LAT LON; ..."` into a ring of `[lon, lat]` (a repeated closing corner
@@ -67,14 +93,18 @@ pub fn parse_corner(text: &str) -> Result<[f64; 2], String> {
 /// ```
 pub fn parse_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError> {
     parse_list(text, |i, part| {
-        parse_corner(part).map_err(|m| format!("corner {i}: {m}"))
+        parse_corner(part).map_err(|source| RegionError::Corner {
+            source_name: super::CORNER_LIST.into(),
+            corner: i,
+            source,
+        })
     })
 }
 
 /// Splits `"A; B; ..."` into corners with `one(number, text)`, then checks the ring.
 fn parse_list(
     text: &str,
-    one: impl Fn(usize, &str) -> Result<[f64; 2], String>,
+    one: impl Fn(usize, &str) -> Result<[f64; 2], RegionError>,
 ) -> Result<Vec<[f64; 2]>, RegionError> {
     let invalid = |message: String| RegionError::Invalid {
         source_name: super::CORNER_LIST.into(),
@@ -83,7 +113,7 @@ fn parse_list(
     let mut ring = Vec::new();
     for (i, part) in text.split(';').enumerate() {
         if !part.trim().is_empty() {
-            ring.push(one(i + 1, part).map_err(invalid)?);
+            ring.push(one(i + 1, part)?);
         }
     }
     finish_ring(ring).map_err(invalid)
@@ -126,11 +156,14 @@ pub fn parse_projected_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError>
             .collect();
         match parsed.as_deref() {
             Some([n, e]) if n.is_finite() && e.is_finite() => Ok([*e, *n]),
-            _ => Err(format!(
-                "corner {i} '{}': in projected coordinates each corner is NORTHING EASTING in \
-                 metres, e.g. \"5397932.106 377676.932\"",
-                part.trim()
-            )),
+            _ => Err(RegionError::Invalid {
+                source_name: super::CORNER_LIST.into(),
+                message: format!(
+                    "corner {i} '{}': in projected coordinates each corner is NORTHING EASTING \
+                     in metres, e.g. \"5397932.106 377676.932\"",
+                    part.trim()
+                ),
+            }),
         }
     })
 }
@@ -185,5 +218,57 @@ mod tests {
         assert!(e.contains("at least 3 distinct"), "{e}");
         let e = parse_corners("0 0; 0 1; x y").unwrap_err().to_string();
         assert!(e.contains("corner 3"), "{e}");
+    }
+
+    #[test]
+    fn corner_errors_are_typed_and_worded() {
+        let e = parse_corner("48.5").unwrap_err();
+        assert_eq!(
+            e,
+            CornerError::OneValue {
+                corner: "48.5".into()
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "corner '48.5' needs a latitude and a longitude, e.g. \"48.7224 7.3368\""
+        );
+        let e = parse_corner(" x y ").unwrap_err();
+        assert_eq!(
+            e,
+            CornerError::Unreadable {
+                corner: "x y".into()
+            }
+        );
+        assert!(
+            e.to_string()
+                .starts_with("cannot read corner 'x y' as LATITUDE LONGITUDE"),
+            "{e}"
+        );
+        let e = parse_corner("48 43 7 20").unwrap_err();
+        assert!(matches!(e, CornerError::Ambiguous { .. }), "{e:?}");
+        assert!(e.to_string().contains("in more than one way"), "{e}");
+        let e = parse_corner("95, 7").unwrap_err();
+        assert!(matches!(e, CornerError::Angle(_)), "{e:?}");
+        // In a list, the corner's number and the list are named around the typed error.
+        match parse_corners("0 0; 0 1; x y").unwrap_err() {
+            RegionError::Corner { corner, source, .. } => {
+                assert_eq!(
+                    (corner, source),
+                    (
+                        3,
+                        CornerError::Unreadable {
+                            corner: "x y".into()
+                        }
+                    )
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(
+            parse_corners("0 0; 0 1; 48.5").unwrap_err().to_string(),
+            "the corner list: corner 3: corner '48.5' needs a latitude and a longitude, e.g. \
+             \"48.7224 7.3368\""
+        );
     }
 }

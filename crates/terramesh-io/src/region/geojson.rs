@@ -12,36 +12,92 @@ use terramesh_core::geometry::{Polygon, Region};
 /// let r = terramesh_io::region::parse_geojson(r#"{"type": "Feature", "properties": {},
 ///   "geometry": {"type": "Polygon", "coordinates": [[[7.0, 48.0], [7.1, 48.0], [7.1, 48.1], [7.0, 48.0]]]}}"#)?;
 /// assert_eq!(r.polygons[0].outer.len(), 4);
-/// # Ok::<(), String>(())
+/// # Ok::<(), terramesh_io::region::GeoJsonError>(())
 /// ```
-pub fn parse_geojson(text: &str) -> Result<Region, String> {
-    let v: Value = serde_json::from_str(text).map_err(|e| {
-        // serde_json ends its message with the position: say it once, first
-        let full = e.to_string();
-        let what = full
-            .strip_suffix(&format!(" at line {} column {}", e.line(), e.column()))
-            .unwrap_or(&full);
-        let what = if e.is_eof() {
-            "the text ends before the JSON does (a truncated file?)"
-        } else {
-            what
-        };
-        format!(
-            "not valid JSON at line {}, column {}: {what}",
-            e.line(),
-            e.column()
-        )
-    })?;
+pub fn parse_geojson(text: &str) -> Result<Region, GeoJsonError> {
+    let v: Value = serde_json::from_str(text).map_err(|error| GeoJsonError::Json { error })?;
     let mut region = Region::default();
     walk(&v, "$", &mut region)?;
     if region.polygons.is_empty() {
-        return Err(
-            "no Polygon or MultiPolygon geometry found; draw the study region as a \
-                    polygon"
-                .into(),
-        );
+        return Err(GeoJsonError::NoPolygon);
     }
     Ok(region)
+}
+
+/// What is wrong with a GeoJSON file ([`parse_geojson`], [`parse_geojson_lines`]); `path` is
+/// the JSON path of the member at fault (`$.features[0].geometry`).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum GeoJsonError {
+    /// Not JSON: the line and column come first, then the JSON parser's words.
+    #[error("{}", json_message(error))]
+    Json {
+        /// The JSON parser's error.
+        error: serde_json::Error,
+    },
+    /// An object without a `"type"`.
+    #[error("{path}: missing \"type\"")]
+    MissingType {
+        /// The object's path.
+        path: String,
+    },
+    /// A `"type"` that GeoJSON does not have.
+    #[error("{path}: unknown GeoJSON type \"{kind}\"")]
+    UnknownType {
+        /// The object's path.
+        path: String,
+        /// The type as written.
+        kind: String,
+    },
+    /// A FeatureCollection without its `"features"` array.
+    #[error("{path}: FeatureCollection without a \"features\" array")]
+    NoFeatures {
+        /// The collection's path.
+        path: String,
+    },
+    /// A GeometryCollection without its `"geometries"`.
+    #[error("{path}: GeometryCollection without \"geometries\"")]
+    NoGeometries {
+        /// The collection's path.
+        path: String,
+    },
+    /// A geometry without `"coordinates"`.
+    #[error("{path}: geometry without \"coordinates\"")]
+    NoCoordinates {
+        /// The geometry's path.
+        path: String,
+    },
+    /// Something else where an array is needed.
+    #[error("{path}: expected an array, found {found}")]
+    NotAnArray {
+        /// The member's path.
+        path: String,
+        /// The member as JSON.
+        found: String,
+    },
+    /// A Polygon with no ring.
+    #[error("{path}: a Polygon needs an outer ring")]
+    NoOuterRing {
+        /// The coordinates' path.
+        path: String,
+    },
+    /// A position that is not an array of at least two numbers.
+    #[error("{path}: expected a position [lon, lat], found {found}")]
+    BadPosition {
+        /// The position's path.
+        path: String,
+        /// The position as JSON.
+        found: String,
+    },
+    /// A polygon where a polyline is asked for ([`parse_geojson_lines`]).
+    #[error("{path}: a polygon where a polyline (LineString or MultiLineString) is expected")]
+    PolygonForLine {
+        /// The polygon's path.
+        path: String,
+    },
+    /// No polygon in a region file ([`parse_geojson`]).
+    #[error("no Polygon or MultiPolygon geometry found; draw the study region as a polygon")]
+    NoPolygon,
 }
 
 /// A polyline read from GeoJSON: the JSON path of its coordinates and its positions.
@@ -56,16 +112,16 @@ pub type GeoJsonLine = (String, Vec<[f64; 2]>);
 /// let l = terramesh_io::region::parse_geojson_lines(r#"{"type": "Feature", "properties": {},
 ///   "geometry": {"type": "LineString", "coordinates": [[0, 0], [10, 5, 120]]}}"#)?;
 /// assert_eq!(l, vec![("$.geometry.coordinates".to_string(), vec![[0.0, 0.0], [10.0, 5.0]])]);
-/// # Ok::<(), String>(())
+/// # Ok::<(), terramesh_io::region::GeoJsonError>(())
 /// ```
-pub fn parse_geojson_lines(text: &str) -> Result<Vec<GeoJsonLine>, String> {
-    let v: Value = serde_json::from_str(text).map_err(|e| json_error(&e))?;
+pub fn parse_geojson_lines(text: &str) -> Result<Vec<GeoJsonLine>, GeoJsonError> {
+    let v: Value = serde_json::from_str(text).map_err(|error| GeoJsonError::Json { error })?;
     let mut lines = Vec::new();
     walk_lines(&v, "$", &mut lines)?;
     Ok(lines)
 }
 
-fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), String> {
+fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), GeoJsonError> {
     each_geometry(v, path, &mut |v, kind, path| match kind {
         "LineString" => {
             let p = format!("{path}.coordinates");
@@ -83,15 +139,20 @@ fn walk_lines(v: &Value, path: &str, out: &mut Vec<GeoJsonLine>) -> Result<(), S
             Ok(())
         }
         "Point" | "MultiPoint" => Ok(()),
-        "Polygon" | "MultiPolygon" => Err(format!(
-            "{path}: a polygon where a polyline (LineString or MultiLineString) is expected"
-        )),
-        other => Err(format!("{path}: unknown GeoJSON type \"{other}\"")),
+        "Polygon" | "MultiPolygon" => Err(GeoJsonError::PolygonForLine { path: path.into() }),
+        other => Err(unknown(path, other)),
     })
 }
 
+fn unknown(path: &str, kind: &str) -> GeoJsonError {
+    GeoJsonError::UnknownType {
+        path: path.into(),
+        kind: kind.into(),
+    }
+}
+
 /// serde_json's error worded with its line and column first.
-fn json_error(e: &serde_json::Error) -> String {
+fn json_message(e: &serde_json::Error) -> String {
     // serde_json ends its message with the position: say it once, first
     let full = e.to_string();
     let what = full
@@ -109,10 +170,10 @@ fn json_error(e: &serde_json::Error) -> String {
     )
 }
 
-fn kind<'a>(v: &'a Value, path: &str) -> Result<&'a str, String> {
+fn kind<'a>(v: &'a Value, path: &str) -> Result<&'a str, GeoJsonError> {
     v.get("type")
         .and_then(Value::as_str)
-        .ok_or_else(|| format!("{path}: missing \"type\""))
+        .ok_or_else(|| GeoJsonError::MissingType { path: path.into() })
 }
 
 /// Calls `leaf` with every geometry of `v` (its kind and path), through FeatureCollections,
@@ -120,14 +181,14 @@ fn kind<'a>(v: &'a Value, path: &str) -> Result<&'a str, String> {
 fn each_geometry(
     v: &Value,
     path: &str,
-    leaf: &mut dyn FnMut(&Value, &str, &str) -> Result<(), String>,
-) -> Result<(), String> {
+    leaf: &mut dyn FnMut(&Value, &str, &str) -> Result<(), GeoJsonError>,
+) -> Result<(), GeoJsonError> {
     match kind(v, path)? {
         "FeatureCollection" => {
             let feats = v
                 .get("features")
                 .and_then(Value::as_array)
-                .ok_or_else(|| format!("{path}: FeatureCollection without a \"features\" array"))?;
+                .ok_or_else(|| GeoJsonError::NoFeatures { path: path.into() })?;
             for (i, f) in feats.iter().enumerate() {
                 each_geometry(f, &format!("{path}.features[{i}]"), leaf)?;
             }
@@ -141,7 +202,7 @@ fn each_geometry(
             let gs = v
                 .get("geometries")
                 .and_then(Value::as_array)
-                .ok_or_else(|| format!("{path}: GeometryCollection without \"geometries\""))?;
+                .ok_or_else(|| GeoJsonError::NoGeometries { path: path.into() })?;
             for (i, g) in gs.iter().enumerate() {
                 each_geometry(g, &format!("{path}.geometries[{i}]"), leaf)?;
             }
@@ -151,7 +212,7 @@ fn each_geometry(
     }
 }
 
-fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
+fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), GeoJsonError> {
     each_geometry(v, path, &mut |v, kind, path| match kind {
         "Polygon" => {
             let c = coords(v, path)?;
@@ -186,24 +247,26 @@ fn walk(v: &Value, path: &str, region: &mut Region) -> Result<(), String> {
             Ok(())
         }
         "Point" | "MultiPoint" => Ok(()),
-        other => Err(format!("{path}: unknown GeoJSON type \"{other}\"")),
+        other => Err(unknown(path, other)),
     })
 }
 
-fn coords<'a>(v: &'a Value, path: &str) -> Result<&'a Value, String> {
+fn coords<'a>(v: &'a Value, path: &str) -> Result<&'a Value, GeoJsonError> {
     v.get("coordinates")
-        .ok_or_else(|| format!("{path}: geometry without \"coordinates\""))
+        .ok_or_else(|| GeoJsonError::NoCoordinates { path: path.into() })
 }
 
-fn array<'a>(v: &'a Value, path: &str) -> Result<&'a Vec<Value>, String> {
-    v.as_array()
-        .ok_or_else(|| format!("{path}: expected an array, found {v}"))
+fn array<'a>(v: &'a Value, path: &str) -> Result<&'a Vec<Value>, GeoJsonError> {
+    v.as_array().ok_or_else(|| GeoJsonError::NotAnArray {
+        path: path.into(),
+        found: v.to_string(),
+    })
 }
 
-fn polygon(v: &Value, path: &str) -> Result<Polygon, String> {
+fn polygon(v: &Value, path: &str) -> Result<Polygon, GeoJsonError> {
     let rings = array(v, path)?;
     if rings.is_empty() {
-        return Err(format!("{path}: a Polygon needs an outer ring"));
+        return Err(GeoJsonError::NoOuterRing { path: path.into() });
     }
     let outer = positions(&rings[0], &format!("{path}[0]"))?;
     let holes = rings[1..]
@@ -214,12 +277,15 @@ fn polygon(v: &Value, path: &str) -> Result<Polygon, String> {
     Ok(Polygon { outer, holes })
 }
 
-fn positions(v: &Value, path: &str) -> Result<Vec<[f64; 2]>, String> {
+fn positions(v: &Value, path: &str) -> Result<Vec<[f64; 2]>, GeoJsonError> {
     array(v, path)?
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let bad = || format!("{path}[{i}]: expected a position [lon, lat], found {p}");
+            let bad = || GeoJsonError::BadPosition {
+                path: format!("{path}[{i}]"),
+                found: p.to_string(),
+            };
             let a = p.as_array().ok_or_else(bad)?;
             if a.len() < 2 {
                 return Err(bad());
@@ -254,10 +320,35 @@ mod tests {
     fn bad_position_names_path() {
         let e = parse_geojson(r#"{"type":"Polygon","coordinates":[[[0,0],[1,"a"],[1,1]]]}"#)
             .unwrap_err();
-        assert!(e.contains("$.coordinates[0][1]"), "{e}");
+        assert!(
+            matches!(&e, GeoJsonError::BadPosition { path, found }
+                if path == "$.coordinates[0][1]" && found == r#"[1,"a"]"#),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            r#"$.coordinates[0][1]: expected a position [lon, lat], found [1,"a"]"#
+        );
         let e = parse_geojson("{\"type\": \"Polygon\",\n \"coordinates\": [").unwrap_err();
-        assert!(e.contains("line 2"), "{e}");
+        assert!(matches!(e, GeoJsonError::Json { .. }), "{e:?}");
+        assert_eq!(
+            e.to_string(),
+            "not valid JSON at line 2, column 17: the text ends before the JSON does (a \
+             truncated file?)"
+        );
         let e = parse_geojson(r#"{"type":"LineString","coordinates":[[0,0],[1,1]]}"#).unwrap_err();
-        assert!(e.contains("no Polygon"), "{e}");
+        assert!(matches!(e, GeoJsonError::NoPolygon), "{e:?}");
+        assert!(e.to_string().starts_with("no Polygon"), "{e}");
+        let e =
+            parse_geojson_lines(r#"{"type":"Feature","geometry":{"type":"Circle"}}"#).unwrap_err();
+        assert!(
+            matches!(&e, GeoJsonError::UnknownType { path, kind }
+                if path == "$.geometry" && kind == "Circle"),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            r#"$.geometry: unknown GeoJSON type "Circle""#
+        );
     }
 }

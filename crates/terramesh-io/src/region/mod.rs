@@ -11,10 +11,10 @@ use std::path::{Path, PathBuf};
 use terramesh_core::coords::{to_utm, CoordError, Zone};
 use terramesh_core::geometry::{validate, Region, ValidationError};
 
-pub use corners::{parse_corner, parse_corners, parse_projected_corners};
-pub use geojson::{parse_geojson, parse_geojson_lines, GeoJsonLine};
-pub use kml::{parse_kml, MAX_KML_DEPTH};
-pub use wkt::{parse_wkt, MAX_WKT_DEPTH};
+pub use corners::{parse_corner, parse_corners, parse_projected_corners, CornerError};
+pub use geojson::{parse_geojson, parse_geojson_lines, GeoJsonError, GeoJsonLine};
+pub use kml::{parse_kml, KmlCoordinateProblem, KmlError, MAX_KML_DEPTH};
+pub use wkt::{parse_wkt, WktError, WktProblem, MAX_WKT_DEPTH};
 
 /// Errors while reading a region.
 #[derive(Debug, thiserror::Error)]
@@ -27,6 +27,26 @@ pub enum RegionError {
         source_name: String,
         /// What is wrong and what to do.
         message: String,
+    },
+    /// A corner of an inline list that does not read.
+    #[error("{source_name}: corner {corner}: {source}")]
+    Corner {
+        /// The list ([`CORNER_LIST`]).
+        source_name: String,
+        /// The corner's 1-based number in the list.
+        corner: usize,
+        /// What is wrong with it.
+        #[source]
+        source: CornerError,
+    },
+    /// A region file (GeoJSON, KML, WKT) whose content does not read as a region.
+    #[error("{source_name}: {source}")]
+    Format {
+        /// The file name.
+        source_name: String,
+        /// What is wrong, with its place in the file.
+        #[source]
+        source: RegionFormatError,
     },
     /// A table error from a corners CSV.
     #[error(transparent)]
@@ -63,6 +83,22 @@ pub enum RegionError {
         #[source]
         source: CoordError,
     },
+}
+
+/// What is wrong with the text of a region file, by format ([`read_region_file`]; also the
+/// outlines of engineering objects).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RegionFormatError {
+    /// A GeoJSON file.
+    #[error(transparent)]
+    GeoJson(#[from] GeoJsonError),
+    /// A KML file.
+    #[error(transparent)]
+    Kml(#[from] KmlError),
+    /// A WKT file.
+    #[error(transparent)]
+    Wkt(#[from] WktError),
 }
 
 /// How errors name an inline corner list ([`RegionInput::Corners`] that is not a file).
@@ -257,16 +293,16 @@ pub fn read_region_file(path: &Path) -> Result<Region, RegionError> {
         .unwrap_or_default();
     let first = text.trim_start().chars().next().unwrap_or(' ');
     let parsed = match ext.as_str() {
-        "geojson" | "json" => parse_geojson(&text),
-        "kml" => parse_kml(&text),
-        "wkt" => parse_wkt(&text),
-        _ if first == '{' => parse_geojson(&text),
-        _ if first == '<' => parse_kml(&text),
-        _ => parse_wkt(&text),
+        "geojson" | "json" => parse_geojson(&text).map_err(RegionFormatError::from),
+        "kml" => parse_kml(&text).map_err(RegionFormatError::from),
+        "wkt" => parse_wkt(&text).map_err(RegionFormatError::from),
+        _ if first == '{' => parse_geojson(&text).map_err(RegionFormatError::from),
+        _ if first == '<' => parse_kml(&text).map_err(RegionFormatError::from),
+        _ => parse_wkt(&text).map_err(RegionFormatError::from),
     };
-    parsed.map_err(|message| RegionError::Invalid {
+    parsed.map_err(|source| RegionError::Format {
         source_name: name,
-        message,
+        source,
     })
 }
 
@@ -325,10 +361,22 @@ mod tests {
             .to_string();
         assert!(e.contains("bow.wkt") && e.contains("(5.0"), "{e}");
         let p = write(&dir, "x.kml", "<kml><Polygon></Polygon></kml>");
-        let e = load(&RegionInput::File(p), RegionCrs::Projected, None)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("x.kml") && e.contains("outerBoundaryIs"), "{e}");
+        let e = load(&RegionInput::File(p), RegionCrs::Projected, None).unwrap_err();
+        assert!(
+            matches!(
+                &e,
+                RegionError::Format {
+                    source: RegionFormatError::Kml(KmlError::NoOuterBoundary { line: 1 }),
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        let e = e.to_string();
+        assert!(
+            e.contains("x.kml: line 1: <Polygon> without <outerBoundaryIs>"),
+            "{e}"
+        );
         let e = load(
             &RegionInput::File(dir.path().join("missing.geojson")),
             RegionCrs::Projected,

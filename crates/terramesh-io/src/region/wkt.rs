@@ -16,9 +16,9 @@ pub const MAX_WKT_DEPTH: usize = 64;
 ///     "POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0), (2 2, 4 2, 4 4, 2 2))\nLINESTRING (1 5, 9 5)")?;
 /// assert_eq!(r.polygons[0].holes.len(), 1);
 /// assert_eq!(r.lines.len(), 1);
-/// # Ok::<(), String>(())
+/// # Ok::<(), terramesh_io::region::WktError>(())
 /// ```
-pub fn parse_wkt(text: &str) -> Result<Region, String> {
+pub fn parse_wkt(text: &str) -> Result<Region, WktError> {
     let mut p = Parser {
         s: text.as_bytes(),
         i: 0,
@@ -36,9 +36,54 @@ pub fn parse_wkt(text: &str) -> Result<Region, String> {
         }
     }
     if region.polygons.is_empty() {
-        return Err("no POLYGON or MULTIPOLYGON found".into());
+        return Err(WktError::NoPolygon);
     }
     Ok(region)
+}
+
+/// What is wrong with a WKT region ([`parse_wkt`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum WktError {
+    /// The text does not read as WKT at a place.
+    #[error("line {line}, column {column}: {problem}, found '{found}'")]
+    Syntax {
+        /// The 1-based line.
+        line: usize,
+        /// The 1-based column (in bytes).
+        column: usize,
+        /// What was expected there.
+        problem: WktProblem,
+        /// The text there (at most 20 characters).
+        found: String,
+    },
+    /// No polygon in the text.
+    #[error("no POLYGON or MULTIPOLYGON found")]
+    NoPolygon,
+}
+
+/// What a WKT text lacks at the place of a [`WktError::Syntax`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum WktProblem {
+    /// A character (`(`) was expected.
+    #[error("expected '{0}'")]
+    Expected(char),
+    /// A `,` or `)` was expected (a list goes on or ends).
+    #[error("expected ',' or ')'")]
+    CommaOrClose,
+    /// A number was expected.
+    #[error("expected a number")]
+    Number,
+    /// A geometry keyword was expected.
+    #[error("expected POLYGON, MULTIPOLYGON, LINESTRING, MULTILINESTRING or GEOMETRYCOLLECTION")]
+    Geometry,
+    /// A `POINT`'s parentheses do not close.
+    #[error("unbalanced parentheses")]
+    Unbalanced,
+    /// `GEOMETRYCOLLECTION`s nested deeper than [`MAX_WKT_DEPTH`].
+    #[error("GEOMETRYCOLLECTIONs nest more than {MAX_WKT_DEPTH} deep; flatten the collection")]
+    TooDeep,
 }
 
 struct Parser<'a> {
@@ -50,18 +95,20 @@ struct Parser<'a> {
 }
 
 impl Parser<'_> {
-    fn at(&self) -> String {
+    fn err(&self, problem: WktProblem) -> WktError {
         let before = &self.text[..self.i.min(self.text.len())];
         let line = before.matches('\n').count() + 1;
-        let col = before.len() - before.rfind('\n').map_or(0, |k| k + 1) + 1;
-        format!("line {line}, column {col}")
-    }
-    fn err(&self, what: &str) -> String {
-        let rest: String = self.text[self.i.min(self.text.len())..]
+        let column = before.len() - before.rfind('\n').map_or(0, |k| k + 1) + 1;
+        let found: String = self.text[self.i.min(self.text.len())..]
             .chars()
             .take(20)
             .collect();
-        format!("{}: {what}, found '{rest}'", self.at())
+        WktError::Syntax {
+            line,
+            column,
+            problem,
+            found,
+        }
     }
     fn skip_ws(&mut self) {
         while self.i < self.s.len() && self.s[self.i].is_ascii_whitespace() {
@@ -71,13 +118,13 @@ impl Parser<'_> {
     fn peek(&self) -> Option<u8> {
         self.s.get(self.i).copied()
     }
-    fn expect(&mut self, c: u8) -> Result<(), String> {
+    fn expect(&mut self, c: u8) -> Result<(), WktError> {
         self.skip_ws();
         if self.peek() == Some(c) {
             self.i += 1;
             Ok(())
         } else {
-            Err(self.err(&format!("expected '{}'", c as char)))
+            Err(self.err(WktProblem::Expected(c as char)))
         }
     }
     fn word(&mut self) -> String {
@@ -102,7 +149,7 @@ impl Parser<'_> {
             }
         }
     }
-    fn geometry(&mut self, region: &mut Region) -> Result<(), String> {
+    fn geometry(&mut self, region: &mut Region) -> Result<(), WktError> {
         let start = self.i;
         let w = self.word();
         if self.modifiers() {
@@ -132,7 +179,7 @@ impl Parser<'_> {
                                 break;
                             }
                         }
-                        None => return Err(self.err("unbalanced parentheses")),
+                        None => return Err(self.err(WktProblem::Unbalanced)),
                         _ => {}
                     }
                     self.i += 1;
@@ -141,10 +188,7 @@ impl Parser<'_> {
             "GEOMETRYCOLLECTION" => {
                 if self.depth == MAX_WKT_DEPTH {
                     self.i = start;
-                    return Err(self.err(&format!(
-                        "GEOMETRYCOLLECTIONs nest more than {MAX_WKT_DEPTH} deep; flatten the \
-                         collection"
-                    )));
+                    return Err(self.err(WktProblem::TooDeep));
                 }
                 self.depth += 1;
                 self.list(|p| p.geometry(region))?;
@@ -152,17 +196,15 @@ impl Parser<'_> {
             }
             _ => {
                 self.i = start;
-                return Err(self.err(
-                    "expected POLYGON, MULTIPOLYGON, LINESTRING, MULTILINESTRING or GEOMETRYCOLLECTION",
-                ));
+                return Err(self.err(WktProblem::Geometry));
             }
         }
         Ok(())
     }
     fn list(
         &mut self,
-        mut item: impl FnMut(&mut Self) -> Result<(), String>,
-    ) -> Result<(), String> {
+        mut item: impl FnMut(&mut Self) -> Result<(), WktError>,
+    ) -> Result<(), WktError> {
         self.expect(b'(')?;
         loop {
             item(self)?;
@@ -173,11 +215,11 @@ impl Parser<'_> {
                     self.i += 1;
                     return Ok(());
                 }
-                _ => return Err(self.err("expected ',' or ')'")),
+                _ => return Err(self.err(WktProblem::CommaOrClose)),
             }
         }
     }
-    fn polygon(&mut self) -> Result<Polygon, String> {
+    fn polygon(&mut self) -> Result<Polygon, WktError> {
         let mut rings = Vec::new();
         self.list(|p| {
             rings.push(p.ring()?);
@@ -189,7 +231,7 @@ impl Parser<'_> {
             holes: rings,
         })
     }
-    fn ring(&mut self) -> Result<Vec<[f64; 2]>, String> {
+    fn ring(&mut self) -> Result<Vec<[f64; 2]>, WktError> {
         let mut pts = Vec::new();
         self.list(|p| {
             let x = p.number()?;
@@ -207,7 +249,7 @@ impl Parser<'_> {
         })?;
         Ok(pts)
     }
-    fn number(&mut self) -> Result<f64, String> {
+    fn number(&mut self) -> Result<f64, WktError> {
         self.skip_ws();
         let st = self.i;
         while self.i < self.s.len()
@@ -221,7 +263,7 @@ impl Parser<'_> {
         let t = &self.text[st..self.i];
         t.parse::<f64>().map_err(|_| {
             self.i = st;
-            self.err("expected a number")
+            self.err(WktProblem::Number)
         })
     }
 }
@@ -249,18 +291,33 @@ mod tests {
         };
         // At the limit the polygon is read; one more level and 50,000 are errors.
         assert_eq!(parse_wkt(&deep(MAX_WKT_DEPTH)).unwrap().polygons.len(), 1);
-        let e = parse_wkt(&deep(MAX_WKT_DEPTH + 1)).unwrap_err();
+        let e = parse_wkt(&deep(MAX_WKT_DEPTH + 1)).unwrap_err().to_string();
         assert!(e.contains("nest more than 64 deep"), "{e}");
-        let e = parse_wkt(&deep(50_000)).unwrap_err();
+        let e = parse_wkt(&deep(50_000)).unwrap_err().to_string();
         assert!(e.contains("line 1, column 1281"), "{e}");
     }
 
     #[test]
     fn errors_give_line_and_column() {
         let e = parse_wkt("POLYGON ((0 0, 1 0,\n 1 x, 0 0))").unwrap_err();
-        assert!(e.starts_with("line 2, column 4"), "{e}");
-        let e = parse_wkt("CIRCLE (0 0, 1)").unwrap_err();
+        assert_eq!(
+            e,
+            WktError::Syntax {
+                line: 2,
+                column: 4,
+                problem: WktProblem::Number,
+                found: "x, 0 0))".into()
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "line 2, column 4: expected a number, found 'x, 0 0))'"
+        );
+        let e = parse_wkt("CIRCLE (0 0, 1)").unwrap_err().to_string();
         assert!(e.contains("expected POLYGON"), "{e}");
         assert!(parse_wkt("POLYGON ((0 0, 1 0, 1 1, 0 0)").is_err());
+        let e = parse_wkt("LINESTRING (0 0, 1 1)").unwrap_err();
+        assert_eq!(e, WktError::NoPolygon);
+        assert_eq!(e.to_string(), "no POLYGON or MULTIPOLYGON found");
     }
 }
