@@ -41,6 +41,12 @@ struct Pass<'a> {
     /// Nodes of cells changed since the sweep began: a poor cell none of whose nodes was
     /// touched failed every operation in the last sweep and would fail again.
     touched: Vec<bool>,
+    /// Per node, the number of the last chunk of poor cells in which an operation changed
+    /// one of its cells (or moved it): a plan made before the chunk that read such a node is
+    /// made again.
+    stamp: Vec<u32>,
+    /// The number of the chunk being mended.
+    mark: u32,
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
     height: InterfaceFn<'a>,
@@ -61,6 +67,39 @@ const MIN_GAIN: f64 = 1e-6;
 
 /// A cell's label: its side of every fault, its unit, its block.
 type Label = (u64, u32, u32);
+
+/// An operation the pass found for a poor cell, to be made by [`Pass::apply`].
+enum Op {
+    /// Node `a` collapsed into `b`: the cells `kill` (those holding both) go, each cell of
+    /// `new` takes its new nodes and smallest angle.
+    Collapse {
+        a: u32,
+        b: u32,
+        kill: Vec<u32>,
+        new: Vec<(u32, [u32; 4], f64)>,
+    },
+    /// Cells `c` and `d` become the three of `new` (the third a new cell labelled as `c`).
+    Flip23 {
+        c: u32,
+        d: u32,
+        new: [([u32; 4], f64); 3],
+    },
+    /// The three cells of `ring` become the two of `new` (in the first two; the third goes).
+    Flip32 {
+        ring: [u32; 3],
+        new: [([u32; 4], f64); 2],
+    },
+    /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
+    Move {
+        v: u32,
+        to: [f64; 3],
+        cells: Vec<u32>,
+        angles: Vec<f64>,
+    },
+}
+
+/// Poor cells planned at once, in parallel, before they are mended in order.
+const CHUNK: usize = 256;
 
 fn c3(p: [f64; 3]) -> Coord3D<f64> {
     Coord3D {
@@ -120,29 +159,148 @@ impl Pass<'_> {
         for v in t {
             self.star[v as usize].push(c);
             self.touched[v as usize] = true;
+            self.stamp[v as usize] = self.mark;
+        }
+    }
+
+    /// Marks the nodes of cell `c` as changed in this chunk.
+    fn stamp_cell(&mut self, c: u32) {
+        for v in self.st.tets[c as usize] {
+            self.stamp[v as usize] = self.mark;
+        }
+    }
+
+    /// The first operation that mends poor cell `c`: collapsing one of its edges (shortest
+    /// first), a flip, moving one of its nodes towards the mean of its neighbours, or up the
+    /// gradient of its worst cell's smallest angle. `seen` gets every node of the cells
+    /// around its nodes: all that the plan read (with those cells), so that the plan holds as
+    /// long as none of them changed.
+    fn plan(&self, c: u32, seen: &mut Vec<u32>) -> Option<Op> {
+        let t = self.st.tets[c as usize];
+        let mut edges: Vec<(f64, u32, u32)> = EDGES
+            .iter()
+            .map(|&(i, j)| {
+                (
+                    d2(self.st.points[t[i] as usize], self.st.points[t[j] as usize]),
+                    t[i],
+                    t[j],
+                )
+            })
+            .collect();
+        edges.sort_by(|x, y| x.0.total_cmp(&y.0));
+        // The cells and labels around the four nodes, once for the twelve tries.
+        let around: Vec<(Vec<u32>, Vec<Label>)> = t
+            .iter()
+            .map(|&v| {
+                let cells = self.cells(v);
+                let labels = self.labels(&cells);
+                (cells, labels)
+            })
+            .collect();
+        seen.clear();
+        for (cells, _) in &around {
+            for &d in cells {
+                seen.extend(self.st.tets[d as usize]);
+            }
+        }
+        seen.sort_unstable();
+        seen.dedup();
+        let at = |v: u32| &around[t.iter().position(|&w| w == v).unwrap()];
+        for &(_, u, v) in &edges {
+            for (a, b) in [(u, v), (v, u)] {
+                if let Some(op) = self.collapse(a, b, [at(a), at(b)]) {
+                    return Some(op);
+                }
+            }
+        }
+        let stars = [0, 1, 2, 3].map(|i| around[i].0.as_slice());
+        if let Some(op) = self.try_flips(c, &stars) {
+            return Some(op);
+        }
+        for v in t {
+            let (cells, labels) = at(v);
+            if let Some(op) = self.smooth(v, cells, labels) {
+                return Some(op);
+            }
+        }
+        t.into_iter().find_map(|v| {
+            let (cells, labels) = at(v);
+            self.optimise(v, cells, labels)
+        })
+    }
+
+    /// Makes operation `op`, stamping the nodes of every cell it changes.
+    fn apply(&mut self, op: Op, done: &mut Improved) {
+        match op {
+            Op::Collapse { a, b, kill, new } => {
+                for &c in &kill {
+                    self.stamp_cell(c);
+                    self.alive[c as usize] = false;
+                }
+                for (c, t, q) in new {
+                    self.stamp_cell(c);
+                    self.st.tets[c as usize] = t;
+                    self.angle[c as usize] = q;
+                    self.star[b as usize].push(c);
+                    for w in t {
+                        self.touched[w as usize] = true;
+                        self.stamp[w as usize] = self.mark;
+                    }
+                }
+                self.star[a as usize].clear();
+                done.collapsed += 1;
+            }
+            Op::Flip23 { c, d, new } => {
+                self.stamp_cell(c);
+                self.stamp_cell(d);
+                self.place(Some(c), c, new[0].0, new[0].1);
+                self.place(Some(d), c, new[1].0, new[1].1);
+                self.place(None, c, new[2].0, new[2].1);
+                done.flipped += 1;
+            }
+            Op::Flip32 { ring, new } => {
+                for c in ring {
+                    self.stamp_cell(c);
+                }
+                self.place(Some(ring[0]), ring[0], new[0].0, new[0].1);
+                self.place(Some(ring[1]), ring[0], new[1].0, new[1].1);
+                self.alive[ring[2] as usize] = false;
+                done.flipped += 1;
+            }
+            Op::Move {
+                v,
+                to,
+                cells,
+                angles,
+            } => {
+                self.st.points[v as usize] = to;
+                for (&c, a) in cells.iter().zip(angles) {
+                    self.angle[c as usize] = a;
+                    for w in self.st.tets[c as usize] {
+                        self.touched[w as usize] = true;
+                        self.stamp[w as usize] = self.mark;
+                    }
+                }
+                done.moved += 1;
+            }
         }
     }
 
     /// The 2-3 flip of face `k` of cell `c` (the face opposite its node `k`): the two cells
     /// on the face become three around the edge between their apexes, if both carry one
     /// label, every new cell is positive (exact) and the smallest angle improves.
-    fn flip23(&mut self, c: u32, k: usize, around: &[u32]) -> bool {
+    fn flip23(&self, c: u32, k: usize, around: &[u32]) -> Option<Op> {
         let t = self.st.tets[c as usize];
         let face: Vec<u32> = (0..4).filter(|&i| i != k).map(|i| t[i]).collect();
-        let Some(d) = around
+        let d = around
             .iter()
             .copied()
-            .find(|&d| d != c && face.iter().all(|v| self.st.tets[d as usize].contains(v)))
-        else {
-            return false;
-        };
+            .find(|&d| d != c && face.iter().all(|v| self.st.tets[d as usize].contains(v)))?;
         if !self.one_label(&[c, d]) {
-            return false;
+            return None;
         }
         let u = self.st.tets[d as usize];
-        let Some(&b) = u.iter().find(|v| !face.contains(v)) else {
-            return false;
-        };
+        let &b = u.iter().find(|v| !face.contains(v))?;
         let old = self.angle[c as usize].min(self.angle[d as usize]);
         // Node i of `t` (on the face) replaced by `b`: the orientation of `t` is kept, so
         // each is positive exactly when the edge between the apexes crosses the face.
@@ -151,37 +309,38 @@ impl Pass<'_> {
             let mut n = t;
             n[i] = b;
             if !positive(self.geo(n)) {
-                return false;
+                return None;
             }
             let q = min_dihedral(self.geo(n));
             if q <= old {
-                return false;
+                return None;
             }
             new.push((n, q));
         }
         let poor = (self.angle[c as usize] < self.floor) as usize
             + (self.angle[d as usize] < self.floor) as usize;
         if poor < 2 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
-            return false;
+            return None;
         }
-        self.place(Some(c), c, new[0].0, new[0].1);
-        self.place(Some(d), c, new[1].0, new[1].1);
-        self.place(None, c, new[2].0, new[2].1);
-        true
+        Some(Op::Flip23 {
+            c,
+            d,
+            new: [new[0], new[1], new[2]],
+        })
     }
 
     /// The 3-2 flip of edge (a, b): the three cells around it become two on the face of
     /// their other nodes, if the ring is closed (an interior edge), the cells carry one
     /// label, `a` and `b` lie strictly on either side of that face (exact) and the smallest
     /// angle improves.
-    fn flip32(&mut self, a: u32, b: u32, around: &[u32]) -> bool {
+    fn flip32(&self, a: u32, b: u32, around: &[u32]) -> Option<Op> {
         let ring: Vec<u32> = around
             .iter()
             .copied()
             .filter(|&c| self.st.tets[c as usize].contains(&b))
             .collect();
         if ring.len() != 3 || !self.one_label(&ring) {
-            return false;
+            return None;
         }
         let mut o: Vec<u32> = ring
             .iter()
@@ -191,7 +350,7 @@ impl Pass<'_> {
         o.sort_unstable();
         o.dedup();
         if o.len() != 3 {
-            return false;
+            return None;
         }
         let p = |v: u32| c3(self.st.points[v as usize]);
         let (sa, sb) = (
@@ -199,7 +358,7 @@ impl Pass<'_> {
             orient3d(p(o[0]), p(o[1]), p(o[2]), p(b)),
         );
         if sa == 0.0 || sb == 0.0 || (sa > 0.0) == (sb > 0.0) {
-            return false;
+            return None;
         }
         let old = ring
             .iter()
@@ -212,11 +371,11 @@ impl Pass<'_> {
                 n.swap(0, 1);
             }
             if !positive(self.geo(n)) {
-                return false;
+                return None;
             }
             let q = min_dihedral(self.geo(n));
             if q <= old {
-                return false;
+                return None;
             }
             new.push((n, q));
         }
@@ -225,12 +384,12 @@ impl Pass<'_> {
             .filter(|&&c| self.angle[c as usize] < self.floor)
             .count();
         if poor < 3 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
-            return false;
+            return None;
         }
-        self.place(Some(ring[0]), ring[0], new[0].0, new[0].1);
-        self.place(Some(ring[1]), ring[0], new[1].0, new[1].1);
-        self.alive[ring[2] as usize] = false;
-        true
+        Some(Op::Flip32 {
+            ring: [ring[0], ring[1], ring[2]],
+            new: [new[0], new[1]],
+        })
     }
 
     fn labels(&self, cells: &[u32]) -> Vec<Label> {
@@ -293,17 +452,17 @@ impl Pass<'_> {
 
     /// Collapses node `a` into its neighbour `b` if allowed and better; `around` holds the
     /// cells and the labels of both (as `cells` and `labels` give them).
-    fn collapse(&mut self, a: u32, b: u32, around: [&(Vec<u32>, Vec<Label>); 2]) -> bool {
+    fn collapse(&self, a: u32, b: u32, around: [&(Vec<u32>, Vec<Label>); 2]) -> Option<Op> {
         let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
         let bound = fa & (TOP | BASE | SIDE);
         // A boundary node only into a node on the same boundaries; never a DSM vertex, never
         // a side node (collapsing those broke the sides on random sites: not understood yet).
         if bound & !fb != 0 || (fa & TOP != 0 && (a as usize) < self.background) || fa & SIDE != 0 {
-            return false;
+            return None;
         }
         let [(ca, la), (cb, lb)] = around;
         if !la.iter().all(|l| lb.binary_search(l).is_ok()) {
-            return false;
+            return None;
         }
         let old = ca
             .iter()
@@ -318,18 +477,18 @@ impl Pass<'_> {
             }
             let t = t.map(|w| if w == a { b } else { w });
             if !positive(self.geo(t)) {
-                return false;
+                return None;
             }
             new.push((c, t, 0.0));
         }
         for e in &mut new {
             e.2 = min_dihedral(self.geo(e.1));
             if e.2 <= old || (bound != 0 && !self.boundary_kept(e.1, b)) {
-                return false;
+                return None;
             }
         }
         if !new.iter().all(|e| self.in_unit(e.1, self.geo(e.1), e.0)) {
-            return false;
+            return None;
         }
         let mut keys: Vec<[u32; 4]> = cb
             .iter()
@@ -345,23 +504,14 @@ impl Pass<'_> {
             k.sort_unstable();
             keys.binary_search(&k).is_ok()
         }) {
-            return false;
+            return None;
         }
-        for &c in ca {
-            if self.st.tets[c as usize].contains(&b) {
-                self.alive[c as usize] = false;
-            }
-        }
-        for (c, t, q) in new {
-            self.st.tets[c as usize] = t;
-            self.angle[c as usize] = q;
-            self.star[b as usize].push(c);
-            for w in t {
-                self.touched[w as usize] = true;
-            }
-        }
-        self.star[a as usize].clear();
-        true
+        let kill = ca
+            .iter()
+            .copied()
+            .filter(|&c| self.st.tets[c as usize].contains(&b))
+            .collect();
+        Some(Op::Collapse { a, b, kill, new })
     }
 
     /// Whether every face of `t` through `b` whose nodes all lie on the terrain (or all on a
@@ -454,14 +604,12 @@ impl Pass<'_> {
 
     /// Moves node `v` (along its surface) up the gradient of the smallest angle of its
     /// worst cell, a few steps, if the smallest angle of its cells improves.
-    fn optimise(&mut self, v: u32, cells: &[u32], labels: &[Label]) -> bool {
+    fn optimise(&self, v: u32, cells: &[u32], labels: &[Label]) -> Option<Op> {
         if cells.is_empty() {
-            return false;
+            return None;
         }
         let p = self.st.points[v as usize];
-        if self.slide(v, labels, p).is_none() {
-            return false;
-        }
+        self.slide(v, labels, p)?;
         let geo = |c: u32, q: [f64; 3]| {
             self.st.tets[c as usize].map(|w| {
                 if w == v {
@@ -530,30 +678,28 @@ impl Pass<'_> {
                 .iter()
                 .all(|&c| self.in_unit(self.st.tets[c as usize], geo(c, q), c))
         {
-            return false;
+            return None;
         }
         let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
-        self.st.points[v as usize] = q;
-        for (&c, a) in cells.iter().zip(angles) {
-            self.angle[c as usize] = a;
-            for w in self.st.tets[c as usize] {
-                self.touched[w as usize] = true;
-            }
-        }
-        true
+        Some(Op::Move {
+            v,
+            to: q,
+            cells: cells.to_vec(),
+            angles,
+        })
     }
 
     /// Tries the 3-2 flip of every edge of cell `c`, then the 2-3 flip of every face.
     /// `around[i]`: the cells around node i of cell `c`.
-    fn try_flips(&mut self, c: u32, around: &[&[u32]; 4]) -> bool {
+    fn try_flips(&self, c: u32, around: &[&[u32]; 4]) -> Option<Op> {
         let t = self.st.tets[c as usize];
         for &(i, j) in &EDGES {
-            if self.flip32(t[i], t[j], around[i]) {
-                return true;
+            if let Some(op) = self.flip32(t[i], t[j], around[i]) {
+                return Some(op);
             }
         }
         // The face opposite node k holds node 0, or node 1 when k is 0.
-        (0..4).any(|k| self.flip23(c, k, around[if k == 0 { 1 } else { 0 }]))
+        (0..4).find_map(|k| self.flip23(c, k, around[if k == 0 { 1 } else { 0 }]))
     }
 
     /// Where a node at `p` on a side and on one surface (between cells labelled `x` and `y`)
@@ -612,9 +758,9 @@ impl Pass<'_> {
     }
 
     /// Moves node `v` towards the mean of its neighbours (along its surface) if better.
-    fn smooth(&mut self, v: u32, cells: &[u32], labels: &[Label]) -> bool {
+    fn smooth(&self, v: u32, cells: &[u32], labels: &[Label]) -> Option<Op> {
         if cells.is_empty() {
-            return false;
+            return None;
         }
         let p = self.st.points[v as usize];
         let mut nb: Vec<u32> = cells
@@ -636,9 +782,7 @@ impl Pass<'_> {
             .fold(f64::MAX, f64::min);
         for s in [1.0, 0.5, 0.25] {
             let to = [0, 1, 2].map(|k| p[k] + s * (mean[k] - p[k]));
-            let Some(q) = self.slide(v, labels, to) else {
-                return false;
-            };
+            let q = self.slide(v, labels, to)?;
             let mut new = Vec::with_capacity(cells.len());
             let mut ok = true;
             for &c in cells {
@@ -676,17 +820,15 @@ impl Pass<'_> {
                 && new.iter().filter(|a| poor(a)).count() <= before
                 && cells.iter().all(|&c| kept(c))
             {
-                self.st.points[v as usize] = q;
-                for (&c, a) in cells.iter().zip(new) {
-                    self.angle[c as usize] = a;
-                    for w in self.st.tets[c as usize] {
-                        self.touched[w as usize] = true;
-                    }
-                }
-                return true;
+                return Some(Op::Move {
+                    v,
+                    to: q,
+                    cells: cells.to_vec(),
+                    angles: new,
+                });
             }
         }
-        false
+        None
     }
 }
 
@@ -732,6 +874,8 @@ pub(crate) fn improve(
     let mut p = Pass {
         alive: vec![true; st.tets.len()],
         touched: vec![true; st.points.len()],
+        stamp: vec![0; st.points.len()],
+        mark: 0,
         floor: below,
         st,
         star,
@@ -761,65 +905,39 @@ pub(crate) fn improve(
         bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
         p.touched.iter_mut().for_each(|t| *t = false);
         let before = done;
-        for c in bad {
-            let c = c as usize;
-            if !p.alive[c] || p.angle[c] >= below {
-                continue;
-            }
-            let t = p.st.tets[c];
-            let mut edges: Vec<(f64, u32, u32)> = EDGES
-                .iter()
-                .map(|&(i, j)| {
-                    (
-                        d2(p.st.points[t[i] as usize], p.st.points[t[j] as usize]),
-                        t[i],
-                        t[j],
-                    )
-                })
-                .collect();
-            edges.sort_by(|x, y| x.0.total_cmp(&y.0));
-            let mut fixed = false;
-            // The cells and labels around the four nodes, once for the twelve tries.
-            let around: Vec<(Vec<u32>, Vec<Label>)> = t
-                .iter()
-                .map(|&v| {
-                    let cells = p.cells(v);
-                    let labels = p.labels(&cells);
-                    (cells, labels)
-                })
-                .collect();
-            let at = |v: u32| &around[t.iter().position(|&w| w == v).unwrap()];
-            'edges: for &(_, u, v) in &edges {
-                for (a, b) in [(u, v), (v, u)] {
-                    if p.collapse(a, b, [at(a), at(b)]) {
-                        done.collapsed += 1;
-                        fixed = true;
-                        break 'edges;
-                    }
+        // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
+        // the cells are mended in order, each with its plan if no node that the plan read has
+        // changed since, else with a plan made again: exactly the serial pass, whatever the
+        // number of threads.
+        for chunk in bad.chunks(CHUNK) {
+            p.mark += 1;
+            let plans: Vec<(Option<Op>, Vec<u32>)> = {
+                let q = &p;
+                chunk
+                    .par_iter()
+                    .map(|&c| {
+                        let mut seen = Vec::new();
+                        if !q.alive[c as usize] || q.angle[c as usize] >= below {
+                            return (None, seen);
+                        }
+                        let op = q.plan(c, &mut seen);
+                        (op, seen)
+                    })
+                    .collect()
+            };
+            for (&c, (op, seen)) in chunk.iter().zip(plans) {
+                if !p.alive[c as usize] || p.angle[c as usize] >= below {
+                    continue;
                 }
-            }
-            let stars = [0, 1, 2, 3].map(|i| around[i].0.as_slice());
-            if !fixed && p.try_flips(c as u32, &stars) {
-                done.flipped += 1;
-                fixed = true;
-            }
-            if !fixed {
-                for v in t {
-                    let (cells, labels) = at(v);
-                    if p.smooth(v, cells, labels) {
-                        done.moved += 1;
-                        fixed = true;
-                        break;
-                    }
-                }
-            }
-            if !fixed {
-                for v in t {
-                    let (cells, labels) = at(v);
-                    if p.optimise(v, cells, labels) {
-                        done.moved += 1;
-                        break;
-                    }
+                let stale = seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] == p.mark);
+                let op = if stale {
+                    let mut seen = Vec::new();
+                    p.plan(c, &mut seen)
+                } else {
+                    op
+                };
+                if let Some(op) = op {
+                    p.apply(op, &mut done);
                 }
             }
         }

@@ -213,8 +213,8 @@ pub struct BlockInterfaces {
     id: u64,
 }
 
-/// The heights of the interfaces (from the top) that [`BlockInterfaces::height`] last found,
-/// per thread: for which set, block and point.
+/// The heights of the interfaces (from the top) that [`BlockInterfaces::height`] found at one
+/// point of one block of one set: a slot of the per-thread memo.
 struct Last {
     id: u64,
     key: BlockKey,
@@ -222,15 +222,29 @@ struct Last {
     z: Vec<f64>,
 }
 
+/// Slots of the per-thread memo (a power of two): about 7 MB per thread with a few
+/// interfaces.
+const MEMO_SLOTS: usize = 1 << 16;
+
 thread_local! {
-    static LAST: std::cell::RefCell<Last> = const {
-        std::cell::RefCell::new(Last {
-            id: u64::MAX,
-            key: BlockKey { positive: 0, counts: 0 },
-            p: [f64::NAN; 2],
-            z: Vec::new(),
-        })
-    };
+    /// Per thread, the columns of heights last found, each in the slot its set, block and
+    /// point hash to (a direct-mapped cache: a new point evicts the one in its slot).
+    static MEMO: std::cell::RefCell<Vec<Last>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// The memo's slot of set `id`, block `key` and point `p`.
+fn slot(id: u64, key: BlockKey, p: [f64; 2]) -> usize {
+    let mut h = id.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    for w in [
+        key.positive,
+        key.counts,
+        p[0].to_bits(),
+        p[1].to_bits().rotate_left(32),
+    ] {
+        h = (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        h ^= h >> 29;
+    }
+    (h >> (64 - MEMO_SLOTS.trailing_zeros())) as usize
 }
 
 /// The next [`BlockInterfaces`]' number.
@@ -386,11 +400,25 @@ impl BlockInterfaces {
     /// above the interface above it, and onto it where the unit between is thinner than
     /// `min_thickness` (pinched out).
     pub fn height(&self, k: usize, key: BlockKey, p: [f64; 2]) -> f64 {
-        // The mesher asks for interfaces 0, 1, 2, ... at one point in turn, and each needs
-        // those above it: the heights found at the last point are kept per thread, so that a
-        // column costs one evaluation per interface, not k.
-        LAST.with(|last| {
-            let mut last = last.borrow_mut();
+        // The mesher asks for interfaces 0, 1, 2, ... at one point in turn, each needs those
+        // above it, and it asks again at the same points (a column's nodes share their plan
+        // point; the quality pass tests a node's cells many times): the heights found at a
+        // point are kept per thread, in a slot of a memo, so that a point costs one evaluation
+        // per interface. The values do not depend on what the memo holds.
+        MEMO.with(|memo| {
+            let mut memo = memo.borrow_mut();
+            if memo.is_empty() {
+                memo.resize_with(MEMO_SLOTS, || Last {
+                    id: u64::MAX,
+                    key: BlockKey {
+                        positive: 0,
+                        counts: 0,
+                    },
+                    p: [f64::NAN; 2],
+                    z: Vec::new(),
+                });
+            }
+            let last = &mut memo[slot(self.id, key, p)];
             if last.id != self.id || last.key != key || last.p != p {
                 last.id = self.id;
                 last.key = key;
