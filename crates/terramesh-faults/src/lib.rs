@@ -147,6 +147,8 @@ mod split;
 mod synth;
 /// The terrain and point location.
 mod terrain;
+/// Fault zones: the walls at half a zone's thickness on either side of a fault, cut in.
+mod zones;
 
 pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
 pub use error::FaultError;
@@ -163,3 +165,7 @@ pub use quality::{min_dihedral, quality, Quality, BINS};
 pub use split::{check_split, split_nodes, SplitMesh, SplitSummary};
 pub use synth::{Site, SynthFault};
 pub use terrain::Terrain;
+pub use zones::{
+    check_zones, ZoneCells, ZoneCheck, ZONE_MAX_FRACTION, ZONE_MIN, ZONE_ON_WALL,
+    ZONE_VOLUME_TOLERANCE,
+};
