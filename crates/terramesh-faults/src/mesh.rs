@@ -984,7 +984,7 @@ pub fn faulted_mesh_with_objects(
         interfaces,
     };
     let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
-    let zones = crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces)?;
+    let zones = crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,

@@ -26,7 +26,10 @@ use crate::mesh::{
     centroid, key, positive, split_cells, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
 };
 use crate::objects::Surfaces;
-use crate::{Fault, FaultError, FaultSet, FaultedMesh, ObjectCells, Terrain, FAULT_TOLERANCE};
+use crate::quality::min_dihedral;
+use crate::{
+    Fault, FaultError, FaultSet, FaultedMesh, MeshSettings, ObjectCells, Terrain, FAULT_TOLERANCE,
+};
 
 /// A node within this distance of a zone's wall (metres) lies on it: a split closer to an
 /// edge's end would leave a cell too thin for its volume to be computed in floating point.
@@ -46,6 +49,7 @@ pub const ZONE_MIN: f64 = 0.01;
 ///     zone: vec![0, 2, 0],
 ///     thickness: vec![0.0, 2.0],
 ///     split_edges: 0,
+///     snapped: 0,
 /// };
 /// assert_eq!(z.faults(), [1]);
 /// // Three units: the zone of fault 1 is material 3.
@@ -60,6 +64,8 @@ pub struct ZoneCells {
     pub thickness: Vec<f64>,
     /// Edges split at the zones' walls.
     pub split_edges: usize,
+    /// Nodes moved onto a zone's wall instead.
+    pub snapped: usize,
 }
 
 impl ZoneCells {
@@ -188,6 +194,113 @@ fn crossing(f: &dyn Fn([f64; 3]) -> f64, a: [f64; 3], b: [f64; 3], va: f64, vb: 
     at(t.clamp(1e-12, 1.0 - 1e-12))
 }
 
+/// Moves the nodes close to a wall onto it before the wall is cut, as the faults' cut does
+/// (`MeshSettings::snap`, `guard_degrees`): a node whose crossing edge (`edges`) is cut within
+/// `snap` of the edge's length from it, that lies on no surface (not on the terrain, the base,
+/// a side, a fault or an interface, and every cell around it of one side of every fault, one
+/// unit, one zone and one object label), moves along the fault's normal onto the wall if every
+/// cell around it stays positive and above the smaller of `guard_degrees` and its smallest
+/// dihedral angle. Inside its star's kernel the star covers the same region, so every label
+/// stays true. Returns the number of nodes moved (their values set to 0).
+#[allow(clippy::too_many_arguments)]
+fn snap(
+    st: &mut State,
+    g: &(dyn Fn([f64; 3]) -> f64 + Sync),
+    fault: &Fault,
+    s: i8,
+    edges: &[(u64, u32)],
+    values: &mut [(f64, i8)],
+    zone: &[u32],
+    objects: &ObjectCells,
+    settings: &MeshSettings,
+) -> usize {
+    let mut cand: Vec<(f64, u32)> = Vec::new();
+    for &(k, _) in edges {
+        let (a, b) = ((k >> 32) as u32, k as u32);
+        let (va, vb) = (values[a as usize].0, values[b as usize].0);
+        let t = va / (va - vb);
+        if t < settings.snap {
+            cand.push((va.abs(), a));
+        }
+        if t > 1.0 - settings.snap {
+            cand.push((vb.abs(), b));
+        }
+    }
+    if cand.is_empty() {
+        return 0;
+    }
+    cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let mut is_cand = vec![false; st.points.len()];
+    for &(_, v) in &cand {
+        is_cand[v as usize] = true;
+    }
+    let mut star: Vec<(u32, u32)> = st
+        .tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(c, t)| {
+            let is_cand = &is_cand;
+            t.iter()
+                .filter(move |&&v| is_cand[v as usize])
+                .map(move |&v| (v, c as u32))
+        })
+        .collect();
+    star.par_sort_unstable();
+    let label = |c: usize| {
+        (
+            st.positive[c],
+            st.below[c],
+            st.block[c],
+            zone[c],
+            objects.object.get(c).copied(),
+            objects.lining.get(c).copied(),
+        )
+    };
+    let mut moved = 0;
+    for &(_, v) in &cand {
+        let vi = v as usize;
+        if values[vi].1 == 0
+            || st.flags[vi] & (TOP | BASE | SIDE | ON_INTERFACE) != 0
+            || st.on_fault[vi] != 0
+        {
+            continue;
+        }
+        let lo = star.partition_point(|e| e.0 < v);
+        let hi = star.partition_point(|e| e.0 <= v);
+        let cells = &star[lo..hi];
+        let Some(first) = cells.first() else {
+            continue;
+        };
+        let one = label(first.1 as usize);
+        if cells.iter().any(|e| label(e.1 as usize) != one) {
+            continue;
+        }
+        let q = st.points[vi];
+        let n = fault.side(q).normal;
+        let gv = g(q);
+        let target: [f64; 3] = std::array::from_fn(|k| q[k] - gv * f64::from(s) * n[k]);
+        if eval(g(target)).1 != 0 {
+            continue;
+        }
+        let geo =
+            |t: &[u32; 4], at: [f64; 3]| t.map(|w| if w == v { at } else { st.points[w as usize] });
+        let old = cells
+            .iter()
+            .map(|e| min_dihedral(geo(&st.tets[e.1 as usize], q)))
+            .fold(f64::MAX, f64::min);
+        let ok = cells.iter().all(|e| {
+            let p = geo(&st.tets[e.1 as usize], target);
+            positive(p) && min_dihedral(p) >= old.min(settings.guard_degrees)
+        });
+        if ok {
+            st.points[vi] = target;
+            values[vi] = (0.0, 0);
+            moved += 1;
+        }
+    }
+    moved
+}
+
 /// Cuts every fault zone's two walls into the mesh and labels the zones' cells (see the
 /// module documentation); the children of a split cell keep its labels, the objects' too.
 pub(crate) fn cut_zones(
@@ -195,13 +308,14 @@ pub(crate) fn cut_zones(
     faults: &FaultSet,
     objects: &mut ObjectCells,
     surfaces: &Surfaces,
+    settings: &MeshSettings,
 ) -> Result<ZoneCells, FaultError> {
     let order = order(faults);
     if order.is_empty() {
         return Ok(ZoneCells::default());
     }
     let mut zone = vec![0u32; st.tets.len()];
-    let mut split_edges = 0;
+    let (mut split_edges, mut snapped) = (0, 0);
     for &f in &order {
         let fault = &faults.faults[f];
         for s in [-1i8, 1] {
@@ -243,6 +357,18 @@ pub(crate) fn cut_zones(
                 .collect();
             edges.par_sort_unstable();
             edges.dedup_by_key(|e| e.0);
+            snapped += snap(
+                st,
+                &g,
+                fault,
+                s,
+                &edges,
+                &mut values,
+                &zone,
+                objects,
+                settings,
+            );
+            edges.retain(|&(k, _)| values[(k >> 32) as usize].1 * values[k as u32 as usize].1 < 0);
             let most = 0.5 * FAULT_TOLERANCE;
             let chords: Vec<[f64; 3]> = edges
                 .par_iter()
@@ -336,6 +462,7 @@ pub(crate) fn cut_zones(
         zone,
         thickness: faults.faults.iter().map(|x| x.zone).collect(),
         split_edges,
+        snapped,
     })
 }
 

@@ -33,9 +33,10 @@ fn build(site: &Site, zones: &[f64]) -> (FaultSet, FaultedMesh, Vec<ZoneCheck>) 
     let summary = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
     let zones = check_zones(&mesh, &set).unwrap();
     println!(
-        "{} cells, {} zone edges split, min dihedral {:.2}, below 5: {}, zones {:?}",
+        "{} cells, {} zone edges split, {} snapped, min dihedral {:.2}, below 5: {}, zones {:?}",
         mesh.tets.len(),
         mesh.zones.split_edges,
+        mesh.zones.snapped,
         summary.quality.min,
         summary.quality.below_5,
         zones
