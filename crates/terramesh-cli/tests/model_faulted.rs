@@ -745,7 +745,8 @@ fn the_report_of_the_faulted_example_shows_its_faults_and_blocks() {
 }
 
 /// Fault zones (`zone`): a copy of the example with a 2 m zone on F1 and a 3 m zone on F3
-/// (which ends at F1). `model.vtu`'s `MaterialIDs` give the zones 8 and 9 after the eight
+/// (which ends at F1), built with `terramesh build` (its model stage is `terramesh model`'s;
+/// the report names the zones). `model.vtu`'s `MaterialIDs` give the zones 8 and 9 after the eight
 /// units, named in `unit_names`, `model.json`, the physical volumes of `model.msh`, the zone
 /// groups of `model.f3grid` and the bodies `unit-zone-F1.ts/.stl`; every cell of F1's zone
 /// has its centroid within 1 m (+1 cm) of F1's true plane (`Site::true_side`, the site's own
@@ -773,17 +774,34 @@ fn fault_zones_are_cells_of_their_own() {
     assert_eq!(zoned.matches("zone = ").count(), 2);
     let project = tmp.path().join("terramesh.toml");
     std::fs::write(&project, &zoned).unwrap();
+    // `terramesh build`: the model stage of `terramesh model` and the report after it.
     let out = tmp.path().join("model");
-    let o = model(&project, &out, &[]);
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "build",
+            project.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+        .output()
+        .unwrap();
     assert!(
         o.status.success(),
-        "terramesh model failed:\n{}",
+        "terramesh build failed:\n{}",
         String::from_utf8_lossy(&o.stderr)
     );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
     let faults = &json["faulted"]["faults"];
     let z1 = &faults[0]["zone"];
+    // The report's fault table names the zones; its block table too.
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains("<td>zone-F1 (MaterialIDs 8), 2, "),
+        "report.html"
+    );
+    assert!(html.contains("fault zones: zone-F1"), "report.html");
     assert_eq!(z1["material"], "zone-F1", "{z1}");
     assert_eq!(z1["material_id"], 8, "{z1}");
     assert_eq!(z1["thickness"], 2.0, "{z1}");
