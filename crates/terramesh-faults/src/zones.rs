@@ -9,7 +9,9 @@
 //! the field s·d(q) − w/2 is evaluated at the nodes of the cells on that side where the fault
 //! is active ([`FaultSet::active`] at their centroid: not beyond a fault it ends at, not below
 //! its depth), every edge whose ends it puts on both sides of the wall (a node within
-//! [`ZONE_ON_WALL`] lies on it) is split at the crossing (regula falsi; a crossing on a face of
+//! [`ZONE_ON_WALL`] lies on it, and a node whose crossing is within `MeshSettings::snap` of it
+//! moves onto the wall where it lies on no surface and its cells stay shaped) is split at the
+//! crossing (regula falsi; a crossing on a face of
 //! another fault or an interface is moved onto that surface along the wall, as for objects),
 //! and every cell of that side whose nodes all lie inside (or on) the wall is a cell of the
 //! zone. The fault's surface has cut every edge already, so on either side the field varies
