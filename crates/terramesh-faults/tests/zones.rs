@@ -107,7 +107,7 @@ fn vertical_zone_is_the_slab() {
     }
     // The materials: the zone after the three units.
     let m = mesh.zones.materials(&mesh.unit, 3);
-    assert!(m.iter().any(|&x| x == 3));
+    assert!(m.contains(&3));
     assert!(m
         .iter()
         .zip(&mesh.zones.zone)
