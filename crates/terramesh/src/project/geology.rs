@@ -997,6 +997,19 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("geology.max_cell_height"), "{e}");
+        // A zone lowers into the plan; a unit already named after it is refused.
+        let zoned = ok.replacen("throw = 5.0", "throw = 5.0\nzone = 2.0", 1);
+        let p = Project::parse("p.toml", &zoned, &[]).unwrap();
+        assert_eq!(p.geology().unwrap().faults[0].zone, 2.0);
+        let taken = zoned.replacen("\"gravel\"]", "\"zone-f1\"]", 1);
+        assert_ne!(taken, zoned);
+        let e = Project::parse("p.toml", &taken, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("geology.faults[F1].zone") && e.contains("'zone-F1'"),
+            "{e}"
+        );
         let p = Project::parse("p.toml", &ok, &["geology.split_faults=true".into()]).unwrap();
         assert!(p.geology().unwrap().split_faults);
     }
