@@ -743,3 +743,169 @@ fn the_report_of_the_faulted_example_shows_its_faults_and_blocks() {
         "no section draws a fault"
     );
 }
+
+/// Fault zones (`zone`): a copy of the example with a 2 m zone on F1 and a 3 m zone on F3
+/// (which ends at F1), built with `terramesh build` (its model stage is `terramesh model`'s;
+/// the report names the zones). `model.vtu`'s `MaterialIDs` give the zones 8 and 9 after the eight
+/// units, named in `unit_names`, `model.json`, the physical volumes of `model.msh`, the zone
+/// groups of `model.f3grid` and the bodies `unit-zone-F1.ts/.stl`; every cell of F1's zone
+/// has its centroid within 1 m (+1 cm) of F1's true plane (`Site::true_side`, the site's own
+/// plane equation) and every cell within 0.99 m of it is in F1's zone; the zone's volume is
+/// its thickness times F1's meshed area within 5 %; the true unit still holds in 99 % of the
+/// volume and every contact within 1 mm. Bad thicknesses are refused naming the key.
+#[test]
+fn fault_zones_are_cells_of_their_own() {
+    let tmp = tempfile::tempdir().unwrap();
+    for f in [
+        "heights.csv",
+        "collars.csv",
+        "intervals.csv",
+        "fault_picks.csv",
+        "f1.csv",
+        "f2.csv",
+        "f3.csv",
+    ] {
+        std::fs::copy(example().join(f), tmp.path().join(f)).unwrap();
+    }
+    let text = std::fs::read_to_string(example().join("terramesh.toml")).unwrap();
+    let zoned = text
+        .replacen("throw = 12.0\n", "throw = 12.0\nzone = 2.0\n", 1)
+        .replacen("throw = 6.0\n", "throw = 6.0\nzone = 3.0\n", 1);
+    assert_eq!(zoned.matches("zone = ").count(), 2);
+    let project = tmp.path().join("terramesh.toml");
+    std::fs::write(&project, &zoned).unwrap();
+    // `terramesh build`: the model stage of `terramesh model` and the report after it.
+    let out = tmp.path().join("model");
+    let o = Command::new(env!("CARGO_BIN_EXE_terramesh"))
+        .args([
+            "build",
+            project.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "terramesh build failed:\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    let faults = &json["faulted"]["faults"];
+    let z1 = &faults[0]["zone"];
+    // The report's fault table names the zones; its block table too.
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains("<td>zone-F1 (MaterialIDs 8), 2, "),
+        "report.html"
+    );
+    assert!(html.contains("fault zones: zone-F1"), "report.html");
+    assert_eq!(z1["material"], "zone-F1", "{z1}");
+    assert_eq!(z1["material_id"], 8, "{z1}");
+    assert_eq!(z1["thickness"], 2.0, "{z1}");
+    assert!(z1["relative_difference"].as_f64().unwrap() < 0.05, "{z1}");
+    assert!(z1["blocks"].as_array().unwrap().len() >= 2, "{z1}");
+    assert!(faults[1].get("zone").is_none(), "F2 has no zone");
+    assert_eq!(faults[2]["zone"]["material_id"], 9);
+    let in_blocks = json["faulted"]["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|b| {
+            b["zones"]
+                .as_array()
+                .is_some_and(|z| z.iter().any(|n| n == "zone-F1"))
+        })
+        .count();
+    assert_eq!(in_blocks, z1["blocks"].as_array().unwrap().len());
+    let v = Vtu::read(&out.join("model.vtu"));
+    let names = v.text("unit_names").unwrap();
+    let names: Vec<&str> = names.split('\0').filter(|s| !s.is_empty()).collect();
+    assert_eq!(names.len(), 10, "{names:?}");
+    assert_eq!(names[8..], ["zone-F1", "zone-F3"]);
+    let msh = std::fs::read_to_string(out.join("model.msh")).unwrap();
+    let f3 = std::fs::read_to_string(out.join("model.f3grid")).unwrap();
+    for z in ["zone-F1", "zone-F3"] {
+        assert!(
+            msh.contains(&format!("3 9 \"{z}\"")) || msh.contains(&format!("\"{z}\"")),
+            "model.msh lacks {z}"
+        );
+        assert!(f3.contains(z), "model.f3grid lacks {z}");
+        for ext in ["ts", "stl"] {
+            assert!(
+                out.join(format!("unit-{z}.{ext}")).is_file(),
+                "unit-{z}.{ext}"
+            );
+        }
+    }
+    let pts = v.array("Name=\"Points\"");
+    let conn = v.array("Name=\"connectivity\"");
+    let mat = v.array("Name=\"MaterialIDs\"");
+    let site = truth();
+    let (mut zone_volume, mut total, mut right) = (0.0, 0.0, 0.0);
+    let (mut zone8, mut zone9) = (0, 0);
+    for (c, &m) in mat.iter().enumerate() {
+        let t: [[f64; 3]; 4] = std::array::from_fn(|i| {
+            let n = conn[4 * c + i] as usize;
+            [pts[3 * n], pts[3 * n + 1], pts[3 * n + 2]]
+        });
+        let vol = tet_volume(t).abs();
+        let q = std::array::from_fn(|k| t.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        let d = site.true_side(0, q).abs();
+        total += vol;
+        match m as usize {
+            8 => {
+                zone8 += 1;
+                zone_volume += vol;
+                assert!(d <= 1.01, "a cell of zone-F1 {d} m from F1 at {q:?}");
+            }
+            9 => zone9 += 1,
+            u => {
+                assert!(d >= 0.99, "a cell of unit {u} {d} m from F1 at {q:?}");
+                if site.true_unit(q) == u {
+                    right += vol;
+                }
+            }
+        }
+    }
+    assert!(zone8 > 0 && zone9 > 0, "{zone8} {zone9}");
+    let expected = 2.0 * faults[0]["area"].as_f64().unwrap();
+    assert!(
+        (zone_volume - expected).abs() < 0.05 * expected,
+        "{zone_volume} {expected}"
+    );
+    assert!((zone_volume - z1["volume"].as_f64().unwrap()).abs() < 1e-6 * zone_volume);
+    let zones = zone_volume
+        + json["faulted"]["faults"][2]["zone"]["volume"]
+            .as_f64()
+            .unwrap();
+    let share = right / (total - zones);
+    assert!(
+        share >= 0.99,
+        "the true unit in {share:.4} of the units' volume"
+    );
+    for m in json["boreholes"].as_array().unwrap() {
+        assert!(m["misfit"].as_f64().unwrap().abs() < 1e-3, "{m}");
+    }
+    // Bad thicknesses, each refused naming the key, nothing written.
+    for (z, want) in [
+        ("zone = -1.0", "geology.faults[F1].zone: -1: give"),
+        ("zone = nan", "geology.faults[F1].zone: NaN: give"),
+        (
+            "zone = 150.0",
+            "geology.faults[F1].zone: fault F1: zone 150: thicker than",
+        ),
+    ] {
+        let bad = zoned.replacen("zone = 2.0", z, 1);
+        let project = tmp.path().join("bad.toml");
+        std::fs::write(&project, &bad).unwrap();
+        let out = tmp.path().join("bad");
+        let o = model(&project, &out, &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(err.contains(want), "{z}: {err} lacks {want}");
+        assert!(!out.exists(), "{z} wrote {}", out.display());
+    }
+}

@@ -149,6 +149,16 @@ pub enum FaultError {
         /// What is wrong and what to do.
         why: String,
     },
+    /// A fault zone's thickness is not a number of metres the mesh can hold.
+    #[error("fault {fault}: zone {zone}: {why}")]
+    Zone {
+        /// The fault.
+        fault: String,
+        /// The thickness given.
+        zone: f64,
+        /// What it must be.
+        why: String,
+    },
     /// A check of the volume mesh failed.
     #[error("check failed: {what} near ({x}, {y}, {z})")]
     Check {

@@ -52,6 +52,9 @@ pub struct FaultSpec {
     pub ends_at: Vec<String>,
     /// Its down-dip extent below the trace, metres (trace faults; default: to the base).
     pub depth: Option<f64>,
+    /// The thickness of its fault zone, metres (0: none): the cells within half of it of the
+    /// fault, on either side, form a zone of their own (see [`crate::ZoneCells`]).
+    pub zone: f64,
 }
 
 impl FaultSpec {
@@ -66,6 +69,7 @@ impl FaultSpec {
             },
             ends_at: Vec::new(),
             depth: None,
+            zone: 0.0,
         }
     }
 
@@ -76,6 +80,7 @@ impl FaultSpec {
             geometry: FaultGeometry::Surface { points, triangles },
             ends_at: Vec::new(),
             depth: None,
+            zone: 0.0,
         }
     }
 
@@ -88,6 +93,12 @@ impl FaultSpec {
     /// Sets its down-dip extent.
     pub fn depth(mut self, depth: f64) -> FaultSpec {
         self.depth = Some(depth);
+        self
+    }
+
+    /// Sets the thickness of its fault zone, metres (0: none).
+    pub fn zone(mut self, thickness: f64) -> FaultSpec {
+        self.zone = thickness;
         self
     }
 }
@@ -188,6 +199,8 @@ pub struct Fault {
     pub ends_at: Vec<(usize, i8)>,
     /// Its down-dip extent.
     pub depth: Option<f64>,
+    /// The thickness of its fault zone, metres (0: none).
+    pub zone: f64,
 }
 
 fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -851,6 +864,7 @@ impl FaultSet {
                 shape,
                 ends_at: Vec::new(),
                 depth: s.depth,
+                zone: crate::zones::check_zone(&s.name, s.zone, terrain)?,
             });
         }
         let known = specs

@@ -120,6 +120,13 @@
 //! cells are labelled by object and lining ([`ObjectCells`]). See `docs/geology.md`,
 //! "Engineering structures".
 //!
+//! # Fault zones ([`FaultSpec::zone`], [`ZoneCells`], [`check_zones`])
+//! A fault with a zone w thick keeps its own surface and faces; the walls at signed distance
+//! ±w/2 from it are cut after the objects (a node close to a wall and on no surface moved
+//! onto it, else the crossing edges split), and the cells between them, where the fault is
+//! active, are the zone's ([`FaultedMesh::zones`]); the local refinement counts each half of a
+//! zone as a slab. See `docs/geology.md`, "Faults (kernel)".
+//!
 //! [`split_nodes`] duplicates the nodes on the faults (one copy per side) and
 //! [`check_split`] verifies that every fault face then appears twice. [`Site`] builds a
 //! synthetic site with a known truth.
@@ -147,6 +154,8 @@ mod split;
 mod synth;
 /// The terrain and point location.
 mod terrain;
+/// Fault zones: the walls at half a zone's thickness on either side of a fault, cut in.
+mod zones;
 
 pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
 pub use error::FaultError;
@@ -163,3 +172,7 @@ pub use quality::{min_dihedral, quality, Quality, BINS};
 pub use split::{check_split, split_nodes, SplitMesh, SplitSummary};
 pub use synth::{Site, SynthFault};
 pub use terrain::Terrain;
+pub use zones::{
+    check_zones, ZoneCells, ZoneCheck, ZONE_MAX_FRACTION, ZONE_MIN, ZONE_ON_WALL,
+    ZONE_VOLUME_TOLERANCE,
+};

@@ -138,6 +138,8 @@ pub struct FaultedMesh {
     pub report: BuildReport,
     /// The engineering objects' labels of every cell (empty objects: all 0).
     pub objects: crate::ObjectCells,
+    /// The fault zones' labels of every cell (empty without zones).
+    pub zones: crate::ZoneCells,
 }
 
 pub(crate) struct State {
@@ -981,7 +983,8 @@ pub fn faulted_mesh_with_objects(
         height,
         interfaces,
     };
-    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
+    let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
+    let zones = crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,
@@ -995,6 +998,7 @@ pub fn faulted_mesh_with_objects(
         units: interfaces + 1,
         report: st.report,
         objects: object_cells,
+        zones,
     })
 }
 

@@ -1464,7 +1464,7 @@ impl Surfaces<'_> {
     /// Otherwise `p` (the chord): a node moved off the wall would leave the cells around it
     /// with nodes on both sides of the wall.
     #[allow(clippy::too_many_arguments)]
-    fn onto(
+    pub(crate) fn onto(
         &self,
         st: &State,
         a: usize,

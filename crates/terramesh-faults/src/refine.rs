@@ -91,6 +91,8 @@ impl Ctx<'_> {
             (Kind::Base, [p[0], p[1], b], [0.0, 0.0, 1.0]),
         ];
         let mut blocks: Vec<BlockKey> = Vec::new();
+        // A fault zone (cut after the quality pass): two slabs, each half its thickness.
+        let mut zone = f64::INFINITY;
         for (f, fault) in self.faults.faults.iter().enumerate() {
             let d: Vec<f64> = zs
                 .iter()
@@ -127,6 +129,9 @@ impl Ctx<'_> {
             });
             if let Some(q) = on {
                 surf.push((Kind::Fault(f), q, fault.side(q).normal));
+                if fault.zone > 0.0 {
+                    zone = zone.min(0.5 * fault.zone);
+                }
             }
         }
         for &z in &zs {
@@ -158,7 +163,7 @@ impl Ctx<'_> {
                 }
             }
         }
-        thin
+        thin.min(zone)
     }
 }
 

@@ -842,6 +842,7 @@ fn fault_key(e: &terramesh_faults::FaultError) -> String {
         F::Depth { fault, .. } => (fault, "depth"),
         F::UnknownEndsAt { fault, .. } | F::NeverMeets { fault, .. } => (fault, "ends_at"),
         F::Faults { fault, .. } => (fault, "name"),
+        F::Zone { fault, .. } => (fault, "zone"),
         _ => return "[[geology.faults]]".to_string(),
     };
     format!("geology.faults[{fault}].{key}")

@@ -1,8 +1,9 @@
 //! The fault kernel's mesh (`terramesh_faults::FaultedMesh`) as the writers take it
 //! ([`faulted_volume`]), one conversion for the facade's geology stage and the writers' tests: a
-//! `VolumeMesh` (tetrahedra, the units as materials, the faces on the terrain, the base and the
+//! `VolumeMesh` (tetrahedra, the units as materials, a fault zone's cells the material
+//! `zone-<fault>` after the units, the faces on the terrain, the base and the
 //! region's sides tagged, the faces between two units of one block tagged
-//! `interface-<lower unit>`, one sealed body per unit) and its `FaultData` (blocks named after
+//! `interface-<lower unit>`, one sealed body per material) and its `FaultData` (blocks named after
 //! their side of each fault, each fault's faces with the local face of the cell on each side).
 //! With split nodes (`terramesh_faults::split_nodes`) each side's faces name its own copies.
 //!
@@ -205,11 +206,20 @@ pub fn faulted_volume(
         f.tag = remap[f.tag as usize];
     }
     tagged.sort_by_key(|f| (f.tag, f.cell, f.nodes));
-    // sealed bodies over the original nodes: faces of a unit's cells whose other side is not
-    // of that unit (or none)
+    // the materials: the units, then a fault zone's cells `zone-<fault>` per fault with a zone
+    let material = mesh.zones.materials(&mesh.unit, mesh.units);
+    let mut names = units[..mesh.units].to_vec();
+    names.extend(
+        mesh.zones
+            .faults()
+            .into_iter()
+            .map(|f| format!("zone-{}", mesh.faults[f])),
+    );
+    // sealed bodies over the original nodes: faces of a material's cells whose other side is
+    // not of that material (or none)
     let by_orig = grouped(&|c, k| key(&nodes3(c, k).map(|v| original[v as usize])));
     drop(by_key);
-    let mut bodies: Vec<Body> = (0..mesh.units)
+    let mut bodies: Vec<Body> = (0..names.len())
         .map(|u| Body {
             unit: u,
             triangles: vec![],
@@ -217,10 +227,10 @@ pub fn faulted_volume(
         .collect();
     for sides in by_orig.chunk_by(|a, b| a.0 == b.0) {
         for &(_, c, f) in sides {
-            let u = mesh.unit[c as usize];
+            let u = material[c as usize];
             if sides
                 .iter()
-                .all(|&(_, d, _)| d == c || mesh.unit[d as usize] != u)
+                .all(|&(_, d, _)| d == c || material[d as usize] != u)
             {
                 let n: Vec<u32> = nodes_of(c as usize, f as usize)
                     .iter()
@@ -234,8 +244,8 @@ pub fn faulted_volume(
     let vm = VolumeMesh {
         points,
         cells,
-        material: mesh.unit.iter().map(|&u| u as i32).collect(),
-        units: units[..mesh.units].to_vec(),
+        material: material.iter().map(|&u| u as i32).collect(),
+        units: names,
         faces: tagged,
         tags: kept,
         bodies,

@@ -106,6 +106,12 @@ fn check_materials(g: &GeologyPlan) -> Result<()> {
             }
             _ => None,
         }))
+        .chain(
+            g.faults
+                .iter()
+                .filter(|f| f.zone > 0.0)
+                .map(|f| format!("zone-{}", f.name)),
+        )
         .collect();
     for o in &g.objects {
         let ObjectSource::Structure { material, .. } = &o.source else {
@@ -121,7 +127,7 @@ fn check_materials(g: &GeologyPlan) -> Result<()> {
         }
         if let Some(t) = taken.iter().find(|t| t.eq_ignore_ascii_case(material)) {
             return Err(bad(format!(
-                "'{t}' already names a unit or a lining's material, and a structure's cells get \
+                "'{t}' already names a unit, a lining's or a fault zone's material, and a structure's cells get \
                  a MaterialIDs value of their own: name its material differently"
             )));
         }
@@ -430,7 +436,9 @@ pub fn finish(
         .into_iter()
         .enumerate()
         .map(|(k, name)| MaterialName {
-            material_id: (g.units.len() + k) as i32,
+            // after the units and the fault zones (`zone-<fault>`)
+            material_id: (g.units.len() + g.faults.iter().filter(|f| f.zone > 0.0).count() + k)
+                as i32,
             name,
         })
         .collect();

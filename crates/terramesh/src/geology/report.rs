@@ -23,7 +23,9 @@ pub const SECTION_STATIONS: usize = 600;
 pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section> {
     let dir = out.join("pictures");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let units = &m.model.mesh.units;
+    // The column's units (a faulted model's mesh names its fault zones' materials after them).
+    let all = &m.model.mesh.units;
+    let units = &all[..m.model.stack.units().min(all.len())];
     let surfaces = &m.model.stack.surfaces;
     let mode = if mesh.triangles.len() > VECTOR_TRIANGLE_LIMIT {
         SvgMode::Raster
@@ -218,7 +220,9 @@ pub fn model_section(out: &Path, m: &ModelBuilt, mesh: &Mesh) -> Result<Section>
 /// direction as meshed, the throw along it) and its fault blocks (volume, cells, units, where
 /// the interfaces come from), from `model.json`'s `faulted`.
 pub fn fault_tables(f: &super::faulted::FaultedSummary) -> [Block; 2] {
-    let faults = Block::Table {
+    // A column of the fault zones, only when a fault has one.
+    let zoned = f.faults.iter().any(|x| x.zone.is_some());
+    let mut faults = Block::Table {
         caption: format!(
             "Faults as meshed ({} faults; the smallest dihedral angle of any cell {:.1} degrees, \
              the largest distance of a fault face from its fault {:.1e} m)",
@@ -257,6 +261,17 @@ pub fn fault_tables(f: &super::faulted::FaultedSummary) -> [Block; 2] {
             })
             .collect(),
     };
+    if let (true, Block::Table { header, rows, .. }) = (zoned, &mut faults) {
+        header.push("zone: material, thickness (m), volume meshed / exact (m³)".into());
+        for (row, x) in rows.iter_mut().zip(&f.faults) {
+            row.push(x.zone.as_ref().map_or("-".into(), |z| {
+                format!(
+                    "{} (MaterialIDs {}), {}, {:.1} / {:.1}",
+                    z.material, z.material_id, z.thickness, z.covered_volume, z.expected_volume
+                )
+            }));
+        }
+    }
     let blocks = Block::Table {
         caption: format!(
             "Fault blocks ({}): each named by its side of every fault that counts there",
@@ -282,7 +297,15 @@ pub fn fault_tables(f: &super::faulted::FaultedSummary) -> [Block; 2] {
                     b.name.clone(),
                     format!("{:.6e}", b.volume),
                     b.cells.to_string(),
-                    b.units.join(", "),
+                    if b.zones.is_empty() {
+                        b.units.join(", ")
+                    } else {
+                        format!(
+                            "{}; fault zones: {}",
+                            b.units.join(", "),
+                            b.zones.join(", ")
+                        )
+                    },
                     format!("{} / {}", from("contacts"), from("throw")),
                 ]
             })

@@ -41,6 +41,10 @@ pub const MAX_LAYERS: usize = 1000;
 pub const DEFAULT_MAX_CELL_HEIGHT: f64 = 10.0;
 /// The largest `geology.max_cell_height` accepted, metres.
 pub const MAX_CELL_HEIGHT: f64 = 10_000.0;
+/// The thickest fault zone (`geology.faults[F].zone`) accepted before the terrain is read,
+/// metres; the fault kernel then holds it to a quarter of the region's smaller extent
+/// (`terramesh_faults::ZONE_MAX_FRACTION`).
+pub const MAX_ZONE: f64 = 1_000.0;
 
 /// Which way a fault moved its hanging wall (`[[geology.faults]] kind`): the sign of `throw`
 /// where a block takes its neighbour's interface.
@@ -88,7 +92,8 @@ pub struct FaultPlan {
     pub throw: Option<f64>,
     /// Normal or reverse.
     pub kind: FaultKind,
-    /// Fault-zone thickness (0: none; others are refused for now).
+    /// Fault-zone thickness, metres (0: none): the cells within half of it of the fault, on
+    /// either side, get a material of their own, `zone-<name>`, after the units.
     pub zone: f64,
 }
 

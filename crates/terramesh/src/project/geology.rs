@@ -29,7 +29,8 @@ use terramesh_io::boreholes::{
 use crate::error::{Error, PathProblem, Result};
 use crate::plan::{
     Base, FaultKind, FaultPlan, FaultSource, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MAX_CELL_HEIGHT,
-    DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_CELL_HEIGHT, MAX_LAYERS, MIN_BASE_ELEVATION,
+    DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_CELL_HEIGHT, MAX_LAYERS, MAX_ZONE,
+    MIN_BASE_ELEVATION,
 };
 
 /// The commented `[geology]` section that `terramesh init --geology` appends to
@@ -536,15 +537,27 @@ impl GeologySection {
                     );
                 }
             }
-            if f.zone != 0.0 {
+            if !(f.zone.is_finite() && (0.0..=MAX_ZONE).contains(&f.zone)) {
                 return bad(
                     "zone",
                     format!(
-                        "{}: fault zones meshed as cells of their own are not supported yet; \
-                         give 0",
+                        "{}: give the fault zone's thickness as 0 (none) or a positive number \
+                         of metres, at most {MAX_ZONE}",
                         terramesh_core::limits::short(f.zone)
                     ),
                 );
+            }
+            if f.zone > 0.0 {
+                let own = format!("zone-{}", f.name);
+                if self.units.iter().any(|u| u.eq_ignore_ascii_case(&own)) {
+                    return bad(
+                        "zone",
+                        format!(
+                            "the zone's cells get the material '{own}', which already names a \
+                             unit: rename the unit or the fault"
+                        ),
+                    );
+                }
             }
             for other in &f.ends_at {
                 if other == &f.name {
@@ -947,7 +960,17 @@ mod tests {
                 "dip = 50.0",
                 "geology.faults[F2].dip: dip applies to a fault given by its trace",
             ),
-            ("throw = 5.0", "zone = 2.0", "geology.faults[F1].zone"),
+            (
+                "throw = 5.0",
+                "zone = -2.0",
+                "geology.faults[F1].zone: -2: give",
+            ),
+            (
+                "throw = 5.0",
+                "zone = nan",
+                "geology.faults[F1].zone: NaN: give",
+            ),
+            ("throw = 5.0", "zone = 1e6", "geology.faults[F1].zone"),
             ("kind = \"reverse\"", "kind = \"sideways\"", "sideways"),
         ] {
             let text = ok.replacen(from, to, 1);
@@ -974,6 +997,19 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("geology.max_cell_height"), "{e}");
+        // A zone lowers into the plan; a unit already named after it is refused.
+        let zoned = ok.replacen("throw = 5.0", "throw = 5.0\nzone = 2.0", 1);
+        let p = Project::parse("p.toml", &zoned, &[]).unwrap();
+        assert_eq!(p.geology().unwrap().faults[0].zone, 2.0);
+        let taken = zoned.replacen("\"gravel\"]", "\"zone-f1\"]", 1);
+        assert_ne!(taken, zoned);
+        let e = Project::parse("p.toml", &taken, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("geology.faults[F1].zone") && e.contains("'zone-F1'"),
+            "{e}"
+        );
         let p = Project::parse("p.toml", &ok, &["geology.split_faults=true".into()]).unwrap();
         assert!(p.geology().unwrap().split_faults);
     }

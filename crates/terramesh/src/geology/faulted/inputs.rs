@@ -73,6 +73,7 @@ pub(crate) fn fault_specs(
         };
         spec.ends_at = f.ends_at.clone();
         spec.depth = f.depth;
+        spec.zone = f.zone;
         specs.push(spec);
     }
     Ok(specs)

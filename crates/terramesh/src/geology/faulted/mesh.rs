@@ -2,7 +2,8 @@
 //! request.
 
 use terramesh_faults::{
-    check as check_mesh, split_nodes, BlockKey, FaultSet, MeshSettings, Terrain,
+    check as check_mesh, check_zones, split_nodes, BlockKey, FaultSet, MeshSettings, Terrain,
+    ZoneCheck,
 };
 
 use super::interfaces::BlockInterfaces;
@@ -19,6 +20,8 @@ pub struct Faulted {
     pub settings: MeshSettings,
     /// The split mesh's node count, when split.
     pub split: Option<usize>,
+    /// The fault zones' checks, one per fault with a zone.
+    pub zones: Vec<ZoneCheck>,
 }
 
 /// Builds and checks the faulted mesh.
@@ -37,11 +40,16 @@ pub fn build_mesh(
             source: Box::new(e),
             unresolved: mesh.report.unresolved,
         })?;
+    let zones = check_zones(&mesh, set).map_err(|e| Error::FaultedMeshCheck {
+        source: Box::new(e),
+        unresolved: mesh.report.unresolved,
+    })?;
     let split = g.split_faults.then(|| split_nodes(&mesh).points.len());
     Ok(Faulted {
         mesh,
         check,
         settings,
         split,
+        zones,
     })
 }

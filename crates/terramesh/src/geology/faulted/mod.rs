@@ -30,7 +30,9 @@ pub use inputs::flat_base;
 pub(crate) use inputs::{fault_error, fault_specs, read_fault_picks};
 pub use interfaces::{BlockInterfaces, InterfaceSource, KRIGED_CONTACTS, PINCH, PLANE_CONTACTS};
 pub use mesh::{build_mesh, Faulted};
-pub use summary::{summarise, BlockSummary, FaultSummary, FaultedSummary, HoleThrow, ThrowRange};
+pub use summary::{
+    summarise, BlockSummary, FaultSummary, FaultedSummary, HoleThrow, ThrowRange, ZoneSummary,
+};
 
 /// A fault as meshed: its faces' corners, for the report.
 #[derive(Debug, Clone)]

@@ -34,6 +34,35 @@ pub struct FaultSummary {
     /// At every borehole that crosses it (`fault_picks.csv`): the mean over the interfaces of
     /// the same difference at the hole.
     pub throw_at_holes: Vec<HoleThrow>,
+    /// Its fault zone, when it has one (`zone`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub zone: Option<ZoneSummary>,
+}
+
+/// A fault zone in `model.json`: its cells (between the walls at half its thickness on either
+/// side of the fault, where the fault is active) and the check of its volume.
+#[derive(Debug, Clone, Serialize)]
+pub struct ZoneSummary {
+    /// Its material: `zone-<fault>`.
+    pub material: String,
+    /// Its `MaterialIDs` value (after the units).
+    pub material_id: usize,
+    /// Its thickness, metres.
+    pub thickness: f64,
+    /// Its cells.
+    pub cells: usize,
+    /// Their volume, m³.
+    pub volume: f64,
+    /// The volume of every cell between its walls, whichever zone it belongs to where two
+    /// zones meet, m³.
+    pub covered_volume: f64,
+    /// Its thickness times the fault's meshed area, m³.
+    pub expected_volume: f64,
+    /// `|covered_volume - expected_volume| / expected_volume`.
+    pub relative_difference: f64,
+    /// The fault blocks its cells are in (a zone's cells are in the block of their side of the
+    /// fault).
+    pub blocks: Vec<String>,
 }
 
 /// An interface's throw along a fault: min, mean and max over its faces.
@@ -75,6 +104,9 @@ pub struct BlockSummary {
     pub units: Vec<String>,
     /// Where each of its interfaces comes from.
     pub interfaces: Vec<InterfaceSource>,
+    /// The fault zones with cells in it (`zone-<fault>`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub zones: Vec<String>,
 }
 
 /// The faulted model's part of `model.json`.
@@ -216,6 +248,7 @@ pub fn summarise(
                 mean_dip_direction: dir,
                 throw_along: throw_along(i),
                 throw_at_holes: at_holes(i),
+                zone: zone_summary(g, f, i),
             }
         })
         .collect();
@@ -243,6 +276,12 @@ pub fn summarise(
                 .map(|(u, _)| u.clone())
                 .collect(),
             interfaces: ifs.sources(m.blocks[b], &g.units),
+            zones: f
+                .zones
+                .iter()
+                .filter(|z| z.blocks.contains(&(b as u32)))
+                .map(|z| format!("zone-{}", z.fault))
+                .collect(),
         })
         .collect();
     let q = &f.check.quality;
@@ -257,4 +296,26 @@ pub fn summarise(
         fault_distance: f.check.fault_distance,
         split_nodes: f.split,
     }
+}
+
+/// Fault `i`'s zone in `model.json`, if it has one.
+fn zone_summary(g: &GeologyPlan, f: &Faulted, i: usize) -> Option<ZoneSummary> {
+    let m = &f.mesh;
+    let k = m.zones.faults().iter().position(|&x| x == i)?;
+    let z = f.zones.get(k)?;
+    Some(ZoneSummary {
+        material: format!("zone-{}", z.fault),
+        material_id: g.units.len() + k,
+        thickness: z.thickness,
+        cells: z.cells,
+        volume: z.volume,
+        covered_volume: z.covered,
+        expected_volume: z.expected,
+        relative_difference: z.volume_error(),
+        blocks: z
+            .blocks
+            .iter()
+            .map(|&b| block_name(&m.faults, &m.blocks[b as usize]))
+            .collect(),
+    })
 }
