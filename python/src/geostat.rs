@@ -7,11 +7,11 @@
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use terramesh::plan::LagPlan;
+use terramesh::plan::{InterpolationPlan, LagPlan};
 use terramesh_geostat::{
     cross_validate as cv, experimental as lags_of, kriging, Data, Direction, Drift, Duplicates,
-    Estimator, FitMethod, Folds, Idw, IdwSearch, Interpolator, LagSettings, Method, Neighbourhood,
-    Variogram, VariogramFile, Weighting, DEFAULT_TOLERANCE,
+    Estimator, FitMethod, Idw, InterpolationMethod, Interpolator, LagSettings, Variogram,
+    VariogramFile, Weighting, DEFAULT_TOLERANCE,
 };
 
 use crate::errors::{input, kernel, to_py};
@@ -255,25 +255,34 @@ fn variogram_fit(
     })
 }
 
-/// The kriging method of its name.
-fn method(name: &str, drift: &str, mean: Option<f64>, d: &Data) -> PyResult<Method> {
+/// Python's interpolation keywords lowered into a single command's plan, as the CLI lowers its
+/// flags (`terramesh interpolate`, `cv`): the plan holds each default and checks each value
+/// ([`InterpolationPlan::kriging`], [`InterpolationPlan::idw`], [`InterpolationPlan::folds`]),
+/// and its errors name the keywords ([`to_py`]). `drift="linear"` is every call's default,
+/// the plan's too: another drift is set as `--drift` is, and refused for `ok` and `sk`, which
+/// would ignore it.
+fn plan(
+    method: InterpolationMethod,
+    drift: &str,
+    mean: Option<f64>,
+    neighbors: Option<usize>,
+) -> PyResult<InterpolationPlan> {
     let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
-    match name.to_ascii_lowercase().as_str() {
-        "sk" | "simple" => Ok(Method::Simple {
-            mean: mean.unwrap_or_else(|| d.mean()),
-        }),
-        "ok" | "ordinary" => Ok(Method::Ordinary),
-        "uk" | "universal" => Ok(Method::Universal(drift)),
-        other => Err(input(format!(
-            "method '{other}': give 'ok', 'uk' or 'sk' (or use terramesh.idw)"
-        ))),
-    }
+    let mut p = InterpolationPlan::single(method);
+    let given = method == InterpolationMethod::Universal || drift != p.drift;
+    p.set_drift(given.then_some(drift)).map_err(to_py)?;
+    p.set_neighbors(neighbors);
+    p.mean = mean;
+    Ok(p)
 }
 
-fn hood(neighbors: Option<usize>) -> Neighbourhood {
-    match neighbors {
-        None => Neighbourhood::All,
-        Some(k) => Neighbourhood::Nearest(k),
+/// The kriging method of `krige`'s `method` (`uk`, `ok`, `sk` or their long names).
+fn kriging_method(name: &str) -> PyResult<InterpolationMethod> {
+    match name.parse() {
+        Ok(InterpolationMethod::Idw) | Err(_) => Err(input(format!(
+            "method '{name}': give 'ok', 'uk' or 'sk' (or use terramesh.idw)"
+        ))),
+        Ok(m) => Ok(m),
     }
 }
 
@@ -299,13 +308,15 @@ fn krige<'py>(
 ) -> PyResult<Estimate<'py>> {
     let d = data(&x, &y, &z, "reject")?;
     let v = model(variogram)?;
-    let m = self::method(method, drift, mean, &d)?;
+    let (m, hood) = plan(kriging_method(method)?, drift, mean, neighbors)?
+        .kriging(&d)
+        .map_err(to_py)?;
     let (txs, tys) = targets(&xt, &yt, 1 + usize::from(return_variance))?;
     let n = txs.len();
     let mut est = results(n)?;
     let mut var = results(if return_variance { n } else { 0 })?;
     let (est, var) = run(py, false, |cancel| {
-        let p = kriging(&d, &v, m, hood(neighbors), return_variance).map_err(kernel)?;
+        let p = kriging(&d, &v, m, hood, return_variance).map_err(kernel)?;
         chunked(n, cancel, |r| {
             let vr = return_variance.then(|| &mut var[r.clone()]);
             p.predict(&chunk(&txs, &tys, r.clone()), &mut est[r.clone()], vr)
@@ -318,15 +329,6 @@ fn krige<'py>(
         PyArray1::from_vec(py, est),
         return_variance.then(|| PyArray1::from_vec(py, var)),
     ))
-}
-
-fn idw_search(neighbors: Option<usize>, radius: Option<f64>) -> PyResult<IdwSearch> {
-    match (neighbors, radius) {
-        (None, None) => Ok(IdwSearch::All),
-        (Some(k), None) => Ok(IdwSearch::Nearest(k)),
-        (None, Some(r)) => Ok(IdwSearch::Radius(r)),
-        (Some(_), Some(_)) => Err(input("idw: give neighbors or radius, not both")),
-    }
 }
 
 /// Inverse distance weighting at the targets.
@@ -347,7 +349,10 @@ fn idw<'py>(
     let d = data(&x, &y, &z, "reject")?;
     let (txs, tys) = targets(&xt, &yt, 1)?;
     let n = txs.len();
-    let s = idw_search(neighbors, radius)?;
+    let mut p = InterpolationPlan::single(InterpolationMethod::Idw);
+    p.set_neighbors(neighbors);
+    (p.radius, p.idw_power) = (radius, power);
+    let (power, s) = p.idw().map_err(to_py)?;
     let mut est = results(n)?;
     let est = run(py, false, |cancel| {
         let p = Idw::new(&d, power, s).map_err(kernel)?;
@@ -380,27 +385,26 @@ fn cross_validate<'py>(
     radius: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = data(&x, &y, &z, "reject")?;
-    let how = if method.eq_ignore_ascii_case("idw") {
-        Interpolator::Idw {
-            power,
-            search: idw_search(neighbors, radius)?,
-        }
+    let m: InterpolationMethod = method.parse().map_err(|e| input(format!("method: {e}")))?;
+    let mut p = plan(m, drift, mean, neighbors)?;
+    (p.radius, p.idw_power, p.cv_folds) = (radius, power, folds.into());
+    let how = if m == InterpolationMethod::Idw {
+        let (power, search) = p.idw().map_err(to_py)?;
+        Interpolator::Idw { power, search }
     } else {
         let v = variogram.ok_or_else(|| {
             input(format!(
                 "cross_validate: method '{method}' needs a variogram"
             ))
         })?;
+        let (method, neighbours) = p.kriging(&d).map_err(to_py)?;
         Interpolator::Kriging {
             variogram: model(v)?,
-            method: self::method(method, drift, mean, &d)?,
-            neighbours: hood(neighbors),
+            method,
+            neighbours,
         }
     };
-    let folds = match folds {
-        None => Folds::LeaveOneOut,
-        Some(k) => Folds::KFold(k),
-    };
+    let folds = p.folds().map_err(to_py)?;
     let r = run(py, false, |_| cv(&d, &how, folds).map_err(kernel))?;
     let out = PyDict::new(py);
     out.set_item("estimate", PyArray1::from_vec(py, r.estimate))?;

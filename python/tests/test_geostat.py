@@ -198,3 +198,46 @@ def test_bad_variograms_and_data_raise_input_errors(field):
         terramesh.krige(x, y, z[:-1], [0.0], [0.0], variogram=Variogram())
     with pytest.raises(terramesh.InputError, match="method"):
         terramesh.krige(x, y, z, [0.0], [0.0], method="nn", variogram=Variogram())
+
+
+def test_interpolation_keywords_are_checked_once_by_the_librarys_plan_naming_them(field):
+    # krige, idw and cross_validate lower their keywords into the plan of `terramesh
+    # interpolate` and `terramesh cv`: the same checks, worded with the keywords.
+    x, y, z = field
+    v = Variogram("exponential", 100.0, 700.0)
+    t = ([500.0], [500.0])
+    for call in (
+        lambda: terramesh.krige(x, y, z, *t, variogram=v, neighbors=0),
+        lambda: terramesh.idw(x, y, z, *t, neighbors=0),
+        lambda: terramesh.cross_validate(x, y, z, method="ok", variogram=v, neighbors=0),
+        lambda: terramesh.cross_validate(x, y, z, method="idw", neighbors=0),
+    ):
+        with pytest.raises(terramesh.InputError, match=r"^neighbors 0: must be at least 1$"):
+            call()
+    with pytest.raises(terramesh.InputError, match=r"^IDW takes neighbors or radius, not both$"):
+        terramesh.idw(x, y, z, *t, neighbors=4, radius=100.0)
+    with pytest.raises(terramesh.InputError, match=r"^power -1: must be a finite number > 0$"):
+        terramesh.idw(x, y, z, *t, power=-1.0)
+    with pytest.raises(terramesh.InputError, match=r"^radius 0: must be a finite number > 0$"):
+        terramesh.cross_validate(x, y, z, method="idw", radius=0.0)
+    # Settings the method would ignore are refused, not dropped.
+    with pytest.raises(terramesh.InputError, match=r"^drift applies to method uk only$"):
+        terramesh.krige(x, y, z, *t, method="ok", drift="quadratic", variogram=v)
+    with pytest.raises(terramesh.InputError, match=r"^mean applies to method sk only$"):
+        terramesh.krige(x, y, z, *t, method="uk", mean=300.0, variogram=v)
+    with pytest.raises(terramesh.InputError,
+                       match=r"^radius applies to method idw; kriging takes neighbors$"):
+        terramesh.cross_validate(x, y, z, method="ok", variogram=v, radius=100.0)
+    with pytest.raises(terramesh.InputError, match=r'^method: unknown interpolation method "nn"'):
+        terramesh.cross_validate(x, y, z, method="nn", variogram=v)
+    with pytest.raises(terramesh.InputError, match=r"^method 'idw': .*terramesh\.idw"):
+        terramesh.krige(x, y, z, *t, method="idw", variogram=v)
+    # The default drift with ok (PyKrige's drop-in calls so) and the long names still krige.
+    def est(**kw):
+        return terramesh.krige(x, y, z, *t, variogram=v, return_variance=False, **kw)[0]
+
+    assert est(method="Ordinary", drift="linear") == est(method="ok")
+    assert est(method="simple", mean=300.0) == est(method="sk", mean=300.0) != est(method="sk")
+    assert est(method="universal", drift="quadratic") != est(method="uk")
+    cv = terramesh.cross_validate(x, y, z, method="IDW", neighbors=8, folds=5)
+    assert cv.n == 300 and cv.variance is None

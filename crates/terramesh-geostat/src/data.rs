@@ -265,7 +265,9 @@ impl Method {
 }
 
 /// An interpolation method by name: `sk`, `ok`, `uk` (kriging) or `idw`, as the project
-/// file's `interpolation.methods` and the command line's `--method` spell them.
+/// file's `interpolation.methods`, the command line's `--method` and Python's `method=` spell
+/// them; the kriging methods also by their long names (`simple`, `ordinary`, `universal`),
+/// which Python has always taken.
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
@@ -273,6 +275,7 @@ impl Method {
 /// let data = Data::new(vec![[0.0, 0.0], [1.0, 0.0]], vec![1.0, 3.0], Duplicates::Reject)?;
 /// let uk: InterpolationMethod = "UK".parse().unwrap();
 /// assert_eq!(uk.method(Drift::Linear, None, &data), Some(Method::Universal(Drift::Linear)));
+/// assert_eq!("Ordinary".parse::<InterpolationMethod>().unwrap(), InterpolationMethod::Ordinary);
 /// let sk = InterpolationMethod::Simple;
 /// assert_eq!(sk.method(Drift::Linear, None, &data), Some(Method::Simple { mean: 2.0 }));
 /// assert_eq!(InterpolationMethod::Idw.method(Drift::Linear, None, &data), None);
@@ -291,9 +294,9 @@ pub enum InterpolationMethod {
 }
 
 terramesh_core::named_enum!(InterpolationMethod, "interpolation method", [
-    InterpolationMethod::Simple => "sk",
-    InterpolationMethod::Ordinary => "ok",
-    InterpolationMethod::Universal => "uk",
+    InterpolationMethod::Simple => "sk" | "simple",
+    InterpolationMethod::Ordinary => "ok" | "ordinary",
+    InterpolationMethod::Universal => "uk" | "universal",
     InterpolationMethod::Idw => "idw",
 ]);
 

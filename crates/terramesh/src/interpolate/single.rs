@@ -76,6 +76,29 @@ impl InterpolationPlan {
             .ok_or(Error::IdwNotKriging)
     }
 
+    /// The kriging method and neighbourhood of the plan's one method, checked: at least one
+    /// neighbour, no radius (IDW's), the mean only for simple kriging. What
+    /// [`InterpolationPlan::engine`] and [`InterpolationPlan::interpolator`] krige with, and
+    /// Python's `krige` and `cross_validate` with the variogram their caller gives.
+    ///
+    /// ```
+    /// use terramesh::plan::InterpolationPlan;
+    /// use terramesh_geostat::{Data, Duplicates, InterpolationMethod, Method, Neighbourhood};
+    /// let data = Data::new(vec![[0.0, 0.0], [1.0, 0.0]], vec![1.0, 3.0], Duplicates::Reject)?;
+    /// let mut p = InterpolationPlan::single(InterpolationMethod::Simple);
+    /// p.set_neighbors(Some(8));
+    /// assert_eq!(p.kriging(&data)?, (Method::Simple { mean: 2.0 }, Neighbourhood::Nearest(8)));
+    /// p.set_neighbors(Some(0));
+    /// let e = p.kriging(&data).unwrap_err();
+    /// assert_eq!(e.render(&|s| s.to_string()), "neighbors 0: must be at least 1");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn kriging(&self, data: &Data) -> Result<(Method, Neighbourhood)> {
+        self.check_neighbors()?;
+        self.check_no_radius("kriging")?;
+        Ok((self.method(data)?, self.neighbourhood()))
+    }
+
     /// The moving neighbourhood of kriging (or all data).
     pub fn neighbourhood(&self) -> Neighbourhood {
         self.neighbors
@@ -201,11 +224,9 @@ impl InterpolationPlan {
                 .map(|i| Box::new(i) as Box<dyn Predictor>)
                 .map_err(|e| in_file(&fd.name, e));
         }
-        self.check_no_radius("kriging")?;
-        let method = self.method(&fd.data)?;
+        let (method, neighbourhood) = self.kriging(&fd.data)?;
         let v = self.resolve_variogram(fd, say)?;
-        kriging(&fd.data, &v, method, self.neighbourhood(), variance)
-            .map_err(|e| in_file(&fd.name, e))
+        kriging(&fd.data, &v, method, neighbourhood, variance).map_err(|e| in_file(&fd.name, e))
     }
 
     /// The interpolator of a cross-validation ([`terramesh_geostat::cross_validate`]).
@@ -214,12 +235,11 @@ impl InterpolationPlan {
             let (power, search) = self.idw()?;
             return Ok(Interpolator::Idw { power, search });
         }
-        self.check_neighbors()?;
-        self.check_no_radius("kriging")?;
+        let (method, neighbours) = self.kriging(&fd.data)?;
         Ok(Interpolator::Kriging {
             variogram: self.resolve_variogram(fd, say)?,
-            method: self.method(&fd.data)?,
-            neighbours: self.neighbourhood(),
+            method,
+            neighbours,
         })
     }
 
