@@ -1303,119 +1303,41 @@ fn crossing(f: &dyn Fn([f64; 3]) -> f64, a: [f64; 3], b: [f64; 3], va: f64, vb: 
 /// that edge is at least this fraction of the cell's longest edge, else at its longest edge.
 const NEAR_LONGEST: f64 = 0.75;
 
-/// Near a tunnel the refinement measures an edge's length along the axis as this fraction of
-/// its true length: the facets of a tunnel's wall only need to be short across the axis (a
-/// straight wall does not stray from a chord along it), so the refinement's cells stretch
-/// along the axis by up to this factor instead of being refined to the facet length in every
-/// direction (Rivara's longest-edge bisection in the stretched space). Measured on the
-/// kernel's lined tunnel through F1 (`circular_tunnel_through_a_fault_has_its_exact_volume`):
-/// 885,824 cells isotropic, 728,096 at 2, but 1,115,241 at 4 and 3,681,491 at 8 (cells near
-/// the wall end far thinner across than the facets need, 0.11 m against 0.8 m isotropic: not
-/// understood yet), so 2.
-const STRETCH: f64 = 2.0;
-
-/// How far from a tunnel's axis (beyond the lining's reach) [`STRETCH`] applies, metres: the
-/// band where the wall's refinement and its grading live.
-const STRETCH_REACH: f64 = 40.0;
-
-/// A tunnel piece's ends, its unit direction and the squared distance from it within which
-/// [`STRETCH`] applies.
-type Axis = ([f64; 3], [f64; 3], [f64; 3], f64);
-
-/// The metric of the refinement near objects: Euclidean, except near a tunnel's axis, where
-/// lengths along it count [`STRETCH`] times less. An edge's length depends on its ends only,
-/// so every cell around it agrees on it.
-#[derive(Default)]
-struct Metric {
-    /// Per tunnel piece: its ends, its unit direction and the squared distance from it
-    /// within which the stretch applies.
-    axes: Vec<Axis>,
+/// The squared length of an edge (by key).
+fn edge_d2(points: &[[f64; 3]], k: u64) -> f64 {
+    let d = sub(points[(k >> 32) as usize], points[k as u32 as usize]);
+    dot(d, d)
 }
 
-impl Metric {
-    fn new(set: &ObjectSet) -> Metric {
-        let mut axes = Vec::new();
-        for o in &set.objects {
-            if let Shape::Tunnel {
-                pieces,
-                profile,
-                outer,
-                ..
-            } = &o.shape
-            {
-                let reach = outer.as_ref().unwrap_or(profile).reach() + STRETCH_REACH;
-                for p in pieces {
-                    axes.push((p.a, p.b, unit(sub(p.b, p.a)), reach * reach));
-                }
-            }
-        }
-        Metric { axes }
-    }
-
-    /// The squared length of segment pq.
-    fn d2(&self, p: [f64; 3], q: [f64; 3]) -> f64 {
-        let d = sub(q, p);
-        let l2 = dot(d, d);
-        if self.axes.is_empty() {
-            return l2;
-        }
-        let m = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
-        let mut best: Option<(f64, [f64; 3])> = None;
-        for &(a, b, t, r2) in &self.axes {
-            let e = sub(b, a);
-            let s = (dot(sub(m, a), e) / dot(e, e)).clamp(0.0, 1.0);
-            let c = sub(m, [a[0] + s * e[0], a[1] + s * e[1], a[2] + s * e[2]]);
-            let dd = dot(c, c);
-            if dd <= r2 && best.is_none_or(|x| dd < x.0) {
-                best = Some((dd, t));
-            }
-        }
-        match best {
-            Some((_, t)) => {
-                let c = dot(d, t);
-                (l2 - (1.0 - 1.0 / (STRETCH * STRETCH)) * c * c).max(0.0)
-            }
-            None => l2,
-        }
-    }
-}
-
-/// The squared length of an edge (by key) in the refinement's metric.
-fn edge_d2(points: &[[f64; 3]], metric: &Metric, k: u64) -> f64 {
-    metric.d2(points[(k >> 32) as usize], points[k as u32 as usize])
-}
-
-/// The key of a cell's longest edge in the refinement's metric (ties: the lowest key, so that
-/// every cell agrees).
-fn longest_edge(points: &[[f64; 3]], metric: &Metric, t: &[u32; 4]) -> u64 {
+/// The key of a cell's longest edge (ties: the lowest key, so that every cell agrees).
+fn longest_edge(points: &[[f64; 3]], t: &[u32; 4]) -> u64 {
     EDGES
         .iter()
         .map(|&(i, j)| key(t[i], t[j]))
         .max_by(|&a, &b| {
-            edge_d2(points, metric, a)
-                .total_cmp(&edge_d2(points, metric, b))
+            edge_d2(points, a)
+                .total_cmp(&edge_d2(points, b))
                 .then(b.cmp(&a))
         })
         .unwrap()
 }
 
 /// Splits the given edges (sorted keys) at the given points, conformally, the children of a
-/// cell keeping its labels; with `longest_first` (a metric), each cell's edges are split
-/// longest first in it.
+/// cell keeping its labels; with `longest_first`, each cell's edges are split longest first.
 fn split_edges(
     st: &mut State,
     labels: &mut ObjectCells,
     keys: &[u64],
     points: Vec<[f64; 3]>,
-    longest_first: Option<&Metric>,
+    longest_first: bool,
 ) {
-    let rank: Option<Vec<u32>> = longest_first.map(|metric| {
-        let d2: Vec<f64> = keys
-            .par_iter()
-            .map(|&k| edge_d2(&st.points, metric, k))
-            .collect();
+    let rank: Option<Vec<u32>> = longest_first.then(|| {
         let mut order: Vec<u32> = (0..keys.len() as u32).collect();
-        order.par_sort_by(|&a, &b| d2[b as usize].total_cmp(&d2[a as usize]).then(a.cmp(&b)));
+        order.sort_by(|&a, &b| {
+            edge_d2(&st.points, keys[b as usize])
+                .total_cmp(&edge_d2(&st.points, keys[a as usize]))
+                .then(a.cmp(&b))
+        });
         let mut rank = vec![0u32; keys.len()];
         for (r, &pos) in order.iter().enumerate() {
             rank[pos as usize] = r as u32;
@@ -1441,7 +1363,7 @@ fn split_edges(
 /// Rivara's closure, relaxed: a cell with edges to split (`keys`, sorted) none of which is
 /// near its longest (within [`NEAR_LONGEST`]) has its longest edge split too, so that no cell
 /// is split at a short edge only.
-fn close(st: &State, metric: &Metric, keys: &mut Vec<u64>) {
+fn close(st: &State, keys: &mut Vec<u64>) {
     loop {
         let mut add: Vec<u64> = st
             .tets
@@ -1451,13 +1373,11 @@ fn close(st: &State, metric: &Metric, keys: &mut Vec<u64>) {
                     .iter()
                     .map(|&(i, j)| key(t[i], t[j]))
                     .filter(|k| keys.binary_search(k).is_ok())
-                    .map(|k| edge_d2(&st.points, metric, k))
+                    .map(|k| edge_d2(&st.points, k))
                     .fold(-1.0, f64::max);
-                if marked < 0.0 {
-                    return None;
-                }
-                let l = longest_edge(&st.points, metric, t);
-                (marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, metric, l)).then_some(l)
+                let l = longest_edge(&st.points, t);
+                (marked >= 0.0 && marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, l))
+                    .then_some(l)
             })
             .collect();
         if add.is_empty() {
@@ -1472,7 +1392,7 @@ fn close(st: &State, metric: &Metric, keys: &mut Vec<u64>) {
 }
 
 /// Bisects the given edges (sorted keys) at their midpoints, every cell at its longest first.
-fn bisect(st: &mut State, metric: &Metric, labels: &mut ObjectCells, keys: &[u64]) {
+fn bisect(st: &mut State, labels: &mut ObjectCells, keys: &[u64]) {
     let mids: Vec<[f64; 3]> = keys
         .iter()
         .map(|&k| {
@@ -1484,7 +1404,7 @@ fn bisect(st: &mut State, metric: &Metric, labels: &mut ObjectCells, keys: &[u64
             ]
         })
         .collect();
-    split_edges(st, labels, keys, mids, Some(metric));
+    split_edges(st, labels, keys, mids, true);
 }
 
 /// The edge of cell `t` to bisect where a wall's facets would stray from it (field `f`, node
@@ -1494,7 +1414,6 @@ fn bisect(st: &mut State, metric: &Metric, labels: &mut ObjectCells, keys: &[u64
 /// only the centroid's does.
 fn straying_edge(
     points: &[[f64; 3]],
-    metric: &Metric,
     t: &[u32; 4],
     v: [f64; 4],
     f: &(dyn Fn([f64; 3]) -> f64 + Sync),
@@ -1506,29 +1425,22 @@ fn straying_edge(
     if l <= 4.0 * tol {
         return None;
     }
-    // Lengths in the refinement's metric choose the edge; true lengths say what is short.
-    let m2 = |(i, j): (usize, usize)| metric.d2(q[i], q[j]);
     let mut best: Option<(usize, usize)> = None;
     for &(a, b) in &EDGES {
         if len((a, b)) <= 4.0 * tol {
             continue;
         }
         let m = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
-        if (f(m) - 0.5 * (v[a] + v[b])).abs() > tol && best.is_none_or(|e| m2((a, b)) > m2(e)) {
+        if (f(m) - 0.5 * (v[a] + v[b])).abs() > tol && best.is_none_or(|e| len((a, b)) > len(e)) {
             best = Some((a, b));
         }
     }
-    let longest = longest_edge(points, metric, t);
     match best {
-        Some((a, b))
-            if m2((a, b)) >= NEAR_LONGEST * NEAR_LONGEST * edge_d2(points, metric, longest) =>
-        {
-            Some(key(t[a], t[b]))
-        }
-        Some(_) => Some(longest),
+        Some((a, b)) if len((a, b)) >= NEAR_LONGEST * l => Some(key(t[a], t[b])),
+        Some(_) => Some(longest_edge(points, t)),
         None => {
             let c = centroid(points, t);
-            ((f(c) - 0.25 * v.iter().sum::<f64>()).abs() > tol).then_some(longest)
+            ((f(c) - 0.25 * v.iter().sum::<f64>()).abs() > tol).then(|| longest_edge(points, t))
         }
     }
 }
@@ -1699,7 +1611,6 @@ pub(crate) fn refine_near_objects(
         });
     }
     let walls = walls(set);
-    let metric = Metric::new(set);
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
@@ -1716,14 +1627,7 @@ pub(crate) fn refine_near_objects(
             .filter_map(|t| {
                 let q = t.map(|n| st.points[n as usize]);
                 let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
-                let m2 = |(i, j): (usize, usize)| metric.d2(q[i], q[j]);
                 let l = EDGES.iter().map(|&e| len(e)).fold(0.0, f64::max);
-                // Which cells are near a wall: in the metric (a straight tunnel's field does
-                // not change along its axis, so a cell long along it is near the wall only if
-                // it is wide enough across; else the cells around the axis, where the field
-                // has a kink, would be refined to the tolerance). The cells the refinement
-                // leaves crossed at a tunnel's end (a flat cap) are refined before the cut.
-                let near = EDGES.iter().map(|&e| m2(e)).fold(0.0, f64::max).sqrt();
                 // A cell is refined where the facets would stray from a wall: an edge whose
                 // midpoint's field deviates from the mean of its ends' by more than the
                 // tolerance, or the centroid's; nothing where the edges are already short.
@@ -1738,7 +1642,7 @@ pub(crate) fn refine_near_objects(
                         continue;
                     }
                     let v = t.map(|n| values[w][n as usize]);
-                    if v.iter().all(|x| x.abs() >= near) {
+                    if v.iter().all(|x| x.abs() >= l) {
                         continue;
                     }
                     let mut best: Option<(usize, usize)> = None;
@@ -1748,7 +1652,7 @@ pub(crate) fn refine_near_objects(
                         }
                         let m = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
                         if (o.field(wall, m) - 0.5 * (v[a] + v[b])).abs() > tol
-                            && best.is_none_or(|e| m2((a, b)) > m2(e))
+                            && best.is_none_or(|e| len((a, b)) > len(e))
                         {
                             best = Some((a, b));
                         }
@@ -1760,20 +1664,16 @@ pub(crate) fn refine_near_objects(
                         }
                     }
                     if let Some(e) = best {
-                        if pick.is_none_or(|p| m2(e) > m2(p)) {
+                        if pick.is_none_or(|p| len(e) > len(p)) {
                             pick = Some(e);
                         }
                     }
                 }
                 pick.map(|(a, b)| {
-                    let longest = longest_edge(&st.points, &metric, t);
-                    if a != b
-                        && m2((a, b))
-                            >= NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, &metric, longest)
-                    {
+                    if a != b && len((a, b)) >= NEAR_LONGEST * l {
                         key(t[a], t[b])
                     } else {
-                        longest
+                        longest_edge(&st.points, t)
                     }
                 })
             })
@@ -1783,13 +1683,13 @@ pub(crate) fn refine_near_objects(
         if keys.is_empty() {
             break;
         }
-        close(st, &metric, &mut keys);
+        close(st, &mut keys);
         if st.tets.len() + 6 * keys.len() > set.max_cells {
             labels.capped = true;
             break;
         }
         labels.refined_edges += keys.len();
-        bisect(st, &metric, &mut labels, &keys);
+        bisect(st, &mut labels, &keys);
     }
     Ok(labels)
 }
@@ -1810,7 +1710,6 @@ const CROSSED_STRAY: f64 = 2.0;
 /// bisected.
 fn refine_missed(
     st: &mut State,
-    metric: &Metric,
     labels: &mut ObjectCells,
     f: &(dyn Fn([f64; 3]) -> f64 + Sync),
     [lo, hi]: [[f64; 3]; 2],
@@ -1852,7 +1751,7 @@ fn refine_missed(
                     // The cut splits it: refined only where its facets would stray from the
                     // wall by more than half the checks' tolerance (a sharp edge of the wall,
                     // a tunnel's end, across the cell; facets left coarse by the cap).
-                    return straying_edge(&st.points, metric, t, v, f, CROSSED_STRAY * tol);
+                    return straying_edge(&st.points, t, v, f, CROSSED_STRAY * tol);
                 }
                 let mut samples: Vec<f64> = EDGES
                     .iter()
@@ -1863,7 +1762,7 @@ fn refine_missed(
                 if !(samples.iter().any(neg) && samples.iter().any(pos)) {
                     return None;
                 }
-                straying_edge(&st.points, metric, t, v, f, tol)
+                straying_edge(&st.points, t, v, f, tol)
             })
             .collect();
         keys.par_sort_unstable();
@@ -1871,9 +1770,9 @@ fn refine_missed(
         if keys.is_empty() {
             break;
         }
-        close(st, metric, &mut keys);
+        close(st, &mut keys);
         total += keys.len();
-        bisect(st, metric, labels, &keys);
+        bisect(st, labels, &keys);
     }
     total
 }
@@ -1890,7 +1789,6 @@ pub(crate) fn cut_objects(
     labels.object = vec![0; st.tets.len()];
     labels.lining = vec![false; st.tets.len()];
     let walls = walls(set);
-    let metric = Metric::new(set);
     // Every wall's crossings missed by its nodes' signs are refined away before any wall is
     // cut (a midpoint of an edge on a wall already cut would lie off that wall).
     for _pass in 0..4 {
@@ -1898,14 +1796,7 @@ pub(crate) fn cut_objects(
         for &(i, w) in &walls {
             let o = &set.objects[i];
             let f = |q: [f64; 3]| o.field(w, q);
-            bisected += refine_missed(
-                st,
-                &metric,
-                &mut labels,
-                &f,
-                o.bbox,
-                set.resolution * o.size,
-            );
+            bisected += refine_missed(st, &mut labels, &f, o.bbox, set.resolution * o.size);
         }
         labels.repaired_edges += bisected;
         if bisected == 0 {
@@ -1995,7 +1886,7 @@ pub(crate) fn cut_objects(
         let mut values = values;
         values.resize(st.points.len() + keys.len(), (0.0, 0));
         let first = st.points.len();
-        split_edges(st, &mut labels, &keys, pts, None);
+        split_edges(st, &mut labels, &keys, pts, false);
         // Where a node moved onto a curved interface or fault inverts a cell, it goes back
         // to the chord.
         for _ in 0..8 {
