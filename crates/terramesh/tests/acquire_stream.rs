@@ -75,7 +75,9 @@ fn the_streamed_table_and_points_are_the_whole_ones() {
                 }
             });
             for band in [1, 7, 1000, 1 << 16] {
-                let out = dir.path().join(format!("streamed-{band}.csv"));
+                let out = dir
+                    .path()
+                    .join(format!("streamed-{band}-{policy:?}-{scale}.csv"));
                 let o = options(out.clone(), margin, policy);
                 let plan = SamplePlan::resolve(&o).unwrap();
                 let s = acquire_in_bands(&plan, scale, band).unwrap().unwrap();
