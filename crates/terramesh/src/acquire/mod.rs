@@ -46,6 +46,7 @@ pub use table::{write_table, Row, SampleTable};
 
 use crate::error::Result;
 use crate::progress::Progress;
+use table::TableWriter;
 
 /// Samples the plan's source, without writing anything.
 pub fn acquire(plan: &SamplePlan, progress: &dyn Progress) -> Result<SampleTable> {
@@ -55,5 +56,49 @@ pub fn acquire(plan: &SamplePlan, progress: &dyn Progress) -> Result<SampleTable
         Source::Points(path) => points::sample_points(plan, path, false, progress),
         Source::Lidar(path) => points::sample_points(plan, path, true, progress),
         Source::Web(endpoint) => web::sample_web(plan, endpoint, progress),
+    }
+}
+
+/// A streamed acquisition ([`acquire_streamed`]): the samples, and their table written but
+/// not yet in place.
+pub struct Streamed<'a> {
+    /// The table's UTM zone, as [`SampleTable::zone`].
+    pub zone: Option<terramesh_core::coords::Zone>,
+    /// The points with an elevation, in the table's order: `[x, y, z]`.
+    pub xyz: Vec<[f64; 3]>,
+    table: TableWriter<'a>,
+    summary: String,
+}
+
+impl Streamed<'_> {
+    /// Puts the table in place, with the notes [`write_table`] gives.
+    pub fn commit(self, progress: &dyn Progress) -> Result<()> {
+        self.table.finish(&self.summary, progress)
+    }
+}
+
+/// Samples the plan's source band by band of grid nodes, writing its table as it goes, with
+/// `z` times `scale`: the table and points of [`acquire`] then [`write_table`] (the same
+/// bytes) without holding every node and row at once. `Ok(None)` where it does not apply
+/// (call those two instead): sources other than a DEM file (point clouds, terrain tiles and
+/// web services are not streamed yet), and points without an elevation under
+/// `on_missing = "error"`. Dropped without [`Streamed::commit`], nothing is written.
+pub fn acquire_streamed(plan: &SamplePlan, scale: f64) -> Result<Option<Streamed<'_>>> {
+    acquire_in_bands(plan, scale, BAND)
+}
+
+/// Grid nodes per band of [`acquire_streamed`]: a band's nodes, their elevations, rows and
+/// table text are held at once (about 250 bytes a node), never the whole grid's.
+pub const BAND: usize = 1 << 16;
+
+/// [`acquire_streamed`] with `band` grid nodes per band (at least 1).
+pub fn acquire_in_bands(
+    plan: &SamplePlan,
+    scale: f64,
+    band: usize,
+) -> Result<Option<Streamed<'_>>> {
+    match &plan.source {
+        Source::Raster(path) => raster::stream_file(plan, path, scale, band),
+        _ => Ok(None),
     }
 }

@@ -9,9 +9,11 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::time::Duration;
 
+use rayon::prelude::*;
 use terramesh_core::coords::Zone;
+use terramesh_core::coords::{to_utm, to_wgs84};
 use terramesh_core::sampling::{
-    grid_nodes, GridPlane, GridSize, Kernel, Margin, Node, SamplingGrid,
+    grid_nodes, GridPlane, GridSize, Kernel, Margin, Node, NodeError, SamplingGrid,
 };
 use terramesh_io::dem::SourceCrs;
 use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
@@ -472,6 +474,70 @@ impl SamplePlan {
     /// The grid nodes over the region.
     pub fn nodes(&self) -> Result<Vec<Node>> {
         let r = self.region()?;
+        let spec = self.grid_spec()?;
+        Ok(grid_nodes(
+            &r.projected,
+            r.geographic.as_ref(),
+            r.zone,
+            &spec,
+            self.options.plane,
+        )?)
+    }
+
+    /// The grid's points before they become nodes: the nodes of [`SamplePlan::nodes`], in
+    /// order, as projected `[x, y]`, or `[lon, lat]` on a latitude/longitude grid; each band of
+    /// them becomes its nodes with [`SamplePlan::nodes_of`], so that the nodes (40 bytes each)
+    /// need not all be held at once. `None` where [`SamplePlan::nodes`] gives an error.
+    pub(crate) fn grid_points(&self) -> Result<Option<Vec<[f64; 2]>>> {
+        let r = self.region()?;
+        let spec = self.grid_spec()?;
+        Ok(match (self.options.plane, &r.geographic, r.zone) {
+            (GridPlane::Utm, _, _) => {
+                Some(spec.build(&r.projected).map_err(NodeError::from)?.nodes)
+            }
+            (GridPlane::LatLon, Some(g), Some(_)) => {
+                Some(spec.build(g).map_err(NodeError::from)?.nodes)
+            }
+            (GridPlane::LatLon, _, _) => None,
+        })
+    }
+
+    /// The nodes of a band of [`SamplePlan::grid_points`], as [`grid_nodes`] makes them.
+    pub(crate) fn nodes_of(&self, points: &[[f64; 2]]) -> Result<Vec<Node>> {
+        let zone = self.region()?.zone;
+        let nodes: std::result::Result<Vec<Node>, NodeError> = match (self.options.plane, zone) {
+            (GridPlane::Utm, None) => {
+                Ok(points.iter().map(|&xy| Node { xy, latlon: None }).collect())
+            }
+            (GridPlane::Utm, Some(z)) => points
+                .par_iter()
+                .with_min_len(4096)
+                .map(|&xy| {
+                    let (lat, lon) = to_wgs84(xy[0], xy[1], z)?;
+                    Ok(Node {
+                        xy,
+                        latlon: Some([lat, lon]),
+                    })
+                })
+                .collect(),
+            (GridPlane::LatLon, z) => points
+                .par_iter()
+                .with_min_len(4096)
+                .map(|&[lon, lat]| {
+                    let p = to_utm(lat, lon, z)?;
+                    Ok(Node {
+                        xy: [p.easting, p.northing],
+                        latlon: Some([lat, lon]),
+                    })
+                })
+                .collect(),
+        };
+        Ok(nodes?)
+    }
+
+    /// The sampling grid over the region.
+    fn grid_spec(&self) -> Result<SamplingGrid> {
+        let r = self.region()?;
         let (lo, hi) = r.projected.bbox().ok_or(Error::EmptyRegion)?;
         let metres = (hi[0] - lo[0], hi[1] - lo[1]);
         let (geo_lo, geo_hi) = match &r.geographic {
@@ -521,18 +587,11 @@ impl SamplePlan {
                 ))
             }
         };
-        let spec = SamplingGrid {
+        Ok(SamplingGrid {
             size,
             margin,
             clip: self.options.clip,
-        };
-        Ok(grid_nodes(
-            &r.projected,
-            r.geographic.as_ref(),
-            r.zone,
-            &spec,
-            self.options.plane,
-        )?)
+        })
     }
 }
 

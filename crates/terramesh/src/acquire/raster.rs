@@ -3,13 +3,15 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
+use terramesh_core::sampling::GridPlane;
 use terramesh_io::dem::{
     open_raster_in, sample_in, sample_nodes, ElevationSource, LatLonBox, SourceCrs, TileMosaic,
 };
 use terramesh_web::{fetch_tiles, TileOptions};
 
-use super::plan::SamplePlan;
-use super::table::SampleTable;
+use super::plan::{OnMissing, SamplePlan};
+use super::table::{SampleTable, TableWriter};
+use super::Streamed;
 use crate::error::{Context, Error, Result};
 use crate::setting::Setting;
 
@@ -25,6 +27,84 @@ pub fn sample_file(s: &SamplePlan, path: &Path) -> Result<SampleTable> {
     sample(s, dem.as_ref(), nodes)
 }
 
+/// Samples a DEM file as [`sample_file`] does, band by band of `band` grid nodes in the
+/// grid's order, each band's rows appended to the table as they come: the same table and
+/// samples (`z` times `scale`) without holding every node and row at once. The raster window
+/// is the one `sample_file` reads (the nodes' box, from a first pass over the bands).
+/// `Ok(None)` where `sample_file` must run instead: the grid is an error, or a node has no
+/// elevation under `on_missing = "error"` (its message counts and spans every node).
+pub(crate) fn stream_file<'a>(
+    s: &'a SamplePlan,
+    path: &Path,
+    scale: f64,
+    band: usize,
+) -> Result<Option<Streamed<'a>>> {
+    let band = band.max(1);
+    let Some(points) = s.grid_points()? else {
+        return Ok(None);
+    };
+    let mut area: Option<LatLonBox> = None;
+    if s.options.plane == GridPlane::LatLon || s.region()?.zone.is_some() {
+        // Every node has a latitude and longitude: the box around them, as LatLonBox::around.
+        for nodes in points.chunks(band) {
+            for n in s.nodes_of(nodes)? {
+                let Some([lat, lon]) = n.latlon.filter(|p| p[0].is_finite() && p[1].is_finite())
+                else {
+                    continue;
+                };
+                let b = area.get_or_insert(LatLonBox {
+                    south: lat,
+                    west: lon,
+                    north: lat,
+                    east: lon,
+                });
+                b.south = b.south.min(lat);
+                b.north = b.north.max(lat);
+                b.west = b.west.min(lon);
+                b.east = b.east.max(lon);
+            }
+        }
+    }
+    let dem = open_raster_in(path, s.options.fill_voids, area.as_ref())?;
+    let zone = table_zone(s, dem.as_ref());
+    let mut table = TableWriter::new(s, zone)?;
+    let mut xyz = Vec::with_capacity(points.len());
+    for nodes in points.chunks(band) {
+        let mut t = sample(s, dem.as_ref(), s.nodes_of(nodes)?)?;
+        if s.options.on_missing == OnMissing::Error && t.rows.iter().any(|r| r.z.is_err()) {
+            return Ok(None);
+        }
+        for r in &mut t.rows {
+            if let Ok(z) = &mut r.z {
+                if scale != 1.0 {
+                    *z *= scale;
+                }
+                xyz.push([r.xy[0], r.xy[1], *z]);
+            }
+        }
+        table.band(&t.rows)?;
+    }
+    Ok(Some(Streamed {
+        zone,
+        xyz,
+        table,
+        summary: summary(s, dem.as_ref()),
+    }))
+}
+
+/// The zone of a table sampled from `dem`: none for a projected source.
+fn table_zone(s: &SamplePlan, dem: &dyn ElevationSource) -> Option<terramesh_core::coords::Zone> {
+    match dem.crs() {
+        SourceCrs::Projected { .. } => None,
+        _ => s.zone,
+    }
+}
+
+/// What was read, for the summary line.
+fn summary(s: &SamplePlan, dem: &dyn ElevationSource) -> String {
+    format!("{} ({} interpolation)", dem.describe(), s.options.kernel)
+}
+
 fn sample(
     s: &SamplePlan,
     dem: &dyn ElevationSource,
@@ -37,10 +117,7 @@ fn sample(
         }
         None => sample_nodes(dem, &nodes, s.zone, s.options.kernel)?,
     };
-    let zone = match dem.crs() {
-        SourceCrs::Projected { .. } => None,
-        _ => s.zone,
-    };
+    let zone = table_zone(s, dem);
     // The tiles a tiled source lacks for the points it could not give (at most a few names).
     let mut lacking = BTreeSet::new();
     for (n, z) in nodes.iter().zip(&z) {
@@ -54,7 +131,7 @@ fn sample(
     Ok(SampleTable {
         zone,
         rows,
-        summary: format!("{} ({} interpolation)", dem.describe(), s.options.kernel),
+        summary: summary(s, dem),
         lacking: lacking.into_iter().collect(),
     })
 }

@@ -135,90 +135,136 @@ pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> R
             ));
         }
     }
-    let geographic = t.zone.is_some();
-    let with_error = s.options.on_missing == OnMissing::Nodata;
-    let mut head = if geographic {
-        "lat,lon,easting,northing,zone,z".to_string()
-    } else {
-        "x,y,z".to_string()
-    };
-    if with_error {
-        head.push_str(",error");
-    }
-    head.push('\n');
-    let zone = t.zone.map(|z| z.to_string()).unwrap_or_default();
-    let chunks: Vec<Vec<u8>> = t
-        .rows
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut b = Vec::with_capacity(chunk.len() * 80);
-            for r in chunk {
-                let z = match (&r.z, s.options.on_missing) {
-                    (Ok(z), _) => Some((*z, "")),
-                    (Err(e), OnMissing::Nodata) => Some((s.options.nodata, e.as_str())),
-                    (Err(_), _) => None,
-                };
-                let Some((z, why)) = z else { continue };
-                // Writing to a Vec cannot fail.
-                if let Some([lat, lon]) = r.latlon.filter(|_| geographic) {
-                    let _ = write_fixed(&mut b, lat, 11);
-                    b.push(b',');
-                    let _ = write_fixed(&mut b, lon, 11);
-                    b.push(b',');
-                }
-                let _ = write_shortest(&mut b, r.xy[0]);
-                b.push(b',');
-                let _ = write_shortest(&mut b, r.xy[1]);
-                b.push(b',');
-                if geographic {
-                    b.extend_from_slice(zone.as_bytes());
-                    b.push(b',');
-                }
-                let _ = write_shortest(&mut b, z);
-                if with_error {
-                    b.push(b',');
-                    if why.contains(',') {
-                        b.push(b'"');
-                        b.extend_from_slice(why.replace('"', "\"\"").as_bytes());
-                        b.push(b'"');
-                    } else {
-                        b.extend_from_slice(why.as_bytes());
-                    }
-                }
-                b.push(b'\n');
-            }
-            b
-        })
-        .collect();
-    let name = s
-        .options
-        .output
-        .as_ref()
-        .map_or("standard output".to_string(), |p| p.display().to_string());
-    let mut out = Output::create(s.options.output.as_deref())
-        .with_context(|| format!("cannot write {name}"))?;
-    out.write_all(head.as_bytes())
-        .and_then(|_| chunks.iter().try_for_each(|c| out.write_all(c)))
-        .with_context(|| format!("writing {name}"))?;
-    out.commit()
-        .with_context(|| format!("cannot write {name}"))?;
-    let written = t.rows.len()
-        - if s.options.on_missing == OnMissing::Skip {
-            missing.len()
+    let mut w = TableWriter::new(s, t.zone)?;
+    w.band(&t.rows)?;
+    w.finish(&t.summary, progress)
+}
+
+/// A sample table being written band by band (the rows in order), atomically: nothing is
+/// written until [`TableWriter::finish`]; dropped unfinished, its temporary file goes.
+pub(crate) struct TableWriter<'a> {
+    s: &'a SamplePlan,
+    out: Output,
+    name: String,
+    zone: Option<String>,
+    rows: usize,
+    missing: usize,
+}
+
+impl<'a> TableWriter<'a> {
+    /// Opens the plan's output (standard output without one) and writes the header of a
+    /// table with points in `zone` (lat/lon and UTM) or without (x, y).
+    pub(crate) fn new(s: &'a SamplePlan, zone: Option<Zone>) -> Result<TableWriter<'a>> {
+        let zone = zone.map(|z| z.to_string());
+        let mut head = if zone.is_some() {
+            "lat,lon,easting,northing,zone,z".to_string()
         } else {
-            0
+            "x,y,z".to_string()
         };
-    progress.note(&t.summary);
-    progress.note(&format!("wrote {written} points to {name}"));
-    if !missing.is_empty() {
-        let what = match s.options.on_missing {
-            OnMissing::Skip => "left out",
-            _ => "written with z = the nodata value and the reason in the error column",
-        };
-        progress.warn(&format!(
-            "{} points had no elevation and were {what}",
-            missing.len()
-        ));
+        if s.options.on_missing == OnMissing::Nodata {
+            head.push_str(",error");
+        }
+        head.push('\n');
+        let name = s
+            .options
+            .output
+            .as_ref()
+            .map_or("standard output".to_string(), |p| p.display().to_string());
+        let mut out = Output::create(s.options.output.as_deref())
+            .with_context(|| format!("cannot write {name}"))?;
+        out.write_all(head.as_bytes())
+            .with_context(|| format!("writing {name}"))?;
+        Ok(TableWriter {
+            s,
+            out,
+            name,
+            zone,
+            rows: 0,
+            missing: 0,
+        })
     }
-    Ok(())
+
+    /// Appends `rows` (after the on-missing policy: a row without elevation is left out, or
+    /// written with the nodata value and the reason).
+    pub(crate) fn band(&mut self, rows: &[Row]) -> Result<()> {
+        let s = self.s;
+        let geographic = self.zone.is_some();
+        let zone = self.zone.as_deref().unwrap_or_default();
+        let with_error = s.options.on_missing == OnMissing::Nodata;
+        let chunks: Vec<Vec<u8>> = rows
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                let mut b = Vec::with_capacity(chunk.len() * 80);
+                for r in chunk {
+                    let z = match (&r.z, s.options.on_missing) {
+                        (Ok(z), _) => Some((*z, "")),
+                        (Err(e), OnMissing::Nodata) => Some((s.options.nodata, e.as_str())),
+                        (Err(_), _) => None,
+                    };
+                    let Some((z, why)) = z else { continue };
+                    // Writing to a Vec cannot fail.
+                    if let Some([lat, lon]) = r.latlon.filter(|_| geographic) {
+                        let _ = write_fixed(&mut b, lat, 11);
+                        b.push(b',');
+                        let _ = write_fixed(&mut b, lon, 11);
+                        b.push(b',');
+                    }
+                    let _ = write_shortest(&mut b, r.xy[0]);
+                    b.push(b',');
+                    let _ = write_shortest(&mut b, r.xy[1]);
+                    b.push(b',');
+                    if geographic {
+                        b.extend_from_slice(zone.as_bytes());
+                        b.push(b',');
+                    }
+                    let _ = write_shortest(&mut b, z);
+                    if with_error {
+                        b.push(b',');
+                        if why.contains(',') {
+                            b.push(b'"');
+                            b.extend_from_slice(why.replace('"', "\"\"").as_bytes());
+                            b.push(b'"');
+                        } else {
+                            b.extend_from_slice(why.as_bytes());
+                        }
+                    }
+                    b.push(b'\n');
+                }
+                b
+            })
+            .collect();
+        self.rows += rows.len();
+        self.missing += rows.iter().filter(|r| r.z.is_err()).count();
+        let name = &self.name;
+        chunks
+            .iter()
+            .try_for_each(|c| self.out.write_all(c))
+            .with_context(|| format!("writing {name}"))
+    }
+
+    /// Commits the table; what was read (`summary`) and written goes to `progress` as notes.
+    pub(crate) fn finish(self, summary: &str, progress: &dyn Progress) -> Result<()> {
+        let (s, name, missing) = (self.s, self.name, self.missing);
+        self.out
+            .commit()
+            .with_context(|| format!("cannot write {name}"))?;
+        let written = self.rows
+            - if s.options.on_missing == OnMissing::Skip {
+                missing
+            } else {
+                0
+            };
+        progress.note(summary);
+        progress.note(&format!("wrote {written} points to {name}"));
+        if missing > 0 {
+            let what = match s.options.on_missing {
+                OnMissing::Skip => "left out",
+                _ => "written with z = the nodata value and the reason in the error column",
+            };
+            progress.warn(&format!(
+                "{missing} points had no elevation and were {what}"
+            ));
+        }
+        Ok(())
+    }
 }

@@ -140,20 +140,24 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
             Some(crate::external_drift::ModelDrift { grid, at_data })
         }
     };
+    // The data the variogram is fitted to: the samples themselves (not a copy: a tiled plan
+    // holds every sample here), or the drift's residuals.
+    let residuals;
     let fit_to = match &drift {
-        None => data.clone(),
+        None => &data,
         Some(d) => {
             let method = match ip.methods.contains(&InterpolationMethod::Universal) {
                 true => Method::Universal(ip.drift),
                 false => Method::Ordinary,
             };
-            crate::external_drift::drift_residuals(&data, &d.at_data, method)
-                .context("interpolation.external_drift_grid")?
+            residuals = crate::external_drift::drift_residuals(&data, &d.at_data, method)
+                .context("interpolation.external_drift_grid")?;
+            &residuals
         }
     };
     // The lag classes and the fit's weights of the plan's variogram settings (`LagPlan`; a
     // project keeps their defaults).
-    let lags = experimental(&fit_to, &ip.lag.settings())
+    let lags = experimental(fit_to, &ip.lag.settings())
         .context("experimental variogram of the samples")?;
     let mut candidates = Vec::new();
     let mut selection = None;
@@ -174,7 +178,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
             .anisotropy
             .eq_ignore_ascii_case("auto")
             .then(crate::fitting::AnisotropyPlan::default);
-        let fitted = crate::fitting::fit(&fit_to, &lags, &plan).context("fitting the variogram")?;
+        let fitted = crate::fitting::fit(fit_to, &lags, &plan).context("fitting the variogram")?;
         candidates = fitted
             .candidates
             .iter()

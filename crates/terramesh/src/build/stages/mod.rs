@@ -12,7 +12,7 @@ use terramesh_core::coords::Zone;
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{Mesh, Quality, SmoothReport};
 
-use crate::acquire::{acquire, write_table, SamplePlan};
+use crate::acquire::{acquire, acquire_streamed, write_table, SamplePlan, SampleTable, Streamed};
 use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
@@ -34,38 +34,60 @@ pub struct Samples {
     pub cell: [f64; 2],
 }
 
+/// What step 1 acquired: a streamed table (a DEM file) or a whole one.
+enum Acquired<'a> {
+    Streamed(Streamed<'a>),
+    Table(SampleTable),
+}
+
 /// Step 1: samples on the project's grid, also written to `out/samples.csv`.
 pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
     let options = p.sample_options(base, &out.join("samples.csv"))?;
     let plan = SamplePlan::resolve(&options)?;
-    let mut table = acquire(&plan, progress)?;
     let metres = p.source.z_unit.metres();
-    if metres != 1.0 {
-        for r in &mut table.rows {
-            if let Ok(z) = &mut r.z {
-                *z *= metres;
+    // A DEM file is sampled band by band (the same table and samples, less memory).
+    let mut got = match acquire_streamed(&plan, metres)? {
+        Some(s) => Acquired::Streamed(s),
+        None => {
+            let mut table = acquire(&plan, progress)?;
+            if metres != 1.0 {
+                for r in &mut table.rows {
+                    if let Ok(z) = &mut r.z {
+                        *z *= metres;
+                    }
+                }
             }
+            Acquired::Table(table)
         }
-    }
+    };
+    let table_zone = match &got {
+        Acquired::Streamed(s) => s.zone,
+        Acquired::Table(t) => t.zone,
+    };
     let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
-    let zone = match table.zone {
+    let zone = match table_zone {
         Some(z) if !own_crs => Some(z),
         _ if own_crs => None,
         _ => return Err(Error::UnconvertedSource),
     };
     let region = plan.region.clone().ok_or(Error::BuildNeedsRegion)?;
-    let mut xyz = Vec::with_capacity(table.rows.len());
-    for r in &table.rows {
-        if let Ok(z) = r.z {
-            xyz.push([r.xy[0], r.xy[1], z]);
-        }
-    }
+    let xyz = match &mut got {
+        Acquired::Streamed(s) => std::mem::take(&mut s.xyz),
+        Acquired::Table(t) => t
+            .rows
+            .iter()
+            .filter_map(|r| r.z.as_ref().ok().map(|&z| [r.xy[0], r.xy[1], z]))
+            .collect(),
+    };
     if xyz.len() < 10 {
         return Err(Error::TooFewSamples { samples: xyz.len() });
     }
     let s = &p.sampling;
     let cell = grid_cell(&xyz, s.rows, s.cols, s.spacing);
-    write_table(&plan, table, progress)?;
+    match got {
+        Acquired::Streamed(s) => s.commit(progress)?,
+        Acquired::Table(t) => write_table(&plan, t, progress)?,
+    }
     Ok(Samples {
         xyz,
         zone,
