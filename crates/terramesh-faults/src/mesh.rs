@@ -305,40 +305,56 @@ impl Field<'_> {
 
     /// The crossing on segment ab (values of opposite signs): Illinois regula falsi.
     fn crossing(&self, a: [f64; 3], b: [f64; 3], va: f64, vb: f64) -> [f64; 3] {
-        let at = |t: f64| {
-            [
-                a[0] + t * (b[0] - a[0]),
-                a[1] + t * (b[1] - a[1]),
-                a[2] + t * (b[2] - a[2]),
-            ]
-        };
-        let (mut t0, mut t1, mut f0, mut f1) = (0.0, 1.0, va, vb);
-        let mut t = f0 / (f0 - f1);
-        let mut last = 0i8;
-        for _ in 0..60 {
-            t = (t0 - f0 * (t1 - t0) / (f1 - f0)).clamp(t0, t1);
-            let (v, s) = self.eval(at(t));
-            if s == 0 || v.abs() < 1e-10 {
-                break;
-            }
-            if (v > 0.0) == (f0 > 0.0) {
-                t0 = t;
-                f0 = v;
-                if last == 1 {
-                    f1 *= 0.5;
-                }
-                last = 1;
-            } else {
-                t1 = t;
-                f1 = v;
-                if last == -1 {
-                    f0 *= 0.5;
-                }
-                last = -1;
-            }
-        }
-        at(t.clamp(1e-12, 1.0 - 1e-12))
+        regula_falsi(a, b, va, vb, 60, |p| {
+            let (v, s) = self.eval(p);
+            (s != 0).then_some(v)
+        })
     }
+}
+
+/// The crossing of segment ab by a field with values `va`, `vb` of opposite signs at its
+/// ends: Illinois regula falsi, at most `iterations` steps, stopping where `value` is `None`
+/// (on the surface, or no finite value) or within 1e-10 of 0; the point kept strictly inside
+/// the segment. The one root finder of the fault, object and zone cuts.
+pub(crate) fn regula_falsi(
+    a: [f64; 3],
+    b: [f64; 3],
+    va: f64,
+    vb: f64,
+    iterations: usize,
+    value: impl Fn([f64; 3]) -> Option<f64>,
+) -> [f64; 3] {
+    let at = |t: f64| {
+        [
+            a[0] + t * (b[0] - a[0]),
+            a[1] + t * (b[1] - a[1]),
+            a[2] + t * (b[2] - a[2]),
+        ]
+    };
+    let (mut t0, mut t1, mut f0, mut f1) = (0.0, 1.0, va, vb);
+    let mut t = f0 / (f0 - f1);
+    let mut last = 0i8;
+    for _ in 0..iterations {
+        t = (t0 - f0 * (t1 - t0) / (f1 - f0)).clamp(t0, t1);
+        let Some(v) = value(at(t)) else { break };
+        if v.abs() < 1e-10 {
+            break;
+        }
+        if (v > 0.0) == (f0 > 0.0) {
+            (t0, f0) = (t, v);
+            if last == 1 {
+                f1 *= 0.5;
+            }
+            last = 1;
+        } else {
+            (t1, f1) = (t, v);
+            if last == -1 {
+                f0 *= 0.5;
+            }
+            last = -1;
+        }
+    }
+    at(t.clamp(1e-12, 1.0 - 1e-12))
 }
 
 fn c3(p: [f64; 3]) -> Coord3D<f64> {

@@ -169,31 +169,7 @@ fn eval(v: f64) -> (f64, i8) {
 
 /// The crossing of segment ab by a field (values of opposite signs), Illinois regula falsi.
 fn crossing(f: &dyn Fn([f64; 3]) -> f64, a: [f64; 3], b: [f64; 3], va: f64, vb: f64) -> [f64; 3] {
-    let at = |t: f64| std::array::from_fn(|k| a[k] + t * (b[k] - a[k]));
-    let (mut t0, mut t1, mut f0, mut f1) = (0.0, 1.0, va, vb);
-    let mut t = f0 / (f0 - f1);
-    let mut last = 0i8;
-    for _ in 0..80 {
-        t = (t0 - f0 * (t1 - t0) / (f1 - f0)).clamp(t0, t1);
-        let v = f(at(t));
-        if !v.is_finite() || v.abs() < 1e-10 {
-            break;
-        }
-        if (v > 0.0) == (f0 > 0.0) {
-            (t0, f0) = (t, v);
-            if last == 1 {
-                f1 *= 0.5;
-            }
-            last = 1;
-        } else {
-            (t1, f1) = (t, v);
-            if last == -1 {
-                f0 *= 0.5;
-            }
-            last = -1;
-        }
-    }
-    at(t.clamp(1e-12, 1.0 - 1e-12))
+    crate::mesh::regula_falsi(a, b, va, vb, 80, |p| Some(f(p)).filter(|v| v.is_finite()))
 }
 
 /// Moves the nodes close to a wall onto it before the wall is cut, as the faults' cut does
