@@ -16,8 +16,8 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use memmap2::MmapMut;
-use serde_json::{json, Value};
-use terramesh_io::export::elevation_colours;
+use serde_json::json;
+use terramesh_io::export::{elevation_colours, glb_json, write_glb_head, GlbLayout, GlbOptions};
 use terramesh_io::output::Output;
 
 use crate::error::{Context, Result};
@@ -95,43 +95,7 @@ pub(crate) fn write_merged_glb(
     if n == 0 {
         (min, max) = ([0.0; 3], [0.0; 3]);
     }
-    let short = n < 65_535;
-    let nt = g.triangles.len();
-    let isize = if short { 2 } else { 4 };
-    // The writer's JSON chunk for one mesh with colours.
-    let mut views = Vec::new();
-    let mut offset = 0usize;
-    let mut view = |len: usize, target: u32| {
-        views.push(
-            json!({ "buffer": 0, "byteOffset": offset, "byteLength": len, "target": target }),
-        );
-        offset += pad4(len);
-        views.len() - 1
-    };
-    let mut accessors = Vec::new();
-    let mut attributes = serde_json::Map::new();
-    let pv = view(12 * n, 34962);
-    accessors.push(json!({
-        "bufferView": pv, "componentType": 5126, "count": n, "type": "VEC3",
-        "min": min.map(f64::from), "max": max.map(f64::from),
-    }));
-    attributes.insert("POSITION".into(), json!(accessors.len() - 1));
-    let nv = view(12 * n, 34962);
-    accessors.push(json!({ "bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3" }));
-    attributes.insert("NORMAL".into(), json!(accessors.len() - 1));
-    let cv = view(12 * n, 34962);
-    accessors.push(json!({ "bufferView": cv, "componentType": 5126, "count": n, "type": "VEC3" }));
-    attributes.insert("COLOR_0".into(), json!(accessors.len() - 1));
-    let iv = view(isize * 3 * nt, 34963);
-    accessors.push(json!({
-        "bufferView": iv, "componentType": if short { 5123 } else { 5125 },
-        "count": 3 * nt, "type": "SCALAR",
-    }));
-    let gl_meshes = vec![json!({
-        "name": g.title,
-        "primitives": [{ "attributes": attributes, "indices": accessors.len() - 1, "material": 0, "mode": 4 }],
-    })];
-    let mut extras = json!({
+    let extras = json!({
         "crs": g.georef.crs_code(),
         "crs_name": g.georef.crs_name(),
         "units": "metre",
@@ -139,47 +103,24 @@ pub(crate) fn write_merged_glb(
         "heights": g.georef.heights(),
         "colours": "COLOR_0: the report's elevation colour map (terrain), linear RGB",
     });
-    if let Value::Object(map) = &mut extras {
-        map.insert("origin".into(), json!(origin));
-        map.insert(
-            "axes".into(),
-            json!("glTF +X = source x (east), +Y = source z (up), +Z = -source y (south); add the root node's translation, then (x, y, z) = (X, -Z, Y)"),
-        );
+    let layout = GlbLayout {
+        name: g.title,
+        vertices: n,
+        triangles: g.triangles.len(),
+        colours: true,
+        min,
+        max,
+    };
+    let opts = GlbOptions {
+        name: g.title,
+        origin,
+        extras,
+    };
+    let json = glb_json(&[layout], &opts)?;
+    if json.total > limit.min(GLB_MAX) {
+        return Ok(Err(json.total));
     }
-    let o = origin;
-    let nodes = vec![
-        json!({
-            "name": g.title,
-            "translation": [o[0], o[2], -o[1]],
-            "children": (1..=1).collect::<Vec<usize>>(),
-            "extras": extras,
-        }),
-        json!({ "name": g.title, "mesh": 0 }),
-    ];
-    let doc = json!({
-        "asset": {
-            "version": "2.0",
-            "generator": concat!("terramesh ", env!("CARGO_PKG_VERSION")),
-            "extras": extras,
-        },
-        "scene": 0,
-        "scenes": [{ "name": g.title, "nodes": [0] }],
-        "nodes": nodes,
-        "meshes": gl_meshes,
-        "materials": [{
-            "name": "terrain",
-            "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0 },
-        }],
-        "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [{ "byteLength": offset }],
-    });
-    let mut text = serde_json::to_vec(&doc)?;
-    text.resize(pad4(text.len()), b' ');
-    let total = 12 + 8 + text.len() + 8 + offset;
-    if total > limit.min(GLB_MAX) {
-        return Ok(Err(total));
-    }
+    let (short, nt) = (layout.short(), layout.triangles);
 
     // The normals: area-weighted sums over the triangles, in their order (`vertex_normals`).
     let acc = normals(acc_path, g.vertices, g.triangles, &rel)?;
@@ -194,14 +135,7 @@ pub(crate) fn write_merged_glb(
     let mut out = Output::create(Some(path)).at(path)?;
     let mut io = || -> io::Result<()> {
         let mut w = BufWriter::with_capacity(1 << 16, &mut out);
-        w.write_all(b"glTF")?;
-        w.write_all(&2u32.to_le_bytes())?;
-        w.write_all(&(total as u32).to_le_bytes())?;
-        w.write_all(&(text.len() as u32).to_le_bytes())?;
-        w.write_all(b"JSON")?;
-        w.write_all(&text)?;
-        w.write_all(&(offset as u32).to_le_bytes())?;
-        w.write_all(b"BIN\0")?;
+        write_glb_head(&mut w, &json)?;
         let put = |w: &mut BufWriter<_>, v: [f32; 3]| -> io::Result<()> {
             for c in v {
                 w.write_all(&c.to_le_bytes())?;
@@ -235,7 +169,7 @@ pub(crate) fn write_merged_glb(
                 w.write_all(&i.to_le_bytes())?;
             }
         }
-        let used = isize * 3 * nt;
+        let used = 3 * nt * if short { 2 } else { 4 };
         w.write_all(&vec![0u8; pad4(used) - used])?;
         w.flush()
     };

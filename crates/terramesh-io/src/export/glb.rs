@@ -154,36 +154,50 @@ fn pad4(n: usize) -> usize {
     n.div_ceil(4) * 4
 }
 
-/// Writes a glTF 2.0 binary with one node and mesh per [`GlbMesh`], children of a root node
-/// that carries the origin as its translation. Each mesh is one indexed triangle primitive
-/// with `POSITION` (float32, with exact min/max), `NORMAL` (area-weighted vertex normals),
-/// `COLOR_0` when given, and u16 or u32 indices; every buffer view starts on 4 bytes.
+/// What a GLB's JSON chunk says of one mesh: its name and shape, not its data. [`write_glb`]
+/// lays its meshes out so; a writer that streams the data from elsewhere (a tiled merge) lays
+/// its mesh out the same way and gets the same bytes.
+#[derive(Debug, Clone, Copy)]
+pub struct GlbLayout<'a> {
+    /// The mesh's (and its node's) name.
+    pub name: &'a str,
+    /// Its number of vertices.
+    pub vertices: usize,
+    /// Its number of triangles.
+    pub triangles: usize,
+    /// Whether it has `COLOR_0`.
+    pub colours: bool,
+    /// The least position, glTF axes (float32), relative to the origin.
+    pub min: [f32; 3],
+    /// The greatest position.
+    pub max: [f32; 3],
+}
+
+impl GlbLayout<'_> {
+    /// Indices as u16 when every index is below 65,535 (the primitive-restart value).
+    pub fn short(&self) -> bool {
+        self.vertices < 65_535
+    }
+}
+
+/// A GLB's JSON chunk (padded with spaces to 4 bytes), the length of its binary chunk (per
+/// mesh its positions, normals, colours if any and indices, each padded to 4 bytes) and the
+/// file's length.
+#[derive(Debug, Clone)]
+pub struct GlbJson {
+    /// The JSON chunk.
+    pub text: Vec<u8>,
+    /// The binary chunk's length.
+    pub bin: usize,
+    /// The file's length (it may pass GLB's 4 GiB: the writer decides).
+    pub total: usize,
+}
+
+/// The JSON chunk of a GLB of `meshes`, as [`write_glb`] writes it.
 ///
 /// # Errors
-/// `InvalidInput` naming the mesh when an index is past its vertices, a vertex is not finite,
-/// or the colours do not match the vertices; and the writer's errors.
-///
-/// ```
-/// # fn main() -> std::io::Result<()> {
-/// use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
-/// let v = [[377_000.0, 5_397_000.0, 350.0], [377_010.0, 5_397_000.0, 352.0], [377_000.0, 5_397_010.0, 351.0]];
-/// let mesh = GlbMesh { name: "dsm", vertices: &v, triangles: &[[0, 1, 2]], colours: None };
-/// let opts = GlbOptions {
-///     name: "dsm",
-///     origin: [377_000.0, 5_397_000.0, 350.0],
-///     extras: serde_json::json!({ "crs": "EPSG:32632" }),
-/// };
-/// let mut buf = Vec::new();
-/// write_glb(&mut buf, &[mesh], &opts)?;
-/// assert_eq!(&buf[..4], b"glTF");
-/// assert_eq!(u32::from_le_bytes(buf[8..12].try_into().unwrap()) as usize, buf.len());
-/// # Ok(()) }
-/// ```
-pub fn write_glb<W: Write>(w: &mut W, meshes: &[GlbMesh], opts: &GlbOptions) -> io::Result<()> {
-    let packed: Vec<Packed> = meshes
-        .iter()
-        .map(|m| pack(m, opts.origin))
-        .collect::<io::Result<_>>()?;
+/// When the JSON cannot be written (never for finite bounds).
+pub fn glb_json(meshes: &[GlbLayout], opts: &GlbOptions) -> io::Result<GlbJson> {
     let mut views = Vec::new();
     let mut accessors = Vec::new();
     let mut gl_meshes = Vec::new();
@@ -195,31 +209,31 @@ pub fn write_glb<W: Write>(w: &mut W, meshes: &[GlbMesh], opts: &GlbOptions) -> 
         offset += pad4(len);
         views.len() - 1
     };
-    for (m, p) in meshes.iter().zip(&packed) {
-        let n = m.vertices.len();
+    for m in meshes {
+        let n = m.vertices;
         let mut attributes = serde_json::Map::new();
         let pv = view(12 * n, 34962, &mut views);
         accessors.push(json!({
             "bufferView": pv, "componentType": 5126, "count": n, "type": "VEC3",
-            "min": p.min.map(f64::from), "max": p.max.map(f64::from),
+            "min": m.min.map(f64::from), "max": m.max.map(f64::from),
         }));
         attributes.insert("POSITION".into(), json!(accessors.len() - 1));
         let nv = view(12 * n, 34962, &mut views);
         accessors
             .push(json!({ "bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3" }));
         attributes.insert("NORMAL".into(), json!(accessors.len() - 1));
-        if m.colours.is_some() {
+        if m.colours {
             let cv = view(12 * n, 34962, &mut views);
             accessors.push(
                 json!({ "bufferView": cv, "componentType": 5126, "count": n, "type": "VEC3" }),
             );
             attributes.insert("COLOR_0".into(), json!(accessors.len() - 1));
         }
-        let isize = if p.short { 2 } else { 4 };
-        let iv = view(isize * 3 * m.triangles.len(), 34963, &mut views);
+        let isize = if m.short() { 2 } else { 4 };
+        let iv = view(isize * 3 * m.triangles, 34963, &mut views);
         accessors.push(json!({
-            "bufferView": iv, "componentType": if p.short { 5123 } else { 5125 },
-            "count": 3 * m.triangles.len(), "type": "SCALAR",
+            "bufferView": iv, "componentType": if m.short() { 5123 } else { 5125 },
+            "count": 3 * m.triangles, "type": "SCALAR",
         }));
         gl_meshes.push(json!({
             "name": m.name,
@@ -265,16 +279,77 @@ pub fn write_glb<W: Write>(w: &mut W, meshes: &[GlbMesh], opts: &GlbOptions) -> 
     let mut text = serde_json::to_vec(&doc).map_err(io::Error::other)?;
     text.resize(pad4(text.len()), b' ');
     let total = 12 + 8 + text.len() + 8 + offset;
-    let total = u32::try_from(total)
-        .map_err(|_| invalid(format!("{total} bytes is past GLB's 4 GiB limit")))?;
+    Ok(GlbJson {
+        text,
+        bin: offset,
+        total,
+    })
+}
+
+/// Writes a GLB's 12-byte header, its JSON chunk and the header of its binary chunk; the
+/// binary chunk's bytes follow.
+///
+/// # Errors
+/// The writer's.
+pub fn write_glb_head<W: Write>(w: &mut W, json: &GlbJson) -> io::Result<()> {
     w.write_all(b"glTF")?;
     w.write_all(&2u32.to_le_bytes())?;
-    w.write_all(&total.to_le_bytes())?;
-    w.write_all(&(text.len() as u32).to_le_bytes())?;
+    w.write_all(&(json.total as u32).to_le_bytes())?;
+    w.write_all(&(json.text.len() as u32).to_le_bytes())?;
     w.write_all(b"JSON")?;
-    w.write_all(&text)?;
-    w.write_all(&(offset as u32).to_le_bytes())?;
-    w.write_all(b"BIN\0")?;
+    w.write_all(&json.text)?;
+    w.write_all(&(json.bin as u32).to_le_bytes())?;
+    w.write_all(b"BIN\0")
+}
+
+/// Writes a glTF 2.0 binary with one node and mesh per [`GlbMesh`], children of a root node
+/// that carries the origin as its translation. Each mesh is one indexed triangle primitive
+/// with `POSITION` (float32, with exact min/max), `NORMAL` (area-weighted vertex normals),
+/// `COLOR_0` when given, and u16 or u32 indices; every buffer view starts on 4 bytes.
+///
+/// # Errors
+/// `InvalidInput` naming the mesh when an index is past its vertices, a vertex is not finite,
+/// or the colours do not match the vertices; and the writer's errors.
+///
+/// ```
+/// # fn main() -> std::io::Result<()> {
+/// use terramesh_io::export::{write_glb, GlbMesh, GlbOptions};
+/// let v = [[377_000.0, 5_397_000.0, 350.0], [377_010.0, 5_397_000.0, 352.0], [377_000.0, 5_397_010.0, 351.0]];
+/// let mesh = GlbMesh { name: "dsm", vertices: &v, triangles: &[[0, 1, 2]], colours: None };
+/// let opts = GlbOptions {
+///     name: "dsm",
+///     origin: [377_000.0, 5_397_000.0, 350.0],
+///     extras: serde_json::json!({ "crs": "EPSG:32632" }),
+/// };
+/// let mut buf = Vec::new();
+/// write_glb(&mut buf, &[mesh], &opts)?;
+/// assert_eq!(&buf[..4], b"glTF");
+/// assert_eq!(u32::from_le_bytes(buf[8..12].try_into().unwrap()) as usize, buf.len());
+/// # Ok(()) }
+/// ```
+pub fn write_glb<W: Write>(w: &mut W, meshes: &[GlbMesh], opts: &GlbOptions) -> io::Result<()> {
+    let packed: Vec<Packed> = meshes
+        .iter()
+        .map(|m| pack(m, opts.origin))
+        .collect::<io::Result<_>>()?;
+    let layouts: Vec<GlbLayout> = meshes
+        .iter()
+        .zip(&packed)
+        .map(|(m, p)| GlbLayout {
+            name: m.name,
+            vertices: m.vertices.len(),
+            triangles: m.triangles.len(),
+            colours: m.colours.is_some(),
+            min: p.min,
+            max: p.max,
+        })
+        .collect();
+    let json = glb_json(&layouts, opts)?;
+    if u32::try_from(json.total).is_err() {
+        let total = json.total;
+        return Err(invalid(format!("{total} bytes is past GLB's 4 GiB limit")));
+    }
+    write_glb_head(w, &json)?;
     let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
     let mut flush = |buf: &mut Vec<u8>, force: bool| -> io::Result<()> {
         if force || buf.len() >= 1 << 16 {

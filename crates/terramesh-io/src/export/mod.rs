@@ -41,7 +41,9 @@ use crate::output::Output;
 
 pub use collada::{write_collada, write_model_kml, ColladaOptions};
 pub use dxf::write_dxf;
-pub use glb::{elevation_colours, write_glb, GlbMesh, GlbOptions};
+pub use glb::{
+    elevation_colours, glb_json, write_glb, write_glb_head, GlbJson, GlbLayout, GlbMesh, GlbOptions,
+};
 pub use kml::{write_kml, KmlStyle};
 pub use msh::Msh41;
 pub use obj::{parse_obj, Obj};
