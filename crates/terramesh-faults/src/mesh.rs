@@ -312,6 +312,28 @@ impl Field<'_> {
     }
 }
 
+/// The cells around each candidate node of a snap (`(node, cell)`, sorted): the stars the
+/// fault and zone cuts move nodes within.
+pub(crate) fn stars(st: &State, cand: &[(f64, u32)]) -> Vec<(u32, u32)> {
+    let mut is_cand = vec![false; st.points.len()];
+    for &(_, v) in cand {
+        is_cand[v as usize] = true;
+    }
+    let mut star: Vec<(u32, u32)> = st
+        .tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(c, t)| {
+            let is_cand = &is_cand;
+            t.iter()
+                .filter(move |&&v| is_cand[v as usize])
+                .map(move |&v| (v, c as u32))
+        })
+        .collect();
+    star.par_sort_unstable();
+    star
+}
+
 /// The crossing of segment ab by a field with values `va`, `vb` of opposite signs at its
 /// ends: Illinois regula falsi, at most `iterations` steps, stopping where `value` is `None`
 /// (on the surface, or no finite value) or within 1e-10 of 0; the point kept strictly inside
@@ -611,22 +633,7 @@ fn cut(
     }
     if !cand.is_empty() {
         cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-        let mut is_cand = vec![false; st.points.len()];
-        for &(_, v) in &cand {
-            is_cand[v as usize] = true;
-        }
-        let mut star: Vec<(u32, u32)> = st
-            .tets
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(c, t)| {
-                let is_cand = &is_cand;
-                t.iter()
-                    .filter(move |&&v| is_cand[v as usize])
-                    .map(move |&v| (v, c as u32))
-            })
-            .collect();
-        star.par_sort_unstable();
+        let star = stars(st, &cand);
         for &(_, v) in &cand {
             if values[v as usize].1 == 0 {
                 continue;

@@ -25,7 +25,7 @@
 use rayon::prelude::*;
 
 use crate::mesh::{
-    centroid, key, positive, split_cells, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
+    centroid, key, positive, split_cells, stars, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
 };
 use crate::objects::Surfaces;
 use crate::quality::min_dihedral;
@@ -208,22 +208,7 @@ fn snap(
         return 0;
     }
     cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    let mut is_cand = vec![false; st.points.len()];
-    for &(_, v) in &cand {
-        is_cand[v as usize] = true;
-    }
-    let mut star: Vec<(u32, u32)> = st
-        .tets
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(c, t)| {
-            let is_cand = &is_cand;
-            t.iter()
-                .filter(move |&&v| is_cand[v as usize])
-                .map(move |&v| (v, c as u32))
-        })
-        .collect();
-    star.par_sort_unstable();
+    let star = stars(st, &cand);
     let label = |c: usize| {
         (
             st.positive[c],
