@@ -222,11 +222,10 @@ fn variogram_fit(
     let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
     let plan = LagPlan {
         weights: w,
-        fit: method,
         reml_block,
         ..LagPlan::default()
     }
-    .plan(model, drift);
+    .plan(model, drift, method);
     run(py, false, |_| {
         let l = lags_of(&d, &s).map_err(kernel)?;
         let fitted = terramesh::fitting::fit(&d, &l, &plan).map_err(to_py)?;

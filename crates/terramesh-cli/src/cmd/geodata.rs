@@ -58,7 +58,8 @@ impl ModelArgs {
     }
 }
 
-/// Lag and fitting flags, shared with `interpolate --variogram auto` and `cv`.
+/// Lag and fitting flags, shared with `interpolate --variogram auto` and `cv` (`--fit` is the
+/// plan's `fit`, the others its [`LagPlan`]).
 #[derive(clap::Args, Debug, Clone)]
 pub struct LagArgs {
     /// Number of lag classes.
@@ -113,7 +114,6 @@ impl LagArgs {
             estimator: self.estimator,
             weights: self.weights,
             max_points: self.max_points,
-            fit: self.fit,
             reml_block: self.reml_block,
         }
     }

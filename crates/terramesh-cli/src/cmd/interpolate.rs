@@ -120,7 +120,7 @@ impl MethodArgs {
         p.set_neighbors(self.neighbors);
         (p.mean, p.radius, p.idw_power) = (self.mean, self.radius, self.power);
         (p.parts, p.variogram) = (self.model.options(), self.variogram.clone());
-        (p.lag, p.duplicates) = (self.lag.options(), self.duplicates);
+        (p.lag, p.fit, p.duplicates) = (self.lag.options(), self.lag.fit, self.duplicates);
         Ok(p)
     }
 }

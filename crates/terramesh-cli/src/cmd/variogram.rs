@@ -63,9 +63,9 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let mut plan = InterpolationPlan::single(terramesh_geostat::InterpolationMethod::Universal);
-    (plan.fit_model, plan.lag, plan.drift) = (args.model, args.lag.options(), args.drift);
+    (plan.fit_model, plan.lag, plan.fit) = (args.model, args.lag.options(), args.lag.fit);
     plan.anisotropy = args.anisotropy.unwrap_or(plan.anisotropy);
-    plan.duplicates = args.duplicates;
+    (plan.drift, plan.duplicates) = (args.drift, args.duplicates);
     let job = VariogramJob {
         data: args.data,
         plan,

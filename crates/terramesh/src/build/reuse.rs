@@ -125,7 +125,7 @@ fn interpolation_key(ip: &crate::plan::InterpolationPlan) -> String {
         ip.cv_folds,
         ip.realisations,
         ip.seed,
-        ip.fit,
+        ip.fit.unwrap_or_default(),
         ip.fit_model,
         ip.anisotropy,
         ip.external_drift_grid

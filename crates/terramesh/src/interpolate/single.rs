@@ -189,7 +189,7 @@ impl InterpolationPlan {
             _ => Drift::Constant,
         };
         let model = self.parts.model.as_deref().unwrap_or("auto");
-        let mut plan = self.lag.plan(model, drift);
+        let mut plan = self.lag.plan(model, drift, self.fit);
         if self.parts.anisotropy_auto()? {
             plan.anisotropy = Some(self.lag.anisotropy_plan()?);
         }

@@ -86,7 +86,7 @@ impl VariogramJob {
         let lags = experimental(&fd.data, &s)
             .map_err(Error::from)
             .context(&fd.name)?;
-        let mut plan = ip.lag.plan(&ip.fit_model, ip.drift);
+        let mut plan = ip.lag.plan(&ip.fit_model, ip.drift, ip.fit);
         match ip.anisotropy.as_str() {
             a if a.eq_ignore_ascii_case("none") => {}
             a if a.eq_ignore_ascii_case("auto") => {

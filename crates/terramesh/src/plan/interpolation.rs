@@ -178,8 +178,8 @@ pub struct InterpolationPlan {
     /// `--range`, ...): given in full, named for a fit, or `auto`. Not a project key.
     #[serde(skip)]
     pub parts: ModelParts,
-    /// The lag classes and the fit's settings of a single command's automatic variogram
-    /// (`--lags`, `--max-dist`, `--fit`, ...). Not a project key: a build fits with the
+    /// The lag classes and the fit's weights of a single command's automatic variogram
+    /// (`--lags`, `--max-dist`, `--weights`, ...). Not a project key: a build fits with the
     /// defaults of [`LagPlan`] and `fit`.
     #[serde(skip)]
     pub lag: LagPlan,
@@ -208,11 +208,15 @@ pub struct InterpolationPlan {
     /// Spectral modes per realisation of `terramesh simulate` (`--modes`). Not a project key.
     #[serde(skip)]
     pub modes: usize,
-    /// How `variogram = "auto"` fits: `wls` (least squares, least cross-validation RMSE; the
-    /// default), `reml` (restricted maximum likelihood with the UK drift over every model and
-    /// every nested pair, the model chosen by AIC) or `loo` (the parameters, then the model, of
-    /// least leave-one-out RMSE of kriging with the UK drift).
-    pub fit: terramesh_geostat::FitMethod,
+    /// How `variogram = "auto"` fits (`interpolation.fit`, `--fit`, Python's `fit`): `wls-loo`
+    /// (the default), `wls` (least squares, least cross-validation RMSE), `reml` (restricted
+    /// maximum likelihood with the UK drift over every model and every nested pair, the model
+    /// chosen by AIC) or `loo` (the parameters, then the model, of least leave-one-out RMSE of
+    /// kriging with the UK drift). A project's is always given (its default, `wls-loo`);
+    /// unset (a single command without `--fit`, [`InterpolationPlan::single`]) it is
+    /// `wls-loo` that falls back to the WLS fit alone on data too few to leave one out
+    /// ([`FitPlan::method`](crate::fitting::FitPlan::method)).
+    pub fit: Option<terramesh_geostat::FitMethod>,
     /// What `variogram = "auto"` fits: `auto` (every model, the best kept), a model name, or a
     /// nested sum of up to three joined by `+` (`spherical+exponential`, fitted jointly).
     pub fit_model: String,
@@ -251,7 +255,7 @@ impl Default for InterpolationPlan {
             realisations: 0,
             seed: 0,
             modes: DEFAULT_MODES,
-            fit: terramesh_geostat::FitMethod::default(),
+            fit: Some(terramesh_geostat::FitMethod::default()),
             fit_model: "auto".into(),
             anisotropy: "none".into(),
             external_drift_grid: None,
@@ -406,6 +410,7 @@ impl InterpolationPlan {
             methods: vec![method],
             variogram: None,
             idw_neighbors: 0,
+            fit: None,
             ..InterpolationPlan::default()
         }
     }

@@ -252,8 +252,6 @@ pub struct LagPlan {
     pub weights: Weighting,
     /// At most this many data for the experimental variogram (0: all).
     pub max_points: usize,
-    /// REML, loo or WLS (`None`: the default of [`FitPlan`]).
-    pub fit: Option<FitMethod>,
     /// REML in blocks of at most this many data (0: exact REML).
     pub reml_block: usize,
 }
@@ -268,7 +266,6 @@ impl Default for LagPlan {
             estimator: Estimator::Matheron,
             weights: Weighting::Cressie,
             max_points: terramesh_geostat::DEFAULT_MAX_POINTS,
-            fit: None,
             reml_block: terramesh_geostat::DEFAULT_REML_BLOCK,
         }
     }
@@ -289,11 +286,12 @@ impl LagPlan {
         }
     }
 
-    /// The fitting plan of `model` (`auto`, a name or a nested sum) for kriging with `drift`.
-    pub fn plan(&self, model: &str, drift: Drift) -> FitPlan {
+    /// The fitting plan of `model` (`auto`, a name or a nested sum) by `method` (the plan's
+    /// [`fit`](super::InterpolationPlan::fit)) for kriging with `drift`.
+    pub fn plan(&self, model: &str, drift: Drift, method: Option<FitMethod>) -> FitPlan {
         FitPlan {
             model: model.to_string(),
-            method: self.fit,
+            method,
             auto: AutoSettings {
                 drift,
                 weighting: self.weights,
@@ -467,7 +465,10 @@ mod tests {
             (k.lags, k.max_dist, k.estimator, k.max_points)
         );
         assert!(s.direction.is_none() && k.direction.is_none());
-        let (a, d) = (l.plan("auto", Drift::Linear).auto, AutoSettings::default());
+        let (a, d) = (
+            l.plan("auto", Drift::Linear, None).auto,
+            AutoSettings::default(),
+        );
         assert_eq!(
             (a.drift, a.weighting, a.block, a.loo_points),
             (d.drift, d.weighting, d.block, d.loo_points)

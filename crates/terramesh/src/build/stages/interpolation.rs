@@ -172,8 +172,7 @@ pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
         } else {
             Drift::Constant
         };
-        let mut plan = ip.lag.plan(&ip.fit_model, drift);
-        plan.method = Some(ip.fit);
+        let mut plan = ip.lag.plan(&ip.fit_model, drift, ip.fit);
         plan.anisotropy = ip
             .anisotropy
             .eq_ignore_ascii_case("auto")
