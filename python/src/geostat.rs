@@ -270,7 +270,7 @@ fn plan(
     let mut p = InterpolationPlan::single(method);
     let given = method == InterpolationMethod::Universal || drift != p.drift;
     p.set_drift(given.then_some(drift)).map_err(to_py)?;
-    p.set_neighbors(neighbors);
+    p.set_neighbors(neighbors).map_err(to_py)?;
     p.mean = mean;
     Ok(p)
 }
@@ -349,7 +349,7 @@ fn idw<'py>(
     let (txs, tys) = targets(&xt, &yt, 1)?;
     let n = txs.len();
     let mut p = InterpolationPlan::single(InterpolationMethod::Idw);
-    p.set_neighbors(neighbors);
+    p.set_neighbors(neighbors).map_err(to_py)?;
     (p.radius, p.idw_power) = (radius, power);
     let (power, s) = p.idw().map_err(to_py)?;
     let mut est = results(n)?;

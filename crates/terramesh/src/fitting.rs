@@ -102,11 +102,16 @@ impl Default for AnisotropyPlan {
 /// # Ok::<(), terramesh::Error>(())
 /// ```
 pub fn parse_models(text: &str) -> Result<Vec<ModelKind>> {
+    parse_models_of(text, Setting::Model)
+}
+
+/// [`parse_models`] with its errors naming `setting` (a fit's model, a given model's name).
+pub(crate) fn parse_models_of(text: &str, setting: Setting) -> Result<Vec<ModelKind>> {
     let names: Vec<&str> = text.split('+').map(str::trim).collect();
     let nested = names.len() > 1;
     if names.len() > MAX_STRUCTURES {
         return Err(Error::setting(
-            Setting::Model,
+            setting,
             text,
             format!(
                 "{} structures: a nested model has at most {MAX_STRUCTURES} besides the nugget",
@@ -118,7 +123,7 @@ pub fn parse_models(text: &str) -> Result<Vec<ModelKind>> {
     for n in names {
         let Ok(kind) = n.parse::<ModelKind>() else {
             return Err(Error::setting(
-                Setting::Model,
+                setting,
                 text,
                 format!(
                     "'{n}' is not a model: expected auto, {}, or up to {MAX_STRUCTURES} of them joined by + (spherical+exponential)",
@@ -129,7 +134,7 @@ pub fn parse_models(text: &str) -> Result<Vec<ModelKind>> {
         if nested && matches!(kind, ModelKind::Nugget | ModelKind::Power) {
             {
                 return Err(Error::setting(
-                    Setting::Model,
+                    setting,
                     text,
                     format!(
                         "a {} structure cannot be nested (the nugget is always part of the model; nest spherical, exponential, gaussian, matern or linear)",

@@ -43,7 +43,7 @@ pub struct ModelArgs {
 }
 
 impl ModelArgs {
-    /// The library's settings of these flags.
+    /// The library's settings of these flags (`--anisotropy` is the plan's `anisotropy`).
     pub fn options(&self) -> ModelParts {
         ModelParts {
             model: self.model.clone(),
@@ -53,7 +53,6 @@ impl ModelArgs {
             shape: self.shape.clone(),
             anisotropy_angle: self.anisotropy_angle,
             anisotropy_ratio: self.anisotropy_ratio,
-            anisotropy: self.anisotropy.clone(),
         }
     }
 }

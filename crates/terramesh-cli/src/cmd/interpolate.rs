@@ -117,10 +117,11 @@ impl MethodArgs {
     pub fn plan(&self) -> Result<InterpolationPlan> {
         let mut p = InterpolationPlan::single(self.method);
         p.set_drift(self.drift).map_err(crate::flag_error)?;
-        p.set_neighbors(self.neighbors);
+        p.set_neighbors(self.neighbors).map_err(crate::flag_error)?;
         (p.mean, p.radius, p.idw_power) = (self.mean, self.radius, self.power);
         (p.parts, p.variogram) = (self.model.options(), self.variogram.clone());
         (p.lag, p.fit, p.duplicates) = (self.lag.options(), self.lag.fit, self.duplicates);
+        p.anisotropy = self.model.anisotropy.clone().unwrap_or(p.anisotropy);
         Ok(p)
     }
 }

@@ -190,6 +190,7 @@ pub fn flag_of(s: terramesh::Setting) -> String {
         S::GridPlane => "--grid-crs",
         S::Classes => "--class",
         S::Output => "-o",
+        S::ModelName | S::FitModel => "--model",
         other => return format!("--{other}"),
     }
     .to_string()

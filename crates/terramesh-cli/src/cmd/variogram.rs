@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use terramesh::interpolate::VariogramJob;
-use terramesh::plan::InterpolationPlan;
 use terramesh_geostat::{Drift, Duplicates};
 
 use super::geodata::LagArgs;
@@ -62,16 +61,14 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let mut plan = InterpolationPlan::single(terramesh_geostat::InterpolationMethod::Universal);
+    let mut job = VariogramJob::new(args.data);
+    let plan = &mut job.plan;
     (plan.fit_model, plan.lag, plan.fit) = (args.model, args.lag.options(), args.lag.fit);
-    plan.anisotropy = args.anisotropy.unwrap_or(plan.anisotropy);
+    plan.anisotropy = args
+        .anisotropy
+        .unwrap_or(std::mem::take(&mut plan.anisotropy));
     (plan.drift, plan.duplicates) = (args.drift, args.duplicates);
-    let job = VariogramJob {
-        data: args.data,
-        plan,
-        output: args.output,
-        plot: args.plot,
-    };
+    (job.output, job.plot) = (args.output, args.plot);
     let file = job.run().map_err(crate::flag_error)?;
     if job.output.is_some() {
         eprintln!("terramesh: variogram model: {}", file.model);

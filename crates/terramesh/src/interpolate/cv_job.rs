@@ -13,7 +13,7 @@
 //! assert!(job.table(&stats).starts_with("key,value\nn,5\nfolds,leave-one-out\nrmse,"));
 //!
 //! job.plan.cv_folds = 1.into();
-//! assert_eq!(job.run(&|_| {}).unwrap_err().render(&|s| format!("--{s}")), "--folds 1: must be at least 2");
+//! assert_eq!(job.run(&|_| {}).unwrap_err().render(&|s| format!("--{s}")), "--folds 1: one fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more folds");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -31,7 +31,7 @@ pub struct CvJob {
     /// The data file.
     pub data: PathBuf,
     /// The method, its settings, its external drift and the folds (`cv_folds`: k-fold with
-    /// at least 2, unset: leave-one-out): a single command's plan
+    /// at least 2, unset or 0: leave-one-out): a single command's plan
     /// ([`InterpolationPlan::single`]).
     pub plan: InterpolationPlan,
 }
@@ -46,8 +46,8 @@ impl CvJob {
     /// variogram, an external drift's coefficient) goes to `say`.
     pub fn run(&self, say: &dyn Fn(&str)) -> Result<CvStats> {
         let m = &self.plan;
-        let fd = read_data(&self.data, m.duplicates)?;
         let folds = m.folds()?;
+        let fd = read_data(&self.data, m.duplicates)?;
         let r = match m.external_drift(&self.data, &fd, say)? {
             Some(k) => cross_validate_external(
                 &fd.data,
@@ -71,6 +71,7 @@ impl CvJob {
             .plan
             .cv_folds
             .get()
+            .filter(|k| *k != 0)
             .map_or("leave-one-out".to_string(), |k| k.to_string());
         let mut t = format!("key,value\nn,{}\nfolds,{folds}\n", s.n);
         t += &format!(

@@ -104,6 +104,7 @@ impl InterpolateJob {
     /// when every target is done.
     pub fn run(&self, say: &dyn Fn(&str)) -> Result<()> {
         let m = &self.plan;
+        m.check()?;
         let fd = read_data(&self.data, m.duplicates)?;
         let want_var = m.primary() != InterpolationMethod::Idw && !self.no_variance;
         if self.variance_grid.is_some() {

@@ -1,10 +1,10 @@
 //! The single commands' interpolation (`terramesh interpolate`, `cv`, `simulate`) lowered from
 //! their [`InterpolationPlan`] to the kernels' types: a [`Predictor`], an [`Interpolator`] for
-//! cross-validation, or kriging with an external drift; the checks of what the plan's one
-//! method takes.
+//! cross-validation, or kriging with an external drift, each after the plan's one check
+//! ([`InterpolationPlan::check`]: what the plan's one method takes, and every range).
 //!
 //! A front end lowers its flags or keywords into the plan ([`InterpolationPlan::single`]) and
-//! renders the [`Error::Setting`]s these checks return in its words ([`Error::render`]).
+//! renders the [`Error::Setting`]s the check returns in its words ([`Error::render`]).
 //!
 //! ```
 //! use terramesh::plan::InterpolationPlan;
@@ -23,7 +23,7 @@
 //!
 //! // IDW takes a number of neighbours or a radius, not both.
 //! let mut m = InterpolationPlan::single(InterpolationMethod::Idw);
-//! m.set_neighbors(Some(4));
+//! m.set_neighbors(Some(4))?;
 //! m.radius = Some(20.0);
 //! let e = m.engine(&fd, false, &|_| {}).map(|_| ()).unwrap_err();
 //! assert_eq!(e.render(&|s| format!("--{s}")), "IDW takes --neighbors or --radius, not both");
@@ -66,18 +66,15 @@ fn in_file(name: &str, e: GeostatError) -> Error {
 }
 
 impl InterpolationPlan {
-    /// The kriging method; the mean only where it applies.
+    /// The kriging method (the mean of simple kriging given or the data's).
     pub fn method(&self, data: &Data) -> Result<Method> {
-        if self.mean.is_some() && self.primary() != InterpolationMethod::Simple {
-            return Err(own(Setting::Mean, "{mean} applies to {method} sk only"));
-        }
         self.primary()
             .method(self.drift, self.mean, data)
             .ok_or(Error::IdwNotKriging)
     }
 
-    /// The kriging method and neighbourhood of the plan's one method, checked: at least one
-    /// neighbour, no radius (IDW's), the mean only for simple kriging. What
+    /// The kriging method and neighbourhood of the plan's one method, checked
+    /// ([`InterpolationPlan::check`]: no radius, IDW's; the mean only for simple kriging). What
     /// [`InterpolationPlan::engine`] and [`InterpolationPlan::interpolator`] krige with, and
     /// Python's `krige` and `cross_validate` with the variogram their caller gives.
     ///
@@ -86,70 +83,33 @@ impl InterpolationPlan {
     /// use terramesh_geostat::{Data, Duplicates, InterpolationMethod, Method, Neighbourhood};
     /// let data = Data::new(vec![[0.0, 0.0], [1.0, 0.0]], vec![1.0, 3.0], Duplicates::Reject)?;
     /// let mut p = InterpolationPlan::single(InterpolationMethod::Simple);
-    /// p.set_neighbors(Some(8));
+    /// p.set_neighbors(Some(8))?;
     /// assert_eq!(p.kriging(&data)?, (Method::Simple { mean: 2.0 }, Neighbourhood::Nearest(8)));
-    /// p.set_neighbors(Some(0));
+    /// p.radius = Some(5.0);
     /// let e = p.kriging(&data).unwrap_err();
-    /// assert_eq!(e.render(&|s| s.to_string()), "neighbors 0: must be at least 1");
+    /// assert_eq!(e.render(&|s| s.to_string()), "radius applies to method idw; kriging takes neighbors");
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn kriging(&self, data: &Data) -> Result<(Method, Neighbourhood)> {
-        self.check_neighbors()?;
-        self.check_no_radius("kriging")?;
+        self.check()?;
         Ok((self.method(data)?, self.neighbourhood()))
     }
 
-    /// The moving neighbourhood of kriging (or all data).
+    /// The moving neighbourhood of kriging (unset or 0: all data).
     pub fn neighbourhood(&self) -> Neighbourhood {
-        self.neighbors
-            .get()
-            .map_or(Neighbourhood::All, Neighbourhood::Nearest)
-    }
-
-    /// A moving neighbourhood of at least one datum.
-    fn check_neighbors(&self) -> Result<()> {
-        if let Some(0) = self.neighbors.get() {
-            return Err(own(Setting::Neighbors, "{neighbors} 0: must be at least 1"));
+        match self.neighbors.get() {
+            None | Some(0) => Neighbourhood::All,
+            Some(k) => Neighbourhood::Nearest(k),
         }
-        Ok(())
     }
 
-    /// Kriging takes no radius.
-    fn check_no_radius(&self, who: &str) -> Result<()> {
-        if self.radius.is_some() {
-            return Err(own(
-                Setting::Radius,
-                format!("{{radius}} applies to {{method}} idw; {who} takes {{neighbors}}"),
-            ));
-        }
-        Ok(())
-    }
-
-    /// IDW's power and search.
+    /// IDW's power and search, checked ([`InterpolationPlan::check`]).
     pub fn idw(&self) -> Result<(f64, IdwSearch)> {
-        self.check_neighbors()?;
-        if !(self.idw_power.is_finite() && self.idw_power > 0.0) {
-            return Err(own(
-                Setting::Power,
-                format!("{{power}} {}: must be a finite number > 0", self.idw_power),
-            ));
-        }
+        self.check()?;
         let search = match (self.idw_neighbors, self.radius) {
-            (k, Some(_)) if k > 0 => {
-                return Err(own(
-                    Setting::Radius,
-                    "IDW takes {neighbors} or {radius}, not both",
-                ))
-            }
+            (_, Some(r)) => IdwSearch::Radius(r),
             (0, None) => IdwSearch::All,
             (k, None) => IdwSearch::Nearest(k),
-            (_, Some(r)) if !(r.is_finite() && r > 0.0) => {
-                return Err(own(
-                    Setting::Radius,
-                    format!("{{radius}} {r}: must be a finite number > 0"),
-                ))
-            }
-            (_, Some(r)) => IdwSearch::Radius(r),
         };
         Ok((self.idw_power, search))
     }
@@ -161,7 +121,7 @@ impl InterpolationPlan {
             .as_deref()
             .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
         let auto_model = self.parts.is_auto();
-        if self.parts.anisotropy_auto()? && !fitting && !auto_model {
+        if self.anisotropy_auto() && !fitting && !auto_model {
             return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the anisotropy with the variogram: give {variogram} auto (the model's angle and ratio are otherwise {anisotropy-angle} and {anisotropy-ratio})"));
         }
         if let Some(v) = self.parts.explicit_or_fit(fitting)? {
@@ -190,7 +150,7 @@ impl InterpolationPlan {
         };
         let model = self.parts.model.as_deref().unwrap_or("auto");
         let mut plan = self.lag.plan(model, drift, self.fit);
-        if self.parts.anisotropy_auto()? {
+        if self.anisotropy_auto() {
             plan.anisotropy = Some(self.lag.anisotropy_plan()?);
         }
         Ok(VariogramSource::Fit {
@@ -217,7 +177,6 @@ impl InterpolationPlan {
         variance: bool,
         say: &dyn Fn(&str),
     ) -> Result<Box<dyn Predictor>> {
-        self.check_neighbors()?;
         if self.primary() == InterpolationMethod::Idw {
             let (power, search) = self.idw()?;
             return Idw::new(&fd.data, power, search)
@@ -243,7 +202,9 @@ impl InterpolationPlan {
         })
     }
 
-    /// The checks of a conditional simulation's method and counts, before any file is read.
+    /// The checks of a conditional simulation, before any file is read: the plan's
+    /// ([`InterpolationPlan::check`]) and what `terramesh simulate` needs besides: a kriging
+    /// method and at least one realisation.
     pub fn check_simulation(&self) -> Result<()> {
         if self.primary() == InterpolationMethod::Idw {
             return Err(own(
@@ -251,16 +212,12 @@ impl InterpolationPlan {
                 "{method} idw: simulation conditions by kriging; give sk, ok or uk",
             ));
         }
-        self.check_no_radius("simulation")?;
-        self.check_neighbors()?;
-        for (setting, n) in [
-            (Setting::Realisations, self.realisations),
-            (Setting::Modes, self.modes),
-        ] {
-            if n == 0 {
-                let name = terramesh_core::vocab::Named::name(setting);
-                return Err(own(setting, format!("{{{name}}} 0: give at least 1")));
-            }
+        self.check()?;
+        if self.realisations == 0 {
+            return Err(own(
+                Setting::Realisations,
+                "{realisations} 0: give at least 1",
+            ));
         }
         Ok(())
     }
@@ -281,17 +238,9 @@ impl InterpolationPlan {
         else {
             return Ok(None);
         };
-        let method = match self.primary() {
-            InterpolationMethod::Ordinary | InterpolationMethod::Universal => {
-                self.method(&fd.data)?
-            }
-            other => {
-                let s = self.external_drift_setting();
-                return Err(own(s, format!("{{{s}}}: kriging with an external drift is {{method}} ok (the constant and the drift) or uk (the polynomial and the drift), not {other}")));
-            }
-        };
-        self.check_no_radius("kriging")?;
-        self.check_neighbors()?;
+        // The method is ok or uk ([`InterpolationPlan::check`]).
+        self.check()?;
+        let method = self.method(&fd.data)?;
         let at_data = source.at_data(data, fd, self.duplicates)?;
         let vs = self.variogram_source()?;
         let variogram = drift_variogram(&vs, fd, &at_data, method, source.setting())?;
@@ -398,7 +347,7 @@ mod tests {
         let mut m = spherical(InterpolationMethod::Universal);
         m.mean = Some(3.0);
         assert_eq!(
-            flags(m.method(&fd.data).unwrap_err()),
+            flags(m.kriging(&fd.data).unwrap_err()),
             "--mean applies to --method sk only"
         );
         // A radius is IDW's: kriging and cross-validation of kriging refuse it.
@@ -410,10 +359,7 @@ mod tests {
             flags(m.engine(&fd, true, &|_| {}).map(|_| ()).unwrap_err()),
             want
         );
-        assert_eq!(
-            flags(m.check_simulation().unwrap_err()),
-            "--radius applies to --method idw; simulation takes --neighbors"
-        );
+        assert_eq!(flags(m.check_simulation().unwrap_err()), want);
         let m = InterpolationPlan::single(InterpolationMethod::Idw);
         assert!(flags(m.check_simulation().unwrap_err()).starts_with("--method idw: "));
     }
@@ -456,7 +402,7 @@ mod tests {
     fn idw_search_settings_are_checked() {
         let mut m = InterpolationPlan::single(InterpolationMethod::Idw);
         assert!(matches!(m.idw().unwrap(), (_, IdwSearch::All)));
-        m.set_neighbors(Some(5));
+        m.set_neighbors(Some(5)).unwrap();
         assert!(matches!(m.idw().unwrap(), (_, IdwSearch::Nearest(5))));
         m.idw_power = -1.0;
         assert_eq!(
@@ -464,12 +410,13 @@ mod tests {
             "--power -1: must be a finite number > 0"
         );
         m.idw_power = 2.0;
-        m.set_neighbors(Some(0));
+        // A single command's words have no 0 (unset is all data).
         assert_eq!(
-            flags(m.idw().unwrap_err()),
+            flags(m.set_neighbors(Some(0)).unwrap_err()),
             "--neighbors 0: must be at least 1"
         );
-        m.set_neighbors(None);
+        assert_eq!(m.idw_neighbors, 5);
+        m.set_neighbors(None).unwrap();
         m.radius = Some(f64::NAN);
         assert_eq!(
             flags(m.idw().unwrap_err()),
@@ -480,5 +427,61 @@ mod tests {
             m.idw().unwrap_err().to_string(),
             "radius NaN: must be a finite number > 0"
         );
+    }
+
+    /// Every driver checks a range with the one [`InterpolationPlan::check`]: a project and a
+    /// single command refuse the same value with the same error, each front end wording it.
+    #[test]
+    fn one_check_for_the_project_and_the_single_commands() {
+        use crate::project::{key_of, Project, TEMPLATE};
+        let project = |set: &str| {
+            Project::parse("t.toml", TEMPLATE, &[set.to_string()])
+                .unwrap_err()
+                .to_string()
+        };
+        let mut idw = InterpolationPlan::single(InterpolationMethod::Idw);
+        idw.idw_power = -1.0;
+        assert_eq!(
+            flags(idw.idw().unwrap_err()),
+            "--power -1: must be a finite number > 0"
+        );
+        let e = project("interpolation.idw_power=-1.0");
+        assert!(
+            e.contains("interpolation.idw_power -1: must be a finite number > 0"),
+            "{e}"
+        );
+        // `terramesh variogram --anisotropy` and `interpolation.anisotropy`: one check.
+        let mut v = InterpolationPlan::single(InterpolationMethod::Universal);
+        v.anisotropy = "yes".into();
+        let e = v.check().unwrap_err();
+        assert_eq!(flags(e), "--anisotropy 'yes': expected auto or none");
+        let e = project("interpolation.anisotropy=\"yes\"");
+        assert!(
+            e.contains("interpolation.anisotropy 'yes': expected auto or none"),
+            "{e}"
+        );
+        // An external drift that the one method would ignore, from either source.
+        let mut m = InterpolationPlan::single(InterpolationMethod::Idw);
+        m.external_drift = Some("g".into());
+        assert!(flags(m.check().unwrap_err()).ends_with(", not idw"));
+        let mut m = spherical(InterpolationMethod::Simple);
+        m.external_drift_grid = Some("g.tif".into());
+        let e = m.check().unwrap_err();
+        assert!(flags(e).starts_with("--external-drift-grid: kriging with an external drift"));
+        assert!(m.check().unwrap_err().render(&key_of).ends_with(", not sk"));
+        // Folds: 0 is leave-one-out for every driver, 1 is refused.
+        let mut m = spherical(InterpolationMethod::Ordinary);
+        m.cv_folds = 0.into();
+        assert!(matches!(
+            m.folds().unwrap(),
+            terramesh_geostat::Folds::LeaveOneOut
+        ));
+        m.cv_folds = 1.into();
+        assert!(flags(m.folds().unwrap_err()).starts_with("--folds 1: one fold leaves nothing"));
+        // Too few neighbours for universal kriging's drift: a single command's too.
+        let mut m = spherical(InterpolationMethod::Universal);
+        m.set_neighbors(Some(2)).unwrap();
+        assert!(flags(m.kriging(&data().data).unwrap_err())
+            .starts_with("--neighbors 2 is too few: universal kriging with a linear drift"));
     }
 }

@@ -81,24 +81,15 @@ impl VariogramJob {
             }
         }
         let ip = &self.plan;
+        ip.check()?;
         let fd = read_data(&self.data, ip.duplicates)?;
         let s = ip.lag.settings();
         let lags = experimental(&fd.data, &s)
             .map_err(Error::from)
             .context(&fd.name)?;
         let mut plan = ip.lag.plan(&ip.fit_model, ip.drift, ip.fit);
-        match ip.anisotropy.as_str() {
-            a if a.eq_ignore_ascii_case("none") => {}
-            a if a.eq_ignore_ascii_case("auto") => {
-                plan.anisotropy = Some(ip.lag.anisotropy_plan()?)
-            }
-            a => {
-                return Err(Error::setting(
-                    Setting::Anisotropy,
-                    "",
-                    format!("{{anisotropy}} '{a}': expected auto"),
-                ))
-            }
+        if ip.anisotropy_auto() {
+            plan.anisotropy = Some(ip.lag.anisotropy_plan()?);
         }
         let fitted = crate::fitting::fit(&fd.data, &lags, &plan).context(&fd.name)?;
         let (fit, cands, directions) = (fitted.fit, fitted.candidates, fitted.directions);

@@ -7,9 +7,10 @@
 //! `methods`, `--neighbors` is `neighbors` for kriging and `idw_neighbors` for IDW, and the
 //! settings no project key reaches (yet) are fields that a project cannot set (`mean`,
 //! `radius`, `duplicates`, `external_drift`, `parts`, `lag`, `modes`), each with its default
-//! here; a single command checks them where it lowers the plan to the kernels
-//! ([`InterpolationPlan::engine`], [`InterpolationPlan::interpolator`],
-//! [`InterpolationPlan::check_simulation`], [`InterpolationPlan::folds`]).
+//! here. Every driver checks the plan with the one [`InterpolationPlan::check`]: a build when
+//! it parses the project, a single command's job before it reads a file, and the lowering to
+//! the kernels ([`InterpolationPlan::kriging`], [`InterpolationPlan::idw`],
+//! [`InterpolationPlan::folds`]).
 
 use std::path::PathBuf;
 
@@ -75,7 +76,9 @@ impl Numbers {
 }
 
 impl VariogramSpec {
-    /// The variogram, or an error naming the key (`interpolation.model.psill`, ...).
+    /// The variogram, checked by the one check of a given variogram
+    /// ([`ModelParts::variogram`]); an error names the setting, worded by a project as its key
+    /// (`interpolation.model.psill`, ...).
     ///
     /// ```
     /// use terramesh::project::{Project, TEMPLATE};
@@ -84,75 +87,24 @@ impl VariogramSpec {
     /// let v = p.interpolation.model.unwrap().variogram()?;
     /// assert_eq!((v.structures.len(), v.structures[1].range), (2, 900.0));
     /// let e = Project::parse("t.toml", TEMPLATE, &set("{ model = \"spherical+exponential\", psill = 8.0, range = [300.0, 900.0] }")).unwrap_err();
-    /// assert!(e.to_string().contains("interpolation.model.psill"), "{e}");
+    /// assert!(e.to_string().contains("interpolation.model.psill 8: interpolation.model.model spherical+exponential has 2 structures"), "{e}");
     /// # Ok::<(), terramesh::Error>(())
     /// ```
     pub fn variogram(&self) -> Result<terramesh_geostat::Variogram> {
-        use terramesh_geostat::{Anisotropy, Structure, Variogram};
-        let kinds = crate::fitting::parse_models(&self.model).map_err(|e| {
-            Error::setting(
-                Setting::ModelName,
-                "",
-                e.render(&|_| String::new()).trim_start(),
-            )
-        })?;
-        let n = kinds.len();
-        let list = |setting: Setting, v: &Numbers, one_for_all: bool| -> Result<Vec<f64>> {
-            let v = v.values();
-            match v.len() {
-                k if k == n => Ok(v),
-                1 if one_for_all => Ok(vec![v[0]; n]),
-                k => Err(Error::setting(
-                    setting,
-                    "",
-                    format!(
-                        "{k} values for the {n} structures of \"{}\": give a list of {n}",
-                        self.model
-                    ),
-                )),
-            }
-        };
-        let psill = list(Setting::Psill, &self.psill, false)?;
-        let range = list(Setting::Range, &self.range, false)?;
-        let shape = match &self.shape {
-            Some(s) => Some(list(Setting::Shape, s, true)?),
-            None => None,
-        };
-        for (setting, vals) in [(Setting::Psill, &psill), (Setting::Range, &range)] {
-            if let Some(v) = vals.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-                return Err(Error::setting(setting, "", format!("{v} must be positive")));
-            }
+        self.parts().variogram()
+    }
+
+    /// The table as the parts every front end gives a model in.
+    pub fn parts(&self) -> ModelParts {
+        ModelParts {
+            model: Some(self.model.clone()),
+            psill: self.psill.values(),
+            range: self.range.values(),
+            nugget: Some(self.nugget),
+            shape: self.shape.as_ref().map(Numbers::values).unwrap_or_default(),
+            anisotropy_angle: self.anisotropy_angle,
+            anisotropy_ratio: self.anisotropy_ratio,
         }
-        if !(self.nugget.is_finite() && self.nugget >= 0.0) {
-            return Err(Error::setting(
-                Setting::Nugget,
-                "",
-                format!("{} must be 0 or positive", self.nugget),
-            ));
-        }
-        let anisotropy = match (self.anisotropy_angle, self.anisotropy_ratio) {
-            (None, None) => None,
-            (a, r) => Some(Anisotropy {
-                angle: a.unwrap_or(0.0),
-                ratio: r.unwrap_or(1.0),
-            }),
-        };
-        let v = Variogram {
-            nugget: self.nugget,
-            structures: (0..n)
-                .map(|i| {
-                    let mut s = Structure::new(kinds[i], psill[i], range[i]);
-                    if let Some(sh) = &shape {
-                        s.shape = sh[i];
-                    }
-                    s
-                })
-                .collect(),
-            anisotropy,
-        };
-        v.validate()
-            .map_err(|e| Error::setting(Setting::Model, "", e))?;
-        Ok(v)
     }
 }
 
@@ -221,7 +173,8 @@ pub struct InterpolationPlan {
     /// nested sum of up to three joined by `+` (`spherical+exponential`, fitted jointly).
     pub fit_model: String,
     /// `none`, or `auto`: `variogram = "auto"` fits geometric anisotropy too, from directional
-    /// variograms along 8 azimuths.
+    /// variograms along 8 azimuths (`interpolation.anisotropy`; the `--anisotropy` of
+    /// `terramesh variogram`, `interpolate`, `cv` and `simulate`).
     pub anisotropy: String,
     /// Kriging with an external drift: a raster (GeoTIFF or ESRI ASCII grid, in the project's
     /// projected coordinates) sampled bilinearly at the samples and the mesh vertices, as a
@@ -316,9 +269,24 @@ impl std::fmt::Debug for Auto {
 }
 
 impl InterpolationPlan {
-    /// Checks every value: the one range check of `[interpolation]` (a given variogram
-    /// included, [`VariogramSpec::variogram`]).
+    /// Checks every value: the one range check of the plan, for every driver (a build's
+    /// `Project::parse`, the single commands' jobs, Python's `krige`, `idw` and
+    /// `cross_validate` through [`InterpolationPlan::kriging`] and [`InterpolationPlan::idw`]).
+    /// A given variogram is checked by [`ModelParts::variogram`] (a project's table through
+    /// [`VariogramSpec::variogram`]). Each error names its [`Setting`], for the front end to
+    /// word.
+    ///
+    /// ```
+    /// use terramesh::plan::InterpolationPlan;
+    /// use terramesh_geostat::InterpolationMethod;
+    /// let mut p = InterpolationPlan::single(InterpolationMethod::Idw);
+    /// p.idw_power = -1.0;
+    /// let e = p.check().unwrap_err();
+    /// assert_eq!(e.render(&|s| format!("--{s}")), "--power -1: must be a finite number > 0");
+    /// assert_eq!(e.render(&terramesh::project::key_of), "interpolation.idw_power -1: must be a finite number > 0");
+    /// ```
     pub fn check(&self) -> Result<()> {
+        use InterpolationMethod as M;
         if self.methods.is_empty() {
             return Err(Error::setting(
                 Setting::Methods,
@@ -326,67 +294,105 @@ impl InterpolationPlan {
                 "name at least one of \"uk\", \"ok\", \"sk\", \"idw\" (the first gives the DSM)",
             ));
         }
+        if self.mean.is_some() && self.primary() != M::Simple {
+            return Err(own(Setting::Mean, "{mean} applies to {method} sk only"));
+        }
         let neighbors = self.neighbors.or(0);
-        if neighbors != 0 && neighbors < self.drift.terms() {
-            return Err(Error::setting(
+        if self.methods.contains(&M::Universal) && neighbors != 0 && neighbors < self.drift.terms()
+        {
+            return Err(own(
                 Setting::Neighbors,
-                "",
                 format!(
-                    "{} is too few: universal kriging with a {} drift needs at least {} \
-                     neighbours (or 0 for all samples)",
-                    neighbors,
+                    "{{neighbors}} {neighbors} is too few: universal kriging with a {} drift \
+                     needs at least {} neighbours (or all the data)",
                     self.drift,
                     self.drift.terms()
                 ),
             ));
         }
-        if self.cv_folds.get() == Some(1) {
-            return Err(Error::setting(
-                Setting::Folds,
-                "",
-                "1 fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more folds",
-            ));
+        if let Some(r) = self.radius {
+            if self.primary() != M::Idw {
+                return Err(own(
+                    Setting::Radius,
+                    "{radius} applies to {method} idw; kriging takes {neighbors}",
+                ));
+            }
+            if self.idw_neighbors > 0 {
+                return Err(own(
+                    Setting::Radius,
+                    "IDW takes {neighbors} or {radius}, not both",
+                ));
+            }
+            if !(r.is_finite() && r > 0.0) {
+                return Err(own(
+                    Setting::Radius,
+                    format!("{{radius}} {r}: must be a finite number > 0"),
+                ));
+            }
         }
         if !(self.idw_power.is_finite() && self.idw_power > 0.0) {
-            return Err(Error::setting(Setting::Power, "", "must be positive"));
+            return Err(own(
+                Setting::Power,
+                format!("{{power}} {}: must be a finite number > 0", self.idw_power),
+            ));
+        }
+        if self.cv_folds.get() == Some(1) {
+            return Err(own(
+                Setting::Folds,
+                "{folds} 1: one fold leaves nothing to fit: give 0 (leave-one-out) or 2 or more \
+                 folds",
+            ));
+        }
+        if self.modes == 0 {
+            return Err(own(Setting::Modes, "{modes} 0: give at least 1"));
         }
         if let Some(v) = &self.model {
             v.variogram()?;
         }
         if !self.fit_model.eq_ignore_ascii_case("auto") {
-            if let Err(e) = crate::fitting::parse_models(&self.fit_model) {
-                return Err(Error::setting(
-                    Setting::FitModel,
-                    "",
-                    e.render(&|_| String::new()).trim_start(),
-                ));
-            }
+            crate::fitting::parse_models_of(&self.fit_model, Setting::FitModel)?;
         }
         match self.anisotropy.to_ascii_lowercase().as_str() {
-            "none" | "auto" => {}
+            "none" => {}
+            "auto" => {
+                if self.parts.anisotropy_angle.is_some() || self.parts.anisotropy_ratio.is_some() {
+                    return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the angle and ratio: give it or {anisotropy-angle}/{anisotropy-ratio}, not both"));
+                }
+            }
             _ => {
-                return Err(Error::setting(
+                return Err(own(
                     Setting::Anisotropy,
-                    "",
                     format!(
-                        "\"{}\": expected \"none\" or \"auto\" (a given model's anisotropy is \
-                         model.anisotropy_angle and model.anisotropy_ratio)",
+                        "{{anisotropy}} '{}': expected auto or none",
                         self.anisotropy
                     ),
                 ))
             }
         }
-        if self.external_drift_grid.is_some() && self.methods.contains(&InterpolationMethod::Simple)
-        {
-            return Err(Error::setting(
-                Setting::ExternalDriftGrid,
-                "",
-                "simple kriging (\"sk\" in interpolation.methods) has a known mean and no \
-                 drift: krige with \"uk\" or \"ok\"",
-            ));
+        if self.external_drift.is_some() || self.external_drift_grid.is_some() {
+            let kriged = self
+                .methods
+                .iter()
+                .any(|m| matches!(m, M::Ordinary | M::Universal));
+            let simple = self.methods.iter().find(|m| **m == M::Simple);
+            if let Some(other) = simple.or(self.methods.first().filter(|_| !kriged)) {
+                let s = self.external_drift_setting();
+                return Err(own(s, format!("{{{s}}}: kriging with an external drift is ok (the constant and the drift) or uk (the polynomial and the drift) in {{method}}, not {other}")));
+            }
         }
         Ok(())
     }
+
+    /// Whether `anisotropy` asks for the anisotropy fit (`auto`; [`InterpolationPlan::check`]
+    /// refuses any other word but `none`).
+    pub fn anisotropy_auto(&self) -> bool {
+        self.anisotropy.eq_ignore_ascii_case("auto")
+    }
+}
+
+/// The error of a setting whose message names its own setting (and maybe others) as `{name}`.
+fn own(setting: Setting, message: impl Into<String>) -> Error {
+    Error::setting(setting, "", message.into())
 }
 
 impl InterpolationPlan {
@@ -399,11 +405,12 @@ impl InterpolationPlan {
     /// use terramesh::plan::InterpolationPlan;
     /// use terramesh_geostat::{Drift, InterpolationMethod};
     /// let mut p = InterpolationPlan::single(InterpolationMethod::Idw);
-    /// p.set_neighbors(Some(8));
+    /// p.set_neighbors(Some(8))?;
     /// assert_eq!((p.primary(), p.idw_neighbors, p.variogram.is_none()), (InterpolationMethod::Idw, 8, true));
     /// let mut ok = InterpolationPlan::single(InterpolationMethod::Ordinary);
     /// let e = ok.set_drift(Some(Drift::Quadratic)).unwrap_err();
     /// assert_eq!(e.render(&|s| format!("--{s}")), "--drift applies to --method uk only");
+    /// # Ok::<(), terramesh::Error>(())
     /// ```
     pub fn single(method: InterpolationMethod) -> InterpolationPlan {
         InterpolationPlan {
@@ -439,13 +446,19 @@ impl InterpolationPlan {
     }
 
     /// A single command's neighbourhood (`--neighbors K`; unset: all data): `neighbors` of
-    /// kriging, and `idw_neighbors` of IDW (0 there meaning all data). `Some(0)` is kept in
-    /// `neighbors`, where the single commands refuse it (at least 1).
-    pub fn set_neighbors(&mut self, k: Option<usize>) {
+    /// kriging, and `idw_neighbors` of IDW (0 there meaning all data). A single command's
+    /// words have no 0 (a project's `neighbors = 0`, all data, is a single command's unset):
+    /// it is refused here, where they are lowered, as `--drift` is by
+    /// [`InterpolationPlan::set_drift`].
+    pub fn set_neighbors(&mut self, k: Option<usize>) -> Result<()> {
+        if k == Some(0) {
+            return Err(own(Setting::Neighbors, "{neighbors} 0: must be at least 1"));
+        }
         self.neighbors = k.into();
         if self.primary() == InterpolationMethod::Idw {
             self.idw_neighbors = k.unwrap_or(0);
         }
+        Ok(())
     }
 
     /// `variogram`, or `auto` (a project's default: fit from the samples) when unset.
@@ -463,18 +476,14 @@ impl InterpolationPlan {
         }
     }
 
-    /// The folds of a single command's cross-validation (`terramesh cv --folds K`): unset,
-    /// leave-one-out; else at least 2.
+    /// The folds of a single command's cross-validation (`terramesh cv --folds K`), checked
+    /// ([`InterpolationPlan::check`]): unset or 0, leave-one-out; else at least 2.
     pub fn folds(&self) -> Result<terramesh_geostat::Folds> {
         use terramesh_geostat::Folds;
-        match self.cv_folds.get() {
-            None => Ok(Folds::LeaveOneOut),
-            Some(k) if k < 2 => Err(Error::setting(
-                Setting::Folds,
-                "",
-                format!("{{folds}} {k}: must be at least 2"),
-            )),
-            Some(k) => Ok(Folds::KFold(k)),
-        }
+        self.check()?;
+        Ok(match self.cv_folds.get() {
+            None | Some(0) => Folds::LeaveOneOut,
+            Some(k) => Folds::KFold(k),
+        })
     }
 }

@@ -1,13 +1,14 @@
 //! The variogram sub-plan: the lag classes of an experimental variogram and the settings of its
-//! fit ([`LagPlan`]), and a variogram model as the command line (`--model`, `--psill`,
-//! `--range`, ...) gives it in parts ([`ModelParts`]), checked and lowered to the kernel's
-//! [`Variogram`] or to a fit's [`FitPlan`]. Both are fields of the
+//! fit ([`LagPlan`]), and a variogram model given in parts ([`ModelParts`]), checked and
+//! lowered to the kernel's [`Variogram`] or to a fit's [`FitPlan`]. Both are fields of the
 //! [`InterpolationPlan`](super::InterpolationPlan) that `terramesh variogram`, `interpolate`,
-//! `cv` and `simulate` lower into; a project file gives its model as a table instead
-//! ([`VariogramSpec`](super::VariogramSpec)), worded as keys.
+//! `cv` and `simulate` lower into (`--model`, `--psill`, `--range`, ...); a project file gives
+//! its model as a table ([`VariogramSpec`](super::VariogramSpec)), which lowers into the same
+//! parts: [`ModelParts::variogram`] is the one check of a given variogram for every front end.
 //!
 //! Every error is an [`Error::Setting`] that names the settings involved, so that each front
-//! end words them its own way ([`Error::render`]).
+//! end words them its own way ([`Error::render`]): `--psill` on the command line,
+//! `interpolation.model.psill` in a project.
 //!
 //! ```
 //! use terramesh::plan::ModelParts;
@@ -25,9 +26,17 @@
 //! // One partial sill for two structures is refused, naming both settings.
 //! let bad = ModelParts { psill: vec![8000.0], ..m };
 //! let e = bad.explicit_or_fit(false).unwrap_err();
+//! let flag = |s: terramesh::Setting| match s {
+//!     terramesh::Setting::ModelName => "--model".to_string(),
+//!     s => format!("--{s}"),
+//! };
 //! assert_eq!(
-//!     e.render(&|s| format!("--{s}")),
-//!     "--psill 8000: --model spherical+exponential has 2 structures: give 2 values separated by commas (got 1)"
+//!     e.render(&flag),
+//!     "--psill 8000: --model spherical+exponential has 2 structures: give a list of 2 values, one per structure (got 1)"
+//! );
+//! assert_eq!(
+//!     e.render(&terramesh::project::key_of),
+//!     "interpolation.model.psill 8000: interpolation.model.model spherical+exponential has 2 structures: give a list of 2 values, one per structure (got 1)"
 //! );
 //! # Ok::<(), terramesh::Error>(())
 //! ```
@@ -37,7 +46,7 @@ use terramesh_geostat::{
     Structure, Variogram, Weighting,
 };
 
-use crate::error::{Context, Error, Result};
+use crate::error::{Error, Result};
 use crate::fitting::{AnisotropyPlan, FitPlan};
 use crate::setting::Setting;
 
@@ -59,8 +68,6 @@ pub struct ModelParts {
     pub anisotropy_angle: Option<f64>,
     /// A given anisotropy's minor/major range ratio in (0, 1].
     pub anisotropy_ratio: Option<f64>,
-    /// `auto`: fit the anisotropy with the variogram.
-    pub anisotropy: Option<String>,
 }
 
 /// The error of a setting whose message names its own setting (and maybe others) as `{name}`.
@@ -88,7 +95,7 @@ fn per_structure(
         k => Err(own(
             setting,
             format!(
-                "{{{setting}}} {}: {{model}} {name} has {n} structures: give {n} values separated by commas (got {k})",
+                "{{{setting}}} {}: {{model-name}} {name} has {n} structures: give a list of {n} values, one per structure (got {k})",
                 list(values)
             ),
         )),
@@ -96,24 +103,6 @@ fn per_structure(
 }
 
 impl ModelParts {
-    /// Whether `anisotropy` is `auto` (any other value is an error, and so is a given angle
-    /// or ratio beside it).
-    pub fn anisotropy_auto(&self) -> Result<bool> {
-        match self.anisotropy.as_deref() {
-            None => Ok(false),
-            Some(a) if a.eq_ignore_ascii_case("auto") => {
-                if self.anisotropy_angle.is_some() || self.anisotropy_ratio.is_some() {
-                    return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the angle and ratio: give it or {anisotropy-angle}/{anisotropy-ratio}, not both".into()));
-                }
-                Ok(true)
-            }
-            Some(a) => Err(own(
-                Setting::Anisotropy,
-                format!("{{anisotropy}} '{a}': expected auto (give a known anisotropy by {{anisotropy-angle}} DEG {{anisotropy-ratio}} R)"),
-            )),
-        }
-    }
-
     /// Whether `model` is `auto`.
     pub fn is_auto(&self) -> bool {
         self.model
@@ -123,13 +112,13 @@ impl ModelParts {
 
     /// The variogram given in full; `None` when `model` is absent or `auto`, or (with `fit`:
     /// the variogram is fitted) names models without partial sills and ranges, which are
-    /// then fitted.
+    /// then fitted. A model given is checked by [`ModelParts::variogram`].
     pub fn explicit_or_fit(&self, fit: bool) -> Result<Option<Variogram>> {
         let Some(name) = self.model.as_deref() else {
             if !self.psill.is_empty() || !self.range.is_empty() {
                 return Err(own(
                     Setting::Psill,
-                    "{psill}/{range} need {model} (e.g. {model} spherical)".into(),
+                    "{psill}/{range} need {model-name} (e.g. {model-name} spherical)".into(),
                 ));
             }
             return Ok(None);
@@ -139,7 +128,20 @@ impl ModelParts {
         {
             return Ok(None);
         }
-        let kinds = crate::fitting::parse_models(name)?;
+        self.variogram().map(Some)
+    }
+
+    /// The one check of a variogram given in full, for every front end (the command line's
+    /// flags, a project's `interpolation.model` table, [`VariogramSpec::variogram`]): the
+    /// model names ([`Setting::ModelName`]), one partial sill, range and shape per structure
+    /// (a shape may be one for all), each partial sill and the nugget finite and at least 0,
+    /// each range finite and above 0, a sill above 0, a given anisotropy's ratio in (0, 1]
+    /// and angle finite. Each error names its setting ([`Setting::Psill`], ...).
+    ///
+    /// [`VariogramSpec::variogram`]: super::VariogramSpec::variogram
+    pub fn variogram(&self) -> Result<Variogram> {
+        let name = self.model.as_deref().unwrap_or_default();
+        let kinds = crate::fitting::parse_models_of(name, Setting::ModelName)?;
         let n = kinds.len();
         let nugget = self.nugget.unwrap_or(0.0);
         finite_at_least(Setting::Nugget, "{nugget}", &[nugget], false)?;
@@ -203,8 +205,10 @@ impl ModelParts {
             structures,
             anisotropy,
         };
-        v.validate().context("the variogram")?;
-        Ok(Some(v))
+        // What the checks above leave to the kernel: a shape out of its model's range.
+        v.validate()
+            .map_err(|e| Error::setting(Setting::Shape, "", e))?;
+        Ok(v)
     }
 
     /// The values of the list setting `setting` (psill or range) for `n` structures; a lone
@@ -227,7 +231,7 @@ impl ModelParts {
                 };
                 Err(own(
                     setting,
-                    format!("{{model}} {name} needs {{{setting}}} ({what}{many})"),
+                    format!("{{model-name}} {name} needs {{{setting}}} ({what}{many})"),
                 ))
             }
             _ => per_structure(setting, values, n, name, false),
@@ -346,7 +350,10 @@ mod tests {
     use super::*;
 
     fn flags(e: Error) -> String {
-        e.render(&|s| format!("--{s}"))
+        e.render(&|s| match s {
+            Setting::ModelName => "--model".into(),
+            s => format!("--{s}"),
+        })
     }
 
     fn nested() -> ModelParts {
@@ -454,6 +461,75 @@ mod tests {
         );
     }
 
+    /// A project's `interpolation.model` table and the command line's flags go through the
+    /// one check ([`ModelParts::variogram`]): the same error, each front end wording it.
+    #[test]
+    fn a_project_table_and_the_flags_share_one_check() {
+        use crate::plan::{Numbers, VariogramSpec};
+        use crate::project::key_of;
+        let spec = VariogramSpec {
+            model: "matern+spherical".into(),
+            psill: Numbers::Many(vec![1.0, 2.0]),
+            range: Numbers::Many(vec![10.0, -30.0]),
+            nugget: 0.0,
+            shape: None,
+            anisotropy_angle: None,
+            anisotropy_ratio: None,
+        };
+        let flagged = ModelParts {
+            range: vec![10.0, -30.0],
+            nugget: Some(0.0),
+            ..nested()
+        };
+        assert_eq!(spec.parts(), flagged);
+        let want = "--range -30: must be a finite number > 0";
+        assert_eq!(flags(flagged.explicit_or_fit(false).unwrap_err()), want);
+        assert_eq!(flags(spec.variogram().unwrap_err()), want);
+        assert_eq!(
+            spec.variogram().unwrap_err().render(&key_of),
+            "interpolation.model.range -30: must be a finite number > 0"
+        );
+        // The model's name is `--model` on the command line, `interpolation.model.model` in a
+        // project.
+        let bad = VariogramSpec {
+            model: "matern+cubic".into(),
+            ..spec.clone()
+        };
+        assert!(flags(bad.variogram().unwrap_err()).starts_with("--model 'matern+cubic': "));
+        assert!(bad
+            .variogram()
+            .unwrap_err()
+            .render(&key_of)
+            .starts_with("interpolation.model.model 'matern+cubic': 'cubic' is not a model"));
+        // A zero partial sill beside a positive one is a sill, in a project too (a project
+        // refused it before the one check).
+        let zero = VariogramSpec {
+            psill: Numbers::Many(vec![0.0, 2.0]),
+            range: Numbers::Many(vec![10.0, 30.0]),
+            ..spec.clone()
+        };
+        assert_eq!(zero.variogram().unwrap().structures[0].psill, 0.0);
+        // A shape out of its model's range names the shape.
+        let power = ModelParts {
+            model: Some("power".into()),
+            psill: vec![1.0],
+            range: vec![1.0],
+            shape: vec![3.0],
+            ..ModelParts::default()
+        };
+        let e = power.variogram().unwrap_err();
+        assert!(flags(e).starts_with("--shape: "));
+        let ratio = VariogramSpec {
+            anisotropy_ratio: Some(2.0),
+            range: Numbers::Many(vec![10.0, 30.0]),
+            ..spec
+        };
+        assert_eq!(
+            ratio.variogram().unwrap_err().render(&key_of),
+            "interpolation.model.anisotropy_ratio 2: must be in (0, 1] (the minor range over the major)"
+        );
+    }
+
     /// A build fits the DSM's variogram with the plan's `LagPlan`, which a project cannot set:
     /// its defaults are the kernels' (what the build used before), so the DSM is unchanged.
     #[test]
@@ -476,16 +552,7 @@ mod tests {
     }
 
     #[test]
-    fn the_anisotropy_fit_is_asked_for_by_auto_only() {
-        let mut m = nested();
-        assert!(!m.anisotropy_auto().unwrap());
-        m.anisotropy = Some("AUTO".into());
-        assert!(m.anisotropy_auto().unwrap());
-        m.anisotropy_angle = Some(30.0);
-        assert!(flags(m.anisotropy_auto().unwrap_err()).contains("not both"));
-        m.anisotropy = Some("yes".into());
-        assert!(flags(m.anisotropy_auto().unwrap_err())
-            .starts_with("--anisotropy 'yes': expected auto"));
+    fn the_anisotropy_fit_contradicts_a_direction_and_a_bad_tolerance() {
         let l = LagPlan {
             azimuth: Some(30.0),
             ..LagPlan::default()
