@@ -297,10 +297,11 @@ fn errors_name_file_line_flag_and_value() {
         ip(&good, &["--method", "idw", "--power", "-1"]),
         &["--power -1"],
     );
-    // too few neighbours for the drift
+    // too few neighbours for the drift: refused by the plan's check (as a project's
+    // interpolation.neighbors is), naming the flag, before the data are read
     let mut a = vec!["--method", "uk", "--drift", "quadratic", "--neighbors", "4"];
     a.extend(sph);
-    call(ip(&good, &a), &["good.csv", "at least 6"]);
+    call(ip(&good, &a), &["--neighbors 4", "at least 6"]);
     // a bad target names file, line, column and value
     let bt = write(d, "bt.csv", "x,y\n1,1\n2,oops\n");
     fails_with(
