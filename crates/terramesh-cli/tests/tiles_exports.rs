@@ -1,7 +1,9 @@
 //! `terramesh tiles merge` writes the surface formats a one-piece build writes (issue 33, goal
 //! 4): each merged file, streamed by the merge, is byte for byte what the one writer
 //! interface of a one-piece build (`terramesh_io::export::writer`) writes for the merged
-//! mesh, and its labels (TSurf's CRS) are the one-piece build's.
+//! mesh, and its labels (TSurf's CRS) are the one-piece build's; the folders `3dtiles/` and
+//! `terrain/` are, file for file, what the one-piece build's writers
+//! (`terramesh::gltf::write_dsm_tileset`, `terramesh::build::terrain::write`) write for it.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -75,18 +77,20 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
     for ext in surfaces {
         assert!(files.contains(&format!("dsm.{ext}").as_str()), "{files:?}");
     }
-    let skipped: Vec<&str> = merged["not_merged"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s["format"].as_str().unwrap())
-        .collect();
-    assert_eq!(skipped, ["3dtiles", "terrain"]);
+    // Every export of the example's export.formats is merged, the folders included.
     assert!(
-        said.contains("not merged") && said.contains("3dtiles"),
-        "{said}"
+        merged.get("not_merged").is_none(),
+        "{}",
+        merged["not_merged"]
     );
-    for name in ["dsm.kml", "dsm.dae", "dsm-model.kml"] {
+    assert!(!said.contains("not merged"), "{said}");
+    for name in [
+        "dsm.kml",
+        "dsm.dae",
+        "dsm-model.kml",
+        "3dtiles/tileset.json",
+        "terrain/layer.json",
+    ] {
         assert!(files.contains(&name), "{files:?}");
     }
     assert!(
@@ -254,8 +258,78 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
     }
     assert_eq!(compared.len(), surfaces.len() + 1, "{compared:?}");
 
+    // The folders: the one-piece writers on the merged mesh, as a planar mesh around the
+    // plan's origin (the tile grid's corner) over the plan's region, with the example's
+    // georeference (its UTM zone; the example names no vertical datum) and title.
+    let ring: Vec<[f64; 2]> = m["region"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+        .collect();
+    let mesh = terramesh_mesh::Mesh {
+        origin: [origin[0], origin[1]],
+        points: xy
+            .iter()
+            .map(|p| [p[0] - origin[0], p[1] - origin[1]])
+            .collect(),
+        triangles: triangles.clone(),
+        constraint_edges: Vec::new(),
+    };
+    let dsm = terramesh::gltf::Dsm {
+        mesh: &mesh,
+        z: &z,
+        georef: &georef,
+        title: &title,
+    };
+    let want = tmp.path().join("want");
+    std::fs::create_dir_all(&want).unwrap();
+    let region = terramesh_core::geometry::Region::from_ring(ring);
+    let settings = terramesh_mesh::LodSettings::default();
+    let info = terramesh::gltf::write_dsm_tileset(&want.join("3dtiles"), &region, &dsm, &settings)
+        .unwrap();
+    assert!(info.contents >= 2, "a tree of {} contents", info.contents);
+    // The terrain's resolution is the planar mesh's mean edge length, as a one-piece build
+    // takes it from its mesh's quality after smoothing.
+    let res = terramesh_mesh::Quality::planar(&mesh).edge.mean;
+    terramesh::build::terrain::write(&want, &geo, &triangles, res, &title).unwrap();
+    for folder in ["3dtiles", "terrain"] {
+        let (got, expected) = (tree(&out.join(folder)), tree(&want.join(folder)));
+        let names = |t: &[(String, Vec<u8>)]| t.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&got), names(&expected), "{folder}: the files");
+        assert!(got.len() > 3, "{folder}: {} files", got.len());
+        for ((name, a), (_, b)) in got.iter().zip(&expected) {
+            assert!(
+                a == b,
+                "{folder}/{name}: the merge's file ({} bytes) differs from the one-piece \
+                 writer's ({} bytes)",
+                a.len(),
+                b.len()
+            );
+        }
+    }
+
     // And the geometry read back: the OBJ's vertices and triangles are the VTU's.
     let (v, t) = parse_obj(&std::fs::read_to_string(out.join("dsm.obj")).unwrap()).unwrap();
     assert_eq!(v, points);
     assert_eq!(t, triangles);
+}
+
+/// Every file under `dir`, by its path relative to it (sorted), with its bytes.
+fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    fn walk(root: &Path, d: &Path, out: &mut Vec<(String, Vec<u8>)>) {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                let rel = p.strip_prefix(root).unwrap().to_string_lossy().into_owned();
+                out.push((rel, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
 }
