@@ -309,6 +309,8 @@ fn merged_exports_are_the_one_piece_writers_on_the_merged_mesh() {
         }
     }
 
+    independent_check(&out, &tmp.path().join("verify"), &points, &fields);
+
     // And the geometry read back: the OBJ's vertices and triangles are the VTU's.
     let (v, t) = parse_obj(&std::fs::read_to_string(out.join("dsm.obj")).unwrap()).unwrap();
     assert_eq!(v, points);
@@ -332,4 +334,63 @@ fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
     walk(dir, dir, &mut out);
     out.sort();
     out
+}
+
+/// The merged folders read by the independent verifier (`tests/verify/verify_outputs.py`:
+/// every GLB through the Khronos glTF-Validator; the tileset's tree, boxes containing their
+/// content and errors, its heights through PROJ and EGM96, py3dtiles' reader; the terrain's
+/// `layer.json`, every tile through the `quantized-mesh-tile` reader, edge indices, shared
+/// edges, heights against the DSM and EGM96). Its reference, `dsm-vertices.csv`, is written
+/// from the merged `dsm.vtu` into a copy `dir` of the folders. Without `.venv-verify` (made by
+/// `.ci/verify-setup.sh`) it fails when `CI` is set and otherwise prints "skipped" and passes,
+/// the rule of `tests/build_verify.rs`.
+fn independent_check(out: &Path, dir: &Path, points: &[[f64; 3]], fields: &[Vec<f64>]) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let python = root.join(".venv-verify/bin/python");
+    if !python.exists() {
+        let msg = format!(
+            "{} is missing: run .ci/verify-setup.sh to install the independent readers",
+            python.display()
+        );
+        assert!(std::env::var_os("CI").is_none(), "CI is set and {msg}");
+        eprintln!("tiles_exports: verify_outputs.py skipped ({msg})");
+        return;
+    }
+    for (name, bytes) in tree(out) {
+        if ["dsm.vtu", "dsm.tif", "dsm.glb"].contains(&name.as_str())
+            || name.starts_with("3dtiles")
+            || name.starts_with("terrain")
+        {
+            let p = dir.join(&name);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, bytes).unwrap();
+        }
+    }
+    // x, y, elevation_uk, kriging_std, elevation_idw (the verifier's columns).
+    let mut csv = String::from("x,y,elevation_uk,kriging_std,elevation_idw\n");
+    for (i, p) in points.iter().enumerate() {
+        let [uk, std, idw] = [0, 1, 2].map(|k| fields[k][i]);
+        csv += &format!("{:?},{:?},{uk:?},{std:?},{idw:?}\n", p[0], p[1]);
+    }
+    std::fs::write(dir.join("dsm-vertices.csv"), csv).unwrap();
+    let run = Command::new(&python)
+        .arg(root.join("tests/verify/verify_outputs.py"))
+        .arg(dir)
+        .args([
+            "--only",
+            "3dtiles",
+            "--only",
+            "terrain",
+            "--only",
+            "glb: glTF-Validator",
+        ])
+        .output()
+        .expect("run tests/verify/verify_outputs.py");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    println!("{stdout}");
+    assert!(
+        run.status.success() && stdout.contains("9 passed, 0 failed"),
+        "verify_outputs.py failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }

@@ -34,7 +34,7 @@ pub const TILESET_BYTES_PER_VERTEX: f64 = 500.0;
 /// Peak memory of the terrain writer on the merged mesh, bytes per vertex (the ellipsoidal
 /// positions, the indexed surface's copy of them and of the triangles, its grid index), with
 /// the margin of [`TILESET_BYTES_PER_VERTEX`].
-pub const TERRAIN_BYTES_PER_VERTEX: f64 = 250.0;
+pub const TERRAIN_BYTES_PER_VERTEX: f64 = 450.0;
 
 /// The merged mesh, as the scratch files hold it, and the labels of the folder exports.
 pub(crate) struct FolderInput<'a> {
