@@ -24,16 +24,18 @@ use terramesh_mesh::{triangle_quality, LodSettings, Mesh};
 
 use crate::error::Result;
 
-/// Peak memory of the 3D Tiles writer on the merged mesh, bytes per vertex (its planar mesh
-/// and absolute vertices, the level-of-detail tree with its leaves (a copy of the mesh cut
-/// into cells) and their conversion to the tileset's frame, the point locator and the
-/// adaptive meshes of the coarser levels): about 2.3 times the 210 bytes a vertex measured
-/// over the merge without it on the Fort Worth plan (docs/scaling.md), for a margin.
+/// Peak memory of the 3D Tiles writer on the merged mesh, bytes per vertex: its planar mesh
+/// and absolute vertices, the point locator, the adaptive meshes of the coarser levels, the
+/// leaves (a copy of the mesh cut into cells, each cell's vertex map of 4 bytes a vertex of the
+/// mesh on every thread at once) and their conversion to the tileset's frame. Measured on the
+/// Fort Worth plan (1,029,671 vertices, 2 threads): 244 bytes a vertex of peak resident size
+/// over a merge without it (docs/scaling.md); about twice that, for the margin.
 pub const TILESET_BYTES_PER_VERTEX: f64 = 500.0;
 
-/// Peak memory of the terrain writer on the merged mesh, bytes per vertex (the ellipsoidal
-/// positions, the indexed surface's copy of them and of the triangles, its grid index), with
-/// the margin of [`TILESET_BYTES_PER_VERTEX`].
+/// Peak memory of the terrain writer on the merged mesh, bytes per vertex: the ellipsoidal
+/// positions, the indexed surface's copy of them and of the triangles, its grid index, and the
+/// pyramid's tiles (65 x 65 heights and normals each, as many as the region has at the mesh's
+/// resolution). Measured as [`TILESET_BYTES_PER_VERTEX`]: 228 bytes a vertex; about twice that.
 pub const TERRAIN_BYTES_PER_VERTEX: f64 = 450.0;
 
 /// The merged mesh, as the scratch files hold it, and the labels of the folder exports.
