@@ -276,6 +276,8 @@ fn tiled_build_equals_the_one_piece_build_with_watertight_seams() {
             "dsm.dae",
             "dsm-model.kml",
             "dsm.glb",
+            "3dtiles/tileset.json",
+            "terrain/layer.json",
             "dsm.tif",
             "dsm.asc"
         ]

@@ -16,7 +16,9 @@
 //! vertices around the centre of the mesh's bounding box. `dsm.glb` is streamed from the same
 //! scratch files by [`super::glb_merge`] (the writer's bytes, without its in-memory arrays);
 //! a mesh whose GLB would pass 4 GiB is skipped. The folders (3D Tiles, terrain tiles: a
-//! level-of-detail tree of the whole mesh) are not merged yet ([`Skipped`]).
+//! level-of-detail tree of the whole mesh) are written from the same scratch files by the
+//! one-piece build's writers ([`super::lod_merge`]), unless their memory would pass the limit
+//! ([`Skipped`]).
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -65,6 +67,8 @@ pub(crate) struct Labels<'a> {
     /// Where the project lies on the Earth (KML, COLLADA), as the one-piece build places it;
     /// `None`: the geographic formats are not merged.
     pub georef: Option<terramesh::georef::Georef>,
+    /// The region's outline as the plan records it (3D Tiles' coarser levels mesh it).
+    pub region: &'a [[f64; 2]],
 }
 
 /// The scratch files of the merged mesh, removed on drop.
@@ -135,6 +139,7 @@ pub(crate) fn write_surfaces(
     let mut skipped = Vec::new();
     let mut wanted = Vec::new();
     let mut glb = false;
+    let mut folders = Vec::new();
     for &f in terramesh_io::export::all_formats().iter() {
         if !labels.formats.contains(&f) || f == Format::Vtu {
             continue;
@@ -147,22 +152,17 @@ pub(crate) fn write_surfaces(
             Target::File(ext) if !needs.glb && (placed || !(needs.geographic || needs.enu)) => {
                 wanted.push((f, ext));
             }
-            Target::File(_) => skipped.push(Skipped {
+            Target::Folder(_) if placed => folders.push(f),
+            Target::File(_) | Target::Folder(_) => skipped.push(Skipped {
                 format: f.name().into(),
                 why: "the plan records no CRS that places the region on the Earth (a plan made \
                       by an older terramesh, or a CRS without an EPSG code): plan again, or \
                       build it in one piece"
                     .into(),
             }),
-            Target::Folder(_) => skipped.push(Skipped {
-                format: f.name().into(),
-                why: "a folder of tiles made from a level-of-detail tree of the whole mesh: not \
-                      merged yet; build it in one piece"
-                    .into(),
-            }),
         }
     }
-    if wanted.is_empty() && !glb {
+    if wanted.is_empty() && !glb && folders.is_empty() {
         return Ok(Surfaces {
             files: Vec::new(),
             skipped,
@@ -174,8 +174,9 @@ pub(crate) fn write_surfaces(
     let needs = |f: fn(&terramesh_io::export::Needs) -> bool| {
         wanted.iter().any(|(w, _)| f(&writer(*w).needs()))
     };
+    let terrain = folders.contains(&Format::Terrain);
     let geo = match &labels.georef {
-        Some(g) if needs(|n| n.geographic || n.enu) => Some(g),
+        Some(g) if terrain || needs(|n| n.geographic || n.enu) => Some(g),
         _ => None,
     };
     let lo = write_scratch(plan, m, seams, &scratch.0, geo)?;
@@ -209,6 +210,17 @@ pub(crate) fn write_surfaces(
                      build a part of the region in one piece"
                 ),
             }),
+        }
+    }
+    if let Some(georef) = &labels.georef {
+        for f in folders {
+            match write_folder(f, out, &scratch.0, labels, georef)? {
+                Ok(path) => written.push(path),
+                Err(why) => skipped.push(Skipped {
+                    format: f.name().into(),
+                    why,
+                }),
+            }
         }
     }
     drop(scratch);
@@ -389,6 +401,40 @@ fn write_scratch(
         file.flush().at(&dir.join(name))?;
     }
     Ok((lo, hi))
+}
+
+/// Writes the folder `f` (`3dtiles`, `terrain`) into `out` from the scratch files in `dir`
+/// ([`super::lod_merge`]); `Ok(Err(why))` when its memory would pass the limit.
+fn write_folder(
+    f: Format,
+    out: &Path,
+    dir: &Path,
+    labels: &Labels,
+    georef: &terramesh::georef::Georef,
+) -> Result<std::result::Result<PathBuf, String>> {
+    let (xy, z, tris) = (
+        map(&dir.join(XY))?,
+        map(&dir.join(Z))?,
+        map(&dir.join(TRIS))?,
+    );
+    let geo = match f {
+        Format::Terrain => map(&dir.join(GEO))?,
+        _ => None,
+    };
+    let input = super::lod_merge::FolderInput {
+        xy: slice::<[f64; 2]>(&xy),
+        z: slice::<f64>(&z),
+        triangles: slice::<[u32; 3]>(&tris),
+        geo: slice::<[f64; 3]>(&geo),
+        origin: [labels.stl_origin[0], labels.stl_origin[1]],
+        region: labels.region,
+        title: labels.title,
+        georef,
+    };
+    match f {
+        Format::Terrain => super::lod_merge::write_terrain(out, &input),
+        _ => super::lod_merge::write_tileset(out, &input),
+    }
 }
 
 /// Writes `path` (`dsm.glb`) from the scratch files in `dir` ([`super::glb_merge`]);

@@ -12,7 +12,8 @@
 //! * [`merge()`]: streams the tiles into `dsm.vtu`, `dsm.tif`, `dsm.asc`, the other surface
 //!   single-file formats of `export.formats` (`dsm.obj`, `.ply`, `.stl`, `.ts`, `.msh`,
 //!   `.dxf`, `.kml`, `.dae`, through the one-piece build's writers; `dsm.glb`, the glTF
-//!   writer's bytes streamed) and a report, and,
+//!   writer's bytes streamed; `3dtiles/` and `terrain/`, the one-piece writers on the merged
+//!   mesh) and a report, and,
 //!   with `[geology]`, `model.vtu`, `interfaces/<unit>.tif` and `model.json`, and from the
 //!   merged volume mesh the boundary meshes, `model.msh`, `model.f3grid` and the bodies.
 //! * [`write_slurm`]: an `sbatch` array script and the merge job.
@@ -55,6 +56,7 @@ mod geology_tile;
 mod geometry;
 mod glb_merge;
 mod grid_merge;
+mod lod_merge;
 mod manifest;
 mod merge;
 mod merged;

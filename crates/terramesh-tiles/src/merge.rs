@@ -8,9 +8,11 @@
 //! row by row, one row in memory (`grid_merge.rs`). The other surface formats of the
 //! project's `export.formats` (OBJ, PLY, STL, TSurf, MSH, DXF, KML, COLLADA) go through the
 //! one-piece build's writers, reading the merged mesh from mapped scratch files
-//! (`exports.rs`); glTF is the glTF writer's bytes streamed from them (`glb_merge.rs`). The
-//! formats that need the whole mesh at once (3D Tiles, Cesium terrain, the sealed solid, the
-//! report's 3D view, the pictures) are not made by the merge (`merge.json`'s `not_merged`):
+//! (`exports.rs`); glTF is the glTF writer's bytes streamed from them (`glb_merge.rs`); 3D
+//! Tiles and Cesium terrain are the one-piece writers on the merged mesh read from them
+//! (`lod_merge.rs`: both trees read the whole mesh, so they hold it, within the memory
+//! limit). The sealed solid, the report's 3D view and the pictures are not made by the merge
+//! (`merge.json`'s `not_merged` lists the formats of `export.formats` it did not write):
 //! build them from `dsm.vtu` or in one piece.
 
 use std::collections::HashMap;
@@ -121,6 +123,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         field_data: Vec::new(),
         stl_origin: [m.origin[0], m.origin[1], 0.0],
         georef: georef_of(m, &project)?,
+        region: &m.region,
     };
     let surfaces = super::exports::write_surfaces(plan, m, &seams, out, &labels)?;
     written.extend(surfaces.files);
@@ -174,19 +177,19 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
 
 /// Where the plan's region lies on the Earth, as the one-piece build places it (a UTM zone, or
 /// the project's CRS by its EPSG code, with the vertical datum the project names), when KML,
-/// COLLADA or glTF are asked for; `None` for a plan that does not record it (made before
+/// COLLADA, glTF, 3D Tiles or terrain tiles are asked for; `None` for a plan that does not record it (made before
 /// `crs_text.zone`) or a CRS without an EPSG code.
 fn georef_of(
     m: &Manifest,
     project: &terramesh::project::Project,
 ) -> Result<Option<terramesh::georef::Georef>> {
     use terramesh_io::export::Format;
-    if !project
-        .export
-        .formats
-        .iter()
-        .any(|f| matches!(f, Format::Kml | Format::Collada | Format::Glb))
-    {
+    if !project.export.formats.iter().any(|f| {
+        matches!(
+            f,
+            Format::Kml | Format::Collada | Format::Glb | Format::Tiles3d | Format::Terrain
+        )
+    }) {
         return Ok(None);
     }
     let Some(text) = &m.crs_text else {

@@ -21,7 +21,7 @@ pub mod reuse;
 pub mod scale;
 pub(crate) mod stages;
 pub mod staging;
-mod terrain;
+pub mod terrain;
 pub(crate) mod viewer;
 
 use std::path::Path;

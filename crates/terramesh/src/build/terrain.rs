@@ -11,8 +11,15 @@ use crate::error::{Context, Result};
 
 /// Writes `out/terrain` from the DSM's vertices as longitude, latitude (degrees) and
 /// elevation above the geoid, down to the level whose spacing reaches `resolution_m` (the
-/// mesh's mean edge length). Returns the path of its `layer.json`.
-pub(super) fn write(
+/// mesh's mean edge length: a one-piece build gives its planar mesh's
+/// [`terramesh_mesh::Quality`] `edge.mean` after smoothing). Returns the path of its
+/// `layer.json`. A one-piece build calls it from its export stage and `tiles merge` on the
+/// merged mesh, so both write the same bytes for the same mesh.
+///
+/// # Errors
+/// A DSM that cannot be indexed ([`terramesh_io::export::TerrainError`]), or a file that cannot
+/// be written, naming it.
+pub fn write(
     out: &Path,
     geo: &[[f64; 3]],
     tris: &[[u32; 3]],
