@@ -7,8 +7,10 @@
 //! it touches improves and (a move, or a flip among cells not all below the floor) no more
 //! of them fall below the floor.
 //!
-//! What an operation may change is decided from the cells' labels (their side of every fault
-//! and their unit): a node whose cells all carry one label lies on no fault and no interface;
+//! What an operation may change is decided from the cells' labels (their side of every fault,
+//! their unit, their block and the fault zones they lie in): a node whose cells all carry one
+//! label lies on no fault, no interface and no zone's wall; a node between the inside and the
+//! outside of one zone moves along its wall and is collapsed only into a node on that wall;
 //! a node may be collapsed into a neighbour only if every label around it is found around the
 //! neighbour too (so the neighbour lies on every surface the node lies on), and never if it
 //! lies on the terrain or a side (the DSM and the region's outline stay as they are); a node

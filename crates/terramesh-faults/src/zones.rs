@@ -4,8 +4,10 @@
 //! A fault with a zone w thick keeps its own surface (cut as every fault, its faces the fault's
 //! faces, its two sides the blocks); the zone's two walls, the surfaces at a signed distance
 //! ±w/2 from the fault (the distance of [`crate::Side`]: to the plane of the fault's nearest
-//! piece, so a planar fault's walls are the two parallel planes), are cut after the quality
-//! pass and the engineering objects, as the objects' walls are: on each side s of the fault
+//! piece, so a planar fault's walls are the two parallel planes), are cut after the faults and
+//! interfaces and before the quality pass (which keeps them: every cell keeps the zones it
+//! lies in, a bit per fault, as one more label) and the engineering objects, as the objects'
+//! walls are: on each side s of the fault
 //! the field s·d(q) − w/2 is evaluated at the nodes of the cells on that side where the fault
 //! is active ([`FaultSet::active`] at their centroid: not beyond a fault it ends at, not below
 //! its depth), every edge whose ends it puts on both sides of the wall (a node within
@@ -18,7 +20,8 @@
 //! along an edge as the distance to a plane does: an edge crosses a wall at most once.
 //!
 //! A cell inside two zones (two zones that cross, or a zone that reaches the fault another
-//! ends at) belongs to the zone of the fault that ends at no other, then to the first in the
+//! ends at) lies in both while the mesh is made (so that both walls stay faces), and is
+//! labelled with the zone of the fault that ends at no other, then the first in the
 //! project's order: at a Y junction the zone of the fault that goes on is continuous and the
 //! other's stops at its wall.
 
