@@ -8,7 +8,7 @@ MODEL_DIR holds what terramesh_io::model::write_faulted_model writes: model.vtu 
 fault-<name>.vtu (every face once from each side, with OpenGeoSys' bulk_node_ids,
 bulk_element_ids, bulk_face_ids) and fault-<name>.ts; model.msh with a physical surface
 fault-<name> per fault; model.f3grid with face groups fault-<name> and a zone group per block
-(slot 2). The rest of the model (cells, boundary meshes, bodies, ogs) is check_model.py's.
+(slot 2); a fault zone's cells, if any, the material `zone-<fault>` of unit_names. The rest of the model (cells, boundary meshes, bodies, ogs) is check_model.py's.
 Prints `PASS name` or `FAIL name: why` per check, then `N passed, M failed`; exits 1 if any
 failed. See docs/geology.md, "Faulted model files".
 """
@@ -219,6 +219,117 @@ def check_msh_faults(f):
         gmsh.finalize()
 
 
+def point_triangle(p, tri):
+    """Distance of points p (n, 3) to triangles tri (m, 3, 3): (n, m) distances and whether the
+    nearest point lies strictly inside the triangle (the point's projection on its plane)."""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    n = np.cross(b - a, c - a)
+    nn = np.einsum("ij,ij->i", n, n)
+    w = p[:, None, :] - a[None]
+    h = np.einsum("nmk,mk->nm", w, n) / np.sqrt(nn)
+    q = p[:, None, :] - (h / np.sqrt(nn))[..., None] * n[None]
+    # barycentric signs of the projection: the three sub-triangles' normals against n
+    inside = np.ones(h.shape, dtype=bool)
+    for u, v in ((a, b), (b, c), (c, a)):
+        inside &= np.einsum("nmk,mk->nm", np.cross(v[None] - u[None], q - u[None]), n) > 0
+    def seg(u, v):
+        d = v - u
+        t = np.clip(np.einsum("nmk,mk->nm", p[:, None, :] - u[None], d) / np.einsum("ij,ij->i", d, d), 0, 1)
+        return np.linalg.norm(p[:, None, :] - (u[None] + t[..., None] * d[None]), axis=2)
+    edge = np.minimum(np.minimum(seg(a, b), seg(b, c)), seg(c, a))
+    return np.where(inside, np.abs(h), edge), inside
+
+
+def fault_distances(points, tri, reach):
+    """Per point: the distance to the nearest of the triangles tri (inf beyond `reach` of every
+    triangle's bounding box) and whether that nearest point lies inside a triangle. Triangles
+    are binned in a grid of cubes of their median size, each in every cube its box grown by
+    `reach` meets; a point is tested against its cube's triangles only."""
+    size = max(float(np.median(np.linalg.norm(tri[:, 1] - tri[:, 0], axis=1))), reach, 1e-6)
+    lo, hi = tri.min(axis=1) - reach, tri.max(axis=1) + reach
+    bins = {}
+    for i, (l, h) in enumerate(zip(np.floor(lo / size).astype(np.int64), np.floor(hi / size).astype(np.int64))):
+        for x in range(l[0], h[0] + 1):
+            for y in range(l[1], h[1] + 1):
+                for z in range(l[2], h[2] + 1):
+                    bins.setdefault((x, y, z), []).append(i)
+    key = np.floor(points / size).astype(np.int64)
+    dist = np.full(len(points), np.inf)
+    inside = np.zeros(len(points), dtype=bool)
+    uniq, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    order = np.argsort(inv, kind="stable")
+    starts = np.searchsorted(inv[order], np.arange(len(uniq) + 1))
+    for g, k in enumerate(map(tuple, uniq.tolist())):
+        cand = bins.get(k)
+        if not cand:
+            continue
+        idx = order[starts[g]:starts[g + 1]]
+        d, ins = point_triangle(points[idx], tri[cand])
+        j = np.argmin(d, axis=1)
+        dist[idx] = d[np.arange(len(idx)), j]
+        inside[idx] = ins[np.arange(len(idx)), j]
+    return dist, inside
+
+
+def tet_volumes(pts, cells):
+    v = np.array([c for _, c in cells], dtype=np.int64)
+    a, b, c, d = (pts[v[:, k]] for k in range(4))
+    return np.abs(np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)) / 6.0
+
+
+def check_zones(f):
+    """Fault zones (materials `zone-<fault>` in unit_names): each a slab along fault-<fault>.ts,
+    read from the files alone. Its thickness w is twice the largest distance of its cells'
+    nodes from the fault's triangles, of the nodes over the inside of a triangle (the nodes on
+    its walls; beyond the fault's edges, on the terrain, the distance to the nearest edge is
+    larger); its cells lie on both sides of
+    the fault (two blocks or more); every cell whose centroid lies over the inside of a fault
+    triangle less than w/2 − 1 cm from it is in a zone; the volume of the zone cells whose
+    centroids lie within w/2 of the fault (w beyond its edges) is w times the fault's area within 5 %. A model
+    without zones passes."""
+    zones = [(m, n[len("zone-"):]) for m, n in enumerate(f.units) if n.startswith("zone-")]
+    if not zones:
+        return
+    require(all(t == "tetra" for t, _ in f.cells), "zones: the model has cells other than tetrahedra")
+    v = np.array([c for _, c in f.cells], dtype=np.int64)
+    cen = f.points[v].mean(axis=1)
+    vol = tet_volumes(f.points, f.cells)
+    in_zone = np.isin(f.mats, [m for m, _ in zones])
+    for mat, name in zones:
+        require(name in f.faults, f"model.vtu: material zone-{name} names no fault of fault_names")
+        tv, tt = read_tsurf(f.model.path(f"fault-{name}.ts"))
+        tri = tv[np.array(tt)]
+        area = float(0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum())
+        mine = f.mats == mat
+        require(mine.any(), f"zone-{name}: no cells")
+        nodes = np.unique(v[mine])
+        extent = float(np.ptp(f.points, axis=0).max())
+        reach = 4.0
+        while True:
+            dn, over = fault_distances(f.points[nodes], tri, reach)
+            if np.isfinite(dn).all() or reach > extent:
+                break
+            reach *= 2.0
+        require(np.isfinite(dn).all(), f"zone-{name}: nodes far from fault-{name}.ts")
+        require(over.any(), f"zone-{name}: no node lies over the inside of a triangle of fault-{name}.ts")
+        w = 2.0 * float(dn[over].max())
+        require(w > 0.02, f"zone-{name}: its nodes lie on fault-{name}.ts (thickness {w} m)")
+        blocks = np.unique(f.block[mine])
+        require(len(blocks) >= 2, f"zone-{name}: its cells lie in one block ({blocks}), not on both sides")
+        dc, inside = fault_distances(cen, tri, 0.5 * w + 0.1)
+        miss = inside & (dc < 0.5 * w - 0.01) & ~in_zone
+        if miss.any():
+            raise CheckFailed(f"zone-{name}: {int(miss.sum())} cells {float(dc[miss].min()):.3f} m or more from "
+                              f"fault-{name}.ts (thickness {w:.3f} m) are in no zone, e.g. cell "
+                              f"{int(np.nonzero(miss)[0][0])}")
+        # beyond the fault's edges (its trace on the terrain, the sides) the distance to its
+        # triangles grows faster than the distance to its plane: count zone cells out to w there
+        covered = float(vol[in_zone & (dc < np.where(inside, 0.5 * w, w))].sum())
+        close(covered, w * area, 0.05, f"zone-{name}: the zone cells' volume within {w / 2:.3f} m of "
+              f"fault-{name}.ts vs thickness {w:.3f} m times its area {area:.1f} m²")
+
+
 CHECKS = [
     ("model.vtu: block, fault_names, block_names", check_vtu_block),
     ("fault-<name>.vtu: faces of both sides", check_fault_meshes),
@@ -226,6 +337,7 @@ CHECKS = [
     ("fault-<name>.ts", check_fault_tsurf),
     ("model.f3grid: fault face groups, block zone groups (meshio)", check_f3grid_groups),
     ("model.msh: fault surfaces, unit volumes (gmsh)", check_msh_faults),
+    ("zone-<fault> materials: slabs along fault-<fault>.ts", check_zones),
 ]
 
 

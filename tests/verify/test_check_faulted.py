@@ -131,3 +131,66 @@ def test_checks_read_numbers_not_names():
     n = len(faces) // 2
     assert any(not set(a) & set(b) for a, b in zip(faces[:n], faces[n:]))
     assert np.isfinite(f.points).all()
+
+
+class _Slab:
+    """A box 10 m x 10 m x 10 m from x = -5 to 5, its cubes (1 m) split into six tetrahedra
+    each (Kuhn), a vertical fault on x = 0 (fault-F.ts: two triangles over the box's section),
+    the cells with |x| < 1 the material zone-F (a 2 m zone), blocks by the side of x = 0: what
+    check_zones reads of a Faulted, without files but the fault's TSurf."""
+
+    def __init__(self, root):
+        n = 10
+        idx = lambda i, j, k: (i * (n + 1) + j) * (n + 1) + k
+        self.points = np.array([[i - 5.0, j, k] for i in range(n + 1) for j in range(n + 1)
+                                for k in range(n + 1)])
+        perms = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
+        cells = []
+        for i in range(n):
+            for j in range(n):
+                for k in range(n):
+                    for p in perms:
+                        c, t = [i, j, k], [idx(i, j, k)]
+                        for axis in p:
+                            c[axis] += 1
+                            t.append(idx(*c))
+                        cells.append(("tetra", tuple(t)))
+        self.cells = cells
+        cen = self.points[np.array([c for _, c in cells])].mean(axis=1)
+        self.units = ["rock", "zone-F"]
+        self.faults = ["F"]
+        self.mats = np.where(np.abs(cen[:, 0]) < 1.0, 1, 0).astype(np.int32)
+        self.block = (cen[:, 0] > 0).astype(np.int32)
+        ts = root / "fault-F.ts"
+        ts.write_text("GOCAD TSurf 1\nVRTX 1 0 0 0\nVRTX 2 0 10 0\nVRTX 3 0 10 10\nVRTX 4 0 0 10\n"
+                      "TRGL 1 2 3\nTRGL 1 3 4\nEND\n")
+        self.model = type("M", (), {"path": lambda _, name: root / name})()
+
+
+def test_zone_slab_passes(tmp_path):
+    cf.check_zones(_Slab(tmp_path))
+
+
+def test_zone_cell_labelled_as_its_unit_fails(tmp_path):
+    s = _Slab(tmp_path)
+    cen = s.points[np.array([c for _, c in s.cells])].mean(axis=1)
+    inner = np.nonzero((np.abs(cen[:, 0]) < 0.5) & (cen[:, 1] > 3) & (cen[:, 2] > 3))[0]
+    s.mats[inner[0]] = 0
+    with pytest.raises(cf.CheckFailed, match="are in no zone"):
+        cf.check_zones(s)
+
+
+def test_zone_on_one_side_fails(tmp_path):
+    s = _Slab(tmp_path)
+    s.block[:] = 0
+    with pytest.raises(cf.CheckFailed, match="in one block"):
+        cf.check_zones(s)
+
+
+def test_zone_thinner_than_its_walls_fails(tmp_path):
+    # half of the zone's cells taken out where its far wall still stands: the volume is short
+    s = _Slab(tmp_path)
+    cen = s.points[np.array([c for _, c in s.cells])].mean(axis=1)
+    s.mats[(cen[:, 0] > 0) & (cen[:, 0] < 1) & (cen[:, 1] < 5)] = 0
+    with pytest.raises(cf.CheckFailed, match="in no zone|vs thickness"):
+        cf.check_zones(s)

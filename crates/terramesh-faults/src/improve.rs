@@ -7,8 +7,10 @@
 //! it touches improves and (a move, or a flip among cells not all below the floor) no more
 //! of them fall below the floor.
 //!
-//! What an operation may change is decided from the cells' labels (their side of every fault
-//! and their unit): a node whose cells all carry one label lies on no fault and no interface;
+//! What an operation may change is decided from the cells' labels (their side of every fault,
+//! their unit, their block and the fault zones they lie in): a node whose cells all carry one
+//! label lies on no fault, no interface and no zone's wall; a node between the inside and the
+//! outside of one zone moves along its wall and is collapsed only into a node on that wall;
 //! a node may be collapsed into a neighbour only if every label around it is found around the
 //! neighbour too (so the neighbour lies on every surface the node lies on), and never if it
 //! lies on the terrain or a side (the DSM and the region's outline stay as they are); a node
@@ -23,7 +25,7 @@ use crate::mesh::{
     outline_edge, positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
 };
 use crate::quality::min_dihedral;
-use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE};
+use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
 
 /// What the quality pass did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -65,8 +67,9 @@ struct Pass<'a> {
 /// A node is moved only if the smallest angle of its cells gains at least this (degrees).
 const MIN_GAIN: f64 = 1e-6;
 
-/// A cell's label: its side of every fault, its unit, its block.
-type Label = (u64, u32, u32);
+/// A cell's label: its side of every fault, its unit, its block, the fault zones it lies in
+/// (bit f: between the walls of fault f's zone).
+type Label = (u64, u32, u32, u64);
 
 /// An operation the pass found for a poor cell, to be made by [`Pass::apply`].
 enum Op {
@@ -127,15 +130,22 @@ impl Pass<'_> {
         c
     }
 
-    /// Whether the cells carry one label (side of every fault, unit, block): then no face or
-    /// edge between them lies on a fault or an interface, and a flip among them keeps every
-    /// surface.
+    /// The label of cell `c`.
+    fn label(&self, c: u32) -> Label {
+        let c = c as usize;
+        (
+            self.st.positive[c],
+            self.st.below[c],
+            self.st.block[c],
+            self.st.zone.get(c).copied().unwrap_or(0),
+        )
+    }
+
+    /// Whether the cells carry one label (side of every fault, unit, block, zone): then no
+    /// face or edge between them lies on a fault, an interface or a zone's wall, and a flip
+    /// among them keeps every surface.
     fn one_label(&self, cells: &[u32]) -> bool {
-        let l = |c: u32| {
-            let c = c as usize;
-            (self.st.positive[c], self.st.below[c], self.st.block[c])
-        };
-        cells.iter().all(|&c| l(c) == l(cells[0]))
+        cells.iter().all(|&c| self.label(c) == self.label(cells[0]))
     }
 
     /// Puts tetrahedron `t` (smallest angle `q`) in cell `c`, or in a new cell (with the
@@ -149,6 +159,9 @@ impl Pass<'_> {
                 self.st.positive.push(self.st.positive[l]);
                 self.st.below.push(self.st.below[l]);
                 self.st.block.push(self.st.block[l]);
+                if !self.st.zone.is_empty() {
+                    self.st.zone.push(self.st.zone[l]);
+                }
                 self.alive.push(true);
                 self.angle.push(q);
                 (self.st.tets.len() - 1) as u32
@@ -393,13 +406,7 @@ impl Pass<'_> {
     }
 
     fn labels(&self, cells: &[u32]) -> Vec<Label> {
-        let mut l: Vec<(u64, u32, u32)> = cells
-            .iter()
-            .map(|&c| {
-                let c = c as usize;
-                (self.st.positive[c], self.st.below[c], self.st.block[c])
-            })
-            .collect();
+        let mut l: Vec<Label> = cells.iter().map(|&c| self.label(c)).collect();
         l.sort_unstable();
         l.dedup();
         l
@@ -461,9 +468,10 @@ impl Pass<'_> {
             return None;
         }
         let [(ca, la), (cb, lb)] = around;
-        if !la.iter().all(|l| lb.binary_search(l).is_ok()) {
+        if !la.iter().all(|l| lb.binary_search(l).is_ok()) || !self.zone_kept(a, b, la) {
             return None;
         }
+        let walled = la.iter().any(|l| l.3 != la[0].3);
         let old = ca
             .iter()
             .map(|&c| self.angle[c as usize])
@@ -487,7 +495,10 @@ impl Pass<'_> {
                 return None;
             }
         }
-        if !new.iter().all(|e| self.in_unit(e.1, self.geo(e.1), e.0)) {
+        if !new.iter().all(|e| {
+            let g = self.geo(e.1);
+            self.in_unit(e.1, g, e.0) && self.in_zone(g, e.0, walled)
+        }) {
             return None;
         }
         let mut keys: Vec<[u32; 4]> = cb
@@ -561,7 +572,7 @@ impl Pass<'_> {
 
     /// Where node `v` may go towards `to`: anywhere if free, along its one interface or its
     /// one fault; `None` if it may not move.
-    fn slide(&self, v: u32, labels: &[(u64, u32, u32)], to: [f64; 3]) -> Option<[f64; 3]> {
+    fn slide(&self, v: u32, labels: &[Label], to: [f64; 3]) -> Option<[f64; 3]> {
         let f = self.st.flags[v as usize];
         let p = self.st.points[v as usize];
         if f & (TOP | BASE | SIDE) != 0 {
@@ -577,12 +588,17 @@ impl Pass<'_> {
         }
         match labels {
             [_] if f & ON_INTERFACE == 0 => Some(to),
-            [x, y] if x.0 == y.0 && x.2 == y.2 && y.1 == x.1 + 1 => {
+            [x, y] if x.3 == y.3 && x.0 == y.0 && x.2 == y.2 && y.1 == x.1 + 1 => {
                 // On interface x.1 of block x.2 only.
                 let z = (self.height)(x.1 as usize, self.blocks[x.2 as usize], [to[0], to[1]]);
                 z.is_finite().then_some([to[0], to[1], z])
             }
-            [x, y] if f & ON_INTERFACE == 0 && x.1 == y.1 && (x.0 ^ y.0).count_ones() == 1 => {
+            [x, y]
+                if f & ON_INTERFACE == 0
+                    && x.3 == y.3
+                    && x.1 == y.1
+                    && (x.0 ^ y.0).count_ones() == 1 =>
+            {
                 let fault = &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize];
                 let mut q = to;
                 for _ in 0..4 {
@@ -598,8 +614,86 @@ impl Pass<'_> {
                 }
                 (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
             }
+            [x, y] if f & ON_INTERFACE == 0 => {
+                // On the wall of a zone only: along it (projected along the fault's normal).
+                let (fault, s) = self.wall_of(p, x, y)?;
+                let fault = &self.faults.faults[fault];
+                let g = crate::zones::wall(fault, s);
+                let mut q = to;
+                for _ in 0..4 {
+                    let v = g(q);
+                    if v.abs() <= 0.1 * ON_SURFACE {
+                        return Some(q);
+                    }
+                    let n = fault.side(q).normal;
+                    q = [0, 1, 2].map(|k| q[k] - v * f64::from(s) * n[k]);
+                }
+                (g(q).abs() <= 0.1 * ON_SURFACE).then_some(q)
+            }
             _ => None,
         }
+    }
+
+    /// The zone wall that a node at `p` between cells labelled `x` and `y` lies on: the
+    /// fault and its side, if the labels differ in one zone only, and `p` lies on that wall
+    /// (within [`ZONE_ON_WALL`]: where a zone ends because its fault does, the labels change
+    /// across faces that are no wall).
+    fn wall_of(&self, p: [f64; 3], x: &Label, y: &Label) -> Option<(usize, i8)> {
+        if x.0 != y.0 || x.1 != y.1 || x.2 != y.2 || (x.3 ^ y.3).count_ones() != 1 {
+            return None;
+        }
+        let f = (x.3 ^ y.3).trailing_zeros() as usize;
+        let s = if x.0 >> f & 1 == 1 { 1 } else { -1 };
+        let on = crate::zones::wall(&self.faults.faults[f], s)(p).abs() <= ZONE_ON_WALL;
+        on.then_some((f, s))
+    }
+
+    /// Whether collapsing node `a` (cells labelled `la`) into `b` keeps the zones: where
+    /// `a`'s cells lie in the same zones it does; else they must differ in one zone only,
+    /// `a` lie on that zone's wall on one side of its fault, and `b` on the same wall, so
+    /// that the new faces between the zone's cells and the others lie on the wall.
+    fn zone_kept(&self, a: u32, b: u32, la: &[Label]) -> bool {
+        let differ = la.iter().fold(0, |m, l| m | (l.3 ^ la[0].3));
+        if differ == 0 {
+            return true;
+        }
+        if differ.count_ones() != 1 {
+            return false;
+        }
+        let f = differ.trailing_zeros() as usize;
+        let bit = la[0].0 >> f & 1;
+        if la.iter().any(|l| l.0 >> f & 1 != bit) {
+            return false;
+        }
+        let g = crate::zones::wall(&self.faults.faults[f], if bit == 1 { 1 } else { -1 });
+        g(self.st.points[a as usize]).abs() <= ZONE_ON_WALL
+            && g(self.st.points[b as usize]).abs() <= ZONE_ON_WALL
+    }
+
+    /// Whether a cell at `g` labelled as cell `like` keeps the zones as [`crate::check_zones`]
+    /// sees them, at half its tolerance: for every fault with a zone, its centroid inside
+    /// the walls where the fault is active if the cell is in that zone, else not inside
+    /// them. Tested only for operations on a node of a wall (`walled`: its cells differ in
+    /// their zones).
+    fn in_zone(&self, g: [[f64; 3]; 4], like: u32, walled: bool) -> bool {
+        if !walled {
+            return true;
+        }
+        let tol = 0.5 * crate::FAULT_TOLERANCE;
+        let (p, z) = (self.st.positive[like as usize], self.st.zone[like as usize]);
+        let c = [0, 1, 2].map(|k| g.iter().map(|q| q[k]).sum::<f64>() / 4.0);
+        self.faults.faults.iter().enumerate().all(|(f, x)| {
+            if x.zone <= 0.0 {
+                return true;
+            }
+            let s = if p >> f & 1 == 1 { 1 } else { -1 };
+            let inside = crate::zones::wall(x, s)(c);
+            if z >> f & 1 == 1 {
+                self.faults.active(f, p, c) && inside <= tol
+            } else {
+                !self.faults.active(f, p, c) || inside >= -tol
+            }
+        })
     }
 
     /// Moves node `v` (along its surface) up the gradient of the smallest angle of its
@@ -673,10 +767,12 @@ impl Pass<'_> {
                 break;
             }
         }
+        let walled = labels.iter().any(|l| l.3 != labels[0].3);
         if best < old + MIN_GAIN
-            || !cells
-                .iter()
-                .all(|&c| self.in_unit(self.st.tets[c as usize], geo(c, q), c))
+            || !cells.iter().all(|&c| {
+                let g = geo(c, q);
+                self.in_unit(self.st.tets[c as usize], g, c) && self.in_zone(g, c, walled)
+            })
         {
             return None;
         }
@@ -705,13 +801,10 @@ impl Pass<'_> {
     /// Where a node at `p` on a side and on one surface (between cells labelled `x` and `y`)
     /// may go towards `to`: along the line where that interface or fault meets the side (its
     /// one edge of the outline; not at a corner), if it lands on the surface.
-    fn along_side(
-        &self,
-        p: [f64; 3],
-        x: &(u64, u32, u32),
-        y: &(u64, u32, u32),
-        to: [f64; 3],
-    ) -> Option<[f64; 3]> {
+    fn along_side(&self, p: [f64; 3], x: &Label, y: &Label, to: [f64; 3]) -> Option<[f64; 3]> {
+        if x.3 != y.3 {
+            return None;
+        }
         let e = outline_edge(self.terrain, p)?;
         if x.0 == y.0 && x.2 == y.2 && y.1 == x.1 + 1 {
             // Interface x.1 of block x.2: along the edge, at the interface's height.
@@ -780,6 +873,7 @@ impl Pass<'_> {
             .iter()
             .map(|&c| self.angle[c as usize])
             .fold(f64::MAX, f64::min);
+        let walled = labels.iter().any(|l| l.3 != labels[0].3);
         for s in [1.0, 0.5, 0.25] {
             let to = [0, 1, 2].map(|k| p[k] + s * (mean[k] - p[k]));
             let q = self.slide(v, labels, to)?;
@@ -814,7 +908,7 @@ impl Pass<'_> {
                         self.st.points[w as usize]
                     }
                 });
-                self.in_unit(t, g, c)
+                self.in_unit(t, g, c) && self.in_zone(g, c, walled)
             };
             if ok
                 && new.iter().filter(|a| poor(a)).count() <= before
@@ -955,6 +1049,9 @@ pub(crate) fn improve(
             st.positive[k] = st.positive[c];
             st.below[k] = st.below[c];
             st.block[k] = st.block[c];
+            if !st.zone.is_empty() {
+                st.zone[k] = st.zone[c];
+            }
             k += 1;
         }
     }
@@ -962,6 +1059,9 @@ pub(crate) fn improve(
     st.positive.truncate(k);
     st.below.truncate(k);
     st.block.truncate(k);
+    if !st.zone.is_empty() {
+        st.zone.truncate(k);
+    }
     let mut used = vec![u32::MAX; st.points.len()];
     for t in &st.tets {
         for &v in t {
@@ -1016,6 +1116,7 @@ mod tests {
             positive: vec![0; m],
             below,
             block: vec![0; m],
+            zone: Vec::new(),
             report: BuildReport::default(),
         };
         for t in &mut st.tets {

@@ -73,10 +73,11 @@
 //!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
 //!    the smallest angle of its worst cell. What may change is read from the cells' labels
-//!    (side of every fault, unit): a node whose cells carry one label lies on no surface and
-//!    may move anywhere (on a side: vertically; on the base: horizontally); a node between two
-//!    units of one block moves along that interface (its height taken from `height`); a node
-//!    between the two sides of one fault moves along the fault (projected on it). A node is
+//!    (side of every fault, unit, fault zones): a node whose cells carry one label lies on no
+//!    surface and may move anywhere (on a side: vertically; on the base: horizontally); a node
+//!    between two units of one block moves along that interface (its height taken from
+//!    `height`); a node between the two sides of one fault moves along the fault (projected on
+//!    it); a node between the inside and the outside of one zone, on its wall, along the wall. A node is
 //!    collapsed into a neighbour only if every label around it is found around the neighbour
 //!    (so the neighbour lies on every surface it lies on), a node on the base only into one on
 //!    the base, never a node on a side, a node on the terrain only if the cutting made it
@@ -122,10 +123,13 @@
 //!
 //! # Fault zones ([`FaultSpec::zone`], [`ZoneCells`], [`check_zones`])
 //! A fault with a zone w thick keeps its own surface and faces; the walls at signed distance
-//! ±w/2 from it are cut after the objects (a node close to a wall and on no surface moved
-//! onto it, else the crossing edges split), and the cells between them, where the fault is
-//! active, are the zone's ([`FaultedMesh::zones`]); the local refinement counts each half of a
-//! zone as a slab. See `docs/geology.md`, "Faults (kernel)".
+//! ±w/2 from it are cut after the interfaces and before the quality pass (a node close to a
+//! wall and on no surface moved onto it, else the crossing edges split), and the cells between
+//! them, where the fault is active, are the zone's ([`FaultedMesh::zones`]). The quality pass
+//! keeps every cell's zones as one more label: no flip across a wall, a node on a wall moved
+//! along it or collapsed into a node on the same wall only, the cells it makes checked
+//! against the walls. The local refinement counts each half of a zone as a slab. See
+//! `docs/geology.md`, "Faults (kernel)".
 //!
 //! [`split_nodes`] duplicates the nodes on the faults (one copy per side) and
 //! [`check_split`] verifies that every fault face then appears twice. [`Site`] builds a

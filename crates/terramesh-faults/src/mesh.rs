@@ -151,6 +151,10 @@ pub(crate) struct State {
     pub(crate) positive: Vec<u64>,
     pub(crate) below: Vec<u32>,
     pub(crate) block: Vec<u32>,
+    /// Per cell, bit f: the cell lies between the walls of fault f's zone (empty until the
+    /// zones are cut, and without zones); kept by every split and the quality pass, so that
+    /// every wall stays a set of faces where two zones cross too.
+    pub(crate) zone: Vec<u64>,
     pub(crate) report: BuildReport,
 }
 
@@ -542,6 +546,7 @@ pub(crate) fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, F
         positive: vec![0; m],
         below: vec![0; m],
         block: vec![0; m],
+        zone: Vec::new(),
         report: BuildReport {
             background_cells: m,
             ..BuildReport::default()
@@ -761,6 +766,9 @@ pub(crate) fn split_cells_ranked(
             st.positive.push(st.positive[c]);
             st.below.push(st.below[c]);
             st.block.push(st.block[c]);
+            if !st.zone.is_empty() {
+                st.zone.push(st.zone[c]);
+            }
             child(c);
         }
     }
@@ -986,6 +994,17 @@ pub fn faulted_mesh_with_objects(
             }
         }
     }
+    let surfaces = crate::objects::Surfaces {
+        faults,
+        blocks: &blocks,
+        height,
+        interfaces,
+    };
+    // The zones' walls are cut before the quality pass, which keeps the zone labels (and so
+    // the walls, as it keeps the faults and interfaces) while it mends the cells next to them.
+    let mut object_cells = object_cells;
+    let mut zones =
+        crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
     let done = crate::improve::improve(
         &mut st,
         faults,
@@ -1000,14 +1019,8 @@ pub fn faulted_mesh_with_objects(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
-    let surfaces = crate::objects::Surfaces {
-        faults,
-        blocks: &blocks,
-        height,
-        interfaces,
-    };
-    let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
-    let zones = crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
+    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
+    zones.zone = crate::zones::labels(faults, &st.zone);
     let fault_faces = fault_faces(&st, faults);
     Ok(FaultedMesh {
         points: st.points,

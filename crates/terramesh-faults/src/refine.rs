@@ -91,7 +91,7 @@ impl Ctx<'_> {
             (Kind::Base, [p[0], p[1], b], [0.0, 0.0, 1.0]),
         ];
         let mut blocks: Vec<BlockKey> = Vec::new();
-        // A fault zone (cut after the quality pass): two slabs, each half its thickness.
+        // A fault zone (its walls cut before the quality pass): two slabs, each half its thickness.
         let mut zone = f64::INFINITY;
         for (f, fault) in self.faults.faults.iter().enumerate() {
             let d: Vec<f64> = zs

@@ -4,8 +4,10 @@
 //! A fault with a zone w thick keeps its own surface (cut as every fault, its faces the fault's
 //! faces, its two sides the blocks); the zone's two walls, the surfaces at a signed distance
 //! ±w/2 from the fault (the distance of [`crate::Side`]: to the plane of the fault's nearest
-//! piece, so a planar fault's walls are the two parallel planes), are cut after the quality
-//! pass and the engineering objects, as the objects' walls are: on each side s of the fault
+//! piece, so a planar fault's walls are the two parallel planes), are cut after the faults and
+//! interfaces and before the quality pass (which keeps them: every cell keeps the zones it
+//! lies in, a bit per fault, as one more label) and the engineering objects, as the objects'
+//! walls are: on each side s of the fault
 //! the field s·d(q) − w/2 is evaluated at the nodes of the cells on that side where the fault
 //! is active ([`FaultSet::active`] at their centroid: not beyond a fault it ends at, not below
 //! its depth), every edge whose ends it puts on both sides of the wall (a node within
@@ -18,7 +20,8 @@
 //! along an edge as the distance to a plane does: an edge crosses a wall at most once.
 //!
 //! A cell inside two zones (two zones that cross, or a zone that reaches the fault another
-//! ends at) belongs to the zone of the fault that ends at no other, then to the first in the
+//! ends at) lies in both while the mesh is made (so that both walls stay faces), and is
+//! labelled with the zone of the fault that ends at no other, then the first in the
 //! project's order: at a Y junction the zone of the fault that goes on is continuous and the
 //! other's stops at its wall.
 
@@ -147,8 +150,26 @@ fn order(faults: &FaultSet) -> Vec<usize> {
     o
 }
 
+/// Every cell's zone label from the zones it lies in (bit f: between the walls of fault f's
+/// zone): the first of them in [`order`], as 1 + the fault; 0 in none. Empty without zones.
+pub(crate) fn labels(faults: &FaultSet, inside: &[u64]) -> Vec<u32> {
+    let order = order(faults);
+    if order.is_empty() {
+        return Vec::new();
+    }
+    inside
+        .par_iter()
+        .map(|&m| {
+            order
+                .iter()
+                .find(|&&f| m >> f & 1 == 1)
+                .map_or(0, |&f| f as u32 + 1)
+        })
+        .collect()
+}
+
 /// The field of the wall of `fault`'s zone on side `s`: negative inside the zone.
-fn wall(fault: &Fault, s: i8) -> impl Fn([f64; 3]) -> f64 + Sync + '_ {
+pub(crate) fn wall(fault: &Fault, s: i8) -> impl Fn([f64; 3]) -> f64 + Sync + '_ {
     move |q| f64::from(s) * fault.side(q).distance - 0.5 * fault.zone
 }
 
@@ -188,7 +209,6 @@ fn snap(
     s: i8,
     edges: &[(u64, u32)],
     values: &mut [(f64, i8)],
-    zone: &[u32],
     objects: &ObjectCells,
     settings: &MeshSettings,
 ) -> usize {
@@ -214,7 +234,7 @@ fn snap(
             st.positive[c],
             st.below[c],
             st.block[c],
-            zone[c],
+            st.zone[c],
             objects.object.get(c).copied(),
             objects.lining.get(c).copied(),
         )
@@ -277,7 +297,7 @@ pub(crate) fn cut_zones(
     if order.is_empty() {
         return Ok(ZoneCells::default());
     }
-    let mut zone = vec![0u32; st.tets.len()];
+    st.zone = vec![0u64; st.tets.len()];
     let (mut split_edges, mut snapped) = (0, 0);
     for &f in &order {
         let fault = &faults.faults[f];
@@ -320,17 +340,7 @@ pub(crate) fn cut_zones(
                 .collect();
             edges.par_sort_unstable();
             edges.dedup_by_key(|e| e.0);
-            snapped += snap(
-                st,
-                &g,
-                fault,
-                s,
-                &edges,
-                &mut values,
-                &zone,
-                objects,
-                settings,
-            );
+            snapped += snap(st, &g, fault, s, &edges, &mut values, objects, settings);
             edges.retain(|&(k, _)| values[(k >> 32) as usize].1 * values[k as u32 as usize].1 < 0);
             let most = 0.5 * FAULT_TOLERANCE;
             let chords: Vec<[f64; 3]> = edges
@@ -359,8 +369,6 @@ pub(crate) fn cut_zones(
                 values.push((0.0, 0));
             }
             split_cells(st, &keys, first as u32, |c| {
-                let z = zone[c];
-                zone.push(z);
                 let x = sel[c];
                 sel.push(x);
                 if !objects.object.is_empty() {
@@ -414,15 +422,15 @@ pub(crate) fn cut_zones(
                     }
                 })
                 .collect();
-            for (z, i) in zone.iter_mut().zip(inside) {
-                if i && *z == 0 {
-                    *z = f as u32 + 1;
-                }
+            for (z, i) in st.zone.iter_mut().zip(inside) {
+                *z |= u64::from(i) << f;
             }
         }
     }
     Ok(ZoneCells {
-        zone,
+        // The cells' zones stay in `st.zone` (the quality pass and the objects' cut keep
+        // them); [`labels`] gives the labels at the end.
+        zone: Vec::new(),
         thickness: faults.faults.iter().map(|x| x.zone).collect(),
         split_edges,
         snapped,

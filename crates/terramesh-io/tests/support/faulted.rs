@@ -73,6 +73,24 @@ pub fn kernel_mesh(site: &Site, max_cell_height: f64) -> FaultedMesh {
     .unwrap()
 }
 
+/// The kernel's mesh of [`site`] with a fault zone `zones[f]` metres thick on fault f (0: none).
+pub fn kernel_mesh_zoned(site: &Site, max_cell_height: f64, zones: &[f64]) -> FaultedMesh {
+    let mut specs = site.specs();
+    for (s, &z) in specs.iter_mut().zip(zones) {
+        s.zone = z;
+    }
+    let set = FaultSet::new(&specs, &site.terrain, site.base).unwrap();
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    faulted_mesh(
+        &site.terrain,
+        &set,
+        site.tops.len(),
+        &h,
+        &MeshSettings::new(site.base, max_cell_height),
+    )
+    .unwrap()
+}
+
 /// The writers' model of a kernel mesh: [`terramesh_io::model::faulted_volume`], the facade's
 /// own conversion, with [`UNITS`] and the site's base.
 pub fn model(site: &Site, mesh: &FaultedMesh, split: bool) -> (VolumeMesh, FaultData) {
