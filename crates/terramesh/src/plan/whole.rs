@@ -75,3 +75,40 @@ impl Plan {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::project::Project;
+
+    /// Every example's plan, faults and engineering objects included, reads back from JSON
+    /// as it was (a tiled build's manifest holds it so).
+    #[test]
+    fn every_example_plan_reads_back_from_json() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+        let mut objects = 0;
+        let mut faults = 0;
+        for name in [
+            "haut-barr",
+            "kimberlina",
+            "shellmound",
+            "faulted",
+            "structures",
+        ] {
+            let p = Project::load(&root.join(name).join("terramesh.toml"), &[]).unwrap();
+            let plan = p.plan();
+            if let Some(g) = &plan.geology {
+                objects += g.objects.len();
+                faults += g.faults.len();
+            }
+            let json = serde_json::to_string_pretty(&plan).unwrap();
+            let again: Plan = serde_json::from_str(&json).unwrap();
+            assert_eq!(again, plan, "{name}: {json}");
+            again.check().unwrap();
+        }
+        assert!(
+            objects > 0 && faults > 0,
+            "{objects} objects, {faults} faults"
+        );
+    }
+}

@@ -341,7 +341,11 @@ mod tests {
         all.extend(KNOWN_VERTICAL_DATUMS.iter().map(|k| HeightDatum::Epsg(k.1)));
         for d in all {
             let json = serde_json::to_string(&d).unwrap();
-            assert_eq!(serde_json::from_str::<HeightDatum>(&json).unwrap(), d, "{json}");
+            assert_eq!(
+                serde_json::from_str::<HeightDatum>(&json).unwrap(),
+                d,
+                "{json}"
+            );
         }
     }
 }
