@@ -669,9 +669,12 @@ fn tiles_run_on_the_stored_plan_not_the_project_file() {
         &[],
     ));
     let m = manifest(&p);
-    let stored = m["plan"].as_str().unwrap();
-    assert!(stored.contains("min_angle = 25"), "{stored}");
-    assert_eq!(m["mesh"]["min_angle"].as_f64(), Some(25.0));
+    // The typed plan, restricted to a tile: the override, the size limit resolved, no strips.
+    let mesh = &m["plan"]["mesh"];
+    assert_eq!(mesh["min_angle"].as_f64(), Some(25.0), "{mesh}");
+    assert!(mesh["max_area"].as_f64().is_some_and(|a| a > 0.0), "{mesh}");
+    assert!(mesh["strips"].is_null(), "{mesh}");
+    assert_eq!(m["plan"]["interpolation"]["neighbors"].as_u64(), Some(64));
     // The project file is now something else entirely.
     std::fs::write(&project, "this is not a project").unwrap();
     for id in ids(&p) {

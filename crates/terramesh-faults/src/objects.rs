@@ -41,7 +41,8 @@ pub const ON_WALL: f64 = 1e-3;
 pub const OBJECT_TOLERANCE: f64 = 0.01;
 
 /// A tunnel's cross-section, centred on its axis.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "shape", rename_all = "lowercase")]
 pub enum Profile {
     /// A circle of this diameter.
     Circle {

@@ -20,7 +20,6 @@ use super::manifest::{owner, tile_dir, update, Manifest, State, Tile, TileSummar
 use super::partition::in_window;
 use crate::error::{Context, Doing, Result, TilesError as Error};
 use terramesh::build::Surface;
-use terramesh::project::Project;
 
 /// Set to a comma-separated list of tile ids, makes those tiles fail on purpose (to test
 /// retries and the rerun of a failed tile).
@@ -105,10 +104,8 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
             });
         }
     }
-    // The plan as it was planned (the project file is not read again).
-    let project = Project::parse(&m.project.display().to_string(), &m.plan, &[])
-        .doing(|| Doing::PlanStored)?;
-    let ip = &project.interpolation;
+    // The plan as it was planned, read with the manifest (the project file is not read).
+    let ip = &m.plan.interpolation;
     // The data window: the extent grown by the halo. The tile reads its own samples file
     // (plans before it existed: the whole region's, keeping its window).
     let file = match &tile.data {
@@ -147,6 +144,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     // The mesh: the planned ring, no vertex added on it, boundary fixed while smoothing.
     let t = Instant::now();
     let (mut mesh, _) = m
+        .plan
         .mesh
         .builder(None)
         .keep_boundary(true)
@@ -154,8 +152,8 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         .doing(|| Doing::Meshing {
             tile: tile.id.clone(),
         })?;
-    if m.mesh.smooth > 0 {
-        smooth_keeping(&mut mesh, m.mesh.smoother, m.mesh.smooth, &[]);
+    if m.plan.mesh.smooth > 0 {
+        smooth_keeping(&mut mesh, m.plan.mesh.smoother, m.plan.mesh.smooth, &[]);
     }
     let positions = planned_positions(&mesh, &tile.ring, &tile.id)?;
     let (positions, triangles) = sorted(positions, &mesh.triangles);
@@ -177,7 +175,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
         InterpolationMethod::Universal => (uk.clone(), &uk_engine),
         InterpolationMethod::Idw => (idw.clone(), &idw_engine),
         _ => {
-            other = Surface::primary(&project, &data, &variogram)?;
+            other = Surface::primary(ip, &data, &variogram)?;
             (other.predict(&positions, false)?.0, &other)
         }
     };
@@ -200,7 +198,7 @@ fn run(plan: &Path, m: &Manifest, tile: &Tile) -> Result<TileSummary> {
     let t = Instant::now();
     let model = match &m.geology {
         Some(gp) => Some(super::geology_tile::build_model(
-            plan, gp, &project, tile, &positions, &triangles, &dsm,
+            plan, gp, &m.plan, tile, &positions, &triangles, &dsm,
         )?),
         None => None,
     };

@@ -128,7 +128,8 @@ pub enum TilesError {
     },
     /// A manifest written by another version of terramesh.
     #[error(
-        "{}: manifest version {version} (this terramesh reads {reads}): plan again",
+        "{}: manifest version {version} (this terramesh reads {reads}): plan again with \
+         terramesh tiles plan",
         path.display()
     )]
     ManifestVersion {

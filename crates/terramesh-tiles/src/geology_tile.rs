@@ -14,7 +14,7 @@ use crate::error::{Context, Doing, PlanMismatch, Result, TilesError as Error};
 use terramesh::build::Surface;
 use terramesh::geology::model::{assemble_estimated, Base};
 use terramesh::plan::Base as BaseKey;
-use terramesh::project::Project;
+use terramesh::plan::Plan;
 
 /// One tile's geological model.
 pub(crate) struct TileModel {
@@ -33,18 +33,19 @@ pub(crate) struct TileModel {
 }
 
 /// Builds the model of one tile on its planar mesh (`xy`, its absolute positions, the planned
-/// ones on the boundary; `triangles`) under `terrain`.
+/// ones on the boundary; `triangles`) under `terrain`, with the manifest's plan `project`.
 pub(crate) fn build_model(
     plan: &Path,
     gp: &GeologyPlan,
-    project: &Project,
+    project: &Plan,
     tile: &super::manifest::Tile,
     xy: &[[f64; 2]],
     triangles: &[[u32; 3]],
     terrain: &[f64],
 ) -> Result<TileModel> {
     let g = project
-        .geology()
+        .geology
+        .as_ref()
         .ok_or(Error::PlanProject(PlanMismatch::NoGeology))?;
     let [x0, y0, x1, y1] = tile.extent;
     let hh = tile.geology_halo.unwrap_or(0.0);

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Context, Result, TilesError as Error};
+use crate::error::{Context, Doing, Result, TilesError as Error};
 
 /// The manifest's file name in the plan folder.
 pub const MANIFEST: &str = "tiles.json";
@@ -23,8 +23,9 @@ pub const LOCK: &str = "tiles.lock";
 pub const SAMPLES: &str = "samples.f64";
 /// The variogram every tile uses.
 pub const VARIOGRAM: &str = "variogram.json";
-/// The manifest format's version.
-pub const VERSION: u32 = 2;
+/// The manifest format's version: 3 since [`Manifest::plan`] is the typed plan (2 stored
+/// the project's TOML text, which each tile parsed again).
+pub const VERSION: u32 = 3;
 /// The most tiles a plan holds (`tiles plan` refuses a tile size that makes more).
 pub const MAX_TILES: usize = 100_000;
 
@@ -178,11 +179,15 @@ pub struct Manifest {
     pub project: PathBuf,
     /// Its `--set` overrides (for the record: the tiles run on [`Manifest::plan`]).
     pub set: Vec<String>,
-    /// The resolved plan every tile runs on: the project's TOML with the overrides applied
-    /// ([`terramesh::project::Project::plan_text`]), parsed again by each tile under the
-    /// project's file name; the project file itself is not read again, so a tile runs on the
-    /// plan as it was planned.
-    pub plan: String,
+    /// The resolved plan every tile runs on, restricted to a tile: the project's
+    /// ([`terramesh::project::Project::plan_in`], the overrides applied, the paths resolved
+    /// against the project file's absolute folder), with the mesh sub-plan every tile meshes
+    /// with: the size limit the one-piece build would use (`max_area` from the sampling cell
+    /// when the project gives none) and no strips (the tiles are the parallelism). A tile
+    /// and the merge read it as it is, checked ([`terramesh::plan::Plan::check`]); neither
+    /// reads the project file nor parses a project, so a tile runs on the plan as it was
+    /// planned.
+    pub plan: terramesh::plan::Plan,
     /// The tiles' side, metres.
     pub tile_size: f64,
     /// The south-west corner of the tile grid.
@@ -197,10 +202,6 @@ pub struct Manifest {
     pub variogram: String,
     /// The kriging frame of all the data (centre and scale), which every tile kriges in.
     pub frame: ([f64; 2], f64),
-    /// The mesh sub-plan of every tile: the project's, with the size limit the one-piece build
-    /// would use (`max_area` from the sampling cell when the project gives none) and no strips
-    /// (the tiles are the parallelism).
-    pub mesh: terramesh::plan::MeshPlan,
     /// The seams' and the outline's vertex spacing (0.7 target edge lengths, as the strips'
     /// cuts of `terramesh-mesh`).
     pub seam_spacing: f64,
@@ -405,17 +406,27 @@ impl Manifest {
             Ok(text) => text,
             Err(source) => return Err(Error::NoManifest { path, source }),
         };
-        let m: Manifest = serde_json::from_str(&text).at(&path)?;
-        if m.version != VERSION {
+        // The version first: another version's fields may not read as this one's (version 2
+        // stored the plan as TOML text).
+        #[derive(Deserialize)]
+        struct Version {
+            version: u32,
+        }
+        let v: Version = serde_json::from_str(&text).at(&path)?;
+        if v.version != VERSION {
             return Err(Error::ManifestVersion {
                 path,
-                version: m.version,
+                version: v.version,
                 reads: VERSION,
             });
         }
+        let m: Manifest = serde_json::from_str(&text).at(&path)?;
         if let Err(source) = m.check() {
             return Err(Error::Manifest { path, source });
         }
+        m.plan
+            .check()
+            .map_err(|e| Error::from(e).within(Doing::PlanStored).at(&path))?;
         Ok(m)
     }
 

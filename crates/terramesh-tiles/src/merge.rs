@@ -26,7 +26,7 @@ use super::appended::{self, put_f64, Array, Section, Values};
 use super::files::{self, Vertex};
 use super::manifest::{tile_dir, Manifest, State, Tile};
 use super::merged::Merged;
-use crate::error::{Context, Doing, Result, TilesError as Error};
+use crate::error::{Context, Result, TilesError as Error};
 
 /// Merges the built tiles of `plan` into `out` (created if needed): `dsm.vtu`, `dsm.tif`,
 /// `dsm.asc`, `merge.json` and `report.html` (a tile map with each tile's timings). Every
@@ -104,9 +104,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
     written.push(vtu);
 
     // The other surface formats of the project's `export.formats`, streamed.
-    let project =
-        terramesh::project::Project::parse(&m.project.display().to_string(), &m.plan, &[])
-            .doing(|| Doing::PlanStored)?;
+    let project = &m.plan;
     let title = project
         .title
         .clone()
@@ -122,7 +120,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
         crs_name: &crs_name,
         field_data: Vec::new(),
         stl_origin: [m.origin[0], m.origin[1], 0.0],
-        georef: georef_of(m, &project)?,
+        georef: georef_of(m, project)?,
         region: &m.region,
     };
     let surfaces = super::exports::write_surfaces(plan, m, &seams, out, &labels)?;
@@ -181,7 +179,7 @@ fn merge_into(plan: &Path, m: &Manifest, out: &Path, t0: Instant) -> Result<Merg
 /// `crs_text.zone`) or a CRS without an EPSG code.
 fn georef_of(
     m: &Manifest,
-    project: &terramesh::project::Project,
+    project: &terramesh::plan::Plan,
 ) -> Result<Option<terramesh::georef::Georef>> {
     use terramesh_io::export::Format;
     if !project.export.formats.iter().any(|f| {
@@ -207,7 +205,7 @@ fn georef_of(
         _ => None,
     };
     // glTF's `extras` name the datum as a one-piece build's do (`build/exports.rs`).
-    Ok(georef.map(|g| match project.named_height_datum() {
+    Ok(georef.map(|g| match &project.vertical_datum {
         Some(d) => g.with_datum(d.name(), d.describe()),
         None => g,
     }))

@@ -329,22 +329,26 @@ pub fn plan(
         }
         g
     });
+    let project_file = std::path::absolute(project_file).at(project_file)?;
+    let folder = project_file.parent().unwrap_or(Path::new(""));
     let mut manifest = Manifest {
         version: VERSION,
-        project: std::path::absolute(project_file).at(project_file)?,
+        plan: terramesh::plan::Plan {
+            mesh: terramesh::plan::MeshPlan {
+                max_area,
+                strips: None,
+                ..m.clone()
+            },
+            ..project.plan_in(folder)
+        },
+        project: project_file.clone(),
         set: set.to_vec(),
-        plan: project.plan_text().to_string(),
         tile_size,
         origin: lo,
         shape,
         region: outline,
         variogram: VARIOGRAM.into(),
         frame: (frame.centre, frame.scale),
-        mesh: terramesh::plan::MeshPlan {
-            max_area,
-            strips: None,
-            ..m.clone()
-        },
         seam_spacing: spacing,
         data: DataRule {
             samples: SAMPLES.into(),

@@ -44,11 +44,7 @@ impl Margin {
             Margin::PerAxis([x, y]) if x.is_finite() && y.is_finite() && x >= 0.0 && y >= 0.0 => {
                 (x, y)
             }
-            m => {
-                return Err(GridError::Invalid(format!(
-                    "margin {m:?} must be finite and not negative"
-                )))
-            }
+            margin => return Err(GridError::Margin { margin }),
         };
         Ok(([lo[0] - mx, lo[1] - my], [hi[0] + mx, hi[1] + my]))
     }
@@ -66,13 +62,66 @@ pub struct SamplingGrid {
     pub clip: bool,
 }
 
-/// Errors building a grid.
+/// Errors building a grid: which request was refused, with its values.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum GridError {
-    /// The grid request is invalid.
-    #[error("{0}")]
-    Invalid(String),
+    /// A margin that is not finite or is negative.
+    #[error("margin {margin:?} must be finite and not negative")]
+    Margin {
+        /// The margin asked for.
+        margin: Margin,
+    },
+    /// A region without vertices.
+    #[error("the region has no vertices")]
+    EmptyRegion,
+    /// A region whose bounding box has no area.
+    #[error("the region has zero width or height")]
+    FlatRegion {
+        /// The bounding box's width.
+        width: f64,
+        /// Its height.
+        height: f64,
+    },
+    /// Fewer than 2 rows or columns.
+    #[error("a grid needs at least 2 rows and 2 columns, got {rows} x {cols}")]
+    TooFewNodes {
+        /// Rows asked for.
+        rows: usize,
+        /// Columns asked for.
+        cols: usize,
+    },
+    /// A spacing that is not a positive number.
+    #[error("spacing {spacing} must be a positive number")]
+    Spacing {
+        /// The spacing asked for.
+        spacing: f64,
+    },
+    /// More nodes than a grid holds (500 million).
+    #[error(
+        "{rows} x {cols} = {total} nodes is too many; use fewer rows/columns or a larger spacing"
+    )]
+    TooManyNodes {
+        /// Rows.
+        rows: usize,
+        /// Columns.
+        cols: usize,
+        /// Rows times columns.
+        total: u128,
+    },
+    /// Nodes that would pass the memory ceiling ([`crate::limits`]).
+    #[error("{rows} x {cols}: {limit}; use fewer rows/columns or a larger spacing")]
+    OverMemory {
+        /// Rows.
+        rows: usize,
+        /// Columns.
+        cols: usize,
+        /// The estimate and the ceiling.
+        limit: crate::limits::TooLarge,
+    },
+    /// A latitude/longitude grid over a region that is not geographic.
+    #[error("a latitude/longitude grid needs a geographic region")]
+    LatLonNotGeographic,
 }
 
 /// A grid of sample nodes, in the plane of the region.
@@ -104,13 +153,13 @@ impl SamplingGrid {
     /// # Ok::<(), terramesh_core::sampling::GridError>(())
     /// ```
     pub fn build(&self, region: &Region) -> Result<Grid, GridError> {
-        let bad = |m: String| GridError::Invalid(m);
-        let (lo, hi) = region
-            .bbox()
-            .ok_or_else(|| bad("the region has no vertices".into()))?;
+        let (lo, hi) = region.bbox().ok_or(GridError::EmptyRegion)?;
         let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         if !(w > 0.0 && h > 0.0) {
-            return Err(bad("the region has zero width or height".into()));
+            return Err(GridError::FlatRegion {
+                width: w,
+                height: h,
+            });
         }
         let (lo, hi) = self.margin.enlarge(lo, hi)?;
         let (x0, y0) = (lo[0], lo[1]);
@@ -118,15 +167,13 @@ impl SamplingGrid {
         let (rows, cols, dx, dy) = match self.size {
             GridSize::RowsCols { rows, cols } => {
                 if rows < 2 || cols < 2 {
-                    return Err(bad(format!(
-                        "a grid needs at least 2 rows and 2 columns, got {rows} x {cols}"
-                    )));
+                    return Err(GridError::TooFewNodes { rows, cols });
                 }
                 (rows, cols, w / (cols - 1) as f64, h / (rows - 1) as f64)
             }
             GridSize::Spacing(s) => {
                 if !(s.is_finite() && s > 0.0) {
-                    return Err(bad(format!("spacing {s} must be a positive number")));
+                    return Err(GridError::Spacing { spacing: s });
                 }
                 let n = |len: f64| (len / s * (1.0 + 1e-12)).floor() as usize + 1;
                 (n(h), n(w), s, s)
@@ -134,18 +181,12 @@ impl SamplingGrid {
         };
         let total = rows as u128 * cols as u128;
         if total > 500_000_000 {
-            return Err(bad(format!(
-                "{rows} x {cols} = {total} nodes is too many; use fewer rows/columns or a larger spacing"
-            )));
+            return Err(GridError::TooManyNodes { rows, cols, total });
         }
         // A node ([f64; 2]) and its grid index, 24 bytes, against the memory ceiling.
         crate::limits::Estimate::new("grid nodes", total as f64, 24.0)
             .check()
-            .map_err(|e| {
-                bad(format!(
-                    "{rows} x {cols}: {e}; use fewer rows/columns or a larger spacing"
-                ))
-            })?;
+            .map_err(|limit| GridError::OverMemory { rows, cols, limit })?;
         let mut nodes = Vec::with_capacity(if self.clip { 0 } else { total as usize });
         let mut index = Vec::with_capacity(nodes.capacity());
         for r in 0..rows {
@@ -266,5 +307,116 @@ mod tests {
         assert!(mk(GridSize::Spacing(0.0), Margin::Fraction(0.0)).is_err());
         assert!(mk(GridSize::Spacing(1.0), Margin::Fraction(-0.1)).is_err());
         assert!(mk(GridSize::Spacing(1e-6), Margin::Fraction(0.0)).is_err());
+    }
+
+    fn build(size: GridSize, margin: Margin, region: &Region) -> GridError {
+        SamplingGrid {
+            size,
+            margin,
+            clip: false,
+        }
+        .build(region)
+        .unwrap_err()
+    }
+
+    const TWO: GridSize = GridSize::RowsCols { rows: 2, cols: 2 };
+    const NONE: Margin = Margin::Fraction(0.0);
+
+    #[test]
+    fn a_bad_margin_is_refused_with_its_value() {
+        let e = build(TWO, Margin::Absolute(-1.0), &rect());
+        assert_eq!(
+            e,
+            GridError::Margin {
+                margin: Margin::Absolute(-1.0)
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "margin Absolute(-1.0) must be finite and not negative"
+        );
+    }
+
+    #[test]
+    fn a_region_without_vertices_is_refused() {
+        let e = build(TWO, NONE, &Region::from_ring(vec![]));
+        assert_eq!(e, GridError::EmptyRegion);
+        assert_eq!(e.to_string(), "the region has no vertices");
+    }
+
+    #[test]
+    fn a_flat_region_is_refused_with_its_extent() {
+        let line = Region::from_ring(vec![[0.0, 5.0], [10.0, 5.0], [4.0, 5.0]]);
+        let e = build(TWO, NONE, &line);
+        assert_eq!(
+            e,
+            GridError::FlatRegion {
+                width: 10.0,
+                height: 0.0
+            }
+        );
+        assert_eq!(e.to_string(), "the region has zero width or height");
+    }
+
+    #[test]
+    fn too_few_rows_are_refused_with_the_counts() {
+        let e = build(GridSize::RowsCols { rows: 1, cols: 5 }, NONE, &rect());
+        assert_eq!(e, GridError::TooFewNodes { rows: 1, cols: 5 });
+        assert_eq!(
+            e.to_string(),
+            "a grid needs at least 2 rows and 2 columns, got 1 x 5"
+        );
+    }
+
+    #[test]
+    fn a_bad_spacing_is_refused_with_its_value() {
+        let e = build(GridSize::Spacing(-2.0), NONE, &rect());
+        assert_eq!(e, GridError::Spacing { spacing: -2.0 });
+        assert_eq!(e.to_string(), "spacing -2 must be a positive number");
+    }
+
+    #[test]
+    fn too_many_nodes_are_refused_with_the_counts() {
+        let size = GridSize::RowsCols {
+            rows: 100_000,
+            cols: 10_000,
+        };
+        let e = build(size, NONE, &rect());
+        assert_eq!(
+            e,
+            GridError::TooManyNodes {
+                rows: 100_000,
+                cols: 10_000,
+                total: 1_000_000_000
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "100000 x 10000 = 1000000000 nodes is too many; use fewer rows/columns or a larger \
+             spacing"
+        );
+    }
+
+    #[test]
+    fn nodes_past_the_memory_ceiling_are_refused_with_the_estimate() {
+        // 400 million nodes of 24 bytes: under the node cap, over the default 8 GiB. A ceiling
+        // raised by the environment would let the grid allocate 9.6 GB: not here.
+        if std::env::var_os(crate::limits::MAX_MEMORY_VAR).is_some() {
+            return;
+        }
+        let size = GridSize::RowsCols {
+            rows: 20_000,
+            cols: 20_000,
+        };
+        let e = build(size, NONE, &rect());
+        let GridError::OverMemory { rows, cols, limit } = &e else {
+            panic!("{e:?}");
+        };
+        assert_eq!((*rows, *cols), (20_000, 20_000));
+        assert_eq!(
+            e.to_string(),
+            format!("20000 x 20000: {limit}; use fewer rows/columns or a larger spacing")
+        );
+        assert!(limit.to_string().contains("grid nodes"), "{limit}");
     }
 }

@@ -94,9 +94,7 @@ pub fn grid_nodes(
                 })
             })
             .collect(),
-        (GridPlane::LatLon, _, _) => Err(NodeError::Grid(GridError::Invalid(
-            "a latitude/longitude grid needs a geographic region".into(),
-        ))),
+        (GridPlane::LatLon, _, _) => Err(NodeError::Grid(GridError::LatLonNotGeographic)),
     }
 }
 
@@ -110,4 +108,29 @@ pub enum NodeError {
     /// A node could not be converted between UTM and WGS-84.
     #[error(transparent)]
     Coord(#[from] CoordError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{GridSize, Margin};
+
+    #[test]
+    fn a_latlon_grid_over_a_projected_region_is_refused() {
+        let r = Region::from_ring(vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]);
+        let spec = SamplingGrid {
+            size: GridSize::RowsCols { rows: 2, cols: 2 },
+            margin: Margin::Fraction(0.0),
+            clip: false,
+        };
+        let e = grid_nodes(&r, None, None, &spec, GridPlane::LatLon).unwrap_err();
+        assert!(
+            matches!(e, NodeError::Grid(GridError::LatLonNotGeographic)),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "a latitude/longitude grid needs a geographic region"
+        );
+    }
 }

@@ -76,7 +76,8 @@ use terramesh_geology::boreholes::{ContactError, HoleRules};
 pub const DEFAULT_MAX_INVERSION: f64 = 10.0;
 
 /// The unit log of the holes.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum LogFile {
     /// `hole,from,to,unit`.
     Intervals(PathBuf),
@@ -85,7 +86,8 @@ pub enum LogFile {
 }
 
 /// The files of a borehole data set.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BoreholeFiles {
     /// `hole,x,y,z` or `hole,lat,lon,z`.
     pub collars: PathBuf,

@@ -106,9 +106,9 @@ fn parse_list(
     text: &str,
     one: impl Fn(usize, &str) -> Result<[f64; 2], RegionError>,
 ) -> Result<Vec<[f64; 2]>, RegionError> {
-    let invalid = |message: String| RegionError::Invalid {
+    let too_few = |distinct| RegionError::TooFewCorners {
         source_name: super::CORNER_LIST.into(),
-        message,
+        distinct,
     };
     let mut ring = Vec::new();
     for (i, part) in text.split(';').enumerate() {
@@ -116,7 +116,7 @@ fn parse_list(
             ring.push(one(i + 1, part)?);
         }
     }
-    finish_ring(ring).map_err(invalid)
+    finish_ring(ring).map_err(too_few)
 }
 
 /// Reads a corners CSV with columns `lat,lon` (decimal or DMS).
@@ -132,9 +132,9 @@ pub(super) fn read_corners_csv(path: &Path) -> Result<Vec<[f64; 2]>, RegionError
             .map_err(|e| t.bad_value(r, lo, &e.to_string()))?;
         ring.push([lon, lat]);
     }
-    finish_ring(ring).map_err(|message| RegionError::Invalid {
+    finish_ring(ring).map_err(|distinct| RegionError::TooFewCorners {
         source_name: path.display().to_string(),
-        message,
+        distinct,
     })
 }
 
@@ -156,13 +156,10 @@ pub fn parse_projected_corners(text: &str) -> Result<Vec<[f64; 2]>, RegionError>
             .collect();
         match parsed.as_deref() {
             Some([n, e]) if n.is_finite() && e.is_finite() => Ok([*e, *n]),
-            _ => Err(RegionError::Invalid {
+            _ => Err(RegionError::ProjectedCorner {
                 source_name: super::CORNER_LIST.into(),
-                message: format!(
-                    "corner {i} '{}': in projected coordinates each corner is NORTHING EASTING \
-                     in metres, e.g. \"5397932.106 377676.932\"",
-                    part.trim()
-                ),
+                corner: i,
+                text: part.trim().to_string(),
             }),
         }
     })
@@ -177,14 +174,15 @@ pub(super) fn read_projected_csv(path: &Path) -> Result<Vec<[f64; 2]>, RegionErr
     for r in 0..t.records.len() {
         ring.push([t.number(r, x)?, t.number(r, y)?]);
     }
-    finish_ring(ring).map_err(|message| RegionError::Invalid {
+    finish_ring(ring).map_err(|distinct| RegionError::TooFewCorners {
         source_name: path.display().to_string(),
-        message,
+        distinct,
     })
 }
 
-/// Drops a repeated closing vertex and consecutive duplicates; requires 3 distinct vertices.
-pub(crate) fn finish_ring(mut ring: Vec<[f64; 2]>) -> Result<Vec<[f64; 2]>, String> {
+/// Drops a repeated closing vertex and consecutive duplicates; requires 3 distinct vertices
+/// (the error: how many it has).
+pub(crate) fn finish_ring(mut ring: Vec<[f64; 2]>) -> Result<Vec<[f64; 2]>, usize> {
     ring.dedup();
     if ring.len() > 1 && ring.first() == ring.last() {
         ring.pop();
@@ -193,10 +191,7 @@ pub(crate) fn finish_ring(mut ring: Vec<[f64; 2]>) -> Result<Vec<[f64; 2]>, Stri
     distinct.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
     distinct.dedup();
     if distinct.len() < 3 {
-        return Err(format!(
-            "a region needs at least 3 distinct corners, found {}",
-            distinct.len()
-        ));
+        return Err(distinct.len());
     }
     Ok(ring)
 }
@@ -269,6 +264,45 @@ mod tests {
             parse_corners("0 0; 0 1; 48.5").unwrap_err().to_string(),
             "the corner list: corner 3: corner '48.5' needs a latitude and a longitude, e.g. \
              \"48.7224 7.3368\""
+        );
+    }
+
+    #[test]
+    fn too_few_distinct_corners_are_counted_in_the_list_or_the_file() {
+        let e = parse_corners("0 0; 0 1; 0 0").unwrap_err();
+        assert!(
+            matches!(&e, RegionError::TooFewCorners { source_name, distinct: 2 }
+                if source_name == crate::region::CORNER_LIST),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "the corner list: a region needs at least 3 distinct corners, found 2"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("corners.csv");
+        std::fs::write(&path, "x,y\n1,2\n1,2\n").unwrap();
+        let e = read_projected_csv(&path).unwrap_err();
+        assert!(
+            matches!(&e, RegionError::TooFewCorners { source_name, distinct: 1 }
+                if *source_name == path.display().to_string()),
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_projected_corner_that_does_not_read_is_named_with_its_text() {
+        let e =
+            parse_projected_corners("5397932 377676; 5397926 377941; 5398326 east").unwrap_err();
+        assert!(
+            matches!(&e, RegionError::ProjectedCorner { source_name, corner: 3, text }
+                if source_name == crate::region::CORNER_LIST && text == "5398326 east"),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "the corner list: corner 3 '5398326 east': in projected coordinates each corner is \
+             NORTHING EASTING in metres, e.g. \"5397932.106 377676.932\""
         );
     }
 }

@@ -20,13 +20,32 @@ pub use wkt::{parse_wkt, WktError, WktProblem, MAX_WKT_DEPTH};
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum RegionError {
-    /// A corner list or file that cannot be understood.
-    #[error("{source_name}: {message}")]
-    Invalid {
-        /// The inline text or file name.
+    /// A corner list or file with fewer than 3 distinct corners.
+    #[error("{source_name}: a region needs at least 3 distinct corners, found {distinct}")]
+    TooFewCorners {
+        /// The inline text ([`CORNER_LIST`]) or file name.
         source_name: String,
-        /// What is wrong and what to do.
-        message: String,
+        /// The distinct corners it has.
+        distinct: usize,
+    },
+    /// A corner of an inline list of projected corners that is not `NORTHING EASTING`.
+    #[error(
+        "{source_name}: corner {corner} '{text}': in projected coordinates each corner is \
+         NORTHING EASTING in metres, e.g. \"5397932.106 377676.932\""
+    )]
+    ProjectedCorner {
+        /// The list ([`CORNER_LIST`]).
+        source_name: String,
+        /// The corner's 1-based number in the list.
+        corner: usize,
+        /// The corner as written (trimmed).
+        text: String,
+    },
+    /// A region without vertices.
+    #[error("{source_name}: the region has no vertices")]
+    NoVertices {
+        /// The region's source.
+        source_name: String,
     },
     /// A corner of an inline list that does not read.
     #[error("{source_name}: corner {corner}: {source}")]
@@ -244,9 +263,8 @@ fn project_named(
     let zone = match zone {
         Some(z) => z,
         None => {
-            let (lo, hi) = geographic.bbox().ok_or_else(|| RegionError::Invalid {
+            let (lo, hi) = geographic.bbox().ok_or_else(|| RegionError::NoVertices {
                 source_name: name.to_string(),
-                message: "the region has no vertices".into(),
             })?;
             Zone::for_point(0.5 * (lo[1] + hi[1]), 0.5 * (lo[0] + hi[0]))
                 .map_err(|e| failed("the centre of the region".into(), e))?
@@ -314,6 +332,16 @@ fn looks_like_file(s: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_region_without_vertices_is_refused_naming_it() {
+        let e = project(Region::from_ring(vec![]), None).unwrap_err();
+        assert!(
+            matches!(&e, RegionError::NoVertices { source_name } if source_name == "the region"),
+            "{e:?}"
+        );
+        assert_eq!(e.to_string(), "the region: the region has no vertices");
+    }
 
     fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> PathBuf {
         let p = dir.path().join(name);

@@ -35,6 +35,7 @@
 use serde::Serialize;
 use terramesh_geostat::{Folds, InterpolationMethod};
 
+use crate::plan::InterpolationPlan;
 use crate::project::Project;
 
 /// The largest number of samples that the defaults krige globally and cross-validate by
@@ -121,28 +122,7 @@ pub fn choose(p: &Project, samples: usize) -> Choice {
         "interpolation.methods is idw alone: no variogram fitted, nothing kriged".into()
     };
     let big = samples > MAX_GLOBAL_SAMPLES;
-    let (neighbours, neighbours_why) = match (ip.neighbors.get(), big) {
-        (Some(0), _) => (
-            Neighbours::All,
-            "global: interpolation.neighbors = 0".to_string(),
-        ),
-        (Some(k), _) => (
-            Neighbours::Nearest(k),
-            format!("{k} neighbours: interpolation.neighbors = {k}"),
-        ),
-        (None, false) => (
-            Neighbours::All,
-            format!("global (the default up to {MAX_GLOBAL_SAMPLES} samples): {samples} samples"),
-        ),
-        (None, true) => (
-            Neighbours::Nearest(DEFAULT_NEIGHBORS),
-            format!(
-                "{DEFAULT_NEIGHBORS} neighbours (the default above {MAX_GLOBAL_SAMPLES} \
-                 samples, global kriging growing as n³): {samples} samples; \
-                 interpolation.neighbors = 0 asks for global kriging"
-            ),
-        ),
-    };
+    let (neighbours, neighbours_why) = choose_neighbours(ip, samples);
     let global = neighbours == Neighbours::All && krige;
     let (folds, folds_why) = match (ip.cv_folds.get(), big) {
         (Some(0), _) => (
@@ -183,6 +163,32 @@ pub fn choose(p: &Project, samples: usize) -> Choice {
         neighbours_why,
         folds,
         folds_why,
+    }
+}
+
+/// The kriging neighbourhood of `ip` on `samples` samples, and why ([`choose`]'s).
+pub fn choose_neighbours(ip: &InterpolationPlan, samples: usize) -> (Neighbours, String) {
+    match (ip.neighbors.get(), samples > MAX_GLOBAL_SAMPLES) {
+        (Some(0), _) => (
+            Neighbours::All,
+            "global: interpolation.neighbors = 0".to_string(),
+        ),
+        (Some(k), _) => (
+            Neighbours::Nearest(k),
+            format!("{k} neighbours: interpolation.neighbors = {k}"),
+        ),
+        (None, false) => (
+            Neighbours::All,
+            format!("global (the default up to {MAX_GLOBAL_SAMPLES} samples): {samples} samples"),
+        ),
+        (None, true) => (
+            Neighbours::Nearest(DEFAULT_NEIGHBORS),
+            format!(
+                "{DEFAULT_NEIGHBORS} neighbours (the default above {MAX_GLOBAL_SAMPLES} \
+                 samples, global kriging growing as n³): {samples} samples; \
+                 interpolation.neighbors = 0 asks for global kriging"
+            ),
+        ),
     }
 }
 

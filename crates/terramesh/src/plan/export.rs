@@ -1,7 +1,7 @@
 //! The export sub-plan (`[export]`): the surface formats, the sealed solid's base, the DSM
 //! grid, pictures and the report; its defaults and its one range check.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use terramesh_io::export::{Format, DEFAULT_FORMATS};
 
 use crate::error::{Error, Result};
@@ -15,7 +15,7 @@ pub const MIN_BASE_ELEVATION: f64 = terramesh_core::limits::MIN_ELEVATION;
 pub const MAX_BASE_ELEVATION: f64 = terramesh_core::limits::MAX_ELEVATION;
 
 /// `[export]`: step 5.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExportPlan {
     /// Surface formats: `vtu`, `obj`, `ply`, `stl`, `ts`, `msh`, `dxf`, `kml`, `dae` (COLLADA

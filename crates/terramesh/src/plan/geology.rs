@@ -59,7 +59,8 @@ pub enum FaultKind {
 }
 
 /// How a fault's surface is given, paths resolved.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum FaultSource {
     /// A trace on the terrain, a dip (degrees below horizontal) and a dip direction (degrees
     /// clockwise from grid north).
@@ -78,7 +79,8 @@ pub enum FaultSource {
 }
 
 /// One fault of `[[geology.faults]]`, lowered.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FaultPlan {
     /// Its name.
     pub name: String,
@@ -98,7 +100,8 @@ pub struct FaultPlan {
 }
 
 /// The model bottom.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Base {
     /// Chosen by the model builder below the lowest interface.
     Auto,
@@ -110,7 +113,8 @@ pub enum Base {
 
 /// The geology sub-plan: `[geology]` lowered, every value typed, paths resolved, per-unit
 /// settings in column order.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GeologyPlan {
     /// The borehole files, when the project gives boreholes.
     pub boreholes: Option<BoreholeFiles>,

@@ -14,7 +14,7 @@
 
 use std::path::PathBuf;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use terramesh_geostat::{Drift, Duplicates, InterpolationMethod, DEFAULT_IDW_POWER, DEFAULT_MODES};
 
 use super::variogram::{LagPlan, ModelParts};
@@ -32,7 +32,7 @@ pub const DEFAULT_IDW_NEIGHBORS: usize = 16;
 /// range = 600.0, nugget = 1.0 }`, or nested, `model = { model = "spherical+exponential",
 /// psill = [800.0, 400.0], range = [300.0, 900.0], nugget = 1.0 }`, with optional
 /// `shape` (one or a list), `anisotropy_angle` and `anisotropy_ratio`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VariogramSpec {
     /// Model name (`spherical`, `exponential`, `gaussian`, ...), or up to three joined by `+`.
@@ -56,7 +56,7 @@ pub struct VariogramSpec {
 }
 
 /// A number, or a list of numbers (one per nested structure).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum Numbers {
     /// One value.
@@ -109,7 +109,7 @@ impl VariogramSpec {
 }
 
 /// `[interpolation]`: step 4.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InterpolationPlan {
     /// Methods to run (`uk`, `ok`, `sk`, `idw`); the first gives the DSM elevations, all are
@@ -231,7 +231,7 @@ impl Default for InterpolationPlan {
 /// assert_eq!(Auto::from(0).get(), Some(0)); // asked for: global kriging, leave-one-out
 /// assert_eq!(format!("{:?} {:?}", Auto::UNSET, Auto::from(64)), "0 64");
 /// ```
-#[derive(Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(transparent)]
 pub struct Auto(Option<usize>);
 

@@ -18,6 +18,7 @@ mod mesh;
 mod objects;
 mod sample;
 mod variogram;
+mod whole;
 
 pub use export::{ExportPlan, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 pub use geology::{
@@ -31,3 +32,4 @@ pub use mesh::{MeshPlan, DEFAULT_SMOOTH, MAX_STRIPS};
 pub use objects::{ObjectPlan, ObjectSource, Profile, DEFAULT_STRUCTURE_RESOLUTION};
 pub use sample::{SamplingPlan, DEFAULT_COLS, DEFAULT_MARGIN, DEFAULT_ROWS};
 pub use variogram::{LagPlan, ModelParts};
+pub use whole::Plan;

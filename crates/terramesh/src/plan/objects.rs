@@ -8,7 +8,8 @@ use std::path::PathBuf;
 pub use terramesh_faults::{Profile, STRUCTURE_RESOLUTION as DEFAULT_STRUCTURE_RESOLUTION};
 
 /// What an object is and where its geometry comes from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum ObjectSource {
     /// A tunnel: its axis file (CSV `x,y,z`), its profile and its lining's thickness (0:
     /// none).
@@ -39,7 +40,8 @@ pub enum ObjectSource {
 }
 
 /// One object, lowered.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ObjectPlan {
     /// Its name.
     pub name: String,

@@ -1,7 +1,7 @@
 //! The sampling sub-plan (`[sampling]`): the grid of the paper's step 1, its defaults and its
 //! one range check.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use terramesh_core::sampling::Kernel;
 
 use crate::error::{Error, Result};
@@ -15,7 +15,7 @@ pub const DEFAULT_COLS: usize = 50;
 pub const DEFAULT_MARGIN: f64 = 0.1;
 
 /// `[sampling]`: the grid of the paper's step 1.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SamplingPlan {
     /// Grid rows (north-south).

@@ -267,6 +267,14 @@ fn vertical_code(code: u32) -> Result<u16, HeightDatumError> {
     u16::try_from(code).map_err(|_| HeightDatumError::TooLarge { code })
 }
 
+/// As [`HeightDatum::name`] writes it (`egm96`, `EPSG:<code>`, `source`), which
+/// `FromStr` reads back.
+impl serde::Serialize for HeightDatum {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.name())
+    }
+}
+
 impl<'de> Deserialize<'de> for HeightDatum {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<HeightDatum, D::Error> {
         let s = String::deserialize(d)?;
@@ -323,6 +331,21 @@ mod tests {
             assert_eq!(vertical_code(u32::from(*code)), Ok(*code), "{name}");
             let by_code: HeightDatum = format!("EPSG:{code}").parse().unwrap();
             assert_eq!(by_code.name(), *name);
+        }
+    }
+
+    /// A tiled build's manifest stores the datum in JSON: every datum reads back as it was.
+    #[test]
+    fn every_datum_reads_back_from_json() {
+        let mut all = vec![HeightDatum::Source, HeightDatum::Epsg(5703)];
+        all.extend(KNOWN_VERTICAL_DATUMS.iter().map(|k| HeightDatum::Epsg(k.1)));
+        for d in all {
+            let json = serde_json::to_string(&d).unwrap();
+            assert_eq!(
+                serde_json::from_str::<HeightDatum>(&json).unwrap(),
+                d,
+                "{json}"
+            );
         }
     }
 }

@@ -19,7 +19,7 @@ pub use objects::{ExcavationSection, StructureSection, TunnelSection};
 
 use std::path::PathBuf;
 
-use crate::plan::{ExportPlan, GeologyPlan, InterpolationPlan, MeshPlan, SamplingPlan};
+use crate::plan::{ExportPlan, GeologyPlan, InterpolationPlan, MeshPlan, Plan, SamplingPlan};
 use serde::Deserialize;
 
 /// A whole project.
@@ -85,6 +85,42 @@ impl Project {
     /// ```
     pub fn plan_text(&self) -> &str {
         &self.text
+    }
+
+    /// The resolved plan the stages take ([`Plan`]), its paths resolved against the project
+    /// file's folder (as [`Project::geology`]'s).
+    pub fn plan(&self) -> Plan {
+        self.plan_with(self.geology_settings.clone())
+    }
+
+    /// [`Project::plan`] with the paths resolved against `folder` instead: a tiled build
+    /// stores the plan with the project file's absolute folder, so that a tile finds the files
+    /// from any working directory.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use terramesh::project::{Project, GEOLOGY_TEMPLATE, TEMPLATE};
+    /// let text = format!("{TEMPLATE}{GEOLOGY_TEMPLATE}");
+    /// let p = Project::parse("site/terramesh.toml", &text, &[])?;
+    /// let plan = p.plan_in(Path::new("/data/site"));
+    /// let again = Project::parse("/data/site/terramesh.toml", &text, &[])?;
+    /// assert_eq!(plan, again.plan());
+    /// # Ok::<(), terramesh::Error>(())
+    /// ```
+    pub fn plan_in(&self, folder: &std::path::Path) -> Plan {
+        self.plan_with(self.geology.as_ref().map(|g| g.lower(folder)))
+    }
+
+    fn plan_with(&self, geology: Option<GeologyPlan>) -> Plan {
+        Plan {
+            title: self.title.clone(),
+            sampling: self.sampling.clone(),
+            mesh: self.mesh.clone(),
+            interpolation: self.interpolation.clone(),
+            export: self.export.clone(),
+            geology,
+            vertical_datum: self.named_height_datum(),
+        }
     }
 }
 

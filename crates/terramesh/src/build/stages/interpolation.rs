@@ -13,6 +13,7 @@ use terramesh_geostat::{
 
 use crate::build::scale::Choice;
 use crate::error::{Context, Error, Result};
+use crate::plan::InterpolationPlan;
 use crate::project::Project;
 
 /// Step 4: vertex elevations by UK and IDW, a DSM grid, and cross-validation.
@@ -430,21 +431,29 @@ impl Surface {
         )))
     }
 
-    /// The surface of the project's first interpolation method, which gives the DSM.
-    pub fn primary(p: &Project, data: &Data, v: &Variogram) -> Result<Surface> {
-        Surface::primary_with(p, data, v, None)
+    /// The surface of the plan's first interpolation method, which gives the DSM.
+    pub fn primary(ip: &InterpolationPlan, data: &Data, v: &Variogram) -> Result<Surface> {
+        Surface::primary_of(ip, data, v, None)
     }
 
-    /// [`Surface::primary`], with the external drift when there is one.
+    /// [`Surface::primary`] of a project, with the external drift when there is one.
     pub(crate) fn primary_with(
         p: &Project,
         data: &Data,
         v: &Variogram,
         drift: Option<&crate::external_drift::ModelDrift>,
     ) -> Result<Surface> {
-        let ip = &p.interpolation;
-        let neighbors = crate::build::scale::choose(p, data.len())
-            .neighbours
+        Surface::primary_of(&p.interpolation, data, v, drift)
+    }
+
+    fn primary_of(
+        ip: &InterpolationPlan,
+        data: &Data,
+        v: &Variogram,
+        drift: Option<&crate::external_drift::ModelDrift>,
+    ) -> Result<Surface> {
+        let neighbors = crate::build::scale::choose_neighbours(ip, data.len())
+            .0
             .count();
         match ip.methods[0].method(ip.drift, None, data) {
             Some(method) => Surface::kriging_with(data, v, method, neighbors, drift),
