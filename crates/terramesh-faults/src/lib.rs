@@ -132,6 +132,8 @@
 //! synthetic site with a known truth.
 #![warn(missing_docs)]
 
+/// The structures' parts above the terrain, added on it.
+mod above;
 /// The checks of a faulted mesh.
 mod check;
 /// The error type.
