@@ -103,7 +103,6 @@ pub(crate) fn add_above(
                 top_of.insert(v, id);
             }
         }
-        let mut made = 0usize;
         for &n in &under {
             taken[n] = true;
             let (f, below) = terrain_faces[n];
@@ -137,10 +136,8 @@ pub(crate) fn add_above(
                 if !zones.zone.is_empty() {
                     zones.zone.push(0);
                 }
-                made += 1;
             }
         }
-        let _ = made;
     }
     labels.above_cells = st.tets.len() - first_cell;
     Ok(())
@@ -198,7 +195,33 @@ fn refine_under(
     let tol = set.resolution * o.size;
     let [lo, hi] = o.bbox;
     let mut total = 0;
+    let near_box = |p: [f64; 3]| (0..3).all(|k| p[k] >= lo[k] - 1.0 && p[k] <= hi[k] + 1.0);
     for _ in 0..40 {
+        // An edge is bisected only if no cell around it has a node outside the solid (beyond
+        // ON_WALL) and its midpoint is not outside either: the new node then lies inside or
+        // on the wall, and no cell gets nodes on both sides of it (the midpoint of a chord
+        // between two walls at a corner lies inside; a node outside beside it would make a
+        // cell straddle the wall).
+        let outside: Vec<bool> = st
+            .points
+            .iter()
+            .map(|&p| !near_box(p) || o.field(Wall::Inner, p) > ON_WALL)
+            .collect();
+        let mut blocked: Vec<u64> = st
+            .tets
+            .iter()
+            .filter(|t| {
+                t.iter().any(|&v| outside[v as usize])
+                    && t.iter().any(|&v| st.flags[v as usize] & TOP != 0)
+            })
+            .flat_map(|t| {
+                crate::mesh::EDGES
+                    .iter()
+                    .map(move |&(i, j)| crate::mesh::key(t[i], t[j]))
+            })
+            .collect();
+        blocked.sort_unstable();
+        blocked.dedup();
         let mut keys: Vec<u64> = Vec::new();
         for (f, _) in terrain_faces(st) {
             let q = f.map(|v| st.points[v as usize]);
@@ -213,9 +236,15 @@ fn refine_under(
                 if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() <= 4.0 * tol {
                     continue;
                 }
+                let k = crate::mesh::key(f[a], f[b]);
+                if blocked.binary_search(&k).is_ok() {
+                    continue;
+                }
                 let m = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
-                if (top(o, m) - 0.5 * (top(o, pa) + top(o, pb))).abs() > tol {
-                    keys.push(crate::mesh::key(f[a], f[b]));
+                if (top(o, m) - 0.5 * (top(o, pa) + top(o, pb))).abs() > tol
+                    && o.field(Wall::Inner, m) <= ON_WALL
+                {
+                    keys.push(k);
                 }
             }
         }
