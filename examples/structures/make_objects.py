@@ -35,7 +35,7 @@ def main():
     # A 60 x 50 m pit, floor at 135 m (about 15 m deep), south of F3.
     (HERE / "pit.wkt").write_text("POLYGON ((60 40, 120 40, 120 90, 60 90, 60 40))\n")
     # A dam's block, 50 x 40 m, from 140 m (below the terrain, about 155 m there) to 170 m:
-    # the part below the terrain replaces the rock; the part above is not modelled yet.
+    # the part below the terrain replaces the rock; the part above is added on the terrain.
     (HERE / "dam.stl").write_text(box_stl("dam", [280.0, 60.0, 140.0], [330.0, 100.0, 170.0]))
 
 

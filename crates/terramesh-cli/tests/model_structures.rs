@@ -190,7 +190,76 @@ fn a_tunnel_through_a_fault_a_pit_and_a_dam_are_cut_into_the_faulted_model() {
     let pit = objects[1]["meshed_volume"].as_f64().unwrap();
     assert!((stages[0]["excavated_volume"].as_f64().unwrap() - pit).abs() < 1e-6 * pit);
     assert_eq!(objects[2]["stage"], 0);
+    // The dam (a 50 x 40 x 30 m box from 140 m, below the terrain at about 155 m, to 170 m):
+    // its part above the terrain is modelled, so its exact volume is the whole box's.
+    let dam = &objects[2];
+    assert!(
+        (dam["exact_volume"].as_f64().unwrap() - 50.0 * 40.0 * 30.0).abs() < 1e-6,
+        "{dam}"
+    );
     object_files_agree_with_model_json(&out, &json);
+    dam_rises_above_the_terrain(&out);
+}
+
+/// The dam's cells above the terrain are in `model.vtu` (object 3, up to its top at 170 m,
+/// above every terrain node of the model), and its exposed surface is the boundary mesh
+/// `model-side-structures.vtu`, whose faces reach its top.
+fn dam_rises_above_the_terrain(out: &Path) {
+    let vtu = std::fs::read_to_string(out.join("model.vtu")).unwrap();
+    let object: Vec<i32> = vtu_array(&vtu, "object")
+        .chunks(4)
+        .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let points: Vec<f64> = vtu_array(&vtu, "Points")
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let conn: Vec<usize> = vtu_array(&vtu, "connectivity")
+        .chunks(8)
+        .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as usize)
+        .collect();
+    // The highest terrain node around the dam (the terrain under it is no longer on the
+    // boundary).
+    let top = std::fs::read_to_string(out.join("model-top.vtu")).unwrap();
+    let near = |q: &[f64]| q[0] > 270.0 && q[0] < 340.0 && q[1] > 50.0 && q[1] < 110.0;
+    let terrain_z = vtu_array(&top, "Points")
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect::<Vec<f64>>()
+        .chunks(3)
+        .filter(|q| near(q))
+        .map(|q| q[2])
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        terrain_z > 140.0 && terrain_z < 170.0,
+        "the terrain reaches {terrain_z} near the dam"
+    );
+    // (every column cell keeps a node on the terrain: count centroids)
+    let above = conn
+        .chunks(4)
+        .zip(&object)
+        .filter(|(t, &o)| {
+            o == 3 && t.iter().map(|&v| points[3 * v + 2]).sum::<f64>() / 4.0 > terrain_z + 1.0
+        })
+        .count();
+    assert!(
+        above > 0,
+        "no dam cell above the terrain (highest {terrain_z})"
+    );
+    // Near the dam, only its cells rise above the terrain.
+    assert!(conn.chunks(4).zip(&object).all(|(t, &o)| {
+        o == 3
+            || !t.iter().all(|&v| near(&points[3 * v..3 * v + 3]))
+            || t.iter().all(|&v| points[3 * v + 2] <= terrain_z + 1e-9)
+    }));
+    let exposed = std::fs::read_to_string(out.join("model-side-structures.vtu")).unwrap();
+    let zs: Vec<f64> = vtu_array(&exposed, "Points")
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .skip(2)
+        .step_by(3)
+        .collect();
+    assert!(zs.iter().any(|&z| (z - 170.0).abs() < 1e-9), "{zs:?}");
 }
 
 /// Decodes the appended base64 array `name` of a `.vtu` written by terramesh.
@@ -410,6 +479,8 @@ fn bad_objects_are_refused_naming_the_object_and_the_key_and_nothing_is_written(
     let text = site(tmp.path(), true);
     let open = box_stl([280.0, 60.0, 140.0], [330.0, 100.0, 170.0]);
     let open = open.rsplit_once("facet normal").unwrap().0.to_string() + "endsolid dam\n";
+    // A dam floating 30 m above the terrain.
+    let floating = box_stl([280.0, 60.0, 200.0], [330.0, 100.0, 230.0]);
     // (the project, a file replaced with its text, what the error must name)
     type Case<'a> = (String, Option<(&'a str, &'a str)>, Vec<&'a str>);
     let cases: Vec<Case> = vec![
@@ -449,6 +520,15 @@ fn bad_objects_are_refused_naming_the_object_and_the_key_and_nothing_is_written(
             vec![
                 "geology.structures[dam].material",
                 "'marl' already names a unit",
+            ],
+        ),
+        (
+            text.clone(),
+            Some(("dam.stl", floating.as_str())),
+            vec![
+                "geology.structures[dam].solid",
+                "floating",
+                "below the terrain",
             ],
         ),
         (

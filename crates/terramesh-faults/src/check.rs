@@ -25,6 +25,12 @@ pub struct CheckSummary {
     pub interior_faces: usize,
     /// Boundary faces on the terrain, on the base and on the sides.
     pub boundary_faces: [usize; 3],
+    /// Boundary faces of the structures' parts above the terrain (their exposed surface,
+    /// checked on the solid by [`crate::check_objects`]).
+    pub structure_faces: usize,
+    /// The volume of the cells above the terrain (the structures' parts above it), m³:
+    /// `volume` is `expected_volume` plus this.
+    pub above_volume: f64,
     /// Faces of every fault.
     pub fault_faces: Vec<usize>,
     /// The area of every fault as meshed, m².
@@ -68,8 +74,12 @@ fn rotated(f: [u32; 3]) -> [u32; 3] {
 /// 2. every face in one cell (boundary) or two with opposite orientations (interior);
 /// 3. the boundary closed (every edge in two boundary faces, once each way) and only on the
 ///    terrain (nodes and centroid on the DSM, facing up), the base (facing down) or the sides
-///    (on an edge of the region's outline, vertical);
-/// 4. the cells' volume equal to the terrain-to-base volume to [`VOLUME_TOLERANCE`];
+///    (on an edge of the region's outline, vertical), or a face of a cell of a structure's part
+///    above the terrain (the last `objects.above_cells` cells: the structure's exposed
+///    surface, which [`crate::check_objects`] checks on the solid);
+/// 4. the volume of the cells under the terrain equal to the terrain-to-base volume to
+///    [`VOLUME_TOLERANCE`] (the cells above it, a structure's, add theirs:
+///    [`CheckSummary::above_volume`]); checks 5 to 8 are of the cells under the terrain;
 /// 5. every cell's block the block of its centroid, its side of every fault the side of its
 ///    centroid, and its unit the unit at its centroid in its block (within
 ///    [`FAULT_TOLERANCE`]);
@@ -112,6 +122,15 @@ pub fn check(
             return Err(fail(origin, format!("cell {c} has no valid unit or block")));
         }
     }
+    let above = mesh.objects.above_cells;
+    if above > m {
+        return Err(fail(
+            origin,
+            format!("{above} cells above the terrain recorded in a mesh of {m}"),
+        ));
+    }
+    // The first cell of the structures' parts above the terrain.
+    let first_above = m - above;
     let p = &mesh.points;
     // 1. Positive volumes: exactly, and as the writers compute them (a cell so flat that its
     // floating-point volume is zero or negative is refused by every writer).
@@ -141,6 +160,7 @@ pub fn check(
     let faces = all_faces(&mesh.tets);
     let oriented = |e: &(u128, u32, u8)| outward_faces(&mesh.tets[e.1 as usize])[e.2 as usize];
     let mut boundary: Vec<[u32; 3]> = Vec::new();
+    let mut boundary_cell: Vec<u32> = Vec::new();
     let mut interior: Vec<(u128, u32, u32)> = Vec::new();
     let mut i = 0;
     while i < faces.len() {
@@ -149,7 +169,10 @@ pub fn check(
             j += 1;
         }
         match j - i {
-            1 => boundary.push(oriented(&faces[i])),
+            1 => {
+                boundary.push(oriented(&faces[i]));
+                boundary_cell.push(faces[i].1);
+            }
             2 => {
                 let (a, b) = (
                     rotated(oriented(&faces[i])),
@@ -214,7 +237,8 @@ pub fn check(
             .max(1.0);
     let classes: Vec<Result<u8, FaultError>> = boundary
         .par_iter()
-        .map(|f| {
+        .zip(&boundary_cell)
+        .map(|(f, &cell)| {
             let q = f.map(|v| p[v as usize]);
             let u = [q[1][0] - q[0][0], q[1][1] - q[0][1], q[1][2] - q[0][2]];
             let w = [q[2][0] - q[0][0], q[2][1] - q[0][1], q[2][2] - q[0][2]];
@@ -248,12 +272,19 @@ pub fn check(
                     }
                 }
             }
+            if cell as usize >= first_above {
+                return Ok(3);
+            }
             Err(fail(c, "a boundary face is on neither the terrain, the base nor a side (or faces the wrong way)".into()))
         })
         .collect();
     let mut boundary_faces = [0usize; 3];
+    let mut structure_faces = 0;
     for c in classes {
-        boundary_faces[c? as usize] += 1;
+        match c? {
+            3 => structure_faces += 1,
+            k => boundary_faces[k as usize] += 1,
+        }
     }
     // 4. Volume.
     let vols: Vec<f64> = mesh
@@ -265,11 +296,13 @@ pub fn check(
         })
         .collect();
     let volume: f64 = vols.iter().sum();
+    let under: f64 = vols[..first_above].iter().sum();
+    let above_volume: f64 = vols[first_above..].iter().sum();
     let expected_volume = terrain.volume_above(settings.base);
-    if (volume - expected_volume).abs() > VOLUME_TOLERANCE * expected_volume.abs() {
+    if (under - expected_volume).abs() > VOLUME_TOLERANCE * expected_volume.abs() {
         return Err(fail(
             origin,
-            format!("the cells' volume {volume} m³ differs from the terrain-to-base volume {expected_volume} m³"),
+            format!("the volume {under} m³ of the cells under the terrain differs from the terrain-to-base volume {expected_volume} m³"),
         ));
     }
     // 5, 6. Blocks, sides, units; cells straddling a fault or an interface.
@@ -328,6 +361,9 @@ pub fn check(
     let per_cell: Vec<Result<(bool, bool), FaultError>> = (0..m)
         .into_par_iter()
         .map(|c| {
+            if c >= first_above {
+                return Ok((false, false));
+            }
             let t = mesh.tets[c];
             let q = centroid(p, &t);
             for (f, fault) in faults.faults.iter().enumerate() {
@@ -396,6 +432,7 @@ pub fn check(
     // 7. Fault faces.
     let mut expected: Vec<(u128, u32)> = interior
         .par_iter()
+        .filter(|&&(_, c1, c2)| (c1.max(c2) as usize) < first_above)
         .flat_map_iter(|&(key, c1, c2)| {
             let diff = cell_sides[c1 as usize] ^ cell_sides[c2 as usize];
             let cell_sides = &cell_sides;
@@ -491,7 +528,7 @@ pub fn check(
     }
     let mut block_cells = vec![0; mesh.blocks.len()];
     let mut unit_volumes = vec![0.0; mesh.units];
-    for c in 0..m {
+    for c in 0..first_above {
         block_cells[mesh.block[c] as usize] += 1;
         unit_volumes[mesh.unit[c] as usize] += vols[c];
     }
@@ -500,6 +537,8 @@ pub fn check(
         expected_volume,
         interior_faces: interior.len(),
         boundary_faces,
+        structure_faces,
+        above_volume,
         fault_faces,
         fault_areas,
         fault_distance,

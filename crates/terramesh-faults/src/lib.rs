@@ -92,8 +92,9 @@
 //!
 //! # What is guaranteed and what is measured
 //! Guaranteed by construction and verified by [`check`]: conformity (every interior face in
-//! two cells, oppositely oriented), a closed boundary on the terrain, base and sides only, the
-//! volume (to 1e-9 relative: the terrain and base are never moved), positive volumes (exact
+//! two cells, oppositely oriented), a closed boundary on the terrain, base and sides only (and a
+//! structure's exposed surface above the terrain), the volume under the terrain (to 1e-9
+//! relative: the terrain and base are never moved), positive volumes (exact
 //! orientation test, and the floating-point volume the writers compute positive too: a cell
 //! flat to rounding reads 0 degrees in [`min_dihedral`], so the quality pass never keeps one),
 //! no cell straddling a fault, fault faces within 1 cm of their fault.
@@ -118,8 +119,11 @@
 //! longest edge, so that the cells keep their shape), and after the quality pass every wall
 //! cuts the mesh as a fault does (a crossing moved onto a fault or an interface stays on the
 //! wall);
-//! cells are labelled by object and lining ([`ObjectCells`]). See `docs/geology.md`,
-//! "Engineering structures".
+//! cells are labelled by object and lining ([`ObjectCells`]). A structure that rises above the
+//! terrain gets its part above added last, as columns of cells on the terrain's faces under it
+//! up to the solid's top (those faces become interior; the structure's exposed surface joins
+//! the boundary; [`ObjectCells::above_cells`]); a solid wholly above the terrain is refused.
+//! See `docs/geology.md`, "Engineering structures".
 //!
 //! # Fault zones ([`FaultSpec::zone`], [`ZoneCells`], [`check_zones`])
 //! A fault with a zone w thick keeps its own surface and faces; the walls at signed distance
@@ -136,6 +140,8 @@
 //! synthetic site with a known truth.
 #![warn(missing_docs)]
 
+/// The structures' parts above the terrain, added on it.
+mod above;
 /// The checks of a faulted mesh.
 mod check;
 /// The error type.

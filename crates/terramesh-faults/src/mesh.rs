@@ -1019,9 +1019,13 @@ pub fn faulted_mesh_with_objects(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
-    let object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
+    let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     zones.zone = crate::zones::labels(faults, &st.zone);
-    let fault_faces = fault_faces(&st, faults);
+    // The structures' parts above the terrain, last: their cells carry no fault face.
+    crate::above::add_above(&mut st, objects, &mut object_cells, &mut zones)?;
+    let mut fault_faces = fault_faces(&st, faults);
+    let first_above = st.tets.len() - object_cells.above_cells;
+    fault_faces.retain(|f| f.cells.iter().all(|&c| (c as usize) < first_above));
     Ok(FaultedMesh {
         points: st.points,
         tets: st.tets,

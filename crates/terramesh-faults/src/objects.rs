@@ -215,9 +215,12 @@ pub struct Object {
     pub exact: [f64; 2],
     /// How the exact volume was found.
     pub exact_method: &'static str,
-    size: f64,
-    bbox: [[f64; 3]; 2],
+    pub(crate) size: f64,
+    pub(crate) bbox: [[f64; 3]; 2],
     shape: Shape,
+    /// A structure that rises above the terrain: its part above is added to the model
+    /// (`above.rs`).
+    pub(crate) rises: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -679,6 +682,7 @@ impl Object {
                 "0: stages count from 1 (the first excavated)",
             ));
         }
+        let mut rises = false;
         let (shape, size, bbox, exact, method) = match &spec.geometry {
             ObjectGeometry::Tunnel {
                 axis,
@@ -1035,6 +1039,37 @@ impl Object {
                     .map(|k| bbox[1][k] - bbox[0][k])
                     .fold(f64::INFINITY, f64::min);
                 let _ = base;
+                // How far the solid's underside lies above the terrain: over its vertices,
+                // and over the terrain's vertices under it (the terrain may rise inside a
+                // large triangle).
+                let mut gap = f64::INFINITY;
+                let mut rises_here = false;
+                for p in vertices {
+                    let h = terrain.height_or_nearest([p[0], p[1]]);
+                    gap = gap.min(p[2] - h);
+                    rises_here |= p[2] > h + ON_WALL;
+                }
+                for (p, &h) in terrain.points.iter().zip(&terrain.heights) {
+                    if p[0] < bbox[0][0]
+                        || p[0] > bbox[1][0]
+                        || p[1] < bbox[0][1]
+                        || p[1] > bbox[1][1]
+                    {
+                        continue;
+                    }
+                    let zs = crossings(vertices, triangles, p[0], p[1]);
+                    if let (Some(lo), Some(hi)) = (zs.first(), zs.last()) {
+                        gap = gap.min(lo - h);
+                        rises_here |= *hi > h + ON_WALL;
+                    }
+                }
+                if gap >= -ON_WALL {
+                    return Err(err(spec, "solid", format!(
+                        "the solid lies wholly above the terrain ({}: its lowest point {gap:.3} m above the terrain under it) and does not reach into the ground; a structure's part below the terrain replaces the rock and its part above is added on it: lower the solid or extend its base below the terrain",
+                        if gap > ON_WALL { "floating" } else { "touching it only" }
+                    )));
+                }
+                rises = rises_here;
                 (
                     Shape::Structure {
                         vertices: vertices.clone(),
@@ -1061,6 +1096,7 @@ impl Object {
             size,
             bbox,
             shape,
+            rises,
         };
         o.exact_volumes(terrain, base);
         Ok(o)
@@ -1094,6 +1130,22 @@ impl Object {
         if under && !matches!(self.shape, Shape::Excavation { .. }) {
             return;
         }
+        // A structure that rises above the terrain is modelled whole above the base (its part
+        // above the terrain is added): its enclosed volume if it lies above the base and
+        // inside the region's plan.
+        let whole = match &self.shape {
+            Shape::Structure { vertices, .. } => {
+                self.rises
+                    && lo[2] > base
+                    && vertices.iter().all(|p| terrain.contains([p[0], p[1]]))
+            }
+            _ => false,
+        };
+        if whole {
+            self.exact_method = "enclosed volume (divergence theorem; the part above the terrain is added to the model)";
+            return;
+        }
+        let rises = self.rises;
         const N: usize = 512;
         let (dx, dy) = ((hi[0] - lo[0]) / N as f64, (hi[1] - lo[1]) / N as f64);
         let walls: Vec<Wall> = self.walls().to_vec();
@@ -1106,7 +1158,7 @@ impl Object {
                     let Some(top) = terrain.height([x, y]) else {
                         continue;
                     };
-                    let (z0, z1) = (lo[2].max(base), hi[2].min(top));
+                    let (z0, z1) = (lo[2].max(base), if rises { hi[2] } else { hi[2].min(top) });
                     if z1 <= z0 {
                         continue;
                     }
@@ -1137,28 +1189,7 @@ impl Object {
                 vertices,
                 triangles,
             } => {
-                // The crossings of the vertical line, exactly located triangles, z by the plane.
-                let q = [x, y, 0.0];
-                let mut zs: Vec<f64> = triangles
-                    .iter()
-                    .filter_map(|t| {
-                        let [a, b, c] = t.map(|v| vertices[v as usize]);
-                        let o = orient2d(c2(a), c2(b), c2(c));
-                        if o == 0.0 {
-                            return None;
-                        }
-                        let (b, c) = if o > 0.0 { (b, c) } else { (c, b) };
-                        if side_sos(a, b, q) < 0.0
-                            || side_sos(b, c, q) < 0.0
-                            || side_sos(c, a, q) < 0.0
-                        {
-                            return None;
-                        }
-                        let n = cross(sub(b, a), sub(c, a));
-                        Some(a[2] - (n[0] * (x - a[0]) + n[1] * (y - a[1])) / n[2])
-                    })
-                    .collect();
-                zs.sort_by(f64::total_cmp);
+                let zs = crossings(vertices, triangles, x, y);
                 zs.chunks(2)
                     .filter(|c| c.len() == 2)
                     .map(|c| (c[1].min(z1) - c[0].max(z0)).max(0.0))
@@ -1223,6 +1254,97 @@ impl Object {
     }
 }
 
+/// The elevations where the vertical line through (x, y) crosses a closed triangulated
+/// surface, sorted (exactly located triangles, with the point perturbed symbolically so that
+/// a line through an edge crosses one of its triangles; z by the triangle's plane).
+fn crossings(vertices: &[[f64; 3]], triangles: &[[u32; 3]], x: f64, y: f64) -> Vec<f64> {
+    let q = [x, y, 0.0];
+    let mut zs: Vec<f64> = triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|v| vertices[v as usize]);
+            let o = orient2d(c2(a), c2(b), c2(c));
+            if o == 0.0 {
+                return None;
+            }
+            let (b, c) = if o > 0.0 { (b, c) } else { (c, b) };
+            if side_sos(a, b, q) < 0.0 || side_sos(b, c, q) < 0.0 || side_sos(c, a, q) < 0.0 {
+                return None;
+            }
+            let n = cross(sub(b, a), sub(c, a));
+            Some(a[2] - (n[0] * (x - a[0]) + n[1] * (y - a[1])) / n[2])
+        })
+        .collect();
+    zs.sort_by(f64::total_cmp);
+    zs
+}
+
+impl Object {
+    /// A structure's crossings of the vertical line through (x, y), sorted (empty for other
+    /// objects).
+    pub(crate) fn crossings(&self, x: f64, y: f64) -> Vec<f64> {
+        match &self.shape {
+            Shape::Structure {
+                vertices,
+                triangles,
+            } => crossings(vertices, triangles, x, y),
+            _ => Vec::new(),
+        }
+    }
+
+    /// A structure's highest point over (x, y) within `reach` in plan: the highest plane
+    /// elevation at (x, y) of the triangles (not vertical) whose plan lies within `reach` of
+    /// it, so that a node cut onto a vertical wall (within [`ON_WALL`]) gets the top of the
+    /// wall; `None` if none is that close.
+    pub(crate) fn top_near(&self, x: f64, y: f64, reach: f64) -> Option<f64> {
+        let Shape::Structure {
+            vertices,
+            triangles,
+        } = &self.shape
+        else {
+            return None;
+        };
+        let mut top: Option<f64> = None;
+        for t in triangles {
+            let [a, b, c] = t.map(|v| vertices[v as usize]);
+            let n = cross(sub(b, a), sub(c, a));
+            if n[2].abs() <= 1e-12 * dot(n, n).sqrt() {
+                continue;
+            }
+            let lo = [a[0].min(b[0]).min(c[0]), a[1].min(b[1]).min(c[1])];
+            let hi = [a[0].max(b[0]).max(c[0]), a[1].max(b[1]).max(c[1])];
+            if x < lo[0] - reach || x > hi[0] + reach || y < lo[1] - reach || y > hi[1] + reach {
+                continue;
+            }
+            // The plan distance to the triangle: 0 inside, else to the nearest edge.
+            let p = [x, y];
+            let inside = {
+                let s = |u: [f64; 3], v: [f64; 3]| {
+                    (v[0] - u[0]) * (p[1] - u[1]) - (v[1] - u[1]) * (p[0] - u[0])
+                };
+                let (s1, s2, s3) = (s(a, b), s(b, c), s(c, a));
+                (s1 >= 0.0 && s2 >= 0.0 && s3 >= 0.0) || (s1 <= 0.0 && s2 <= 0.0 && s3 <= 0.0)
+            };
+            let near = inside
+                || [(a, b), (b, c), (c, a)].iter().any(|&(u, v)| {
+                    let e = [v[0] - u[0], v[1] - u[1]];
+                    let l2 = e[0] * e[0] + e[1] * e[1];
+                    let t = if l2 > 0.0 {
+                        (((p[0] - u[0]) * e[0] + (p[1] - u[1]) * e[1]) / l2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    (u[0] + t * e[0] - p[0]).hypot(u[1] + t * e[1] - p[1]) <= reach
+                });
+            if near {
+                let z = a[2] - (n[0] * (x - a[0]) + n[1] * (y - a[1])) / n[2];
+                top = Some(top.map_or(z, |m: f64| m.max(z)));
+            }
+        }
+        top
+    }
+}
+
 fn point_in_ring(p: [f64; 2], ring: &[[f64; 2]]) -> bool {
     let n = ring.len();
     let mut inside = false;
@@ -1253,6 +1375,13 @@ pub struct ObjectCells {
     /// Edges bisected, before a wall's cut, in the cells it crosses where its facets would
     /// stray from it (what the refinement left, capped or not).
     pub repaired_edges: usize,
+    /// The cells of the structures' parts above the terrain: the last this many cells of the
+    /// mesh (0 when no structure rises above the terrain). They stand on the terrain's faces
+    /// under the structure, which become interior faces.
+    pub above_cells: usize,
+    /// Terrain edges bisected under the structures that rise above the terrain, where the
+    /// columns' tops would stray from the solid's top.
+    pub top_edges: usize,
 }
 
 fn eval(v: f64) -> (f64, i8) {
@@ -1993,7 +2122,10 @@ pub fn check_objects(
         y: p[1],
         z: p[2],
     };
-    if cells.object.len() != tets.len() || cells.lining.len() != tets.len() {
+    if cells.object.len() != tets.len()
+        || cells.lining.len() != tets.len()
+        || cells.above_cells > tets.len()
+    {
         return Err(fail(
             [0.0; 3],
             "the objects' per-cell arrays have the wrong length".into(),
@@ -2091,6 +2223,20 @@ pub fn check_objects(
             }
             i += 2;
         } else {
+            // A face of a structure's part above the terrain on the model's boundary: its
+            // exposed surface, on the solid.
+            let c = faces[i].1 as usize;
+            if c + cells.above_cells >= tets.len() && cells.object[c] != 0 {
+                let k = cells.object[c] as usize - 1;
+                let o = &set.objects[k];
+                let nodes = crate::mesh::outward_faces(&tets[c])[faces[i].2 as usize];
+                let d = nodes
+                    .iter()
+                    .map(|&v| o.field(Wall::Inner, points[v as usize]).abs())
+                    .fold(0.0, f64::max);
+                out[k].boundary_faces += 1;
+                out[k].boundary_distance = out[k].boundary_distance.max(d);
+            }
             i += 1;
         }
     }

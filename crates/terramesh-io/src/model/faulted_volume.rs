@@ -132,9 +132,15 @@ pub fn faulted_volume(
     for u in &units[1..mesh.units] {
         tags.push(FaceTag::Interface(u.to_string()));
     }
+    // the exposed surface of the structures' parts above the terrain (the last cells): a tag
+    // of its own, `structures`, last
+    let first_above = tets.len() - mesh.objects.above_cells.min(tets.len());
+    let exposed = tags.len() as u16;
+    tags.push(FaceTag::Side("structures".into()));
     let mut tagged = Vec::new();
     for sides in by_key.chunk_by(|a, b| a.0 == b.0) {
         let tag = match sides {
+            [(_, c, f)] if *c as usize >= first_above => Some((exposed, *c, *f)),
             [(_, c, f)] if !fault_side.contains_key(&(*c, *f)) => {
                 let n = nodes_of(*c as usize, *f as usize);
                 let p: Vec<[f64; 3]> = n.iter().map(|&v| points[v as usize]).collect();
@@ -167,7 +173,10 @@ pub fn faulted_volume(
             }
             [(_, a, fa), (_, b, fb)] => {
                 let (a, b) = (*a as usize, *b as usize);
-                if mesh.block[a] == mesh.block[b] && mesh.unit[a] != mesh.unit[b] {
+                if mesh.block[a] == mesh.block[b]
+                    && mesh.unit[a] != mesh.unit[b]
+                    && a.max(b) < first_above
+                {
                     let (c, f) = if mesh.unit[a] > mesh.unit[b] {
                         (a, *fa)
                     } else {

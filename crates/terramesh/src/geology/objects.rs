@@ -342,7 +342,8 @@ pub fn finish(
         }
         let v = tet_volume(&mesh.points, t);
         let k = o as usize - 1;
-        if !cells.lining[c] {
+        // (a structure's cells above the terrain, the last `above_cells`, are in no unit)
+        if !cells.lining[c] && c + cells.above_cells < mesh.tets.len() {
             per_unit[k][mesh.unit[c] as usize] += v;
         }
         blocks[k].push(mesh.block[c]);
