@@ -27,6 +27,7 @@ pub mod blocks;
 pub mod boreholes;
 pub mod colour;
 pub mod dem;
+pub mod exactnum;
 pub mod export;
 pub mod faults;
 pub mod folder;

@@ -155,7 +155,7 @@ fn fixed_into(buf: &mut [u8; 48], v: f64, decimals: usize) -> usize {
 #[inline]
 pub fn write_shortest<W: Write>(w: &mut W, v: f64) -> io::Result<()> {
     let v = if v == 0.0 { 0.0 } else { v };
-    write!(w, "{v}")
+    crate::exactnum::write_display(w, v)
 }
 
 #[cfg(test)]

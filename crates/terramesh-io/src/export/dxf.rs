@@ -3,6 +3,8 @@
 
 use std::io::{self, Write};
 
+use crate::exactnum::push_display;
+
 /// Writes the triangles as `3DFACE` entities on `layer` (the fourth corner repeats the third).
 ///
 /// ```
@@ -26,11 +28,18 @@ pub fn write_dxf<W: Write>(
     w.write_all(b"0\nSECTION\n2\nENTITIES\n")?;
     crate::blocks::write_in_blocks(w, triangles.len(), crate::blocks::BLOCK, |r, w| {
         for t in &triangles[r] {
-            writeln!(w, "0\n3DFACE\n8\n{layer}")?;
+            w.extend_from_slice(b"0\n3DFACE\n8\n");
+            w.extend_from_slice(layer.as_bytes());
+            w.push(b'\n');
             let corners = [t[0], t[1], t[2], t[2]];
             for (k, &i) in corners.iter().enumerate() {
                 let v = vertices[i as usize];
-                writeln!(w, "1{k}\n{}\n2{k}\n{}\n3{k}\n{}", v[0], v[1], v[2])?;
+                let k = b'0' + k as u8;
+                for (axis, &c) in [b'1', b'2', b'3'].iter().zip(&v) {
+                    w.extend_from_slice(&[*axis, k, b'\n']);
+                    push_display(w, c);
+                    w.push(b'\n');
+                }
             }
         }
         Ok(())

@@ -4,6 +4,7 @@ use std::io::{self, Write};
 
 use super::{MeshView, MeshWriter};
 use crate::blocks::{write_in_blocks, BLOCK};
+use crate::exactnum::{push_debug, push_u64};
 
 /// The Gmsh MSH 4.1 writer.
 pub struct Msh41;
@@ -38,13 +39,22 @@ impl MeshWriter for Msh41 {
         )?;
         writeln!(out, "$EndEntities")?;
         writeln!(out, "$Nodes\n1 {np} 1 {np}\n2 1 0 {np}")?;
-        for i in 1..=np {
-            writeln!(out, "{i}")?;
-        }
+        write_in_blocks(out, np, BLOCK, |r, out| {
+            for i in r {
+                push_u64(out, i as u64 + 1);
+                out.push(b'\n');
+            }
+            Ok(())
+        })?;
         write_in_blocks(out, np, BLOCK, |r, out| {
             for i in r {
                 let p = m.point(i);
-                writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+                push_debug(out, p[0]);
+                out.push(b' ');
+                push_debug(out, p[1]);
+                out.push(b' ');
+                push_debug(out, p[2]);
+                out.push(b'\n');
             }
             Ok(())
         })?;
@@ -53,7 +63,12 @@ impl MeshWriter for Msh41 {
         write_in_blocks(out, nt, BLOCK, |r, out| {
             for k in r {
                 let t = m.triangles[k];
-                writeln!(out, "{} {} {} {}", k + 1, t[0] + 1, t[1] + 1, t[2] + 1)?;
+                push_u64(out, k as u64 + 1);
+                for c in t {
+                    out.push(b' ');
+                    push_u64(out, u64::from(c) + 1);
+                }
+                out.push(b'\n');
             }
             Ok(())
         })?;

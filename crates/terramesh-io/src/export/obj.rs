@@ -4,6 +4,7 @@ use std::io::{self, Write};
 
 use super::{MeshView, MeshWriter};
 use crate::blocks::{write_in_blocks, BLOCK};
+use crate::exactnum::{push_debug, push_u64};
 
 /// The OBJ writer.
 pub struct Obj;
@@ -25,13 +26,25 @@ impl MeshWriter for Obj {
         write_in_blocks(out, m.points.len(), BLOCK, |r, out| {
             for i in r {
                 let p = m.point(i);
-                writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+                out.extend_from_slice(b"v ");
+                push_debug(out, p[0]);
+                out.push(b' ');
+                push_debug(out, p[1]);
+                out.push(b' ');
+                push_debug(out, p[2]);
+                out.push(b'\n');
             }
             Ok(())
         })?;
         write_in_blocks(out, m.triangles.len(), BLOCK, |r, out| {
             for t in &m.triangles[r] {
-                writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+                out.extend_from_slice(b"f ");
+                push_u64(out, u64::from(t[0]) + 1);
+                out.push(b' ');
+                push_u64(out, u64::from(t[1]) + 1);
+                out.push(b' ');
+                push_u64(out, u64::from(t[2]) + 1);
+                out.push(b'\n');
             }
             Ok(())
         })

@@ -6,6 +6,7 @@ use std::io::{self, Write};
 
 use super::{MeshView, MeshWriter};
 use crate::blocks::{write_in_blocks, BLOCK};
+use crate::exactnum::{push_debug, push_u64};
 
 /// The VTU writer.
 pub struct Vtu;
@@ -52,7 +53,12 @@ impl MeshWriter for Vtu {
         write_in_blocks(out, np, BLOCK, |r, out| {
             for i in r {
                 let p = m.point(i);
-                writeln!(out, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+                push_debug(out, p[0]);
+                out.push(b' ');
+                push_debug(out, p[1]);
+                out.push(b' ');
+                push_debug(out, p[2]);
+                out.push(b'\n');
             }
             Ok(())
         })?;
@@ -63,7 +69,12 @@ impl MeshWriter for Vtu {
         )?;
         write_in_blocks(out, nt, BLOCK, |r, out| {
             for t in &m.triangles[r] {
-                writeln!(out, "{} {} {}", t[0], t[1], t[2])?;
+                push_u64(out, t[0].into());
+                out.push(b' ');
+                push_u64(out, t[1].into());
+                out.push(b' ');
+                push_u64(out, t[2].into());
+                out.push(b'\n');
             }
             Ok(())
         })?;
@@ -72,16 +83,24 @@ impl MeshWriter for Vtu {
             out,
             "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
         )?;
-        for k in 1..=nt {
-            writeln!(out, "{}", 3 * k)?;
-        }
+        write_in_blocks(out, nt, BLOCK, |r, out| {
+            for k in r {
+                push_u64(out, 3 * (k as u64 + 1));
+                out.push(b'\n');
+            }
+            Ok(())
+        })?;
         writeln!(out, "</DataArray>")?;
         writeln!(
             out,
             "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
         )?;
-        for _ in 0..nt {
-            writeln!(out, "5")?;
+        let fives = [*b"5\n"; 4096].concat();
+        let mut left = nt;
+        while left > 0 {
+            let k = left.min(4096);
+            out.write_all(&fives[..2 * k])?;
+            left -= k;
         }
         writeln!(
             out,
