@@ -343,6 +343,10 @@ def check_boundary_meshes(model):
                 require(n[2] > 0, f"{name}: face {f} does not face up")
             elif name == "model-bottom.vtu":
                 require(n[2] < 0, f"{name}: face {f} does not face down")
+            elif name == "model-side-structures.vtu":
+                # A structure's exposed surface above the terrain (a dam's faces and crest):
+                # any orientation; being on the boundary, once, is checked above.
+                pass
             else:
                 want = {"north": (0, 1), "south": (0, -1), "east": (1, 0), "west": (-1, 0)}.get(name[11:-4])
                 require(abs(n[2]) < 1e-9, f"{name}: face {f} is not vertical")
@@ -562,16 +566,25 @@ def run_ogs(model, prj, tmp, extra=None):
 
 def check_ogs_diffusion(model):
     """OpenGeoSys steady-state diffusion on model.vtu, homogeneous conductivity, u = z on
-    model-top and model-bottom, no flow through the sides: the exact solution u = z holds at
-    every node to 1e-9 of the z range."""
+    model-top and model-bottom (and on a structure's exposed surface above the terrain,
+    model-side-structures, where there is one: it is not vertical, so no flow through it would
+    not be u = z), no flow through the vertical sides: the exact solution u = z holds at every
+    node to 1e-9 of the z range."""
     pts, _, _, names, _ = model.vtu()
     media = "".join(
         f"<medium id=\"{k}\"><properties>"
         "<property><name>diffusion</name><type>Constant</type><value>1</value></property>"
         "<property><name>reference_temperature</name><type>Constant</type><value>293.15</value></property>"
         "</properties></medium>" for k in range(len(names)))
+    extra = {"<!--MEDIA-->": media}
+    if "model-side-structures.vtu" in boundary_names(model):
+        extra["<mesh>model-bottom.vtu</mesh>"] = (
+            "<mesh>model-bottom.vtu</mesh><mesh>model-side-structures.vtu</mesh>")
+        extra["</boundary_conditions>"] = (
+            "<boundary_condition><mesh>model-side-structures</mesh><type>Dirichlet</type>"
+            "<parameter>z</parameter></boundary_condition></boundary_conditions>")
     with tempfile.TemporaryDirectory() as tmp:
-        out = run_ogs(model, "diffusion.prj", tmp, {"<!--MEDIA-->": media})
+        out = run_ogs(model, "diffusion.prj", tmp, extra)
     require("pressure" in out.point_data, f"ogs output lacks 'pressure' ({sorted(out.point_data)})")
     u = np.asarray(out.point_data["pressure"]).ravel()
     zr = np.ptp(pts[:, 2])
