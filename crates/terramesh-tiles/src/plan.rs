@@ -284,6 +284,11 @@ impl Windows for super::plan_stream::Near<'_> {
 /// The plan with every sample in memory (and the geology's plan, which reads them).
 fn plan_held(how: &How) -> Result<Planned> {
     let (project, out) = (how.project, how.out);
+    // A record of a bucketed plan made into this folder before does not describe this one.
+    let record = out.join(super::plan_stream::FIT_RECORD);
+    if record.exists() {
+        std::fs::remove_file(&record).at(&record)?;
+    }
     let mut samples = stages::sample(project, how.base, out, how.progress)?;
     let shape = region_shape(how, &samples)?;
     let model = stages::model(project, &samples, how.base)?;

@@ -116,12 +116,12 @@ fn bucketed_plan_equals_the_in_memory_plan_with_a_reml_fit() {
     let tmp = tempfile::tempdir().unwrap();
     let project = points_project(
         tmp.path(),
-        3_000,
-        40,
+        1_500,
+        30,
         "methods = [\"uk\"]\nneighbors = 12\nfit = \"reml\"",
     );
     let fit = both_ways(tmp.path(), &project, &[], 200.0);
-    assert_eq!((fit["samples"].as_u64(), fit["all"].as_bool()), (Some(3_000), Some(true)));
+    assert_eq!((fit["samples"].as_u64(), fit["all"].as_bool()), (Some(1_500), Some(true)));
 }
 
 /// A DEM file (sampled band by band) in 3 x 3 tiles: the same files.
@@ -130,11 +130,11 @@ fn bucketed_plan_equals_the_in_memory_plan_from_a_dem() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let mut asc =
-        String::from("ncols 40\nnrows 40\nxllcorner 499900\nyllcorner 3999900\ncellsize 25\n");
-    for r in 0..40 {
-        let row: Vec<String> = (0..40)
+        String::from("ncols 60\nnrows 60\nxllcorner 499800\nyllcorner 3999800\ncellsize 25\n");
+    for r in 0..60 {
+        let row: Vec<String> = (0..60)
             .map(|c| {
-                let (x, y) = (c as f64 * 25.0, (39 - r) as f64 * 25.0);
+                let (x, y) = (c as f64 * 25.0, (59 - r) as f64 * 25.0);
                 format!("{:.3}", 300.0 + 20.0 * (x / 130.0).sin() * (y / 170.0).cos() + 0.01 * x)
             })
             .collect();
