@@ -97,8 +97,8 @@ pub use cv::{
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
 pub use error::{GeostatError, Result};
 pub use experimental::{
-    diameter, draw_key, draw_subset, experimental, Direction, Estimator, Lag, LagSettings, DEFAULT_LAGS,
-    DEFAULT_MAX_POINTS, DEFAULT_TOLERANCE,
+    diameter, draw_key, draw_subset, experimental, Direction, Estimator, Lag, LagSettings,
+    DEFAULT_LAGS, DEFAULT_MAX_POINTS, DEFAULT_TOLERANCE,
 };
 pub use file::{
     CandidateEntry, CandidateSummary, FitSummary, LagSummary, VariogramFile, VariogramFileError,

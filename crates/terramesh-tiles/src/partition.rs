@@ -61,7 +61,9 @@ fn write_windows(
     let mut keep: Vec<u32> = Vec::new();
     for t in windows {
         let path = plan.join(samples_file(t.id));
-        counts.push(write_window(&path, buckets, xy, z, t.extent, t.halo, &mut keep)?);
+        counts.push(write_window(
+            &path, buckets, xy, z, t.extent, t.halo, &mut keep,
+        )?);
     }
     Ok(counts)
 }

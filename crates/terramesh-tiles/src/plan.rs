@@ -5,11 +5,11 @@ use std::path::Path;
 
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
+use super::geology::GeologyPlan;
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
     DataRule, GridSpec, Manifest, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM, VERSION,
 };
-use super::geology::GeologyPlan;
 use crate::error::{Context, Result, TilesError as Error, Untileable};
 use terramesh::build as stages;
 use terramesh::progress::Progress;
@@ -176,7 +176,16 @@ pub fn plan(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Planned> {
-    plan_with(project, project_file, set, base, tile_size, out, progress, false)
+    plan_with(
+        project,
+        project_file,
+        set,
+        base,
+        tile_size,
+        out,
+        progress,
+        false,
+    )
 }
 
 /// [`plan`] with every sample in memory (the way a project with `[geology]` is planned): the
@@ -191,7 +200,16 @@ pub fn plan_in_memory(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Planned> {
-    plan_with(project, project_file, set, base, tile_size, out, progress, true)
+    plan_with(
+        project,
+        project_file,
+        set,
+        base,
+        tile_size,
+        out,
+        progress,
+        true,
+    )
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -309,9 +327,15 @@ fn plan_held(how: &How) -> Result<Planned> {
         z: data.z(),
         keep: Vec::new(),
     };
-    lay_out(how, &samples, shape, data.len(), frame, &mut held, &|rects, h| {
-        super::geology_plan::plan_geology(project, &samples, data.z(), out, rects, h)
-    })
+    lay_out(
+        how,
+        &samples,
+        shape,
+        data.len(),
+        frame,
+        &mut held,
+        &|rects, h| super::geology_plan::plan_geology(project, &samples, data.z(), out, rects, h),
+    )
 }
 
 /// The plan that holds no more than a cell's samples, a window's and the fit's draw
@@ -389,7 +413,10 @@ fn plan_streamed(how: &How, scratch: &Path) -> Result<Planned> {
 }
 
 /// Writes `PLAN/variogram.json` and reads it back (what every tile reads).
-fn write_variogram(out: &Path, v: &terramesh_geostat::Variogram) -> Result<terramesh_geostat::Variogram> {
+fn write_variogram(
+    out: &Path,
+    v: &terramesh_geostat::Variogram,
+) -> Result<terramesh_geostat::Variogram> {
     let vpath = out.join(VARIOGRAM);
     let json = VariogramFile::new(v.clone()).to_json_pretty();
     terramesh_io::output::write_atomic(&vpath, json.as_bytes()).at(&vpath)?;

@@ -472,7 +472,10 @@ pub(crate) fn write_samples(store: &Store, samples: &Path, fit: &FitPlan) -> Res
             let key = (draw_key(j), j, rec);
             if heap.len() < fit.draw {
                 heap.push(key);
-            } else if heap.peek().is_some_and(|top| (key.0, key.1) < (top.0, top.1)) {
+            } else if heap
+                .peek()
+                .is_some_and(|top| (key.0, key.1) < (top.0, top.1))
+            {
                 heap.pop();
                 heap.push(key);
             }
@@ -553,7 +556,10 @@ fn merge_cells(store: &Store, each: &mut dyn FnMut(Merged) -> Result<()>) -> Res
 }
 
 /// Merges files of [`Merged`] records, each in increasing `first`, by `first`.
-fn merge_files(files: &[(PathBuf, usize)], each: &mut dyn FnMut(Merged) -> Result<()>) -> Result<()> {
+fn merge_files(
+    files: &[(PathBuf, usize)],
+    each: &mut dyn FnMut(Merged) -> Result<()>,
+) -> Result<()> {
     let mut readers = Vec::with_capacity(files.len());
     let mut heap = BinaryHeap::new();
     for (k, (path, count)) in files.iter().enumerate() {
@@ -615,8 +621,14 @@ impl<'a> Near<'a> {
         let g = self.store.grid;
         let [x0, y0, x1, y1] = extent;
         let (o, s, [nx, ny]) = (g.origin, g.size, g.shape);
-        let (i0, i1) = (cell_of(x0 - halo, o[0], s, nx), cell_of(x1 + halo, o[0], s, nx));
-        let (j0, j1) = (cell_of(y0 - halo, o[1], s, ny), cell_of(y1 + halo, o[1], s, ny));
+        let (i0, i1) = (
+            cell_of(x0 - halo, o[0], s, nx),
+            cell_of(x1 + halo, o[0], s, nx),
+        );
+        let (j0, j1) = (
+            cell_of(y0 - halo, o[1], s, ny),
+            cell_of(y1 + halo, o[1], s, ny),
+        );
         let mut out = Vec::new();
         for j in j0..=j1 {
             for i in i0..=i1 {

@@ -101,7 +101,12 @@ fn points_project(dir: &Path, n: usize, dups: usize, interpolation: &str) -> Pat
 #[test]
 fn bucketed_plan_equals_the_in_memory_plan_with_duplicates_and_a_drawn_fit() {
     let tmp = tempfile::tempdir().unwrap();
-    let project = points_project(tmp.path(), 12_000, 150, "methods = [\"uk\", \"idw\"]\nneighbors = 16");
+    let project = points_project(
+        tmp.path(),
+        12_000,
+        150,
+        "methods = [\"uk\", \"idw\"]\nneighbors = 16",
+    );
     let fit = both_ways(tmp.path(), &project, &[], 150.0);
     assert_eq!(fit["samples"], 12_000, "{fit}");
     let held = fit["fitted_on"].as_u64().unwrap();
@@ -121,7 +126,10 @@ fn bucketed_plan_equals_the_in_memory_plan_with_a_reml_fit() {
         "methods = [\"uk\"]\nneighbors = 12\nfit = \"reml\"",
     );
     let fit = both_ways(tmp.path(), &project, &[], 200.0);
-    assert_eq!((fit["samples"].as_u64(), fit["all"].as_bool()), (Some(1_500), Some(true)));
+    assert_eq!(
+        (fit["samples"].as_u64(), fit["all"].as_bool()),
+        (Some(1_500), Some(true))
+    );
 }
 
 /// A DEM file (sampled band by band) in 3 x 3 tiles: the same files.
@@ -135,7 +143,10 @@ fn bucketed_plan_equals_the_in_memory_plan_from_a_dem() {
         let row: Vec<String> = (0..60)
             .map(|c| {
                 let (x, y) = (c as f64 * 25.0, (59 - r) as f64 * 25.0);
-                format!("{:.3}", 300.0 + 20.0 * (x / 130.0).sin() * (y / 170.0).cos() + 0.01 * x)
+                format!(
+                    "{:.3}",
+                    300.0 + 20.0 * (x / 130.0).sin() * (y / 170.0).cos() + 0.01 * x
+                )
             })
             .collect();
         asc += &row.join(" ");
