@@ -194,6 +194,9 @@ pub(crate) fn reach_near(
     })
 }
 
+/// Puts into its vector the samples in a window grown by its distance ([`reach_with`]).
+pub(crate) type WindowFn<'a> = dyn FnMut(f64, &mut Vec<[f64; 2]>) -> Result<()> + 'a;
+
 /// [`reach_near`] of `n` samples, whatever holds them: `window(g, near)` puts into `near` the
 /// samples [`in_window`] of the extent `r` grown by `g`, in their order (a tiled plan reads
 /// them from its cells' files, `plan_stream`).
@@ -203,7 +206,7 @@ pub(crate) fn reach_with(
     r: [f64; 4],
     h: f64,
     guess: f64,
-    window: &mut dyn FnMut(f64, &mut Vec<[f64; 2]>) -> Result<()>,
+    window: &mut WindowFn,
 ) -> Result<(f64, usize)> {
     let k = k.max(1).min(n);
     let mut g = if guess > 0.0 && guess.is_finite() {
