@@ -647,7 +647,11 @@ impl<'a> Near<'a> {
         let n = self.store.n;
         let (halo, _) = reach_with(n, k, r, h, guess, &mut |g, near| {
             near.clear();
-            for (path, count) in self.cells(r, g) {
+            let cells = self.cells(r, g);
+            // Room for every sample of the cells at once (pages never written are not held),
+            // rather than a vector grown by doubling (both copies held while it moves).
+            near.reserve(cells.iter().map(|c| c.1).sum());
+            for (path, count) in cells {
                 let mut rd = Records::<5>::open(&path, count, 1 << 16)?;
                 while let Some(b) = rd.next()? {
                     let p = [f64::from_bits(b[0]), f64::from_bits(b[1])];
