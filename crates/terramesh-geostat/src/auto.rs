@@ -24,7 +24,7 @@ use terramesh_core::vocab::Named;
 use crate::cv::{cross_validate, Candidate, Folds, Interpolator};
 use crate::data::{Data, Drift, Method};
 use crate::error::{GeostatError, Result};
-use crate::experimental::{draw_subset, Lag};
+use crate::experimental::Lag;
 use crate::fit::{fit_model, Fit, Weighting};
 use crate::loo_fit::{fit_loo_within, loo, spacing, Effort};
 use crate::model::{ModelKind, Structure, Variogram};
@@ -71,7 +71,7 @@ terramesh_core::named_enum!(FitMethod, "fit method", [
 ]);
 
 /// Largest number of data in the leave-one-out RMSE of [`FitMethod::WlsLoo`] (a fixed
-/// pseudo-random subset of them above it, [`draw_subset`]).
+/// pseudo-random subset of them above it, [`draw_subset`](crate::draw_subset)).
 pub const WLS_LOO_POINTS: usize = 1000;
 
 /// Relative margin of leave-one-out RMSE within which [`FitMethod::WlsLoo`] counts its
@@ -224,7 +224,7 @@ fn fit_auto_by(
         other => other,
     })?;
     let sub = match s.loo_points {
-        Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
+        Some(m) if data.population() > m => data.draw(m),
         _ => data.clone(),
     };
     // REML: every model alone, then every pair of bounded structures (nested, fitted
@@ -337,9 +337,11 @@ pub fn fit_auto_wls_loo(
     kinds: &[ModelKind],
     s: &AutoSettings,
 ) -> Result<(Fit, Vec<Candidate>, Selection)> {
-    let m = s.loo_points.map_or(data.len(), |m| m.min(WLS_LOO_POINTS));
-    let sub = if data.len() > m {
-        data.subset(&draw_subset(data.len(), m))
+    let m = s
+        .loo_points
+        .map_or(data.population(), |m| m.min(WLS_LOO_POINTS));
+    let sub = if data.population() > m {
+        data.draw(m)
     } else {
         data.clone()
     };
@@ -477,7 +479,7 @@ pub fn fit_auto_wls_loo(
     let selection = Selection {
         method: FitMethod::WlsLoo,
         drift: Some(s.drift),
-        points: data.len(),
+        points: data.population(),
         blocks: 1,
         cv_points: Some(sub.len()),
     };

@@ -314,8 +314,13 @@ impl Candidate {
     }
 }
 
+/// Largest number of data in [`fit_auto`]'s leave-one-out choice ([`Data::strided`] of them
+/// above it).
+pub const FIT_AUTO_POINTS: usize = 2000;
+
 /// Fits every model in `kinds` and picks the one with the least leave-one-out RMSE of
-/// ordinary kriging in a neighbourhood of 32 (on at most 2,000 data, chosen evenly).
+/// ordinary kriging in a neighbourhood of 32 (on at most [`FIT_AUTO_POINTS`] data, chosen
+/// evenly: [`Data::strided`]).
 ///
 /// ```
 /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
@@ -336,9 +341,8 @@ pub fn fit_auto(
     weighting: Weighting,
     kinds: &[ModelKind],
 ) -> Result<(Fit, Vec<Candidate>)> {
-    let sub = if data.len() > 2000 {
-        let idx: Vec<usize> = (0..2000).map(|i| i * data.len() / 2000).collect();
-        data.subset(&idx)
+    let sub = if data.population() > FIT_AUTO_POINTS {
+        data.strided(FIT_AUTO_POINTS)
     } else {
         data.clone()
     };

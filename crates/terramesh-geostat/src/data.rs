@@ -31,6 +31,17 @@ pub struct Data {
     xy: Vec<[f64; 2]>,
     z: Vec<f64>,
     frame: Option<KrigingFrame>,
+    /// Where these data stand for a larger population ([`Data::drawn`]).
+    drawn: Option<Box<Drawn>>,
+}
+
+/// What [`Data::drawn`] data stand for: the population's size and diameter, and the index of
+/// each datum in it.
+#[derive(Clone, Debug, PartialEq)]
+struct Drawn {
+    population: usize,
+    index: Vec<usize>,
+    diameter: f64,
 }
 
 /// The centred frame kriging evaluates distances and drift terms in: the centroid of the
@@ -83,7 +94,12 @@ impl Data {
         let same = |a: usize, b: usize| xy[a][0] == xy[b][0] && xy[a][1] == xy[b][1];
         let has_dup = order.windows(2).find(|w| same(w[0], w[1]));
         match (has_dup, duplicates) {
-            (None, _) => Ok(Data { xy, z, frame: None }),
+            (None, _) => Ok(Data {
+                xy,
+                z,
+                frame: None,
+                drawn: None,
+            }),
             (Some(w), Duplicates::Reject) => Err(GeostatError::DuplicateLocation {
                 first: w[0],
                 second: w[1],
@@ -119,6 +135,7 @@ impl Data {
                     xy: nxy,
                     z: nz,
                     frame: None,
+                    drawn: None,
                 })
             }
         }
@@ -155,6 +172,103 @@ impl Data {
             xy: idx.iter().map(|&i| self.xy[i]).collect(),
             z: idx.iter().map(|&i| self.z[i]).collect(),
             frame: self.frame,
+            drawn: None,
+        }
+    }
+
+    /// Data standing for a population of `population` data that is not held (a tiled plan of
+    /// more samples than memory holds): the data at `index` in it (increasing), and the
+    /// population's `diameter` ([`diameter`](crate::diameter) of all its locations).
+    ///
+    /// The fits read such data as they read the population wherever they read a draw of it:
+    /// [`Data::draw`] of `m` is [`draw_subset`](crate::draw_subset)`(population, m)` of the
+    /// population, exactly, when `index` holds it (it holds the draws of every smaller `m`
+    /// too), [`Data::strided`] likewise; [`Data::population`] and [`Data::diameter`] are the
+    /// population's. The values are validated as [`Data::new`] does (duplicates rejected).
+    ///
+    /// ```
+    /// # fn main() -> Result<(), terramesh_geostat::GeostatError> {
+    /// use terramesh_geostat::{draw_subset, Data, Duplicates};
+    /// let xy: Vec<[f64; 2]> = (0..1000).map(|i| [(i % 40) as f64, (i / 40) as f64]).collect();
+    /// let z: Vec<f64> = xy.iter().map(|p| p[0] * p[1]).collect();
+    /// let all = Data::new(xy.clone(), z.clone(), Duplicates::Reject)?;
+    /// let held = draw_subset(1000, 100);
+    /// let part = Data::drawn(held.iter().map(|&i| xy[i]).collect(), held.iter().map(|&i| z[i]).collect(), held, 1000, 50.0)?;
+    /// assert_eq!((part.len(), part.population(), part.diameter()), (100, 1000, 50.0));
+    /// assert_eq!(part.draw(30), all.draw(30));
+    /// # Ok(()) }
+    /// ```
+    pub fn drawn(
+        xy: Vec<[f64; 2]>,
+        z: Vec<f64>,
+        index: Vec<usize>,
+        population: usize,
+        diameter: f64,
+    ) -> Result<Data> {
+        assert_eq!(index.len(), z.len(), "one index per datum");
+        assert!(
+            index.windows(2).all(|w| w[0] < w[1]) && index.last().is_none_or(|&i| i < population),
+            "increasing indices into the population"
+        );
+        let mut d = Data::new(xy, z, Duplicates::Reject)?;
+        d.drawn = Some(Box::new(Drawn {
+            population,
+            index,
+            diameter,
+        }));
+        Ok(d)
+    }
+
+    /// The number of data these stand for: [`Data::len`], or the population of
+    /// [`Data::drawn`] data.
+    pub fn population(&self) -> usize {
+        self.drawn.as_ref().map_or(self.len(), |d| d.population)
+    }
+
+    /// The largest distance between two locations of the population ([`diameter`](crate::diameter)).
+    pub fn diameter(&self) -> f64 {
+        match &self.drawn {
+            Some(d) => d.diameter,
+            None => crate::diameter(&self.xy),
+        }
+    }
+
+    /// `m` of the population drawn by [`draw_subset`](crate::draw_subset): its `m` indices of
+    /// least [`draw_key`](crate::draw_key), in order (all of these data where `m` is at least
+    /// [`Data::population`]). For [`Data::drawn`] data, the least keys among the indices held.
+    pub fn draw(&self, m: usize) -> Data {
+        match &self.drawn {
+            None => self.subset(&crate::draw_subset(self.len(), m)),
+            Some(d) => {
+                let mut pos: Vec<usize> = (0..self.len()).collect();
+                if m < pos.len() {
+                    pos.select_nth_unstable_by_key(m, |&k| {
+                        (crate::draw_key(d.index[k]), d.index[k])
+                    });
+                    pos.truncate(m);
+                    pos.sort_unstable();
+                }
+                self.subset(&pos)
+            }
+        }
+    }
+
+    /// `m` of the population chosen evenly: the indices `i * population / m` for `i` in
+    /// `0..m` (all of these data where `m` is at least [`Data::population`]). For
+    /// [`Data::drawn`] data, those of these indices held.
+    pub fn strided(&self, m: usize) -> Data {
+        let n = self.population();
+        if m >= n {
+            return self.subset(&(0..self.len()).collect::<Vec<_>>());
+        }
+        match &self.drawn {
+            None => self.subset(&(0..m).map(|i| i * n / m).collect::<Vec<_>>()),
+            Some(d) => {
+                let pos: Vec<usize> = (0..m)
+                    .filter_map(|i| d.index.binary_search(&(i * n / m)).ok())
+                    .collect();
+                self.subset(&pos)
+            }
         }
     }
 
@@ -165,6 +279,7 @@ impl Data {
             xy: self.xy.clone(),
             z,
             frame: self.frame,
+            drawn: self.drawn.clone(),
         }
     }
 

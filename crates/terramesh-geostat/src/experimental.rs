@@ -88,17 +88,30 @@ pub fn draw_subset(n: usize, m: usize) -> Vec<usize> {
     if m >= n {
         return (0..n).collect();
     }
-    let key = |i: usize| {
-        let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    };
     let mut idx: Vec<usize> = (0..n).collect();
-    idx.select_nth_unstable_by_key(m, |&i| (key(i), i));
+    idx.select_nth_unstable_by_key(m, |&i| (draw_key(i), i));
     let mut out = idx[..m].to_vec();
     out.sort_unstable();
     out
+}
+
+/// The key of index `i` in [`draw_subset`]: the draw is the `m` indices of least
+/// `(draw_key(i), i)`, so the draw of `m` is within the draw of any larger number (a stream
+/// keeps the least keys to draw from data it does not hold, [`Data::drawn`](crate::Data::drawn)).
+///
+/// ```
+/// use terramesh_geostat::{draw_key, draw_subset};
+/// let mut keys: Vec<(u64, usize)> = (0..500).map(|i| (draw_key(i), i)).collect();
+/// keys.sort();
+/// let mut least: Vec<usize> = keys[..20].iter().map(|k| k.1).collect();
+/// least.sort();
+/// assert_eq!(least, draw_subset(500, 20));
+/// ```
+pub fn draw_key(i: usize) -> u64 {
+    let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// One lag class of an experimental variogram.
@@ -181,14 +194,14 @@ pub fn experimental(data: &Data, s: &LagSettings) -> Result<Vec<Lag>> {
             return Err(bad("max-dist", m, "must be finite and > 0"))
         }
         Some(m) => m,
-        None => 0.5 * diameter(data.xy()),
+        None => 0.5 * data.diameter(),
     };
     if let Some(m) = s.max_points {
         if m < 2 {
             return Err(bad("max-points", m as f64, "must be at least 2"));
         }
-        if data.len() > m {
-            let sub = data.subset(&draw_subset(data.len(), m));
+        if data.population() > m {
+            let sub = data.draw(m);
             let settings = LagSettings {
                 max_dist: Some(max),
                 max_points: None,

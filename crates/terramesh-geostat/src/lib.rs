@@ -91,12 +91,14 @@ pub use auto::{
     fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, lag_rmse, AutoSettings, FitMethod, Selection,
     DEFAULT_LOO_POINTS, WLS_LOO_POINTS, WLS_LOO_REFINED, WLS_LOO_ROUNDING, WLS_LOO_TIE,
 };
-pub use cv::{cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator};
+pub use cv::{
+    cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator, FIT_AUTO_POINTS,
+};
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
 pub use error::{GeostatError, Result};
 pub use experimental::{
-    diameter, draw_subset, experimental, Direction, Estimator, Lag, LagSettings, DEFAULT_LAGS,
-    DEFAULT_MAX_POINTS, DEFAULT_TOLERANCE,
+    diameter, draw_key, draw_subset, experimental, Direction, Estimator, Lag, LagSettings,
+    DEFAULT_LAGS, DEFAULT_MAX_POINTS, DEFAULT_TOLERANCE,
 };
 pub use file::{
     CandidateEntry, CandidateSummary, FitSummary, LagSummary, VariogramFile, VariogramFileError,

@@ -17,7 +17,6 @@ use crate::auto::AutoSettings;
 use crate::cv::{cross_validate, Folds, Interpolator};
 use crate::data::{Data, Drift, Method};
 use crate::error::{GeostatError, Result};
-use crate::experimental::draw_subset;
 use crate::model::{ModelKind, Variogram};
 use crate::optim::nelder_mead;
 use crate::predictor::Neighbourhood;
@@ -59,7 +58,7 @@ pub struct LooFit {
 pub fn fit_loo(data: &Data, start: &Variogram, s: &AutoSettings) -> Result<LooFit> {
     start.validate()?;
     let sub = match s.loo_points {
-        Some(m) if data.len() > m => data.subset(&draw_subset(data.len(), m)),
+        Some(m) if data.population() > m => data.draw(m),
         _ => data.clone(),
     };
     let (hmin, hmax) = spacing(&sub);
@@ -87,9 +86,9 @@ pub fn fit_wls_loo(data: &Data, start: &Variogram, s: &AutoSettings) -> Result<L
     start.validate()?;
     let m = s
         .loo_points
-        .map_or(data.len(), |m| m.min(crate::WLS_LOO_POINTS));
-    let sub = if data.len() > m {
-        data.subset(&draw_subset(data.len(), m))
+        .map_or(data.population(), |m| m.min(crate::WLS_LOO_POINTS));
+    let sub = if data.population() > m {
+        data.draw(m)
     } else {
         data.clone()
     };

@@ -67,6 +67,7 @@ mod model_merge;
 mod model_stream;
 mod partition;
 mod plan;
+mod plan_stream;
 mod report;
 mod slurm;
 
@@ -92,5 +93,6 @@ pub use merged::Merged;
 pub use model_export::MergedExports;
 pub use model_merge::{MergedModel, MergedUnit};
 pub use partition::{in_window, samples_file, SAMPLES_DIR};
-pub use plan::{check_halo, parse_tile_size, plan, Planned};
+pub use plan::{check_halo, parse_tile_size, plan, plan_in_memory, Planned};
+pub use plan_stream::{FIT_ALL, FIT_SUBSAMPLE};
 pub use slurm::{check_sbatch_value, write_slurm, SbatchValueError, SlurmOptions, SlurmScripts};

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use super::manifest::{cell_of, Manifest};
+use super::manifest::cell_of;
 use crate::error::{Context, Result, TilesError as Error};
 
 /// The folder of the per-tile sample files in the plan.
@@ -37,44 +37,17 @@ pub fn in_window(extent: [f64; 4], halo: f64, p: [f64; 2]) -> bool {
     p[0] >= x0 - h && p[0] <= x1 + h && p[1] >= y0 - h && p[1] <= y1 + h
 }
 
-/// Writes every tile's samples file (`PLAN/samples/ID.f64`, `[x, y, z]` little-endian `f64`
-/// triples) from the samples `xy`, `z` (in the order of `PLAN/samples.f64`), and returns each
-/// tile's count in the order of `m.tiles`.
-///
-/// The samples are bucketed once by the tile grid's cells of `m` ([`Buckets`]); a tile
-/// gathers the buckets of the cells its window overlaps, keeps the samples [`in_window`]
-/// accepts and writes them in their original order.
-pub(crate) fn write_tile_samples(
-    plan: &Path,
-    m: &Manifest,
-    buckets: &Buckets,
-    xy: &[[f64; 2]],
-    z: &[f64],
-) -> Result<Vec<usize>> {
-    let windows: Vec<Window> = m
-        .tiles
-        .iter()
-        .map(|t| Window {
-            id: &t.id,
-            extent: t.extent,
-            halo: t.halo,
-        })
-        .collect();
-    debug_assert_eq!(
-        (buckets.origin, buckets.size, buckets.shape),
-        (m.origin, m.tile_size, m.shape)
-    );
-    write_windows(plan, buckets, &windows, xy, z)
-}
-
 /// A tile's data window.
+#[cfg(test)]
 struct Window<'a> {
     id: &'a str,
     extent: [f64; 4],
     halo: f64,
 }
 
-/// [`write_tile_samples`] for the `windows`, the samples bucketed by `buckets`.
+/// Each window's samples file (`PLAN/samples/ID.f64`, `[x, y, z]` little-endian `f64`
+/// triples) from the samples `xy`, `z` bucketed by `buckets`; each window's count.
+#[cfg(test)]
 fn write_windows(
     plan: &Path,
     buckets: &Buckets,
@@ -87,12 +60,28 @@ fn write_windows(
     let mut counts = Vec::with_capacity(windows.len());
     let mut keep: Vec<u32> = Vec::new();
     for t in windows {
-        buckets.window(xy, t.extent, t.halo, &mut keep);
         let path = plan.join(samples_file(t.id));
-        write_records(&path, keep.iter().map(|&k| k as usize), xy, z)?;
-        counts.push(keep.len());
+        counts.push(write_window(
+            &path, buckets, xy, z, t.extent, t.halo, &mut keep,
+        )?);
     }
     Ok(counts)
+}
+
+/// Writes the samples of `xy`, `z` [`in_window`] of `extent` and `halo` to `path`, in their
+/// order (`keep`: scratch); returns their count.
+pub(crate) fn write_window(
+    path: &Path,
+    buckets: &Buckets,
+    xy: &[[f64; 2]],
+    z: &[f64],
+    extent: [f64; 4],
+    halo: f64,
+    keep: &mut Vec<u32>,
+) -> Result<usize> {
+    buckets.window(xy, extent, halo, keep);
+    write_records(path, keep.iter().map(|&k| k as usize), xy, z)?;
+    Ok(keep.len())
 }
 
 /// The samples bucketed by the cells of the tile grid (a counting sort of their indices, 4
@@ -196,20 +185,40 @@ pub(crate) fn reach_near(
     h: f64,
     guess: f64,
 ) -> Result<(f64, usize)> {
-    let k = k.max(1).min(xy.len());
+    let mut keep = Vec::new();
+    reach_with(xy.len(), k, r, h, guess, &mut |g, near| {
+        buckets.window(xy, r, g, &mut keep);
+        near.clear();
+        near.extend(keep.iter().map(|&i| xy[i as usize]));
+        Ok(())
+    })
+}
+
+/// Puts into its vector the samples in a window grown by its distance ([`reach_with`]).
+pub(crate) type WindowFn<'a> = dyn FnMut(f64, &mut Vec<[f64; 2]>) -> Result<()> + 'a;
+
+/// [`reach_near`] of `n` samples, whatever holds them: `window(g, near)` puts into `near` the
+/// samples [`in_window`] of the extent `r` grown by `g`, in their order (a tiled plan reads
+/// them from its cells' files, `plan_stream`).
+pub(crate) fn reach_with(
+    n: usize,
+    k: usize,
+    r: [f64; 4],
+    h: f64,
+    guess: f64,
+    window: &mut WindowFn,
+) -> Result<(f64, usize)> {
+    let k = k.max(1).min(n);
     let mut g = if guess > 0.0 && guess.is_finite() {
         guess
     } else {
         (r[2] - r[0]).max(r[3] - r[1])
     };
-    let mut keep = Vec::new();
     let mut near: Vec<[f64; 2]> = Vec::new();
     for tried in 1.. {
-        buckets.window(xy, r, g, &mut keep);
-        let all = keep.len() == xy.len();
-        if keep.len() >= k {
-            near.clear();
-            near.extend(keep.iter().map(|&i| xy[i as usize]));
+        window(g, &mut near)?;
+        let all = near.len() == n;
+        if near.len() >= k {
             let tree: ImmutableKdTree<f64, 2> =
                 ImmutableKdTree::new_from_slice(&near).map_err(|e| Error::SearchTree {
                     points: "the samples".into(),

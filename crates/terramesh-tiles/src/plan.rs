@@ -5,6 +5,7 @@ use std::path::Path;
 
 use terramesh_geostat::{InterpolationMethod, VariogramFile};
 
+use super::geology::GeologyPlan;
 use super::geometry::{ccw_ring, clip, clip_concave, ring_and_seams};
 use super::manifest::{
     DataRule, GridSpec, Manifest, Seam, State, Tile, TileData, SAMPLES, VARIOGRAM, VERSION,
@@ -175,6 +176,53 @@ pub fn plan(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Planned> {
+    plan_with(
+        project,
+        project_file,
+        set,
+        base,
+        tile_size,
+        out,
+        progress,
+        false,
+    )
+}
+
+/// [`plan`] with every sample in memory (the way a project with `[geology]` is planned): the
+/// same files, for the test that compares the two.
+#[doc(hidden)]
+pub fn plan_in_memory(
+    project: &Project,
+    project_file: &Path,
+    set: &[String],
+    base: &Path,
+    tile_size: f64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Planned> {
+    plan_with(
+        project,
+        project_file,
+        set,
+        base,
+        tile_size,
+        out,
+        progress,
+        true,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn plan_with(
+    project: &Project,
+    project_file: &Path,
+    set: &[String],
+    base: &Path,
+    tile_size: f64,
+    out: &Path,
+    progress: &dyn Progress,
+    in_memory: bool,
+) -> Result<Planned> {
     check_tileable(project)?;
     if !(tile_size.is_finite() && tile_size > 0.0) {
         return Err(Error::TileSize { tile_size });
@@ -182,13 +230,215 @@ pub fn plan(
     project.check_inputs(base)?;
     check_plan_folder(out)?;
     std::fs::create_dir_all(out).at(out)?;
-    let mut samples = stages::sample(project, base, out, progress)?;
+    let how = How {
+        project,
+        project_file,
+        set,
+        base,
+        tile_size,
+        out,
+        progress,
+    };
+    if in_memory || project.geology().is_some() {
+        return plan_held(&how);
+    }
+    let scratch = out.join(super::plan_stream::SCRATCH);
+    if scratch.exists() {
+        std::fs::remove_dir_all(&scratch).at(&scratch)?;
+    }
+    std::fs::create_dir_all(&scratch).at(&scratch)?;
+    let planned = plan_streamed(&how, &scratch);
+    // The scratch files go whatever happened (a failed plan is made again from the start).
+    let _ = std::fs::remove_dir_all(&scratch);
+    planned
+}
+
+/// What [`plan`] was asked.
+struct How<'a> {
+    project: &'a Project,
+    project_file: &'a Path,
+    set: &'a [String],
+    base: &'a Path,
+    tile_size: f64,
+    out: &'a Path,
+    progress: &'a dyn Progress,
+}
+
+/// The samples' side of the plan: each tile's halo and samples file.
+trait Windows {
+    /// The halo of the tile `r` over `k` neighbours (`partition::reach_near`).
+    fn reach(&mut self, k: usize, r: [f64; 4], h: f64, guess: f64) -> Result<f64>;
+    /// Writes the samples in the window of `extent` grown by `halo` to `path`; their count.
+    fn write(&mut self, path: &Path, extent: [f64; 4], halo: f64) -> Result<usize>;
+}
+
+/// Every sample in memory, bucketed by tile cell.
+struct Held<'a> {
+    buckets: super::partition::Buckets,
+    xy: &'a [[f64; 2]],
+    z: &'a [f64],
+    keep: Vec<u32>,
+}
+
+impl Windows for Held<'_> {
+    fn reach(&mut self, k: usize, r: [f64; 4], h: f64, guess: f64) -> Result<f64> {
+        Ok(super::partition::reach_near(&self.buckets, self.xy, k, r, h, guess)?.0)
+    }
+    fn write(&mut self, path: &Path, extent: [f64; 4], halo: f64) -> Result<usize> {
+        let (b, keep) = (&self.buckets, &mut self.keep);
+        super::partition::write_window(path, b, self.xy, self.z, extent, halo, keep)
+    }
+}
+
+impl Windows for super::plan_stream::Near<'_> {
+    fn reach(&mut self, k: usize, r: [f64; 4], h: f64, guess: f64) -> Result<f64> {
+        super::plan_stream::Near::reach(self, k, r, h, guess)
+    }
+    fn write(&mut self, path: &Path, extent: [f64; 4], halo: f64) -> Result<usize> {
+        super::plan_stream::Near::write(self, path, extent, halo)
+    }
+}
+
+/// The plan with every sample in memory (and the geology's plan, which reads them).
+fn plan_held(how: &How) -> Result<Planned> {
+    let (project, out) = (how.project, how.out);
+    // A record of a bucketed plan made into this folder before does not describe this one.
+    let record = out.join(super::plan_stream::FIT_RECORD);
+    if record.exists() {
+        std::fs::remove_file(&record).at(&record)?;
+    }
+    let mut samples = stages::sample(project, how.base, out, how.progress)?;
+    let shape = region_shape(how, &samples)?;
+    let model = stages::model(project, &samples, how.base)?;
+    if project.geology().is_none() {
+        // Only the geology's plan reads the samples again; the halos and the tiles' files are
+        // made of the kriging data (duplicates merged): 24 bytes a sample less from here on.
+        samples.xyz = Vec::new();
+    }
+    let variogram = write_variogram(out, &model.variogram)?;
+    let data = &model.data;
+    let frame = data.frame(&variogram);
+    // The samples, as kriging sees them (duplicates merged), in order.
+    super::partition::write_all_samples(&out.join(SAMPLES), data.xy(), data.z())?;
+    let (lo, size, cells) = shape.grid;
+    let mut held = Held {
+        buckets: super::partition::Buckets::new(lo, size, cells, data.xy())?,
+        xy: data.xy(),
+        z: data.z(),
+        keep: Vec::new(),
+    };
+    lay_out(
+        how,
+        &samples,
+        shape,
+        data.len(),
+        frame,
+        &mut held,
+        &|rects, h| super::geology_plan::plan_geology(project, &samples, data.z(), out, rects, h),
+    )
+}
+
+/// The plan that holds no more than a cell's samples, a window's and the fit's draw
+/// ([`super::plan_stream`]).
+fn plan_streamed(how: &How, scratch: &Path) -> Result<Planned> {
+    use super::plan_stream as ps;
+    let (project, out) = (how.project, how.out);
+    let mut raw = ps::RawSink::create(scratch.join("raw.f64"))?;
+    let sampled = stages::sample_into(project, how.base, out, how.progress, &mut raw)?;
+    let (raw, count) = raw.finish()?;
+    debug_assert_eq!(count, sampled.count);
+    let samples = sampled.samples;
+    let shape = region_shape(how, &samples)?;
+    let (lo, size, cells) = shape.grid;
+    let grid = ps::Grid {
+        origin: lo,
+        size,
+        shape: cells,
+    };
+    let store = ps::bucket(&raw, count, grid, scratch)?;
+    let n = store.n;
+    let mut fit = ps::FitPlan::of(project, n);
+    let samples_path = out.join(SAMPLES);
+    let mut written = ps::write_samples(&store, &samples_path, &fit)?;
+    let flat = |d: &terramesh_geostat::Data| d.z().iter().all(|&z| Some(&z) == d.z().first());
+    if !fit.all && (written.constant || flat(&written.data)) {
+        // A constant field's nominal model reads the whole extent: every sample, if few enough.
+        if n <= ps::FIT_ALL {
+            fit = ps::FitPlan {
+                all: true,
+                draw: 0,
+                strided: 0,
+                exact: true,
+            };
+            written.data = ps::read_all(&samples_path, n)?;
+        } else {
+            fit.exact = false;
+        }
+    }
+    let held = written.data.len();
+    let why = if fit.all {
+        format!("every sample ({n}): the fit reads them all")
+    } else if fit.exact {
+        format!(
+            "{held} of {n} samples: the draws its fit reads (the experimental variogram's {} \
+             and the leave-one-out's; the data's diameter from every sample), so the variogram \
+             is the one all of them give",
+            fit.draw
+        )
+    } else {
+        format!(
+            "{held} of {n} samples drawn (more than {} samples and a fit that reads every \
+             datum: REML, leave-one-out, anisotropy or max_points = 0): the variogram can \
+             differ from the one all of them give",
+            ps::FIT_ALL
+        )
+    };
+    how.progress.note(&format!("variogram fitted on {why}"));
+    let model = stages::model_of(project, written.data, how.base)?;
+    let variogram = write_variogram(out, &model.variogram)?;
+    drop(model);
+    let record = serde_json::json!({
+        "samples": n,
+        "fitted_on": held,
+        "all": fit.all,
+        "same_as_every_sample": fit.exact,
+        "why": why,
+    });
+    let fpath = out.join(ps::FIT_RECORD);
+    terramesh_io::output::write_atomic(&fpath, serde_json::to_string_pretty(&record)?.as_bytes())
+        .at(&fpath)?;
+    let frame = ps::frame(&samples_path, n, &variogram)?;
+    let mut near = ps::Near::new(&store);
+    lay_out(how, &samples, shape, n, frame, &mut near, &|_, _| Ok(None))
+}
+
+/// Writes `PLAN/variogram.json` and reads it back (what every tile reads).
+fn write_variogram(
+    out: &Path,
+    v: &terramesh_geostat::Variogram,
+) -> Result<terramesh_geostat::Variogram> {
+    let vpath = out.join(VARIOGRAM);
+    let json = VariogramFile::new(v.clone()).to_json_pretty();
+    terramesh_io::output::write_atomic(&vpath, json.as_bytes()).at(&vpath)?;
+    Ok(terramesh::variogram_file::read_variogram_file(&vpath)?)
+}
+
+/// The region's outline and the tile grid.
+struct Shape {
+    outline: Vec<[f64; 2]>,
+    region: Vec<[f64; 2]>,
+    convex: bool,
+    /// The tile grid: origin, tile size, columns and rows.
+    grid: ([f64; 2], f64, [usize; 2]),
+}
+
+fn region_shape(how: &How, samples: &stages::Samples) -> Result<Shape> {
     let polys = &samples.region.projected.polygons;
     let holes: usize = polys.iter().map(|p| p.holes.len()).sum();
     let lines = samples.region.projected.lines.len();
     if polys.len() != 1 || holes > 0 || lines > 0 {
         return Err(Error::RegionShape {
-            file: project_file.to_path_buf(),
+            file: how.project_file.to_path_buf(),
             polygons: polys.len(),
             holes,
             lines,
@@ -196,41 +446,7 @@ pub fn plan(
     }
     let outline = polys[0].outer.clone();
     let (region, convex) = ccw_ring(&outline)?;
-    let whole = terramesh_core::geometry::Region::from_ring(region.clone());
-    let model = stages::model(project, &samples, base)?;
-    if project.geology().is_none() {
-        // Only the geology's plan reads the samples again; the halos and the tiles' files are
-        // made of the kriging data (duplicates merged): 24 bytes a sample less from here on.
-        samples.xyz = Vec::new();
-    }
-    // The variogram file every tile (and a one-piece build given it) reads.
-    let vpath = out.join(VARIOGRAM);
-    let json = VariogramFile::new(model.variogram.clone()).to_json_pretty();
-    terramesh_io::output::write_atomic(&vpath, json.as_bytes()).at(&vpath)?;
-    let variogram = terramesh::variogram_file::read_variogram_file(&vpath)?;
-    let data = &model.data;
-    let frame = data.frame(&variogram);
-    // The samples, as kriging sees them (duplicates merged), in order.
-    super::partition::write_all_samples(&out.join(SAMPLES), data.xy(), data.z())?;
-
-    let ip = &project.interpolation;
-    let k = if ip.methods.contains(&InterpolationMethod::Idw) {
-        ip.neighbors.or(0).max(ip.idw_neighbors)
-    } else {
-        ip.neighbors.or(0)
-    }
-    .min(data.len());
-    let m = &project.mesh;
-    let max_area = m.area(Some(samples.cell[0] * samples.cell[1]));
-    let budget = match (max_area, m.max_edge) {
-        (Some(a), Some(l)) => a.min(EQUILATERAL_AREA * l * l),
-        (Some(a), None) => a,
-        (None, Some(l)) => EQUILATERAL_AREA * l * l,
-        (None, None) => unreachable!("a size follows from the cell"),
-    };
-    let spacing = SEAM_SPACING * (budget / EQUILATERAL_AREA).sqrt();
-    let spec = stages::dsm_grid(project, &samples)?;
-
+    let tile_size = how.tile_size;
     // The tile grid over the region's bounding box.
     let (lo, hi) = samples.region.projected.bbox().ok_or(Error::EmptyRegion)?;
     let shape = [
@@ -240,6 +456,53 @@ pub fn plan(
     if shape[0] * shape[1] > super::manifest::MAX_TILES {
         return Err(Error::TooManyTiles { tile_size, shape });
     }
+    Ok(Shape {
+        outline,
+        region,
+        convex,
+        grid: (lo, tile_size, shape),
+    })
+}
+
+/// The geology's plan of the tiles' extents and the probe spacing (none without `[geology]`).
+type GeologyOf<'a> = dyn Fn(&[[f64; 4]], f64) -> Result<Option<(GeologyPlan, Vec<f64>)>> + 'a;
+
+/// The tiles, their halos, seams and samples files, and `tiles.json`.
+#[allow(clippy::too_many_arguments)]
+fn lay_out(
+    how: &How,
+    samples: &stages::Samples,
+    shape: Shape,
+    n: usize,
+    frame: terramesh_geostat::KrigingFrame,
+    windows: &mut dyn Windows,
+    geology: &GeologyOf,
+) -> Result<Planned> {
+    let (project, out, tile_size) = (how.project, how.out, how.tile_size);
+    let Shape {
+        outline,
+        region,
+        convex,
+        grid: (lo, _, shape),
+    } = shape;
+    let whole = terramesh_core::geometry::Region::from_ring(region.clone());
+    let ip = &project.interpolation;
+    let k = if ip.methods.contains(&InterpolationMethod::Idw) {
+        ip.neighbors.or(0).max(ip.idw_neighbors)
+    } else {
+        ip.neighbors.or(0)
+    }
+    .min(n);
+    let m = &project.mesh;
+    let max_area = m.area(Some(samples.cell[0] * samples.cell[1]));
+    let budget = match (max_area, m.max_edge) {
+        (Some(a), Some(l)) => a.min(EQUILATERAL_AREA * l * l),
+        (Some(a), None) => a,
+        (None, Some(l)) => EQUILATERAL_AREA * l * l,
+        (None, None) => unreachable!("a size follows from the cell"),
+    };
+    let spacing = SEAM_SPACING * (budget / EQUILATERAL_AREA).sqrt();
+    let spec = stages::dsm_grid(project, samples)?;
     let rect = |i: usize, j: usize| {
         [
             lo[0] + i as f64 * tile_size,
@@ -274,9 +537,10 @@ pub fn plan(
             && (j as usize) < shape[1]
             && !polys[j as usize * shape[0] + i as usize].is_empty()
     };
-    // The samples by tile cell: each tile's halo from the samples near it (no search tree
-    // over the region), then each tile's samples file.
-    let buckets = super::partition::Buckets::new(lo, tile_size, shape, data.xy())?;
+    // Each tile's halo from the samples near it (no search tree over the region), then its
+    // samples file, so that a tile reads only its window.
+    let dir = out.join(super::partition::SAMPLES_DIR);
+    std::fs::create_dir_all(&dir).at(&dir)?;
     let h = samples.cell[0].min(samples.cell[1]).min(tile_size / 4.0);
     let mut tiles = Vec::new();
     let mut max_halo: f64 = 0.0;
@@ -303,10 +567,13 @@ pub fn plan(
                 .collect();
             let neighbours = seams.iter().map(|s| s.neighbour.clone()).collect();
             // The halo: the farthest k-th neighbour over probes, plus the probes' reach.
-            let (halo, _) = super::partition::reach_near(&buckets, data.xy(), k, r, h, 4.0 * h)?;
+            let halo = windows.reach(k, r, h, 4.0 * h)?;
             max_halo = max_halo.max(halo);
+            let tid = id(i, j);
+            let file = super::partition::samples_file(&tid);
+            let count = windows.write(&out.join(&file), r, halo)?;
             tiles.push(Tile {
-                id: id(i, j),
+                id: tid,
                 index: [i, j],
                 extent: r,
                 halo,
@@ -317,21 +584,21 @@ pub fn plan(
                 error: None,
                 built: None,
                 geology_halo: None,
-                data: None,
+                data: Some(TileData { file, count }),
             });
         }
     }
     let rects: Vec<[f64; 4]> = tiles.iter().map(|t| t.extent).collect();
-    let geology = super::geology_plan::plan_geology(project, &samples, data.z(), out, &rects, h)?;
+    let geology = geology(&rects, h)?;
     let geology = geology.map(|(g, halos)| {
         for (t, halo) in tiles.iter_mut().zip(halos) {
             t.geology_halo = Some(halo);
         }
         g
     });
-    let project_file = std::path::absolute(project_file).at(project_file)?;
+    let project_file = std::path::absolute(how.project_file).at(how.project_file)?;
     let folder = project_file.parent().unwrap_or(Path::new(""));
-    let mut manifest = Manifest {
+    let manifest = Manifest {
         version: VERSION,
         plan: terramesh::plan::Plan {
             mesh: terramesh::plan::MeshPlan {
@@ -342,7 +609,7 @@ pub fn plan(
             ..project.plan_in(folder)
         },
         project: project_file.clone(),
-        set: set.to_vec(),
+        set: how.set.to_vec(),
         tile_size,
         origin: lo,
         shape,
@@ -352,7 +619,7 @@ pub fn plan(
         seam_spacing: spacing,
         data: DataRule {
             samples: SAMPLES.into(),
-            count: data.len(),
+            count: n,
             neighbours: k,
             rule: "a tile uses the samples in its extent grown by its halo on every side; the \
                    halo reaches past the k-th nearest sample of every point of the extent; the \
@@ -384,20 +651,11 @@ pub fn plan(
         geology,
         tiles,
     };
-    // Every tile's own samples, so that a tile reads only its window.
-    let counts =
-        super::partition::write_tile_samples(out, &manifest, &buckets, data.xy(), data.z())?;
-    for (t, count) in manifest.tiles.iter_mut().zip(counts) {
-        t.data = Some(TileData {
-            file: super::partition::samples_file(&t.id),
-            count,
-        });
-    }
     manifest.write(out)?;
     Ok(Planned {
         tiles: manifest.tiles.len(),
         shape,
-        samples: data.len(),
+        samples: n,
         max_halo,
     })
 }

@@ -87,6 +87,41 @@ pub fn acquire_streamed(plan: &SamplePlan, scale: f64) -> Result<Option<Streamed
     acquire_in_bands(plan, scale, BAND)
 }
 
+/// Where a streamed acquisition puts its points ([`acquire_streamed_into`]), band by band in
+/// the table's order: a vector (what [`acquire_streamed`] holds) or a file (a tiled plan,
+/// which holds none).
+pub trait PointSink {
+    /// The next band's points with an elevation, `[x, y, z]`.
+    fn points(&mut self, xyz: &[[f64; 3]]) -> Result<()>;
+    /// At most `n` points will come (the grid's nodes), before the first band.
+    fn expect(&mut self, _n: usize) {}
+}
+
+impl PointSink for Vec<[f64; 3]> {
+    fn expect(&mut self, n: usize) {
+        self.reserve_exact(n);
+    }
+    fn points(&mut self, xyz: &[[f64; 3]]) -> Result<()> {
+        self.extend_from_slice(xyz);
+        Ok(())
+    }
+}
+
+/// [`acquire_in_bands`] with each band's points given to `sink` instead of kept
+/// ([`Streamed::xyz`] is empty). Where it returns `Ok(None)`, `sink` may have had the
+/// points of the bands before the one that declined: discard them.
+pub fn acquire_streamed_into<'a>(
+    plan: &'a SamplePlan,
+    scale: f64,
+    band: usize,
+    sink: &mut dyn PointSink,
+) -> Result<Option<Streamed<'a>>> {
+    match &plan.source {
+        Source::Raster(path) => raster::stream_file(plan, path, scale, band, sink),
+        _ => Ok(None),
+    }
+}
+
 /// Grid nodes per band of [`acquire_streamed`]: a band's nodes, their elevations, rows and
 /// table text are held at once (about 250 bytes a node), never the whole grid's.
 pub const BAND: usize = 1 << 16;
@@ -97,8 +132,7 @@ pub fn acquire_in_bands(
     scale: f64,
     band: usize,
 ) -> Result<Option<Streamed<'_>>> {
-    match &plan.source {
-        Source::Raster(path) => raster::stream_file(plan, path, scale, band),
-        _ => Ok(None),
-    }
+    let mut xyz = Vec::new();
+    let got = acquire_streamed_into(plan, scale, band, &mut xyz)?;
+    Ok(got.map(|s| Streamed { xyz, ..s }))
 }

@@ -38,6 +38,7 @@ pub(crate) fn stream_file<'a>(
     path: &Path,
     scale: f64,
     band: usize,
+    sink: &mut dyn super::PointSink,
 ) -> Result<Option<Streamed<'a>>> {
     let band = band.max(1);
     let Some(points) = s.grid_points()? else {
@@ -68,12 +69,14 @@ pub(crate) fn stream_file<'a>(
     let dem = open_raster_in(path, s.options.fill_voids, area.as_ref())?;
     let zone = table_zone(s, dem.as_ref());
     let mut table = TableWriter::new(s, zone)?;
-    let mut xyz = Vec::with_capacity(points.len());
+    sink.expect(points.len());
+    let mut xyz = Vec::new();
     for nodes in points.chunks(band) {
         let mut t = sample(s, dem.as_ref(), s.nodes_of(nodes)?)?;
         if s.options.on_missing == OnMissing::Error && t.rows.iter().any(|r| r.z.is_err()) {
             return Ok(None);
         }
+        xyz.clear();
         for r in &mut t.rows {
             if let Ok(z) = &mut r.z {
                 if scale != 1.0 {
@@ -82,11 +85,12 @@ pub(crate) fn stream_file<'a>(
                 xyz.push([r.xy[0], r.xy[1], *z]);
             }
         }
+        sink.points(&xyz)?;
         table.band(&t.rows)?;
     }
     Ok(Some(Streamed {
         zone,
-        xyz,
+        xyz: Vec::new(),
         table,
         summary: summary(s, dem.as_ref()),
     }))

@@ -34,7 +34,7 @@ pub use exports::Written;
 pub use pictures::{short_numbers, Picture};
 /// The stages a tile of a tiled build (`terramesh-tiles`) shares with a one-piece build: the
 /// samples, the variogram, the DSM grid's layout and the predictors.
-pub use stages::{dsm_grid, model, sample, Surface};
+pub use stages::{dsm_grid, model, model_of, sample, sample_into, SampleSink, Sampled, Surface};
 pub use stages::{Interpolated, Meshed, Model, Samples};
 pub use viewer::{VIEWER_MODEL_VERTICES, VIEWER_SAMPLES, VIEWER_VERTICES};
 

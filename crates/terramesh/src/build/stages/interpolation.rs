@@ -126,8 +126,13 @@ pub fn sample_data(s: &Samples) -> Result<Data> {
 
 /// Step 4a: the variogram of the samples (needed before meshing for adaptive refinement).
 pub fn model(p: &Project, s: &Samples, base: &Path) -> Result<Model> {
+    model_of(p, sample_data(s)?, base)
+}
+
+/// [`model`] of the samples' kriging data `data` (duplicates merged): these may be
+/// [`Data::drawn`] data standing for more samples than are held (a tiled plan's).
+pub fn model_of(p: &Project, data: Data, base: &Path) -> Result<Model> {
     let ip = &p.interpolation;
-    let data = sample_data(s)?;
     // Kriging with an external drift: the raster at the samples, and a variogram fitted to
     // the residuals of the drift (its own variation taken out).
     let drift = match &ip.external_drift_grid {

@@ -3,7 +3,7 @@
 
 mod interpolation;
 
-pub use interpolation::{dsm_grid, model, Interpolated, Model, Surface};
+pub use interpolation::{dsm_grid, model, model_of, Interpolated, Model, Surface};
 pub(crate) use interpolation::{interpolate, sample_data, Fit};
 
 use std::path::Path;
@@ -12,7 +12,10 @@ use terramesh_core::coords::Zone;
 use terramesh_io::region::LoadedRegion;
 use terramesh_mesh::{Mesh, Quality, SmoothReport};
 
-use crate::acquire::{acquire, acquire_streamed, write_table, SamplePlan, SampleTable, Streamed};
+use crate::acquire::{
+    acquire, acquire_streamed, acquire_streamed_into, write_table, PointSink, SamplePlan,
+    SampleTable, Streamed, BAND,
+};
 use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
@@ -98,6 +101,121 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
     })
 }
 
+/// What [`sample_into`] sampled: its count and extent (its points went to the sink).
+pub struct Sampled {
+    /// The samples, without their points ([`Samples::xyz`] is empty).
+    pub samples: Samples,
+    /// How many points went to the sink.
+    pub count: usize,
+}
+
+/// Counts the points a [`PointSink`] gets and their extent.
+struct Counting<'a> {
+    inner: &'a mut dyn SampleSink,
+    count: usize,
+    lo: [f64; 2],
+    hi: [f64; 2],
+}
+
+impl PointSink for Counting<'_> {
+    fn points(&mut self, xyz: &[[f64; 3]]) -> Result<()> {
+        for p in xyz {
+            self.lo = [self.lo[0].min(p[0]), self.lo[1].min(p[1])];
+            self.hi = [self.hi[0].max(p[0]), self.hi[1].max(p[1])];
+        }
+        self.count += xyz.len();
+        self.inner.points(xyz)
+    }
+}
+
+/// Where [`sample_into`] puts the samples: a [`PointSink`] that can start again.
+pub trait SampleSink: PointSink {
+    /// Forgets every point had so far (the streaming declined; the whole acquisition's points
+    /// come next).
+    fn restart(&mut self) -> Result<()>;
+}
+
+/// [`sample`] with the points given to `sink` (in the order of [`Samples::xyz`]) instead of
+/// held: a DEM file is sampled band by band and nothing holds its points; other sources are
+/// acquired whole (their table in memory, as [`sample`]) and then given to `sink`.
+pub fn sample_into(
+    p: &Project,
+    base: &Path,
+    out: &Path,
+    progress: &dyn Progress,
+    sink: &mut dyn SampleSink,
+) -> Result<Sampled> {
+    let options = p.sample_options(base, &out.join("samples.csv"))?;
+    let plan = SamplePlan::resolve(&options)?;
+    let metres = p.source.z_unit.metres();
+    let mut counting = Counting {
+        inner: sink,
+        count: 0,
+        lo: [f64::INFINITY; 2],
+        hi: [f64::NEG_INFINITY; 2],
+    };
+    let got = match acquire_streamed_into(&plan, metres, BAND, &mut counting)? {
+        Some(s) => Acquired::Streamed(s),
+        None => {
+            counting.inner.restart()?;
+            (counting.count, counting.lo, counting.hi) =
+                (0, [f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            let mut table = acquire(&plan, progress)?;
+            if metres != 1.0 {
+                for r in &mut table.rows {
+                    if let Ok(z) = &mut r.z {
+                        *z *= metres;
+                    }
+                }
+            }
+            let mut band = Vec::with_capacity(BAND);
+            for r in &table.rows {
+                if let Ok(z) = &r.z {
+                    band.push([r.xy[0], r.xy[1], *z]);
+                    if band.len() == BAND {
+                        counting.points(&band)?;
+                        band.clear();
+                    }
+                }
+            }
+            counting.points(&band)?;
+            Acquired::Table(table)
+        }
+    };
+    let table_zone = match &got {
+        Acquired::Streamed(s) => s.zone,
+        Acquired::Table(t) => t.zone,
+    };
+    let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
+    let zone = match table_zone {
+        Some(z) if !own_crs => Some(z),
+        _ if own_crs => None,
+        _ => return Err(Error::UnconvertedSource),
+    };
+    let region = plan.region.clone().ok_or(Error::BuildNeedsRegion)?;
+    let count = counting.count;
+    if count < 10 {
+        return Err(Error::TooFewSamples { samples: count });
+    }
+    let s = &p.sampling;
+    let cell = cell_of_extent(counting.lo, counting.hi, s.rows, s.cols, s.spacing);
+    match got {
+        Acquired::Streamed(s) => s.commit(progress)?,
+        Acquired::Table(t) => write_table(&plan, t, progress)?,
+    }
+    Ok(Sampled {
+        samples: Samples {
+            xyz: Vec::new(),
+            zone,
+            crs: p.region.crs.crs().cloned(),
+            region,
+            source: options.source,
+            cell,
+        },
+        count,
+    })
+}
+
 impl Samples {
     /// The EPSG code of the project's coordinates (the UTM zone's, or the project CRS's).
     pub fn epsg(&self) -> Option<u32> {
@@ -120,15 +238,26 @@ impl Samples {
 }
 
 fn grid_cell(xyz: &[[f64; 3]], rows: usize, cols: usize, spacing: Option<f64>) -> [f64; 2] {
-    if let Some(s) = spacing {
-        return [s, s];
-    }
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in xyz {
         for k in 0..2 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
         }
+    }
+    cell_of_extent(lo, hi, rows, cols, spacing)
+}
+
+/// The sampling cell of samples spanning `lo` to `hi` ([`grid_cell`]).
+fn cell_of_extent(
+    lo: [f64; 2],
+    hi: [f64; 2],
+    rows: usize,
+    cols: usize,
+    spacing: Option<f64>,
+) -> [f64; 2] {
+    if let Some(s) = spacing {
+        return [s, s];
     }
     [
         (hi[0] - lo[0]) / (cols.max(2) - 1) as f64,
