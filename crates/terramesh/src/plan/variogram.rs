@@ -54,7 +54,9 @@ use crate::setting::Setting;
 /// for a fit, or `auto`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ModelParts {
-    /// A model name, a nested sum `a+b[+c]`, or `auto`.
+    /// A model name or a nested sum `a+b[+c]` given in full (with `psill` and `range`), or
+    /// `auto`. A single command's plan holds a model named for a fit in its `fit_model`
+    /// instead ([`InterpolationPlan::set_model`](super::InterpolationPlan::set_model)).
     pub model: Option<String>,
     /// Partial sill per structure.
     pub psill: Vec<f64>,
