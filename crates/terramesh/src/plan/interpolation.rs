@@ -469,7 +469,8 @@ impl InterpolationPlan {
     /// and ranges beside `variogram` `auto`) goes to `fit_model`, the one field of what a fit
     /// fits (`--model auto` asks for the fit, as `--variogram auto`); a model given in full,
     /// or a name still missing its parameters (refused by [`ModelParts::variogram`]), stays in
-    /// `parts`.
+    /// `parts`, as does `auto` beside partial sills or ranges (refused by
+    /// [`ModelParts::explicit_or_fit`]: `auto` fits them).
     ///
     /// ```
     /// use terramesh::plan::{InterpolationPlan, ModelParts};
@@ -492,7 +493,8 @@ impl InterpolationPlan {
             .as_deref()
             .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
         let bare = parts.psill.is_empty() && parts.range.is_empty();
-        if parts.is_auto() || (fitting && bare) {
+        // `--model auto` beside `--psill`/`--range` stays in `parts`, whose check refuses it.
+        if (parts.is_auto() && bare) || (fitting && bare) {
             if let Some(name) = parts.model.take() {
                 if name.eq_ignore_ascii_case("auto") && self.variogram.is_none() {
                     self.variogram = Some("auto".into());
