@@ -494,7 +494,7 @@ impl InterpolationPlan {
             .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
         let bare = parts.psill.is_empty() && parts.range.is_empty();
         // `--model auto` beside `--psill`/`--range` stays in `parts`, whose check refuses it.
-        if (parts.is_auto() && bare) || (fitting && bare) {
+        if bare && (fitting || parts.is_auto()) {
             if let Some(name) = parts.model.take() {
                 if name.eq_ignore_ascii_case("auto") && self.variogram.is_none() {
                     self.variogram = Some("auto".into());
