@@ -200,6 +200,36 @@ def test_bad_variograms_and_data_raise_input_errors(field):
         terramesh.krige(x, y, z, [0.0], [0.0], method="nn", variogram=Variogram())
 
 
+def test_a_bad_json_variogram_is_refused_naming_its_field():
+    # A variogram given as JSON (a dict, text or a variogram.json) is the kernel's contract,
+    # checked by the kernel's check as the CLI's --variogram FILE.json is (ARCHITECTURE.md,
+    # "A given variogram"): each error names the JSON field.
+    good = {"nugget": 0.0, "structures": [{"type": "spherical", "psill": 1.0, "range": 5.0}]}
+    assert Variogram.from_json(good).structures[0]["range"] == 5.0
+    cases = [
+        ({"structures": [{"type": "spherical", "psill": 1.0, "range": -5.0}]},
+         r"^variogram( file: model)?: structure 1 \(spherical\) range = -5: must be finite and > 0$"),
+        ({"nugget": -1.0},
+         r"^variogram( file: model)?: nugget = -1: must be finite and >= 0$"),
+        ({"structures": [{"type": "spherical", "psill": 1.0, "range": 5.0},
+                         {"type": "exponential", "psill": -2.0, "range": 9.0}]},
+         r"^variogram( file: model)?: structure 2 \(exponential\) psill = -2: must be finite and >= 0$"),
+        ({"anisotropy": {"angle": 30.0, "ratio": 2.0}},
+         r"^variogram( file: model)?: anisotropy ratio = 2: must be in \(0, 1\]$"),
+    ]
+    for change, message in cases:
+        bad = {**good, **change}
+        for given in (bad, {"model": bad}, json.dumps({"model": bad})):
+            with pytest.raises(terramesh.InputError, match=message):
+                Variogram.from_json(given)
+        with pytest.raises(terramesh.InputError, match=message):
+            Variogram(structures=bad.get("structures"), nugget=bad.get("nugget", 0.0),
+                      anisotropy_angle=(bad.get("anisotropy") or {}).get("angle"),
+                      anisotropy_ratio=(bad.get("anisotropy") or {}).get("ratio"))
+        with pytest.raises(terramesh.InputError, match=message):
+            terramesh.krige([0.0, 1.0], [0.0, 1.0], [1.0, 2.0], [0.5], [0.5], variogram=bad)
+
+
 def test_interpolation_keywords_are_checked_once_by_the_librarys_plan_naming_them(field):
     # krige, idw and cross_validate lower their keywords into the plan of `terramesh
     # interpolate` and `terramesh cv`: the same checks, worded with the keywords.

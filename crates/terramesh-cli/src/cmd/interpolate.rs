@@ -119,7 +119,8 @@ impl MethodArgs {
         p.set_drift(self.drift).map_err(crate::flag_error)?;
         p.set_neighbors(self.neighbors).map_err(crate::flag_error)?;
         (p.mean, p.radius, p.idw_power) = (self.mean, self.radius, self.power);
-        (p.parts, p.variogram) = (self.model.options(), self.variogram.clone());
+        p.variogram = self.variogram.clone();
+        p.set_model(self.model.options());
         (p.lag, p.fit, p.duplicates) = (self.lag.options(), self.lag.fit, self.duplicates);
         p.anisotropy = self.model.anisotropy.clone().unwrap_or(p.anisotropy);
         Ok(p)

@@ -120,8 +120,7 @@ impl InterpolationPlan {
             .variogram
             .as_deref()
             .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
-        let auto_model = self.parts.is_auto();
-        if self.anisotropy_auto() && !fitting && !auto_model {
+        if self.anisotropy_auto() && !fitting {
             return Err(own(Setting::Anisotropy, "{anisotropy} auto fits the anisotropy with the variogram: give {variogram} auto (the model's angle and ratio are otherwise {anisotropy-angle} and {anisotropy-ratio})"));
         }
         if let Some(v) = self.parts.explicit_or_fit(fitting)? {
@@ -136,7 +135,6 @@ impl InterpolationPlan {
         match self.variogram.as_deref() {
             _ if fitting => self.fit_plan(),
             Some(file) => Ok(VariogramSource::File(file.into())),
-            None if auto_model => self.fit_plan(),
             None => Err(own(Setting::Variogram, "kriging needs a variogram: {variogram} auto, {variogram} FILE.json, or {model} NAME {psill} C {range} A [{nugget} C0]")),
         }
     }
@@ -148,8 +146,7 @@ impl InterpolationPlan {
             InterpolationMethod::Universal => self.drift,
             _ => Drift::Constant,
         };
-        let model = self.parts.model.as_deref().unwrap_or("auto");
-        let mut plan = self.lag.plan(model, drift, self.fit);
+        let mut plan = self.lag.plan(&self.fit_model, drift, self.fit);
         if self.anisotropy_auto() {
             plan.anisotropy = Some(self.lag.anisotropy_plan()?);
         }
@@ -372,8 +369,16 @@ mod tests {
             .starts_with("kriging needs a variogram: --variogram auto, --variogram FILE.json"));
         m.variogram = Some("auto".into());
         assert!(m.variogram_source().unwrap().fits());
-        // A named model with --variogram auto is fitted; with its parameters it is given.
-        m.parts.model = Some("exponential".into());
+        // A named model with --variogram auto is fitted (the one field of the model to fit);
+        // with its parameters it is given.
+        m.set_model(ModelParts {
+            model: Some("exponential".into()),
+            ..ModelParts::default()
+        });
+        assert_eq!(
+            (m.fit_model.as_str(), m.parts.model.as_deref()),
+            ("exponential", None)
+        );
         match m.variogram_source().unwrap() {
             VariogramSource::Fit { plan, .. } => assert_eq!(plan.model, "exponential"),
             other => panic!("{other:?}"),

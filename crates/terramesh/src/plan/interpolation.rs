@@ -170,7 +170,10 @@ pub struct InterpolationPlan {
     /// ([`FitPlan::method`](crate::fitting::FitPlan::method)).
     pub fit: Option<terramesh_geostat::FitMethod>,
     /// What `variogram = "auto"` fits: `auto` (every model, the best kept), a model name, or a
-    /// nested sum of up to three joined by `+` (`spherical+exponential`, fitted jointly).
+    /// nested sum of up to three joined by `+` (`spherical+exponential`, fitted jointly). The
+    /// one field of the model to fit for every front end: `interpolation.fit_model`, the
+    /// `--model` of `terramesh variogram`, and the `--model` of `interpolate`, `cv` and
+    /// `simulate` when it names a model for a fit ([`InterpolationPlan::set_model`]).
     pub fit_model: String,
     /// `none`, or `auto`: `variogram = "auto"` fits geometric anisotropy too, from directional
     /// variograms along 8 azimuths (`interpolation.anisotropy`; the `--anisotropy` of
@@ -459,6 +462,47 @@ impl InterpolationPlan {
             self.idw_neighbors = k.unwrap_or(0);
         }
         Ok(())
+    }
+
+    /// A single command's model flags (`--model`, `--psill`, `--range`, ...), lowered after
+    /// `variogram` is set: a model named for a fit (`auto`, or a name without partial sills
+    /// and ranges beside `variogram` `auto`) goes to `fit_model`, the one field of what a fit
+    /// fits (`--model auto` asks for the fit, as `--variogram auto`); a model given in full,
+    /// or a name still missing its parameters (refused by [`ModelParts::variogram`]), stays in
+    /// `parts`, as does `auto` beside partial sills or ranges (refused by
+    /// [`ModelParts::explicit_or_fit`]: `auto` fits them).
+    ///
+    /// ```
+    /// use terramesh::plan::{InterpolationPlan, ModelParts};
+    /// use terramesh_geostat::InterpolationMethod;
+    /// let named = |m: &str| ModelParts { model: Some(m.into()), ..ModelParts::default() };
+    /// let mut p = InterpolationPlan::single(InterpolationMethod::Ordinary);
+    /// p.variogram = Some("auto".into());
+    /// p.set_model(named("spherical+exponential"));
+    /// assert_eq!((p.fit_model.as_str(), p.parts.model.as_deref()), ("spherical+exponential", None));
+    /// let mut p = InterpolationPlan::single(InterpolationMethod::Ordinary);
+    /// p.set_model(named("auto"));
+    /// assert_eq!((p.fit_model.as_str(), p.variogram.as_deref()), ("auto", Some("auto")));
+    /// let mut p = InterpolationPlan::single(InterpolationMethod::Ordinary);
+    /// p.set_model(named("spherical")); // no --variogram auto: a model given, lacking --psill
+    /// assert_eq!(p.parts.model.as_deref(), Some("spherical"));
+    /// ```
+    pub fn set_model(&mut self, mut parts: ModelParts) {
+        let fitting = self
+            .variogram
+            .as_deref()
+            .is_some_and(|s| s.eq_ignore_ascii_case("auto"));
+        let bare = parts.psill.is_empty() && parts.range.is_empty();
+        // `--model auto` beside `--psill`/`--range` stays in `parts`, whose check refuses it.
+        if bare && (fitting || parts.is_auto()) {
+            if let Some(name) = parts.model.take() {
+                if name.eq_ignore_ascii_case("auto") && self.variogram.is_none() {
+                    self.variogram = Some("auto".into());
+                }
+                self.fit_model = name;
+            }
+        }
+        self.parts = parts;
     }
 
     /// `variogram`, or `auto` (a project's default: fit from the samples) when unset.

@@ -54,7 +54,9 @@ use crate::setting::Setting;
 /// for a fit, or `auto`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ModelParts {
-    /// A model name, a nested sum `a+b[+c]`, or `auto`.
+    /// A model name or a nested sum `a+b[+c]` given in full (with `psill` and `range`), or
+    /// `auto`. A single command's plan holds a model named for a fit in its `fit_model`
+    /// instead ([`InterpolationPlan::set_model`](super::InterpolationPlan::set_model)).
     pub model: Option<String>,
     /// Partial sill per structure.
     pub psill: Vec<f64>,
@@ -123,9 +125,16 @@ impl ModelParts {
             }
             return Ok(None);
         };
-        if name.eq_ignore_ascii_case("auto")
-            || (fit && self.psill.is_empty() && self.range.is_empty())
-        {
+        let bare = self.psill.is_empty() && self.range.is_empty();
+        if name.eq_ignore_ascii_case("auto") && !bare {
+            return Err(own(
+                Setting::Psill,
+                "{psill}/{range} are the parameters of a model given: {model-name} auto fits \
+                 them; give {model-name} NAME with them, or leave them out"
+                    .into(),
+            ));
+        }
+        if name.eq_ignore_ascii_case("auto") || (fit && bare) {
             return Ok(None);
         }
         self.variogram().map(Some)
@@ -459,6 +468,13 @@ mod tests {
             flags(m.explicit_or_fit(false).unwrap_err()),
             "--psill/--range need --model (e.g. --model spherical)"
         );
+        // `--model auto` fits the parameters: given beside it, they are refused, not ignored.
+        let m = ModelParts {
+            model: Some("auto".into()),
+            ..nested()
+        };
+        assert!(flags(m.explicit_or_fit(true).unwrap_err())
+            .starts_with("--psill/--range are the parameters of a model given: --model auto"));
     }
 
     /// A project's `interpolation.model` table and the command line's flags go through the
