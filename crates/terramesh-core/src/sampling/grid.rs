@@ -99,15 +99,15 @@ pub enum GridError {
     },
     /// More nodes than a grid holds (500 million).
     #[error(
-        "{rows} x {cols} = {total} nodes is too many; use fewer rows/columns or a larger spacing"
+        "{rows} x {cols} = {} nodes is too many; use fewer rows/columns or a larger spacing",
+        *rows as u128 * *cols as u128
     )]
     TooManyNodes {
         /// Rows.
         rows: usize,
-        /// Columns.
+        /// Columns (the product is not stored: a `u128` field would make every error that
+        /// carries a `GridError` 16-byte aligned, and the facade's `Error` larger).
         cols: usize,
-        /// Rows times columns.
-        total: u128,
     },
     /// Nodes that would pass the memory ceiling ([`crate::limits`]).
     #[error("{rows} x {cols}: {limit}; use fewer rows/columns or a larger spacing")]
@@ -116,8 +116,9 @@ pub enum GridError {
         rows: usize,
         /// Columns.
         cols: usize,
-        /// The estimate and the ceiling.
-        limit: crate::limits::TooLarge,
+        /// The estimate and the ceiling (boxed: it is the largest part of any `GridError`,
+        /// which the facade's and the tiles' errors carry).
+        limit: Box<crate::limits::TooLarge>,
     },
     /// A latitude/longitude grid over a region that is not geographic.
     #[error("a latitude/longitude grid needs a geographic region")]
@@ -181,12 +182,16 @@ impl SamplingGrid {
         };
         let total = rows as u128 * cols as u128;
         if total > 500_000_000 {
-            return Err(GridError::TooManyNodes { rows, cols, total });
+            return Err(GridError::TooManyNodes { rows, cols });
         }
         // A node ([f64; 2]) and its grid index, 24 bytes, against the memory ceiling.
         crate::limits::Estimate::new("grid nodes", total as f64, 24.0)
             .check()
-            .map_err(|limit| GridError::OverMemory { rows, cols, limit })?;
+            .map_err(|limit| GridError::OverMemory {
+                rows,
+                cols,
+                limit: Box::new(limit),
+            })?;
         let mut nodes = Vec::with_capacity(if self.clip { 0 } else { total as usize });
         let mut index = Vec::with_capacity(nodes.capacity());
         for r in 0..rows {
@@ -387,7 +392,6 @@ mod tests {
             GridError::TooManyNodes {
                 rows: 100_000,
                 cols: 10_000,
-                total: 1_000_000_000
             }
         );
         assert_eq!(
