@@ -92,10 +92,21 @@ pub(crate) fn too_large_for(name: &str, t: terramesh_core::limits::TooLarge) -> 
     ))
 }
 
+/// A setting as its Python keyword (`min_angle`).
+pub(crate) fn keyword(s: terramesh::Setting) -> String {
+    s.to_string().replace([' ', '-'], "_")
+}
+
 /// The exception of a facade error: the class follows the innermost cause, the message is
 /// the whole chain with settings named as Python keywords (`min_angle`).
 pub(crate) fn to_py(e: terramesh::Error) -> PyErr {
-    let text = e.render(&|s| s.to_string().replace([' ', '-'], "_"));
+    to_py_as(e, &keyword)
+}
+
+/// [`to_py`] with the settings named by `name` (a function whose keyword for a setting is
+/// not its name: `variogram_fit`'s `model` is the plan's `fit_model`).
+pub(crate) fn to_py_as(e: terramesh::Error, name: &dyn Fn(terramesh::Setting) -> String) -> PyErr {
+    let text = e.render(name);
     let mut cur = &e;
     while let terramesh::Error::Context { source, .. } = cur {
         cur = source;

@@ -14,7 +14,7 @@ use terramesh_geostat::{
     VariogramFile, Weighting, DEFAULT_TOLERANCE,
 };
 
-use crate::errors::{input, kernel, to_py};
+use crate::errors::{input, kernel, keyword, to_py, to_py_as};
 use crate::run::{chunked, fits, floats, pair, room, run, Floats};
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -188,9 +188,12 @@ fn experimental<'py>(
 }
 
 /// Fits `model` (`auto`, a name or a nested sum `a+b[+c]`) to the data by `fit` (`wls-loo`, `wls`,
-/// `reml` with `drift`, `loo`; the library's [`FitMethod`] names), through the facade's
-/// [`terramesh::fitting::fit`] as `terramesh variogram` does; returns the variogram file's
-/// JSON (model, lags, fit, candidates, selection, experimental).
+/// `reml` with `drift`, `loo`; the library's [`FitMethod`] names), as `terramesh variogram`
+/// does: the keywords lowered into the plan of that command (`VariogramJob`'s
+/// [`InterpolationPlan`]: `fit_model`, `fit`, `lag`, `drift`), checked once by
+/// [`InterpolationPlan::check`] with errors naming the keywords ([`fit_error`]), and fitted
+/// from the plan's own [`LagPlan::plan`] through the facade's [`terramesh::fitting::fit`];
+/// returns the variogram file's JSON (model, lags, fit, candidates, selection, experimental).
 #[pyfunction]
 #[pyo3(signature = (x, y, z, model="auto", weighting="cressie", lags=terramesh_geostat::DEFAULT_LAGS, max_dist=None, estimator="matheron", azimuth=None, tolerance=None, max_points=Some(terramesh_geostat::DEFAULT_MAX_POINTS), fit=None, drift="linear", reml_block=terramesh_geostat::DEFAULT_REML_BLOCK))]
 #[allow(clippy::too_many_arguments)]
@@ -212,23 +215,39 @@ fn variogram_fit(
     reml_block: usize,
 ) -> PyResult<String> {
     let d = data(&x, &y, &z, "mean")?;
-    let s = lag_settings(lags, max_dist, estimator, azimuth, tolerance, max_points)?;
-    let w: Weighting = weighting
+    let estimator: Estimator = estimator
+        .parse()
+        .map_err(|e| input(format!("estimator: {e}")))?;
+    let weights: Weighting = weighting
         .parse()
         .map_err(|e| input(format!("weighting: {e}")))?;
     let method: Option<FitMethod> = fit
         .map(|f| f.parse().map_err(|e| input(format!("fit: {e}"))))
         .transpose()?;
     let drift: Drift = drift.parse().map_err(|e| input(format!("drift: {e}")))?;
-    let plan = LagPlan {
-        weights: w,
+    // The plan of `terramesh variogram` (`VariogramJob::new`), filled as its flags fill it.
+    let mut p = InterpolationPlan::single(InterpolationMethod::Universal);
+    (p.fit_model, p.fit, p.drift) = (model.to_string(), method, drift);
+    p.lag = LagPlan {
+        lags,
+        max_dist,
+        azimuth,
+        tolerance: tolerance.unwrap_or(DEFAULT_TOLERANCE),
+        estimator,
+        weights,
+        // `None`: all the data, the plan's 0.
+        max_points: max_points.unwrap_or(0),
         reml_block,
-        ..LagPlan::default()
-    }
-    .plan(model, drift, method);
+    };
+    p.check().map_err(fit_error)?;
+    let mut s = p.lag.settings();
+    // An explicit 0 is not the plan's "all": the kernel refuses it, naming max_points, as
+    // before.
+    s.max_points = max_points;
+    let plan = p.lag.plan(&p.fit_model, p.drift, p.fit);
     run(py, false, |_| {
         let l = lags_of(&d, &s).map_err(kernel)?;
-        let fitted = terramesh::fitting::fit(&d, &l, &plan).map_err(to_py)?;
+        let fitted = terramesh::fitting::fit(&d, &l, &plan).map_err(fit_error)?;
         let mut f = VariogramFile::new(fitted.fit.variogram.clone());
         f.points = d.len();
         f.lags = Some(terramesh_geostat::LagSummary {
@@ -240,7 +259,7 @@ fn variogram_fit(
         });
         f.experimental = l;
         f.fit = Some(terramesh_geostat::FitSummary {
-            weights: w,
+            weights: p.lag.weights,
             objective: fitted.fit.objective,
             rmse: fitted.fit.rmse,
         });
@@ -251,6 +270,16 @@ fn variogram_fit(
             .collect();
         f.selection = fitted.selection;
         Ok(f.to_json_pretty())
+    })
+}
+
+/// A facade error of `variogram_fit`, its settings worded as its keywords: the plan's model
+/// to fit ([`Setting::FitModel`](terramesh::Setting::FitModel)) is the keyword `model`, the
+/// others as [`to_py`] words them (`reml_block`).
+fn fit_error(e: terramesh::Error) -> PyErr {
+    to_py_as(e, &|s| match s {
+        terramesh::Setting::FitModel => "model".to_string(),
+        s => keyword(s),
     })
 }
 

@@ -3,6 +3,7 @@
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -149,6 +150,48 @@ def test_variogram_fit_refuses_a_bad_fit_or_drift_naming_it():
         Variogram.fit(x, y, x, fit="mle")
     with pytest.raises(terramesh.InputError, match='drift: .*"cubic"'):
         Variogram.fit(x, y, x, fit="reml", drift="cubic")
+
+
+def test_variogram_fit_is_checked_by_the_plan_naming_its_keywords_and_fits_as_the_cli(tmp_path):
+    # Variogram.fit lowers its keywords into the plan of `terramesh variogram`: the model to
+    # fit is checked by the plan's one check before any lag class is computed (so before the
+    # kernel's refusal of max_points=1), worded with the keyword `model`.
+    x, y = np.arange(50.0), np.arange(50.0) % 7
+    for bad in ("cubic", "spherical+cubic", "nugget+power"):
+        with pytest.raises(terramesh.InputError, match=rf"^model '{re.escape(bad)}': "):
+            Variogram.fit(x, y, x, model=bad, max_points=1)
+    with pytest.raises(terramesh.InputError, match=r"^lags 0: "):
+        Variogram.fit(x, y, x, lags=0)
+    with pytest.raises(terramesh.InputError, match=r"max.points = 1: must be at least 2"):
+        Variogram.fit(x, y, x, max_points=1)
+    # A normal fit is the CLI's: the same file but for the data's name and the lag summary's
+    # max_dist (the CLI records the last class's bound, Python the keyword given).
+    rng = np.random.default_rng(3)
+    x, y = rng.uniform(0, 1000, 200), rng.uniform(0, 1000, 200)
+    z = np.sin(x / 150) + np.cos(y / 200)
+    py = Variogram.fit(x, y, z, model="spherical+exponential", lags=12, weighting="pairs")
+    auto = Variogram.fit(x, y, z)
+    assert py.fit_info["fit"]["weights"] == "pairs" and auto.fit_info["candidates"]
+    root = pathlib.Path(__file__).resolve().parents[2]
+    binary = os.environ.get("TERRAMESH_BIN") or str(root / "target" / "release" / "terramesh")
+    if not os.path.exists(binary):
+        if os.environ.get("CI"):
+            pytest.fail(f"{binary} missing: cargo build --release -p terramesh-cli first")
+        pytest.skip(f"skipped: {binary} missing (cargo build --release -p terramesh-cli)")
+    csv = tmp_path / "d.csv"
+    np.savetxt(csv, np.column_stack([x, y, z]), delimiter=",", header="x,y,z", comments="",
+               fmt="%.17g")
+    for v, flags in ((py, ["--model", "spherical+exponential", "--lags", "12", "--weights",
+                           "pairs"]), (auto, [])):
+        out = tmp_path / "v.json"
+        p = subprocess.run([binary, "variogram", "--data", str(csv), *flags, "-o", str(out)],
+                           capture_output=True, text=True)
+        assert p.returncode == 0, p.stderr
+        cli, mine = json.loads(out.read_text()), dict(v.fit_info)
+        assert Variogram.from_json(out) == v
+        for k in ("fit", "candidates", "selection", "experimental"):
+            assert mine[k] == cli[k], k
+        assert {**mine["lags"], "max_dist": None} == {**cli["lags"], "max_dist": None}
 
 
 def test_exact_reml_beyond_memory_is_refused_naming_reml_block():
