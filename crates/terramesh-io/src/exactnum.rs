@@ -51,7 +51,7 @@ fn short_expansion(v: f64) -> bool {
 /// Shortest digits of a finite nonzero `v` (no leading or trailing zeros) and the position of
 /// the decimal point relative to their start (value = 0.d1d2... * 10^point); `v`'s sign aside.
 #[inline]
-fn shortest(v: f64, digits: &mut [u8; 24]) -> (usize, i32) {
+pub(crate) fn shortest(v: f64, digits: &mut [u8; 24]) -> (usize, i32) {
     let mut r = ryu::Buffer::new();
     let s = r.format_finite(v.abs()).as_bytes();
     let (mant, exp) = match s.iter().position(|&c| c == b'e') {

@@ -1,6 +1,7 @@
 //! Fast number text for the large text writers: the layout of Rust's `{}` (`Display`), made
-//! with `ryu` (shortest round-trip digits) and `itoa` into a stack buffer, without the
-//! formatting machinery (`core::fmt`), which dominated the writing of a 640,000-cell model.
+//! with `ryu` (shortest round-trip digits, taken apart by `exactnum::shortest`) and `itoa`
+//! into a stack buffer, without the formatting machinery (`core::fmt`), which dominated the
+//! writing of a 640,000-cell model.
 //!
 //! `Display` never uses an exponent (`1e21` is written `1000000000000000000000`, `1e-7`
 //! `0.0000001`, `1.0` `1`); ryu's shortest digits are placed around the decimal point the same
@@ -19,36 +20,15 @@ pub(crate) fn write_f64<W: Write + ?Sized>(w: &mut W, v: f64) -> io::Result<()> 
     if !v.is_finite() {
         return write!(w, "{v}");
     }
-    let mut r = ryu::Buffer::new();
-    let s = r.format_finite(v).as_bytes();
-    // sign, digits without the point, exponent
-    let (neg, s) = match s.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        _ => (false, s),
+    // ryu's shortest digits and the point's position: the same as `exactnum`'s
+    let mut digits = [0u8; 24];
+    let (n, point) = if v == 0.0 {
+        (0, 0)
+    } else {
+        crate::exactnum::shortest(v, &mut digits)
     };
-    let (mant, exp) = match s.iter().position(|&c| c == b'e') {
-        Some(e) => (&s[..e], parse_exp(&s[e + 1..])),
-        None => (s, 0),
-    };
-    let mut digits = [0u8; 40];
-    let mut n = 0;
-    let mut point = mant.len() as i32; // the decimal point's position in `digits`
-    for &c in mant {
-        if c == b'.' {
-            point = n as i32;
-        } else {
-            digits[n] = c;
-            n += 1;
-        }
-    }
-    // leading and trailing zeros ("0.00123", "1.0")
-    let lead = digits[..n].iter().take_while(|&&c| c == b'0').count();
-    let mut d = &digits[lead..n];
-    point -= lead as i32;
-    while let Some((&b'0', rest)) = d.split_last() {
-        d = rest;
-    }
-    let point = point + exp;
+    let d = &digits[..n];
+    let neg = v.is_sign_negative();
     if neg {
         w.write_all(b"-")?;
     }
@@ -78,21 +58,6 @@ pub(crate) fn write_f64<W: Write + ?Sized>(w: &mut W, v: f64) -> io::Result<()> 
         w.write_all(a)?;
         w.write_all(b".")?;
         w.write_all(b)
-    }
-}
-
-fn parse_exp(s: &[u8]) -> i32 {
-    let (neg, s) = match s.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        _ => (false, s),
-    };
-    let v = s
-        .iter()
-        .fold(0i32, |a, &c| a * 10 + i32::from(c.wrapping_sub(b'0')));
-    if neg {
-        -v
-    } else {
-        v
     }
 }
 
