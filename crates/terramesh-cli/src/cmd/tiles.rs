@@ -31,8 +31,8 @@ enum Sub {
     /// Build one tile into PLAN/tiles/ID/ (atomically) and mark it done; a done tile is left
     /// as it is, a failed one records why and can be built again.
     Build(BuildArgs),
-    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, the project's single-file
-    /// exports but glb (obj, ply, stl, ts, msh, dxf, kml, dae), merge.json, report.html.
+    /// Join the built tiles into OUT/: dsm.vtu, dsm.tif, dsm.asc, the project's other exports
+    /// (obj, ply, stl, ts, msh, dxf, kml, dae, glb, 3dtiles/, terrain/), merge.json, report.html.
     Merge(MergeArgs),
     /// Write Slurm scripts: an sbatch array (one tile per task) and a merge job after it.
     Slurm(SlurmArgs),
