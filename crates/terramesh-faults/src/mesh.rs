@@ -399,6 +399,32 @@ pub(crate) fn positive(p: [[f64; 3]; 4]) -> bool {
         && terramesh_core::volume::tetra_volume(p[0], p[1], p[2], p[3]) > 0.0
 }
 
+/// Puts the new nodes (index `first` on, each moved off the midpoint of its edge, `chords[i]`
+/// being node `first + i`'s place on the chord) of every cell that is not [`positive`] back on
+/// their chord, for up to 8 rounds: where a node moved onto a curved interface, fault, wall or
+/// zone wall inverts a cell. The objects' and the zones' cuts share it.
+pub(crate) fn revert_inverted(st: &mut State, first: usize, chords: &[[f64; 3]]) {
+    for _ in 0..8 {
+        let bad: Vec<u32> = st
+            .tets
+            .par_iter()
+            .filter(|t| !positive(t.map(|v| st.points[v as usize])))
+            .flat_map_iter(|t| t.iter().copied().filter(|&v| v as usize >= first))
+            .collect();
+        let mut reverted = 0;
+        for v in bad {
+            let c = chords[v as usize - first];
+            if st.points[v as usize] != c {
+                st.points[v as usize] = c;
+                reverted += 1;
+            }
+        }
+        if reverted == 0 {
+            break;
+        }
+    }
+}
+
 pub(crate) fn key(a: u32, b: u32) -> u64 {
     (a.min(b) as u64) << 32 | a.max(b) as u64
 }

@@ -1991,32 +1991,9 @@ pub(crate) fn cut_objects(
         let first = st.points.len();
         split_edges(st, &mut labels, &keys, pts, false);
         // Where a node moved onto a curved interface or fault inverts a cell, it goes back
-        // to the chord.
-        for _ in 0..8 {
-            let bad: Vec<u32> = st
-                .tets
-                .par_iter()
-                .filter(|t| {
-                    let q = t.map(|v| st.points[v as usize]);
-                    // Exactly positive, and positive in floating point too (the writers
-                    // compute volumes in floating point).
-                    !crate::mesh::positive(q)
-                        || terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3]) <= 0.0
-                })
-                .flat_map_iter(|t| t.iter().copied().filter(|&v| v as usize >= first))
-                .collect();
-            let mut reverted = 0;
-            for v in bad {
-                let c = chords[v as usize - first];
-                if st.points[v as usize] != c {
-                    st.points[v as usize] = c;
-                    reverted += 1;
-                }
-            }
-            if reverted == 0 {
-                break;
-            }
-        }
+        // to the chord (`positive` is exact and, as the writers compute volumes, in floating
+        // point too).
+        crate::mesh::revert_inverted(st, first, &chords);
         let inside: Vec<bool> = st
             .tets
             .par_iter()

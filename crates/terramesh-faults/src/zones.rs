@@ -380,25 +380,7 @@ pub(crate) fn cut_zones(
             split_edges += keys.len();
             // Where a node moved onto a curved interface or fault inverts a cell, it goes
             // back to the chord.
-            for _ in 0..8 {
-                let bad: Vec<u32> = st
-                    .tets
-                    .par_iter()
-                    .filter(|t| !positive(t.map(|v| st.points[v as usize])))
-                    .flat_map_iter(|t| t.iter().copied().filter(|&v| v as usize >= first))
-                    .collect();
-                let mut reverted = 0;
-                for v in bad {
-                    let c = chords[v as usize - first];
-                    if st.points[v as usize] != c {
-                        st.points[v as usize] = c;
-                        reverted += 1;
-                    }
-                }
-                if reverted == 0 {
-                    break;
-                }
-            }
+            crate::mesh::revert_inverted(st, first, &chords);
             let inside: Vec<bool> = st
                 .tets
                 .par_iter()
