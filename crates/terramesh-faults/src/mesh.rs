@@ -827,6 +827,32 @@ fn sides(st: &State, values: &[(f64, i8)], field: &Field, cell: usize) -> i8 {
     }
 }
 
+/// Whether cell `t`, cut conformally by a surface, lies on its negative side: `values[v].1`
+/// is each node's side (1, -1, 0 on the surface). A node strictly on the positive side puts
+/// the cell outside, one strictly on the negative side (and none positive) inside; a cell with
+/// every node on the surface is decided by the sign of `f` at its centroid. The objects' and
+/// the zones' cuts share it.
+pub(crate) fn inside_cut(
+    points: &[[f64; 3]],
+    t: &[u32; 4],
+    values: &[(f64, i8)],
+    f: impl Fn([f64; 3]) -> f64,
+) -> bool {
+    let (mut p, mut n) = (false, false);
+    for &v in t {
+        match values[v as usize].1 {
+            1 => p = true,
+            -1 => n = true,
+            _ => {}
+        }
+    }
+    match (p, n) {
+        (false, true) => true,
+        (true, _) => false,
+        (false, false) => f(centroid(points, t)) < 0.0,
+    }
+}
+
 pub(crate) fn centroid(points: &[[f64; 3]], t: &[u32; 4]) -> [f64; 3] {
     let mut c = [0.0; 3];
     for &v in t {

@@ -1997,21 +1997,7 @@ pub(crate) fn cut_objects(
         let inside: Vec<bool> = st
             .tets
             .par_iter()
-            .map(|t| {
-                let (mut p, mut n) = (false, false);
-                for &v in t {
-                    match values[v as usize].1 {
-                        1 => p = true,
-                        -1 => n = true,
-                        _ => {}
-                    }
-                }
-                match (p, n) {
-                    (false, true) => true,
-                    (true, _) => false,
-                    (false, false) => f(centroid(&st.points, t)) < 0.0,
-                }
-            })
+            .map(|t| crate::mesh::inside_cut(&st.points, t, &values, f))
             .collect();
         let mut count = 0usize;
         for (c, inside) in inside.into_iter().enumerate() {

@@ -385,24 +385,7 @@ pub(crate) fn cut_zones(
                 .tets
                 .par_iter()
                 .zip(&sel)
-                .map(|(t, &x)| {
-                    if !x {
-                        return false;
-                    }
-                    let (mut p, mut n) = (false, false);
-                    for &v in t {
-                        match values[v as usize].1 {
-                            1 => p = true,
-                            -1 => n = true,
-                            _ => {}
-                        }
-                    }
-                    match (p, n) {
-                        (false, true) => true,
-                        (true, _) => false,
-                        (false, false) => g(centroid(&st.points, t)) < 0.0,
-                    }
-                })
+                .map(|(t, &x)| x && crate::mesh::inside_cut(&st.points, t, &values, &g))
                 .collect();
             for (z, i) in st.zone.iter_mut().zip(inside) {
                 *z |= u64::from(i) << f;
