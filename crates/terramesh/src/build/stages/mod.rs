@@ -43,6 +43,23 @@ enum Acquired<'a> {
     Table(SampleTable),
 }
 
+impl Acquired<'_> {
+    /// The UTM zone the samples were converted to, none for a project in its own projected
+    /// CRS; a source left in other coordinates is refused.
+    fn zone(&self, p: &Project) -> Result<Option<terramesh_core::coords::Zone>> {
+        let table_zone = match self {
+            Acquired::Streamed(s) => s.zone,
+            Acquired::Table(t) => t.zone,
+        };
+        let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
+        match table_zone {
+            Some(z) if !own_crs => Ok(Some(z)),
+            _ if own_crs => Ok(None),
+            _ => Err(Error::UnconvertedSource),
+        }
+    }
+}
+
 /// Step 1: samples on the project's grid, also written to `out/samples.csv`.
 pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> Result<Samples> {
     let options = p.sample_options(base, &out.join("samples.csv"))?;
@@ -63,16 +80,7 @@ pub fn sample(p: &Project, base: &Path, out: &Path, progress: &dyn Progress) -> 
             Acquired::Table(table)
         }
     };
-    let table_zone = match &got {
-        Acquired::Streamed(s) => s.zone,
-        Acquired::Table(t) => t.zone,
-    };
-    let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
-    let zone = match table_zone {
-        Some(z) if !own_crs => Some(z),
-        _ if own_crs => None,
-        _ => return Err(Error::UnconvertedSource),
-    };
+    let zone = got.zone(p)?;
     let region = plan.region.clone().ok_or(Error::BuildNeedsRegion)?;
     let xyz = match &mut got {
         Acquired::Streamed(s) => std::mem::take(&mut s.xyz),
@@ -182,16 +190,7 @@ pub fn sample_into(
             Acquired::Table(table)
         }
     };
-    let table_zone = match &got {
-        Acquired::Streamed(s) => s.zone,
-        Acquired::Table(t) => t.zone,
-    };
-    let own_crs = p.region.crs.region_crs() == terramesh_io::region::RegionCrs::Projected;
-    let zone = match table_zone {
-        Some(z) if !own_crs => Some(z),
-        _ if own_crs => None,
-        _ => return Err(Error::UnconvertedSource),
-    };
+    let zone = got.zone(p)?;
     let region = plan.region.clone().ok_or(Error::BuildNeedsRegion)?;
     let count = counting.count;
     if count < 10 {
