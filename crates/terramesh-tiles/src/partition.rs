@@ -84,12 +84,45 @@ pub(crate) fn write_window(
     Ok(keep.len())
 }
 
+/// The tile grid samples are bucketed by: `origin`, the cells' `size` and their `shape`
+/// (columns, rows).
+#[derive(Clone, Copy)]
+pub(crate) struct Grid {
+    pub(crate) origin: [f64; 2],
+    pub(crate) size: f64,
+    pub(crate) shape: [usize; 2],
+}
+
+impl Grid {
+    /// The cell of `p` (clamped at the grid's edges).
+    pub(crate) fn cell(&self, p: [f64; 2]) -> usize {
+        let i = cell_of(p[0], self.origin[0], self.size, self.shape[0]);
+        let j = cell_of(p[1], self.origin[1], self.size, self.shape[1]);
+        j * self.shape[0] + i
+    }
+
+    /// The cells the window of `extent` grown by `halo` overlaps, in increasing order. The
+    /// cell of a coordinate is monotone in it (clamped at the grid's edges), so every point
+    /// of the window lies in one of the cells between the cells of the window's corners.
+    pub(crate) fn window_cells(&self, extent: [f64; 4], halo: f64) -> impl Iterator<Item = usize> {
+        let [x0, y0, x1, y1] = extent;
+        let (o, s, [nx, ny]) = (self.origin, self.size, self.shape);
+        let (i0, i1) = (
+            cell_of(x0 - halo, o[0], s, nx),
+            cell_of(x1 + halo, o[0], s, nx),
+        );
+        let (j0, j1) = (
+            cell_of(y0 - halo, o[1], s, ny),
+            cell_of(y1 + halo, o[1], s, ny),
+        );
+        (j0..=j1).flat_map(move |j| (i0..=i1).map(move |i| j * nx + i))
+    }
+}
+
 /// The samples bucketed by the cells of the tile grid (a counting sort of their indices, 4
 /// bytes a sample), to gather a window's samples without a search tree over the region.
 pub(crate) struct Buckets {
-    origin: [f64; 2],
-    size: f64,
-    shape: [usize; 2],
+    grid: Grid,
     /// Cell `c`'s samples are `order[start[c]..start[c + 1]]`, in increasing order.
     start: Vec<usize>,
     order: Vec<u32>,
@@ -110,9 +143,11 @@ impl Buckets {
             });
         }
         let mut b = Buckets {
-            origin,
-            size,
-            shape,
+            grid: Grid {
+                origin,
+                size,
+                shape,
+            },
             start: vec![0usize; shape[0] * shape[1] + 1],
             order: vec![0u32; xy.len()],
         };
@@ -133,9 +168,7 @@ impl Buckets {
     }
 
     fn cell(&self, p: [f64; 2]) -> usize {
-        let i = cell_of(p[0], self.origin[0], self.size, self.shape[0]);
-        let j = cell_of(p[1], self.origin[1], self.size, self.shape[1]);
-        j * self.shape[0] + i
+        self.grid.cell(p)
     }
 
     /// Into `keep`, in increasing order: the indices of the samples [`in_window`] of `extent`
@@ -143,27 +176,14 @@ impl Buckets {
     /// so every sample of the window lies in one of the cells between the cells of the
     /// window's corners.
     pub(crate) fn window(&self, xy: &[[f64; 2]], extent: [f64; 4], halo: f64, keep: &mut Vec<u32>) {
-        let [x0, y0, x1, y1] = extent;
-        let (o, s, [nx, ny]) = (self.origin, self.size, self.shape);
-        let (i0, i1) = (
-            cell_of(x0 - halo, o[0], s, nx),
-            cell_of(x1 + halo, o[0], s, nx),
-        );
-        let (j0, j1) = (
-            cell_of(y0 - halo, o[1], s, ny),
-            cell_of(y1 + halo, o[1], s, ny),
-        );
         keep.clear();
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let c = j * nx + i;
-                keep.extend(
-                    self.order[self.start[c]..self.start[c + 1]]
-                        .iter()
-                        .copied()
-                        .filter(|&k| in_window(extent, halo, xy[k as usize])),
-                );
-            }
+        for c in self.grid.window_cells(extent, halo) {
+            keep.extend(
+                self.order[self.start[c]..self.start[c + 1]]
+                    .iter()
+                    .copied()
+                    .filter(|&k| in_window(extent, halo, xy[k as usize])),
+            );
         }
         keep.sort_unstable();
     }

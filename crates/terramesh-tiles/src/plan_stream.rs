@@ -29,7 +29,6 @@ use terramesh::acquire::PointSink;
 use terramesh::build::SampleSink;
 use terramesh_geostat::{draw_key, Data, Duplicates, KrigingFrame, Variogram};
 
-use super::manifest::cell_of;
 use super::partition::{in_window, reach_with};
 use crate::error::{Context, Result};
 use terramesh::Context as _;
@@ -194,21 +193,7 @@ impl Merged {
     }
 }
 
-/// The tile grid the samples are bucketed by.
-#[derive(Clone, Copy)]
-pub(crate) struct Grid {
-    pub(crate) origin: [f64; 2],
-    pub(crate) size: f64,
-    pub(crate) shape: [usize; 2],
-}
-
-impl Grid {
-    fn cell(&self, p: [f64; 2]) -> usize {
-        let i = cell_of(p[0], self.origin[0], self.size, self.shape[0]);
-        let j = cell_of(p[1], self.origin[1], self.size, self.shape[1]);
-        j * self.shape[0] + i
-    }
-}
+pub(crate) use super::partition::Grid;
 
 /// The merged samples by tile cell, on disk (`SCRATCH/m<cell>.bin`, in the data's order).
 pub(crate) struct Store {
@@ -618,24 +603,10 @@ impl<'a> Near<'a> {
 
     /// The cells, with samples, that the window of `extent` grown by `halo` overlaps.
     fn cells(&self, extent: [f64; 4], halo: f64) -> Vec<(PathBuf, usize)> {
-        let g = self.store.grid;
-        let [x0, y0, x1, y1] = extent;
-        let (o, s, [nx, ny]) = (g.origin, g.size, g.shape);
-        let (i0, i1) = (
-            cell_of(x0 - halo, o[0], s, nx),
-            cell_of(x1 + halo, o[0], s, nx),
-        );
-        let (j0, j1) = (
-            cell_of(y0 - halo, o[1], s, ny),
-            cell_of(y1 + halo, o[1], s, ny),
-        );
         let mut out = Vec::new();
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let c = j * nx + i;
-                if self.store.counts[c] > 0 {
-                    out.push((merged_file(&self.store.dir, c), self.store.counts[c]));
-                }
+        for c in self.store.grid.window_cells(extent, halo) {
+            if self.store.counts[c] > 0 {
+                out.push((merged_file(&self.store.dir, c), self.store.counts[c]));
             }
         }
         out
