@@ -36,7 +36,7 @@ fn truth(site: &Site, mesh: &FaultedMesh) -> f64 {
 fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
     println!(
         "{name}: {} cells ({} background), {} blocks, fault faces {:?}, snapped {}, split {}, \
-         unresolved {}, collapsed {}, moved {}, truth {:.6}, max fault \
+         unresolved {}, collapsed {}, moved {}, inserted {}, truth {:.6}, max fault \
          distance {:.2e} m, min dihedral {:.2} deg, mean {:.1}, below 5: {}, histogram {:?}",
         mesh.tets.len(),
         mesh.report.background_cells,
@@ -47,6 +47,7 @@ fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
         mesh.report.unresolved,
         mesh.report.collapsed,
         mesh.report.moved,
+        mesh.report.inserted,
         fraction,
         s.fault_distance,
         s.quality.min,
