@@ -17,6 +17,15 @@
 //! on the base only into a node on the base. The cells of a collapsed node's star are then
 //! cones from the neighbour over the star's boundary: with every cone positive they tile the
 //! same region, so conformity, the volume and every label are kept.
+//!
+//! Last, a poor cell that none of these mends gets a new node on one of its edges (longest
+//! first), where the edge's midpoint lies on every surface the edge lies on: each cell
+//! around the edge becomes two cones from the node, labelled as their parent, and the node
+//! is placed by a compass search along its one surface (or nowhere, on two), kept if every
+//! new cell is positive (exact) and better than the old cells' worst, with no more of them
+//! below the floor. With [`verify_each_operation`] (and in debug builds) every operation is
+//! checked after it is made: positive cells, each face in two cells on its two sides or on
+//! the boundary, the volume kept to 1e-9, no cell across a fault.
 
 use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
@@ -33,6 +42,8 @@ pub(crate) struct Improved {
     pub collapsed: usize,
     pub moved: usize,
     pub flipped: usize,
+    /// Nodes added by splitting an edge of a poor cell.
+    pub inserted: usize,
 }
 
 struct Pass<'a> {
@@ -62,6 +73,20 @@ struct Pass<'a> {
     floor: f64,
     /// Half the tolerance of `check` for a boundary node on the terrain, a side or the base.
     tol: f64,
+    /// Whether every operation is checked after it is made ([`Pass::verify`]).
+    verify: bool,
+}
+
+static VERIFY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Makes the quality pass check the mesh around every operation after it is made (always in
+/// debug builds): every cell it made positive (exact), each of their faces in exactly one
+/// other cell on the other side or on the boundary (its nodes on the terrain, the base or a
+/// side), their volume that of the cells they replace to 1e-9 relative, no cell with nodes
+/// more than 1 cm on both sides of a fault; it panics otherwise. For tests: it costs time.
+#[doc(hidden)]
+pub fn verify_each_operation(on: bool) {
+    VERIFY.store(on, std::sync::atomic::Ordering::Relaxed);
 }
 
 /// A node is moved only if the smallest angle of its cells gains at least this (degrees).
@@ -92,6 +117,17 @@ enum Op {
         ring: [u32; 3],
         new: [([u32; 4], f64); 2],
     },
+    /// Edge (`a`, `b`) split by a new node at `at` (flags `flags`, faults `on_fault`): every
+    /// cell of `ring` (the cells around the edge) becomes its two halves `kids` (the first
+    /// with `b` replaced by the new node, [`NEW`] in the plan, the second with `a`), each
+    /// with its smallest angle; the second is a new cell labelled as its parent.
+    Split {
+        at: [f64; 3],
+        flags: u8,
+        on_fault: u64,
+        ring: Vec<u32>,
+        kids: Vec<([u32; 4], f64, [u32; 4], f64)>,
+    },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {
         v: u32,
@@ -103,6 +139,31 @@ enum Op {
 
 /// Poor cells planned at once, in parallel, before they are mended in order.
 const CHUNK: usize = 256;
+
+/// The directions of the compass search of a new node's place: the six axes and the eight
+/// diagonals.
+const COMPASS: [[f64; 3]; 14] = {
+    const D: f64 = 0.577_350_269_189_625_8;
+    [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [D, D, D],
+        [D, D, -D],
+        [D, -D, D],
+        [D, -D, -D],
+        [-D, D, D],
+        [-D, D, -D],
+        [-D, -D, D],
+        [-D, -D, -D],
+    ]
+};
+
+/// The new node of a planned split, in the cells it makes (its index is known when it is made).
+const NEW: u32 = u32::MAX;
 
 fn c3(p: [f64; 3]) -> Coord3D<f64> {
     Coord3D {
@@ -236,10 +297,17 @@ impl Pass<'_> {
                 return Some(op);
             }
         }
-        t.into_iter().find_map(|v| {
+        if let Some(op) = t.into_iter().find_map(|v| {
             let (cells, labels) = at(v);
             self.optimise(v, cells, labels)
-        })
+        }) {
+            return Some(op);
+        }
+        // Last, a new node on one of its edges, longest first.
+        edges
+            .iter()
+            .rev()
+            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
     }
 
     /// Makes operation `op`, stamping the nodes of every cell it changes.
@@ -279,6 +347,28 @@ impl Pass<'_> {
                 self.place(Some(ring[1]), ring[0], new[1].0, new[1].1);
                 self.alive[ring[2] as usize] = false;
                 done.flipped += 1;
+            }
+            Op::Split {
+                at,
+                flags,
+                on_fault,
+                ring,
+                kids,
+            } => {
+                let n = self.st.points.len() as u32;
+                self.st.points.push(at);
+                self.st.flags.push(flags);
+                self.st.on_fault.push(on_fault);
+                self.star.push(Vec::new());
+                self.touched.push(true);
+                self.stamp.push(self.mark);
+                let fix = |t: [u32; 4]| t.map(|w| if w == NEW { n } else { w });
+                for (&c, (t1, q1, t2, q2)) in ring.iter().zip(kids) {
+                    self.stamp_cell(c);
+                    self.place(Some(c), c, fix(t1), q1);
+                    self.place(None, c, fix(t2), q2);
+                }
+                done.inserted += 1;
             }
             Op::Move {
                 v,
@@ -423,10 +513,15 @@ impl Pass<'_> {
     /// collapsed can otherwise make faces that cut across a bend of another interface, which
     /// a slab a few centimetres thick (near a pinch-out) cannot absorb.
     fn in_unit(&self, t: [u32; 4], g: [[f64; 3]; 4], like: u32) -> bool {
-        if !t
+        let on = t
             .iter()
-            .any(|&v| self.st.flags[v as usize] & ON_INTERFACE != 0)
-        {
+            .any(|&v| self.st.flags[v as usize] & ON_INTERFACE != 0);
+        self.in_unit_if(on, g, like)
+    }
+
+    /// [`Pass::in_unit`] for a cell with a node on an interface (`on`), else true.
+    fn in_unit_if(&self, on: bool, g: [[f64; 3]; 4], like: u32) -> bool {
+        if !on {
             return true;
         }
         let tol = 0.5 * crate::FAULT_TOLERANCE;
@@ -573,8 +668,16 @@ impl Pass<'_> {
     /// Where node `v` may go towards `to`: anywhere if free, along its one interface or its
     /// one fault; `None` if it may not move.
     fn slide(&self, v: u32, labels: &[Label], to: [f64; 3]) -> Option<[f64; 3]> {
-        let f = self.st.flags[v as usize];
-        let p = self.st.points[v as usize];
+        self.slide_at(
+            self.st.flags[v as usize],
+            self.st.points[v as usize],
+            labels,
+            to,
+        )
+    }
+
+    /// [`Pass::slide`] for a node with flags `f` at `p`.
+    fn slide_at(&self, f: u8, p: [f64; 3], labels: &[Label], to: [f64; 3]) -> Option<[f64; 3]> {
         if f & (TOP | BASE | SIDE) != 0 {
             // Off the interfaces and faults, a node on a side moves vertically (it stays on
             // the same edges of the outline), a node on the base horizontally; on the base
@@ -926,6 +1029,351 @@ impl Pass<'_> {
     }
 }
 
+impl Pass<'_> {
+    /// Splits edge (`a`, `b`) of a poor cell (`ca`: the cells around `a`) by a new node, if
+    /// that mends the cells around the edge: the node goes at the edge's midpoint, where it
+    /// must lie on every surface the edge lies on (each fault, interface and zone wall
+    /// between the labels around the edge within [`ON_SURFACE`], the terrain within `tol`,
+    /// the side on one outline edge; a curved surface's chord is refused), then it slides
+    /// (as a moved node, along its one surface, or nowhere on two) towards the mean of its
+    /// neighbours and up the gradient of its worst cell's smallest angle. Every cell around
+    /// the edge becomes two cones from the new node (exactly its halves at the midpoint),
+    /// each labelled as its parent. Kept if every new cell is positive (exact), their
+    /// smallest angle beats the old cells' and no more of them are below the floor, and, as
+    /// for a move, every cell keeps its unit and zones as the checks see them.
+    fn split(&self, a: u32, b: u32, ca: &[u32]) -> Option<Op> {
+        let ring: Vec<u32> = ca
+            .iter()
+            .copied()
+            .filter(|&c| self.st.tets[c as usize].contains(&b))
+            .collect();
+        if ring.is_empty() {
+            return None;
+        }
+        let labels = self.labels(&ring);
+        // The faces of the ring through the edge: (a, b, x) is inside the mesh when two of
+        // its cells hold x, on the boundary when one does.
+        let mut third: Vec<u32> = ring
+            .iter()
+            .flat_map(|&c| self.st.tets[c as usize])
+            .filter(|&v| v != a && v != b)
+            .collect();
+        third.sort_unstable();
+        let mut boundary = Vec::new();
+        let mut i = 0;
+        while i < third.len() {
+            let j = i + third[i..].iter().take_while(|&&v| v == third[i]).count();
+            match j - i {
+                1 => boundary.push(third[i]),
+                2 => {}
+                _ => return None,
+            }
+            i = j;
+        }
+        let (pa, pb) = (self.st.points[a as usize], self.st.points[b as usize]);
+        let m = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+        let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);
+        let mut flags = 0u8;
+        for &x in &boundary {
+            let on = fa & fb & self.st.flags[x as usize] & (TOP | BASE | SIDE);
+            let px = self.st.points[x as usize];
+            if on == 0
+                || !self.face_on_boundary([pa, m, px], on)
+                || !self.face_on_boundary([m, pb, px], on)
+            {
+                return None;
+            }
+            flags |= on;
+        }
+        // Every surface between the labels around the edge passes through the midpoint.
+        let l0 = labels[0];
+        let sides = labels.iter().fold(0u64, |x, l| x | (l.0 ^ l0.0));
+        let zones = labels.iter().fold(0u64, |x, l| x | (l.3 ^ l0.3));
+        for f in 0..self.faults.faults.len() {
+            if sides >> f & 1 == 1 && self.faults.faults[f].side(m).distance.abs() > ON_SURFACE {
+                return None;
+            }
+            if zones >> f & 1 == 1 {
+                let bit = l0.0 >> f & 1;
+                if labels.iter().any(|l| l.0 >> f & 1 != bit) {
+                    return None;
+                }
+                let g = crate::zones::wall(&self.faults.faults[f], if bit == 1 { 1 } else { -1 });
+                if g(m).abs() > ON_SURFACE {
+                    return None;
+                }
+            }
+        }
+        for l in &labels {
+            let (lo, hi) = labels
+                .iter()
+                .filter(|k| k.2 == l.2)
+                .fold((l.1, l.1), |(lo, hi), k| (lo.min(k.1), hi.max(k.1)));
+            for k in lo..hi {
+                let z = (self.height)(k as usize, self.blocks[l.2 as usize], [m[0], m[1]]);
+                if (z - m[2]).abs().is_nan() || (z - m[2]).abs() > ON_SURFACE {
+                    return None;
+                }
+                flags |= ON_INTERFACE;
+            }
+        }
+        let on_fault = sides & self.st.on_fault[a as usize] & self.st.on_fault[b as usize];
+        let halves: Vec<(u32, [u32; 4], [u32; 4])> = ring
+            .iter()
+            .map(|&c| {
+                let t = self.st.tets[c as usize];
+                (
+                    c,
+                    t.map(|w| if w == b { NEW } else { w }),
+                    t.map(|w| if w == a { NEW } else { w }),
+                )
+            })
+            .collect();
+        let old = ring
+            .iter()
+            .map(|&c| self.angle[c as usize])
+            .fold(f64::MAX, f64::min);
+        let poor = ring
+            .iter()
+            .filter(|&&c| self.angle[c as usize] < self.floor)
+            .count();
+        let geo = |t: [u32; 4], q: [f64; 3]| {
+            t.map(|w| {
+                if w == NEW {
+                    q
+                } else {
+                    self.st.points[w as usize]
+                }
+            })
+        };
+        let angle = |t: [u32; 4], q: [f64; 3]| {
+            let g = geo(t, q);
+            if positive(g) {
+                min_dihedral(g)
+            } else {
+                -1.0
+            }
+        };
+        // The smallest angle of the new cells with the node at q, and how many are below the
+        // floor.
+        let eval = |q: [f64; 3]| {
+            let (mut worst, mut n) = (f64::MAX, 0usize);
+            for &(_, t1, t2) in &halves {
+                for t in [t1, t2] {
+                    let x = angle(t, q);
+                    worst = worst.min(x);
+                    n += (x < self.floor) as usize;
+                }
+            }
+            (worst, n)
+        };
+        let (mut best, mut count) = eval(m);
+        let mut q = m;
+        // Towards the mean of the neighbours.
+        let mut mean = [0.0; 3];
+        let nb = third.len() as f64 + 2.0;
+        for v in third.iter().copied().chain([a, b]) {
+            for (s, x) in mean.iter_mut().zip(self.st.points[v as usize]) {
+                *s += x / nb;
+            }
+        }
+        for s in [1.0, 0.5, 0.25] {
+            let to = [0, 1, 2].map(|k| m[k] + s * (mean[k] - m[k]));
+            let Some(r) = self.slide_at(flags, m, &labels, to) else {
+                break;
+            };
+            let (x, n) = eval(r);
+            if x > best && n <= poor {
+                (best, count, q) = (x, n, r);
+                break;
+            }
+        }
+        // A compass search: the best of 14 directions at a step that halves when none is
+        // better (the smallest angle is not smooth where two cells tie for the worst).
+        let len = d2(pa, pb).sqrt();
+        let mut h = 0.25 * len;
+        if self.slide_at(flags, m, &labels, m).is_some() {
+            for _ in 0..24 {
+                if h < 1e-3 * len {
+                    break;
+                }
+                let mut step: Option<(f64, usize, [f64; 3])> = None;
+                for d in COMPASS {
+                    let to = [0, 1, 2].map(|k| q[k] + h * d[k]);
+                    let Some(r) = self.slide_at(flags, m, &labels, to) else {
+                        continue;
+                    };
+                    let (x, k) = eval(r);
+                    if x > step.map_or(best, |s| s.0) && k <= poor.max(count) {
+                        step = Some((x, k, r));
+                    }
+                }
+                match step {
+                    Some(s) => (best, count, q) = s,
+                    None => h *= 0.5,
+                }
+            }
+        }
+        if best < old + MIN_GAIN || count > poor {
+            return None;
+        }
+        let walled = zones != 0;
+        let on = |t: [u32; 4]| {
+            t.iter().any(|&w| {
+                if w == NEW {
+                    flags & ON_INTERFACE != 0
+                } else {
+                    self.st.flags[w as usize] & ON_INTERFACE != 0
+                }
+            })
+        };
+        let mut kids = Vec::with_capacity(halves.len());
+        for &(c, t1, t2) in &halves {
+            for t in [t1, t2] {
+                let g = geo(t, q);
+                if !self.in_unit_if(on(t), g, c) || !self.in_zone(g, c, walled) {
+                    return None;
+                }
+            }
+            kids.push((t1, angle(t1, q), t2, angle(t2, q)));
+        }
+        Some(Op::Split {
+            at: q,
+            flags,
+            on_fault,
+            ring,
+            kids,
+        })
+    }
+
+    /// The cells an operation changes or removes, as they are before it.
+    fn cells_of(&self, op: &Op) -> Vec<u32> {
+        match op {
+            Op::Collapse { kill, new, .. } => kill
+                .iter()
+                .copied()
+                .chain(new.iter().map(|e| e.0))
+                .collect(),
+            Op::Flip23 { c, d, .. } => vec![*c, *d],
+            Op::Flip32 { ring, .. } => ring.to_vec(),
+            Op::Split { ring, .. } => ring.clone(),
+            Op::Move { cells, .. } => cells.clone(),
+        }
+    }
+
+    fn volume(&self, cells: &[u32]) -> f64 {
+        cells
+            .iter()
+            .map(|&c| {
+                let g = self.geo(self.st.tets[c as usize]);
+                terramesh_core::volume::tetra_volume(g[0], g[1], g[2], g[3])
+            })
+            .sum()
+    }
+
+    /// Checks the mesh around the cells `after` that an operation made of cells whose volume
+    /// was `volume` (see [`verify_each_operation`]); panics on a broken invariant.
+    fn verify(&self, volume: f64, after: &[u32]) {
+        let v = self.volume(after);
+        assert!(
+            (v - volume).abs() <= 1e-9 * volume.abs(),
+            "quality pass: volume {volume} became {v}"
+        );
+        let p = |v: u32| c3(self.st.points[v as usize]);
+        for &c in after {
+            let t = self.st.tets[c as usize];
+            assert!(
+                positive(self.geo(t)),
+                "quality pass: cell {c} {t:?} not positive"
+            );
+            for (k, f) in crate::mesh::outward_faces(&t).into_iter().enumerate() {
+                let apex = t[[3, 2, 0, 1][k]];
+                let others: Vec<u32> = self
+                    .cells(f[0])
+                    .into_iter()
+                    .filter(|&d| d != c && f.iter().all(|w| self.st.tets[d as usize].contains(w)))
+                    .collect();
+                match others[..] {
+                    [] => {
+                        let on = f
+                            .iter()
+                            .fold(TOP | BASE | SIDE, |m, &w| m & self.st.flags[w as usize]);
+                        assert!(
+                            on != 0,
+                            "quality pass: face {f:?} of cell {c} on no boundary"
+                        );
+                    }
+                    [d] => {
+                        let u = self.st.tets[d as usize];
+                        let &x = u.iter().find(|w| !f.contains(w)).unwrap();
+                        let (s1, s2) = (
+                            orient3d(p(f[0]), p(f[1]), p(f[2]), p(apex)),
+                            orient3d(p(f[0]), p(f[1]), p(f[2]), p(x)),
+                        );
+                        assert!(
+                            s1 * s2 < 0.0,
+                            "quality pass: cells {c} and {d} on one side of their face"
+                        );
+                    }
+                    _ => panic!("quality pass: face {f:?} in {} cells", others.len() + 1),
+                }
+            }
+            for fault in &self.faults.faults {
+                let d: Vec<f64> = self
+                    .geo(t)
+                    .iter()
+                    .map(|&q| fault.side(q).distance)
+                    .collect();
+                assert!(
+                    !(d.iter().any(|&x| x > crate::FAULT_TOLERANCE)
+                        && d.iter().any(|&x| x < -crate::FAULT_TOLERANCE)),
+                    "quality pass: cell {c} across fault {}",
+                    fault.name
+                );
+            }
+        }
+    }
+
+    /// Whether a face at `q` lies on the boundary `on` names (bits of [`TOP`] and [`SIDE`]:
+    /// on the DSM, its centroid and edge midpoints too; on one edge of the outline; the base
+    /// is a plane).
+    fn face_on_boundary(&self, q: [[f64; 3]; 3], on: u8) -> bool {
+        if on & TOP != 0 {
+            let mid = |i: usize, j: usize| [0, 1, 2].map(|k| 0.5 * (q[i][k] + q[j][k]));
+            let c = [0, 1, 2].map(|k| (q[0][k] + q[1][k] + q[2][k]) / 3.0);
+            let dsm = |r: [f64; 3]| {
+                self.terrain
+                    .height([r[0], r[1]])
+                    .is_some_and(|h| (h - r[2]).abs() <= self.tol)
+            };
+            if ![q[0], q[1], q[2], c, mid(0, 1), mid(1, 2), mid(0, 2)]
+                .into_iter()
+                .all(dsm)
+            {
+                return false;
+            }
+        }
+        on & SIDE == 0 || self.on_outline_edge(&q)
+    }
+
+    /// Whether the points lie on one edge of the region's outline (within `tol`).
+    fn on_outline_edge(&self, q: &[[f64; 3]]) -> bool {
+        self.terrain.outline.iter().any(|&[i, j]| {
+            let (pa, pb) = (
+                self.terrain.points[i as usize],
+                self.terrain.points[j as usize],
+            );
+            let e = [pb[0] - pa[0], pb[1] - pa[1]];
+            let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+            q.iter().all(|r| {
+                let d = ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
+                let s = ((r[0] - pa[0]) * e[0] + (r[1] - pa[1]) * e[1]) / (l * l);
+                d.abs() <= self.tol && (-1e-12..=1.0 + 1e-12).contains(&s)
+            })
+        })
+    }
+}
+
 /// Improves the cells whose smallest dihedral angle is below `below` degrees, in at most
 /// `passes` sweeps (worst first), then drops the collapsed cells and unused nodes.
 #[allow(clippy::too_many_arguments)] // the state, its surfaces and the pass's two settings
@@ -980,6 +1428,7 @@ pub(crate) fn improve(
         interfaces,
         terrain,
         background,
+        verify: cfg!(debug_assertions) || VERIFY.load(std::sync::atomic::Ordering::Relaxed),
         tol: 0.5e-9
             * terrain
                 .heights
@@ -1031,7 +1480,19 @@ pub(crate) fn improve(
                     op
                 };
                 if let Some(op) = op {
-                    p.apply(op, &mut done);
+                    if p.verify {
+                        let before = p.cells_of(&op);
+                        let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);
+                        p.apply(op, &mut done);
+                        let after: Vec<u32> = before
+                            .into_iter()
+                            .filter(|&c| p.alive[c as usize])
+                            .chain(first..p.st.tets.len() as u32)
+                            .collect();
+                        p.verify(volume, &after);
+                    } else {
+                        p.apply(op, &mut done);
+                    }
                 }
             }
         }

@@ -68,11 +68,12 @@
 //!    block, the number of interfaces above it its unit. A fault's faces are the faces
 //!    between cells on its two sides where it is active.
 //! 4. A quality pass (`MeshSettings::improve_degrees`, default 5; `improve_passes`, default
-//!    3): every cell whose smallest dihedral angle is below that, worst first, is mended by
+//!    6): every cell whose smallest dihedral angle is below that, worst first, is mended by
 //!    the first of: collapsing one of its edges (shortest first); a 3-2 flip of one of its
 //!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
-//!    the smallest angle of its worst cell. What may change is read from the cells' labels
+//!    the smallest angle of its worst cell; splitting one of its edges by a new node placed by
+//!    a compass search (on every surface the edge lies on). What may change is read from the cells' labels
 //!    (side of every fault, unit, fault zones): a node whose cells carry one label lies on no
 //!    surface and may move anywhere (on a side: vertically; on the base: horizontally); a node
 //!    between two units of one block moves along that interface (its height taken from
@@ -170,6 +171,8 @@ mod zones;
 pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
 pub use error::FaultError;
 pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG_TRACE_DEGREES};
+#[doc(hidden)]
+pub use improve::verify_each_operation;
 pub use mesh::{
     faulted_mesh, faulted_mesh_with_objects, BuildReport, FaultFace, FaultedMesh, InterfaceFn,
     MeshSettings, ON_SURFACE,

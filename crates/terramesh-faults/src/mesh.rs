@@ -43,9 +43,10 @@ pub struct MeshSettings {
     /// below the smaller of this and what it was, degrees (default 10).
     pub guard_degrees: f64,
     /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
-    /// by edge collapses and node moves that keep every label (default 5; 0 turns it off).
+    /// by edge collapses, flips, node moves and edge splits that keep every label (default 5;
+    /// 0 turns it off).
     pub improve_degrees: f64,
-    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 3).
+    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 6).
     pub improve_passes: usize,
     /// Before meshing, planar triangles whose longest edge exceeds this many times the
     /// thinnest slab at their vertices (between two nearly parallel surfaces: terrain, base,
@@ -70,7 +71,7 @@ impl MeshSettings {
             snap: 0.35,
             guard_degrees: 10.0,
             improve_degrees: 5.0,
-            improve_passes: 3,
+            improve_passes: 6,
             refine_ratio: 10.0,
             refine_min_thickness: 0.25,
             refine_max_cells: 600_000,
@@ -110,6 +111,8 @@ pub struct BuildReport {
     pub moved: usize,
     /// Flips (2-3 and 3-2) made by the quality pass.
     pub flipped: usize,
+    /// Nodes added by the quality pass (edges of poor cells split).
+    pub inserted: usize,
 }
 
 /// A tetrahedral volume mesh cut by faults and interfaces.
@@ -1071,6 +1074,7 @@ pub fn faulted_mesh_with_objects(
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
+    st.report.inserted = done.inserted;
     let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     zones.zone = crate::zones::labels(faults, &st.zone);
     // The structures' parts above the terrain, last: their cells carry no fault face.
