@@ -111,8 +111,14 @@ fn held(n: u64) -> std::result::Result<(), terramesh_core::limits::TooLarge> {
     terramesh_core::limits::Estimate::new(HELD, n as f64, 24.0)
         .check()
         .map(|_| ())
-        .map_err(|t| t.with_remedy(terramesh_core::limits::Remedy::raise("spacing")))
+        .map_err(|t| t.with_remedy(REMEDY))
 }
+
+/// What makes fewer points (the message words the field as it is).
+const REMEDY: terramesh_core::limits::Remedy = terramesh_core::limits::Remedy {
+    verb: "use fewer rows and columns or a larger",
+    setting: "spacing",
+};
 
 /// What a [`PointSink`] that holds the points refuses.
 const HELD: &str = "samples held in memory (a tiled plan holds none)";
@@ -132,7 +138,7 @@ impl PointSink for Vec<[f64; 3]> {
                 count: n as f64,
                 bytes: 24.0 * n as f64,
                 limit: None,
-                remedy: Some(terramesh_core::limits::Remedy::raise("spacing")),
+                remedy: Some(REMEDY),
             })
         })
     }
