@@ -97,9 +97,12 @@ pub enum GridError {
         /// The spacing asked for.
         spacing: f64,
     },
-    /// More nodes than a grid holds (500 million).
+    /// More nodes than a grid holds: [`MAX_LISTED_NODES`] listed whole
+    /// ([`SamplingGrid::build`]), [`MAX_STREAMED_NODES`] sampled node by node
+    /// ([`SamplingGrid::layout`]).
     #[error(
-        "{rows} x {cols} = {} nodes is too many; use fewer rows/columns or a larger spacing",
+        "{rows} x {cols} = {} nodes is too many (at most {limit}); use fewer rows/columns or a \
+         larger spacing",
         *rows as u128 * *cols as u128
     )]
     TooManyNodes {
@@ -108,6 +111,8 @@ pub enum GridError {
         /// Columns (the product is not stored: a `u128` field would make every error that
         /// carries a `GridError` 16-byte aligned, and the facade's `Error` larger).
         cols: usize,
+        /// The most nodes that way.
+        limit: u64,
     },
     /// Nodes that would pass the memory ceiling ([`crate::limits`]).
     #[error("{rows} x {cols}: {limit}; use fewer rows/columns or a larger spacing")]
@@ -154,6 +159,61 @@ impl SamplingGrid {
     /// # Ok::<(), terramesh_core::sampling::GridError>(())
     /// ```
     pub fn build(&self, region: &Region) -> Result<Grid, GridError> {
+        let layout = self.layout(region)?;
+        let (rows, cols) = (layout.rows, layout.cols);
+        let total = layout.unclipped();
+        if total > MAX_LISTED_NODES {
+            return Err(GridError::TooManyNodes {
+                rows,
+                cols,
+                limit: MAX_LISTED_NODES,
+            });
+        }
+        // A node ([f64; 2]) and its grid index, 24 bytes, against the memory ceiling.
+        crate::limits::Estimate::new("grid nodes", total as f64, 24.0)
+            .check()
+            .map_err(|limit| GridError::OverMemory {
+                rows,
+                cols,
+                limit: Box::new(limit),
+            })?;
+        let mut nodes = Vec::with_capacity(if self.clip { 0 } else { total as usize });
+        let mut index = Vec::with_capacity(nodes.capacity());
+        // Both fit in a u32: each is at most MAX_LISTED_NODES / 2.
+        for ([r, c], xy) in layout.nodes(region) {
+            nodes.push(xy);
+            index.push((r as u32, c as u32));
+        }
+        Ok(Grid {
+            rows,
+            cols,
+            nodes,
+            index,
+        })
+    }
+
+    /// The grid's rows, columns and spacing over `region`, its nodes not listed: the grid of
+    /// [`SamplingGrid::build`], whose nodes [`GridLayout::nodes`] yields one at a time in the
+    /// same order (the same values), so that a grid of any size can be sampled band by band in
+    /// a fixed amount of memory. Refuses what `build` refuses but the listed node count and its
+    /// memory: only grids of more than [`MAX_STREAMED_NODES`] nodes.
+    ///
+    /// ```
+    /// use terramesh_core::geometry::Region;
+    /// use terramesh_core::sampling::{GridSize, SamplingGrid, Margin};
+    /// let tri = Region::from_ring(vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]);
+    /// let spec = SamplingGrid { size: GridSize::Spacing(0.5), margin: Margin::Fraction(0.1),
+    ///                           clip: true };
+    /// let listed = spec.build(&tri)?;
+    /// let streamed: Vec<[f64; 2]> = spec.layout(&tri)?.nodes(&tri).map(|(_, xy)| xy).collect();
+    /// assert_eq!(streamed, listed.nodes);
+    /// // 10^10 nodes: too many to list, not to stream.
+    /// let huge = SamplingGrid { size: GridSize::RowsCols { rows: 100_000, cols: 100_000 }, ..spec };
+    /// assert!(huge.build(&tri).is_err());
+    /// assert_eq!(huge.layout(&tri)?.unclipped(), 10_000_000_000);
+    /// # Ok::<(), terramesh_core::sampling::GridError>(())
+    /// ```
+    pub fn layout(&self, region: &Region) -> Result<GridLayout, GridError> {
         let (lo, hi) = region.bbox().ok_or(GridError::EmptyRegion)?;
         let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         if !(w > 0.0 && h > 0.0) {
@@ -163,7 +223,6 @@ impl SamplingGrid {
             });
         }
         let (lo, hi) = self.margin.enlarge(lo, hi)?;
-        let (x0, y0) = (lo[0], lo[1]);
         let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         let (rows, cols, dx, dy) = match self.size {
             GridSize::RowsCols { rows, cols } => {
@@ -176,49 +235,120 @@ impl SamplingGrid {
                 if !(s.is_finite() && s > 0.0) {
                     return Err(GridError::Spacing { spacing: s });
                 }
-                let n = |len: f64| (len / s * (1.0 + 1e-12)).floor() as usize + 1;
+                // Saturating: a spacing so small that the count passes usize is refused below
+                // as too many nodes, not wrapped to none.
+                let n = |len: f64| ((len / s * (1.0 + 1e-12)).floor() as usize).saturating_add(1);
                 (n(h), n(w), s, s)
             }
         };
-        let total = rows as u128 * cols as u128;
-        if total > 500_000_000 {
-            return Err(GridError::TooManyNodes { rows, cols });
-        }
-        // A node ([f64; 2]) and its grid index, 24 bytes, against the memory ceiling.
-        crate::limits::Estimate::new("grid nodes", total as f64, 24.0)
-            .check()
-            .map_err(|limit| GridError::OverMemory {
+        if rows as u128 * cols as u128 > MAX_STREAMED_NODES as u128 {
+            return Err(GridError::TooManyNodes {
                 rows,
                 cols,
-                limit: Box::new(limit),
-            })?;
-        let mut nodes = Vec::with_capacity(if self.clip { 0 } else { total as usize });
-        let mut index = Vec::with_capacity(nodes.capacity());
-        for r in 0..rows {
-            let y = if r + 1 == rows && matches!(self.size, GridSize::RowsCols { .. }) {
-                y0 + h
-            } else {
-                y0 + r as f64 * dy
-            };
-            for c in 0..cols {
-                let x = if c + 1 == cols && matches!(self.size, GridSize::RowsCols { .. }) {
-                    x0 + w
-                } else {
-                    x0 + c as f64 * dx
-                };
-                if self.clip && !region.contains([x, y]) {
-                    continue;
-                }
-                nodes.push([x, y]);
-                index.push((r as u32, c as u32));
-            }
+                limit: MAX_STREAMED_NODES,
+            });
         }
-        Ok(Grid {
+        Ok(GridLayout {
             rows,
             cols,
-            nodes,
-            index,
+            origin: lo,
+            size: [w, h],
+            step: [dx, dy],
+            exact_ends: matches!(self.size, GridSize::RowsCols { .. }),
+            clip: self.clip,
         })
+    }
+}
+
+/// At most this many nodes in a grid listed whole ([`SamplingGrid::build`], 24 bytes a node).
+pub const MAX_LISTED_NODES: u64 = 500_000_000;
+
+/// At most this many nodes in a grid sampled node by node ([`SamplingGrid::layout`]): it holds
+/// no node, but 10^12 samples are about 24 TB of points and days of sampling, surely a
+/// mistaken size or spacing.
+pub const MAX_STREAMED_NODES: u64 = 1_000_000_000_000;
+
+/// A sampling grid laid out over a region ([`SamplingGrid::layout`]): its size and spacing,
+/// without its nodes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridLayout {
+    /// Rows of the full (unclipped) grid.
+    pub rows: usize,
+    /// Columns of the full grid.
+    pub cols: usize,
+    origin: [f64; 2],
+    size: [f64; 2],
+    step: [f64; 2],
+    /// A rows x cols grid puts its last row and column on the box's edges exactly.
+    exact_ends: bool,
+    clip: bool,
+}
+
+impl GridLayout {
+    /// Nodes of the full (unclipped) grid, `rows x cols`: after clipping, at most this many.
+    pub fn unclipped(&self) -> u64 {
+        self.rows as u64 * self.cols as u64
+    }
+
+    /// Whether the nodes are clipped to the region.
+    pub fn clipped(&self) -> bool {
+        self.clip
+    }
+
+    /// The nodes `([row, col], [x, y])`, row by row from the south, west to east in each row;
+    /// when clipped, only those `region` contains (`region` must be the one laid out over).
+    pub fn nodes<'a>(&self, region: &'a Region) -> GridNodes<'a> {
+        GridNodes {
+            layout: *self,
+            region,
+            next: [0, 0],
+        }
+    }
+
+    fn x(&self, c: usize) -> f64 {
+        if self.exact_ends && c + 1 == self.cols {
+            self.origin[0] + self.size[0]
+        } else {
+            self.origin[0] + c as f64 * self.step[0]
+        }
+    }
+
+    fn y(&self, r: usize) -> f64 {
+        if self.exact_ends && r + 1 == self.rows {
+            self.origin[1] + self.size[1]
+        } else {
+            self.origin[1] + r as f64 * self.step[1]
+        }
+    }
+}
+
+/// The nodes of a [`GridLayout`], one at a time ([`GridLayout::nodes`]).
+#[derive(Debug, Clone)]
+pub struct GridNodes<'a> {
+    layout: GridLayout,
+    region: &'a Region,
+    next: [usize; 2],
+}
+
+impl Iterator for GridNodes<'_> {
+    type Item = ([usize; 2], [f64; 2]);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let g = &self.layout;
+        while self.next[0] < g.rows {
+            let [r, c] = self.next;
+            self.next = if c + 1 == g.cols {
+                [r + 1, 0]
+            } else {
+                [r, c + 1]
+            };
+            let xy = [g.x(c), g.y(r)];
+            if g.clip && !self.region.contains(xy) {
+                continue;
+            }
+            return Some(([r, c], xy));
+        }
+        None
     }
 }
 
@@ -392,12 +522,13 @@ mod tests {
             GridError::TooManyNodes {
                 rows: 100_000,
                 cols: 10_000,
+                limit: MAX_LISTED_NODES,
             }
         );
         assert_eq!(
             e.to_string(),
-            "100000 x 10000 = 1000000000 nodes is too many; use fewer rows/columns or a larger \
-             spacing"
+            "100000 x 10000 = 1000000000 nodes is too many (at most 500000000); use fewer \
+             rows/columns or a larger spacing"
         );
     }
 
@@ -422,5 +553,126 @@ mod tests {
             format!("20000 x 20000: {limit}; use fewer rows/columns or a larger spacing")
         );
         assert!(limit.to_string().contains("grid nodes"), "{limit}");
+    }
+
+    /// An L-shaped polygon (concave, with a notch) for clipping.
+    fn ell() -> Region {
+        Region::from_ring(vec![
+            [0.0, 0.0],
+            [40.0, 0.0],
+            [40.0, 10.0],
+            [12.5, 10.0],
+            [12.5, 35.0],
+            [0.0, 35.0],
+        ])
+    }
+
+    #[test]
+    fn the_streamed_grid_yields_the_listed_grid_node_for_node() {
+        let tri = Region::from_ring(vec![[3.0, -2.0], [31.0, 4.0], [9.0, 27.5]]);
+        let sizes = [
+            GridSize::RowsCols { rows: 2, cols: 2 },
+            GridSize::RowsCols { rows: 37, cols: 23 },
+            GridSize::Spacing(0.7),
+            GridSize::Spacing(3.0),
+        ];
+        let margins = [
+            Margin::Fraction(0.0),
+            Margin::Fraction(0.13),
+            Margin::Absolute(2.5),
+            Margin::PerAxis([1.0, 4.0]),
+        ];
+        let mut clipped_away = 0;
+        for region in [rect(), ell(), tri] {
+            for size in sizes {
+                for margin in margins {
+                    for clip in [false, true] {
+                        let spec = SamplingGrid { size, margin, clip };
+                        let listed = spec.build(&region).unwrap();
+                        let layout = spec.layout(&region).unwrap();
+                        assert_eq!((layout.rows, layout.cols), (listed.rows, listed.cols));
+                        assert_eq!(layout.unclipped(), (listed.rows * listed.cols) as u64);
+                        let (mut nodes, mut index) = (Vec::new(), Vec::new());
+                        for ([r, c], xy) in layout.nodes(&region) {
+                            nodes.push(xy);
+                            index.push((r as u32, c as u32));
+                        }
+                        // Bit for bit: the same f64 values, order and grid indices.
+                        let bits = |v: &[[f64; 2]]| -> Vec<[u64; 2]> {
+                            v.iter().map(|p| p.map(f64::to_bits)).collect()
+                        };
+                        assert_eq!(bits(&nodes), bits(&listed.nodes), "{spec:?}");
+                        assert_eq!(index, listed.index, "{spec:?}");
+                        if clip {
+                            assert!(nodes.iter().all(|p| region.contains(*p)), "{spec:?}");
+                            clipped_away += layout.unclipped() as usize - nodes.len();
+                        } else {
+                            assert_eq!(nodes.len() as u64, layout.unclipped());
+                        }
+                    }
+                }
+            }
+        }
+        // The clipped cases did clip (the L's notch and the triangle's corners).
+        assert!(clipped_away > 1000, "{clipped_away}");
+    }
+
+    #[test]
+    fn a_streamed_grid_takes_more_nodes_than_a_listed_one_but_not_any_number() {
+        // 10^10 nodes: refused listed (the named limit), laid out to stream; its nodes come
+        // one at a time (the first and the 100,001st here), none listed.
+        let size = GridSize::RowsCols {
+            rows: 100_000,
+            cols: 100_000,
+        };
+        let spec = SamplingGrid {
+            size,
+            margin: NONE,
+            clip: false,
+        };
+        assert!(matches!(
+            spec.build(&rect()),
+            Err(GridError::TooManyNodes {
+                limit: MAX_LISTED_NODES,
+                ..
+            })
+        ));
+        let region = rect();
+        let layout = spec.layout(&region).unwrap();
+        assert_eq!(layout.unclipped(), 10_000_000_000);
+        let mut nodes = layout.nodes(&region);
+        assert_eq!(nodes.next(), Some(([0, 0], [100.0, 200.0])));
+        assert_eq!(
+            nodes.nth(99_999),
+            Some(([1, 0], [100.0, 200.0 + 100.0 / 99_999.0]))
+        );
+        // More than 10^12: refused with the counts and the limit, before any node.
+        let spec = SamplingGrid {
+            size: GridSize::Spacing(1e-5),
+            ..spec
+        };
+        let e = spec.layout(&rect()).unwrap_err();
+        assert_eq!(
+            e,
+            GridError::TooManyNodes {
+                rows: 10_000_001,
+                cols: 5_000_001,
+                limit: MAX_STREAMED_NODES,
+            }
+        );
+        assert!(
+            e.to_string()
+                .contains("nodes is too many (at most 1000000000000)"),
+            "{e}"
+        );
+        // A spacing so small that the count passes usize is refused, not wrapped to no node.
+        let spec = SamplingGrid {
+            size: GridSize::Spacing(1e-300),
+            ..spec
+        };
+        assert!(matches!(
+            spec.layout(&rect()),
+            Err(GridError::TooManyNodes { .. })
+        ));
     }
 }

@@ -93,13 +93,54 @@ pub fn acquire_streamed(plan: &SamplePlan, scale: f64) -> Result<Option<Streamed
 pub trait PointSink {
     /// The next band's points with an elevation, `[x, y, z]`.
     fn points(&mut self, xyz: &[[f64; 3]]) -> Result<()>;
-    /// At most `n` points will come (the grid's nodes), before the first band.
-    fn expect(&mut self, _n: usize) {}
+    /// At most `n` points will come (the grid's nodes, before clipping), before anything is
+    /// sampled: a sink that holds them refuses more than the memory ceiling
+    /// ([`terramesh_core::limits`]).
+    fn admit(&self, _n: u64) -> Result<()> {
+        Ok(())
+    }
+    /// `n` points will come at most (the grid's nodes, after clipping), before the first band:
+    /// a sink that holds them makes room for them.
+    fn expect(&mut self, _n: usize) -> Result<()> {
+        Ok(())
+    }
 }
 
+/// The memory a [`PointSink`] holding `n` points needs, against the ceiling.
+fn held(n: u64) -> std::result::Result<(), terramesh_core::limits::TooLarge> {
+    terramesh_core::limits::Estimate::new(HELD, n as f64, 24.0)
+        .check()
+        .map(|_| ())
+        .map_err(|t| t.with_remedy(REMEDY))
+}
+
+/// What makes fewer points (the message words the field as it is).
+const REMEDY: terramesh_core::limits::Remedy = terramesh_core::limits::Remedy {
+    verb: "use fewer rows and columns or a larger",
+    setting: "spacing",
+};
+
+/// What a [`PointSink`] that holds the points refuses.
+const HELD: &str = "samples held in memory (a tiled plan holds none)";
+
 impl PointSink for Vec<[f64; 3]> {
-    fn expect(&mut self, n: usize) {
-        self.reserve_exact(n);
+    /// Checks the points (24 bytes each) against the memory ceiling: a grid too large to hold
+    /// is refused before it is sampled, as listing its nodes was (a `tiles plan`, whose sink
+    /// holds none, takes it).
+    fn admit(&self, n: u64) -> Result<()> {
+        Ok(held(n)?)
+    }
+    fn expect(&mut self, n: usize) -> Result<()> {
+        held(n as u64)?;
+        self.try_reserve_exact(n).map_err(|_| {
+            crate::error::Error::TooLarge(terramesh_core::limits::TooLarge {
+                what: HELD,
+                count: n as f64,
+                bytes: 24.0 * n as f64,
+                limit: None,
+                remedy: Some(REMEDY),
+            })
+        })
     }
     fn points(&mut self, xyz: &[[f64; 3]]) -> Result<()> {
         self.extend_from_slice(xyz);

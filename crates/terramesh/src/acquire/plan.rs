@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use terramesh_core::coords::Zone;
 use terramesh_core::coords::{to_utm, to_wgs84};
 use terramesh_core::sampling::{
-    grid_nodes, GridPlane, GridSize, Kernel, Margin, Node, NodeError, SamplingGrid,
+    grid_nodes, GridLayout, GridPlane, GridSize, Kernel, Margin, Node, NodeError, SamplingGrid,
 };
 use terramesh_io::dem::SourceCrs;
 use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
@@ -484,25 +484,28 @@ impl SamplePlan {
         )?)
     }
 
-    /// The grid's points before they become nodes: the nodes of [`SamplePlan::nodes`], in
-    /// order, as projected `[x, y]`, or `[lon, lat]` on a latitude/longitude grid; each band of
-    /// them becomes its nodes with [`SamplePlan::nodes_of`], so that the nodes (40 bytes each)
-    /// need not all be held at once. `None` where [`SamplePlan::nodes`] gives an error.
-    pub(crate) fn grid_points(&self) -> Result<Option<Vec<[f64; 2]>>> {
+    /// The grid's points before they become nodes, laid out but not listed: the nodes of
+    /// [`SamplePlan::nodes`], in order, yielded one at a time as projected `[x, y]`, or
+    /// `[lon, lat]` on a latitude/longitude grid, with the plane they lie in; each band of them
+    /// becomes its nodes with [`SamplePlan::nodes_of`], so that no step holds every node (a
+    /// grid of up to [`MAX_STREAMED_NODES`](terramesh_core::sampling::MAX_STREAMED_NODES)
+    /// nodes, against the [`MAX_LISTED_NODES`](terramesh_core::sampling::MAX_LISTED_NODES)
+    /// and the memory ceiling of [`SamplePlan::nodes`]). `None` where [`SamplePlan::nodes`]
+    /// gives an error other than those.
+    pub(crate) fn grid_points(&self) -> Result<Option<GridPoints<'_>>> {
         let r = self.region()?;
         let spec = self.grid_spec()?;
-        Ok(match (self.options.plane, &r.geographic, r.zone) {
-            (GridPlane::Utm, _, _) => {
-                Some(spec.build(&r.projected).map_err(NodeError::from)?.nodes)
-            }
-            (GridPlane::LatLon, Some(g), Some(_)) => {
-                Some(spec.build(g).map_err(NodeError::from)?.nodes)
-            }
-            (GridPlane::LatLon, _, _) => None,
-        })
+        let plane = match (self.options.plane, &r.geographic, r.zone) {
+            (GridPlane::Utm, _, _) => &r.projected,
+            (GridPlane::LatLon, Some(g), Some(_)) => g,
+            (GridPlane::LatLon, _, _) => return Ok(None),
+        };
+        let layout = spec.layout(plane).map_err(NodeError::from)?;
+        Ok(Some(GridPoints { layout, plane }))
     }
 
-    /// The nodes of a band of [`SamplePlan::grid_points`], as [`grid_nodes`] makes them.
+    /// The nodes of a band of [`SamplePlan::grid_points`]' points, as [`grid_nodes`] makes
+    /// them.
     pub(crate) fn nodes_of(&self, points: &[[f64; 2]]) -> Result<Vec<Node>> {
         let zone = self.region()?.zone;
         let nodes: std::result::Result<Vec<Node>, NodeError> = match (self.options.plane, zone) {
@@ -573,7 +576,7 @@ impl SamplePlan {
                     ));
                 }
                 let (mlo, mhi) = self.options.margin.projected().enlarge(lo, hi)?;
-                let n = |len: f64| (len / s).floor() as usize + 1;
+                let n = |len: f64| ((len / s).floor() as usize).saturating_add(1);
                 GridSize::RowsCols {
                     rows: n(mhi[1] - mlo[1]).max(2),
                     cols: n(mhi[0] - mlo[0]).max(2),
@@ -592,6 +595,21 @@ impl SamplePlan {
             margin,
             clip: self.options.clip,
         })
+    }
+}
+
+/// The grid of a plan laid out over the region in its plane ([`SamplePlan::grid_points`]).
+pub(crate) struct GridPoints<'a> {
+    /// The grid's rows, columns and spacing.
+    pub layout: GridLayout,
+    /// The region in the grid's plane (projected, or `[lon, lat]`).
+    plane: &'a terramesh_core::geometry::Region,
+}
+
+impl GridPoints<'_> {
+    /// The points, one at a time in the grid's order.
+    pub fn points(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        self.layout.nodes(self.plane).map(|(_, xy)| xy)
     }
 }
 

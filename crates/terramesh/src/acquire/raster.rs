@@ -3,14 +3,14 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use terramesh_core::sampling::GridPlane;
+use terramesh_core::sampling::{GridPlane, MAX_LISTED_NODES};
 use terramesh_io::dem::{
     open_raster_in, sample_in, sample_nodes, ElevationSource, LatLonBox, SourceCrs, TileMosaic,
 };
 use terramesh_web::{fetch_tiles, TileOptions};
 
 use super::plan::{OnMissing, SamplePlan};
-use super::table::{SampleTable, TableWriter};
+use super::table::{MissingTally, SampleTable, TableWriter};
 use super::Streamed;
 use crate::error::{Context, Error, Result};
 use crate::setting::Setting;
@@ -30,9 +30,13 @@ pub fn sample_file(s: &SamplePlan, path: &Path) -> Result<SampleTable> {
 /// Samples a DEM file as [`sample_file`] does, band by band of `band` grid nodes in the
 /// grid's order, each band's rows appended to the table as they come: the same table and
 /// samples (`z` times `scale`) without holding every node and row at once. The raster window
-/// is the one `sample_file` reads (the nodes' box, from a first pass over the bands).
+/// is the one `sample_file` reads (the nodes' box, from a first pass over the bands). The
+/// grid's points are made band by band too ([`SamplePlan::grid_points`]): nothing holds the
+/// whole grid, whatever its size (up to `MAX_STREAMED_NODES`).
 /// `Ok(None)` where `sample_file` must run instead: the grid is an error, or a node has no
-/// elevation under `on_missing = "error"` (its message counts and spans every node).
+/// elevation under `on_missing = "error"` (its message counts and spans every node) and the
+/// grid can be listed (at most `MAX_LISTED_NODES`); a larger one gives that message itself,
+/// after its last band, and writes nothing.
 pub(crate) fn stream_file<'a>(
     s: &'a SamplePlan,
     path: &Path,
@@ -41,14 +45,27 @@ pub(crate) fn stream_file<'a>(
     sink: &mut dyn super::PointSink,
 ) -> Result<Option<Streamed<'a>>> {
     let band = band.max(1);
-    let Some(points) = s.grid_points()? else {
+    let Some(grid) = s.grid_points()? else {
         return Ok(None);
     };
+    sink.admit(grid.layout.unclipped())?;
+    // The grid's points band by band, made as they are needed (never all of them at once).
+    let mut points = Vec::with_capacity(band.min(grid.layout.unclipped() as usize));
     let mut area: Option<LatLonBox> = None;
-    if s.options.plane == GridPlane::LatLon || s.region()?.zone.is_some() {
-        // Every node has a latitude and longitude: the box around them, as LatLonBox::around.
-        for nodes in points.chunks(band) {
-            for n in s.nodes_of(nodes)? {
+    // How many nodes: the full grid's, or those kept by the clip (counted in the first pass).
+    let mut count = grid.layout.unclipped() as usize;
+    let geographic = s.options.plane == GridPlane::LatLon || s.region()?.zone.is_some();
+    if geographic || grid.layout.clipped() {
+        count = 0;
+        let mut all = grid.points();
+        while next_band(&mut all, &mut points, band) {
+            count += points.len();
+            if !geographic {
+                continue;
+            }
+            // Every node has a latitude and longitude: the box around them, as
+            // LatLonBox::around.
+            for n in s.nodes_of(&points)? {
                 let Some([lat, lon]) = n.latlon.filter(|p| p[0].is_finite() && p[1].is_finite())
                 else {
                     continue;
@@ -69,12 +86,20 @@ pub(crate) fn stream_file<'a>(
     let dem = open_raster_in(path, s.options.fill_voids, area.as_ref())?;
     let zone = table_zone(s, dem.as_ref());
     let mut table = TableWriter::new(s, zone)?;
-    sink.expect(points.len());
+    sink.expect(count)?;
+    let mut tally = MissingTally::new();
+    let listable = grid.layout.unclipped() <= MAX_LISTED_NODES;
     let mut xyz = Vec::new();
-    for nodes in points.chunks(band) {
-        let mut t = sample(s, dem.as_ref(), s.nodes_of(nodes)?)?;
-        if s.options.on_missing == OnMissing::Error && t.rows.iter().any(|r| r.z.is_err()) {
-            return Ok(None);
+    let mut all = grid.points();
+    while next_band(&mut all, &mut points, band) {
+        let mut t = sample(s, dem.as_ref(), s.nodes_of(&points)?)?;
+        if s.options.on_missing == OnMissing::Error {
+            tally.rows(&t.rows, &t.lacking);
+            // A grid that can be listed declines, for the whole acquisition's checks in their
+            // order; one too large to list goes on, for the same message from the tally.
+            if tally.any() && listable {
+                return Ok(None);
+            }
         }
         xyz.clear();
         for r in &mut t.rows {
@@ -88,12 +113,27 @@ pub(crate) fn stream_file<'a>(
         sink.points(&xyz)?;
         table.band(&t.rows)?;
     }
+    if let Some(e) = tally.error(s) {
+        return Err(e);
+    }
     Ok(Some(Streamed {
         zone,
         xyz: Vec::new(),
         table,
         summary: summary(s, dem.as_ref()),
     }))
+}
+
+/// The next `band` points of `all` into `points` (replacing the last band's); false when none
+/// is left.
+fn next_band(
+    all: &mut impl Iterator<Item = [f64; 2]>,
+    points: &mut Vec<[f64; 2]>,
+    band: usize,
+) -> bool {
+    points.clear();
+    points.extend(all.take(band));
+    !points.is_empty()
 }
 
 /// The zone of a table sampled from `dem`: none for a projected source.

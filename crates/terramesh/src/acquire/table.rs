@@ -13,6 +13,7 @@ use crate::progress::Progress;
 use crate::setting::Setting;
 
 /// One output point.
+#[derive(Clone)]
 pub struct Row {
     /// WGS-84 `[lat, lon]` (geographic output).
     pub latlon: Option<[f64; 2]>,
@@ -53,21 +54,14 @@ pub(crate) fn node_rows<E: std::fmt::Display>(
         .collect()
 }
 
-/// `" (the grid spans lat A to B, lon C to D)"`, or x and y for projected points.
-fn extent(rows: &[Row]) -> String {
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    let geographic = rows.iter().all(|r| r.latlon.is_some());
-    for r in rows {
-        let p = match r.latlon {
-            Some(ll) if geographic => ll,
-            _ => r.xy,
-        };
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+/// `" (the points span lat A to B, lon C to D: ...)"`, or x and y for projected points: the
+/// extent of every row, latitude/longitude where every row has them.
+fn extent(lo: [[f64; 2]; 2], hi: [[f64; 2]; 2], geographic: bool) -> String {
+    let (lo, hi) = if geographic {
+        (lo[0], hi[0])
+    } else {
+        (lo[1], hi[1])
+    };
     if !lo[0].is_finite() {
         String::new()
     } else if geographic {
@@ -82,6 +76,95 @@ fn extent(rows: &[Row]) -> String {
              them)",
             lo[0], hi[0], lo[1], hi[1]
         )
+    }
+}
+
+/// The points without an elevation, tallied band by band ([`MissingTally::rows`]) for the
+/// message of `on_missing = "error"` ([`MissingTally::error`]): the same message whether the
+/// rows come at once or in bands, holding no row but the first missing one.
+pub(crate) struct MissingTally {
+    missing: usize,
+    total: usize,
+    first: Option<(usize, Row)>,
+    /// Extents `[latlon, xy]`.
+    lo: [[f64; 2]; 2],
+    hi: [[f64; 2]; 2],
+    geographic: bool,
+    lacking: std::collections::BTreeSet<String>,
+}
+
+impl MissingTally {
+    pub(crate) fn new() -> MissingTally {
+        MissingTally {
+            missing: 0,
+            total: 0,
+            first: None,
+            lo: [[f64::INFINITY; 2]; 2],
+            hi: [[f64::NEG_INFINITY; 2]; 2],
+            geographic: true,
+            lacking: Default::default(),
+        }
+    }
+
+    /// The next rows, and the tiles the source lacks for them.
+    pub(crate) fn rows(&mut self, rows: &[Row], lacking: &[String]) {
+        for (i, r) in rows.iter().enumerate() {
+            if r.z.is_err() {
+                if self.first.is_none() {
+                    self.first = Some((self.total + i, r.clone()));
+                }
+                self.missing += 1;
+            }
+            match r.latlon {
+                Some(ll) => self.grow(0, ll),
+                None => self.geographic = false,
+            }
+            self.grow(1, r.xy);
+        }
+        self.total += rows.len();
+        self.lacking.extend(lacking.iter().cloned());
+    }
+
+    fn grow(&mut self, k: usize, p: [f64; 2]) {
+        for (a, v) in p.into_iter().enumerate() {
+            self.lo[k][a] = self.lo[k][a].min(v);
+            self.hi[k][a] = self.hi[k][a].max(v);
+        }
+    }
+
+    /// Whether a row so far has no elevation.
+    pub(crate) fn any(&self) -> bool {
+        self.missing > 0
+    }
+
+    /// The error of `on_missing = "error"` when a row has no elevation.
+    pub(crate) fn error(&self, s: &SamplePlan) -> Option<Error> {
+        let (i, r) = self.first.as_ref()?;
+        let at = match r.latlon {
+            Some([lat, lon]) => format!("lat {lat:.7}, lon {lon:.7}"),
+            None => format!("x {}, y {}", r.xy[0], r.xy[1]),
+        };
+        let files: Vec<String> = self.lacking.iter().cloned().collect();
+        Some(Error::setting(
+            Setting::OnMissing,
+            "",
+            format!(
+                "{} of {} points have no elevation in {}{}; the first (point {}, {at}): \
+                 {}.{} Use {{on-missing}} nodata or skip to write the others{}",
+                self.missing,
+                self.total,
+                s.options.source,
+                extent(self.lo, self.hi, self.geographic),
+                i + 1,
+                r.z.as_ref().err().map_or("", |e| e.as_str()),
+                lacking(&files, &s.options.source),
+                if matches!(s.source, super::plan::Source::Web(_)) {
+                    ", or rerun with {resume} to ask again for the failed points only"
+                } else {
+                    ""
+                }
+            ),
+        ))
     }
 }
 
@@ -103,36 +186,11 @@ fn lacking(files: &[String], source: &impl std::fmt::Display) -> String {
 /// Applies the on-missing policy and writes the table atomically to the plan's output
 /// (standard output without one); what was read and written goes to `progress` as notes.
 pub fn write_table(s: &SamplePlan, t: SampleTable, progress: &dyn Progress) -> Result<()> {
-    let missing: Vec<usize> = (0..t.rows.len())
-        .filter(|&i| t.rows[i].z.is_err())
-        .collect();
     if s.options.on_missing == OnMissing::Error {
-        if let Some(&i) = missing.first() {
-            let r = &t.rows[i];
-            let at = match r.latlon {
-                Some([lat, lon]) => format!("lat {lat:.7}, lon {lon:.7}"),
-                None => format!("x {}, y {}", r.xy[0], r.xy[1]),
-            };
-            return Err(Error::setting(
-                Setting::OnMissing,
-                "",
-                format!(
-                    "{} of {} points have no elevation in {}{}; the first (point {}, {at}): \
-                     {}.{} Use {{on-missing}} nodata or skip to write the others{}",
-                    missing.len(),
-                    t.rows.len(),
-                    s.options.source,
-                    extent(&t.rows),
-                    i + 1,
-                    r.z.as_ref().err().map_or("", |e| e.as_str()),
-                    lacking(&t.lacking, &s.options.source),
-                    if matches!(s.source, super::plan::Source::Web(_)) {
-                        ", or rerun with {resume} to ask again for the failed points only"
-                    } else {
-                        ""
-                    }
-                ),
-            ));
+        let mut tally = MissingTally::new();
+        tally.rows(&t.rows, &t.lacking);
+        if let Some(e) = tally.error(s) {
+            return Err(e);
         }
     }
     let mut w = TableWriter::new(s, t.zone)?;
@@ -266,5 +324,55 @@ impl<'a> TableWriter<'a> {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::acquire::SampleOptions;
+
+    #[test]
+    fn the_missing_points_message_is_the_same_tallied_in_bands() {
+        let dir = tempfile::tempdir().unwrap();
+        let dem = dir.path().join("dem.tif");
+        std::fs::write(&dem, b"").unwrap();
+        let mut o = SampleOptions::new(dem.display().to_string());
+        o.on_missing = OnMissing::Error;
+        let s = SamplePlan::resolve(&o).unwrap();
+        let row = |i: usize, ll: bool| Row {
+            latlon: ll.then_some([48.0 + i as f64 * 1e-3, 7.0 - i as f64 * 1e-3]),
+            xy: [1000.0 * i as f64, 5e6 - 10.0 * i as f64],
+            z: if i % 3 == 1 {
+                Err(format!("void {i}"))
+            } else {
+                Ok(i as f64)
+            },
+        };
+        for ll in [true, false] {
+            let rows: Vec<Row> = (0..20).map(|i| row(i, ll)).collect();
+            let mut whole = MissingTally::new();
+            whole.rows(&rows, &["b.hgt".into(), "a.hgt".into()]);
+            let want = whole.error(&s).unwrap().to_string();
+            assert!(want.starts_with("7 of 20 points"), "{want}");
+            assert!(want.contains("the first (point 2, "), "{want}");
+            assert!(want.contains("void 1."), "{want}");
+            assert!(want.contains("a.hgt, b.hgt"), "{want}");
+            for band in [1, 3, 7] {
+                let mut t = MissingTally::new();
+                for (k, b) in rows.chunks(band).enumerate() {
+                    let lacking: Vec<String> = match k {
+                        0 => vec!["b.hgt".into()],
+                        1 => vec!["a.hgt".into(), "b.hgt".into()],
+                        _ => vec![],
+                    };
+                    t.rows(b, &lacking);
+                }
+                assert_eq!(t.error(&s).unwrap().to_string(), want, "band {band}");
+            }
+        }
+        let mut none = MissingTally::new();
+        none.rows(&[row(0, true), row(2, true)], &[]);
+        assert!(!none.any() && none.error(&s).is_none());
     }
 }
