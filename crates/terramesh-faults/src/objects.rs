@@ -1466,16 +1466,35 @@ fn split_edges(
 /// Rivara's closure, relaxed: a cell with edges to split (`keys`, sorted) none of which is
 /// near its longest (within [`NEAR_LONGEST`]) has its longest edge split too, so that no cell
 /// is split at a short edge only.
+///
+/// Only the cells with an edge marked in the previous sweep are looked at (all marked edges
+/// in the first): a cell without one decided the same before, or added its longest edge,
+/// which is then marked and near its longest. Only such a cell's longest edge is measured.
 fn close(st: &State, keys: &mut Vec<u64>) {
-    loop {
+    let mut fresh: Vec<u64> = keys.clone();
+    while !fresh.is_empty() {
+        // Only cells with two ends of freshly marked edges can hold one.
+        let mut end = vec![false; st.points.len()];
+        for &k in &fresh {
+            end[(k >> 32) as usize] = true;
+            end[k as u32 as usize] = true;
+        }
+        let marked_set: &[u64] = keys;
         let mut add: Vec<u64> = st
             .tets
             .par_iter()
             .filter_map(|t| {
+                if t.iter().filter(|&&v| end[v as usize]).count() < 2
+                    || !EDGES
+                        .iter()
+                        .any(|&(i, j)| fresh.binary_search(&key(t[i], t[j])).is_ok())
+                {
+                    return None;
+                }
                 let marked = EDGES
                     .iter()
                     .map(|&(i, j)| key(t[i], t[j]))
-                    .filter(|k| keys.binary_search(k).is_ok())
+                    .filter(|k| marked_set.binary_search(k).is_ok())
                     .map(|k| edge_d2(&st.points, k))
                     .fold(-1.0, f64::max);
                 let l = longest_edge(&st.points, t);
@@ -1483,14 +1502,13 @@ fn close(st: &State, keys: &mut Vec<u64>) {
                     .then_some(l)
             })
             .collect();
-        if add.is_empty() {
-            break;
-        }
         add.par_sort_unstable();
         add.dedup();
-        keys.extend(add);
+        // Keys already marked (another cell's longest) change nothing.
+        add.retain(|k| keys.binary_search(k).is_err());
+        keys.extend_from_slice(&add);
         keys.par_sort_unstable();
-        keys.dedup();
+        fresh = add;
     }
 }
 
