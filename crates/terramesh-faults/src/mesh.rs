@@ -113,6 +113,9 @@ pub struct BuildReport {
     pub flipped: usize,
     /// Nodes added by the quality pass (edges of poor cells split).
     pub inserted: usize,
+    /// Edges split where they cross the crease of an interface, the line where the unit above
+    /// it pinches out.
+    pub crease_splits: usize,
 }
 
 /// A tetrahedral volume mesh cut by faults and interfaces.
@@ -803,6 +806,95 @@ pub(crate) fn split_cells_ranked(
     }
 }
 
+/// Splits the edges of `cells` that cross the crease of interface `k` (`k` > 0) in block
+/// `block`, among the cells with a node on interface `k - 1` and none above it. Where the unit
+/// between them pinches out, interface `k` is interface `k - 1` (the geological model's rule:
+/// a unit thinner than its minimum thickness takes no volume), elsewhere it lies below, so
+/// interface `k` has a crease along the line where the unit starts. The cut of interface `k`
+/// places nodes where edges cross it, none on that crease, and a cell of the thin unit whose
+/// plan spans the crease can have every node on the unit's two interfaces and its centroid a
+/// centimetre outside the unit (which cells do so depends on the interfaces' last bits).
+/// Splitting those edges at the crease first (found by bisection in plan, the new node moved
+/// vertically onto the two interfaces where they are one, or left on its chord where that
+/// would invert a cell) gives the unit's cells no plan across it. Returns the number of edges
+/// split.
+fn cut_crease(
+    st: &mut State,
+    cells: &[u32],
+    height: InterfaceFn,
+    k: usize,
+    block: BlockKey,
+) -> usize {
+    let pinched = |q: [f64; 3]| {
+        let p = [q[0], q[1]];
+        height(k - 1, block, p) - height(k, block, p) <= 0.0
+    };
+    let above = Field::Interface(height, k - 1, block);
+    let mut keys: Vec<u64> = cells
+        .par_iter()
+        .flat_map_iter(|&c| {
+            let t = st.tets[c as usize];
+            let g = t.map(|v| st.points[v as usize]);
+            let sides = g.map(|q| above.eval(q).1);
+            let next = !sides.contains(&1) && sides.contains(&0);
+            let pin = if next { g.map(pinched) } else { [false; 4] };
+            EDGES
+                .iter()
+                .filter(move |&&(i, j)| next && pin[i] != pin[j])
+                .map(move |&(i, j)| key(t[i], t[j]))
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.dedup();
+    // The crease's point on each edge (on the pinched side); edges it crosses within 1 % of
+    // an end are left.
+    let split: Vec<(u64, [f64; 3])> = keys
+        .par_iter()
+        .filter_map(|&e| {
+            let (a, b) = (st.points[(e >> 32) as usize], st.points[e as u32 as usize]);
+            let at = |t: f64| [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
+            let pa = pinched(a);
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..40 {
+                let mid = 0.5 * (lo + hi);
+                if pinched(at(mid)) == pa {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let t = if pa { lo } else { hi };
+            (0.01..=0.99).contains(&t).then(|| (e, at(t)))
+        })
+        .collect();
+    if split.is_empty() {
+        return 0;
+    }
+    let first = st.points.len();
+    let keys: Vec<u64> = split.iter().map(|s| s.0).collect();
+    let mut chords = Vec::with_capacity(split.len());
+    for &(e, p) in &split {
+        let (a, b) = ((e >> 32) as usize, e as u32 as usize);
+        let flags = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE);
+        let on_fault = st.on_fault[a] & st.on_fault[b];
+        let z = height(k - 1, block, [p[0], p[1]]);
+        let free = flags == 0 && on_fault == 0 && z.is_finite();
+        chords.push(p);
+        st.points.push(if free { [p[0], p[1], z] } else { p });
+        st.flags.push(flags | if free { ON_INTERFACE } else { 0 });
+        st.on_fault.push(on_fault);
+    }
+    split_cells(st, &keys, first as u32, |_| {});
+    revert_inverted(st, first, &chords);
+    for (i, c) in chords.iter().enumerate() {
+        if st.points[first + i] == *c {
+            st.flags[first + i] &= !ON_INTERFACE;
+        }
+    }
+    st.report.crease_splits += keys.len();
+    keys.len()
+}
+
 /// The side of every selected cell from its nodes' values: +1, -1, or 0 for a cell with
 /// nodes on both sides (unresolved); a cell with every node on the surface takes the side
 /// of its centroid.
@@ -996,6 +1088,15 @@ pub fn faulted_mesh_with_objects(
                     value: z,
                     why: "must be a finite elevation",
                 });
+            }
+        }
+        if k > 0 {
+            for (b, &bk) in blocks.iter().enumerate() {
+                let before = st.tets.len();
+                cut_crease(&mut st, &by_block[b], height, k, bk);
+                for c in before..st.tets.len() {
+                    by_block[st.block[c] as usize].push(c as u32);
+                }
             }
         }
         for _round in 0..ROUNDS {
