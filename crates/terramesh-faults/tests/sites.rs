@@ -57,6 +57,20 @@ fn report(name: &str, mesh: &FaultedMesh, s: &CheckSummary, fraction: f64) {
     );
 }
 
+/// The X junction: two faults crossing (NS dipping 70 degrees, EW dipping 60) through three
+/// interfaces (the site of `x_junction`, also used by `quality_pass`, the
+/// thread test and the per-operation checks).
+fn x_junction_site() -> Site {
+    site(
+        vec![
+            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
+            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
+        ],
+        vec![95.0, 60.0, 30.0],
+        0.2,
+    )
+}
+
 /// A 200 m site with one fault dipping 60 degrees east and three interfaces (the site of
 /// `one_dipping_fault`, also the first of `quality_pass`).
 fn one_fault_site() -> Site {
@@ -262,14 +276,7 @@ fn fault_one_metre_from_a_vertex_and_through_vertices() {
 
 #[test]
 fn x_junction() {
-    let s = site(
-        vec![
-            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
-            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
-        ],
-        vec![95.0, 60.0, 30.0],
-        0.2,
-    );
+    let s = x_junction_site();
     assert_site("X junction", &s, 4);
 }
 
@@ -356,14 +363,7 @@ fn thin_interbed() {
 #[test]
 fn quality_pass() {
     let one = one_fault_site();
-    let x = site(
-        vec![
-            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
-            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
-        ],
-        vec![95.0, 60.0, 30.0],
-        0.2,
-    );
+    let x = x_junction_site();
     let apart = site(
         vec![
             SynthFault::new("A", [100.0, -20.0], [100.0, 220.0], 70.0, 90.0, 5.0),
@@ -424,14 +424,7 @@ fn quality_pass() {
 /// the pass, so several chunks, many of whose plans go stale).
 #[test]
 fn same_mesh_on_any_number_of_threads() {
-    let x = site(
-        vec![
-            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
-            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
-        ],
-        vec![95.0, 60.0, 30.0],
-        0.2,
-    );
+    let x = x_junction_site();
     let on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -756,14 +749,7 @@ fn quality_pass_checked_after_every_operation() {
         vec![90.0, 50.0],
         0.2,
     );
-    let x = site(
-        vec![
-            SynthFault::new("NS", [90.0, -20.0], [110.0, 220.0], 70.0, 95.0, 10.0),
-            SynthFault::new("EW", [-20.0, 110.0], [220.0, 90.0], 60.0, 0.0, 6.0),
-        ],
-        vec![95.0, 60.0, 30.0],
-        0.2,
-    );
+    let x = x_junction_site();
     for (name, s) in [("dip 20", &low), ("X junction", &x)] {
         // `build` runs every check of the mesh.
         let (_, mesh, _, _) = build(s, 8.0);
