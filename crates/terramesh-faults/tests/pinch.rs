@@ -14,9 +14,14 @@
 //! unit's thickness jumping from 0 to 1 mm), 9 failed: 3 so and 6 with a cell of no volume
 //! (two crossings of one face found at the jump, the same point).
 //!
-//! The meshes here are the cut's, without the quality pass (`improve_degrees = 0`): with it,
-//! after the crease's split, 1 of the 18 still fails with a cell in the wrong unit, which the
-//! pass makes (its guard tests only cells with a node on an interface).
+//! Each mesh is checked twice: as the cut leaves it (`improve_degrees = 0`) and after the
+//! quality pass (its default settings). The pass's flips (2-3 and 3-2, among cells of one
+//! label) tested no unit: the new cells tile the old ones, but a unit's region is not convex
+//! (curved interfaces, the crease), so a new cell's centroid could lie outside it. On the two
+//! sites of `FLIP_SITES` 4 of 6 meshes failed so after the pass (and passed without it); a
+//! 2-3 flip made every failing cell (seen with `verify_each_operation`). The six sites of
+//! `SITES` pass with the pass as it was. Now every operation tests every cell it makes or
+//! changes, whatever its nodes, by `check`'s rule at half its tolerance.
 
 use terramesh_faults::*;
 
@@ -45,18 +50,29 @@ fn terrain(step: f64) -> Terrain {
     Terrain::new(points, tris, heights).unwrap()
 }
 
-#[test]
-fn a_unit_pinching_out_keeps_every_cell_in_its_unit_whatever_the_rounding() {
+/// The six sites: (the DSM's triangle size, the pinch-out line's angle in degrees, the slope
+/// at which the unit thickens across it).
+const SITES: [(f64, f64, f64); 6] = [
+    (10.0, 17.0, 0.02),
+    (10.0, 17.0, 0.05),
+    (10.0, 61.0, 0.03),
+    (12.0, 33.0, 0.04),
+    (8.0, 74.0, 0.02),
+    (15.0, 5.0, 0.06),
+];
+
+/// Two more sites, found by meshing 48 others with the quality pass on: before its flips
+/// tested the new cells' units, 4 of their 6 meshes failed with "cell N is recorded in unit
+/// 1, not the unit at its centroid" (all with the pass off pass).
+const FLIP_SITES: [(f64, f64, f64); 2] = [(12.0, 55.0, 0.06), (8.0, 66.0, 0.06)];
+
+/// Meshes each site three times (the interface as it is and moved by ±1e-9 m), with
+/// `improve_degrees` (0: the quality pass off; `None`: the default, on) and returns the number
+/// of meshes and each failure of `check`.
+fn pinch_sites(sites: &[(f64, f64, f64)], improve_degrees: Option<f64>) -> (usize, Vec<String>) {
     let mut failures = Vec::new();
     let mut runs = 0;
-    for (step, angle, slope) in [
-        (10.0, 17.0, 0.02),
-        (10.0, 17.0, 0.05),
-        (10.0, 61.0, 0.03),
-        (12.0, 33.0, 0.04),
-        (8.0, 74.0, 0.02),
-        (15.0, 5.0, 0.06),
-    ] {
+    for &(step, angle, slope) in sites {
         let t = terrain(step);
         let set = FaultSet::new(&[], &t, 0.0).unwrap();
         let (s, c) = f64::to_radians(angle).sin_cos();
@@ -86,7 +102,9 @@ fn a_unit_pinching_out_keeps_every_cell_in_its_unit_whatever_the_rounding() {
                 }
             };
             let mut settings = MeshSettings::new(0.0, 10.0);
-            settings.improve_degrees = 0.0;
+            if let Some(d) = improve_degrees {
+                settings.improve_degrees = d;
+            }
             let mesh = faulted_mesh(&t, &set, 3, &h, &settings).unwrap();
             runs += 1;
             if let Err(e) = check(&mesh, &t, &set, &settings, &h) {
@@ -96,10 +114,44 @@ fn a_unit_pinching_out_keeps_every_cell_in_its_unit_whatever_the_rounding() {
             }
         }
     }
+    (runs, failures)
+}
+
+#[test]
+fn a_unit_pinching_out_keeps_every_cell_in_its_unit_whatever_the_rounding() {
+    let sites: Vec<_> = SITES.iter().chain(&FLIP_SITES).copied().collect();
+    let (runs, failures) = pinch_sites(&sites, Some(0.0));
+    assert_eq!(runs, 24);
     assert!(
         failures.is_empty(),
         "{} of {runs} meshes failed:\n{}",
         failures.len(),
         failures.join("\n")
     );
+}
+
+#[test]
+fn the_quality_pass_keeps_every_cell_in_its_unit_at_a_pinch_out() {
+    let sites: Vec<_> = SITES.iter().chain(&FLIP_SITES).copied().collect();
+    let (runs, failures) = pinch_sites(&sites, None);
+    assert_eq!(runs, 24);
+    assert!(
+        failures.is_empty(),
+        "{} of {runs} meshes failed after the quality pass:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+/// A site where the cut itself (the quality pass off) leaves a cell in the wrong unit, for
+/// every rounding: "cell N is recorded in unit 2, not the unit at its centroid near (0.001,
+/// 86.874, 39.984)", a cell at the region's side (x = 0) at the interface 20 m under the
+/// pinching unit. Found by the same 48-site search; not the quality pass's (the cut's), left
+/// for the cut.
+#[test]
+#[ignore = "a defect of the cut, not fixed yet (see the test's documentation)"]
+fn the_cut_keeps_every_cell_in_its_unit_at_the_side() {
+    let (runs, failures) = pinch_sites(&[(10.0, 62.0, 0.06)], Some(0.0));
+    assert_eq!(runs, 3);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
