@@ -653,23 +653,8 @@ impl Pass<'_> {
                     return false;
                 }
             }
-            if all(SIDE) {
-                let on_one = self.terrain.outline.iter().any(|&[i, j]| {
-                    let (pa, pb) = (
-                        self.terrain.points[i as usize],
-                        self.terrain.points[j as usize],
-                    );
-                    let e = [pb[0] - pa[0], pb[1] - pa[1]];
-                    let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
-                    q.iter().all(|r| {
-                        let d = ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
-                        let s = ((r[0] - pa[0]) * e[0] + (r[1] - pa[1]) * e[1]) / (l * l);
-                        d.abs() <= self.tol && (-1e-12..=1.0 + 1e-12).contains(&s)
-                    })
-                });
-                if !on_one {
-                    return false;
-                }
+            if all(SIDE) && !self.on_outline_edge(&q) {
+                return false;
             }
         }
         true
