@@ -1714,29 +1714,6 @@ fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
         .collect()
 }
 
-/// Whether a wall (field `f`, values `v` at the cell's nodes `q`) can cut a cell: its nodes
-/// lie on both sides of it or on it, or no ball around a node or the centroid that holds the
-/// cell (radius: its farthest node) lies on one side of the wall, reading the field as the
-/// distance to the wall. Only such cells ask for refinement: the field strays as much on a
-/// chord beside a curved wall as on one across it, but only the cells the wall cuts make its
-/// facets. Where the field overstates the distance (near an excavation's edges), a cell the
-/// wall does cut can be missed here; [`refine_missed`] refines those before the cut.
-fn may_cut(q: &[[f64; 3]; 4], v: [f64; 4], f: impl Fn([f64; 3]) -> f64) -> bool {
-    if v.iter().any(|x| !x.is_finite()) {
-        return true;
-    }
-    if v.iter().any(|&x| x <= 0.0) && v.iter().any(|&x| x >= 0.0) {
-        return true;
-    }
-    let reach = |p: [f64; 3]| q.iter().map(|&n| norm(sub(n, p))).fold(0.0, f64::max);
-    if (0..4).any(|i| v[i].abs() > reach(q[i])) {
-        return false;
-    }
-    let c = [0, 1, 2].map(|k| 0.25 * (q[0][k] + q[1][k] + q[2][k] + q[3][k]));
-    let fc = f(c);
-    !(fc.is_finite() && fc.abs() > reach(c))
-}
-
 /// Refines the background mesh near the objects (before the faults and the interfaces are
 /// cut, so that their cuts land on the refined edges and every node they make lies on them).
 pub(crate) fn refine_near_objects(
@@ -1755,8 +1732,8 @@ pub(crate) fn refine_near_objects(
         });
     }
     let walls = walls(set);
-    // Refinement at the walls: bisect every cell that a wall can cut (`may_cut`) whose
-    // facets would stray from it, while its edges are longer than the object's target.
+    // Refinement near the walls: bisect the longest edge of every cell near a wall whose
+    // longest edge is longer than the object's target.
     for _round in 0..40 {
         let values: Vec<Vec<f64>> = walls
             .iter()
@@ -1786,7 +1763,7 @@ pub(crate) fn refine_near_objects(
                         continue;
                     }
                     let v = t.map(|n| values[w][n as usize]);
-                    if !may_cut(&q, v, |p| o.field(wall, p)) {
+                    if v.iter().all(|x| x.abs() >= l) {
                         continue;
                     }
                     let mut best: Option<(usize, usize)> = None;
@@ -2278,73 +2255,6 @@ pub fn check_objects(
 mod tests {
     use super::*;
     use crate::{min_dihedral, MeshSettings, Site};
-
-    /// `may_cut` is conservative: every cell of a background mesh in which a lined circular
-    /// tunnel's walls take both signs (at 35 points of the cell: its nodes and a barycentric
-    /// grid inside it) is one it says a wall can cut; and it leaves out cells that the band
-    /// before it refined (a node within the cell's longest edge of the wall).
-    #[test]
-    fn may_cut_keeps_every_cell_a_wall_cuts() {
-        let site = Site::new(
-            200.0,
-            10,
-            0.2,
-            1,
-            [120.0, 0.02, -0.01],
-            0.0,
-            vec![90.0, 60.0, 30.0],
-            [0.01, 0.0],
-            vec![],
-        )
-        .unwrap();
-        let spec = ObjectSpec {
-            name: "diversion".into(),
-            stage: 1,
-            geometry: ObjectGeometry::Tunnel {
-                axis: vec![[20.0, 90.0, 45.0], [180.0, 110.0, 45.0]],
-                profile: Profile::Circle { diameter: 10.0 },
-                lining: 0.5,
-            },
-        };
-        let set = ObjectSet::new(&[spec], &site.terrain, site.base).unwrap();
-        let o = &set.objects[0];
-        let st =
-            crate::mesh::background(&site.terrain, &MeshSettings::new(site.base, 10.0)).unwrap();
-        let (mut cut, mut narrowed) = (0, 0);
-        for &wall in o.walls() {
-            for t in &st.tets {
-                let q = t.map(|n| st.points[n as usize]);
-                let v = q.map(|p| o.field(wall, p));
-                let mut samples = Vec::new();
-                for i in 0..=4u32 {
-                    for j in 0..=4 - i {
-                        for k in 0..=4 - i - j {
-                            let w = [i, j, k, 4 - i - j - k].map(|x| f64::from(x) / 4.0);
-                            let p = [0, 1, 2].map(|d| (0..4).map(|n| w[n] * q[n][d]).sum());
-                            samples.push(o.field(wall, p));
-                        }
-                    }
-                }
-                let crossed = samples.iter().any(|&x| x < 0.0) && samples.iter().any(|&x| x > 0.0);
-                let may = may_cut(&q, v, |p| o.field(wall, p));
-                if crossed {
-                    cut += 1;
-                    assert!(
-                        may,
-                        "a cell the wall cuts is left out: nodes {q:?}, field {v:?}"
-                    );
-                }
-                let l = EDGES
-                    .iter()
-                    .map(|&(a, b)| norm(sub(q[a], q[b])))
-                    .fold(0.0, f64::max);
-                if !may && v.iter().any(|x| x.abs() < l) {
-                    narrowed += 1;
-                }
-            }
-        }
-        assert!(cut > 0 && narrowed > 0, "cut {cut}, narrowed {narrowed}");
-    }
 
     /// The refinement near a horseshoe tunnel (its corners keep the facets straying from the
     /// wall down to the smallest edges) keeps every cell positive in floating point and of a
