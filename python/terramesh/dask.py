@@ -31,6 +31,7 @@ import os
 import shutil
 import subprocess
 import sys
+import uuid
 from dataclasses import dataclass, field
 
 __all__ = ["TileReport", "build_tiles", "find_binary", "main"]
@@ -137,19 +138,30 @@ def build_tiles(
     # The client's TERRAMESH_BIN, as before; else each worker runs its own package's command.
     exe = binary or os.environ.get("TERRAMESH_BIN")
     ids = list(tiles) if tiles is not None else _tile_ids(plan)
+    # One key per call and tile: a key reused while the scheduler still holds the last call's
+    # task (a failed tile built again at once) would return that task's result, not a new one.
+    run = uuid.uuid4().hex[:8]
     futures = {
         tid: client.submit(
-            _build_one, exe, plan, tid, key=f"terramesh-tile-{tid}", retries=retries, pure=False
+            _build_one,
+            exe,
+            plan,
+            tid,
+            key=f"terramesh-tile-{tid}-{run}",
+            retries=retries,
+            pure=False,
         )
         for tid in ids
     }
     wait(list(futures.values()))
     report = TileReport()
     for tid, fut in futures.items():
-        if fut.status == "finished":
+        # `result()`, not the status after `wait`: a task whose worker died may still read as
+        # lost or pending there and then finish on another worker (its exception was None).
+        try:
             report.built[tid] = fut.result()
-        else:
-            report.failed[tid] = str(fut.exception())
+        except Exception as e:  # the tile's own error, after its retries
+            report.failed[tid] = str(e)
     if merge_to is not None and report.ok:
         out = os.path.abspath(os.fspath(merge_to))
         report.merged = client.submit(
