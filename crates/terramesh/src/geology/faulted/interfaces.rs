@@ -521,7 +521,7 @@ impl BlockInterfaces {
 
     /// The height of interface `k` (the top of unit `k + 1`) in block `key` at `p`: never
     /// above the interface above it, and onto it where the unit between is thinner than
-    /// `min_thickness` (pinched out), continuous where the unit starts ([`pinched`]).
+    /// `min_thickness` (pinched out), continuous where the unit starts (`pinched`).
     pub fn height(&self, k: usize, key: BlockKey, p: [f64; 2]) -> f64 {
         // The mesher asks for interfaces 0, 1, 2, ... at one point in turn, each needs those
         // above it, and it asks again at the same points (a column's nodes share their plan
