@@ -440,16 +440,22 @@ impl Pass<'_> {
         })
     }
 
+    /// The cells of `cells` that hold node `b` (of a node's cells, those around its edge to
+    /// `b`).
+    fn holding(&self, cells: &[u32], b: u32) -> Vec<u32> {
+        cells
+            .iter()
+            .copied()
+            .filter(|&c| self.st.tets[c as usize].contains(&b))
+            .collect()
+    }
+
     /// The 3-2 flip of edge (a, b): the three cells around it become two on the face of
     /// their other nodes, if the ring is closed (an interior edge), the cells carry one
     /// label, `a` and `b` lie strictly on either side of that face (exact), both new cells
     /// lie in the unit ([`Pass::in_unit`]) and the smallest angle improves.
     fn flip32(&self, a: u32, b: u32, around: &[u32]) -> Option<Op> {
-        let ring: Vec<u32> = around
-            .iter()
-            .copied()
-            .filter(|&c| self.st.tets[c as usize].contains(&b))
-            .collect();
+        let ring = self.holding(around, b);
         if ring.len() != 3 || !self.one_label(&ring) {
             return None;
         }
@@ -622,11 +628,7 @@ impl Pass<'_> {
         }) {
             return None;
         }
-        let kill = ca
-            .iter()
-            .copied()
-            .filter(|&c| self.st.tets[c as usize].contains(&b))
-            .collect();
+        let kill = self.holding(ca, b);
         Some(Op::Collapse { a, b, kill, new })
     }
 
@@ -1037,11 +1039,7 @@ impl Pass<'_> {
     /// smallest angle beats the old cells' and no more of them are below the floor, and, as
     /// for a move, every cell keeps its unit and zones as the checks see them.
     fn split(&self, a: u32, b: u32, ca: &[u32]) -> Option<Op> {
-        let ring: Vec<u32> = ca
-            .iter()
-            .copied()
-            .filter(|&c| self.st.tets[c as usize].contains(&b))
-            .collect();
+        let ring = self.holding(ca, b);
         if ring.is_empty() {
             return None;
         }
