@@ -63,6 +63,7 @@ mod auto;
 mod band;
 mod cv;
 mod data;
+mod dual;
 mod error;
 mod experimental;
 mod file;
@@ -95,6 +96,7 @@ pub use cv::{
     cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator, FIT_AUTO_POINTS,
 };
 pub use data::{Data, Drift, Duplicates, InterpolationMethod, KrigingFrame, Method};
+pub use dual::DualKriging;
 pub use error::{GeostatError, Result};
 pub use experimental::{
     diameter, draw_key, draw_subset, experimental, Direction, Estimator, Lag, LagSettings,

@@ -5,7 +5,7 @@ use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
 use terramesh_faults::{BlockKey, FaultSet};
 use terramesh_geostat::{
-    experimental, fit_auto, Data, Drift, Duplicates, LagSettings, ModelKind, Named, Variogram,
+    experimental, fit_auto, Data, Drift, DualKriging, Duplicates, LagSettings, ModelKind, Named,
     Weighting,
 };
 use terramesh_io::boreholes::Boreholes;
@@ -50,7 +50,7 @@ type Samples = Vec<([f64; 2], f64)>;
 #[derive(Clone)]
 struct Fit {
     plane: [f64; 3],
-    kriged: Option<Dual>,
+    kriged: Option<DualKriging>,
     residuals: Vec<([f64; 2], f64)>,
 }
 
@@ -64,7 +64,7 @@ pub const KRIGED_CONTACTS: usize = 7;
 /// (`geology::fields`: the variogram fitted automatically, universal kriging with a linear
 /// drift over all the contacts), or `None` when they are too few (fewer than
 /// [`KRIGED_CONTACTS`] distinct locations), all equal, or no variogram fits.
-fn kriged(p: &[([f64; 2], f64)]) -> Option<Dual> {
+fn kriged(p: &[([f64; 2], f64)]) -> Option<DualKriging> {
     let data = Data::new(
         p.iter().map(|(q, _)| *q).collect(),
         p.iter().map(|(_, z)| *z).collect(),
@@ -86,123 +86,7 @@ fn kriged(p: &[([f64; 2], f64)]) -> Option<Dual> {
     }
     let lags = experimental(&data, &LagSettings::default()).ok()?;
     let (fit, _) = fit_auto(&data, &lags, Weighting::Cressie, ModelKind::ALL).ok()?;
-    Dual::new(data.xy(), data.z(), fit.variogram)
-}
-
-/// Universal kriging with a linear drift over every contact of one interface in one block, in
-/// its dual form: the system `[Γ F; Fᵀ 0] [b; a] = [z; 0]` (Γ the semivariances between the
-/// data, F their drift terms `1, x, y`) is solved once, and the estimate at `p` is then
-/// `Σ b_i γ(p − x_i) + a · (1, x, y)`, the same as the ordinary (primal) universal kriging
-/// estimate, with no system per point. The mesher asks for an interface's height at every
-/// node it places and at every step of every edge's crossing search: solving the kriging
-/// system there was half of `terramesh model`'s time on a 1,000,000-cell site.
-#[derive(Clone)]
-struct Dual {
-    /// The data's centre: the drift's coordinates are taken from it (UTM northings are ~5e6).
-    origin: [f64; 2],
-    /// The data, centred and mapped to the variogram's isotropic space.
-    xy: Vec<[f64; 2]>,
-    /// The weights of the semivariances.
-    b: Vec<f64>,
-    /// The drift's coefficients, on centred coordinates.
-    a: [f64; 3],
-    variogram: Variogram,
-}
-
-impl Dual {
-    fn new(xy: &[[f64; 2]], z: &[f64], variogram: Variogram) -> Option<Dual> {
-        let n = xy.len();
-        let origin = [
-            xy.iter().map(|p| p[0]).sum::<f64>() / n as f64,
-            xy.iter().map(|p| p[1]).sum::<f64>() / n as f64,
-        ];
-        let centred: Vec<[f64; 2]> = xy
-            .iter()
-            .map(|p| [p[0] - origin[0], p[1] - origin[1]])
-            .collect();
-        let iso: Vec<[f64; 2]> = centred.iter().map(|&p| variogram.transform(p)).collect();
-        let m = n + 3;
-        let mut a = vec![0.0; m * m];
-        let mut r = vec![0.0; m];
-        for i in 0..n {
-            for j in 0..n {
-                a[i * m + j] = if i == j {
-                    0.0
-                } else {
-                    variogram.gamma(dist(iso[i], iso[j]))
-                };
-            }
-            let f = [1.0, centred[i][0], centred[i][1]];
-            for t in 0..3 {
-                a[i * m + n + t] = f[t];
-                a[(n + t) * m + i] = f[t];
-            }
-            r[i] = z[i];
-        }
-        let x = solve(a, r, m)?;
-        Some(Dual {
-            origin,
-            xy: iso,
-            b: x[..n].to_vec(),
-            a: [x[n], x[n + 1], x[n + 2]],
-            variogram,
-        })
-    }
-
-    fn at(&self, p: [f64; 2]) -> f64 {
-        let c = [p[0] - self.origin[0], p[1] - self.origin[1]];
-        let q = self.variogram.transform(c);
-        let mut s = self.a[0] + self.a[1] * c[0] + self.a[2] * c[1];
-        for (x, b) in self.xy.iter().zip(&self.b) {
-            let h = dist(q, *x);
-            // γ(0) = 0: at a datum the estimate is the datum (kriging is exact there).
-            if h > 0.0 {
-                s += b * self.variogram.gamma(h);
-            }
-        }
-        s
-    }
-}
-
-fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
-    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
-}
-
-/// Solves the dense `m` x `m` system `a x = r` (row-major) by Gaussian elimination with partial
-/// pivoting; `None` if it is singular to rounding or the solution is not finite.
-fn solve(mut a: Vec<f64>, mut r: Vec<f64>, m: usize) -> Option<Vec<f64>> {
-    let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-    if !(scale > 0.0 && scale.is_finite()) {
-        return None;
-    }
-    for c in 0..m {
-        let p = (c..m).max_by(|&i, &j| a[i * m + c].abs().total_cmp(&a[j * m + c].abs()))?;
-        if a[p * m + c].abs() <= 1e-13 * scale {
-            return None;
-        }
-        if p != c {
-            for k in 0..m {
-                a.swap(p * m + k, c * m + k);
-            }
-            r.swap(p, c);
-        }
-        let d = a[c * m + c];
-        for i in c + 1..m {
-            let f = a[i * m + c] / d;
-            if f != 0.0 {
-                for k in c..m {
-                    a[i * m + k] -= f * a[c * m + k];
-                }
-                r[i] -= f * r[c];
-            }
-        }
-    }
-    let mut x = vec![0.0; m];
-    for c in (0..m).rev() {
-        let s: f64 = (c + 1..m).map(|k| a[c * m + k] * x[k]).sum();
-        x[c] = (r[c] - s) / a[c * m + c];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    DualKriging::new(data.xy(), data.z(), fit.variogram)
 }
 
 impl Fit {
@@ -624,7 +508,8 @@ impl BlockInterfaces {
 
 #[cfg(test)]
 mod tests {
-    use super::{kriged, pinched, Dual, PINCH};
+    use super::{kriged, pinched, PINCH};
+    use terramesh_geostat::DualKriging;
     use terramesh_geostat::{
         kriging, Anisotropy, Data, Drift, Duplicates, Method, ModelKind, Neighbourhood, Structure,
         Variogram,
@@ -697,7 +582,7 @@ mod tests {
                 ]);
             }
         }
-        let check = |dual: &Dual, v: &Variogram| {
+        let check = |dual: &DualKriging, v: &Variogram| {
             let k = kriging(
                 &data,
                 v,
@@ -718,11 +603,11 @@ mod tests {
             }
         };
         for v in &models {
-            let dual = Dual::new(data.xy(), data.z(), v.clone()).expect("solvable");
+            let dual = DualKriging::new(data.xy(), data.z(), v.clone()).expect("solvable");
             check(&dual, v);
         }
         let fitted = kriged(&p).expect("25 contacts are kriged");
-        check(&fitted, &fitted.variogram.clone());
+        check(&fitted, &fitted.variogram().clone());
     }
 
     /// A pinching unit's thickness is continuous in the interfaces' distance and is that
