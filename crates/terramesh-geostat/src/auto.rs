@@ -1,7 +1,7 @@
 //! The automatic choice of a variogram by restricted maximum likelihood (`--variogram auto`).
 //!
 //! Each model of the family is first fitted by weighted least squares to the experimental
-//! variogram ([`fit_model`]); that fit is only the starting point of a REML fit with the
+//! variogram ([`fit_model`](crate::fit_model)); that fit is only the starting point of a REML fit with the
 //! drift of the kriging that will use it ([`fit_reml`](crate::fit_reml), in blocks of
 //! [`DEFAULT_REML_BLOCK`] data); Matérn is fitted for ν = 3/2 and 5/2 (ν = ½ is the
 //! exponential) and keeps the better. The family is every model alone and every pair of
@@ -25,7 +25,7 @@ use crate::cv::{cross_validate, Candidate, Folds, Interpolator};
 use crate::data::{Data, Drift, Method};
 use crate::error::{GeostatError, Result};
 use crate::experimental::Lag;
-use crate::fit::{fit_model, Fit, Weighting};
+use crate::fit::{fit_model_bounded, Fit, Weighting};
 use crate::loo_fit::{fit_loo_within, loo, spacing, Effort};
 use crate::model::{ModelKind, Structure, Variogram};
 use crate::predictor::Neighbourhood;
@@ -84,6 +84,12 @@ pub const WLS_LOO_TIE: f64 = 0.03;
 /// [`fit_auto_wls_loo`] refuses to choose (the data lie on the drift to rounding) and the
 /// caller falls back to the WLS fit.
 pub const WLS_LOO_ROUNDING: f64 = 1e-9;
+
+/// The nugget, relative to the first structure's sill, of [`FitMethod::WlsLoo`]'s options
+/// "without nugget" of a model smooth at the origin (Gaussian, Matérn ν > 1/2; the others
+/// have none): it keeps their kriging systems solvable and their surfaces from oscillating.
+/// The choice counts these options as having no nugget.
+pub const WLS_LOO_NONE: f64 = 1e-4;
 
 /// Number of models that [`FitMethod::WlsLoo`] refines (those of least leave-one-out RMSE
 /// from their WLS fits).
@@ -305,14 +311,16 @@ fn fit_auto_by(
 }
 
 /// The default automatic fit ([`FitMethod::WlsLoo`]): every model of `kinds` fitted by
-/// weighted least squares to `lags` (Matérn at ν = 3/2 and 5/2), each fit scored by the
+/// weighted least squares to `lags` with its range at most the data's diameter
+/// ([`wls_loo_range_bound`]; Matérn at ν = 3/2 and 5/2), each fit scored by the
 /// leave-one-out RMSE of kriging with `s.drift` (Dubrule's closed form for a bounded model,
 /// 64 neighbours for an unbounded one) on at most [`WLS_LOO_POINTS`] data, the
 /// [`WLS_LOO_REFINED`] best refined by one short Nelder–Mead run on that RMSE (as
-/// [`fit_loo`](crate::fit_loo), scale from the standardised errors). Each start is also
-/// scored with a nugget of 1e-4 of its sill. Among all these options (starts and
-/// refinements), those within [`WLS_LOO_TIE`] of the least RMSE count as equal, and the one
-/// of least relative nugget is kept. Returns the chosen fit (its `objective` is its
+/// [`fit_loo`](crate::fit_loo), scale from the standardised errors) from their best option.
+/// Each start is also scored without nugget (a smooth model with [`WLS_LOO_NONE`] of its
+/// sill, which counts as none). Among all these options (starts and refinements), those
+/// within [`WLS_LOO_TIE`] of the least RMSE count as equal, and the one of least relative
+/// nugget is kept, then the one of least RMSE. Returns the chosen fit (its `objective` is its
 /// leave-one-out RMSE; its model's candidate holds it, the others their least RMSE), every
 /// candidate, and what chose it.
 ///
@@ -346,23 +354,31 @@ pub fn fit_auto_wls_loo(
         data.clone()
     };
     let (hmin, hmax) = spacing(&sub);
+    let cap = wls_loo_range_bound(data);
     // Each model's WLS fits (both Matérn starts) and their leave-one-out RMSEs.
-    let scored: Vec<Result<Vec<(Variogram, f64)>>> = kinds
+    // Each option: the model, its leave-one-out RMSE, and whether it is a start's option
+    // without nugget (which the choice counts as having none).
+    let scored: Vec<Result<Vec<(Variogram, f64, bool)>>> = kinds
         .par_iter()
         .map(|&kind| {
             let mut all = Vec::new();
-            // Each start as WLS fitted it and with the least nugget the refinement allows
-            // (1e-4 of the first structure's sill): WLS on lag classes puts into the
-            // nugget what kriging between close data does not want, and the refinement's
-            // steps would not bring it down from there.
-            for w in starts(hmax, &sub, lags, kind, s)? {
+            // Each start as WLS fitted it and without nugget (a smooth model: with a nugget
+            // of WLS_LOO_NONE of its sill, which keeps its kriging system solvable and its
+            // surface from oscillating): WLS on lag classes puts into the nugget what
+            // kriging between close data does not want, and the refinement's steps would
+            // not bring it down from there.
+            for w in starts(hmax, &sub, lags, kind, s, cap)? {
                 let mut low = w.clone();
                 if let Some(t) = w.structures.first().filter(|t| t.kind != ModelKind::Nugget) {
-                    low.nugget = 1e-4 * t.psill;
+                    low.nugget = if smooth(&w) {
+                        WLS_LOO_NONE * t.psill
+                    } else {
+                        0.0
+                    };
                 }
-                for v in [w, low] {
+                for (v, none) in [(w, false), (low, true)] {
                     if let Some((rmse, _)) = loo(&sub, &v, s.drift) {
-                        all.push((v, rmse));
+                        all.push((v, rmse, none));
                     }
                 }
             }
@@ -375,7 +391,7 @@ pub fn fit_auto_wls_loo(
             Ok(all)
         })
         .collect();
-    let least = |all: &[(Variogram, f64)]| -> usize {
+    let least = |all: &[(Variogram, f64, bool)]| -> usize {
         (0..all.len())
             .min_by(|&a, &b| all[a].1.total_cmp(&all[b].1))
             .expect("not empty")
@@ -398,16 +414,17 @@ pub fn fit_auto_wls_loo(
         })
         .collect();
     // Every option: each kind's starts and its refinement.
-    let mut options: Vec<Vec<(Variogram, f64)>> = Vec::new();
+    let mut options: Vec<Vec<(Variogram, f64, bool)>> = Vec::new();
     for (i, one) in scored.iter().enumerate() {
         let mut all = one.as_ref().map_or(Vec::new(), Clone::clone);
         if let Some(f) = refined.iter().find(|r| r.0 == i).and_then(|r| r.1.clone()) {
-            all.push((f.variogram, f.cv_rmse));
+            all.push((f.variogram, f.cv_rmse, false));
         }
         options.push(all);
     }
     // The choice: among the options within WLS_LOO_TIE of the least RMSE, the one of least
-    // relative nugget (then the least RMSE, then the first).
+    // relative nugget, a start's option without nugget counting as none (a smooth model's,
+    // with WLS_LOO_NONE of its sill; then the least RMSE, then the first).
     let min = options
         .iter()
         .flatten()
@@ -426,11 +443,11 @@ pub fn fit_auto_wls_loo(
     }
     let mut chosen: Option<(usize, usize, f64, f64)> = None; // kind, option, nugget ratio, rmse
     for (i, all) in options.iter().enumerate() {
-        for (j, (v, rmse)) in all.iter().enumerate() {
+        for (j, (v, rmse, none)) in all.iter().enumerate() {
             if *rmse > (1.0 + WLS_LOO_TIE) * min {
                 continue;
             }
-            let ratio = nugget_ratio(v);
+            let ratio = if *none { 0.0 } else { nugget_ratio(v) };
             if chosen.is_none_or(|c| ratio < c.2 || (ratio == c.2 && *rmse < c.3)) {
                 chosen = Some((i, j, ratio, *rmse));
             }
@@ -446,7 +463,7 @@ pub fn fit_auto_wls_loo(
                     Some(c) if c.0 == i => c.1,
                     _ => least(&options[i]),
                 };
-                let (v, rmse) = options[i][j].clone();
+                let (v, rmse, _) = options[i][j].clone();
                 let fit = Fit {
                     rmse: lag_rmse(lags, &v),
                     variogram: v,
@@ -496,6 +513,35 @@ pub fn fit_auto_wls_loo(
     }
 }
 
+/// The largest range that [`FitMethod::WlsLoo`]'s WLS fits may take: the data's diameter
+/// (the largest distance between two of them).
+///
+/// Beyond the largest distance in the data a bounded model's range is not seen by any pair:
+/// on terrain whose experimental variogram still rises at the last lag class, the WLS fit
+/// of a spherical or exponential model otherwise runs to the fit's own bound (4 times the
+/// largest lag distance, twice the diameter), where the model near the origin is a straight
+/// line whose slope the data cannot tell from that of a shorter range. PyKrige bounds its
+/// range the same way (by its largest lag distance, about 0.9 of the diameter).
+///
+/// ```
+/// use terramesh_geostat::{wls_loo_range_bound, Data, Duplicates};
+/// let xy = vec![[0.0, 0.0], [30.0, 0.0], [0.0, 40.0], [10.0, 10.0]];
+/// let data = Data::new(xy, vec![1.0, 2.0, 3.0, 4.0], Duplicates::Reject)?;
+/// assert_eq!(wls_loo_range_bound(&data), 50.0);
+/// # Ok::<(), terramesh_geostat::GeostatError>(())
+/// ```
+pub fn wls_loo_range_bound(data: &Data) -> f64 {
+    data.diameter()
+}
+
+/// A model smooth at the origin (a Gaussian or Matérn ν > 1/2 structure): without nugget,
+/// its kriging of close data is ill-conditioned and oscillates.
+fn smooth(v: &Variogram) -> bool {
+    v.structures
+        .iter()
+        .any(|t| t.kind == ModelKind::Gaussian || (t.kind == ModelKind::Matern && t.shape > 0.5))
+}
+
 /// The nugget relative to the sill (to the structures' partial sills for an unbounded
 /// model); 1 for a pure nugget.
 fn nugget_ratio(v: &Variogram) -> f64 {
@@ -518,33 +564,36 @@ fn starts(
     lags: &[Lag],
     kind: ModelKind,
     s: &AutoSettings,
+    max_range: f64,
 ) -> Result<Vec<Variogram>> {
-    Ok(match fit_model(lags, kind, s.weighting) {
-        Ok(f) if kind == ModelKind::Matern => [1.5, 2.5]
-            .iter()
-            .map(|&nu| {
-                let mut v = f.variogram.clone();
-                v.structures[0].shape = nu;
-                v
-            })
-            .collect(),
-        Ok(f) => vec![f.variogram],
-        Err(e) => {
-            // No WLS fit (e.g. too few lag classes): start from the data's variance.
-            let z = sub.z();
-            let m = sub.mean();
-            let var = z.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / z.len() as f64;
-            if !(var > 0.0) {
-                return Err(e);
+    Ok(
+        match fit_model_bounded(lags, kind, s.weighting, max_range) {
+            Ok(f) if kind == ModelKind::Matern => [1.5, 2.5]
+                .iter()
+                .map(|&nu| {
+                    let mut v = f.variogram.clone();
+                    v.structures[0].shape = nu;
+                    v
+                })
+                .collect(),
+            Ok(f) => vec![f.variogram],
+            Err(e) => {
+                // No WLS fit (e.g. too few lag classes): start from the data's variance.
+                let z = sub.z();
+                let m = sub.mean();
+                let var = z.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / z.len() as f64;
+                if !(var > 0.0) {
+                    return Err(e);
+                }
+                let st = Structure::new(kind, 0.9 * var, hmax / 3.0);
+                vec![Variogram {
+                    nugget: 0.1 * var,
+                    structures: vec![st],
+                    anisotropy: None,
+                }]
             }
-            let st = Structure::new(kind, 0.9 * var, hmax / 3.0);
-            vec![Variogram {
-                nugget: 0.1 * var,
-                structures: vec![st],
-                anisotropy: None,
-            }]
-        }
-    })
+        },
+    )
 }
 
 /// One candidate by leave-one-out: WLS starts, each minimised, the least RMSE kept.
@@ -555,7 +604,7 @@ fn fit_one_loo(
     kind: ModelKind,
     s: &AutoSettings,
 ) -> Result<Fitted> {
-    let starts = starts(c.hmax, sub, lags, kind, s)?;
+    let starts = starts(c.hmax, sub, lags, kind, s, f64::INFINITY)?;
     let mut best: Option<crate::LooFit> = None;
     let mut last_err = None;
     for st in &starts {
@@ -608,7 +657,7 @@ fn fit_one(
     kind: ModelKind,
     s: &AutoSettings,
 ) -> Result<Fitted> {
-    let starts = starts(c.hmax, sub, lags, kind, s)?;
+    let starts = starts(c.hmax, sub, lags, kind, s, f64::INFINITY)?;
     let mut best: Option<RemlFit> = None;
     let mut last_err = None;
     for st in &starts {

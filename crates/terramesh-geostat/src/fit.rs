@@ -57,6 +57,17 @@ pub struct Fit {
 /// # Ok(()) }
 /// ```
 pub fn fit_model(lags: &[Lag], kind: ModelKind, weighting: Weighting) -> Result<Fit> {
+    fit_model_bounded(lags, kind, weighting, f64::INFINITY)
+}
+
+/// [`fit_model`] with the range of a bounded model at most `max_range` (the scan's upper
+/// end is the lesser of `4 h_max` and `max_range`, when that is above `h_min/4`).
+pub fn fit_model_bounded(
+    lags: &[Lag],
+    kind: ModelKind,
+    weighting: Weighting,
+    max_range: f64,
+) -> Result<Fit> {
     let pts: Vec<(f64, f64, f64)> = lags
         .iter()
         .filter(|l| l.pairs > 0 && l.gamma.is_finite() && l.distance > 0.0)
@@ -90,7 +101,8 @@ pub fn fit_model(lags: &[Lag], kind: ModelKind, weighting: Weighting) -> Result<
             let (o, c0, c) = eval(hmax);
             (o, c0, c, hmax)
         } else {
-            let (lo, hi) = ((hmin / 4.0).ln(), (4.0 * hmax).ln());
+            let top = (4.0 * hmax).min(max_range).max(hmin / 2.0);
+            let (lo, hi) = ((hmin / 4.0).ln(), top.ln());
             let m = 60;
             let grid: Vec<f64> = (0..=m)
                 .map(|k| lo + (hi - lo) * k as f64 / m as f64)

@@ -89,8 +89,9 @@ pub use aniso::{
     fit_anisotropy, fit_anisotropy_lags, AnisotropyFit, DirectionalLags, DEFAULT_DIRECTIONS,
 };
 pub use auto::{
-    fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, lag_rmse, AutoSettings, FitMethod, Selection,
-    DEFAULT_LOO_POINTS, WLS_LOO_POINTS, WLS_LOO_REFINED, WLS_LOO_ROUNDING, WLS_LOO_TIE,
+    fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, lag_rmse, wls_loo_range_bound, AutoSettings,
+    FitMethod, Selection, DEFAULT_LOO_POINTS, WLS_LOO_NONE, WLS_LOO_POINTS, WLS_LOO_REFINED,
+    WLS_LOO_ROUNDING, WLS_LOO_TIE,
 };
 pub use cv::{
     cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator, FIT_AUTO_POINTS,
@@ -105,7 +106,7 @@ pub use experimental::{
 pub use file::{
     CandidateEntry, CandidateSummary, FitSummary, LagSummary, VariogramFile, VariogramFileError,
 };
-pub use fit::{fit_model, Fit, Weighting};
+pub use fit::{fit_model, fit_model_bounded, Fit, Weighting};
 pub use global::MIN_RELATIVE_PIVOT;
 pub use global::{DenseRoute, GlobalKriging, BLOCK, TRUNCATION_TOLERANCE};
 pub use idw::{Idw, Search as IdwSearch, DEFAULT_IDW_POWER};
