@@ -822,21 +822,45 @@ fn cut_crease(
     st: &mut State,
     cells: &[u32],
     height: InterfaceFn,
+    j: usize,
     k: usize,
     block: BlockKey,
 ) -> usize {
     let pinched = |q: [f64; 3]| {
         let p = [q[0], q[1]];
-        height(k - 1, block, p) - height(k, block, p) <= 0.0
+        height(j - 1, block, p) - height(j, block, p) <= 0.0
     };
-    let above = Field::Interface(height, k - 1, block);
+    // Unit j's own base (j = k): the cells just under the interface above; an interface
+    // further down (j < k): the cells it crosses or touches.
+    let (near, own) = if j == k {
+        (Field::Interface(height, k - 1, block), true)
+    } else {
+        (Field::Interface(height, k, block), false)
+    };
+    // Each node's side once (not once per cell).
+    let mut need = vec![false; st.points.len()];
+    for &c in cells {
+        for &v in &st.tets[c as usize] {
+            need[v as usize] = true;
+        }
+    }
+    let side: Vec<i8> = st
+        .points
+        .par_iter()
+        .zip(&need)
+        .map(|(&q, &n)| if n { near.eval(q).1 } else { 0 })
+        .collect();
     let mut keys: Vec<u64> = cells
         .par_iter()
         .flat_map_iter(|&c| {
             let t = st.tets[c as usize];
             let g = t.map(|v| st.points[v as usize]);
-            let sides = g.map(|q| above.eval(q).1);
-            let next = !sides.contains(&1) && sides.contains(&0);
+            let sides = t.map(|v| side[v as usize]);
+            let next = if own {
+                !sides.contains(&1) && sides.contains(&0)
+            } else {
+                sides.contains(&0) || (sides.contains(&1) && sides.contains(&-1))
+            };
             let pin = if next { g.map(pinched) } else { [false; 4] };
             EDGES
                 .iter()
@@ -864,7 +888,26 @@ fn cut_crease(
                 }
             }
             let t = if pa { lo } else { hi };
-            (0.01..=0.99).contains(&t).then(|| (e, at(t)))
+            if !(0.01..=0.99).contains(&t) {
+                return None;
+            }
+            if !own {
+                // Interface k bends there (unit j's pinch-out line is a crease of interface k
+                // only where interface k follows interface j): the change of its slope along
+                // the edge over CREASE_STEP on either side.
+                let l = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                let d = CREASE_STEP / l.max(1e-12);
+                let z = |u: f64| {
+                    let q = at(u);
+                    height(k, block, [q[0], q[1]])
+                };
+                let (zl, z0, zr) = (z(t - d), z(t), z(t + d));
+                let bend = ((zr - z0) - (z0 - zl)) / CREASE_STEP;
+                if bend.is_nan() || bend.abs() <= CREASE_BEND {
+                    return None;
+                }
+            }
+            Some((e, at(t)))
         })
         .collect();
     if split.is_empty() {
@@ -877,7 +920,7 @@ fn cut_crease(
         let (a, b) = ((e >> 32) as usize, e as u32 as usize);
         let flags = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE);
         let on_fault = st.on_fault[a] & st.on_fault[b];
-        let z = height(k - 1, block, [p[0], p[1]]);
+        let z = height(if own { k - 1 } else { k }, block, [p[0], p[1]]);
         let free = flags == 0 && on_fault == 0 && z.is_finite();
         chords.push(p);
         st.points.push(if free { [p[0], p[1], z] } else { p });
@@ -894,6 +937,14 @@ fn cut_crease(
     st.report.crease_splits += keys.len();
     keys.len()
 }
+
+/// The distance in plan (metres) on either side of a unit's pinch-out line over which
+/// [`cut_crease`] measures the bend of an interface further down.
+const CREASE_STEP: f64 = 0.05;
+/// The change of slope (along an edge) that makes a bend a crease: 0.005 (0.3 degrees; a
+/// smooth interface bends by its curvature times `CREASE_STEP`, 1.5e-4 on the kernel's test
+/// sites).
+const CREASE_BEND: f64 = 0.005;
 
 /// The side of every selected cell from its nodes' values: +1, -1, or 0 for a cell with
 /// nodes on both sides (unresolved); a cell with every node on the surface takes the side
@@ -1091,11 +1142,15 @@ pub fn faulted_mesh_with_objects(
             }
         }
         if k > 0 {
-            for (b, &bk) in blocks.iter().enumerate() {
-                let before = st.tets.len();
-                cut_crease(&mut st, &by_block[b], height, k, bk);
-                for c in before..st.tets.len() {
-                    by_block[st.block[c] as usize].push(c as u32);
+            // Unit k's pinch-out line first (a crease of its base), then every unit's above
+            // where interface k follows it (a crease there too).
+            for j in (1..=k).rev() {
+                for (b, &bk) in blocks.iter().enumerate() {
+                    let before = st.tets.len();
+                    cut_crease(&mut st, &by_block[b], height, j, k, bk);
+                    for c in before..st.tets.len() {
+                        by_block[st.block[c] as usize].push(c as u32);
+                    }
                 }
             }
         }
