@@ -194,9 +194,9 @@ impl Buckets {
 /// its search tree, so about 40 MB, whatever the samples of a tile or a window.
 pub const WINDOW_POINTS: usize = 1 << 20;
 
-/// At most this many `k`-th-nearest candidate distances (8 bytes each, 16 MB) are kept for a
-/// block of probes whose window is larger than [`WINDOW_POINTS`] ([`reach_with`]).
-pub const PROBE_DISTANCES: usize = 1 << 21;
+/// At most this many `k`-th-nearest candidate distances (8 bytes each) are kept for a
+/// block of probes whose window is larger than [`WINDOW_POINTS`] ([`reach_with`]): 8 MB.
+pub const PROBE_DISTANCES: usize = 1 << 20;
 
 /// What a tile's halo held: the most window points held at once and the windows read.
 #[derive(Clone, Copy, Debug, Default)]
@@ -388,7 +388,8 @@ pub(crate) fn reach_with(
         b: [0, lattice.n[1]],
     }];
     let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
-    let mut near: Vec<[f64; 2]> = Vec::new();
+    // Room for the bound at once (pages never written are not held), not grown by doubling.
+    let mut near: Vec<[f64; 2]> = Vec::with_capacity(bound.window.min(n).saturating_add(1));
     while let Some(block) = todo.pop() {
         let rect = block.rect(&lattice);
         let mut g = g0;
@@ -438,7 +439,9 @@ pub(crate) fn reach_with(
             // Few enough probes to keep their k least distances: the window in chunks.
             let probes = block.probes();
             let mut best = vec![f64::INFINITY; probes * k];
-            let mut chunk: Vec<[f64; 2]> = Vec::new();
+            // The window's buffer holds the chunks (one buffer of `bound.window` points).
+            let mut chunk = std::mem::take(&mut near);
+            chunk.clear();
             let mut failed: Option<crate::error::TilesError> = None;
             let search = |chunk: &[[f64; 2]], best: &mut [f64]| -> Result<()> {
                 let tree = tree_of(chunk)?;
@@ -493,7 +496,7 @@ pub(crate) fn reach_with(
             if !chunk.is_empty() {
                 search(&chunk, &mut best)?;
             }
-            drop(chunk);
+            near = chunk;
             let all = total == n;
             if total >= k {
                 let limit = if all { f64::INFINITY } else { g };
