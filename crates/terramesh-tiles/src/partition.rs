@@ -383,30 +383,44 @@ pub(crate) fn reach_with(
     let lattice = Lattice::new(r, h);
     let mut stats = ReachStats::default();
     let mut farthest: f64 = 0.0;
-    let mut todo = vec![Block {
-        a: [0, lattice.n[0]],
-        b: [0, lattice.n[1]],
-    }];
+    // Blocks to do, each with its first trial halo.
+    let mut todo = vec![(
+        Block {
+            a: [0, lattice.n[0]],
+            b: [0, lattice.n[1]],
+        },
+        g0,
+    )];
     let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
     // Room for the bound at once (pages never written are not held), not grown by doubling.
     let mut near: Vec<[f64; 2]> = Vec::with_capacity(bound.window.min(n).saturating_add(1));
-    while let Some(block) = todo.pop() {
+    while let Some((block, first)) = todo.pop() {
         let rect = block.rect(&lattice);
-        let mut g = g0;
+        let mut g = first;
+        // The largest trial halo whose window held at most the bound (a half's window at it
+        // holds no more: its first trial).
+        let mut fitted = first;
+        let mut chunked = false;
         'trials: loop {
-            stats.windows += 1;
             near.clear();
             let mut count = 0usize;
-            window(rect, g, &mut |p| {
-                count += 1;
-                if count > bound.window {
-                    return false;
-                }
-                near.push(p);
-                true
-            })?;
+            if !chunked {
+                stats.windows += 1;
+                window(rect, g, &mut |p| {
+                    count += 1;
+                    if count > bound.window {
+                        return false;
+                    }
+                    near.push(p);
+                    true
+                })?;
+            } else {
+                count = bound.window + 1;
+            }
             stats.held = stats.held.max(near.len());
             if count <= bound.window {
+                fitted = g;
+
                 let all = count == n;
                 if count >= k {
                     let tree = tree_of(&near)?;
@@ -433,9 +447,10 @@ pub(crate) fn reach_with(
             }
             // More than `bound.window` samples in the window.
             if block.probes() > 1 && block.probes() * k > bound.distances {
-                todo.extend(block.halves());
+                todo.extend(block.halves().map(|half| (half, fitted)));
                 break 'trials;
             }
+            chunked = true;
             // Few enough probes to keep their k least distances: the window in chunks.
             let probes = block.probes();
             let mut best = vec![f64::INFINITY; probes * k];
@@ -506,6 +521,12 @@ pub(crate) fn reach_with(
                 if reach <= limit {
                     farthest = farthest.max(reach);
                     break 'trials;
+                }
+                // Each probe's k-th distance in this window is at least its k-th among all
+                // samples, so a window grown to the largest of them holds for every probe.
+                if reach.is_finite() && reach > 2.0 * g {
+                    g = reach * (1.0 + 1e-9);
+                    continue;
                 }
             }
             g *= 2.0;
