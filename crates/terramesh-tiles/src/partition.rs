@@ -189,14 +189,43 @@ impl Buckets {
     }
 }
 
+/// At most this many window points are held at once (and searched in one tree) while a
+/// tile's halo is computed ([`reach_with`]): about 16 bytes a point and as much again for
+/// its search tree, so about 40 MB, whatever the samples of a tile or a window.
+pub const WINDOW_POINTS: usize = 1 << 20;
+
+/// At most this many `k`-th-nearest candidate distances (8 bytes each) are kept for a
+/// block of probes whose window is larger than [`WINDOW_POINTS`] ([`reach_with`]): 8 MB.
+pub const PROBE_DISTANCES: usize = 1 << 20;
+
+/// What a tile's halo held: the most window points held at once and the windows read.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ReachStats {
+    /// The most points held at once (at most the bound's `window`).
+    pub(crate) held: usize,
+    /// Windows read (trials of a block, chunked passes included).
+    pub(crate) windows: usize,
+    /// Windows searched in chunks (larger than the bound for a block of few probes).
+    pub(crate) chunked: usize,
+}
+
+/// The memory bound of [`reach_with`]: points held at once and candidate distances kept.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bound {
+    pub(crate) window: usize,
+    pub(crate) distances: usize,
+}
+
+impl Bound {
+    /// [`WINDOW_POINTS`] and [`PROBE_DISTANCES`].
+    pub(crate) const PLAN: Bound = Bound {
+        window: WINDOW_POINTS,
+        distances: PROBE_DISTANCES,
+    };
+}
+
 /// [`reach`] of the extent `r` over every sample of `xy`, computed from the samples near the
 /// extent only (no search tree over the region), bit for bit the same value.
-///
-/// The samples in the window of a trial halo `g` (starting at `guess`, doubled until it holds)
-/// are searched: where the `k`-th nearest window sample of every probe `q` is at most `g`
-/// away, no sample outside the window is as near (every point outside it lies farther than
-/// `g` from the extent), so the window's `k`-th distances are the region's, and so is their
-/// maximum. Returns the halo and the trial halos tried.
 pub(crate) fn reach_near(
     buckets: &Buckets,
     xy: &[[f64; 2]],
@@ -204,55 +233,306 @@ pub(crate) fn reach_near(
     r: [f64; 4],
     h: f64,
     guess: f64,
-) -> Result<(f64, usize)> {
-    let mut keep = Vec::new();
-    reach_with(xy.len(), k, r, h, guess, &mut |g, near| {
-        buckets.window(xy, r, g, &mut keep);
-        near.clear();
-        near.extend(keep.iter().map(|&i| xy[i as usize]));
+    bound: Bound,
+) -> Result<(f64, ReachStats)> {
+    reach_with(xy.len(), k, r, h, guess, bound, &mut |rect, g, each| {
+        for c in buckets.grid.window_cells(rect, g) {
+            for &i in &buckets.order[buckets.start[c]..buckets.start[c + 1]] {
+                let p = xy[i as usize];
+                if in_window(rect, g, p) && !each(p) {
+                    return Ok(());
+                }
+            }
+        }
         Ok(())
     })
 }
 
-/// Puts into its vector the samples in a window grown by its distance ([`reach_with`]).
-pub(crate) type WindowFn<'a> = dyn FnMut(f64, &mut Vec<[f64; 2]>) -> Result<()> + 'a;
+/// Streams to `each` the samples [`in_window`] of a rectangle grown by a distance, in any
+/// order, until `each` returns `false` ([`reach_with`]).
+pub(crate) type WindowFn<'a> =
+    dyn FnMut([f64; 4], f64, &mut dyn FnMut([f64; 2]) -> bool) -> Result<()> + 'a;
 
-/// [`reach_near`] of `n` samples, whatever holds them: `window(g, near)` puts into `near` the
-/// samples [`in_window`] of the extent `r` grown by `g`, in their order (a tiled plan reads
-/// them from its cells' files, `plan_stream`).
+/// The probes of a tile: a lattice of `n[0]` x `n[1]` points over `r`.
+struct Lattice {
+    r: [f64; 4],
+    n: [usize; 2],
+}
+
+impl Lattice {
+    fn new(r: [f64; 4], h: f64) -> Lattice {
+        Lattice {
+            r,
+            n: [
+                ((r[2] - r[0]) / h).ceil() as usize + 1,
+                ((r[3] - r[1]) / h).ceil() as usize + 1,
+            ],
+        }
+    }
+    fn x(&self, a: usize) -> f64 {
+        self.r[0] + (self.r[2] - self.r[0]) * a as f64 / (self.n[0] - 1) as f64
+    }
+    fn y(&self, b: usize) -> f64 {
+        self.r[1] + (self.r[3] - self.r[1]) * b as f64 / (self.n[1] - 1) as f64
+    }
+    fn step(&self) -> f64 {
+        let r = self.r;
+        ((r[2] - r[0]) / (self.n[0] - 1) as f64).max((r[3] - r[1]) / (self.n[1] - 1) as f64)
+    }
+}
+
+/// A block of probes: lattice indices `a0..a1` x `b0..b1`.
+#[derive(Clone, Copy)]
+struct Block {
+    a: [usize; 2],
+    b: [usize; 2],
+}
+
+impl Block {
+    fn probes(&self) -> usize {
+        (self.a[1] - self.a[0]) * (self.b[1] - self.b[0])
+    }
+    /// The rectangle of its probes (their coordinates at its corners).
+    fn rect(&self, l: &Lattice) -> [f64; 4] {
+        [
+            l.x(self.a[0]),
+            l.y(self.b[0]),
+            l.x(self.a[1] - 1),
+            l.y(self.b[1] - 1),
+        ]
+    }
+    /// The two halves along its longer side (in probes).
+    fn halves(&self) -> [Block; 2] {
+        let (na, nb) = (self.a[1] - self.a[0], self.b[1] - self.b[0]);
+        if na >= nb {
+            let m = self.a[0] + na / 2;
+            [
+                Block {
+                    a: [self.a[0], m],
+                    b: self.b,
+                },
+                Block {
+                    a: [m, self.a[1]],
+                    b: self.b,
+                },
+            ]
+        } else {
+            let m = self.b[0] + nb / 2;
+            [
+                Block {
+                    a: self.a,
+                    b: [self.b[0], m],
+                },
+                Block {
+                    a: self.a,
+                    b: [m, self.b[1]],
+                },
+            ]
+        }
+    }
+    fn each(&self, l: &Lattice, f: &mut dyn FnMut(usize, [f64; 2]) -> bool) -> bool {
+        let mut i = 0;
+        for b in self.b[0]..self.b[1] {
+            for a in self.a[0]..self.a[1] {
+                if !f(i, [l.x(a), l.y(b)]) {
+                    return false;
+                }
+                i += 1;
+            }
+        }
+        true
+    }
+}
+
+fn tree_of(points: &[[f64; 2]]) -> Result<ImmutableKdTree<f64, 2>> {
+    ImmutableKdTree::new_from_slice(points).map_err(|e| Error::SearchTree {
+        points: "the samples".into(),
+        why: format!("{e:?}"),
+    })
+}
+
+/// [`reach`] of `n` samples, whatever holds them, holding at most `bound.window` of them at
+/// once: `window(rect, g, each)` streams the samples [`in_window`] of `rect` grown by `g`.
+///
+/// The tile's probes (the lattice of [`reach`]) are taken in blocks. A block's samples in the
+/// window of a trial distance `g` (starting at `guess`, doubled until it holds) are searched:
+/// where the `k`-th nearest window sample of every probe `q` of the block is at most `g`
+/// away, no sample outside the window is as near (every point outside it lies farther than
+/// `g` from the block), so the window's `k`-th distances are the region's. A window of more
+/// than `bound.window` samples splits its block in two (each half from `guess` again); a
+/// block of at most `bound.distances / k` probes whose window is still too large is searched
+/// in chunks of `bound.window` samples, one search tree a chunk, each probe keeping its `k`
+/// least squared distances. Every probe's `k`-th distance is therefore the one a tree of
+/// every sample gives (the same squared distances, computed point by point), and the halo,
+/// their maximum padded by the step ([`pad`]), is the same bit for bit.
 pub(crate) fn reach_with(
     n: usize,
     k: usize,
     r: [f64; 4],
     h: f64,
     guess: f64,
+    bound: Bound,
     window: &mut WindowFn,
-) -> Result<(f64, usize)> {
+) -> Result<(f64, ReachStats)> {
     let k = k.max(1).min(n);
-    let mut g = if guess > 0.0 && guess.is_finite() {
+    let g0 = if guess > 0.0 && guess.is_finite() {
         guess
     } else {
         (r[2] - r[0]).max(r[3] - r[1])
     };
-    let mut near: Vec<[f64; 2]> = Vec::new();
-    for tried in 1.. {
-        window(g, &mut near)?;
-        let all = near.len() == n;
-        if near.len() >= k {
-            let tree: ImmutableKdTree<f64, 2> =
-                ImmutableKdTree::new_from_slice(&near).map_err(|e| Error::SearchTree {
-                    points: "the samples".into(),
-                    why: format!("{e:?}"),
+    let lattice = Lattice::new(r, h);
+    let mut stats = ReachStats::default();
+    let mut farthest: f64 = 0.0;
+    // Blocks to do, each with its first trial halo.
+    let mut todo = vec![(
+        Block {
+            a: [0, lattice.n[0]],
+            b: [0, lattice.n[1]],
+        },
+        g0,
+    )];
+    let kk = std::num::NonZeroUsize::new(k.max(1)).expect("k >= 1");
+    // Room for the bound at once (pages never written are not held), not grown by doubling.
+    let mut near: Vec<[f64; 2]> = Vec::with_capacity(bound.window.min(n).saturating_add(1));
+    while let Some((block, first)) = todo.pop() {
+        let rect = block.rect(&lattice);
+        let mut g = first;
+        // The largest trial halo whose window held at most the bound (a half's window at it
+        // holds no more: its first trial).
+        let mut fitted = first;
+        let mut chunked = false;
+        'trials: loop {
+            near.clear();
+            let mut count = 0usize;
+            if !chunked {
+                stats.windows += 1;
+                window(rect, g, &mut |p| {
+                    count += 1;
+                    if count > bound.window {
+                        return false;
+                    }
+                    near.push(p);
+                    true
                 })?;
-            // A probe whose k-th window sample lies past `g` ends the trial.
-            let limit = if all { f64::INFINITY } else { g };
-            if let Some((farthest, step)) = farthest(&tree, k, r, h, limit) {
-                return Ok((pad(farthest, step), tried));
+            } else {
+                count = bound.window + 1;
             }
+            stats.held = stats.held.max(near.len());
+            if count <= bound.window {
+                fitted = g;
+
+                let all = count == n;
+                if count >= k {
+                    let tree = tree_of(&near)?;
+                    // A probe whose k-th window sample lies past `g` ends the trial.
+                    let limit = if all { f64::INFINITY } else { g };
+                    let mut reach: f64 = 0.0;
+                    let held = block.each(&lattice, &mut |_, q| {
+                        let found = tree
+                            .query(&q)
+                            .nearest_n::<SquaredEuclidean<f64>>(kk)
+                            .execute();
+                        if let Some(last) = found.last() {
+                            reach = reach.max(last.distance.sqrt());
+                        }
+                        reach <= limit
+                    });
+                    if held {
+                        farthest = farthest.max(reach);
+                        break 'trials;
+                    }
+                }
+                g *= 2.0;
+                continue;
+            }
+            // More than `bound.window` samples in the window.
+            if block.probes() > 1 && block.probes() * k > bound.distances {
+                todo.extend(block.halves().map(|half| (half, fitted)));
+                break 'trials;
+            }
+            chunked = true;
+            // Few enough probes to keep their k least distances: the window in chunks.
+            let probes = block.probes();
+            let mut best = vec![f64::INFINITY; probes * k];
+            // The window's buffer holds the chunks (one buffer of `bound.window` points).
+            let mut chunk = std::mem::take(&mut near);
+            chunk.clear();
+            let mut failed: Option<crate::error::TilesError> = None;
+            let search = |chunk: &[[f64; 2]], best: &mut [f64]| -> Result<()> {
+                let tree = tree_of(chunk)?;
+                let mut merged = Vec::with_capacity(k);
+                block.each(&lattice, &mut |i, q| {
+                    let mut found: Vec<f64> = tree
+                        .query(&q)
+                        .nearest_n::<SquaredEuclidean<f64>>(kk)
+                        .execute()
+                        .iter()
+                        .map(|f| f.distance)
+                        .collect();
+                    found.sort_unstable_by(f64::total_cmp);
+                    let mine = &mut best[i * k..(i + 1) * k];
+                    merged.clear();
+                    let (mut x, mut y) = (0, 0);
+                    while merged.len() < k && (x < k || y < found.len()) {
+                        let take_found =
+                            y < found.len() && (x >= k || found[y].total_cmp(&mine[x]).is_lt());
+                        if take_found {
+                            merged.push(found[y]);
+                            y += 1;
+                        } else {
+                            merged.push(mine[x]);
+                            x += 1;
+                        }
+                    }
+                    mine.copy_from_slice(&merged[..k]);
+                    true
+                });
+                Ok(())
+            };
+            stats.windows += 1;
+            stats.chunked += 1;
+            let mut total = 0usize;
+            window(rect, g, &mut |p| {
+                total += 1;
+                chunk.push(p);
+                if chunk.len() == bound.window {
+                    if let Err(e) = search(&chunk, &mut best) {
+                        failed = Some(e);
+                        return false;
+                    }
+                    chunk.clear();
+                }
+                true
+            })?;
+            if let Some(e) = failed {
+                return Err(e);
+            }
+            stats.held = stats.held.max(bound.window);
+            if !chunk.is_empty() {
+                search(&chunk, &mut best)?;
+            }
+            near = chunk;
+            let all = total == n;
+            if total >= k {
+                let limit = if all { f64::INFINITY } else { g };
+                let reach = (0..probes)
+                    .map(|i| best[i * k + k - 1].sqrt())
+                    .fold(0.0f64, f64::max);
+                if reach <= limit {
+                    farthest = farthest.max(reach);
+                    break 'trials;
+                }
+                // Each probe's k-th distance in this window is at least its k-th among all
+                // samples, so a window grown to the largest of them holds for every probe.
+                if reach.is_finite() && reach > 2.0 * g {
+                    g = reach * (1.0 + 1e-9);
+                    continue;
+                }
+            }
+            g *= 2.0;
         }
-        g *= 2.0;
     }
-    unreachable!("the window grows until it holds every sample")
+    Ok((pad(farthest, lattice.step()), stats))
 }
 
 /// Writes the samples `xy`, `z` to `path` as `[x, y, z]` little-endian `f64` triples,
@@ -336,7 +616,9 @@ mod tests {
 
     /// The halo from the samples near a tile is the halo from a search tree over all of them,
     /// bit for bit: clustered samples, an empty corner (whose halo reaches far), ties on a
-    /// lattice, and a first guess far too small (the window grows).
+    /// lattice, and a first guess far too small (the window grows); and so it is under a
+    /// bound of a few dozen points held at once (blocks split, windows searched in chunks),
+    /// which is never exceeded.
     #[test]
     fn the_halo_from_nearby_samples_is_the_halo_from_all_of_them() {
         let (origin, size, shape) = ([0.0, 0.0], 100.0, [4, 3]);
@@ -358,7 +640,12 @@ mod tests {
         }
         let tree: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(&xy).unwrap();
         let buckets = Buckets::new(origin, size, shape, &xy).unwrap();
+        let small = Bound {
+            window: 60,
+            distances: 64,
+        };
         let mut grew = 0;
+        let (mut most_held, mut largest, mut chunked) = (0, 0, 0);
         for k in [1, 16, 32] {
             for j in 0..3 {
                 for i in 0..4 {
@@ -369,15 +656,31 @@ mod tests {
                         (j + 1) as f64 * size,
                     ];
                     let want = reach(&tree, k, r, 5.0);
-                    let (got, tried) = reach_near(&buckets, &xy, k, r, 5.0, 1.0).unwrap();
+                    let (got, plan) =
+                        reach_near(&buckets, &xy, k, r, 5.0, 1.0, Bound::PLAN).unwrap();
                     assert_eq!(got.to_bits(), want.to_bits(), "k {k}, tile {i},{j}");
-                    assert!(tried > 1, "a guess of 1 m holds nowhere");
-                    grew = grew.max(tried);
+                    assert!(plan.windows > 1, "a guess of 1 m holds nowhere");
+                    grew = grew.max(plan.windows);
+                    largest = largest.max(plan.held);
+                    let (got, bounded) = reach_near(&buckets, &xy, k, r, 5.0, 1.0, small).unwrap();
+                    assert_eq!(
+                        got.to_bits(),
+                        want.to_bits(),
+                        "bounded: k {k}, tile {i},{j}"
+                    );
+                    assert!(bounded.held <= small.window, "held {}", bounded.held);
+                    most_held = most_held.max(bounded.held);
+                    chunked += bounded.chunked;
+                    assert_eq!(plan.chunked, 0, "k {k}, tile {i},{j}");
                 }
             }
         }
         // The empty corner's window grew past its neighbours' samples.
         assert!(grew >= 8, "{grew}");
+        // Unbounded, a window held far more than the small bound: the bound was at work.
+        assert!(largest > 10 * small.window, "{largest}");
+        assert_eq!(most_held, small.window);
+        assert!(chunked > 0, "no window was searched in chunks");
     }
 
     /// Every window's file holds exactly the samples a scan of all of them keeps, in order:

@@ -282,7 +282,8 @@ struct Held<'a> {
 
 impl Windows for Held<'_> {
     fn reach(&mut self, k: usize, r: [f64; 4], h: f64, guess: f64) -> Result<f64> {
-        Ok(super::partition::reach_near(&self.buckets, self.xy, k, r, h, guess)?.0)
+        let bound = super::partition::Bound::PLAN;
+        Ok(super::partition::reach_near(&self.buckets, self.xy, k, r, h, guess, bound)?.0)
     }
     fn write(&mut self, path: &Path, extent: [f64; 4], halo: f64) -> Result<usize> {
         let (b, keep) = (&self.buckets, &mut self.keep);

@@ -29,7 +29,7 @@ use terramesh::acquire::PointSink;
 use terramesh::build::SampleSink;
 use terramesh_geostat::{draw_key, Data, Duplicates, KrigingFrame, Variogram};
 
-use super::partition::{in_window, reach_with};
+use super::partition::{in_window, reach_with, Bound, ReachStats};
 use crate::error::{Context, Result};
 use terramesh::Context as _;
 
@@ -49,6 +49,11 @@ pub const FIT_SUBSAMPLE: usize = 100_000;
 
 /// The record of what the variogram was fitted on, in the plan folder.
 pub(crate) const FIT_RECORD: &str = "fit.json";
+
+/// At most this many samples of a tile cell are held at once while its duplicates are merged
+/// (32 bytes each as read, 40 merged, 16 for its hull: about 20 MB); a larger cell is merged
+/// in sorted runs on disk.
+pub const CELL_CHUNK: usize = 1 << 19;
 
 /// Each tile cell's buffer when bucketing.
 const BUF: usize = 1 << 15;
@@ -214,8 +219,15 @@ fn merged_file(dir: &Path, c: usize) -> PathBuf {
 }
 
 /// Buckets the `count` raw samples of `raw` by the cells of `grid` and merges each cell's
-/// duplicates, into `dir`. Removes `raw`.
+/// duplicates, into `dir`. Removes `raw`. A cell of more than [`CELL_CHUNK`] samples is
+/// merged in sorted runs on disk ([`merge_cell_in_runs`]), so that no more than that many
+/// samples of a cell are held at once.
 pub(crate) fn bucket(raw: &Path, count: usize, grid: Grid, dir: &Path) -> Result<Store> {
+    bucket_in(raw, count, grid, dir, CELL_CHUNK)
+}
+
+/// [`bucket`], holding at most `chunk` samples of a cell at once.
+fn bucket_in(raw: &Path, count: usize, grid: Grid, dir: &Path, chunk: usize) -> Result<Store> {
     let cells = grid.shape[0] * grid.shape[1];
     // The cells' counts, and the values checked as `Data::new` checks them.
     let mut raw_counts = vec![0usize; cells];
@@ -278,6 +290,10 @@ pub(crate) fn bucket(raw: &Path, count: usize, grid: Grid, dir: &Path) -> Result
     };
     for &c in &full {
         let path = bucket_file(c);
+        if raw_counts[c] > chunk {
+            merge_cell_in_runs(&mut store, c, &path, raw_counts[c], chunk)?;
+            continue;
+        }
         let mut r = Records::<4>::open(&path, raw_counts[c], 1 << 16)?;
         let mut recs: Vec<[u64; 4]> = Vec::with_capacity(raw_counts[c]);
         while let Some(b) = r.next()? {
@@ -331,6 +347,211 @@ pub(crate) fn bucket(raw: &Path, count: usize, grid: Grid, dir: &Path) -> Result
     }
     store.hull = hull(std::mem::take(&mut store.hull));
     Ok(store)
+}
+
+/// `Data::new`'s order of raw records `[x, y, z, index]`: x, y, then the index.
+fn xy_order(a: &[u64; 4], b: &[u64; 4]) -> std::cmp::Ordering {
+    let f = f64::from_bits;
+    f(a[0])
+        .total_cmp(&f(b[0]))
+        .then(f(a[1]).total_cmp(&f(b[1])))
+        .then(a[3].cmp(&b[3]))
+}
+
+/// Writes `recs` to `path`.
+fn write_run<const N: usize>(path: &Path, recs: impl Iterator<Item = [u64; N]>) -> Result<()> {
+    let mut w = BufWriter::with_capacity(1 << 16, File::create(path).at(path)?);
+    for r in recs {
+        put(&mut w, r, path)?;
+    }
+    w.into_inner().map_err(|e| e.into_error()).at(path)?;
+    Ok(())
+}
+
+/// The head of a run in a merge: its record, its run and the order.
+struct Head<'a, const N: usize> {
+    rec: [u64; N],
+    run: usize,
+    order: &'a dyn Fn(&[u64; N], &[u64; N]) -> std::cmp::Ordering,
+}
+
+impl<const N: usize> Ord for Head<'_, N> {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        // The least record first (a max-heap reversed), ties by run.
+        (self.order)(&o.rec, &self.rec).then(o.run.cmp(&self.run))
+    }
+}
+impl<const N: usize> PartialOrd for Head<'_, N> {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl<const N: usize> PartialEq for Head<'_, N> {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o).is_eq()
+    }
+}
+impl<const N: usize> Eq for Head<'_, N> {}
+
+/// Merges the sorted runs (files of `N`-word records, each in `order`) into `each`, at most
+/// [`FANIN`] at a time (in levels through `dir` above that); removes the runs.
+fn merge_runs<const N: usize>(
+    mut runs: Vec<(PathBuf, usize)>,
+    dir: &Path,
+    tag: &str,
+    order: &dyn Fn(&[u64; N], &[u64; N]) -> std::cmp::Ordering,
+    each: &mut dyn FnMut([u64; N]) -> Result<()>,
+) -> Result<()> {
+    let mut level = 0;
+    while runs.len() > FANIN {
+        let mut next = Vec::new();
+        for (g, group) in runs.chunks(FANIN).enumerate() {
+            let out = dir.join(format!("{tag}-l{level}-{g}.bin"));
+            let mut w = BufWriter::with_capacity(1 << 16, File::create(&out).at(&out)?);
+            merge_open(group, order, &mut |r| put(&mut w, r, &out))?;
+            w.into_inner().map_err(|e| e.into_error()).at(&out)?;
+            next.push((out, group.iter().map(|r| r.1).sum()));
+        }
+        runs = next;
+        level += 1;
+    }
+    merge_open(&runs, order, each)
+}
+
+/// Merges at most [`FANIN`] sorted runs into `each`, removing them once read.
+fn merge_open<const N: usize>(
+    runs: &[(PathBuf, usize)],
+    order: &dyn Fn(&[u64; N], &[u64; N]) -> std::cmp::Ordering,
+    each: &mut dyn FnMut([u64; N]) -> Result<()>,
+) -> Result<()> {
+    let mut readers = Vec::with_capacity(runs.len());
+    let mut heap = BinaryHeap::new();
+    for (run, (path, count)) in runs.iter().enumerate() {
+        let mut r = Records::<N>::open(path, *count, 1 << 14)?;
+        if let Some(rec) = r.next()? {
+            heap.push(Head { rec, run, order });
+        }
+        readers.push(r);
+    }
+    while let Some(Head { rec, run, .. }) = heap.pop() {
+        each(rec)?;
+        if let Some(rec) = readers[run].next()? {
+            heap.push(Head { rec, run, order });
+        }
+    }
+    drop(readers);
+    for (path, _) in runs {
+        std::fs::remove_file(path).at(path)?;
+    }
+    Ok(())
+}
+
+/// Merges the duplicates of cell `c` (its `count` raw records in `path`, removed) holding at
+/// most `chunk` of them at once: sorted runs of `chunk` records in `Data::new`'s order, merged;
+/// each location's samples (consecutive then) merged as in [`bucket`]; the merged samples in
+/// runs of `chunk` sorted by first occurrence, merged into the cell's file. The same records
+/// in the same order as [`bucket`]'s merge in memory (the same order of the same keys, the
+/// same sums), and the hull of the cell's hulls of each run.
+fn merge_cell_in_runs(
+    store: &mut Store,
+    c: usize,
+    path: &Path,
+    count: usize,
+    chunk: usize,
+) -> Result<()> {
+    let dir = store.dir.clone();
+    let mut runs = Vec::new();
+    {
+        let mut r = Records::<4>::open(path, count, 1 << 16)?;
+        let mut recs: Vec<[u64; 4]> = Vec::with_capacity(chunk.min(count));
+        loop {
+            recs.clear();
+            while recs.len() < chunk {
+                match r.next()? {
+                    Some(b) => recs.push(b),
+                    None => break,
+                }
+            }
+            if recs.is_empty() {
+                break;
+            }
+            recs.sort_unstable_by(xy_order);
+            let run = dir.join(format!("s{c}-{}.bin", runs.len()));
+            write_run(&run, recs.iter().copied())?;
+            runs.push((run, recs.len()));
+        }
+    }
+    std::fs::remove_file(path).at(path)?;
+    let f = f64::from_bits;
+    let mut merged: Vec<Merged> = Vec::with_capacity(chunk.min(count));
+    let mut by_first: Vec<(PathBuf, usize)> = Vec::new();
+    let mut group: Vec<[u64; 4]> = Vec::new();
+    let mut n = 0usize;
+    let mut has_dup = false;
+    let mut hull_points: Vec<[f64; 2]> = std::mem::take(&mut store.hull);
+    let flush = |merged: &mut Vec<Merged>,
+                 by_first: &mut Vec<(PathBuf, usize)>,
+                 hull_points: &mut Vec<[f64; 2]>|
+     -> Result<()> {
+        merged.sort_unstable_by_key(|m| m.first);
+        hull_points.extend(hull(merged.iter().map(|m| [m.x, m.y]).collect()));
+        if hull_points.len() > 1 << 16 {
+            *hull_points = hull(std::mem::take(hull_points));
+        }
+        let run = dir.join(format!("f{c}-{}.bin", by_first.len()));
+        write_run(&run, merged.iter().map(Merged::bits))?;
+        by_first.push((run, merged.len()));
+        merged.clear();
+        Ok(())
+    };
+    let mut close = |group: &mut Vec<[u64; 4]>, merged: &mut Vec<Merged>| {
+        if let Some(g) = group.first() {
+            let s: f64 = group.iter().map(|r| f(r[2])).sum();
+            merged.push(Merged {
+                x: f(g[0]),
+                y: f(g[1]),
+                one: f(g[2]),
+                mean: s / group.len() as f64,
+                first: g[3],
+            });
+            has_dup |= group.len() > 1;
+            n += 1;
+            group.clear();
+        }
+    };
+    merge_runs(runs, &dir, &format!("s{c}"), &xy_order, &mut |rec| {
+        if group
+            .first()
+            .is_some_and(|g| !(f(g[0]) == f(rec[0]) && f(g[1]) == f(rec[1])))
+        {
+            close(&mut group, &mut merged);
+            if merged.len() >= chunk {
+                flush(&mut merged, &mut by_first, &mut hull_points)?;
+            }
+        }
+        group.push(rec);
+        Ok(())
+    })?;
+    close(&mut group, &mut merged);
+    if !merged.is_empty() {
+        flush(&mut merged, &mut by_first, &mut hull_points)?;
+    }
+    drop(merged);
+    store.hull = hull_points;
+    store.has_dup |= has_dup;
+    let out = merged_file(&dir, c);
+    let mut w = BufWriter::with_capacity(1 << 16, File::create(&out).at(&out)?);
+    merge_runs(
+        by_first,
+        &dir,
+        &format!("f{c}"),
+        &|a: &[u64; 5], b: &[u64; 5]| a[4].cmp(&b[4]),
+        &mut |rec| put(&mut w, rec, &out),
+    )?;
+    w.into_inner().map_err(|e| e.into_error()).at(&out)?;
+    store.counts[c] = n;
+    store.n += n;
+    Ok(())
 }
 
 /// The convex hull's points of `p` as `terramesh_geostat::diameter` finds them (its
@@ -613,27 +834,34 @@ impl<'a> Near<'a> {
     }
 
     /// The halo of the tile `r` (`partition::reach_near`'s, from the cells near it: the k-th
-    /// distances do not depend on the order of the window's points).
+    /// distances do not depend on the order of the window's points), holding at most
+    /// [`super::partition::WINDOW_POINTS`] of them at once.
     pub(crate) fn reach(&mut self, k: usize, r: [f64; 4], h: f64, guess: f64) -> Result<f64> {
+        Ok(self.reach_bounded(k, r, h, guess, Bound::PLAN)?.0)
+    }
+
+    /// [`Near::reach`] under `bound`, with what it held.
+    pub(crate) fn reach_bounded(
+        &mut self,
+        k: usize,
+        r: [f64; 4],
+        h: f64,
+        guess: f64,
+        bound: Bound,
+    ) -> Result<(f64, ReachStats)> {
         let n = self.store.n;
-        let (halo, _) = reach_with(n, k, r, h, guess, &mut |g, near| {
-            near.clear();
-            let cells = self.cells(r, g);
-            // Room for every sample of the cells at once (pages never written are not held),
-            // rather than a vector grown by doubling (both copies held while it moves).
-            near.reserve(cells.iter().map(|c| c.1).sum());
-            for (path, count) in cells {
+        reach_with(n, k, r, h, guess, bound, &mut |rect, g, each| {
+            for (path, count) in self.cells(rect, g) {
                 let mut rd = Records::<5>::open(&path, count, 1 << 16)?;
                 while let Some(b) = rd.next()? {
                     let p = [f64::from_bits(b[0]), f64::from_bits(b[1])];
-                    if in_window(r, g, p) {
-                        near.push(p);
+                    if in_window(rect, g, p) && !each(p) {
+                        return Ok(());
                     }
                 }
             }
             Ok(())
-        })?;
-        Ok(halo)
+        })
     }
 
     /// Writes the samples of the tile `extent`'s window (grown by `halo`) to `path`, in the
@@ -654,5 +882,87 @@ impl<'a> Near<'a> {
         })?;
         o.commit().at(path)?;
         Ok(count)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The files of a scratch folder, by name.
+    fn files(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| {
+                let p = e.unwrap().path();
+                let name = p.file_name().unwrap().to_string_lossy().into_owned();
+                (name, std::fs::read(&p).unwrap())
+            })
+            .collect()
+    }
+
+    /// A cell merged in sorted runs of a few samples (in levels, past [`FANIN`] runs) gives
+    /// the merged files, counts, duplicates flag and diameter of the merge in memory, byte for
+    /// byte, and leaves no run behind.
+    #[test]
+    fn a_cell_merged_in_runs_is_the_cell_merged_in_memory() {
+        let mut raw = Vec::new();
+        for k in 0..3000u64 {
+            // irregular points over a 2 x 2 grid of 10 m cells and a little outside it
+            let f = |m: u64| ((k * m) % 1009) as f64 / 1009.0 * 22.0 - 1.0;
+            let p = [f(7919), f(104_729)];
+            raw.push([p[0], p[1], (k % 97) as f64 * 0.37]);
+            if k % 11 == 0 {
+                // a duplicate now, another later
+                raw.push([p[0], p[1], k as f64]);
+            }
+        }
+        for k in 0..300 {
+            let p = raw[k * 7];
+            raw.push([p[0], p[1], -(k as f64) * 1.5]);
+        }
+        let grid = Grid {
+            origin: [0.0, 0.0],
+            size: 10.0,
+            shape: [2, 2],
+        };
+        let run = |chunk: usize| {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("raw.f64");
+            let mut bytes = Vec::new();
+            for p in &raw {
+                for v in p {
+                    bytes.extend(v.to_le_bytes());
+                }
+            }
+            std::fs::write(&path, bytes).unwrap();
+            let store = bucket_in(&path, raw.len(), grid, dir.path(), chunk).unwrap();
+            let d = terramesh_geostat::diameter(&store.hull);
+            let out = (
+                files(dir.path()),
+                store.counts.clone(),
+                store.n,
+                store.has_dup,
+                d.to_bits(),
+            );
+            (out, dir)
+        };
+        let (want, _a) = run(usize::MAX);
+        assert!(want.3, "duplicates");
+        assert!(want.2 < raw.len() && want.1.iter().all(|&c| c > 100));
+        for chunk in [1, 3, 7, 1000] {
+            let (got, _b) = run(chunk);
+            assert_eq!(
+                got.0.keys().collect::<Vec<_>>(),
+                want.0.keys().collect::<Vec<_>>(),
+                "chunk {chunk}"
+            );
+            assert!(got.0 == want.0, "chunk {chunk}: the merged files differ");
+            assert_eq!(
+                (&got.1, got.2, got.3, got.4),
+                (&want.1, want.2, want.3, want.4),
+                "chunk {chunk}"
+            );
+        }
     }
 }
