@@ -26,6 +26,9 @@
 //! below the floor. With [`verify_each_operation`] (and in debug builds) every operation is
 //! checked after it is made: positive cells, each face in two cells on its two sides or on
 //! the boundary, the volume kept to 1e-9, no cell across a fault.
+//!
+//! The engineering objects' walls are kept as the zones' are (module `walls`): the objects
+//! are cut before the pass and each cell's object label is part of its label.
 
 use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
