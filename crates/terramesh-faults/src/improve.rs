@@ -26,6 +26,9 @@
 //! below the floor. With [`verify_each_operation`] (and in debug builds) every operation is
 //! checked after it is made: positive cells, each face in two cells on its two sides or on
 //! the boundary, the volume kept to 1e-9, no cell across a fault.
+//!
+//! The engineering objects' walls are kept as the zones' are (module `walls`): the objects
+//! are cut before the pass and each cell's object label is part of its label.
 
 use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
@@ -34,7 +37,9 @@ use crate::mesh::{
     outline_edge, positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
 };
 use crate::quality::min_dihedral;
-use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
+use crate::{BlockKey, FaultSet, ObjectCells, ObjectSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
+
+mod walls;
 
 /// What the quality pass did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -75,6 +80,10 @@ struct Pass<'a> {
     tol: f64,
     /// Whether every operation is checked after it is made ([`Pass::verify`]).
     verify: bool,
+    /// The engineering objects cut before the pass (their walls are kept, `walls.rs`).
+    objects: &'a ObjectSet,
+    /// Per cell, its object label ([`walls::code`]; empty without objects).
+    object: Vec<u32>,
 }
 
 static VERIFY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -95,8 +104,8 @@ pub fn verify_each_operation(on: bool) {
 const MIN_GAIN: f64 = 1e-6;
 
 /// A cell's label: its side of every fault, its unit, its block, the fault zones it lies in
-/// (bit f: between the walls of fault f's zone).
-type Label = (u64, u32, u32, u64);
+/// (bit f: between the walls of fault f's zone), its object label ([`walls::code`]).
+type Label = (u64, u32, u32, u64, u32);
 
 /// An operation the pass found for a poor cell, to be made by [`Pass::apply`].
 enum Op {
@@ -201,6 +210,7 @@ impl Pass<'_> {
             self.st.below[c],
             self.st.block[c],
             self.st.zone.get(c).copied().unwrap_or(0),
+            self.object.get(c).copied().unwrap_or(0),
         )
     }
 
@@ -224,6 +234,9 @@ impl Pass<'_> {
                 self.st.block.push(self.st.block[l]);
                 if !self.st.zone.is_empty() {
                     self.st.zone.push(self.st.zone[l]);
+                }
+                if !self.object.is_empty() {
+                    self.object.push(self.object[l]);
                 }
                 self.alive.push(true);
                 self.angle.push(q);
@@ -430,7 +443,10 @@ impl Pass<'_> {
         }
         // The new cells tile the old two, but a unit's region is not convex: each new cell's
         // centroid must lie in the unit as well.
-        if !new.iter().all(|n| self.in_unit(self.geo(n.0), c)) {
+        if !new
+            .iter()
+            .all(|n| self.in_unit(self.geo(n.0), c) && self.in_objects(self.geo(n.0), c))
+        {
             return None;
         }
         Some(Op::Flip23 {
@@ -503,7 +519,9 @@ impl Pass<'_> {
         if poor < 3 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
             return None;
         }
-        if !new.iter().all(|n| self.in_unit(self.geo(n.0), ring[0])) {
+        if !new.iter().all(|n| {
+            self.in_unit(self.geo(n.0), ring[0]) && self.in_objects(self.geo(n.0), ring[0])
+        }) {
             return None;
         }
         Some(Op::Flip32 {
@@ -579,7 +597,10 @@ impl Pass<'_> {
             return None;
         }
         let [(ca, la), (cb, lb)] = around;
-        if !la.iter().all(|l| lb.binary_search(l).is_ok()) || !self.zone_kept(a, b, la) {
+        if !la.iter().all(|l| lb.binary_search(l).is_ok())
+            || !self.zone_kept(a, b, la)
+            || !self.object_kept(a, b, la)
+        {
             return None;
         }
         let walled = la.iter().any(|l| l.3 != la[0].3);
@@ -608,7 +629,7 @@ impl Pass<'_> {
         }
         if !new.iter().all(|e| {
             let g = self.geo(e.1);
-            self.in_unit(g, e.0) && self.in_zone(g, e.0, walled)
+            self.in_unit(g, e.0) && self.in_zone(g, e.0, walled) && self.in_objects(g, e.0)
         }) {
             return None;
         }
@@ -675,6 +696,10 @@ impl Pass<'_> {
 
     /// [`Pass::slide`] for a node with flags `f` at `p`.
     fn slide_at(&self, f: u8, p: [f64; 3], labels: &[Label], to: [f64; 3]) -> Option<[f64; 3]> {
+        if Self::on_object_wall(labels) {
+            // On an object's wall: it stays.
+            return None;
+        }
         if f & (TOP | BASE | SIDE) != 0 {
             // Off the interfaces and faults, a node on a side moves vertically (it stays on
             // the same edges of the outline), a node on the base horizontally; on the base
@@ -871,7 +896,7 @@ impl Pass<'_> {
         if best < old + MIN_GAIN
             || !cells.iter().all(|&c| {
                 let g = geo(c, q);
-                self.in_unit(g, c) && self.in_zone(g, c, walled)
+                self.in_unit(g, c) && self.in_zone(g, c, walled) && self.in_objects(g, c)
             })
         {
             return None;
@@ -1008,7 +1033,7 @@ impl Pass<'_> {
                         self.st.points[w as usize]
                     }
                 });
-                self.in_unit(g, c) && self.in_zone(g, c, walled)
+                self.in_unit(g, c) && self.in_zone(g, c, walled) && self.in_objects(g, c)
             };
             if ok
                 && new.iter().filter(|a| poor(a)).count() <= before
@@ -1096,6 +1121,9 @@ impl Pass<'_> {
                     return None;
                 }
             }
+        }
+        if !self.object_wall_through(&labels, m) {
+            return None;
         }
         for l in &labels {
             let (lo, hi) = labels
@@ -1215,7 +1243,7 @@ impl Pass<'_> {
         for &(c, t1, t2) in &halves {
             for t in [t1, t2] {
                 let g = geo(t, q);
-                if !self.in_unit(g, c) || !self.in_zone(g, c, walled) {
+                if !self.in_unit(g, c) || !self.in_zone(g, c, walled) || !self.in_objects(g, c) {
                     return None;
                 }
             }
@@ -1324,6 +1352,7 @@ impl Pass<'_> {
                     fault.name
                 );
             }
+            self.verify_objects(c);
             assert!(
                 self.in_unit_within(self.geo(t), c, crate::FAULT_TOLERANCE),
                 "quality pass: cell {c} {:?} outside its unit {}",
@@ -1386,11 +1415,14 @@ pub(crate) fn improve(
     background: usize,
     below: f64,
     passes: usize,
+    objects: &ObjectSet,
+    object_cells: &mut ObjectCells,
 ) -> Improved {
     let mut done = Improved::default();
     if passes == 0 || below <= 0.0 {
         return done;
     }
+    let object = walls::codes(object_cells, st.tets.len(), objects);
     let angle: Vec<f64> = st
         .tets
         .par_iter()
@@ -1428,6 +1460,8 @@ pub(crate) fn improve(
         terrain,
         background,
         verify: cfg!(debug_assertions) || VERIFY.load(std::sync::atomic::Ordering::Relaxed),
+        objects,
+        object,
         tol: 0.5e-9
             * terrain
                 .heights
@@ -1501,6 +1535,7 @@ pub(crate) fn improve(
     }
     // Drop the dead cells and renumber the nodes still used.
     let alive = p.alive;
+    let mut object = p.object;
     let st = p.st;
     let mut k = 0;
     for (c, &live) in alive.iter().enumerate() {
@@ -1512,6 +1547,9 @@ pub(crate) fn improve(
             if !st.zone.is_empty() {
                 st.zone[k] = st.zone[c];
             }
+            if !object.is_empty() {
+                object[k] = object[c];
+            }
             k += 1;
         }
     }
@@ -1522,6 +1560,8 @@ pub(crate) fn improve(
     if !st.zone.is_empty() {
         st.zone.truncate(k);
     }
+    object.truncate(k);
+    walls::write_back(&object, object_cells);
     let mut used = vec![u32::MAX; st.points.len()];
     for t in &st.tets {
         for &v in t {
@@ -1592,7 +1632,19 @@ mod tests {
         .unwrap();
         let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
         let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
-        let done = improve(&mut st, &faults, &[], &h, 0, &terrain, n, 20.0, 2);
+        let done = improve(
+            &mut st,
+            &faults,
+            &[],
+            &h,
+            0,
+            &terrain,
+            n,
+            20.0,
+            2,
+            &ObjectSet::default(),
+            &mut ObjectCells::default(),
+        );
         (st, done)
     }
 

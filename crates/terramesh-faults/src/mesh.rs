@@ -1050,7 +1050,8 @@ pub fn faulted_mesh(
 }
 
 /// [`faulted_mesh`] with engineering objects (tunnels, excavations, structures) cut in after
-/// the faults, the interfaces and the quality pass (see [`crate::ObjectSet`]).
+/// the faults, the interfaces and the zones, before the quality pass, which keeps their walls
+/// (see [`crate::ObjectSet`]).
 ///
 /// # Errors
 /// As [`faulted_mesh`], and [`FaultError::Object`] for an object no part of which lies in the
@@ -1211,11 +1212,13 @@ pub fn faulted_mesh_with_objects(
         height,
         interfaces,
     };
-    // The zones' walls are cut before the quality pass, which keeps the zone labels (and so
-    // the walls, as it keeps the faults and interfaces) while it mends the cells next to them.
+    // The zones' and the objects' walls are cut before the quality pass, which keeps the
+    // zone and object labels (and so the walls, as it keeps the faults and interfaces) while
+    // it mends the cells next to them.
     let mut object_cells = object_cells;
     let mut zones =
         crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
+    let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     let done = crate::improve::improve(
         &mut st,
         faults,
@@ -1226,12 +1229,13 @@ pub fn faulted_mesh_with_objects(
         background_nodes,
         settings.improve_degrees,
         settings.improve_passes,
+        objects,
+        &mut object_cells,
     );
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
     st.report.inserted = done.inserted;
-    let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     zones.zone = crate::zones::labels(faults, &st.zone);
     // The structures' parts above the terrain, last: their cells carry no fault face.
     crate::above::add_above(&mut st, objects, &mut object_cells, &mut zones)?;

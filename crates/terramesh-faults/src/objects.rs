@@ -1898,8 +1898,8 @@ fn refine_missed(
     total
 }
 
-/// Cuts every object's walls into the mesh (after the faults, the interfaces and the quality
-/// pass) and labels the cells (a cell in several objects takes the first in project order);
+/// Cuts every object's walls into the mesh (after the faults, the interfaces and the zones,
+/// before the quality pass) and labels the cells (a cell in several objects takes the first in project order);
 /// `labels` carries what [`refine_near_objects`] did.
 pub(crate) fn cut_objects(
     st: &mut State,
