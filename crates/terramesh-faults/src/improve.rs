@@ -33,7 +33,7 @@ use robust::{orient3d, Coord3D};
 use crate::mesh::{
     outline_edge, positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
 };
-use crate::quality::min_dihedral;
+use crate::quality::{min_dihedral, positive_min_dihedral};
 use crate::{BlockKey, FaultSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
 
 /// What the quality pass did.
@@ -54,11 +54,10 @@ struct Pass<'a> {
     /// Nodes of cells changed since the sweep began: a poor cell none of whose nodes was
     /// touched failed every operation in the last sweep and would fail again.
     touched: Vec<bool>,
-    /// Per node, the number of the last chunk of poor cells in which an operation changed
-    /// one of its cells (or moved it): a plan made before the chunk that read such a node is
-    /// made again.
+    /// Per node, the number of the last operation that changed one of its cells (or moved
+    /// it): a plan made before that operation that read such a node is made again.
     stamp: Vec<u32>,
-    /// The number of the chunk being mended.
+    /// The number of operations made so far (the last one's number).
     mark: u32,
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
@@ -141,6 +140,10 @@ enum Op {
 
 /// Poor cells planned at once, in parallel, before they are mended in order.
 const CHUNK: usize = 256;
+
+/// Stale plans made again at once, in parallel (a constant: the cells planned again, and so
+/// the work, do not depend on the number of threads; the mesh never does).
+const REPLAN: usize = 16;
 
 /// The directions of the compass search of a new node's place: the six axes and the eight
 /// diagonals.
@@ -239,7 +242,7 @@ impl Pass<'_> {
         }
     }
 
-    /// Marks the nodes of cell `c` as changed in this chunk.
+    /// Marks the nodes of cell `c` as changed by the operation being made.
     fn stamp_cell(&mut self, c: u32) {
         for v in self.st.tets[c as usize] {
             self.stamp[v as usize] = self.mark;
@@ -312,8 +315,9 @@ impl Pass<'_> {
             .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
     }
 
-    /// Makes operation `op`, stamping the nodes of every cell it changes.
+    /// Makes operation `op`, stamping the nodes of every cell it changes with its number.
     fn apply(&mut self, op: Op, done: &mut Improved) {
+        self.mark += 1;
         match op {
             Op::Collapse { a, b, kill, new } => {
                 for &c in &kill {
@@ -414,11 +418,9 @@ impl Pass<'_> {
         for i in (0..4).filter(|&i| i != k) {
             let mut n = t;
             n[i] = b;
-            if !positive(self.geo(n)) {
-                return None;
-            }
-            let q = min_dihedral(self.geo(n));
-            if q <= old {
+            // -1 where not positive.
+            let q = positive_min_dihedral(self.geo(n));
+            if q < 0.0 || q <= old {
                 return None;
             }
             new.push((n, q));
@@ -814,18 +816,25 @@ impl Pass<'_> {
             })
         };
         // The smallest angle over the cells with `v` at `q` (-1 if one is not positive),
-        // and the worst cell.
-        let eval = |q: [f64; 3]| {
+        // the worst cell (the first of the smallest) and how many are below the floor; `None`
+        // as soon as a cell is no better than `above` or more than `most` are below the floor
+        // (a step that would be refused: the rest of its cells need not be measured).
+        let eval = |q: [f64; 3], above: f64, most: usize| {
             let (mut worst, mut poor) = ((f64::MAX, 0u32), 0);
             for &c in cells {
-                let g = geo(c, q);
-                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                let a = positive_min_dihedral(geo(c, q));
+                if a <= above {
+                    return None;
+                }
                 if a < worst.0 {
                     worst = (a, c);
                 }
                 poor += (a < self.floor) as usize;
+                if poor > most {
+                    return None;
+                }
             }
-            (worst, poor)
+            Some((worst, poor))
         };
         let mut len = f64::MAX;
         for &c in cells {
@@ -835,7 +844,7 @@ impl Pass<'_> {
                 }
             }
         }
-        let ((old, mut worst), poor) = eval(p);
+        let ((old, mut worst), poor) = eval(p, f64::NEG_INFINITY, usize::MAX)?;
         let (mut best, mut q) = (old, p);
         for _ in 0..4 {
             let h = 1e-4 * len;
@@ -856,8 +865,7 @@ impl Pass<'_> {
                 let Some(r) = self.slide(v, labels, to) else {
                     break;
                 };
-                let ((a, w), n) = eval(r);
-                if a > best && n <= poor {
+                if let Some(((a, w), _)) = eval(r, best, poor) {
                     (best, worst, q) = (a, w, r);
                     stepped = true;
                     break;
@@ -987,7 +995,7 @@ impl Pass<'_> {
                         self.st.points[w as usize]
                     }
                 });
-                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                let a = positive_min_dihedral(g);
                 if a < old + MIN_GAIN {
                     ok = false;
                     break;
@@ -1139,28 +1147,30 @@ impl Pass<'_> {
                 }
             })
         };
-        let angle = |t: [u32; 4], q: [f64; 3]| {
-            let g = geo(t, q);
-            if positive(g) {
-                min_dihedral(g)
-            } else {
-                -1.0
-            }
-        };
+        let angle = |t: [u32; 4], q: [f64; 3]| positive_min_dihedral(geo(t, q));
+        let trial: Vec<[u32; 4]> = halves.iter().flat_map(|h| [h.1, h.2]).collect();
+        // The cell that refused the last trial place: measured first at the next (a place
+        // is refused by its worst cell, often the same one).
+        let first = std::cell::Cell::new(0usize);
         // The smallest angle of the new cells with the node at q, and how many are below the
-        // floor.
-        let eval = |q: [f64; 3]| {
+        // floor; `None` as soon as a cell is no better than `above` or more than `most` are
+        // below the floor (a place that would be refused). The smallest angle and the count
+        // do not depend on the order the cells are measured in.
+        let eval = |q: [f64; 3], above: f64, most: usize| {
             let (mut worst, mut n) = (f64::MAX, 0usize);
-            for &(_, t1, t2) in &halves {
-                for t in [t1, t2] {
-                    let x = angle(t, q);
-                    worst = worst.min(x);
-                    n += (x < self.floor) as usize;
+            let s = first.get();
+            for i in (s..trial.len()).chain(0..s) {
+                let x = angle(trial[i], q);
+                worst = worst.min(x);
+                n += (x < self.floor) as usize;
+                if x <= above || n > most {
+                    first.set(i);
+                    return None;
                 }
             }
-            (worst, n)
+            Some((worst, n))
         };
-        let (mut best, mut count) = eval(m);
+        let (mut best, mut count) = eval(m, f64::NEG_INFINITY, usize::MAX)?;
         let mut q = m;
         // Towards the mean of the neighbours.
         let mut mean = [0.0; 3];
@@ -1175,8 +1185,7 @@ impl Pass<'_> {
             let Some(r) = self.slide_at(flags, m, &labels, to) else {
                 break;
             };
-            let (x, n) = eval(r);
-            if x > best && n <= poor {
+            if let Some((x, n)) = eval(r, best, poor) {
                 (best, count, q) = (x, n, r);
                 break;
             }
@@ -1196,8 +1205,7 @@ impl Pass<'_> {
                     let Some(r) = self.slide_at(flags, m, &labels, to) else {
                         continue;
                     };
-                    let (x, k) = eval(r);
-                    if x > step.map_or(best, |s| s.0) && k <= poor.max(count) {
+                    if let Some((x, k)) = eval(r, step.map_or(best, |s| s.0), poor.max(count)) {
                         step = Some((x, k, r));
                     }
                 }
@@ -1449,36 +1457,56 @@ pub(crate) fn improve(
         let before = done;
         // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
         // the cells are mended in order, each with its plan if no node that the plan read has
-        // changed since, else with a plan made again: exactly the serial pass, whatever the
-        // number of threads.
+        // changed since it was made, else with a plan made again: exactly the serial pass,
+        // whatever the number of threads. A stale plan is made again together with those of
+        // the next stale cells of the chunk (up to REPLAN, in parallel, on the mesh as it is
+        // then), each kept for its cell if nothing it read changes before the cell's turn.
         for chunk in bad.chunks(CHUNK) {
-            p.mark += 1;
-            let plans: Vec<(Option<Op>, Vec<u32>)> = {
+            let made = p.mark;
+            let mut plans: Vec<(Option<Op>, Vec<u32>, u32)> = {
                 let q = &p;
                 chunk
                     .par_iter()
                     .map(|&c| {
                         let mut seen = Vec::new();
                         if !q.alive[c as usize] || q.angle[c as usize] >= below {
-                            return (None, seen);
+                            return (None, seen, made);
                         }
                         let op = q.plan(c, &mut seen);
-                        (op, seen)
+                        (op, seen, made)
                     })
                     .collect()
             };
-            for (&c, (op, seen)) in chunk.iter().zip(plans) {
-                if !p.alive[c as usize] || p.angle[c as usize] >= below {
+            for i in 0..chunk.len() {
+                let poor = |p: &Pass, c: u32| p.alive[c as usize] && p.angle[c as usize] < below;
+                let stale = |p: &Pass, (_, seen, at): &(Option<Op>, Vec<u32>, u32)| {
+                    seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] > *at)
+                };
+                if !poor(&p, chunk[i]) {
                     continue;
                 }
-                let stale = seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] == p.mark);
-                let op = if stale {
-                    let mut seen = Vec::new();
-                    p.plan(c, &mut seen)
-                } else {
-                    op
-                };
-                if let Some(op) = op {
+                if stale(&p, &plans[i]) {
+                    let again: Vec<usize> = (i..chunk.len())
+                        .filter(|&j| poor(&p, chunk[j]) && stale(&p, &plans[j]))
+                        .take(REPLAN)
+                        .collect();
+                    let now = p.mark;
+                    let fresh: Vec<(Option<Op>, Vec<u32>)> = {
+                        let q = &p;
+                        again
+                            .par_iter()
+                            .map(|&j| {
+                                let mut seen = Vec::new();
+                                let op = q.plan(chunk[j], &mut seen);
+                                (op, seen)
+                            })
+                            .collect()
+                    };
+                    for (j, (op, seen)) in again.into_iter().zip(fresh) {
+                        plans[j] = (op, seen, now);
+                    }
+                }
+                if let Some(op) = plans[i].0.take() {
                     if p.verify {
                         let before = p.cells_of(&op);
                         let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);

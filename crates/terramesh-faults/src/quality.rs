@@ -40,13 +40,36 @@ pub fn min_dihedral(p: [[f64; 3]; 4]) -> f64 {
     let o = orient3d(c(p[0]), c(p[1]), c(p[2]), c(p[3]));
     let v = tetra_volume(p[0], p[1], p[2], p[3]);
     // Ours is positive when orient3d is negative (terramesh_core::volume's node order).
-    let sign = if o < 0.0 && v > 0.0 {
-        1.0
+    if o < 0.0 && v > 0.0 {
+        angle_of(p, 1.0)
     } else if o > 0.0 && v < 0.0 {
-        -1.0
+        angle_of(p, -1.0)
     } else {
-        return 0.0;
+        0.0
+    }
+}
+
+/// [`min_dihedral`] of a cell that is positive (`mesh::positive`: exact orientation negative
+/// and floating-point volume positive), else -1: the quality pass's measure of a trial cell,
+/// with one orientation test where `positive` then `min_dihedral` made two.
+pub(crate) fn positive_min_dihedral(p: [[f64; 3]; 4]) -> f64 {
+    let c = |q: [f64; 3]| Coord3D {
+        x: q[0],
+        y: q[1],
+        z: q[2],
     };
+    if orient3d(c(p[0]), c(p[1]), c(p[2]), c(p[3])) < 0.0
+        && tetra_volume(p[0], p[1], p[2], p[3]) > 0.0
+    {
+        angle_of(p, 1.0)
+    } else {
+        -1.0
+    }
+}
+
+/// The smallest dihedral angle of a cell whose faces' normals point out when multiplied by
+/// `sign` (0 if a face is degenerate).
+fn angle_of(p: [[f64; 3]; 4], sign: f64) -> f64 {
     // The faces wound counter-clockwise seen from outside a positive cell, opposite vertex
     // 3, 2, 0 and 1 (`mesh::outward_faces`): their normals point out of it.
     let faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
