@@ -140,7 +140,8 @@ pub fn quality(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Quality {
 
 #[cfg(test)]
 mod tests {
-    use super::min_dihedral;
+    use super::{min_dihedral, positive_min_dihedral};
+    use crate::mesh::positive;
 
     /// A cell the quality pass made on a thinned set of the faulted example's holes: its four
     /// nodes lie in one plane to rounding (floating-point volume -1.3e-16 m³, exactly
@@ -169,5 +170,45 @@ mod tests {
         let a = min_dihedral(q);
         assert!(a > 54.0 && a < 55.0);
         assert_eq!(min_dihedral([q[1], q[0], q[2], q[3]]), a);
+    }
+
+    /// The pass's one-test measure is `min_dihedral` of a positive cell and -1 otherwise, bit
+    /// for bit: on cells of every orientation, near-flat ones (a node moved by 1e-15 m off
+    /// the plane of the others, where rounding decides the floating-point volume's sign) and
+    /// flat ones.
+    #[test]
+    fn positive_measure_is_the_angle_of_a_positive_cell() {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut pos, mut neg) = (0, 0);
+        for i in 0..20_000 {
+            let mut p = [[0.0; 3]; 4];
+            for q in &mut p {
+                *q = [next() * 10.0 + 300.0, next() * 10.0 - 50.0, next() * 10.0];
+            }
+            if i % 4 == 1 {
+                // The fourth node on the plane of the other three, to rounding.
+                let (u, v) = (next(), next());
+                p[3] = [0, 1, 2].map(|k| {
+                    p[0][k] + u * (p[1][k] - p[0][k]) + v * (p[2][k] - p[0][k]) + 1e-15 * next()
+                });
+            }
+            if i % 4 == 2 {
+                p[3] = p[1];
+            }
+            let want = if positive(p) { min_dihedral(p) } else { -1.0 };
+            assert_eq!(positive_min_dihedral(p).to_bits(), want.to_bits(), "{p:?}");
+            if want >= 0.0 {
+                pos += 1;
+            } else {
+                neg += 1;
+            }
+        }
+        assert!(pos > 1000 && neg > 1000, "{pos} positive, {neg} not");
     }
 }
