@@ -74,6 +74,57 @@ struct Pass<'a> {
     tol: f64,
     /// Whether every operation is checked after it is made ([`Pass::verify`]).
     verify: bool,
+    /// The answers of [`Pass::in_unit`] found so far (by any thread).
+    units: UnitMemo,
+}
+
+/// What [`Pass::in_unit`] depends on: the cell's nodes (bit for bit, in order), its unit and
+/// its block.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+struct UnitKey {
+    g: [[u64; 3]; 4],
+    unit: u32,
+    block: u32,
+}
+
+/// A memo of [`Pass::in_unit`]'s answers, shared by the threads: the pass tests the same
+/// trial cells again and again (the plans of poor cells that share a node try the same moves
+/// and collapses; a stale plan, made again, tries most of what it tried before; a cell left
+/// poor is planned again in the next sweep), and each test evaluates every interface at its
+/// centroid. Direct-mapped (a new answer replaces the one in its slot), each slot locked on
+/// its own, keys compared in full: an answer is the function's, whatever the memo holds, so
+/// the mesh does not depend on the threads' timing.
+struct UnitMemo {
+    slots: Vec<std::sync::Mutex<Option<(UnitKey, bool)>>>,
+}
+
+impl UnitMemo {
+    /// A memo of one slot per 4 cells of a mesh of `cells` (a power of two, 1,024 to 262,144
+    /// slots: about 30 MB at most).
+    fn new(cells: usize) -> Self {
+        let n = (cells / 4).next_power_of_two().clamp(1 << 10, 1 << 18);
+        Self {
+            slots: (0..n).map(|_| std::sync::Mutex::new(None)).collect(),
+        }
+    }
+
+    fn slot(&self, k: &UnitKey) -> &std::sync::Mutex<Option<(UnitKey, bool)>> {
+        let mut h = 0x9E37_79B9_7F4A_7C15u64 ^ (u64::from(k.unit) << 32 | u64::from(k.block));
+        for w in k.g.iter().flatten() {
+            h = (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            h ^= h >> 29;
+        }
+        &self.slots[(h >> (64 - self.slots.len().trailing_zeros())) as usize]
+    }
+
+    fn get(&self, k: &UnitKey) -> Option<bool> {
+        let s = self.slot(k).lock().unwrap_or_else(|e| e.into_inner());
+        s.as_ref().filter(|(key, _)| key == k).map(|e| e.1)
+    }
+
+    fn put(&self, k: UnitKey, ok: bool) {
+        *self.slot(&k).lock().unwrap_or_else(|e| e.into_inner()) = Some((k, ok));
+    }
 }
 
 static VERIFY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -535,7 +586,17 @@ impl Pass<'_> {
     /// collapsed can make faces that cut across a bend of another interface, which a slab a
     /// few centimetres thick (near a pinch-out) cannot absorb.
     fn in_unit(&self, g: [[f64; 3]; 4], like: u32) -> bool {
-        self.in_unit_within(g, like, 0.5 * crate::FAULT_TOLERANCE)
+        let key = UnitKey {
+            g: g.map(|p| p.map(f64::to_bits)),
+            unit: self.st.below[like as usize],
+            block: self.st.block[like as usize],
+        };
+        if let Some(known) = self.units.get(&key) {
+            return known;
+        }
+        let ok = self.in_unit_within(g, like, 0.5 * crate::FAULT_TOLERANCE);
+        self.units.put(key, ok);
+        ok
     }
 
     /// [`Pass::in_unit`] with tolerance `tol` (metres).
@@ -1420,6 +1481,7 @@ pub(crate) fn improve(
             star[v as usize].push(c as u32);
         }
     }
+    let units = UnitMemo::new(st.tets.len());
     let mut p = Pass {
         alive: vec![true; st.tets.len()],
         touched: vec![true; st.points.len()],
@@ -1436,6 +1498,7 @@ pub(crate) fn improve(
         terrain,
         background,
         verify: cfg!(debug_assertions) || VERIFY.load(std::sync::atomic::Ordering::Relaxed),
+        units,
         tol: 0.5e-9
             * terrain
                 .heights
