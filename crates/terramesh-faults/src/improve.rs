@@ -1506,90 +1506,96 @@ pub(crate) fn improve(
                 .fold(0.0f64, |s, h| s.max(h.abs()))
                 .max(1.0),
     };
-    for _ in 0..passes {
-        let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
-            .filter(|&c| {
-                let c = c as usize;
-                p.alive[c]
-                    && p.angle[c] < below
-                    && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
-            })
-            .collect();
-        bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
-        p.touched.iter_mut().for_each(|t| *t = false);
-        let before = done;
-        // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
-        // the cells are mended in order, each with its plan if no node that the plan read has
-        // changed since it was made, else with a plan made again: exactly the serial pass,
-        // whatever the number of threads. A stale plan is made again together with those of
-        // the next stale cells of the chunk (up to REPLAN, in parallel, on the mesh as it is
-        // then), each kept for its cell if nothing it read changes before the cell's turn.
-        for chunk in bad.chunks(CHUNK) {
-            let made = p.mark;
-            let mut plans: Vec<(Option<Op>, Vec<u32>, u32)> = {
-                let q = &p;
-                chunk
-                    .par_iter()
-                    .map(|&c| {
-                        let mut seen = Vec::new();
-                        if !q.alive[c as usize] || q.angle[c as usize] >= below {
-                            return (None, seen, made);
-                        }
-                        let op = q.plan(c, &mut seen);
-                        (op, seen, made)
-                    })
-                    .collect()
-            };
-            for i in 0..chunk.len() {
-                let poor = |p: &Pass, c: u32| p.alive[c as usize] && p.angle[c as usize] < below;
-                let stale = |p: &Pass, (_, seen, at): &(Option<Op>, Vec<u32>, u32)| {
-                    seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] > *at)
+    // The sweeps run on a thread of the pool, so that the many small parallel batches (a
+    // chunk's plans, a few stale plans made again) are run by it and the others at once
+    // instead of each waiting for a sleeping thread to wake and take it.
+    rayon::scope(|_| {
+        for _ in 0..passes {
+            let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
+                .filter(|&c| {
+                    let c = c as usize;
+                    p.alive[c]
+                        && p.angle[c] < below
+                        && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
+                })
+                .collect();
+            bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
+            p.touched.iter_mut().for_each(|t| *t = false);
+            let before = done;
+            // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
+            // the cells are mended in order, each with its plan if no node that the plan read has
+            // changed since it was made, else with a plan made again: exactly the serial pass,
+            // whatever the number of threads. A stale plan is made again together with those of
+            // the next stale cells of the chunk (up to REPLAN, in parallel, on the mesh as it is
+            // then), each kept for its cell if nothing it read changes before the cell's turn.
+            for chunk in bad.chunks(CHUNK) {
+                let made = p.mark;
+                let mut plans: Vec<(Option<Op>, Vec<u32>, u32)> = {
+                    let q = &p;
+                    chunk
+                        .par_iter()
+                        .map(|&c| {
+                            let mut seen = Vec::new();
+                            if !q.alive[c as usize] || q.angle[c as usize] >= below {
+                                return (None, seen, made);
+                            }
+                            let op = q.plan(c, &mut seen);
+                            (op, seen, made)
+                        })
+                        .collect()
                 };
-                if !poor(&p, chunk[i]) {
-                    continue;
-                }
-                if stale(&p, &plans[i]) {
-                    let again: Vec<usize> = (i..chunk.len())
-                        .filter(|&j| poor(&p, chunk[j]) && stale(&p, &plans[j]))
-                        .take(REPLAN)
-                        .collect();
-                    let now = p.mark;
-                    let fresh: Vec<(Option<Op>, Vec<u32>)> = {
-                        let q = &p;
-                        again
-                            .par_iter()
-                            .map(|&j| {
-                                let mut seen = Vec::new();
-                                let op = q.plan(chunk[j], &mut seen);
-                                (op, seen)
-                            })
-                            .collect()
+                for i in 0..chunk.len() {
+                    let poor =
+                        |p: &Pass, c: u32| p.alive[c as usize] && p.angle[c as usize] < below;
+                    let stale = |p: &Pass, (_, seen, at): &(Option<Op>, Vec<u32>, u32)| {
+                        seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] > *at)
                     };
-                    for (j, (op, seen)) in again.into_iter().zip(fresh) {
-                        plans[j] = (op, seen, now);
+                    if !poor(&p, chunk[i]) {
+                        continue;
                     }
-                }
-                if let Some(op) = plans[i].0.take() {
-                    if p.verify {
-                        let before = p.cells_of(&op);
-                        let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);
-                        p.apply(op, &mut done);
-                        let after: Vec<u32> = before
-                            .into_iter()
-                            .filter(|&c| p.alive[c as usize])
-                            .chain(first..p.st.tets.len() as u32)
+                    if stale(&p, &plans[i]) {
+                        let again: Vec<usize> = (i..chunk.len())
+                            .filter(|&j| poor(&p, chunk[j]) && stale(&p, &plans[j]))
+                            .take(REPLAN)
                             .collect();
-                        p.verify(volume, &after);
-                    } else {
-                        p.apply(op, &mut done);
+                        let now = p.mark;
+                        let fresh: Vec<(Option<Op>, Vec<u32>)> = {
+                            let q = &p;
+                            again
+                                .par_iter()
+                                .map(|&j| {
+                                    let mut seen = Vec::new();
+                                    let op = q.plan(chunk[j], &mut seen);
+                                    (op, seen)
+                                })
+                                .collect()
+                        };
+                        for (j, (op, seen)) in again.into_iter().zip(fresh) {
+                            plans[j] = (op, seen, now);
+                        }
+                    }
+                    if let Some(op) = plans[i].0.take() {
+                        if p.verify {
+                            let before = p.cells_of(&op);
+                            let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);
+                            p.apply(op, &mut done);
+                            let after: Vec<u32> = before
+                                .into_iter()
+                                .filter(|&c| p.alive[c as usize])
+                                .chain(first..p.st.tets.len() as u32)
+                                .collect();
+                            p.verify(volume, &after);
+                        } else {
+                            p.apply(op, &mut done);
+                        }
                     }
                 }
             }
+            if done == before {
+                break;
+            }
         }
-        if done == before {
-            break;
-        }
-    }
+    });
     // Drop the dead cells and renumber the nodes still used.
     let alive = p.alive;
     let st = p.st;
