@@ -36,7 +36,7 @@ use robust::{orient3d, Coord3D};
 use crate::mesh::{
     outline_edge, positive, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP,
 };
-use crate::quality::min_dihedral;
+use crate::quality::{min_dihedral, positive_min_dihedral};
 use crate::{BlockKey, FaultSet, ObjectCells, ObjectSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
 
 mod walls;
@@ -59,11 +59,10 @@ struct Pass<'a> {
     /// Nodes of cells changed since the sweep began: a poor cell none of whose nodes was
     /// touched failed every operation in the last sweep and would fail again.
     touched: Vec<bool>,
-    /// Per node, the number of the last chunk of poor cells in which an operation changed
-    /// one of its cells (or moved it): a plan made before the chunk that read such a node is
-    /// made again.
+    /// Per node, the number of the last operation that changed one of its cells (or moved
+    /// it): a plan made before that operation that read such a node is made again.
     stamp: Vec<u32>,
-    /// The number of the chunk being mended.
+    /// The number of operations made so far (the last one's number).
     mark: u32,
     faults: &'a FaultSet,
     blocks: &'a [BlockKey],
@@ -84,6 +83,57 @@ struct Pass<'a> {
     objects: &'a ObjectSet,
     /// Per cell, its object label ([`walls::code`]; empty without objects).
     object: Vec<u32>,
+    /// The answers of [`Pass::in_unit`] found so far (by any thread).
+    units: UnitMemo,
+}
+
+/// What [`Pass::in_unit`] depends on: the cell's nodes (bit for bit, in order), its unit and
+/// its block.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+struct UnitKey {
+    g: [[u64; 3]; 4],
+    unit: u32,
+    block: u32,
+}
+
+/// A memo of [`Pass::in_unit`]'s answers, shared by the threads: the pass tests the same
+/// trial cells again and again (the plans of poor cells that share a node try the same moves
+/// and collapses; a stale plan, made again, tries most of what it tried before; a cell left
+/// poor is planned again in the next sweep), and each test evaluates every interface at its
+/// centroid. Direct-mapped (a new answer replaces the one in its slot), each slot locked on
+/// its own, keys compared in full: an answer is the function's, whatever the memo holds, so
+/// the mesh does not depend on the threads' timing.
+struct UnitMemo {
+    slots: Vec<std::sync::Mutex<Option<(UnitKey, bool)>>>,
+}
+
+impl UnitMemo {
+    /// A memo of one slot per 4 cells of a mesh of `cells` (a power of two, 1,024 to 262,144
+    /// slots: about 30 MB at most).
+    fn new(cells: usize) -> Self {
+        let n = (cells / 4).next_power_of_two().clamp(1 << 10, 1 << 18);
+        Self {
+            slots: (0..n).map(|_| std::sync::Mutex::new(None)).collect(),
+        }
+    }
+
+    fn slot(&self, k: &UnitKey) -> &std::sync::Mutex<Option<(UnitKey, bool)>> {
+        let mut h = 0x9E37_79B9_7F4A_7C15u64 ^ (u64::from(k.unit) << 32 | u64::from(k.block));
+        for w in k.g.iter().flatten() {
+            h = (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            h ^= h >> 29;
+        }
+        &self.slots[(h >> (64 - self.slots.len().trailing_zeros())) as usize]
+    }
+
+    fn get(&self, k: &UnitKey) -> Option<bool> {
+        let s = self.slot(k).lock().unwrap_or_else(|e| e.into_inner());
+        s.as_ref().filter(|(key, _)| key == k).map(|e| e.1)
+    }
+
+    fn put(&self, k: UnitKey, ok: bool) {
+        *self.slot(&k).lock().unwrap_or_else(|e| e.into_inner()) = Some((k, ok));
+    }
 }
 
 static VERIFY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -150,6 +200,10 @@ enum Op {
 
 /// Poor cells planned at once, in parallel, before they are mended in order.
 const CHUNK: usize = 256;
+
+/// Stale plans made again at once, in parallel (a constant: the cells planned again, and so
+/// the work, do not depend on the number of threads; the mesh never does).
+const REPLAN: usize = 16;
 
 /// The directions of the compass search of a new node's place: the six axes and the eight
 /// diagonals.
@@ -252,7 +306,7 @@ impl Pass<'_> {
         }
     }
 
-    /// Marks the nodes of cell `c` as changed in this chunk.
+    /// Marks the nodes of cell `c` as changed by the operation being made.
     fn stamp_cell(&mut self, c: u32) {
         for v in self.st.tets[c as usize] {
             self.stamp[v as usize] = self.mark;
@@ -325,8 +379,9 @@ impl Pass<'_> {
             .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
     }
 
-    /// Makes operation `op`, stamping the nodes of every cell it changes.
+    /// Makes operation `op`, stamping the nodes of every cell it changes with its number.
     fn apply(&mut self, op: Op, done: &mut Improved) {
+        self.mark += 1;
         match op {
             Op::Collapse { a, b, kill, new } => {
                 for &c in &kill {
@@ -427,11 +482,9 @@ impl Pass<'_> {
         for i in (0..4).filter(|&i| i != k) {
             let mut n = t;
             n[i] = b;
-            if !positive(self.geo(n)) {
-                return None;
-            }
-            let q = min_dihedral(self.geo(n));
-            if q <= old {
+            // -1 where not positive.
+            let q = positive_min_dihedral(self.geo(n));
+            if q < 0.0 || q <= old {
                 return None;
             }
             new.push((n, q));
@@ -551,7 +604,17 @@ impl Pass<'_> {
     /// collapsed can make faces that cut across a bend of another interface, which a slab a
     /// few centimetres thick (near a pinch-out) cannot absorb.
     fn in_unit(&self, g: [[f64; 3]; 4], like: u32) -> bool {
-        self.in_unit_within(g, like, 0.5 * crate::FAULT_TOLERANCE)
+        let key = UnitKey {
+            g: g.map(|p| p.map(f64::to_bits)),
+            unit: self.st.below[like as usize],
+            block: self.st.block[like as usize],
+        };
+        if let Some(known) = self.units.get(&key) {
+            return known;
+        }
+        let ok = self.in_unit_within(g, like, 0.5 * crate::FAULT_TOLERANCE);
+        self.units.put(key, ok);
+        ok
     }
 
     /// [`Pass::in_unit`] with tolerance `tol` (metres).
@@ -839,18 +902,25 @@ impl Pass<'_> {
             })
         };
         // The smallest angle over the cells with `v` at `q` (-1 if one is not positive),
-        // and the worst cell.
-        let eval = |q: [f64; 3]| {
+        // the worst cell (the first of the smallest) and how many are below the floor; `None`
+        // as soon as a cell is no better than `above` or more than `most` are below the floor
+        // (a step that would be refused: the rest of its cells need not be measured).
+        let eval = |q: [f64; 3], above: f64, most: usize| {
             let (mut worst, mut poor) = ((f64::MAX, 0u32), 0);
             for &c in cells {
-                let g = geo(c, q);
-                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                let a = positive_min_dihedral(geo(c, q));
+                if a <= above {
+                    return None;
+                }
                 if a < worst.0 {
                     worst = (a, c);
                 }
                 poor += (a < self.floor) as usize;
+                if poor > most {
+                    return None;
+                }
             }
-            (worst, poor)
+            Some((worst, poor))
         };
         let mut len = f64::MAX;
         for &c in cells {
@@ -860,7 +930,7 @@ impl Pass<'_> {
                 }
             }
         }
-        let ((old, mut worst), poor) = eval(p);
+        let ((old, mut worst), poor) = eval(p, f64::NEG_INFINITY, usize::MAX)?;
         let (mut best, mut q) = (old, p);
         for _ in 0..4 {
             let h = 1e-4 * len;
@@ -881,8 +951,7 @@ impl Pass<'_> {
                 let Some(r) = self.slide(v, labels, to) else {
                     break;
                 };
-                let ((a, w), n) = eval(r);
-                if a > best && n <= poor {
+                if let Some(((a, w), _)) = eval(r, best, poor) {
                     (best, worst, q) = (a, w, r);
                     stepped = true;
                     break;
@@ -1012,7 +1081,7 @@ impl Pass<'_> {
                         self.st.points[w as usize]
                     }
                 });
-                let a = if positive(g) { min_dihedral(g) } else { -1.0 };
+                let a = positive_min_dihedral(g);
                 if a < old + MIN_GAIN {
                     ok = false;
                     break;
@@ -1167,28 +1236,30 @@ impl Pass<'_> {
                 }
             })
         };
-        let angle = |t: [u32; 4], q: [f64; 3]| {
-            let g = geo(t, q);
-            if positive(g) {
-                min_dihedral(g)
-            } else {
-                -1.0
-            }
-        };
+        let angle = |t: [u32; 4], q: [f64; 3]| positive_min_dihedral(geo(t, q));
+        let trial: Vec<[u32; 4]> = halves.iter().flat_map(|h| [h.1, h.2]).collect();
+        // The cell that refused the last trial place: measured first at the next (a place
+        // is refused by its worst cell, often the same one).
+        let first = std::cell::Cell::new(0usize);
         // The smallest angle of the new cells with the node at q, and how many are below the
-        // floor.
-        let eval = |q: [f64; 3]| {
+        // floor; `None` as soon as a cell is no better than `above` or more than `most` are
+        // below the floor (a place that would be refused). The smallest angle and the count
+        // do not depend on the order the cells are measured in.
+        let eval = |q: [f64; 3], above: f64, most: usize| {
             let (mut worst, mut n) = (f64::MAX, 0usize);
-            for &(_, t1, t2) in &halves {
-                for t in [t1, t2] {
-                    let x = angle(t, q);
-                    worst = worst.min(x);
-                    n += (x < self.floor) as usize;
+            let s = first.get();
+            for i in (s..trial.len()).chain(0..s) {
+                let x = angle(trial[i], q);
+                worst = worst.min(x);
+                n += (x < self.floor) as usize;
+                if x <= above || n > most {
+                    first.set(i);
+                    return None;
                 }
             }
-            (worst, n)
+            Some((worst, n))
         };
-        let (mut best, mut count) = eval(m);
+        let (mut best, mut count) = eval(m, f64::NEG_INFINITY, usize::MAX)?;
         let mut q = m;
         // Towards the mean of the neighbours.
         let mut mean = [0.0; 3];
@@ -1203,8 +1274,7 @@ impl Pass<'_> {
             let Some(r) = self.slide_at(flags, m, &labels, to) else {
                 break;
             };
-            let (x, n) = eval(r);
-            if x > best && n <= poor {
+            if let Some((x, n)) = eval(r, best, poor) {
                 (best, count, q) = (x, n, r);
                 break;
             }
@@ -1224,8 +1294,7 @@ impl Pass<'_> {
                     let Some(r) = self.slide_at(flags, m, &labels, to) else {
                         continue;
                     };
-                    let (x, k) = eval(r);
-                    if x > step.map_or(best, |s| s.0) && k <= poor.max(count) {
+                    if let Some((x, k)) = eval(r, step.map_or(best, |s| s.0), poor.max(count)) {
                         step = Some((x, k, r));
                     }
                 }
@@ -1444,6 +1513,7 @@ pub(crate) fn improve(
             star[v as usize].push(c as u32);
         }
     }
+    let units = UnitMemo::new(st.tets.len());
     let mut p = Pass {
         alive: vec![true; st.tets.len()],
         touched: vec![true; st.points.len()],
@@ -1462,6 +1532,7 @@ pub(crate) fn improve(
         verify: cfg!(debug_assertions) || VERIFY.load(std::sync::atomic::Ordering::Relaxed),
         objects,
         object,
+        units,
         tol: 0.5e-9
             * terrain
                 .heights
@@ -1469,70 +1540,96 @@ pub(crate) fn improve(
                 .fold(0.0f64, |s, h| s.max(h.abs()))
                 .max(1.0),
     };
-    for _ in 0..passes {
-        let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
-            .filter(|&c| {
-                let c = c as usize;
-                p.alive[c]
-                    && p.angle[c] < below
-                    && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
-            })
-            .collect();
-        bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
-        p.touched.iter_mut().for_each(|t| *t = false);
-        let before = done;
-        // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
-        // the cells are mended in order, each with its plan if no node that the plan read has
-        // changed since, else with a plan made again: exactly the serial pass, whatever the
-        // number of threads.
-        for chunk in bad.chunks(CHUNK) {
-            p.mark += 1;
-            let plans: Vec<(Option<Op>, Vec<u32>)> = {
-                let q = &p;
-                chunk
-                    .par_iter()
-                    .map(|&c| {
-                        let mut seen = Vec::new();
-                        if !q.alive[c as usize] || q.angle[c as usize] >= below {
-                            return (None, seen);
-                        }
-                        let op = q.plan(c, &mut seen);
-                        (op, seen)
-                    })
-                    .collect()
-            };
-            for (&c, (op, seen)) in chunk.iter().zip(plans) {
-                if !p.alive[c as usize] || p.angle[c as usize] >= below {
-                    continue;
-                }
-                let stale = seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] == p.mark);
-                let op = if stale {
-                    let mut seen = Vec::new();
-                    p.plan(c, &mut seen)
-                } else {
-                    op
+    // The sweeps run on a thread of the pool, so that the many small parallel batches (a
+    // chunk's plans, a few stale plans made again) are run by it and the others at once
+    // instead of each waiting for a sleeping thread to wake and take it.
+    rayon::scope(|_| {
+        for _ in 0..passes {
+            let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
+                .filter(|&c| {
+                    let c = c as usize;
+                    p.alive[c]
+                        && p.angle[c] < below
+                        && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
+                })
+                .collect();
+            bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
+            p.touched.iter_mut().for_each(|t| *t = false);
+            let before = done;
+            // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
+            // the cells are mended in order, each with its plan if no node that the plan read has
+            // changed since it was made, else with a plan made again: exactly the serial pass,
+            // whatever the number of threads. A stale plan is made again together with those of
+            // the next stale cells of the chunk (up to REPLAN, in parallel, on the mesh as it is
+            // then), each kept for its cell if nothing it read changes before the cell's turn.
+            for chunk in bad.chunks(CHUNK) {
+                let made = p.mark;
+                let mut plans: Vec<(Option<Op>, Vec<u32>, u32)> = {
+                    let q = &p;
+                    chunk
+                        .par_iter()
+                        .map(|&c| {
+                            let mut seen = Vec::new();
+                            if !q.alive[c as usize] || q.angle[c as usize] >= below {
+                                return (None, seen, made);
+                            }
+                            let op = q.plan(c, &mut seen);
+                            (op, seen, made)
+                        })
+                        .collect()
                 };
-                if let Some(op) = op {
-                    if p.verify {
-                        let before = p.cells_of(&op);
-                        let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);
-                        p.apply(op, &mut done);
-                        let after: Vec<u32> = before
-                            .into_iter()
-                            .filter(|&c| p.alive[c as usize])
-                            .chain(first..p.st.tets.len() as u32)
+                for i in 0..chunk.len() {
+                    let poor =
+                        |p: &Pass, c: u32| p.alive[c as usize] && p.angle[c as usize] < below;
+                    let stale = |p: &Pass, (_, seen, at): &(Option<Op>, Vec<u32>, u32)| {
+                        seen.is_empty() || seen.iter().any(|&v| p.stamp[v as usize] > *at)
+                    };
+                    if !poor(&p, chunk[i]) {
+                        continue;
+                    }
+                    if stale(&p, &plans[i]) {
+                        let again: Vec<usize> = (i..chunk.len())
+                            .filter(|&j| poor(&p, chunk[j]) && stale(&p, &plans[j]))
+                            .take(REPLAN)
                             .collect();
-                        p.verify(volume, &after);
-                    } else {
-                        p.apply(op, &mut done);
+                        let now = p.mark;
+                        let fresh: Vec<(Option<Op>, Vec<u32>)> = {
+                            let q = &p;
+                            again
+                                .par_iter()
+                                .map(|&j| {
+                                    let mut seen = Vec::new();
+                                    let op = q.plan(chunk[j], &mut seen);
+                                    (op, seen)
+                                })
+                                .collect()
+                        };
+                        for (j, (op, seen)) in again.into_iter().zip(fresh) {
+                            plans[j] = (op, seen, now);
+                        }
+                    }
+                    if let Some(op) = plans[i].0.take() {
+                        if p.verify {
+                            let before = p.cells_of(&op);
+                            let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);
+                            p.apply(op, &mut done);
+                            let after: Vec<u32> = before
+                                .into_iter()
+                                .filter(|&c| p.alive[c as usize])
+                                .chain(first..p.st.tets.len() as u32)
+                                .collect();
+                            p.verify(volume, &after);
+                        } else {
+                            p.apply(op, &mut done);
+                        }
                     }
                 }
             }
+            if done == before {
+                break;
+            }
         }
-        if done == before {
-            break;
-        }
-    }
+    });
     // Drop the dead cells and renumber the nodes still used.
     let alive = p.alive;
     let mut object = p.object;

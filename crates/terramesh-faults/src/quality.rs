@@ -40,13 +40,36 @@ pub fn min_dihedral(p: [[f64; 3]; 4]) -> f64 {
     let o = orient3d(c(p[0]), c(p[1]), c(p[2]), c(p[3]));
     let v = tetra_volume(p[0], p[1], p[2], p[3]);
     // Ours is positive when orient3d is negative (terramesh_core::volume's node order).
-    let sign = if o < 0.0 && v > 0.0 {
-        1.0
+    if o < 0.0 && v > 0.0 {
+        angle_of(p, 1.0)
     } else if o > 0.0 && v < 0.0 {
-        -1.0
+        angle_of(p, -1.0)
     } else {
-        return 0.0;
+        0.0
+    }
+}
+
+/// [`min_dihedral`] of a cell that is positive (`mesh::positive`: exact orientation negative
+/// and floating-point volume positive), else -1: the quality pass's measure of a trial cell,
+/// with one orientation test where `positive` then `min_dihedral` made two.
+pub(crate) fn positive_min_dihedral(p: [[f64; 3]; 4]) -> f64 {
+    let c = |q: [f64; 3]| Coord3D {
+        x: q[0],
+        y: q[1],
+        z: q[2],
     };
+    if orient3d(c(p[0]), c(p[1]), c(p[2]), c(p[3])) < 0.0
+        && tetra_volume(p[0], p[1], p[2], p[3]) > 0.0
+    {
+        angle_of(p, 1.0)
+    } else {
+        -1.0
+    }
+}
+
+/// The smallest dihedral angle of a cell whose faces' normals point out when multiplied by
+/// `sign` (0 if a face is degenerate).
+fn angle_of(p: [[f64; 3]; 4], sign: f64) -> f64 {
     // The faces wound counter-clockwise seen from outside a positive cell, opposite vertex
     // 3, 2, 0 and 1 (`mesh::outward_faces`): their normals point out of it.
     let faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
@@ -117,7 +140,8 @@ pub fn quality(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Quality {
 
 #[cfg(test)]
 mod tests {
-    use super::min_dihedral;
+    use super::{min_dihedral, positive_min_dihedral};
+    use crate::mesh::positive;
 
     /// A cell the quality pass made on a thinned set of the faulted example's holes: its four
     /// nodes lie in one plane to rounding (floating-point volume -1.3e-16 m³, exactly
@@ -146,5 +170,45 @@ mod tests {
         let a = min_dihedral(q);
         assert!(a > 54.0 && a < 55.0);
         assert_eq!(min_dihedral([q[1], q[0], q[2], q[3]]), a);
+    }
+
+    /// The pass's one-test measure is `min_dihedral` of a positive cell and -1 otherwise, bit
+    /// for bit: on cells of every orientation, near-flat ones (a node moved by 1e-15 m off
+    /// the plane of the others, where rounding decides the floating-point volume's sign) and
+    /// flat ones.
+    #[test]
+    fn positive_measure_is_the_angle_of_a_positive_cell() {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut pos, mut neg) = (0, 0);
+        for i in 0..20_000 {
+            let mut p = [[0.0; 3]; 4];
+            for q in &mut p {
+                *q = [next() * 10.0 + 300.0, next() * 10.0 - 50.0, next() * 10.0];
+            }
+            if i % 4 == 1 {
+                // The fourth node on the plane of the other three, to rounding.
+                let (u, v) = (next(), next());
+                p[3] = [0, 1, 2].map(|k| {
+                    p[0][k] + u * (p[1][k] - p[0][k]) + v * (p[2][k] - p[0][k]) + 1e-15 * next()
+                });
+            }
+            if i % 4 == 2 {
+                p[3] = p[1];
+            }
+            let want = if positive(p) { min_dihedral(p) } else { -1.0 };
+            assert_eq!(positive_min_dihedral(p).to_bits(), want.to_bits(), "{p:?}");
+            if want >= 0.0 {
+                pos += 1;
+            } else {
+                neg += 1;
+            }
+        }
+        assert!(pos > 1000 && neg > 1000, "{pos} positive, {neg} not");
     }
 }
