@@ -727,6 +727,12 @@ fn committed_structures_fixture_is_current() {
         );
     }
     assert_eq!(std::fs::read_dir(&fixture).unwrap().count(), names.len());
+    // Committed data stays under 200 KB (the project's rule for fixtures and crops).
+    let size: u64 = names
+        .iter()
+        .map(|n| std::fs::metadata(fixture.join(n)).unwrap().len())
+        .sum();
+    assert!(size < 200_000, "the committed fixture is {size} bytes");
 }
 
 /// A portal: where the tunnel's cells reach the model's side, their faces there are part of
