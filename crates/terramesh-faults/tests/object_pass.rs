@@ -5,58 +5,8 @@
 
 use terramesh_faults::*;
 
-/// The 200 m synthetic site with one fault dipping 60 degrees east and three interfaces
-/// under a flat terrain at 120 m.
-fn site() -> Site {
-    Site::new(
-        200.0,
-        10,
-        0.2,
-        1,
-        [120.0, 0.0, 0.0],
-        0.0,
-        vec![90.0, 60.0, 30.0],
-        [0.01, 0.0],
-        vec![SynthFault::new(
-            "F1",
-            [80.0, -50.0],
-            [120.0, 250.0],
-            60.0,
-            90.0,
-            12.0,
-        )],
-    )
-    .unwrap()
-}
-
-/// A closed box, outward oriented.
-fn box_solid(lo: [f64; 3], hi: [f64; 3]) -> ObjectGeometry {
-    let v = (0..8)
-        .map(|k| {
-            [
-                if k & 1 == 0 { lo[0] } else { hi[0] },
-                if k & 2 == 0 { lo[1] } else { hi[1] },
-                if k & 4 == 0 { lo[2] } else { hi[2] },
-            ]
-        })
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles = quads
-        .iter()
-        .flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    ObjectGeometry::Structure {
-        vertices: v,
-        triangles,
-    }
-}
+mod common;
+use common::{box_solid, flat_site};
 
 /// A lined circular tunnel 6 m across through F1, a pit with 60-degree faces and a box
 /// structure under the terrain.
@@ -173,7 +123,7 @@ fn build(site: &Site) -> (FaultedMesh, Vec<ObjectCheck>, Quality) {
 /// with `--nocapture`; the bounds below leave room for rounding on other machines).
 #[test]
 fn quality_pass_mends_the_cells_next_to_object_walls() {
-    let (mesh, checks, q) = build(&site());
+    let (mesh, checks, q) = build(&flat_site());
     let (cells, poor, min) = near_walls(&mesh);
     assert!(cells > 10_000, "{cells} cells at the walls");
     assert!(
@@ -194,7 +144,7 @@ fn quality_pass_mends_the_cells_next_to_object_walls() {
 #[test]
 fn quality_pass_never_moves_a_cell_across_an_object_wall() {
     verify_each_operation(true);
-    let (mesh, _, _) = build(&site());
+    let (mesh, _, _) = build(&flat_site());
     verify_each_operation(false);
     assert!(mesh.report.collapsed > 0 && mesh.report.flipped > 0);
     // The three objects keep their cells: the lining only in the tunnel, every label in range.

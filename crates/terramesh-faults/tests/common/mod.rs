@@ -1,0 +1,55 @@
+//! Sites and solids shared by the kernel's object tests (`dam_above.rs`, `object_pass.rs`).
+
+use terramesh_faults::*;
+
+/// The 200 m synthetic site with one fault dipping 60 degrees east (trace near x = 90 to 96
+/// for y = 40 to 70) and three interfaces under a flat terrain at 120 m.
+pub fn flat_site() -> Site {
+    Site::new(
+        200.0,
+        10,
+        0.2,
+        1,
+        [120.0, 0.0, 0.0],
+        0.0,
+        vec![90.0, 60.0, 30.0],
+        [0.01, 0.0],
+        vec![SynthFault::new(
+            "F1",
+            [80.0, -50.0],
+            [120.0, 250.0],
+            60.0,
+            90.0,
+            12.0,
+        )],
+    )
+    .unwrap()
+}
+
+/// A closed box, outward oriented.
+pub fn box_solid(lo: [f64; 3], hi: [f64; 3]) -> ObjectGeometry {
+    let v = (0..8)
+        .map(|k| {
+            [
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            ]
+        })
+        .collect();
+    let quads: [[u32; 4]; 6] = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    ObjectGeometry::Structure {
+        vertices: v,
+        triangles: quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect(),
+    }
+}
