@@ -580,6 +580,12 @@ fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
 }
 
 impl ObjectSet {
+    /// The distance [`check_objects`] allows object `o`'s cells to stray from its walls
+    /// (metres): the larger of [`OBJECT_TOLERANCE`] and 4 times its facet tolerance.
+    pub(crate) fn tolerance(&self, o: &Object) -> f64 {
+        OBJECT_TOLERANCE.max(4.0 * self.resolution * o.size)
+    }
+
     /// Validates the objects against the region (the terrain's plan and the base) and computes
     /// their exact volumes inside the model.
     ///
@@ -1979,7 +1985,7 @@ pub(crate) fn cut_objects(
         // A move onto a fault or an interface (along it, staying on the wall) may take the
         // node this far from the chord (half the tolerance of check_objects); a farther one
         // (an edge between two nodes of the surface that is not on its faces) keeps the chord.
-        let most = 0.5 * OBJECT_TOLERANCE.max(4.0 * set.resolution * o.size);
+        let most = 0.5 * set.tolerance(o);
         let chords: Vec<[f64; 3]> = keys
             .par_iter()
             .map(|&k| {
@@ -2116,7 +2122,7 @@ pub fn check_objects(
     for (i, o) in set.objects.iter().enumerate() {
         out[i].exact = o.exact[0];
         out[i].lining_exact = o.exact[1];
-        let tol = OBJECT_TOLERANCE.max(4.0 * set.resolution * o.size);
+        let tol = set.tolerance(o);
         out[i].tolerance = tol;
         for &w in o.walls() {
             let f = |q: [f64; 3]| o.field(w, q);

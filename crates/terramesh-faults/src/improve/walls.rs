@@ -140,10 +140,9 @@ impl Pass<'_> {
             }
         }
         let c = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
-        let res = self.objects.resolution;
         self.objects.objects.iter().enumerate().all(|(i, o)| {
             let mine = code / 2 == i as u32 + 1;
-            let tol = OBJECT_TOLERANCE.max(4.0 * res * o.size);
+            let tol = self.objects.tolerance(o);
             let margin = 1e-3 + o.size * 1e-6 + tol;
             let [blo, bhi] = o.bbox;
             if !mine && (0..3).any(|k| hi[k] < blo[k] - margin || lo[k] > bhi[k] + margin) {
