@@ -316,6 +316,35 @@ mod tests {
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
+    /// Bytes of several blocks and a partial one, written in pieces of awkward sizes: the file
+    /// holds them exactly, whether the folder takes `O_DIRECT` (ext4 here) or not (tmpfs).
+    #[test]
+    fn blocks_and_a_tail_are_written_exactly() {
+        let data: Vec<u8> = (0..3 * CHUNK + 12_345)
+            .map(|i| (i * 7 + i / 4099) as u8)
+            .collect();
+        let mut dirs = vec![tempfile::tempdir().unwrap()];
+        if let Ok(d) = tempfile::tempdir_in("/dev/shm") {
+            dirs.push(d);
+        }
+        for dir in &dirs {
+            for size in [data.len(), CHUNK, CHUNK - 1, 5, 0] {
+                let p = dir.path().join(format!("f{size}.bin"));
+                let mut o = Output::create(Some(&p)).unwrap();
+                let (mut at, mut step) = (0, 1);
+                while at < size {
+                    let k = step.min(size - at);
+                    o.write_all(&data[at..at + k]).unwrap();
+                    at += k;
+                    step = step * 3 + 1;
+                }
+                o.flush().unwrap();
+                o.commit().unwrap();
+                assert!(fs::read(&p).unwrap() == data[..size], "{size} bytes in {p:?}");
+            }
+        }
+    }
+
     #[test]
     fn missing_directory_is_a_clear_error() {
         let e = Output::create(Some(Path::new("/nonexistent-dir/x.csv")))
