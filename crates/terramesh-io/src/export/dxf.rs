@@ -124,9 +124,8 @@ mod tests {
         ];
         let text = super::VertexText::new(&v);
         for (i, p) in v.iter().enumerate() {
-            let got = text.get(i);
-            for k in 0..3 {
-                assert_eq!(got[k], format!("{}", p[k]).as_bytes(), "{i} {k}");
+            for (k, (got, c)) in text.get(i).iter().zip(p).enumerate() {
+                assert_eq!(*got, format!("{c}").as_bytes(), "{i} {k}");
             }
         }
         // across parts
