@@ -340,7 +340,10 @@ mod tests {
                 }
                 o.flush().unwrap();
                 o.commit().unwrap();
-                assert!(fs::read(&p).unwrap() == data[..size], "{size} bytes in {p:?}");
+                assert!(
+                    fs::read(&p).unwrap() == data[..size],
+                    "{size} bytes in {p:?}"
+                );
             }
         }
     }
