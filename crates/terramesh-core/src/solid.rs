@@ -219,7 +219,7 @@ fn closed_fast(triangles: &[[u32; 3]]) -> bool {
             })
             .collect();
         e.par_sort_unstable();
-        e.len() % 2 == 0
+        e.len().is_multiple_of(2)
             && e.par_chunks(2)
                 .all(|p| p[0] >> 1 == p[1] >> 1 && p[0] & 1 == 0 && p[1] & 1 == 1)
     })
