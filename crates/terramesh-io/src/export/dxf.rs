@@ -66,13 +66,16 @@ const PART: usize = 1 << 14;
 /// lengths.
 struct VertexText {
     parts: Vec<Vec<u8>>,
-    at: Vec<(u32, [u16; 3])>,
+    at: Vec<Where>,
 }
+
+/// Where a vertex's text starts in its part, and its three numbers' lengths.
+type Where = (u32, [u16; 3]);
 
 impl VertexText {
     fn new(vertices: &[[f64; 3]]) -> VertexText {
         use rayon::prelude::*;
-        let made: Vec<(Vec<u8>, Vec<(u32, [u16; 3])>)> = vertices
+        let made: Vec<(Vec<u8>, Vec<Where>)> = vertices
             .par_chunks(PART)
             .map(|part| {
                 let mut text = Vec::with_capacity(part.len() * 48);
