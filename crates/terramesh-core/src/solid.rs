@@ -148,6 +148,16 @@ fn uses(edges: &[u64], a: u32, b: u32) -> usize {
 /// assert!(check_closed(&t[..3]).is_err());
 /// ```
 pub fn check_closed(triangles: &[[u32; 3]]) -> Result<(), SolidError> {
+    if closed_fast(triangles) {
+        return Ok(());
+    }
+    // Something is wrong: find the first bad edge as the error names it.
+    check_closed_general(triangles)
+}
+
+/// [`check_closed`] by the directed edges' sorted runs and a binary search for each one's
+/// reverse: the first bad edge in `(a, b)` order.
+fn check_closed_general(triangles: &[[u32; 3]]) -> Result<(), SolidError> {
     let edges = sorted_edges(triangles);
     // The first bad edge in (a, b) order.
     let bad = runs(&edges)
@@ -163,6 +173,60 @@ pub fn check_closed(triangles: &[[u32; 3]]) -> Result<(), SolidError> {
         }),
     }
 }
+
+/// Whether every edge of `triangles` is used exactly once in each direction: the undirected
+/// edges with their direction in the lowest bit, sorted in parallel, in pairs of the same edge
+/// one way and the other (one sort and a scan, without [`check_closed`]'s binary search per
+/// edge, which only the error needs). The edges go in passes by their lower vertex, at most
+/// [`EDGES_PER_PASS`] each, so that the memory is a pass's (both directions of an edge share
+/// its lower vertex, so they meet in the same pass).
+fn closed_fast(triangles: &[[u32; 3]]) -> bool {
+    use rayon::prelude::*;
+    // Two indices and a bit in 64: below 2^31 vertices (else the general path decides).
+    let Some(&top) = triangles.iter().flatten().max() else {
+        return true;
+    };
+    if top >= 1 << 31 {
+        return false;
+    }
+    // Edges per lower vertex, and passes of whole vertex ranges.
+    let mut count = vec![0u32; top as usize + 1];
+    for t in triangles {
+        for k in 0..3 {
+            count[t[k].min(t[(k + 1) % 3]) as usize] += 1;
+        }
+    }
+    let mut ranges = Vec::new();
+    let (mut lo, mut sum) = (0usize, 0usize);
+    for (v, &c) in count.iter().enumerate() {
+        if sum + c as usize > EDGES_PER_PASS && sum > 0 {
+            ranges.push((lo as u64, v as u64));
+            (lo, sum) = (v, 0);
+        }
+        sum += c as usize;
+    }
+    ranges.push((lo as u64, count.len() as u64));
+    drop(count);
+    ranges.into_iter().all(|(lo, hi)| {
+        let mut e: Vec<u64> = triangles
+            .par_iter()
+            .flat_map_iter(|t| {
+                (0..3).filter_map(move |k| {
+                    let (a, b) = (u64::from(t[k]), u64::from(t[(k + 1) % 3]));
+                    let m = a.min(b);
+                    (lo <= m && m < hi).then_some((m << 33) | (a.max(b) << 1) | u64::from(a > b))
+                })
+            })
+            .collect();
+        e.par_sort_unstable();
+        e.len().is_multiple_of(2)
+            && e.par_chunks(2)
+                .all(|p| p[0] >> 1 == p[1] >> 1 && p[0] & 1 == 0 && p[1] & 1 == 1)
+    })
+}
+
+/// Edges [`closed_fast`] sorts at a time (8 bytes each).
+const EDGES_PER_PASS: usize = 1 << 22;
 
 /// Signed volume enclosed by a closed triangulation (positive when normals point outward),
 /// by the divergence theorem about the first vertex (for precision at UTM magnitudes).
@@ -257,6 +321,42 @@ mod tests {
         assert_eq!(s.wall_triangles, 2 * (4 * 5 + 4));
         let want = volume_above(&v, &t, 0.0);
         assert!((volume(&s.vertices, &s.triangles) - want).abs() < 1e-9 * want);
+    }
+
+    #[test]
+    fn the_fast_check_agrees_with_the_general_one() {
+        let (v, t) = grid(9, 7);
+        let closed = extrude(&v, &t, 0.0).unwrap().triangles;
+        let mut cases = vec![closed.clone(), t.clone(), Vec::new()];
+        // one face flipped, one doubled, one dropped, a degenerate face added
+        let mut c = closed.clone();
+        c[5] = [c[5][0], c[5][2], c[5][1]];
+        cases.push(c);
+        let mut c = closed.clone();
+        c.push(closed[3]);
+        cases.push(c);
+        cases.push(closed[1..].to_vec());
+        let mut c = closed.clone();
+        c.push([4, 4, 4]);
+        cases.push(c);
+        // a closed tetrahedron and the same with its faces reversed (closed too)
+        let tet = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+        cases.push(tet.iter().map(|t| [t[0], t[2], t[1]]).collect());
+        cases.push(tet);
+        for (k, c) in cases.iter().enumerate() {
+            assert_eq!(closed_fast(c), check_closed_general(c).is_ok(), "case {k}");
+            assert_eq!(check_closed(c), check_closed_general(c), "case {k}");
+        }
+        assert!(closed_fast(&closed) && !closed_fast(&t));
+        // more than one pass: a large closed solid, and it with one face flipped
+        let (v, t) = grid(1200, 1200);
+        let mut s = extrude(&v, &t, 0.0).unwrap().triangles;
+        assert!(3 * s.len() > 2 * EDGES_PER_PASS);
+        assert!(closed_fast(&s));
+        let k = s.len() / 2;
+        s[k] = [s[k][0], s[k][2], s[k][1]];
+        assert!(!closed_fast(&s));
+        assert!(check_closed(&s).is_err());
     }
 
     #[test]

@@ -31,21 +31,28 @@ where
     F: Fn(Range<usize>, &mut Vec<u8>) -> io::Result<()> + Sync,
 {
     let block = block.max(1);
-    let window = block * 2 * rayon::current_num_threads().max(1);
+    let per_window = 2 * rayon::current_num_threads().max(1);
+    let window = block * per_window;
+    // The window's buffers, kept from one window to the next: after the first, formatting
+    // neither grows (copies) nor allocates (faults in) a buffer.
+    let mut bufs: Vec<Vec<u8>> = Vec::new();
     let mut start = 0;
     while start < n {
         let end = (start + window).min(n);
         let starts: Vec<usize> = (start..end).step_by(block).collect();
-        let bufs: Vec<io::Result<Vec<u8>>> = starts
-            .into_par_iter()
-            .map(|a| {
-                let mut b = Vec::with_capacity(64 * block);
-                format(a..(a + block).min(end), &mut b)?;
-                Ok(b)
+        if bufs.len() < starts.len() {
+            bufs.resize_with(starts.len(), || Vec::with_capacity(64 * block));
+        }
+        bufs[..starts.len()]
+            .par_iter_mut()
+            .zip(starts)
+            .map(|(b, a)| {
+                b.clear();
+                format(a..(a + block).min(end), b)
             })
-            .collect();
-        for b in bufs {
-            w.write_all(&b?)?;
+            .collect::<io::Result<()>>()?;
+        for b in &bufs[..((end - start).div_ceil(block))] {
+            w.write_all(b)?;
         }
         start = end;
     }

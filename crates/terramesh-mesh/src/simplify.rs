@@ -225,29 +225,40 @@ pub fn simplify_to(
     }
 
     let mut rounds = 0;
+    // Each vertex's location starts at a vertex of the face it lay in the round before (the
+    // copy only gains vertices, so that face's corners stay near it): a walk of a step or two.
+    let mut hints = vec![u32::MAX; n];
     let max_error = loop {
-        let errors = vertical_errors(&copy.cdt, mesh, z, &copy.src, &order, &copy.used);
+        let errors = vertical_errors(
+            &copy.cdt, mesh, z, &copy.src, &order, &copy.used, &mut hints,
+        );
         let max_error = errors.iter().map(|e| e.1).fold(0.0, f64::max);
         let room = max_vertices.saturating_sub(copy.src.len());
         if room == 0 || max_error == 0.0 || rounds == MAX_ROUNDS {
             break max_error;
         }
-        // The furthest vertex of each face of the copy, the largest errors first.
-        let mut worst: Vec<(f64, u32)> = vec![(0.0, u32::MAX); copy.cdt.num_all_faces()];
+        // The furthest vertex of each face of the copy, the largest errors first, each with
+        // a corner of its face (`hints`) where the insertion's walk starts: the faces are
+        // split by the insertions before it, but that corner stays next to it (without it,
+        // spade walks from the last vertex inserted, across the copy between picks in order
+        // of error).
+        let mut worst: Vec<(f64, u32, u32)> =
+            vec![(0.0, u32::MAX, u32::MAX); copy.cdt.num_all_faces()];
         for (k, &(face, err)) in errors.iter().enumerate() {
             if face == u32::MAX {
                 continue;
             }
             let w = &mut worst[face as usize];
             if err > w.0 {
-                *w = (err, order[k]);
+                *w = (err, order[k], hints[k]);
             }
         }
-        let mut picks: Vec<(f64, u32)> = worst.into_iter().filter(|w| w.0 > 0.0).collect();
+        let mut picks: Vec<(f64, u32, u32)> = worst.into_iter().filter(|w| w.0 > 0.0).collect();
         picks.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         picks.truncate(room);
-        for (_, v) in picks {
-            copy.insert(mesh, v as usize)?;
+        for (_, v, hint) in picks {
+            let hint = (hint != u32::MAX).then(|| FixedVertexHandle::from_index(hint as usize));
+            copy.insert_near(mesh, v as usize, hint)?;
         }
         rounds += 1;
     };
@@ -274,16 +285,28 @@ struct Copy {
 
 impl Copy {
     fn insert(&mut self, mesh: &Mesh, v: usize) -> Result<(), SimplifyError> {
+        self.insert_near(mesh, v, None)
+    }
+
+    /// Inserts full-mesh vertex `v`, its location starting at `hint` when given.
+    fn insert_near(
+        &mut self,
+        mesh: &Mesh,
+        v: usize,
+        hint: Option<FixedVertexHandle>,
+    ) -> Result<(), SimplifyError> {
         let p = mesh.points[v];
-        let h = self
-            .cdt
-            .insert(Point2::new(p[0], p[1]))
-            .map_err(|e| SimplifyError::Insertion {
-                vertex: v,
-                x: p[0],
-                y: p[1],
-                why: format!("{e:?}"),
-            })?;
+        let q = Point2::new(p[0], p[1]);
+        let h = match hint {
+            Some(hint) => self.cdt.insert_with_hint(q, hint),
+            None => self.cdt.insert(q),
+        }
+        .map_err(|e| SimplifyError::Insertion {
+            vertex: v,
+            x: p[0],
+            y: p[1],
+            why: format!("{e:?}"),
+        })?;
         if h.index() == self.src.len() {
             self.src.push(v as u32);
         }
@@ -294,7 +317,9 @@ impl Copy {
 }
 
 /// For each vertex of `order` (full-mesh indices): the face of the copy it lies in and its
-/// vertical error there; `(u32::MAX, 0.0)` for vertices of the copy.
+/// vertical error there; `(u32::MAX, 0.0)` for vertices of the copy. `hints[k]`: a copy vertex
+/// near `order[k]` where the walk starts (`u32::MAX`: the previous vertex's), updated to one of
+/// the face found.
 fn vertical_errors(
     cdt: &Cdt,
     mesh: &Mesh,
@@ -302,18 +327,23 @@ fn vertical_errors(
     src: &[u32],
     order: &[u32],
     used: &[bool],
+    hints: &mut [u32],
 ) -> Vec<(u32, f64)> {
     const CHUNK: usize = 4096;
     let height = |h: FixedVertexHandle| z[src[h.index()] as usize];
     let mut out = vec![(u32::MAX, 0.0); order.len()];
     out.par_chunks_mut(CHUNK)
         .zip(order.par_chunks(CHUNK))
-        .for_each(|(out, vs)| {
+        .zip(hints.par_chunks_mut(CHUNK))
+        .for_each(|((out, vs), hs)| {
             let mut hint = FixedVertexHandle::from_index(0);
-            for (o, &v) in out.iter_mut().zip(vs) {
+            for ((o, &v), h) in out.iter_mut().zip(vs).zip(hs) {
                 let v = v as usize;
                 if used[v] {
                     continue;
+                }
+                if *h != u32::MAX {
+                    hint = FixedVertexHandle::from_index(*h as usize);
                 }
                 let p = mesh.points[v];
                 let q = Point2::new(p[0], p[1]);
@@ -356,6 +386,7 @@ fn vertical_errors(
                     PositionInTriangulation::OutsideOfConvexHull(_)
                     | PositionInTriangulation::NoTriangulation => (u32::MAX, 0.0),
                 };
+                *h = hint.index() as u32;
             }
         });
     out

@@ -121,8 +121,9 @@ fn data_section(out: &mut dyn Write, tag: &str, arrays: &[(&str, &[f64])]) -> io
             "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
         )?;
         write_in_blocks(out, values.len(), BLOCK, |r, out| {
-            for v in &values[r] {
-                writeln!(out, "{v:?}")?;
+            for &v in &values[r] {
+                push_debug(out, v);
+                out.push(b'\n');
             }
             Ok(())
         })?;

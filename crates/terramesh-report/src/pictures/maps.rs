@@ -245,19 +245,26 @@ fn contour_segment(
     t: &[u32; 3],
     level: f64,
 ) -> Option<((f64, f64), (f64, f64))> {
-    let mut pts = Vec::with_capacity(2);
+    // (no allocation: this runs for every triangle at every level)
+    let below = t.map(|i| v[i as usize] - level < 0.0);
+    if below[0] == below[1] && below[1] == below[2] {
+        return None;
+    }
+    let mut pts = [(0.0, 0.0); 3];
+    let mut n = 0;
     for k in 0..3 {
         let (i, j) = (t[k] as usize, t[(k + 1) % 3] as usize);
         let (a, b) = (v[i] - level, v[j] - level);
         if (a < 0.0) != (b < 0.0) {
             let f = a / (a - b);
-            pts.push((
+            pts[n] = (
                 xy[i][0] + f * (xy[j][0] - xy[i][0]),
                 xy[i][1] + f * (xy[j][1] - xy[i][1]),
-            ));
+            );
+            n += 1;
         }
     }
-    (pts.len() == 2).then(|| (pts[0], pts[1]))
+    (n == 2).then_some((pts[0], pts[1]))
 }
 
 /// A 1-2-5 step not smaller than `raw`.

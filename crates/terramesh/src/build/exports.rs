@@ -145,6 +145,7 @@ pub fn write_all(
     let mesh = &m.mesh;
     let n = mesh.points.len();
     let abs: Vec<[f64; 3]> = (0..n)
+        .into_par_iter()
         .map(|i| {
             let q = mesh.absolute(i);
             [q[0], q[1], it.dsm[i]]
@@ -153,7 +154,7 @@ pub fn write_all(
     let tris = &mesh.triangles;
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
     let min_angle: Vec<f64> = tris
-        .iter()
+        .par_iter()
         .map(|t| {
             let q = t.map(|i| {
                 let a = mesh.points[i as usize];
