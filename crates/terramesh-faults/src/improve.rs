@@ -12,7 +12,9 @@
 //! label lies on no fault, no interface and no zone's wall; a node between the inside and the
 //! outside of one zone moves along its wall and is collapsed only into a node on that wall;
 //! a node may be collapsed into a neighbour only if every label around it is found around the
-//! neighbour too (so the neighbour lies on every surface the node lies on), and never if it
+//! neighbour too (so the neighbour lies on every surface the node lies on), or, within
+//! [`MERGE`] of it, up to the unit (two blocks' interfaces crossing a fault junction a few
+//! millimetres apart; the cells made are held to their units as every collapse's), and never if it
 //! lies on the terrain or a side (the DSM and the region's outline stay as they are); a node
 //! on the base only into a node on the base. The cells of a collapsed node's star are then
 //! cones from the neighbour over the star's boundary: with every cone positive they tile the
@@ -156,6 +158,11 @@ const MIN_GAIN: f64 = 1e-6;
 /// A cell's label: its side of every fault, its unit, its block, the fault zones it lies in
 /// (bit f: between the walls of fault f's zone), its object label ([`walls::code`]).
 type Label = (u64, u32, u32, u64, u32);
+
+/// Nodes closer than this (metres) may be collapsed into each other although they lie on
+/// different interfaces (of one block or of blocks meeting at a fault): the fault
+/// tolerance of [`crate::check`], twice the half of it that every new cell is held to.
+const MERGE: f64 = crate::FAULT_TOLERANCE;
 
 /// An operation the pass found for a poor cell, to be made by [`Pass::apply`].
 enum Op {
@@ -660,10 +667,19 @@ impl Pass<'_> {
             return None;
         }
         let [(ca, la), (cb, lb)] = around;
-        if !la.iter().all(|l| lb.binary_search(l).is_ok())
-            || !self.zone_kept(a, b, la)
-            || !self.object_kept(a, b, la)
-        {
+        // Two nodes closer than MERGE may differ in their units: where two blocks'
+        // interfaces cross a fault junction a few millimetres apart, the edge between their
+        // nodes makes a sliver of every cell around it; the cells it makes are held to their
+        // units below (`in_unit`, at half `check`'s tolerance) as every collapse's are.
+        let short = d2(self.st.points[a as usize], self.st.points[b as usize]) <= MERGE * MERGE;
+        let found = |l: &Label| {
+            lb.binary_search(l).is_ok()
+                || (short
+                    && lb
+                        .iter()
+                        .any(|m| (m.0, m.2, m.3, m.4) == (l.0, l.2, l.3, l.4)))
+        };
+        if !la.iter().all(found) || !self.zone_kept(a, b, la) || !self.object_kept(a, b, la) {
             return None;
         }
         let walled = la.iter().any(|l| l.3 != la[0].3);

@@ -67,8 +67,8 @@
 //! 3. Every cell then lies on one side of every fault and interface: its side bits give its
 //!    block, the number of interfaces above it its unit. A fault's faces are the faces
 //!    between cells on its two sides where it is active.
-//! 4. A quality pass (`MeshSettings::improve_degrees`, default 5; `improve_passes`, default
-//!    6): every cell whose smallest dihedral angle is below that, worst first, is mended by
+//! 4. A quality pass (`MeshSettings::improve_degrees`, default 6; `improve_passes`, at
+//!    most 30 sweeps, stopping at one that changes nothing): every cell whose smallest dihedral angle is below that, worst first, is mended by
 //!    the first of: collapsing one of its edges (shortest first); a 3-2 flip of one of its
 //!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
@@ -80,7 +80,9 @@
 //!    `height`); a node between the two sides of one fault moves along the fault (projected on
 //!    it); a node between the inside and the outside of one zone, on its wall, along the wall. A node is
 //!    collapsed into a neighbour only if every label around it is found around the neighbour
-//!    (so the neighbour lies on every surface it lies on), a node on the base only into one on
+//!    (so the neighbour lies on every surface it lies on), or, for a neighbour within
+//!    `check`'s 1 cm, a label of the same fault sides, zones and objects in another unit
+//!    (where two blocks' interfaces cross a fault junction millimetres apart), a node on the base only into one on
 //!    the base, never a node on a side, a node on the terrain only if the cutting made it
 //!    (never a DSM vertex) and only into a terrain node, the new terrain faces checked on the
 //!    DSM. An operation is kept only if every new cell has a positive volume (exact

@@ -43,10 +43,12 @@ pub struct MeshSettings {
     /// below the smaller of this and what it was, degrees (default 10).
     pub guard_degrees: f64,
     /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
-    /// by edge collapses, flips, node moves and edge splits that keep every label (default 5;
-    /// 0 turns it off).
+    /// by edge collapses, flips, node moves and edge splits that keep every label (default 6:
+    /// a degree above issue 31's 5-degree floor, so that the cells just above it are mended
+    /// too and make room for the poor cells next to them; 0 turns it off).
     pub improve_degrees: f64,
-    /// Sweeps of that quality pass over the cells below `improve_degrees` (default 6).
+    /// At most this many sweeps of that quality pass over the cells below `improve_degrees`
+    /// (default 30); the pass stops at the first sweep that changes nothing.
     pub improve_passes: usize,
     /// Before meshing, planar triangles whose longest edge exceeds this many times the
     /// thinnest slab at their vertices (between two nearly parallel surfaces: terrain, base,
@@ -70,8 +72,8 @@ impl MeshSettings {
             max_cell_height,
             snap: 0.35,
             guard_degrees: 10.0,
-            improve_degrees: 5.0,
-            improve_passes: 6,
+            improve_degrees: 6.0,
+            improve_passes: 30,
             refine_ratio: 10.0,
             refine_min_thickness: 0.25,
             refine_max_cells: 600_000,
