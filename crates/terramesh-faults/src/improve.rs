@@ -87,6 +87,48 @@ struct Pass<'a> {
     object: Vec<u32>,
     /// The answers of [`Pass::in_unit`] found so far (by any thread).
     units: UnitMemo,
+    /// What the plans found and their time, with `TERRAMESH_PASS_STATS` set ([`Stats`]).
+    stats: Option<Stats>,
+}
+
+/// The pass's own figures, printed per sweep on standard error when the environment variable
+/// `TERRAMESH_PASS_STATS` is set (for profiling; nothing else changes): the cells below the
+/// floor, the plans made (and made again, stale), the operations made, and per kind of plan
+/// (the operation it found, or none) how many and their summed time on all threads.
+#[derive(Default)]
+struct Stats {
+    /// Per outcome (collapse, flip, move to the mean, gradient move, split, none): plans.
+    plans: [std::sync::atomic::AtomicU64; 6],
+    /// The same, nanoseconds.
+    nanos: [std::sync::atomic::AtomicU64; 6],
+    replans: std::sync::atomic::AtomicU64,
+}
+
+impl Stats {
+    fn from_env() -> Option<Self> {
+        std::env::var_os("TERRAMESH_PASS_STATS").map(|_| Self::default())
+    }
+
+    /// One line for sweep `sweep` (from 1), resetting the counts.
+    fn print(&self, sweep: usize, poor: usize, made: usize, secs: f64) {
+        use std::sync::atomic::Ordering::Relaxed;
+        let take = |a: &std::sync::atomic::AtomicU64| a.swap(0, Relaxed);
+        let kinds = ["collapse", "flip", "mean", "gradient", "split", "none"];
+        let per: Vec<String> = kinds
+            .iter()
+            .enumerate()
+            .map(|(k, name)| {
+                let (n, t) = (take(&self.plans[k]), take(&self.nanos[k]));
+                format!("{name} {n} ({:.2} s)", t as f64 * 1e-9)
+            })
+            .collect();
+        eprintln!(
+            "quality pass: sweep {sweep}: {poor} cells below the floor, {made} operations, \
+             {} plans made again, {secs:.2} s; plans: {}",
+            take(&self.replans),
+            per.join(", ")
+        );
+    }
 }
 
 /// What [`Pass::in_unit`] depends on: the cell's nodes (bit for bit, in order), its unit and
@@ -326,6 +368,20 @@ impl Pass<'_> {
     /// around its nodes: all that the plan read (with those cells), so that the plan holds as
     /// long as none of them changed.
     fn plan(&self, c: u32, seen: &mut Vec<u32>) -> Option<Op> {
+        let Some(stats) = &self.stats else {
+            return self.plan_kind(c, seen).0;
+        };
+        let t0 = std::time::Instant::now();
+        let (op, k) = self.plan_kind(c, seen);
+        let ns = t0.elapsed().as_nanos() as u64;
+        stats.plans[k].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        stats.nanos[k].fetch_add(ns, std::sync::atomic::Ordering::Relaxed);
+        op
+    }
+
+    /// [`Pass::plan`] and the kind of plan found (0 collapse, 1 flip, 2 move to the mean, 3
+    /// gradient move, 4 split, 5 none).
+    fn plan_kind(&self, c: u32, seen: &mut Vec<u32>) -> (Option<Op>, usize) {
         let t = self.st.tets[c as usize];
         let mut edges: Vec<(f64, u32, u32)> = EDGES
             .iter()
@@ -359,31 +415,33 @@ impl Pass<'_> {
         for &(_, u, v) in &edges {
             for (a, b) in [(u, v), (v, u)] {
                 if let Some(op) = self.collapse(a, b, [at(a), at(b)]) {
-                    return Some(op);
+                    return (Some(op), 0);
                 }
             }
         }
         let stars = [0, 1, 2, 3].map(|i| around[i].0.as_slice());
         if let Some(op) = self.try_flips(c, &stars) {
-            return Some(op);
+            return (Some(op), 1);
         }
         for v in t {
             let (cells, labels) = at(v);
             if let Some(op) = self.smooth(v, cells, labels) {
-                return Some(op);
+                return (Some(op), 2);
             }
         }
         if let Some(op) = t.into_iter().find_map(|v| {
             let (cells, labels) = at(v);
             self.optimise(v, cells, labels)
         }) {
-            return Some(op);
+            return (Some(op), 3);
         }
         // Last, a new node on one of its edges, longest first.
-        edges
+        let op = edges
             .iter()
             .rev()
-            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
+            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0));
+        let kind = if op.is_some() { 4 } else { 5 };
+        (op, kind)
     }
 
     /// Makes operation `op`, stamping the nodes of every cell it changes with its number.
@@ -1549,6 +1607,7 @@ pub(crate) fn improve(
         objects,
         object,
         units,
+        stats: Stats::from_env(),
         tol: 0.5e-9
             * terrain
                 .heights
@@ -1560,7 +1619,8 @@ pub(crate) fn improve(
     // chunk's plans, a few stale plans made again) are run by it and the others at once
     // instead of each waiting for a sleeping thread to wake and take it.
     rayon::scope(|_| {
-        for _ in 0..passes {
+        for sweep in 1..=passes {
+            let started = std::time::Instant::now();
             let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
                 .filter(|&c| {
                     let c = c as usize;
@@ -1572,6 +1632,7 @@ pub(crate) fn improve(
             bad.sort_by(|&x, &y| p.angle[x as usize].total_cmp(&p.angle[y as usize]));
             p.touched.iter_mut().for_each(|t| *t = false);
             let before = done;
+            let mut made_ops = 0;
             // The plans of a chunk of poor cells are made in parallel on the mesh as it is, then
             // the cells are mended in order, each with its plan if no node that the plan read has
             // changed since it was made, else with a plan made again: exactly the serial pass,
@@ -1620,11 +1681,18 @@ pub(crate) fn improve(
                                 })
                                 .collect()
                         };
+                        if let Some(s) = &p.stats {
+                            s.replans.fetch_add(
+                                again.len() as u64,
+                                std::sync::atomic::Ordering::Relaxed,
+                            );
+                        }
                         for (j, (op, seen)) in again.into_iter().zip(fresh) {
                             plans[j] = (op, seen, now);
                         }
                     }
                     if let Some(op) = plans[i].0.take() {
+                        made_ops += 1;
                         if p.verify {
                             let before = p.cells_of(&op);
                             let (volume, first) = (p.volume(&before), p.st.tets.len() as u32);
@@ -1640,6 +1708,9 @@ pub(crate) fn improve(
                         }
                     }
                 }
+            }
+            if let Some(s) = &p.stats {
+                s.print(sweep, bad.len(), made_ops, started.elapsed().as_secs_f64());
             }
             if done == before {
                 break;

@@ -1067,6 +1067,22 @@ pub fn faulted_mesh_with_objects(
     objects: &crate::ObjectSet,
 ) -> Result<FaultedMesh, FaultError> {
     let dsm_vertices = terrain.points.len();
+    // With `TERRAMESH_PASS_STATS` set (for profiling), each stage's end: its time since the
+    // start, the cells and those below 5 degrees.
+    let started = std::time::Instant::now();
+    let stats = std::env::var_os("TERRAMESH_PASS_STATS").is_some();
+    let stage = |what: &str, st: &State| {
+        if stats {
+            let q = crate::quality::quality(&st.points, &st.tets);
+            eprintln!(
+                "faulted mesh: {what} at {:.2} s: {} cells, {} below 5 degrees, smallest {:.3}",
+                started.elapsed().as_secs_f64(),
+                st.tets.len(),
+                q.below_5,
+                q.min
+            );
+        }
+    };
     let refined = crate::refine::refine(terrain, faults, interfaces, height, settings)?;
     let added = refined
         .as_ref()
@@ -1079,6 +1095,7 @@ pub fn faulted_mesh_with_objects(
     // edges or inside its triangles) may be collapsed into another terrain node where the new
     // terrain faces still lie on the DSM.
     let background_nodes = dsm_vertices * (st.points.len() / terrain.points.len());
+    stage("background", &st);
     let object_cells = crate::objects::refine_near_objects(&mut st, objects)?;
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
@@ -1097,6 +1114,7 @@ pub fn faulted_mesh_with_objects(
             *p |= b;
         }
     }
+    stage("faults cut", &st);
     // The blocks.
     let keys: Vec<BlockKey> = st
         .positive
@@ -1208,6 +1226,7 @@ pub fn faulted_mesh_with_objects(
             }
         }
     }
+    stage("interfaces cut", &st);
     let surfaces = crate::objects::Surfaces {
         faults,
         blocks: &blocks,
@@ -1221,6 +1240,7 @@ pub fn faulted_mesh_with_objects(
     let mut zones =
         crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
     let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
+    stage("zones and objects cut", &st);
     let done = crate::improve::improve(
         &mut st,
         faults,
@@ -1234,6 +1254,7 @@ pub fn faulted_mesh_with_objects(
         objects,
         &mut object_cells,
     );
+    stage("quality pass", &st);
     st.report.collapsed = done.collapsed;
     st.report.moved = done.moved;
     st.report.flipped = done.flipped;
