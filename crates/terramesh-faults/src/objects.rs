@@ -470,7 +470,7 @@ impl Object {
             return None;
         }
         let (x, y, rho) = across(to);
-        if !(rho > 1e-6 * r) {
+        if rho.is_nan() || rho <= 1e-6 * r {
             return None;
         }
         let s = r / rho - 1.0;
