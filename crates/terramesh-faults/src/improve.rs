@@ -834,8 +834,8 @@ impl Pass<'_> {
     /// [`Pass::slide`] for a node with flags `f` at `p`.
     fn slide_at(&self, f: u8, p: [f64; 3], labels: &[Label], to: [f64; 3]) -> Option<[f64; 3]> {
         if Self::on_object_wall(labels) {
-            // On an object's wall: it stays.
-            return None;
+            // On an object's wall: along a tunnel's barrel only, else it stays.
+            return self.along_object_wall(f, p, labels, to);
         }
         if f & (TOP | BASE | SIDE) != 0 {
             // Off the interfaces and faults, a node on a side moves vertically (it stays on

@@ -422,6 +422,61 @@ impl Object {
             &[Wall::Inner]
         }
     }
+
+    /// Where a node at `p` on wall `wall` may slide towards `to` and stay on it: `to`
+    /// projected across the axis onto a circular tunnel's barrel, where `p` and the point
+    /// found lie in one straight piece, at least `margin` from its end planes (caps and
+    /// mitres) and `p` on the wall within [`ON_WALL`]. `None` elsewhere (other profiles and
+    /// objects, whose flat faces meet at edges and corners; caps, mitres): the node stays.
+    pub(crate) fn along_wall(
+        &self,
+        wall: Wall,
+        p: [f64; 3],
+        to: [f64; 3],
+        margin: f64,
+    ) -> Option<[f64; 3]> {
+        let Shape::Tunnel {
+            pieces,
+            profile,
+            outer,
+            ..
+        } = &self.shape
+        else {
+            return None;
+        };
+        let prof = match (wall, outer) {
+            (Wall::Outer, Some(o)) => o,
+            _ => profile,
+        };
+        let Profile::Circle { diameter } = *prof else {
+            return None;
+        };
+        let r = diameter / 2.0;
+        let within = |pc: &Piece, q: [f64; 3], m: f64| {
+            dot(sub(q, pc.a), pc.start) >= m && dot(sub(q, pc.b), pc.end) <= -m
+        };
+        // One piece only, even where pieces overlap (a sharp bend): the field's own.
+        let one = |q: [f64; 3]| pieces.iter().filter(|pc| within(pc, q, -margin)).count() == 1;
+        let pc = pieces.iter().find(|pc| within(pc, p, margin))?;
+        if !one(p) {
+            return None;
+        }
+        let across = |q: [f64; 3]| {
+            let d = sub(q, pc.a);
+            let (x, y) = (dot(d, pc.n), dot(d, pc.u));
+            (x, y, (x * x + y * y).sqrt())
+        };
+        if (across(p).2 - r).abs() > ON_WALL {
+            return None;
+        }
+        let (x, y, rho) = across(to);
+        if rho.is_nan() || rho <= 1e-6 * r {
+            return None;
+        }
+        let s = r / rho - 1.0;
+        let q = [0, 1, 2].map(|k| to[k] + s * (x * pc.n[k] + y * pc.u[k]));
+        (q.iter().all(|v| v.is_finite()) && within(pc, q, margin) && one(q)).then_some(q)
+    }
 }
 
 /// The squared distance from `p` to a triangle (Ericson, *Real-Time Collision Detection*, 5.1.5).
@@ -2261,6 +2316,68 @@ pub fn check_objects(
 mod tests {
     use super::*;
     use crate::{min_dihedral, MeshSettings, Site};
+
+    /// A node on a circular tunnel's barrel slides along it (onto the circle of its piece,
+    /// its place along the axis kept), but not near a cap or a mitre, and not on another
+    /// profile's wall.
+    #[test]
+    fn a_node_slides_along_a_circular_barrel_only() {
+        let t = Terrain::new(
+            vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+            vec![100.0; 4],
+        )
+        .unwrap();
+        let tunnel = |profile| ObjectSpec {
+            name: "T".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[10.0, 50.0, 50.0], [50.0, 50.0, 50.0], [90.0, 60.0, 50.0]],
+                profile,
+                lining: 0.5,
+            },
+        };
+        let set = ObjectSet::new(&[tunnel(Profile::Circle { diameter: 10.0 })], &t, 0.0).unwrap();
+        let o = &set.objects[0];
+        let p = [30.0, 50.0, 55.0];
+        assert!(o.field(Wall::Inner, p).abs() < 1e-12);
+        let q = o
+            .along_wall(Wall::Inner, p, [30.4, 51.0, 55.3], 0.01)
+            .unwrap();
+        assert!(o.field(Wall::Inner, q).abs() < 1e-9, "{q:?} off the wall");
+        assert!((q[0] - 30.4).abs() < 1e-12 && q[1] > 50.5);
+        // The lining's outer wall, radius 5.5.
+        let p = [30.0, 44.5, 50.0];
+        let q = o
+            .along_wall(Wall::Outer, p, [29.0, 44.0, 51.0], 0.01)
+            .unwrap();
+        assert!(o.field(Wall::Outer, q).abs() < 1e-9);
+        // Not off the wall, not across a cap or onto the mitre at the bend.
+        assert!(o
+            .along_wall(Wall::Inner, [30.0, 50.0, 56.0], [30.0, 50.0, 56.0], 0.01)
+            .is_none());
+        assert!(o
+            .along_wall(Wall::Inner, [10.005, 50.0, 55.0], [11.0, 50.0, 55.0], 0.01)
+            .is_none());
+        assert!(o
+            .along_wall(Wall::Inner, [11.0, 50.0, 55.0], [9.0, 50.0, 55.0], 0.01)
+            .is_none());
+        assert!(o
+            .along_wall(Wall::Inner, [49.0, 50.0, 55.0], [52.0, 50.0, 55.0], 0.01)
+            .is_none());
+        let set = ObjectSet::new(
+            &[tunnel(Profile::Rectangle {
+                width: 10.0,
+                height: 10.0,
+            })],
+            &t,
+            0.0,
+        )
+        .unwrap();
+        assert!(set.objects[0]
+            .along_wall(Wall::Inner, [30.0, 50.0, 55.0], [30.5, 50.5, 55.0], 0.01)
+            .is_none());
+    }
 
     /// The refinement near a horseshoe tunnel (its corners keep the facets straying from the
     /// wall down to the smallest edges) keeps every cell positive in floating point and of a

@@ -4,8 +4,9 @@
 //!
 //! Each cell carries an object label (its [`code`]) in the pass's [`Label`], so a flip is made
 //! only among cells of one object label (no wall face is removed) and a node whose cells
-//! carry two object labels lies on a wall: it does not move ([`Pass::slide_at`] refuses it),
-//! and it is collapsed only into a node on the same wall ([`Pass::object_kept`]). Every cell
+//! carry two object labels lies on a wall: it moves only along a circular tunnel's barrel
+//! ([`Pass::along_object_wall`]; elsewhere [`Pass::slide_at`] refuses it), and it is
+//! collapsed only into a node on the same wall ([`Pass::object_kept`]). Every cell
 //! an operation makes or changes must lie on its side of every wall near it
 //! ([`Pass::in_objects`]): no node more than [`ON_WALL`] on the wrong side (the cut took
 //! nodes that close as on the wall), its centroid and edge midpoints within half the checks'
@@ -14,6 +15,7 @@
 //! midpoint lies on the wall between the labels around it ([`Pass::object_wall_through`]).
 
 use super::{Label, Pass};
+use crate::mesh::{BASE, ON_INTERFACE, SIDE, TOP};
 use crate::objects::{Wall, OBJECT_TOLERANCE, ON_WALL};
 use crate::{ObjectCells, ObjectSet};
 
@@ -111,6 +113,31 @@ impl Pass<'_> {
             }
             None => false,
         }
+    }
+
+    /// Where a node at `p` on one object's wall (flags `f`, its cells' labels `labels`) may go
+    /// towards `to`: along that wall ([`crate::Object::along_wall`]: a circular tunnel's
+    /// barrel, away from its caps and mitres), if its cells differ in their object label only
+    /// (two labels with one wall between them) and the node lies on no interface, fault,
+    /// zone wall or the model's boundary; `None` otherwise (it stays). The cells it changes
+    /// are then tested as every operation's are ([`Pass::in_objects`]).
+    pub(super) fn along_object_wall(
+        &self,
+        f: u8,
+        p: [f64; 3],
+        labels: &[Label],
+        to: [f64; 3],
+    ) -> Option<[f64; 3]> {
+        let x = labels[0];
+        if f & (TOP | BASE | SIDE | ON_INTERFACE) != 0
+            || labels
+                .iter()
+                .any(|l| (l.0, l.1, l.2, l.3) != (x.0, x.1, x.2, x.3))
+        {
+            return None;
+        }
+        let (o, w) = self.one_wall(labels)??;
+        self.objects.objects[o].along_wall(w, p, to, 10.0 * ON_WALL)
     }
 
     /// Whether the object wall between the labels around an edge (if any) passes through its
