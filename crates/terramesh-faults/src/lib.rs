@@ -68,7 +68,8 @@
 //!    block, the number of interfaces above it its unit. A fault's faces are the faces
 //!    between cells on its two sides where it is active.
 //! 4. A quality pass (`MeshSettings::improve_degrees`, default 6; `improve_passes`, at
-//!    most 30 sweeps, stopping at one that changes nothing): every cell whose smallest dihedral angle is below that, worst first, is mended by
+//!    most 30 sweeps, stopping at one that changes nothing, and after the sixth at one that
+//!    starts with more than 4,096 poor cells): every cell whose smallest dihedral angle is below that, worst first, is mended by
 //!    the first of: collapsing one of its edges (shortest first); a 3-2 flip of one of its
 //!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of

@@ -48,7 +48,8 @@ pub struct MeshSettings {
     /// too and make room for the poor cells next to them; 0 turns it off).
     pub improve_degrees: f64,
     /// At most this many sweeps of that quality pass over the cells below `improve_degrees`
-    /// (default 30); the pass stops at the first sweep that changes nothing.
+    /// (default 30); the pass stops at the first sweep that changes nothing, and after the
+    /// sixth at the first that starts with more than 4,096 poor cells (a bounded tail).
     pub improve_passes: usize,
     /// Before meshing, planar triangles whose longest edge exceeds this many times the
     /// thinnest slab at their vertices (between two nearly parallel surfaces: terrain, base,
