@@ -154,3 +154,48 @@ fn quality_pass_never_moves_a_cell_across_an_object_wall() {
         assert!(!mesh.objects.lining[c] || o == 1);
     }
 }
+
+/// The objects' refinement, cut and the quality pass around them give the same mesh, bit for
+/// bit, on one thread, two and three (as `same_mesh_on_any_number_of_threads` in sites.rs for
+/// the faulted mesh without objects).
+#[test]
+fn same_mesh_with_objects_on_any_number_of_threads() {
+    let site = flat_site();
+    let settings = MeshSettings::new(site.base, 10.0);
+    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
+    let objects = ObjectSet::new(&specs(), &site.terrain, site.base).unwrap();
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                faulted_mesh_with_objects(
+                    &site.terrain,
+                    &set,
+                    site.tops.len(),
+                    &h,
+                    &settings,
+                    &objects,
+                )
+                .unwrap()
+            })
+    };
+    let bits = |m: &FaultedMesh| -> Vec<[u64; 3]> {
+        m.points.iter().map(|p| p.map(f64::to_bits)).collect()
+    };
+    let one = on(1);
+    assert!(one.objects.object.iter().any(|&o| o != 0));
+    for n in [2, 3] {
+        let other = on(n);
+        assert_eq!(one.report, other.report, "{n} threads");
+        assert_eq!(one.tets.len(), other.tets.len(), "{n} threads");
+        assert_eq!(bits(&one), bits(&other), "{n} threads");
+        assert_eq!(one.tets, other.tets, "{n} threads");
+        assert_eq!(one.unit, other.unit, "{n} threads");
+        assert_eq!(one.block, other.block, "{n} threads");
+        assert_eq!(one.objects.object, other.objects.object, "{n} threads");
+        assert_eq!(one.objects.lining, other.objects.lining, "{n} threads");
+    }
+}
