@@ -15,7 +15,8 @@ use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// Bytes a file output gathers before it writes them (a multiple of [`ALIGN`]).
+/// Bytes a file output gathers before it writes them (a multiple of the 4,096-byte alignment
+/// that `O_DIRECT` asks).
 pub const CHUNK: usize = 1 << 20;
 /// The alignment `O_DIRECT` asks of a write's memory, offset and length (a page: at least
 /// the logical block size of the usual devices).
