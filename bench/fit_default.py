@@ -61,16 +61,21 @@ def random_split(lon, lat, z, rng, n_truth, n_data):
     return d, t
 
 
+def take_opt(argv, name, default):
+    """The value after `name` in `argv`, both removed from it; `default` when absent."""
+    if name in argv:
+        i = argv.index(name)
+        v = argv[i + 1]
+        del argv[i:i + 2]
+        return v
+    return default
+
+
 def main():
     argv = sys.argv[1:]
 
     def opt(name, default):
-        if name in argv:
-            i = argv.index(name)
-            v = argv[i + 1]
-            del argv[i:i + 2]
-            return v
-        return default
+        return take_opt(argv, name, default)
 
     seeds = [int(s) for s in opt("--seeds", "15").split(",")]
     fits = opt("--fits", "default,wls,loo,reml").split(",")

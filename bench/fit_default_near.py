@@ -74,12 +74,7 @@ def main():
     argv = sys.argv[1:]
 
     def opt(name, default):
-        if name in argv:
-            i = argv.index(name)
-            v = argv[i + 1]
-            del argv[i:i + 2]
-            return v
-        return default
+        return fd.take_opt(argv, name, default)
 
     seeds = [int(s) for s in opt("--seeds", "15").split(",")]
     m, k = float(opt("--spacings", "5")), int(opt("--classes", "8"))
