@@ -570,8 +570,15 @@ impl GlobalKriging {
     }
 }
 
+/// faer's parallelism for the kriging system (its factor and solves, the leave-one-out
+/// inverse): one thread, whatever rayon's pool. faer splits its products by the degree of
+/// parallelism it is given (`Par::rayon(0)` is the pool's thread count), which reassociates
+/// their sums: the weights, and so every estimate, differed in their last bits with
+/// `RAYON_NUM_THREADS` (on `examples/faulted`'s ill-conditioned Matérn fit, by 5e-11 m,
+/// enough to change the terrain's refinement and the faulted meshes). One thread gives what
+/// one thread gave before, on any pool; the predictions stay parallel over the targets.
 pub(crate) fn par() -> Par {
-    faer::get_global_parallelism()
+    Par::rayon(1)
 }
 
 /// `NotFiniteAt` the first target whose `what` is not finite.
