@@ -570,15 +570,20 @@ impl GlobalKriging {
     }
 }
 
-/// faer's parallelism for the kriging system (its factor and solves, the leave-one-out
-/// inverse): one thread, whatever rayon's pool. faer splits its products by the degree of
-/// parallelism it is given (`Par::rayon(0)` is the pool's thread count), which reassociates
-/// their sums: the weights, and so every estimate, differed in their last bits with
-/// `RAYON_NUM_THREADS` (on `examples/faulted`'s ill-conditioned Matérn fit, by 5e-11 m,
-/// enough to change the terrain's refinement and the faulted meshes). One thread gives what
-/// one thread gave before, on any pool; the predictions stay parallel over the targets.
+/// The degree of parallelism faer is given for the kriging system (its factor and solves, the
+/// leave-one-out inverse, REML's factors): a fixed number of tasks, whatever rayon's pool.
+const FAER_TASKS: usize = 8;
+
+/// faer's parallelism for the kriging system: [`FAER_TASKS`] tasks on rayon's pool. faer
+/// splits its products into as many jobs as the degree it is given, and the split sets the
+/// order of their sums; with its default (`Par::rayon(0)`, the pool's thread count) the
+/// weights, and so every estimate, differed in their last bits with `RAYON_NUM_THREADS` (on
+/// `examples/faulted`'s ill-conditioned Matérn fit by about 5e-11 m, enough to change the
+/// terrain's refinement and the faulted meshes). A fixed degree gives the same bits on 1, 2,
+/// 3 or 16 threads and still lets the factor use up to eight cores; the tasks simply queue
+/// on a smaller pool.
 pub(crate) fn par() -> Par {
-    Par::rayon(1)
+    Par::rayon(FAER_TASKS)
 }
 
 /// `NotFiniteAt` the first target whose `what` is not finite.
