@@ -4,7 +4,7 @@
 use terramesh_geostat::{
     experimental, fit_auto_wls_loo, fit_model, fit_model_bounded, wls_loo_range_bound,
     AutoSettings, Data, Duplicates, LagSettings, ModelKind, Named, Variogram, Weighting,
-    WLS_LOO_NONE, WLS_LOO_TIE,
+    WLS_LOO_NONE, WLS_LOO_TIE, WLS_LOO_UNSEEN_RANGE,
 };
 
 fn key(i: u64) -> u64 {
@@ -102,4 +102,48 @@ fn wls_loo_keeps_the_least_nugget_within_the_tie_counting_tiny_nuggets_as_none()
         "{:?}",
         best.variogram
     );
+}
+
+#[test]
+fn a_choice_at_the_range_bound_gets_the_unseen_range() {
+    // On this surface the WLS fits of the exponential and the spherical run to the bound
+    // (the first test), and their options without nugget are within the tie.
+    let data = rising(900);
+    let lags = experimental(&data, &LagSettings::default()).unwrap();
+    let kinds = [ModelKind::Spherical, ModelKind::Exponential];
+    let (best, cands, _) =
+        fit_auto_wls_loo(&data, &lags, &kinds, &AutoSettings::default()).unwrap();
+    let t = &best.variogram.structures[0];
+    assert_eq!(best.variogram.structures.len(), 1);
+    assert_eq!(
+        (t.kind, best.variogram.nugget),
+        (ModelKind::Exponential, 0.0)
+    );
+    let want = WLS_LOO_UNSEEN_RANGE * wls_loo_range_bound(&data);
+    assert!(
+        (t.range - want).abs() <= 1e-9 * want,
+        "range {} against {want}",
+        t.range
+    );
+    assert!(t.psill > 0.0 && t.psill.is_finite(), "{:?}", best.variogram);
+    // The exponential's candidate holds it, and it is within the tie.
+    let e = cands
+        .iter()
+        .find(|c| c.model == ModelKind::Exponential)
+        .unwrap();
+    assert_eq!(e.fit.as_ref(), Some(&best));
+    let min = cands
+        .iter()
+        .filter_map(|c| c.cv_rmse)
+        .fold(f64::INFINITY, f64::min);
+    assert!(best.objective <= (1.0 + WLS_LOO_TIE) * min);
+    // Without the exponential among the models a spherical at the bound is kept as it is.
+    let (sph, _, _) = fit_auto_wls_loo(
+        &data,
+        &lags,
+        &[ModelKind::Spherical],
+        &AutoSettings::default(),
+    )
+    .unwrap();
+    assert_eq!(sph.variogram.structures[0].kind, ModelKind::Spherical);
 }
