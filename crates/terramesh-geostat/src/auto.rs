@@ -91,17 +91,6 @@ pub const WLS_LOO_ROUNDING: f64 = 1e-9;
 /// The choice counts these options as having no nugget.
 pub const WLS_LOO_NONE: f64 = 1e-4;
 
-/// The range, as a fraction of the data's diameter, that [`FitMethod::WlsLoo`] gives its
-/// chosen option when that option is an exponential or spherical structure without nugget
-/// whose range sits at the diameter bound ([`wls_loo_range_bound`]): an exponential without
-/// nugget at this range instead, its sill the leave-one-out scale, if its leave-one-out RMSE
-/// is less than the chosen option's. There the experimental
-/// variogram still rises at its last class, neither the WLS fit nor leave-one-out identifies
-/// the range, and the surface between the data is better with a range well inside the
-/// region (docs/geostatistics.md, "Unseen range": chosen on hidden-truth seeds 15-18 of five
-/// terrains, confirmed on held-out seeds).
-pub const WLS_LOO_UNSEEN_RANGE: f64 = 0.3;
-
 /// Number of models that [`FitMethod::WlsLoo`] refines (those of least leave-one-out RMSE
 /// from their WLS fits).
 pub const WLS_LOO_REFINED: usize = 2;
@@ -461,34 +450,6 @@ pub fn fit_auto_wls_loo(
             let ratio = if *none { 0.0 } else { nugget_ratio(v) };
             if chosen.is_none_or(|c| ratio < c.2 || (ratio == c.2 && *rmse < c.3)) {
                 chosen = Some((i, j, ratio, *rmse));
-            }
-        }
-    }
-    // A chosen exponential or spherical without nugget at the range bound: the range is not
-    // seen by the data; an exponential without nugget at WLS_LOO_UNSEEN_RANGE of the
-    // diameter instead (the exponential's candidate holds it), its sill the leave-one-out
-    // scale, if its leave-one-out RMSE is less than the chosen option's.
-    if let Some(c) = chosen {
-        let v = &options[c.0][c.1].0;
-        let e = kinds.iter().position(|&k| k == ModelKind::Exponential);
-        if let (Some(e), [t]) = (e, v.structures.as_slice()) {
-            if v.nugget == 0.0
-                && matches!(t.kind, ModelKind::Exponential | ModelKind::Spherical)
-                && t.range >= 0.999 * cap
-                && scored[e].is_ok()
-            {
-                let mut u = Variogram::single(
-                    ModelKind::Exponential,
-                    0.0,
-                    1.0,
-                    WLS_LOO_UNSEEN_RANGE * cap,
-                )?;
-                u.anisotropy = v.anisotropy;
-                if let Some((rmse, scale)) = loo(&sub, &u, s.drift).filter(|r| r.0 < c.3) {
-                    u.structures[0].psill = scale;
-                    options[e].push((u, rmse, true));
-                    chosen = Some((e, options[e].len() - 1, 0.0, rmse));
-                }
             }
         }
     }

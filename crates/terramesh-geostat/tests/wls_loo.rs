@@ -2,10 +2,9 @@
 //! the options it scores.
 
 use terramesh_geostat::{
-    cross_validate, experimental, fit_auto_wls_loo, fit_model, fit_model_bounded,
-    wls_loo_range_bound, AutoSettings, Data, Drift, Duplicates, Folds, Interpolator, LagSettings,
-    Method, ModelKind, Named, Neighbourhood, Variogram, Weighting, WLS_LOO_NONE, WLS_LOO_TIE,
-    WLS_LOO_UNSEEN_RANGE,
+    experimental, fit_auto_wls_loo, fit_model, fit_model_bounded, wls_loo_range_bound,
+    AutoSettings, Data, Duplicates, LagSettings, ModelKind, Named, Variogram, Weighting,
+    WLS_LOO_NONE, WLS_LOO_TIE,
 };
 
 fn key(i: u64) -> u64 {
@@ -103,67 +102,4 @@ fn wls_loo_keeps_the_least_nugget_within_the_tie_counting_tiny_nuggets_as_none()
         "{:?}",
         best.variogram
     );
-}
-
-/// The leave-one-out RMSE of universal kriging with a linear drift (the default fit's
-/// criterion on at most 1,000 data: all of them here).
-fn loo_rmse(data: &Data, v: &Variogram) -> f64 {
-    let how = Interpolator::Kriging {
-        variogram: v.clone(),
-        method: Method::Universal(Drift::Linear),
-        neighbours: Neighbourhood::All,
-    };
-    cross_validate(data, &how, Folds::LeaveOneOut)
-        .unwrap()
-        .stats
-        .rmse
-}
-
-#[test]
-fn a_choice_at_the_range_bound_becomes_the_unseen_range_where_leave_one_out_prefers_it() {
-    // On this surface the WLS fits of the spherical and the exponential run to the diameter
-    // bound (the first test), and the choice is a structure without nugget there.
-    let data = rising(900);
-    let lags = experimental(&data, &LagSettings::default()).unwrap();
-    let cap = wls_loo_range_bound(&data);
-    let (sph, _, _) = fit_auto_wls_loo(
-        &data,
-        &lags,
-        &[ModelKind::Spherical],
-        &AutoSettings::default(),
-    )
-    .unwrap();
-    let t = &sph.variogram.structures[0];
-    assert_eq!((t.kind, sph.variogram.nugget), (ModelKind::Spherical, 0.0));
-    assert!(t.range >= 0.999 * cap, "{:?}", sph.variogram);
-    // With the exponential among the models, the rule's option: an exponential without
-    // nugget at WLS_LOO_UNSEEN_RANGE of the diameter, kept where its leave-one-out RMSE is
-    // the lesser.
-    let unseen =
-        Variogram::single(ModelKind::Exponential, 0.0, 1.0, WLS_LOO_UNSEEN_RANGE * cap).unwrap();
-    let (rule, spherical) = (loo_rmse(&data, &unseen), loo_rmse(&data, &sph.variogram));
-    assert!((spherical - sph.objective).abs() <= 1e-9 * spherical);
-    let kinds = [ModelKind::Spherical, ModelKind::Exponential];
-    let (best, cands, _) =
-        fit_auto_wls_loo(&data, &lags, &kinds, &AutoSettings::default()).unwrap();
-    if rule < spherical {
-        let u = &best.variogram.structures[0];
-        assert_eq!(
-            (u.kind, best.variogram.nugget),
-            (ModelKind::Exponential, 0.0)
-        );
-        assert!((u.range - WLS_LOO_UNSEEN_RANGE * cap).abs() <= 1e-9 * cap);
-        assert!(u.psill > 0.0 && u.psill.is_finite());
-        assert!((best.objective - rule).abs() <= 1e-9 * rule);
-        let e = cands
-            .iter()
-            .find(|c| c.model == ModelKind::Exponential)
-            .unwrap();
-        assert_eq!(e.fit.as_ref(), Some(&best));
-    } else {
-        assert_eq!(
-            best, sph,
-            "leave-one-out {rule} of the rule's option against {spherical}"
-        );
-    }
 }
