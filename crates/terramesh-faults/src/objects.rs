@@ -1899,17 +1899,35 @@ fn refine_missed(
 ) -> usize {
     let mut total = 0;
     for _ in 0..40 {
-        let margin = 1.0 + 1e-6 * tol;
+        // The field is read at every node of every cell that reaches the object's box (plus
+        // a margin), however far its other nodes lie outside it: a cell across the box's
+        // boundary may be crossed by the wall. (Reading it only at the nodes within 1 m of
+        // the box skipped such cells where they were wider than that: a box's edge through
+        // cells left coarse by the cap was cut as a chamfer, and a cell inside the box was
+        // labelled outside.)
+        let margin = 1e-3 + 1e-6 * tol;
+        let reach: Vec<u32> = st
+            .tets
+            .par_iter()
+            .filter(|t| {
+                (0..3).all(|k| {
+                    t.iter()
+                        .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
+                        && t.iter()
+                            .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
+                })
+            })
+            .flat_map_iter(|t| t.iter().copied())
+            .collect();
+        let mut near = vec![false; st.points.len()];
+        for n in reach {
+            near[n as usize] = true;
+        }
         let values: Vec<f64> = st
             .points
             .par_iter()
-            .map(|&q| {
-                if (0..3).any(|k| q[k] < lo[k] - margin || q[k] > hi[k] + margin) {
-                    f64::INFINITY
-                } else {
-                    f(q)
-                }
-            })
+            .zip(&near)
+            .map(|(&q, &near)| if near { f(q) } else { f64::INFINITY })
             .collect();
         let mut keys: Vec<u64> = st
             .tets

@@ -374,3 +374,28 @@ fn bad_objects_are_refused_naming_the_object_and_the_key() {
         "{deep:?}"
     );
 }
+
+/// Correctness must not depend on the cap of the refinement near objects: with no refinement
+/// at all (cap 0), the cells the walls cross are the background's, about 10 m wide, and the
+/// crossed-cells pass before the cut must still refine every one that a wall crosses. It
+/// skipped every cell with a node more than 1 m outside an object's box, so a box's edge
+/// through coarse cells was cut as a chamfer and a cell inside the box was labelled outside
+/// ("cell ... is labelled outside but lies inside the wall of structure ...", as the faulted
+/// benchmark's dam did at its corner with the cap at 2,000,000 cells).
+#[test]
+fn a_box_on_unrefined_coarse_cells_is_cut_cleanly() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    let block = ObjectSpec {
+        name: "block".into(),
+        stage: 1,
+        geometry: box_solid([121.3, 41.7, 71.1], [158.9, 68.4, 88.6]),
+    };
+    let (mesh, checks, _) = build_capped(&site, &[block], 0);
+    assert!(
+        mesh.objects.capped,
+        "the refinement should have been capped"
+    );
+    let exact = (158.9 - 121.3) * (68.4 - 41.7) * (88.6 - 71.1);
+    assert!((checks[0].exact - exact).abs() < 1e-9 * exact);
+    assert!(checks[0].volume_error() < 0.01, "{:?}", checks[0]);
+}

@@ -190,9 +190,25 @@ pub fn kernel_mesh_with_objects(
     resolution: f64,
     max_cells: usize,
 ) -> FaultedMesh {
+    kernel_mesh_with_specs(
+        site,
+        max_cell_height,
+        &object_specs(scale),
+        resolution,
+        max_cells,
+    )
+}
+
+/// [`kernel_mesh_with_objects`] with the objects `specs`.
+pub fn kernel_mesh_with_specs(
+    site: &Site,
+    max_cell_height: f64,
+    specs: &[terramesh_faults::ObjectSpec],
+    resolution: f64,
+    max_cells: usize,
+) -> FaultedMesh {
     let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
-    let mut objects =
-        terramesh_faults::ObjectSet::new(&object_specs(scale), &site.terrain, site.base).unwrap();
+    let mut objects = terramesh_faults::ObjectSet::new(specs, &site.terrain, site.base).unwrap();
     objects.resolution = resolution;
     objects.max_cells = max_cells;
     let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
