@@ -878,10 +878,7 @@ fn keeps_sides(
         for &(_, c) in star {
             let t = st.tets[c as usize];
             let before = centroid(&st.points, &t);
-            let mut after = before;
-            for i in 0..3 {
-                after[i] += 0.25 * (target[i] - q[i]);
-            }
+            let after = [0, 1, 2].map(|i| before[i] + 0.25 * (target[i] - q[i]));
             if (fault.side(before).sign > 0) != (fault.side(after).sign > 0) {
                 return false;
             }
