@@ -55,9 +55,14 @@
 //!    interface; onto a fault along its normal, vertically on a side, horizontally on the
 //!    base, not if on an earlier fault; onto an interface vertically, or along the dip line
 //!    of the one fault it lies on so that it stays on it, or for a node on a side and one
-//!    fault along the line where they meet) and if no cell of its star would
-//!    invert or fall below the smaller of `guard_degrees` and its current smallest dihedral
-//!    angle; then every edge that still crosses is split at its crossing (found by
+//!    fault along the line where they meet) and if no cell of its star would invert, no
+//!    cell's centroid would change its side of a fault (the check's block test), no node
+//!    would cross an interface of another block its star reaches, and the star's smallest
+//!    dihedral angle would stay at or above the smaller of `guard_degrees` and what it is,
+//!    or else the cells the snap leaves (split where the surface still crosses them) would
+//!    be no worse than those that splitting its crossing edges would make (as isosurface
+//!    stuffing and lattice cleaving decide); then every edge that still crosses is split at
+//!    its crossing (found by
 //!    regula falsi on the field) and every cell is split at its split edges, the lowest edge
 //!    first: exactly what splitting those edges one after another through the whole mesh
 //!    would give, so the mesh stays conformal, every child keeps a positive volume, and

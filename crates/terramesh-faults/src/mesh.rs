@@ -39,8 +39,12 @@ pub struct MeshSettings {
     /// A vertex whose crossing edge is cut within this fraction of its length from it is moved
     /// onto the surface instead, where it may move (default 0.35).
     pub snap: f64,
-    /// A move is refused if it would bring the smallest dihedral angle of the vertex's cells
-    /// below the smaller of this and what it was, degrees (default 10).
+    /// A move is made if it keeps the smallest dihedral angle of the vertex's cells at or
+    /// above the smaller of this and what it was, degrees (default 10), or else if the cells
+    /// it leaves (split where the surface still crosses them) are no worse than those that
+    /// splitting the vertex's crossing edges instead would make; never if a cell would
+    /// invert or the check would read a cell differently (its centroid's side of a fault, or
+    /// a node's side of an interface of another block).
     pub guard_degrees: f64,
     /// After cutting, cells whose smallest dihedral angle is below this (degrees) are improved
     /// by edge collapses, flips, node moves and edge splits that keep every label (default 6:
@@ -618,12 +622,14 @@ fn split_tet(t: [u32; 4], keys: &[u64], rank: Option<&[u32]>, first: u32, out: &
 /// Cuts the selected cells (all if `None`) by a field: snaps, then splits every crossing
 /// edge. Returns the values at the nodes of the selected cells (new nodes: on the surface;
 /// other nodes: 0) and the number of edges split.
+#[allow(clippy::too_many_arguments)]
 fn cut(
     st: &mut State,
     cells: Option<&[u32]>,
     field: &Field,
     s: &MeshSettings,
     faults: &FaultSet,
+    blocks: &[BlockKey],
     terrain: &Terrain,
 ) -> (Vec<(f64, i8)>, usize) {
     let mut need = vec![cells.is_none(); st.points.len()];
@@ -701,11 +707,36 @@ fn cut(
                 .iter()
                 .map(|t| min_dihedral(geo(t, q)))
                 .fold(f64::MAX, f64::min);
-            let ok = cells.iter().all(|t| {
+            let mut after = f64::MAX;
+            for t in &cells {
                 let g = geo(t, target);
-                positive(g) && min_dihedral(g) >= old.min(s.guard_degrees)
-            });
-            if ok {
+                after = after.min(if positive(g) { min_dihedral(g) } else { -1.0 });
+            }
+            if after < 0.0 {
+                continue;
+            }
+            // Better than the guard, or no worse than the cells that splitting the star's
+            // crossing edges would make (as isosurface stuffing and lattice cleaving decide).
+            let ok = after >= old.min(s.guard_degrees) || {
+                let place = |w: u32, at: [f64; 3]| if w == v { at } else { st.points[w as usize] };
+                let value = |w: u32, snapped: bool| {
+                    if w == v && snapped {
+                        (0.0, 0)
+                    } else {
+                        values[w as usize]
+                    }
+                };
+                let snapped = cells
+                    .iter()
+                    .map(|t| split_min(*t, |w| place(w, target), |w| value(w, true)))
+                    .fold(f64::MAX, f64::min);
+                let split = cells
+                    .iter()
+                    .map(|t| split_min(*t, |w| place(w, q), |w| value(w, false)))
+                    .fold(f64::MAX, f64::min);
+                snapped >= split
+            };
+            if ok && keeps_sides(st, field, faults, blocks, v, q, target, &star[lo..hi]) {
                 st.points[v as usize] = target;
                 values[v as usize] = (0.0, 0);
                 st.report.snapped += 1;
@@ -753,6 +784,131 @@ fn cut(
     split_cells(st, &keys, first, |_| {});
     st.report.split_edges += keys.len();
     (values, keys.len())
+}
+
+/// The smallest dihedral angle of the cells that splitting cell `t` (node `w` at `at(w)`, of
+/// value `value(w)`: signed distance, side) at every edge whose ends lie on opposite sides
+/// would make, each edge at its linear crossing and in [`split_tet`]'s order; the cell's own
+/// angle if no edge crosses. The snap guard's measure of what the split would make.
+fn split_min(t: [u32; 4], at: impl Fn(u32) -> [f64; 3], value: impl Fn(u32) -> (f64, i8)) -> f64 {
+    let mut keys = [0u64; 6];
+    let mut n = 0;
+    for &(i, j) in &EDGES {
+        if value(t[i]).1 * value(t[j]).1 < 0 {
+            keys[n] = key(t[i], t[j]);
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return min_dihedral(t.map(&at));
+    }
+    let keys = &mut keys[..n];
+    keys.sort_unstable();
+    let new: Vec<[f64; 3]> = keys
+        .iter()
+        .map(|&k| {
+            let (a, b) = ((k >> 32) as u32, k as u32);
+            let (pa, pb) = (at(a), at(b));
+            let (va, vb) = (value(a).0, value(b).0);
+            let u = va / (va - vb);
+            [0, 1, 2].map(|i| pa[i] + u * (pb[i] - pa[i]))
+        })
+        .collect();
+    // Local numbers for the new nodes, above every node of the mesh.
+    let first = u32::MAX - 8;
+    let mut out = Vec::with_capacity(8);
+    split_tet(t, keys, None, first, &mut out);
+    out.iter()
+        .map(|c| {
+            min_dihedral(c.map(|w| {
+                if w >= first {
+                    new[(w - first) as usize]
+                } else {
+                    at(w)
+                }
+            }))
+        })
+        .fold(f64::MAX, f64::min)
+}
+
+/// Whether moving node `v` from `q` to `target` keeps what the check reads of the cells of
+/// its star (`star`: `(v, cell)` pairs): the node's side of every fault it is not on and each
+/// cell's centroid's side of every fault (a cell's block is its centroid's), but the fault
+/// being cut; and in an interface cut, the node's side of every interface down to the one cut
+/// in each other block its star reaches (a node on a fault moves along it, into the other
+/// block's units), so that no cell of that block comes to straddle an interface. A planar
+/// fault farther from `q` than the star reaches (plus the move) is skipped: no centroid can
+/// cross it.
+#[allow(clippy::too_many_arguments)]
+fn keeps_sides(
+    st: &State,
+    field: &Field,
+    faults: &FaultSet,
+    blocks: &[BlockKey],
+    v: u32,
+    q: [f64; 3],
+    target: [f64; 3],
+    star: &[(u32, u32)],
+) -> bool {
+    let dist = |a: [f64; 3], b: [f64; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    let mut reach: f64 = 0.0;
+    for &(_, c) in star {
+        for &w in &st.tets[c as usize] {
+            reach = reach.max(dist(q, st.points[w as usize]));
+        }
+    }
+    let reach = reach + dist(q, target);
+    let own = match field {
+        Field::Fault(f, _) => Some(*f),
+        Field::Interface(..) => None,
+    };
+    for (g, fault) in faults.faults.iter().enumerate() {
+        if own == Some(g) {
+            continue;
+        }
+        let here = fault.side(q);
+        if fault.is_plane() && here.distance.abs() > 2.0 * reach {
+            continue;
+        }
+        if st.on_fault[v as usize] >> g & 1 == 0 && fault.side(target).sign != here.sign {
+            return false;
+        }
+        for &(_, c) in star {
+            let t = st.tets[c as usize];
+            let before = centroid(&st.points, &t);
+            let after = [0, 1, 2].map(|i| before[i] + 0.25 * (target[i] - q[i]));
+            if (fault.side(before).sign > 0) != (fault.side(after).sign > 0) {
+                return false;
+            }
+        }
+    }
+    if let Field::Interface(h, k, key) = field {
+        let mut seen: Vec<u32> = Vec::new();
+        for &(_, c) in star {
+            let b = st.block[c as usize];
+            if blocks[b as usize] == *key || seen.contains(&b) {
+                continue;
+            }
+            seen.push(b);
+            for j in 0..=*k {
+                let side = |r: [f64; 3]| {
+                    let d = r[2] - h(j, blocks[b as usize], [r[0], r[1]]);
+                    if d.abs() <= ON_SURFACE {
+                        0
+                    } else {
+                        d.signum() as i8
+                    }
+                };
+                let (a, z) = (side(q), side(target));
+                if a != 0 && z != a && z != 0 {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 /// Splits every cell at its edges among `keys` (sorted edge keys whose new nodes are already
@@ -1100,7 +1256,7 @@ pub fn faulted_mesh_with_objects(
     let object_cells = crate::objects::refine_near_objects(&mut st, objects)?;
     for (f, fault) in faults.faults.iter().enumerate() {
         let field = Field::Fault(f, fault);
-        let (values, _) = cut(&mut st, None, &field, settings, faults, terrain);
+        let (values, _) = cut(&mut st, None, &field, settings, faults, &[], terrain);
         let bits: Vec<u64> = (0..st.tets.len())
             .into_par_iter()
             .map(|c| {
@@ -1187,6 +1343,7 @@ pub fn faulted_mesh_with_objects(
                     &field,
                     settings,
                     faults,
+                    &blocks,
                     terrain,
                 )
                 .1;
