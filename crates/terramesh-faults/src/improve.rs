@@ -59,8 +59,17 @@ struct Pass<'a> {
     star: Vec<Vec<u32>>,
     angle: Vec<f64>,
     /// Nodes of cells changed since the sweep began: a poor cell none of whose nodes was
-    /// touched failed every operation in the last sweep and would fail again.
+    /// touched failed every operation in the last sweep and would fail again. While the
+    /// sweep is [`Pass::heavy`], a move that gains less than [`HEAVY_GAIN`] touches nothing.
     touched: Vec<bool>,
+    /// Per cell, whether its plan found nothing since it was last made or changed: while
+    /// many cells are poor ([`Pass::heavy`]) it is not planned again until it is changed.
+    barren: Vec<bool>,
+    /// Whether this sweep began with more than [`TAIL_CELLS`] cells below the floor: then a
+    /// gradient move must gain [`HEAVY_GAIN`], a move that gains less than that does not
+    /// mark its nodes as touched, and a barren cell is not planned. In the tail every
+    /// operation counts, as before.
+    heavy: bool,
     /// Per node, the number of the last operation that changed one of its cells (or moved
     /// it): a plan made before that operation that read such a node is made again.
     stamp: Vec<u32>,
@@ -101,7 +110,10 @@ struct Stats {
     plans: [std::sync::atomic::AtomicU64; 6],
     /// The same, nanoseconds.
     nanos: [std::sync::atomic::AtomicU64; 6],
+    /// Per kind of try (collapse, flip, move to the mean, gradient move, split): the
+    /// nanoseconds spent in the tries that found nothing before a plan's outcome.
     replans: std::sync::atomic::AtomicU64,
+    stage: [std::sync::atomic::AtomicU64; 5],
 }
 
 impl Stats {
@@ -110,7 +122,7 @@ impl Stats {
     }
 
     /// One line for sweep `sweep` (from 1), resetting the counts.
-    fn print(&self, sweep: usize, poor: usize, made: usize, secs: f64) {
+    fn print(&self, sweep: usize, all: usize, poor: usize, made: usize, secs: f64) {
         use std::sync::atomic::Ordering::Relaxed;
         let take = |a: &std::sync::atomic::AtomicU64| a.swap(0, Relaxed);
         let kinds = ["collapse", "flip", "mean", "gradient", "split", "none"];
@@ -123,10 +135,21 @@ impl Stats {
             })
             .collect();
         eprintln!(
-            "quality pass: sweep {sweep}: {poor} cells below the floor, {made} operations, \
+            "quality pass: sweep {sweep}: {all} cells below the floor, {poor} planned, \
+             {made} operations, \
              {} plans made again, {secs:.2} s; plans: {}",
             take(&self.replans),
             per.join(", ")
+        );
+        let st: Vec<String> = self
+            .stage
+            .iter()
+            .map(|a| format!("{:.2}", take(a) as f64 * 1e-9))
+            .collect();
+        eprintln!(
+            "quality pass: sweep {sweep}: time in the tries of every plan (collapse, flip, \
+             mean, gradient, split): {} s",
+            st.join(", ")
         );
     }
 }
@@ -196,6 +219,13 @@ pub fn verify_each_operation(on: bool) {
 
 /// A node is moved only if the smallest angle of its cells gains at least this (degrees).
 const MIN_GAIN: f64 = 1e-6;
+
+/// While many cells are poor ([`Pass::heavy`]), a gradient move must gain at least this
+/// (degrees), and a move (to the mean or up the gradient) that gains less does not mark its
+/// nodes as touched, so that the cells around them are not planned again in the next sweep
+/// for it: each later sweep of a 1.3 M-cell model cost as much as the first, spent on
+/// gradient moves of tiny gain and on plans of the cells around them that found nothing.
+const HEAVY_GAIN: f64 = 0.1;
 
 /// A cell's label: its side of every fault, its unit, its block, the fault zones it lies in
 /// (bit f: between the walls of fault f's zone), its object label ([`walls::code`]).
@@ -350,12 +380,14 @@ impl Pass<'_> {
                     self.object.push(self.object[l]);
                 }
                 self.alive.push(true);
+                self.barren.push(false);
                 self.angle.push(q);
                 (self.st.tets.len() - 1) as u32
             }
         };
         self.st.tets[c as usize] = t;
         self.angle[c as usize] = q;
+        self.barren[c as usize] = false;
         for v in t {
             self.star[v as usize].push(c);
             self.touched[v as usize] = true;
@@ -420,6 +452,17 @@ impl Pass<'_> {
         seen.sort_unstable();
         seen.dedup();
         let at = |v: u32| &around[t.iter().position(|&w| w == v).unwrap()];
+        let mut clock = self.stats.as_ref().map(|_| std::time::Instant::now());
+        let mut lap = |k: usize| {
+            if let (Some(s), Some(c)) = (&self.stats, clock.as_mut()) {
+                let now = std::time::Instant::now();
+                s.stage[k].fetch_add(
+                    (now - *c).as_nanos() as u64,
+                    std::sync::atomic::Ordering::Relaxed,
+                );
+                *c = now;
+            }
+        };
         for &(_, u, v) in &edges {
             for (a, b) in [(u, v), (v, u)] {
                 if let Some(op) = self.collapse(a, b, [at(a), at(b)]) {
@@ -427,27 +470,32 @@ impl Pass<'_> {
                 }
             }
         }
+        lap(0);
         let stars = [0, 1, 2, 3].map(|i| around[i].0.as_slice());
         if let Some(op) = self.try_flips(c, &stars) {
             return (Some(op), 1);
         }
+        lap(1);
         for v in t {
             let (cells, labels) = at(v);
             if let Some(op) = self.smooth(v, cells, labels) {
                 return (Some(op), 2);
             }
         }
+        lap(2);
         if let Some(op) = t.into_iter().find_map(|v| {
             let (cells, labels) = at(v);
             self.optimise(v, cells, labels)
         }) {
             return (Some(op), 3);
         }
+        lap(3);
         // Last, a new node on one of its edges, longest first.
         let op = edges
             .iter()
             .rev()
             .find_map(|&(_, u, v)| self.split(u, v, &at(u).0));
+        lap(4);
         let kind = if op.is_some() { 4 } else { 5 };
         (op, kind)
     }
@@ -465,6 +513,7 @@ impl Pass<'_> {
                     self.stamp_cell(c);
                     self.st.tets[c as usize] = t;
                     self.angle[c as usize] = q;
+                    self.barren[c as usize] = false;
                     self.star[b as usize].push(c);
                     for w in t {
                         self.touched[w as usize] = true;
@@ -520,10 +569,16 @@ impl Pass<'_> {
                 angles,
             } => {
                 self.st.points[v as usize] = to;
+                let old = cells
+                    .iter()
+                    .map(|&c| self.angle[c as usize])
+                    .fold(f64::MAX, f64::min);
+                let new = angles.iter().copied().fold(f64::MAX, f64::min);
+                let loud = !self.heavy || new - old >= HEAVY_GAIN;
                 for (&c, a) in cells.iter().zip(angles) {
                     self.angle[c as usize] = a;
                     for w in self.st.tets[c as usize] {
-                        self.touched[w as usize] = true;
+                        self.touched[w as usize] |= loud;
                         self.stamp[w as usize] = self.mark;
                     }
                 }
@@ -1044,7 +1099,7 @@ impl Pass<'_> {
             }
         }
         let walled = labels.iter().any(|l| l.3 != labels[0].3);
-        if best < old + MIN_GAIN
+        if best < old + if self.heavy { HEAVY_GAIN } else { MIN_GAIN }
             || !cells.iter().all(|&c| {
                 let g = geo(c, q);
                 self.in_unit(g, c) && self.in_zone(g, c, walled) && self.in_objects(g, c)
@@ -1555,7 +1610,9 @@ impl Pass<'_> {
 
 /// Improves the cells whose smallest dihedral angle is below `below` degrees, in at most
 /// `passes` sweeps (worst first; after [`FULL_SWEEPS`] only while at most [`TAIL_CELLS`]
-/// cells are poor), then drops the collapsed cells and unused nodes.
+/// cells are poor), then drops the collapsed cells and unused nodes. A sweep that begins
+/// with more than [`TAIL_CELLS`] poor cells is economical ([`Pass::heavy`]); the first sweep
+/// with fewer plans every poor cell.
 #[allow(clippy::too_many_arguments)] // the state, its surfaces and the pass's two settings
 pub(crate) fn improve(
     st: &mut State,
@@ -1600,6 +1657,8 @@ pub(crate) fn improve(
     let mut p = Pass {
         alive: vec![true; st.tets.len()],
         touched: vec![true; st.points.len()],
+        barren: vec![false; st.tets.len()],
+        heavy: true,
         stamp: vec![0; st.points.len()],
         mark: 0,
         floor: below,
@@ -1630,12 +1689,21 @@ pub(crate) fn improve(
     rayon::scope(|_| {
         for sweep in 1..=passes {
             let started = std::time::Instant::now();
+            let all_poor = (0..p.st.tets.len())
+                .filter(|&c| p.alive[c] && p.angle[c] < below)
+                .count();
+            // The first sweep of the tail plans every poor cell again (those left by a
+            // quiet move or barren included).
+            let fresh = p.heavy && all_poor <= TAIL_CELLS;
+            p.heavy = all_poor > TAIL_CELLS;
             let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
                 .filter(|&c| {
                     let c = c as usize;
                     p.alive[c]
                         && p.angle[c] < below
-                        && p.st.tets[c].iter().any(|&v| p.touched[v as usize])
+                        && (fresh
+                            || ((!p.heavy || !p.barren[c])
+                                && p.st.tets[c].iter().any(|&v| p.touched[v as usize])))
                 })
                 .collect();
             if sweep > FULL_SWEEPS && bad.len() > TAIL_CELLS {
@@ -1703,6 +1771,9 @@ pub(crate) fn improve(
                             plans[j] = (op, seen, now);
                         }
                     }
+                    if plans[i].0.is_none() {
+                        p.barren[chunk[i] as usize] = true;
+                    }
                     if let Some(op) = plans[i].0.take() {
                         made_ops += 1;
                         if p.verify {
@@ -1722,7 +1793,13 @@ pub(crate) fn improve(
                 }
             }
             if let Some(s) = &p.stats {
-                s.print(sweep, bad.len(), made_ops, started.elapsed().as_secs_f64());
+                s.print(
+                    sweep,
+                    all_poor,
+                    bad.len(),
+                    made_ops,
+                    started.elapsed().as_secs_f64(),
+                );
             }
             if done == before {
                 break;
