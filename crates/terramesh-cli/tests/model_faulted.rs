@@ -141,8 +141,8 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
     // The quality pinned (measured: 5 cells below 5 degrees, the smallest 0.81 degrees, the
     // same on any number of threads; 45 and 0.089 before the pass merged nodes a few
     // millimetres apart on the junction of F1 and F2, aimed at 6 degrees and swept until
-    // nothing changed). The pin leaves room because a change in the DSM's last bits (faer's
-    // kernels differ between processors) moved the count between 8 and 16 before.
+    // nothing changed). The pin leaves room: changes in the DSM's last bits alone (from the
+    // thread count, before faer got a fixed degree) moved the count between 8 and 16.
     let smallest = faulted["min_dihedral_degrees"].as_f64().unwrap();
     let below = faulted["cells_below_5_degrees"].as_u64().unwrap();
     eprintln!("{below} cells below 5 degrees, the smallest {smallest:.4} degrees");
