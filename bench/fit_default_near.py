@@ -70,6 +70,18 @@ def near_origin(d, kind, diam, m, k):
     return float(np.exp(r.x[0])), float(np.exp(r.x[1]))
 
 
+def draw(name, seed):
+    """One draw of a terrain: the data and targets split as fit_default.py splits them,
+    written as CSV under fit_default.OUT; returns (data, targets, tag, data path, targets path)."""
+    rng = np.random.default_rng(seed)
+    d, t = ht.split(*fd.TERRAINS[name](), rng, 20000)
+    tag = f"{name}-grid-1200-{seed}"
+    dp, tp = os.path.join(fd.OUT, f"{tag}-data.csv"), os.path.join(fd.OUT, f"{tag}-targets.csv")
+    np.savetxt(dp, d, delimiter=",", header="x,y,z", comments="", fmt="%.10g")
+    np.savetxt(tp, t[:, :2], delimiter=",", header="x,y", comments="", fmt="%.10g")
+    return d, t, tag, dp, tp
+
+
 def main():
     argv = sys.argv[1:]
 
@@ -87,12 +99,7 @@ def main():
     print("|---|---|---|---|---|---|---|")
     for seed in seeds:
         for name in names:
-            rng = np.random.default_rng(seed)
-            d, t = ht.split(*fd.TERRAINS[name](), rng, 20000)
-            tag = f"{name}-grid-1200-{seed}"
-            dp, tp = os.path.join(fd.OUT, f"{tag}-data.csv"), os.path.join(fd.OUT, f"{tag}-targets.csv")
-            np.savetxt(dp, d, delimiter=",", header="x,y,z", comments="", fmt="%.10g")
-            np.savetxt(tp, t[:, :2], delimiter=",", header="x,y", comments="", fmt="%.10g")
+            d, t, tag, dp, tp = draw(name, seed)
             out = os.path.join(fd.OUT, f"{tag}-near-out.csv")
             rmse = lambda v: float(np.sqrt(np.mean(
                 (ht.terramesh_uk(dp, tp, out, ["--variogram", v]) - t[:, 2]) ** 2)))

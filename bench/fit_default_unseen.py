@@ -64,12 +64,7 @@ def main():
     print("|" + "---|" * (5 + len(fr)))
     for seed in seeds:
         for name in names:
-            rng = np.random.default_rng(seed)
-            d, t = ht.split(*fd.TERRAINS[name](), rng, 20000)
-            tag = f"{name}-grid-1200-{seed}"
-            dp, tp = os.path.join(fd.OUT, f"{tag}-data.csv"), os.path.join(fd.OUT, f"{tag}-targets.csv")
-            np.savetxt(dp, d, delimiter=",", header="x,y,z", comments="", fmt="%.10g")
-            np.savetxt(tp, t[:, :2], delimiter=",", header="x,y", comments="", fmt="%.10g")
+            d, t, tag, dp, tp = fn.draw(name, seed)
             cache = os.path.join(fd.OUT, f"{tag}-pykrige-20000.json")
             if known and seed in fn.KNOWN and name in fn.KNOWN_NAMES:
                 best = fn.KNOWN[seed][fn.KNOWN_NAMES.index(name)]
