@@ -110,9 +110,10 @@ struct Stats {
     plans: [std::sync::atomic::AtomicU64; 6],
     /// The same, nanoseconds.
     nanos: [std::sync::atomic::AtomicU64; 6],
+    /// Plans made again because a node they read changed before they were applied.
+    replans: std::sync::atomic::AtomicU64,
     /// Per kind of try (collapse, flip, move to the mean, gradient move, split): the
     /// nanoseconds spent in the tries that found nothing before a plan's outcome.
-    replans: std::sync::atomic::AtomicU64,
     stage: [std::sync::atomic::AtomicU64; 5],
 }
 

@@ -6,7 +6,7 @@
 use terramesh_faults::*;
 
 mod common;
-use common::{box_solid, flat_site};
+use common::{box_solid, check_site, flat_site, mesh_with};
 
 /// A gravity dam's trapezoidal section (base `b` wide at `z0`, crest `c` wide at `z1`, centred
 /// on x = `x`) extruded from y0 to y1, outward oriented.
@@ -67,20 +67,9 @@ fn dam(geometry: ObjectGeometry) -> ObjectSpec {
 /// Builds the model with the dam, runs every check, and returns the mesh, the dam's check and
 /// the model's.
 fn build(site: &Site, spec: ObjectSpec) -> (FaultedMesh, ObjectCheck, CheckSummary) {
-    let settings = MeshSettings::new(site.base, 10.0);
-    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
     let objects = ObjectSet::new(&[spec], &site.terrain, site.base).unwrap();
-    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
-    let mesh = faulted_mesh_with_objects(
-        &site.terrain,
-        &set,
-        site.tops.len(),
-        &h,
-        &settings,
-        &objects,
-    )
-    .unwrap();
-    let summary = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
+    let mesh = mesh_with(site, &objects);
+    let summary = check_site(site, &mesh);
     let c = check_objects(&mesh.points, &mesh.tets, &mesh.objects, &objects)
         .unwrap()
         .remove(0);

@@ -6,7 +6,7 @@
 use terramesh_faults::*;
 
 mod common;
-use common::{box_solid, flat_site};
+use common::{box_solid, check_site, flat_site, mesh_with};
 
 /// A lined circular tunnel 6 m across through F1, a pit with 60-degree faces and a box
 /// structure under the terrain.
@@ -69,20 +69,9 @@ fn near_walls(mesh: &FaultedMesh) -> (usize, usize, f64) {
 /// `check_objects`, prints the figures and returns the mesh, the objects' checks and the
 /// quality.
 fn build(site: &Site) -> (FaultedMesh, Vec<ObjectCheck>, Quality) {
-    let settings = MeshSettings::new(site.base, 10.0);
-    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
     let objects = ObjectSet::new(&specs(), &site.terrain, site.base).unwrap();
-    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
-    let mesh = faulted_mesh_with_objects(
-        &site.terrain,
-        &set,
-        site.tops.len(),
-        &h,
-        &settings,
-        &objects,
-    )
-    .unwrap();
-    let summary = check(&mesh, &site.terrain, &set, &settings, &h).unwrap();
+    let mesh = mesh_with(site, &objects);
+    let summary = check_site(site, &mesh);
     let checks = check_objects(&mesh.points, &mesh.tets, &mesh.objects, &objects).unwrap();
     let q = summary.quality.clone();
     let (cells, poor, min) = near_walls(&mesh);
@@ -161,26 +150,13 @@ fn quality_pass_never_moves_a_cell_across_an_object_wall() {
 #[test]
 fn same_mesh_with_objects_on_any_number_of_threads() {
     let site = flat_site();
-    let settings = MeshSettings::new(site.base, 10.0);
-    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
     let objects = ObjectSet::new(&specs(), &site.terrain, site.base).unwrap();
-    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
     let on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| {
-                faulted_mesh_with_objects(
-                    &site.terrain,
-                    &set,
-                    site.tops.len(),
-                    &h,
-                    &settings,
-                    &objects,
-                )
-                .unwrap()
-            })
+            .install(|| mesh_with(&site, &objects))
     };
     let bits = |m: &FaultedMesh| -> Vec<[u64; 3]> {
         m.points.iter().map(|p| p.map(f64::to_bits)).collect()

@@ -1,4 +1,5 @@
-//! Sites and solids shared by the kernel's object tests (`dam_above.rs`, `object_pass.rs`).
+//! Sites, solids and the meshing and checking of a site with objects, shared by the
+//! kernel's object tests (`dam_above.rs`, `object_pass.rs`).
 
 use terramesh_faults::*;
 
@@ -52,4 +53,25 @@ pub fn box_solid(lo: [f64; 3], hi: [f64; 3]) -> ObjectGeometry {
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .collect(),
     }
+}
+
+/// The site's default mesh settings (`MeshSettings::new(site.base, 10.0)`) and its faults.
+fn setup(site: &Site) -> (MeshSettings, FaultSet) {
+    let settings = MeshSettings::new(site.base, 10.0);
+    let set = FaultSet::new(&site.specs(), &site.terrain, site.base).unwrap();
+    (settings, set)
+}
+
+/// The site meshed with `objects` at its default settings.
+pub fn mesh_with(site: &Site, objects: &ObjectSet) -> FaultedMesh {
+    let (settings, set) = setup(site);
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    faulted_mesh_with_objects(&site.terrain, &set, site.tops.len(), &h, &settings, objects).unwrap()
+}
+
+/// Every check of the sealed model on a mesh of the site ([`mesh_with`]).
+pub fn check_site(site: &Site, mesh: &FaultedMesh) -> CheckSummary {
+    let (settings, set) = setup(site);
+    let h = |k: usize, key: BlockKey, p: [f64; 2]| site.height(k, key, p);
+    check(mesh, &site.terrain, &set, &settings, &h).unwrap()
 }

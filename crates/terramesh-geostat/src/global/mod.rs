@@ -579,9 +579,9 @@ const FAER_TASKS: usize = 8;
 /// order of their sums; with its default (`Par::rayon(0)`, the pool's thread count) the
 /// weights, and so every estimate, differed in their last bits with `RAYON_NUM_THREADS` (on
 /// `examples/faulted`'s ill-conditioned Matérn fit by about 5e-11 m, enough to change the
-/// terrain's refinement and the faulted meshes). A fixed degree gives the same bits on 1, 2,
-/// 3 or 16 threads and still lets the factor use up to eight cores; the tasks simply queue
-/// on a smaller pool.
+/// terrain's refinement and the faulted meshes). A fixed degree gives the same bits on any
+/// number of threads (tested on 1, 2 and 3) and still lets the factor use up to eight
+/// cores; the tasks simply queue on a smaller pool.
 pub(crate) fn par() -> Par {
     Par::rayon(FAER_TASKS)
 }
