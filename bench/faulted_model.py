@@ -6,9 +6,10 @@ peak memory, cell count and quality, and the ratio of the run with objects to th
 
     python3 bench/faulted_model.py [--bin target/release/terramesh] [--out bench-out/faulted]
                                    [--max-area 900] [--max-cell-height 8] [--runs 2]
+                                   [--size 2400 [--no-objects]]
 
 The site is the truth of examples/faulted/make_site.py (its closed form, imported from there)
-scaled to 2.4 km x 2.4 km with two more faults: F1 normal, F2 reverse, F3 normal ending at F1,
+scaled to 2.4 km x 2.4 km (or `--size` metres: the whole layout scaled, faults only) with two more faults: F1 normal, F2 reverse, F3 normal ending at F1,
 F4 and F5 normal, crossing the others. 36 vertical boreholes are logged from the truth every
 centimetre, with `fault_picks.csv` where a hole crosses a fault; the terrain is a plane given as
 points 50 m apart. Issue 31's goal: at most 10 s and 2 GB for about 1,000,000 cells on a
@@ -36,6 +37,7 @@ site = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(site)
 
 SIZE = 2400.0
+K = 1.0  # --size / 2400: every plan coordinate of the layout below is scaled by it
 # Flatter strata than the example's, so that the top interface stays under the terrain over
 # 2.4 km.
 site.DIP = [0.002, 0.001]
@@ -48,6 +50,15 @@ site.FAULTS = [
 ]
 
 
+def scale(k: float):
+    """Scales the layout's plan coordinates (faults' traces; the holes, terrain points and
+    objects through K) by k: the same site on a smaller or larger square."""
+    global SIZE, K
+    SIZE, K = 2400.0 * k, k
+    site.FAULTS = [(n, [[k * a[0], k * a[1]], [k * b[0], k * b[1]]], *rest)
+                   for n, (a, b), *rest in site.FAULTS]
+
+
 def write_site(d: Path):
     """The site's files: terrain points, fault traces, collars, intervals and picks."""
     rng = random.Random(32)
@@ -56,7 +67,7 @@ def write_site(d: Path):
         fh.write("x,y,z\n")
         for j in range(-2, 51):
             for i in range(-2, 51):
-                x, y = 50.0 * i, 50.0 * j
+                x, y = 50.0 * K * i, 50.0 * K * j
                 fh.write(f"{x},{y},{site.terrain(x, y):.6f}\n")
     for name, (a, b), *_ in site.FAULTS:
         (d / f"{name.lower()}.csv").write_text(f"x,y\n{a[0]},{a[1]}\n{b[0]},{b[1]}\n")
@@ -64,8 +75,8 @@ def write_site(d: Path):
     step = 0.01
     for j in range(6):
         for i in range(6):
-            x = 200.0 + 400.0 * i + rng.uniform(-60.0, 60.0)
-            y = 200.0 + 400.0 * j + rng.uniform(-60.0, 60.0)
+            x = K * (200.0 + 400.0 * i + rng.uniform(-60.0, 60.0))
+            y = K * (200.0 + 400.0 * j + rng.uniform(-60.0, 60.0))
             name = f"B{6 * j + i + 1:02d}"
             zc = site.terrain(x, y)
             collars.append(f"{name},{x:.3f},{y:.3f},{zc:.6f}")
@@ -206,7 +217,14 @@ def main():
     ap.add_argument("--max-cell-height", type=float, default=8.0)
     ap.add_argument("--runs", type=int, default=2, help="timed runs of each project (best kept)")
     ap.add_argument("--no-objects", action="store_true", help="only the site without objects")
+    ap.add_argument("--size", type=float, default=2400.0,
+                    help="the square's side, m: the whole layout scaled by size / 2400")
     args = ap.parse_args()
+    if args.size != 2400.0:
+        if not args.no_objects:
+            sys.exit("--size needs --no-objects: issue 32's objects (a 2 km tunnel) are laid out "
+                     "for the 2.4 km site")
+        scale(args.size / 2400.0)
     d = Path(args.out)
     write_site(d)
     floor = write_objects(d)
