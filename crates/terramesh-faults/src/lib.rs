@@ -47,7 +47,19 @@
 //! 1. A background mesh: one column of nodes per planar vertex of the DSM, the same number of
 //!    levels in every column (enough for `max_cell_height` in the thickest column), every
 //!    prism split into three tetrahedra by the lowest-global-index diagonal rule, so that
-//!    neighbours agree on their shared quadrilaterals.
+//!    neighbours agree on their shared quadrilaterals. With `MeshSettings::layered` (off by
+//!    default) the levels follow the interfaces instead: each unit owns the same range of
+//!    level indices in every column (as many as `max_cell_height` asks for where it is
+//!    thickest), placed at the column's interface heights (of the fault block of its terrain
+//!    node) with the unit's sub-levels evenly between; the levels a thinner unit does not
+//!    need coincide with its base, those of a unit pinched out (within [`ON_SURFACE`]) with
+//!    its top, coinciding levels are one node, and a prism's tetrahedra with a repeated node
+//!    are dropped (the lowest-index rule still splits every quadrilateral of four nodes the
+//!    same way in both its prisms, so the mesh conforms). Inside a block every interface is
+//!    then already made of prism faces; off by default because the sub-layers, all at most
+//!    `max_cell_height`, are thinner than the uniform levels and a thin unit is one layer of
+//!    flat prisms: the bench project ends with more cells below 5 degrees (`docs/geology.md`,
+//!    "A layered background").
 //! 2. Every fault, then every interface (per fault block, `height(k, block, xy)`) cuts the
 //!    mesh in turn as an implicit field: a node within [`ON_SURFACE`] of the surface lies on
 //!    it; a node whose crossing edge is cut within `snap` (default 0.35) of the edge from it
@@ -159,6 +171,8 @@ mod error;
 mod fault;
 /// The quality pass: edge collapses, flips and node moves.
 mod improve;
+/// The layered background mesh: column levels at the interfaces.
+mod layers;
 /// The conformal volume mesh.
 mod mesh;
 /// Engineering objects: tunnels, excavations and structures cut into the mesh.
