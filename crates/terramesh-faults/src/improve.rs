@@ -483,9 +483,6 @@ impl Pass<'_> {
         if let Some(op) = self.try_flips(c, &stars) {
             return (Some(op), 1);
         }
-        if let Some(op) = self.tail_ops(c, &stars) {
-            return (Some(op), 1);
-        }
         lap(1);
         for v in t {
             let (cells, labels) = at(v);
@@ -505,7 +502,9 @@ impl Pass<'_> {
         let op = edges
             .iter()
             .rev()
-            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0));
+            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
+            // In the tail sweeps only, the operations of module `tail` (counted as splits).
+            .or_else(|| self.tail_ops(c, &stars));
         lap(4);
         let kind = if op.is_some() { 4 } else { 5 };
         (op, kind)
