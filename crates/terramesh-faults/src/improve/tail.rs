@@ -1,6 +1,7 @@
 //! Operations of the quality pass's tail: tried only in the sweeps that begin with at most
-//! [`super::TAIL_CELLS`] poor cells ([`Pass::heavy`] false), after the flips and before the
-//! moves, so that they cost the heavy sweeps of a large model nothing.
+//! [`super::TAIL_CELLS`] poor cells ([`Pass::heavy`] false), and only for a poor cell that
+//! every other operation failed to mend (after the edge split), so that they cost the heavy
+//! sweeps of a large model nothing and change nothing that the pass mended before.
 //!
 //! **Edge removal** (the n-to-2n−4 flip, Shewchuk's "edge removal"): the n cells (4 to
 //! [`RING_MAX`]) around an interior edge (a, b) of a poor cell, all of one label, are
@@ -16,9 +17,10 @@
 //! old one was below it, and every new cell lies in its unit and on its side of the objects'
 //! walls ([`Pass::in_unit`], [`Pass::in_objects`]).
 //!
-//! On `examples/faulted` the cells it mends are slivers next to a node the cutting put on a
-//! fault and an interface (such a node may not move): the edge between a free node and that
-//! node has a ring of 4 or 5 cells of one label, where the 3-2 flip cannot apply.
+//! **A fault node moved between two units** ([`Pass::fault_move`]): a node on one fault only
+//! whose two sides are in different units (the throw) may not move in
+//! [`Pass::slide_at`] (it moves a fault node only between cells of one unit); here it moves
+//! along the fault by a compass search, every cell held to its unit as a move's are.
 
 use super::{Improved, Op, Pass};
 use crate::mesh::{positive, BASE, ON_INTERFACE, SIDE, TOP};
@@ -353,8 +355,10 @@ mod tests {
 
     /// Four cells around the edge (a, b) = (nodes 4, 5), one of their ring's nodes 0.15 m
     /// off the edge: the cells on either side of it are slivers (9 degrees). No node may
-    /// move (all on the terrain, the DSM's own), no 2-3 or 3-2 flip mends them: the 4-4
-    /// edge removal does (48 degrees), the edge gone, the volume kept.
+    /// move (all on the terrain, the DSM's own), no 2-3 or 3-2 flip mends them, and with a
+    /// 45-degree floor no split of an edge does (its 8 halves would put more cells below the
+    /// floor than the 4 there): the 4-4 edge removal does (48 degrees), the edge gone, the
+    /// volume kept, every operation verified.
     #[test]
     fn edge_removal_mends_a_ring_of_four() {
         let points = vec![
@@ -412,7 +416,7 @@ mod tests {
             0,
             &terrain,
             n,
-            20.0,
+            45.0,
             2,
             &ObjectSet::default(),
             &mut ObjectCells::default(),
