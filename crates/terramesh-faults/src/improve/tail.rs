@@ -87,7 +87,10 @@ impl Pass<'_> {
             (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
         };
         let p = self.st.points[v as usize];
-        onto(p)?;
+        // On the fault itself (not a face between blocks beyond its end), as the cut left it.
+        if fault.side(p).distance.abs() > ON_SURFACE {
+            return None;
+        }
         let geo = |c: u32, q: [f64; 3]| {
             self.st.tets[c as usize].map(|w| {
                 if w == v {
