@@ -41,6 +41,7 @@ use crate::mesh::{
 use crate::quality::{min_dihedral, positive_min_dihedral};
 use crate::{BlockKey, FaultSet, ObjectCells, ObjectSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
 
+mod tail;
 mod walls;
 
 /// What the quality pass did.
@@ -269,6 +270,12 @@ enum Op {
         ring: Vec<u32>,
         kids: Vec<([u32; 4], f64, [u32; 4], f64)>,
     },
+    /// The cells of `ring` (of one label) replaced by the cells of `new`, which tile the
+    /// same region (an edge removal, module `tail`).
+    Replace {
+        ring: Vec<u32>,
+        new: Vec<([u32; 4], f64)>,
+    },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {
         v: u32,
@@ -495,7 +502,9 @@ impl Pass<'_> {
         let op = edges
             .iter()
             .rev()
-            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0));
+            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
+            // In the tail sweeps only, the operations of module `tail` (counted as splits).
+            .or_else(|| self.tail_ops(c, &stars));
         lap(4);
         let kind = if op.is_some() { 4 } else { 5 };
         (op, kind)
@@ -563,6 +572,7 @@ impl Pass<'_> {
                 }
                 done.inserted += 1;
             }
+            Op::Replace { ring, new } => self.replace(ring, new, done),
             Op::Move {
                 v,
                 to,
@@ -1475,7 +1485,7 @@ impl Pass<'_> {
                 .collect(),
             Op::Flip23 { c, d, .. } => vec![*c, *d],
             Op::Flip32 { ring, .. } => ring.to_vec(),
-            Op::Split { ring, .. } => ring.clone(),
+            Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
             Op::Move { cells, .. } => cells.clone(),
         }
     }

@@ -91,7 +91,9 @@
 //!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
 //!    the smallest angle of its worst cell; splitting one of its edges by a new node placed by
-//!    a compass search (on every surface the edge lies on). What may change is read from the cells' labels
+//!    a compass search (on every surface the edge lies on); last, in the sweeps that begin
+//!    with at most 4,096 poor cells only, removing one of its edges (the n-to-2n-4 flip of a
+//!    ring of 4 to 7 cells of one label) or moving along its fault a node between two units. What may change is read from the cells' labels
 //!    (side of every fault, unit, fault zones): a node whose cells carry one label lies on no
 //!    surface and may move anywhere (on a side: vertically; on the base: horizontally); a node
 //!    between two units of one block moves along that interface (its height taken from
@@ -124,8 +126,10 @@
 //! wide can stay slivers after the quality pass: a cell of a slab t thick cut from columns
 //! of planar cells s wide has a dihedral angle near atan(t / s), so 5 degrees needs s <=
 //! about 11 t there, which the local refinement provides within its budget; the 5-degree
-//! floor of issue 31 is reached on the test sites without faults only; see
-//! `docs/geology.md`), and cells left
+//! floor of issue 31 is reached on the test sites without faults only; the last cells of
+//! `examples/faulted` lie next to nodes on a fault and an interface or a side, which may not
+//! move, none forced by the geometry (no two surfaces meet there at less than about 60
+//! degrees); see `docs/geology.md`), and cells left
 //! straddling an interface where two
 //! blocks' interface lines cross on a fault face after the last round
 //! ([`BuildReport::unresolved`]; [`check`] refuses a cell that straddles one).
