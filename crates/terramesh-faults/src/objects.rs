@@ -23,6 +23,8 @@ use robust::{orient2d, orient3d, Coord, Coord3D};
 use crate::mesh::{centroid, key, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
 use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
 
+mod crossing;
+
 /// The default of [`ObjectSet::resolution`] (`geology.structure_resolution`): how far the
 /// facets may stray from an object's exact boundary, as a fraction of the object's size (a
 /// tunnel's radius, half its smaller profile dimension; an excavation's depth; a structure's
@@ -1878,7 +1880,8 @@ pub(crate) fn refine_near_objects(
 
 /// The cells a wall crosses (nodes on both sides) are refined before the cut where their
 /// facets would stray from it by more than this times the refinement's tolerance (half the
-/// checks' tolerance).
+/// checks' tolerance); so are the cells whose nodes do not straddle it where it may reach into
+/// them deeper than that (the part of it the cut cannot see).
 const CROSSED_STRAY: f64 = 2.0;
 
 /// Refines, round after round, the cells that a wall crosses where its facets would stray from
@@ -1886,17 +1889,21 @@ const CROSSED_STRAY: f64 = 2.0;
 /// the objects stops at that cap, and the wall then crossed cells many times its tolerance
 /// wide, some with every node outside it (an edge across a tunnel's crown: no sign change,
 /// nothing cut, a cell labelled outside with most of its volume inside). A cell is crossed
-/// where its nodes, its edges' midpoints and its centroid have fields of both signs (beyond
-/// [`ON_WALL`]). Only these cells are bisected (with the relaxed Rivara closure), so the cost
-/// is that of the wall's surface, not of the band the refinement covers. Returns the edges
-/// bisected.
-fn refine_missed(
-    st: &mut State,
-    labels: &mut ObjectCells,
-    f: &(dyn Fn([f64; 3]) -> f64 + Sync),
-    [lo, hi]: [[f64; 3]; 2],
-    tol: f64,
-) -> usize {
+/// where its nodes' fields have both signs (beyond [`ON_WALL`]); a cell whose nodes do not
+/// straddle the wall is refined where the wall may reach into it deeper than
+/// [`CROSSED_STRAY`] times the tolerance, by a conservative test of the object's kind
+/// ([`Object::reach_into`], module `crossing`: it never misses such a cell; sampling the field
+/// at the edges' midpoints and the centroid, as before, missed a wall passing between them).
+/// Only these cells are bisected (with the relaxed Rivara closure), so the cost is that of the
+/// wall's surface, not of the band the refinement covers. Returns the edges bisected.
+fn refine_missed(st: &mut State, labels: &mut ObjectCells, o: &Object, w: Wall, tol: f64) -> usize {
+    let f = |q: [f64; 3]| o.field(w, q);
+    let [lo, hi] = o.bbox;
+    // The field's magnitude is at most this times the distance to the wall.
+    let lip = match o.kind {
+        "excavation" => crossing::EXCAVATION_LIPSCHITZ,
+        _ => 1.0,
+    };
     let mut total = 0;
     for _ in 0..40 {
         // The field is read at every node of every cell that reaches the object's box (plus
@@ -1942,27 +1949,30 @@ fn refine_missed(
                     .iter()
                     .map(|&(i, j)| norm(sub(q[i], q[j])))
                     .fold(0.0, f64::max);
-                if l <= 4.0 * tol || v.iter().all(|x| x.abs() >= l) {
+                if l <= 4.0 * tol {
                     return None;
                 }
                 let neg = |x: &f64| *x < -ON_WALL;
                 let pos = |x: &f64| *x > ON_WALL;
                 if v.iter().any(neg) && v.iter().any(pos) {
+                    if v.iter().all(|x| x.abs() >= l) {
+                        return None;
+                    }
                     // The cut splits it: refined only where its facets would stray from the
                     // wall by more than half the checks' tolerance (a sharp edge of the wall,
                     // a tunnel's end, across the cell; facets left coarse by the cap).
-                    return straying_edge(&st.points, t, v, f, CROSSED_STRAY * tol);
+                    return straying_edge(&st.points, t, v, &f, CROSSED_STRAY * tol);
                 }
-                let mut samples: Vec<f64> = EDGES
-                    .iter()
-                    .map(|&(a, b)| f([0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]))))
-                    .collect();
-                samples.push(f(centroid(&st.points, t)));
-                samples.extend(v);
-                if !(samples.iter().any(neg) && samples.iter().any(pos)) {
+                // Out of reach: a node farther from the wall than the cell is wide.
+                if v.iter().all(|x| x.abs() > lip * l + ON_WALL) {
                     return None;
                 }
-                straying_edge(&st.points, t, v, f, tol)
+                let stop = CROSSED_STRAY * tol;
+                if o.reach_into(w, &q, v, stop) <= stop {
+                    return None;
+                }
+                straying_edge(&st.points, t, v, &f, tol)
+                    .or_else(|| Some(longest_edge(&st.points, t)))
             })
             .collect();
         keys.par_sort_unstable();
@@ -1995,8 +2005,7 @@ pub(crate) fn cut_objects(
         let mut bisected = 0;
         for &(i, w) in &walls {
             let o = &set.objects[i];
-            let f = |q: [f64; 3]| o.field(w, q);
-            bisected += refine_missed(st, &mut labels, &f, o.bbox, set.resolution * o.size);
+            bisected += refine_missed(st, &mut labels, o, w, set.resolution * o.size);
         }
         labels.repaired_edges += bisected;
         if bisected == 0 {
