@@ -1769,6 +1769,17 @@ enum On {
     Interface(usize),
 }
 
+/// With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), what a step of the
+/// objects' passes did: its time, the edges it bisected or split, the cells after it.
+fn object_stats(what: std::fmt::Arguments, since: std::time::Instant, edges: usize, cells: usize) {
+    if std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
+        eprintln!(
+            "objects: {what}: {edges} edges, {cells} cells after, {:.2} s",
+            since.elapsed().as_secs_f64()
+        );
+    }
+}
+
 fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
     set.objects
         .iter()
@@ -1795,9 +1806,12 @@ pub(crate) fn refine_near_objects(
         });
     }
     let walls = walls(set);
+    let since = std::time::Instant::now();
+    let mut rounds = 0;
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
+        rounds += 1;
         let values: Vec<Vec<f64>> = walls
             .iter()
             .map(|&(i, w)| {
@@ -1875,6 +1889,15 @@ pub(crate) fn refine_near_objects(
         labels.refined_edges += keys.len();
         bisect(st, &mut labels, &keys);
     }
+    object_stats(
+        format_args!(
+            "refinement near objects, {rounds} rounds, capped {}",
+            labels.capped
+        ),
+        since,
+        labels.refined_edges,
+        st.tets.len(),
+    );
     Ok(labels)
 }
 
@@ -1895,8 +1918,19 @@ const CROSSED_STRAY: f64 = 2.0;
 /// ([`Object::reach_into`], module `crossing`: it never misses such a cell; sampling the field
 /// at the edges' midpoints and the centroid, as before, missed a wall passing between them).
 /// Only these cells are bisected (with the relaxed Rivara closure), so the cost is that of the
-/// wall's surface, not of the band the refinement covers. Returns the edges bisected.
-fn refine_missed(st: &mut State, labels: &mut ObjectCells, o: &Object, w: Wall, tol: f64) -> usize {
+/// wall's surface, not of the band the refinement covers. Returns the edges bisected, the
+/// rounds, and the cells flagged (all rounds): crossed (nodes on both sides), and reached
+/// without a sign change at the nodes.
+fn refine_missed(
+    st: &mut State,
+    labels: &mut ObjectCells,
+    o: &Object,
+    w: Wall,
+    tol: f64,
+) -> (usize, usize, [usize; 2]) {
+    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+    let flagged = [AtomicUsize::new(0), AtomicUsize::new(0)];
+    let mut rounds = 0;
     let f = |q: [f64; 3]| o.field(w, q);
     let [lo, hi] = o.bbox;
     // The field's magnitude is at most this times the distance to the wall.
@@ -1906,6 +1940,7 @@ fn refine_missed(st: &mut State, labels: &mut ObjectCells, o: &Object, w: Wall, 
     };
     let mut total = 0;
     for _ in 0..40 {
+        rounds += 1;
         // The field is read at every node of every cell that reaches the object's box (plus
         // a margin), however far its other nodes lie outside it: a cell across the box's
         // boundary may be crossed by the wall. (Reading it only at the nodes within 1 m of
@@ -1961,7 +1996,11 @@ fn refine_missed(st: &mut State, labels: &mut ObjectCells, o: &Object, w: Wall, 
                     // The cut splits it: refined only where its facets would stray from the
                     // wall by more than half the checks' tolerance (a sharp edge of the wall,
                     // a tunnel's end, across the cell; facets left coarse by the cap).
-                    return straying_edge(&st.points, t, v, &f, CROSSED_STRAY * tol);
+                    let e = straying_edge(&st.points, t, v, &f, CROSSED_STRAY * tol);
+                    if e.is_some() {
+                        flagged[0].fetch_add(1, Relaxed);
+                    }
+                    return e;
                 }
                 // Out of reach: a node farther from the wall than the cell is wide.
                 if v.iter().all(|x| x.abs() > lip * l + ON_WALL) {
@@ -1971,6 +2010,7 @@ fn refine_missed(st: &mut State, labels: &mut ObjectCells, o: &Object, w: Wall, 
                 if o.reach_into(w, &q, v, stop) <= stop {
                     return None;
                 }
+                flagged[1].fetch_add(1, Relaxed);
                 straying_edge(&st.points, t, v, &f, tol)
                     .or_else(|| Some(longest_edge(&st.points, t)))
             })
@@ -1984,7 +2024,7 @@ fn refine_missed(st: &mut State, labels: &mut ObjectCells, o: &Object, w: Wall, 
         total += keys.len();
         bisect(st, labels, &keys);
     }
-    total
+    (total, rounds, flagged.map(|a| a.into_inner()))
 }
 
 /// Cuts every object's walls into the mesh (after the faults, the interfaces and the zones,
@@ -2005,7 +2045,20 @@ pub(crate) fn cut_objects(
         let mut bisected = 0;
         for &(i, w) in &walls {
             let o = &set.objects[i];
-            bisected += refine_missed(st, &mut labels, o, w, set.resolution * o.size);
+            let since = std::time::Instant::now();
+            let (edges, rounds, [crossed, reached]) =
+                refine_missed(st, &mut labels, o, w, set.resolution * o.size);
+            object_stats(
+                format_args!(
+                    "crossed cells of {} {} ({w:?}), pass {_pass}, {rounds} rounds, cells \
+                     flagged: {crossed} crossed, {reached} reached without a sign change",
+                    o.kind, o.name
+                ),
+                since,
+                edges,
+                st.tets.len(),
+            );
+            bisected += edges;
         }
         labels.repaired_edges += bisected;
         if bisected == 0 {
@@ -2014,6 +2067,7 @@ pub(crate) fn cut_objects(
     }
     for &(i, w) in &walls {
         let o = &set.objects[i];
+        let since = std::time::Instant::now();
         let f = |q: [f64; 3]| o.field(w, q);
         let [lo, hi] = o.bbox;
         let margin = 1e-3 + o.size * 1e-6;
@@ -2105,6 +2159,12 @@ pub(crate) fn cut_objects(
             .par_iter()
             .map(|t| crate::mesh::inside_cut(&st.points, t, &values, f))
             .collect();
+        object_stats(
+            format_args!("cut of {} {} ({w:?})", o.kind, o.name),
+            since,
+            keys.len(),
+            st.tets.len(),
+        );
         let mut count = 0usize;
         for (c, inside) in inside.into_iter().enumerate() {
             if !inside {
