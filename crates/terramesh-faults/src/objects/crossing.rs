@@ -304,7 +304,8 @@ fn overlap(tri: &[[f64; 3]; 3], q: &[[f64; 3]; 4]) -> f64 {
     let mut least = f64::INFINITY;
     let mut axis = |a: [f64; 3]| -> bool {
         let l = norm(a);
-        if !(l > 1e-12 * scale * scale) {
+        // A degenerate axis (parallel edges), or NaN: skipped.
+        if l.is_nan() || l <= 1e-12 * scale * scale {
             return false;
         }
         let a = a.map(|c| c / l);
