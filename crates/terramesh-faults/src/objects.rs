@@ -23,6 +23,8 @@ use robust::{orient2d, orient3d, Coord, Coord3D};
 use crate::mesh::{centroid, key, InterfaceFn, State, BASE, EDGES, ON_INTERFACE, SIDE, TOP};
 use crate::{BlockKey, FaultError, FaultSet, Terrain, ON_SURFACE};
 
+mod crossing;
+
 /// The default of [`ObjectSet::resolution`] (`geology.structure_resolution`): how far the
 /// facets may stray from an object's exact boundary, as a fraction of the object's size (a
 /// tunnel's radius, half its smaller profile dimension; an excavation's depth; a structure's
@@ -1767,6 +1769,17 @@ enum On {
     Interface(usize),
 }
 
+/// With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), what a step of the
+/// objects' passes did: its time, the edges it bisected or split, the cells after it.
+fn object_stats(what: std::fmt::Arguments, since: std::time::Instant, edges: usize, cells: usize) {
+    if std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
+        eprintln!(
+            "objects: {what}: {edges} edges, {cells} cells after, {:.2} s",
+            since.elapsed().as_secs_f64()
+        );
+    }
+}
+
 fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
     set.objects
         .iter()
@@ -1793,9 +1806,12 @@ pub(crate) fn refine_near_objects(
         });
     }
     let walls = walls(set);
+    let since = std::time::Instant::now();
+    let mut rounds = 0;
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
+        rounds += 1;
         let values: Vec<Vec<f64>> = walls
             .iter()
             .map(|&(i, w)| {
@@ -1873,12 +1889,22 @@ pub(crate) fn refine_near_objects(
         labels.refined_edges += keys.len();
         bisect(st, &mut labels, &keys);
     }
+    object_stats(
+        format_args!(
+            "refinement near objects, {rounds} rounds, capped {}",
+            labels.capped
+        ),
+        since,
+        labels.refined_edges,
+        st.tets.len(),
+    );
     Ok(labels)
 }
 
 /// The cells a wall crosses (nodes on both sides) are refined before the cut where their
 /// facets would stray from it by more than this times the refinement's tolerance (half the
-/// checks' tolerance).
+/// checks' tolerance); so are the cells whose nodes do not straddle it where it may reach into
+/// them deeper than that (the part of it the cut cannot see).
 const CROSSED_STRAY: f64 = 2.0;
 
 /// Refines, round after round, the cells that a wall crosses where its facets would stray from
@@ -1886,19 +1912,35 @@ const CROSSED_STRAY: f64 = 2.0;
 /// the objects stops at that cap, and the wall then crossed cells many times its tolerance
 /// wide, some with every node outside it (an edge across a tunnel's crown: no sign change,
 /// nothing cut, a cell labelled outside with most of its volume inside). A cell is crossed
-/// where its nodes, its edges' midpoints and its centroid have fields of both signs (beyond
-/// [`ON_WALL`]). Only these cells are bisected (with the relaxed Rivara closure), so the cost
-/// is that of the wall's surface, not of the band the refinement covers. Returns the edges
-/// bisected.
+/// where its nodes' fields have both signs (beyond [`ON_WALL`]); a cell whose nodes do not
+/// straddle the wall is refined where the wall may reach into it deeper than
+/// [`CROSSED_STRAY`] times the tolerance, by a conservative test of the object's kind
+/// ([`Object::reach_into`], module `crossing`: it never misses such a cell; sampling the field
+/// at the edges' midpoints and the centroid, as before, missed a wall passing between them).
+/// Only these cells are bisected (with the relaxed Rivara closure), so the cost is that of the
+/// wall's surface, not of the band the refinement covers. Returns the edges bisected, the
+/// rounds, and the cells flagged (all rounds): crossed (nodes on both sides), and reached
+/// without a sign change at the nodes.
 fn refine_missed(
     st: &mut State,
     labels: &mut ObjectCells,
-    f: &(dyn Fn([f64; 3]) -> f64 + Sync),
-    [lo, hi]: [[f64; 3]; 2],
+    o: &Object,
+    w: Wall,
     tol: f64,
-) -> usize {
+) -> (usize, usize, [usize; 2]) {
+    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+    let flagged = [AtomicUsize::new(0), AtomicUsize::new(0)];
+    let mut rounds = 0;
+    let f = |q: [f64; 3]| o.field(w, q);
+    let [lo, hi] = o.bbox;
+    // The field's magnitude is at most this times the distance to the wall.
+    let lip = match o.kind {
+        "excavation" => crossing::EXCAVATION_LIPSCHITZ,
+        _ => 1.0,
+    };
     let mut total = 0;
     for _ in 0..40 {
+        rounds += 1;
         // The field is read at every node of every cell that reaches the object's box (plus
         // a margin), however far its other nodes lie outside it: a cell across the box's
         // boundary may be crossed by the wall. (Reading it only at the nodes within 1 m of
@@ -1942,27 +1984,35 @@ fn refine_missed(
                     .iter()
                     .map(|&(i, j)| norm(sub(q[i], q[j])))
                     .fold(0.0, f64::max);
-                if l <= 4.0 * tol || v.iter().all(|x| x.abs() >= l) {
+                if l <= 4.0 * tol {
                     return None;
                 }
                 let neg = |x: &f64| *x < -ON_WALL;
                 let pos = |x: &f64| *x > ON_WALL;
                 if v.iter().any(neg) && v.iter().any(pos) {
+                    if v.iter().all(|x| x.abs() >= l) {
+                        return None;
+                    }
                     // The cut splits it: refined only where its facets would stray from the
                     // wall by more than half the checks' tolerance (a sharp edge of the wall,
                     // a tunnel's end, across the cell; facets left coarse by the cap).
-                    return straying_edge(&st.points, t, v, f, CROSSED_STRAY * tol);
+                    let e = straying_edge(&st.points, t, v, &f, CROSSED_STRAY * tol);
+                    if e.is_some() {
+                        flagged[0].fetch_add(1, Relaxed);
+                    }
+                    return e;
                 }
-                let mut samples: Vec<f64> = EDGES
-                    .iter()
-                    .map(|&(a, b)| f([0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]))))
-                    .collect();
-                samples.push(f(centroid(&st.points, t)));
-                samples.extend(v);
-                if !(samples.iter().any(neg) && samples.iter().any(pos)) {
+                // Out of reach: a node farther from the wall than the cell is wide.
+                if v.iter().all(|x| x.abs() > lip * l + ON_WALL) {
                     return None;
                 }
-                straying_edge(&st.points, t, v, f, tol)
+                let stop = CROSSED_STRAY * tol;
+                if o.reach_into(w, &q, v, stop) <= stop {
+                    return None;
+                }
+                flagged[1].fetch_add(1, Relaxed);
+                straying_edge(&st.points, t, v, &f, tol)
+                    .or_else(|| Some(longest_edge(&st.points, t)))
             })
             .collect();
         keys.par_sort_unstable();
@@ -1974,7 +2024,7 @@ fn refine_missed(
         total += keys.len();
         bisect(st, labels, &keys);
     }
-    total
+    (total, rounds, flagged.map(|a| a.into_inner()))
 }
 
 /// Cuts every object's walls into the mesh (after the faults, the interfaces and the zones,
@@ -1995,8 +2045,20 @@ pub(crate) fn cut_objects(
         let mut bisected = 0;
         for &(i, w) in &walls {
             let o = &set.objects[i];
-            let f = |q: [f64; 3]| o.field(w, q);
-            bisected += refine_missed(st, &mut labels, &f, o.bbox, set.resolution * o.size);
+            let since = std::time::Instant::now();
+            let (edges, rounds, [crossed, reached]) =
+                refine_missed(st, &mut labels, o, w, set.resolution * o.size);
+            object_stats(
+                format_args!(
+                    "crossed cells of {} {} ({w:?}), pass {_pass}, {rounds} rounds, cells \
+                     flagged: {crossed} crossed, {reached} reached without a sign change",
+                    o.kind, o.name
+                ),
+                since,
+                edges,
+                st.tets.len(),
+            );
+            bisected += edges;
         }
         labels.repaired_edges += bisected;
         if bisected == 0 {
@@ -2005,6 +2067,7 @@ pub(crate) fn cut_objects(
     }
     for &(i, w) in &walls {
         let o = &set.objects[i];
+        let since = std::time::Instant::now();
         let f = |q: [f64; 3]| o.field(w, q);
         let [lo, hi] = o.bbox;
         let margin = 1e-3 + o.size * 1e-6;
@@ -2096,6 +2159,12 @@ pub(crate) fn cut_objects(
             .par_iter()
             .map(|t| crate::mesh::inside_cut(&st.points, t, &values, f))
             .collect();
+        object_stats(
+            format_args!("cut of {} {} ({w:?})", o.kind, o.name),
+            since,
+            keys.len(),
+            st.tets.len(),
+        );
         let mut count = 0usize;
         for (c, inside) in inside.into_iter().enumerate() {
             if !inside {
