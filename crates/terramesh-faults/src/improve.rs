@@ -229,6 +229,16 @@ const MIN_GAIN: f64 = 1e-6;
 /// gradient moves of tiny gain and on plans of the cells around them that found nothing.
 const HEAVY_GAIN: f64 = 0.1;
 
+/// A cell whose smallest angle is below this (degrees) is planned as in the tail even in a
+/// heavy sweep: a move that mends it need gain only [`MIN_GAIN`] (and touches its nodes),
+/// and it is planned again while a node of it is touched although its plan found nothing.
+/// The bench's worst cells (0.013 degrees, slivers on an interface against the north side
+/// whose nodes may move only along the interface or the side) are mended only by gradient
+/// moves that gain less than [`HEAVY_GAIN`], and since no sweep there starts with at most
+/// [`TAIL_CELLS`] poor cells, the tail never ran to make them. Such cells are few, so
+/// this costs little.
+const HEAVY_LOW: f64 = 1.0;
+
 /// A cell's label: its side of every fault, its unit, its block, the fault zones it lies in
 /// (bit f: between the walls of fault f's zone), its object label ([`walls::code`]).
 type Label = (u64, u32, u32, u64, u32);
@@ -299,6 +309,30 @@ const REPLAN: usize = 16;
 pub(crate) const FULL_SWEEPS: usize = 6;
 /// The most poor cells a sweep after [`FULL_SWEEPS`] may start with.
 pub(crate) const TAIL_CELLS: usize = 4_096;
+
+/// The most steps of a split's compass search (each step tries [`COMPASS`]'s 14 directions,
+/// or halves the step when none is better).
+const COMPASS_STEPS: usize = 24;
+
+/// While many cells are poor ([`Pass::heavy`]), a poor cell is split only at one of its
+/// this many longest edges, and each compass search takes at most [`HEAVY_COMPASS_STEPS`]
+/// steps: the splits' compass searches were most of the time of the plans that found
+/// nothing (the bench's sweep 3: 61 of the 90 thread-seconds of the failed tries), and a
+/// short edge's split rarely mends a sliver that no collapse of it did.
+const HEAVY_SPLIT_EDGES: usize = 3;
+
+/// The most steps of a split's compass search in a heavy sweep ([`HEAVY_SPLIT_EDGES`]).
+const HEAVY_COMPASS_STEPS: usize = 12;
+
+/// A move's least gain (degrees) from the worst angle `old` of the cells it changes: in a heavy
+/// sweep [`HEAVY_GAIN`], unless `old` is below [`HEAVY_LOW`]; else [`MIN_GAIN`].
+fn least_gain(heavy: bool, old: f64) -> f64 {
+    if heavy && old >= HEAVY_LOW {
+        HEAVY_GAIN
+    } else {
+        MIN_GAIN
+    }
+}
 
 /// The directions of the compass search of a new node's place: the six axes and the eight
 /// diagonals.
@@ -498,10 +532,17 @@ impl Pass<'_> {
             return (Some(op), 3);
         }
         lap(3);
-        // Last, a new node on one of its edges, longest first.
+        // Last, a new node on one of its edges, longest first (in a heavy sweep on one of
+        // the longest few only).
+        let tries = if self.heavy {
+            HEAVY_SPLIT_EDGES
+        } else {
+            EDGES.len()
+        };
         let op = edges
             .iter()
             .rev()
+            .take(tries)
             .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
             // In the tail sweeps only, the operations of module `tail` (counted as splits).
             .or_else(|| self.tail_ops(c, &stars));
@@ -585,7 +626,7 @@ impl Pass<'_> {
                     .map(|&c| self.angle[c as usize])
                     .fold(f64::MAX, f64::min);
                 let new = angles.iter().copied().fold(f64::MAX, f64::min);
-                let loud = !self.heavy || new - old >= HEAVY_GAIN;
+                let loud = !self.heavy || new - old >= least_gain(true, old);
                 for (&c, a) in cells.iter().zip(angles) {
                     self.angle[c as usize] = a;
                     for w in self.st.tets[c as usize] {
@@ -1110,7 +1151,7 @@ impl Pass<'_> {
             }
         }
         let walled = labels.iter().any(|l| l.3 != labels[0].3);
-        if best < old + if self.heavy { HEAVY_GAIN } else { MIN_GAIN }
+        if best < old + least_gain(self.heavy, old)
             || !cells.iter().all(|&c| {
                 let g = geo(c, q);
                 self.in_unit(g, c) && self.in_zone(g, c, walled) && self.in_objects(g, c)
@@ -1432,7 +1473,12 @@ impl Pass<'_> {
         let len = d2(pa, pb).sqrt();
         let mut h = 0.25 * len;
         if self.slide_at(flags, m, &labels, m).is_some() {
-            for _ in 0..24 {
+            let steps = if self.heavy {
+                HEAVY_COMPASS_STEPS
+            } else {
+                COMPASS_STEPS
+            };
+            for _ in 0..steps {
                 if h < 1e-3 * len {
                     break;
                 }
@@ -1713,7 +1759,7 @@ pub(crate) fn improve(
                     p.alive[c]
                         && p.angle[c] < below
                         && (fresh
-                            || ((!p.heavy || !p.barren[c])
+                            || ((!p.heavy || !p.barren[c] || p.angle[c] < HEAVY_LOW)
                                 && p.st.tets[c].iter().any(|&v| p.touched[v as usize])))
                 })
                 .collect();

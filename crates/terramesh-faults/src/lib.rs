@@ -91,9 +91,14 @@
 //!    edges or a 2-3 flip of one of its faces, among cells of one label only; moving one of
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
 //!    the smallest angle of its worst cell; splitting one of its edges by a new node placed by
-//!    a compass search (on every surface the edge lies on); last, in the sweeps that begin
-//!    with at most 4,096 poor cells only, removing one of its edges (the n-to-2n-4 flip of a
-//!    ring of 4 to 7 cells of one label) or moving along its fault a node between two units. What may change is read from the cells' labels
+//!    a compass search (on every surface the edge lies on; at most 24 steps); last, in the
+//!    sweeps that begin with at most 4,096 poor cells only, removing one of its edges (the
+//!    n-to-2n-4 flip of a ring of 4 to 7 cells of one label) or moving along its fault a node
+//!    between two units. A sweep that starts with more than 4,096 poor cells is economical: a
+//!    gradient move must gain 0.1 degrees, a cell whose plan found nothing is not planned
+//!    again until it is changed (both not for a cell below 1 degree), and a split is tried on
+//!    the cell's 3 longest edges only, with at most 12 steps of compass search. What may
+//!    change is read from the cells' labels
 //!    (side of every fault, unit, fault zones): a node whose cells carry one label lies on no
 //!    surface and may move anywhere (on a side: vertically; on the base: horizontally); a node
 //!    between two units of one block moves along that interface (its height taken from
