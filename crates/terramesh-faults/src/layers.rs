@@ -19,7 +19,7 @@
 
 use rayon::prelude::*;
 
-use crate::mesh::{checked_thickest, split_prism, BuildReport, State, BASE, SIDE, TOP};
+use crate::mesh::{checked_thickest, split_prism, State, BASE, SIDE, TOP};
 use crate::{FaultError, FaultSet, InterfaceFn, MeshSettings, Terrain, ON_SURFACE};
 
 /// The elevations of a column's unit boundaries, top to bottom: the terrain `h`, every
@@ -193,7 +193,6 @@ pub(crate) fn layered_background(
             })
         })
         .collect();
-    let m = tets.len();
     if std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
         // For profiling: per unit, its cells and those below 5 degrees (a cell's unit: its
         // lowest level's), its thickness over the columns.
@@ -231,23 +230,7 @@ pub(crate) fn layered_background(
             .collect();
         eprintln!("layered background: {levels} levels, sub-layers {most:?}; per unit (cells, below 5): {count:?}; thickness (min, max): {thick:?}; median planar edge {:.1}", terrain.median_edge());
     }
-    Ok((
-        State {
-            points,
-            on_fault: vec![0; flags.len()],
-            flags,
-            tets,
-            positive: vec![0; m],
-            below: vec![0; m],
-            block: vec![0; m],
-            zone: Vec::new(),
-            report: BuildReport {
-                background_cells: m,
-                ..BuildReport::default()
-            },
-        },
-        background_nodes,
-    ))
+    Ok((State::background(points, flags, tets), background_nodes))
 }
 
 #[cfg(test)]

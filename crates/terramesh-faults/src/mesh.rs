@@ -181,6 +181,28 @@ pub(crate) struct State {
     pub(crate) report: BuildReport,
 }
 
+impl State {
+    /// A background mesh before any cut: its nodes, their flags and its cells, no node on a
+    /// fault, every cell's labels zero, its report counting the cells.
+    pub(crate) fn background(points: Vec<[f64; 3]>, flags: Vec<u8>, tets: Vec<[u32; 4]>) -> State {
+        let m = tets.len();
+        State {
+            points,
+            on_fault: vec![0; flags.len()],
+            flags,
+            tets,
+            positive: vec![0; m],
+            below: vec![0; m],
+            block: vec![0; m],
+            zone: Vec::new(),
+            report: BuildReport {
+                background_cells: m,
+                ..BuildReport::default()
+            },
+        }
+    }
+}
+
 /// The height of interface `k` (the top of unit `k + 1`) in a fault block, at a plan point.
 pub type InterfaceFn<'a> = &'a (dyn Fn(usize, BlockKey, [f64; 2]) -> f64 + Sync);
 
@@ -595,21 +617,7 @@ pub(crate) fn background(terrain: &Terrain, s: &MeshSettings) -> Result<State, F
             })
         })
         .collect();
-    let m = tets.len();
-    Ok(State {
-        points,
-        on_fault: vec![0; flags.len()],
-        flags,
-        tets,
-        positive: vec![0; m],
-        below: vec![0; m],
-        block: vec![0; m],
-        zone: Vec::new(),
-        report: BuildReport {
-            background_cells: m,
-            ..BuildReport::default()
-        },
-    })
+    Ok(State::background(points, flags, tets))
 }
 
 /// Splits `t` at every edge in `keys` (sorted), the edge of the lowest rank first (`rank[pos]`
