@@ -1936,6 +1936,16 @@ mod tests {
         tets: Vec<[u32; 4]>,
         below: Vec<u32>,
     ) -> (State, Improved) {
+        pass_at(points, tets, below, 20.0)
+    }
+
+    /// [`pass_below`] with the floor `degrees` (also for the tests of module `tail`).
+    pub(super) fn pass_at(
+        points: Vec<[f64; 3]>,
+        tets: Vec<[u32; 4]>,
+        below: Vec<u32>,
+        degrees: f64,
+    ) -> (State, Improved) {
         let n = points.len();
         let m = tets.len();
         let mut st = State {
@@ -1970,7 +1980,7 @@ mod tests {
             0,
             &terrain,
             n,
-            20.0,
+            degrees,
             2,
             &ObjectSet::default(),
             &mut ObjectCells::default(),

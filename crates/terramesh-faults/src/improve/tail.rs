@@ -350,10 +350,8 @@ fn edge_angle(g: [[f64; 3]; 4], i: usize, j: usize) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::improve;
-    use crate::mesh::{positive, BuildReport, State, TOP};
+    use crate::mesh::positive;
     use crate::quality::min_dihedral;
-    use crate::{BlockKey, FaultSet, ObjectCells, ObjectSet, Terrain};
     use terramesh_core::volume::tetra_volume;
 
     /// Four cells around the edge (a, b) = (nodes 4, 5), one of their ring's nodes 0.15 m
@@ -390,40 +388,8 @@ mod tests {
         };
         let (old, volume) = measure(&points, &tets);
         assert!(old < 10.0, "{old}");
-        let n = points.len();
-        let mut st = State {
-            points,
-            flags: vec![TOP; n],
-            on_fault: vec![0; n],
-            positive: vec![0; 4],
-            below: vec![0; 4],
-            block: vec![0; 4],
-            zone: Vec::new(),
-            tets,
-            report: BuildReport::default(),
-        };
-        let terrain = Terrain::new(
-            vec![[-100.0, -100.0], [100.0, -100.0], [0.0, 100.0]],
-            vec![[0, 1, 2]],
-            vec![10.0; 3],
-        )
-        .unwrap();
-        let faults = FaultSet::new(&[], &terrain, -10.0).unwrap();
-        let h = |_: usize, _: BlockKey, _: [f64; 2]| 0.0;
         super::super::verify_each_operation(true);
-        let done = improve(
-            &mut st,
-            &faults,
-            &[],
-            &h,
-            0,
-            &terrain,
-            n,
-            45.0,
-            2,
-            &ObjectSet::default(),
-            &mut ObjectCells::default(),
-        );
+        let (st, done) = super::super::tests::pass_at(points, tets, vec![0; 4], 45.0);
         assert_eq!(done.flipped, 1, "{done:?}");
         assert_eq!(st.tets.len(), 4);
         assert!(
