@@ -143,6 +143,8 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
     // millimetres apart on the junction of F1 and F2, aimed at 6 degrees and swept until
     // nothing changed). The pin leaves room: changes in the DSM's last bits alone (from the
     // thread count, before faer got a fixed degree) moved the count between 8 and 16.
+    // The local refinement did all it should within its budget.
+    assert!(faulted.get("refine_budget").is_none(), "{faulted}");
     let smallest = faulted["min_dihedral_degrees"].as_f64().unwrap();
     let below = faulted["cells_below_5_degrees"].as_u64().unwrap();
     eprintln!("{below} cells below 5 degrees, the smallest {smallest:.4} degrees");
@@ -216,6 +218,8 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
     }
 }
 
+/// Split nodes; and, in the same run (one build fewer), a refinement budget too small for
+/// the DSM's planar mesh: the build warns, also when quiet, and `model.json` says so.
 #[test]
 fn split_faults_duplicates_the_nodes_on_the_faults() {
     let tmp = tempfile::tempdir().unwrap();
@@ -223,11 +227,23 @@ fn split_faults_duplicates_the_nodes_on_the_faults() {
     let o = model(
         &example().join("terramesh.toml"),
         &out,
-        &["geology.split_faults=true"],
+        &["geology.split_faults=true", "geology.refine_max_cells=1000"],
     );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("local refinement was skipped at geology.refine_max_cells = 1000"),
+        "{stderr}"
+    );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
+    let budget = &json["faulted"]["refine_budget"];
+    assert_eq!(budget["max_cells"], 1000);
+    assert_eq!(budget["skipped"], true);
+    assert!(
+        budget["triangles_too_wide"].as_u64().unwrap() > 0,
+        "{budget}"
+    );
     let split = json["faulted"]["split_nodes"].as_u64().unwrap();
     let v = Vtu::read(&out.join("model.vtu"));
     let n = v.array("Name=\"Points\"").len() as u64 / 3;

@@ -206,13 +206,14 @@ pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG
 pub use improve::verify_each_operation;
 pub use mesh::{
     faulted_mesh, faulted_mesh_with_objects, BuildReport, FaultFace, FaultedMesh, InterfaceFn,
-    MeshSettings, ON_SURFACE,
+    MeshSettings, ON_SURFACE, REFINE_MAX_CELLS,
 };
 pub use objects::{
     check_objects, Object, ObjectCells, ObjectCheck, ObjectGeometry, ObjectSet, ObjectSpec,
     Profile, Wall, OBJECT_MAX_CELLS, OBJECT_TOLERANCE, STRUCTURE_RESOLUTION,
 };
 pub use quality::{min_dihedral, quality, Quality, BINS};
+pub use refine::RefineBudget;
 pub use split::{check_split, split_nodes, SplitMesh, SplitSummary};
 pub use synth::{Site, SynthFault};
 pub use terrain::Terrain;

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
 
 use crate::quality::min_dihedral;
-use crate::{BlockKey, Fault, FaultError, FaultSet, Terrain};
+use crate::{BlockKey, Fault, FaultError, FaultSet, RefineBudget, Terrain};
 
 /// A vertex on the terrain.
 pub(crate) const TOP: u8 = 1;
@@ -78,6 +78,10 @@ pub struct MeshSettings {
     pub layered: bool,
 }
 
+/// The default budget of the local refinement, background cells
+/// (`MeshSettings::refine_max_cells`).
+pub const REFINE_MAX_CELLS: usize = 600_000;
+
 impl MeshSettings {
     /// The defaults for a base and a vertical cell size.
     pub fn new(base: f64, max_cell_height: f64) -> MeshSettings {
@@ -90,7 +94,7 @@ impl MeshSettings {
             improve_passes: 30,
             refine_ratio: 10.0,
             refine_min_thickness: 0.25,
-            refine_max_cells: 600_000,
+            refine_max_cells: REFINE_MAX_CELLS,
             layered: false,
         }
     }
@@ -113,6 +117,11 @@ pub struct FaultFace {
 pub struct BuildReport {
     /// Planar triangles added by refining where slabs are thin (0: the DSM's planar mesh).
     pub refined_triangles: usize,
+    /// Set where `MeshSettings::refine_max_cells` skipped the refinement or stopped it while
+    /// planar triangles were still too wide for the slabs under them: the cells cut from
+    /// those columns may stay below the quality floor. `None` where the refinement did all
+    /// it should (or is off).
+    pub refine_budget: Option<RefineBudget>,
     /// Cells of the background mesh.
     pub background_cells: usize,
     /// Vertices moved onto a surface.
@@ -1267,7 +1276,8 @@ pub fn faulted_mesh_with_objects(
             );
         }
     };
-    let refined = crate::refine::refine(terrain, faults, interfaces, height, settings)?;
+    let (refined, refine_budget) =
+        crate::refine::refine(terrain, faults, interfaces, height, settings)?;
     let added = refined
         .as_ref()
         .map_or(0, |r| r.triangles.len() - terrain.triangles.len());
@@ -1292,6 +1302,7 @@ pub fn faulted_mesh_with_objects(
         (st, nodes)
     };
     st.report.refined_triangles = added;
+    st.report.refine_budget = refine_budget;
     stage("background", &st);
     let object_cells = crate::objects::refine_near_objects(&mut st, objects)?;
     for (f, fault) in faults.faults.iter().enumerate() {

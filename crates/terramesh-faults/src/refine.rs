@@ -322,14 +322,29 @@ impl Planar<'_> {
     }
 }
 
-/// The refined terrain, or `None` where nothing needs refining (or refining is off).
+/// Where `refine_max_cells` kept the refinement from narrowing every column it should have
+/// (see [`crate::BuildReport::refine_budget`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RefineBudget {
+    /// The budget, `MeshSettings::refine_max_cells`.
+    pub max_cells: usize,
+    /// Whether the budget skipped the refinement altogether (the DSM's planar mesh alone
+    /// nearly fills it) rather than stopping it part way.
+    pub skipped: bool,
+    /// Planar triangles still wider than `refine_ratio` times the thinnest slab at their
+    /// vertices when it stopped: the columns whose cells may be slivers.
+    pub still_wide: usize,
+}
+
+/// The refined terrain (`None` where nothing needed refining, or refining is off or was
+/// skipped), and where the budget stopped the refinement while triangles were still too wide.
 pub(crate) fn refine(
     terrain: &Terrain,
     faults: &FaultSet,
     interfaces: usize,
     height: InterfaceFn,
     s: &MeshSettings,
-) -> Result<Option<Terrain>, FaultError> {
+) -> Result<(Option<Terrain>, Option<RefineBudget>), FaultError> {
     if !(s.refine_ratio >= 0.0 && s.refine_ratio.is_finite()) {
         return Err(FaultError::Setting {
             name: "refine_ratio".into(),
@@ -349,22 +364,21 @@ pub(crate) fn refine(
         || s.max_cell_height.is_nan()
         || s.max_cell_height <= 0.0
     {
-        return Ok(None);
+        return Ok((None, None));
     }
     let thickest = terrain
         .heights
         .iter()
         .fold(0.0f64, |m, &h| m.max(h - s.base));
     if !(thickest > 0.0 && thickest.is_finite()) {
-        return Ok(None);
+        return Ok((None, None));
     }
     let levels = ((thickest / s.max_cell_height).ceil() as usize).max(1) + 1;
     let per_triangle = 3 * (levels - 1);
     let max_tris = s.refine_max_cells / per_triangle;
-    // A budget that leaves room for a patch only is not worth measuring every vertex.
-    if (terrain.triangles.len() as f64) * (1.0 + MIN_GROWTH) > max_tris as f64 {
-        return Ok(None);
-    }
+    // A budget that leaves room for a patch only is not worth refining in: the triangles are
+    // measured once, to say how many it leaves too wide.
+    let skip = (terrain.triangles.len() as f64) * (1.0 + MIN_GROWTH) > max_tris as f64;
     let ctx = Ctx {
         terrain,
         faults,
@@ -387,6 +401,7 @@ pub(crate) fn refine(
     }
     let mut thin: Vec<f64> = Vec::new();
     let mut changed = false;
+    let mut stopped = skip;
     for _ in 0..ROUNDS {
         // The thinnest slab at every vertex not measured yet, within reach of its triangles.
         let mut reach = vec![0.0f64; pl.points.len()];
@@ -416,7 +431,18 @@ pub(crate) fn refine(
             })
             .collect();
         if marked.is_empty() {
+            stopped = false;
             break;
+        }
+        if skip {
+            return Ok((
+                None,
+                Some(RefineBudget {
+                    max_cells: s.refine_max_cells,
+                    skipped: true,
+                    still_wide: marked.len(),
+                }),
+            ));
         }
         marked.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
         let mut any = false;
@@ -429,14 +455,39 @@ pub(crate) fn refine(
             }
         }
         changed |= any;
-        if !any || pl.tris.len() + 8 > max_tris {
+        if pl.tris.len() + 8 > max_tris {
+            stopped = true;
+            break;
+        }
+        if !any {
             break;
         }
     }
+    // Triangles still too wide where the budget stopped it (a vertex added by the last
+    // round counts by its triangle's measured vertices).
+    let budget = if stopped {
+        let still_wide = (0..pl.tris.len() as u32)
+            .into_par_iter()
+            .filter(|&t| {
+                let m = pl.tris[t as usize]
+                    .iter()
+                    .map(|&v| thin.get(v as usize).copied().unwrap_or(f64::INFINITY))
+                    .fold(f64::INFINITY, f64::min);
+                pl.longest_len(t) > s.refine_ratio * m.max(s.refine_min_thickness)
+            })
+            .count();
+        (still_wide > 0).then_some(RefineBudget {
+            max_cells: s.refine_max_cells,
+            skipped: false,
+            still_wide,
+        })
+    } else {
+        None
+    };
     if !changed {
-        return Ok(None);
+        return Ok((None, budget));
     }
-    Terrain::new(pl.points, pl.tris, pl.heights).map(Some)
+    Terrain::new(pl.points, pl.tris, pl.heights).map(|t| (Some(t), budget))
 }
 
 #[cfg(test)]
@@ -450,6 +501,17 @@ mod tests {
 
     /// Refines a region over a sloping terrain with a fault and a 0.4 m unit everywhere.
     fn refined(pts: &[[f64; 2]], tris: Vec<[u32; 3]>) -> (Terrain, Option<Terrain>) {
+        let (t, r, budget) = refined_within(pts, tris, 200_000);
+        assert_eq!(budget, None);
+        (t, r)
+    }
+
+    /// As [`refined`], within a budget of `max_cells` background cells.
+    fn refined_within(
+        pts: &[[f64; 2]],
+        tris: Vec<[u32; 3]>,
+        max_cells: usize,
+    ) -> (Terrain, Option<Terrain>, Option<RefineBudget>) {
         let terrain =
             Terrain::new(pts.to_vec(), tris, pts.iter().map(|&p| h(p)).collect()).unwrap();
         let faults = FaultSet::new(
@@ -465,9 +527,43 @@ mod tests {
         .unwrap();
         let height = |k: usize, _b: BlockKey, p: [f64; 2]| 60.0 - 0.4 * k as f64 + 0.01 * p[0];
         let mut s = MeshSettings::new(0.0, 20.0);
-        s.refine_max_cells = 200_000;
-        let r = refine(&terrain, &faults, 2, &height, &s).unwrap();
-        (terrain, r)
+        s.refine_max_cells = max_cells;
+        let (r, budget) = refine(&terrain, &faults, 2, &height, &s).unwrap();
+        (terrain, r, budget)
+    }
+
+    #[test]
+    fn a_budget_that_skips_or_stops_the_refinement_is_reported() {
+        let pts = [
+            [0.0, 0.0],
+            [100.0, 0.0],
+            [100.0, 100.0],
+            [0.0, 100.0],
+            [47.3, 52.9],
+        ];
+        let tris = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
+        // 7 levels over the 105 m thickest column: 18 cells per planar triangle.
+        // Room for 4 triangles, the DSM's own: skipped, every triangle too wide.
+        let (_, r, budget) = refined_within(&pts, tris.clone(), 18 * 4);
+        assert!(r.is_none());
+        let b = budget.expect("the budget skipped the refinement");
+        assert!(b.skipped);
+        assert_eq!(b.max_cells, 72);
+        assert_eq!(b.still_wide, 4);
+        // Room for 100: refined part way, some triangles still too wide.
+        let (t, r, budget) = refined_within(&pts, tris.clone(), 18 * 100);
+        let r = r.expect("refined within the budget");
+        assert!(r.triangles.len() <= 100, "{}", r.triangles.len());
+        assert_valid(&t, &r);
+        let b = budget.expect("the budget stopped the refinement");
+        assert!(!b.skipped);
+        assert!(
+            b.still_wide > 0 && b.still_wide <= r.triangles.len(),
+            "{b:?}"
+        );
+        // Room enough: no report (asserted by `refined`).
+        let (_, r) = refined(&pts, tris);
+        assert!(r.is_some());
     }
 
     /// The refined planar mesh is conforming (every edge once each way, or once on the

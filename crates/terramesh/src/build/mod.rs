@@ -292,6 +292,9 @@ fn geology_stage(
             )
         },
     )?;
+    if let Some(b) = (built.summary.faulted.as_ref()).and_then(|f| f.refine_budget.as_ref()) {
+        st.progress.warn(&b.warning());
+    }
     if project
         .export
         .formats

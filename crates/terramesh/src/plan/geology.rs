@@ -39,6 +39,11 @@ pub const MAX_LAYERS: usize = 1000;
 /// (`geology.max_cell_height`): the background mesh under the DSM has as many levels as the
 /// thickest column needs for it.
 pub const DEFAULT_MAX_CELL_HEIGHT: f64 = 10.0;
+/// The local refinement's budget by default, background cells (`geology.refine_max_cells`).
+pub const DEFAULT_REFINE_MAX_CELLS: usize = terramesh_faults::REFINE_MAX_CELLS;
+/// The largest `geology.refine_max_cells` accepted: the background mesh's cells take about
+/// 100 bytes each before the cut.
+pub const MAX_REFINE_MAX_CELLS: usize = 50_000_000;
 /// The largest `geology.max_cell_height` accepted, metres.
 pub const MAX_CELL_HEIGHT: f64 = 10_000.0;
 /// The thickest fault zone (`geology.faults[F].zone`) accepted before the terrain is read,
@@ -144,6 +149,9 @@ pub struct GeologyPlan {
     pub split_faults: bool,
     /// The largest vertical cell size of a faulted model, metres.
     pub max_cell_height: f64,
+    /// The budget of the faulted mesh's local refinement where slabs are thin, background
+    /// cells (`geology.refine_max_cells`).
+    pub refine_max_cells: usize,
     /// The engineering objects (tunnels, excavations, structures) in project order.
     pub objects: Vec<super::ObjectPlan>,
     /// How far an object's facets may stray from its boundary, as a fraction of its size

@@ -23,7 +23,8 @@ mod whole;
 pub use export::{ExportPlan, MAX_BASE_ELEVATION, MIN_BASE_ELEVATION};
 pub use geology::{
     Base, FaultKind, FaultPlan, FaultSource, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MAX_CELL_HEIGHT,
-    DEFAULT_MIN_THICKNESS, MAX_CELL_HEIGHT, MAX_LAYERS, MAX_ZONE,
+    DEFAULT_MIN_THICKNESS, DEFAULT_REFINE_MAX_CELLS, MAX_CELL_HEIGHT, MAX_LAYERS,
+    MAX_REFINE_MAX_CELLS, MAX_ZONE,
 };
 pub use interpolation::{
     Auto, InterpolationPlan, Numbers, VariogramSpec, DEFAULT_IDW_NEIGHBORS, DEFAULT_METHODS,

@@ -29,8 +29,8 @@ use terramesh_io::boreholes::{
 use crate::error::{Error, PathProblem, Result};
 use crate::plan::{
     Base, FaultKind, FaultPlan, FaultSource, GeologyPlan, DEFAULT_LAYERS, DEFAULT_MAX_CELL_HEIGHT,
-    DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_CELL_HEIGHT, MAX_LAYERS, MAX_ZONE,
-    MIN_BASE_ELEVATION,
+    DEFAULT_MIN_THICKNESS, MAX_BASE_ELEVATION, MAX_CELL_HEIGHT, MAX_LAYERS, MAX_REFINE_MAX_CELLS,
+    MAX_ZONE, MIN_BASE_ELEVATION,
 };
 
 /// The commented `[geology]` section that `terramesh init --geology` appends to
@@ -87,6 +87,9 @@ pub struct GeologySection {
     /// The largest vertical size of a cell of a faulted model, metres.
     #[serde(default = "default_max_cell_height")]
     pub max_cell_height: f64,
+    /// The budget of the local refinement of a faulted model, background cells.
+    #[serde(default = "default_refine_max_cells")]
+    pub refine_max_cells: usize,
     /// `[[geology.tunnels]]` (issue 32).
     #[serde(default)]
     pub tunnels: Vec<super::TunnelSection>,
@@ -138,6 +141,10 @@ pub struct FaultSection {
 
 fn default_max_cell_height() -> f64 {
     DEFAULT_MAX_CELL_HEIGHT
+}
+
+fn default_refine_max_cells() -> usize {
+    crate::plan::DEFAULT_REFINE_MAX_CELLS
 }
 
 fn default_min_thickness() -> f64 {
@@ -376,6 +383,7 @@ impl GeologySection {
             fault_picks: self.fault_picks.as_ref().map(|p| base.join(p)),
             split_faults: self.split_faults,
             max_cell_height: self.max_cell_height,
+            refine_max_cells: self.refine_max_cells,
             objects: super::objects::lower(
                 &self.tunnels,
                 &self.excavations,
@@ -396,6 +404,15 @@ impl GeologySection {
                 format!(
                     "{} m: give a positive number of metres, at most {MAX_CELL_HEIGHT}",
                     terramesh_core::limits::short(h)
+                ),
+            ));
+        }
+        if self.refine_max_cells > MAX_REFINE_MAX_CELLS {
+            return Err((
+                "geology.refine_max_cells".into(),
+                format!(
+                    "{} cells: give at most {} (0 turns the refinement off)",
+                    self.refine_max_cells, MAX_REFINE_MAX_CELLS
                 ),
             ));
         }
@@ -997,6 +1014,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("geology.max_cell_height"), "{e}");
+        assert_eq!(g.refine_max_cells, crate::plan::DEFAULT_REFINE_MAX_CELLS);
+        let p = Project::parse("p.toml", &ok, &["geology.refine_max_cells=2000000".into()]);
+        assert_eq!(p.unwrap().geology().unwrap().refine_max_cells, 2_000_000);
+        let too_many = format!("geology.refine_max_cells={}", MAX_REFINE_MAX_CELLS + 1);
+        let e = Project::parse("p.toml", &ok, &[too_many]).unwrap_err();
+        assert!(e.to_string().contains("geology.refine_max_cells"), "{e}");
         // A zone lowers into the plan; a unit already named after it is refused.
         let zoned = ok.replacen("throw = 5.0", "throw = 5.0\nzone = 2.0", 1);
         let p = Project::parse("p.toml", &zoned, &[]).unwrap();

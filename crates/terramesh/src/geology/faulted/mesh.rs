@@ -32,7 +32,12 @@ pub fn build_mesh(
     ifs: &BlockInterfaces,
     base: f64,
 ) -> Result<Faulted> {
-    let settings = MeshSettings::new(base, g.max_cell_height);
+    let mut settings = MeshSettings::new(base, g.max_cell_height);
+    settings.refine_max_cells = g.refine_max_cells;
+    if g.refine_max_cells == 0 {
+        // No budget: no refinement, and nothing to report about it.
+        settings.refine_ratio = 0.0;
+    }
     let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
     let mesh = crate::geology::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
     let check =

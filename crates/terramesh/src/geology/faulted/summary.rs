@@ -131,6 +131,43 @@ pub struct FaultedSummary {
     /// Nodes after splitting the faults' nodes (`geology.split_faults`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub split_nodes: Option<usize>,
+    /// Where `geology.refine_max_cells` skipped or stopped the local refinement while planar
+    /// triangles were still too wide for the slabs under them (absent where it did all it
+    /// should): the cells cut from those columns may stay below 5 degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refine_budget: Option<RefineBudgetSummary>,
+}
+
+/// `faulted.refine_budget` in `model.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct RefineBudgetSummary {
+    /// `geology.refine_max_cells`.
+    pub max_cells: usize,
+    /// Whether the refinement was skipped altogether (the DSM's planar mesh alone nearly
+    /// fills the budget) rather than stopped part way.
+    pub skipped: bool,
+    /// Planar triangles still wider than 10 times the thinnest slab at their vertices.
+    pub triangles_too_wide: usize,
+}
+
+impl RefineBudgetSummary {
+    /// The warning a build prints.
+    pub fn warning(&self) -> String {
+        format!(
+            "the faulted mesh's local refinement {} at geology.refine_max_cells = {} \
+             background cells, leaving {} planar triangles wider than 10 times the thinnest \
+             slab under them (thin units or faults close together): cells cut from those \
+             columns may stay below 5 degrees (model.json: faulted.refine_budget); raise \
+             geology.refine_max_cells for a finer mesh there",
+            if self.skipped {
+                "was skipped"
+            } else {
+                "stopped"
+            },
+            self.max_cells,
+            self.triangles_too_wide
+        )
+    }
 }
 
 fn tet_volume(p: &[[f64; 3]], t: &[u32; 4]) -> f64 {
@@ -295,6 +332,11 @@ pub fn summarise(
         dihedral_histogram: q.histogram.clone(),
         fault_distance: f.check.fault_distance,
         split_nodes: f.split,
+        refine_budget: f.mesh.report.refine_budget.map(|b| RefineBudgetSummary {
+            max_cells: b.max_cells,
+            skipped: b.skipped,
+            triangles_too_wide: b.still_wide,
+        }),
     }
 }
 
