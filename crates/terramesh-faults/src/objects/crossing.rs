@@ -681,3 +681,99 @@ fn pit_reach(
         worst
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Random cells around an L-shaped pit (sloping faces, tops varying along the outline, and
+    /// vertical faces): a cell that [`Pit::piece`] clears must hold no point inside the solid
+    /// (its nodes outside) or outside it (its nodes inside) by more than a millimetre, by
+    /// dense sampling; and the test must clear most cells that the sampling finds clear.
+    #[test]
+    fn the_pit_test_never_clears_a_crossed_cell() {
+        let outline = [
+            [0.0, 0.0],
+            [30.0, 0.0],
+            [30.0, 12.0],
+            [11.0, 12.0],
+            [11.0, 25.0],
+            [0.0, 25.0],
+        ];
+        let tops = [100.0, 103.0, 101.0, 99.0, 104.0, 100.5];
+        let mut seed = 7u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for angle in [55.0f64, 90.0] {
+            let a = angle.to_radians();
+            let pit = Pit::new(&outline, &tops, 92.0, a.sin(), a.cos());
+            // The solid's field: negative inside, with the distance to the outline outside it.
+            let value = |x: [f64; 3]| {
+                let mut d = f64::INFINITY;
+                let mut f = pit.floor - x[2];
+                for i in 0..outline.len() {
+                    f = f.max(pit.term(i, x));
+                    let (p, e, l2, _) = pit.edge(i);
+                    let t = (((x[0] - p[0]) * e[0] + (x[1] - p[1]) * e[1]) / l2).clamp(0.0, 1.0);
+                    d = d.min((p[0] + t * e[0] - x[0]).hypot(p[1] + t * e[1] - x[1]));
+                }
+                if point_in_ring([x[0], x[1]], &outline) {
+                    f.max(-d)
+                } else {
+                    d.max(f)
+                }
+            };
+            let (mut cleared, mut clear, mut hidden) = (0, 0, 0);
+            for _ in 0..4000 {
+                let size = 0.5 + 8.0 * rnd();
+                let c = [
+                    -5.0 + 40.0 * rnd(),
+                    -5.0 + 35.0 * rnd(),
+                    88.0 + 14.0 * rnd(),
+                ];
+                let q: [[f64; 3]; 4] =
+                    std::array::from_fn(|_| [0, 1, 2].map(|k| c[k] + size * (rnd() - 0.5)));
+                let v = q.map(value);
+                let out = v.iter().all(|&x| x > ON_WALL);
+                let inside = v.iter().all(|&x| x < -ON_WALL);
+                if !out && !inside {
+                    continue;
+                }
+                let mut worst = 0.0f64;
+                for _ in 0..3000 {
+                    let mut w = [rnd(), rnd(), rnd(), rnd()].map(|x: f64| x * x * x);
+                    let s: f64 = w.iter().sum();
+                    w = w.map(|x| x / s);
+                    let x = [0, 1, 2].map(|k| (0..4).map(|i| w[i] * q[i][k]).sum::<f64>());
+                    let f = value(x);
+                    worst = worst.max(if out { -f } else { f });
+                }
+                let verdict = pit.piece(&q, out, inside);
+                if verdict == Verdict::Clear {
+                    cleared += 1;
+                    assert!(
+                        worst <= 2.0 * ON_WALL,
+                        "angle {angle}: cell {q:?} cleared, but a point {worst} across the wall"
+                    );
+                }
+                if worst <= 0.0 {
+                    clear += 1;
+                } else if worst > 2.0 * ON_WALL {
+                    // Crossed with every node on one side: the cells the test is for.
+                    hidden += 1;
+                    assert_ne!(verdict, Verdict::Clear);
+                }
+            }
+            println!(
+                "angle {angle}: {cleared} cleared of {clear} found clear by sampling; \
+                 {hidden} crossed with every node on one side"
+            );
+            assert!(hidden > 0);
+            assert!(cleared * 10 >= clear * 8, "{cleared} of {clear}");
+        }
+    }
+}
