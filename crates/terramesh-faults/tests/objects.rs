@@ -405,10 +405,9 @@ fn a_box_on_unrefined_coarse_cells_is_cut_cleanly() {
 /// small enough to lie between those points, the refinement near objects capped at 0 cells so
 /// that only the crossed-cells pass can see it. The sampling missed it (the cut found no cell
 /// inside: "no part of the object lies inside the model"); the pass's conservative test per
-/// kind (a solid's triangles against the cell, a tunnel piece's convex field's bound over it)
-/// must find the cells and refine them until the cut sees it, within 1 % of its volume. (An
-/// excavation's test is not conservative yet, see `objects/crossing.rs`: a pit 1.8 x 1.4 m,
-/// 1.1 m deep, in these cells was found with 5 levels of the test's cuts, not with 2.)
+/// kind (a solid's triangles against the cell, a tunnel piece's convex field's bound over it,
+/// a pit's planar faces against it)
+/// must find the cells and refine them until the cut sees it, within 1 % of its volume.
 fn small_object_is_cut(site: &Site, spec: ObjectSpec) {
     let (mesh, checks, _) = build_capped(site, &[spec], 0);
     assert!(

@@ -22,18 +22,28 @@
 //!   pieces first screened by the nodes' values (`g(node) > the node's farthest edge`: the
 //!   piece is out of reach). Cell inside (no node outside): inside one piece's solid when
 //!   all its nodes are (convexity), else the reach is unknown (cells across a bend's mitre).
-//! - An excavation: the field's magnitude is at most [`EXCAVATION_LIPSCHITZ`] times the
-//!   distance to the wall (its terms are signed distances to the faces' planes and the
-//!   floor, the sloping faces' tops following the terrain), so a node whose `|field|`
-//!   exceeds that times its farthest edge keeps the wall out of the cell. Where no node does,
-//!   the cell is cut into 8 (the midpoints of its edges) again and again: a node of a piece
-//!   on the wall's other side proves a crossing; a piece no larger than `stop` bounds the
-//!   reach by its size (a point of it across the wall is at most that far from a node on
-//!   this side). **Not conservative yet:** a cell still undecided after [`MAX_LEVEL`] cuts
-//!   falls back to the sampling of before (a sign change at its edges' midpoints or its
-//!   centroid); deeper cuts made the benchmark's pit cost minutes, since a planar face close
-//!   to a cell's face is cleared only by pieces as small as `stop`. An exact test for the
-//!   planar faces (each face's plane against the cell, as for a solid's triangles) is left.
+//! - An excavation (module's [`Pit`]): its solid is the points over its outline `P` with
+//!   `z >= floor` and, for each outline edge, `tau = (h(t) - z) cos - d sin <= 0` (the
+//!   field's terms: `t` the position along the edge clamped to it, `h` the top interpolated
+//!   along it, `d` the distance to it). Over a footprint (the nodes' xy) within the edge's
+//!   slab (`0 <= t <= 1`) and on one side of its line, `tau` is linear: a half-space (the
+//!   face's plane; at 90 degrees the vertical plane of the outline). A cell whose nodes lie
+//!   outside: the half-spaces of the floor, of every edge planar over the footprint and of
+//!   the outline (one edge across the footprint: its inner side; none: the footprint inside
+//!   the outline or, then cleared, outside it), each moved [`ON_WALL`] into the solid, are
+//!   intersected with the cell (a vertex of three of their planes that satisfies all:
+//!   [`feasible`]); empty clears the cell, non-empty with every term planar and the outline
+//!   known is a crossing. A term not planar there (beyond an edge's end its term is a cone
+//!   about the end vertex, as at an L's inner corner) is left out of the intersection (a
+//!   relaxation: still conservative) unless its Lipschitz bound from a node puts the whole
+//!   cell on its outer side (cleared). A cell whose nodes lie inside: the planar terms and
+//!   the floor hold on it (they hold at its nodes and are linear); an outline edge across
+//!   its footprint is a crossing; the other terms must be shown negative over it by their
+//!   Lipschitz bound. An undecided cell is cut into 8 at its edges' midpoints, at most
+//!   [`MAX_LEVEL`] times (a node of a piece across the wall: a crossing; a piece no wider than
+//!   `stop`: that deep at most), then taken as crossed. Conservative (unit test
+//!   `the_pit_test_never_clears_a_crossed_cell`); the field's bound against the distance
+//!   ([`EXCAVATION_LIPSCHITZ`]) still clears the far cells first.
 
 use super::{cross, dot, norm, point_in_ring, sub, Object, Piece, Profile, Shape, Wall, ON_WALL};
 
@@ -41,9 +51,9 @@ use super::{cross, dot, norm, point_in_ring, sub, Object, Piece, Profile, Shape,
 /// documentation).
 pub(super) const EXCAVATION_LIPSCHITZ: f64 = 2.0;
 
-/// The most times an excavation's test cuts a cell into 8. More made the benchmark's pit
-/// (300 x 200 m, faces on cells about 30 m wide) cost minutes: a planar face near a cell's
-/// face is never cleared by the bound, only by pieces as small as `stop`.
+/// The most times an excavation's test cuts an undecided cell into 8 (then it is taken as
+/// crossed). The exact test of the planar faces decides the cells along them; what is left
+/// undecided is near a cone (beyond an edge's end) or several outline edges.
 const MAX_LEVEL: usize = 2;
 
 /// Frank-Wolfe steps per tunnel piece.
