@@ -537,7 +537,7 @@ impl<'a> Pit<'a> {
                 nv = nv.map(|c| -c);
             }
             let l = norm(nv);
-            if !(l > 0.0) {
+            if l.is_nan() || l <= 0.0 {
                 return Verdict::Unknown;
             }
             let nv = nv.map(|c| c / l);
@@ -591,7 +591,7 @@ fn overlap2(seg: &[[f64; 2]; 2], foot: &[[f64; 2]; 4]) -> f64 {
     let mut least = f64::INFINITY;
     let mut axis = |a: [f64; 2]| {
         let l = (a[0] * a[0] + a[1] * a[1]).sqrt();
-        if !(l > 1e-12) {
+        if l.is_nan() || l <= 1e-12 {
             return;
         }
         let a = [a[0] / l, a[1] / l];
