@@ -3,6 +3,17 @@
 //! every other operation failed to mend (after the edge split), so that they cost the heavy
 //! sweeps of a large model nothing and change nothing that the pass mended before.
 //!
+//! **Merging nodes a few centimetres apart** ([`Pass::merge`]): where surfaces meet at a
+//! line or a point (a fault and an interface, two faults, a fault and the terrain or a
+//! side), the cut leaves nodes millimetres to centimetres apart, each on some of the
+//! surfaces (a fault's node 1.5 cm inside a side beside the side's own node on the same
+//! fault and interface; a fault's trace 1 mm from a DSM vertex; two faults' junction with
+//! two blocks' interfaces 7 mm apart). Every cell around them is a sliver, and no collapse
+//! mends them: each would leave a flat cell on a third node of the group, or needs every
+//! label of one node around the other. The merge joins the whole group at once, at one of
+//! its nodes (or, inside the model, at its centroid) that lies within half of `check`'s
+//! tolerance of every surface between the labels around the group.
+//!
 //! **Edge removal** (the n-to-2n−4 flip, Shewchuk's "edge removal"): the n cells (4 to
 //! [`RING_MAX`]) around an interior edge (a, b) of a poor cell, all of one label, are
 //! replaced by the 2(n − 2) cells made of a triangulation of the ring of their other nodes
@@ -580,12 +591,12 @@ fn edge_angle(g: [[f64; 3]; 4], i: usize, j: usize) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use crate::mesh::{positive, State, BASE, TOP};
+    use crate::mesh::{positive, State, BASE, SIDE, TOP};
     use crate::quality::min_dihedral;
     use crate::{FaultSet, FaultSpec, ObjectCells, ObjectSet, Terrain, FAULT_TOLERANCE};
     use terramesh_core::volume::tetra_volume;
 
-    /// A 2 x 2 x 1 m box under a flat terrain (z = 0, base z = -1), cut by a vertical fault
+    /// A 2 x 2 x 1 m region under a flat terrain (z = 0, base z = -1), cut by a vertical fault
     /// x = 0, each half coned from its centre. A DSM vertex `d` lies on the terrain 2 mm
     /// east of the fault, beside the node `f` where the cut put the fault's trace: the two
     /// cells holding both (their top faces have an angle of 0.1 degrees) are slivers of 0.14
@@ -635,8 +646,9 @@ mod tests {
             [d, h, e],
             [d, e, f],
             [d, f, b],
-            [b2, c2, h2],
-            [b2, h2, e2],
+            [g, b2, c2],
+            [g, c2, h2],
+            [g, h2, e2],
             [c, c2, h2],
             [c, h2, h],
             [b, b2, c2],
@@ -656,12 +668,7 @@ mod tests {
             }
         }
         let terrain = Terrain::new(
-            vec![
-                [-100.0, -100.0],
-                [100.0, -100.0],
-                [100.0, 100.0],
-                [-100.0, 100.0],
-            ],
+            vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
             vec![[0, 1, 2], [0, 2, 3]],
             vec![0.0; 4],
         )
@@ -672,9 +679,11 @@ mod tests {
             let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
             u64::from(faults.faults[0].side(m).sign > 0)
         };
-        let mut flags = vec![TOP; 7];
-        flags.extend([BASE; 7]);
-        flags.extend([0, 0, TOP]);
+        // The box's sides are the region's outline.
+        let mut flags = vec![TOP | SIDE; 6];
+        flags.push(TOP);
+        flags.extend([BASE | SIDE; 6]);
+        flags.extend([BASE, 0, 0, TOP]);
         let n = points.len();
         let mut on_fault = vec![0u64; n];
         for v in [b, e, b2, e2, g, f] {
