@@ -258,6 +258,16 @@ enum Op {
         kill: Vec<u32>,
         new: Vec<(u32, [u32; 4], f64)>,
     },
+    /// The nodes `gone` merged into `r`, which moves to `at` (module `tail`): the cells `kill` (holding two of
+    /// them) go, each cell of `new` takes its new nodes and smallest angle; `r` takes the
+    /// interface flag and the faults of every merged node.
+    Merge {
+        r: u32,
+        at: [f64; 3],
+        gone: Vec<u32>,
+        kill: Vec<u32>,
+        new: Vec<(u32, [u32; 4], f64)>,
+    },
     /// Cells `c` and `d` become the three of `new` (the third a new cell labelled as `c`).
     Flip23 {
         c: u32,
@@ -574,6 +584,13 @@ impl Pass<'_> {
                 self.star[a as usize].clear();
                 done.collapsed += 1;
             }
+            Op::Merge {
+                r,
+                at,
+                gone,
+                kill,
+                new,
+            } => self.merged(r, at, gone, kill, new, done),
             Op::Flip23 { c, d, new } => {
                 self.stamp_cell(c);
                 self.stamp_cell(d);
@@ -1524,7 +1541,7 @@ impl Pass<'_> {
     /// The cells an operation changes or removes, as they are before it.
     fn cells_of(&self, op: &Op) -> Vec<u32> {
         match op {
-            Op::Collapse { kill, new, .. } => kill
+            Op::Collapse { kill, new, .. } | Op::Merge { kill, new, .. } => kill
                 .iter()
                 .copied()
                 .chain(new.iter().map(|e| e.0))

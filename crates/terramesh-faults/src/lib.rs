@@ -92,7 +92,10 @@
 //!    its nodes towards the mean of its neighbours; moving one of its nodes up the gradient of
 //!    the smallest angle of its worst cell; splitting one of its edges by a new node placed by
 //!    a compass search (on every surface the edge lies on; at most 24 steps); last, in the
-//!    sweeps that begin with at most 4,096 poor cells only, removing one of its edges (the
+//!    sweeps that begin with at most 4,096 poor cells only, merging nodes of it at most 5 cm
+//!    apart with the nodes that close around them into one (the cells holding two of them
+//!    go; the kept node, or their centroid inside the model, within 5 mm of every fault and
+//!    interface between the labels around them), removing one of its edges (the
 //!    n-to-2n-4 flip of a ring of 4 to 7 cells of one label) or moving along its fault a node
 //!    between two units. A sweep that starts with more than 4,096 poor cells is economical: a
 //!    gradient move must gain 0.1 degrees, a cell whose plan found nothing is not planned

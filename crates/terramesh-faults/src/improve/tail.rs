@@ -3,6 +3,17 @@
 //! every other operation failed to mend (after the edge split), so that they cost the heavy
 //! sweeps of a large model nothing and change nothing that the pass mended before.
 //!
+//! **Merging nodes a few centimetres apart** ([`Pass::merge`]): where surfaces meet at a
+//! line or a point (a fault and an interface, two faults, a fault and the terrain or a
+//! side), the cut leaves nodes millimetres to centimetres apart, each on some of the
+//! surfaces (a fault's node 1.5 cm inside a side beside the side's own node on the same
+//! fault and interface; a fault's trace 1 mm from a DSM vertex; two faults' junction with
+//! two blocks' interfaces 7 mm apart). Every cell around them is a sliver, and no collapse
+//! mends them: each would leave a flat cell on a third node of the group, or needs every
+//! label of one node around the other. The merge joins the whole group at once, at one of
+//! its nodes (or, inside the model, at its centroid) that lies within half of `check`'s
+//! tolerance of every surface between the labels around the group.
+//!
 //! **Edge removal** (the n-to-2n−4 flip, Shewchuk's "edge removal"): the n cells (4 to
 //! [`RING_MAX`]) around an interior edge (a, b) of a poor cell, all of one label, are
 //! replaced by the 2(n − 2) cells made of a triangulation of the ring of their other nodes
@@ -22,11 +33,16 @@
 //! [`Pass::slide_at`] (it moves a fault node only between cells of one unit); here it moves
 //! along the fault by a compass search, every cell held to its unit as a move's are.
 
-use super::{Improved, Op, Pass};
+use super::{Improved, Label, Op, Pass};
 use crate::mesh::{positive, BASE, ON_INTERFACE, SIDE, TOP};
 use crate::quality::{min_dihedral, positive_min_dihedral};
 use crate::ON_SURFACE;
 use robust::orient3d;
+
+/// The longest edge whose nodes a merge joins (metres): nodes this close, cut onto surfaces
+/// that meet at a line or a point (a fault and an interface, two faults, a fault and the
+/// terrain or a side), make slivers of every cell around them.
+pub(super) const MERGE_REACH: f64 = 0.05;
 
 /// The largest ring an edge removal replaces (its dynamic programme costs n³ / 6 triangles).
 pub(super) const RING_MAX: usize = 7;
@@ -45,6 +61,9 @@ impl Pass<'_> {
             .map(|&(i, j)| (edge_angle(self.geo(t), i, j), i, j))
             .collect();
         edges.sort_by(|x, y| x.0.total_cmp(&y.0));
+        if let Some(op) = self.merge_near(t, around) {
+            return Some(op);
+        }
         if let Some(op) = edges
             .iter()
             .find_map(|&(_, i, j)| self.remove_edge(t[i], t[j], around[i]))
@@ -52,6 +71,193 @@ impl Pass<'_> {
             return Some(op);
         }
         (0..4).find_map(|i| self.fault_move(t[i], around[i]))
+    }
+
+    /// Merges nodes of poor cell `t` that lie within [`MERGE_REACH`] of each other, with
+    /// the nodes around them that lie that close (see [`Pass::merge`]): first each short
+    /// edge's nodes with every node near them, then the edge's two nodes alone.
+    fn merge_near(&self, t: [u32; 4], around: &[&[u32]; 4]) -> Option<Op> {
+        let pt = |v: u32| self.st.points[v as usize];
+        let near = |a: u32, b: u32| super::d2(pt(a), pt(b)) <= MERGE_REACH * MERGE_REACH;
+        let mut short: Vec<(f64, usize, usize)> = crate::mesh::EDGES
+            .iter()
+            .filter(|&&(i, j)| near(t[i], t[j]))
+            .map(|&(i, j)| (super::d2(pt(t[i]), pt(t[j])), i, j))
+            .collect();
+        short.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for &(_, i, j) in &short {
+            // Only nodes of the cells around the poor cell's nodes (those its plan read).
+            let mut group = vec![t[i], t[j]];
+            for k in [i, j] {
+                for &c in around[k] {
+                    for w in self.st.tets[c as usize] {
+                        if !group.contains(&w) && group.iter().any(|&g| near(g, w)) {
+                            group.push(w);
+                        }
+                    }
+                }
+            }
+            // The nearest first: the whole group, then without its farthest node, down to
+            // the edge alone.
+            let from = |w: u32| super::d2(pt(w), pt(t[i])).min(super::d2(pt(w), pt(t[j])));
+            group[2..].sort_by(|&x, &y| from(x).total_cmp(&from(y)));
+            if let Some(op) = (2..=group.len())
+                .rev()
+                .find_map(|n| self.merge(&group[..n]))
+            {
+                return Some(op);
+            }
+        }
+        None
+    }
+
+    /// Merges the nodes of `group` (at most a few centimetres apart) into one of them, `r`:
+    /// every cell holding two of them goes, every other cell around them takes `r` in their
+    /// place. The cells around the group tile a region whose boundary holds no node of the
+    /// group (but on the model's boundary), so if every new cell is positive (exact
+    /// `orient3d`) they tile the same region, as a collapse's do (a collapse is the merge of
+    /// an edge; merged one by one, a third node of the group makes a flat cell). Each cell
+    /// keeps its label, so the faces between labels now meet at `r`: `r` must lie within
+    /// half of `check`'s tolerance of every fault and interface between the labels around
+    /// the group (the faults whose sides differ; every interface between the units of one
+    /// block and side), on every boundary a node of the group lies on (and be the group's
+    /// DSM vertex if it has one), and the new faces on the terrain and the sides must lie on
+    /// the DSM and on an outline edge. Every new cell must be better than the group's worst,
+    /// lie in its unit and on its side of every fault (its centroid: `check` compares the
+    /// fault faces with the centroids' sides) and of the objects' walls; the group's cells
+    /// must be in one zone and object label. Of the nodes that pass, the one whose worst new
+    /// cell is best.
+    fn merge(&self, group: &[u32]) -> Option<Op> {
+        let mut cells: Vec<u32> = group.iter().flat_map(|&v| self.cells(v)).collect();
+        cells.sort_unstable();
+        cells.dedup();
+        let labels: Vec<Label> = self.labels(&cells);
+        let first = *labels.first()?;
+        if labels.iter().any(|l| (l.3, l.4) != (first.3, first.4)) {
+            return None;
+        }
+        let differ = labels.iter().fold(0u64, |m, l| m | (l.0 ^ first.0));
+        // Per side and block, the interfaces between its lowest and highest unit here.
+        let mut spans: Vec<(u64, u32, u32, u32)> = Vec::new();
+        for l in &labels {
+            match spans.iter_mut().find(|s| (s.0, s.1) == (l.0, l.2)) {
+                Some(s) => (s.2, s.3) = (s.2.min(l.1), s.3.max(l.1)),
+                None => spans.push((l.0, l.2, l.1, l.1)),
+            }
+        }
+        let flags = |v: u32| self.st.flags[v as usize];
+        let pt = |v: u32| self.st.points[v as usize];
+        let bound = group
+            .iter()
+            .fold(0, |m, &v| m | flags(v) & (TOP | BASE | SIDE));
+        let dsm: Vec<u32> = group
+            .iter()
+            .copied()
+            .filter(|&v| flags(v) & TOP != 0 && (v as usize) < self.background)
+            .collect();
+        if dsm.len() > 1 {
+            return None;
+        }
+        let half = 0.5 * crate::FAULT_TOLERANCE;
+        let on_surfaces = |p: [f64; 3]| {
+            (0..self.faults.faults.len()).all(|f| {
+                differ >> f & 1 == 0 || self.faults.faults[f].side(p).distance.abs() <= half
+            }) && spans.iter().all(|&(_, b, lo, hi)| {
+                (lo..hi).all(|k| {
+                    let z = (self.height)(k as usize, self.blocks[b as usize], [p[0], p[1]]);
+                    (z - p[2]).abs() <= half
+                })
+            })
+        };
+        let mut best: Option<(f64, Op)> = None;
+        // Each node where it is; inside the model, also the first node at the group's
+        // centroid (where surfaces meet a few millimetres apart at each node).
+        let n = group.len() as f64;
+        let mid = [0, 1, 2].map(|k| group.iter().map(|&v| pt(v)[k]).sum::<f64>() / n);
+        let tries = group
+            .iter()
+            .map(|&r| (r, pt(r)))
+            .chain((bound == 0).then_some((group[0], mid)));
+        for (r, at) in tries {
+            if flags(r) & bound != bound || dsm.first().is_some_and(|&d| d != r) || !on_surfaces(at)
+            {
+                continue;
+            }
+            let geo = |u: [u32; 4]| u.map(|w| if w == r { at } else { pt(w) });
+            // The cells that change (those of `r` alone stay as they are), and their worst.
+            let moved = |w: u32| (w != r || at != pt(r)) && group.contains(&w);
+            let changed: Vec<u32> = cells
+                .iter()
+                .copied()
+                .filter(|&c| self.st.tets[c as usize].into_iter().any(moved))
+                .collect();
+            let old = changed
+                .iter()
+                .map(|&c| self.angle[c as usize])
+                .fold(f64::MAX, f64::min);
+            let (mut kill, mut new) = (Vec::new(), Vec::new());
+            let mut worst = f64::MAX;
+            let ok = changed.iter().all(|&c| {
+                let t = self.st.tets[c as usize];
+                let u = t.map(|w| if group.contains(&w) { r } else { w });
+                if (0..4).any(|i| (i + 1..4).any(|j| u[i] == u[j])) {
+                    kill.push(c);
+                    return true;
+                }
+                if !positive(geo(u)) {
+                    return false;
+                }
+                let a = min_dihedral(geo(u));
+                worst = worst.min(a);
+                new.push((c, u, a));
+                a > old && (bound == 0 || self.boundary_kept(u, r))
+            });
+            if !ok || best.as_ref().is_some_and(|b| b.0 >= worst) {
+                continue;
+            }
+            // No two cells on the same nodes (a new cell and one of `r`'s that stays).
+            let stay = cells.iter().filter(|c| changed.binary_search(c).is_err());
+            let mut keys: Vec<[u32; 4]> = new
+                .iter()
+                .map(|e| e.1)
+                .chain(stay.map(|&c| self.st.tets[c as usize]))
+                .map(|mut k| {
+                    k.sort_unstable();
+                    k
+                })
+                .collect();
+            keys.sort_unstable();
+            if keys.windows(2).any(|w| w[0] == w[1]) {
+                continue;
+            }
+            let sides = |g: [[f64; 3]; 4], c: u32| {
+                let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+                let p = self.st.positive[c as usize];
+                self.faults
+                    .faults
+                    .iter()
+                    .enumerate()
+                    .all(|(f, x)| (x.side(m).sign > 0) == (p >> f & 1 == 1))
+            };
+            if !new.iter().all(|e| {
+                let g = geo(e.1);
+                sides(g, e.0) && self.in_unit(g, e.0) && self.in_objects(g, e.0)
+            }) {
+                continue;
+            }
+            let gone: Vec<u32> = group.iter().copied().filter(|&v| v != r).collect();
+            best = Some((
+                worst,
+                Op::Merge {
+                    r,
+                    at,
+                    gone,
+                    kill,
+                    new,
+                },
+            ));
+        }
+        best.map(|b| b.1)
     }
 
     /// Moves node `v` (`cells`: its cells) along the fault it lies on where the units on the
@@ -301,6 +507,41 @@ impl Pass<'_> {
         Some(Op::Replace { ring, new })
     }
 
+    /// Makes [`Op::Merge`].
+    pub(super) fn merged(
+        &mut self,
+        r: u32,
+        at: [f64; 3],
+        gone: Vec<u32>,
+        kill: Vec<u32>,
+        new: Vec<(u32, [u32; 4], f64)>,
+        done: &mut Improved,
+    ) {
+        self.st.points[r as usize] = at;
+        for &c in &kill {
+            self.stamp_cell(c);
+            self.alive[c as usize] = false;
+        }
+        for (c, t, q) in new {
+            self.stamp_cell(c);
+            self.st.tets[c as usize] = t;
+            self.angle[c as usize] = q;
+            self.barren[c as usize] = false;
+            self.star[r as usize].push(c);
+            for w in t {
+                self.touched[w as usize] = true;
+                self.stamp[w as usize] = self.mark;
+            }
+        }
+        for v in gone {
+            let v = v as usize;
+            self.st.flags[r as usize] |= self.st.flags[v] & ON_INTERFACE;
+            self.st.on_fault[r as usize] |= self.st.on_fault[v];
+            self.star[v].clear();
+            done.collapsed += 1;
+        }
+    }
+
     /// Makes [`Op::Replace`]: the cells of `ring` (of one label) become those of `new`, the
     /// first in the ring's cells, the rest new cells labelled as `ring[0]`.
     pub(super) fn replace(
@@ -350,9 +591,182 @@ fn edge_angle(g: [[f64; 3]; 4], i: usize, j: usize) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use crate::mesh::positive;
+    use crate::mesh::{positive, State, BASE, SIDE, TOP};
     use crate::quality::min_dihedral;
+    use crate::{FaultSet, FaultSpec, ObjectCells, ObjectSet, Terrain, FAULT_TOLERANCE};
     use terramesh_core::volume::tetra_volume;
+
+    /// A 2 x 2 x 1 m region under a flat terrain (z = 0, base z = -1), cut by a vertical fault
+    /// x = 0, each half coned from its centre. A DSM vertex `d` lies on the terrain 2 mm
+    /// east of the fault, beside the node `f` where the cut put the fault's trace: the two
+    /// cells holding both (their top faces have an angle of 0.1 degrees) are slivers of 0.14
+    /// degrees. Nothing else can mend them: `d` may not move or be collapsed (the DSM's
+    /// own), `f` lies on the terrain (it may not move) and on the fault where `d` does not
+    /// (a collapse needs every label around `f` around `d`), and no flip or split changes
+    /// the top's triangles. The merge of `f` into `d` (2 mm from the fault: within half of
+    /// `check`'s tolerance) does: the slivers go, the fault's faces meet at `d`, every cell
+    /// stays on its side of the fault, the volume is kept, every operation verified.
+    #[test]
+    fn merge_mends_a_dsm_vertex_beside_a_fault_trace() {
+        let top = [
+            [-1.0, -1.0],
+            [0.0, -1.0],
+            [1.0, -1.0],
+            [-1.0, 1.0],
+            [0.0, 1.0],
+            [1.0, 1.0],
+        ];
+        let mut points: Vec<[f64; 3]> = top.iter().map(|p| [p[0], p[1], 0.0]).collect();
+        points.push([0.002, 0.0, 0.0]); // d = 6
+        points.extend(top.iter().map(|p| [p[0], p[1], -1.0])); // 7..=12
+        points.push([0.0, 0.0, -1.0]); // g = 13
+        points.push([-0.5, 0.0, -0.5]); // left centre = 14
+        points.push([0.5, 0.0, -0.5]); // right centre = 15
+        points.push([0.0, 0.0, 0.0]); // f = 16, the cut's node on the fault's trace
+        let (a, b, c, dd, e, h, d) = (0, 1, 2, 3, 4, 5, 6);
+        let (a2, b2, c2, dd2, e2, h2, g, f) = (7, 8, 9, 10, 11, 12, 13, 16);
+        let fault = [[b, f, g], [b, g, b2], [f, e, e2], [f, e2, g]];
+        let left = [
+            [a, b, f],
+            [a, f, e],
+            [a, e, dd],
+            [a2, b2, g],
+            [a2, g, e2],
+            [a2, e2, dd2],
+            [a, dd, dd2],
+            [a, dd2, a2],
+            [a, a2, b2],
+            [a, b2, b],
+            [dd, e, e2],
+            [dd, e2, dd2],
+        ];
+        let right = [
+            [d, b, c],
+            [d, c, h],
+            [d, h, e],
+            [d, e, f],
+            [d, f, b],
+            [g, b2, c2],
+            [g, c2, h2],
+            [g, h2, e2],
+            [c, c2, h2],
+            [c, h2, h],
+            [b, b2, c2],
+            [b, c2, c],
+            [e, h, h2],
+            [e, h2, e2],
+        ];
+        let mut tets: Vec<[u32; 4]> = Vec::new();
+        for (centre, faces) in [(14, &left[..]), (15, &right[..])] {
+            for t in fault.iter().chain(faces) {
+                tets.push([centre, t[0], t[1], t[2]]);
+            }
+        }
+        for t in &mut tets {
+            if !positive(t.map(|v| points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        let terrain = Terrain::new(
+            vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+            vec![0.0; 4],
+        )
+        .unwrap();
+        let spec = FaultSpec::trace("F", vec![[0.0, -100.0], [0.0, 100.0]], 90.0, 90.0);
+        let faults = FaultSet::new(&[spec], &terrain, -1.0).unwrap();
+        let side = |g: [[f64; 3]; 4]| {
+            let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+            u64::from(faults.faults[0].side(m).sign > 0)
+        };
+        // The box's sides are the region's outline.
+        let mut flags = vec![TOP | SIDE; 6];
+        flags.push(TOP);
+        flags.extend([BASE | SIDE; 6]);
+        flags.extend([BASE, 0, 0, TOP]);
+        let n = points.len();
+        let mut on_fault = vec![0u64; n];
+        for v in [b, e, b2, e2, g, f] {
+            on_fault[v as usize] = 1;
+        }
+        let positive_side: Vec<u64> = tets
+            .iter()
+            .map(|t| side(t.map(|v| points[v as usize])))
+            .collect();
+        let measure = |p: &[[f64; 3]], tets: &[[u32; 4]]| {
+            let (mut worst, mut volume) = (f64::MAX, 0.0);
+            for t in tets {
+                let g = t.map(|v| p[v as usize]);
+                assert!(positive(g), "{t:?}");
+                worst = worst.min(min_dihedral(g));
+                volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
+            }
+            (worst, volume)
+        };
+        let (old, volume) = measure(&points, &tets);
+        assert!(old < 0.5, "{old}");
+        let m = tets.len();
+        let mut st = State {
+            points,
+            flags,
+            on_fault,
+            tets,
+            positive: positive_side,
+            below: vec![0; m],
+            block: vec![0; m],
+            zone: Vec::new(),
+            report: crate::mesh::BuildReport::default(),
+        };
+        super::super::verify_each_operation(true);
+        let h = |_: usize, _: crate::BlockKey, _: [f64; 2]| 0.0;
+        let done = super::super::improve(
+            &mut st,
+            &faults,
+            &[],
+            &h,
+            0,
+            &terrain,
+            7,
+            5.0,
+            4,
+            &ObjectSet::default(),
+            &mut ObjectCells::default(),
+        );
+        assert!(done.collapsed >= 1, "{done:?}");
+        // `f` is gone (the points are renumbered: none is left at its place), `d` stays.
+        assert!(
+            !st.points.iter().any(|p| p == &[0.0, 0.0, 0.0]),
+            "{:?}",
+            st.points
+        );
+        assert!(st.points.contains(&[0.002, 0.0, 0.0]));
+        let (new, after) = measure(&st.points, &st.tets);
+        assert!(new >= 5.0, "{old} -> {new}");
+        assert!(
+            (after - volume).abs() <= 1e-12 * volume,
+            "{volume} -> {after}"
+        );
+        // Every cell on its recorded side (its centroid's: what `check` compares), and
+        // every face between the two sides within `check`'s tolerance of the fault.
+        let fault = &faults.faults[0];
+        for (t, &s) in st.tets.iter().zip(&st.positive) {
+            assert_eq!(side(t.map(|v| st.points[v as usize])), s, "{t:?}");
+        }
+        let mut between = 0;
+        for (i, t) in st.tets.iter().enumerate() {
+            for (j, u) in st.tets.iter().enumerate() {
+                let shared: Vec<u32> = t.iter().copied().filter(|v| u.contains(v)).collect();
+                if i < j && shared.len() == 3 && st.positive[i] != st.positive[j] {
+                    between += 1;
+                    for v in shared {
+                        let q = st.points[v as usize];
+                        assert!(fault.side(q).distance.abs() <= FAULT_TOLERANCE, "{q:?}");
+                    }
+                }
+            }
+        }
+        assert!(between >= 4, "{between} faces between the sides");
+    }
 
     /// Four cells around the edge (a, b) = (nodes 4, 5), one of their ring's nodes 0.15 m
     /// off the edge: the cells on either side of it are slivers (9 degrees). No node may
