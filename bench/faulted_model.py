@@ -9,7 +9,7 @@ peak memory, cell count and quality, and the ratio of the run with objects to th
                                    [--size 2400 [--no-objects]]
 
 The site is the truth of examples/faulted/make_site.py (its closed form, imported from there)
-scaled to 2.4 km x 2.4 km (or `--size` metres: the whole layout scaled, faults only) with two more faults: F1 normal, F2 reverse, F3 normal ending at F1,
+scaled to 2.4 km x 2.4 km (or `--size` metres: the whole layout scaled, objects too) with two more faults: F1 normal, F2 reverse, F3 normal ending at F1,
 F4 and F5 normal, crossing the others. 36 vertical boreholes are logged from the truth every
 centimetre, with `fault_picks.csv` where a hole crosses a fault; the terrain is a plane given as
 points 50 m apart. Issue 31's goal: at most 10 s and 2 GB for about 1,000,000 cells on a
@@ -120,13 +120,21 @@ def box_stl(lo, hi):
 
 def write_objects(d: Path):
     """A 2 km lined tunnel (west to east at y = 1200 m, 80 m elevation, through F1 and F4), a
-    300 x 200 m pit 15 m deep and a dam's foundation block 200 x 60 m, 12 m deep."""
-    (d / "tunnel.csv").write_text("x,y,z\n200,1200,80\n2200,1200,80\n")
-    (d / "pit.wkt").write_text("POLYGON ((300 300, 600 300, 600 500, 300 500, 300 300))\n")
-    x0, y0 = 1300.0, 1900.0
+    300 x 200 m pit 15 m deep and a dam's foundation block 200 x 60 m, 12 m deep; with
+    `--size`, their plan coordinates scaled as the site's (the tunnel's profile, the pit's and
+    the dam's depths kept)."""
+    def k(v):
+        return f"{K * v:g}"
+
+    (d / "tunnel.csv").write_text(f"x,y,z\n{k(200)},{k(1200)},80\n{k(2200)},{k(1200)},80\n")
+    ring = ", ".join(f"{k(x)} {k(y)}" for x, y in
+                     [(300, 300), (600, 300), (600, 500), (300, 500), (300, 300)])
+    (d / "pit.wkt").write_text(f"POLYGON (({ring}))\n")
+    x0, y0 = 1300.0 * K, 1900.0 * K
     top = site.terrain(x0, y0)
-    (d / "dam.stl").write_text(box_stl([x0, y0, top - 12.0], [x0 + 200.0, y0 + 60.0, top + 30.0]))
-    pit_floor = min(site.terrain(x, y) for x in (300, 600) for y in (300, 500)) - 15.0
+    (d / "dam.stl").write_text(box_stl([x0, y0, top - 12.0],
+                                       [x0 + 200.0 * K, y0 + 60.0 * K, top + 30.0]))
+    pit_floor = min(site.terrain(K * x, K * y) for x in (300, 600) for y in (300, 500)) - 15.0
     return pit_floor
 
 
@@ -221,9 +229,6 @@ def main():
                     help="the square's side, m: the whole layout scaled by size / 2400")
     args = ap.parse_args()
     if args.size != 2400.0:
-        if not args.no_objects:
-            sys.exit("--size needs --no-objects: issue 32's objects (a 2 km tunnel) are laid out "
-                     "for the 2.4 km site")
         scale(args.size / 2400.0)
     d = Path(args.out)
     write_site(d)

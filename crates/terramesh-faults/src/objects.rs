@@ -2027,6 +2027,231 @@ fn refine_missed(
     (total, rounds, flagged.map(|a| a.into_inner()))
 }
 
+/// Nodes within this fraction of their shortest edge of a tunnel's wall are moved onto it
+/// before the wall is cut ([`snap_to_wall`]).
+const SNAP_REACH: f64 = 0.45;
+
+/// A node snapped onto a wall leaves no cell of its star with a smallest dihedral angle below
+/// the smaller of this (degrees) and the star's smallest before the move.
+const SNAP_ANGLE: f64 = 8.0;
+
+/// Moves the free nodes near a tunnel's wall onto it before the wall is cut, so that the
+/// edges from them no longer cross it (isosurface stuffing's snap): each edge the cut splits
+/// splits every cell around it, and the splits close to an edge's end make the slivers that
+/// the quality pass then collapses. A node is moved only if it lies within [`SNAP_REACH`] of
+/// its shortest edge of the wall, is free (on no fault, interface, terrain, base or side of
+/// the region; every cell around it of one block, unit, fault side, zone and object label:
+/// so no surface cut before moves), stays on its side of every wall cut before (`cut`), and
+/// if every cell around it stays positive, no cell gets all four nodes on the wall, no cell
+/// falls below [`SNAP_ANGLE`] (or the star's smallest angle before, if lower), and a cell on
+/// one side of the wall keeps the wall out of it by [`CROSSED_STRAY`] times the tolerance at
+/// its edges' midpoints, its faces' centroids and its centroid (the sag of its facets on the
+/// wall). Nodes are visited nearest the wall first, one at a time (the result does not depend
+/// on the thread count). Returns the nodes moved.
+fn snap_to_wall(
+    st: &mut State,
+    labels: &ObjectCells,
+    set: &ObjectSet,
+    cut: &[(usize, Wall)],
+    i: usize,
+    w: Wall,
+    [reach, angle]: [f64; 2],
+) -> usize {
+    let o = &set.objects[i];
+    let tol = set.resolution * o.size;
+    let f = |q: [f64; 3]| o.field(w, q);
+    let [lo, hi] = o.bbox;
+    let margin = o.size;
+    let n = st.points.len();
+    let near: Vec<bool> = st
+        .points
+        .par_iter()
+        .map(|q| (0..3).all(|k| q[k] >= lo[k] - margin && q[k] <= hi[k] + margin))
+        .collect();
+    let mut vals: Vec<f64> = st
+        .points
+        .par_iter()
+        .zip(&near)
+        .map(|(&q, &near)| if near { f(q) } else { f64::INFINITY })
+        .collect();
+    // The cells around each node near the wall (compressed rows).
+    let mut start = vec![0u32; n + 1];
+    for t in &st.tets {
+        for &v in t {
+            if near[v as usize] {
+                start[v as usize + 1] += 1;
+            }
+        }
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut star = vec![0u32; start[n] as usize];
+    for (c, t) in st.tets.iter().enumerate() {
+        for &v in t {
+            if near[v as usize] {
+                star[fill[v as usize] as usize] = c as u32;
+                fill[v as usize] += 1;
+            }
+        }
+    }
+    let label = |c: usize| {
+        (
+            st.block[c],
+            st.below[c],
+            st.positive[c],
+            st.zone.get(c).copied().unwrap_or(0),
+            labels.object[c],
+            labels.lining[c],
+        )
+    };
+    // A node's shortest edge.
+    let shortest = |points: &[[f64; 3]], v: usize, cells: &[u32]| {
+        let mut a = f64::INFINITY;
+        for &c in cells {
+            for &u in &st.tets[c as usize] {
+                if u as usize != v {
+                    a = a.min(norm(sub(points[u as usize], points[v])));
+                }
+            }
+        }
+        a
+    };
+    let mut cand: Vec<(f64, u32)> = (0..n)
+        .into_par_iter()
+        .filter_map(|v| {
+            let x = vals[v].abs();
+            if !x.is_finite() || x <= ON_WALL || st.flags[v] != 0 || st.on_fault[v] != 0 {
+                return None;
+            }
+            let cells = &star[start[v] as usize..start[v + 1] as usize];
+            let first = label(*cells.first()? as usize);
+            if cells.iter().any(|&c| label(c as usize) != first) {
+                return None;
+            }
+            let short = shortest(&st.points, v, cells);
+            (x <= reach * short).then_some((x / short, v as u32))
+        })
+        .collect();
+    cand.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let stray = CROSSED_STRAY * tol;
+    let mut moved = 0;
+    for &(_, v) in &cand {
+        let v = v as usize;
+        let cells = &star[start[v] as usize..start[v + 1] as usize];
+        let short = shortest(&st.points, v, cells);
+        let p0 = st.points[v];
+        if vals[v].abs() <= ON_WALL || vals[v].abs() > reach * short {
+            continue;
+        }
+        // Newton's steps onto the wall (the field's gradient by central differences).
+        let mut p = p0;
+        let mut fp = vals[v];
+        let h = 1e-4 * short;
+        for _ in 0..6 {
+            if fp.abs() <= 0.05 * ON_WALL {
+                break;
+            }
+            let g = [0, 1, 2].map(|k| {
+                let (mut a, mut b) = (p, p);
+                a[k] += h;
+                b[k] -= h;
+                (f(a) - f(b)) / (2.0 * h)
+            });
+            let gg = dot(g, g);
+            if gg.is_nan() || gg <= 1e-12 {
+                break;
+            }
+            p = [0, 1, 2].map(|k| p[k] - fp * g[k] / gg);
+            fp = f(p);
+        }
+        if fp.is_nan() || fp.abs() > 0.05 * ON_WALL || norm(sub(p, p0)) > 1.5 * reach * short {
+            continue;
+        }
+        // The walls cut before: the node stays clearly on its side of each.
+        if cut.iter().any(|&(j, wj)| {
+            let oj = &set.objects[j];
+            let (a, b) = (oj.field(wj, p0), oj.field(wj, p));
+            a.abs() <= ON_WALL || b.abs() <= ON_WALL || (a < 0.0) != (b < 0.0)
+        }) {
+            continue;
+        }
+        let at = |u: u32| {
+            if u as usize == v {
+                p
+            } else {
+                st.points[u as usize]
+            }
+        };
+        let mut ok = true;
+        let (mut before, mut after) = (f64::INFINITY, f64::INFINITY);
+        for &c in cells {
+            let t = st.tets[c as usize];
+            let on = t
+                .iter()
+                .filter(|&&u| u as usize != v && vals[u as usize].abs() <= ON_WALL)
+                .count();
+            if on == 3 {
+                ok = false;
+                break;
+            }
+            before = before.min(crate::quality::min_dihedral(
+                t.map(|u| st.points[u as usize]),
+            ));
+            let q = t.map(at);
+            let a = crate::quality::positive_min_dihedral(q);
+            if a < 0.0 {
+                ok = false;
+                break;
+            }
+            after = after.min(a);
+            // The cell's side of the wall (its other nodes'), and the sag of the wall into it.
+            let side = t
+                .iter()
+                .filter(|&&u| u as usize != v)
+                .map(|&u| vals[u as usize])
+                .find(|x| x.abs() > ON_WALL);
+            let Some(side) = side else {
+                continue;
+            };
+            if t.iter().any(|&u| {
+                u as usize != v
+                    && vals[u as usize].abs() > ON_WALL
+                    && (vals[u as usize] < 0.0) != (side < 0.0)
+            }) {
+                continue; // crossed: the cut splits it
+            }
+            let s = side.signum();
+            let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+            let mut samples: Vec<[f64; 3]> = EDGES.iter().map(|&(a, b)| mid(q[a], q[b])).collect();
+            for skip in 0..4 {
+                let mut c3 = [0.0; 3];
+                for (k, x) in q.iter().enumerate() {
+                    if k != skip {
+                        for d in 0..3 {
+                            c3[d] += x[d] / 3.0;
+                        }
+                    }
+                }
+                samples.push(c3);
+            }
+            samples.push([0, 1, 2].map(|d| 0.25 * (q[0][d] + q[1][d] + q[2][d] + q[3][d])));
+            if samples.iter().any(|&m| s * f(m) < -stray) {
+                ok = false;
+                break;
+            }
+        }
+        if !ok || after < before.min(angle) {
+            continue;
+        }
+        st.points[v] = p;
+        vals[v] = 0.0;
+        moved += 1;
+    }
+    moved
+}
+
 /// Cuts every object's walls into the mesh (after the faults, the interfaces and the zones,
 /// before the quality pass) and labels the cells (a cell in several objects takes the first in project order);
 /// `labels` carries what [`refine_near_objects`] did.
@@ -2065,8 +2290,26 @@ pub(crate) fn cut_objects(
             break;
         }
     }
-    for &(i, w) in &walls {
+    for (wi, &(i, w)) in walls.iter().enumerate() {
         let o = &set.objects[i];
+        if o.kind == "tunnel" {
+            let since = std::time::Instant::now();
+            let moved = snap_to_wall(
+                st,
+                &labels,
+                set,
+                &walls[..wi],
+                i,
+                w,
+                [SNAP_REACH, SNAP_ANGLE],
+            );
+            object_stats(
+                format_args!("snap onto {} {} ({w:?})", o.kind, o.name),
+                since,
+                moved,
+                st.tets.len(),
+            );
+        }
         let since = std::time::Instant::now();
         let f = |q: [f64; 3]| o.field(w, q);
         let [lo, hi] = o.bbox;
@@ -2515,5 +2758,97 @@ mod tests {
             worst > 1.0,
             "a cell of {worst} degrees after the refinement"
         );
+    }
+
+    /// The snap before a tunnel's cut moves nodes onto the wall (within a millimetre), keeps
+    /// every cell positive, leaves no cell with all four nodes on the wall, and leaves less than
+    /// half the edges crossing the wall for the cut to split.
+    #[test]
+    fn snapping_onto_a_lined_tunnel_leaves_fewer_edges_to_cut() {
+        let site = Site::new(
+            200.0,
+            10,
+            0.2,
+            1,
+            [120.0, 0.02, -0.01],
+            0.0,
+            vec![90.0, 60.0, 30.0],
+            [0.01, 0.0],
+            vec![],
+        )
+        .unwrap();
+        let spec = ObjectSpec {
+            name: "T".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[30.0, 100.0, 45.0], [170.0, 110.0, 45.0]],
+                profile: Profile::Circle { diameter: 6.0 },
+                lining: 0.3,
+            },
+        };
+        let set = ObjectSet::new(&[spec], &site.terrain, site.base).unwrap();
+        let mut st =
+            crate::mesh::background(&site.terrain, &MeshSettings::new(site.base, 10.0)).unwrap();
+        let mut labels = refine_near_objects(&mut st, &set).unwrap();
+        labels.object = vec![0; st.tets.len()];
+        labels.lining = vec![false; st.tets.len()];
+        let o = &set.objects[0];
+        let crossing = |st: &State| {
+            let v: Vec<f64> = st.points.iter().map(|&q| o.field(Wall::Inner, q)).collect();
+            let mut keys: Vec<u64> = st
+                .tets
+                .iter()
+                .flat_map(|t| {
+                    EDGES
+                        .iter()
+                        .filter(|&&(a, b)| {
+                            let (x, y) = (v[t[a] as usize], v[t[b] as usize]);
+                            (x < -ON_WALL && y > ON_WALL) || (x > ON_WALL && y < -ON_WALL)
+                        })
+                        .map(|&(a, b)| key(t[a], t[b]))
+                        .collect::<Vec<_>>()
+                })
+                .collect();
+            keys.sort_unstable();
+            keys.dedup();
+            keys.len()
+        };
+        let (before, points) = (crossing(&st), st.points.clone());
+        let moved = snap_to_wall(
+            &mut st,
+            &labels,
+            &set,
+            &[],
+            0,
+            Wall::Inner,
+            [SNAP_REACH, SNAP_ANGLE],
+        );
+        assert!(moved > 0, "no node snapped");
+        let changed: Vec<usize> = (0..points.len())
+            .filter(|&v| points[v] != st.points[v])
+            .collect();
+        assert_eq!(changed.len(), moved);
+        for &v in &changed {
+            let d = o.field(Wall::Inner, st.points[v]);
+            assert!(d.abs() <= ON_WALL, "node {v} snapped {d} m off the wall");
+        }
+        for t in &st.tets {
+            let q = t.map(|v| st.points[v as usize]);
+            assert!(
+                crate::mesh::positive(q),
+                "cell {t:?} not positive after the snap"
+            );
+            assert!(
+                q.iter().any(|&p| o.field(Wall::Inner, p).abs() > ON_WALL),
+                "cell {t:?} with every node on the wall"
+            );
+        }
+        let after = crossing(&st);
+        // 43,453 -> 13,892 measured: the cut splits less than half the edges it split before.
+        assert!(
+            2 * after < before,
+            "{after} edges cross the wall after the snap, {before} before"
+        );
+        eprintln!("snap: {moved} nodes moved, crossing edges {before} -> {after}");
     }
 }
