@@ -41,6 +41,10 @@ pub const MAX_LAYERS: usize = 1000;
 pub const DEFAULT_MAX_CELL_HEIGHT: f64 = 10.0;
 /// The local refinement's budget by default, background cells (`geology.refine_max_cells`).
 pub const DEFAULT_REFINE_MAX_CELLS: usize = terramesh_faults::REFINE_MAX_CELLS;
+fn default_refine_max_cells() -> usize {
+    DEFAULT_REFINE_MAX_CELLS
+}
+
 /// The largest `geology.refine_max_cells` accepted: the background mesh's cells take about
 /// 100 bytes each before the cut.
 pub const MAX_REFINE_MAX_CELLS: usize = 50_000_000;
@@ -150,7 +154,9 @@ pub struct GeologyPlan {
     /// The largest vertical cell size of a faulted model, metres.
     pub max_cell_height: f64,
     /// The budget of the faulted mesh's local refinement where slabs are thin, background
-    /// cells (`geology.refine_max_cells`).
+    /// cells (`geology.refine_max_cells`; a plan written before the key existed reads the
+    /// default).
+    #[serde(default = "default_refine_max_cells")]
     pub refine_max_cells: usize,
     /// The engineering objects (tunnels, excavations, structures) in project order.
     pub objects: Vec<super::ObjectPlan>,
