@@ -561,26 +561,32 @@ impl Pass<'_> {
         (op, kind)
     }
 
+    /// The cells of a collapse or a merge: those of `kill` go, those of `new` (cell, nodes,
+    /// angle) take their new nodes and join the star of the kept node `keep`.
+    fn collapse_cells(&mut self, keep: u32, kill: &[u32], new: Vec<(u32, [u32; 4], f64)>) {
+        for &c in kill {
+            self.stamp_cell(c);
+            self.alive[c as usize] = false;
+        }
+        for (c, t, q) in new {
+            self.stamp_cell(c);
+            self.st.tets[c as usize] = t;
+            self.angle[c as usize] = q;
+            self.barren[c as usize] = false;
+            self.star[keep as usize].push(c);
+            for w in t {
+                self.touched[w as usize] = true;
+                self.stamp[w as usize] = self.mark;
+            }
+        }
+    }
+
     /// Makes operation `op`, stamping the nodes of every cell it changes with its number.
     fn apply(&mut self, op: Op, done: &mut Improved) {
         self.mark += 1;
         match op {
             Op::Collapse { a, b, kill, new } => {
-                for &c in &kill {
-                    self.stamp_cell(c);
-                    self.alive[c as usize] = false;
-                }
-                for (c, t, q) in new {
-                    self.stamp_cell(c);
-                    self.st.tets[c as usize] = t;
-                    self.angle[c as usize] = q;
-                    self.barren[c as usize] = false;
-                    self.star[b as usize].push(c);
-                    for w in t {
-                        self.touched[w as usize] = true;
-                        self.stamp[w as usize] = self.mark;
-                    }
-                }
+                self.collapse_cells(b, &kill, new);
                 self.star[a as usize].clear();
                 done.collapsed += 1;
             }

@@ -2709,13 +2709,10 @@ mod tests {
             .is_none());
     }
 
-    /// The refinement near a horseshoe tunnel (its corners keep the facets straying from the
-    /// wall down to the smallest edges) keeps every cell positive in floating point and of a
-    /// bounded shape: bisecting the edge that strays, whatever its length, made needles and
-    /// then cells flat to rounding (859 of them here, and the box structure's test failed).
-    #[test]
-    fn refinement_near_a_tunnel_keeps_cells_shaped() {
-        let site = Site::new(
+    /// A 200 m unfaulted site of three planar interfaces under a sloping terrain, for the
+    /// tunnels' refinement and snap.
+    fn unfaulted_site() -> Site {
+        Site::new(
             200.0,
             10,
             0.2,
@@ -2726,7 +2723,16 @@ mod tests {
             [0.01, 0.0],
             vec![],
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    /// The refinement near a horseshoe tunnel (its corners keep the facets straying from the
+    /// wall down to the smallest edges) keeps every cell positive in floating point and of a
+    /// bounded shape: bisecting the edge that strays, whatever its length, made needles and
+    /// then cells flat to rounding (859 of them here, and the box structure's test failed).
+    #[test]
+    fn refinement_near_a_tunnel_keeps_cells_shaped() {
+        let site = unfaulted_site();
         let spec = ObjectSpec {
             name: "gallery".into(),
             stage: 1,
@@ -2765,18 +2771,7 @@ mod tests {
     /// half the edges crossing the wall for the cut to split.
     #[test]
     fn snapping_onto_a_lined_tunnel_leaves_fewer_edges_to_cut() {
-        let site = Site::new(
-            200.0,
-            10,
-            0.2,
-            1,
-            [120.0, 0.02, -0.01],
-            0.0,
-            vec![90.0, 60.0, 30.0],
-            [0.01, 0.0],
-            vec![],
-        )
-        .unwrap();
+        let site = unfaulted_site();
         let spec = ObjectSpec {
             name: "T".into(),
             stage: 1,

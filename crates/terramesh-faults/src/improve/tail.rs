@@ -518,21 +518,7 @@ impl Pass<'_> {
         done: &mut Improved,
     ) {
         self.st.points[r as usize] = at;
-        for &c in &kill {
-            self.stamp_cell(c);
-            self.alive[c as usize] = false;
-        }
-        for (c, t, q) in new {
-            self.stamp_cell(c);
-            self.st.tets[c as usize] = t;
-            self.angle[c as usize] = q;
-            self.barren[c as usize] = false;
-            self.star[r as usize].push(c);
-            for w in t {
-                self.touched[w as usize] = true;
-                self.stamp[w as usize] = self.mark;
-            }
-        }
+        self.collapse_cells(r, &kill, new);
         for v in gone {
             let v = v as usize;
             self.st.flags[r as usize] |= self.st.flags[v] & ON_INTERFACE;
@@ -595,6 +581,18 @@ mod tests {
     use crate::quality::min_dihedral;
     use crate::{FaultSet, FaultSpec, ObjectCells, ObjectSet, Terrain, FAULT_TOLERANCE};
     use terramesh_core::volume::tetra_volume;
+
+    /// The smallest dihedral angle and the volume of `tets`, every cell asserted positive.
+    fn measure(p: &[[f64; 3]], tets: &[[u32; 4]]) -> (f64, f64) {
+        let (mut worst, mut volume) = (f64::MAX, 0.0);
+        for t in tets {
+            let g = t.map(|v| p[v as usize]);
+            assert!(positive(g), "{t:?}");
+            worst = worst.min(min_dihedral(g));
+            volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
+        }
+        (worst, volume)
+    }
 
     /// A 2 x 2 x 1 m region under a flat terrain (z = 0, base z = -1), cut by a vertical fault
     /// x = 0, each half coned from its centre. A DSM vertex `d` lies on the terrain 2 mm
@@ -693,16 +691,6 @@ mod tests {
             .iter()
             .map(|t| side(t.map(|v| points[v as usize])))
             .collect();
-        let measure = |p: &[[f64; 3]], tets: &[[u32; 4]]| {
-            let (mut worst, mut volume) = (f64::MAX, 0.0);
-            for t in tets {
-                let g = t.map(|v| p[v as usize]);
-                assert!(positive(g), "{t:?}");
-                worst = worst.min(min_dihedral(g));
-                volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
-            }
-            (worst, volume)
-        };
         let (old, volume) = measure(&points, &tets);
         assert!(old < 0.5, "{old}");
         let m = tets.len();
@@ -790,16 +778,6 @@ mod tests {
                 t.swap(0, 1);
             }
         }
-        let measure = |p: &[[f64; 3]], tets: &[[u32; 4]]| {
-            let (mut worst, mut volume) = (f64::MAX, 0.0);
-            for t in tets {
-                let g = t.map(|v| p[v as usize]);
-                assert!(positive(g), "{t:?}");
-                worst = worst.min(min_dihedral(g));
-                volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
-            }
-            (worst, volume)
-        };
         let (old, volume) = measure(&points, &tets);
         assert!(old < 10.0, "{old}");
         super::super::verify_each_operation(true);
