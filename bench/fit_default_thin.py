@@ -100,26 +100,8 @@ def main():
     print("|---|---|---|---|---|---|---|---|")
     for seed in seeds:
         for name in names:
-            d, t, tag, dp, tp = fn.draw(name, seed)
-            cache = os.path.join(fd.OUT, f"{tag}-pykrige-20000.json")
-            if known and seed in fn.KNOWN and name in fn.KNOWN_NAMES:
-                best = fn.KNOWN[seed][fn.KNOWN_NAMES.index(name)]
-            else:
-                if not os.path.exists(cache):
-                    json.dump({m: float(np.sqrt(np.mean((ht.pykrige_uk(d, t, m)[0] - t[:, 2]) ** 2)))
-                               for m in ("spherical", "exponential", "gaussian", "power", "linear")},
-                              open(cache, "w"))
-                best = min(json.load(open(cache)).values())
-            vj = os.path.join(fd.OUT, f"{tag}-thin-default.json")
-            ht.run(["variogram", "--data", dp, "--drift", "linear", "-o", vj])
-            model = json.load(open(vj))["model"]
+            d, t, best, model, r0, diam, at_bound = fu.default_against_best(name, seed, known, "thin")
             rmse = lambda e: float(np.sqrt(np.mean((e - t[:, 2]) ** 2)))
-            r0 = rmse(ht.terramesh_uk(dp, tp, os.path.join(fd.OUT, f"{tag}-thin-out.csv"),
-                                      ["--variogram", vj])) - best
-            diam = float(pdist(d[:, :2]).max())
-            st = model["structures"]
-            at_bound = (model["nugget"] == 0 and len(st) == 1
-                        and st[0]["type"] in ("exponential", "spherical") and st[0]["range"] >= 0.999 * diam)
             if not at_bound:
                 rows.append((name, r0, r0, r0, r0))
                 print(f"| {name} | {seed} | {best:.3f} | {r0:+.4f} | {r0:+.4f} | {r0:+.4f} | {r0:+.4f} | not at the bound |")
@@ -130,6 +112,7 @@ def main():
             rest = np.setdiff1d(np.arange(len(d)), sub)
             r2 = float(np.mean(cKDTree(x[sub]).query(x[rest])[0]))
             rt = float(np.mean(cKDTree(x).query(t[:, :2])[0]))
+            st = model["structures"]
             cands = [(st[0]["type"], st[0]["range"], None)] + [("exponential", f * diam, f) for f in fr]
             crit = []
             for kind, a, f in cands:

@@ -51,6 +51,33 @@ def uk_exponential(d, t, a):
     return out
 
 
+def default_against_best(name, seed, known, label):
+    """One draw: its data and truth, the best PyKrige RMSE (the docs' figure with `known`,
+    else the five fits, cached), the default fit's model, its RMSE minus that best, the
+    data's diameter, and whether the model is a lone exponential or spherical without nugget
+    at the range bound (the diameter). `label` names the scratch files."""
+    d, t, tag, dp, tp = fn.draw(name, seed)
+    cache = os.path.join(fd.OUT, f"{tag}-pykrige-20000.json")
+    if known and seed in fn.KNOWN and name in fn.KNOWN_NAMES:
+        best = fn.KNOWN[seed][fn.KNOWN_NAMES.index(name)]
+    else:
+        if not os.path.exists(cache):
+            json.dump({m: float(np.sqrt(np.mean((ht.pykrige_uk(d, t, m)[0] - t[:, 2]) ** 2)))
+                       for m in ("spherical", "exponential", "gaussian", "power", "linear")},
+                      open(cache, "w"))
+        best = min(json.load(open(cache)).values())
+    vj = os.path.join(fd.OUT, f"{tag}-{label}-default.json")
+    ht.run(["variogram", "--data", dp, "--drift", "linear", "-o", vj])
+    model = json.load(open(vj))["model"]
+    e = ht.terramesh_uk(dp, tp, os.path.join(fd.OUT, f"{tag}-{label}-out.csv"), ["--variogram", vj])
+    r0 = float(np.sqrt(np.mean((e - t[:, 2]) ** 2))) - best
+    diam = float(pdist(d[:, :2]).max())
+    st = model["structures"]
+    at_bound = (model["nugget"] == 0 and len(st) == 1
+                and st[0]["type"] in ("exponential", "spherical") and st[0]["range"] >= 0.999 * diam)
+    return d, t, best, model, r0, diam, at_bound
+
+
 def main():
     argv = sys.argv[1:]
     seeds = [int(s) for s in fd.take_opt(argv, "--seeds", "15").split(",")]
@@ -64,26 +91,8 @@ def main():
     print("|" + "---|" * (5 + len(fr)))
     for seed in seeds:
         for name in names:
-            d, t, tag, dp, tp = fn.draw(name, seed)
-            cache = os.path.join(fd.OUT, f"{tag}-pykrige-20000.json")
-            if known and seed in fn.KNOWN and name in fn.KNOWN_NAMES:
-                best = fn.KNOWN[seed][fn.KNOWN_NAMES.index(name)]
-            else:
-                if not os.path.exists(cache):
-                    json.dump({m: float(np.sqrt(np.mean((ht.pykrige_uk(d, t, m)[0] - t[:, 2]) ** 2)))
-                               for m in ("spherical", "exponential", "gaussian", "power", "linear")},
-                              open(cache, "w"))
-                best = min(json.load(open(cache)).values())
-            vj = os.path.join(fd.OUT, f"{tag}-unseen-default.json")
-            ht.run(["variogram", "--data", dp, "--drift", "linear", "-o", vj])
-            model = json.load(open(vj))["model"]
+            d, t, best, model, r0, diam, at_bound = default_against_best(name, seed, known, "unseen")
             rmse = lambda e: float(np.sqrt(np.mean((e - t[:, 2]) ** 2)))
-            r0 = rmse(ht.terramesh_uk(dp, tp, os.path.join(fd.OUT, f"{tag}-unseen-out.csv"),
-                                      ["--variogram", vj])) - best
-            diam = float(pdist(d[:, :2]).max())
-            st = model["structures"]
-            at_bound = (model["nugget"] == 0 and len(st) == 1
-                        and st[0]["type"] in ("exponential", "spherical") and st[0]["range"] >= 0.999 * diam)
             rr = [rmse(uk_exponential(d, t, f * diam)) - best if at_bound else r0 for f in fr]
             rows.append((name, r0, rr))
             print(f"| {name} | {seed} | {best:.3f} | {r0:+.4f} | " + " | ".join(f"{v:+.4f}" for v in rr)
