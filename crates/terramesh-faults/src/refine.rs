@@ -499,6 +499,15 @@ mod tests {
         100.0 + 0.05 * p[0] - 0.02 * p[1]
     }
 
+    /// A 100 m square with a jittered centre.
+    const SQUARE: [[f64; 2]; 5] = [
+        [0.0, 0.0],
+        [100.0, 0.0],
+        [100.0, 100.0],
+        [0.0, 100.0],
+        [47.3, 52.9],
+    ];
+
     /// Refines a region over a sloping terrain with a fault and a 0.4 m unit everywhere.
     fn refined(pts: &[[f64; 2]], tris: Vec<[u32; 3]>) -> (Terrain, Option<Terrain>) {
         let (t, r, budget) = refined_within(pts, tris, 200_000);
@@ -534,13 +543,7 @@ mod tests {
 
     #[test]
     fn a_budget_that_skips_or_stops_the_refinement_is_reported() {
-        let pts = [
-            [0.0, 0.0],
-            [100.0, 0.0],
-            [100.0, 100.0],
-            [0.0, 100.0],
-            [47.3, 52.9],
-        ];
+        let pts = SQUARE;
         let tris = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
         // 7 levels over the 105 m thickest column: 18 cells per planar triangle.
         // Room for 4 triangles, the DSM's own: skipped, every triangle too wide.
@@ -611,13 +614,7 @@ mod tests {
     #[test]
     fn refined_mesh_is_conforming_and_on_the_terrain() {
         // A square with a jittered centre: refined down to 10 x 0.4 m = 4 m edges.
-        let pts = [
-            [0.0, 0.0],
-            [100.0, 0.0],
-            [100.0, 100.0],
-            [0.0, 100.0],
-            [47.3, 52.9],
-        ];
+        let pts = SQUARE;
         let (t, r) = refined(&pts, vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]);
         let r = r.unwrap();
         println!("square: {} triangles", r.triangles.len());
