@@ -405,10 +405,9 @@ fn a_box_on_unrefined_coarse_cells_is_cut_cleanly() {
 /// small enough to lie between those points, the refinement near objects capped at 0 cells so
 /// that only the crossed-cells pass can see it. The sampling missed it (the cut found no cell
 /// inside: "no part of the object lies inside the model"); the pass's conservative test per
-/// kind (a solid's triangles against the cell, a tunnel piece's convex field's bound over it)
-/// must find the cells and refine them until the cut sees it, within 1 % of its volume. (An
-/// excavation's test is not conservative yet, see `objects/crossing.rs`: a pit 1.8 x 1.4 m,
-/// 1.1 m deep, in these cells was found with 5 levels of the test's cuts, not with 2.)
+/// kind (a solid's triangles against the cell, a tunnel piece's convex field's bound over it,
+/// a pit's planar faces against it)
+/// must find the cells and refine them until the cut sees it, within 1 % of its volume.
 fn small_object_is_cut(site: &Site, spec: ObjectSpec) {
     let (mesh, checks, _) = build_capped(site, &[spec], 0);
     assert!(
@@ -446,4 +445,63 @@ fn a_short_thin_tunnel_between_the_sampled_points_is_cut() {
             0.0,
         ),
     );
+}
+
+/// A pit named `name` with the outline `outline` (a ring), floor and face angle.
+fn small_pit(name: &str, outline: Vec<[f64; 2]>, floor: f64, face_angle: f64) -> ObjectSpec {
+    ObjectSpec {
+        name: name.into(),
+        stage: 1,
+        geometry: ObjectGeometry::Excavation {
+            outline,
+            floor,
+            face_angle,
+        },
+    }
+}
+
+/// Issue 32: the excavation's test was not conservative (the field's bound, cut twice, then
+/// the sampling of edges' midpoints and centroid): a pit 1.8 x 1.4 m, 1.1 m deep, in the
+/// 200 m site's cells about 20 m wide (refinement near objects capped at 0) lay between the
+/// sampled points and was not cut ("no part of the object lies inside the model"). The
+/// exact test of its planar faces (`objects/crossing.rs`) must find it.
+#[test]
+fn a_small_pit_between_the_sampled_points_is_cut() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    let outline = vec![
+        [60.31, 133.22],
+        [62.11, 133.22],
+        [62.11, 134.62],
+        [60.31, 134.62],
+    ];
+    small_object_is_cut(&site, small_pit("sump", outline, 118.77, 75.0));
+}
+
+/// The same for a non-convex (L-shaped) outline: the faces meet in a cone at its inner
+/// corner, and an edge's plane holds only on its side of the outline.
+#[test]
+fn a_small_l_shaped_pit_between_the_sampled_points_is_cut() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    let outline = vec![
+        [143.12, 57.31],
+        [145.43, 57.31],
+        [145.43, 58.27],
+        [144.08, 58.27],
+        [144.08, 59.66],
+        [143.12, 59.66],
+    ];
+    small_object_is_cut(&site, small_pit("trench", outline, 121.52, 70.0));
+}
+
+/// The same for vertical faces (`face_angle` 90): the pit is a prism over its outline.
+#[test]
+fn a_small_vertical_pit_between_the_sampled_points_is_cut() {
+    let site = faulted_site([120.0, 0.02, -0.01]);
+    let outline = vec![
+        [101.47, 71.38],
+        [102.61, 71.91],
+        [102.09, 73.02],
+        [100.95, 72.49],
+    ];
+    small_object_is_cut(&site, small_pit("shaft", outline, 120.41, 90.0));
 }
