@@ -6,10 +6,12 @@
 //! terrain at `face_angle` down to its floor; a structure's closed triangulated surface (inside
 //! by exact ray parity, `robust::orient2d`/`orient3d` with a symbolic perturbation).
 //!
-//! After the faults, the interfaces and the quality pass, the mesh is refined near every
+//! Before the faults and the interfaces are cut, the background mesh is refined near every
 //! object (the longest edge of every cell near a boundary is bisected, conformally, round
-//! after round, until no such edge is longer than `resolution` times the object's size), then
-//! every object's field cuts the mesh as a fault's does: every edge that crosses the boundary
+//! after round, until no such edge is longer than `resolution` times the object's size), and
+//! then wherever a wall crosses or reaches into a cell that this refinement's cap left coarse
+//! (no midpoint of a bisected edge then lies off a curved surface already cut). After the
+//! faults, the interfaces and the zones, every object's field cuts the mesh as a fault's does: every edge that crosses the boundary
 //! is split at its crossing (regula falsi on the field) and every cell at its split edges,
 //! the lowest edge first, so that the mesh stays conformal and no cell crosses the boundary.
 //! Splitting an edge at a point of the edge changes no face's geometry, so the terrain, the
@@ -1789,7 +1791,10 @@ fn walls(set: &ObjectSet) -> Vec<(usize, Wall)> {
 }
 
 /// Refines the background mesh near the objects (before the faults and the interfaces are
-/// cut, so that their cuts land on the refined edges and every node they make lies on them).
+/// cut, so that their cuts land on the refined edges and every node they make lies on them),
+/// then the cells that the walls cross or reach into whatever the cap left
+/// ([`refine_missed`]): these too before any cut, since the midpoint of an edge that a cut
+/// put on a curved fault, interface or wall lies on its chord, off the surface.
 pub(crate) fn refine_near_objects(
     st: &mut State,
     set: &ObjectSet,
@@ -1898,6 +1903,34 @@ pub(crate) fn refine_near_objects(
         labels.refined_edges,
         st.tets.len(),
     );
+    // Every wall's crossings missed by its nodes' signs are refined away here too, before
+    // any surface is cut: the midpoint of an edge on a wall, a fault or an interface already
+    // cut lies on the edge's chord, off that surface where it is curved (on an interface, a
+    // cell around it then has nodes on both sides of it: "straddles an interface").
+    for pass in 0..4 {
+        let mut bisected = 0;
+        for &(i, w) in &walls {
+            let o = &set.objects[i];
+            let since = std::time::Instant::now();
+            let (edges, rounds, [crossed, reached]) =
+                refine_missed(st, &mut labels, o, w, set.resolution * o.size);
+            object_stats(
+                format_args!(
+                    "crossed cells of {} {} ({w:?}), pass {pass}, {rounds} rounds, cells \
+                     flagged: {crossed} crossed, {reached} reached without a sign change",
+                    o.kind, o.name
+                ),
+                since,
+                edges,
+                st.tets.len(),
+            );
+            bisected += edges;
+        }
+        labels.repaired_edges += bisected;
+        if bisected == 0 {
+            break;
+        }
+    }
     Ok(labels)
 }
 
@@ -1908,7 +1941,11 @@ pub(crate) fn refine_near_objects(
 const CROSSED_STRAY: f64 = 2.0;
 
 /// Refines, round after round, the cells that a wall crosses where its facets would stray from
-/// it (see [`straying_edge`]), whatever [`ObjectSet::max_cells`] left: the refinement near
+/// it (see [`straying_edge`]), whatever [`ObjectSet::max_cells`] left (on the background
+/// mesh, before the faults, the interfaces, the zones and the walls are cut: it bisects edges
+/// at their midpoints, which would lie off any curved surface already cut; bisecting edges on
+/// an interface after its cut left cells with nodes more than 1 cm on both sides of it,
+/// "straddles an interface", with the excavation's exact test): the refinement near
 /// the objects stops at that cap, and the wall then crossed cells many times its tolerance
 /// wide, some with every node outside it (an edge across a tunnel's crown: no sign change,
 /// nothing cut, a cell labelled outside with most of its volume inside). A cell is crossed
@@ -2254,7 +2291,8 @@ fn snap_to_wall(
 
 /// Cuts every object's walls into the mesh (after the faults, the interfaces and the zones,
 /// before the quality pass) and labels the cells (a cell in several objects takes the first in project order);
-/// `labels` carries what [`refine_near_objects`] did.
+/// `labels` carries what [`refine_near_objects`] did (both refinements: no edge is bisected
+/// here).
 pub(crate) fn cut_objects(
     st: &mut State,
     set: &ObjectSet,
@@ -2264,32 +2302,6 @@ pub(crate) fn cut_objects(
     labels.object = vec![0; st.tets.len()];
     labels.lining = vec![false; st.tets.len()];
     let walls = walls(set);
-    // Every wall's crossings missed by its nodes' signs are refined away before any wall is
-    // cut (a midpoint of an edge on a wall already cut would lie off that wall).
-    for _pass in 0..4 {
-        let mut bisected = 0;
-        for &(i, w) in &walls {
-            let o = &set.objects[i];
-            let since = std::time::Instant::now();
-            let (edges, rounds, [crossed, reached]) =
-                refine_missed(st, &mut labels, o, w, set.resolution * o.size);
-            object_stats(
-                format_args!(
-                    "crossed cells of {} {} ({w:?}), pass {_pass}, {rounds} rounds, cells \
-                     flagged: {crossed} crossed, {reached} reached without a sign change",
-                    o.kind, o.name
-                ),
-                since,
-                edges,
-                st.tets.len(),
-            );
-            bisected += edges;
-        }
-        labels.repaired_edges += bisected;
-        if bisected == 0 {
-            break;
-        }
-    }
     for (wi, &(i, w)) in walls.iter().enumerate() {
         let o = &set.objects[i];
         if o.kind == "tunnel" {
