@@ -2868,6 +2868,82 @@ mod tests {
         );
     }
 
+    /// Near a straight circular tunnel the refinement stretches its cells along the axis
+    /// (lengths along it counted at [`AXIAL_STRETCH`]): fewer cells than the isotropic
+    /// refinement (`axial_stretch` 1), every cell still of a bounded shape, and the cells
+    /// around the barrel's middle longer along the axis than across it.
+    #[test]
+    fn refinement_near_a_tunnel_stretches_cells_along_its_axis() {
+        let site = unfaulted_site();
+        let spec = ObjectSpec {
+            name: "T".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[30.0, 100.0, 45.0], [170.0, 100.0, 45.0]],
+                profile: Profile::Circle { diameter: 6.0 },
+                lining: 0.3,
+            },
+        };
+        let mut set = ObjectSet::new(&[spec], &site.terrain, site.base).unwrap();
+        let refine = |set: &ObjectSet| {
+            let mut st =
+                crate::mesh::background(&site.terrain, &MeshSettings::new(site.base, 10.0))
+                    .unwrap();
+            let labels = refine_near_objects(&mut st, set).unwrap();
+            assert!(!labels.capped);
+            st
+        };
+        set.axial_stretch = 1.0;
+        let iso = refine(&set);
+        set.axial_stretch = AXIAL_STRETCH;
+        let st = refine(&set);
+        let worst = |st: &State| {
+            st.tets
+                .iter()
+                .map(|t| min_dihedral(t.map(|v| st.points[v as usize])))
+                .fold(f64::MAX, f64::min)
+        };
+        // The mean extent along the axis (x) over across it, of the cells whose centroid lies
+        // within 1 m of the wall in the barrel's middle.
+        let aspect = |st: &State| {
+            let (mut sum, mut n) = (0.0, 0);
+            for t in &st.tets {
+                let q = t.map(|v| st.points[v as usize]);
+                let c = centroid(&st.points, t);
+                let rho = ((c[1] - 100.0).powi(2) + (c[2] - 45.0).powi(2)).sqrt();
+                if !(60.0..140.0).contains(&c[0]) || (rho - 3.0).abs() > 1.0 {
+                    continue;
+                }
+                let (mut ax, mut cr) = (0.0f64, 0.0f64);
+                for &(i, j) in &EDGES {
+                    let d = sub(q[j], q[i]);
+                    ax = ax.max(d[0].abs());
+                    cr = cr.max((d[1] * d[1] + d[2] * d[2]).sqrt());
+                }
+                sum += ax / cr;
+                n += 1;
+            }
+            sum / n as f64
+        };
+        let (a_iso, a) = (aspect(&iso), aspect(&st));
+        eprintln!(
+            "cells {} isotropic, {} stretched; worst {:.2} and {:.2} degrees; aspect {a_iso:.2} \
+             and {a:.2}",
+            iso.tets.len(),
+            st.tets.len(),
+            worst(&iso),
+            worst(&st)
+        );
+        assert!(
+            3 * st.tets.len() < 2 * iso.tets.len(),
+            "{} cells stretched against {} isotropic",
+            st.tets.len(),
+            iso.tets.len()
+        );
+        assert!(a > 1.5 * a_iso, "aspect {a} stretched, {a_iso} isotropic");
+        assert!(worst(&st) > 1.0, "a cell of {} degrees", worst(&st));
+    }
+
     /// The snap before a tunnel's cut moves nodes onto the wall (within a millimetre), keeps
     /// every cell positive, leaves no cell with all four nodes on the wall, and leaves less than
     /// half the edges crossing the wall for the cut to split.
