@@ -1479,6 +1479,10 @@ const NEAR_LONGEST: f64 = 0.75;
 /// change along it), and isotropic cells there made most of the refinement's cells.
 pub const AXIAL_STRETCH: f64 = 0.3;
 
+/// A tunnel piece's axis in the [`Metric`]: its ends, unit direction, and the tunnel's reach
+/// (the lining's outer profile's, if any).
+type Axis = ([f64; 3], [f64; 3], [f64; 3], f64);
+
 /// The metric of the refinement near objects: Euclidean, but within [`Metric::NEAR`] times
 /// a tunnel's reach of a piece's axis the length along that axis counts at
 /// [`AXIAL_STRETCH`] of it, graded back to Euclidean at [`Metric::FAR`] times the reach, and
@@ -1488,9 +1492,7 @@ pub const AXIAL_STRETCH: f64 = 0.3;
 /// depends on its two ends only (read at its midpoint), so that every cell around it agrees
 /// on its longest edge.
 pub(crate) struct Metric {
-    /// Per tunnel piece: its ends, unit axis, and the tunnel's reach (the lining's outer
-    /// profile's, if any).
-    axes: Vec<([f64; 3], [f64; 3], [f64; 3], f64)>,
+    axes: Vec<Axis>,
     stretch: f64,
 }
 
