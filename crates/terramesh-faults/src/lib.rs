@@ -213,7 +213,7 @@ pub use mesh::{
 };
 pub use objects::{
     check_objects, Object, ObjectCells, ObjectCheck, ObjectGeometry, ObjectSet, ObjectSpec,
-    Profile, Wall, OBJECT_MAX_CELLS, OBJECT_TOLERANCE, STRUCTURE_RESOLUTION,
+    Profile, Wall, AXIAL_STRETCH, OBJECT_MAX_CELLS, OBJECT_TOLERANCE, STRUCTURE_RESOLUTION,
 };
 pub use quality::{min_dihedral, quality, Quality, BINS};
 pub use refine::RefineBudget;

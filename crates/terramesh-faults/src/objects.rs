@@ -596,6 +596,9 @@ pub struct ObjectSet {
     /// Refinement near objects stops before the mesh would pass this many cells (default
     /// [`OBJECT_MAX_CELLS`]).
     pub max_cells: usize,
+    /// Near a tunnel, the refinement measures lengths along its axis at this fraction of
+    /// them (default [`AXIAL_STRETCH`]; 1 refines isotropically).
+    pub axial_stretch: f64,
 }
 
 fn err(spec: &ObjectSpec, key: &'static str, why: impl Into<String>) -> FaultError {
@@ -713,6 +716,7 @@ impl ObjectSet {
             objects,
             resolution: STRUCTURE_RESOLUTION,
             max_cells: OBJECT_MAX_CELLS,
+            axial_stretch: AXIAL_STRETCH,
         })
     }
 
@@ -1471,41 +1475,128 @@ fn crossing(f: &dyn Fn([f64; 3]) -> f64, a: [f64; 3], b: [f64; 3], va: f64, vb: 
 /// that edge is at least this fraction of the cell's longest edge, else at its longest edge.
 const NEAR_LONGEST: f64 = 0.75;
 
-/// The squared length of an edge (by key).
-fn edge_d2(points: &[[f64; 3]], k: u64) -> f64 {
-    let d = sub(points[(k >> 32) as usize], points[k as u32 as usize]);
-    dot(d, d)
+/// Near a tunnel's straight piece, the refinement measures an edge's length along the axis
+/// at this fraction of it (cells stretched along the axis, about 1 / this times longer than
+/// wide): the facets of a barrel need cells small across the axis only (its field does not
+/// change along it), and isotropic cells there made most of the refinement's cells.
+pub const AXIAL_STRETCH: f64 = 0.3;
+
+/// A tunnel piece's axis in the [`Metric`]: its ends, unit direction, and the tunnel's reach
+/// (the lining's outer profile's, if any).
+type Axis = ([f64; 3], [f64; 3], [f64; 3], f64);
+
+/// The metric of the refinement near objects: Euclidean, but within [`Metric::NEAR`] times
+/// a tunnel's reach of a piece's axis the length along that axis counts at
+/// [`AXIAL_STRETCH`] of it, graded back to Euclidean at [`Metric::FAR`] times the reach, and
+/// near the piece's ends (caps and mitres, where the wall's field changes along the axis:
+/// the cap's rim needs cells small along the axis too) Euclidean within one reach of the
+/// end plane, graded to the whole stretch at [`Metric::NEAR`] reaches inside. An edge's length
+/// depends on its two ends only (read at its midpoint), so that every cell around it agrees
+/// on its longest edge.
+pub(crate) struct Metric {
+    axes: Vec<Axis>,
+    stretch: f64,
 }
 
-/// The key of a cell's longest edge (ties: the lowest key, so that every cell agrees).
-fn longest_edge(points: &[[f64; 3]], t: &[u32; 4]) -> u64 {
+impl Metric {
+    const NEAR: f64 = 2.0;
+    const FAR: f64 = 4.0;
+
+    /// Stretched along the axes of the set's tunnels by `stretch` (1: Euclidean).
+    pub(crate) fn new(set: &ObjectSet, stretch: f64) -> Metric {
+        let mut axes = Vec::new();
+        if stretch < 1.0 {
+            for o in &set.objects {
+                if let Shape::Tunnel {
+                    pieces,
+                    profile,
+                    outer,
+                    ..
+                } = &o.shape
+                {
+                    let reach = outer.as_ref().unwrap_or(profile).reach();
+                    for p in pieces {
+                        let t = unit(sub(p.b, p.a));
+                        axes.push((p.a, p.b, t, reach));
+                    }
+                }
+            }
+        }
+        Metric { axes, stretch }
+    }
+
+    /// The squared length of segment pq in this metric.
+    fn d2(&self, p: [f64; 3], q: [f64; 3]) -> f64 {
+        let d = sub(q, p);
+        let e2 = dot(d, d);
+        if self.axes.is_empty() {
+            return e2;
+        }
+        let m = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+        // The nearest piece's axis (within its far distance): the stretch's weight there.
+        let mut best: Option<(f64, [f64; 3], f64)> = None;
+        for &(a, b, t, reach) in &self.axes {
+            let e = sub(b, a);
+            let len = norm(e);
+            let along = dot(sub(m, a), t);
+            let s = (along / len).clamp(0.0, 1.0);
+            let r = norm(sub(m, [a[0] + s * e[0], a[1] + s * e[1], a[2] + s * e[2]]));
+            if r >= Self::FAR * reach || best.is_some_and(|x| r >= x.0) {
+                continue;
+            }
+            let across = ((Self::FAR * reach - r) / ((Self::FAR - Self::NEAR) * reach)).min(1.0);
+            let inside = along.min(len - along);
+            let ends = ((inside - reach) / ((Self::NEAR - 1.0) * reach)).clamp(0.0, 1.0);
+            best = Some((r, t, across * ends));
+        }
+        let Some((_, t, w)) = best else {
+            return e2;
+        };
+        let s = 1.0 - w * (1.0 - self.stretch);
+        let along = dot(d, t);
+        (e2 - (1.0 - s * s) * along * along).max(0.0)
+    }
+
+    /// The length of segment pq in this metric.
+    fn len(&self, p: [f64; 3], q: [f64; 3]) -> f64 {
+        self.d2(p, q).sqrt()
+    }
+}
+
+/// The squared length of an edge (by key) in the metric.
+fn edge_d2(m: &Metric, points: &[[f64; 3]], k: u64) -> f64 {
+    m.d2(points[(k >> 32) as usize], points[k as u32 as usize])
+}
+
+/// The key of a cell's longest edge in the metric (ties: the lowest key, so that every cell
+/// agrees).
+fn longest_edge(m: &Metric, points: &[[f64; 3]], t: &[u32; 4]) -> u64 {
     EDGES
         .iter()
         .map(|&(i, j)| key(t[i], t[j]))
-        .max_by(|&a, &b| {
-            edge_d2(points, a)
-                .total_cmp(&edge_d2(points, b))
-                .then(b.cmp(&a))
-        })
+        .map(|k| (k, edge_d2(m, points, k)))
+        .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
         .unwrap()
+        .0
 }
 
 /// Splits the given edges (sorted keys) at the given points, conformally, the children of a
-/// cell keeping its labels; with `longest_first`, each cell's edges are split longest first.
+/// cell keeping its labels; with `longest_first`, each cell's edges are split longest first
+/// (in that metric).
 fn split_edges(
     st: &mut State,
     labels: &mut ObjectCells,
     keys: &[u64],
     points: Vec<[f64; 3]>,
-    longest_first: bool,
+    longest_first: Option<&Metric>,
 ) {
-    let rank: Option<Vec<u32>> = longest_first.then(|| {
+    let rank: Option<Vec<u32>> = longest_first.map(|m| {
+        let d2: Vec<f64> = keys
+            .par_iter()
+            .map(|&k| edge_d2(m, &st.points, k))
+            .collect();
         let mut order: Vec<u32> = (0..keys.len() as u32).collect();
-        order.sort_by(|&a, &b| {
-            edge_d2(&st.points, keys[b as usize])
-                .total_cmp(&edge_d2(&st.points, keys[a as usize]))
-                .then(a.cmp(&b))
-        });
+        order.sort_by(|&a, &b| d2[b as usize].total_cmp(&d2[a as usize]).then(a.cmp(&b)));
         let mut rank = vec![0u32; keys.len()];
         for (r, &pos) in order.iter().enumerate() {
             rank[pos as usize] = r as u32;
@@ -1535,7 +1626,7 @@ fn split_edges(
 /// Only the cells with an edge marked in the previous sweep are looked at (all marked edges
 /// in the first): a cell without one decided the same before, or added its longest edge,
 /// which is then marked and near its longest. Only such a cell's longest edge is measured.
-fn close(st: &State, keys: &mut Vec<u64>) {
+fn close(m: &Metric, st: &State, keys: &mut Vec<u64>) {
     let mut fresh: Vec<u64> = keys.clone();
     while !fresh.is_empty() {
         // Only cells with two ends of freshly marked edges can hold one.
@@ -1560,10 +1651,10 @@ fn close(st: &State, keys: &mut Vec<u64>) {
                     .iter()
                     .map(|&(i, j)| key(t[i], t[j]))
                     .filter(|k| marked_set.binary_search(k).is_ok())
-                    .map(|k| edge_d2(&st.points, k))
+                    .map(|k| edge_d2(m, &st.points, k))
                     .fold(-1.0, f64::max);
-                let l = longest_edge(&st.points, t);
-                (marked >= 0.0 && marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(&st.points, l))
+                let l = longest_edge(m, &st.points, t);
+                (marked >= 0.0 && marked < NEAR_LONGEST * NEAR_LONGEST * edge_d2(m, &st.points, l))
                     .then_some(l)
             })
             .collect();
@@ -1578,7 +1669,7 @@ fn close(st: &State, keys: &mut Vec<u64>) {
 }
 
 /// Bisects the given edges (sorted keys) at their midpoints, every cell at its longest first.
-fn bisect(st: &mut State, labels: &mut ObjectCells, keys: &[u64]) {
+fn bisect(m: &Metric, st: &mut State, labels: &mut ObjectCells, keys: &[u64]) {
     let mids: Vec<[f64; 3]> = keys
         .iter()
         .map(|&k| {
@@ -1590,7 +1681,7 @@ fn bisect(st: &mut State, labels: &mut ObjectCells, keys: &[u64]) {
             ]
         })
         .collect();
-    split_edges(st, labels, keys, mids, true);
+    split_edges(st, labels, keys, mids, Some(m));
 }
 
 /// The edge of cell `t` to bisect where a wall's facets would stray from it (field `f`, node
@@ -1599,6 +1690,7 @@ fn bisect(st: &mut State, labels: &mut ObjectCells, keys: &[u64]) {
 /// [`NEAR_LONGEST`] of the cell's longest edge, else the longest edge), or the longest edge if
 /// only the centroid's does.
 fn straying_edge(
+    m: &Metric,
     points: &[[f64; 3]],
     t: &[u32; 4],
     v: [f64; 4],
@@ -1607,26 +1699,28 @@ fn straying_edge(
 ) -> Option<u64> {
     let q = t.map(|n| points[n as usize]);
     let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
+    let mlen = |(i, j): (usize, usize)| m.len(q[i], q[j]);
     let l = EDGES.iter().map(|&e| len(e)).fold(0.0, f64::max);
     if l <= 4.0 * tol {
         return None;
     }
+    let ml = EDGES.iter().map(|&e| mlen(e)).fold(0.0, f64::max);
     let mut best: Option<(usize, usize)> = None;
     for &(a, b) in &EDGES {
         if len((a, b)) <= 4.0 * tol {
             continue;
         }
-        let m = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
-        if (f(m) - 0.5 * (v[a] + v[b])).abs() > tol && best.is_none_or(|e| len((a, b)) > len(e)) {
+        let c = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
+        if (f(c) - 0.5 * (v[a] + v[b])).abs() > tol && best.is_none_or(|e| mlen((a, b)) > mlen(e)) {
             best = Some((a, b));
         }
     }
     match best {
-        Some((a, b)) if len((a, b)) >= NEAR_LONGEST * l => Some(key(t[a], t[b])),
-        Some(_) => Some(longest_edge(points, t)),
+        Some((a, b)) if mlen((a, b)) >= NEAR_LONGEST * ml => Some(key(t[a], t[b])),
+        Some(_) => Some(longest_edge(m, points, t)),
         None => {
             let c = centroid(points, t);
-            ((f(c) - 0.25 * v.iter().sum::<f64>()).abs() > tol).then(|| longest_edge(points, t))
+            ((f(c) - 0.25 * v.iter().sum::<f64>()).abs() > tol).then(|| longest_edge(m, points, t))
         }
     }
 }
@@ -1811,6 +1905,7 @@ pub(crate) fn refine_near_objects(
         });
     }
     let walls = walls(set);
+    let metric = Metric::new(set, set.axial_stretch);
     let since = std::time::Instant::now();
     let mut rounds = 0;
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
@@ -1830,7 +1925,9 @@ pub(crate) fn refine_near_objects(
             .filter_map(|t| {
                 let q = t.map(|n| st.points[n as usize]);
                 let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
+                let mlen = |(i, j): (usize, usize)| metric.len(q[i], q[j]);
                 let l = EDGES.iter().map(|&e| len(e)).fold(0.0, f64::max);
+                let ml = EDGES.iter().map(|&e| mlen(e)).fold(0.0, f64::max);
                 // A cell is refined where the facets would stray from a wall: an edge whose
                 // midpoint's field deviates from the mean of its ends' by more than the
                 // tolerance, or the centroid's; nothing where the edges are already short.
@@ -1845,7 +1942,12 @@ pub(crate) fn refine_near_objects(
                         continue;
                     }
                     let v = t.map(|n| values[w][n as usize]);
-                    if v.iter().all(|x| x.abs() >= l) {
+                    // Out of reach: every node farther from the wall than the cell is wide
+                    // (across a tunnel's axis, in the metric: its barrel's field does not
+                    // change along it; a wider reach refined a band as thick as the
+                    // stretched cells are long).
+                    let wide = if o.kind == "tunnel" { ml } else { l };
+                    if v.iter().all(|x| x.abs() >= wide) {
                         continue;
                     }
                     let mut best: Option<(usize, usize)> = None;
@@ -1855,7 +1957,7 @@ pub(crate) fn refine_near_objects(
                         }
                         let m = [0, 1, 2].map(|k| 0.5 * (q[a][k] + q[b][k]));
                         if (o.field(wall, m) - 0.5 * (v[a] + v[b])).abs() > tol
-                            && best.is_none_or(|e| len((a, b)) > len(e))
+                            && best.is_none_or(|e| mlen((a, b)) > mlen(e))
                         {
                             best = Some((a, b));
                         }
@@ -1867,16 +1969,16 @@ pub(crate) fn refine_near_objects(
                         }
                     }
                     if let Some(e) = best {
-                        if pick.is_none_or(|p| len(e) > len(p)) {
+                        if pick.is_none_or(|p| mlen(e) > mlen(p)) {
                             pick = Some(e);
                         }
                     }
                 }
                 pick.map(|(a, b)| {
-                    if a != b && len((a, b)) >= NEAR_LONGEST * l {
+                    if a != b && mlen((a, b)) >= NEAR_LONGEST * ml {
                         key(t[a], t[b])
                     } else {
-                        longest_edge(&st.points, t)
+                        longest_edge(&metric, &st.points, t)
                     }
                 })
             })
@@ -1886,13 +1988,13 @@ pub(crate) fn refine_near_objects(
         if keys.is_empty() {
             break;
         }
-        close(st, &mut keys);
+        close(&metric, st, &mut keys);
         if st.tets.len() + 6 * keys.len() > set.max_cells {
             labels.capped = true;
             break;
         }
         labels.refined_edges += keys.len();
-        bisect(st, &mut labels, &keys);
+        bisect(&metric, st, &mut labels, &keys);
     }
     object_stats(
         format_args!(
@@ -1913,7 +2015,7 @@ pub(crate) fn refine_near_objects(
             let o = &set.objects[i];
             let since = std::time::Instant::now();
             let (edges, rounds, [crossed, reached]) =
-                refine_missed(st, &mut labels, o, w, set.resolution * o.size);
+                refine_missed(&metric, st, &mut labels, o, w, set.resolution * o.size);
             object_stats(
                 format_args!(
                     "crossed cells of {} {} ({w:?}), pass {pass}, {rounds} rounds, cells \
@@ -1959,6 +2061,7 @@ const CROSSED_STRAY: f64 = 2.0;
 /// rounds, and the cells flagged (all rounds): crossed (nodes on both sides), and reached
 /// without a sign change at the nodes.
 fn refine_missed(
+    metric: &Metric,
     st: &mut State,
     labels: &mut ObjectCells,
     o: &Object,
@@ -2033,7 +2136,7 @@ fn refine_missed(
                     // The cut splits it: refined only where its facets would stray from the
                     // wall by more than half the checks' tolerance (a sharp edge of the wall,
                     // a tunnel's end, across the cell; facets left coarse by the cap).
-                    let e = straying_edge(&st.points, t, v, &f, CROSSED_STRAY * tol);
+                    let e = straying_edge(metric, &st.points, t, v, &f, CROSSED_STRAY * tol);
                     if e.is_some() {
                         flagged[0].fetch_add(1, Relaxed);
                     }
@@ -2048,8 +2151,8 @@ fn refine_missed(
                     return None;
                 }
                 flagged[1].fetch_add(1, Relaxed);
-                straying_edge(&st.points, t, v, &f, tol)
-                    .or_else(|| Some(longest_edge(&st.points, t)))
+                straying_edge(metric, &st.points, t, v, &f, tol)
+                    .or_else(|| Some(longest_edge(metric, &st.points, t)))
             })
             .collect();
         keys.par_sort_unstable();
@@ -2057,9 +2160,9 @@ fn refine_missed(
         if keys.is_empty() {
             break;
         }
-        close(st, &mut keys);
+        close(metric, st, &mut keys);
         total += keys.len();
-        bisect(st, labels, &keys);
+        bisect(metric, st, labels, &keys);
     }
     (total, rounds, flagged.map(|a| a.into_inner()))
 }
@@ -2404,7 +2507,7 @@ pub(crate) fn cut_objects(
         let mut values = values;
         values.resize(st.points.len() + keys.len(), (0.0, 0));
         let first = st.points.len();
-        split_edges(st, &mut labels, &keys, pts, false);
+        split_edges(st, &mut labels, &keys, pts, None);
         // Where a node moved onto a curved interface or fault inverts a cell, it goes back
         // to the chord (`positive` is exact and, as the writers compute volumes, in floating
         // point too).
@@ -2776,6 +2879,82 @@ mod tests {
             worst > 1.0,
             "a cell of {worst} degrees after the refinement"
         );
+    }
+
+    /// Near a straight circular tunnel the refinement stretches its cells along the axis
+    /// (lengths along it counted at [`AXIAL_STRETCH`]): fewer cells than the isotropic
+    /// refinement (`axial_stretch` 1), every cell still of a bounded shape, and the cells
+    /// around the barrel's middle longer along the axis than across it.
+    #[test]
+    fn refinement_near_a_tunnel_stretches_cells_along_its_axis() {
+        let site = unfaulted_site();
+        let spec = ObjectSpec {
+            name: "T".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[30.0, 100.0, 45.0], [170.0, 100.0, 45.0]],
+                profile: Profile::Circle { diameter: 6.0 },
+                lining: 0.3,
+            },
+        };
+        let mut set = ObjectSet::new(&[spec], &site.terrain, site.base).unwrap();
+        let refine = |set: &ObjectSet| {
+            let mut st =
+                crate::mesh::background(&site.terrain, &MeshSettings::new(site.base, 10.0))
+                    .unwrap();
+            let labels = refine_near_objects(&mut st, set).unwrap();
+            assert!(!labels.capped);
+            st
+        };
+        set.axial_stretch = 1.0;
+        let iso = refine(&set);
+        set.axial_stretch = AXIAL_STRETCH;
+        let st = refine(&set);
+        let worst = |st: &State| {
+            st.tets
+                .iter()
+                .map(|t| min_dihedral(t.map(|v| st.points[v as usize])))
+                .fold(f64::MAX, f64::min)
+        };
+        // The mean extent along the axis (x) over across it, of the cells whose centroid lies
+        // within 1 m of the wall in the barrel's middle.
+        let aspect = |st: &State| {
+            let (mut sum, mut n) = (0.0, 0);
+            for t in &st.tets {
+                let q = t.map(|v| st.points[v as usize]);
+                let c = centroid(&st.points, t);
+                let rho = ((c[1] - 100.0).powi(2) + (c[2] - 45.0).powi(2)).sqrt();
+                if !(60.0..140.0).contains(&c[0]) || (rho - 3.0).abs() > 1.0 {
+                    continue;
+                }
+                let (mut ax, mut cr) = (0.0f64, 0.0f64);
+                for &(i, j) in &EDGES {
+                    let d = sub(q[j], q[i]);
+                    ax = ax.max(d[0].abs());
+                    cr = cr.max((d[1] * d[1] + d[2] * d[2]).sqrt());
+                }
+                sum += ax / cr;
+                n += 1;
+            }
+            sum / n as f64
+        };
+        let (a_iso, a) = (aspect(&iso), aspect(&st));
+        eprintln!(
+            "cells {} isotropic, {} stretched; worst {:.2} and {:.2} degrees; aspect {a_iso:.2} \
+             and {a:.2}",
+            iso.tets.len(),
+            st.tets.len(),
+            worst(&iso),
+            worst(&st)
+        );
+        assert!(
+            3 * st.tets.len() < 2 * iso.tets.len(),
+            "{} cells stretched against {} isotropic",
+            st.tets.len(),
+            iso.tets.len()
+        );
+        assert!(a > 1.5 * a_iso, "aspect {a} stretched, {a_iso} isotropic");
+        assert!(worst(&st) > 1.0, "a cell of {} degrees", worst(&st));
     }
 
     /// The snap before a tunnel's cut moves nodes onto the wall (within a millimetre), keeps
