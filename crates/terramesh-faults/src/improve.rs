@@ -296,6 +296,17 @@ enum Op {
         ring: Vec<u32>,
         new: Vec<([u32; 4], f64)>,
     },
+    /// Edge (a, c) split at its ring node `b` (module `tail`): the cells `kill` (holding
+    /// a, c and b) go, each cell of `kids` becomes its two cones from `b` (the first in the
+    /// cell, the second a new cell labelled as it), with their smallest angles; `b` takes
+    /// the interface flag `flags` and the faults `on_fault`.
+    Pierce {
+        b: u32,
+        flags: u8,
+        on_fault: u64,
+        kill: Vec<u32>,
+        kids: Vec<(u32, [u32; 4], f64, [u32; 4], f64)>,
+    },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {
         v: u32,
@@ -637,6 +648,13 @@ impl Pass<'_> {
                 done.inserted += 1;
             }
             Op::Replace { ring, new } => self.replace(ring, new, done),
+            Op::Pierce {
+                b,
+                flags,
+                on_fault,
+                kill,
+                kids,
+            } => self.pierced(b, flags, on_fault, kill, kids, done),
             Op::Move {
                 v,
                 to,
@@ -1555,6 +1573,9 @@ impl Pass<'_> {
             Op::Flip23 { c, d, .. } => vec![*c, *d],
             Op::Flip32 { ring, .. } => ring.to_vec(),
             Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
+            Op::Pierce { kill, kids, .. } => {
+                kill.iter().copied().chain(kids.iter().map(|k| k.0)).collect()
+            }
             Op::Move { cells, .. } => cells.clone(),
         }
     }

@@ -70,7 +70,178 @@ impl Pass<'_> {
         {
             return Some(op);
         }
+        if let Some(op) = self.pierce_best(t, around) {
+            return Some(op);
+        }
         (0..4).find_map(|i| self.fault_move(t[i], around[i]))
+    }
+
+    /// The best [`Pass::pierce`] of poor cell `t`: each of its edges split at each of the
+    /// cell's two other nodes.
+    fn pierce_best(&self, t: [u32; 4], around: &[&[u32]; 4]) -> Option<Op> {
+        let mut best: Option<(f64, Op)> = None;
+        for &(i, j) in &crate::mesh::EDGES {
+            for k in (0..4).filter(|&k| k != i && k != j) {
+                if let Some((q, op)) = self.pierce(t[i], t[j], t[k], around[i], around[k]) {
+                    if best.as_ref().is_none_or(|b| q > b.0) {
+                        best = Some((q, op));
+                    }
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+
+    /// Splits edge (`a`, `c`) at its ring node `b` (`ca`, `cb`: the cells around `a` and
+    /// `b`): where surfaces meet at a line (two faults, a fault and an interface, a fault or
+    /// an interface and a side), the cut leaves nodes along the line a metre or so apart,
+    /// and an edge between two of them passes beside a third, `b`, which no move may take
+    /// off the line: every cell holding the three is a sliver. Each cell around the edge
+    /// that does not hold `b` becomes its two cones from `b` (`c` replaced by `b`, and `a`
+    /// replaced by `b`), labelled as their parent; the cells holding `b` go. This is the
+    /// edge's split at a new node collapsed into `b`: the cones from `b` over the faces of
+    /// the edge's ring that do not hold `b`, which tile the same region when every one is
+    /// positive (exact `orient3d`). If the edge lies on a side (its ring open), `a`, `c`,
+    /// `b` and the ring's other end must lie on one edge of the outline (the side's face
+    /// (a, c, end) becomes (a, b, end) and (b, c, end)). The labels around the edge may
+    /// differ: `b` must then lie within half of `check`'s tolerance of every fault whose
+    /// sides differ among them and of every interface between the units of one side and
+    /// block there, as a merged node must (it takes those faults and the interface flag),
+    /// the cells must share their zones and object label, and every new cell must be better
+    /// than the ring's worst, in its unit, on its side of every fault (its centroid) and of
+    /// the objects' walls. Returns the worst new cell's angle and the operation.
+    fn pierce(&self, a: u32, c: u32, b: u32, ca: &[u32], cb: &[u32]) -> Option<(f64, Op)> {
+        let ring = self.holding(ca, c);
+        if ring.len() < 2 {
+            return None;
+        }
+        // Each ring node is in two of the ring's cells (closed), or the two ends in one.
+        let mut third: Vec<u32> = ring
+            .iter()
+            .flat_map(|&d| self.st.tets[d as usize])
+            .filter(|&v| v != a && v != c)
+            .collect();
+        third.sort_unstable();
+        let mut ends = Vec::new();
+        let mut i = 0;
+        while i < third.len() {
+            let j = i + third[i..].iter().take_while(|&&v| v == third[i]).count();
+            match j - i {
+                1 => ends.push(third[i]),
+                2 => {}
+                _ => return None,
+            }
+            i = j;
+        }
+        let pt = |v: u32| self.st.points[v as usize];
+        let kill = self.holding(&ring, b);
+        match (ends.len(), kill.len()) {
+            (0, 2) => {}
+            (2, 1) if ends.contains(&b) => {
+                let e = if ends[0] == b { ends[1] } else { ends[0] };
+                let all = [a, c, b, e];
+                if all.iter().any(|&v| self.st.flags[v as usize] & SIDE == 0)
+                    || !self.on_outline_edge(&all.map(pt))
+                {
+                    return None;
+                }
+            }
+            _ => return None,
+        }
+        let labels: Vec<Label> = self.labels(&ring);
+        let first = labels[0];
+        if labels.iter().any(|l| (l.3, l.4) != (first.3, first.4)) {
+            return None;
+        }
+        let differ = labels.iter().fold(0u64, |m, l| m | (l.0 ^ first.0));
+        let half = 0.5 * crate::FAULT_TOLERANCE;
+        let p = pt(b);
+        let mut interface = false;
+        for f in 0..self.faults.faults.len() {
+            if differ >> f & 1 == 1 && self.faults.faults[f].side(p).distance.abs() > half {
+                return None;
+            }
+        }
+        for l in &labels {
+            let (lo, hi) = labels
+                .iter()
+                .filter(|k| (k.0, k.2) == (l.0, l.2))
+                .fold((l.1, l.1), |(lo, hi), k| (lo.min(k.1), hi.max(k.1)));
+            for k in lo..hi {
+                let z = (self.height)(k as usize, self.blocks[l.2 as usize], [p[0], p[1]]);
+                if z.is_nan() || (z - p[2]).abs() > half {
+                    return None;
+                }
+                interface = true;
+            }
+        }
+        let old = ring
+            .iter()
+            .map(|&d| self.angle[d as usize])
+            .fold(f64::MAX, f64::min);
+        let mut kids = Vec::with_capacity(ring.len());
+        let mut worst = f64::MAX;
+        for &d in ring.iter().filter(|d| !kill.contains(d)) {
+            let t = self.st.tets[d as usize];
+            let u1 = t.map(|w| if w == c { b } else { w });
+            let u2 = t.map(|w| if w == a { b } else { w });
+            let (g1, g2) = (self.geo(u1), self.geo(u2));
+            if !positive(g1) || !positive(g2) {
+                return None;
+            }
+            let (q1, q2) = (min_dihedral(g1), min_dihedral(g2));
+            if q1 <= old || q2 <= old {
+                return None;
+            }
+            worst = worst.min(q1).min(q2);
+            kids.push((d, u1, q1, u2, q2));
+        }
+        let sides = |g: [[f64; 3]; 4], d: u32| {
+            let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+            let s = self.st.positive[d as usize];
+            self.faults
+                .faults
+                .iter()
+                .enumerate()
+                .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1))
+        };
+        if !kids.iter().all(|&(d, u1, _, u2, _)| {
+            [u1, u2].into_iter().all(|u| {
+                let g = self.geo(u);
+                sides(g, d) && self.in_unit(g, d) && self.in_objects(g, d)
+            })
+        }) {
+            return None;
+        }
+        // No two cells on the same nodes (a new cell and one of `b`'s that stays).
+        let mut keys: Vec<[u32; 4]> = kids
+            .iter()
+            .flat_map(|k| [k.1, k.3])
+            .chain(
+                cb.iter()
+                    .filter(|d| !kill.contains(d))
+                    .map(|&d| self.st.tets[d as usize]),
+            )
+            .map(|mut k| {
+                k.sort_unstable();
+                k
+            })
+            .collect();
+        keys.sort_unstable();
+        if keys.windows(2).any(|w| w[0] == w[1]) {
+            return None;
+        }
+        let flags = if interface { ON_INTERFACE } else { 0 };
+        Some((
+            worst,
+            Op::Pierce {
+                b,
+                flags,
+                on_fault: differ,
+                kill,
+                kids,
+            },
+        ))
     }
 
     /// Merges nodes of poor cell `t` that lie within [`MERGE_REACH`] of each other, with
@@ -526,6 +697,30 @@ impl Pass<'_> {
             self.star[v].clear();
             done.collapsed += 1;
         }
+    }
+
+    /// Makes [`Op::Pierce`].
+    pub(super) fn pierced(
+        &mut self,
+        b: u32,
+        flags: u8,
+        on_fault: u64,
+        kill: Vec<u32>,
+        kids: Vec<(u32, [u32; 4], f64, [u32; 4], f64)>,
+        done: &mut Improved,
+    ) {
+        self.st.flags[b as usize] |= flags;
+        self.st.on_fault[b as usize] |= on_fault;
+        for &d in &kill {
+            self.stamp_cell(d);
+            self.alive[d as usize] = false;
+        }
+        for (d, t1, q1, t2, q2) in kids {
+            self.stamp_cell(d);
+            self.place(Some(d), d, t1, q1);
+            self.place(None, d, t2, q2);
+        }
+        done.flipped += 1;
     }
 
     /// Makes [`Op::Replace`]: the cells of `ring` (of one label) become those of `new`, the
