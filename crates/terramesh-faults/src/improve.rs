@@ -1573,9 +1573,11 @@ impl Pass<'_> {
             Op::Flip23 { c, d, .. } => vec![*c, *d],
             Op::Flip32 { ring, .. } => ring.to_vec(),
             Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
-            Op::Pierce { kill, kids, .. } => {
-                kill.iter().copied().chain(kids.iter().map(|k| k.0)).collect()
-            }
+            Op::Pierce { kill, kids, .. } => kill
+                .iter()
+                .copied()
+                .chain(kids.iter().map(|k| k.0))
+                .collect(),
             Op::Move { cells, .. } => cells.clone(),
         }
     }

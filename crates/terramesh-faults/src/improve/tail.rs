@@ -988,4 +988,108 @@ mod tests {
         assert!(new > 40.0, "{old} -> {new}");
         assert!((after - volume).abs() <= 1e-12 * volume);
     }
+
+    /// A vertical fault x = 0 and a curved interface z = 0.05 (1 - y²) meet along a bent
+    /// line; the cut left three nodes on it, a = (0, -1, 0), c = (0, 1, 0) and b = (0, 0,
+    /// 0.05) between them, 5 cm off the chord a–c, and the edge (a, c) under the interface
+    /// with the four cells around it: the two holding b are slivers (4.05 degrees). No node
+    /// may move or be collapsed (all the DSM's, as a node on two surfaces may not move off
+    /// their line), the cells around (a, c) lie on two sides of the fault (no flip or edge
+    /// removal), and with a 60-degree floor no split of an edge does (its 8 halves would put
+    /// more cells below the floor than the 4 there): the pierce of (a, c) at b does (the
+    /// four cones from b, 53 degrees, on their sides of the fault and under the interface),
+    /// the edge gone, the volume kept, every operation verified.
+    #[test]
+    fn pierce_mends_three_nodes_along_a_fault_and_an_interface() {
+        let points: Vec<[f64; 3]> = vec![
+            [0.0, -1.0, 0.0],  // a = 0
+            [0.0, 1.0, 0.0],   // c = 1
+            [0.0, 0.0, 0.05],  // b = 2
+            [1.0, 0.0, 0.05],  // east, on the interface = 3
+            [-1.0, 0.0, 0.05], // west, on the interface = 4
+            [0.0, 0.0, -1.0],  // on the fault, under = 5
+            [0.0, 0.0, 1.0],   // on the fault, over = 6
+        ];
+        let (a, c, b, e, w, d, u) = (0, 1, 2, 3, 4, 5, 6);
+        // (cell, east of the fault, under the interface)
+        let cells: Vec<([u32; 4], u64, u32)> = vec![
+            ([a, c, b, e], 1, 1),
+            ([a, c, e, d], 1, 1),
+            ([a, c, d, w], 0, 1),
+            ([a, c, w, b], 0, 1),
+            ([a, b, e, u], 1, 0),
+            ([b, c, e, u], 1, 0),
+            ([a, b, u, w], 0, 0),
+            ([b, c, u, w], 0, 0),
+        ];
+        let mut tets: Vec<[u32; 4]> = cells.iter().map(|x| x.0).collect();
+        for t in &mut tets {
+            if !positive(t.map(|v| points[v as usize])) {
+                t.swap(0, 1);
+            }
+        }
+        let (old, volume) = measure(&points, &tets);
+        assert!(old < 5.0, "{old}");
+        let terrain = Terrain::new(
+            vec![[-10.0, -10.0], [10.0, -10.0], [10.0, 10.0], [-10.0, 10.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+            vec![10.0; 4],
+        )
+        .unwrap();
+        let spec = FaultSpec::trace("F", vec![[0.0, -100.0], [0.0, 100.0]], 90.0, 90.0);
+        let faults = FaultSet::new(&[spec], &terrain, -10.0).unwrap();
+        let side = |g: [[f64; 3]; 4]| {
+            let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+            u64::from(faults.faults[0].side(m).sign > 0)
+        };
+        // The east side is the fault's positive one.
+        assert_eq!(side([[1.0, 0.0, 0.0]; 4]), 1);
+        let n = points.len();
+        let m = tets.len();
+        let mut st = State {
+            points,
+            flags: vec![TOP; n],
+            on_fault: vec![0; n],
+            tets,
+            positive: cells.iter().map(|x| x.1).collect(),
+            below: cells.iter().map(|x| x.2).collect(),
+            block: vec![0; m],
+            zone: Vec::new(),
+            report: crate::mesh::BuildReport::default(),
+        };
+        for v in [a, c, b, d, u] {
+            st.on_fault[v as usize] = 1;
+        }
+        super::super::verify_each_operation(true);
+        let h = |_: usize, _: crate::BlockKey, p: [f64; 2]| 0.05 * (1.0 - p[1] * p[1]);
+        let blocks = [crate::BlockKey::default()];
+        let done = super::super::improve(
+            &mut st,
+            &faults,
+            &blocks,
+            &h,
+            1,
+            &terrain,
+            n,
+            60.0,
+            4,
+            &ObjectSet::default(),
+            &mut ObjectCells::default(),
+        );
+        assert!(done.flipped >= 1 && done.inserted == 0, "{done:?}");
+        assert!(
+            !st.tets.iter().any(|t| t.contains(&a) && t.contains(&c)),
+            "{:?}",
+            st.tets
+        );
+        let (new, after) = measure(&st.points, &st.tets);
+        assert!(new >= 50.0, "{old} -> {new}");
+        assert!(
+            (after - volume).abs() <= 1e-12 * volume,
+            "{volume} -> {after}"
+        );
+        for (t, &s) in st.tets.iter().zip(&st.positive) {
+            assert_eq!(side(t.map(|v| st.points[v as usize])), s, "{t:?}");
+        }
+    }
 }
