@@ -141,7 +141,7 @@ impl Pass<'_> {
                 let e = if ends[0] == b { ends[1] } else { ends[0] };
                 let all = [a, c, b, e];
                 if all.iter().any(|&v| self.st.flags[v as usize] & SIDE == 0)
-                    || !self.on_outline_edge(&all.map(pt))
+                    || !self.on_one_side(&all.map(pt))
                 {
                     return None;
                 }
@@ -697,6 +697,26 @@ impl Pass<'_> {
             self.star[v].clear();
             done.collapsed += 1;
         }
+    }
+
+    /// Whether the points lie on the outline and on the line of one of its edges (within
+    /// `tol`): on one side of the region, which may span several of the outline's edges
+    /// (the DSM's vertices along a straight side).
+    fn on_one_side(&self, q: &[[f64; 3]]) -> bool {
+        if !q.iter().all(|r| self.on_outline_edge(&[*r])) {
+            return false;
+        }
+        self.terrain.outline.iter().any(|&[i, j]| {
+            let (pa, pb) = (
+                self.terrain.points[i as usize],
+                self.terrain.points[j as usize],
+            );
+            let e = [pb[0] - pa[0], pb[1] - pa[1]];
+            let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
+            let off = |r: &[f64; 3]| ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
+            let s = ((q[0][0] - pa[0]) * e[0] + (q[0][1] - pa[1]) * e[1]) / (l * l);
+            (-1e-12..=1.0 + 1e-12).contains(&s) && q.iter().all(|r| off(r).abs() <= self.tol)
+        })
     }
 
     /// Makes [`Op::Pierce`].
