@@ -542,7 +542,7 @@ impl Pass<'_> {
         for v in t {
             let (cells, labels) = at(v);
             if let Some(op) = self.smooth(v, cells, labels) {
-                return (Some(op), 2);
+                return (Some(self.pierce_or(op, t, &stars)), 2);
             }
         }
         lap(2);
@@ -550,7 +550,7 @@ impl Pass<'_> {
             let (cells, labels) = at(v);
             self.optimise(v, cells, labels)
         }) {
-            return (Some(op), 3);
+            return (Some(self.pierce_or(op, t, &stars)), 3);
         }
         lap(3);
         // Last, a new node on one of its edges, longest first (in a heavy sweep on one of
