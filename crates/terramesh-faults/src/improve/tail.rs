@@ -28,6 +28,19 @@
 //! old one was below it, and every new cell lies in its unit and on its side of the objects'
 //! walls ([`Pass::in_unit`], [`Pass::in_objects`]).
 //!
+//! **An edge split at its ring node** ([`Pass::pierce`]): where two surfaces meet at a line
+//! (two faults, a fault and an interface, a fault or an interface and a side), the cut
+//! leaves nodes along the line a metre or so apart; a cell edge between two of them, a and
+//! c, passes beside a third, b, which no move may take off the line, and every cell holding
+//! the three is a sliver. Each cell around (a, c) not holding b becomes its two cones from b,
+//! labelled as their parent, and those holding b go: the edge split at a new node that is
+//! then collapsed into b, so positive cones tile the same region. The labels around the edge
+//! may differ (b lies on every surface between them within half of `check`'s tolerance, as
+//! a merged node must). On a side the edge's ring is open and the side's face (a, c, end)
+//! becomes two faces through b, all four nodes on one side. Tried after the edge removal,
+//! and in a tail sweep instead of a move that gains less than [`super::HEAVY_GAIN`]
+//! ([`Pass::pierce_or`]).
+//!
 //! **A fault node moved between two units** ([`Pass::fault_move`]): a node on one fault only
 //! whose two sides are in different units (the throw) may not move in
 //! [`Pass::slide_at`] (it moves a fault node only between cells of one unit); here it moves
