@@ -140,7 +140,8 @@ impl Pass<'_> {
     /// the edge's ring that do not hold `b`, which tile the same region when every one is
     /// positive (exact `orient3d`). If the edge lies on a side (its ring open), `a`, `c`,
     /// `b` and the ring's other end must lie on one edge of the outline (the side's face
-    /// (a, c, end) becomes (a, b, end) and (b, c, end)). The labels around the edge may
+    /// (a, c, end) becomes (a, b, end) and (b, c, end), the quadrilateral a, b, c, end
+    /// convex in the side's plane and the new faces vertical, [`side_flip`]). The labels around the edge may
     /// differ: `b` must then lie within half of `check`'s tolerance of every fault whose
     /// sides differ among them and of every interface between the units of one side and
     /// block there, as a merged node must (it takes those faults and the interface flag),
@@ -178,7 +179,8 @@ impl Pass<'_> {
                 let e = if ends[0] == b { ends[1] } else { ends[0] };
                 let all = [a, c, b, e];
                 if all.iter().any(|&v| self.st.flags[v as usize] & SIDE == 0)
-                    || !self.on_one_side(&all.map(pt))
+                    || !self.on_outline_edge(&all.map(pt))
+                    || !side_flip([pt(a), pt(c), pt(b), pt(e)])
                 {
                     return None;
                 }
@@ -736,26 +738,6 @@ impl Pass<'_> {
         }
     }
 
-    /// Whether the points lie on the outline and on the line of one of its edges (within
-    /// `tol`): on one side of the region, which may span several of the outline's edges
-    /// (the DSM's vertices along a straight side).
-    fn on_one_side(&self, q: &[[f64; 3]]) -> bool {
-        if !q.iter().all(|r| self.on_outline_edge(&[*r])) {
-            return false;
-        }
-        self.terrain.outline.iter().any(|&[i, j]| {
-            let (pa, pb) = (
-                self.terrain.points[i as usize],
-                self.terrain.points[j as usize],
-            );
-            let e = [pb[0] - pa[0], pb[1] - pa[1]];
-            let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
-            let off = |r: &[f64; 3]| ((r[0] - pa[0]) * e[1] - (r[1] - pa[1]) * e[0]) / l;
-            let s = ((q[0][0] - pa[0]) * e[0] + (q[0][1] - pa[1]) * e[1]) / (l * l);
-            (-1e-12..=1.0 + 1e-12).contains(&s) && q.iter().all(|r| off(r).abs() <= self.tol)
-        })
-    }
-
     /// Makes [`Op::Pierce`].
     pub(super) fn pierced(
         &mut self,
@@ -796,6 +778,37 @@ impl Pass<'_> {
         }
         done.flipped += 1;
     }
+}
+
+/// Whether the side's faces (a, c, b) and (a, c, e) (`q`: a, c, b, e, on one outline edge)
+/// may become (a, b, e) and (b, c, e): the quadrilateral a, b, c, e convex in the side's
+/// plane (exact `orient2d` along the side and up), so that the new faces cover the old two
+/// and face the same way, and each new face vertical as `check` tests a side's face.
+fn side_flip(q: [[f64; 3]; 4]) -> bool {
+    let [a, c, b, e] = q;
+    // Along the side: the horizontal direction from a to c (or to e, or b).
+    let d = [c, e, b]
+        .into_iter()
+        .map(|r| [r[0] - a[0], r[1] - a[1]])
+        .find(|d| d[0] != 0.0 || d[1] != 0.0);
+    let Some(d) = d else {
+        return false;
+    };
+    let p2 = |r: [f64; 3]| robust::Coord {
+        x: (r[0] - a[0]) * d[0] + (r[1] - a[1]) * d[1],
+        y: r[2],
+    };
+    let o = |x, y, z| robust::orient2d(p2(x), p2(y), p2(z));
+    let vertical = |f: [[f64; 3]; 3]| {
+        let u = [f[1][0] - f[0][0], f[1][1] - f[0][1]];
+        let w = [f[2][0] - f[0][0], f[2][1] - f[0][1]];
+        let nz = u[0] * w[1] - u[1] * w[0];
+        nz.abs() <= 1e-9 * (u[0] * u[0] + u[1] * u[1] + w[0] * w[0] + w[1] * w[1]).max(1e-300)
+    };
+    o(a, c, b) * o(a, c, e) < 0.0
+        && o(b, e, a) * o(b, e, c) < 0.0
+        && vertical([a, b, e])
+        && vertical([b, c, e])
 }
 
 /// The dihedral angle of tetrahedron `g` at its edge (i, j), degrees.
