@@ -248,6 +248,9 @@ type Label = (u64, u32, u32, u64, u32);
 /// tolerance of [`crate::check`], twice the half of it that every new cell is held to.
 const MERGE: f64 = crate::FAULT_TOLERANCE;
 
+/// A cell of a pierce ([`Op::Pierce`]) and its two cones, each with its smallest angle.
+type Kids = (u32, [u32; 4], f64, [u32; 4], f64);
+
 /// An operation the pass found for a poor cell, to be made by [`Pass::apply`].
 enum Op {
     /// Node `a` collapsed into `b`: the cells `kill` (those holding both) go, each cell of
@@ -305,7 +308,7 @@ enum Op {
         flags: u8,
         on_fault: u64,
         kill: Vec<u32>,
-        kids: Vec<(u32, [u32; 4], f64, [u32; 4], f64)>,
+        kids: Vec<Kids>,
     },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {

@@ -745,7 +745,7 @@ impl Pass<'_> {
         flags: u8,
         on_fault: u64,
         kill: Vec<u32>,
-        kids: Vec<(u32, [u32; 4], f64, [u32; 4], f64)>,
+        kids: Vec<super::Kids>,
         done: &mut Improved,
     ) {
         self.st.flags[b as usize] |= flags;
