@@ -248,6 +248,9 @@ type Label = (u64, u32, u32, u64, u32);
 /// tolerance of [`crate::check`], twice the half of it that every new cell is held to.
 const MERGE: f64 = crate::FAULT_TOLERANCE;
 
+/// A cell of a pierce ([`Op::Pierce`]) and its two cones, each with its smallest angle.
+type Kids = (u32, [u32; 4], f64, [u32; 4], f64);
+
 /// An operation the pass found for a poor cell, to be made by [`Pass::apply`].
 enum Op {
     /// Node `a` collapsed into `b`: the cells `kill` (those holding both) go, each cell of
@@ -295,6 +298,17 @@ enum Op {
     Replace {
         ring: Vec<u32>,
         new: Vec<([u32; 4], f64)>,
+    },
+    /// Edge (a, c) split at its ring node `b` (module `tail`): the cells `kill` (holding
+    /// a, c and b) go, each cell of `kids` becomes its two cones from `b` (the first in the
+    /// cell, the second a new cell labelled as it), with their smallest angles; `b` takes
+    /// the interface flag `flags` and the faults `on_fault`.
+    Pierce {
+        b: u32,
+        flags: u8,
+        on_fault: u64,
+        kill: Vec<u32>,
+        kids: Vec<Kids>,
     },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {
@@ -531,7 +545,7 @@ impl Pass<'_> {
         for v in t {
             let (cells, labels) = at(v);
             if let Some(op) = self.smooth(v, cells, labels) {
-                return (Some(op), 2);
+                return (Some(self.pierce_or(op, t, &stars)), 2);
             }
         }
         lap(2);
@@ -539,7 +553,7 @@ impl Pass<'_> {
             let (cells, labels) = at(v);
             self.optimise(v, cells, labels)
         }) {
-            return (Some(op), 3);
+            return (Some(self.pierce_or(op, t, &stars)), 3);
         }
         lap(3);
         // Last, a new node on one of its edges, longest first (in a heavy sweep on one of
@@ -637,6 +651,13 @@ impl Pass<'_> {
                 done.inserted += 1;
             }
             Op::Replace { ring, new } => self.replace(ring, new, done),
+            Op::Pierce {
+                b,
+                flags,
+                on_fault,
+                kill,
+                kids,
+            } => self.pierced(b, flags, on_fault, kill, kids, done),
             Op::Move {
                 v,
                 to,
@@ -1555,6 +1576,11 @@ impl Pass<'_> {
             Op::Flip23 { c, d, .. } => vec![*c, *d],
             Op::Flip32 { ring, .. } => ring.to_vec(),
             Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
+            Op::Pierce { kill, kids, .. } => kill
+                .iter()
+                .copied()
+                .chain(kids.iter().map(|k| k.0))
+                .collect(),
             Op::Move { cells, .. } => cells.clone(),
         }
     }
