@@ -743,6 +743,32 @@ impl Pass<'_> {
             .collect()
     }
 
+    /// The open ends of the ring `ring` of cells around edge (`a`, `b`): each node of the
+    /// ring other than `a` and `b` lies in two of its cells (the faces through the edge
+    /// inside the mesh) or, at the ends of a ring on the boundary, in one; those are
+    /// returned (none for a closed ring), after the ring's nodes sorted, each once per cell
+    /// that holds it. `None` if a node lies in more than two (not a ring).
+    fn ring_ends(&self, ring: &[u32], a: u32, b: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+        let mut third: Vec<u32> = ring
+            .iter()
+            .flat_map(|&c| self.st.tets[c as usize])
+            .filter(|&v| v != a && v != b)
+            .collect();
+        third.sort_unstable();
+        let mut ends = Vec::new();
+        let mut i = 0;
+        while i < third.len() {
+            let j = i + third[i..].iter().take_while(|&&v| v == third[i]).count();
+            match j - i {
+                1 => ends.push(third[i]),
+                2 => {}
+                _ => return None,
+            }
+            i = j;
+        }
+        Some((third, ends))
+    }
+
     /// The 3-2 flip of edge (a, b): the three cells around it become two on the face of
     /// their other nodes, if the ring is closed (an interior edge), the cells carry one
     /// label, `a` and `b` lie strictly on either side of that face (exact), both new cells
@@ -1373,23 +1399,7 @@ impl Pass<'_> {
         let labels = self.labels(&ring);
         // The faces of the ring through the edge: (a, b, x) is inside the mesh when two of
         // its cells hold x, on the boundary when one does.
-        let mut third: Vec<u32> = ring
-            .iter()
-            .flat_map(|&c| self.st.tets[c as usize])
-            .filter(|&v| v != a && v != b)
-            .collect();
-        third.sort_unstable();
-        let mut boundary = Vec::new();
-        let mut i = 0;
-        while i < third.len() {
-            let j = i + third[i..].iter().take_while(|&&v| v == third[i]).count();
-            match j - i {
-                1 => boundary.push(third[i]),
-                2 => {}
-                _ => return None,
-            }
-            i = j;
-        }
+        let (third, boundary) = self.ring_ends(&ring, a, b)?;
         let (pa, pb) = (self.st.points[a as usize], self.st.points[b as usize]);
         let m = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
         let (fa, fb) = (self.st.flags[a as usize], self.st.flags[b as usize]);

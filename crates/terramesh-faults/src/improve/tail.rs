@@ -154,23 +154,7 @@ impl Pass<'_> {
             return None;
         }
         // Each ring node is in two of the ring's cells (closed), or the two ends in one.
-        let mut third: Vec<u32> = ring
-            .iter()
-            .flat_map(|&d| self.st.tets[d as usize])
-            .filter(|&v| v != a && v != c)
-            .collect();
-        third.sort_unstable();
-        let mut ends = Vec::new();
-        let mut i = 0;
-        while i < third.len() {
-            let j = i + third[i..].iter().take_while(|&&v| v == third[i]).count();
-            match j - i {
-                1 => ends.push(third[i]),
-                2 => {}
-                _ => return None,
-            }
-            i = j;
-        }
+        let (_, ends) = self.ring_ends(&ring, a, c)?;
         let pt = |v: u32| self.st.points[v as usize];
         let kill = self.holding(&ring, b);
         match (ends.len(), kill.len()) {
