@@ -2056,7 +2056,9 @@ mod tests {
         tets
     }
 
-    fn summary(points: &[[f64; 3]], tets: &[[u32; 4]]) -> (f64, f64) {
+    /// The smallest dihedral angle and the volume of `tets`, every cell asserted positive
+    /// (also the tail's tests' measure).
+    pub(super) fn summary(points: &[[f64; 3]], tets: &[[u32; 4]]) -> (f64, f64) {
         let mut worst = f64::MAX;
         let mut volume = 0.0;
         for t in tets {

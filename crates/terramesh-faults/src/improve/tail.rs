@@ -826,22 +826,9 @@ fn edge_angle(g: [[f64; 3]; 4], i: usize, j: usize) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use crate::improve::tests::summary;
     use crate::mesh::{positive, State, BASE, SIDE, TOP};
-    use crate::quality::min_dihedral;
     use crate::{FaultSet, FaultSpec, ObjectCells, ObjectSet, Terrain, FAULT_TOLERANCE};
-    use terramesh_core::volume::tetra_volume;
-
-    /// The smallest dihedral angle and the volume of `tets`, every cell asserted positive.
-    fn measure(p: &[[f64; 3]], tets: &[[u32; 4]]) -> (f64, f64) {
-        let (mut worst, mut volume) = (f64::MAX, 0.0);
-        for t in tets {
-            let g = t.map(|v| p[v as usize]);
-            assert!(positive(g), "{t:?}");
-            worst = worst.min(min_dihedral(g));
-            volume += tetra_volume(g[0], g[1], g[2], g[3]).abs();
-        }
-        (worst, volume)
-    }
 
     /// A 2 x 2 x 1 m region under a flat terrain (z = 0, base z = -1), cut by a vertical fault
     /// x = 0, each half coned from its centre. A DSM vertex `d` lies on the terrain 2 mm
@@ -940,7 +927,7 @@ mod tests {
             .iter()
             .map(|t| side(t.map(|v| points[v as usize])))
             .collect();
-        let (old, volume) = measure(&points, &tets);
+        let (old, volume) = summary(&points, &tets);
         assert!(old < 0.5, "{old}");
         let m = tets.len();
         let mut st = State {
@@ -977,7 +964,7 @@ mod tests {
             st.points
         );
         assert!(st.points.contains(&[0.002, 0.0, 0.0]));
-        let (new, after) = measure(&st.points, &st.tets);
+        let (new, after) = summary(&st.points, &st.tets);
         assert!(new >= 5.0, "{old} -> {new}");
         assert!(
             (after - volume).abs() <= 1e-12 * volume,
@@ -1027,7 +1014,7 @@ mod tests {
                 t.swap(0, 1);
             }
         }
-        let (old, volume) = measure(&points, &tets);
+        let (old, volume) = summary(&points, &tets);
         assert!(old < 10.0, "{old}");
         super::super::verify_each_operation(true);
         let (st, done) = super::super::tests::pass_at(points, tets, vec![0; 4], 45.0);
@@ -1038,7 +1025,7 @@ mod tests {
             "{:?}",
             st.tets
         );
-        let (new, after) = measure(&st.points, &st.tets);
+        let (new, after) = summary(&st.points, &st.tets);
         assert!(new > 40.0, "{old} -> {new}");
         assert!((after - volume).abs() <= 1e-12 * volume);
     }
@@ -1082,7 +1069,7 @@ mod tests {
                 t.swap(0, 1);
             }
         }
-        let (old, volume) = measure(&points, &tets);
+        let (old, volume) = summary(&points, &tets);
         assert!(old < 5.0, "{old}");
         let terrain = Terrain::new(
             vec![[-10.0, -10.0], [10.0, -10.0], [10.0, 10.0], [-10.0, 10.0]],
@@ -1136,7 +1123,7 @@ mod tests {
             "{:?}",
             st.tets
         );
-        let (new, after) = measure(&st.points, &st.tets);
+        let (new, after) = summary(&st.points, &st.tets);
         assert!(new >= 50.0, "{old} -> {new}");
         assert!(
             (after - volume).abs() <= 1e-12 * volume,
