@@ -41,6 +41,7 @@ use crate::mesh::{
 use crate::quality::{min_dihedral, positive_min_dihedral};
 use crate::{BlockKey, FaultSet, ObjectCells, ObjectSet, Terrain, ON_SURFACE, ZONE_ON_WALL};
 
+mod cavity;
 mod tail;
 mod walls;
 
@@ -310,6 +311,14 @@ enum Op {
         kill: Vec<u32>,
         kids: Vec<Kids>,
     },
+    /// A new node at `at` inside the cavity `kill` (cells of one label, module `cavity`):
+    /// the cavity's cells replaced by the cones of `new` ([`NEW`] the new node), each with
+    /// its smallest angle.
+    Insert {
+        at: [f64; 3],
+        kill: Vec<u32>,
+        new: Vec<([u32; 4], f64)>,
+    },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {
         v: u32,
@@ -545,7 +554,7 @@ impl Pass<'_> {
         for v in t {
             let (cells, labels) = at(v);
             if let Some(op) = self.smooth(v, cells, labels) {
-                return (Some(self.pierce_or(op, t, &stars)), 2);
+                return (Some(self.pierce_or(op, c, &stars)), 2);
             }
         }
         lap(2);
@@ -553,7 +562,7 @@ impl Pass<'_> {
             let (cells, labels) = at(v);
             self.optimise(v, cells, labels)
         }) {
-            return (Some(self.pierce_or(op, t, &stars)), 3);
+            return (Some(self.pierce_or(op, c, &stars)), 3);
         }
         lap(3);
         // Last, a new node on one of its edges, longest first (in a heavy sweep on one of
@@ -651,6 +660,7 @@ impl Pass<'_> {
                 done.inserted += 1;
             }
             Op::Replace { ring, new } => self.replace(ring, new, done),
+            Op::Insert { at, kill, new } => self.inserted(at, kill, new, done),
             Op::Pierce {
                 b,
                 flags,
@@ -1586,6 +1596,7 @@ impl Pass<'_> {
             Op::Flip23 { c, d, .. } => vec![*c, *d],
             Op::Flip32 { ring, .. } => ring.to_vec(),
             Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
+            Op::Insert { kill, .. } => kill.clone(),
             Op::Pierce { kill, kids, .. } => kill
                 .iter()
                 .copied()

@@ -86,7 +86,9 @@ impl Pass<'_> {
         if let Some(op) = self.pierce_best(t, around) {
             return Some(op);
         }
-        (0..4).find_map(|i| self.fault_move(t[i], around[i]))
+        (0..4)
+            .find_map(|i| self.fault_move(t[i], around[i]))
+            .or_else(|| self.insert(c, around))
     }
 
     /// In a tail sweep, the best [`Pass::pierce`] of poor cell `t` instead of move `op` if
@@ -94,7 +96,8 @@ impl Pass<'_> {
     /// where surfaces meet gained some 1e-4 degrees per sweep from gradient moves of a node
     /// beside it (the 800 m bench's cell of 0.116 degrees against the south side, moved in
     /// every one of the 30 sweeps), so that the tail's operations were never tried.
-    pub(super) fn pierce_or(&self, op: Op, t: [u32; 4], around: &[&[u32]; 4]) -> Op {
+    pub(super) fn pierce_or(&self, op: Op, c: u32, around: &[&[u32]; 4]) -> Op {
+        let t = self.st.tets[c as usize];
         if self.heavy {
             return op;
         }
@@ -107,6 +110,15 @@ impl Pass<'_> {
             if new - old < super::HEAVY_GAIN {
                 if let Some(p) = self.pierce_best(t, around) {
                     return p;
+                }
+                // A new node in the cavity of the cell's label, if it gains more.
+                if let Some(p) = self.insert(c, around) {
+                    if let Op::Insert { new: cones, .. } = &p {
+                        let q = cones.iter().map(|x| x.1).fold(f64::MAX, f64::min);
+                        if q > new {
+                            return p;
+                        }
+                    }
                 }
             }
         }
