@@ -826,7 +826,11 @@ fn cut(
 /// value `value(w)`: signed distance, side) at every edge whose ends lie on opposite sides
 /// would make, each edge at its linear crossing and in [`split_tet`]'s order; the cell's own
 /// angle if no edge crosses. The snap guard's measure of what the split would make.
-fn split_min(t: [u32; 4], at: impl Fn(u32) -> [f64; 3], value: impl Fn(u32) -> (f64, i8)) -> f64 {
+pub(crate) fn split_min(
+    t: [u32; 4],
+    at: impl Fn(u32) -> [f64; 3],
+    value: impl Fn(u32) -> (f64, i8),
+) -> f64 {
     let mut keys = [0u64; 6];
     let mut n = 0;
     for &(i, j) in &EDGES {

@@ -2169,10 +2169,11 @@ fn refine_missed(
 
 /// Nodes within this fraction of their shortest edge of a tunnel's wall are moved onto it
 /// before the wall is cut ([`snap_to_wall`]).
-const SNAP_REACH: f64 = 0.45;
+const SNAP_REACH: f64 = 0.6;
 
 /// A node snapped onto a wall leaves no cell of its star with a smallest dihedral angle below
-/// the smaller of this (degrees) and the star's smallest before the move.
+/// the smaller of this (degrees) and the star's smallest before the move, unless the snapped
+/// star, cut, is no worse than the star cut without the snap ([`snap_to_wall`]).
 const SNAP_ANGLE: f64 = 8.0;
 
 /// Moves the free nodes near a tunnel's wall onto it before the wall is cut, so that the
@@ -2183,7 +2184,9 @@ const SNAP_ANGLE: f64 = 8.0;
 /// the region; every cell around it of one block, unit, fault side, zone and object label:
 /// so no surface cut before moves), stays on its side of every wall cut before (`cut`), and
 /// if every cell around it stays positive, no cell gets all four nodes on the wall, no cell
-/// falls below [`SNAP_ANGLE`] (or the star's smallest angle before, if lower), and a cell on
+/// falls below [`SNAP_ANGLE`] (or the star's smallest angle before, if lower; else the star
+/// after the snap, each cell split at its edges that still cross, must be no worse than the
+/// star split without it, `mesh::split_min`: stretched cells often start below the angle), and a cell on
 /// one side of the wall keeps the wall out of it by [`CROSSED_STRAY`] times the tolerance at
 /// its edges' midpoints, its faces' centroids and its centroid (the sag of its facets on the
 /// wall). Nodes are visited nearest the wall first, one at a time (the result does not depend
@@ -2382,8 +2385,46 @@ fn snap_to_wall(
                 break;
             }
         }
-        if !ok || after < before.min(angle) {
+        if !ok {
             continue;
+        }
+        if after < before.min(angle) {
+            // Or no worse than the cells that splitting the star's crossing edges would make
+            // (as isosurface stuffing and lattice cleaving decide, and the faults' and
+            // interfaces' cut in `mesh.rs`): stretched cells often start below the angle.
+            let value = |w: u32, snapped: bool| {
+                let w = w as usize;
+                if w == v && snapped {
+                    return (0.0, 0);
+                }
+                let x = if vals[w].is_finite() {
+                    vals[w]
+                } else {
+                    f(st.points[w])
+                };
+                if x.abs() <= ON_WALL {
+                    (0.0, 0)
+                } else {
+                    eval(x)
+                }
+            };
+            let snapped = cells
+                .iter()
+                .map(|&c| crate::mesh::split_min(st.tets[c as usize], at, |w| value(w, true)))
+                .fold(f64::MAX, f64::min);
+            let split = cells
+                .iter()
+                .map(|&c| {
+                    crate::mesh::split_min(
+                        st.tets[c as usize],
+                        |w| st.points[w as usize],
+                        |w| value(w, false),
+                    )
+                })
+                .fold(f64::MAX, f64::min);
+            if snapped < split {
+                continue;
+            }
         }
         st.points[v] = p;
         vals[v] = 0.0;
@@ -2507,7 +2548,9 @@ pub(crate) fn cut_objects(
         let mut values = values;
         values.resize(st.points.len() + keys.len(), (0.0, 0));
         let first = st.points.len();
-        split_edges(st, &mut labels, &keys, pts, None);
+        // Each cell's crossing edges are split longest first (Euclidean), so that a cell cut
+        // into a tetrahedron and a prism, or two prisms, takes the shorter diagonals.
+        split_edges(st, &mut labels, &keys, pts, Some(&Metric::new(set, 1.0)));
         // Where a node moved onto a curved interface or fault inverts a cell, it goes back
         // to the chord (`positive` is exact and, as the writers compute volumes, in floating
         // point too).
