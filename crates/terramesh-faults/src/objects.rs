@@ -1950,6 +1950,14 @@ pub(crate) fn refine_near_objects(
                     if v.iter().all(|x| x.abs() >= wide) {
                         continue;
                     }
+                    // Only a cell that the wall crosses (nodes on both sides, or on it) or
+                    // reaches into deeper than the tolerance holds facets of it: refining any
+                    // other cell near the wall makes no facet closer to it (its children are
+                    // not crossed either), and that band made most of this refinement's cells.
+                    let crossed = v.iter().any(|x| *x < ON_WALL) && v.iter().any(|x| *x > -ON_WALL);
+                    if !crossed && o.reach_into(wall, &q, v, tol) <= tol {
+                        continue;
+                    }
                     let mut best: Option<(usize, usize)> = None;
                     for &(a, b) in &EDGES {
                         if len((a, b)) <= 4.0 * tol {
