@@ -7,8 +7,9 @@
 //! by exact ray parity, `robust::orient2d`/`orient3d` with a symbolic perturbation).
 //!
 //! Before the faults and the interfaces are cut, the background mesh is refined near every
-//! object (the longest edge of every cell near a boundary is bisected, conformally, round
-//! after round, until no such edge is longer than `resolution` times the object's size), and
+//! object (every cell that a wall crosses or reaches into, where its facets would stray from
+//! the wall by more than `resolution` times the object's size, is bisected, conformally,
+//! round after round; the cells near a wall that it does not cross are left), and
 //! then wherever a wall crosses or reaches into a cell that this refinement's cap left coarse
 //! (no midpoint of a bisected edge then lies off a curved surface already cut). After the
 //! faults, the interfaces and the zones, every object's field cuts the mesh as a fault's does: every edge that crosses the boundary
