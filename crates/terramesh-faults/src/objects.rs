@@ -7,8 +7,9 @@
 //! by exact ray parity, `robust::orient2d`/`orient3d` with a symbolic perturbation).
 //!
 //! Before the faults and the interfaces are cut, the background mesh is refined near every
-//! object (the longest edge of every cell near a boundary is bisected, conformally, round
-//! after round, until no such edge is longer than `resolution` times the object's size), and
+//! object (every cell that a wall crosses or reaches into, where its facets would stray from
+//! the wall by more than `resolution` times the object's size, is bisected, conformally,
+//! round after round; the cells near a wall that it does not cross are left), and
 //! then wherever a wall crosses or reaches into a cell that this refinement's cap left coarse
 //! (no midpoint of a bisected edge then lies off a curved surface already cut). After the
 //! faults, the interfaces and the zones, every object's field cuts the mesh as a fault's does: every edge that crosses the boundary
@@ -1912,17 +1913,31 @@ pub(crate) fn refine_near_objects(
     // longest edge is longer than the object's target.
     for _round in 0..40 {
         rounds += 1;
+        // Each wall's field, read only at the nodes of the cells that reach its object's box
+        // (no other cell can be crossed or reached by it: infinite elsewhere).
         let values: Vec<Vec<f64>> = walls
             .iter()
             .map(|&(i, w)| {
                 let o = &set.objects[i];
-                st.points.par_iter().map(|&q| o.field(w, q)).collect()
+                let near = near_box(st, o, 1e-3 + 1e-6 * set.resolution * o.size);
+                st.points
+                    .par_iter()
+                    .zip(&near)
+                    .map(|(&q, &near)| if near { o.field(w, q) } else { f64::INFINITY })
+                    .collect()
             })
             .collect();
         let mut keys: Vec<u64> = st
             .tets
             .par_iter()
             .filter_map(|t| {
+                // A cell out of every object's box is left (without measuring it: most are).
+                if !values
+                    .iter()
+                    .any(|v| t.iter().all(|&n| v[n as usize].is_finite()))
+                {
+                    return None;
+                }
                 let q = t.map(|n| st.points[n as usize]);
                 let len = |(i, j): (usize, usize)| norm(sub(q[i], q[j]));
                 let mlen = |(i, j): (usize, usize)| metric.len(q[i], q[j]);
@@ -1942,6 +1957,9 @@ pub(crate) fn refine_near_objects(
                         continue;
                     }
                     let v = t.map(|n| values[w][n as usize]);
+                    if v.iter().any(|x| !x.is_finite()) {
+                        continue;
+                    }
                     // Out of reach: every node farther from the wall than the cell is wide
                     // (across a tunnel's axis, in the metric: its barrel's field does not
                     // change along it; a wider reach refined a band as thick as the
@@ -1967,6 +1985,15 @@ pub(crate) fn refine_near_objects(
                         if (o.field(wall, c) - 0.25 * v.iter().sum::<f64>()).abs() > tol {
                             best = Some((0, 0));
                         }
+                    }
+                    // Only a cell that the wall crosses (nodes on both sides, or on it) or
+                    // reaches into deeper than the tolerance holds facets of it: refining any
+                    // other cell near the wall makes no facet closer to it (its children are
+                    // not crossed either), and that band made most of this refinement's cells.
+                    // (Tested last: the test of a cell the wall may reach is the costliest.)
+                    let crossed = v.iter().any(|x| *x < ON_WALL) && v.iter().any(|x| *x > -ON_WALL);
+                    if best.is_some() && !crossed && o.reach_into(wall, &q, v, tol) <= tol {
+                        best = None;
                     }
                     if let Some(e) = best {
                         if pick.is_none_or(|p| mlen(e) > mlen(p)) {
@@ -2036,6 +2063,31 @@ pub(crate) fn refine_near_objects(
     Ok(labels)
 }
 
+/// Whether each node belongs to a cell that reaches the object's bounding box grown by
+/// `margin` (a cell across the box's boundary may be crossed by the wall, however far its
+/// other nodes lie outside it).
+fn near_box(st: &State, o: &Object, margin: f64) -> Vec<bool> {
+    let [lo, hi] = o.bbox;
+    let reach: Vec<u32> = st
+        .tets
+        .par_iter()
+        .filter(|t| {
+            (0..3).all(|k| {
+                t.iter()
+                    .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
+                    && t.iter()
+                        .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
+            })
+        })
+        .flat_map_iter(|t| t.iter().copied())
+        .collect();
+    let mut near = vec![false; st.points.len()];
+    for n in reach {
+        near[n as usize] = true;
+    }
+    near
+}
+
 /// The cells a wall crosses (nodes on both sides) are refined before the cut where their
 /// facets would stray from it by more than this times the refinement's tolerance (half the
 /// checks' tolerance); so are the cells whose nodes do not straddle it where it may reach into
@@ -2072,7 +2124,6 @@ fn refine_missed(
     let flagged = [AtomicUsize::new(0), AtomicUsize::new(0)];
     let mut rounds = 0;
     let f = |q: [f64; 3]| o.field(w, q);
-    let [lo, hi] = o.bbox;
     // The field's magnitude is at most this times the distance to the wall.
     let lip = match o.kind {
         "excavation" => crossing::EXCAVATION_LIPSCHITZ,
@@ -2087,24 +2138,7 @@ fn refine_missed(
         // the box skipped such cells where they were wider than that: a box's edge through
         // cells left coarse by the cap was cut as a chamfer, and a cell inside the box was
         // labelled outside.)
-        let margin = 1e-3 + 1e-6 * tol;
-        let reach: Vec<u32> = st
-            .tets
-            .par_iter()
-            .filter(|t| {
-                (0..3).all(|k| {
-                    t.iter()
-                        .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
-                        && t.iter()
-                            .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
-                })
-            })
-            .flat_map_iter(|t| t.iter().copied())
-            .collect();
-        let mut near = vec![false; st.points.len()];
-        for n in reach {
-            near[n as usize] = true;
-        }
+        let near = near_box(st, o, 1e-3 + 1e-6 * tol);
         let values: Vec<f64> = st
             .points
             .par_iter()
