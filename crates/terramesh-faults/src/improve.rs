@@ -405,6 +405,22 @@ fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 impl Pass<'_> {
+    /// The smallest dihedral angle of `cells` (`f64::MAX` for none).
+    fn worst(&self, cells: &[u32]) -> f64 {
+        cells
+            .iter()
+            .map(|&c| self.angle[c as usize])
+            .fold(f64::MAX, f64::min)
+    }
+
+    /// How many of `cells` are below the floor.
+    fn poor(&self, cells: &[u32]) -> usize {
+        cells
+            .iter()
+            .filter(|&&c| self.angle[c as usize] < self.floor)
+            .count()
+    }
+
     fn cells(&self, v: u32) -> Vec<u32> {
         // A cell enters a node's list once: when it is made, or when the node replaces one
         // of its nodes (it did not hold the node before).
@@ -675,10 +691,7 @@ impl Pass<'_> {
                 angles,
             } => {
                 self.st.points[v as usize] = to;
-                let old = cells
-                    .iter()
-                    .map(|&c| self.angle[c as usize])
-                    .fold(f64::MAX, f64::min);
+                let old = self.worst(&cells);
                 let new = angles.iter().copied().fold(f64::MAX, f64::min);
                 let loud = !self.heavy || new - old >= least_gain(true, old);
                 for (&c, a) in cells.iter().zip(angles) {
@@ -806,10 +819,7 @@ impl Pass<'_> {
         if sa == 0.0 || sb == 0.0 || (sa > 0.0) == (sb > 0.0) {
             return None;
         }
-        let old = ring
-            .iter()
-            .map(|&c| self.angle[c as usize])
-            .fold(f64::MAX, f64::min);
+        let old = self.worst(&ring);
         let mut new = Vec::with_capacity(2);
         for apex in [a, b] {
             let mut n = [o[0], o[1], o[2], apex];
@@ -825,10 +835,7 @@ impl Pass<'_> {
             }
             new.push((n, q));
         }
-        let poor = ring
-            .iter()
-            .filter(|&&c| self.angle[c as usize] < self.floor)
-            .count();
+        let poor = self.poor(&ring);
         if poor < 3 && new.iter().filter(|n| n.1 < self.floor).count() > poor {
             return None;
         }
@@ -936,10 +943,7 @@ impl Pass<'_> {
             return None;
         }
         let walled = la.iter().any(|l| l.3 != la[0].3);
-        let old = ca
-            .iter()
-            .map(|&c| self.angle[c as usize])
-            .fold(f64::MAX, f64::min);
+        let old = self.worst(ca);
         // Positive volumes first (cheap, and most refusals), then the angles.
         let mut new = Vec::with_capacity(ca.len());
         for &c in ca {
@@ -1332,10 +1336,7 @@ impl Pass<'_> {
                 *m += x / nb.len() as f64;
             }
         }
-        let old = cells
-            .iter()
-            .map(|&c| self.angle[c as usize])
-            .fold(f64::MAX, f64::min);
+        let old = self.worst(cells);
         let walled = labels.iter().any(|l| l.3 != labels[0].3);
         for s in [1.0, 0.5, 0.25] {
             let to = [0, 1, 2].map(|k| p[k] + s * (mean[k] - p[k]));
@@ -1472,14 +1473,8 @@ impl Pass<'_> {
                 )
             })
             .collect();
-        let old = ring
-            .iter()
-            .map(|&c| self.angle[c as usize])
-            .fold(f64::MAX, f64::min);
-        let poor = ring
-            .iter()
-            .filter(|&&c| self.angle[c as usize] < self.floor)
-            .count();
+        let old = self.worst(&ring);
+        let poor = self.poor(&ring);
         let geo = |t: [u32; 4], q: [f64; 3]| {
             t.map(|w| {
                 if w == NEW {

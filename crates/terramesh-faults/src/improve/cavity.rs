@@ -122,14 +122,8 @@ impl Pass<'_> {
                 u
             })
             .collect();
-        let old = cavity
-            .iter()
-            .map(|&d| self.angle[d as usize])
-            .fold(f64::MAX, f64::min);
-        let poor = cavity
-            .iter()
-            .filter(|&&d| self.angle[d as usize] < self.floor)
-            .count();
+        let old = self.worst(&cavity);
+        let poor = self.poor(&cavity);
         let eval = |p: [f64; 3], above: f64, most: usize| {
             let (mut worst, mut n) = (f64::MAX, 0usize);
             for &u in &cones {

@@ -102,10 +102,7 @@ impl Pass<'_> {
             return op;
         }
         if let Op::Move { cells, angles, .. } = &op {
-            let old = cells
-                .iter()
-                .map(|&c| self.angle[c as usize])
-                .fold(f64::MAX, f64::min);
+            let old = self.worst(cells);
             let new = angles.iter().copied().fold(f64::MAX, f64::min);
             if new - old < super::HEAVY_GAIN {
                 if let Some(p) = self.pierce_best(t, around) {
@@ -210,10 +207,7 @@ impl Pass<'_> {
                 interface = true;
             }
         }
-        let old = ring
-            .iter()
-            .map(|&d| self.angle[d as usize])
-            .fold(f64::MAX, f64::min);
+        let old = self.worst(&ring);
         let mut kids = Vec::with_capacity(ring.len());
         let mut worst = f64::MAX;
         for &d in ring.iter().filter(|d| !kill.contains(d)) {
@@ -397,10 +391,7 @@ impl Pass<'_> {
                 .copied()
                 .filter(|&c| self.st.tets[c as usize].into_iter().any(moved))
                 .collect();
-            let old = changed
-                .iter()
-                .map(|&c| self.angle[c as usize])
-                .fold(f64::MAX, f64::min);
+            let old = self.worst(&changed);
             let (mut kill, mut new) = (Vec::new(), Vec::new());
             let mut worst = f64::MAX;
             let ok = changed.iter().all(|&c| {
@@ -524,14 +515,8 @@ impl Pass<'_> {
             }
             Some((worst, n))
         };
-        let old = cells
-            .iter()
-            .map(|&c| self.angle[c as usize])
-            .fold(f64::MAX, f64::min);
-        let poor = cells
-            .iter()
-            .filter(|&&c| self.angle[c as usize] < self.floor)
-            .count();
+        let old = self.worst(cells);
+        let poor = self.poor(cells);
         let mut len = f64::MAX;
         for &c in cells {
             for w in self.st.tets[c as usize] {
@@ -668,10 +653,7 @@ impl Pass<'_> {
                 best[i * n + k] = b;
             }
         }
-        let old = ring
-            .iter()
-            .map(|&d| self.angle[d as usize])
-            .fold(f64::MAX, f64::min);
+        let old = self.worst(&ring);
         if best[n - 1] <= old.max(0.0) {
             return None;
         }
@@ -697,10 +679,7 @@ impl Pass<'_> {
                 new.push((t, positive_min_dihedral(g)));
             }
         }
-        let poor = ring
-            .iter()
-            .filter(|&&d| self.angle[d as usize] < self.floor)
-            .count();
+        let poor = self.poor(&ring);
         if poor < n && new.iter().filter(|x| x.1 < self.floor).count() > poor {
             return None;
         }
