@@ -389,6 +389,46 @@ const COMPASS: [[f64; 3]; 14] = {
     ]
 };
 
+/// A compass search from `start`, whose worst angle is `best` with `count` cells below the
+/// floor: the best of the 14 [`COMPASS`] directions at a step `h` (each trial point mapped by
+/// `onto`, which may refuse it, then scored by `eval(point, worst to beat, most below the
+/// floor)`), the step halved when none is better (the smallest angle is not smooth where two
+/// cells tie for the worst), for at most `steps` rounds or until `h` is below 1e-3 of `len`.
+/// Returns the best point found with its worst angle and count. Shared by the split, the
+/// fault move of the tail and the cavity insertion.
+#[allow(clippy::too_many_arguments)]
+fn compass_search(
+    start: [f64; 3],
+    (mut best, mut count): (f64, usize),
+    poor: usize,
+    mut h: f64,
+    len: f64,
+    steps: usize,
+    onto: impl Fn([f64; 3]) -> Option<[f64; 3]>,
+    eval: impl Fn([f64; 3], f64, usize) -> Option<(f64, usize)>,
+) -> (f64, usize, [f64; 3]) {
+    let mut q = start;
+    for _ in 0..steps {
+        if h < 1e-3 * len {
+            break;
+        }
+        let mut step: Option<(f64, usize, [f64; 3])> = None;
+        for d in COMPASS {
+            let Some(r) = onto([0, 1, 2].map(|k| q[k] + h * d[k])) else {
+                continue;
+            };
+            if let Some((x, n)) = eval(r, step.map_or(best, |s| s.0), poor.max(count)) {
+                step = Some((x, n, r));
+            }
+        }
+        match step {
+            Some(s) => (best, count, q) = s,
+            None => h *= 0.5,
+        }
+    }
+    (best, count, q)
+}
+
 /// The new node of a planned split, in the cells it makes (its index is known when it is made).
 const NEW: u32 = u32::MAX;
 
@@ -1530,32 +1570,22 @@ impl Pass<'_> {
         // A compass search: the best of 14 directions at a step that halves when none is
         // better (the smallest angle is not smooth where two cells tie for the worst).
         let len = d2(pa, pb).sqrt();
-        let mut h = 0.25 * len;
         if self.slide_at(flags, m, &labels, m).is_some() {
             let steps = if self.heavy {
                 HEAVY_COMPASS_STEPS
             } else {
                 COMPASS_STEPS
             };
-            for _ in 0..steps {
-                if h < 1e-3 * len {
-                    break;
-                }
-                let mut step: Option<(f64, usize, [f64; 3])> = None;
-                for d in COMPASS {
-                    let to = [0, 1, 2].map(|k| q[k] + h * d[k]);
-                    let Some(r) = self.slide_at(flags, m, &labels, to) else {
-                        continue;
-                    };
-                    if let Some((x, k)) = eval(r, step.map_or(best, |s| s.0), poor.max(count)) {
-                        step = Some((x, k, r));
-                    }
-                }
-                match step {
-                    Some(s) => (best, count, q) = s,
-                    None => h *= 0.5,
-                }
-            }
+            (best, count, q) = compass_search(
+                q,
+                (best, count),
+                poor,
+                0.25 * len,
+                len,
+                steps,
+                |to| self.slide_at(flags, m, &labels, to),
+                eval,
+            );
         }
         if best < old + MIN_GAIN || count > poor {
             return None;

@@ -20,7 +20,7 @@
 //! the floor, in its unit (`check`'s rule at half its tolerance), on its recorded side of
 //! every fault (its centroid) and of the objects' walls.
 
-use super::{Op, Pass, COMPASS, COMPASS_STEPS, MIN_GAIN, NEW};
+use super::{compass_search, Op, Pass, COMPASS_STEPS, MIN_GAIN, NEW};
 use crate::mesh::positive;
 use crate::quality::positive_min_dihedral;
 
@@ -136,34 +136,18 @@ impl Pass<'_> {
             }
             Some((worst, n))
         };
-        let (mut best, mut count) = eval(p0, 0.0, usize::MAX)?;
-        let mut p = p0;
+        let start = eval(p0, 0.0, usize::MAX)?;
         // A compass search, as a split's, from a step of a quarter of the cavity's cell's
         // shortest edge to the cell.
         let g = self.geo(self.st.tets[c as usize]);
-        let mut h = 0.25
+        let h = 0.25
             * crate::mesh::EDGES
                 .iter()
                 .map(|&(i, j)| super::d2(g[i], g[j]).sqrt())
                 .fold(f64::MAX, f64::min)
                 .max(1e-3);
-        let len = h * 4.0;
-        for _ in 0..COMPASS_STEPS {
-            if h < 1e-3 * len {
-                break;
-            }
-            let mut step: Option<(f64, usize, [f64; 3])> = None;
-            for d in COMPASS {
-                let r = [0, 1, 2].map(|k| p[k] + h * d[k]);
-                if let Some((x, n)) = eval(r, step.map_or(best, |s| s.0), poor.max(count)) {
-                    step = Some((x, n, r));
-                }
-            }
-            match step {
-                Some(s) => (best, count, p) = s,
-                None => h *= 0.5,
-            }
-        }
+        let (best, count, p) =
+            compass_search(p0, start, poor, h, h * 4.0, COMPASS_STEPS, Some, eval);
         if best < old + MIN_GAIN || (count > poor && best < old + INSERT_GAIN) {
             return None;
         }

@@ -525,26 +525,18 @@ impl Pass<'_> {
                 }
             }
         }
-        let (mut best, mut q) = (old, p);
-        let mut h = 0.25 * len;
-        for _ in 0..24 {
-            if h < 1e-3 * len {
-                break;
-            }
-            let mut step: Option<(f64, [f64; 3])> = None;
-            for d in super::COMPASS {
-                let Some(r) = onto([0, 1, 2].map(|k| q[k] + h * d[k])) else {
-                    continue;
-                };
-                if let Some((a, _)) = eval(r, step.map_or(best, |s| s.0), poor) {
-                    step = Some((a, r));
-                }
-            }
-            match step {
-                Some(s) => (best, q) = s,
-                None => h *= 0.5,
-            }
-        }
+        // Every point `eval` accepts has at most `poor` cells below the floor, so the search's
+        // bound stays `poor` (the count starts there).
+        let (best, _, q) = super::compass_search(
+            p,
+            (old, poor),
+            poor,
+            0.25 * len,
+            len,
+            super::COMPASS_STEPS,
+            onto,
+            eval,
+        );
         if best < old + super::MIN_GAIN
             || !cells.iter().all(|&c| {
                 let g = geo(c, q);
