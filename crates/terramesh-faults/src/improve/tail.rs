@@ -57,6 +57,13 @@ use robust::orient3d;
 /// terrain or a side), make slivers of every cell around them.
 pub(super) const MERGE_REACH: f64 = 0.05;
 
+/// The longest edge whose two nodes alone a merge joins, where no group within
+/// [`MERGE_REACH`] merges (metres).
+pub(super) const LINE_REACH: f64 = 0.25;
+
+/// The most nodes a merge beyond [`MERGE_REACH`] joins.
+const LINE_GROUP: usize = 4;
+
 /// The largest ring an edge removal replaces (its dynamic programme costs n³ / 6 triangles).
 pub(super) const RING_MAX: usize = 7;
 
@@ -306,6 +313,37 @@ impl Pass<'_> {
                 .find_map(|n| self.merge(&group[..n]))
             {
                 return Some(op);
+            }
+        }
+        // A short edge on a line where surfaces meet, beyond the reach (two events on one
+        // line cut separately, 10 to 25 cm apart): its nodes with the nearest few of those
+        // within [`LINE_REACH`] of them (the node where a third surface crosses the line).
+        let reach = |a: u32, b: u32| super::d2(pt(a), pt(b)) <= LINE_REACH * LINE_REACH;
+        let mut long: Vec<(f64, usize, usize)> = crate::mesh::EDGES
+            .iter()
+            .filter(|&&(i, j)| !near(t[i], t[j]) && reach(t[i], t[j]))
+            .map(|&(i, j)| (super::d2(pt(t[i]), pt(t[j])), i, j))
+            .collect();
+        long.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for &(_, i, j) in &long {
+            let mut group = vec![t[i], t[j]];
+            for k in [i, j] {
+                for &c in around[k] {
+                    for w in self.st.tets[c as usize] {
+                        if !group.contains(&w) && (reach(t[i], w) || reach(t[j], w)) {
+                            group.push(w);
+                        }
+                    }
+                }
+            }
+            let from = |w: u32| super::d2(pt(w), pt(t[i])).min(super::d2(pt(w), pt(t[j])));
+            group[2..].sort_by(|&x, &y| from(x).total_cmp(&from(y)));
+            group.truncate(LINE_GROUP);
+            let r = (2..=group.len())
+                .rev()
+                .find_map(|n| self.merge(&group[..n]));
+            if r.is_some() {
+                return r;
             }
         }
         None
