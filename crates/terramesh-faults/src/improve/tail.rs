@@ -863,6 +863,19 @@ mod tests {
     /// stays on its side of the fault, the volume is kept, every operation verified.
     #[test]
     fn merge_mends_a_dsm_vertex_beside_a_fault_trace() {
+        merge_beside_a_fault_trace([0.002, 0.0, 0.0]);
+    }
+
+    /// The same with the DSM vertex 12 cm along the trace from the cut's node and 3 mm
+    /// beside it (two events on one line cut separately: the 800 m site's colluvium base
+    /// crossing the line where F1 and F3 meet 11 cm from a node on both): beyond
+    /// [`MERGE_REACH`], the merge within [`LINE_REACH`] joins them.
+    #[test]
+    fn merge_mends_a_dsm_vertex_along_a_fault_trace() {
+        merge_beside_a_fault_trace([0.003, 0.12, 0.0]);
+    }
+
+    fn merge_beside_a_fault_trace(dv: [f64; 3]) {
         let top = [
             [-1.0, -1.0],
             [0.0, -1.0],
@@ -872,7 +885,7 @@ mod tests {
             [1.0, 1.0],
         ];
         let mut points: Vec<[f64; 3]> = top.iter().map(|p| [p[0], p[1], 0.0]).collect();
-        points.push([0.002, 0.0, 0.0]); // d = 6
+        points.push(dv); // d = 6
         points.extend(top.iter().map(|p| [p[0], p[1], -1.0])); // 7..=12
         points.push([0.0, 0.0, -1.0]); // g = 13
         points.push([-0.5, 0.0, -0.5]); // left centre = 14
@@ -984,7 +997,7 @@ mod tests {
             "{:?}",
             st.points
         );
-        assert!(st.points.contains(&[0.002, 0.0, 0.0]));
+        assert!(st.points.contains(&dv));
         let (new, after) = summary(&st.points, &st.tets);
         assert!(new >= 5.0, "{old} -> {new}");
         assert!(
