@@ -12,7 +12,10 @@
 //! mends them: each would leave a flat cell on a third node of the group, or needs every
 //! label of one node around the other. The merge joins the whole group at once, at one of
 //! its nodes (or, inside the model, at its centroid) that lies within half of `check`'s
-//! tolerance of every surface between the labels around the group.
+//! tolerance of every surface between the labels around the group. Where no group within
+//! [`MERGE_REACH`] merges, a poor cell's edge of up to [`LINE_REACH`] is tried with the few
+//! nodes within that reach of it: two events on one line cut separately (the node where a
+//! third surface crosses a line where two meet, 10 to 25 cm from a node on the line).
 //!
 //! **Edge removal** (the n-to-2n−4 flip, Shewchuk's "edge removal"): the n cells (4 to
 //! [`RING_MAX`]) around an interior edge (a, b) of a poor cell, all of one label, are
