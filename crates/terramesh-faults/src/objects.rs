@@ -2098,6 +2098,57 @@ impl FieldCache {
     }
 }
 
+#[cfg(test)]
+mod field_cache_tests {
+    use super::FieldCache;
+    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+
+    /// Over rounds that add nodes and change which are near, the cache gives what reading the
+    /// field at every near node each round gives (infinite elsewhere), reading each node once.
+    #[test]
+    fn a_cached_field_is_the_field_read_each_round() {
+        let reads = AtomicUsize::new(0);
+        let f = |q: [f64; 3]| {
+            reads.fetch_add(1, Relaxed);
+            q[0] * q[0] + q[1] - 3.0 * q[2]
+        };
+        let mut cache = FieldCache::default();
+        let mut points: Vec<[f64; 3]> = Vec::new();
+        let mut expected_reads = 0;
+        let mut read_before = vec![false; 40];
+        for round in 0..4 {
+            points.extend((0..10).map(|i| {
+                let x = (round * 10 + i) as f64;
+                [x * 0.5, -x, x * x * 0.01]
+            }));
+            let near: Vec<bool> = (0..points.len()).map(|i| (i + round) % 3 != 0).collect();
+            for (i, &n) in near.iter().enumerate() {
+                if n && !read_before[i] {
+                    read_before[i] = true;
+                    expected_reads += 1;
+                }
+            }
+            let got = cache.values(&points, &near, f);
+            let want: Vec<f64> = points
+                .iter()
+                .zip(&near)
+                .map(|(&q, &n)| {
+                    if n {
+                        q[0] * q[0] + q[1] - 3.0 * q[2]
+                    } else {
+                        f64::INFINITY
+                    }
+                })
+                .collect();
+            assert_eq!(got.len(), want.len());
+            for (a, b) in got.iter().zip(&want) {
+                assert_eq!(a.to_bits(), b.to_bits());
+            }
+            assert_eq!(reads.load(Relaxed), expected_reads, "round {round}");
+        }
+    }
+}
+
 /// Whether each node belongs to a cell that reaches the object's bounding box grown by
 /// `margin` (a cell across the box's boundary may be crossed by the wall, however far its
 /// other nodes lie outside it).

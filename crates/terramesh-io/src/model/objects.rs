@@ -571,3 +571,82 @@ fn face_key(m: &VolumeMesh, canon: &[u32], c: usize, f: usize) -> [u32; 4] {
     k.sort_unstable();
     k
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use terramesh_core::volume::Cell;
+
+    /// Three unit cubes in a row along x (six tetrahedra each, Kuhn), a point of the last
+    /// one copied (as split fault nodes are) into one of its cells; the objects in cells of
+    /// the first cube. The boundaries from every face sorted once ([`all_sides`], as
+    /// `write_object_model` finds them) are those of [`object_boundaries`] (the faces near
+    /// the objects only), and nonempty.
+    #[test]
+    fn boundaries_from_all_faces_are_those_from_the_faces_near_the_objects() {
+        let mut points: Vec<[f64; 3]> = Vec::new();
+        for x in 0..4 {
+            for i in 0..4 {
+                points.push([x as f64, (i & 1) as f64, ((i >> 1) & 1) as f64]);
+            }
+        }
+        // corner (dx, dy, dz) of cube x
+        let id = |x: u32, d: u32| (x + (d & 1)) * 4 + ((d >> 1) & 1) + ((d >> 2) & 1) * 2;
+        let kuhn = [
+            [0, 1, 3, 7],
+            [0, 1, 5, 7],
+            [0, 2, 3, 7],
+            [0, 2, 6, 7],
+            [0, 4, 5, 7],
+            [0, 4, 6, 7],
+        ];
+        let mut cells = Vec::new();
+        for x in 0..3 {
+            for t in kuhn {
+                cells.push(Cell::tetra(t.map(|d| id(x, d))));
+            }
+        }
+        // a split copy of the last cube's far corner, used by its last cell
+        points.push(points[id(2, 7) as usize]);
+        let copy = points.len() as u32 - 1;
+        let last = cells.len() - 1;
+        cells[last] = Cell::tetra(kuhn[5].map(|d| if d == 7 { copy } else { id(2, d) }));
+        let n = cells.len();
+        let m = VolumeMesh {
+            points,
+            cells,
+            material: vec![0; n],
+            units: vec!["sand".into()],
+            ..Default::default()
+        };
+        let mut object = vec![0; n];
+        let mut lining = vec![false; n];
+        object[..4].copy_from_slice(&[1, 1, 1, 2]);
+        lining[2] = true;
+        let d = ObjectData {
+            objects: vec![
+                ModelObject {
+                    name: "t".into(),
+                    kind: ObjectKind::Tunnel,
+                    stage: 1,
+                    material: None,
+                    lining: true,
+                },
+                ModelObject {
+                    name: "pit".into(),
+                    kind: ObjectKind::Excavation,
+                    stage: 2,
+                    material: None,
+                    lining: false,
+                },
+            ],
+            object,
+            lining,
+        };
+        let near = object_boundaries(&m, &d);
+        let all = boundaries_of(&d, &all_sides(&m));
+        assert_eq!(near.len(), 3);
+        assert!(near.iter().all(|b| !b.is_empty()), "{near:?}");
+        assert_eq!(near, all);
+    }
+}
