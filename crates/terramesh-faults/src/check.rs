@@ -105,6 +105,19 @@ pub fn check(
     let n = mesh.points.len();
     let m = mesh.tets.len();
     let origin = [0.0; 3];
+    // With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), each step's time.
+    let stats = std::env::var_os("TERRAMESH_PASS_STATS")
+        .map(|_| std::cell::Cell::new(std::time::Instant::now()));
+    let lap = |what: &str| {
+        if let Some(t) = &stats {
+            let now = std::time::Instant::now();
+            eprintln!(
+                "check: {what}: {:.2} s",
+                now.duration_since(t.get()).as_secs_f64()
+            );
+            t.set(now);
+        }
+    };
     if mesh.unit.len() != m || mesh.block.len() != m || mesh.positive.len() != m {
         return Err(fail(
             origin,
@@ -156,6 +169,7 @@ pub fn check(
             ),
         ));
     }
+    lap("volumes");
     // 2. Faces.
     let faces = all_faces(&mesh.tets);
     let oriented = |e: &(u128, u32, u8)| outward_faces(&mesh.tets[e.1 as usize])[e.2 as usize];
@@ -199,6 +213,7 @@ pub fn check(
         }
         i = j;
     }
+    lap("faces");
     // 3. The boundary: closed, and only on the terrain, the base and the sides.
     let mut edges: Vec<(u32, u32, bool)> = boundary
         .iter()
@@ -229,6 +244,7 @@ pub fn check(
         }
         i = j;
     }
+    lap("boundary closed");
     let scale = 1e-9
         * terrain
             .heights
@@ -286,6 +302,7 @@ pub fn check(
             k => boundary_faces[k as usize] += 1,
         }
     }
+    lap("boundary classes");
     // 4. Volume.
     let vols: Vec<f64> = mesh
         .tets
@@ -305,6 +322,7 @@ pub fn check(
             format!("the volume {under} m³ of the cells under the terrain differs from the terrain-to-base volume {expected_volume} m³"),
         ));
     }
+    lap("volume");
     // 5, 6. Blocks, sides, units; cells straddling a fault or an interface.
     let nf = faults.faults.len();
     let node_sides: Vec<Vec<i8>> = p
@@ -324,6 +342,7 @@ pub fn check(
                 .collect()
         })
         .collect();
+    lap("node sides");
     let cell_sides: Vec<u64> = (0..m)
         .into_par_iter()
         .map(|c| {
@@ -333,6 +352,7 @@ pub fn check(
             })
         })
         .collect();
+    lap("cell sides");
     // Every interface's height at every node, once per block the node's cells are recorded
     // in (a node is in 20 cells or so: once per cell cost most of the check).
     let ni = mesh.units - 1;
@@ -352,12 +372,26 @@ pub fn check(
             (0..ni).map(move |k| height(k, key, [r[0], r[1]]))
         })
         .collect();
+    // Where each node's pairs start in `pairs` (sorted by node, then block): a node's few
+    // pairs found by a short scan there, not by a binary search over all of them (4 nodes
+    // times the interfaces per cell: that search cost most of the check).
+    let mut first = vec![0u32; n + 1];
+    for &e in &pairs {
+        first[(e >> 32) as usize + 1] += 1;
+    }
+    for v in 0..n {
+        first[v + 1] += first[v];
+    }
     let node_height = |v: u32, b: u32, k: usize| {
-        let i = pairs
-            .binary_search(&((v as u64) << 32 | b as u64))
-            .expect("every node of every cell");
+        let (lo, hi) = (first[v as usize] as usize, first[v as usize + 1] as usize);
+        let i = lo
+            + pairs[lo..hi]
+                .iter()
+                .position(|&e| e as u32 == b)
+                .expect("every node of every cell");
         node_heights[i * ni + k]
     };
+    lap("node heights");
     let per_cell: Vec<Result<(bool, bool), FaultError>> = (0..m)
         .into_par_iter()
         .map(|c| {
@@ -429,6 +463,7 @@ pub fn check(
             ));
         }
     }
+    lap("per cell");
     // 7. Fault faces.
     let mut expected: Vec<(u128, u32)> = interior
         .par_iter()
@@ -481,6 +516,7 @@ pub fn check(
             ),
         ));
     }
+    lap("fault faces compared");
     let mut fault_faces = vec![0usize; nf];
     let mut fault_areas = vec![0.0; nf];
     let mut fault_distance: f64 = 0.0;
@@ -532,6 +568,7 @@ pub fn check(
         block_cells[mesh.block[c] as usize] += 1;
         unit_volumes[mesh.unit[c] as usize] += vols[c];
     }
+    lap("fault faces measured");
     Ok(CheckSummary {
         volume,
         expected_volume,
@@ -544,6 +581,10 @@ pub fn check(
         fault_distance,
         block_cells,
         unit_volumes,
-        quality: quality(p, &mesh.tets),
+        quality: {
+            let q = quality(p, &mesh.tets);
+            lap("quality");
+            q
+        },
     })
 }

@@ -1909,22 +1909,24 @@ pub(crate) fn refine_near_objects(
     let metric = Metric::new(set, set.axial_stretch);
     let since = std::time::Instant::now();
     let mut rounds = 0;
+    // Each wall's field at the nodes read so far (the rounds only add nodes).
+    let mut read: Vec<FieldCache> = walls.iter().map(|_| FieldCache::default()).collect();
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
         rounds += 1;
         // Each wall's field, read only at the nodes of the cells that reach its object's box
-        // (no other cell can be crossed or reached by it: infinite elsewhere).
+        // (no other cell can be crossed or reached by it: infinite elsewhere); the box's
+        // nodes once per object (a tunnel's two walls share them).
+        let mut near: Vec<Option<Vec<bool>>> = vec![None; set.objects.len()];
         let values: Vec<Vec<f64>> = walls
             .iter()
-            .map(|&(i, w)| {
+            .zip(&mut read)
+            .map(|(&(i, w), read)| {
                 let o = &set.objects[i];
-                let near = near_box(st, o, 1e-3 + 1e-6 * set.resolution * o.size);
-                st.points
-                    .par_iter()
-                    .zip(&near)
-                    .map(|(&q, &near)| if near { o.field(w, q) } else { f64::INFINITY })
-                    .collect()
+                let near = near[i]
+                    .get_or_insert_with(|| near_box(st, o, 1e-3 + 1e-6 * set.resolution * o.size));
+                read.values(&st.points, near, |q| o.field(w, q))
             })
             .collect();
         let mut keys: Vec<u64> = st
@@ -2063,6 +2065,90 @@ pub(crate) fn refine_near_objects(
     Ok(labels)
 }
 
+/// A wall's field at the nodes, kept over the refinement's rounds, which only add nodes (and
+/// never move one): each node's field is read once, the first time it is asked for.
+#[derive(Default)]
+struct FieldCache(Vec<f64>);
+
+impl FieldCache {
+    /// The field at every node where `near`, infinite elsewhere: as reading `f` at each node
+    /// where `near` every time (the same values), reading only the nodes not read before.
+    fn values(
+        &mut self,
+        points: &[[f64; 3]],
+        near: &[bool],
+        f: impl Fn([f64; 3]) -> f64 + Sync,
+    ) -> Vec<f64> {
+        // (NaN: not read yet; a field that is NaN is read again, and is NaN again)
+        self.0.resize(points.len(), f64::NAN);
+        self.0
+            .par_iter_mut()
+            .zip(points)
+            .zip(near)
+            .for_each(|((v, &q), &near)| {
+                if near && v.is_nan() {
+                    *v = f(q);
+                }
+            });
+        self.0
+            .iter()
+            .zip(near)
+            .map(|(&v, &near)| if near { v } else { f64::INFINITY })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod field_cache_tests {
+    use super::FieldCache;
+    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+
+    /// Over rounds that add nodes and change which are near, the cache gives what reading the
+    /// field at every near node each round gives (infinite elsewhere), reading each node once.
+    #[test]
+    fn a_cached_field_is_the_field_read_each_round() {
+        let reads = AtomicUsize::new(0);
+        let f = |q: [f64; 3]| {
+            reads.fetch_add(1, Relaxed);
+            q[0] * q[0] + q[1] - 3.0 * q[2]
+        };
+        let mut cache = FieldCache::default();
+        let mut points: Vec<[f64; 3]> = Vec::new();
+        let mut expected_reads = 0;
+        let mut read_before = vec![false; 40];
+        for round in 0..4 {
+            points.extend((0..10).map(|i| {
+                let x = (round * 10 + i) as f64;
+                [x * 0.5, -x, x * x * 0.01]
+            }));
+            let near: Vec<bool> = (0..points.len()).map(|i| (i + round) % 3 != 0).collect();
+            for (i, &n) in near.iter().enumerate() {
+                if n && !read_before[i] {
+                    read_before[i] = true;
+                    expected_reads += 1;
+                }
+            }
+            let got = cache.values(&points, &near, f);
+            let want: Vec<f64> = points
+                .iter()
+                .zip(&near)
+                .map(|(&q, &n)| {
+                    if n {
+                        q[0] * q[0] + q[1] - 3.0 * q[2]
+                    } else {
+                        f64::INFINITY
+                    }
+                })
+                .collect();
+            assert_eq!(got.len(), want.len());
+            for (a, b) in got.iter().zip(&want) {
+                assert_eq!(a.to_bits(), b.to_bits());
+            }
+            assert_eq!(reads.load(Relaxed), expected_reads, "round {round}");
+        }
+    }
+}
+
 /// Whether each node belongs to a cell that reaches the object's bounding box grown by
 /// `margin` (a cell across the box's boundary may be crossed by the wall, however far its
 /// other nodes lie outside it).
@@ -2130,6 +2216,7 @@ fn refine_missed(
         _ => 1.0,
     };
     let mut total = 0;
+    let mut read = FieldCache::default();
     for _ in 0..40 {
         rounds += 1;
         // The field is read at every node of every cell that reaches the object's box (plus
@@ -2137,14 +2224,9 @@ fn refine_missed(
         // boundary may be crossed by the wall. (Reading it only at the nodes within 1 m of
         // the box skipped such cells where they were wider than that: a box's edge through
         // cells left coarse by the cap was cut as a chamfer, and a cell inside the box was
-        // labelled outside.)
+        // labelled outside.) A node's field is read once over the rounds.
         let near = near_box(st, o, 1e-3 + 1e-6 * tol);
-        let values: Vec<f64> = st
-            .points
-            .par_iter()
-            .zip(&near)
-            .map(|(&q, &near)| if near { f(q) } else { f64::INFINITY })
-            .collect();
+        let values: Vec<f64> = read.values(&st.points, &near, &f);
         let mut keys: Vec<u64> = st
             .tets
             .par_iter()

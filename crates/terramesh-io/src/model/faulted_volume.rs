@@ -226,8 +226,12 @@ pub fn faulted_volume(
     );
     // sealed bodies over the original nodes: faces of a material's cells whose other side is
     // not of that material (or none)
-    let by_orig = grouped(&|c, k| key(&nodes3(c, k).map(|v| original[v as usize])));
-    drop(by_key);
+    // (unsplit, every node is its own original: the same vector as `by_key`, not sorted again)
+    let by_orig = if split {
+        grouped(&|c, k| key(&nodes3(c, k).map(|v| original[v as usize])))
+    } else {
+        by_key
+    };
     let mut bodies: Vec<Body> = (0..names.len())
         .map(|u| Body {
             unit: u,

@@ -225,6 +225,8 @@ fn write_files(
     // With objects, the structures' and linings' cells take materials of their own after the
     // units: every writer takes that copy of the mesh.
     let mut relabelled;
+    // with objects in cells, every face sorted once for both the bodies and the boundaries
+    let mut sides = None;
     let mesh = match objects {
         Some(d) => {
             check_objects(mesh, faults, d)?;
@@ -236,13 +238,19 @@ fn write_files(
                 ..mesh.clone()
             };
             if d.object.iter().any(|&o| o > 0) {
-                relabelled.bodies = objects::material_bodies(&relabelled);
+                let all = objects::all_sides(&relabelled);
+                relabelled.bodies = objects::material_bodies(&relabelled, &all);
+                sides = Some(all);
             }
             &relabelled
         }
         None => mesh,
     };
-    let boundaries = &objects.map(|d| object_boundaries(mesh, d));
+    let boundaries = &objects.map(|d| match &sides {
+        Some(all) => objects::boundaries_of(d, all),
+        None => object_boundaries(mesh, d),
+    });
+    drop(sides);
     // the points' text, for model.msh, model.f3grid and the bodies' TSurf
     let pts = &crate::textsink::PointText::new(&mesh.points);
     let blocks = &passes::Indexed::new(mesh);

@@ -300,9 +300,7 @@ pub(super) fn stages(d: &ObjectData) -> Vec<u32> {
 /// # Panics
 /// On what [`check_objects`] rejects.
 pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
-    let groups = d.groups();
     let cell_group = d.cell_groups();
-    let mut out = vec![Vec::new(); groups.len()];
     // the objects' bounding box: a neighbour has at least three points in it
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for (c, &g) in cell_group.iter().enumerate() {
@@ -317,7 +315,7 @@ pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
         }
     }
     if lo[0] > hi[0] {
-        return out;
+        return vec![Vec::new(); d.groups().len()];
     }
     let inside = |p: [f64; 3]| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]);
     let canon = &canonical_points(m);
@@ -339,6 +337,31 @@ pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
         })
         .collect();
     sides.par_sort_unstable();
+    boundaries_of(d, &sides)
+}
+
+/// Every face of `m`'s cells by its points' canonical ids (split fault nodes share one),
+/// sorted: what [`material_bodies`] and [`boundaries_of`] read.
+pub(super) fn all_sides(m: &VolumeMesh) -> Vec<([u32; 4], u32, u8)> {
+    let canon = &canonical_points(m);
+    let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            (0..cell_faces(m.cells[c].kind).len())
+                .map(move |f| (face_key(m, canon, c, f), c as u32, f as u8))
+        })
+        .collect();
+    sides.par_sort_unstable();
+    sides
+}
+
+/// [`object_boundaries`] from `sides`, the sorted faces of the cells near the objects (at
+/// least those with three points in the objects' bounding box) or of all cells
+/// ([`all_sides`]): the same boundaries either way, since every cell that shares a face with
+/// an object's cell has that face's three points in the box.
+pub(super) fn boundaries_of(d: &ObjectData, sides: &[([u32; 4], u32, u8)]) -> Vec<Vec<FaceSide>> {
+    let cell_group = d.cell_groups();
+    let mut out = vec![Vec::new(); d.groups().len()];
     for group in sides.chunk_by(|a, b| a.0 == b.0) {
         for &(_, c, f) in group {
             let g = cell_group[c as usize];
@@ -491,16 +514,8 @@ pub(super) fn boundary_groups(
 /// counter-clockwise seen from outside its cell (quadrilaterals split in two); bodies without
 /// faces left out. What `unit-<name>.ts` and `.stl` hold for a model with objects, whose
 /// structures and linings take their cells out of the units.
-pub(super) fn material_bodies(m: &VolumeMesh) -> Vec<Body> {
-    let canon = &canonical_points(m);
-    let key = |c: usize, f: usize| face_key(m, canon, c, f);
-    let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
-        .into_par_iter()
-        .flat_map_iter(|c| {
-            (0..cell_faces(m.cells[c].kind).len()).map(move |f| (key(c, f), c as u32, f as u8))
-        })
-        .collect();
-    sides.par_sort_unstable();
+/// `sides` are all faces of `m`'s cells, sorted ([`all_sides`]).
+pub(super) fn material_bodies(m: &VolumeMesh, sides: &[([u32; 4], u32, u8)]) -> Vec<Body> {
     let mut bodies: Vec<Body> = (0..m.units.len())
         .map(|unit| Body {
             unit,
@@ -555,4 +570,83 @@ fn face_key(m: &VolumeMesh, canon: &[u32], c: usize, f: usize) -> [u32; 4] {
     }
     k.sort_unstable();
     k
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use terramesh_core::volume::Cell;
+
+    /// Three unit cubes in a row along x (six tetrahedra each, Kuhn), a point of the last
+    /// one copied (as split fault nodes are) into one of its cells; the objects in cells of
+    /// the first cube. The boundaries from every face sorted once ([`all_sides`], as
+    /// `write_object_model` finds them) are those of [`object_boundaries`] (the faces near
+    /// the objects only), and nonempty.
+    #[test]
+    fn boundaries_from_all_faces_are_those_from_the_faces_near_the_objects() {
+        let mut points: Vec<[f64; 3]> = Vec::new();
+        for x in 0..4 {
+            for i in 0..4 {
+                points.push([x as f64, (i & 1) as f64, ((i >> 1) & 1) as f64]);
+            }
+        }
+        // corner (dx, dy, dz) of cube x
+        let id = |x: u32, d: u32| (x + (d & 1)) * 4 + ((d >> 1) & 1) + ((d >> 2) & 1) * 2;
+        let kuhn = [
+            [0, 1, 3, 7],
+            [0, 1, 5, 7],
+            [0, 2, 3, 7],
+            [0, 2, 6, 7],
+            [0, 4, 5, 7],
+            [0, 4, 6, 7],
+        ];
+        let mut cells = Vec::new();
+        for x in 0..3 {
+            for t in kuhn {
+                cells.push(Cell::tetra(t.map(|d| id(x, d))));
+            }
+        }
+        // a split copy of the last cube's far corner, used by its last cell
+        points.push(points[id(2, 7) as usize]);
+        let copy = points.len() as u32 - 1;
+        let last = cells.len() - 1;
+        cells[last] = Cell::tetra(kuhn[5].map(|d| if d == 7 { copy } else { id(2, d) }));
+        let n = cells.len();
+        let m = VolumeMesh {
+            points,
+            cells,
+            material: vec![0; n],
+            units: vec!["sand".into()],
+            ..Default::default()
+        };
+        let mut object = vec![0; n];
+        let mut lining = vec![false; n];
+        object[..4].copy_from_slice(&[1, 1, 1, 2]);
+        lining[2] = true;
+        let d = ObjectData {
+            objects: vec![
+                ModelObject {
+                    name: "t".into(),
+                    kind: ObjectKind::Tunnel,
+                    stage: 1,
+                    material: None,
+                    lining: true,
+                },
+                ModelObject {
+                    name: "pit".into(),
+                    kind: ObjectKind::Excavation,
+                    stage: 2,
+                    material: None,
+                    lining: false,
+                },
+            ],
+            object,
+            lining,
+        };
+        let near = object_boundaries(&m, &d);
+        let all = boundaries_of(&d, &all_sides(&m));
+        assert_eq!(near.len(), 3);
+        assert!(near.iter().all(|b| !b.is_empty()), "{near:?}");
+        assert_eq!(near, all);
+    }
 }

@@ -147,7 +147,18 @@ pub fn check_inputs(g: &GeologyPlan) -> Result<()> {
     Ok(())
 }
 
-/// The faulted stage's mesh with the objects cut in, their checks passed.
+/// The objects as validated for the mesh and their checks on it, kept for [`finish`] (which
+/// would otherwise read the objects and check the mesh a second time).
+#[derive(Debug, Clone, Default)]
+pub struct MeshedObjects {
+    /// The objects, validated ([`object_set`]).
+    pub set: ObjectSet,
+    /// Their checks on the mesh (`check_objects`), one per object; none without objects.
+    pub checks: Vec<ObjectCheck>,
+}
+
+/// The faulted stage's mesh with the objects cut in, their checks passed, and the objects
+/// with those checks.
 ///
 /// # Errors
 /// An object refused (see [`object_set`]) or the kernel's errors; a failed check of the
@@ -159,18 +170,28 @@ pub(crate) fn mesh(
     interfaces: usize,
     height: InterfaceFn,
     settings: &MeshSettings,
-) -> Result<FaultedMesh> {
+) -> Result<(FaultedMesh, MeshedObjects)> {
     let objects = object_set(g, terrain, settings.base)?;
     let mesh = faulted_mesh_with_objects(terrain, set, interfaces, height, settings, &objects)
         .map_err(|e| object_error(g, e))?;
-    if !objects.objects.is_empty() {
+    let lap = super::faulted::Lap::new();
+    let checks = if objects.objects.is_empty() {
+        Vec::new()
+    } else {
         check_objects(&mesh.points, &mesh.tets, &mesh.objects, &objects).map_err(|e| {
             Error::ObjectCheck {
                 source: Box::new(e),
             }
-        })?;
-    }
-    Ok(mesh)
+        })?
+    };
+    lap.say("the objects' checks (check_objects)");
+    Ok((
+        mesh,
+        MeshedObjects {
+            set: objects,
+            checks,
+        },
+    ))
 }
 
 /// The writers' labels of the objects (`None` without objects): their names, kinds, stages
@@ -309,28 +330,41 @@ fn tet_volume(p: &[[f64; 3]], t: &[u32; 4]) -> f64 {
     terramesh_core::volume::tetra_volume(q[0], q[1], q[2], q[3])
 }
 
-/// The objects' figures for `model.json` (`None` without objects). `unit_at` gives the unit
-/// at a point (for a tunnel's length per unit), `block_names` the names of the kernel's
-/// blocks.
+/// The objects' figures for `model.json` (`None` without objects). `objects` are the objects
+/// and their checks as the mesh stage made them ([`mesh`]), `unit_at` gives the unit at a
+/// point (for a tunnel's length per unit), `block_names` the names of the kernel's blocks.
 ///
 /// # Errors
-/// Reading the objects again (they were read for the mesh) or their checks.
+/// Reading a tunnel's axis again (for its length per unit), or checks that do not match the
+/// objects (one per object: a bug to report).
 pub fn finish(
     g: &GeologyPlan,
     mesh: &FaultedMesh,
-    terrain: &Terrain,
-    base: f64,
-    unit_at: &dyn Fn([f64; 3]) -> Option<usize>,
+    objects: &MeshedObjects,
+    unit_at: &(dyn Fn([f64; 3]) -> Option<usize> + Sync),
     block_names: &[String],
 ) -> Result<Option<ObjectsSummary>> {
+    use rayon::prelude::*;
     if g.objects.is_empty() {
         return Ok(None);
     }
-    let set = object_set(g, terrain, base)?;
-    let checks: Vec<ObjectCheck> = check_objects(&mesh.points, &mesh.tets, &mesh.objects, &set)
-        .map_err(|e| Error::ObjectFigures {
-            source: Box::new(e),
-        })?;
+    let (set, checks) = (&objects.set, &objects.checks);
+    if checks.len() != set.objects.len() || set.objects.len() != g.objects.len() {
+        return Err(Error::ObjectFigures {
+            source: Box::new(FaultError::Check {
+                what: format!(
+                    "{} objects in the project, {} validated and {} checked: the objects' \
+                     figures need one check per object",
+                    g.objects.len(),
+                    set.objects.len(),
+                    checks.len()
+                ),
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            }),
+        });
+    }
     let cells = &mesh.objects;
     let mut per_unit = vec![vec![0.0; g.units.len()]; set.objects.len()];
     let mut blocks = vec![Vec::new(); set.objects.len()];
@@ -364,7 +398,7 @@ pub fn finish(
     }
     stages.sort_by_key(|s| s.stage);
     let mut out = Vec::new();
-    for (k, (o, c)) in set.objects.iter().zip(&checks).enumerate() {
+    for (k, (o, c)) in set.objects.iter().zip(checks).enumerate() {
         let plan = &g.objects[k];
         let lengths = match &plan.source {
             ObjectSource::Tunnel { axis, .. } => {
@@ -377,12 +411,16 @@ pub fn finish(
                     let d = [0, 1, 2].map(|i| w[1][i] - w[0][i]);
                     let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                     let n = (l / 0.1).ceil().max(1.0) as usize;
-                    for s in 0..n {
-                        let f = (s as f64 + 0.5) / n as f64;
-                        let q = [0, 1, 2].map(|i| w[0][i] + f * d[i]);
-                        if let Some(u) = unit_at(q) {
-                            len[u] += l / n as f64;
-                        }
+                    // the samples' units in parallel, summed in their order (the same sums)
+                    let units: Vec<Option<usize>> = (0..n)
+                        .into_par_iter()
+                        .map(|s| {
+                            let f = (s as f64 + 0.5) / n as f64;
+                            unit_at([0, 1, 2].map(|i| w[0][i] + f * d[i]))
+                        })
+                        .collect();
+                    for u in units.into_iter().flatten() {
+                        len[u] += l / n as f64;
                     }
                 }
                 Some(len)

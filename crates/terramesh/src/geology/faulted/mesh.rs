@@ -22,6 +22,8 @@ pub struct Faulted {
     pub split: Option<usize>,
     /// The fault zones' checks, one per fault with a zone.
     pub zones: Vec<ZoneCheck>,
+    /// The engineering objects and their checks (empty without objects).
+    pub objects: crate::geology::objects::MeshedObjects,
 }
 
 /// Builds and checks the faulted mesh.
@@ -39,16 +41,21 @@ pub fn build_mesh(
         settings.refine_ratio = 0.0;
     }
     let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
-    let mesh = crate::geology::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
+    let lap = super::Lap::new();
+    let (mesh, objects) =
+        crate::geology::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
+    lap.say("the mesh, the objects' checks included");
     let check =
         check_mesh(&mesh, terrain, set, &settings, &h).map_err(|e| Error::FaultedMeshCheck {
             source: Box::new(e),
             unresolved: mesh.report.unresolved,
         })?;
+    lap.say("the mesh's checks (check)");
     let zones = check_zones(&mesh, set).map_err(|e| Error::FaultedMeshCheck {
         source: Box::new(e),
         unresolved: mesh.report.unresolved,
     })?;
+    lap.say("the zones' checks");
     let split = g.split_faults.then(|| split_nodes(&mesh).points.len());
     Ok(Faulted {
         mesh,
@@ -56,5 +63,6 @@ pub fn build_mesh(
         settings,
         split,
         zones,
+        objects,
     })
 }

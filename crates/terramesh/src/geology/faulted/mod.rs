@@ -124,8 +124,10 @@ pub(crate) fn run(
         &g.units,
     )?;
     let faulted = build_mesh(g, &terrain, &set, &ifs, base)?;
+    let lap = Lap::new();
     let (volume, data) =
         terramesh_io::model::faulted_volume(&faulted.mesh, &g.units, base, g.split_faults);
+    lap.say("the writers' model (faulted_volume)");
     // The surfaces at the planar vertices, for the pictures, the statistics and the grids: at
     // each vertex an interface in the block where it lies there.
     let n = g.units.len();
@@ -153,6 +155,7 @@ pub(crate) fn run(
         source: Box::new(e),
     })?;
     let stats = terramesh_geology::unit_stats(&planar, &stack, &volume);
+    lap.say("the surfaces at the planar vertices and the units' statistics");
     let crs_name = match (crs.and_then(Crs::epsg), crs) {
         (Some(e), _) => format!("EPSG:{e}"),
         (None, Some(c)) => c.definition().to_string(),
@@ -175,6 +178,7 @@ pub(crate) fn run(
         terramesh_io::model::ModelWriteError::Mesh(source) => Error::FaultedMeshWrite { source },
         e => Error::ModelWrite(e),
     })?;
+    lap.say("model.vtu, .msh, .f3grid, the faults' and objects' files and the bodies");
     let mut files: Vec<std::path::PathBuf> = written.into_iter().map(|f| out.join(f)).collect();
     let dir = out.join("interfaces");
     std::fs::create_dir_all(&dir).map_err(write_error(&dir))?;
@@ -198,6 +202,7 @@ pub(crate) fn run(
         o.commit().map_err(write_error(&path))?;
         files.push(path);
     }
+    lap.say("the interfaces' grids");
     // Every contact against its own block's interface; the collars against the terrain.
     let mut misfits = Vec::new();
     if let Some(b) = holes {
@@ -260,12 +265,13 @@ pub(crate) fn run(
                 .into();
         }
     }
+    lap.say("the misfits and the model's summary");
     summary.faulted = Some(summarise(g, &faulted, &ifs, &set, &picks));
+    lap.say("the faulted summary (model.json faulted)");
     summary.objects = crate::geology::objects::finish(
         g,
         &faulted.mesh,
-        &terrain,
-        base,
+        &faulted.objects,
         &|q| {
             crate::geology::objects::unit_at(
                 q,
@@ -282,6 +288,7 @@ pub(crate) fn run(
             .map(|f| f.blocks.iter().map(|b| b.name.clone()).collect::<Vec<_>>())
             .unwrap_or_default(),
     )?;
+    lap.say("the objects' figures (model.json objects)");
     let path = out.join("model.json");
     let text = serde_json::to_string_pretty(&summary)?;
     let mut o = terramesh_io::output::Output::create(Some(&path))?;
@@ -316,6 +323,7 @@ pub(crate) fn run(
         &faulted.mesh.objects.object,
         &named,
     );
+    lap.say("model.json and the faults' and objects' sheets for the report");
     Ok(crate::geology::stage::ModelBuilt {
         model,
         summary,
@@ -325,6 +333,28 @@ pub(crate) fn run(
         faults,
         objects,
     })
+}
+
+/// With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), each step of the
+/// geology stage after the mesh said on stderr with its time since the previous one.
+pub(crate) struct Lap(Option<std::cell::Cell<std::time::Instant>>);
+
+impl Lap {
+    pub(crate) fn new() -> Lap {
+        Lap(std::env::var_os("TERRAMESH_PASS_STATS")
+            .map(|_| std::cell::Cell::new(std::time::Instant::now())))
+    }
+
+    pub(crate) fn say(&self, what: &str) {
+        if let Some(t) = &self.0 {
+            let now = std::time::Instant::now();
+            eprintln!(
+                "geology stage: {what}: {:.2} s",
+                now.duration_since(t.get()).as_secs_f64()
+            );
+            t.set(now);
+        }
+    }
 }
 
 /// Said of `file` when writing it fails ([`Error::WriteFile`]).

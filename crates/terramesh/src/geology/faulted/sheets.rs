@@ -5,8 +5,6 @@
 //! matched by their corners' coordinates, so a mesh whose nodes are split at the faults
 //! still pairs the faces on both sides of a fault inside an object.
 
-use std::collections::HashMap;
-
 use super::FaultSheet;
 
 /// One sheet per named object (`names`: its number in `object`, 1 = first, and its name),
@@ -17,55 +15,52 @@ pub(crate) fn object_sheets(
     object: &[u32],
     names: &[(u32, String)],
 ) -> Vec<FaultSheet> {
-    // Per object, each face by its sorted corners' coordinates: how many of its cells have
-    // it, and the face as the first one saw it, oriented away from that cell.
+    use rayon::prelude::*;
+    // Every face of an object's cell: its object, its sorted corners' coordinates (the key)
+    // and the face oriented away from its cell; sorted by object and key, a face that only
+    // one cell of its object has is on the object's boundary (keys are distinct within an
+    // object's run there, so the order of equal keys does not matter).
     type Key = [[u64; 3]; 3];
-    type Faces = HashMap<Key, (u32, [[f64; 3]; 3])>;
-    let mut faces: HashMap<u32, Faces> = HashMap::new();
-    for (c, t) in tets.iter().enumerate() {
-        let o = object.get(c).copied().unwrap_or(0);
-        if o == 0 {
-            continue;
-        }
-        let map = faces.entry(o).or_default();
-        let q = t.map(|v| points[v as usize]);
-        for opp in 0..4 {
-            let mut f: [[f64; 3]; 3] = [0, 1, 2].map(|k| q[(opp + 1 + k) % 4]);
-            let (a, b, c3, d) = (f[0], f[1], f[2], q[opp]);
-            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let w = [c3[0] - a[0], c3[1] - a[1], c3[2] - a[2]];
-            let n = [
-                u[1] * w[2] - u[2] * w[1],
-                u[2] * w[0] - u[0] * w[2],
-                u[0] * w[1] - u[1] * w[0],
-            ];
-            let s = n[0] * (d[0] - a[0]) + n[1] * (d[1] - a[1]) + n[2] * (d[2] - a[2]);
-            if s > 0.0 {
-                f.swap(1, 2);
-            }
-            let mut key: Key = f.map(|p| p.map(f64::to_bits));
-            key.sort_unstable();
-            map.entry(key).or_insert((0, f)).0 += 1;
+    let mut faces: Vec<(u32, Key, [[f64; 3]; 3])> = tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(c, t)| {
+            let o = object.get(c).copied().unwrap_or(0);
+            let q = t.map(|v| points[v as usize]);
+            (0..4).filter(move |_| o != 0).map(move |opp| {
+                let mut f: [[f64; 3]; 3] = [0, 1, 2].map(|k| q[(opp + 1 + k) % 4]);
+                let (a, b, c3, d) = (f[0], f[1], f[2], q[opp]);
+                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let w = [c3[0] - a[0], c3[1] - a[1], c3[2] - a[2]];
+                let n = [
+                    u[1] * w[2] - u[2] * w[1],
+                    u[2] * w[0] - u[0] * w[2],
+                    u[0] * w[1] - u[1] * w[0],
+                ];
+                let s = n[0] * (d[0] - a[0]) + n[1] * (d[1] - a[1]) + n[2] * (d[2] - a[2]);
+                if s > 0.0 {
+                    f.swap(1, 2);
+                }
+                let mut key: Key = f.map(|p| p.map(f64::to_bits));
+                key.sort_unstable();
+                (o, key, f)
+            })
+        })
+        .collect();
+    faces.par_sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    // per object, its boundary faces in increasing key
+    let mut boundary: std::collections::HashMap<u32, Vec<[[f64; 3]; 3]>> =
+        std::collections::HashMap::new();
+    for run in faces.chunk_by(|a, b| a.0 == b.0 && a.1 == b.1) {
+        if let [(o, _, f)] = run {
+            boundary.entry(*o).or_default().push(*f);
         }
     }
     names
         .iter()
-        .map(|(o, name)| {
-            let mut tris: Vec<(Key, [[f64; 3]; 3])> = faces
-                .get(o)
-                .map(|m| {
-                    m.iter()
-                        .filter(|(_, v)| v.0 == 1)
-                        .map(|(k, v)| (*k, v.1))
-                        .collect()
-                })
-                .unwrap_or_default();
-            // The hash map's order is not the same from run to run: sorted, the report is.
-            tris.sort_unstable_by_key(|t| t.0);
-            FaultSheet {
-                name: name.clone(),
-                triangles: tris.into_iter().map(|t| t.1).collect(),
-            }
+        .map(|(o, name)| FaultSheet {
+            name: name.clone(),
+            triangles: boundary.get(o).cloned().unwrap_or_default(),
         })
         .collect()
 }
