@@ -2115,7 +2115,7 @@ mod field_cache_tests {
         let mut cache = FieldCache::default();
         let mut points: Vec<[f64; 3]> = Vec::new();
         let mut expected_reads = 0;
-        let mut read_before = vec![false; 40];
+        let mut read_before = [false; 40];
         for round in 0..4 {
             points.extend((0..10).map(|i| {
                 let x = (round * 10 + i) as f64;
@@ -2226,7 +2226,7 @@ fn refine_missed(
         // cells left coarse by the cap was cut as a chamfer, and a cell inside the box was
         // labelled outside.) A node's field is read once over the rounds.
         let near = near_box(st, o, 1e-3 + 1e-6 * tol);
-        let values: Vec<f64> = read.values(&st.points, &near, &f);
+        let values: Vec<f64> = read.values(&st.points, &near, f);
         let mut keys: Vec<u64> = st
             .tets
             .par_iter()

@@ -331,7 +331,7 @@ fn tet_volume(p: &[[f64; 3]], t: &[u32; 4]) -> f64 {
 }
 
 /// The objects' figures for `model.json` (`None` without objects). `objects` are the objects
-/// and their checks as the mesh stage made them ([`mesh`]), `unit_at` gives the unit at a
+/// and their checks as the mesh stage made them (`mesh`), `unit_at` gives the unit at a
 /// point (for a tunnel's length per unit), `block_names` the names of the kernel's blocks.
 ///
 /// # Errors
