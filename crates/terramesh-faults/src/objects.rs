@@ -3154,26 +3154,7 @@ mod tests {
         labels.object = vec![0; st.tets.len()];
         labels.lining = vec![false; st.tets.len()];
         let o = &set.objects[0];
-        let crossing = |st: &State| {
-            let v: Vec<f64> = st.points.iter().map(|&q| o.field(Wall::Inner, q)).collect();
-            let mut keys: Vec<u64> = st
-                .tets
-                .iter()
-                .flat_map(|t| {
-                    EDGES
-                        .iter()
-                        .filter(|&&(a, b)| {
-                            let (x, y) = (v[t[a] as usize], v[t[b] as usize]);
-                            (x < -ON_WALL && y > ON_WALL) || (x > ON_WALL && y < -ON_WALL)
-                        })
-                        .map(|&(a, b)| key(t[a], t[b]))
-                        .collect::<Vec<_>>()
-                })
-                .collect();
-            keys.sort_unstable();
-            keys.dedup();
-            keys.len()
-        };
+        let crossing = |st: &State| crossing_edges(st, o);
         let (before, points) = (crossing(&st), st.points.clone());
         let moved = snap_to_wall(
             &mut st,
@@ -3211,6 +3192,29 @@ mod tests {
             "{after} edges cross the wall after the snap, {before} before"
         );
         eprintln!("snap: {moved} nodes moved, crossing edges {before} -> {after}");
+    }
+
+    /// The edges of `st` whose ends lie clearly on two sides of `o`'s inner wall (the edges
+    /// a cut of that wall would split).
+    fn crossing_edges(st: &State, o: &Object) -> usize {
+        let v: Vec<f64> = st.points.iter().map(|&q| o.field(Wall::Inner, q)).collect();
+        let mut keys: Vec<u64> = st
+            .tets
+            .iter()
+            .flat_map(|t| {
+                EDGES
+                    .iter()
+                    .filter(|&&(a, b)| {
+                        let (x, y) = (v[t[a] as usize], v[t[b] as usize]);
+                        (x < -ON_WALL && y > ON_WALL) || (x > ON_WALL && y < -ON_WALL)
+                    })
+                    .map(|&(a, b)| key(t[a], t[b]))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        keys.len()
     }
 
     /// The pit's and the box's planar walls are snapped onto before their cut, as a tunnel's
@@ -3262,27 +3266,7 @@ mod tests {
         let mut st =
             crate::mesh::background(&site.terrain, &MeshSettings::new(site.base, 10.0)).unwrap();
         let labels = refine_near_objects(&mut st, &set).unwrap();
-        let crossing = |st: &State, o: &Object| {
-            let v: Vec<f64> = st.points.iter().map(|&q| o.field(Wall::Inner, q)).collect();
-            let mut keys: Vec<u64> = st
-                .tets
-                .iter()
-                .flat_map(|t| {
-                    EDGES
-                        .iter()
-                        .filter(|&&(a, b)| {
-                            let (x, y) = (v[t[a] as usize], v[t[b] as usize]);
-                            (x < -ON_WALL && y > ON_WALL) || (x > ON_WALL && y < -ON_WALL)
-                        })
-                        .map(|&(a, b)| key(t[a], t[b]))
-                        .collect::<Vec<_>>()
-                })
-                .collect();
-            keys.sort_unstable();
-            keys.dedup();
-            keys.len()
-        };
-        let before: Vec<usize> = set.objects.iter().map(|o| crossing(&st, o)).collect();
+        let before: Vec<usize> = set.objects.iter().map(|o| crossing_edges(&st, o)).collect();
         let faults = FaultSet::new(&[], &site.terrain, site.base).unwrap();
         let blocks =
             vec![BlockKey::default(); 1 + st.block.iter().copied().max().unwrap_or(0) as usize];
