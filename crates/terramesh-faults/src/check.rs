@@ -106,18 +106,7 @@ pub fn check(
     let m = mesh.tets.len();
     let origin = [0.0; 3];
     // With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), each step's time.
-    let stats = std::env::var_os("TERRAMESH_PASS_STATS")
-        .map(|_| std::cell::Cell::new(std::time::Instant::now()));
-    let lap = |what: &str| {
-        if let Some(t) = &stats {
-            let now = std::time::Instant::now();
-            eprintln!(
-                "check: {what}: {:.2} s",
-                now.duration_since(t.get()).as_secs_f64()
-            );
-            t.set(now);
-        }
-    };
+    let lap = crate::Lap::new("check");
     if mesh.unit.len() != m || mesh.block.len() != m || mesh.positive.len() != m {
         return Err(fail(
             origin,
@@ -169,7 +158,7 @@ pub fn check(
             ),
         ));
     }
-    lap("volumes");
+    lap.say("volumes");
     // 2. Faces.
     let faces = all_faces(&mesh.tets);
     let oriented = |e: &(u128, u32, u8)| outward_faces(&mesh.tets[e.1 as usize])[e.2 as usize];
@@ -213,7 +202,7 @@ pub fn check(
         }
         i = j;
     }
-    lap("faces");
+    lap.say("faces");
     // 3. The boundary: closed, and only on the terrain, the base and the sides.
     let mut edges: Vec<(u32, u32, bool)> = boundary
         .iter()
@@ -244,7 +233,7 @@ pub fn check(
         }
         i = j;
     }
-    lap("boundary closed");
+    lap.say("boundary closed");
     let scale = 1e-9
         * terrain
             .heights
@@ -302,7 +291,7 @@ pub fn check(
             k => boundary_faces[k as usize] += 1,
         }
     }
-    lap("boundary classes");
+    lap.say("boundary classes");
     // 4. Volume.
     let vols: Vec<f64> = mesh
         .tets
@@ -322,7 +311,7 @@ pub fn check(
             format!("the volume {under} m³ of the cells under the terrain differs from the terrain-to-base volume {expected_volume} m³"),
         ));
     }
-    lap("volume");
+    lap.say("volume");
     // 5, 6. Blocks, sides, units; cells straddling a fault or an interface.
     let nf = faults.faults.len();
     let node_sides: Vec<Vec<i8>> = p
@@ -342,7 +331,7 @@ pub fn check(
                 .collect()
         })
         .collect();
-    lap("node sides");
+    lap.say("node sides");
     let cell_sides: Vec<u64> = (0..m)
         .into_par_iter()
         .map(|c| {
@@ -352,7 +341,7 @@ pub fn check(
             })
         })
         .collect();
-    lap("cell sides");
+    lap.say("cell sides");
     // Every interface's height at every node, once per block the node's cells are recorded
     // in (a node is in 20 cells or so: once per cell cost most of the check).
     let ni = mesh.units - 1;
@@ -391,7 +380,7 @@ pub fn check(
                 .expect("every node of every cell");
         node_heights[i * ni + k]
     };
-    lap("node heights");
+    lap.say("node heights");
     let per_cell: Vec<Result<(bool, bool), FaultError>> = (0..m)
         .into_par_iter()
         .map(|c| {
@@ -463,7 +452,7 @@ pub fn check(
             ));
         }
     }
-    lap("per cell");
+    lap.say("per cell");
     // 7. Fault faces.
     let mut expected: Vec<(u128, u32)> = interior
         .par_iter()
@@ -516,7 +505,7 @@ pub fn check(
             ),
         ));
     }
-    lap("fault faces compared");
+    lap.say("fault faces compared");
     let mut fault_faces = vec![0usize; nf];
     let mut fault_areas = vec![0.0; nf];
     let mut fault_distance: f64 = 0.0;
@@ -568,7 +557,7 @@ pub fn check(
         block_cells[mesh.block[c] as usize] += 1;
         unit_volumes[mesh.unit[c] as usize] += vols[c];
     }
-    lap("fault faces measured");
+    lap.say("fault faces measured");
     Ok(CheckSummary {
         volume,
         expected_volume,
@@ -583,7 +572,7 @@ pub fn check(
         unit_volumes,
         quality: {
             let q = quality(p, &mesh.tets);
-            lap("quality");
+            lap.say("quality");
             q
         },
     })

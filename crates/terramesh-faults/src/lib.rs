@@ -183,6 +183,8 @@ mod error;
 mod fault;
 /// The quality pass: edge collapses, flips and node moves.
 mod improve;
+/// A profiling timer of steps (`TERRAMESH_PASS_STATS`).
+mod lap;
 /// The layered background mesh: column levels at the interfaces.
 mod layers;
 /// The conformal volume mesh.
@@ -207,6 +209,7 @@ pub use error::FaultError;
 pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG_TRACE_DEGREES};
 #[doc(hidden)]
 pub use improve::verify_each_operation;
+pub use lap::Lap;
 pub use mesh::{
     faulted_mesh, faulted_mesh_with_objects, BuildReport, FaultFace, FaultedMesh, InterfaceFn,
     MeshSettings, ON_SURFACE, REFINE_MAX_CELLS,

@@ -174,7 +174,7 @@ pub(crate) fn mesh(
     let objects = object_set(g, terrain, settings.base)?;
     let mesh = faulted_mesh_with_objects(terrain, set, interfaces, height, settings, &objects)
         .map_err(|e| object_error(g, e))?;
-    let lap = super::faulted::Lap::new();
+    let lap = terramesh_faults::Lap::new("geology stage");
     let checks = if objects.objects.is_empty() {
         Vec::new()
     } else {

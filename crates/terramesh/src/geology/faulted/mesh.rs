@@ -41,7 +41,7 @@ pub fn build_mesh(
         settings.refine_ratio = 0.0;
     }
     let h = |k: usize, key: BlockKey, p: [f64; 2]| ifs.height(k, key, p);
-    let lap = super::Lap::new();
+    let lap = terramesh_faults::Lap::new("geology stage");
     let (mesh, objects) =
         crate::geology::objects::mesh(g, terrain, set, g.units.len() - 1, &h, &settings)?;
     lap.say("the mesh, the objects' checks included");

@@ -124,7 +124,7 @@ pub(crate) fn run(
         &g.units,
     )?;
     let faulted = build_mesh(g, &terrain, &set, &ifs, base)?;
-    let lap = Lap::new();
+    let lap = terramesh_faults::Lap::new("geology stage");
     let (volume, data) =
         terramesh_io::model::faulted_volume(&faulted.mesh, &g.units, base, g.split_faults);
     lap.say("the writers' model (faulted_volume)");
@@ -333,28 +333,6 @@ pub(crate) fn run(
         faults,
         objects,
     })
-}
-
-/// With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), each step of the
-/// geology stage after the mesh said on stderr with its time since the previous one.
-pub(crate) struct Lap(Option<std::cell::Cell<std::time::Instant>>);
-
-impl Lap {
-    pub(crate) fn new() -> Lap {
-        Lap(std::env::var_os("TERRAMESH_PASS_STATS")
-            .map(|_| std::cell::Cell::new(std::time::Instant::now())))
-    }
-
-    pub(crate) fn say(&self, what: &str) {
-        if let Some(t) = &self.0 {
-            let now = std::time::Instant::now();
-            eprintln!(
-                "geology stage: {what}: {:.2} s",
-                now.duration_since(t.get()).as_secs_f64()
-            );
-            t.set(now);
-        }
-    }
 }
 
 /// Said of `file` when writing it fails ([`Error::WriteFile`]).
