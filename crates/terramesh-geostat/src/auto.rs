@@ -91,12 +91,6 @@ pub const WLS_LOO_ROUNDING: f64 = 1e-9;
 /// The choice counts these options as having no nugget.
 pub const WLS_LOO_NONE: f64 = 1e-4;
 
-/// The options that [`FitMethod::WlsLoo`] puts in place of a chosen exponential or
-/// spherical without nugget whose range is at [`wls_loo_range_bound`]: each model without
-/// nugget at this fraction of the bound; the one of least leave-one-out RMSE is kept.
-pub const WLS_LOO_SHORT: &[(ModelKind, f64)] =
-    &[(ModelKind::Exponential, 0.6), (ModelKind::Spherical, 0.87)];
-
 /// Number of models that [`FitMethod::WlsLoo`] refines (those of least leave-one-out RMSE
 /// from their WLS fits).
 pub const WLS_LOO_REFINED: usize = 2;
@@ -447,56 +441,15 @@ pub fn fit_auto_wls_loo(
             "the data lie on the drift to rounding (leave-one-out RMSE {min:.3e} against a range of {spread:.3e}): leave-one-out cannot choose a model"
         )));
     }
-    // kind, option, nugget ratio, linear at the origin to the end, rmse
-    let mut chosen: Option<(usize, usize, f64, bool, f64)> = None;
+    let mut chosen: Option<(usize, usize, f64, f64)> = None; // kind, option, nugget ratio, rmse
     for (i, all) in options.iter().enumerate() {
         for (j, (v, rmse, none)) in all.iter().enumerate() {
             if *rmse > (1.0 + WLS_LOO_TIE) * min {
                 continue;
             }
             let ratio = if *none { 0.0 } else { nugget_ratio(v) };
-            let lin = linear(v);
-            if chosen.is_none_or(|c| (ratio, lin, *rmse) < (c.2, c.3, c.4)) {
-                chosen = Some((i, j, ratio, lin, *rmse));
-            }
-        }
-    }
-    // An exponential or spherical without nugget at the range bound: the range the data
-    // cannot see. The option of least leave-one-out RMSE among WLS_LOO_SHORT instead (the
-    // sill scaled to standardised errors of unit variance).
-    if let Some(c) = chosen {
-        let v = &options[c.0][c.1].0;
-        let at_bound = v.nugget == 0.0
-            && v.structures.len() == 1
-            && matches!(
-                v.structures[0].kind,
-                ModelKind::Exponential | ModelKind::Spherical
-            )
-            && v.structures[0].range >= 0.999 * cap;
-        if at_bound {
-            let psill = v.structures[0].psill;
-            let mut short: Option<(usize, Variogram, f64)> = None;
-            for &(kind, f) in WLS_LOO_SHORT {
-                let Some(k) = kinds.iter().position(|&k| k == kind) else {
-                    continue;
-                };
-                let mut w = Variogram {
-                    nugget: 0.0,
-                    structures: vec![Structure::new(kind, psill, f * cap)],
-                    anisotropy: v.anisotropy,
-                };
-                if let Some((rmse, s2)) = loo(&sub, &w, s.drift) {
-                    if s2 > 0.0 && s2.is_finite() {
-                        w.structures[0].psill *= s2;
-                    }
-                    if short.as_ref().is_none_or(|b| rmse < b.2) {
-                        short = Some((k, w, rmse));
-                    }
-                }
-            }
-            if let Some((k, w, rmse)) = short {
-                options[k].push((w, rmse, true));
-                chosen = Some((k, options[k].len() - 1, 0.0, false, rmse));
+            if chosen.is_none_or(|c| ratio < c.2 || (ratio == c.2 && *rmse < c.3)) {
+                chosen = Some((i, j, ratio, *rmse));
             }
         }
     }
@@ -587,14 +540,6 @@ fn smooth(v: &Variogram) -> bool {
     v.structures
         .iter()
         .any(|t| t.kind == ModelKind::Gaussian || (t.kind == ModelKind::Matern && t.shape > 0.5))
-}
-
-/// A model linear at the origin without curvature (a linear structure or a power of
-/// exponent 1): the choice ranks it after the others of equal nugget.
-fn linear(v: &Variogram) -> bool {
-    v.structures.len() == 1
-        && (v.structures[0].kind == ModelKind::Linear
-            || (v.structures[0].kind == ModelKind::Power && v.structures[0].shape == 1.0))
 }
 
 /// The nugget relative to the sill (to the structures' partial sills for an unbounded

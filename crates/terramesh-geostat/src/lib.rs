@@ -91,7 +91,7 @@ pub use aniso::{
 pub use auto::{
     fit_auto_loo, fit_auto_reml, fit_auto_wls_loo, lag_rmse, wls_loo_range_bound, AutoSettings,
     FitMethod, Selection, DEFAULT_LOO_POINTS, WLS_LOO_NONE, WLS_LOO_POINTS, WLS_LOO_REFINED,
-    WLS_LOO_ROUNDING, WLS_LOO_SHORT, WLS_LOO_TIE,
+    WLS_LOO_ROUNDING, WLS_LOO_TIE,
 };
 pub use cv::{
     cross_validate, fit_auto, Candidate, CvResult, CvStats, Folds, Interpolator, FIT_AUTO_POINTS,
