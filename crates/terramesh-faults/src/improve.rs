@@ -1587,7 +1587,13 @@ impl Pass<'_> {
                 eval,
             );
         }
-        if best < old + MIN_GAIN || count > poor {
+        // In a light sweep, also a split that leaves more cells below the floor than the edge
+        // had if its worst cell gains [`cavity::INSERT_GAIN`], as an insertion may: a sliver
+        // against a short edge on a line where surfaces meet, which only a node near that
+        // edge mends, is lifted above the floor at the price of a few cells just under it.
+        if best < old + MIN_GAIN
+            || (count > poor && (self.heavy || best < old + cavity::INSERT_GAIN))
+        {
             return None;
         }
         let walled = zones != 0;

@@ -30,7 +30,7 @@ const CAVITY_MAX: usize = 48;
 /// An insertion that puts more cells below the floor than its cavity held is kept only if
 /// its worst cell gains this much (degrees): the cavity's cells are replaced by about twice
 /// as many cones, and the new poor ones are mended by the later sweeps.
-const INSERT_GAIN: f64 = 1.0;
+pub(super) const INSERT_GAIN: f64 = 1.0;
 
 impl Pass<'_> {
     /// The best [`Op::Insert`] for poor cell `c` (`around[i]`: the cells around its node i).
