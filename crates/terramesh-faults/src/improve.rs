@@ -632,7 +632,7 @@ impl Pass<'_> {
             .iter()
             .rev()
             .take(tries)
-            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0))
+            .find_map(|&(_, u, v)| self.split(u, v, &at(u).0, false))
             // In the tail sweeps only, the operations of module `tail` (counted as splits).
             .or_else(|| self.tail_ops(c, &stars));
         lap(4);
@@ -1440,9 +1440,10 @@ impl Pass<'_> {
     /// neighbours and up the gradient of its worst cell's smallest angle. Every cell around
     /// the edge becomes two cones from the new node (exactly its halves at the midpoint),
     /// each labelled as its parent. Kept if every new cell is positive (exact), their
-    /// smallest angle beats the old cells' and no more of them are below the floor, and, as
+    /// smallest angle beats the old cells' and no more of them are below the floor (if
+    /// `lenient`, more if the smallest gains [`cavity::INSERT_GAIN`]), and, as
     /// for a move, every cell keeps its unit and zones as the checks see them.
-    fn split(&self, a: u32, b: u32, ca: &[u32]) -> Option<Op> {
+    fn split(&self, a: u32, b: u32, ca: &[u32], lenient: bool) -> Option<Op> {
         let ring = self.holding(ca, b);
         if ring.is_empty() {
             return None;
@@ -1587,7 +1588,10 @@ impl Pass<'_> {
                 eval,
             );
         }
-        if best < old + MIN_GAIN || count > poor {
+        // A lenient split (the tail's last resort) may leave more cells below the floor than
+        // the edge had if its worst cell gains [`cavity::INSERT_GAIN`], as an insertion may.
+        if best < old + MIN_GAIN || (count > poor && (!lenient || best < old + cavity::INSERT_GAIN))
+        {
             return None;
         }
         let walled = zones != 0;

@@ -44,6 +44,10 @@
 //! and in a tail sweep instead of a move that gains less than [`super::HEAVY_GAIN`]
 //! ([`Pass::pierce_or`]).
 //!
+//! **A lenient split** ([`Pass::lenient_split`], the last resort, after the insertion): an
+//! edge split that may leave more cells below the floor than the edge had if the worst cell
+//! gains [`super::cavity::INSERT_GAIN`], as an insertion may.
+//!
 //! **A fault node moved between two units** ([`Pass::fault_move`]): a node on one fault only
 //! whose two sides are in different units (the throw) may not move in
 //! [`Pass::slide_at`] (it moves a fault node only between cells of one unit); here it moves
@@ -99,6 +103,29 @@ impl Pass<'_> {
         (0..4)
             .find_map(|i| self.fault_move(t[i], around[i]))
             .or_else(|| self.insert(c, around))
+            .or_else(|| self.lenient_split(t, around))
+    }
+
+    /// The last resort: a split of an edge of poor cell `t` (the longest first) that may
+    /// leave more cells below the floor than the edge had if its worst cell gains
+    /// [`super::cavity::INSERT_GAIN`] ([`Pass::split`], `lenient`). A sliver whose flat
+    /// angle lies at a short edge on a line where two surfaces meet (a fault and an
+    /// interface or a side) with its other nodes metres away is mended only by a node near
+    /// that edge, and every split of its cells leaves a few halves just under the floor.
+    fn lenient_split(&self, t: [u32; 4], around: &[&[u32]; 4]) -> Option<Op> {
+        #[cfg(test)]
+        if super::cavity::tests::LENIENT_OFF.load(std::sync::atomic::Ordering::Relaxed) {
+            return None;
+        }
+        let pt = |v: u32| self.st.points[v as usize];
+        let mut edges: Vec<(f64, usize, usize)> = crate::mesh::EDGES
+            .iter()
+            .map(|&(i, j)| (super::d2(pt(t[i]), pt(t[j])), i, j))
+            .collect();
+        edges.sort_by(|x, y| y.0.total_cmp(&x.0));
+        edges
+            .iter()
+            .find_map(|&(_, i, j)| self.split(t[i], t[j], around[i], true))
     }
 
     /// In a tail sweep, the best [`Pass::pierce`] of poor cell `t` instead of move `op` if
