@@ -1868,11 +1868,14 @@ enum On {
 
 /// With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), what a step of the
 /// objects' passes did: its time, the edges it bisected or split, the cells after it.
+/// (`cpu`: the process's CPU seconds when the line is written, to compare steps on a shared
+/// machine.)
 fn object_stats(what: std::fmt::Arguments, since: std::time::Instant, edges: usize, cells: usize) {
     if std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
         eprintln!(
-            "objects: {what}: {edges} edges, {cells} cells after, {:.2} s",
-            since.elapsed().as_secs_f64()
+            "objects: {what}: {edges} edges, {cells} cells after, {:.2} s (cpu at {:.2} s)",
+            since.elapsed().as_secs_f64(),
+            crate::lap::cpu_seconds()
         );
     }
 }
@@ -1911,6 +1914,8 @@ pub(crate) fn refine_near_objects(
     let mut rounds = 0;
     // Each wall's field at the nodes read so far (the rounds only add nodes).
     let mut read: Vec<FieldCache> = walls.iter().map(|_| FieldCache::default()).collect();
+    // Only the cells with a node made by the previous round are tested (see [`Tested`]).
+    let mut tested = Tested::default();
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
@@ -1933,6 +1938,9 @@ pub(crate) fn refine_near_objects(
             .tets
             .par_iter()
             .filter_map(|t| {
+                if tested.known(t) {
+                    return None;
+                }
                 // A cell out of every object's box is left (without measuring it: most are).
                 if !values
                     .iter()
@@ -2012,6 +2020,7 @@ pub(crate) fn refine_near_objects(
                 })
             })
             .collect();
+        tested.all_before(st.points.len());
         keys.par_sort_unstable();
         keys.dedup();
         if keys.is_empty() {
@@ -2038,13 +2047,22 @@ pub(crate) fn refine_near_objects(
     // any surface is cut: the midpoint of an edge on a wall, a fault or an interface already
     // cut lies on the edge's chord, off that surface where it is curved (on an interface, a
     // cell around it then has nodes on both sides of it: "straddles an interface").
+    // Each wall's cells known not to need it (from its previous pass).
+    let mut tested: Vec<Tested> = walls.iter().map(|_| Tested::default()).collect();
     for pass in 0..4 {
         let mut bisected = 0;
-        for &(i, w) in &walls {
+        for (&(i, w), tested) in walls.iter().zip(&mut tested) {
             let o = &set.objects[i];
             let since = std::time::Instant::now();
-            let (edges, rounds, [crossed, reached]) =
-                refine_missed(&metric, st, &mut labels, o, w, set.resolution * o.size);
+            let (edges, rounds, [crossed, reached]) = refine_missed(
+                &metric,
+                st,
+                &mut labels,
+                o,
+                w,
+                set.resolution * o.size,
+                tested,
+            );
             object_stats(
                 format_args!(
                     "crossed cells of {} {} ({w:?}), pass {pass}, {rounds} rounds, cells \
@@ -2063,6 +2081,32 @@ pub(crate) fn refine_near_objects(
         }
     }
     Ok(labels)
+}
+
+/// The cells a round of the refinement near objects (or of [`refine_missed`], for one wall)
+/// need not test: those whose nodes all precede a node count at which every cell was tested
+/// and not flagged. A round's test of a cell reads only its nodes (which never move) and the
+/// walls' fields there, so an unchanged cell not flagged is not flagged again; a flagged
+/// cell is bisected (its key is one of its edges), and every child of a bisection holds the
+/// new midpoint, a node made after the test. The fields are read where a node belongs to a
+/// cell reaching the object's box ([`near_box`]), which a node can lose (its cells split) but
+/// never gain (a child reaches the box only if its parent did), so an unchanged cell's nodes
+/// can only turn unread (infinite), which flags nothing. The same cells are flagged as when
+/// every cell is tested each round: the refinement's mesh does not change.
+#[derive(Default)]
+struct Tested(u32);
+
+impl Tested {
+    /// Whether cell `t` is known not to be flagged.
+    fn known(&self, t: &[u32; 4]) -> bool {
+        t.iter().all(|&n| n < self.0)
+    }
+
+    /// Every cell whose nodes all precede node `n` has been tested and, if flagged, will be
+    /// bisected before the next test.
+    fn all_before(&mut self, n: usize) {
+        self.0 = n as u32;
+    }
 }
 
 /// A wall's field at the nodes, kept over the refinement's rounds, which only add nodes (and
@@ -2205,6 +2249,7 @@ fn refine_missed(
     o: &Object,
     w: Wall,
     tol: f64,
+    tested: &mut Tested,
 ) -> (usize, usize, [usize; 2]) {
     use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
     let flagged = [AtomicUsize::new(0), AtomicUsize::new(0)];
@@ -2231,6 +2276,9 @@ fn refine_missed(
             .tets
             .par_iter()
             .filter_map(|t| {
+                if tested.known(t) {
+                    return None;
+                }
                 let v = t.map(|n| values[n as usize]);
                 if v.iter().any(|x| !x.is_finite()) {
                     return None;
@@ -2271,6 +2319,7 @@ fn refine_missed(
                     .or_else(|| Some(longest_edge(metric, &st.points, t)))
             })
             .collect();
+        tested.all_before(st.points.len());
         keys.par_sort_unstable();
         keys.dedup();
         if keys.is_empty() {
