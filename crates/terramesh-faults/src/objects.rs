@@ -1916,6 +1916,8 @@ pub(crate) fn refine_near_objects(
     let mut read: Vec<FieldCache> = walls.iter().map(|_| FieldCache::default()).collect();
     // Only the cells with a node made by the previous round are tested (see [`Tested`]).
     let mut tested = Tested::default();
+    // Which cells reach each object's box, kept over the rounds (see [`NearBox`]).
+    let mut boxes: Vec<NearBox> = set.objects.iter().map(|_| NearBox::default()).collect();
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
@@ -1929,8 +1931,8 @@ pub(crate) fn refine_near_objects(
             .zip(&mut read)
             .map(|(&(i, w), read)| {
                 let o = &set.objects[i];
-                let near = near[i]
-                    .get_or_insert_with(|| near_box(st, o, 1e-3 + 1e-6 * set.resolution * o.size));
+                let margin = 1e-3 + 1e-6 * set.resolution * o.size;
+                let near = near[i].get_or_insert_with(|| boxes[i].near(st, o, margin));
                 read.values(&st.points, near, |q| o.field(w, q))
             })
             .collect();
@@ -2062,6 +2064,7 @@ pub(crate) fn refine_near_objects(
                 w,
                 set.resolution * o.size,
                 tested,
+                &mut boxes[i],
             );
             object_stats(
                 format_args!(
@@ -2193,29 +2196,50 @@ mod field_cache_tests {
     }
 }
 
-/// Whether each node belongs to a cell that reaches the object's bounding box grown by
-/// `margin` (a cell across the box's boundary may be crossed by the wall, however far its
-/// other nodes lie outside it).
-fn near_box(st: &State, o: &Object, margin: f64) -> Vec<bool> {
-    let [lo, hi] = o.bbox;
-    let reach: Vec<u32> = st
-        .tets
-        .par_iter()
-        .filter(|t| {
-            (0..3).all(|k| {
-                t.iter()
-                    .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
-                    && t.iter()
-                        .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
-            })
-        })
-        .flat_map_iter(|t| t.iter().copied())
-        .collect();
-    let mut near = vec![false; st.points.len()];
-    for n in reach {
-        near[n as usize] = true;
+/// Which cells reach an object's bounding box grown by a margin, kept over the refinement's
+/// rounds (which only split cells: a cell whose nodes all precede the node count of the last
+/// look is unchanged, and so is whether it reaches the box), for [`NearBox::near`].
+#[derive(Default)]
+struct NearBox {
+    reach: Vec<bool>,
+    tested: Tested,
+    margin: f64,
+}
+
+impl NearBox {
+    /// Whether each node belongs to a cell that reaches the object's bounding box grown by
+    /// `margin` (a cell across the box's boundary may be crossed by the wall, however far
+    /// its other nodes lie outside it). Only the cells made since the last call (with the
+    /// same margin) are measured.
+    fn near(&mut self, st: &State, o: &Object, margin: f64) -> Vec<bool> {
+        let [lo, hi] = o.bbox;
+        if margin.to_bits() != self.margin.to_bits() {
+            *self = NearBox {
+                margin,
+                ..NearBox::default()
+            };
+        }
+        self.reach.resize(st.tets.len(), false);
+        let tested = &self.tested;
+        self.reach.par_iter_mut().zip(&st.tets).for_each(|(r, t)| {
+            if !tested.known(t) {
+                *r = (0..3).all(|k| {
+                    t.iter()
+                        .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
+                        && t.iter()
+                            .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
+                });
+            }
+        });
+        self.tested.all_before(st.points.len());
+        let mut near = vec![false; st.points.len()];
+        for (t, _) in st.tets.iter().zip(&self.reach).filter(|(_, &r)| r) {
+            for &n in t {
+                near[n as usize] = true;
+            }
+        }
+        near
     }
-    near
 }
 
 /// The cells a wall crosses (nodes on both sides) are refined before the cut where their
@@ -2242,6 +2266,7 @@ const CROSSED_STRAY: f64 = 2.0;
 /// wall's surface, not of the band the refinement covers. Returns the edges bisected, the
 /// rounds, and the cells flagged (all rounds): crossed (nodes on both sides), and reached
 /// without a sign change at the nodes.
+#[allow(clippy::too_many_arguments)] // the state, the wall and its two caches
 fn refine_missed(
     metric: &Metric,
     st: &mut State,
@@ -2250,6 +2275,7 @@ fn refine_missed(
     w: Wall,
     tol: f64,
     tested: &mut Tested,
+    boxes: &mut NearBox,
 ) -> (usize, usize, [usize; 2]) {
     use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
     let flagged = [AtomicUsize::new(0), AtomicUsize::new(0)];
@@ -2270,7 +2296,7 @@ fn refine_missed(
         // the box skipped such cells where they were wider than that: a box's edge through
         // cells left coarse by the cap was cut as a chamfer, and a cell inside the box was
         // labelled outside.) A node's field is read once over the rounds.
-        let near = near_box(st, o, 1e-3 + 1e-6 * tol);
+        let near = boxes.near(st, o, 1e-3 + 1e-6 * tol);
         let values: Vec<f64> = read.values(&st.points, &near, f);
         let mut keys: Vec<u64> = st
             .tets
