@@ -140,8 +140,9 @@ impl Stats {
         eprintln!(
             "quality pass: sweep {sweep}: {all} cells below the floor, {poor} planned, \
              {made} operations, \
-             {} plans made again, {secs:.2} s; plans: {}",
+             {} plans made again, {secs:.2} s (cpu at {:.2} s); plans: {}",
             take(&self.replans),
+            crate::lap::cpu_seconds(),
             per.join(", ")
         );
         let st: Vec<String> = self

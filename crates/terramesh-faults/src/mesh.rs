@@ -1272,8 +1272,10 @@ pub fn faulted_mesh_with_objects(
         if stats {
             let q = crate::quality::quality(&st.points, &st.tets);
             eprintln!(
-                "faulted mesh: {what} at {:.2} s: {} cells, {} below 5 degrees, smallest {:.3}",
+                "faulted mesh: {what} at {:.2} s (cpu {:.2} s): {} cells, {} below 5 degrees, \
+                 smallest {:.3}",
                 started.elapsed().as_secs_f64(),
+                crate::lap::cpu_seconds(),
                 st.tets.len(),
                 q.below_5,
                 q.min

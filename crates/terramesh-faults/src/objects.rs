@@ -1868,11 +1868,14 @@ enum On {
 
 /// With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), what a step of the
 /// objects' passes did: its time, the edges it bisected or split, the cells after it.
+/// (`cpu`: the process's CPU seconds when the line is written, to compare steps on a shared
+/// machine.)
 fn object_stats(what: std::fmt::Arguments, since: std::time::Instant, edges: usize, cells: usize) {
     if std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
         eprintln!(
-            "objects: {what}: {edges} edges, {cells} cells after, {:.2} s",
-            since.elapsed().as_secs_f64()
+            "objects: {what}: {edges} edges, {cells} cells after, {:.2} s (cpu at {:.2} s)",
+            since.elapsed().as_secs_f64(),
+            crate::lap::cpu_seconds()
         );
     }
 }
@@ -1911,6 +1914,10 @@ pub(crate) fn refine_near_objects(
     let mut rounds = 0;
     // Each wall's field at the nodes read so far (the rounds only add nodes).
     let mut read: Vec<FieldCache> = walls.iter().map(|_| FieldCache::default()).collect();
+    // Only the cells with a node made by the previous round are tested (see [`Tested`]).
+    let mut tested = Tested::default();
+    // Which cells reach each object's box, kept over the rounds (see [`NearBox`]).
+    let mut boxes: Vec<NearBox> = set.objects.iter().map(|_| NearBox::default()).collect();
     // Refinement near the walls: bisect the longest edge of every cell near a wall whose
     // longest edge is longer than the object's target.
     for _round in 0..40 {
@@ -1924,8 +1931,8 @@ pub(crate) fn refine_near_objects(
             .zip(&mut read)
             .map(|(&(i, w), read)| {
                 let o = &set.objects[i];
-                let near = near[i]
-                    .get_or_insert_with(|| near_box(st, o, 1e-3 + 1e-6 * set.resolution * o.size));
+                let margin = 1e-3 + 1e-6 * set.resolution * o.size;
+                let near = near[i].get_or_insert_with(|| boxes[i].near(st, o, margin));
                 read.values(&st.points, near, |q| o.field(w, q))
             })
             .collect();
@@ -1933,6 +1940,9 @@ pub(crate) fn refine_near_objects(
             .tets
             .par_iter()
             .filter_map(|t| {
+                if tested.known(t) {
+                    return None;
+                }
                 // A cell out of every object's box is left (without measuring it: most are).
                 if !values
                     .iter()
@@ -2012,6 +2022,7 @@ pub(crate) fn refine_near_objects(
                 })
             })
             .collect();
+        tested.all_before(st.points.len());
         keys.par_sort_unstable();
         keys.dedup();
         if keys.is_empty() {
@@ -2038,13 +2049,23 @@ pub(crate) fn refine_near_objects(
     // any surface is cut: the midpoint of an edge on a wall, a fault or an interface already
     // cut lies on the edge's chord, off that surface where it is curved (on an interface, a
     // cell around it then has nodes on both sides of it: "straddles an interface").
+    // Each wall's cells known not to need it (from its previous pass).
+    let mut tested: Vec<Tested> = walls.iter().map(|_| Tested::default()).collect();
     for pass in 0..4 {
         let mut bisected = 0;
-        for &(i, w) in &walls {
+        for (&(i, w), tested) in walls.iter().zip(&mut tested) {
             let o = &set.objects[i];
             let since = std::time::Instant::now();
-            let (edges, rounds, [crossed, reached]) =
-                refine_missed(&metric, st, &mut labels, o, w, set.resolution * o.size);
+            let (edges, rounds, [crossed, reached]) = refine_missed(
+                &metric,
+                st,
+                &mut labels,
+                o,
+                w,
+                set.resolution * o.size,
+                tested,
+                &mut boxes[i],
+            );
             object_stats(
                 format_args!(
                     "crossed cells of {} {} ({w:?}), pass {pass}, {rounds} rounds, cells \
@@ -2063,6 +2084,32 @@ pub(crate) fn refine_near_objects(
         }
     }
     Ok(labels)
+}
+
+/// The cells a round of the refinement near objects (or of [`refine_missed`], for one wall)
+/// need not test: those whose nodes all precede a node count at which every cell was tested
+/// and not flagged. A round's test of a cell reads only its nodes (which never move) and the
+/// walls' fields there, so an unchanged cell not flagged is not flagged again; a flagged
+/// cell is bisected (its key is one of its edges), and every child of a bisection holds the
+/// new midpoint, a node made after the test. The fields are read where a node belongs to a
+/// cell reaching the object's box ([`near_box`]), which a node can lose (its cells split) but
+/// never gain (a child reaches the box only if its parent did), so an unchanged cell's nodes
+/// can only turn unread (infinite), which flags nothing. The same cells are flagged as when
+/// every cell is tested each round: the refinement's mesh does not change.
+#[derive(Default)]
+struct Tested(u32);
+
+impl Tested {
+    /// Whether cell `t` is known not to be flagged.
+    fn known(&self, t: &[u32; 4]) -> bool {
+        t.iter().all(|&n| n < self.0)
+    }
+
+    /// Every cell whose nodes all precede node `n` has been tested and, if flagged, will be
+    /// bisected before the next test.
+    fn all_before(&mut self, n: usize) {
+        self.0 = n as u32;
+    }
 }
 
 /// A wall's field at the nodes, kept over the refinement's rounds, which only add nodes (and
@@ -2149,29 +2196,50 @@ mod field_cache_tests {
     }
 }
 
-/// Whether each node belongs to a cell that reaches the object's bounding box grown by
-/// `margin` (a cell across the box's boundary may be crossed by the wall, however far its
-/// other nodes lie outside it).
-fn near_box(st: &State, o: &Object, margin: f64) -> Vec<bool> {
-    let [lo, hi] = o.bbox;
-    let reach: Vec<u32> = st
-        .tets
-        .par_iter()
-        .filter(|t| {
-            (0..3).all(|k| {
-                t.iter()
-                    .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
-                    && t.iter()
-                        .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
-            })
-        })
-        .flat_map_iter(|t| t.iter().copied())
-        .collect();
-    let mut near = vec![false; st.points.len()];
-    for n in reach {
-        near[n as usize] = true;
+/// Which cells reach an object's bounding box grown by a margin, kept over the refinement's
+/// rounds (which only split cells: a cell whose nodes all precede the node count of the last
+/// look is unchanged, and so is whether it reaches the box), for [`NearBox::near`].
+#[derive(Default)]
+struct NearBox {
+    reach: Vec<bool>,
+    tested: Tested,
+    margin: f64,
+}
+
+impl NearBox {
+    /// Whether each node belongs to a cell that reaches the object's bounding box grown by
+    /// `margin` (a cell across the box's boundary may be crossed by the wall, however far
+    /// its other nodes lie outside it). Only the cells made since the last call (with the
+    /// same margin) are measured.
+    fn near(&mut self, st: &State, o: &Object, margin: f64) -> Vec<bool> {
+        let [lo, hi] = o.bbox;
+        if margin.to_bits() != self.margin.to_bits() {
+            *self = NearBox {
+                margin,
+                ..NearBox::default()
+            };
+        }
+        self.reach.resize(st.tets.len(), false);
+        let tested = &self.tested;
+        self.reach.par_iter_mut().zip(&st.tets).for_each(|(r, t)| {
+            if !tested.known(t) {
+                *r = (0..3).all(|k| {
+                    t.iter()
+                        .any(|&n| st.points[n as usize][k] <= hi[k] + margin)
+                        && t.iter()
+                            .any(|&n| st.points[n as usize][k] >= lo[k] - margin)
+                });
+            }
+        });
+        self.tested.all_before(st.points.len());
+        let mut near = vec![false; st.points.len()];
+        for (t, _) in st.tets.iter().zip(&self.reach).filter(|(_, &r)| r) {
+            for &n in t {
+                near[n as usize] = true;
+            }
+        }
+        near
     }
-    near
 }
 
 /// The cells a wall crosses (nodes on both sides) are refined before the cut where their
@@ -2198,6 +2266,7 @@ const CROSSED_STRAY: f64 = 2.0;
 /// wall's surface, not of the band the refinement covers. Returns the edges bisected, the
 /// rounds, and the cells flagged (all rounds): crossed (nodes on both sides), and reached
 /// without a sign change at the nodes.
+#[allow(clippy::too_many_arguments)] // the state, the wall and its two caches
 fn refine_missed(
     metric: &Metric,
     st: &mut State,
@@ -2205,6 +2274,8 @@ fn refine_missed(
     o: &Object,
     w: Wall,
     tol: f64,
+    tested: &mut Tested,
+    boxes: &mut NearBox,
 ) -> (usize, usize, [usize; 2]) {
     use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
     let flagged = [AtomicUsize::new(0), AtomicUsize::new(0)];
@@ -2225,12 +2296,15 @@ fn refine_missed(
         // the box skipped such cells where they were wider than that: a box's edge through
         // cells left coarse by the cap was cut as a chamfer, and a cell inside the box was
         // labelled outside.) A node's field is read once over the rounds.
-        let near = near_box(st, o, 1e-3 + 1e-6 * tol);
+        let near = boxes.near(st, o, 1e-3 + 1e-6 * tol);
         let values: Vec<f64> = read.values(&st.points, &near, f);
         let mut keys: Vec<u64> = st
             .tets
             .par_iter()
             .filter_map(|t| {
+                if tested.known(t) {
+                    return None;
+                }
                 let v = t.map(|n| values[n as usize]);
                 if v.iter().any(|x| !x.is_finite()) {
                     return None;
@@ -2271,6 +2345,7 @@ fn refine_missed(
                     .or_else(|| Some(longest_edge(metric, &st.points, t)))
             })
             .collect();
+        tested.all_before(st.points.len());
         keys.par_sort_unstable();
         keys.dedup();
         if keys.is_empty() {
