@@ -288,6 +288,10 @@ pub(super) mod tests {
     pub(super) static OFF: std::sync::atomic::AtomicBool =
         std::sync::atomic::AtomicBool::new(false);
 
+    /// Held by each test that sets [`OFF`] or [`LENIENT_OFF`], so that two of them running
+    /// at once do not turn the other's operation off.
+    static FLAGS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
     /// The cavity of the 800 m bench's cell of 4.80 degrees in `sandstone_b` beside F1 (its
     /// nodes on F1 and on the interface under it; the 23 cells of its unit whose
     /// circumsphere holds its centroid, read from `model.vtu`, moved near the origin and
@@ -299,6 +303,7 @@ pub(super) mod tests {
     /// verified.
     #[test]
     fn insert_mends_a_sliver_in_its_cavity() {
+        let _flags = FLAGS.lock().unwrap_or_else(|e| e.into_inner());
         let (points, tets) = cavity_of_the_800m_sliver();
         let (old, volume) = summary(&points, &tets);
         super::super::verify_each_operation(true);
@@ -330,6 +335,7 @@ pub(super) mod tests {
     /// short edge on a line where a fault meets a side or an interface, were stuck so).
     #[test]
     fn lenient_split_mends_the_sliver_without_the_insertion() {
+        let _flags = FLAGS.lock().unwrap_or_else(|e| e.into_inner());
         let (points, tets) = cavity_of_the_800m_sliver();
         let (old, volume) = summary(&points, &tets);
         super::super::verify_each_operation(true);
