@@ -288,8 +288,8 @@ pub(super) mod tests {
     pub(super) static OFF: std::sync::atomic::AtomicBool =
         std::sync::atomic::AtomicBool::new(false);
 
-    /// Held by each test that sets [`OFF`] or [`LENIENT_OFF`], so that two of them running
-    /// at once do not turn the other's operation off.
+    /// Held while a test sets [`OFF`] or [`LENIENT_OFF`], so that two tests running at once
+    /// do not turn the other's operation off.
     static FLAGS: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
     /// The cavity of the 800 m bench's cell of 4.80 degrees in `sandstone_b` beside F1 (its
@@ -303,27 +303,15 @@ pub(super) mod tests {
     /// verified.
     #[test]
     fn insert_mends_a_sliver_in_its_cavity() {
-        let _flags = FLAGS.lock().unwrap_or_else(|e| e.into_inner());
-        let (points, tets) = cavity_of_the_800m_sliver();
-        let (old, volume) = summary(&points, &tets);
-        super::super::verify_each_operation(true);
-        let n = points.len();
         // Without the insertion (and the lenient split) no operation mends the sliver.
-        OFF.store(true, std::sync::atomic::Ordering::Relaxed);
-        LENIENT_OFF.store(true, std::sync::atomic::Ordering::Relaxed);
-        let (st, _) = pass_at(points.clone(), tets.clone(), vec![0; tets.len()], 20.0);
-        OFF.store(false, std::sync::atomic::Ordering::Relaxed);
-        LENIENT_OFF.store(false, std::sync::atomic::Ordering::Relaxed);
-        let (without, _) = summary(&st.points, &st.tets);
-        assert!(without < 5.0, "{old} -> {without} without the insertion");
-        let (st, done) = pass_at(points, tets.clone(), vec![0; tets.len()], 20.0);
-        assert!(done.inserted >= 1, "{done:?}");
-        assert!(st.points.len() > n);
-        let (new, after) = summary(&st.points, &st.tets);
-        assert!(new >= 10.0, "{old} -> {new}");
+        let without = pass_on_the_sliver(false, false);
+        assert!(without.new < 5.0, "{without:?} without the insertion");
+        let with = pass_on_the_sliver(true, true);
+        assert!(with.inserted >= 1 && with.added >= 1, "{with:?}");
+        assert!(with.new >= 10.0, "{with:?}");
         assert!(
-            (after - volume).abs() <= 1e-12 * volume,
-            "{volume} -> {after}"
+            (with.after - with.volume).abs() <= 1e-12 * with.volume,
+            "{with:?}"
         );
     }
 
@@ -335,22 +323,48 @@ pub(super) mod tests {
     /// short edge on a line where a fault meets a side or an interface, were stuck so).
     #[test]
     fn lenient_split_mends_the_sliver_without_the_insertion() {
-        let _flags = FLAGS.lock().unwrap_or_else(|e| e.into_inner());
+        let r = pass_on_the_sliver(false, true);
+        assert!(r.inserted >= 1 && r.added >= 1, "{r:?}");
+        assert!(r.new >= r.old + 1.0 && r.new > 5.0, "{r:?}");
+        assert!((r.after - r.volume).abs() <= 1e-12 * r.volume, "{r:?}");
+    }
+
+    /// What the pass (floor 20 degrees, every operation verified) did to the 800 m sliver's
+    /// cavity: the worst angle and the volume before and after, the operations counted as
+    /// insertions (splits included), the nodes added.
+    #[derive(Debug)]
+    struct Mended {
+        old: f64,
+        new: f64,
+        volume: f64,
+        after: f64,
+        inserted: usize,
+        added: usize,
+    }
+
+    /// The pass on the 800 m sliver's cavity with the insertion and the lenient split on or
+    /// off (holding [`FLAGS`] while the switches are set).
+    fn pass_on_the_sliver(insert: bool, lenient: bool) -> Mended {
+        use std::sync::atomic::Ordering::Relaxed;
         let (points, tets) = cavity_of_the_800m_sliver();
         let (old, volume) = summary(&points, &tets);
         super::super::verify_each_operation(true);
         let n = points.len();
-        OFF.store(true, std::sync::atomic::Ordering::Relaxed);
+        let _flags = FLAGS.lock().unwrap_or_else(|e| e.into_inner());
+        OFF.store(!insert, Relaxed);
+        LENIENT_OFF.store(!lenient, Relaxed);
         let (st, done) = pass_at(points, tets.clone(), vec![0; tets.len()], 20.0);
-        OFF.store(false, std::sync::atomic::Ordering::Relaxed);
-        assert!(done.inserted >= 1, "{done:?}");
-        assert!(st.points.len() > n);
+        OFF.store(false, Relaxed);
+        LENIENT_OFF.store(false, Relaxed);
         let (new, after) = summary(&st.points, &st.tets);
-        assert!(new >= old + 1.0 && new > 5.0, "{old} -> {new}");
-        assert!(
-            (after - volume).abs() <= 1e-12 * volume,
-            "{volume} -> {after}"
-        );
+        Mended {
+            old,
+            new,
+            volume,
+            after,
+            inserted: done.inserted,
+            added: st.points.len() - n,
+        }
     }
 
     /// The 800 m bench's sliver of 4.80 degrees and the cells of its cavity (see
