@@ -6,8 +6,8 @@ use std::cell::Cell;
 use std::time::Instant;
 
 /// Says each step's time since the previous one (or since [`Lap::new`]) as
-/// `<prefix>: <step>: <seconds> s (cpu <seconds> s)`, only where `TERRAMESH_PASS_STATS` is set; nothing else
-/// changes.
+/// `<prefix>: <step>: <seconds> s (cpu <seconds> s)`, only where `TERRAMESH_PASS_STATS` is
+/// set; nothing else changes.
 pub struct Lap {
     prefix: &'static str,
     last: Option<Cell<(Instant, f64)>>,
