@@ -390,7 +390,7 @@ pub fn check(
             let t = mesh.tets[c];
             let q = centroid(p, &t);
             for (f, fault) in faults.faults.iter().enumerate() {
-                let s: Vec<i8> = t.iter().map(|&v| node_sides[v as usize][f]).collect();
+                let s: [i8; 4] = t.map(|v| node_sides[v as usize][f]);
                 if s.contains(&1) && s.contains(&-1) {
                     return Err(fail(q, format!("cell {c} straddles fault {}", fault.name)));
                 }

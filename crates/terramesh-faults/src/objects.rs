@@ -2868,21 +2868,31 @@ pub fn check_objects(
             "the objects' per-cell arrays have the wrong length".into(),
         ));
     }
+    // With `TERRAMESH_PASS_STATS` set (for profiling; nothing else changes), each step's time.
+    let lap = crate::Lap::new("check_objects");
     let mut out = vec![ObjectCheck::default(); set.objects.len()];
     for (i, o) in set.objects.iter().enumerate() {
         out[i].exact = o.exact[0];
         out[i].lining_exact = o.exact[1];
-        let tol = set.tolerance(o);
-        out[i].tolerance = tol;
-        for &w in o.walls() {
-            let f = |q: [f64; 3]| o.field(w, q);
-            let [lo, hi] = o.bbox;
-            let bad = tets.par_iter().enumerate().find_map_any(|(c, t)| {
-                let q = t.map(|v| points[v as usize]);
+        out[i].tolerance = set.tolerance(o);
+    }
+    // Every wall of every object in one pass over the cells (not one pass per wall); the
+    // failure reported is that of the first wall failing, at its lowest cell.
+    let all_walls = walls(set);
+    let bad = tets
+        .par_iter()
+        .enumerate()
+        .filter_map(|(c, t)| {
+            let q = t.map(|v| points[v as usize]);
+            for (j, &(i, w)) in all_walls.iter().enumerate() {
+                let o = &set.objects[i];
+                let tol = out[i].tolerance;
+                let f = |q: [f64; 3]| o.field(w, q);
+                let [lo, hi] = o.bbox;
                 if q.iter()
                     .all(|p| (0..3).any(|k| p[k] < lo[k] - 1.0 || p[k] > hi[k] + 1.0))
                 {
-                    return None;
+                    continue;
                 }
                 let v = q.map(f);
                 let straddles = v.iter().any(|&x| x < -OBJECT_TOLERANCE)
@@ -2891,35 +2901,64 @@ pub fn check_objects(
                     cells.object[c] == i as u32 + 1 && (w == Wall::Outer || !cells.lining[c]);
                 let cen = centroid(points, t);
                 let fc = f(cen);
-                if straddles {
+                let what = if straddles {
                     let (lo, hi) = v.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-                    Some((c, cen, format!("has nodes on both sides (field {lo:.3} to {hi:.3} m, tolerance {tol:.3}) of")))
+                    format!("has nodes on both sides (field {lo:.3} to {hi:.3} m, tolerance {tol:.3}) of")
                 } else if label_in && fc > tol {
-                    Some((c, cen, "is labelled inside but lies outside".to_string()))
+                    "is labelled inside but lies outside".to_string()
                 } else if !label_in && cells.object[c] == 0 && fc < -tol {
-                    Some((c, cen, "is labelled outside but lies inside".to_string()))
+                    "is labelled outside but lies inside".to_string()
                 } else {
-                    None
-                }
-            });
-            if let Some((c, p, what)) = bad {
-                return Err(fail(
-                    p,
-                    format!(
-                        "cell {c} {what} the {}wall of {} {}",
-                        if w == Wall::Outer {
-                            "lining's outer "
-                        } else {
-                            ""
-                        },
-                        o.kind,
-                        o.name
-                    ),
-                ));
+                    continue;
+                };
+                return Some((j, c, cen, what));
+            }
+            None
+        })
+        .min_by_key(|b| (b.0, b.1));
+    if let Some((j, c, p, what)) = bad {
+        let (i, w) = all_walls[j];
+        let o = &set.objects[i];
+        return Err(fail(
+            p,
+            format!(
+                "cell {c} {what} the {}wall of {} {}",
+                if w == Wall::Outer {
+                    "lining's outer "
+                } else {
+                    ""
+                },
+                o.kind,
+                o.name
+            ),
+        ));
+    }
+    lap.say("walls");
+    // The faces between cells of different labels: each has a cell in an object, so only the
+    // faces of the cells with three nodes of an object's cells are sorted (every cell that
+    // shares a face with an object's cell is one of them: the runs of equal faces that hold
+    // an object's cell are those of all the faces, and the others add nothing below).
+    let mut marked = vec![false; points.len()];
+    for (t, &o) in tets.iter().zip(&cells.object) {
+        if o != 0 {
+            for &v in t {
+                marked[v as usize] = true;
             }
         }
     }
-    let faces = crate::mesh::all_faces(tets);
+    let mut faces: Vec<(u128, u32, u8)> = tets
+        .par_iter()
+        .enumerate()
+        .filter(|&(c, t)| {
+            cells.object[c] != 0 || t.iter().filter(|&&v| marked[v as usize]).count() >= 3
+        })
+        .flat_map_iter(|(c, t)| {
+            let f = crate::mesh::outward_faces(t);
+            (0..4u8).map(move |k| (crate::mesh::face_key(&f[k as usize]), c as u32, k))
+        })
+        .collect();
+    faces.par_sort_unstable();
+    drop(marked);
     let mut i = 0;
     while i < faces.len() {
         if i + 1 < faces.len() && faces[i].0 == faces[i + 1].0 {
@@ -2977,6 +3016,7 @@ pub fn check_objects(
             i += 1;
         }
     }
+    lap.say("faces");
     for (c, t) in tets.iter().enumerate() {
         let o = cells.object[c];
         if o == 0 {
@@ -2992,6 +3032,7 @@ pub fn check_objects(
             r.volume += v;
         }
     }
+    lap.say("volumes");
     for (i, r) in out.iter().enumerate() {
         if r.boundary_distance > r.tolerance {
             let o = &set.objects[i];

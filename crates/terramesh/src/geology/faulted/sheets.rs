@@ -16,18 +16,45 @@ pub(crate) fn object_sheets(
     names: &[(u32, String)],
 ) -> Vec<FaultSheet> {
     use rayon::prelude::*;
-    // Every face of an object's cell: its object, its sorted corners' coordinates (the key)
-    // and the face oriented away from its cell; sorted by object and key, a face that only
-    // one cell of its object has is on the object's boundary (keys are distinct within an
-    // object's run there, so the order of equal keys does not matter).
-    type Key = [[u64; 3]; 3];
-    let mut faces: Vec<(u32, Key, [[f64; 3]; 3])> = tets
+    // Faces are matched by their corners' coordinates: every point stands for the first point
+    // with its coordinates' bits (its canonical id), so that a face's sorted canonical ids are
+    // equal exactly where its sorted corners' coordinates are.
+    let bits = |i: u32| points[i as usize].map(f64::to_bits);
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (bits(i), i));
+    let mut canon = vec![0u32; points.len()];
+    for w in 0..order.len() {
+        canon[order[w] as usize] = if w > 0 && bits(order[w]) == bits(order[w - 1]) {
+            canon[order[w - 1] as usize]
+        } else {
+            order[w]
+        };
+    }
+    // Every face of an object's cell (cell and the node opposite it): its object and its
+    // sorted canonical corners; sorted by both, a face that only one cell of its object has
+    // is on the object's boundary.
+    let mut faces: Vec<(u32, [u32; 3], u32, u8)> = tets
         .par_iter()
         .enumerate()
         .flat_map_iter(|(c, t)| {
             let o = object.get(c).copied().unwrap_or(0);
-            let q = t.map(|v| points[v as usize]);
-            (0..4).filter(move |_| o != 0).map(move |opp| {
+            let canon = &canon;
+            (0..4u8).filter(move |_| o != 0).map(move |opp| {
+                let mut key = [1, 2, 3].map(|k| canon[t[(opp as usize + k) % 4] as usize]);
+                key.sort_unstable();
+                (o, key, c as u32, opp)
+            })
+        })
+        .collect();
+    faces.par_sort_unstable();
+    // The boundary faces, oriented away from their cell, with the key they are given in
+    // (their sorted corners' coordinates: distinct within an object's boundary).
+    type Key = [[u64; 3]; 3];
+    let mut found: Vec<(u32, Key, [[f64; 3]; 3])> = faces
+        .par_chunk_by(|a, b| a.0 == b.0 && a.1 == b.1)
+        .filter_map(|run| match run {
+            [(o, _, c, opp)] => {
+                let (opp, q) = (*opp as usize, tets[*c as usize].map(|v| points[v as usize]));
                 let mut f: [[f64; 3]; 3] = [0, 1, 2].map(|k| q[(opp + 1 + k) % 4]);
                 let (a, b, c3, d) = (f[0], f[1], f[2], q[opp]);
                 let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
@@ -43,18 +70,17 @@ pub(crate) fn object_sheets(
                 }
                 let mut key: Key = f.map(|p| p.map(f64::to_bits));
                 key.sort_unstable();
-                (o, key, f)
-            })
+                Some((*o, key, f))
+            }
+            _ => None,
         })
         .collect();
-    faces.par_sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    found.par_sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
     // per object, its boundary faces in increasing key
     let mut boundary: std::collections::HashMap<u32, Vec<[[f64; 3]; 3]>> =
         std::collections::HashMap::new();
-    for run in faces.chunk_by(|a, b| a.0 == b.0 && a.1 == b.1) {
-        if let [(o, _, f)] = run {
-            boundary.entry(*o).or_default().push(*f);
-        }
+    for (o, _, f) in found {
+        boundary.entry(o).or_default().push(f);
     }
     names
         .iter()
