@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
 use terramesh_core::volume::tetra_volume;
 
-use crate::mesh::{all_faces, centroid, face_key, outward_faces, InterfaceFn};
+use crate::mesh::{centroid, face_key, outward_faces, InterfaceFn};
 use crate::{quality, FaultError, FaultSet, FaultedMesh, MeshSettings, Quality, Terrain};
 
 /// Relative tolerance of the volume check.
@@ -66,6 +66,87 @@ fn c3(p: [f64; 3]) -> Coord3D<f64> {
 fn rotated(f: [u32; 3]) -> [u32; 3] {
     let m = (0..3).min_by_key(|&i| f[i]).unwrap();
     [f[m], f[(m + 1) % 3], f[(m + 2) % 3]]
+}
+
+/// Every face of the cells `keep` admits, as [`all_faces`] gives them: `(key, cell, local
+/// face)`, sorted. Where the nodes' numbers fit 21 bits and the cells' 30, each face is packed
+/// into one `u128` (its three sorted nodes, its cell, its local face: the same order) while
+/// sorting, half the bytes of the tuples and one comparison each; else the tuples.
+pub(crate) struct SortedFaces {
+    packed: Vec<u128>,
+    wide: Vec<(u128, u32, u8)>,
+}
+
+impl SortedFaces {
+    pub(crate) fn new(
+        tets: &[[u32; 4]],
+        nodes: usize,
+        keep: &(dyn Fn(usize, &[u32; 4]) -> bool + Sync),
+    ) -> SortedFaces {
+        if nodes > 1 << 21 || tets.len() > 1 << 30 {
+            let mut wide: Vec<(u128, u32, u8)> = tets
+                .par_iter()
+                .enumerate()
+                .filter(|&(c, t)| keep(c, t))
+                .flat_map_iter(|(c, t)| {
+                    let f = outward_faces(t);
+                    (0..4u8).map(move |k| (face_key(&f[k as usize]), c as u32, k))
+                })
+                .collect();
+            wide.par_sort_unstable();
+            return SortedFaces {
+                packed: Vec::new(),
+                wide,
+            };
+        }
+        let mut packed: Vec<u128> = tets
+            .par_iter()
+            .enumerate()
+            .filter(|&(c, t)| keep(c, t))
+            .flat_map_iter(|(c, t)| {
+                let f = outward_faces(t);
+                (0..4u8).map(move |k| {
+                    let mut n = f[k as usize];
+                    n.sort_unstable();
+                    let key = (n[0] as u128) << 42 | (n[1] as u128) << 21 | n[2] as u128;
+                    key << 32 | (c as u128) << 2 | k as u128
+                })
+            })
+            .collect();
+        packed.par_sort_unstable();
+        SortedFaces {
+            packed,
+            wide: Vec::new(),
+        }
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.packed.len() + self.wide.len()
+    }
+
+    /// Face `i` in order: its key (of [`face_key`]), cell and local face.
+    pub(crate) fn get(&self, i: usize) -> (u128, u32, u8) {
+        if self.packed.is_empty() {
+            return self.wide[i];
+        }
+        let e = self.packed[i];
+        let key = e >> 32;
+        let m = (1u128 << 21) - 1;
+        (
+            (key >> 42) << 64 | (key >> 21 & m) << 32 | (key & m),
+            (e as u32) >> 2,
+            (e & 3) as u8,
+        )
+    }
+
+    /// Whether faces `i` and `j` are one face.
+    pub(crate) fn same(&self, i: usize, j: usize) -> bool {
+        if self.packed.is_empty() {
+            self.wide[i].0 == self.wide[j].0
+        } else {
+            self.packed[i] >> 32 == self.packed[j] >> 32
+        }
+    }
 }
 
 /// Checks a faulted mesh:
@@ -160,7 +241,7 @@ pub fn check(
     }
     lap.say("volumes");
     // 2. Faces.
-    let faces = all_faces(&mesh.tets);
+    let faces = SortedFaces::new(&mesh.tets, n, &|_, _| true);
     let oriented = |e: &(u128, u32, u8)| outward_faces(&mesh.tets[e.1 as usize])[e.2 as usize];
     let mut boundary: Vec<[u32; 3]> = Vec::new();
     let mut boundary_cell: Vec<u32> = Vec::new();
@@ -168,40 +249,39 @@ pub fn check(
     let mut i = 0;
     while i < faces.len() {
         let mut j = i + 1;
-        while j < faces.len() && faces[j].0 == faces[i].0 {
+        while j < faces.len() && faces.same(j, i) {
             j += 1;
         }
+        let fi = faces.get(i);
         match j - i {
             1 => {
-                boundary.push(oriented(&faces[i]));
-                boundary_cell.push(faces[i].1);
+                boundary.push(oriented(&fi));
+                boundary_cell.push(fi.1);
             }
             2 => {
-                let (a, b) = (
-                    rotated(oriented(&faces[i])),
-                    rotated(oriented(&faces[i + 1])),
-                );
+                let fj = faces.get(i + 1);
+                let (a, b) = (rotated(oriented(&fi)), rotated(oriented(&fj)));
                 if a[0] != b[0] || a[1] != b[2] || a[2] != b[1] {
                     return Err(fail(
                         p[a[0] as usize],
                         format!(
                             "cells {} and {} share a face with the same orientation",
-                            faces[i].1,
-                            faces[i + 1].1
+                            fi.1, fj.1
                         ),
                     ));
                 }
-                interior.push((faces[i].0, faces[i].1, faces[i + 1].1));
+                interior.push((fi.0, fi.1, fj.1));
             }
             k => {
                 return Err(fail(
-                    p[oriented(&faces[i])[0] as usize],
+                    p[oriented(&fi)[0] as usize],
                     format!("a face is in {k} cells"),
                 ))
             }
         }
         i = j;
     }
+    drop(faces);
     lap.say("faces");
     // 3. The boundary: closed, and only on the terrain, the base and the sides.
     let mut edges: Vec<(u32, u32, bool)> = boundary
@@ -576,4 +656,46 @@ pub fn check(
             q
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packed faces read back as `all_faces` gives them, in the same order (two cubes of
+    /// six tetrahedra with node numbers scattered up to 2^21 - 1), and a filter keeps the
+    /// faces of the cells it admits only, in order.
+    #[test]
+    fn packed_faces_are_all_faces_in_order() {
+        let id = |i: u32| (i * 262_139) % (1 << 21);
+        let kuhn = [
+            [0, 1, 3, 7],
+            [0, 1, 5, 7],
+            [0, 2, 3, 7],
+            [0, 2, 6, 7],
+            [0, 4, 5, 7],
+            [0, 4, 6, 7],
+        ];
+        let mut tets = Vec::new();
+        for x in 0..2u32 {
+            for t in kuhn {
+                tets.push(t.map(|d: u32| id(x * 4 + (d & 1) * 4 + (d >> 1))));
+            }
+        }
+        let all = crate::mesh::all_faces(&tets);
+        let packed = SortedFaces::new(&tets, 1 << 21, &|_, _| true);
+        assert!(packed.wide.is_empty() && packed.len() == all.len());
+        for (i, e) in all.iter().enumerate() {
+            assert_eq!(packed.get(i), *e);
+            if i > 0 {
+                assert_eq!(packed.same(i - 1, i), all[i - 1].0 == e.0);
+            }
+        }
+        let some = SortedFaces::new(&tets, 1 << 21, &|c, _| c % 2 == 0);
+        let kept: Vec<_> = all.iter().filter(|e| e.1 % 2 == 0).copied().collect();
+        assert_eq!((0..some.len()).map(|i| some.get(i)).collect::<Vec<_>>(), kept);
+        let wide = SortedFaces::new(&tets, (1 << 21) + 1, &|_, _| true);
+        assert!(wide.packed.is_empty());
+        assert_eq!((0..wide.len()).map(|i| wide.get(i)).collect::<Vec<_>>(), all);
+    }
 }

@@ -2946,23 +2946,15 @@ pub fn check_objects(
             }
         }
     }
-    let mut faces: Vec<(u128, u32, u8)> = tets
-        .par_iter()
-        .enumerate()
-        .filter(|&(c, t)| {
-            cells.object[c] != 0 || t.iter().filter(|&&v| marked[v as usize]).count() >= 3
-        })
-        .flat_map_iter(|(c, t)| {
-            let f = crate::mesh::outward_faces(t);
-            (0..4u8).map(move |k| (crate::mesh::face_key(&f[k as usize]), c as u32, k))
-        })
-        .collect();
-    faces.par_sort_unstable();
+    let faces = crate::check::SortedFaces::new(tets, points.len(), &|c, t| {
+        cells.object[c] != 0 || t.iter().filter(|&&v| marked[v as usize]).count() >= 3
+    });
     drop(marked);
     let mut i = 0;
     while i < faces.len() {
-        if i + 1 < faces.len() && faces[i].0 == faces[i + 1].0 {
-            let (a, b) = (faces[i].1 as usize, faces[i + 1].1 as usize);
+        let fi = faces.get(i);
+        if i + 1 < faces.len() && faces.same(i, i + 1) {
+            let (a, b) = (fi.1 as usize, faces.get(i + 1).1 as usize);
             let la = (cells.object[a], cells.lining[a]);
             let lb = (cells.object[b], cells.lining[b]);
             if la != lb {
@@ -2972,7 +2964,7 @@ pub fn check_objects(
                 } else {
                     (lb, la)
                 };
-                let nodes = crate::mesh::outward_faces(&tets[a])[faces[i].2 as usize];
+                let nodes = crate::mesh::outward_faces(&tets[a])[fi.2 as usize];
                 let dist = |o: &Object, w: Wall| {
                     nodes
                         .iter()
@@ -3001,11 +2993,11 @@ pub fn check_objects(
         } else {
             // A face of a structure's part above the terrain on the model's boundary: its
             // exposed surface, on the solid.
-            let c = faces[i].1 as usize;
+            let c = fi.1 as usize;
             if c + cells.above_cells >= tets.len() && cells.object[c] != 0 {
                 let k = cells.object[c] as usize - 1;
                 let o = &set.objects[k];
-                let nodes = crate::mesh::outward_faces(&tets[c])[faces[i].2 as usize];
+                let nodes = crate::mesh::outward_faces(&tets[c])[fi.2 as usize];
                 let d = nodes
                     .iter()
                     .map(|&v| o.field(Wall::Inner, points[v as usize]).abs())

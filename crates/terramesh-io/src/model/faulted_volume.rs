@@ -69,6 +69,24 @@ pub fn faulted_volume(
     base: f64,
     split: bool,
 ) -> (VolumeMesh, FaultData) {
+    let (vm, fd, _) = faulted_volume_with_faces(mesh, units, base, split);
+    (vm, fd)
+}
+
+/// Every face of a [`VolumeMesh`]'s tetrahedra by its sorted node ids, with its cell and local
+/// face, sorted: kept from [`faulted_volume_with_faces`] for
+/// [`super::write_object_model_with_faces`], which would otherwise sort every face again.
+#[derive(Debug, Clone, Default)]
+pub struct MeshFaces(pub(super) Vec<([u32; 3], u32, u8)>);
+
+/// [`faulted_volume`], with the model's faces sorted ([`MeshFaces`]) when its nodes are not
+/// split (`None` when they are: the writers match split nodes by their coordinates).
+pub fn faulted_volume_with_faces(
+    mesh: &FaultedMesh,
+    units: &[String],
+    base: f64,
+    split: bool,
+) -> (VolumeMesh, FaultData, Option<MeshFaces>) {
     let (points, tets, original) = if split {
         let s = split_nodes(mesh);
         (s.points, s.tets, s.original)
@@ -228,6 +246,7 @@ pub fn faulted_volume(
     // not of that material (or none)
     // (unsplit, every node is its own original: the same vector as `by_key`, not sorted again)
     let by_orig = if split {
+        drop(by_key);
         grouped(&|c, k| key(&nodes3(c, k).map(|v| original[v as usize])))
     } else {
         by_key
@@ -245,15 +264,14 @@ pub fn faulted_volume(
                 .iter()
                 .all(|&(_, d, _)| d == c || material[d as usize] != u)
             {
-                let n: Vec<u32> = nodes_of(c as usize, f as usize)
-                    .iter()
-                    .map(|&v| original[v as usize])
-                    .collect();
-                bodies[u as usize].triangles.push([n[0], n[1], n[2]]);
+                let n = nodes3(c as usize, f as usize).map(|v| original[v as usize]);
+                bodies[u as usize].triangles.push(n);
             }
         }
     }
     bodies.retain(|b| !b.triangles.is_empty());
+    // unsplit, `by_orig` is every face of this mesh by its own nodes
+    let faces = (!split).then_some(MeshFaces(by_orig));
     let vm = VolumeMesh {
         points,
         cells,
@@ -272,5 +290,5 @@ pub fn faulted_volume(
             .collect(),
         faults: fault_faces,
     };
-    (vm, fd)
+    (vm, fd, faces)
 }

@@ -71,7 +71,7 @@ pub use bodies::{body_mesh, stl_origin, write_body_stl, write_body_tsurf};
 pub use boundary::{boundary_mesh, boundary_tags, BoundaryMesh};
 pub use check::{check_mesh, check_mesh_with, MeshError};
 pub use faces::{cell_faces, ogs_face_index};
-pub use faulted_volume::{block_name, faulted_volume};
+pub use faulted_volume::{block_name, faulted_volume, faulted_volume_with_faces, MeshFaces};
 pub use faults::{
     check_faults, fault_mesh, side_nodes, write_fault_tsurf, FaceSide, FaultData, FaultFaces,
     FaultMesh,
@@ -163,7 +163,7 @@ pub fn write_model_with(
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
-    write_files(dir, mesh, None, None, info, volumes)
+    write_files(dir, mesh, None, None, info, volumes, None)
 }
 
 /// Writes every file of a faulted model into the existing folder `dir`: what [`write_model`]
@@ -181,7 +181,7 @@ pub fn write_faulted_model(
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
-    write_files(dir, mesh, Some(faults), None, info, volumes)
+    write_files(dir, mesh, Some(faults), None, info, volumes, None)
 }
 
 /// Writes every file of a model with engineering objects (issue 32) into the existing folder
@@ -207,7 +207,23 @@ pub fn write_object_model(
     info: &ModelInfo,
     volumes: Option<&[f64]>,
 ) -> Result<Vec<String>, ModelWriteError> {
-    write_files(dir, mesh, faults, Some(objects), info, volumes)
+    write_files(dir, mesh, faults, Some(objects), info, volumes, None)
+}
+
+/// [`write_object_model`], with the mesh's faces already sorted by [`faulted_volume_with_faces`]
+/// (then not sorted again where they are what the bodies and the objects' boundaries read:
+/// see [`MeshFaces`]); the same files.
+#[allow(clippy::too_many_arguments)]
+pub fn write_object_model_with_faces(
+    dir: &Path,
+    mesh: &VolumeMesh,
+    faults: Option<&FaultData>,
+    objects: &ObjectData,
+    info: &ModelInfo,
+    volumes: Option<&[f64]>,
+    faces: Option<MeshFaces>,
+) -> Result<Vec<String>, ModelWriteError> {
+    write_files(dir, mesh, faults, Some(objects), info, volumes, faces)
 }
 
 fn write_files(
@@ -217,6 +233,7 @@ fn write_files(
     objects: Option<&ObjectData>,
     info: &ModelInfo,
     volumes: Option<&[f64]>,
+    faces: Option<MeshFaces>,
 ) -> Result<Vec<String>, ModelWriteError> {
     check_mesh_with(mesh, volumes)?;
     if let Some(f) = faults {
@@ -225,32 +242,52 @@ fn write_files(
     // With objects, the structures' and linings' cells take materials of their own after the
     // units: every writer takes that copy of the mesh.
     let mut relabelled;
-    // with objects in cells, every face sorted once for both the bodies and the boundaries
+    // with objects in cells, every face sorted once (or given) for both the bodies and the
+    // objects' boundaries, found side by side
     let mut sides = None;
     let mesh = match objects {
         Some(d) => {
             check_objects(mesh, faults, d)?;
             let mut units = mesh.units.clone();
             units.extend(extra_materials(&d.objects));
+            let any = d.object.iter().any(|&o| o > 0);
             relabelled = VolumeMesh {
+                points: mesh.points.clone(),
+                cells: mesh.cells.clone(),
                 material: d.material_ids(&mesh.material, mesh.units.len()),
                 units,
-                ..mesh.clone()
+                faces: mesh.faces.clone(),
+                tags: mesh.tags.clone(),
+                // made again below from every face
+                bodies: if any { Vec::new() } else { mesh.bodies.clone() },
             };
-            if d.object.iter().any(|&o| o > 0) {
-                let all = objects::all_sides(&relabelled);
-                relabelled.bodies = objects::material_bodies(&relabelled, &all);
-                sides = Some(all);
+            if any {
+                // the faces the caller sorted, where they are those of `all_sides`
+                let given = faces.filter(|f| objects::faces_are_sides(&relabelled, &f.0));
+                let (bodies, boundaries) = match &given {
+                    Some(f) => rayon::join(
+                        || objects::material_bodies(&relabelled, &f.0),
+                        || objects::boundaries_of(d, &f.0),
+                    ),
+                    None => {
+                        let all = objects::all_sides(&relabelled);
+                        rayon::join(
+                            || objects::material_bodies(&relabelled, &all),
+                            || objects::boundaries_of(d, &all),
+                        )
+                    }
+                };
+                relabelled.bodies = bodies;
+                sides = Some(boundaries);
             }
             &relabelled
         }
         None => mesh,
     };
-    let boundaries = &objects.map(|d| match &sides {
-        Some(all) => objects::boundaries_of(d, all),
+    let boundaries = &objects.map(|d| match sides.take() {
+        Some(b) => b,
         None => object_boundaries(mesh, d),
     });
-    drop(sides);
     // the points' text, for model.msh, model.f3grid and the bodies' TSurf
     let pts = &crate::textsink::PointText::new(&mesh.points);
     let blocks = &passes::Indexed::new(mesh);

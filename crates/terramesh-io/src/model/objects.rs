@@ -13,7 +13,7 @@
 use std::io::{self, Write};
 
 use rayon::prelude::*;
-use terramesh_core::volume::{Body, FaceTag, VolumeMesh};
+use terramesh_core::volume::{Body, CellKind, FaceTag, VolumeMesh};
 
 use super::boundary::BoundaryMesh;
 use super::faces::{cell_faces, compact_nodes};
@@ -343,7 +343,23 @@ pub fn object_boundaries(m: &VolumeMesh, d: &ObjectData) -> Vec<Vec<FaceSide>> {
 /// Every face of `m`'s cells by its points' canonical ids (split fault nodes share one),
 /// sorted: what [`material_bodies`] and [`boundaries_of`] read.
 pub(super) fn all_sides(m: &VolumeMesh) -> Vec<([u32; 4], u32, u8)> {
-    let canon = &canonical_points(m);
+    sides_by(m, &canonical_points(m))
+}
+
+/// Whether `faces` ([`super::MeshFaces`], every face of `m`'s tetrahedra by its node ids,
+/// sorted) are what [`all_sides`] would sort: every cell a tetrahedron, a face per cell and
+/// side, and every point its own canonical id (no two points at the same coordinates), so
+/// that node ids and canonical ids sort alike. Else [`all_sides`] is what the writers read.
+pub(super) fn faces_are_sides(m: &VolumeMesh, faces: &[([u32; 3], u32, u8)]) -> bool {
+    faces.len() == 4 * m.cells.len()
+        && m.cells.par_iter().all(|c| c.kind == CellKind::Tetra)
+        && canonical_points(m)
+            .par_iter()
+            .enumerate()
+            .all(|(i, &c)| c as usize == i)
+}
+
+fn sides_by(m: &VolumeMesh, canon: &[u32]) -> Vec<([u32; 4], u32, u8)> {
     let mut sides: Vec<([u32; 4], u32, u8)> = (0..m.cells.len())
         .into_par_iter()
         .flat_map_iter(|c| {
@@ -359,7 +375,10 @@ pub(super) fn all_sides(m: &VolumeMesh) -> Vec<([u32; 4], u32, u8)> {
 /// least those with three points in the objects' bounding box) or of all cells
 /// ([`all_sides`]): the same boundaries either way, since every cell that shares a face with
 /// an object's cell has that face's three points in the box.
-pub(super) fn boundaries_of(d: &ObjectData, sides: &[([u32; 4], u32, u8)]) -> Vec<Vec<FaceSide>> {
+pub(super) fn boundaries_of<K: PartialEq + Sync>(
+    d: &ObjectData,
+    sides: &[(K, u32, u8)],
+) -> Vec<Vec<FaceSide>> {
     let cell_group = d.cell_groups();
     let mut out = vec![Vec::new(); d.groups().len()];
     for group in sides.chunk_by(|a, b| a.0 == b.0) {
@@ -515,7 +534,7 @@ pub(super) fn boundary_groups(
 /// faces left out. What `unit-<name>.ts` and `.stl` hold for a model with objects, whose
 /// structures and linings take their cells out of the units.
 /// `sides` are all faces of `m`'s cells, sorted ([`all_sides`]).
-pub(super) fn material_bodies(m: &VolumeMesh, sides: &[([u32; 4], u32, u8)]) -> Vec<Body> {
+pub(super) fn material_bodies<K: PartialEq>(m: &VolumeMesh, sides: &[(K, u32, u8)]) -> Vec<Body> {
     let mut bodies: Vec<Body> = (0..m.units.len())
         .map(|unit| Body {
             unit,

@@ -125,8 +125,14 @@ pub(crate) fn run(
     )?;
     let faulted = build_mesh(g, &terrain, &set, &ifs, base)?;
     let lap = terramesh_faults::Lap::new("geology stage");
-    let (volume, data) =
-        terramesh_io::model::faulted_volume(&faulted.mesh, &g.units, base, g.split_faults);
+    let (volume, data, faces) = terramesh_io::model::faulted_volume_with_faces(
+        &faulted.mesh,
+        &g.units,
+        base,
+        g.split_faults,
+    );
+    // kept for the objects' writers only (which would sort them again)
+    let faces = faces.filter(|_| !g.objects.is_empty());
     lap.say("the writers' model (faulted_volume)");
     // The surfaces at the planar vertices, for the pictures, the statistics and the grids: at
     // each vertex an interface in the block where it lies there.
@@ -169,9 +175,15 @@ pub(crate) fn run(
     };
     let objects = crate::geology::objects::object_data(g, &faulted.mesh);
     let written = match &objects {
-        Some(d) => {
-            terramesh_io::model::write_object_model(out, &volume, Some(&data), d, &info, None)
-        }
+        Some(d) => terramesh_io::model::write_object_model_with_faces(
+            out,
+            &volume,
+            Some(&data),
+            d,
+            &info,
+            None,
+            faces,
+        ),
         None => write_faulted_model(out, &volume, &data, &info, None),
     }
     .map_err(|e| match e {
