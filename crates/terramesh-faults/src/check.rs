@@ -693,9 +693,15 @@ mod tests {
         }
         let some = SortedFaces::new(&tets, 1 << 21, &|c, _| c % 2 == 0);
         let kept: Vec<_> = all.iter().filter(|e| e.1 % 2 == 0).copied().collect();
-        assert_eq!((0..some.len()).map(|i| some.get(i)).collect::<Vec<_>>(), kept);
+        assert_eq!(
+            (0..some.len()).map(|i| some.get(i)).collect::<Vec<_>>(),
+            kept
+        );
         let wide = SortedFaces::new(&tets, (1 << 21) + 1, &|_, _| true);
         assert!(wide.packed.is_empty());
-        assert_eq!((0..wide.len()).map(|i| wide.get(i)).collect::<Vec<_>>(), all);
+        assert_eq!(
+            (0..wide.len()).map(|i| wide.get(i)).collect::<Vec<_>>(),
+            all
+        );
     }
 }

@@ -24,8 +24,8 @@ use terramesh_core::volume::VolumeMesh;
 use terramesh_faults::FaultedMesh;
 use terramesh_io::export::parse_tsurf;
 use terramesh_io::model::{
-    cell_faces, write_faulted_model, write_object_model, FaultData, MeshError, ModelInfo,
-    ModelWriteError, ObjectData,
+    cell_faces, faulted_volume_with_faces, write_faulted_model, write_object_model,
+    write_object_model_with_faces, FaultData, MeshError, ModelInfo, ModelWriteError, ObjectData,
 };
 
 fn root() -> PathBuf {
@@ -582,6 +582,33 @@ fn split_nodes_give_the_same_object_boundaries() {
             )
         };
         assert_eq!(read(x.path()), read(y.path()), "object-{name}.vtu");
+    }
+}
+
+/// The faces `faulted_volume_with_faces` keeps give the same files, byte for byte, as the
+/// writers' own sort of every face; with split nodes it keeps none.
+#[test]
+fn kept_faces_give_the_same_files() {
+    let (k, a, fa, da) = objected(false);
+    let s = site_of(4, vec![90.0, 60.0]);
+    let units: Vec<String> = support::faulted::UNITS
+        .iter()
+        .map(|u| u.to_string())
+        .collect();
+    let (b, fb, faces) = faulted_volume_with_faces(&k, &units, s.base, false);
+    assert!(faces.is_some());
+    assert!(faulted_volume_with_faces(&k, &units, s.base, true)
+        .2
+        .is_none());
+    let (x, y) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let wx = write_object_model(x.path(), &a, Some(&fa), &da, &info(), None).unwrap();
+    let wy =
+        write_object_model_with_faces(y.path(), &b, Some(&fb), &da, &info(), None, faces).unwrap();
+    assert_eq!(wx, wy);
+    assert!(wx.iter().any(|n| n.starts_with("object-")));
+    for name in &wx {
+        let read = |d: &Path| std::fs::read(d.join(name)).unwrap();
+        assert!(read(x.path()) == read(y.path()), "{name} differs");
     }
 }
 
