@@ -91,10 +91,10 @@ impl Pass<'_> {
         if let Some(op) = self.merge_near(t, around) {
             return Some(op);
         }
-        if let Some(op) = edges
-            .iter()
-            .find_map(|&(_, i, j)| self.remove_edge(t[i], t[j], around[i]))
-        {
+        if let Some(op) = edges.iter().find_map(|&(_, i, j)| {
+            self.remove_edge(t[i], t[j], around[i])
+                .or_else(|| self.flip_fault_edge(t[i], t[j], around[i]))
+        }) {
             return Some(op);
         }
         if let Some(op) = self.pierce_best(t, around) {
@@ -665,6 +665,174 @@ impl Pass<'_> {
         if !(pairs[k].contains(&poly[0]) && pairs[k].contains(&poly[n - 1])) {
             return None;
         }
+        let old = self.worst(&ring);
+        let (best, new) = self.fill_ring(&poly, a, b)?;
+        if best <= old.max(0.0) {
+            return None;
+        }
+        let poor = self.poor(&ring);
+        if poor < n && new.iter().filter(|x| x.1 < self.floor).count() > poor {
+            return None;
+        }
+        if !new.iter().all(|x| {
+            let g = self.geo(x.0);
+            self.in_unit(g, ring[0]) && self.in_objects(g, ring[0])
+        }) {
+            return None;
+        }
+        Some(Op::Replace { ring, new })
+    }
+
+    /// The flip of edge (`a`, `b`) on a fault (`around`: the cells around `a`): where two
+    /// lines on a fault (its lines with an interface and with another fault) meet at a
+    /// blunt angle, the fault's triangle across that corner is flat (the example's F2 face
+    /// with 158 degrees where F2, F3 and block 1's interface meet), and every cell on it is a
+    /// sliver whatever its apex. The edge's ring is closed and of two labels, each half a
+    /// chain of 1 to [`RING_MAX`] − 2 cells between the two fault faces (a, b, c) and
+    /// (a, b, d); each half is replaced by the best triangulation of its polygon (c, its
+    /// nodes, d) joined to `a` and to `b` ([`Pass::fill_ring`]), so that the fault's two
+    /// faces become (c, d, a) and (c, d, b), shared by both halves. Kept if the faces' centroids
+    /// and the new edge's midpoint lie within half of `check`'s tolerance of every fault whose
+    /// sides differ between the halves (the zones and object labels the same), and, as an
+    /// edge removal, if the worst cell gains, no more cells fall below the floor unless every
+    /// old one was below it, and every new cell lies in its unit, on its side of every fault
+    /// (its centroid) and of the objects' walls.
+    fn flip_fault_edge(&self, a: u32, b: u32, around: &[u32]) -> Option<Op> {
+        let ring = self.holding(around, b);
+        if !(2..=2 * RING_MAX).contains(&ring.len()) {
+            return None;
+        }
+        let labels = self.labels(&ring);
+        if labels.len() != 2 || (labels[0].3, labels[0].4) != (labels[1].3, labels[1].4) {
+            return None;
+        }
+        let differ = labels[0].0 ^ labels[1].0;
+        if differ == 0 {
+            return None;
+        }
+        // The ring closed, and each half a chain between the same two ends.
+        let (_, ends) = self.ring_ends(&ring, a, b)?;
+        if !ends.is_empty() {
+            return None;
+        }
+        let halves: Vec<Vec<u32>> = labels
+            .iter()
+            .map(|l| {
+                ring.iter()
+                    .copied()
+                    .filter(|&c| self.label(c) == *l)
+                    .collect()
+            })
+            .collect();
+        let mut chains = Vec::with_capacity(2);
+        for half in &halves {
+            let (_, ends) = self.ring_ends(half, a, b)?;
+            if ends.len() != 2 || !(2..RING_MAX).contains(&half.len()) {
+                return None;
+            }
+            chains.push((self.chain(half, a, b, ends[0])?, ends));
+        }
+        if chains[0].1 != chains[1].1 {
+            return None;
+        }
+        let [c, d] = [chains[0].1[0], chains[0].1[1]];
+        let pt = |v: u32| self.st.points[v as usize];
+        let half_tol = 0.5 * crate::FAULT_TOLERANCE;
+        let mean = |q: &[[f64; 3]]| {
+            [0, 1, 2].map(|k| q.iter().map(|r| r[k]).sum::<f64>() / q.len() as f64)
+        };
+        let probes = [
+            mean(&[pt(c), pt(d)]),
+            mean(&[pt(c), pt(d), pt(a)]),
+            mean(&[pt(c), pt(d), pt(b)]),
+        ];
+        for (f, fault) in self.faults.faults.iter().enumerate() {
+            if differ >> f & 1 == 1
+                && probes
+                    .iter()
+                    .any(|&q| fault.side(q).distance.abs() > half_tol)
+            {
+                return None;
+            }
+        }
+        let old = self.worst(&ring);
+        let mut new = Vec::with_capacity(2);
+        let mut worst = f64::MAX;
+        for ((poly, _), half) in chains.iter().zip(&halves) {
+            let (q, cells) = self.fill_ring(poly, a, b)?;
+            worst = worst.min(q);
+            new.push((half.clone(), cells));
+        }
+        if worst <= old.max(0.0) {
+            return None;
+        }
+        let poor = self.poor(&ring);
+        let now = new
+            .iter()
+            .flat_map(|h| &h.1)
+            .filter(|x| x.1 < self.floor)
+            .count();
+        if poor < ring.len() && now > poor {
+            return None;
+        }
+        let sides = |g: [[f64; 3]; 4], like: u32| {
+            let m = mean(&g);
+            let s = self.st.positive[like as usize];
+            self.faults
+                .faults
+                .iter()
+                .enumerate()
+                .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1))
+        };
+        if !new.iter().all(|(half, cells)| {
+            cells.iter().all(|x| {
+                let g = self.geo(x.0);
+                sides(g, half[0]) && self.in_unit(g, half[0]) && self.in_objects(g, half[0])
+            })
+        }) {
+            return None;
+        }
+        Some(Op::Replace2 { halves: new })
+    }
+
+    /// The nodes of the chain of cells `half` around edge (`a`, `b`) in order from its end
+    /// `c` (each cell holds two consecutive ones); `None` if the cells are not a chain.
+    fn chain(&self, half: &[u32], a: u32, b: u32, c: u32) -> Option<Vec<u32>> {
+        let pairs: Vec<[u32; 2]> = half
+            .iter()
+            .map(|&d| {
+                let o: Vec<u32> = self.st.tets[d as usize]
+                    .into_iter()
+                    .filter(|&v| v != a && v != b)
+                    .collect();
+                [o[0], o[1]]
+            })
+            .collect();
+        let mut poly = vec![c];
+        let mut used = vec![false; pairs.len()];
+        while poly.len() <= pairs.len() {
+            let last = poly[poly.len() - 1];
+            let k = (0..pairs.len()).find(|&k| !used[k] && pairs[k].contains(&last))?;
+            used[k] = true;
+            let next = if pairs[k][0] == last {
+                pairs[k][1]
+            } else {
+                pairs[k][0]
+            };
+            if poly.contains(&next) {
+                return None;
+            }
+            poly.push(next);
+        }
+        Some(poly)
+    }
+
+    /// The cells of the triangulation of polygon `poly` (the nodes around edge (`a`, `b`) in
+    /// order; the polygon closed by its edge from the last node to the first) joined to `a`
+    /// and to `b` whose worst cell is best (Klincsek's dynamic programme), with that worst
+    /// cell's angle; `None` if no triangulation's cells are all positive (exact).
+    fn fill_ring(&self, poly: &[u32], a: u32, b: u32) -> Option<(f64, Vec<([u32; 4], f64)>)> {
+        let n = poly.len();
         // Which way the polygon turns around the edge, seen from `a`: counterclockwise when
         // orient3d(r0, r1, a, b) > 0 (then a triangle (ri, rj, rk), i < j < k, has `a` on
         // its negative side, and the cell [ri, rj, rk, a] is positive).
@@ -713,10 +881,6 @@ impl Pass<'_> {
                 best[i * n + k] = b;
             }
         }
-        let old = self.worst(&ring);
-        if best[n - 1] <= old.max(0.0) {
-            return None;
-        }
         let mut tris = Vec::with_capacity(n - 2);
         let mut todo = vec![(0, n - 1)];
         while let Some((i, k)) = todo.pop() {
@@ -739,17 +903,7 @@ impl Pass<'_> {
                 new.push((t, positive_min_dihedral(g)));
             }
         }
-        let poor = self.poor(&ring);
-        if poor < n && new.iter().filter(|x| x.1 < self.floor).count() > poor {
-            return None;
-        }
-        if !new.iter().all(|x| {
-            let g = self.geo(x.0);
-            self.in_unit(g, ring[0]) && self.in_objects(g, ring[0])
-        }) {
-            return None;
-        }
-        Some(Op::Replace { ring, new })
+        Some((best[n - 1], new))
     }
 
     /// Makes [`Op::Merge`].
