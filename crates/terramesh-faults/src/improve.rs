@@ -250,6 +250,9 @@ type Label = (u64, u32, u32, u64, u32);
 /// tolerance of [`crate::check`], twice the half of it that every new cell is held to.
 const MERGE: f64 = crate::FAULT_TOLERANCE;
 
+/// Cells (their nodes) each with its smallest angle.
+type Cells = Vec<([u32; 4], f64)>;
+
 /// A cell of a pierce ([`Op::Pierce`]) and its two cones, each with its smallest angle.
 type Kids = (u32, [u32; 4], f64, [u32; 4], f64);
 
@@ -314,9 +317,7 @@ enum Op {
     },
     /// Each half's cells (of one label) replaced by the cells of its `new`, which tile the
     /// same region (a flip of an edge on a fault, module `tail`).
-    Replace2 {
-        halves: Vec<(Vec<u32>, Vec<([u32; 4], f64)>)>,
-    },
+    Replace2 { halves: Vec<(Vec<u32>, Cells)> },
     /// A new node at `at` inside the cavity `kill` (cells of one label, module `cavity`):
     /// the cavity's cells replaced by the cones of `new` ([`NEW`] the new node), each with
     /// its smallest angle.

@@ -831,7 +831,7 @@ impl Pass<'_> {
     /// order; the polygon closed by its edge from the last node to the first) joined to `a`
     /// and to `b` whose worst cell is best (Klincsek's dynamic programme), with that worst
     /// cell's angle; `None` if no triangulation's cells are all positive (exact).
-    fn fill_ring(&self, poly: &[u32], a: u32, b: u32) -> Option<(f64, Vec<([u32; 4], f64)>)> {
+    fn fill_ring(&self, poly: &[u32], a: u32, b: u32) -> Option<(f64, super::Cells)> {
         let n = poly.len();
         // Which way the polygon turns around the edge, seen from `a`: counterclockwise when
         // orient3d(r0, r1, a, b) > 0 (then a triangle (ri, rj, rk), i < j < k, has `a` on
