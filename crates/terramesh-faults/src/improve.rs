@@ -250,6 +250,9 @@ type Label = (u64, u32, u32, u64, u32);
 /// tolerance of [`crate::check`], twice the half of it that every new cell is held to.
 const MERGE: f64 = crate::FAULT_TOLERANCE;
 
+/// Cells (their nodes) each with its smallest angle.
+type Cells = Vec<([u32; 4], f64)>;
+
 /// A cell of a pierce ([`Op::Pierce`]) and its two cones, each with its smallest angle.
 type Kids = (u32, [u32; 4], f64, [u32; 4], f64);
 
@@ -312,6 +315,9 @@ enum Op {
         kill: Vec<u32>,
         kids: Vec<Kids>,
     },
+    /// Each half's cells (of one label) replaced by the cells of its `new`, which tile the
+    /// same region (a flip of an edge on a fault, module `tail`).
+    Replace2 { halves: Vec<(Vec<u32>, Cells)> },
     /// A new node at `at` inside the cavity `kill` (cells of one label, module `cavity`):
     /// the cavity's cells replaced by the cones of `new` ([`NEW`] the new node), each with
     /// its smallest angle.
@@ -717,6 +723,12 @@ impl Pass<'_> {
                 done.inserted += 1;
             }
             Op::Replace { ring, new } => self.replace(ring, new, done),
+            Op::Replace2 { halves } => {
+                for (ring, new) in halves {
+                    self.replace(ring, new, done);
+                }
+                done.flipped -= 1;
+            }
             Op::Insert { at, kill, new } => self.inserted(at, kill, new, done),
             Op::Pierce {
                 b,
@@ -1627,6 +1639,7 @@ impl Pass<'_> {
             Op::Flip32 { ring, .. } => ring.to_vec(),
             Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
             Op::Insert { kill, .. } => kill.clone(),
+            Op::Replace2 { halves } => halves.iter().flat_map(|h| h.0.clone()).collect(),
             Op::Pierce { kill, kids, .. } => kill
                 .iter()
                 .copied()
