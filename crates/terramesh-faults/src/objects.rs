@@ -1637,7 +1637,7 @@ fn close(m: &Metric, st: &State, keys: &mut Vec<u64>) {
     if keys.is_empty() {
         return;
     }
-    let (start, cells) = node_cells(st);
+    let (start, cells) = node_cells(st, |_| true);
     let mut fresh: Vec<u64> = keys.clone();
     while !fresh.is_empty() {
         // The cells holding a freshly marked edge: those around its first node that hold
@@ -1680,13 +1680,16 @@ fn close(m: &Metric, st: &State, keys: &mut Vec<u64>) {
     }
 }
 
-/// Each node's cells: the cells of node `n` are `cells[start[n]..start[n + 1]]`, ascending.
-fn node_cells(st: &State) -> (Vec<u32>, Vec<u32>) {
+/// Each kept node's cells (compressed rows): the cells of node `n` are
+/// `cells[start[n]..start[n + 1]]`, ascending; none for a node `keep` refuses.
+fn node_cells(st: &State, keep: impl Fn(usize) -> bool) -> (Vec<u32>, Vec<u32>) {
     let n = st.points.len();
     let mut start = vec![0u32; n + 1];
     for t in &st.tets {
         for &v in t {
-            start[v as usize + 1] += 1;
+            if keep(v as usize) {
+                start[v as usize + 1] += 1;
+            }
         }
     }
     for i in 0..n {
@@ -1696,8 +1699,10 @@ fn node_cells(st: &State) -> (Vec<u32>, Vec<u32>) {
     let mut cells = vec![0u32; start[n] as usize];
     for (c, t) in st.tets.iter().enumerate() {
         for &v in t {
-            cells[next[v as usize] as usize] = c as u32;
-            next[v as usize] += 1;
+            if keep(v as usize) {
+                cells[next[v as usize] as usize] = c as u32;
+                next[v as usize] += 1;
+            }
         }
     }
     (start, cells)
@@ -2442,28 +2447,8 @@ fn snap_to_wall(
         .zip(&near)
         .map(|(&q, &near)| if near { f(q) } else { f64::INFINITY })
         .collect();
-    // The cells around each node near the wall (compressed rows).
-    let mut start = vec![0u32; n + 1];
-    for t in &st.tets {
-        for &v in t {
-            if near[v as usize] {
-                start[v as usize + 1] += 1;
-            }
-        }
-    }
-    for k in 0..n {
-        start[k + 1] += start[k];
-    }
-    let mut fill = start.clone();
-    let mut star = vec![0u32; start[n] as usize];
-    for (c, t) in st.tets.iter().enumerate() {
-        for &v in t {
-            if near[v as usize] {
-                star[fill[v as usize] as usize] = c as u32;
-                fill[v as usize] += 1;
-            }
-        }
-    }
+    // The cells around each node near the wall.
+    let (start, star) = node_cells(st, |v| near[v]);
     let label = |c: usize| {
         (
             st.block[c],
