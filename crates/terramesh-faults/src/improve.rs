@@ -43,6 +43,7 @@ use crate::{BlockKey, FaultSet, ObjectCells, ObjectSet, Terrain, ON_SURFACE, ZON
 
 mod cavity;
 mod tail;
+mod trace;
 mod walls;
 
 /// What the quality pass did.
@@ -325,6 +326,15 @@ enum Op {
         at: [f64; 3],
         kill: Vec<u32>,
         new: Vec<([u32; 4], f64)>,
+    },
+    /// A new node at `at` (flags `flags`, faults `on_fault`) on a fault inside a cavity of
+    /// the cells on its two sides (module `trace`): each half's cells (of one label)
+    /// replaced by its cones ([`NEW`] the new node), each with its smallest angle.
+    InsertOn {
+        at: [f64; 3],
+        flags: u8,
+        on_fault: u64,
+        halves: Vec<(Vec<u32>, Cells)>,
     },
     /// Node `v` moved to `to`: `cells` (its cells) take the smallest angles `angles`.
     Move {
@@ -730,6 +740,12 @@ impl Pass<'_> {
                 done.flipped -= 1;
             }
             Op::Insert { at, kill, new } => self.inserted(at, kill, new, done),
+            Op::InsertOn {
+                at,
+                flags,
+                on_fault,
+                halves,
+            } => self.inserted_on(at, flags, on_fault, halves, done),
             Op::Pierce {
                 b,
                 flags,
@@ -1639,7 +1655,9 @@ impl Pass<'_> {
             Op::Flip32 { ring, .. } => ring.to_vec(),
             Op::Split { ring, .. } | Op::Replace { ring, .. } => ring.clone(),
             Op::Insert { kill, .. } => kill.clone(),
-            Op::Replace2 { halves } => halves.iter().flat_map(|h| h.0.clone()).collect(),
+            Op::Replace2 { halves } | Op::InsertOn { halves, .. } => {
+                halves.iter().flat_map(|h| h.0.clone()).collect()
+            }
             Op::Pierce { kill, kids, .. } => kill
                 .iter()
                 .copied()

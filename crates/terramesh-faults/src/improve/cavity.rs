@@ -25,7 +25,7 @@ use crate::mesh::positive;
 use crate::quality::positive_min_dihedral;
 
 /// The most cells a cavity may hold.
-const CAVITY_MAX: usize = 48;
+pub(super) const CAVITY_MAX: usize = 48;
 
 /// An insertion that puts more cells below the floor than its cavity held is kept only if
 /// its worst cell gains this much (degrees): the cavity's cells are replaced by about twice
@@ -184,7 +184,7 @@ impl Pass<'_> {
 
     /// The faces of the cavity's boundary: (cell, i) for the face of `cell` opposite its
     /// node i that no other cell of the cavity holds.
-    fn boundary(&self, cavity: &[u32]) -> Vec<(u32, usize)> {
+    pub(super) fn boundary(&self, cavity: &[u32]) -> Vec<(u32, usize)> {
         let mut out = Vec::new();
         for &d in cavity {
             let t = self.st.tets[d as usize];
@@ -201,7 +201,7 @@ impl Pass<'_> {
     }
 
     /// The places of cell `t`'s nodes, [`NEW`] at `p`.
-    fn geo_at(&self, t: [u32; 4], p: [f64; 3]) -> [[f64; 3]; 4] {
+    pub(super) fn geo_at(&self, t: [u32; 4], p: [f64; 3]) -> [[f64; 3]; 4] {
         t.map(|w| {
             if w == NEW {
                 p
@@ -269,7 +269,7 @@ fn circumcentre(g: [[f64; 3]; 4]) -> Option<[f64; 3]> {
 
 /// Whether `p` lies inside the sphere through the cell's nodes (floating point: the
 /// cavity's growth is a heuristic; positivity decides).
-fn holds(g: [[f64; 3]; 4], p: [f64; 3]) -> bool {
+pub(super) fn holds(g: [[f64; 3]; 4], p: [f64; 3]) -> bool {
     circumcentre(g).is_some_and(|o| super::d2(o, p) < super::d2(o, g[0]))
 }
 

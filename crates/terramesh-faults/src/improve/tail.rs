@@ -101,8 +101,12 @@ impl Pass<'_> {
             return Some(op);
         }
         (0..4)
-            .find_map(|i| self.fault_move(t[i], around[i]))
+            .find_map(|i| {
+                self.fault_move(t[i], around[i])
+                    .or_else(|| self.trace_move(t[i], around[i]))
+            })
             .or_else(|| self.insert(c, around))
+            .or_else(|| self.insert_on_fault(c, around))
             .or_else(|| self.lenient_split(t, around))
     }
 
