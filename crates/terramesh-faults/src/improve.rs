@@ -46,6 +46,8 @@ mod tail;
 mod trace;
 mod walls;
 
+pub use trace::trace_operations;
+
 /// What the quality pass did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub(crate) struct Improved {

@@ -208,7 +208,7 @@ pub use check::{check, CheckSummary, FAULT_TOLERANCE, VOLUME_TOLERANCE};
 pub use error::FaultError;
 pub use fault::{BlockKey, Fault, FaultGeometry, FaultSet, FaultSpec, Side, ALONG_TRACE_DEGREES};
 #[doc(hidden)]
-pub use improve::verify_each_operation;
+pub use improve::{trace_operations, verify_each_operation};
 pub use lap::Lap;
 pub use mesh::{
     faulted_mesh, faulted_mesh_with_objects, BuildReport, FaultFace, FaultedMesh, InterfaceFn,

@@ -1,22 +1,56 @@
-//! **A node of a fault's trace moved along the trace** ([`Pass::trace_move`]), an operation
-//! of the tail (module `tail`): where a fault dipping gently meets the terrain, its hanging
-//! wall is a thin wedge, and a DSM vertex a few decimetres off the fault (which never moves:
-//! it is the terrain's data) next to a trace node metres away makes slivers of the wedge's
-//! cells between them and the fault's nodes below. The trace node lies on the terrain and on
-//! the fault, so no move of the pass may take it anywhere; here it slides along the line
-//! where the two meet (each trial place brought back onto both by Newton's steps), by a
+//! Operations of the tail (module `tail`, tried after every other but the lenient split) for
+//! a fault dipping gently under the terrain: its hanging wall near the trace is a thin wedge,
+//! and a DSM vertex a few decimetres off the fault (which never moves: it is the terrain's
+//! data) beside trace nodes 20 m apart and fault nodes metres below makes slivers of the
+//! wedge's cells (the 20-degree dip site's last 6 cells below 5 degrees: DSM vertices 0.25
+//! to 0.7 m off the fault, 0.7 to 2 m from the trace).
+//!
+//! **A trace node moved along the trace** ([`Pass::trace_move`]): a node of the cut on the
+//! terrain and on one fault may not move in [`Pass::slide_at`]; here it slides along the
+//! line where the two meet (each trial place brought back onto both by Newton's steps), by a
 //! compass search, kept if the smallest angle of its cells improves, no more of them fall
-//! below the floor, every face of its cells on the terrain still lies on the DSM (its
-//! nodes, centroid and edge midpoints: where the DSM folds under the node, nothing moves),
-//! every face between its cells on the two sides of a fault stays within half of `check`'s
-//! tolerance of the fault (its centroid and the midpoints of its edges through the node),
-//! and every cell lies in its unit, on its side of every fault (its centroid) and of the
-//! objects' walls.
+//! below the floor, every face of its cells on the terrain still lies on the DSM (its nodes,
+//! centroid and edge midpoints: where the DSM folds under the node, it stays), every face
+//! between its cells on the two sides of the fault stays within half of `check`'s tolerance
+//! of the fault (its centroid and the midpoints of its edges through the node), and every
+//! cell lies in its unit, on its side of every fault (its centroid) and of the objects'
+//! walls.
+//!
+//! **A new node on a fault** ([`Pass::insert_on_fault`]): the insertion of module `cavity`
+//! across a fault. The node goes on an edge of the poor cell that lies on a fault (its ring
+//! of two labels, the fault's two sides in one unit, zone and object label; on the trace
+//! too if the edge lies on the terrain, seven trial places along it) or inside a face of it
+//! on a fault (at its centroid and towards each corner, then moving along the fault); its
+//! cavity is grown from the cells holding that edge or face to cells of the two labels whose
+//! circumsphere holds it, as a cavity's, and each face of the cavity's boundary gets a cone
+//! from the node, labelled as the cell that held the face: the faces between the two sides
+//! inside the cavity (on the fault, as the node is) are replaced by the cones' faces through
+//! the node, and on the trace the cavity's faces on the terrain are dropped (the node lies
+//! in their plane) and replaced by the cones' faces through it. With every cone positive
+//! (exact) the cones tile the cavity; kept, as an insertion is, if they are better than the
+//! cavity's worst cell (which holds the poor cell), no more of them are below the floor
+//! unless the worst gains [`super::cavity::INSERT_GAIN`], their volume is the cavity's to
+//! 1e-9, each lies in its unit, on its side of every fault (its centroid) and of the
+//! objects' walls, each new face between the two sides lies within half of `check`'s
+//! tolerance of the fault (its centroid) and each new face on the terrain on the DSM.
 
 use super::{Label, Op, Pass};
 use crate::mesh::{positive, BASE, ON_INTERFACE, SIDE, TOP};
 use crate::quality::{min_dihedral, positive_min_dihedral};
 use crate::ON_SURFACE;
+
+static OFF: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Turns this module's operations (the trace node's move and the new node on a fault) off or
+/// on, for every model meshed after (for tests: they show what the pass does without them).
+#[doc(hidden)]
+pub fn trace_operations(on: bool) {
+    OFF.store(!on, std::sync::atomic::Ordering::Relaxed);
+}
+
+fn off() -> bool {
+    OFF.load(std::sync::atomic::Ordering::Relaxed)
+}
 
 impl Pass<'_> {
     /// Moves trace node `v` (`cells`: its cells) along its fault's trace (see the module's
@@ -25,7 +59,8 @@ impl Pass<'_> {
     /// the two sides of that fault, in the same zones and object label.
     pub(super) fn trace_move(&self, v: u32, cells: &[u32]) -> Option<Op> {
         let f = self.st.flags[v as usize];
-        if f & TOP == 0
+        if off()
+            || f & TOP == 0
             || f & (BASE | SIDE | ON_INTERFACE) != 0
             || (v as usize) < self.background
             || cells.is_empty()
@@ -124,7 +159,7 @@ impl Pass<'_> {
             let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
             let (a11, a12, a22) = (dot(n, n), dot(n, m), dot(m, m));
             let det = a11 * a22 - a12 * a12;
-            if !(det > 1e-12 * a11 * a22) {
+            if det.is_nan() || det <= 1e-12 * a11 * a22 {
                 return None;
             }
             let l1 = (a22 * r1 - a12 * r2) / det;
@@ -183,9 +218,7 @@ impl Pass<'_> {
                 let face: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
                 let r: Vec<[f64; 3]> = face.iter().map(|&w| pt(w)).collect();
                 let r = [r[0], r[1], r[2]];
-                let top = face
-                    .iter()
-                    .all(|&w| self.st.flags[w as usize] & TOP != 0);
+                let top = face.iter().all(|&w| self.st.flags[w as usize] & TOP != 0);
                 if top && !self.face_on_boundary(r, TOP) {
                     return false;
                 }
@@ -199,10 +232,7 @@ impl Pass<'_> {
                     let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
                     let centre = [0, 1, 2].map(|k| (r[0][k] + r[1][k] + r[2][k]) / 3.0);
                     let probes = [centre, mid(r[0], r[1]), mid(r[1], r[2]), mid(r[0], r[2])];
-                    if probes
-                        .iter()
-                        .any(|&x| fault.side(x).distance.abs() > half)
-                    {
+                    if probes.iter().any(|&x| fault.side(x).distance.abs() > half) {
                         return false;
                     }
                 }
@@ -211,10 +241,13 @@ impl Pass<'_> {
         true
     }
 
-    /// A new node on a fault (and on the terrain, on its trace) inside a cavity of the
-    /// cells on its two sides (see the module's doc): for each edge of poor cell `t` on a
-    /// fault whose ring holds the cells of one label on each side, trial places along it.
+    /// The best new node on a fault (and on the terrain, on its trace) inside a cavity of the
+    /// cells on its two sides that holds poor cell `c` (`around[i]`: the cells around its
+    /// node i; see the module's doc).
     pub(super) fn insert_on_fault(&self, c: u32, around: &[&[u32]; 4]) -> Option<Op> {
+        if off() {
+            return None;
+        }
         let t = self.st.tets[c as usize];
         let mut best: Option<(f64, Op)> = None;
         for &(i, j) in &crate::mesh::EDGES {
@@ -240,10 +273,14 @@ impl Pass<'_> {
         // Each face of the cell on a fault, at its centroid and towards each corner.
         for skip in 0..4 {
             let f: Vec<u32> = (0..4).filter(|&j| j != skip).map(|j| t[j]).collect();
-            let Some(d) = around[if skip == 0 { 1 } else { 0 }].iter().copied().find(|&d| {
-                !t.iter().all(|w| self.st.tets[d as usize].contains(w))
-                    && f.iter().all(|w| self.st.tets[d as usize].contains(w))
-            }) else {
+            let Some(d) = around[if skip == 0 { 1 } else { 0 }]
+                .iter()
+                .copied()
+                .find(|&d| {
+                    !t.iter().all(|w| self.st.tets[d as usize].contains(w))
+                        && f.iter().all(|w| self.st.tets[d as usize].contains(w))
+                })
+            else {
                 continue;
             };
             let (x, y) = (self.label(c), self.label(d));
@@ -255,7 +292,12 @@ impl Pass<'_> {
             let len = (0..3)
                 .map(|i| super::d2(q[i], q[(i + 1) % 3]).sqrt())
                 .fold(0.0, f64::max);
-            for w in [[1.0, 1.0, 1.0], [4.0, 1.0, 1.0], [1.0, 4.0, 1.0], [1.0, 1.0, 4.0]] {
+            for w in [
+                [1.0, 1.0, 1.0],
+                [4.0, 1.0, 1.0],
+                [1.0, 4.0, 1.0],
+                [1.0, 1.0, 4.0],
+            ] {
                 let n = w[0] + w[1] + w[2];
                 let p0 = [0, 1, 2].map(|k| (0..3).map(|i| w[i] * q[i][k]).sum::<f64>() / n);
                 if let Some((a, op)) = self.insert_on_face([c, d], p0, fi, len) {
@@ -310,7 +352,13 @@ impl Pass<'_> {
 
     /// [`Pass::insert_on_fault`] on the face of fault `fi` between cells `pair`, from the
     /// trial place `p0` on it (moving along the fault).
-    fn insert_on_face(&self, pair: [u32; 2], p0: [f64; 3], fi: usize, len: f64) -> Option<(f64, Op)> {
+    fn insert_on_face(
+        &self,
+        pair: [u32; 2],
+        p0: [f64; 3],
+        fi: usize,
+        len: f64,
+    ) -> Option<(f64, Op)> {
         let fault = &self.faults.faults[fi];
         let onto = |to: [f64; 3]| {
             let mut q = to;
@@ -378,9 +426,9 @@ impl Pass<'_> {
             let u = self.st.tets[d as usize];
             on_top && (0..4).filter(|&j| j != i).all(|j| top(u[j])) && {
                 let f: Vec<u32> = (0..4).filter(|&j| j != i).map(|j| u[j]).collect();
-                !near.iter().any(|&e| {
-                    e != d && f.iter().all(|w| self.st.tets[e as usize].contains(w))
-                })
+                !near
+                    .iter()
+                    .any(|&e| e != d && f.iter().all(|w| self.st.tets[e as usize].contains(w)))
             }
         };
         let faces = loop {
@@ -448,23 +496,18 @@ impl Pass<'_> {
             Some((worst, n))
         };
         let start = eval(p0, 0.0, usize::MAX)?;
-        let (best, count, p) = super::compass_search(
-            p0,
-            start,
-            poor,
-            h,
-            len,
-            super::COMPASS_STEPS,
-            onto,
-            eval,
-        );
+        let (best, count, p) =
+            super::compass_search(p0, start, poor, h, len, super::COMPASS_STEPS, onto, eval);
         if best < old + super::MIN_GAIN || (count > poor && best < old + super::cavity::INSERT_GAIN)
         {
             return None;
         }
         // The volume kept (the dropped terrain faces covered by the new ones exactly once).
         let vol = |g: [[f64; 3]; 4]| terramesh_core::volume::tetra_volume(g[0], g[1], g[2], g[3]);
-        let before: f64 = cavity.iter().map(|&d| vol(self.geo(self.st.tets[d as usize]))).sum();
+        let before: f64 = cavity
+            .iter()
+            .map(|&d| vol(self.geo(self.st.tets[d as usize])))
+            .sum();
         let after: f64 = cones.iter().map(|&(_, u)| vol(self.geo_at(u, p))).sum();
         if (after - before).abs() > 1e-9 * before.abs() {
             return None;
@@ -521,7 +564,11 @@ impl Pass<'_> {
         let halves: Vec<(Vec<u32>, super::Cells)> = labels
             .iter()
             .map(|l| {
-                let kill = cavity.iter().copied().filter(|&d| self.label(d) == *l).collect();
+                let kill = cavity
+                    .iter()
+                    .copied()
+                    .filter(|&d| self.label(d) == *l)
+                    .collect();
                 let new = cones
                     .iter()
                     .filter(|&&(d, _)| self.label(d) == *l)
