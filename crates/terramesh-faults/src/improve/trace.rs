@@ -421,12 +421,14 @@ impl Pass<'_> {
                 }
             }
         }
-        // The terrain's faces of the cavity (dropped: the node lies in their plane).
+        // The terrain's faces of the cavity (no cell on their other side; dropped: the node
+        // lies in their plane).
         let dropped = |d: u32, i: usize| {
             let u = self.st.tets[d as usize];
             on_top && (0..4).filter(|&j| j != i).all(|j| top(u[j])) && {
                 let f: Vec<u32> = (0..4).filter(|&j| j != i).map(|j| u[j]).collect();
-                !near
+                !self
+                    .cells(f[0])
                     .iter()
                     .any(|&e| e != d && f.iter().all(|w| self.st.tets[e as usize].contains(w)))
             }
