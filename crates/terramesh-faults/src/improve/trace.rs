@@ -17,7 +17,9 @@
 //! walls.
 //!
 //! **A new node on a fault** ([`Pass::insert_on_fault`]): the insertion of module `cavity`
-//! across a fault. The node goes on an edge of the poor cell that lies on a fault (its ring
+//! across a fault, for a poor cell with a node on the terrain (so that the sweeps of a model
+//! with many poor cells elsewhere do not pay for it). The node goes on an edge of the poor
+//! cell that lies on a fault (its ring
 //! of two labels, the fault's two sides in one unit, zone and object label; on the trace
 //! too if the edge lies on the terrain, seven trial places along it) or inside a face of it
 //! on a fault (at its centroid and towards each corner, then moving along the fault); its
@@ -245,10 +247,13 @@ impl Pass<'_> {
     /// cells on its two sides that holds poor cell `c` (`around[i]`: the cells around its
     /// node i; see the module's doc).
     pub(super) fn insert_on_fault(&self, c: u32, around: &[&[u32]; 4]) -> Option<Op> {
-        if off() {
+        let t = self.st.tets[c as usize];
+        // Only under the terrain (the wedge of a gently dipping fault's hanging wall), so
+        // that the tail's sweeps of a model with many poor cells elsewhere (pinch-outs) do not
+        // pay for its cavities.
+        if off() || !t.iter().any(|&v| self.st.flags[v as usize] & TOP != 0) {
             return None;
         }
-        let t = self.st.tets[c as usize];
         let mut best: Option<(f64, Op)> = None;
         for &(i, j) in &crate::mesh::EDGES {
             let (a, b) = (t[i], t[j]);
