@@ -3136,6 +3136,47 @@ mod tests {
     /// A node on a circular tunnel's barrel slides along it (onto the circle of its piece,
     /// its place along the axis kept), but not near a cap or a mitre, and not on another
     /// profile's wall.
+    /// A lining cell flat against a lined tunnel's cap inside its profile (every node on the
+    /// tunnel's wall, its centroid inside) is labelled as the tunnel; a lining cell with a
+    /// node off the wall, or one whose centroid lies outside the tunnel, keeps its label.
+    #[test]
+    fn a_lining_cell_flat_against_a_cap_is_labelled_as_the_tunnel() {
+        let t = Terrain::new(
+            vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+            vec![100.0; 4],
+        )
+        .unwrap();
+        let spec = ObjectSpec {
+            name: "T".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[10.0, 50.0, 50.0], [90.0, 50.0, 50.0]],
+                profile: Profile::Circle { diameter: 10.0 },
+                lining: 0.5,
+            },
+        };
+        let set = ObjectSet::new(&[spec], &t, 0.0).unwrap();
+        // Radius 5 around (y, z) = (50, 50), cap at x = 10.
+        let points = vec![
+            [10.0, 50.0, 46.0],   // on the cap, radius 4
+            [10.0, 50.6, 46.2],   // on the cap
+            [10.0, 49.4, 46.2],   // on the cap
+            [10.003, 50.0, 45.0], // on the barrel, 3 mm from the cap
+            [10.3, 50.0, 44.8],   // in the lining, off the tunnel's wall
+            [10.0, 50.0, 44.8],   // on the cap, in the lining's annulus
+        ];
+        let tets = vec![[0, 1, 2, 3], [3, 1, 2, 4], [3, 1, 2, 5]];
+        let st = State::background(points, vec![0; 6], tets);
+        let mut labels = ObjectCells {
+            object: vec![1; 3],
+            lining: vec![true; 3],
+            ..ObjectCells::default()
+        };
+        assert_eq!(relabel_cap_slivers(&st, &set, &mut labels), 1);
+        assert_eq!(labels.lining, [false, true, true]);
+    }
+
     #[test]
     fn a_node_slides_along_a_circular_barrel_only() {
         let t = Terrain::new(
