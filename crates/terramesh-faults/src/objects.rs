@@ -293,54 +293,81 @@ pub enum Wall {
 }
 
 impl Object {
+    /// A tunnel's field at `q` as its two terms: the profile's (the barrel, swept along the
+    /// axis) and the end caps' (`-inf` away from the first and last pieces); the field is
+    /// their max. Other objects: their field and `-inf`.
+    fn tunnel_terms(&self, wall: Wall, q: [f64; 3]) -> (f64, f64) {
+        let Shape::Tunnel {
+            pieces,
+            profile,
+            outer,
+            ..
+        } = &self.shape
+        else {
+            return (self.field(wall, q), f64::NEG_INFINITY);
+        };
+        let prof = match (wall, outer) {
+            (Wall::Outer, Some(o)) => o,
+            _ => profile,
+        };
+        // The piece whose mitre planes enclose q (the first, else the piece of the nearest
+        // axis segment): a union of pieces by the min of their fields would read near zero
+        // on every mitre plane inside the tunnel.
+        let last = pieces.len() - 1;
+        let k = pieces
+            .iter()
+            .enumerate()
+            .position(|(k, p)| {
+                (k == 0 || dot(sub(q, p.a), p.start) >= 0.0)
+                    && (k == last || dot(sub(q, p.b), p.end) < 0.0)
+            })
+            .unwrap_or_else(|| {
+                let d = |p: &Piece| {
+                    let e = sub(p.b, p.a);
+                    let t = (dot(sub(q, p.a), e) / dot(e, e)).clamp(0.0, 1.0);
+                    norm(sub(
+                        q,
+                        [p.a[0] + t * e[0], p.a[1] + t * e[1], p.a[2] + t * e[2]],
+                    ))
+                };
+                (0..pieces.len())
+                    .min_by(|&x, &y| d(&pieces[x]).total_cmp(&d(&pieces[y])))
+                    .unwrap()
+            });
+        let p = &pieces[k];
+        let d = sub(q, p.a);
+        let f = prof.sdf(dot(d, p.n), dot(d, p.u));
+        let mut cap = f64::NEG_INFINITY;
+        if k == 0 {
+            cap = cap.max(-dot(d, p.start));
+        }
+        if k == last {
+            cap = cap.max(dot(sub(q, p.b), p.end));
+        }
+        (f, cap)
+    }
+
+    /// A lined tunnel's barrel at `q`: the field of wall `wall` without the end caps, which
+    /// the tunnel's wall and its lining's outer wall share (`None` for other objects and
+    /// unlined tunnels). On a cap's plane both walls read zero over the whole disk, so a
+    /// cell flat against it inside the tunnel's profile lies on both within any tolerance.
+    pub(crate) fn barrel(&self, wall: Wall, q: [f64; 3]) -> Option<f64> {
+        (self.has_lining && matches!(self.shape, Shape::Tunnel { .. }))
+            .then(|| self.tunnel_terms(wall, q).0)
+    }
+
     /// The field of a wall at `q`: negative inside, zero on the boundary, about the distance
     /// to it (a lower or an upper bound near edges and corners, with the right sign).
     pub fn field(&self, wall: Wall, q: [f64; 3]) -> f64 {
         match &self.shape {
-            Shape::Tunnel {
-                pieces,
-                profile,
-                outer,
-                ..
-            } => {
-                let prof = match (wall, outer) {
-                    (Wall::Outer, Some(o)) => o,
-                    _ => profile,
-                };
-                // The piece whose mitre planes enclose q (the first, else the piece of the
-                // nearest axis segment): a union of pieces by the min of their fields would
-                // read near zero on every mitre plane inside the tunnel.
-                let last = pieces.len() - 1;
-                let k = pieces
-                    .iter()
-                    .enumerate()
-                    .position(|(k, p)| {
-                        (k == 0 || dot(sub(q, p.a), p.start) >= 0.0)
-                            && (k == last || dot(sub(q, p.b), p.end) < 0.0)
-                    })
-                    .unwrap_or_else(|| {
-                        let d = |p: &Piece| {
-                            let e = sub(p.b, p.a);
-                            let t = (dot(sub(q, p.a), e) / dot(e, e)).clamp(0.0, 1.0);
-                            norm(sub(
-                                q,
-                                [p.a[0] + t * e[0], p.a[1] + t * e[1], p.a[2] + t * e[2]],
-                            ))
-                        };
-                        (0..pieces.len())
-                            .min_by(|&x, &y| d(&pieces[x]).total_cmp(&d(&pieces[y])))
-                            .unwrap()
-                    });
-                let p = &pieces[k];
-                let d = sub(q, p.a);
-                let mut f = prof.sdf(dot(d, p.n), dot(d, p.u));
-                if k == 0 {
-                    f = f.max(-dot(d, p.start));
+            Shape::Tunnel { .. } => {
+                // (The caps' term only where it applies, as a NaN profile reads.)
+                let (f, cap) = self.tunnel_terms(wall, q);
+                if cap == f64::NEG_INFINITY {
+                    f
+                } else {
+                    f.max(cap)
                 }
-                if k == last {
-                    f = f.max(dot(sub(q, p.b), p.end));
-                }
-                f
             }
             Shape::Excavation {
                 outline,
@@ -430,8 +457,9 @@ impl Object {
 
     /// Where a node at `p` on wall `wall` may slide towards `to` and stay on it: `to`
     /// projected across the axis onto a circular tunnel's barrel, where `p` and the point
-    /// found lie in one straight piece, at least `margin` from its end planes (caps and
-    /// mitres) and `p` on the wall within [`ON_WALL`]. `None` elsewhere (other profiles and
+    /// found lie in one straight piece, the point found at least `margin` from its end planes
+    /// (caps and mitres; `p` may be nearer a cap, not a mitre) and `p` on the wall within
+    /// [`ON_WALL`]. `None` elsewhere (other profiles and
     /// objects, whose flat faces meet at edges and corners; caps, mitres): the node stays.
     pub(crate) fn along_wall(
         &self,
@@ -462,7 +490,10 @@ impl Object {
         };
         // One piece only, even where pieces overlap (a sharp bend): the field's own.
         let one = |q: [f64; 3]| pieces.iter().filter(|pc| within(pc, q, -margin)).count() == 1;
-        let pc = pieces.iter().find(|pc| within(pc, p, margin))?;
+        // The node itself may lie closer to a cap than `margin` (a node the cut or the snap
+        // left a few millimetres from the cap's plane, whose cells are slivers flat against
+        // it): it may slide away from the cap, not closer. At a mitre `one` keeps it.
+        let pc = pieces.iter().find(|pc| within(pc, p, -ON_WALL))?;
         if !one(p) {
             return None;
         }
@@ -1462,6 +1493,43 @@ fn eval(v: f64) -> (f64, i8) {
     } else {
         (v, -1)
     }
+}
+
+/// A lined tunnel's lining cells that lie flat against a cap inside the tunnel's profile
+/// (every node within [`ON_WALL`] of the tunnel's wall, the centroid inside it and more than
+/// half the checks' tolerance inside its barrel) are labelled as the tunnel. Both walls share
+/// the cap's plane, so such a cell lies on both within any tolerance and its label is the
+/// cut's choice; labelled as the lining it gives the nodes on the cap three labels (rock,
+/// lining, tunnel), which the quality pass keeps fixed, and stays a sliver. Returns the cells
+/// relabelled.
+fn relabel_cap_slivers(st: &State, set: &ObjectSet, labels: &mut ObjectCells) -> usize {
+    let mut n = 0;
+    for (i, o) in set.objects.iter().enumerate() {
+        if o.barrel(Wall::Inner, o.bbox[0]).is_none() {
+            continue;
+        }
+        let number = i as u32 + 1;
+        let flip: Vec<usize> = (0..st.tets.len())
+            .into_par_iter()
+            .filter(|&c| {
+                if labels.object[c] != number || !labels.lining[c] {
+                    return false;
+                }
+                let t = st.tets[c];
+                if t.iter()
+                    .any(|&v| o.field(Wall::Inner, st.points[v as usize]).abs() > ON_WALL)
+                {
+                    return false;
+                }
+                o.field(Wall::Inner, crate::mesh::centroid(&st.points, &t)) < 0.0
+            })
+            .collect();
+        for c in flip {
+            labels.lining[c] = false;
+            n += 1;
+        }
+    }
+    n
 }
 
 /// The crossing of segment ab by a field (values of opposite signs), Illinois regula falsi.
@@ -2826,6 +2894,7 @@ pub(crate) fn cut_objects(
             });
         }
     }
+    relabel_cap_slivers(st, set, &mut labels);
     Ok(labels)
 }
 
@@ -3067,6 +3136,47 @@ mod tests {
     /// A node on a circular tunnel's barrel slides along it (onto the circle of its piece,
     /// its place along the axis kept), but not near a cap or a mitre, and not on another
     /// profile's wall.
+    /// A lining cell flat against a lined tunnel's cap inside its profile (every node on the
+    /// tunnel's wall, its centroid inside) is labelled as the tunnel; a lining cell with a
+    /// node off the wall, or one whose centroid lies outside the tunnel, keeps its label.
+    #[test]
+    fn a_lining_cell_flat_against_a_cap_is_labelled_as_the_tunnel() {
+        let t = Terrain::new(
+            vec![[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+            vec![100.0; 4],
+        )
+        .unwrap();
+        let spec = ObjectSpec {
+            name: "T".into(),
+            stage: 1,
+            geometry: ObjectGeometry::Tunnel {
+                axis: vec![[10.0, 50.0, 50.0], [90.0, 50.0, 50.0]],
+                profile: Profile::Circle { diameter: 10.0 },
+                lining: 0.5,
+            },
+        };
+        let set = ObjectSet::new(&[spec], &t, 0.0).unwrap();
+        // Radius 5 around (y, z) = (50, 50), cap at x = 10.
+        let points = vec![
+            [10.0, 50.0, 46.0],   // on the cap, radius 4
+            [10.0, 50.6, 46.2],   // on the cap
+            [10.0, 49.4, 46.2],   // on the cap
+            [10.003, 50.0, 45.0], // on the barrel, 3 mm from the cap
+            [10.3, 50.0, 44.8],   // in the lining, off the tunnel's wall
+            [10.0, 50.0, 44.8],   // on the cap, in the lining's annulus
+        ];
+        let tets = vec![[0, 1, 2, 3], [3, 1, 2, 4], [3, 1, 2, 5]];
+        let st = State::background(points, vec![0; 6], tets);
+        let mut labels = ObjectCells {
+            object: vec![1; 3],
+            lining: vec![true; 3],
+            ..ObjectCells::default()
+        };
+        assert_eq!(relabel_cap_slivers(&st, &set, &mut labels), 1);
+        assert_eq!(labels.lining, [false, true, true]);
+    }
+
     #[test]
     fn a_node_slides_along_a_circular_barrel_only() {
         let t = Terrain::new(
@@ -3103,8 +3213,21 @@ mod tests {
         assert!(o
             .along_wall(Wall::Inner, [30.0, 50.0, 56.0], [30.0, 50.0, 56.0], 0.01)
             .is_none());
+        // A node 5 mm from the cap slides away from it (it stayed, before), not closer.
+        let q = o
+            .along_wall(Wall::Inner, [10.005, 50.0, 55.0], [11.0, 50.0, 55.1], 0.01)
+            .unwrap();
+        assert!(o.field(Wall::Inner, q).abs() < 1e-9 && (q[0] - 11.0).abs() < 1e-12);
         assert!(o
-            .along_wall(Wall::Inner, [10.005, 50.0, 55.0], [11.0, 50.0, 55.0], 0.01)
+            .along_wall(
+                Wall::Inner,
+                [10.005, 50.0, 55.0],
+                [10.003, 50.0, 55.0],
+                0.01
+            )
+            .is_none());
+        assert!(o
+            .along_wall(Wall::Inner, [9.995, 50.0, 55.0], [11.0, 50.0, 55.0], 0.01)
             .is_none());
         assert!(o
             .along_wall(Wall::Inner, [11.0, 50.0, 55.0], [9.0, 50.0, 55.0], 0.01)

@@ -200,6 +200,15 @@ impl Pass<'_> {
                 if v.iter().any(|&x| side * x < -eps) || side * o.field(w, c) < -far {
                     return false;
                 }
+                // A lining's cell keeps out of its tunnel's barrel: flat against a cap's
+                // plane inside the profile it lies on both walls within any tolerance.
+                if mine
+                    && code & 1 == 1
+                    && w == Wall::Inner
+                    && o.barrel(w, c).is_some_and(|b| b < -far)
+                {
+                    return false;
+                }
                 !strict
                     || crate::mesh::EDGES.iter().all(|&(a, b)| {
                         let m = [0, 1, 2].map(|k| 0.5 * (g[a][k] + g[b][k]));
