@@ -408,6 +408,20 @@ const COMPASS: [[f64; 3]; 14] = {
     ]
 };
 
+/// `to` projected onto `fault` along its normal, a few steps, if it comes within a tenth of
+/// [`ON_SURFACE`] of it.
+fn onto_fault(fault: &crate::fault::Fault, to: [f64; 3]) -> Option<[f64; 3]> {
+    let mut q = to;
+    for _ in 0..4 {
+        let s = fault.side(q);
+        if s.distance.abs() <= 0.1 * ON_SURFACE {
+            return Some(q);
+        }
+        q = [0, 1, 2].map(|k| q[k] - s.distance * s.normal[k]);
+    }
+    (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
+}
+
 /// A compass search from `start`, whose worst angle is `best` with `count` cells below the
 /// floor: the best of the 14 [`COMPASS`] directions at a step `h` (each trial point mapped by
 /// `onto`, which may refuse it, then scored by `eval(point, worst to beat, most below the
@@ -932,6 +946,21 @@ impl Pass<'_> {
         t.map(|w| self.st.points[w as usize])
     }
 
+    /// Whether a cell at `g` made in place of cell `like` (or changed) keeps `like`'s place:
+    /// its centroid on `like`'s side of every fault, and [`Pass::in_unit`] and
+    /// [`Pass::in_objects`].
+    fn in_place(&self, g: [[f64; 3]; 4], like: u32) -> bool {
+        let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        let s = self.st.positive[like as usize];
+        self.faults
+            .faults
+            .iter()
+            .enumerate()
+            .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1))
+            && self.in_unit(g, like)
+            && self.in_objects(g, like)
+    }
+
     /// Whether cell `like`'s unit holds a cell at `g` as [`crate::check`] will see it, with
     /// half its tolerance: the centroid in that unit of its block and no interface with
     /// nodes on both sides. Every cell an operation makes or changes is tested, whatever its
@@ -1131,20 +1160,10 @@ impl Pass<'_> {
                     && x.1 == y.1
                     && (x.0 ^ y.0).count_ones() == 1 =>
             {
-                let fault = &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize];
-                let mut q = to;
-                for _ in 0..4 {
-                    let s = fault.side(q);
-                    if s.distance.abs() <= 0.1 * ON_SURFACE {
-                        return Some(q);
-                    }
-                    q = [
-                        q[0] - s.distance * s.normal[0],
-                        q[1] - s.distance * s.normal[1],
-                        q[2] - s.distance * s.normal[2],
-                    ];
-                }
-                (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
+                onto_fault(
+                    &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize],
+                    to,
+                )
             }
             [x, y] if f & ON_INTERFACE == 0 => {
                 // On the wall of a zone only: along it (projected along the fault's normal).

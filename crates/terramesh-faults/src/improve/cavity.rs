@@ -153,18 +153,7 @@ impl Pass<'_> {
         }
         // Each cone in its unit, on its cell's side of every fault and of the objects' walls.
         for (&u, &(d, _)) in cones.iter().zip(&faces) {
-            let g = self.geo_at(u, p);
-            let m = [0, 1, 2].map(|k| g.iter().map(|q| q[k]).sum::<f64>() / 4.0);
-            let s = self.st.positive[d as usize];
-            if !self
-                .faults
-                .faults
-                .iter()
-                .enumerate()
-                .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1))
-                || !self.in_unit(g, d)
-                || !self.in_objects(g, d)
-            {
+            if !self.in_place(self.geo_at(u, p), d) {
                 return None;
             }
         }

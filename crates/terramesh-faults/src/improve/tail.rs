@@ -266,21 +266,10 @@ impl Pass<'_> {
             worst = worst.min(q1).min(q2);
             kids.push((d, u1, q1, u2, q2));
         }
-        let sides = |g: [[f64; 3]; 4], d: u32| {
-            let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
-            let s = self.st.positive[d as usize];
-            self.faults
-                .faults
-                .iter()
-                .enumerate()
-                .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1))
-        };
-        if !kids.iter().all(|&(d, u1, _, u2, _)| {
-            [u1, u2].into_iter().all(|u| {
-                let g = self.geo(u);
-                sides(g, d) && self.in_unit(g, d) && self.in_objects(g, d)
-            })
-        }) {
+        if !kids
+            .iter()
+            .all(|&(d, u1, _, u2, _)| [u1, u2].into_iter().all(|u| self.in_place(self.geo(u), d)))
+        {
             return None;
         }
         // No two cells on the same nodes (a new cell and one of `b`'s that stays).
@@ -499,19 +488,7 @@ impl Pass<'_> {
             if keys.windows(2).any(|w| w[0] == w[1]) {
                 continue;
             }
-            let sides = |g: [[f64; 3]; 4], c: u32| {
-                let m = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
-                let p = self.st.positive[c as usize];
-                self.faults
-                    .faults
-                    .iter()
-                    .enumerate()
-                    .all(|(f, x)| (x.side(m).sign > 0) == (p >> f & 1 == 1))
-            };
-            if !new.iter().all(|e| {
-                let g = geo(e.1);
-                sides(g, e.0) && self.in_unit(g, e.0) && self.in_objects(g, e.0)
-            }) {
+            if !new.iter().all(|e| self.in_place(geo(e.1), e.0)) {
                 continue;
             }
             let gone: Vec<u32> = group.iter().copied().filter(|&v| v != r).collect();
@@ -550,35 +527,48 @@ impl Pass<'_> {
             return None;
         }
         let fault = &self.faults.faults[(x.0 ^ y.0).trailing_zeros() as usize];
-        let onto = |to: [f64; 3]| {
-            let mut q = to;
-            for _ in 0..4 {
-                let s = fault.side(q);
-                if s.distance.abs() <= 0.1 * ON_SURFACE {
-                    return Some(q);
-                }
-                q = [0, 1, 2].map(|k| q[k] - s.distance * s.normal[k]);
-            }
-            (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
-        };
+        let onto = |to: [f64; 3]| super::onto_fault(fault, to);
         let p = self.st.points[v as usize];
         // On the fault itself (not a face between blocks beyond its end), as the cut left it.
         if fault.side(p).distance.abs() > ON_SURFACE {
             return None;
         }
-        let geo = |c: u32, q: [f64; 3]| {
-            self.st.tets[c as usize].map(|w| {
-                if w == v {
-                    q
-                } else {
-                    self.st.points[w as usize]
-                }
+        self.search_move(v, cells, onto, |q| {
+            cells.iter().all(|&c| {
+                let g = self.moved(c, v, q);
+                self.in_unit(g, c) && self.in_objects(g, c)
             })
-        };
+        })
+    }
+
+    /// Cell `c`'s corners with node `v` at `q`.
+    fn moved(&self, c: u32, v: u32, q: [f64; 3]) -> [[f64; 3]; 4] {
+        self.st.tets[c as usize].map(|w| {
+            if w == v {
+                q
+            } else {
+                self.st.points[w as usize]
+            }
+        })
+    }
+
+    /// Moves node `v` (`cells`: its cells) to the best place of a compass search over the
+    /// points `onto` gives (a surface, a curve), if the smallest angle of its cells gains at
+    /// least [`super::MIN_GAIN`], no more of them fall below the floor, and `kept` accepts
+    /// the new place. The fault's and the trace's moves
+    /// ([`Pass::fault_move`], [`Pass::trace_move`]).
+    pub(super) fn search_move(
+        &self,
+        v: u32,
+        cells: &[u32],
+        onto: impl Fn([f64; 3]) -> Option<[f64; 3]>,
+        kept: impl Fn([f64; 3]) -> bool,
+    ) -> Option<Op> {
+        let p = self.st.points[v as usize];
         let eval = |q: [f64; 3], above: f64, most: usize| {
             let (mut worst, mut n) = (f64::MAX, 0usize);
             for &c in cells {
-                let a = positive_min_dihedral(geo(c, q));
+                let a = positive_min_dihedral(self.moved(c, v, q));
                 worst = worst.min(a);
                 n += (a < self.floor) as usize;
                 if a <= above || n > most {
@@ -609,15 +599,13 @@ impl Pass<'_> {
             onto,
             eval,
         );
-        if best < old + super::MIN_GAIN
-            || !cells.iter().all(|&c| {
-                let g = geo(c, q);
-                self.in_unit(g, c) && self.in_objects(g, c)
-            })
-        {
+        if best < old + super::MIN_GAIN || !kept(q) {
             return None;
         }
-        let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
+        let angles: Vec<f64> = cells
+            .iter()
+            .map(|&c| min_dihedral(self.moved(c, v, q)))
+            .collect();
         Some(Op::Move {
             v,
             to: q,
@@ -779,21 +767,10 @@ impl Pass<'_> {
         if poor < ring.len() && now > poor {
             return None;
         }
-        let sides = |g: [[f64; 3]; 4], like: u32| {
-            let m = mean(&g);
-            let s = self.st.positive[like as usize];
-            self.faults
-                .faults
-                .iter()
-                .enumerate()
-                .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1))
-        };
-        if !new.iter().all(|(half, cells)| {
-            cells.iter().all(|x| {
-                let g = self.geo(x.0);
-                sides(g, half[0]) && self.in_unit(g, half[0]) && self.in_objects(g, half[0])
-            })
-        }) {
+        if !new
+            .iter()
+            .all(|(half, cells)| cells.iter().all(|x| self.in_place(self.geo(x.0), half[0])))
+        {
             return None;
         }
         Some(Op::Replace2 { halves: new })

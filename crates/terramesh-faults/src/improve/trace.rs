@@ -38,7 +38,7 @@
 
 use super::{Label, Op, Pass};
 use crate::mesh::{positive, BASE, ON_INTERFACE, SIDE, TOP};
-use crate::quality::{min_dihedral, positive_min_dihedral};
+use crate::quality::positive_min_dihedral;
 use crate::ON_SURFACE;
 
 static OFF: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -85,58 +85,12 @@ impl Pass<'_> {
         {
             return None;
         }
-        let onto = |to: [f64; 3]| self.onto_trace(fi, to);
-        let geo = |c: u32, q: [f64; 3]| {
-            self.st.tets[c as usize].map(|w| {
-                if w == v {
-                    q
-                } else {
-                    self.st.points[w as usize]
-                }
-            })
-        };
-        let eval = |q: [f64; 3], above: f64, most: usize| {
-            let (mut worst, mut n) = (f64::MAX, 0usize);
-            for &c in cells {
-                let a = positive_min_dihedral(geo(c, q));
-                worst = worst.min(a);
-                n += (a < self.floor) as usize;
-                if a <= above || n > most {
-                    return None;
-                }
-            }
-            Some((worst, n))
-        };
-        let old = self.worst(cells);
-        let poor = self.poor(cells);
-        let mut len = f64::MAX;
-        for &c in cells {
-            for w in self.st.tets[c as usize] {
-                if w != v {
-                    len = len.min(super::d2(p, self.st.points[w as usize]).sqrt());
-                }
-            }
-        }
-        let (best, _, q) = super::compass_search(
-            p,
-            (old, poor),
-            poor,
-            0.25 * len,
-            len,
-            super::COMPASS_STEPS,
-            onto,
-            eval,
-        );
-        if best < old + super::MIN_GAIN || !self.trace_kept(v, q, cells, fi) {
-            return None;
-        }
-        let angles: Vec<f64> = cells.iter().map(|&c| min_dihedral(geo(c, q))).collect();
-        Some(Op::Move {
+        self.search_move(
             v,
-            to: q,
-            cells: cells.to_vec(),
-            angles,
-        })
+            cells,
+            |to| self.onto_trace(fi, to),
+            |q| self.trace_kept(v, q, cells, fi),
+        )
     }
 
     /// The point of fault `fi`'s trace (where it meets the DSM) nearest `to`, by Newton's
@@ -202,17 +156,10 @@ impl Pass<'_> {
             if positive_min_dihedral(g) < 0.0 {
                 return false;
             }
-            let m = [0, 1, 2].map(|k| g.iter().map(|r| r[k]).sum::<f64>() / 4.0);
-            let s = self.st.positive[c as usize];
-            let sides = self
-                .faults
-                .faults
-                .iter()
-                .enumerate()
-                .all(|(f, x)| (x.side(m).sign > 0) == (s >> f & 1 == 1));
-            if !sides || !self.in_unit(g, c) || !self.in_objects(g, c) {
+            if !self.in_place(g, c) {
                 return false;
             }
+            let s = self.st.positive[c as usize];
             for skip in 0..4 {
                 if t[skip] == v {
                     continue;
@@ -365,17 +312,7 @@ impl Pass<'_> {
         len: f64,
     ) -> Option<(f64, Op)> {
         let fault = &self.faults.faults[fi];
-        let onto = |to: [f64; 3]| {
-            let mut q = to;
-            for _ in 0..4 {
-                let s = fault.side(q);
-                if s.distance.abs() <= 0.1 * ON_SURFACE {
-                    return Some(q);
-                }
-                q = [0, 1, 2].map(|k| q[k] - s.distance * s.normal[k]);
-            }
-            (fault.side(q).distance.abs() <= 0.1 * ON_SURFACE).then_some(q)
-        };
+        let onto = |to: [f64; 3]| super::onto_fault(fault, to);
         let p0 = onto(p0)?;
         self.insert_on(&pair, pair[0], p0, fi, false, 0.125 * len, len, onto)
     }
@@ -522,19 +459,10 @@ impl Pass<'_> {
         let half = 0.5 * crate::FAULT_TOLERANCE;
         for (ci, &(d, u)) in cones.iter().enumerate() {
             let g = self.geo_at(u, p);
-            let m = [0, 1, 2].map(|k| g.iter().map(|q| q[k]).sum::<f64>() / 4.0);
-            let sd = self.st.positive[d as usize];
-            if !self
-                .faults
-                .faults
-                .iter()
-                .enumerate()
-                .all(|(f, x)| (x.side(m).sign > 0) == (sd >> f & 1 == 1))
-                || !self.in_unit(g, d)
-                || !self.in_objects(g, d)
-            {
+            if !self.in_place(g, d) {
                 return None;
             }
+            let sd = self.st.positive[d as usize];
             // Its faces through the new node: on the terrain, on the DSM; between the two
             // sides, on the fault.
             for (skip, _) in u.iter().enumerate().filter(|(_, &w)| w != super::NEW) {
