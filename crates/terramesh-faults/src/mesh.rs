@@ -1096,7 +1096,15 @@ fn cut_crease(
                 // (An interface further down keeps the 1 % rule: splits so close to an end
                 // there made cells of no volume in the cut after, on every site of
                 // `tests/pinch.rs`.)
-                let q = if pa { b } else { a };
+                // The thickness is taken as far from the crease on its unpinched side as the
+                // nearest end is (that end itself where it is the unpinched one).
+                let near = if t < 0.5 { 0.0 } else { 1.0 };
+                let u = if pa {
+                    t + (t - near).abs()
+                } else {
+                    t - (t - near).abs()
+                };
+                let q = at(u.clamp(0.0, 1.0));
                 let p = [q[0], q[1]];
                 if !own || height(j - 1, block, p) - height(j, block, p) < CREASE_NEAR {
                     return None;
@@ -1262,6 +1270,23 @@ fn cut_flank(
                     hi = m2;
                 }
             }
+            // A crease of a flank only: the slope along the edge changes there by more than
+            // `FLANK_BEND` over `CREASE_STEP` on either side (a wedge's or a smooth
+            // interface's bends are far less).
+            {
+                let l = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                let m = 0.5 * (lo + hi);
+                let d = CREASE_STEP / l.max(1e-12);
+                let z = |u: f64| {
+                    let q = at(u.clamp(0.0, 1.0));
+                    height(k, block, [q[0], q[1]])
+                };
+                let (zl, z0, zr) = (z(m - d), z(m), z(m + d));
+                let bend = ((zr - z0) - (z0 - zl)) / CREASE_STEP;
+                if bend.is_nan() || bend.abs() <= FLANK_BEND {
+                    return None;
+                }
+            }
             // Not within a millimetre of an end (a flank's foot can be a centimetre from a
             // node on the flank: the quality pass mends the short edge).
             let t = 0.5 * (lo + hi);
@@ -1299,6 +1324,10 @@ fn cut_flank(
     st.report.crease_splits += keys.len();
     keys.len()
 }
+
+/// The change of slope that makes a crease a flank's for [`cut_flank`] (1: 45 degrees; the
+/// facade's flanks are steeper than 80, a wedge's crease a few hundredths).
+const FLANK_BEND: f64 = 1.0;
 
 /// [`cut_flank`] splits no edge closer than this to an end (metres).
 const FLANK_END: f64 = 1e-3;
