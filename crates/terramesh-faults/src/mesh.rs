@@ -1270,20 +1270,26 @@ fn cut_flank(
                     hi = m2;
                 }
             }
-            // A crease of a flank only: the slope along the edge changes there by more than
-            // `FLANK_BEND` over `CREASE_STEP` on either side (a wedge's or a smooth
-            // interface's bends are far less).
+            // A crease of a flank only: the interface's gradient in plan, `CREASE_STEP` along
+            // the edge on either side, differs by more than `FLANK_BEND` (a wedge's or a
+            // smooth interface's bends are far less). The gradient, not the slope along the
+            // edge: an edge nearly along the flank crosses it at a low slope.
             {
                 let l = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
                 let m = 0.5 * (lo + hi);
                 let d = CREASE_STEP / l.max(1e-12);
-                let z = |u: f64| {
+                let grad = |u: f64| {
                     let q = at(u.clamp(0.0, 1.0));
-                    height(k, block, [q[0], q[1]])
+                    let h = |x: f64, y: f64| height(k, block, [x, y]);
+                    let e = FLANK_GRAD_STEP;
+                    [
+                        (h(q[0] + e, q[1]) - h(q[0] - e, q[1])) / (2.0 * e),
+                        (h(q[0], q[1] + e) - h(q[0], q[1] - e)) / (2.0 * e),
+                    ]
                 };
-                let (zl, z0, zr) = (z(m - d), z(m), z(m + d));
-                let bend = ((zr - z0) - (z0 - zl)) / CREASE_STEP;
-                if bend.is_nan() || bend.abs() <= FLANK_BEND {
+                let (gl, gr) = (grad(m - d), grad(m + d));
+                let bend = (gr[0] - gl[0]).hypot(gr[1] - gl[1]);
+                if bend.is_nan() || bend <= FLANK_BEND {
                     return None;
                 }
             }
@@ -1325,9 +1331,13 @@ fn cut_flank(
     keys.len()
 }
 
-/// The change of slope that makes a crease a flank's for [`cut_flank`] (1: 45 degrees; the
-/// facade's flanks are steeper than 80, a wedge's crease a few hundredths).
+/// The change of the interface's gradient (in plan) that makes a crease a flank's for
+/// [`cut_flank`] (1: 45 degrees; the facade's flanks are steeper than 80, a wedge's crease a
+/// few hundredths).
 const FLANK_BEND: f64 = 1.0;
+
+/// The step (metres) of [`cut_flank`]'s central differences for the interface's gradient.
+const FLANK_GRAD_STEP: f64 = 1e-4;
 
 /// [`cut_flank`] splits no edge closer than this to an end (metres).
 const FLANK_END: f64 = 1e-3;

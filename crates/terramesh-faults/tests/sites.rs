@@ -872,7 +872,6 @@ fn blunt(thick: f64, min: f64, settings: Option<MeshSettings>) -> (FaultedMesh, 
 /// the quality pass, which leaves no cell below 5 degrees: a blunt end (unlike a wedge) is no
 /// limit on the angles.
 #[test]
-#[ignore = "passes with cut_flank unrestricted (commit 92a1199), which broke pinch_out; with the bend limit it fails again (docs/geology.md)"]
 fn blunt_pinch_out() {
     let mut floors = Vec::new();
     for (thick, min) in BLUNT {
