@@ -1088,7 +1088,27 @@ fn cut_crease(
             }
             let t = if pa { lo } else { hi };
             if !(0.01..=0.99).contains(&t) {
-                return None;
+                // Within 1 % of an end: left where the unit is still thinner than
+                // `CREASE_NEAR` at the end on its unpinched side (the crease is then as good
+                // as at that node); a unit ending in a steep flank (the facade's rule, the
+                // thickness rising to `min_thickness` within millimetres) is thick there, and
+                // a face from that node across the crease would miss the interface by it.
+                // (An interface further down keeps the 1 % rule: splits so close to an end
+                // there made cells of no volume in the cut after, on every site of
+                // `tests/pinch.rs`.)
+                // The thickness is taken as far from the crease on its unpinched side as the
+                // nearest end is (that end itself where it is the unpinched one).
+                let near = if t < 0.5 { 0.0 } else { 1.0 };
+                let u = if pa {
+                    t + (t - near).abs()
+                } else {
+                    t - (t - near).abs()
+                };
+                let q = at(u.clamp(0.0, 1.0));
+                let p = [q[0], q[1]];
+                if !own || height(j - 1, block, p) - height(j, block, p) < CREASE_NEAR {
+                    return None;
+                }
             }
             if !own {
                 // Interface k bends there (unit j's pinch-out line is a crease of interface k
@@ -1136,6 +1156,198 @@ fn cut_crease(
     st.report.crease_splits += keys.len();
     keys.len()
 }
+
+/// Splits the edges on interface `k` (`k` > 0; both ends on it) of the `cells` (in block
+/// `block`) across a pinch-out line in plan (their nodes differ in which units above
+/// interface `k` pinch out there) where interface `k` leaves the edge's chord by more than
+/// [`CREASE_NEAR`]: at the point farthest from the chord, the new node on interface `k` (or
+/// left on its chord where that would invert a cell). The facade's pinch rule ends a unit in
+/// a steep flank (its thickness rising from 0 to `min_thickness` within millimetres of the
+/// pinch-out line), so interface `k` has a second crease at the flank's foot, which
+/// [`cut_crease`] (at the pinch-out line) does not reach: a face from a node on the pinch-out
+/// line to a node beyond the foot passes up to the flank's height over the unit's base, and a
+/// cell under it straddles the unit. Returns the number of edges split.
+fn cut_flank(
+    st: &mut State,
+    cells: &[u32],
+    height: InterfaceFn,
+    k: usize,
+    block: BlockKey,
+) -> usize {
+    let side = |q: [f64; 3]| {
+        let d = q[2] - height(k, block, [q[0], q[1]]);
+        if d.abs() <= ON_SURFACE {
+            0
+        } else if d > 0.0 {
+            1
+        } else {
+            -1
+        }
+    };
+    // Bit j - 1: unit j (between interfaces j - 1 and j) pinched out at the node's plan point.
+    let pinched = |q: [f64; 3]| -> u64 {
+        let p = [q[0], q[1]];
+        let mut bits = 0;
+        let mut below = height(k, block, p);
+        for j in (1..=k).rev() {
+            let above = height(j - 1, block, p);
+            if above - below <= 0.0 {
+                bits |= 1 << ((j - 1) % 64);
+            }
+            below = above;
+        }
+        bits
+    };
+    let mut need = vec![false; st.points.len()];
+    for &c in cells {
+        for &v in &st.tets[c as usize] {
+            need[v as usize] = true;
+        }
+    }
+    // Each node's pinched units (by its plan point) and its side of interface k (0 on it).
+    let state: Vec<(u64, i8)> = st
+        .points
+        .par_iter()
+        .zip(&need)
+        .map(|(&q, &n)| if n { (pinched(q), side(q)) } else { (0, 0) })
+        .collect();
+    // The edges of the cells across a pinch-out line in plan (their nodes' pinched units
+    // differ), but those with ends on both sides (the cut's).
+    let mut keys: Vec<u64> = cells
+        .par_iter()
+        .flat_map_iter(|&c| {
+            let t = st.tets[c as usize];
+            let s = t.map(|v| state[v as usize]);
+            let across = s.iter().any(|x| x.0 != s[0].0);
+            EDGES
+                .iter()
+                .filter(move |&&(i, j)| across && s[i].1 * s[j].1 >= 0)
+                .map(move |&(i, j)| key(t[i], t[j]))
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.dedup();
+    // Along each, the signed distance of the chord over interface k; the edge is split where
+    // it is largest on the side neither end is on, if more than `CREASE_NEAR` (interface k
+    // crosses the edge there and back, or creases between two ends on it).
+    let split: Vec<(u64, [f64; 3], f64)> = keys
+        .par_iter()
+        .filter_map(|&e| {
+            let (va, vb) = ((e >> 32) as usize, e as u32 as usize);
+            let (a, b) = (st.points[va], st.points[vb]);
+            let (sa, sb) = (state[va].1, state[vb].1);
+            let sign = if sa != 0 { -sa } else { -sb };
+            let at = |t: f64| [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i]));
+            // Distance on the wanted side (both ends on the interface: either side).
+            let off = |t: f64| {
+                let q = at(t);
+                let d = q[2] - height(k, block, [q[0], q[1]]);
+                if sign == 0 {
+                    d.abs()
+                } else {
+                    d * sign as f64
+                }
+            };
+            const N: usize = 32;
+            let (mut best, mut d) = (0, 0.0);
+            for i in 1..N {
+                let v = off(i as f64 / N as f64);
+                if v > d {
+                    (best, d) = (i, v);
+                }
+            }
+            if d <= CREASE_NEAR {
+                return None;
+            }
+            // Golden-section search for the farthest point about the best sample.
+            let (mut lo, mut hi) = ((best - 1) as f64 / N as f64, (best + 1) as f64 / N as f64);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            for _ in 0..40 {
+                let (m1, m2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+                if off(m1) < off(m2) {
+                    lo = m1;
+                } else {
+                    hi = m2;
+                }
+            }
+            // A crease of a flank only: the interface's gradient in plan, `CREASE_STEP` along
+            // the edge on either side, differs by more than `FLANK_BEND` (a wedge's or a
+            // smooth interface's bends are far less). The gradient, not the slope along the
+            // edge: an edge nearly along the flank crosses it at a low slope.
+            {
+                let l = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                let m = 0.5 * (lo + hi);
+                let d = CREASE_STEP / l.max(1e-12);
+                let grad = |u: f64| {
+                    let q = at(u.clamp(0.0, 1.0));
+                    let h = |x: f64, y: f64| height(k, block, [x, y]);
+                    let e = FLANK_GRAD_STEP;
+                    [
+                        (h(q[0] + e, q[1]) - h(q[0] - e, q[1])) / (2.0 * e),
+                        (h(q[0], q[1] + e) - h(q[0], q[1] - e)) / (2.0 * e),
+                    ]
+                };
+                let (gl, gr) = (grad(m - d), grad(m + d));
+                let bend = (gr[0] - gl[0]).hypot(gr[1] - gl[1]);
+                if bend.is_nan() || bend <= FLANK_BEND {
+                    return None;
+                }
+            }
+            // Not within a millimetre of an end (a flank's foot can be a centimetre from a
+            // node on the flank: the quality pass mends the short edge).
+            let t = 0.5 * (lo + hi);
+            let l = (0..3).map(|i| (b[i] - a[i]).powi(2)).sum::<f64>().sqrt();
+            if t * l < FLANK_END || (1.0 - t) * l < FLANK_END {
+                return None;
+            }
+            let q = at(t);
+            Some((e, q, height(k, block, [q[0], q[1]])))
+        })
+        .collect();
+    if split.is_empty() {
+        return 0;
+    }
+    let first = st.points.len();
+    let keys: Vec<u64> = split.iter().map(|s| s.0).collect();
+    let mut chords = Vec::with_capacity(split.len());
+    for &(e, p, z) in &split {
+        let (a, b) = ((e >> 32) as usize, e as u32 as usize);
+        let flags = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE);
+        let on_fault = st.on_fault[a] & st.on_fault[b];
+        let free = flags == 0 && on_fault == 0 && z.is_finite();
+        chords.push(p);
+        st.points.push(if free { [p[0], p[1], z] } else { p });
+        st.flags.push(flags | if free { ON_INTERFACE } else { 0 });
+        st.on_fault.push(on_fault);
+    }
+    split_cells(st, &keys, first as u32, |_| {});
+    revert_inverted(st, first, &chords);
+    for (i, c) in chords.iter().enumerate() {
+        if st.points[first + i] == *c {
+            st.flags[first + i] &= !ON_INTERFACE;
+        }
+    }
+    st.report.crease_splits += keys.len();
+    keys.len()
+}
+
+/// The change of the interface's gradient (in plan) that makes a crease a flank's for
+/// [`cut_flank`] (1: 45 degrees; the facade's flanks are steeper than 80, a wedge's crease a
+/// few hundredths).
+const FLANK_BEND: f64 = 1.0;
+
+/// The step (metres) of [`cut_flank`]'s central differences for the interface's gradient.
+const FLANK_GRAD_STEP: f64 = 1e-4;
+
+/// [`cut_flank`] splits no edge closer than this to an end (metres).
+const FLANK_END: f64 = 1e-3;
+
+/// The most rounds of [`cut_flank`] and the cut after it, per interface.
+const FLANK_PASSES: usize = 4;
+
+/// The thickness (metres) under which [`cut_crease`] leaves a crease that crosses an edge
+/// within 1 % of its end: a quarter of `check`'s tolerance.
+const CREASE_NEAR: f64 = 0.25 * crate::FAULT_TOLERANCE;
 
 /// The distance in plan (metres) on either side of a unit's pinch-out line over which
 /// [`cut_crease`] measures the bend of an interface further down.
@@ -1389,26 +1601,45 @@ pub fn faulted_mesh_with_objects(
                 }
             }
         }
-        for _round in 0..ROUNDS {
-            let mut splits = 0;
+        // The cut, then the foot of a pinching unit's flank (a second crease of interface k)
+        // and the cut again (a node there left on its chord, new edges on the interface across
+        // the foot), at most `FLANK_PASSES` times.
+        for pass in 0..=FLANK_PASSES {
+            for _round in 0..ROUNDS {
+                let mut splits = 0;
+                for (b, &bk) in blocks.iter().enumerate() {
+                    let field = Field::Interface(height, k, bk);
+                    let before = st.tets.len();
+                    splits += cut(
+                        &mut st,
+                        Some(&by_block[b]),
+                        &field,
+                        settings,
+                        faults,
+                        &blocks,
+                        terrain,
+                    )
+                    .1;
+                    for c in before..st.tets.len() {
+                        by_block[st.block[c] as usize].push(c as u32);
+                    }
+                }
+                if splits == 0 {
+                    break;
+                }
+            }
+            if k == 0 || pass == FLANK_PASSES {
+                break;
+            }
+            let mut flank = 0;
             for (b, &bk) in blocks.iter().enumerate() {
-                let field = Field::Interface(height, k, bk);
                 let before = st.tets.len();
-                splits += cut(
-                    &mut st,
-                    Some(&by_block[b]),
-                    &field,
-                    settings,
-                    faults,
-                    &blocks,
-                    terrain,
-                )
-                .1;
+                flank += cut_flank(&mut st, &by_block[b], height, k, bk);
                 for c in before..st.tets.len() {
                     by_block[st.block[c] as usize].push(c as u32);
                 }
             }
-            if splits == 0 {
+            if flank == 0 {
                 break;
             }
         }
