@@ -1132,14 +1132,32 @@ fn cut_crease(
     if split.is_empty() {
         return 0;
     }
+    let split: Vec<(u64, [f64; 3], f64)> = split
+        .into_iter()
+        .map(|(e, p)| {
+            (
+                e,
+                p,
+                height(if own { k - 1 } else { k }, block, [p[0], p[1]]),
+            )
+        })
+        .collect();
+    split_onto(st, &split)
+}
+
+/// Splits each edge `e` of `split` at `p`, the new node moved vertically to `z` (on the
+/// interface) unless an end lies on the boundary or a fault or `z` is not finite; a node
+/// whose move would invert a cell stays on its chord ([`revert_inverted`]) and is not marked
+/// on the interface. Counted in `crease_splits`; returns how many edges were split.
+/// [`cut_crease`]'s and [`cut_flank`]'s splits.
+fn split_onto(st: &mut State, split: &[(u64, [f64; 3], f64)]) -> usize {
     let first = st.points.len();
     let keys: Vec<u64> = split.iter().map(|s| s.0).collect();
     let mut chords = Vec::with_capacity(split.len());
-    for &(e, p) in &split {
+    for &(e, p, z) in split {
         let (a, b) = ((e >> 32) as usize, e as u32 as usize);
         let flags = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE);
         let on_fault = st.on_fault[a] & st.on_fault[b];
-        let z = height(if own { k - 1 } else { k }, block, [p[0], p[1]]);
         let free = flags == 0 && on_fault == 0 && z.is_finite();
         chords.push(p);
         st.points.push(if free { [p[0], p[1], z] } else { p });
@@ -1307,28 +1325,7 @@ fn cut_flank(
     if split.is_empty() {
         return 0;
     }
-    let first = st.points.len();
-    let keys: Vec<u64> = split.iter().map(|s| s.0).collect();
-    let mut chords = Vec::with_capacity(split.len());
-    for &(e, p, z) in &split {
-        let (a, b) = ((e >> 32) as usize, e as u32 as usize);
-        let flags = st.flags[a] & st.flags[b] & (TOP | BASE | SIDE);
-        let on_fault = st.on_fault[a] & st.on_fault[b];
-        let free = flags == 0 && on_fault == 0 && z.is_finite();
-        chords.push(p);
-        st.points.push(if free { [p[0], p[1], z] } else { p });
-        st.flags.push(flags | if free { ON_INTERFACE } else { 0 });
-        st.on_fault.push(on_fault);
-    }
-    split_cells(st, &keys, first as u32, |_| {});
-    revert_inverted(st, first, &chords);
-    for (i, c) in chords.iter().enumerate() {
-        if st.points[first + i] == *c {
-            st.flags[first + i] &= !ON_INTERFACE;
-        }
-    }
-    st.report.crease_splits += keys.len();
-    keys.len()
+    split_onto(st, &split)
 }
 
 /// The change of the interface's gradient (in plan) that makes a crease a flank's for
