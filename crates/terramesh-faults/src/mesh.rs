@@ -1704,7 +1704,14 @@ pub fn faulted_mesh_with_objects(
     st.report.inserted = done.inserted;
     zones.zone = crate::zones::labels(faults, &st.zone);
     // The structures' parts above the terrain, last: their cells carry no fault face.
-    crate::above::add_above(&mut st, objects, &mut object_cells, &mut zones)?;
+    crate::above::add_above(
+        &mut st,
+        objects,
+        &mut object_cells,
+        &mut zones,
+        terrain,
+        background_nodes,
+    )?;
     let mut fault_faces = fault_faces(&st, faults);
     let first_above = st.tets.len() - object_cells.above_cells;
     fault_faces.retain(|f| f.cells.iter().all(|&c| (c as usize) < first_above));
