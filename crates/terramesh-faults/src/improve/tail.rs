@@ -49,7 +49,8 @@
 //! gains [`super::cavity::INSERT_GAIN`], as an insertion may.
 //!
 //! **A lenient move** ([`Pass::lenient_move`], after the lenient split, and in a tail sweep
-//! instead of a move that gains less than [`super::HEAVY_GAIN`] if better): a node of the
+//! instead of a move that gains less than [`super::HEAVY_GAIN`] if better; only in a sweep
+//! that began with at most [`super::LENIENT_CELLS`] cells below the floor): a node of the
 //! poor cell moved along what it lies on (as [`Pass::slide`] allows) by a compass search that
 //! may take more of its cells below the floor, kept if their smallest angle gains
 //! [`super::HEAVY_GAIN`], every cell in its unit, zones and objects. A sliver flat against a
@@ -187,6 +188,9 @@ impl Pass<'_> {
 
     /// The best [`Pass::lenient_move`] of a node of poor cell `t`.
     fn best_lenient_move(&self, t: [u32; 4], around: &[&[u32]; 4]) -> Option<Op> {
+        if !self.lenient {
+            return None;
+        }
         (0..4)
             .filter_map(|i| self.lenient_move(t[i], around[i]))
             .map(|m| (move_worst(&m), m))
@@ -1080,6 +1084,14 @@ fn edge_angle(g: [[f64; 3]; 4], i: usize, j: usize) -> f64 {
     }
 }
 
+/// The smallest angle of the cells that move `op` changes.
+fn move_worst(op: &Op) -> f64 {
+    match op {
+        Op::Move { angles, .. } => angles.iter().copied().fold(f64::MAX, f64::min),
+        _ => f64::MIN,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::improve::tests::summary;
@@ -1535,13 +1547,5 @@ mod tests {
             }
         }
         assert_eq!(between, 2);
-    }
-}
-
-/// The smallest angle of the cells that move `op` changes.
-fn move_worst(op: &Op) -> f64 {
-    match op {
-        Op::Move { angles, .. } => angles.iter().copied().fold(f64::MAX, f64::min),
-        _ => f64::MIN,
     }
 }
