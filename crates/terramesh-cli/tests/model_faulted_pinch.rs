@@ -406,7 +406,7 @@ fn a_thinning_interbed_is_kept_where_thicker_than_min_thickness_and_pinches_out_
         "{near_below} below 5 degrees near the line, smallest {near_smallest}"
     );
     assert!(
-        below <= 1 && smallest >= 4.9,
+        below == 0 && smallest >= 5.0,
         "{below} below 5, smallest {smallest}"
     );
 }

@@ -75,6 +75,9 @@ struct Pass<'a> {
     /// mark its nodes as touched, and a barren cell is not planned. In the tail every
     /// operation counts, as before.
     heavy: bool,
+    /// Whether this sweep began with at most [`LENIENT_CELLS`] cells below the floor: only
+    /// then may the tail's lenient move ([`Pass::lenient_move`]) leave more cells below it.
+    lenient: bool,
     /// Per node, the number of the last operation that changed one of its cells (or moved
     /// it): a plan made before that operation that read such a node is made again.
     stamp: Vec<u32>,
@@ -361,6 +364,11 @@ const REPLAN: usize = 16;
 pub(crate) const FULL_SWEEPS: usize = 6;
 /// The most poor cells a sweep after [`FULL_SWEEPS`] may start with.
 pub(crate) const TAIL_CELLS: usize = 4_096;
+
+/// The most cells below the floor at a sweep's start for the tail's lenient move
+/// ([`Pass::lenient_move`]): it is for the last few slivers of a mesh, and where many cells are
+/// poor (a wedge the data makes, `tests/pinch.rs`) its searches cost every sweep without end.
+pub(crate) const LENIENT_CELLS: usize = 64;
 
 /// The most steps of a split's compass search (each step tries [`COMPASS`]'s 14 directions,
 /// or halves the step when none is better).
@@ -1868,6 +1876,7 @@ pub(crate) fn improve(
         touched: vec![true; st.points.len()],
         barren: vec![false; st.tets.len()],
         heavy: true,
+        lenient: false,
         stamp: vec![0; st.points.len()],
         mark: 0,
         floor: below,
@@ -1903,8 +1912,11 @@ pub(crate) fn improve(
                 .count();
             // The first sweep of the tail plans every poor cell again (those left by a
             // quiet move or barren included).
-            let fresh = p.heavy && all_poor <= TAIL_CELLS;
+            // So does the first sweep that may make lenient moves.
+            let fresh =
+                (p.heavy && all_poor <= TAIL_CELLS) || (!p.lenient && all_poor <= LENIENT_CELLS);
             p.heavy = all_poor > TAIL_CELLS;
+            p.lenient = all_poor <= LENIENT_CELLS;
             let mut bad: Vec<u32> = (0..p.st.tets.len() as u32)
                 .filter(|&c| {
                     let c = c as usize;

@@ -88,6 +88,7 @@ impl Pass<'_> {
         self.search_move(
             v,
             cells,
+            false,
             |to| self.onto_trace(fi, to),
             |q| self.trace_kept(v, q, cells, fi),
         )
