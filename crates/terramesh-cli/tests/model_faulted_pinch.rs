@@ -15,10 +15,14 @@
 #[allow(dead_code)]
 mod vtu_read;
 
-use std::path::{Path, PathBuf};
+#[path = "support/faulted_example.rs"]
+#[allow(dead_code)]
+mod faulted_example;
+
 use std::process::Command;
 
-use terramesh_faults::{min_dihedral, Site, SynthFault};
+use faulted_example::{example, tet_volume, truth};
+use terramesh_faults::{min_dihedral, Site};
 use vtu_read::Vtu;
 
 /// `weak_1`'s thickness at the south-west corner (x + y = 0) and at the north-east one
@@ -29,65 +33,6 @@ const MIN_THICKNESS: f64 = 1.0;
 /// The unit that pinches out (`weak_1`), and the interface under it (the top of
 /// `sandstone_b`), whose height the thinning changes.
 const WEAK: usize = 2;
-
-fn example() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .nth(2)
-        .unwrap()
-        .join("examples/faulted")
-}
-
-/// The example's truth from its `site.json` (as `model_faulted.rs` reads it).
-fn site() -> Site {
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(example().join("site.json")).unwrap())
-            .unwrap();
-    let f64s = |v: &serde_json::Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect()
-    };
-    let plane = f64s(&v["plane"]);
-    let dip = f64s(&v["dip"]);
-    let faults = v["faults"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| {
-            let t: Vec<Vec<f64>> = f["trace"].as_array().unwrap().iter().map(f64s).collect();
-            let mut s = SynthFault::new(
-                f["name"].as_str().unwrap(),
-                [t[0][0], t[0][1]],
-                [t[1][0], t[1][1]],
-                f["dip"].as_f64().unwrap(),
-                f["dip_direction"].as_f64().unwrap(),
-                f["throw"].as_f64().unwrap(),
-            );
-            if let Some(e) = f["ends_at"].as_array() {
-                s.ends_at = Some((
-                    e[0].as_u64().unwrap() as usize,
-                    e[1].as_i64().unwrap() as i8,
-                ));
-            }
-            s
-        })
-        .collect();
-    Site::new(
-        400.0,
-        2,
-        0.0,
-        0,
-        [plane[0], plane[1], plane[2]],
-        v["base"].as_f64().unwrap(),
-        f64s(&v["tops"]),
-        [dip[0], dip[1]],
-        faults,
-    )
-    .unwrap()
-}
 
 /// The truth: the example's faults and strata, `weak_1` `thickness(x, y)` thick where `thin`.
 struct Truth {
@@ -159,14 +104,6 @@ impl Truth {
     }
 }
 
-fn tet_volume(p: [[f64; 3]; 4]) -> f64 {
-    let d = |a: [f64; 3], b: [f64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let (u, v, w) = (d(p[0], p[1]), d(p[0], p[2]), d(p[0], p[3]));
-    (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
-        + u[2] * (v[0] * w[1] - v[1] * w[0]))
-        / 6.0
-}
-
 #[test]
 fn a_thinning_interbed_is_kept_where_thicker_than_min_thickness_and_pinches_out_across_faults() {
     let units: Vec<String> = [
@@ -184,7 +121,7 @@ fn a_thinning_interbed_is_kept_where_thicker_than_min_thickness_and_pinches_out_
     let collars = std::fs::read_to_string(example().join("collars.csv")).unwrap();
     // The generator is make_site.py's: from the example's truth it writes the example's log.
     let example_truth = Truth {
-        site: site(),
+        site: truth(),
         thin: false,
     };
     // (to the centimetre: B14's sample at 97.275 m lies on F2 to rounding, which the two
@@ -204,7 +141,7 @@ fn a_thinning_interbed_is_kept_where_thicker_than_min_thickness_and_pinches_out_
         }
     }
     let truth = Truth {
-        site: site(),
+        site: truth(),
         thin: true,
     };
     let tmp = tempfile::tempdir().unwrap();

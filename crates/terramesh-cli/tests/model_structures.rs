@@ -234,19 +234,12 @@ fn min_dihedral(g: [[f64; 3]; 4]) -> f64 {
 /// tunnel and the barrel's nodes near the caps could slide away from them (flat cells on the
 /// caps' planes, whose nodes carried three labels and stayed), 5 after.
 fn lined_tunnel_cells_keep_their_angles(out: &Path) {
-    let vtu = std::fs::read_to_string(out.join("model.vtu")).unwrap();
-    let object: Vec<i32> = vtu_array(&vtu, "object")
-        .chunks(4)
-        .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let points: Vec<f64> = vtu_array(&vtu, "Points")
-        .chunks(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let conn: Vec<usize> = vtu_array(&vtu, "connectivity")
-        .chunks(8)
-        .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as usize)
-        .collect();
+    let ModelCells {
+        object,
+        points,
+        conn,
+        ..
+    } = ModelCells::read(out);
     let poor = conn
         .chunks(4)
         .zip(&object)
@@ -265,35 +258,66 @@ fn lined_tunnel_cells_keep_their_angles(out: &Path) {
     );
 }
 
+/// What the objects' checks read of a model: `model.vtu`'s cells' `object`, its points and
+/// connectivity, and the highest terrain node around the dam (`model-top.vtu`: the terrain
+/// under the dam is no longer on the boundary).
+struct ModelCells {
+    object: Vec<i32>,
+    points: Vec<f64>,
+    conn: Vec<usize>,
+    terrain_z: f64,
+}
+
+impl ModelCells {
+    /// Whether a point lies around the dam in plan.
+    fn near(q: &[f64]) -> bool {
+        q[0] > 270.0 && q[0] < 340.0 && q[1] > 50.0 && q[1] < 110.0
+    }
+
+    fn read(out: &Path) -> ModelCells {
+        let vtu = std::fs::read_to_string(out.join("model.vtu")).unwrap();
+        let object: Vec<i32> = vtu_array(&vtu, "object")
+            .chunks(4)
+            .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        let points: Vec<f64> = vtu_array(&vtu, "Points")
+            .chunks(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        let conn: Vec<usize> = vtu_array(&vtu, "connectivity")
+            .chunks(8)
+            .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as usize)
+            .collect();
+        let top = std::fs::read_to_string(out.join("model-top.vtu")).unwrap();
+        let terrain_z = vtu_array(&top, "Points")
+            .chunks(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+            .collect::<Vec<f64>>()
+            .chunks(3)
+            .filter(|q| Self::near(q))
+            .map(|q| q[2])
+            .fold(f64::NEG_INFINITY, f64::max);
+        ModelCells {
+            object,
+            points,
+            conn,
+            terrain_z,
+        }
+    }
+}
+
 /// The dam's cells above the terrain (object 3, a node above the terrain's highest node near
 /// the dam) below 5 degrees: 67 of them, the smallest 0.50 degrees, when the columns stood on
 /// the terrain as the quality pass left it; 34, the smallest 1.43, once the terrain nodes
 /// under the dam are moved for the columns' sake and the columns' split order is chosen
 /// (`above.rs`, "The terrain under a structure").
 fn dam_cells_above_the_terrain_keep_their_angles(out: &Path) {
-    let vtu = std::fs::read_to_string(out.join("model.vtu")).unwrap();
-    let object: Vec<i32> = vtu_array(&vtu, "object")
-        .chunks(4)
-        .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let points: Vec<f64> = vtu_array(&vtu, "Points")
-        .chunks(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let conn: Vec<usize> = vtu_array(&vtu, "connectivity")
-        .chunks(8)
-        .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as usize)
-        .collect();
-    let top = std::fs::read_to_string(out.join("model-top.vtu")).unwrap();
-    let near = |q: &[f64]| q[0] > 270.0 && q[0] < 340.0 && q[1] > 50.0 && q[1] < 110.0;
-    let terrain_z = vtu_array(&top, "Points")
-        .chunks(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect::<Vec<f64>>()
-        .chunks(3)
-        .filter(|q| near(q))
-        .map(|q| q[2])
-        .fold(f64::NEG_INFINITY, f64::max);
+    let ModelCells {
+        object,
+        points,
+        conn,
+        terrain_z,
+    } = ModelCells::read(out);
     let angles: Vec<f64> = conn
         .chunks(4)
         .zip(&object)
@@ -322,31 +346,13 @@ fn dam_cells_above_the_terrain_keep_their_angles(out: &Path) {
 /// above every terrain node of the model), and its exposed surface is the boundary mesh
 /// `model-side-structures.vtu`, whose faces reach its top.
 fn dam_rises_above_the_terrain(out: &Path) {
-    let vtu = std::fs::read_to_string(out.join("model.vtu")).unwrap();
-    let object: Vec<i32> = vtu_array(&vtu, "object")
-        .chunks(4)
-        .map(|b| i32::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let points: Vec<f64> = vtu_array(&vtu, "Points")
-        .chunks(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let conn: Vec<usize> = vtu_array(&vtu, "connectivity")
-        .chunks(8)
-        .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as usize)
-        .collect();
-    // The highest terrain node around the dam (the terrain under it is no longer on the
-    // boundary).
-    let top = std::fs::read_to_string(out.join("model-top.vtu")).unwrap();
-    let near = |q: &[f64]| q[0] > 270.0 && q[0] < 340.0 && q[1] > 50.0 && q[1] < 110.0;
-    let terrain_z = vtu_array(&top, "Points")
-        .chunks(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect::<Vec<f64>>()
-        .chunks(3)
-        .filter(|q| near(q))
-        .map(|q| q[2])
-        .fold(f64::NEG_INFINITY, f64::max);
+    let ModelCells {
+        object,
+        points,
+        conn,
+        terrain_z,
+    } = ModelCells::read(out);
+    let near = ModelCells::near;
     assert!(
         terrain_z > 140.0 && terrain_z < 170.0,
         "the terrain reaches {terrain_z} near the dam"
