@@ -46,6 +46,15 @@ use crate::mesh::{all_faces, outward_faces, positive, State, BASE, SIDE, TOP};
 use crate::objects::{ObjectCells, ObjectSet, Wall, ON_WALL};
 use crate::{FaultError, ZoneCells};
 
+/// A column's three tetrahedra by the lowest-index rule: over its terrain nodes in their
+/// order (0, 1, 2), each corner a node and whether it is the node's top. [`add_above`] stands
+/// them and [`column_angle`] scores them.
+const COLUMN: [[(usize, bool); 4]; 3] = [
+    [(0, false), (1, false), (2, false), (2, true)],
+    [(0, false), (1, false), (1, true), (2, true)],
+    [(0, false), (0, true), (1, true), (2, true)],
+];
+
 /// Adds the parts of the structures above the terrain to the mesh (see the module's notes).
 ///
 /// # Errors
@@ -146,9 +155,9 @@ pub(crate) fn add_above(
             let (f, below) = terrain_faces[n];
             let mut b = f;
             b.sort_unstable_by_key(|&w| rank_of(w));
-            let [a, bb, c] = b;
-            let [ta, tb, tc] = [top_of[&a], top_of[&bb], top_of[&c]];
-            for t in [[a, bb, c, tc], [a, bb, tb, tc], [a, ta, tb, tc]] {
+            let tops = b.map(|w| top_of[&w]);
+            for cell in COLUMN {
+                let t = cell.map(|(k, up)| if up { tops[k] } else { b[k] });
                 if (0..4).any(|x| (x + 1..4).any(|y| t[x] == t[y])) {
                     continue;
                 }
@@ -347,11 +356,7 @@ fn column_angle(
     let node = |k: usize, up: bool| if up { t[k].unwrap_or(q[k]) } else { q[k] };
     let key = |k: usize, up: bool| if up && t[k].is_some() { 3 + k } else { k };
     let mut worst: Option<f64> = None;
-    for cell in [
-        [(0, false), (1, false), (2, false), (2, true)],
-        [(0, false), (1, false), (1, true), (2, true)],
-        [(0, false), (0, true), (1, true), (2, true)],
-    ] {
+    for cell in COLUMN {
         let keys = cell.map(|(k, up)| key(k, up));
         if (0..4).any(|x| (x + 1..4).any(|y| keys[x] == keys[y])) {
             continue;
