@@ -15,7 +15,7 @@ mod faulted_example;
 use std::path::Path;
 use std::process::Command;
 
-use faulted_example::{example, root, tet_volume, truth};
+use faulted_example::{assert_checks_pass, example, root, tet_volume, truth};
 use vtu_read::Vtu;
 
 fn model(project: &Path, out: &Path, sets: &[&str]) -> std::process::Output {
@@ -57,21 +57,10 @@ fn the_faulted_example_is_meshed_with_every_fault_and_the_true_unit_in_99_percen
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("model.json")).unwrap()).unwrap();
-    // The kernel's checks passed (a failed one is an error) and say so.
-    let checks = &json["checks"];
-    assert_eq!(checks["closed"], true);
-    assert_eq!(checks["conformal"], true);
-    assert!(
-        checks["relative_difference"].as_f64().unwrap() < 1e-9,
-        "{checks}"
-    );
+    assert_checks_pass(&json);
     let faulted = &json["faulted"];
-    assert!(
-        faulted["fault_distance"].as_f64().unwrap() < 0.01,
-        "{faulted}"
-    );
-    // The quality pinned (measured: no cell below 5 degrees, the smallest 5.70 degrees, since
-    // the tail flips an edge on a fault (F2's face with a 158-degree corner where F2, F3 and
+    // The quality pinned (measured: no cell below 5 degrees, the smallest 6.00 degrees, since
+    // the tail's lenient move; 5.70 since the tail flips an edge on a fault (F2's face with a 158-degree corner where F2, F3 and
     // block 1's interface meet); 1 and 3.19 before it, since the tail's lenient split; 3 and
     // 2.72 before that, 5 before the tail inserted a node inside a cavity of one label, 45
     // and 0.089 before the pass merged nodes a few millimetres apart on the junction of F1

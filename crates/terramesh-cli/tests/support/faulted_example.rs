@@ -80,3 +80,21 @@ pub fn tet_volume(p: [[f64; 3]; 4]) -> f64 {
         + u[2] * (v[0] * w[1] - v[1] * w[0]))
         / 6.0
 }
+
+/// The kernel's checks passed (a failed one is an error) and `model.json` says so: closed,
+/// conformal, the cells' volume the terrain-to-base volume to 1e-9, fault faces within 1 cm
+/// of their faults.
+pub fn assert_checks_pass(json: &serde_json::Value) {
+    let checks = &json["checks"];
+    assert_eq!(checks["closed"], true, "{checks}");
+    assert_eq!(checks["conformal"], true, "{checks}");
+    assert!(
+        checks["relative_difference"].as_f64().unwrap() < 1e-9,
+        "{checks}"
+    );
+    let faulted = &json["faulted"];
+    assert!(
+        faulted["fault_distance"].as_f64().unwrap() < 0.01,
+        "{faulted}"
+    );
+}
