@@ -201,11 +201,15 @@ impl Pass<'_> {
                     return false;
                 }
                 // A lining's cell keeps out of its tunnel's barrel: flat against a cap's
-                // plane inside the profile it lies on both walls within any tolerance.
+                // plane inside the profile it lies on both walls within any tolerance. A
+                // cell the cut left deeper (an operation changes it, as a move of a barrel
+                // node away from the cap does) may stay as deep, not go deeper.
                 if mine
                     && code & 1 == 1
                     && w == Wall::Inner
-                    && o.barrel(w, c).is_some_and(|b| b < -far)
+                    && o.barrel(w, c).is_some_and(|b| {
+                        b < -far && (!strict || b < self.barrel_depth(o, like) - ON_WALL)
+                    })
                 {
                     return false;
                 }
@@ -216,6 +220,17 @@ impl Pass<'_> {
                     })
             })
         })
+    }
+
+    /// The barrel's field ([`crate::Object::barrel`], of the tunnel's wall) at the centroid
+    /// of cell `c` as it is now (`f64::MAX` without a barrel, or for a cell not yet made).
+    fn barrel_depth(&self, o: &crate::Object, c: u32) -> f64 {
+        let Some(&t) = self.st.tets.get(c as usize) else {
+            return f64::MAX;
+        };
+        let g = self.geo(t);
+        let c = [0, 1, 2].map(|k| g.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+        o.barrel(Wall::Inner, c).unwrap_or(f64::MAX)
     }
 
     /// [`Pass::objects_hold`] for an operation: strictly.
