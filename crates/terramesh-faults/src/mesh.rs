@@ -1015,8 +1015,10 @@ pub(crate) fn split_cells_ranked(
 /// centimetre outside the unit (which cells do so depends on the interfaces' last bits).
 /// Splitting those edges at the crease first (found by bisection in plan, the new node moved
 /// vertically onto the two interfaces where they are one, or left on its chord where that
-/// would invert a cell) gives the unit's cells no plan across it. Returns the number of edges
-/// split.
+/// would invert a cell) gives the unit's cells no plan across it. `known`: the nodes' sides
+/// of the interface the cells are chosen by (`k - 1` for `j == k`, else `k`) found so far,
+/// extended here by the nodes added since (no node moves between the calls that share it).
+/// Returns the number of edges split.
 fn cut_crease(
     st: &mut State,
     cells: &[u32],
@@ -1024,6 +1026,7 @@ fn cut_crease(
     j: usize,
     k: usize,
     block: BlockKey,
+    known: &mut Vec<i8>,
 ) -> usize {
     let pinched = |q: [f64; 3]| {
         let p = [q[0], q[1]];
@@ -1036,19 +1039,28 @@ fn cut_crease(
     } else {
         (Field::Interface(height, k, block), false)
     };
-    // Each node's side once (not once per cell).
-    let mut need = vec![false; st.points.len()];
-    for &c in cells {
-        for &v in &st.tets[c as usize] {
-            need[v as usize] = true;
+    // Each node's side once (not once per cell), and once per interface and block: `known`
+    // holds the sides of the nodes before `known.len()` (those of `cells` right: the cells
+    // are those or their children, whose other nodes are new), found again for none of them.
+    let from = known.len();
+    if from < st.points.len() {
+        let mut need = vec![false; st.points.len() - from];
+        for &c in cells {
+            for &v in &st.tets[c as usize] {
+                if v as usize >= from {
+                    need[v as usize - from] = true;
+                }
+            }
         }
+        known.par_extend(st.points[from..].par_iter().zip(&need).map(|(&q, &n)| {
+            if n {
+                near.eval(q).1
+            } else {
+                0
+            }
+        }));
     }
-    let side: Vec<i8> = st
-        .points
-        .par_iter()
-        .zip(&need)
-        .map(|(&q, &n)| if n { near.eval(q).1 } else { 0 })
-        .collect();
+    let side: &[i8] = known;
     let mut keys: Vec<u64> = cells
         .par_iter()
         .flat_map_iter(|&c| {
@@ -1555,6 +1567,9 @@ pub fn faulted_mesh_with_objects(
     for (c, &b) in st.block.iter().enumerate() {
         by_block[b as usize].push(c as u32);
     }
+    // Per block, the sides of its cells' nodes of the interface last labelled (the last cut's
+    // values), for the creases of the next interface's units.
+    let mut sides_above: Vec<Vec<i8>> = vec![Vec::new(); blocks.len()];
     for k in 0..interfaces {
         // A height that is not a number would read as "on the interface": refuse it.
         for (b, &bk) in blocks.iter().enumerate() {
@@ -1587,11 +1602,20 @@ pub fn faulted_mesh_with_objects(
         }
         if k > 0 {
             // Unit k's pinch-out line first (a crease of its base), then every unit's above
-            // where interface k follows it (a crease there too).
+            // where interface k follows it (a crease there too). The nodes' sides of
+            // interface k - 1 (unit k's crease) are the cells' labelling's just above, and
+            // those of interface k (every crease above) are found once per block: the creases
+            // move no node, so only the nodes their splits add are found later.
+            let mut sides_k: Vec<Vec<i8>> = vec![Vec::new(); blocks.len()];
             for j in (1..=k).rev() {
                 for (b, &bk) in blocks.iter().enumerate() {
                     let before = st.tets.len();
-                    cut_crease(&mut st, &by_block[b], height, j, k, bk);
+                    let known = if j == k {
+                        &mut sides_above[b]
+                    } else {
+                        &mut sides_k[b]
+                    };
+                    cut_crease(&mut st, &by_block[b], height, j, k, bk, known);
                     for c in before..st.tets.len() {
                         by_block[st.block[c] as usize].push(c as u32);
                     }
@@ -1658,6 +1682,9 @@ pub fn faulted_mesh_with_objects(
                 .par_iter()
                 .map(|&c| (c as usize, sides(&st, &values, &field, c as usize)))
                 .collect();
+            if k + 1 < interfaces {
+                sides_above[b] = values.par_iter().map(|v| v.1).collect();
+            }
             for (c, s) in res {
                 let s = if s == 0 {
                     st.report.unresolved += 1;
