@@ -1393,6 +1393,18 @@ impl Object {
         }
     }
 
+    /// A structure's closed surface: its vertices and outward triangles (`None` for other
+    /// objects).
+    pub(crate) fn solid(&self) -> Option<(&[[f64; 3]], &[[u32; 3]])> {
+        match &self.shape {
+            Shape::Structure {
+                vertices,
+                triangles,
+            } => Some((vertices, triangles)),
+            _ => None,
+        }
+    }
+
     /// A structure's highest point over (x, y) within `reach` in plan: the highest plane
     /// elevation at (x, y) of the triangles (not vertical) whose plan lies within `reach` of
     /// it, so that a node cut onto a vertical wall (within [`ON_WALL`]) gets the top of the
