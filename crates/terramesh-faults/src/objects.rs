@@ -1395,7 +1395,7 @@ impl Object {
 
     /// A structure's closed surface: its vertices and outward triangles (`None` for other
     /// objects).
-    pub(crate) fn solid(&self) -> Option<(&[[f64; 3]], &[[u32; 3]])> {
+    pub(crate) fn solid(&self) -> Option<Solid<'_>> {
         match &self.shape {
             Shape::Structure {
                 vertices,
@@ -1457,6 +1457,9 @@ impl Object {
         top
     }
 }
+
+/// A structure's closed surface: its vertices and its outward triangles.
+pub(crate) type Solid<'a> = (&'a [[f64; 3]], &'a [[u32; 3]]);
 
 fn point_in_ring(p: [f64; 2], ring: &[[f64; 2]]) -> bool {
     let n = ring.len();
