@@ -41,14 +41,36 @@
 //! columns: every node starts at rank 0 (the lowest-index rule) and a node whose columns
 //! are below 5 degrees is made the lowest or the highest of its neighbours where that
 //! improves its columns' smallest angle. Models without a rising structure are untouched.
+//!
+//! # Corners and layers
+//!
+//! Before the walls are cut, [`seat_corners`] puts a terrain node on each corner of a rising
+//! structure's trace on the terrain (where a sharp edge of its solid crosses the terrain):
+//! without it the cut joins the two walls by a chord across the corner. A column of three
+//! tetrahedra over a face of smallest altitude d and height H has a cell with a dihedral
+//! angle near atan(d / H) (its middle cell, between a bottom edge and a top edge): the faces
+//! a decimetre to a metre wide along the walls under a 14 m dam made slivers whatever the
+//! face's shape. So each column is stood in layers, one number of them for the whole
+//! structure ([`LAYER`]): every terrain node's vertical edge is split at the same fractions
+//! of its height, and each column's front (one node on each of its three vertical edges)
+//! climbs one node at a time, the lowest next node first (ties by the split order): each
+//! step one tetrahedron, its apex straight above a front node, so positive wherever the
+//! face is (exact `orient3d`), and neighbouring columns, climbing their shared edges in the
+//! same order, share their sides.
 
 use crate::mesh::{all_faces, outward_faces, positive, State, BASE, SIDE, TOP};
 use crate::objects::{ObjectCells, ObjectSet, Wall, ON_WALL};
 use crate::{FaultError, ZoneCells};
 
-/// A column's three tetrahedra by the lowest-index rule: over its terrain nodes in their
-/// order (0, 1, 2), each corner a node and whether it is the node's top. [`add_above`] stands
-/// them and [`column_angle`] scores them.
+/// A structure's columns are stood in layers no taller than this times the median, over the
+/// terrain nodes under it, of the longest terrain edge at a node (see the module's notes).
+const LAYER: f64 = 0.5;
+/// At most this many layers.
+const MAX_LAYERS: usize = 64;
+
+/// A column's three tetrahedra by the lowest-index rule (one layer): over its terrain nodes
+/// in their order (0, 1, 2), each corner a node and whether it is the node's top.
+/// [`column_angle`] scores them for [`mend_under`] and [`order_columns`].
 const COLUMN: [[(usize, bool); 4]; 3] = [
     [(0, false), (1, false), (2, false), (2, true)],
     [(0, false), (1, false), (1, true), (2, true)],
@@ -150,25 +172,89 @@ pub(crate) fn add_above(
                 .collect::<Vec<_>>(),
         );
         let rank_of = |w: u32| (rank.get(&w).copied().unwrap_or(0), w);
+        // Each terrain node's vertical edge, from the node to its top, in steps about as
+        // tall as the faces at the node are wide (see the module's notes): its nodes from
+        // the bottom up.
+        let mut width: std::collections::HashMap<u32, f64> = std::collections::HashMap::new();
+        for &n in &under {
+            let f = terrain_faces[n].0;
+            let q = f.map(|v| st.points[v as usize]);
+            let e =
+                [(0, 1), (1, 2), (2, 0)].map(|(a, b)| (q[b][0] - q[a][0]).hypot(q[b][1] - q[a][1]));
+            let longest = e.iter().copied().fold(0.0f64, f64::max);
+            for v in f {
+                let w = width.entry(v).or_insert(0.0);
+                *w = w.max(longest);
+            }
+        }
+        // One number of layers for the whole structure, so that the fronts climb level:
+        // layers no taller than half the median (over its terrain nodes) of the longest
+        // terrain edge at a node.
+        let mut widths: Vec<f64> = width.values().copied().collect();
+        widths.sort_by(f64::total_cmp);
+        let tallest = top_of
+            .iter()
+            .map(|(&v, &t)| st.points[t as usize][2] - st.points[v as usize][2])
+            .fold(0.0f64, f64::max);
+        let median = widths.get(widths.len() / 2).copied().unwrap_or(0.0);
+        let layers = if median > 0.0 {
+            (tallest / (LAYER * median))
+                .ceil()
+                .clamp(1.0, MAX_LAYERS as f64) as usize
+        } else {
+            1
+        };
+        let mut ladder: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+        let mut vs: Vec<u32> = top_of.keys().copied().collect();
+        vs.sort_unstable();
+        for v in vs {
+            let top = top_of[&v];
+            let mut nodes = vec![v];
+            if top != v {
+                let (p, t) = (st.points[v as usize], st.points[top as usize][2]);
+                let h = t - p[2];
+                let n = layers;
+                for i in 1..n {
+                    st.points.push([p[0], p[1], p[2] + h * i as f64 / n as f64]);
+                    st.flags.push(0);
+                    st.on_fault.push(0);
+                    nodes.push(st.points.len() as u32 - 1);
+                }
+                nodes.push(top);
+            }
+            ladder.insert(v, nodes);
+        }
+        // The order in which the columns' fronts climb: by height, then the split order.
+        let key = |v: u32, i: usize| {
+            let z = st.points[ladder[&v][i] as usize][2];
+            (z, rank_of(v), i)
+        };
         for &n in &under {
             taken[n] = true;
             let (f, below) = terrain_faces[n];
-            let mut b = f;
-            b.sort_unstable_by_key(|&w| rank_of(w));
-            let tops = b.map(|w| top_of[&w]);
-            for cell in COLUMN {
-                let t = cell.map(|(k, up)| if up { tops[k] } else { b[k] });
-                if (0..4).any(|x| (x + 1..4).any(|y| t[x] == t[y])) {
-                    continue;
-                }
+            let steps = f.map(|v| &ladder[&v]);
+            let mut at = [0usize; 3];
+            loop {
+                let next = (0..3)
+                    .filter(|&k| at[k] + 1 < steps[k].len())
+                    .min_by(|&x, &y| {
+                        let (a, b) = (key(f[x], at[x] + 1), key(f[y], at[y] + 1));
+                        a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2)))
+                    });
+                let Some(k) = next else { break };
+                let t = [
+                    steps[0][at[0]],
+                    steps[1][at[1]],
+                    steps[2][at[2]],
+                    steps[k][at[k] + 1],
+                ];
+                at[k] += 1;
                 let q = t.map(|v| st.points[v as usize]);
                 let cell = if positive(q) {
                     t
                 } else {
                     let s = [t[1], t[0], t[2], t[3]];
                     if !positive(s.map(|v| st.points[v as usize])) {
-                        // Flat: the column's edges at two of its nodes collapse into a
-                        // plane; it has no volume to add.
                         continue;
                     }
                     s
@@ -729,4 +815,363 @@ fn order_columns(
         }
     }
     rank
+}
+
+/// The corners of a rising structure's trace on the terrain: where an edge of its solid
+/// between two triangles not in one plane (a box's vertical edge) crosses the terrain, at the
+/// terrain's height there (so on the DSM exactly, and on the edge in plan to rounding).
+/// Each edge is read in pieces of at most a metre, a sign change of its height over the
+/// terrain's bisected; corners closer than a micrometre are one.
+pub(crate) fn trace_corners(o: &crate::Object, terrain: &crate::Terrain) -> Vec<[f64; 3]> {
+    let Some((vertices, triangles)) = o.solid() else {
+        return Vec::new();
+    };
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| vertices[v as usize]);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        n.map(|x| x / l)
+    };
+    let mut sides: std::collections::BTreeMap<(u32, u32), Vec<[f64; 3]>> =
+        std::collections::BTreeMap::new();
+    for t in triangles {
+        let n = normal(t);
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            sides.entry((a.min(b), a.max(b))).or_default().push(n);
+        }
+    }
+    let mut corners: Vec<[f64; 3]> = Vec::new();
+    for (&(a, b), ns) in &sides {
+        let sharp =
+            ns.len() != 2 || ns[0].iter().zip(&ns[1]).map(|(x, y)| x * y).sum::<f64>() < 1.0 - 1e-9;
+        if !sharp {
+            continue;
+        }
+        let (pa, pb) = (vertices[a as usize], vertices[b as usize]);
+        let at = |s: f64| [0, 1, 2].map(|k| pa[k] + s * (pb[k] - pa[k]));
+        // The edge's height over the terrain at s, and its point on the terrain.
+        let over = |s: f64| {
+            let q = at(s);
+            terrain
+                .height([q[0], q[1]])
+                .map(|h| (q[2] - h, [q[0], q[1], h]))
+        };
+        let len = (0..3).map(|k| (pb[k] - pa[k]).powi(2)).sum::<f64>().sqrt();
+        let pieces = (len.ceil() as usize).max(1);
+        for i in 0..pieces {
+            let (mut s0, mut s1) = (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64);
+            let (Some((g0, q0)), Some((g1, q1))) = (over(s0), over(s1)) else {
+                continue;
+            };
+            let corner = if g0 == 0.0 {
+                q0
+            } else if g1 == 0.0 && i + 1 == pieces {
+                q1
+            } else if (g0 < 0.0) != (g1 < 0.0) {
+                let mut q = q0;
+                for _ in 0..200 {
+                    let m = 0.5 * (s0 + s1);
+                    if m <= s0 || m >= s1 {
+                        break;
+                    }
+                    let Some((g, r)) = over(m) else { break };
+                    q = r;
+                    if g == 0.0 {
+                        break;
+                    }
+                    if (g < 0.0) == (g0 < 0.0) {
+                        s0 = m;
+                    } else {
+                        s1 = m;
+                    }
+                }
+                q
+            } else {
+                continue;
+            };
+            let seen = corners
+                .iter()
+                .any(|c| (0..3).map(|k| (c[k] - corner[k]).powi(2)).sum::<f64>() < 1e-12);
+            if !seen {
+                corners.push(corner);
+            }
+        }
+    }
+    corners
+}
+
+/// Puts a terrain node on every corner of each rising structure's trace on the terrain
+/// ([`trace_corners`]) before the structures' walls are cut, so that the cut's trace of the
+/// walls on the terrain turns at the corner instead of cutting it off with a chord (a
+/// terrain face across the corner, thin or obtuse, under a column of slivers). Where no
+/// terrain node lies within [`ON_WALL`] of a corner, the best of these (by the smallest
+/// dihedral angle of the cells they change) is made: a free terrain node of the terrain
+/// face holding the corner in plan, or of a face beside it, moved onto it (made after the
+/// background, on no fault, interface, side or base, its cells of one label, its terrain
+/// faces still on the DSM); the face split at the corner (its cell into three); an edge of
+/// the face split there (its cells into two each; the terrain faces around the edge still
+/// on the DSM). Every changed cell must be positive (exact `orient3d`). The new node's
+/// cells keep their cell's labels. Returns the corners seated.
+pub(crate) fn seat_corners(
+    st: &mut State,
+    set: &ObjectSet,
+    terrain: &crate::Terrain,
+    background: usize,
+) -> usize {
+    let mut seated = 0;
+    for o in set.objects.iter().filter(|o| o.rises) {
+        for p in trace_corners(o, terrain) {
+            seated += usize::from(seat(st, p, terrain, background));
+        }
+    }
+    seated
+}
+
+/// Seats one corner (see [`seat_corners`]); false where a node is there already or no
+/// terrain face holds it.
+fn seat(st: &mut State, p: [f64; 3], terrain: &crate::Terrain, background: usize) -> bool {
+    use robust::{orient2d, Coord};
+    let c2 = |q: [f64; 3]| Coord { x: q[0], y: q[1] };
+    let tol = 0.5e-9
+        * terrain
+            .heights
+            .iter()
+            .fold(0.0f64, |s, h| s.max(h.abs()))
+            .max(1.0);
+    let plan = |q: [f64; 3]| (q[0] - p[0]).hypot(q[1] - p[1]);
+    // The terrain faces (seen from above) of the cells with a terrain node within `reach` of
+    // the corner in plan, the reach doubled until one holds the corner.
+    let mut reach = 2.0;
+    let (face, cell) = loop {
+        let near: Vec<usize> = (0..st.tets.len())
+            .filter(|&c| {
+                st.tets[c].iter().any(|&v| {
+                    st.flags[v as usize] & TOP != 0 && plan(st.points[v as usize]) <= reach
+                })
+            })
+            .collect();
+        let mut faces: Vec<(u128, usize, [u32; 3])> = Vec::new();
+        for &c in &near {
+            for f in outward_faces(&st.tets[c]) {
+                if f.iter().all(|&v| st.flags[v as usize] & TOP != 0) {
+                    faces.push((crate::mesh::face_key(&f), c, f));
+                }
+            }
+        }
+        faces.sort_unstable_by_key(|x| x.0);
+        let once: Vec<(usize, [u32; 3])> = faces
+            .iter()
+            .enumerate()
+            .filter(|&(i, x)| {
+                (i == 0 || faces[i - 1].0 != x.0) && faces.get(i + 1).is_none_or(|y| y.0 != x.0)
+            })
+            .map(|(_, x)| (x.1, x.2))
+            .collect();
+        if once.iter().flat_map(|(_, f)| f).any(|&v| {
+            let q = st.points[v as usize];
+            (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f64>() <= ON_WALL * ON_WALL
+        }) {
+            return false;
+        }
+        let holding = once.iter().find(|(_, f)| {
+            let q = f.map(|v| c2(st.points[v as usize]));
+            let pc = c2(p);
+            orient2d(q[0], q[1], q[2]) > 0.0
+                && orient2d(q[0], q[1], pc) >= 0.0
+                && orient2d(q[1], q[2], pc) >= 0.0
+                && orient2d(q[2], q[0], pc) >= 0.0
+        });
+        if let Some(&(c, f)) = holding {
+            break (f, c);
+        }
+        reach *= 2.0;
+        if reach > 1e4 {
+            return false;
+        }
+    };
+    // The cells around the face's nodes and the nodes across its edges.
+    let mut nodes: Vec<u32> = face.to_vec();
+    for c in 0..st.tets.len() {
+        let t = st.tets[c];
+        for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+            let (a, b) = (face[i], face[j]);
+            if c != cell && t.contains(&a) && t.contains(&b) {
+                for f in outward_faces(&t) {
+                    if f.contains(&a)
+                        && f.contains(&b)
+                        && f.iter().all(|&v| st.flags[v as usize] & TOP != 0)
+                    {
+                        nodes.extend(f.iter().filter(|&&v| v != a && v != b));
+                    }
+                }
+            }
+        }
+    }
+    nodes.sort_unstable();
+    nodes.dedup();
+    let around: Vec<usize> = (0..st.tets.len())
+        .filter(|&c| st.tets[c].iter().any(|v| nodes.contains(v)))
+        .collect();
+    let star = |v: u32| -> Vec<usize> {
+        around
+            .iter()
+            .copied()
+            .filter(|&c| st.tets[c].contains(&v))
+            .collect()
+    };
+    // The terrain faces among cells `cells` (each node's faces are all in its star), at
+    // `place`, lie on the DSM.
+    let on_dsm = |cells: &[[u32; 4]], place: &dyn Fn(u32) -> [f64; 3]| {
+        let mut faces: Vec<(u128, [u32; 3])> = cells
+            .iter()
+            .flat_map(outward_faces)
+            .filter(|f| {
+                f.iter()
+                    .all(|&v| v == u32::MAX || st.flags[v as usize] & TOP != 0)
+            })
+            .map(|f| (crate::mesh::face_key(&f), f))
+            .collect();
+        faces.sort_unstable_by_key(|x| x.0);
+        faces.iter().enumerate().all(|(i, &(k, f))| {
+            let twice =
+                (i > 0 && faces[i - 1].0 == k) || faces.get(i + 1).is_some_and(|y| y.0 == k);
+            if twice {
+                return true;
+            }
+            let g = f.map(place);
+            let mut probes = vec![[0, 1, 2].map(|k| (g[0][k] + g[1][k] + g[2][k]) / 3.0)];
+            for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+                probes.push([0, 1, 2].map(|k| 0.5 * (g[a][k] + g[b][k])));
+            }
+            probes.extend(g);
+            probes.iter().all(|r| {
+                terrain
+                    .height([r[0], r[1]])
+                    .is_some_and(|h| (h - r[2]).abs() <= tol)
+            })
+        })
+    };
+    // The new node stands for u32::MAX in the candidates' cells.
+    const NEW: u32 = u32::MAX;
+    let place = |v: u32| if v == NEW { p } else { st.points[v as usize] };
+    let score = |cells: &[[u32; 4]], place: &dyn Fn(u32) -> [f64; 3]| -> Option<f64> {
+        let mut worst = f64::INFINITY;
+        for t in cells {
+            let g = t.map(place);
+            if !positive(g) {
+                return None;
+            }
+            worst = worst.min(crate::quality::min_dihedral(g));
+        }
+        on_dsm(cells, place).then_some(worst)
+    };
+    enum Seat {
+        Move(u32),
+        /// The split's ends (the face's or the edge's nodes) and each cell's children.
+        Split(Vec<u32>, Vec<(usize, Vec<[u32; 4]>)>),
+    }
+    let mut best: Option<(f64, Seat)> = None;
+    let mut offer = |a: Option<f64>, s: Seat| {
+        if let Some(a) = a {
+            if best.as_ref().is_none_or(|(b, _)| a > *b) {
+                best = Some((a, s));
+            }
+        }
+    };
+    // A free terrain node moved onto the corner.
+    for &w in &nodes {
+        let wi = w as usize;
+        if wi < background || st.flags[wi] != TOP || st.on_fault[wi] != 0 {
+            continue;
+        }
+        let cells = star(w);
+        let c0 = cells[0];
+        let zone = |c: usize| st.zone.get(c).copied().unwrap_or(0);
+        if cells.iter().any(|&c| {
+            (st.positive[c], st.below[c], st.block[c], zone(c))
+                != (st.positive[c0], st.below[c0], st.block[c0], zone(c0))
+        }) {
+            continue;
+        }
+        let ts: Vec<[u32; 4]> = cells.iter().map(|&c| st.tets[c]).collect();
+        let moved = |v: u32| if v == w { p } else { st.points[v as usize] };
+        offer(score(&ts, &moved), Seat::Move(w));
+    }
+    // The face split at the corner.
+    let t = st.tets[cell];
+    let kids: Vec<[u32; 4]> = face
+        .iter()
+        .map(|&v| t.map(|u| if u == v { NEW } else { u }))
+        .collect();
+    offer(
+        score(&kids, &place),
+        Seat::Split(face.to_vec(), vec![(cell, kids)]),
+    );
+    // An edge of the face split at the corner.
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        let (a, b) = (face[i], face[j]);
+        let mut split = Vec::new();
+        let mut all = Vec::new();
+        for c in star(a).into_iter().filter(|&c| st.tets[c].contains(&b)) {
+            let t = st.tets[c];
+            let two = [a, b].map(|v| t.map(|u| if u == v { NEW } else { u }));
+            all.extend(two);
+            split.push((c, two.to_vec()));
+        }
+        offer(score(&all, &place), Seat::Split(vec![a, b], split));
+    }
+    let Some((angle, how)) = best else {
+        return false;
+    };
+    if std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
+        eprintln!(
+            "objects: corner ({:.3}, {:.3}, {:.3}) seated by {}, its cells' smallest angle {angle:.2} degrees",
+            p[0],
+            p[1],
+            p[2],
+            match &how {
+                Seat::Move(_) => "a move",
+                Seat::Split(e, _) if e.len() == 3 => "a face split",
+                Seat::Split(..) => "an edge split",
+            }
+        );
+    }
+    match how {
+        Seat::Move(w) => st.points[w as usize] = p,
+        Seat::Split(ends, split) => {
+            let id = st.points.len() as u32;
+            st.points.push(p);
+            st.flags.push(
+                ends.iter()
+                    .fold(TOP | BASE | SIDE, |f, &v| f & st.flags[v as usize]),
+            );
+            st.on_fault.push(
+                ends.iter()
+                    .fold(u64::MAX, |f, &v| f & st.on_fault[v as usize]),
+            );
+            for (c, kids) in split {
+                for (k, kid) in kids.into_iter().enumerate() {
+                    let kid = kid.map(|u| if u == NEW { id } else { u });
+                    if k == 0 {
+                        st.tets[c] = kid;
+                    } else {
+                        st.tets.push(kid);
+                        st.positive.push(st.positive[c]);
+                        st.below.push(st.below[c]);
+                        st.block.push(st.block[c]);
+                        if !st.zone.is_empty() {
+                            st.zone.push(st.zone[c]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    true
 }

@@ -1709,6 +1709,12 @@ pub fn faulted_mesh_with_objects(
     let mut object_cells = object_cells;
     let mut zones =
         crate::zones::cut_zones(&mut st, faults, &mut object_cells, &surfaces, settings)?;
+    // A terrain node on each corner of a rising structure's trace on the terrain, before its
+    // walls are cut (`above.rs`).
+    let seated = crate::above::seat_corners(&mut st, objects, terrain, background_nodes);
+    if seated > 0 && std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
+        eprintln!("objects: {seated} corners of the structures' traces on the terrain seated");
+    }
     let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     stage("zones and objects cut", &st);
     let done = crate::improve::improve(

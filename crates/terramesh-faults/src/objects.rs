@@ -1393,6 +1393,18 @@ impl Object {
         }
     }
 
+    /// A structure's closed surface: its vertices and outward triangles (`None` for other
+    /// objects).
+    pub(crate) fn solid(&self) -> Option<Solid<'_>> {
+        match &self.shape {
+            Shape::Structure {
+                vertices,
+                triangles,
+            } => Some((vertices, triangles)),
+            _ => None,
+        }
+    }
+
     /// A structure's highest point over (x, y) within `reach` in plan: the highest plane
     /// elevation at (x, y) of the triangles (not vertical) whose plan lies within `reach` of
     /// it, so that a node cut onto a vertical wall (within [`ON_WALL`]) gets the top of the
@@ -1445,6 +1457,9 @@ impl Object {
         top
     }
 }
+
+/// A structure's closed surface: its vertices and its outward triangles.
+pub(crate) type Solid<'a> = (&'a [[f64; 3]], &'a [[u32; 3]]);
 
 fn point_in_ring(p: [f64; 2], ring: &[[f64; 2]]) -> bool {
     let n = ring.len();
