@@ -57,6 +57,14 @@
 //! step one tetrahedron, its apex straight above a front node, so positive wherever the
 //! face is (exact `orient3d`), and neighbouring columns, climbing their shared edges in the
 //! same order, share their sides.
+//!
+//! Then [`seat_near_walls`] moves the free terrain nodes near a wall (farther than
+//! [`ON_WALL`], within [`NEAR_WALL`] of their shortest edge) onto the wall's trace on the
+//! terrain: a node 2.7 mm inside a wall of the test `dam_above`'s tall box had its edges cut
+//! millimetres from it, two wall nodes 14 cm apart beside it, and the terrain faces around it
+//! (an angle of 0.024 degrees in plan) carried columns of 0.024-degree cells; a node's
+//! position alone could not mend them ([`mend_under`]: with a 14 cm wall edge in its faces
+//! and a node 8 m away, one of its faces stays thin wherever it goes).
 
 use crate::mesh::{all_faces, outward_faces, positive, State, BASE, SIDE, TOP};
 use crate::objects::{ObjectCells, ObjectSet, Wall, ON_WALL};
@@ -1174,4 +1182,165 @@ fn seat(st: &mut State, p: [f64; 3], terrain: &crate::Terrain, background: usize
         }
     }
     true
+}
+
+/// A terrain node this close to a rising structure's wall (times its shortest edge) is moved
+/// onto the wall's trace on the terrain before the cut ([`seat_near_walls`]).
+const NEAR_WALL: f64 = 0.25;
+
+/// A node seated on a wall leaves no cell around it below the smaller of this (degrees) and
+/// their smallest before the move ([`seat_near_walls`]).
+const NEAR_WALL_ANGLE: f64 = 8.0;
+
+/// Moves the free terrain nodes near a rising structure's wall onto the wall's trace on the
+/// terrain before the walls are cut: a node a few millimetres inside the wall otherwise has
+/// its edges cut a few millimetres from it, and the terrain faces the cut leaves around it
+/// (thin, with a wall edge centimetres long) carry columns of slivers (the vertical edge at a
+/// face's corner has the face's angle there in plan). A node is moved only if it lies
+/// farther than [`ON_WALL`] from the wall and within [`NEAR_WALL`] of its shortest edge, was
+/// on the terrain and on no fault, interface, side or base (a background node too: the move
+/// is kept only if its terrain faces stay on the DSM, so a DSM vertex where the terrain bends
+/// stays),
+/// every cell around it of one unit, block, fault side and zone; the target is the point of
+/// the trace nearest in plan (Newton steps on the solid's field along the DSM), and the
+/// move is kept if every cell around the node stays positive (exact `orient3d`), its
+/// terrain faces stay on the DSM (nodes, edge midpoints, centroid) and no cell around it
+/// falls below [`NEAR_WALL_ANGLE`] or their smallest before, if lower. Returns the nodes
+/// moved.
+pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::Terrain) -> usize {
+    let tol = 0.5e-9
+        * terrain
+            .heights
+            .iter()
+            .fold(0.0f64, |s, h| s.max(h.abs()))
+            .max(1.0);
+    let mut moved = 0;
+    for o in set.objects.iter().filter(|o| o.rises) {
+        let [lo, hi] = o.bbox;
+        let field = |x: f64, y: f64| -> Option<f64> {
+            let z = terrain.height([x, y])?;
+            Some(o.field(Wall::Inner, [x, y, z]))
+        };
+        let cand: Vec<u32> = (0..st.points.len())
+            .filter(|&v| {
+                let p = st.points[v];
+                st.flags[v] == TOP
+                    && st.on_fault[v] == 0
+                    && (0..2).all(|k| p[k] >= lo[k] - 1.0 && p[k] <= hi[k] + 1.0)
+                    && o.field(Wall::Inner, p).abs() > ON_WALL
+            })
+            .map(|v| v as u32)
+            .collect();
+        if cand.is_empty() {
+            continue;
+        }
+        let mut star: std::collections::HashMap<u32, Vec<usize>> =
+            cand.iter().map(|&v| (v, Vec::new())).collect();
+        for (c, t) in st.tets.iter().enumerate() {
+            for v in t {
+                if let Some(s) = star.get_mut(v) {
+                    s.push(c);
+                }
+            }
+        }
+        for &v in &cand {
+            let cells = &star[&v];
+            let p = st.points[v as usize];
+            let shortest = cells
+                .iter()
+                .flat_map(|&c| st.tets[c])
+                .filter(|&w| w != v)
+                .map(|w| {
+                    let q = st.points[w as usize];
+                    (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f64>().sqrt()
+                })
+                .fold(f64::INFINITY, f64::min);
+            let f0 = o.field(Wall::Inner, p);
+            if f0.abs() > NEAR_WALL * shortest {
+                continue;
+            }
+            let c0 = cells[0];
+            let zone = |c: usize| st.zone.get(c).copied().unwrap_or(0);
+            if cells.iter().any(|&c| {
+                (st.positive[c], st.below[c], st.block[c], zone(c))
+                    != (st.positive[c0], st.below[c0], st.block[c0], zone(c0))
+            }) {
+                continue;
+            }
+            // The trace's nearest point in plan: Newton steps on the field along the DSM.
+            let (mut x, mut y) = (p[0], p[1]);
+            let mut ok = false;
+            for _ in 0..20 {
+                let Some(g) = field(x, y) else { break };
+                if g.abs() <= 1e-3 * ON_WALL {
+                    ok = true;
+                    break;
+                }
+                let e = 1e-6 * (1.0 + x.abs().max(y.abs()));
+                let (Some(gx0), Some(gx1), Some(gy0), Some(gy1)) = (
+                    field(x - e, y),
+                    field(x + e, y),
+                    field(x, y - e),
+                    field(x, y + e),
+                ) else {
+                    break;
+                };
+                let d = [(gx1 - gx0) / (2.0 * e), (gy1 - gy0) / (2.0 * e)];
+                let n2 = d[0] * d[0] + d[1] * d[1];
+                if n2 < 1e-12 {
+                    break;
+                }
+                x -= g * d[0] / n2;
+                y -= g * d[1] / n2;
+            }
+            let Some(z) = terrain.height([x, y]) else {
+                continue;
+            };
+            let q = [x, y, z];
+            if !ok || (x - p[0]).hypot(y - p[1]) > NEAR_WALL * shortest {
+                continue;
+            }
+            let place = |w: u32| if w == v { q } else { st.points[w as usize] };
+            let mut before = f64::INFINITY;
+            let mut after = f64::INFINITY;
+            let mut fine = true;
+            for &c in cells {
+                let t = st.tets[c];
+                let g = t.map(place);
+                if !positive(g) {
+                    fine = false;
+                    break;
+                }
+                before = before.min(crate::quality::min_dihedral(
+                    t.map(|w| st.points[w as usize]),
+                ));
+                after = after.min(crate::quality::min_dihedral(g));
+                // Its faces on the terrain stay on the DSM.
+                for f in outward_faces(&t) {
+                    if !f.contains(&v) || !f.iter().all(|&w| st.flags[w as usize] & TOP != 0) {
+                        continue;
+                    }
+                    let h = f.map(place);
+                    let mut probes = vec![[0, 1, 2].map(|k| (h[0][k] + h[1][k] + h[2][k]) / 3.0)];
+                    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+                        probes.push([0, 1, 2].map(|k| 0.5 * (h[a][k] + h[b][k])));
+                    }
+                    probes.extend(h);
+                    if !probes.iter().all(|r| {
+                        terrain
+                            .height([r[0], r[1]])
+                            .is_some_and(|hz| (hz - r[2]).abs() <= tol)
+                    }) {
+                        fine = false;
+                    }
+                }
+            }
+            if !fine || after < NEAR_WALL_ANGLE.min(before) {
+                continue;
+            }
+            st.points[v as usize] = q;
+            moved += 1;
+        }
+    }
+    moved
 }

@@ -1715,6 +1715,10 @@ pub fn faulted_mesh_with_objects(
     if seated > 0 && std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
         eprintln!("objects: {seated} corners of the structures' traces on the terrain seated");
     }
+    let near = crate::above::seat_near_walls(&mut st, objects, terrain);
+    if near > 0 && std::env::var_os("TERRAMESH_PASS_STATS").is_some() {
+        eprintln!("objects: {near} terrain nodes near the structures' walls seated on them");
+    }
     let mut object_cells = crate::objects::cut_objects(&mut st, objects, object_cells, &surfaces)?;
     stage("zones and objects cut", &st);
     let done = crate::improve::improve(

@@ -301,9 +301,11 @@ fn a_tall_dam_has_a_node_on_each_corner_and_layered_columns() {
     // The dam's walls are meshed on the solid: with a node on each corner no boundary face of
     // the dam cuts a corner by a chord (main before the corners were seated: 0.45 m here).
     assert!(c.boundary_distance < 1e-3, "{c:?}");
-    // Quality of the part above the terrain, reported, not yet at issue 31's 5 degrees on
-    // this site: the smallest is a column over a terrain face left thin along a wall by the
-    // cut (0.024 degrees here; 0.005 before the corners were seated and the columns layered).
+    // Quality of the part above the terrain, issue 31's 5 degrees: a terrain node a few
+    // millimetres inside a wall is seated on the wall before the cut (`seat_near_walls`),
+    // which otherwise cut its edges millimetres from it and left thin terrain faces under
+    // columns of slivers (6.162 degrees here; 0.024 before the seat, 0.005 before the corners
+    // were seated and the columns layered).
     let worst = (first..mesh.tets.len())
         .map(|cell| min_dihedral(mesh.tets[cell].map(|v| mesh.points[v as usize])))
         .fold(f64::INFINITY, f64::min);
@@ -311,5 +313,5 @@ fn a_tall_dam_has_a_node_on_each_corner_and_layered_columns() {
         "above the terrain: {} cells, smallest dihedral {worst:.3}",
         mesh.objects.above_cells
     );
-    assert!(worst > 0.01, "smallest dihedral above the terrain {worst}");
+    assert!(worst > 5.0, "smallest dihedral above the terrain {worst}");
 }
