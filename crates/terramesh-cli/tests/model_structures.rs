@@ -313,7 +313,8 @@ impl ModelCells {
 /// the terrain as the quality pass left it; 34, the smallest 1.43, once the terrain nodes
 /// under the dam are moved for the columns' sake and the columns' split order is chosen
 /// (`above.rs`, "The terrain under a structure"); 9, the smallest 1.57, once a terrain node
-/// is seated on each corner of the dam's trace and the columns stand in layers.
+/// is seated on each corner of the dam's trace and the columns stand in layers; 8, the
+/// smallest 1.45, once terrain nodes near its walls are seated on them before the cut.
 fn dam_cells_above_the_terrain_keep_their_angles(out: &Path) {
     let ModelCells {
         object,
@@ -340,7 +341,7 @@ fn dam_cells_above_the_terrain_keep_their_angles(out: &Path) {
     );
     assert!(!angles.is_empty(), "no dam cell above the terrain");
     assert!(
-        poor <= 15 && least > 1.2,
+        poor <= 10 && least > 1.2,
         "{poor} of the dam's cells above the terrain below 5 degrees, the smallest {least}"
     );
 }

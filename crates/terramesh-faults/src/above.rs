@@ -648,16 +648,7 @@ fn mend_under(
                 }
                 for f in &terrain_faces {
                     let g = f.map(|w| if w == v { q } else { st.points[w as usize] });
-                    let mut probes = vec![[0, 1, 2].map(|k| (g[0][k] + g[1][k] + g[2][k]) / 3.0)];
-                    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-                        probes.push([0, 1, 2].map(|k| 0.5 * (g[a][k] + g[b][k])));
-                    }
-                    probes.push(q);
-                    if !probes.iter().all(|r| {
-                        terrain
-                            .height([r[0], r[1]])
-                            .is_some_and(|h| (h - r[2]).abs() <= tol)
-                    }) {
+                    if !on_dsm(terrain, g, tol) {
                         return None;
                     }
                 }
@@ -1052,17 +1043,7 @@ fn seat(st: &mut State, p: [f64; 3], terrain: &crate::Terrain, background: usize
             if twice {
                 return true;
             }
-            let g = f.map(place);
-            let mut probes = vec![[0, 1, 2].map(|k| (g[0][k] + g[1][k] + g[2][k]) / 3.0)];
-            for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-                probes.push([0, 1, 2].map(|k| 0.5 * (g[a][k] + g[b][k])));
-            }
-            probes.extend(g);
-            probes.iter().all(|r| {
-                terrain
-                    .height([r[0], r[1]])
-                    .is_some_and(|h| (h - r[2]).abs() <= tol)
-            })
+            on_dsm(terrain, f.map(place), tol)
         })
     };
     // The new node stands for u32::MAX in the candidates' cells.
@@ -1169,13 +1150,7 @@ fn seat(st: &mut State, p: [f64; 3], terrain: &crate::Terrain, background: usize
                     if k == 0 {
                         st.tets[c] = kid;
                     } else {
-                        st.tets.push(kid);
-                        st.positive.push(st.positive[c]);
-                        st.below.push(st.below[c]);
-                        st.block.push(st.block[c]);
-                        if !st.zone.is_empty() {
-                            st.zone.push(st.zone[c]);
-                        }
+                        st.push_child(c, kid);
                     }
                 }
             }
@@ -1320,17 +1295,7 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
                     if !f.contains(&v) || !f.iter().all(|&w| st.flags[w as usize] & TOP != 0) {
                         continue;
                     }
-                    let h = f.map(place);
-                    let mut probes = vec![[0, 1, 2].map(|k| (h[0][k] + h[1][k] + h[2][k]) / 3.0)];
-                    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-                        probes.push([0, 1, 2].map(|k| 0.5 * (h[a][k] + h[b][k])));
-                    }
-                    probes.extend(h);
-                    if !probes.iter().all(|r| {
-                        terrain
-                            .height([r[0], r[1]])
-                            .is_some_and(|hz| (hz - r[2]).abs() <= tol)
-                    }) {
+                    if !on_dsm(terrain, f.map(place), tol) {
                         fine = false;
                     }
                 }
@@ -1343,4 +1308,21 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
         }
     }
     moved
+}
+
+/// Whether a terrain face `g` lies on the DSM within `tol`: its corners, its edges' midpoints
+/// and its centroid (the DSM is linear on its own triangles, so a face that crosses one of
+/// its bends leaves one of these probes off it). Shared by [`mend_under`], [`seat_corners`]
+/// and [`seat_near_walls`], which move terrain nodes along the DSM.
+fn on_dsm(terrain: &crate::Terrain, g: [[f64; 3]; 3], tol: f64) -> bool {
+    let mut probes = vec![[0, 1, 2].map(|k| (g[0][k] + g[1][k] + g[2][k]) / 3.0)];
+    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+        probes.push([0, 1, 2].map(|k| 0.5 * (g[a][k] + g[b][k])));
+    }
+    probes.extend(g);
+    probes.iter().all(|r| {
+        terrain
+            .height([r[0], r[1]])
+            .is_some_and(|h| (h - r[2]).abs() <= tol)
+    })
 }

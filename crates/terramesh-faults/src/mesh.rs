@@ -191,6 +191,17 @@ pub(crate) struct State {
 }
 
 impl State {
+    /// Appends `tet`, a child of cell `parent` (a split's), with the parent's labels.
+    pub(crate) fn push_child(&mut self, parent: usize, tet: [u32; 4]) {
+        self.tets.push(tet);
+        self.positive.push(self.positive[parent]);
+        self.below.push(self.below[parent]);
+        self.block.push(self.block[parent]);
+        if !self.zone.is_empty() {
+            self.zone.push(self.zone[parent]);
+        }
+    }
+
     /// A background mesh before any cut: its nodes, their flags and its cells, no node on a
     /// fault, every cell's labels zero, its report counting the cells.
     pub(crate) fn background(points: Vec<[f64; 3]>, flags: Vec<u8>, tets: Vec<[u32; 4]>) -> State {
@@ -993,13 +1004,7 @@ pub(crate) fn split_cells_ranked(
     for (c, kids) in children {
         st.tets[c] = kids[0];
         for &k in &kids[1..] {
-            st.tets.push(k);
-            st.positive.push(st.positive[c]);
-            st.below.push(st.below[c]);
-            st.block.push(st.block[c]);
-            if !st.zone.is_empty() {
-                st.zone.push(st.zone[c]);
-            }
+            st.push_child(c, k);
             child(c);
         }
     }
