@@ -541,13 +541,7 @@ impl Pass<'_> {
             Some(c) => c,
             None => {
                 let l = like as usize;
-                self.st.tets.push(t);
-                self.st.positive.push(self.st.positive[l]);
-                self.st.below.push(self.st.below[l]);
-                self.st.block.push(self.st.block[l]);
-                if !self.st.zone.is_empty() {
-                    self.st.zone.push(self.st.zone[l]);
-                }
+                self.st.push_child(l, t);
                 if !self.object.is_empty() {
                     self.object.push(self.object[l]);
                 }
