@@ -1080,12 +1080,7 @@ fn seat(st: &mut State, p: [f64; 3], terrain: &crate::Terrain, background: usize
             continue;
         }
         let cells = star(w);
-        let c0 = cells[0];
-        let zone = |c: usize| st.zone.get(c).copied().unwrap_or(0);
-        if cells.iter().any(|&c| {
-            (st.positive[c], st.below[c], st.block[c], zone(c))
-                != (st.positive[c0], st.below[c0], st.block[c0], zone(c0))
-        }) {
+        if !st.same_labels(&cells) {
             continue;
         }
         let ts: Vec<[u32; 4]> = cells.iter().map(|&c| st.tets[c]).collect();
@@ -1234,12 +1229,7 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
             if f0.abs() > NEAR_WALL * shortest {
                 continue;
             }
-            let c0 = cells[0];
-            let zone = |c: usize| st.zone.get(c).copied().unwrap_or(0);
-            if cells.iter().any(|&c| {
-                (st.positive[c], st.below[c], st.block[c], zone(c))
-                    != (st.positive[c0], st.below[c0], st.block[c0], zone(c0))
-            }) {
+            if !st.same_labels(cells) {
                 continue;
             }
             // The trace's nearest point in plan: Newton steps on the field along the DSM.

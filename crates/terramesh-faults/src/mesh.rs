@@ -191,6 +191,16 @@ pub(crate) struct State {
 }
 
 impl State {
+    /// Whether every cell of `cells` has the first one's labels (faults' sides, unit, block,
+    /// fault zone): a node inside them all is free to move.
+    pub(crate) fn same_labels(&self, cells: &[usize]) -> bool {
+        let zone = |c: usize| self.zone.get(c).copied().unwrap_or(0);
+        let key = |c: usize| (self.positive[c], self.below[c], self.block[c], zone(c));
+        cells
+            .first()
+            .is_none_or(|&c0| cells.iter().all(|&c| key(c) == key(c0)))
+    }
+
     /// Appends `tet`, a child of cell `parent` (a split's), with the parent's labels.
     pub(crate) fn push_child(&mut self, parent: usize, tet: [u32; 4]) {
         self.tets.push(tet);
