@@ -67,7 +67,9 @@ pub use mesh::{Mesh, SanityError};
 pub use quality::{triangle_quality, Quality, Stats, TriangleQuality};
 pub use report::BuildReport;
 pub use simplify::{simplify, simplify_to, Simplified, SimplifyError, MIN_LOD_TRIANGLES};
-pub use smooth::{smooth, smooth_keeping, SmoothReport, Smoother, DEFAULT_SMOOTHER};
+pub use smooth::{
+    smooth, smooth_keeping, smooth_keeping_from, SmoothReport, Smoother, DEFAULT_SMOOTHER,
+};
 
 use terramesh_core::geometry::ValidationError;
 

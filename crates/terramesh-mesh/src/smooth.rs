@@ -3,6 +3,8 @@
 //! (optimal Delaunay triangulation: the area-weighted mean of the star's circumcentres),
 //! followed by Delaunay edge flips.
 
+use rayon::prelude::*;
+
 use crate::mesh::{orient, Mesh};
 
 /// Smoothing method, named `laplacian`, `smart` and `odt` (see
@@ -101,6 +103,52 @@ pub fn smooth_keeping(
     iterations: usize,
     keep: &[u32],
 ) -> SmoothReport {
+    smooth_levels(mesh, smoother, iterations, keep, None, PARALLEL_LEVEL)
+}
+
+/// [`smooth_keeping`] given the mesh's planar quality before smoothing, `before` (what
+/// [`Quality::planar`](crate::Quality::planar) of `mesh` gives, which a caller that reports it
+/// has measured already): the same result without measuring it again.
+///
+/// ```
+/// use terramesh_core::geometry::Region;
+/// use terramesh_mesh::{smooth_keeping, smooth_keeping_from, MeshBuilder, Quality, Smoother};
+/// let r = Region::from_ring(vec![[0.0, 0.0], [30.0, 0.0], [30.0, 10.0], [0.0, 10.0]]);
+/// let (mut a, _) = MeshBuilder::new().max_area(3.0).build(&r)?;
+/// let mut b = a.clone();
+/// let before = Quality::planar(&a);
+/// let rep = smooth_keeping_from(&mut a, Smoother::Smart, 10, &[], &before);
+/// assert_eq!(rep, smooth_keeping(&mut b, Smoother::Smart, 10, &[]));
+/// assert_eq!(a.points, b.points);
+/// # Ok::<(), terramesh_mesh::MeshError>(())
+/// ```
+pub fn smooth_keeping_from(
+    mesh: &mut Mesh,
+    smoother: Smoother,
+    iterations: usize,
+    keep: &[u32],
+    before: &crate::Quality,
+) -> SmoothReport {
+    smooth_levels(
+        mesh,
+        smoother,
+        iterations,
+        keep,
+        Some(before),
+        PARALLEL_LEVEL,
+    )
+}
+
+/// [`smooth_keeping`] (with the quality before, when measured), the levels of at least
+/// `parallel` vertices tried in parallel.
+fn smooth_levels(
+    mesh: &mut Mesh,
+    smoother: Smoother,
+    iterations: usize,
+    keep: &[u32],
+    before: Option<&crate::Quality>,
+    parallel: usize,
+) -> SmoothReport {
     let mut report = SmoothReport::default();
     if iterations == 0 || mesh.triangles.is_empty() {
         return report;
@@ -112,39 +160,52 @@ pub fn smooth_keeping(
         }
     }
     let (off, tris) = mesh.vertex_stars();
-    let q0 = crate::Quality::planar(mesh);
+    let measured;
+    let q0 = match before {
+        Some(q) => q,
+        None => {
+            measured = crate::Quality::planar(mesh);
+            &measured
+        }
+    };
     // Size limits met by refinement stay met: no move or flip makes a triangle larger than
     // the largest one, or an edge longer than the longest one, before smoothing.
     let (global_min, area_cap, edge_cap) = (q0.min_angle, q0.area.max, q0.edge.max);
+    // Gauss-Seidel sweeps in vertex order, run level by level (`wavefront`): no two vertices
+    // of a level are neighbours, so a level's moves are tried in parallel and give the
+    // positions of the sweep in order, on any number of threads.
+    let (order, level_off) = wavefront(mesh, &fixed, &off, &tris);
+    let mut outcome: Vec<Outcome> = Vec::new();
     for _ in 0..iterations {
         let mut moved = 0;
-        for v in 0..mesh.points.len() {
-            let Some(star) = crate::smooth::free_star(&fixed, &off, &tris, v) else {
-                continue;
+        for l in 0..level_off.len() - 1 {
+            let level = &order[level_off[l]..level_off[l + 1]];
+            let m: &Mesh = mesh;
+            let try_one = |&v: &u32| {
+                let star = &tris[off[v as usize]..off[v as usize + 1]];
+                try_move(
+                    m, smoother, v as usize, star, global_min, area_cap, edge_cap,
+                )
             };
-            let target = match smoother {
-                Smoother::Laplacian | Smoother::Smart => neighbour_mean(mesh, v, star),
-                Smoother::Odt => odt_point(mesh, star),
-            };
-            let Some(target) = target else { continue };
-            let old = mesh.points[v];
-            let old_min = star_min_angle(mesh, star);
-            mesh.points[v] = target;
-            let valid = star
-                .iter()
-                .all(|&t| orient_tri(mesh, mesh.triangles[t as usize]) > 0.0);
-            let ok = valid
-                && star_within(mesh, star, area_cap, edge_cap)
-                && match smoother {
-                    Smoother::Laplacian => true,
-                    Smoother::Smart => star_min_angle(mesh, star) >= old_min,
-                    Smoother::Odt => star_min_angle(mesh, star) >= old_min.min(global_min),
-                };
-            if ok {
-                moved += 1;
+            outcome.clear();
+            if level.len() < parallel {
+                outcome.extend(level.iter().map(try_one));
             } else {
-                mesh.points[v] = old;
-                report.rejected += 1;
+                level
+                    .par_iter()
+                    .with_min_len(parallel.div_ceil(2))
+                    .map(try_one)
+                    .collect_into_vec(&mut outcome);
+            }
+            for (&v, o) in level.iter().zip(&outcome) {
+                match *o {
+                    Outcome::Skipped => {}
+                    Outcome::Moved(p) => {
+                        mesh.points[v as usize] = p;
+                        moved += 1;
+                    }
+                    Outcome::Rejected => report.rejected += 1,
+                }
             }
         }
         report.moves += moved;
@@ -156,11 +217,18 @@ pub fn smooth_keeping(
     report
 }
 
-/// True when every triangle of the star is within the area and edge caps.
-fn star_within(mesh: &Mesh, star: &[u32], area_cap: f64, edge_cap: f64) -> bool {
+/// True when every triangle of the star, its vertices at `pos`, is within the area and edge
+/// caps.
+fn star_within_by(
+    mesh: &Mesh,
+    star: &[u32],
+    area_cap: f64,
+    edge_cap: f64,
+    pos: impl Fn(u32) -> [f64; 2],
+) -> bool {
     let cap2 = edge_cap * edge_cap;
     star.iter().all(|&t| {
-        let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.points[i as usize]);
+        let [a, b, c] = mesh.triangles[t as usize].map(&pos);
         let d2 = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
         0.5 * orient(a, b, c) <= area_cap
             && d2(a, b) <= cap2
@@ -169,14 +237,122 @@ fn star_within(mesh: &Mesh, star: &[u32], area_cap: f64, edge_cap: f64) -> bool 
     })
 }
 
-fn orient_tri(mesh: &Mesh, t: [u32; 3]) -> f64 {
-    let [a, b, c] = t.map(|i| mesh.points[i as usize]);
+/// The orientation of triangle `t` with its vertices at `pos`.
+fn orient_by(t: [u32; 3], pos: impl Fn(u32) -> [f64; 2]) -> f64 {
+    let [a, b, c] = t.map(pos);
     orient(a, b, c)
 }
 
-/// Smallest angle of the star, in degrees. The smallest angle of a triangle is opposite its
-/// shortest edge and at most 60 degrees, so `asin(2 A / (b c))` with `b`, `c` the two longer
-/// edges gives it with one transcendental call.
+/// Levels below this many vertices are tried on the calling thread; larger ones in pieces of
+/// at least half as many (a move takes about a microsecond).
+const PARALLEL_LEVEL: usize = 128;
+
+/// What trying to move one vertex gave.
+#[derive(Clone, Copy)]
+enum Outcome {
+    /// No target (no neighbours, or a degenerate star for ODT): not counted.
+    Skipped,
+    /// Accepted: the new position.
+    Moved([f64; 2]),
+    /// The move would fold a triangle, break a size cap or the smoother's angle rule.
+    Rejected,
+}
+
+/// The free vertices (those with a star) in levels: a vertex's level is one more than the
+/// highest level of its free neighbours with a lower index (0 without any). A sweep in
+/// vertex order reads, at each vertex, its lower neighbours' new positions and its higher
+/// neighbours' old ones; level by level, every lower neighbour has moved and no higher one
+/// has, and no two neighbours share a level. Returns the vertices by level (ascending within
+/// each) and the levels' offsets into them.
+fn wavefront(mesh: &Mesh, fixed: &[bool], off: &[usize], tris: &[u32]) -> (Vec<u32>, Vec<usize>) {
+    const NONE: u32 = u32::MAX;
+    let n = mesh.points.len();
+    let mut level = vec![NONE; n];
+    let mut levels = 0usize;
+    for v in 0..n {
+        let Some(star) = free_star(fixed, off, tris, v) else {
+            continue;
+        };
+        let mut l = 0;
+        for &t in star {
+            for u in mesh.triangles[t as usize] {
+                let lu = level[u as usize];
+                if (u as usize) < v && lu != NONE {
+                    l = l.max(lu + 1);
+                }
+            }
+        }
+        level[v] = l;
+        levels = levels.max(l as usize + 1);
+    }
+    let mut level_off = vec![0usize; levels + 1];
+    for &l in &level {
+        if l != NONE {
+            level_off[l as usize + 1] += 1;
+        }
+    }
+    for i in 0..levels {
+        level_off[i + 1] += level_off[i];
+    }
+    let mut fill = level_off.clone();
+    let mut order = vec![0u32; level_off[levels]];
+    for (v, &l) in level.iter().enumerate() {
+        if l != NONE {
+            order[fill[l as usize]] = v as u32;
+            fill[l as usize] += 1;
+        }
+    }
+    (order, level_off)
+}
+
+/// One vertex's move of a sweep: its target, and whether the star stays valid, within the
+/// caps and (for the smart and ODT smoothers) no worse in its smallest angle.
+fn try_move(
+    mesh: &Mesh,
+    smoother: Smoother,
+    v: usize,
+    star: &[u32],
+    global_min: f64,
+    area_cap: f64,
+    edge_cap: f64,
+) -> Outcome {
+    let target = match smoother {
+        Smoother::Laplacian | Smoother::Smart => neighbour_mean(mesh, v, star),
+        Smoother::Odt => odt_point(mesh, star),
+    };
+    let Some(target) = target else {
+        return Outcome::Skipped;
+    };
+    let old = |i: u32| mesh.points[i as usize];
+    let new = |i: u32| {
+        if i as usize == v {
+            target
+        } else {
+            mesh.points[i as usize]
+        }
+    };
+    let valid = star
+        .iter()
+        .all(|&t| orient_by(mesh.triangles[t as usize], new) > 0.0);
+    let ok = valid
+        && star_within_by(mesh, star, area_cap, edge_cap, new)
+        && match smoother {
+            Smoother::Laplacian => true,
+            Smoother::Smart => {
+                star_min_angle_by(mesh, star, new) >= star_min_angle_by(mesh, star, old)
+            }
+            Smoother::Odt => {
+                star_min_angle_by(mesh, star, new)
+                    >= star_min_angle_by(mesh, star, old).min(global_min)
+            }
+        };
+    if ok {
+        Outcome::Moved(target)
+    } else {
+        Outcome::Rejected
+    }
+}
+
 /// The star (incident triangles) of vertex `v` from [`Mesh::vertex_stars`], or `None` for a
 /// fixed vertex or one without triangles: the vertices smoothing may move.
 pub(crate) fn free_star<'a>(
@@ -188,10 +364,14 @@ pub(crate) fn free_star<'a>(
     (!fixed[v] && off[v] != off[v + 1]).then(|| &tris[off[v]..off[v + 1]])
 }
 
-pub(crate) fn star_min_angle(mesh: &Mesh, star: &[u32]) -> f64 {
+/// Smallest angle of the star, in degrees. The smallest angle of a triangle is opposite its
+/// shortest edge and at most 60 degrees, so `asin(2 A / (b c))` with `b`, `c` the two longer
+/// edges gives it with one transcendental call.
+/// The star's vertices are at `pos`.
+fn star_min_angle_by(mesh: &Mesh, star: &[u32], pos: impl Fn(u32) -> [f64; 2]) -> f64 {
     let mut min_sin = f64::INFINITY;
     for &t in star {
-        let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.points[i as usize]);
+        let [a, b, c] = mesh.triangles[t as usize].map(&pos);
         let d2 = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
         let mut e = [d2(a, b), d2(b, c), d2(c, a)];
         e.sort_by(f64::total_cmp);
@@ -201,23 +381,42 @@ pub(crate) fn star_min_angle(mesh: &Mesh, star: &[u32]) -> f64 {
     min_sin.min(1.0).asin().to_degrees()
 }
 
-/// Mean of the neighbours of `v` (each neighbour counted once).
+/// Mean of the neighbours of `v` (each neighbour counted once), added in ascending order.
 pub(crate) fn neighbour_mean(mesh: &Mesh, v: usize, star: &[u32]) -> Option<[f64; 2]> {
-    let mut nb: Vec<u32> = star
-        .iter()
-        .flat_map(|&t| mesh.triangles[t as usize])
-        .filter(|&u| u as usize != v)
-        .collect();
+    // On the stack for stars of up to 16 triangles (nearly all); a vector beyond.
+    let mut buf = [0u32; 48];
+    let mut heap = Vec::new();
+    let nb: &mut [u32] = if 3 * star.len() <= buf.len() {
+        &mut buf[..]
+    } else {
+        heap.resize(3 * star.len(), 0);
+        &mut heap[..]
+    };
+    let mut len = 0;
+    for &t in star {
+        for u in mesh.triangles[t as usize] {
+            if u as usize != v {
+                nb[len] = u;
+                len += 1;
+            }
+        }
+    }
+    let nb = &mut nb[..len];
     nb.sort_unstable();
-    nb.dedup();
-    if nb.is_empty() {
+    let mut n = 0usize;
+    let mut s = [0.0, 0.0];
+    for (i, &u) in nb.iter().enumerate() {
+        if i > 0 && nb[i - 1] == u {
+            continue;
+        }
+        let p = mesh.points[u as usize];
+        s = [s[0] + p[0], s[1] + p[1]];
+        n += 1;
+    }
+    if n == 0 {
         return None;
     }
-    let n = nb.len() as f64;
-    let s = nb.iter().fold([0.0, 0.0], |s, &u| {
-        let p = mesh.points[u as usize];
-        [s[0] + p[0], s[1] + p[1]]
-    });
+    let n = n as f64;
     Some([s[0] / n, s[1] / n])
 }
 
@@ -297,6 +496,73 @@ mod tests {
             assert!(q1.radius_ratio.mean > q0.radius_ratio.mean, "{s:?}");
             if s != Smoother::Laplacian {
                 assert!(q1.min_angle >= q0.min_angle, "{s:?}: {q0:?} -> {q1:?}");
+            }
+        }
+    }
+
+    /// The sweeps as they were written before the levels: vertex by vertex in index order,
+    /// each move made in place.
+    fn smooth_in_order(mesh: &mut Mesh, smoother: Smoother, iterations: usize) -> SmoothReport {
+        let mut report = SmoothReport::default();
+        let fixed = mesh.fixed_vertices();
+        let (off, tris) = mesh.vertex_stars();
+        let q0 = Quality::planar(mesh);
+        let (global_min, area_cap, edge_cap) = (q0.min_angle, q0.area.max, q0.edge.max);
+        for _ in 0..iterations {
+            let mut moved = 0;
+            for v in 0..mesh.points.len() {
+                let Some(star) = free_star(&fixed, &off, &tris, v) else {
+                    continue;
+                };
+                match try_move(mesh, smoother, v, star, global_min, area_cap, edge_cap) {
+                    Outcome::Skipped => {}
+                    Outcome::Moved(p) => {
+                        mesh.points[v] = p;
+                        moved += 1;
+                    }
+                    Outcome::Rejected => report.rejected += 1,
+                }
+            }
+            report.moves += moved;
+            if moved == 0 {
+                break;
+            }
+        }
+        report.flips = crate::flip::delaunay_flips_within(mesh, area_cap, edge_cap);
+        report
+    }
+
+    #[test]
+    fn levels_give_the_sweeps_in_order_on_any_number_of_threads() {
+        let (_, m0) = jittered();
+        let (off, tris) = m0.vertex_stars();
+        let (order, level_off) = wavefront(&m0, &m0.fixed_vertices(), &off, &tris);
+        // Some levels hold several vertices, so something runs in parallel.
+        assert!(
+            level_off.len() - 1 < order.len() / 2,
+            "{} levels",
+            level_off.len() - 1
+        );
+        for s in [Smoother::Laplacian, Smoother::Smart, Smoother::Odt] {
+            let mut want = m0.clone();
+            let r0 = smooth_in_order(&mut want, s, 6);
+            assert!(r0.moves > 0 && r0.rejected > 0, "{s:?}: {r0:?}");
+            for threads in [1, 4] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut got = m0.clone();
+                let r = pool.install(|| smooth_levels(&mut got, s, 6, &[], None, 1));
+                assert_eq!(r, r0, "{s:?}, {threads} threads");
+                let bits = |m: &Mesh| {
+                    m.points
+                        .iter()
+                        .map(|p| p.map(f64::to_bits))
+                        .collect::<Vec<_>>()
+                };
+                assert_eq!(bits(&got), bits(&want), "{s:?}, {threads} threads");
+                assert_eq!(got.triangles, want.triangles, "{s:?}, {threads} threads");
             }
         }
     }

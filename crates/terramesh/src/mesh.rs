@@ -24,8 +24,8 @@ use terramesh_io::export::{write_mesh, writer_for, MeshView};
 use terramesh_io::region::{load, LoadedRegion, RegionCrs, RegionInput};
 use terramesh_io::table::{ReadOptions, Table};
 use terramesh_mesh::{
-    adaptive_mesh, smooth_keeping, AdaptiveReport, AdaptiveSettings, BuildReport, Fallible, Mesh,
-    MeshError, Quality, SmoothReport, Smoother,
+    adaptive_mesh, smooth_keeping_from, AdaptiveReport, AdaptiveSettings, BuildReport, Fallible,
+    Mesh, MeshError, Quality, SmoothReport, Smoother,
 };
 
 use crate::error::{Context, Error, Result};
@@ -90,7 +90,7 @@ pub fn planar(
     }
     let kept = vertices_at(&mesh, keep);
     let unsmoothed = mesh.clone();
-    let r = smooth_keeping(&mut mesh, plan.smoother, plan.smooth, &kept);
+    let r = smooth_keeping_from(&mut mesh, plan.smoother, plan.smooth, &kept, &before);
     let after = Quality::planar(&mesh);
     Ok(PlanarMesh {
         mesh,
