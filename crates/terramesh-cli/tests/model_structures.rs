@@ -314,7 +314,9 @@ impl ModelCells {
 /// under the dam are moved for the columns' sake and the columns' split order is chosen
 /// (`above.rs`, "The terrain under a structure"); 9, the smallest 1.57, once a terrain node
 /// is seated on each corner of the dam's trace and the columns stand in layers; 8, the
-/// smallest 1.45, once terrain nodes near its walls are seated on them before the cut.
+/// smallest 1.45, once terrain nodes near its walls are seated on them before the cut; 5,
+/// the smallest 4.54, once a node beyond a wall whose terrain edge cuts across the corner
+/// (the faces on it straddled the wall) is seated on the wall too.
 fn dam_cells_above_the_terrain_keep_their_angles(out: &Path) {
     let ModelCells {
         object,
@@ -341,7 +343,7 @@ fn dam_cells_above_the_terrain_keep_their_angles(out: &Path) {
     );
     assert!(!angles.is_empty(), "no dam cell above the terrain");
     assert!(
-        poor <= 10 && least > 1.2,
+        poor <= 5 && least > 4.5,
         "{poor} of the dam's cells above the terrain below 5 degrees, the smallest {least}"
     );
 }

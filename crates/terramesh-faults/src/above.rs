@@ -64,7 +64,15 @@
 //! millimetres from it, two wall nodes 14 cm apart beside it, and the terrain faces around it
 //! (an angle of 0.024 degrees in plan) carried columns of 0.024-degree cells; a node's
 //! position alone could not mend them ([`mend_under`]: with a 14 cm wall edge in its faces
-//! and a node 8 m away, one of its faces stays thin wherever it goes).
+//! and a node 8 m away, one of its faces stays thin wherever it goes). It also moves, however
+//! far from the wall, a node outside the solid with a terrain edge that cuts across a corner
+//! of it ([`corner_clipped`]: from a node on one wall to this node beyond the next, inside in
+//! between): the walls' cut splits an edge where the field's sign changes between its ends,
+//! so it left that edge whole, the terrain faces on it straddled the wall, and the column
+//! over each stood partly outside the solid on a collapsed edge, a fan of slivers
+//! (examples/structures: a node 0.24 m beyond the dam's east wall near its north-east
+//! corner, 1.452 degrees; the test `dam_above`'s dam on a sloping terrain: 0.21 m outside
+//! its plan, 0.022 degrees).
 
 use crate::mesh::{all_faces, outward_faces, positive, State, BASE, SIDE, TOP};
 use crate::objects::{ObjectCells, ObjectSet, Wall, ON_WALL};
@@ -1226,7 +1234,12 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
                 })
                 .fold(f64::INFINITY, f64::min);
             let f0 = o.field(Wall::Inner, p);
-            if f0.abs() > NEAR_WALL * shortest {
+            // A node outside with a terrain edge that cuts across a corner of the solid
+            // (inside beyond ON_WALL between ends that are not): the walls' cut, which splits
+            // an edge where its ends' fields change sign, leaves that edge whole, and the
+            // terrain faces on it straddle the wall (see the module's notes).
+            let clips = f0 > ON_WALL && corner_clipped(st, o, v, cells);
+            if f0.abs() > NEAR_WALL * shortest && !clips {
                 continue;
             }
             if !st.same_labels(cells) {
@@ -1262,7 +1275,7 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
                 continue;
             };
             let q = [x, y, z];
-            if !ok || (x - p[0]).hypot(y - p[1]) > NEAR_WALL * shortest {
+            if !ok || (!clips && (x - p[0]).hypot(y - p[1]) > NEAR_WALL * shortest) {
                 continue;
             }
             let place = |w: u32| if w == v { q } else { st.points[w as usize] };
@@ -1298,6 +1311,27 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
         }
     }
     moved
+}
+
+/// Whether a terrain edge of node `v` (outside solid `o`), among the edges of its cells
+/// `cells`, passes inside the solid beyond [`ON_WALL`] between ends that are not inside
+/// beyond it: an edge from a node on one wall (or just outside it) to `v` beyond the next
+/// wall, across the corner between them. The field is read at the edge's eighths.
+fn corner_clipped(st: &State, o: &crate::Object, v: u32, cells: &[usize]) -> bool {
+    let p = st.points[v as usize];
+    cells.iter().flat_map(|&c| st.tets[c]).any(|w| {
+        if w == v || st.flags[w as usize] & TOP == 0 {
+            return false;
+        }
+        let q = st.points[w as usize];
+        if o.field(Wall::Inner, q) < -ON_WALL {
+            return false;
+        }
+        (1..8).any(|i| {
+            let s = f64::from(i) / 8.0;
+            o.field(Wall::Inner, [0, 1, 2].map(|k| p[k] + s * (q[k] - p[k]))) < -ON_WALL
+        })
+    })
 }
 
 /// Whether a terrain face `g` lies on the DSM within `tol`: its corners, its edges' midpoints
