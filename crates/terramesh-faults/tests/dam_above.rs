@@ -6,7 +6,7 @@
 use terramesh_faults::*;
 
 mod common;
-use common::{box_solid, check_site, flat_site, mesh_with};
+use common::{box_solid, check_site, flat_site, mesh_with, site_under};
 
 /// A gravity dam's trapezoidal section (base `b` wide at `z0`, crest `c` wide at `z1`, centred
 /// on x = `x`) extruded from y0 to y1, outward oriented.
@@ -321,25 +321,7 @@ fn a_tall_dam_has_a_node_on_each_corner_and_layered_columns() {
 fn a_dam_on_a_sloping_terrain_stands_within_its_walls() {
     // The flat site's faults and interfaces under a terrain rising 4 m in 100 m eastward and
     // falling 3 m in 100 m northward; tall boxes with their corners off the background's grid.
-    let site = Site::new(
-        200.0,
-        10,
-        0.2,
-        1,
-        [120.0, 0.04, -0.03],
-        0.0,
-        vec![90.0, 60.0, 30.0],
-        [0.01, 0.0],
-        vec![SynthFault::new(
-            "F1",
-            [80.0, -50.0],
-            [120.0, 250.0],
-            60.0,
-            90.0,
-            12.0,
-        )],
-    )
-    .unwrap();
+    let site = site_under([120.0, 0.04, -0.03]);
     let (lo, hi) = ([121.85, 85.65, 110.0], [167.35, 122.15, 150.0]);
     {
         let (mesh, c, summary) = build(&site, dam(box_solid(lo, hi)));

@@ -6,12 +6,18 @@ use terramesh_faults::*;
 /// The 200 m synthetic site with one fault dipping 60 degrees east (trace near x = 90 to 96
 /// for y = 40 to 70) and three interfaces under a flat terrain at 120 m.
 pub fn flat_site() -> Site {
+    site_under([120.0, 0.0, 0.0])
+}
+
+/// The site of [`flat_site`] under the terrain plane `z = terrain[0] + terrain[1] x +
+/// terrain[2] y`.
+pub fn site_under(terrain: [f64; 3]) -> Site {
     Site::new(
         200.0,
         10,
         0.2,
         1,
-        [120.0, 0.0, 0.0],
+        terrain,
         0.0,
         vec![90.0, 60.0, 30.0],
         [0.01, 0.0],
