@@ -507,12 +507,7 @@ fn mend_under(
     let o = &set.objects[i];
     let number = i as u32 + 1;
     let [lo, hi] = o.bbox;
-    let tol = 0.5e-9
-        * terrain
-            .heights
-            .iter()
-            .fold(0.0f64, |s, h| s.max(h.abs()))
-            .max(1.0);
+    let tol = terrain.on_dsm_tolerance();
     let faces = terrain_faces(st);
     // The faces under the structure, by their nodes.
     let mut under: std::collections::HashMap<u32, Vec<[u32; 3]>> = std::collections::HashMap::new();
@@ -948,12 +943,7 @@ pub(crate) fn seat_corners(
 fn seat(st: &mut State, p: [f64; 3], terrain: &crate::Terrain, background: usize) -> bool {
     use robust::{orient2d, Coord};
     let c2 = |q: [f64; 3]| Coord { x: q[0], y: q[1] };
-    let tol = 0.5e-9
-        * terrain
-            .heights
-            .iter()
-            .fold(0.0f64, |s, h| s.max(h.abs()))
-            .max(1.0);
+    let tol = terrain.on_dsm_tolerance();
     let plan = |q: [f64; 3]| (q[0] - p[0]).hypot(q[1] - p[1]);
     // The terrain faces (seen from above) of the cells with a terrain node within `reach` of
     // the corner in plan, the reach doubled until one holds the corner.
@@ -1189,12 +1179,7 @@ const NEAR_WALL_ANGLE: f64 = 8.0;
 /// falls below [`NEAR_WALL_ANGLE`] or their smallest before, if lower. Returns the nodes
 /// moved.
 pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::Terrain) -> usize {
-    let tol = 0.5e-9
-        * terrain
-            .heights
-            .iter()
-            .fold(0.0f64, |s, h| s.max(h.abs()))
-            .max(1.0);
+    let tol = terrain.on_dsm_tolerance();
     let mut moved = 0;
     for o in set.objects.iter().filter(|o| o.rises) {
         let [lo, hi] = o.bbox;
@@ -1259,16 +1244,9 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
             if !clips && (q0[0] - p[0]).hypot(q0[1] - p[1]) > NEAR_WALL * shortest {
                 continue;
             }
-            let e = 1e-6 * (1.0 + q0[0].abs().max(q0[1].abs()));
-            let (Some(gx0), Some(gx1), Some(gy0), Some(gy1)) = (
-                field(q0[0] - e, q0[1]),
-                field(q0[0] + e, q0[1]),
-                field(q0[0], q0[1] - e),
-                field(q0[0], q0[1] + e),
-            ) else {
+            let Some(([gx, gy], _)) = field_differences(&field, q0[0], q0[1]) else {
                 continue;
             };
-            let (gx, gy) = (gx1 - gx0, gy1 - gy0);
             let l = gx.hypot(gy);
             if l.is_nan() || l <= 0.0 {
                 continue;
@@ -1285,10 +1263,13 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
                     }
                 }
             }
+            let before = cells
+                .iter()
+                .map(|&c| crate::quality::min_dihedral(st.tets[c].map(|w| st.points[w as usize])))
+                .fold(f64::INFINITY, f64::min);
             let mut best: Option<([f64; 3], f64)> = None;
             for q in targets {
                 let place = |w: u32| if w == v { q } else { st.points[w as usize] };
-                let mut before = f64::INFINITY;
                 let mut after = f64::INFINITY;
                 let mut fine = true;
                 let mut thinnest = f64::INFINITY;
@@ -1299,9 +1280,6 @@ pub(crate) fn seat_near_walls(st: &mut State, set: &ObjectSet, terrain: &crate::
                         fine = false;
                         break;
                     }
-                    before = before.min(crate::quality::min_dihedral(
-                        t.map(|w| st.points[w as usize]),
-                    ));
                     after = after.min(crate::quality::min_dihedral(g));
                     // Its faces on the terrain stay on the DSM.
                     for f in outward_faces(&t) {
@@ -1354,11 +1332,8 @@ fn onto_trace(
         if g.abs() <= 1e-3 * ON_WALL {
             return Some([x, y, terrain.height([x, y])?]);
         }
-        let e = 1e-6 * (1.0 + x.abs().max(y.abs()));
-        let d = [
-            (field(x + e, y)? - field(x - e, y)?) / (2.0 * e),
-            (field(x, y + e)? - field(x, y - e)?) / (2.0 * e),
-        ];
+        let ([dx, dy], e) = field_differences(field, x, y)?;
+        let d = [dx / (2.0 * e), dy / (2.0 * e)];
         let n2 = d[0] * d[0] + d[1] * d[1];
         if n2 < 1e-12 {
             return None;
@@ -1367,6 +1342,23 @@ fn onto_trace(
         y -= g * d[1] / n2;
     }
     None
+}
+
+/// The central differences of `field` at (x, y) across x and across y, and their half-step
+/// `e` (1e-6 of the coordinates' size): `None` where `field` is not defined.
+fn field_differences(
+    field: &dyn Fn(f64, f64) -> Option<f64>,
+    x: f64,
+    y: f64,
+) -> Option<([f64; 2], f64)> {
+    let e = 1e-6 * (1.0 + x.abs().max(y.abs()));
+    Some((
+        [
+            field(x + e, y)? - field(x - e, y)?,
+            field(x, y + e)? - field(x, y - e)?,
+        ],
+        e,
+    ))
 }
 
 /// A triangle's smallest altitude in plan (twice its area over its longest edge).

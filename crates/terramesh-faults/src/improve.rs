@@ -1888,12 +1888,7 @@ pub(crate) fn improve(
         object,
         units,
         stats: Stats::from_env(),
-        tol: 0.5e-9
-            * terrain
-                .heights
-                .iter()
-                .fold(0.0f64, |s, h| s.max(h.abs()))
-                .max(1.0),
+        tol: terrain.on_dsm_tolerance(),
     };
     // The sweeps run on a thread of the pool, so that the many small parallel batches (a
     // chunk's plans, a few stale plans made again) are run by it and the others at once

@@ -149,6 +149,17 @@ pub struct Terrain {
 }
 
 impl Terrain {
+    /// How far (m) a point may lie from the DSM and still count as on it: 0.5e-9 of the
+    /// largest absolute height (at least 1 m), the rounding of a height interpolated there.
+    pub(crate) fn on_dsm_tolerance(&self) -> f64 {
+        0.5e-9
+            * self
+                .heights
+                .iter()
+                .fold(0.0f64, |s, h| s.max(h.abs()))
+                .max(1.0)
+    }
+
     /// Checks the planar mesh (as [`Planar::new`]) and the heights (one finite value per
     /// vertex).
     ///
