@@ -214,10 +214,44 @@ fn every_stage_has_its_time_and_peak_memory() {
     }
     assert!(b["seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(b["peak_memory_bytes"].as_u64().is_some(), linux, "{b}");
+    // When each stage ran: within the build, the stages before the exports one after
+    // another, the exports, pictures and report (which run at once) after the interpolation;
+    // `outputs_seconds` their span together.
+    let total = b["seconds"].as_f64().unwrap();
+    let span = |s: &serde_json::Value| {
+        let (a, e) = (
+            s["start_seconds"].as_f64().unwrap(),
+            s["end_seconds"].as_f64().unwrap(),
+        );
+        assert!(0.0 <= a && a <= e && e <= total, "{s}");
+        (a, e)
+    };
+    let all = b["stages"].as_array().unwrap();
+    for w in all[..4].windows(2) {
+        assert!(span(&w[0]).1 <= span(&w[1]).0, "{w:?}");
+    }
+    for s in &all[..5] {
+        // A stage's seconds are its span, but the report's, which worked in two parts.
+        let (a, e) = span(s);
+        assert!((e - a - s["seconds"].as_f64().unwrap()).abs() < 1e-6, "{s}");
+    }
+    let outputs: Vec<(f64, f64)> = all[4..].iter().map(span).collect();
+    let interpolated = span(&all[3]).1;
+    assert!(outputs.iter().all(|o| o.0 >= interpolated), "{b}");
+    let together = outputs.iter().map(|o| o.1).fold(0.0, f64::max)
+        - outputs.iter().map(|o| o.0).fold(f64::INFINITY, f64::min);
+    assert!(
+        (b["outputs_seconds"].as_f64().unwrap() - together).abs() < 1e-9,
+        "{b}"
+    );
+    let report = &all[6];
+    assert!(report["seconds"].as_f64().unwrap() <= outputs[2].1 - outputs[2].0 + 1e-6);
     let l = log(&o);
     assert_eq!(l.matches("; peak memory ").count(), stages.len(), "{l}");
+    assert!(l.contains("exports, pictures and report at once: "), "{l}");
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("peak memory"));
+    assert!(html.contains("from - to"));
 }
 
 /// `methods = ["idw"]` fits no variogram and kriges nothing: no variogram.json, no kriging

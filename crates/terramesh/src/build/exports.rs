@@ -134,6 +134,13 @@ fn write_format(
     Ok(files)
 }
 
+/// The sealed solid's base: `export.base_elevation`, else 50 m below the DSM's lowest
+/// vertex, rounded down to the metre.
+pub(super) fn base_elevation(p: &Project, it: &Interpolated) -> f64 {
+    let zmin = it.dsm.iter().copied().fold(f64::INFINITY, f64::min);
+    p.export.base_elevation.unwrap_or((zmin - 50.0).floor())
+}
+
 /// Writes every output of step 5.
 pub fn write_all(
     p: &Project,
@@ -345,8 +352,7 @@ pub fn write_all(
     }));
 
     // The sealed solid: made once, its three files written as jobs of their own.
-    let zmin = it.dsm.iter().copied().fold(f64::INFINITY, f64::min);
-    let base = p.export.base_elevation.unwrap_or((zmin - 50.0).floor());
+    let base = base_elevation(p, it);
     solid = extrude(abs, tris, base).context("export.base_elevation")?;
     check_closed(&solid.triangles).context("the sealed solid")?;
     let vol = volume(&solid.vertices, &solid.triangles);

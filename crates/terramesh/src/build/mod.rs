@@ -24,6 +24,7 @@ pub mod staging;
 pub mod terrain;
 pub(crate) mod viewer;
 
+use std::borrow::Cow;
 use std::path::Path;
 use std::time::Instant;
 
@@ -42,15 +43,29 @@ use crate::error::{Context, Error, Result};
 use crate::progress::Progress;
 use crate::project::Project;
 
-/// Time spent in each stage (`.0`: name and seconds), and the process's peak resident memory
-/// after it (`.1`, bytes, in the same order; `None` where the system does not say), for the
-/// log, `build.json` and the report.
+/// Time spent in each stage (`.0`: name and seconds), the process's peak resident memory
+/// after it (`.1`, bytes, in the same order; `None` where the system does not say), and when
+/// it began and ended, seconds after the build's start (`.2`; `None` for a row that is not a
+/// stage), for the log, `build.json` and the report. A stage's seconds are the time it
+/// worked: the exports, the pictures and the report run at once, so their spans overlap,
+/// and the report's seconds (its 3D view made beside the others, then the page) can be
+/// less than its span.
 #[derive(Debug, Default, Clone)]
-pub struct Timings(pub Vec<(String, f64)>, pub Vec<Option<u64>>);
+pub struct Timings(
+    pub Vec<(String, f64)>,
+    pub Vec<Option<u64>>,
+    pub Vec<Option<[f64; 2]>>,
+);
 
 impl Timings {
-    /// Records a stage: its seconds and the peak memory now.
+    /// Records a row that is not a stage (no span): its seconds and the peak memory now.
     pub fn push(&mut self, name: &str, seconds: f64) -> Option<u64> {
+        self.push_span(name, seconds, None)
+    }
+
+    /// Records a stage: its seconds, when it began and ended (seconds after the build's
+    /// start), and the peak memory now.
+    pub fn push_span(&mut self, name: &str, seconds: f64, span: Option<[f64; 2]>) -> Option<u64> {
         // Linux's VmHWM is the larger of a high-water mark updated only on some events (an
         // unmap, an exit) and the current resident size, so it can read lower than it did
         // after an earlier stage once memory is given back (seen after the concurrent
@@ -62,12 +77,30 @@ impl Timings {
         };
         self.0.push((name.to_string(), seconds));
         self.1.push(peak);
+        self.2.push(span);
         peak
     }
 
     /// The peak memory after stage `k`, `None` where unknown.
     pub fn peak(&self, k: usize) -> Option<u64> {
         self.1.get(k).copied().flatten()
+    }
+
+    /// When stage `k` began and ended, seconds after the build's start.
+    pub fn span(&self, k: usize) -> Option<[f64; 2]> {
+        self.2.get(k).copied().flatten()
+    }
+
+    /// The wall-clock seconds from the first to the last of the stages `names` that ran
+    /// (together, where they overlap), `None` when none did.
+    pub fn together(&self, names: &[&str]) -> Option<f64> {
+        let spans = (0..self.0.len())
+            .filter(|&k| names.contains(&self.0[k].0.as_str()))
+            .filter_map(|k| self.span(k));
+        let (lo, hi) = spans.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), [a, b]| {
+            (lo.min(a), hi.max(b))
+        });
+        (lo <= hi).then_some(hi - lo)
     }
 }
 
@@ -100,11 +133,17 @@ fn write_build_json(
     struct Stage<'a> {
         stage: &'a str,
         seconds: f64,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        start_seconds: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        end_seconds: Option<f64>,
         peak_memory_bytes: Option<u64>,
     }
     #[derive(serde::Serialize)]
     struct File<'a> {
         stages: Vec<Stage<'a>>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        outputs_seconds: Option<f64>,
         seconds: f64,
         peak_memory_bytes: Option<u64>,
         peak_memory: &'a str,
@@ -119,6 +158,8 @@ fn write_build_json(
         .map(|(k, (n, t))| Stage {
             stage: n,
             seconds: *t,
+            start_seconds: timings.span(k).map(|s| s[0]),
+            end_seconds: timings.span(k).map(|s| s[1]),
             peak_memory_bytes: timings.peak(k),
         })
         .collect();
@@ -129,6 +170,7 @@ fn write_build_json(
     };
     let json = serde_json::to_string_pretty(&File {
         stages,
+        outputs_seconds: timings.together(&OUTPUTS),
         seconds: total,
         peak_memory_bytes: peak,
         peak_memory: how,
@@ -143,6 +185,10 @@ fn write_build_json(
 
 /// The report's row of the time up to it.
 const TOTAL_BEFORE_REPORT: &str = "total before report";
+
+/// The stages that run at once after the interpolation: `build.json`'s `outputs_seconds` is
+/// their wall-clock time together, from the first one's start to the last one's end.
+pub const OUTPUTS: [&str; 3] = ["exports", "pictures", "report"];
 
 /// The number of stages [`build`] reports (one more with `[geology]`).
 pub const STAGES: usize = 7;
@@ -167,6 +213,8 @@ struct Stages<'a> {
     k: usize,
     total: usize,
     timings: Timings,
+    /// The build's start, which the stages' spans count from.
+    t0: Instant,
 }
 
 impl Stages<'_> {
@@ -182,7 +230,7 @@ impl Stages<'_> {
         let t = Instant::now();
         let out = f()?;
         let secs = t.elapsed().as_secs_f64();
-        let peak = self.timings.push(name, secs);
+        let peak = self.timings.push_span(name, secs, Some(self.span(t)));
         let detail = format!("{}; peak memory {}", detail(&out), memory_text(peak));
         self.progress.stage_done(name, &detail, secs);
         self.check()?;
@@ -210,6 +258,20 @@ impl Stages<'_> {
             let d = self.run("variogram", || stages::sample_data(samples), |_| why.into())?;
             Ok(stages::Fit::Data(d))
         }
+    }
+
+    /// When something that began at `start` began and ended (now), seconds after the
+    /// build's start.
+    fn span(&self, start: Instant) -> [f64; 2] {
+        let at = |i: Instant| i.saturating_duration_since(self.t0).as_secs_f64();
+        [at(start), at(Instant::now())]
+    }
+
+    /// Runs `f`: what it returns, and when it began and ended ([`Stages::span`]).
+    fn timed<T>(&self, f: impl FnOnce() -> T) -> (T, [f64; 2]) {
+        let t = Instant::now();
+        let r = f();
+        (r, self.span(t))
     }
 
     /// Stops the build when the front end asks.
@@ -316,6 +378,7 @@ fn geology_stage(
 /// `terramesh model` on the DSM kept in `previous` ([`reuse`]) when it was made from the same
 /// settings, inputs and borehole points: the geology stage alone, `samples.csv` and the kept
 /// DSM carried over into `out`. `None` when there is no such DSM (the caller builds one).
+#[allow(clippy::too_many_arguments)]
 fn model_on_kept_dsm(
     project: &Project,
     g: &crate::plan::GeologyPlan,
@@ -324,6 +387,7 @@ fn model_on_kept_dsm(
     previous: &Path,
     progress: &dyn Progress,
     grids: &mut GridsAhead,
+    t0: Instant,
 ) -> Result<Option<Built>> {
     let Some(kept) = reuse::DsmState::read(previous, key) else {
         if previous.join(reuse::FILE).is_file() {
@@ -340,7 +404,7 @@ fn model_on_kept_dsm(
         .as_ref()
         .map(crate::geology::stage::collar_points)
         .unwrap_or_default();
-    if collars != kept.collars {
+    if collars[..] != kept.collars[..] {
         progress.note("the boreholes moved, or others were added: building the DSM again");
         return Ok(None);
     }
@@ -350,6 +414,7 @@ fn model_on_kept_dsm(
         k: 0,
         total: 2,
         timings: Timings::default(),
+        t0,
     };
     st.run(
         "dsm",
@@ -488,6 +553,140 @@ fn build_into(
     }
 }
 
+/// The exports, the pictures and the report, at once: the exports' jobs, the pictures' and
+/// the report's 3D view (its level-of-detail copy of the DSM, the costliest part of the
+/// report) run together on the thread pool, then the report's page is made from what they
+/// made. Each stage's line comes after all three, in the stages' order, with its own time;
+/// the report's time is its 3D view's plus its page's, its span from the start of the three
+/// to its end. `build.json`'s `outputs_seconds` is their time together. `keep` writes the
+/// DSM kept for `terramesh model` beside the exports, in their time.
+#[allow(clippy::too_many_arguments)]
+fn outputs(
+    st: &mut Stages,
+    project: &Project,
+    out: &Path,
+    samples: &stages::Samples,
+    mesh: &stages::Meshed,
+    interp: &stages::Interpolated,
+    geo: Option<&crate::geology::stage::ModelBuilt>,
+    keep: impl FnOnce() -> Result<()> + Send,
+) -> Result<exports::Written> {
+    st.check()?;
+    st.k += 1;
+    st.progress.stage_start(st.k, st.total, "exports");
+    let want_pictures = project.export.pictures || project.export.report;
+    let base = exports::base_elevation(project, interp);
+    let stages = &*st;
+    // The pictures: the DSM's, then the geological model's (with `[geology]`), which the
+    // report's sections show.
+    let draw = || -> Result<(Vec<Picture>, Vec<terramesh_report::report::Section>)> {
+        let pics = pictures::draw_all(out, samples, mesh, interp)?;
+        let mut extra = Vec::new();
+        if let Some(g) = geo {
+            extra.push(crate::geology::report::model_section(out, g, &mesh.mesh)?);
+            extra.extend(crate::geology::ensemble_report::ensemble_section(
+                out, g, &mesh.mesh,
+            )?);
+        }
+        Ok((pics, extra))
+    };
+    let ((written, t_exports), ((pics, t_pictures), (scene, t_scene))) = rayon::join(
+        || {
+            stages.timed(|| {
+                let (w, kept) = rayon::join(
+                    || exports::write_all(project, out, samples, mesh, interp),
+                    keep,
+                );
+                w.and_then(|w| kept.map(|()| w))
+            })
+        },
+        || {
+            rayon::join(
+                || stages.timed(|| want_pictures.then(draw).transpose()),
+                || {
+                    stages.timed(|| {
+                        project
+                            .export
+                            .report
+                            .then(|| viewer::scene(samples, mesh, interp, base, geo))
+                            .transpose()
+                    })
+                },
+            )
+        },
+    );
+    let written = written?;
+    let secs = |s: [f64; 2]| s[1] - s[0];
+    let peak = st
+        .timings
+        .push_span("exports", secs(t_exports), Some(t_exports));
+    st.progress.stage_done(
+        "exports",
+        &format!(
+            "{} files; peak memory {}",
+            written.files.len(),
+            memory_text(peak)
+        ),
+        secs(t_exports),
+    );
+    let Some((pics, extra)) = pics? else {
+        return Ok(written);
+    };
+    st.k += 1;
+    st.progress.stage_start(st.k, st.total, "pictures");
+    let peak = st
+        .timings
+        .push_span("pictures", secs(t_pictures), Some(t_pictures));
+    st.progress.stage_done(
+        "pictures",
+        &format!(
+            "{} pictures, drawn beside the exports; peak memory {}",
+            pics.len(),
+            memory_text(peak)
+        ),
+        secs(t_pictures),
+    );
+    let Some(scene) = scene? else {
+        return Ok(written);
+    };
+    st.k += 1;
+    st.progress.stage_start(st.k, st.total, "report");
+    let t = Instant::now();
+    st.timings
+        .push(TOTAL_BEFORE_REPORT, st.t0.elapsed().as_secs_f64());
+    report::write_report(
+        out,
+        project,
+        samples,
+        mesh,
+        interp,
+        &written,
+        &pics,
+        &st.timings,
+        extra,
+        scene,
+    )?;
+    let page = t.elapsed().as_secs_f64();
+    let span = [t_scene[0], st.span(t)[1]];
+    let peak = st
+        .timings
+        .push_span("report", secs(t_scene) + page, Some(span));
+    st.progress.stage_done(
+        "report",
+        &format!(
+            "report.html (its 3D view made beside the exports); peak memory {}",
+            memory_text(peak)
+        ),
+        secs(t_scene) + page,
+    );
+    if let Some(all) = st.timings.together(&OUTPUTS) {
+        st.progress.note(&format!(
+            "exports, pictures and report at once: {all:.2} s together"
+        ));
+    }
+    Ok(written)
+}
+
 /// [`build_into`], with the grids read ahead.
 #[allow(clippy::too_many_arguments)]
 fn build_into_with(
@@ -509,7 +708,8 @@ fn build_into_with(
         project.geology(),
         project.interpolation.realisations,
     ) {
-        if let Some(built) = model_on_kept_dsm(project, g, key, out, previous, progress, grids)? {
+        if let Some(built) = model_on_kept_dsm(project, g, key, out, previous, progress, grids, t0)?
+        {
             return Ok(built);
         }
     }
@@ -527,6 +727,7 @@ fn build_into_with(
             What::ModelOnly => 5 + 2 * usize::from(project.interpolation.realisations > 0),
         },
         timings: Timings::default(),
+        t0,
     };
     let samples = st.run(
         "samples",
@@ -584,18 +785,26 @@ fn build_into_with(
             }
         },
     )?;
-    if let Some(key) = dsm_key {
-        reuse::DsmState {
-            key,
-            zone: samples.zone,
-            mesh: mesh.mesh.clone(),
-            collars: collars.clone(),
-            dsm: interp.dsm.clone(),
-            grid: interp.grid.0,
-            samples: samples.xyz.len() as u64,
-            source: samples.source.clone(),
+    // The DSM kept for `terramesh model` (reuse.rs): written here for a model alone, beside
+    // the exports for a whole build.
+    let keep = || -> Result<()> {
+        match dsm_key {
+            Some(key) => reuse::DsmState {
+                key,
+                zone: samples.zone,
+                mesh: Cow::Borrowed(&mesh.mesh),
+                collars: Cow::Borrowed(&collars),
+                dsm: Cow::Borrowed(&interp.dsm),
+                grid: interp.grid.0,
+                samples: samples.xyz.len() as u64,
+                source: samples.source.clone(),
+            }
+            .write(out),
+            None => Ok(()),
         }
-        .write(out)?;
+    };
+    if what == What::ModelOnly {
+        keep()?;
     }
     if let (true, Some(model)) = (project.interpolation.realisations > 0, model) {
         let e = st.run(
@@ -653,51 +862,16 @@ fn build_into_with(
             interpolation: Some(interp.choice.record()),
         });
     }
-    let written = st.run(
-        "exports",
-        || exports::write_all(project, out, &samples, &mesh, &interp),
-        |w| format!("{} files", w.files.len()),
+    let written = outputs(
+        &mut st,
+        project,
+        out,
+        &samples,
+        &mesh,
+        &interp,
+        geo.as_ref(),
+        keep,
     )?;
-    if project.export.pictures || project.export.report {
-        let pics = st.run(
-            "pictures",
-            || pictures::draw_all(out, &samples, &mesh, &interp),
-            |p| format!("{} pictures", p.len()),
-        )?;
-        let mut extra = Vec::new();
-        if let Some(g) = &geo {
-            extra.push(crate::geology::report::model_section(out, g, &mesh.mesh)?);
-            extra.extend(crate::geology::ensemble_report::ensemble_section(
-                out, g, &mesh.mesh,
-            )?);
-        }
-        if project.export.report {
-            st.k += 1;
-            progress.stage_start(st.k, st.total, "report");
-            let t = Instant::now();
-            st.timings
-                .push(TOTAL_BEFORE_REPORT, t0.elapsed().as_secs_f64());
-            report::write_report(
-                out,
-                project,
-                &samples,
-                &mesh,
-                &interp,
-                &written,
-                &pics,
-                &st.timings,
-                extra,
-                geo.as_ref(),
-            )?;
-            let secs = t.elapsed().as_secs_f64();
-            let peak = st.timings.push("report", secs);
-            progress.stage_done(
-                "report",
-                &format!("report.html; peak memory {}", memory_text(peak)),
-                secs,
-            );
-        }
-    }
     st.check()?;
     let mut files = written.files;
     if let Some(g) = geo {

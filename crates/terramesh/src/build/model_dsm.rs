@@ -67,9 +67,9 @@ pub(super) fn build_rest(
         reuse::DsmState {
             key,
             zone: samples.zone,
-            mesh: mesh.mesh.clone(),
-            collars,
-            dsm: heights.dsm.clone(),
+            mesh: std::borrow::Cow::Borrowed(&mesh.mesh),
+            collars: collars.into(),
+            dsm: std::borrow::Cow::Borrowed(&heights.dsm),
             grid: heights.grid,
             samples: samples.xyz.len() as u64,
             source: samples.source.clone(),

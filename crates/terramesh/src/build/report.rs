@@ -67,7 +67,7 @@ pub fn write_report(
     pics: &[Picture],
     timings: &Timings,
     extra: Vec<terramesh_report::report::Section>,
-    geo: Option<&crate::geology::stage::ModelBuilt>,
+    scene: terramesh_report::viewer::Scene,
 ) -> Result<()> {
     let title = p
         .title
@@ -212,9 +212,7 @@ pub fn write_report(
     });
     sections.push(Section {
         heading: "3D view".into(),
-        blocks: vec![Block::Viewer(Box::new(super::viewer::scene(
-            s, m, it, w.base, geo,
-        )?))],
+        blocks: vec![Block::Viewer(Box::new(scene))],
     });
     sections.push(Section {
         heading: "Samples".into(),
@@ -421,15 +419,30 @@ pub fn write_report(
     sections.push(Section {
         heading: "Timings".into(),
         blocks: vec![Block::Table {
-            caption: "Time per stage and the process's peak memory after it (VmHWM; this \
-                      machine, this run)"
+            caption: "Time per stage, when it ran (seconds after the build's start: the \
+                      exports, the pictures and the report's 3D view run at once) and the \
+                      process's peak memory after it (VmHWM; this machine, this run)"
                 .into(),
-            header: vec!["stage".into(), "seconds".into(), "peak memory".into()],
+            header: vec![
+                "stage".into(),
+                "seconds".into(),
+                "from - to".into(),
+                "peak memory".into(),
+            ],
             rows: timings
                 .0
                 .iter()
                 .enumerate()
-                .map(|(k, (n, t))| vec![n.clone(), num(*t, 3), super::memory_text(timings.peak(k))])
+                .map(|(k, (n, t))| {
+                    vec![
+                        n.clone(),
+                        num(*t, 3),
+                        timings.span(k).map_or(String::new(), |[a, b]| {
+                            format!("{} - {}", num(a, 2), num(b, 2))
+                        }),
+                        super::memory_text(timings.peak(k)),
+                    ]
+                })
                 .collect(),
         }],
     });

@@ -18,6 +18,7 @@
 //! f64 each), elevations (one f64 per point), the grid (4 f64, 2 u64), the sample count
 //! (u64), the source's name (u64 length, UTF-8), and a checksum of all that (u64).
 
+use std::borrow::Cow;
 use std::hash::{Hash, Hasher};
 use std::io::Write;
 use std::path::Path;
@@ -35,19 +36,20 @@ pub const FILE: &str = "dsm-cache.bin";
 
 const MAGIC: &[u8; 8] = b"TMDSM\0\0\x01";
 
-/// A DSM as kept in [`FILE`].
+/// A DSM as kept in [`FILE`]: the build writes it from its own mesh and elevations
+/// (borrowed), a reading owns them.
 #[derive(Debug, Clone, PartialEq)]
-pub struct DsmState {
+pub struct DsmState<'a> {
     /// The key of the settings and inputs that made it ([`key`]).
     pub key: u64,
     /// The UTM zone of a geographic project.
     pub zone: Option<Zone>,
     /// The planar mesh.
-    pub mesh: Mesh,
+    pub mesh: Cow<'a, Mesh>,
     /// The borehole points inserted as vertices.
-    pub collars: Vec<[f64; 2]>,
+    pub collars: Cow<'a, [[f64; 2]]>,
     /// The DSM elevation at every vertex.
-    pub dsm: Vec<f64>,
+    pub dsm: Cow<'a, [f64]>,
     /// The DSM grid's layout (the interface grids use it).
     pub grid: RasterGrid,
     /// How many samples it was made from.
@@ -178,63 +180,111 @@ pub fn key(p: &Project, base: &Path) -> Result<u64> {
     Ok(h.finish())
 }
 
-fn put_u64(b: &mut Vec<u8>, v: u64) {
-    b.extend_from_slice(&v.to_le_bytes());
+/// The file's bytes on their way to a writer, and the checksum of them (the hash of the
+/// bytes as one slice: their length, then the bytes, fed in pieces).
+struct Sink<'w, W: Write> {
+    w: &'w mut W,
+    h: std::collections::hash_map::DefaultHasher,
 }
 
-fn put_f64(b: &mut Vec<u8>, v: f64) {
-    b.extend_from_slice(&v.to_le_bytes());
+impl<W: Write> Sink<'_, W> {
+    fn put(&mut self, b: &[u8]) -> std::io::Result<()> {
+        self.h.write(b);
+        self.w.write_all(b)
+    }
+    fn u64(&mut self, v: u64) -> std::io::Result<()> {
+        self.put(&v.to_le_bytes())
+    }
+    fn f64s(&mut self, v: &[f64]) -> std::io::Result<()> {
+        // In pieces of at most 512 numbers: no copy of a whole array.
+        let mut piece = [0u8; 8 * 512];
+        for c in v.chunks(512) {
+            for (k, x) in c.iter().enumerate() {
+                piece[8 * k..8 * k + 8].copy_from_slice(&x.to_le_bytes());
+            }
+            self.put(&piece[..8 * c.len()])?;
+        }
+        Ok(())
+    }
+    fn u32s(&mut self, v: &[u32]) -> std::io::Result<()> {
+        let mut piece = [0u8; 4 * 1024];
+        for c in v.chunks(1024) {
+            for (k, x) in c.iter().enumerate() {
+                piece[4 * k..4 * k + 4].copy_from_slice(&x.to_le_bytes());
+            }
+            self.put(&piece[..4 * c.len()])?;
+        }
+        Ok(())
+    }
 }
 
-impl DsmState {
+impl DsmState<'_> {
+    /// The file's length before its checksum.
+    fn body_len(&self) -> usize {
+        let m = &self.mesh;
+        MAGIC.len()
+            + 8
+            + 2
+            + 16
+            + 8
+            + 16 * m.points.len()
+            + 8
+            + 12 * m.triangles.len()
+            + 8
+            + 8 * m.constraint_edges.len()
+            + 8
+            + 16 * self.collars.len()
+            + 8 * self.dsm.len()
+            + 32
+            + 16
+            + 8
+            + 8
+            + self.source.len()
+    }
+
+    /// Writes the file's bytes to `w` as they are made, no copy of the DSM held.
+    pub fn write_to<W: Write>(&self, w: &mut W) -> std::io::Result<()> {
+        let m = &self.mesh;
+        let mut s = Sink { w, h: hasher() };
+        s.h.write_usize(self.body_len());
+        s.put(MAGIC)?;
+        s.u64(self.key)?;
+        match self.zone {
+            Some(z) => s.put(&[z.number(), u8::from(z.is_north())])?,
+            None => s.put(&[0, 0])?,
+        }
+        s.f64s(&m.origin)?;
+        s.u64(m.points.len() as u64)?;
+        s.f64s(m.points.as_flattened())?;
+        s.u64(m.triangles.len() as u64)?;
+        s.u32s(m.triangles.as_flattened())?;
+        s.u64(m.constraint_edges.len() as u64)?;
+        s.u32s(m.constraint_edges.as_flattened())?;
+        s.u64(self.collars.len() as u64)?;
+        s.f64s(self.collars.as_flattened())?;
+        s.f64s(&self.dsm)?;
+        let g = &self.grid;
+        s.f64s(&[g.xmin, g.ymin, g.xmax, g.ymax])?;
+        s.u64(g.nx as u64)?;
+        s.u64(g.ny as u64)?;
+        s.u64(self.samples)?;
+        s.u64(self.source.len() as u64)?;
+        s.put(self.source.as_bytes())?;
+        let sum = s.h.finish();
+        s.w.write_all(&sum.to_le_bytes())
+    }
+
     /// The file's bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let m = &self.mesh;
-        let mut b = Vec::with_capacity(
-            64 + 16 * m.points.len() + 12 * m.triangles.len() + 8 * self.dsm.len(),
-        );
-        b.extend_from_slice(MAGIC);
-        put_u64(&mut b, self.key);
-        match self.zone {
-            Some(z) => b.extend_from_slice(&[z.number(), u8::from(z.is_north())]),
-            None => b.extend_from_slice(&[0, 0]),
-        }
-        put_f64(&mut b, m.origin[0]);
-        put_f64(&mut b, m.origin[1]);
-        put_u64(&mut b, m.points.len() as u64);
-        m.points.iter().flatten().for_each(|&v| put_f64(&mut b, v));
-        put_u64(&mut b, m.triangles.len() as u64);
-        for v in m.triangles.iter().flatten() {
-            b.extend_from_slice(&v.to_le_bytes());
-        }
-        put_u64(&mut b, m.constraint_edges.len() as u64);
-        for v in m.constraint_edges.iter().flatten() {
-            b.extend_from_slice(&v.to_le_bytes());
-        }
-        put_u64(&mut b, self.collars.len() as u64);
-        self.collars
-            .iter()
-            .flatten()
-            .for_each(|&v| put_f64(&mut b, v));
-        self.dsm.iter().for_each(|&v| put_f64(&mut b, v));
-        let g = &self.grid;
-        for v in [g.xmin, g.ymin, g.xmax, g.ymax] {
-            put_f64(&mut b, v);
-        }
-        put_u64(&mut b, g.nx as u64);
-        put_u64(&mut b, g.ny as u64);
-        put_u64(&mut b, self.samples);
-        put_u64(&mut b, self.source.len() as u64);
-        b.extend_from_slice(self.source.as_bytes());
-        let mut h = hasher();
-        b.hash(&mut h);
-        put_u64(&mut b, h.finish());
+        let mut b = Vec::with_capacity(self.body_len() + 8);
+        // Writing into a vector cannot fail.
+        let _ = self.write_to(&mut b);
         b
     }
 
     /// Reads the bytes of [`DsmState::to_bytes`]; `None` when they are not such a file (another
     /// version, truncated, damaged: the checksum differs, an index is out of range).
-    pub fn from_bytes(b: &[u8]) -> Option<DsmState> {
+    pub fn from_bytes(b: &[u8]) -> Option<DsmState<'static>> {
         let body = b.len().checked_sub(8)?;
         let mut h = hasher();
         b[..body].hash(&mut h);
@@ -289,14 +339,14 @@ impl DsmState {
         (r.at == r.b.len()).then_some(DsmState {
             key,
             zone,
-            mesh: Mesh {
+            mesh: Cow::Owned(Mesh {
                 origin,
                 points,
                 triangles,
                 constraint_edges,
-            },
-            collars,
-            dsm,
+            }),
+            collars: Cow::Owned(collars),
+            dsm: Cow::Owned(dsm),
             grid,
             samples,
             source,
@@ -308,7 +358,7 @@ impl DsmState {
         let path = dir.join(FILE);
         let mut o = Output::create(Some(&path))
             .with_context(|| format!("cannot write {}", path.display()))?;
-        o.write_all(&self.to_bytes())
+        self.write_to(&mut o)
             .with_context(|| format!("writing {}", path.display()))?;
         o.commit()
             .with_context(|| format!("cannot write {}", path.display()))?;
@@ -317,7 +367,7 @@ impl DsmState {
 
     /// The state kept in `dir` when it has the key `key`; `None` when there is none, it was
     /// made from other settings, or it cannot be read.
-    pub fn read(dir: &Path, key: u64) -> Option<DsmState> {
+    pub fn read(dir: &Path, key: u64) -> Option<DsmState<'static>> {
         let bytes = std::fs::read(dir.join(FILE)).ok()?;
         DsmState::from_bytes(&bytes).filter(|s| s.key == key)
     }
@@ -361,18 +411,18 @@ impl<'a> Reader<'a> {
 mod tests {
     use super::*;
 
-    fn state() -> DsmState {
+    fn state() -> DsmState<'static> {
         DsmState {
             key: 42,
             zone: Some(Zone::new(32, true).unwrap()),
-            mesh: Mesh {
+            mesh: Cow::Owned(Mesh {
                 origin: [500_000.0, 5_400_000.0],
                 points: vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]],
                 triangles: vec![[0, 1, 2], [0, 2, 3]],
                 constraint_edges: vec![[0, 1], [1, 2], [2, 3], [3, 0]],
-            },
-            collars: vec![[500_005.0, 5_400_005.0]],
-            dsm: vec![1.0, 2.5, -3.25, 1e-300],
+            }),
+            collars: Cow::Owned(vec![[500_005.0, 5_400_005.0]]),
+            dsm: Cow::Owned(vec![1.0, 2.5, -3.25, 1e-300]),
             grid: RasterGrid {
                 xmin: 0.0,
                 ymin: 0.0,
