@@ -435,11 +435,15 @@ fn inside_triangles(cdt: &Cdt) -> Vec<[u32; 3]> {
 /// whose reverse is no triangle's.
 fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     let key = |a: u32, b: u32| (u64::from(a) << 32) | u64::from(b);
-    let mut directed: Vec<u64> = triangles
+    // Collected triangle by triangle into a vector of the exact size (a flat map's collect
+    // would gather pieces and copy them: twice the memory at its peak).
+    let mut by_triangle: Vec<[u64; 3]> = triangles
         .par_iter()
-        .flat_map_iter(|t| [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])])
+        .map(|t| [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])])
         .collect();
+    let directed = by_triangle.as_flattened_mut();
     directed.par_sort_unstable();
+    let directed = &*directed;
     directed
         .par_iter()
         .filter(|&&e| {

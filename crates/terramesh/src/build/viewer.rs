@@ -41,12 +41,6 @@ pub fn scene(
     geo: Option<&ModelBuilt>,
 ) -> Result<Scene> {
     let mesh = &m.mesh;
-    let abs: Vec<[f64; 3]> = (0..mesh.points.len())
-        .map(|i| {
-            let q = mesh.absolute(i);
-            [q[0], q[1], it.dsm[i]]
-        })
-        .collect();
     let diff: Vec<f64> = it.uk.iter().zip(&it.idw).map(|(a, b)| a - b).collect();
     // The DSM, and the kriging's fields when the samples were kriged.
     let mut fields: Vec<&[f64]> = vec![&it.dsm];
@@ -65,7 +59,7 @@ pub fn scene(
     let budget = VIEWER_TRIANGLES.min(2 * vertices);
     let mut notes = Vec::new();
     let (positions, triangles, mut values) = if mesh.triangles.len() > budget
-        || abs.len() > vertices
+        || mesh.points.len() > vertices
     {
         let d = level_of_detail(mesh, &it.dsm, &fields, budget, vertices)?;
         notes.push(format!(
@@ -73,7 +67,7 @@ pub fn scene(
              copy of {} of its vertices and {} triangles (at most {budget}), within {:.3} m of the \
              DSM in elevation at every DSM vertex{}. The exports and the pictures use the \
              full mesh.",
-            abs.len(),
+            mesh.points.len(),
             mesh.triangles.len(),
             d.positions.len(),
             d.triangles.len(),
@@ -87,6 +81,12 @@ pub fn scene(
         (d.positions, d.triangles, d.values)
     } else {
         let values = fields.iter().map(|f| f.to_vec()).collect();
+        let abs = (0..mesh.points.len())
+            .map(|i| {
+                let q = mesh.absolute(i);
+                [q[0], q[1], it.dsm[i]]
+            })
+            .collect();
         (abs, mesh.triangles.clone(), values)
     };
     let model_layers = match geo {
