@@ -3,7 +3,8 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::colour::{hillshade, rgb, shade, ColourMap};
+use super::colour::{hillshade_towards, rgb, shade, sun, ColourMap, ColourTable};
+use super::{on_canvas, pixel_of, RasterAccess};
 
 type Res = Result<(), Box<dyn std::error::Error>>;
 
@@ -181,7 +182,10 @@ where
 }
 
 /// Draws a coloured (and optionally hill-shaded) surface with contour lines and a colour bar.
-pub fn draw_surface<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &SurfaceMap) -> Res
+///
+/// On a backend with [`RasterAccess`] the triangles are filled straight into its pixels (the
+/// same pixels as plotters' polygons give).
+pub fn draw_surface<DB: RasterAccess>(root: &DrawingArea<DB, Shift>, map: &SurfaceMap) -> Res
 where
     DB::ErrorType: 'static,
 {
@@ -189,44 +193,81 @@ where
     let (lo, hi) = value_range(map.values.iter().copied(), map.symmetric);
     let mut chart = plan_chart(root, map.title, map.xy.iter().copied(), 90)?;
     let xy = map.xy;
-    chart.draw_series(map.triangles.iter().map(|t| {
-        let [a, b, c] = t.map(|i| i as usize);
-        let v = (map.values[a] + map.values[b] + map.values[c]) / 3.0;
-        let mut col = rgb(map.colours.at((v - lo) / (hi - lo)));
-        if let Some(z) = map.shade_z {
-            let u = [xy[b][0] - xy[a][0], xy[b][1] - xy[a][1], z[b] - z[a]];
-            let w = [xy[c][0] - xy[a][0], xy[c][1] - xy[a][1], z[c] - z[a]];
+    let sun = sun();
+    let table = ColourTable::new(map.colours);
+    // A triangle's colour from its corners: (x, y, value, shade z) each.
+    let colour = |[a, b, c]: [[f64; 4]; 3]| {
+        let v = (a[2] + b[2] + c[2]) / 3.0;
+        let mut col = rgb(table.at((v - lo) / (hi - lo)));
+        if map.shade_z.is_some() {
+            let u = [b[0] - a[0], b[1] - a[1], b[3] - a[3]];
+            let w = [c[0] - a[0], c[1] - a[1], c[3] - a[3]];
             let n = [
                 u[1] * w[2] - u[2] * w[1],
                 u[2] * w[0] - u[0] * w[2],
                 u[0] * w[1] - u[1] * w[0],
             ];
             let n = if n[2] < 0.0 { n.map(|x| -x) } else { n };
-            col = shade(col, hillshade(n));
+            col = shade(col, hillshade_towards(&sun, n));
         }
-        Polygon::new(
-            vec![
-                (xy[a][0], xy[a][1]),
-                (xy[b][0], xy[b][1]),
-                (xy[c][0], xy[c][1]),
-            ],
-            col.filled(),
-        )
-    }))?;
+        col
+    };
+    let corner = |i: usize| {
+        let z = map.shade_z.map_or(0.0, |z| z[i]);
+        [xy[i][0], xy[i][1], map.values[i], z]
+    };
     // Contours by marching triangles at a "nice" interval.
     let step = nice_step((hi - lo) / 10.0);
-    if step > 0.0 && step.is_finite() {
-        let first = (lo / step).ceil() as i64;
-        let last = (hi / step).floor() as i64;
-        let mut segs = Vec::new();
-        for k in first..=last {
-            let level = k as f64 * step;
-            for t in map.triangles {
-                if let Some(s) = contour_segment(xy, map.values, t, level) {
-                    segs.push(s);
+    let levels = (step > 0.0 && step.is_finite()).then(|| Levels {
+        step,
+        first: (lo / step).ceil() as i64,
+        last: (hi / step).floor() as i64,
+    });
+    // The triangles that may cross a level (in order, with the first such level): most
+    // cross none.
+    let crossing = std::cell::RefCell::new(Vec::new());
+    let area = chart.plotting_area();
+    let filled = on_canvas(area, |canvas| {
+        // Each vertex's pixel and corner once, side by side (one cache line for what a
+        // triangle reads of a vertex), rather than at each of its triangles' corners.
+        let vertex: Vec<((i32, i32), [f64; 4])> = (0..xy.len())
+            .map(|i| (pixel_of(area, &(xy[i][0], xy[i][1])), corner(i)))
+            .collect();
+        let mut crossing = crossing.borrow_mut();
+        // In batches: the corners of many triangles gathered first (their reads from
+        // memory overlap), then coloured and filled.
+        const BATCH: usize = 64;
+        let mut corners = [[((0, 0), [0.0; 4]); 3]; BATCH];
+        for (n, batch) in map.triangles.chunks(BATCH).enumerate() {
+            for (c, t) in corners.iter_mut().zip(batch) {
+                *c = t.map(|i| vertex[i as usize]);
+            }
+            for (k, c) in corners[..batch.len()].iter().enumerate() {
+                let RGBColor(r, g, b) = colour(c.map(|v| v.1));
+                canvas.triangle(c.map(|v| v.0), [r, g, b]);
+                if let Some(levels) = &levels {
+                    if let Some(first) = levels.first_crossing(c.map(|v| v.1[2])) {
+                        crossing.push((n * BATCH + k, first));
+                    }
                 }
             }
         }
+    })?;
+    let mut crossing = crossing.into_inner();
+    if !filled {
+        chart.draw_series(map.triangles.iter().map(|t| {
+            let t = t.map(|i| i as usize);
+            Polygon::new(
+                t.map(|i| (xy[i][0], xy[i][1])).to_vec(),
+                colour(t.map(corner)).filled(),
+            )
+        }))?;
+        if let Some(levels) = &levels {
+            crossing = levels.crossing(map.values, map.triangles);
+        }
+    }
+    if let Some(levels) = &levels {
+        let segs = levels.segments(xy, map.values, map.triangles, &crossing);
         let style = RGBColor(30, 30, 30).mix(0.55).stroke_width(1);
         chart.draw_series(
             segs.into_iter()
@@ -236,6 +277,88 @@ where
     draw_outlines(&mut chart, map.outlines)?;
     colour_bar(root, map.colours, lo, hi, map.unit)?;
     Ok(())
+}
+
+/// A contour segment, from one point to another.
+type Segment = ((f64, f64), (f64, f64));
+
+/// Contour levels `k * step`, `k` from `first` to `last`.
+struct Levels {
+    step: f64,
+    first: i64,
+    last: i64,
+}
+
+impl Levels {
+    fn level(&self, k: i64) -> f64 {
+        k as f64 * self.step
+    }
+
+    /// The first level that a triangle with values `w` may cross ([`contour_segment`] can
+    /// find a crossing only at levels in `(min, max]`), `None` where it crosses none.
+    #[inline]
+    fn first_crossing(&self, w: [f64; 3]) -> Option<i64> {
+        if self.first > self.last {
+            return None;
+        }
+        if w.iter().any(|x| x.is_nan()) {
+            // (A NaN is never below a level: try them all.)
+            return Some(self.first);
+        }
+        let (lo, hi) = (w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2]));
+        // `k * step` grows with k: walk from an estimate to the first level above `lo`.
+        let mut k = ((lo / self.step) as i64).clamp(self.first, self.last);
+        while k > self.first && self.level(k - 1) > lo {
+            k -= 1;
+        }
+        while k <= self.last && self.level(k) <= lo {
+            k += 1;
+        }
+        (k <= self.last && self.level(k) <= hi).then_some(k)
+    }
+
+    /// The triangles that may cross a level, in order, each with its first such level.
+    fn crossing(&self, v: &[f64], triangles: &[[u32; 3]]) -> Vec<(usize, i64)> {
+        triangles
+            .iter()
+            .enumerate()
+            .filter_map(|(n, t)| Some((n, self.first_crossing(t.map(|i| v[i as usize]))?)))
+            .collect()
+    }
+
+    /// The contour segments of the triangles `crossing` ([`Levels::crossing`]): level by
+    /// level, each level's in the order of the triangles, as every triangle tried at every
+    /// level gives them.
+    fn segments(
+        &self,
+        xy: &[[f64; 2]],
+        v: &[f64],
+        triangles: &[[u32; 3]],
+        crossing: &[(usize, i64)],
+    ) -> Vec<Segment> {
+        if self.first > self.last {
+            return Vec::new();
+        }
+        let mut by_level: Vec<Vec<Segment>> =
+            vec![Vec::new(); (self.last - self.first + 1) as usize];
+        for &(n, first) in crossing {
+            let t = &triangles[n];
+            for k in first..=self.last {
+                // (Past the largest value no level is crossed; a NaN's triangle tries all.)
+                let level = self.level(k);
+                if !t
+                    .iter()
+                    .any(|&i| v[i as usize] >= level || v[i as usize].is_nan())
+                {
+                    break;
+                }
+                if let Some(s) = contour_segment(xy, v, t, level) {
+                    by_level[(k - self.first) as usize].push(s);
+                }
+            }
+        }
+        by_level.concat()
+    }
 }
 
 /// The segment where the linear interpolant on triangle `t` crosses `level`.
@@ -354,6 +477,68 @@ mod tests {
         assert!((p.0 - 1.0).abs() < 1e-12 && p.1.abs() < 1e-12);
         assert!(q.0.abs() < 1e-12 && (q.1 - 1.0).abs() < 1e-12);
         assert!(contour_segment(&xy, &v, &[0, 1, 2], 3.0).is_none());
+    }
+
+    #[test]
+    fn contours_tried_at_the_triangles_levels_only_are_the_same_segments() {
+        // A fan of triangles with values on, between and beyond the levels, some infinite,
+        // some NaN.
+        let specials = [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            2.0,
+            2.5,
+            -0.5,
+            7.0,
+        ];
+        let n = 40;
+        let xy: Vec<[f64; 2]> = (0..n).map(|k| [k as f64, (k * k % 7) as f64]).collect();
+        let v: Vec<f64> = (0..n)
+            .map(|k| {
+                if k % 5 == 0 {
+                    specials[k / 5 % specials.len()]
+                } else {
+                    (k * 37 % 23) as f64 * 0.5 - 1.0
+                }
+            })
+            .collect();
+        let mut tris = Vec::new();
+        for a in 0..n as u32 {
+            for b in [1, 3, 7] {
+                tris.push([a, (a + b) % n as u32, (a + 2 * b + 1) % n as u32]);
+            }
+        }
+        for (step, first, last) in [(0.5, -2, 20), (1.0, 0, 9), (2.0, -1, 4), (0.5, 3, 3)] {
+            // Every triangle at every level, level by level.
+            let mut naive = Vec::new();
+            for k in first..=last {
+                for t in &tris {
+                    naive.extend(contour_segment(&xy, &v, t, k as f64 * step));
+                }
+            }
+            let levels = Levels { step, first, last };
+            let fast = levels.segments(&xy, &v, &tris, &levels.crossing(&v, &tris));
+            assert!(naive.len() > 10);
+            // (Infinite values give NaN points: compare bit for bit.)
+            let bits = |s: &[Segment]| -> Vec<[u64; 4]> {
+                s.iter()
+                    .map(|(p, q)| [p.0, p.1, q.0, q.1].map(f64::to_bits))
+                    .collect()
+            };
+            assert!(
+                bits(&fast) == bits(&naive),
+                "step {step}, levels {first}..={last}"
+            );
+        }
+        let none = Levels {
+            step: 1.0,
+            first: 3,
+            last: 2,
+        };
+        assert!(none
+            .segments(&xy, &v, &tris, &none.crossing(&v, &tris))
+            .is_empty());
     }
 
     #[test]

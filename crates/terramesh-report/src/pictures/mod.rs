@@ -7,6 +7,7 @@
 mod chart;
 mod colour;
 mod detail;
+mod fill;
 mod maps;
 mod section;
 mod view3d;
@@ -96,8 +97,7 @@ where
     ensure_font();
     let mut pixels = vec![255u8; size.0 as usize * size.1 as usize * 3];
     {
-        let backend = BitMapBackend::with_buffer(&mut pixels, size);
-        let root = DynBackend::Bitmap(backend).into_drawing_area();
+        let root = DynBackend::Pixels(&mut pixels, size).into_drawing_area();
         draw(&root).map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
@@ -234,6 +234,99 @@ pub enum DynBackend<'a> {
     Bitmap(BitMapBackend<'a>),
     /// Vector.
     Svg(SVGBackend<'a>),
+    /// An RGB buffer (3 bytes a pixel, row by row) of the given size: drawn as `Bitmap`
+    /// draws, and open to [`RasterAccess`], through which the maps and the 3D view fill
+    /// their triangles straight into it (the same pixels, without plotters' per-triangle
+    /// costs).
+    Pixels(&'a mut [u8], (u32, u32)),
+}
+
+/// A drawing backend that may hand out its RGB pixels: [`draw_surface`], [`draw_view3d`] and
+/// [`draw_bodies_view3d`] then fill their triangles into them directly, pixel for pixel as
+/// plotters' bitmap backend fills them; other backends draw plotters' polygons.
+pub trait RasterAccess: plotters_backend::DrawingBackend {
+    /// The RGB pixels (3 bytes a pixel, row by row) and their width and height, if the
+    /// backend is such a buffer.
+    fn rgb_pixels(&mut self) -> Option<(&mut [u8], (u32, u32))> {
+        None
+    }
+}
+
+impl RasterAccess for DynBackend<'_> {
+    fn rgb_pixels(&mut self) -> Option<(&mut [u8], (u32, u32))> {
+        match self {
+            DynBackend::Pixels(buf, size) => Some((&mut **buf, *size)),
+            _ => None,
+        }
+    }
+}
+
+impl RasterAccess for BitMapBackend<'_> {}
+
+impl RasterAccess for SVGBackend<'_> {}
+
+/// An element that draws nothing through plotters: drawn on an area, it runs its function
+/// on the backend's pixels where the backend has them ([`on_canvas`]).
+struct OnCanvas<F> {
+    draw: F,
+    done: std::cell::Cell<bool>,
+}
+
+impl<'a, C: 'a, F> plotters::element::PointCollection<'a, C> for &'a OnCanvas<F> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Empty<&'a C>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::empty()
+    }
+}
+
+impl<DB: RasterAccess, F: Fn(&mut fill::Canvas)> plotters::element::Drawable<DB> for OnCanvas<F> {
+    fn draw<I: Iterator<Item = plotters_backend::BackendCoord>>(
+        &self,
+        _: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> Result<(), plotters_backend::DrawingErrorKind<DB::ErrorType>> {
+        if let Some(mut canvas) = backend
+            .rgb_pixels()
+            .and_then(|(buf, size)| fill::Canvas::new(buf, size))
+        {
+            (self.draw)(&mut canvas);
+            self.done.set(true);
+        }
+        Ok(())
+    }
+}
+
+/// Runs `draw` on the pixels of `area`'s backend if it has them (see [`RasterAccess`]);
+/// whether it ran.
+fn on_canvas<DB, CT>(
+    area: &DrawingArea<DB, CT>,
+    draw: impl Fn(&mut fill::Canvas),
+) -> Result<bool, Box<dyn std::error::Error>>
+where
+    DB: RasterAccess,
+    DB::ErrorType: 'static,
+    CT: plotters::coord::CoordTranslate,
+{
+    let element = OnCanvas {
+        draw,
+        done: std::cell::Cell::new(false),
+    };
+    area.draw(&element)?;
+    Ok(element.done.get())
+}
+
+/// The pixel where `area` draws the point `p` of an element: its coordinates' translation,
+/// clamped to the area (as `DrawingArea::draw` gives them to the backend).
+fn pixel_of<DB, CT>(area: &DrawingArea<DB, CT>, p: &CT::From) -> (i32, i32)
+where
+    DB: plotters_backend::DrawingBackend,
+    CT: plotters::coord::CoordTranslate,
+{
+    let (xs, ys) = area.get_pixel_range();
+    let (x, y) = area.map_coordinate(p);
+    (x.min(xs.end).max(xs.start), y.min(ys.end).max(ys.start))
 }
 
 /// Errors of either backend, as text.
@@ -266,6 +359,13 @@ macro_rules! both {
         match $self {
             DynBackend::Bitmap($b) => $e.map_err(conv),
             DynBackend::Svg($b) => $e.map_err(conv),
+            DynBackend::Pixels(buf, size) => {
+                // A bitmap backend over the buffer for this call (it keeps no state between
+                // calls, and presenting a buffer does nothing).
+                let mut bitmap = BitMapBackend::with_buffer(buf, *size);
+                let $b = &mut bitmap;
+                $e.map_err(conv)
+            }
         }
     };
 }
@@ -277,6 +377,7 @@ impl plotters_backend::DrawingBackend for DynBackend<'_> {
         match self {
             DynBackend::Bitmap(b) => b.get_size(),
             DynBackend::Svg(b) => b.get_size(),
+            DynBackend::Pixels(_, size) => *size,
         }
     }
     fn ensure_prepared(&mut self) -> Result<(), plotters_backend::DrawingErrorKind<DynError>> {

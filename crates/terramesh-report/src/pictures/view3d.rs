@@ -3,7 +3,8 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::colour::{rgb, shade, ColourMap};
+use super::colour::{rgb, shade, ColourMap, ColourTable};
+use super::{on_canvas, pixel_of, RasterAccess};
 
 /// Draws a perspective-free (orthographic) 3D view of the surface seen from the south-west,
 /// 30 degrees above the horizon, with vertical exaggeration `exaggeration`; facets are
@@ -19,7 +20,7 @@ use super::colour::{rgb, shade, ColourMap};
 /// })?;
 /// # Ok(()) }
 /// ```
-pub fn draw_view3d<DB: DrawingBackend>(
+pub fn draw_view3d<DB: RasterAccess>(
     root: &DrawingArea<DB, Shift>,
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -57,7 +58,7 @@ where
 /// })?;
 /// # Ok(()) }
 /// ```
-pub fn draw_bodies_view3d<DB: DrawingBackend>(
+pub fn draw_bodies_view3d<DB: RasterAccess>(
     root: &DrawingArea<DB, Shift>,
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -94,7 +95,7 @@ enum Facets<'a> {
     Bodies(&'a [RGBColor]),
 }
 
-fn draw_facets<DB: DrawingBackend>(
+fn draw_facets<DB: RasterAccess>(
     root: &DrawingArea<DB, Shift>,
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -160,7 +161,8 @@ where
             (40.0 + ph - (q.1 - ymin) * s - (ph - (ymax - ymin) * s) / 2.0) as i32,
         )
     };
-    // Far triangles first (largest depth), ties in index order for determinism.
+    // Far triangles first (largest depth), ties in index order for determinism (the keys
+    // differ, so an unstable sort gives the same order).
     let mut order: Vec<(f64, usize)> = triangles
         .iter()
         .enumerate()
@@ -171,14 +173,18 @@ where
             )
         })
         .collect();
-    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    order.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     let light = {
         let (laz, lel) = (315f64.to_radians(), 45f64.to_radians());
         [laz.sin() * lel.cos(), laz.cos() * lel.cos(), lel.sin()]
     };
-    for &(_, k) in &order {
-        let t = triangles[k];
-        let [a, b, cc] = t.map(|i| vertices[i as usize]);
+    let terrain = match facets {
+        Facets::Terrain => Some(ColourTable::new(ColourMap::Terrain)),
+        Facets::Bodies(_) => None,
+    };
+    // The colour of triangle `k` with corners `a`, `b`, `cc`, `None` where it is not drawn
+    // (facing away).
+    let colour = |k: usize, [a, b, cc]: [[f64; 3]; 3]| {
         let u = [b[0] - a[0], b[1] - a[1], (b[2] - a[2]) * exaggeration];
         let v = [cc[0] - a[0], cc[1] - a[1], (cc[2] - a[2]) * exaggeration];
         let mut nrm = [
@@ -192,12 +198,14 @@ where
                     nrm = nrm.map(|x| -x);
                 }
                 let zt = ((a[2] + b[2] + cc[2]) / 3.0 - zlo) / zspan;
-                rgb(ColourMap::Terrain.at(zt))
+                rgb(terrain
+                    .as_ref()
+                    .map_or_else(|| ColourMap::Terrain.at(zt), |table| table.at(zt)))
             }
             Facets::Bodies(colours) => {
                 // Towards the viewer (azimuth `az`, elevation `el`): facing away is hidden.
                 if nrm[0] * sa * ce + nrm[1] * ca * ce + nrm[2] * se <= 0.0 {
-                    continue;
+                    return None;
                 }
                 colours[k]
             }
@@ -206,9 +214,41 @@ where
             .sqrt()
             .max(1e-300);
         let lambert = ((nrm[0] * light[0] + nrm[1] * light[1] + nrm[2] * light[2]) / len).max(0.0);
-        let col = shade(base, 0.3 + 0.7 * lambert);
-        let pts: Vec<(i32, i32)> = t.iter().map(|&i| to_px(&p[i as usize])).collect();
-        root.draw(&Polygon::new(pts, col.filled()))?;
+        Some(shade(base, 0.3 + 0.7 * lambert))
+    };
+    let filled = on_canvas(root, |canvas| {
+        // Each vertex's pixel once, rather than at each of its triangles' corners, beside
+        // the vertex (one cache line for what a triangle reads of a vertex).
+        let vertex: Vec<((i32, i32), [f64; 3])> = p
+            .iter()
+            .zip(vertices)
+            .map(|(q, v)| (pixel_of(root, &to_px(q)), *v))
+            .collect();
+        // In batches: the corners of many triangles gathered first (their reads from memory
+        // overlap), then coloured and filled.
+        const BATCH: usize = 64;
+        let mut corners = [[((0, 0), [0.0; 3]); 3]; BATCH];
+        for batch in order.chunks(BATCH) {
+            for (c, &(_, k)) in corners.iter_mut().zip(batch) {
+                *c = triangles[k].map(|i| vertex[i as usize]);
+            }
+            for (c, &(_, k)) in corners.iter().zip(batch) {
+                if let Some(RGBColor(r, g, b)) = colour(k, c.map(|v| v.1)) {
+                    canvas.triangle(c.map(|v| v.0), [r, g, b]);
+                }
+            }
+        }
+    })?;
+    if !filled {
+        for &(_, k) in &order {
+            if let Some(col) = colour(k, triangles[k].map(|i| vertices[i as usize])) {
+                let pts: Vec<(i32, i32)> = triangles[k]
+                    .iter()
+                    .map(|&i| to_px(&p[i as usize]))
+                    .collect();
+                root.draw(&Polygon::new(pts, col.filled()))?;
+            }
+        }
     }
     root.draw(&Text::new(
         format!("vertical exaggeration {exaggeration:.1}x, viewed from the south-west"),
