@@ -78,19 +78,10 @@ pub fn extrude(
     if base.is_nan() || base >= min_z {
         return Err(SolidError::BaseTooHigh { base, min_z });
     }
-    // Directed edges, sorted (a run per edge: its uses); boundary edges are used once and
-    // never in reverse. A sorted vector rather than a hash map: an eighth of the memory.
-    let edges = sorted_edges(triangles);
-    if let Some((a, b, c)) = runs(&edges).find(|r| r.2 > 1) {
-        return Err(SolidError::NotManifold(format!(
-            "edge {a}-{b} is used {c} times in the same direction (inconsistent orientation or a fold)"
-        )));
-    }
-    let boundary: Vec<(u32, u32)> = runs(&edges)
-        .filter(|&(a, b, _)| uses(&edges, b, a) == 0)
-        .map(|(a, b, _)| (a, b))
-        .collect();
-    drop(edges);
+    let boundary = match boundary_fast(triangles) {
+        Some(b) => b,
+        None => boundary_general(triangles)?,
+    };
 
     let mut out_v = Vec::with_capacity(vertices.len() * 2);
     out_v.extend_from_slice(vertices);
@@ -112,6 +103,118 @@ pub fn extrude(
         top_triangles: triangles.len(),
         wall_triangles,
     })
+}
+
+/// The boundary edges `a -> b` (used once, never in reverse) of a surface whose directed
+/// edges are each used at most once, in `(a, b)` order; the first edge used more than once in
+/// `(a, b)` order as the error otherwise. Directed edges, sorted (a run per edge: its uses),
+/// and a binary search for each one's reverse.
+fn boundary_general(triangles: &[[u32; 3]]) -> Result<Vec<(u32, u32)>, SolidError> {
+    // A sorted vector rather than a hash map: an eighth of the memory.
+    let edges = sorted_edges(triangles);
+    if let Some((a, b, c)) = runs(&edges).find(|r| r.2 > 1) {
+        return Err(SolidError::NotManifold(format!(
+            "edge {a}-{b} is used {c} times in the same direction (inconsistent orientation or a fold)"
+        )));
+    }
+    Ok(runs(&edges)
+        .filter(|&(a, b, _)| uses(&edges, b, a) == 0)
+        .map(|(a, b, _)| (a, b))
+        .collect())
+}
+
+/// [`boundary_general`]'s boundary by [`edge_buckets`] (no sort of all the edges, no binary
+/// search per edge): each undirected edge used once (a boundary edge, in its direction) or
+/// once each way. `None` where that is not so (an edge used twice the same way, more than
+/// twice, or from a vertex to itself) or the indices are too large: then the general path
+/// decides, and names the error.
+fn boundary_fast(triangles: &[[u32; 3]]) -> Option<Vec<(u32, u32)>> {
+    let mut boundary = Vec::new();
+    let ok = edge_buckets(triangles, |lo, bucket| {
+        let mut i = 0;
+        while i < bucket.len() {
+            let hi = bucket[i] >> 1;
+            if hi == lo {
+                return false;
+            }
+            match bucket[i + 1..]
+                .iter()
+                .take_while(|&&e| e >> 1 == hi)
+                .count()
+            {
+                0 if bucket[i] & 1 == 0 => boundary.push((lo, hi)),
+                0 => boundary.push((hi, lo)),
+                // one each way (sorted: the upward use first)
+                1 if bucket[i] & 1 == 0 && bucket[i + 1] & 1 == 1 => i += 1,
+                _ => return false,
+            }
+            i += 1;
+        }
+        true
+    })?;
+    ok.then(|| {
+        boundary.sort_unstable();
+        boundary
+    })
+}
+
+/// Calls `each(v, bucket)` for every vertex `v`, in order, while it returns `true`: `bucket`
+/// holds the edges of `triangles` whose lower vertex is `v`, each as `w << 1 | d` for its
+/// other vertex `w` and its direction `d` (1 for `w -> v`), sorted. Whether every call
+/// returned `true`; `None` for vertex indices from 2^31 (they do not fit). The edges go in
+/// passes of whole vertex ranges, at most [`EDGES_PER_PASS`] each, so that the memory is a
+/// pass's (4 bytes an edge) and the vertices' counts (4 bytes a vertex): a counting sort by
+/// lower vertex, then each vertex's few edges sorted.
+fn edge_buckets(triangles: &[[u32; 3]], mut each: impl FnMut(u32, &[u32]) -> bool) -> Option<bool> {
+    let Some(&top) = triangles.iter().flatten().max() else {
+        return Some(true);
+    };
+    if top >= 1 << 31 {
+        return None;
+    }
+    let edges = |t: &[u32; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+    // Edges per lower vertex, then where each vertex's bucket starts in its pass.
+    let mut at = vec![0u32; top as usize + 1];
+    for t in triangles {
+        for (a, b) in edges(t) {
+            at[a.min(b) as usize] += 1;
+        }
+    }
+    let mut passes = Vec::new();
+    let (mut lo, mut sum) = (0usize, 0u32);
+    for (v, c) in at.iter_mut().enumerate() {
+        if (sum + *c) as usize > EDGES_PER_PASS && sum > 0 {
+            passes.push((lo, v, sum));
+            (lo, sum) = (v, 0);
+        }
+        (*c, sum) = (sum, sum + *c);
+    }
+    passes.push((lo, top as usize + 1, sum));
+    let mut bucket = Vec::new();
+    for (lo, hi, len) in passes {
+        bucket.clear();
+        bucket.resize(len as usize, 0u32);
+        // `at[v]` advances as vertex v's edges are placed, to where its bucket ends
+        for t in triangles {
+            for (a, b) in edges(t) {
+                let v = a.min(b) as usize;
+                if lo <= v && v < hi {
+                    bucket[at[v] as usize] = (a.max(b) << 1) | u32::from(a > b);
+                    at[v] += 1;
+                }
+            }
+        }
+        let mut begin = 0;
+        for (v, &end) in at.iter().enumerate().take(hi).skip(lo) {
+            let b = &mut bucket[begin..end as usize];
+            b.sort_unstable();
+            if !each(v as u32, b) {
+                return Some(false);
+            }
+            begin = end as usize;
+        }
+    }
+    Some(true)
 }
 
 /// Every directed edge of `triangles` as `a << 32 | b`, sorted.
@@ -174,59 +277,23 @@ fn check_closed_general(triangles: &[[u32; 3]]) -> Result<(), SolidError> {
     }
 }
 
-/// Whether every edge of `triangles` is used exactly once in each direction: the undirected
-/// edges with their direction in the lowest bit, sorted in parallel, in pairs of the same edge
-/// one way and the other (one sort and a scan, without [`check_closed`]'s binary search per
-/// edge, which only the error needs). The edges go in passes by their lower vertex, at most
-/// [`EDGES_PER_PASS`] each, so that the memory is a pass's (both directions of an edge share
-/// its lower vertex, so they meet in the same pass).
+/// Whether every edge of `triangles` is used exactly once in each direction, by
+/// [`edge_buckets`]: each vertex's bucket in pairs of the same edge one way and the other (a
+/// counting sort and a scan, without [`check_closed_general`]'s sort of all the edges and
+/// binary search per edge, which only the error needs). `false` for vertex indices from 2^31
+/// (the general path decides).
 fn closed_fast(triangles: &[[u32; 3]]) -> bool {
-    use rayon::prelude::*;
-    // Two indices and a bit in 64: below 2^31 vertices (else the general path decides).
-    let Some(&top) = triangles.iter().flatten().max() else {
-        return true;
-    };
-    if top >= 1 << 31 {
-        return false;
-    }
-    // Edges per lower vertex, and passes of whole vertex ranges.
-    let mut count = vec![0u32; top as usize + 1];
-    for t in triangles {
-        for k in 0..3 {
-            count[t[k].min(t[(k + 1) % 3]) as usize] += 1;
-        }
-    }
-    let mut ranges = Vec::new();
-    let (mut lo, mut sum) = (0usize, 0usize);
-    for (v, &c) in count.iter().enumerate() {
-        if sum + c as usize > EDGES_PER_PASS && sum > 0 {
-            ranges.push((lo as u64, v as u64));
-            (lo, sum) = (v, 0);
-        }
-        sum += c as usize;
-    }
-    ranges.push((lo as u64, count.len() as u64));
-    drop(count);
-    ranges.into_iter().all(|(lo, hi)| {
-        let mut e: Vec<u64> = triangles
-            .par_iter()
-            .flat_map_iter(|t| {
-                (0..3).filter_map(move |k| {
-                    let (a, b) = (u64::from(t[k]), u64::from(t[(k + 1) % 3]));
-                    let m = a.min(b);
-                    (lo <= m && m < hi).then_some((m << 33) | (a.max(b) << 1) | u64::from(a > b))
-                })
+    edge_buckets(triangles, |lo, bucket| {
+        bucket.len().is_multiple_of(2)
+            && bucket.chunks(2).all(|p| {
+                p[0] >> 1 == p[1] >> 1 && p[0] & 1 == 0 && p[1] & 1 == 1 && p[0] >> 1 != lo
             })
-            .collect();
-        e.par_sort_unstable();
-        e.len().is_multiple_of(2)
-            && e.par_chunks(2)
-                .all(|p| p[0] >> 1 == p[1] >> 1 && p[0] & 1 == 0 && p[1] & 1 == 1)
     })
+    .unwrap_or(false)
 }
 
-/// Edges [`closed_fast`] sorts at a time (8 bytes each).
-const EDGES_PER_PASS: usize = 1 << 22;
+/// Edges [`edge_buckets`] places at a time (4 bytes each).
+const EDGES_PER_PASS: usize = 1 << 23;
 
 /// Signed volume enclosed by a closed triangulation (positive when normals point outward),
 /// by the divergence theorem about the first vertex (for precision at UTM magnitudes).
@@ -357,6 +424,65 @@ mod tests {
         s[k] = [s[k][0], s[k][2], s[k][1]];
         assert!(!closed_fast(&s));
         assert!(check_closed(&s).is_err());
+    }
+
+    /// The boundary by buckets against the sorted edges' (the same edges in the same order
+    /// where the fast path answers; where it does not, the general path is what extrude uses).
+    #[test]
+    fn the_fast_boundary_agrees_with_the_general_one() {
+        let (_, t) = grid(11, 8);
+        let mut cases = vec![t.clone(), Vec::new(), vec![[0, 1, 2]], vec![[2, 1, 0]]];
+        // holes: every k-th triangle dropped
+        for k in [2, 3, 5, 7] {
+            cases.push(
+                t.iter()
+                    .enumerate()
+                    .filter(|(i, _)| i % k != 0)
+                    .map(|(_, t)| *t)
+                    .collect(),
+            );
+        }
+        // one face flipped (its edges used twice the same way), doubled, degenerate
+        let mut c = t.clone();
+        c[9] = [c[9][0], c[9][2], c[9][1]];
+        cases.push(c);
+        let mut c = t.clone();
+        c.push(t[4]);
+        cases.push(c);
+        let mut c = t.clone();
+        c.push([3, 3, 7]);
+        cases.push(c);
+        // an edge used three times (a fin)
+        let mut c = t.clone();
+        c.push([t[0][1], t[0][0], 200]);
+        cases.push(c);
+        // the reversed surface, and triangles in another order
+        cases.push(t.iter().map(|t| [t[0], t[2], t[1]]).collect());
+        cases.push(t.iter().rev().copied().collect());
+        let mut answered = 0;
+        for (k, c) in cases.iter().enumerate() {
+            let general = boundary_general(c);
+            match boundary_fast(c) {
+                Some(b) => {
+                    answered += 1;
+                    assert_eq!(Ok(b), general, "case {k}");
+                }
+                None => assert!(
+                    general.is_err()
+                        || c.iter()
+                            .any(|t| t[0] == t[1] || t[1] == t[2] || t[2] == t[0]),
+                    "case {k}: refused a surface the general path takes"
+                ),
+            }
+        }
+        assert!(answered >= 9, "{answered}");
+        assert!(boundary_fast(&[[0, 1, 1 << 31]]).is_none());
+        // more than one pass
+        let (_, t) = grid(2200, 1300);
+        assert!(3 * t.len() > EDGES_PER_PASS);
+        let b = boundary_fast(&t).unwrap();
+        assert_eq!(b.len(), 2 * (2199 + 1299));
+        assert_eq!(Ok(b), boundary_general(&t));
     }
 
     #[test]

@@ -45,8 +45,19 @@ fn short_expansion(v: f64) -> bool {
         // 5^29 > 10^20: the expansion has more than 20 digits
         return false;
     }
-    (m as u128) * 5u128.pow(k as u32) < 10u128.pow(20)
+    (m as u128) * POW5[k as usize] < 10u128.pow(20)
 }
+
+/// `5^k` for `k` in `0..=28` ([`short_expansion`]'s table).
+const POW5: [u128; 29] = {
+    let mut t = [1u128; 29];
+    let mut k = 1;
+    while k < 29 {
+        t[k] = t[k - 1] * 5;
+        k += 1;
+    }
+    t
+};
 
 /// Shortest digits of a finite nonzero `v` (no leading or trailing zeros) and the position of
 /// the decimal point relative to their start (value = 0.d1d2... * 10^point); `v`'s sign aside.
@@ -143,9 +154,45 @@ fn fast(v: f64, debug: bool, buf: &mut [u8; 48]) -> Option<usize> {
     Some(k)
 }
 
+/// Appends ryu's text of `v` straight to `out` where it is `Display`'s (`debug` false) or
+/// `Debug`'s (true) text byte for byte, and returns whether it did: `1e-4 <= |v| < 1e16`
+/// and not a short expansion. There ryu writes no exponent (its shortest digits `d` satisfy
+/// `1e-5 < d < 1e16`: `1e16` is a double, so no double below it rounds to it) and lays the
+/// digits out as `Debug` does (`123.0`, `0.000123`, `12.5`); `Display` is the same without
+/// an integer's `.0` (only an integer's text ends in `.0`: ryu's digits have no trailing
+/// zero). [`fast`] takes the same digits apart and lays them out again; this skips that.
+#[inline]
+fn push_plain(out: &mut Vec<u8>, v: f64, debug: bool) -> bool {
+    let a = v.abs();
+    // also false for NaN
+    if !(1e-4..1e16).contains(&a) || short_expansion(v) {
+        return false;
+    }
+    out.reserve(RYU_MAX);
+    let len = out.len();
+    // SAFETY: `out` has room for `RYU_MAX` (24) bytes after `len`, the most ryu writes for
+    // any finite double; it writes `n` ASCII bytes there and returns `n`, so the first
+    // `len + n` bytes are initialised.
+    let n = unsafe {
+        let n = ryu::raw::format64(v, out.as_mut_ptr().add(len));
+        out.set_len(len + n);
+        n
+    };
+    if !debug && out[len..].ends_with(b".0") {
+        out.truncate(len + n - 2);
+    }
+    true
+}
+
+/// The most bytes `ryu::raw::format64` writes.
+const RYU_MAX: usize = 24;
+
 /// Appends `v` exactly as `format!("{v}")` writes it.
 #[inline]
 pub fn push_display(out: &mut Vec<u8>, v: f64) {
+    if push_plain(out, v, false) {
+        return;
+    }
     let mut buf = [0u8; 48];
     match fast(v, false, &mut buf) {
         Some(n) => out.extend_from_slice(&buf[..n]),
@@ -158,6 +205,9 @@ pub fn push_display(out: &mut Vec<u8>, v: f64) {
 /// Appends `v` exactly as `format!("{v:?}")` writes it.
 #[inline]
 pub fn push_debug(out: &mut Vec<u8>, v: f64) {
+    if push_plain(out, v, true) {
+        return;
+    }
     let mut buf = [0u8; 48];
     match fast(v, true, &mut buf) {
         Some(n) => out.extend_from_slice(&buf[..n]),
@@ -321,6 +371,46 @@ mod tests {
             }
         }
         assert!(ties > 0, "no case where the shortcut mattered");
+    }
+
+    /// The shortcut of ryu's own text against the digits laid out again ([`fast`]), after
+    /// text already in the vector, on both sides of its bounds and at random.
+    #[test]
+    fn ryu_s_own_text_is_the_laid_out_digits() {
+        let same = |v: f64| {
+            for debug in [false, true] {
+                let mut a = b"x.0".to_vec();
+                if push_plain(&mut a, v, debug) {
+                    let mut buf = [0u8; 48];
+                    let n = fast(v, debug, &mut buf).expect("fast takes what push_plain takes");
+                    assert_eq!(&a[3..], &buf[..n], "{v:e} debug {debug}");
+                } else {
+                    assert_eq!(a, b"x.0", "{v:e}: nothing appended when refused");
+                }
+            }
+        };
+        let mut r = Rng(0x1234_5678_9abc_def1);
+        for b in [1e-4, 1e-5, 1e-7, 1e15, 1e16, 1.0, 10.0, 0.5, 123.0] {
+            let mut x = b;
+            let mut y = b;
+            for _ in 0..2000 {
+                same(x);
+                same(-y);
+                x = f64::from_bits(x.to_bits() + 1);
+                y = f64::from_bits(y.to_bits() - 1);
+            }
+        }
+        for _ in 0..1_000_000 {
+            same(f64::from_bits(r.next()));
+            same((r.next() >> 11) as f64 / (1u64 << 53) as f64 * 1e7 - 5e6);
+            let k = (r.next() % 60) as i32 - 20;
+            same((r.next() >> 11) as f64 * 2f64.powi(k - 53) * 10f64.powi(k / 3));
+            // integers and halves: the `.0` ends
+            same(
+                ((r.next() >> 20) as f64 / 2.0).floor()
+                    * if r.next() & 1 == 0 { 1.0 } else { -0.5 },
+            );
+        }
     }
 
     #[test]

@@ -61,33 +61,60 @@ pub fn push_fixed_exact(out: &mut Vec<u8>, v: f64, decimals: usize) {
     if decimals < POW10.len() && v.is_finite() {
         let scaled = v.abs() * POW10[decimals] as f64;
         if scaled < 4.0e15 {
-            let whole = scaled.floor();
-            let frac = scaled - whole; // exact below 2^52
+            // the floor: truncation of a non-negative value below 2^52 (without libm's call)
+            let whole = scaled as u64;
+            let frac = scaled - whole as f64; // exact below 2^52
             let ulp = f64::from_bits(scaled.to_bits() + 1) - scaled;
             if (frac - 0.5).abs() > 2.0 * ulp {
-                let x = whole as u64 + u64::from(frac > 0.5);
-                let scale = POW10[decimals];
-                let (int, fr) = (x / scale, x % scale);
-                if v.is_sign_negative() {
-                    out.push(b'-');
-                }
-                let mut tmp = itoa::Buffer::new();
-                out.extend_from_slice(tmp.format(int).as_bytes());
-                if decimals > 0 {
-                    out.push(b'.');
-                    let at = out.len();
-                    out.resize(at + decimals, b'0');
-                    let mut f = fr;
-                    for k in (0..decimals).rev() {
-                        out[at + k] = b'0' + (f % 10) as u8;
-                        f /= 10;
-                    }
-                }
+                let x = whole + u64::from(frac > 0.5);
+                push_scaled(out, x, decimals, v.is_sign_negative());
                 return;
             }
         }
     }
     out.extend_from_slice(format!("{v:.decimals$}").as_bytes());
+}
+
+/// Appends `x / 10^decimals` with `decimals` digits after the point (`-` first when
+/// `negative`), for `x < 4e15` and `decimals < 16`: the text is at most 19 bytes, made in a
+/// 32-byte buffer two digits at a time and appended whole (a copy of fixed size), then cut.
+/// The same text as `itoa` of `x / 10^decimals`, `.` and `x % 10^decimals` zero-padded.
+#[inline]
+fn push_scaled(out: &mut Vec<u8>, x: u64, decimals: usize, negative: bool) {
+    let scale = POW10[decimals];
+    let (int, fr) = (x / scale, x % scale);
+    let int_digits = int.checked_ilog10().map_or(1, |l| l as usize + 1);
+    let sign = usize::from(negative);
+    let point = usize::from(decimals > 0);
+    let n = sign + int_digits + point + decimals;
+    let mut buf = [0u8; 32];
+    buf[0] = b'-';
+    put_digits(&mut buf[sign..sign + int_digits], int);
+    buf[sign + int_digits] = b'.';
+    put_digits(&mut buf[n - decimals..n], fr);
+    let len = out.len();
+    out.extend_from_slice(&buf);
+    out.truncate(len + n);
+}
+
+/// Writes the last `out.len()` decimal digits of `v` into `out`, zero-padded on the left.
+#[inline]
+fn put_digits(out: &mut [u8], mut v: u64) {
+    const PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+    let mut i = out.len();
+    while i >= 2 {
+        let r = (v % 100) as usize * 2;
+        v /= 100;
+        i -= 2;
+        out[i..i + 2].copy_from_slice(&PAIRS[r..r + 2]);
+    }
+    if i == 1 {
+        out[0] = b'0' + (v % 10) as u8;
+    }
 }
 
 const POW10: [u64; 16] = [
@@ -208,8 +235,56 @@ mod tests {
             0.25,
             2.675,
             1.0000000000005,
+            -97.48,
+            32.53,
+            -0.00000000004,
+            -0.00000000006,
+            3.9999999999999e15,
+            4.0e15,
+            399.99999999995,
+            -399.99999999995,
+            0.0005,
+            -0.0005,
+            9.9995,
+            f64::MIN_POSITIVE,
+            -5e-324,
+            f64::MAX,
+            f64::NEG_INFINITY,
         ] {
             check(v);
+            check(-v);
+        }
+    }
+
+    /// The digits two at a time against `itoa`, `.` and the zero-padded remainder, after text
+    /// already in the vector, for every number of decimals and integers of every length.
+    #[test]
+    fn scaled_text_is_itoa_s() {
+        let mut state: u64 = 99;
+        for i in 0..400_000u64 {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1442695040888963407);
+            let x = match i % 4 {
+                0 => state % 4_000_000_000_000_001,
+                1 => state >> (12 + (state % 52)),
+                2 => 10u64.pow((state % 16) as u32) - (state >> 63),
+                _ => i,
+            };
+            for (d, &scale) in POW10.iter().enumerate() {
+                let neg = (state >> 7) & 1 == 1;
+                let mut a = b"ab".to_vec();
+                push_scaled(&mut a, x, d, neg);
+                let mut want = b"ab".to_vec();
+                if neg {
+                    want.push(b'-');
+                }
+                want.extend_from_slice(itoa::Buffer::new().format(x / scale).as_bytes());
+                if d > 0 {
+                    want.extend_from_slice(format!(".{:0d$}", x % scale).as_bytes());
+                }
+                assert_eq!(a, want, "{x} {d} {neg}");
+            }
         }
     }
 

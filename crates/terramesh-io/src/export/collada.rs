@@ -6,6 +6,8 @@
 
 use std::io::{self, Write};
 
+use crate::blocks::{write_in_blocks, BLOCK};
+use crate::exactnum::{push_display, push_u64};
 use crate::number::write_shortest;
 
 /// What goes into the COLLADA document besides the geometry.
@@ -121,13 +123,16 @@ pub fn write_collada<W: Write>(
          source=\"#dsm-vertices\" offset=\"0\"/><p>",
         triangles.len()
     )?;
-    let mut ibuf = itoa::Buffer::new();
-    for (k, &i) in triangles.iter().flatten().enumerate() {
-        if k > 0 {
-            w.write_all(b" ")?;
+    let indices = triangles.as_flattened();
+    write_in_blocks(w, indices.len(), BLOCK, |r, out| {
+        for k in r {
+            if k > 0 {
+                out.push(b' ');
+            }
+            push_u64(out, u64::from(indices[k]));
         }
-        w.write_all(ibuf.format(i).as_bytes())?;
-    }
+        Ok(())
+    })?;
     writeln!(
         w,
         "</p></triangles>\n</mesh>\n</geometry>\n</library_geometries>"
@@ -164,14 +169,19 @@ fn write_source<W: Write>(w: &mut W, id: &str, xyz: &[[f64; 3]]) -> io::Result<(
 }
 
 /// Space-separated shortest round-trip doubles.
+/// (`write_shortest`'s text: `Display`'s, zero of either sign as `0`; formatted in blocks
+/// on the thread pool.)
 fn write_values<W: Write>(w: &mut W, values: &[f64]) -> io::Result<()> {
-    for (k, &v) in values.iter().enumerate() {
-        if k > 0 {
-            w.write_all(b" ")?;
+    write_in_blocks(w, values.len(), BLOCK, |r, out| {
+        for k in r {
+            if k > 0 {
+                out.push(b' ');
+            }
+            let v = values[k];
+            push_display(out, if v == 0.0 { 0.0 } else { v });
         }
-        write_shortest(w, v)?;
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 /// Unit per-vertex normals: the sum of the adjacent triangles' cross products (area-weighted),
