@@ -6,7 +6,6 @@
 
 use std::io::{self, Write};
 
-use crate::blocks::{write_in_blocks, BLOCK};
 use crate::exactnum::{push_display, push_u64};
 use crate::number::write_shortest;
 
@@ -124,14 +123,8 @@ pub fn write_collada<W: Write>(
         triangles.len()
     )?;
     let indices = triangles.as_flattened();
-    write_in_blocks(w, indices.len(), BLOCK, |r, out| {
-        for k in r {
-            if k > 0 {
-                out.push(b' ');
-            }
-            push_u64(out, u64::from(indices[k]));
-        }
-        Ok(())
+    write_in_pieces(w, indices.len(), |k, out| {
+        push_u64(out, u64::from(indices[k]))
     })?;
     writeln!(
         w,
@@ -169,19 +162,35 @@ fn write_source<W: Write>(w: &mut W, id: &str, xyz: &[[f64; 3]]) -> io::Result<(
 }
 
 /// Space-separated shortest round-trip doubles.
-/// (`write_shortest`'s text: `Display`'s, zero of either sign as `0`; formatted in blocks
-/// on the thread pool.)
+/// (`write_shortest`'s text: `Display`'s, zero of either sign as `0`.)
 fn write_values<W: Write>(w: &mut W, values: &[f64]) -> io::Result<()> {
-    write_in_blocks(w, values.len(), BLOCK, |r, out| {
-        for k in r {
-            if k > 0 {
-                out.push(b' ');
-            }
-            let v = values[k];
-            push_display(out, if v == 0.0 { 0.0 } else { v });
-        }
-        Ok(())
+    write_in_pieces(w, values.len(), |k, out| {
+        let v = values[k];
+        push_display(out, if v == 0.0 { 0.0 } else { v });
     })
+}
+
+/// Writes items `0..n` separated by spaces, `item` appending item `k`'s text: gathered in a
+/// buffer of about 64 KiB written whole, rather than a write per piece (on the calling
+/// thread: the exports' jobs already run at once).
+fn write_in_pieces<W: Write>(
+    w: &mut W,
+    n: usize,
+    item: impl Fn(usize, &mut Vec<u8>),
+) -> io::Result<()> {
+    const PIECE: usize = 1 << 16;
+    let mut buf = Vec::with_capacity(PIECE + 64);
+    for k in 0..n {
+        if k > 0 {
+            buf.push(b' ');
+        }
+        item(k, &mut buf);
+        if buf.len() >= PIECE {
+            w.write_all(&buf)?;
+            buf.clear();
+        }
+    }
+    w.write_all(&buf)
 }
 
 /// Unit per-vertex normals: the sum of the adjacent triangles' cross products (area-weighted),
