@@ -9,6 +9,7 @@ use terramesh_core::coords::LocalEnu;
 use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_core::vocab::Named;
 use terramesh_geostat::{CandidateEntry, VariogramFile};
+use terramesh_io::exactnum::push_display;
 use terramesh_io::export::{
     all_formats, write_mesh, write_stl, writer, GlbParts, MeshView, SurfaceWriter, Target, ToWrite,
 };
@@ -186,20 +187,28 @@ pub fn write_all(
                 true => b"x,y,elevation_uk,kriging_std,elevation_idw\n".as_slice(),
                 false => b"x,y,elevation_idw\n".as_slice(),
             })?;
+            // Each number as write_shortest writes it (Display's text, zero of either sign
+            // as 0), gathered in a buffer written every 64 KiB, not a write per piece.
+            let mut buf = Vec::with_capacity((1 << 16) + 256);
             for (i, a) in abs.iter().enumerate() {
                 let row = match kriged {
-                    true => vec![a[0], a[1], it.uk[i], it.uk_std[i], it.idw[i]],
-                    false => vec![a[0], a[1], it.idw[i]],
+                    true => [a[0], a[1], it.uk[i], it.uk_std[i], it.idw[i]],
+                    false => [a[0], a[1], it.idw[i], 0.0, 0.0],
                 };
-                for (k, v) in row.iter().enumerate() {
+                let row = &row[..if kriged { 5 } else { 3 }];
+                for (k, &v) in row.iter().enumerate() {
                     if k > 0 {
-                        w.write_all(b",")?;
+                        buf.push(b',');
                     }
-                    write_shortest(w, *v)?;
+                    push_display(&mut buf, if v == 0.0 { 0.0 } else { v });
                 }
-                w.write_all(b"\n")?;
+                buf.push(b'\n');
+                if buf.len() >= 1 << 16 {
+                    w.write_all(&buf)?;
+                    buf.clear();
+                }
             }
-            Ok(())
+            w.write_all(&buf)
         }))
     }));
 
