@@ -195,26 +195,26 @@ impl<W: Write> Sink<'_, W> {
     fn u64(&mut self, v: u64) -> std::io::Result<()> {
         self.put(&v.to_le_bytes())
     }
-    fn f64s(&mut self, v: &[f64]) -> std::io::Result<()> {
-        // In pieces of at most 512 numbers: no copy of a whole array.
-        let mut piece = [0u8; 8 * 512];
-        for c in v.chunks(512) {
-            for (k, x) in c.iter().enumerate() {
-                piece[8 * k..8 * k + 8].copy_from_slice(&x.to_le_bytes());
+    /// Numbers as their little-endian bytes, in pieces of 4 KiB: no copy of a whole array.
+    fn nums<T: Copy, const N: usize>(
+        &mut self,
+        v: &[T],
+        bytes: impl Fn(T) -> [u8; N],
+    ) -> std::io::Result<()> {
+        let mut piece = [0u8; 4096];
+        for c in v.chunks(4096 / N) {
+            for (k, &x) in c.iter().enumerate() {
+                piece[N * k..N * (k + 1)].copy_from_slice(&bytes(x));
             }
-            self.put(&piece[..8 * c.len()])?;
+            self.put(&piece[..N * c.len()])?;
         }
         Ok(())
     }
+    fn f64s(&mut self, v: &[f64]) -> std::io::Result<()> {
+        self.nums(v, f64::to_le_bytes)
+    }
     fn u32s(&mut self, v: &[u32]) -> std::io::Result<()> {
-        let mut piece = [0u8; 4 * 1024];
-        for c in v.chunks(1024) {
-            for (k, x) in c.iter().enumerate() {
-                piece[4 * k..4 * k + 4].copy_from_slice(&x.to_le_bytes());
-            }
-            self.put(&piece[..4 * c.len()])?;
-        }
-        Ok(())
+        self.nums(v, u32::to_le_bytes)
     }
 }
 
