@@ -185,6 +185,12 @@ pub fn write_shortest<W: Write>(w: &mut W, v: f64) -> io::Result<()> {
     crate::exactnum::write_display(w, v)
 }
 
+/// Appends [`write_shortest`]'s text of `v` (`Display`'s, zero of either sign as `0`).
+#[inline]
+pub fn push_shortest(out: &mut Vec<u8>, v: f64) {
+    crate::exactnum::push_display(out, if v == 0.0 { 0.0 } else { v });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

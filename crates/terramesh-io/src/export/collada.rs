@@ -6,8 +6,9 @@
 
 use std::io::{self, Write};
 
-use crate::exactnum::{push_display, push_u64};
-use crate::number::write_shortest;
+use crate::blocks::write_gathered;
+use crate::exactnum::push_u64;
+use crate::number::{push_shortest, write_shortest};
 
 /// What goes into the COLLADA document besides the geometry.
 #[derive(Debug, Clone)]
@@ -123,7 +124,7 @@ pub fn write_collada<W: Write>(
         triangles.len()
     )?;
     let indices = triangles.as_flattened();
-    write_in_pieces(w, indices.len(), |k, out| {
+    write_spaced(w, indices.len(), |k, out| {
         push_u64(out, u64::from(indices[k]))
     })?;
     writeln!(
@@ -161,36 +162,24 @@ fn write_source<W: Write>(w: &mut W, id: &str, xyz: &[[f64; 3]]) -> io::Result<(
     )
 }
 
-/// Space-separated shortest round-trip doubles.
-/// (`write_shortest`'s text: `Display`'s, zero of either sign as `0`.)
+/// Space-separated shortest round-trip doubles (`write_shortest`'s text).
 fn write_values<W: Write>(w: &mut W, values: &[f64]) -> io::Result<()> {
-    write_in_pieces(w, values.len(), |k, out| {
-        let v = values[k];
-        push_display(out, if v == 0.0 { 0.0 } else { v });
-    })
+    write_spaced(w, values.len(), |k, out| push_shortest(out, values[k]))
 }
 
-/// Writes items `0..n` separated by spaces, `item` appending item `k`'s text: gathered in a
-/// buffer of about 64 KiB written whole, rather than a write per piece (on the calling
-/// thread: the exports' jobs already run at once).
-fn write_in_pieces<W: Write>(
+/// Items `0..n` separated by spaces, `item` appending item `k`'s text, gathered
+/// ([`write_gathered`]) on the calling thread: the exports' jobs already run at once.
+fn write_spaced<W: Write>(
     w: &mut W,
     n: usize,
     item: impl Fn(usize, &mut Vec<u8>),
 ) -> io::Result<()> {
-    const PIECE: usize = 1 << 16;
-    let mut buf = Vec::with_capacity(PIECE + 64);
-    for k in 0..n {
+    write_gathered(w, n, |k, out| {
         if k > 0 {
-            buf.push(b' ');
+            out.push(b' ');
         }
-        item(k, &mut buf);
-        if buf.len() >= PIECE {
-            w.write_all(&buf)?;
-            buf.clear();
-        }
-    }
-    w.write_all(&buf)
+        item(k, out)
+    })
 }
 
 /// Unit per-vertex normals: the sum of the adjacent triangles' cross products (area-weighted),

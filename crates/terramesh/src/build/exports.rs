@@ -9,12 +9,12 @@ use terramesh_core::coords::LocalEnu;
 use terramesh_core::solid::{check_closed, extrude, volume};
 use terramesh_core::vocab::Named;
 use terramesh_geostat::{CandidateEntry, VariogramFile};
-use terramesh_io::exactnum::push_display;
+use terramesh_io::blocks::write_gathered;
 use terramesh_io::export::{
     all_formats, write_mesh, write_stl, writer, GlbParts, MeshView, SurfaceWriter, Target, ToWrite,
 };
 use terramesh_io::grid_write::{write_asc, write_geotiff_heights, Heights};
-use terramesh_io::number::write_shortest;
+use terramesh_io::number::{push_shortest, write_shortest};
 use terramesh_io::output::Output;
 use terramesh_mesh::{triangle_quality, Quality};
 
@@ -142,13 +142,14 @@ pub(super) fn base_elevation(p: &Project, it: &Interpolated) -> f64 {
     p.export.base_elevation.unwrap_or((zmin - 50.0).floor())
 }
 
-/// Writes every output of step 5.
+/// Writes every output of step 5, the sealed solid down to `base` ([`base_elevation`]).
 pub fn write_all(
     p: &Project,
     out: &Path,
     s: &Samples,
     m: &Meshed,
     it: &Interpolated,
+    base: f64,
 ) -> Result<Written> {
     let mesh = &m.mesh;
     let n = mesh.points.len();
@@ -187,28 +188,22 @@ pub fn write_all(
                 true => b"x,y,elevation_uk,kriging_std,elevation_idw\n".as_slice(),
                 false => b"x,y,elevation_idw\n".as_slice(),
             })?;
-            // Each number as write_shortest writes it (Display's text, zero of either sign
-            // as 0), gathered in a buffer written every 64 KiB, not a write per piece.
-            let mut buf = Vec::with_capacity((1 << 16) + 256);
-            for (i, a) in abs.iter().enumerate() {
+            // Each number as write_shortest writes it, the rows gathered (write_gathered).
+            let cols = if kriged { 5 } else { 3 };
+            write_gathered(w, abs.len(), |i, buf| {
+                let a = abs[i];
                 let row = match kriged {
                     true => [a[0], a[1], it.uk[i], it.uk_std[i], it.idw[i]],
                     false => [a[0], a[1], it.idw[i], 0.0, 0.0],
                 };
-                let row = &row[..if kriged { 5 } else { 3 }];
-                for (k, &v) in row.iter().enumerate() {
+                for (k, &v) in row[..cols].iter().enumerate() {
                     if k > 0 {
                         buf.push(b',');
                     }
-                    push_display(&mut buf, if v == 0.0 { 0.0 } else { v });
+                    push_shortest(buf, v);
                 }
                 buf.push(b'\n');
-                if buf.len() >= 1 << 16 {
-                    w.write_all(&buf)?;
-                    buf.clear();
-                }
-            }
-            w.write_all(&buf)
+            })
         }))
     }));
 
@@ -361,7 +356,6 @@ pub fn write_all(
     }));
 
     // The sealed solid: made once, its three files written as jobs of their own.
-    let base = base_elevation(p, it);
     solid = extrude(abs, tris, base).context("export.base_elevation")?;
     check_closed(&solid.triangles).context("the sealed solid")?;
     let vol = volume(&solid.vertices, &solid.triangles);

@@ -225,16 +225,27 @@ impl Stages<'_> {
         detail: impl FnOnce(&T) -> String,
     ) -> Result<T> {
         self.check()?;
-        self.k += 1;
-        self.progress.stage_start(self.k, self.total, name);
+        self.start(name);
         let t = Instant::now();
         let out = f()?;
-        let secs = t.elapsed().as_secs_f64();
-        let peak = self.timings.push_span(name, secs, Some(self.span(t)));
-        let detail = format!("{}; peak memory {}", detail(&out), memory_text(peak));
-        self.progress.stage_done(name, &detail, secs);
+        let span = self.span(t);
+        self.done(name, span[1] - span[0], span, &detail(&out));
         self.check()?;
         Ok(out)
+    }
+
+    /// The next stage begins: its number and name to the front end.
+    fn start(&mut self, name: &str) {
+        self.k += 1;
+        self.progress.stage_start(self.k, self.total, name);
+    }
+
+    /// The stage ended: its `seconds` (the time it worked), its `span` and the peak memory
+    /// recorded, and its line (`detail`, then the peak memory) to the front end.
+    fn done(&mut self, name: &str, seconds: f64, span: [f64; 2], detail: &str) {
+        let peak = self.timings.push_span(name, seconds, Some(span));
+        let detail = format!("{detail}; peak memory {}", memory_text(peak));
+        self.progress.stage_done(name, &detail, seconds);
     }
 
     /// The variogram stage: the model fitted when `fit`, else the samples' data alone, with
@@ -572,8 +583,7 @@ fn outputs(
     keep: impl FnOnce() -> Result<()> + Send,
 ) -> Result<exports::Written> {
     st.check()?;
-    st.k += 1;
-    st.progress.stage_start(st.k, st.total, "exports");
+    st.start("exports");
     let want_pictures = project.export.pictures || project.export.report;
     let base = exports::base_elevation(project, interp);
     let stages = &*st;
@@ -594,7 +604,7 @@ fn outputs(
         || {
             stages.timed(|| {
                 let (w, kept) = rayon::join(
-                    || exports::write_all(project, out, samples, mesh, interp),
+                    || exports::write_all(project, out, samples, mesh, interp, base),
                     keep,
                 );
                 w.and_then(|w| kept.map(|()| w))
@@ -617,40 +627,26 @@ fn outputs(
     );
     let written = written?;
     let secs = |s: [f64; 2]| s[1] - s[0];
-    let peak = st
-        .timings
-        .push_span("exports", secs(t_exports), Some(t_exports));
-    st.progress.stage_done(
+    st.done(
         "exports",
-        &format!(
-            "{} files; peak memory {}",
-            written.files.len(),
-            memory_text(peak)
-        ),
         secs(t_exports),
+        t_exports,
+        &format!("{} files", written.files.len()),
     );
     let Some((pics, extra)) = pics? else {
         return Ok(written);
     };
-    st.k += 1;
-    st.progress.stage_start(st.k, st.total, "pictures");
-    let peak = st
-        .timings
-        .push_span("pictures", secs(t_pictures), Some(t_pictures));
-    st.progress.stage_done(
+    st.start("pictures");
+    st.done(
         "pictures",
-        &format!(
-            "{} pictures, drawn beside the exports; peak memory {}",
-            pics.len(),
-            memory_text(peak)
-        ),
         secs(t_pictures),
+        t_pictures,
+        &format!("{} pictures, drawn beside the exports", pics.len()),
     );
     let Some(scene) = scene? else {
         return Ok(written);
     };
-    st.k += 1;
-    st.progress.stage_start(st.k, st.total, "report");
+    st.start("report");
     let t = Instant::now();
     st.timings
         .push(TOTAL_BEFORE_REPORT, st.t0.elapsed().as_secs_f64());
@@ -666,18 +662,13 @@ fn outputs(
         extra,
         scene,
     )?;
-    let page = t.elapsed().as_secs_f64();
-    let span = [t_scene[0], st.span(t)[1]];
-    let peak = st
-        .timings
-        .push_span("report", secs(t_scene) + page, Some(span));
-    st.progress.stage_done(
+    // The report worked on its 3D view beside the others, then on its page.
+    let page = st.span(t);
+    st.done(
         "report",
-        &format!(
-            "report.html (its 3D view made beside the exports); peak memory {}",
-            memory_text(peak)
-        ),
-        secs(t_scene) + page,
+        secs(t_scene) + secs(page),
+        [t_scene[0], page[1]],
+        "report.html (its 3D view made beside the exports)",
     );
     if let Some(all) = st.timings.together(&OUTPUTS) {
         st.progress.note(&format!(
