@@ -90,6 +90,18 @@ fn build(site: &Site, spec: ObjectSpec) -> (FaultedMesh, ObjectCheck, CheckSumma
     (mesh, c, summary)
 }
 
+/// The cells of the objects' parts above the terrain (labelled last).
+fn cells_above(mesh: &FaultedMesh) -> std::ops::Range<usize> {
+    mesh.tets.len() - mesh.objects.above_cells..mesh.tets.len()
+}
+
+/// The smallest dihedral angle of the cells above the terrain, degrees.
+fn smallest_above(mesh: &FaultedMesh) -> f64 {
+    cells_above(mesh)
+        .map(|cell| min_dihedral(mesh.tets[cell].map(|v| mesh.points[v as usize])))
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn area(p: &[[f64; 3]], f: [u32; 3]) -> f64 {
     let q = f.map(|v| p[v as usize]);
     let u = [q[1][0] - q[0][0], q[1][1] - q[0][1], q[1][2] - q[0][2]];
@@ -157,9 +169,8 @@ fn a_box_dam_half_above_the_terrain_is_added_and_sealed() {
     );
     assert!((summary.expected_volume - 200.0 * 200.0 * 120.0).abs() < 1e-6);
     // The dam's cells above the terrain: labelled the dam, above the terrain, last.
-    let first = mesh.tets.len() - mesh.objects.above_cells;
     assert!(mesh.objects.above_cells > 0);
-    for cell in first..mesh.tets.len() {
+    for cell in cells_above(&mesh) {
         assert_eq!(mesh.objects.object[cell], 1);
         assert!(mesh.tets[cell]
             .iter()
@@ -178,7 +189,7 @@ fn a_box_dam_half_above_the_terrain_is_added_and_sealed() {
             && cen[0] < hi[0] - 1e-3
             && cen[1] > lo[1] + 1e-3
             && cen[1] < hi[1] - 1e-3;
-        if (cell as usize) < first {
+        if !cells_above(&mesh).contains(&(cell as usize)) {
             assert!(
                 !(in_plan && (cen[2] - 120.0).abs() < 1e-6),
                 "a terrain face under the dam is still on the boundary at {cen:?}"
@@ -288,8 +299,7 @@ fn a_tall_dam_has_a_node_on_each_corner_and_layered_columns() {
     // The columns are stood in layers: the dam's vertical edges are split, so a column is more
     // than the three cells of one prism, and the part above the terrain has cells whose
     // nodes all lie strictly between the terrain and the crest.
-    let first = mesh.tets.len() - mesh.objects.above_cells;
-    let inner = (first..mesh.tets.len())
+    let inner = cells_above(&mesh)
         .filter(|&cell| {
             mesh.tets[cell].iter().all(|&v| {
                 let z = mesh.points[v as usize][2];
@@ -307,9 +317,7 @@ fn a_tall_dam_has_a_node_on_each_corner_and_layered_columns() {
     // columns of slivers (6.082 degrees here, 6.162 before the seat's point along the trace
     // was chosen; 0.024 before the seat, 0.005 before the corners
     // were seated and the columns layered).
-    let worst = (first..mesh.tets.len())
-        .map(|cell| min_dihedral(mesh.tets[cell].map(|v| mesh.points[v as usize])))
-        .fold(f64::INFINITY, f64::min);
+    let worst = smallest_above(&mesh);
     println!(
         "above the terrain: {} cells, smallest dihedral {worst:.3}",
         mesh.objects.above_cells
@@ -335,8 +343,7 @@ fn a_dam_on_a_sloping_terrain_stands_within_its_walls() {
         // corner between them, the walls' cut (a sign change of the field at the edge's ends)
         // leaves it whole, and the column over a face on it stood outside the wall with a
         // collapsed edge, a fan of slivers (examples/structures: 1.452 degrees).
-        let first = mesh.tets.len() - mesh.objects.above_cells;
-        let outside = (first..mesh.tets.len())
+        let outside = cells_above(&mesh)
             .flat_map(|cell| mesh.tets[cell])
             .map(|v| {
                 let p = mesh.points[v as usize];
@@ -345,9 +352,7 @@ fn a_dam_on_a_sloping_terrain_stands_within_its_walls() {
                     .fold(0.0f64, f64::max)
             })
             .fold(0.0f64, f64::max);
-        let worst = (first..mesh.tets.len())
-            .map(|cell| min_dihedral(mesh.tets[cell].map(|v| mesh.points[v as usize])))
-            .fold(f64::INFINITY, f64::min);
+        let worst = smallest_above(&mesh);
         println!(
             "dam {lo:?} {hi:?}: {} cells above the terrain, a node {outside:.4} m outside its plan, smallest dihedral {worst:.3}",
             mesh.objects.above_cells
